@@ -1,0 +1,28 @@
+/*
+ * lagsimd internals shared by the command line (main.c), offline runs (offline.c), the
+ * real-time LCM server (realtime.c) and replay (replay.c).
+ */
+#ifndef LAGSIMD_DAEMON_H
+#define LAGSIMD_DAEMON_H
+
+#include <stdbool.h>
+#include "scene.h"
+
+typedef struct lagsimd_opts {
+    bool quiet;          /* -q: no live status line */
+    double duration;     /* --duration: sim seconds to run, <= 0 = until stopped */
+    const char *csv;     /* --offline: CSV path, "-" = stdout, NULL = no CSV */
+} lagsimd_opts;
+
+/* Exit codes of lagsimd. */
+enum { LAGSIMD_EXIT_OK = 0, LAGSIMD_EXIT_RUNTIME = 1, LAGSIMD_EXIT_USAGE = 2 };
+
+/* Offline: simulate as fast as possible, write CSV. Returns an exit code. */
+int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o);
+/* The real-time LCM server until SIGINT/SIGTERM (or opts->duration). Returns an exit code. */
+int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o);
+/* Re-simulates a run recorded by lcm-logger from the efforts in its logged states and
+ * prints the largest difference from the logged states. Returns an exit code. */
+int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts *o);
+
+#endif
