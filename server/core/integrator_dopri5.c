@@ -1,0 +1,184 @@
+/*
+ * Dormand-Prince 5(4) with the FSAL property, step-size control on the embedded 4th-order
+ * error (Hairer, Norsett & Wanner, Solving ODEs I, II.4-II.6, code DOPRI5), and its
+ * 4th-order dense output. The internal time/state (s->dp) may run ahead of the public
+ * state in continuous mode; the public state at each tick boundary is then interpolated.
+ * In hard-stop mode the last step is shortened to land on the end exactly (needed when the
+ * input changes there: the right-hand side is discontinuous at that instant).
+ */
+#include <math.h>
+#include <string.h>
+#include "core_internal.h"
+
+/* nodes c = (0, 1/5, 3/10, 4/5, 8/9, 1, 1): autonomous system, not needed */
+static const double a21 = 1.0 / 5;
+static const double a31 = 3.0 / 40, a32 = 9.0 / 40;
+static const double a41 = 44.0 / 45, a42 = -56.0 / 15, a43 = 32.0 / 9;
+static const double a51 = 19372.0 / 6561, a52 = -25360.0 / 2187, a53 = 64448.0 / 6561,
+                    a54 = -212.0 / 729;
+static const double a61 = 9017.0 / 3168, a62 = -355.0 / 33, a63 = 46732.0 / 5247,
+                    a64 = 49.0 / 176, a65 = -5103.0 / 18656;
+static const double a71 = 35.0 / 384, a73 = 500.0 / 1113, a74 = 125.0 / 192,
+                    a75 = -2187.0 / 6784, a76 = 11.0 / 84;
+static const double e1 = 71.0 / 57600, e3 = -71.0 / 16695, e4 = 71.0 / 1920,
+                    e5 = -17253.0 / 339200, e6 = 22.0 / 525, e7 = -1.0 / 40;
+static const double d1 = -12715105075.0 / 11282082432.0, d3 = 87487479700.0 / 32700410799.0,
+                    d4 = -10690763975.0 / 1880347072.0, d5 = 701980252875.0 / 199316789632.0,
+                    d6 = -1453857185.0 / 822651844.0, d7 = 69997945.0 / 29380423.0;
+
+/* Weighted RMS norm of the error estimate (Hairer's err). */
+static double err_norm(int N, const double *err, const double *y0, const double *y1,
+                       double rtol, double atol)
+{
+    double acc = 0.0;
+    for (int i = 0; i < N; i++) {
+        double sk = atol + rtol * fmax(fabs(y0[i]), fabs(y1[i]));
+        double e = err[i] / sk;
+        acc += e * e;
+    }
+    return sqrt(acc / N);
+}
+
+/* Initial step (Hairer's HINIT, simplified): h = 0.01 ||y|| / ||f||, bounded by dt. */
+static double initial_step(const lag_sim *s, int N, const double *y, const double *f)
+{
+    const lag_integrator_def *in = &s->def.integrator;
+    double dny = 0.0, dnf = 0.0;
+    for (int i = 0; i < N; i++) {
+        double sk = in->atol + in->rtol * fabs(y[i]);
+        dny += (y[i] / sk) * (y[i] / sk);
+        dnf += (f[i] / sk) * (f[i] / sk);
+    }
+    double h = (dny <= 1e-10 || dnf <= 1e-10) ? 1e-6 : 0.01 * sqrt(dny / dnf);
+    return fmin(h, in->dt);
+}
+
+/* Interpolates the last accepted step at time t (t_prev <= t <= dp.t). OUT: y */
+static void dense(const lag_sim *s, int N, double t, double *y)
+{
+    double h = s->dp.t - s->dp.t_prev;
+    double th = (t - s->dp.t_prev) / h, th1 = 1.0 - th;
+    for (int i = 0; i < N; i++)
+        y[i] = s->dp.rcont[0][i] +
+               th * (s->dp.rcont[1][i] +
+                     th1 * (s->dp.rcont[2][i] + th * (s->dp.rcont[3][i] + th1 * s->dp.rcont[4][i])));
+}
+
+lag_result lag_dopri5_advance(lag_sim *s, int64_t nticks, bool continuous)
+{
+    const int n = s->nq, N = 2 * n;
+    const lag_integrator_def *in = &s->def.integrator;
+    const double t_start = lag_sim_time(s);
+    const int64_t tick_end = s->tick + nticks;
+    const double t_end = (double)tick_end * in->dt;
+    lag_result r;
+
+    /* (Re)start from the public state when the internal one is not continuous with it. */
+    if (!s->dp.valid || s->dp.t < t_start) {
+        s->dp.t = t_start;
+        memcpy(s->dp.y, s->q, sizeof(double) * n);
+        memcpy(s->dp.y + n, s->qd, sizeof(double) * n);
+        if ((r = lag_sim_rhs(s, s->dp.y, s->dp.k1)) != LAG_OK) return r;
+        if (!(s->dp.h > 0.0)) s->dp.h = initial_step(s, N, s->dp.y, s->dp.k1);
+        s->dp.t_prev = s->dp.t;
+        s->dp.valid = true;
+    }
+
+    double k2[LAG_MAX_STATE], k3[LAG_MAX_STATE], k4[LAG_MAX_STATE], k5[LAG_MAX_STATE],
+        k6[LAG_MAX_STATE], k7[LAG_MAX_STATE], yt[LAG_MAX_STATE], y1[LAG_MAX_STATE],
+        err[LAG_MAX_STATE];
+    double *y = s->dp.y, *k1 = s->dp.k1;
+    bool last_rejected = false;
+
+    while (s->dp.t < t_end) {
+        double h = s->dp.h;
+        bool lands = false;
+        if (!continuous && s->dp.t + h >= t_end) {
+            h = t_end - s->dp.t;
+            lands = true;
+        }
+        if (h < in->dt_min && !lands) return LAG_ERR_STEPSIZE;
+
+        for (int i = 0; i < N; i++) yt[i] = y[i] + h * a21 * k1[i];
+        if ((r = lag_sim_rhs(s, yt, k2)) != LAG_OK) goto fail;
+        for (int i = 0; i < N; i++) yt[i] = y[i] + h * (a31 * k1[i] + a32 * k2[i]);
+        if ((r = lag_sim_rhs(s, yt, k3)) != LAG_OK) goto fail;
+        for (int i = 0; i < N; i++) yt[i] = y[i] + h * (a41 * k1[i] + a42 * k2[i] + a43 * k3[i]);
+        if ((r = lag_sim_rhs(s, yt, k4)) != LAG_OK) goto fail;
+        for (int i = 0; i < N; i++)
+            yt[i] = y[i] + h * (a51 * k1[i] + a52 * k2[i] + a53 * k3[i] + a54 * k4[i]);
+        if ((r = lag_sim_rhs(s, yt, k5)) != LAG_OK) goto fail;
+        for (int i = 0; i < N; i++)
+            yt[i] = y[i] + h * (a61 * k1[i] + a62 * k2[i] + a63 * k3[i] + a64 * k4[i] + a65 * k5[i]);
+        if ((r = lag_sim_rhs(s, yt, k6)) != LAG_OK) goto fail;
+        for (int i = 0; i < N; i++)
+            y1[i] = y[i] + h * (a71 * k1[i] + a73 * k3[i] + a74 * k4[i] + a75 * k5[i] + a76 * k6[i]);
+        if ((r = lag_sim_rhs(s, y1, k7)) != LAG_OK) goto fail;
+        for (int i = 0; i < N; i++)
+            err[i] = h * (e1 * k1[i] + e3 * k3[i] + e4 * k4[i] + e5 * k5[i] + e6 * k6[i] + e7 * k7[i]);
+        double en = err_norm(N, err, y, y1, in->rtol, in->atol);
+        if (!isfinite(en)) { r = LAG_ERR_NONFINITE; goto fail_noshrink; }
+
+        /* Proposed next step: 0.9 err^-1/5, bounded to [0.2, 10] (no growth right after
+         * a rejection). */
+        double fac = en > 0.0 ? 0.9 * pow(en, -0.2) : 10.0;
+        fac = fmin(last_rejected ? 1.0 : 10.0, fmax(0.2, fac));
+        if (en <= 1.0) {
+            if (!lag_state_ok(N, y1, s->def.explode_limit)) {
+                r = lag_state_ok(N, y1, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
+                goto fail_noshrink;
+            }
+            /* dense output coefficients for [t, t + h] */
+            for (int i = 0; i < N; i++) {
+                double ydiff = y1[i] - y[i], bspl = h * k1[i] - ydiff;
+                s->dp.rcont[0][i] = y[i];
+                s->dp.rcont[1][i] = ydiff;
+                s->dp.rcont[2][i] = bspl;
+                s->dp.rcont[3][i] = ydiff - h * k7[i] - bspl;
+                s->dp.rcont[4][i] = h * (d1 * k1[i] + d3 * k3[i] + d4 * k4[i] + d5 * k5[i] +
+                                         d6 * k6[i] + d7 * k7[i]);
+            }
+            s->dp.t_prev = s->dp.t;
+            s->dp.t = lands ? t_end : s->dp.t + h;
+            memcpy(y, y1, sizeof(double) * N);
+            memcpy(k1, k7, sizeof(double) * N); /* FSAL */
+            s->stats.steps_accepted++;
+            /* A step shortened to land keeps the natural proposal for the next one. */
+            if (!lands || h * fac > s->dp.h) s->dp.h = h * fac;
+            last_rejected = false;
+        } else {
+            s->stats.steps_rejected++;
+            s->dp.h = h * fac;
+            last_rejected = true;
+        }
+    }
+
+    /* Public state at t_end: exact if landed, else from the dense output. */
+    if (s->dp.t == t_end) {
+        memcpy(s->q, y, sizeof(double) * n);
+        memcpy(s->qd, y + n, sizeof(double) * n);
+    } else {
+        double ye[LAG_MAX_STATE];
+        dense(s, N, t_end, ye);
+        if (!lag_state_ok(N, ye, s->def.explode_limit)) {
+            s->dp.valid = false;
+            return lag_state_ok(N, ye, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
+        }
+        memcpy(s->q, ye, sizeof(double) * n);
+        memcpy(s->qd, ye + n, sizeof(double) * n);
+    }
+    s->tick = tick_end;
+    return LAG_OK;
+
+fail:
+    /* A singular or non-finite evaluation: try a smaller step before giving up. */
+    s->dp.h *= 0.25;
+    if (s->dp.h >= in->dt_min) {
+        s->stats.steps_rejected++;
+        /* restart the loop from the same internal state */
+        return lag_dopri5_advance(s, tick_end - s->tick, continuous);
+    }
+fail_noshrink:
+    s->dp.valid = false;
+    return r;
+}

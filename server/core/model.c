@@ -1,0 +1,232 @@
+/* Model kinds: the info table, parameter defaults and validation, public dispatch, and
+ * forward dynamics (M qdd = tau - C qd - g solved by Cholesky). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include "core_internal.h"
+
+static const lag_model_info *const infos[LAG_MODEL_COUNT] = {
+    &lag_stick_info, &lag_manipulator_info, &lag_dipc_info,
+};
+static const lag_model_vtable *const vtables[LAG_MODEL_COUNT] = {
+    &lag_stick_vtable, &lag_manipulator_vtable, &lag_dipc_vtable,
+};
+
+const char *lag_result_string(lag_result r)
+{
+    switch (r) {
+    case LAG_OK: return "ok";
+    case LAG_ERR_ARG: return "invalid argument";
+    case LAG_ERR_SINGULAR: return "mass matrix not positive definite";
+    case LAG_ERR_NONFINITE: return "non-finite state";
+    case LAG_ERR_EXPLODE: return "state exceeded explode_limit";
+    case LAG_ERR_NEWTON: return "implicit solver (Newton) did not converge";
+    case LAG_ERR_STEPSIZE: return "adaptive step size fell below dt_min";
+    }
+    return "unknown result";
+}
+
+const lag_model_info *lag_model_info_get(lag_model_kind kind)
+{
+    if ((int)kind < 0 || kind >= LAG_MODEL_COUNT) return NULL;
+    return infos[kind];
+}
+
+int lag_model_kind_from_name(const char *name)
+{
+    for (int k = 0; k < LAG_MODEL_COUNT; k++)
+        if (name && strcmp(name, infos[k]->name) == 0) return k;
+    return -1;
+}
+
+int lag_model_param_index(lag_model_kind kind, const char *name)
+{
+    const lag_model_info *info = lag_model_info_get(kind);
+    if (!info || !name) return -1;
+    for (int i = 0; i < info->np; i++)
+        if (strcmp(name, info->param_names[i]) == 0) return i;
+    return -1;
+}
+
+const lag_model_vtable *lag_model_vt(const lag_model *m) { return vtables[m->kind]; }
+
+void lag_model_default_unfinished(lag_model *m, lag_model_kind kind)
+{
+    const lag_model_info *info = infos[kind];
+    memset(m, 0, sizeof *m);
+    m->kind = kind;
+    m->nq = info->nq;
+    for (int i = 0; i < info->np; i++) m->p[i] = info->param_defaults[i];
+}
+
+/* Uniform rod inertia about its centre, m l^2 / 12, for each inertia still NaN. */
+void lag_model_finish(lag_model *m)
+{
+    double *p = m->p;
+    switch (m->kind) {
+    case LAG_MODEL_STICK:
+        if (isnan(p[LAG_STICK_I])) p[LAG_STICK_I] = p[LAG_STICK_M] * p[LAG_STICK_L] * p[LAG_STICK_L] / 12.0;
+        break;
+    case LAG_MODEL_DIPC:
+        if (isnan(p[LAG_DIPC_I1])) p[LAG_DIPC_I1] = p[LAG_DIPC_M1] * p[LAG_DIPC_L1] * p[LAG_DIPC_L1] / 12.0;
+        if (isnan(p[LAG_DIPC_I2])) p[LAG_DIPC_I2] = p[LAG_DIPC_M2] * p[LAG_DIPC_L2] * p[LAG_DIPC_L2] / 12.0;
+        break;
+    default:
+        break;
+    }
+}
+
+void lag_model_default(lag_model *m, lag_model_kind kind)
+{
+    lag_model_default_unfinished(m, kind);
+    lag_model_finish(m);
+}
+
+lag_result lag_model_validate(const lag_model *m, char *err, size_t errlen)
+{
+    const lag_model_info *info = lag_model_info_get(m->kind);
+    if (!info) {
+        snprintf(err, errlen, "unknown model kind %d", (int)m->kind);
+        return LAG_ERR_ARG;
+    }
+    if (m->nq != info->nq) {
+        snprintf(err, errlen, "model %s has %d coordinates, not %d", info->name, info->nq, m->nq);
+        return LAG_ERR_ARG;
+    }
+    for (int i = 0; i < info->np; i++) {
+        const char *name = info->param_names[i];
+        double v = m->p[i];
+        if (!isfinite(v)) {
+            snprintf(err, errlen, "parameter %s must be a finite number", name);
+            return LAG_ERR_ARG;
+        }
+        /* h0 may be any height; g may be 0 (no gravity) but not negative (flip the
+         * coordinates instead); every mass, length and inertia must be positive. */
+        if (strcmp(name, "h0") == 0) continue;
+        if (strcmp(name, "g") == 0) {
+            if (v < 0) {
+                snprintf(err, errlen, "parameter g must be >= 0 (m/s^2), got %g", v);
+                return LAG_ERR_ARG;
+            }
+            continue;
+        }
+        if (v <= 0) {
+            snprintf(err, errlen, "parameter %s must be > 0 (%s), got %g", name,
+                     info->param_units[i], v);
+            return LAG_ERR_ARG;
+        }
+    }
+    return LAG_OK;
+}
+
+void lag_model_mass(const lag_model *m, const double *q, double *M)
+{
+    vtables[m->kind]->mass(m->p, q, M);
+}
+
+void lag_model_mass_deriv(const lag_model *m, const double *q, double *dM)
+{
+    vtables[m->kind]->mass_deriv(m->p, q, dM);
+}
+
+void lag_model_coriolis(const lag_model *m, const double *q, const double *qd, double *C)
+{
+    vtables[m->kind]->coriolis(m->p, q, qd, C);
+}
+
+void lag_model_gravity(const lag_model *m, const double *q, double *g)
+{
+    vtables[m->kind]->gravity(m->p, q, g);
+}
+
+void lag_model_bias(const lag_model *m, const double *q, const double *qd, double *h)
+{
+    double M[LAG_MAX_DOF * LAG_MAX_DOF];
+    vtables[m->kind]->mass_bias(m->p, q, qd, M, h);
+}
+
+double lag_model_kinetic(const lag_model *m, const double *q, const double *qd)
+{
+    return vtables[m->kind]->kinetic(m->p, q, qd);
+}
+
+double lag_model_potential(const lag_model *m, const double *q)
+{
+    return vtables[m->kind]->potential(m->p, q);
+}
+
+lag_result lag_spd_solve(int n, const double *A, const double *b, double *x)
+{
+    double L[LAG_MAX_STATE * LAG_MAX_STATE];
+    /* Cholesky A = L L^T, lower triangle only. */
+    for (int j = 0; j < n; j++) {
+        double d = A[j * n + j];
+        for (int k = 0; k < j; k++) d -= L[j * n + k] * L[j * n + k];
+        if (!(d > 0.0)) return LAG_ERR_SINGULAR; /* also catches NaN */
+        double ljj = sqrt(d);
+        L[j * n + j] = ljj;
+        for (int i = j + 1; i < n; i++) {
+            double s = A[i * n + j];
+            for (int k = 0; k < j; k++) s -= L[i * n + k] * L[j * n + k];
+            L[i * n + j] = s / ljj;
+        }
+    }
+    double y[LAG_MAX_STATE];
+    for (int i = 0; i < n; i++) {
+        double s = b[i];
+        for (int k = 0; k < i; k++) s -= L[i * n + k] * y[k];
+        y[i] = s / L[i * n + i];
+    }
+    for (int i = n - 1; i >= 0; i--) {
+        double s = y[i];
+        for (int k = i + 1; k < n; k++) s -= L[k * n + i] * x[k];
+        x[i] = s / L[i * n + i];
+    }
+    return LAG_OK;
+}
+
+lag_result lag_lu_solve_inplace(int n, double *A, double *b)
+{
+    for (int k = 0; k < n; k++) {
+        int piv = k;
+        double best = fabs(A[k * n + k]);
+        for (int i = k + 1; i < n; i++)
+            if (fabs(A[i * n + k]) > best) { best = fabs(A[i * n + k]); piv = i; }
+        if (!(best > 0.0)) return LAG_ERR_SINGULAR;
+        if (piv != k) {
+            for (int j = 0; j < n; j++) {
+                double t = A[k * n + j]; A[k * n + j] = A[piv * n + j]; A[piv * n + j] = t;
+            }
+            double t = b[k]; b[k] = b[piv]; b[piv] = t;
+        }
+        for (int i = k + 1; i < n; i++) {
+            double f = A[i * n + k] / A[k * n + k];
+            A[i * n + k] = f;
+            for (int j = k + 1; j < n; j++) A[i * n + j] -= f * A[k * n + j];
+            b[i] -= f * b[k];
+        }
+    }
+    for (int i = n - 1; i >= 0; i--) {
+        double s = b[i];
+        for (int j = i + 1; j < n; j++) s -= A[i * n + j] * b[j];
+        b[i] = s / A[i * n + i];
+    }
+    return LAG_OK;
+}
+
+lag_result lag_model_forward(const lag_model *m, const double *q, const double *qd,
+                             const double *tau, double *qdd)
+{
+    double M[LAG_MAX_DOF * LAG_MAX_DOF], h[LAG_MAX_DOF], r[LAG_MAX_DOF];
+    int n = m->nq;
+    vtables[m->kind]->mass_bias(m->p, q, qd, M, h);
+    for (int i = 0; i < n; i++) r[i] = (tau ? tau[i] : 0.0) - h[i];
+    return lag_spd_solve(n, M, r, qdd);
+}
+
+bool lag_state_ok(int n, const double *x, double limit)
+{
+    for (int i = 0; i < n; i++)
+        if (!isfinite(x[i]) || fabs(x[i]) > limit) return false;
+    return true;
+}
