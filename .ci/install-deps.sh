@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Installs the Debian packages lagsim needs (build, tests, peers for benchmarks, plots).
+# Skips apt entirely when everything is already installed.
+set -euo pipefail
+pkgs=(build-essential cmake pkg-config
+      liblcm-dev liblcm-bin libglib2.0-dev libyaml-dev   # LCM (lcm.pc needs glib's dev package) and libyaml
+      python3                                            # the stdlib-only Python client and some tests
+      libmujoco-dev libsundials-dev gnuplot-nox          # benchmark peers and plots
+      liblcm-java default-jdk-headless)                  # lcm-spy with lagsim's types
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+echo "installing: ${missing[*]}"
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO=sudo
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
