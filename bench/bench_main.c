@@ -1,0 +1,543 @@
+/*
+ * lagsim_bench: work-precision benchmark of lagsim's integrators beside MuJoCo and
+ * SUNDIALS (when built with them).
+ *
+ *   lagsim_bench [--out DIR] [--reps N] [--quick]
+ *
+ * For every scene (bench_common.c): a reference (dopri5 at rtol 1e-13, checked against
+ * gauss4 at a tiny step), then every method over a range of dt (or rtol): max position
+ * error over the horizon, max energy error, RHS evaluations and CPU time per simulated
+ * second (minimum of --reps runs). Prints Markdown tables (the numbers in
+ * docs/readme/bench.md), the cross-checks against the peers, the cost ratios and the
+ * real-time budget table; with --out writes DIR/bench_wp.csv and
+ * DIR/bench_energy_long.csv (100 s chaotic DIPC, energy error vs time).
+ *
+ * --quick (the ctest): short horizons, one coarse point per method, and checks that fail
+ * the run: the reference's two methods agree to 1e-10; at the same dt a higher-order
+ * method is more accurate on every scene; dopri5's error falls with its tolerance; our
+ * rk4 and semi-implicit Euler agree with MuJoCo's RK4 and Euler and with ARKODE's RK4 to
+ * far below their own integration error. Exit status 1 if a check fails.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "bench.h"
+
+typedef struct row {
+    int scene;
+    bench_config c;
+    bench_result r;
+    double pos_err;
+    double energy_err;
+} row;
+
+#define MAX_ROWS 1024
+static row rows[MAX_ROWS];
+static int nrows;
+static int failures;
+
+static void check(bool ok, const char *what, double got, double bound)
+{
+    printf("- check %s: %.3e %s %.3e ... %s\n", what, got, ok ? "ok vs" : "VIOLATES", bound,
+           ok ? "PASS" : "FAIL");
+    if (!ok) failures++;
+}
+
+static const double dts_low[] = {1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5, 1e-5};
+static const double dts_high[] = {1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4};
+static const double rtols[] = {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12};
+#define COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
+
+static bool peer_applies(bench_impl impl, const bench_scene *sc)
+{
+    if (impl == BENCH_MUJOCO)
+        return sc->model.kind == LAG_MODEL_DIPC || sc->model.kind == LAG_MODEL_MANIPULATOR;
+    return true;
+}
+
+/* Appends the configs of the sweep for one scene. OUT: out; returns the count */
+static int sweep_configs(const bench_scene *sc, bool quick, bench_config *out)
+{
+    int n = 0;
+    const double qdt = 5e-3; /* the quick test's coarse point */
+    for (int m = 0; m < LAG_METHOD_COUNT; m++) {
+        bool low = (lag_method_order((lag_method)m) <= 2);
+        if (m == LAG_DOPRI5) {
+            if (quick) {
+                out[n++] = (bench_config){BENCH_LAGSIM, m, sc->period, 1e-5};
+                out[n++] = (bench_config){BENCH_LAGSIM, m, sc->period, 1e-9};
+            } else {
+                for (int i = 0; i < COUNT(rtols); i++)
+                    out[n++] = (bench_config){BENCH_LAGSIM, m, sc->period, rtols[i]};
+            }
+            continue;
+        }
+        if (quick) {
+            out[n++] = (bench_config){BENCH_LAGSIM, m, qdt, 0};
+            continue;
+        }
+        const double *dts = low ? dts_low : dts_high;
+        int nd = low ? COUNT(dts_low) : COUNT(dts_high);
+        for (int i = 0; i < nd; i++) out[n++] = (bench_config){BENCH_LAGSIM, m, dts[i], 0};
+    }
+#ifdef LAGSIM_HAVE_MUJOCO
+    if (peer_applies(BENCH_MUJOCO, sc))
+        for (int m = 0; m < BENCH_MJ_COUNT; m++) {
+            if (quick) {
+                out[n++] = (bench_config){BENCH_MUJOCO, m, qdt, 0};
+                continue;
+            }
+            const double *dts = m == BENCH_MJ_RK4 ? dts_high : dts_low;
+            int nd = m == BENCH_MJ_RK4 ? COUNT(dts_high) : COUNT(dts_low);
+            for (int i = 0; i < nd; i++) out[n++] = (bench_config){BENCH_MUJOCO, m, dts[i], 0};
+        }
+#endif
+#ifdef LAGSIM_HAVE_SUNDIALS
+    for (int m = 0; m < BENCH_SUN_COUNT; m++) {
+        if (m == BENCH_SUN_ARK_RK4) {
+            if (quick) {
+                out[n++] = (bench_config){BENCH_SUNDIALS, m, qdt, 0};
+                continue;
+            }
+            for (int i = 0; i < COUNT(dts_high); i++)
+                out[n++] = (bench_config){BENCH_SUNDIALS, m, dts_high[i], 0};
+            continue;
+        }
+        if (quick) {
+            out[n++] = (bench_config){BENCH_SUNDIALS, m, sc->period, 1e-6};
+            continue;
+        }
+        for (int i = 0; i < COUNT(rtols); i++)
+            out[n++] = (bench_config){BENCH_SUNDIALS, m, sc->period, rtols[i]};
+    }
+#endif
+    return n;
+}
+
+static const char *label(const bench_config *c)
+{
+    static char buf[4][64];
+    static int k;
+    char m[48];
+    k = (k + 1) % 4;
+    snprintf(buf[k], sizeof buf[k], "%s %s", bench_impl_name(c->impl),
+             bench_method_label(c, m, sizeof m));
+    return buf[k];
+}
+
+/* "dt=1e-03" or "rtol=1e-08". */
+static const char *setting(const bench_config *c)
+{
+    static char buf[4][32];
+    static int k;
+    k = (k + 1) % 4;
+    if (bench_config_adaptive(c)) snprintf(buf[k], sizeof buf[k], "rtol=%.0e", c->rtol);
+    else snprintf(buf[k], sizeof buf[k], "dt=%.0e", c->dt);
+    return buf[k];
+}
+
+static const row *find_row(int scene, bench_impl impl, int method, double dt)
+{
+    for (int i = 0; i < nrows; i++)
+        if (rows[i].scene == scene && rows[i].c.impl == impl && rows[i].c.method == method &&
+            fabs(rows[i].c.dt - dt) < 1e-15 && rows[i].r.status == 0)
+            return &rows[i];
+    return NULL;
+}
+
+/* log-log interpolation of CPU time per simulated second at error `e` along one
+ * method's curve (points sorted by error); NaN outside the measured range. */
+static double cpu_at_error(int scene, bench_impl impl, int method, double e)
+{
+    double best = NAN;
+    for (int i = 0; i < nrows; i++) {
+        const row *a = &rows[i];
+        if (a->scene != scene || a->c.impl != impl || a->c.method != method || a->r.status)
+            continue;
+        for (int j = 0; j < nrows; j++) {
+            const row *b = &rows[j];
+            if (b->scene != scene || b->c.impl != impl || b->c.method != method || b->r.status)
+                continue;
+            if (!(a->pos_err >= e && b->pos_err <= e && a->pos_err > b->pos_err)) continue;
+            double la = log(a->pos_err), lb = log(b->pos_err), le = log(e);
+            double w = (le - la) / (lb - la);
+            double lc = (1 - w) * log(a->r.cpu) + w * log(b->r.cpu);
+            double v = exp(lc);
+            /* several brackets (noisy curves): the cheapest */
+            if (isnan(best) || v < best) best = v;
+        }
+    }
+    return best;
+}
+
+static void print_env(void)
+{
+    char model[256] = "unknown";
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    if (f) {
+        char line[512];
+        while (fgets(line, sizeof line, f))
+            if (strncmp(line, "model name", 10) == 0) {
+                char *p = strchr(line, ':');
+                if (p) {
+                    snprintf(model, sizeof model, "%s", p + 2);
+                    model[strcspn(model, "\n")] = 0;
+                }
+                break;
+            }
+        fclose(f);
+    }
+    time_t now = time(NULL);
+    char date[64];
+    strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", gmtime(&now));
+    printf("Run %s on %s.\n", date, model);
+#ifdef LAGSIM_HAVE_MUJOCO
+    printf("Peers: MuJoCo %s", bench_mujoco_version());
+#else
+    printf("Peers: MuJoCo not built");
+#endif
+#ifdef LAGSIM_HAVE_SUNDIALS
+    printf(", SUNDIALS %s.\n", bench_sundials_version());
+#else
+    printf(", SUNDIALS not built.\n");
+#endif
+}
+
+/* Max |q| difference between two configs' trajectories on a scene (untimed runs). */
+static double agreement(const bench_scene *sc, const bench_config *a, const bench_config *b)
+{
+    bench_samples sa, sb;
+    if (bench_samples_alloc(&sa, sc) || bench_samples_alloc(&sb, sc)) return NAN;
+    bench_result ra = bench_measure(sc, a, 1, &sa);
+    bench_result rb = bench_measure(sc, b, 1, &sb);
+    double e = (ra.status || rb.status) ? NAN : bench_max_pos_err(&sa, &sb);
+    bench_samples_free(&sa);
+    bench_samples_free(&sb);
+    return e;
+}
+
+/* ---------------------------------------------------------------- long energy run */
+static void energy_long(const char *outdir, int reps)
+{
+    bench_scene sc[BENCH_SCENE_COUNT];
+    bench_scenes(sc, false);
+    bench_scene s = sc[3];
+    s.horizon = 100.0;
+    bench_config cfg[16];
+    int n = 0;
+    const double dt = 1e-3;
+    cfg[n++] = (bench_config){BENCH_LAGSIM, LAG_EULER, dt, 0};
+    cfg[n++] = (bench_config){BENCH_LAGSIM, LAG_SEMI_IMPLICIT_EULER, dt, 0};
+    cfg[n++] = (bench_config){BENCH_LAGSIM, LAG_IMPLICIT_MIDPOINT, dt, 0};
+    cfg[n++] = (bench_config){BENCH_LAGSIM, LAG_RK4, dt, 0};
+    cfg[n++] = (bench_config){BENCH_LAGSIM, LAG_GAUSS4, dt, 0};
+    cfg[n++] = (bench_config){BENCH_LAGSIM, LAG_DOPRI5, s.period, 1e-8};
+#ifdef LAGSIM_HAVE_MUJOCO
+    cfg[n++] = (bench_config){BENCH_MUJOCO, BENCH_MJ_EULER, dt, 0};
+    cfg[n++] = (bench_config){BENCH_MUJOCO, BENCH_MJ_RK4, dt, 0};
+#endif
+#ifdef LAGSIM_HAVE_SUNDIALS
+    cfg[n++] = (bench_config){BENCH_SUNDIALS, BENCH_SUN_ARK_DP5, s.period, 1e-8};
+#endif
+    bench_samples smp[16];
+    printf("\n## Long chaotic run: DIPC near upright, 100 s, energy error\n\n");
+    printf("| method | setting | max abs(E - E0) over 100 s (J) | at t = 1 s | at t = 10 s | CPU s per sim s |\n");
+    printf("|---|---|---|---|---|---|\n");
+    const double E0 = bench_energy(&s.model, s.q0, s.qd0);
+    for (int i = 0; i < n; i++) {
+        bench_samples_alloc(&smp[i], &s);
+        for (int k = 0; k < smp[i].n * LAG_MAX_DOF; k++) smp[i].q[k] = smp[i].qd[k] = NAN;
+        bench_result r = bench_measure(&s, &cfg[i], reps < 2 ? reps : 2, &smp[i]);
+        double emax = 0, e1 = NAN, e10 = NAN;
+        for (int k = 0; k < smp[i].n; k++) {
+            double e = fabs(bench_energy(&s.model, smp[i].q + k * LAG_MAX_DOF,
+                                         smp[i].qd + k * LAG_MAX_DOF) - E0);
+            if (isnan(e)) { emax = INFINITY; break; }
+            if (e > emax) emax = e;
+            if (k == 100) e1 = emax;
+            if (k == 1000) e10 = emax;
+        }
+        printf("| %s | %s | %.2e%s | %.2e | %.2e | %.3g |\n", label(&cfg[i]), setting(&cfg[i]),
+               emax, r.status ? " (failed: blew up)" : "", e1, e10,
+               r.status ? NAN : r.cpu / s.horizon);
+    }
+    if (outdir) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/bench_energy_long.csv", outdir);
+        FILE *f = fopen(path, "w");
+        if (f) {
+            fprintf(f, "t");
+            for (int i = 0; i < n; i++) fprintf(f, ",%s %s", label(&cfg[i]), setting(&cfg[i]));
+            fprintf(f, "\n");
+            for (int k = 0; k < smp[0].n; k += 10) {
+                fprintf(f, "%.2f", k * s.period);
+                for (int i = 0; i < n; i++) {
+                    double e = fabs(bench_energy(&s.model, smp[i].q + k * LAG_MAX_DOF,
+                                                 smp[i].qd + k * LAG_MAX_DOF) - E0);
+                    if (isfinite(e)) fprintf(f, ",%.6e", e);
+                    else fprintf(f, ",NaN");
+                }
+                fprintf(f, "\n");
+            }
+            fclose(f);
+        }
+    }
+    for (int i = 0; i < n; i++) bench_samples_free(&smp[i]);
+}
+
+/* ---------------------------------------------------------------- main */
+int main(int argc, char **argv)
+{
+    const char *outdir = NULL;
+    int reps = 3;
+    bool quick = false;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) outdir = argv[++i];
+        else if (strcmp(argv[i], "--reps") == 0 && i + 1 < argc) reps = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--quick") == 0) quick = true;
+        else {
+            fprintf(stderr, "usage: %s [--out DIR] [--reps N] [--quick]\n", argv[0]);
+            return 2;
+        }
+    }
+    if (reps < 1) reps = 1;
+    if (quick) reps = 1;
+
+    bench_scene scenes[BENCH_SCENE_COUNT];
+    bench_scenes(scenes, quick);
+    printf("# lagsim work-precision benchmark%s\n\n", quick ? " (quick check)" : "");
+    print_env();
+
+    FILE *csv = NULL;
+    if (outdir) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/bench_wp.csv", outdir);
+        csv = fopen(path, "w");
+        if (!csv) {
+            perror(path);
+            return 2;
+        }
+        fprintf(csv, "scene,impl,method,dt,rtol,pos_err,energy_err,rhs_per_s,steps_per_s,"
+                     "cpu_per_s,us_per_step,status\n");
+    }
+
+    /* References */
+    printf("\n## References (dopri5 rtol 1e-13 vs gauss4 at period/200)\n\n");
+    printf("| scene | horizon (s) | gauss4 dt | max abs(q_dopri5 - q_gauss4) |\n|---|---|---|---|\n");
+    static bench_reference refs[BENCH_SCENE_COUNT];
+    for (int s = 0; s < BENCH_SCENE_COUNT; s++) {
+        if (bench_reference_build(&scenes[s], &refs[s]) != 0) {
+            fprintf(stderr, "bench: no reference for %s\n", scenes[s].name);
+            return 2;
+        }
+        printf("| %s | %g | %.0e | %.2e |\n", scenes[s].name, scenes[s].horizon,
+               refs[s].gauss_dt, refs[s].agreement);
+        if (quick) check(refs[s].agreement < 1e-10, "reference agreement", refs[s].agreement, 1e-10);
+    }
+
+    /* Sweep */
+    for (int s = 0; s < BENCH_SCENE_COUNT; s++) {
+        const bench_scene *sc = &scenes[s];
+        bench_config cfg[256];
+        int nc = sweep_configs(sc, quick, cfg);
+        printf("\n## %s: %s, %g s\n\n", sc->name, sc->title, sc->horizon);
+        printf("| method | setting | max pos err | max energy err (J) | RHS/sim s | CPU s/sim s | us/step |\n");
+        printf("|---|---|---|---|---|---|---|\n");
+        bench_samples smp;
+        bench_samples_alloc(&smp, sc);
+        for (int i = 0; i < nc && nrows < MAX_ROWS; i++) {
+            row *w = &rows[nrows++];
+            w->scene = s;
+            w->c = cfg[i];
+            w->r = bench_measure(sc, &cfg[i], reps, &smp);
+            w->pos_err = w->r.status ? NAN : bench_max_pos_err(&smp, &refs[s].ref);
+            w->energy_err = w->r.status ? NAN : bench_max_energy_err(sc, &smp, &refs[s].ref);
+            double T = sc->horizon;
+            double us_step = w->r.steps ? 1e6 * w->r.cpu / (double)w->r.steps : NAN;
+            if (w->r.status)
+                printf("| %s | %s | failed (%d) | | | | |\n", label(&cfg[i]), setting(&cfg[i]),
+                       w->r.status);
+            else
+                printf("| %s | %s | %.2e | %.2e | %.0f | %.2e | %.3f |\n", label(&cfg[i]),
+                       setting(&cfg[i]), w->pos_err, w->energy_err, (double)w->r.rhs / T,
+                       w->r.cpu / T, us_step);
+            if (csv) {
+                char m[48];
+                fprintf(csv, "%s,%s,%s,%.3g,%.3g,%.6e,%.6e,%.6g,%.6g,%.6e,%.6g,%d\n", sc->name,
+                        bench_impl_name(cfg[i].impl), bench_method_label(&cfg[i], m, sizeof m),
+                        cfg[i].dt, cfg[i].rtol, w->pos_err, w->energy_err,
+                        (double)w->r.rhs / T, (double)w->r.steps / T, w->r.cpu / T, us_step,
+                        w->r.status);
+            }
+            fflush(stdout);
+        }
+        bench_samples_free(&smp);
+    }
+    if (csv) fclose(csv);
+
+    /* Error ordering at the same dt (quick: the coarse point, full: dt = 5e-3). */
+    printf("\n## Error ordering at dt = 5e-3 (higher order => smaller error)\n\n");
+    for (int s = 0; s < BENCH_SCENE_COUNT; s++) {
+        const row *eu = find_row(s, BENCH_LAGSIM, LAG_EULER, 5e-3);
+        const row *se = find_row(s, BENCH_LAGSIM, LAG_SEMI_IMPLICIT_EULER, 5e-3);
+        const row *mp = find_row(s, BENCH_LAGSIM, LAG_IMPLICIT_MIDPOINT, 5e-3);
+        const row *rk = find_row(s, BENCH_LAGSIM, LAG_RK4, 5e-3);
+        const row *g4 = find_row(s, BENCH_LAGSIM, LAG_GAUSS4, 5e-3);
+        printf("%s: euler %.2e, semi-implicit-euler %.2e, implicit-midpoint %.2e, rk4 %.2e, "
+               "gauss4 %.2e\n", scenes[s].name, eu ? eu->pos_err : NAN, se ? se->pos_err : NAN,
+               mp ? mp->pos_err : NAN, rk ? rk->pos_err : NAN, g4 ? g4->pos_err : NAN);
+        if (!quick) continue;
+        /* An explicit Euler that blew up counts as "least accurate". */
+        double e_eu = eu ? eu->pos_err : INFINITY;
+        double e_se = se ? se->pos_err : INFINITY;
+        check(mp && e_eu > mp->pos_err, "euler error > implicit-midpoint error", e_eu,
+              mp ? mp->pos_err : NAN);
+        check(mp && e_se > mp->pos_err, "semi-implicit-euler error > implicit-midpoint error",
+              e_se, mp ? mp->pos_err : NAN);
+        check(mp && rk && mp->pos_err > rk->pos_err, "implicit-midpoint error > rk4 error",
+              mp ? mp->pos_err : NAN, rk ? rk->pos_err : NAN);
+        check(mp && g4 && mp->pos_err > g4->pos_err, "implicit-midpoint error > gauss4 error",
+              mp ? mp->pos_err : NAN, g4 ? g4->pos_err : NAN);
+        const row *d5 = NULL, *d9 = NULL;
+        for (int i = 0; i < nrows; i++)
+            if (rows[i].scene == s && rows[i].c.impl == BENCH_LAGSIM &&
+                rows[i].c.method == LAG_DOPRI5 && rows[i].r.status == 0) {
+                if (rows[i].c.rtol == 1e-5) d5 = &rows[i];
+                if (rows[i].c.rtol == 1e-9) d9 = &rows[i];
+            }
+        check(d5 && d9 && d5->pos_err > d9->pos_err, "dopri5 error rtol 1e-5 > rtol 1e-9",
+              d5 ? d5->pos_err : NAN, d9 ? d9->pos_err : NAN);
+        check(d9 && d9->pos_err < 1e-6, "dopri5 rtol 1e-9 error", d9 ? d9->pos_err : NAN, 1e-6);
+    }
+
+    /* Cross-checks: same method, same dt, same ODE => same trajectory up to rounding. */
+    printf("\n## Cross-checks against the peers (same method, same dt)\n\n");
+    printf("| scene | pair | dt | max abs(q_ours - q_peer) | our error vs reference |\n|---|---|---|---|---|\n");
+    for (int s = 0; s < BENCH_SCENE_COUNT; s++) {
+        const bench_scene *sc = &scenes[s];
+        if (sc->chaotic) continue;
+        static const double xdts[] = {5e-3, 1e-3};
+        for (int x = 0; x < COUNT(xdts); x++) {
+            const double dt = xdts[x];
+            /* Checks at the coarse dt, where the integration error is far above rounding. */
+            const bool chk = quick && x == 0;
+            bench_config ours_rk4 = {BENCH_LAGSIM, LAG_RK4, dt, 0};
+            bench_config ours_se = {BENCH_LAGSIM, LAG_SEMI_IMPLICIT_EULER, dt, 0};
+            bench_samples so;
+            bench_samples_alloc(&so, sc);
+            bench_measure(sc, &ours_rk4, 1, &so);
+            double err_rk4 = bench_max_pos_err(&so, &refs[s].ref);
+            bench_measure(sc, &ours_se, 1, &so);
+            double err_se = bench_max_pos_err(&so, &refs[s].ref);
+            bench_samples_free(&so);
+            (void)err_se;
+            (void)chk;
+#ifdef LAGSIM_HAVE_MUJOCO
+            if (peer_applies(BENCH_MUJOCO, sc)) {
+                bench_config mj_rk4 = {BENCH_MUJOCO, BENCH_MJ_RK4, dt, 0};
+                bench_config mj_eu = {BENCH_MUJOCO, BENCH_MJ_EULER, dt, 0};
+                double a = agreement(sc, &ours_rk4, &mj_rk4);
+                double b = agreement(sc, &ours_se, &mj_eu);
+                printf("| %s | lagsim rk4 vs mujoco RK4 | %.0e | %.2e | %.2e |\n", sc->name, dt,
+                       a, err_rk4);
+                printf("| %s | lagsim semi-implicit-euler vs mujoco Euler | %.0e | %.2e | %.2e |\n",
+                       sc->name, dt, b, err_se);
+                if (chk) {
+                    check(a < 1e-9 && a < 1e-2 * err_rk4, "rk4 vs MuJoCo RK4 agreement", a,
+                          fmin(1e-9, 1e-2 * err_rk4));
+                    check(b < 1e-9 && b < 1e-2 * err_se,
+                          "semi-implicit Euler vs MuJoCo Euler agreement", b,
+                          fmin(1e-9, 1e-2 * err_se));
+                }
+            }
+#endif
+#ifdef LAGSIM_HAVE_SUNDIALS
+            {
+                bench_config ark_rk4 = {BENCH_SUNDIALS, BENCH_SUN_ARK_RK4, dt, 0};
+                double a = agreement(sc, &ours_rk4, &ark_rk4);
+                printf("| %s | lagsim rk4 vs ARKODE RK4 | %.0e | %.2e | %.2e |\n", sc->name, dt,
+                       a, err_rk4);
+                if (chk)
+                    check(a < 1e-9 && a < 1e-2 * err_rk4, "rk4 vs ARKODE RK4 agreement", a,
+                          fmin(1e-9, 1e-2 * err_rk4));
+            }
+#endif
+        }
+    }
+
+    if (!quick) {
+        /* Ratios */
+        printf("\n## Cost ratios\n\n");
+#ifdef LAGSIM_HAVE_MUJOCO
+        for (int s = 0; s < BENCH_SCENE_COUNT; s++) {
+            const row *o = find_row(s, BENCH_LAGSIM, LAG_RK4, 1e-3);
+            const row *p = find_row(s, BENCH_MUJOCO, BENCH_MJ_RK4, 1e-3);
+            const row *oe = find_row(s, BENCH_LAGSIM, LAG_SEMI_IMPLICIT_EULER, 1e-3);
+            const row *pe = find_row(s, BENCH_MUJOCO, BENCH_MJ_EULER, 1e-3);
+            if (o && p)
+                printf("- %s: lagsim rk4 step %.3f us vs MuJoCo RK4 step %.3f us: ratio %.3f "
+                       "(target <= 0.1)\n", scenes[s].name, 1e6 * o->r.cpu / o->r.steps,
+                       1e6 * p->r.cpu / p->r.steps, (o->r.cpu / o->r.steps) / (p->r.cpu / p->r.steps));
+            if (oe && pe)
+                printf("- %s: lagsim semi-implicit-euler step %.3f us vs MuJoCo Euler step %.3f us: "
+                       "ratio %.3f\n", scenes[s].name, 1e6 * oe->r.cpu / oe->r.steps,
+                       1e6 * pe->r.cpu / pe->r.steps,
+                       (oe->r.cpu / oe->r.steps) / (pe->r.cpu / pe->r.steps));
+        }
+#endif
+#ifdef LAGSIM_HAVE_SUNDIALS
+        for (int s = 0; s < BENCH_SCENE_COUNT; s++) {
+            const row *o = find_row(s, BENCH_LAGSIM, LAG_RK4, 1e-3);
+            const row *p = find_row(s, BENCH_SUNDIALS, BENCH_SUN_ARK_RK4, 1e-3);
+            if (o && p)
+                printf("- %s: lagsim rk4 step %.3f us vs ARKODE RK4 step %.3f us: ratio %.3f\n",
+                       scenes[s].name, 1e6 * o->r.cpu / o->r.steps, 1e6 * p->r.cpu / p->r.steps,
+                       (o->r.cpu / o->r.steps) / (p->r.cpu / p->r.steps));
+        }
+        static const double targets[] = {1e-4, 1e-6, 1e-8, 1e-10};
+        for (int s = 0; s < BENCH_SCENE_COUNT; s++) {
+            printf("- %s: lagsim dopri5 / ARKODE DP5 CPU at equal error (target <= 0.5):",
+                   scenes[s].name);
+            for (int i = 0; i < COUNT(targets); i++) {
+                double a = cpu_at_error(s, BENCH_LAGSIM, LAG_DOPRI5, targets[i]);
+                double b = cpu_at_error(s, BENCH_SUNDIALS, BENCH_SUN_ARK_DP5, targets[i]);
+                printf(" %.0e: %.2f;", targets[i], a / b);
+            }
+            printf("\n");
+        }
+#endif
+
+        /* Real-time budget */
+        printf("\n## Real-time budget: cheapest setting reaching a max position error\n\n");
+        printf("CPU = fraction of one core to run the scene in real time (CPU s per simulated s).\n\n");
+        printf("| scene | target | cheapest lagsim method | setting | error | CPU (core fraction) "
+               "| cheapest peer | setting | error | CPU |\n|---|---|---|---|---|---|---|---|---|---|\n");
+        static const double budget[] = {1e-3, 1e-6, 1e-9};
+        for (int s = 0; s < BENCH_SCENE_COUNT; s++)
+            for (int t = 0; t < COUNT(budget); t++) {
+                const row *bo = NULL, *bp = NULL;
+                for (int i = 0; i < nrows; i++) {
+                    const row *w = &rows[i];
+                    if (w->scene != s || w->r.status || !(w->pos_err <= budget[t])) continue;
+                    const row **b = w->c.impl == BENCH_LAGSIM ? &bo : &bp;
+                    if (!*b || w->r.cpu < (*b)->r.cpu) *b = w;
+                }
+                double T = scenes[s].horizon;
+                printf("| %s | %.0e ", scenes[s].name, budget[t]);
+                if (bo) printf("| %s | %s | %.1e | %.2e ", label(&bo->c), setting(&bo->c),
+                               bo->pos_err, bo->r.cpu / T);
+                else printf("| none in sweep | | | ");
+                if (bp) printf("| %s | %s | %.1e | %.2e |\n", label(&bp->c), setting(&bp->c),
+                               bp->pos_err, bp->r.cpu / T);
+                else printf("| none in sweep | | | |\n");
+            }
+        energy_long(outdir, reps);
+    }
+
+    for (int s = 0; s < BENCH_SCENE_COUNT; s++) bench_reference_free(&refs[s]);
+    if (quick) printf("\n%d check(s) failed\n", failures);
+    return failures ? 1 : 0;
+}
