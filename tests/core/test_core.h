@@ -1,0 +1,536 @@
+/*
+ * Shared helpers of the core's physics tests (tests/core/test_*.c).
+ *
+ * The point of these tests is independence: nothing here reads the core's closed forms.
+ * Each model is written again from the body kinematics of shared/BRIEF.md (centre-of-mass
+ * positions r_c(q), their velocities v_c(q, qd), body angular velocities omega), in complex
+ * arithmetic so that derivatives can be taken by the complex step
+ *
+ *     f'(x) = Im f(x + i h) / h + O(h^2 f'''),   h = 1e-20,
+ *
+ * which has no subtractive cancellation: for h this small the truncation term is below
+ * 1e-40 and the result is exact to a few ulps of the terms of f. T and U are then
+ *     T = sum_b 1/2 m_b v_b . v_b + 1/2 I_b omega_b^2,   U = sum_b m_b g y_b,
+ * and M, dM/dq, g, dL/dq, dL/dqd follow from T and U by complex steps alone.
+ *
+ * Test style (Box2D): plain C, no framework. ENSURE/ENSURE_NEAR print the failing
+ * expression with its context and count the failure; main returns the failure count.
+ */
+#ifndef LAGSIM_TEST_CORE_H
+#define LAGSIM_TEST_CORE_H
+
+#include <complex.h>
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lagsim/lagsim.h"
+
+/* complex.h defines I; the inertias are called I in the brief, so the macro must go. */
+#undef I
+typedef double complex cplx;
+
+#define TC_PI 3.14159265358979323846
+#define TC_EPS DBL_EPSILON
+/* complex-step size: any h with h^2 * |f'''| far below eps |f'| works; 1e-20 does. */
+#define TC_CSTEP 1e-20
+
+/* ------------------------------------------------------------------ failure reporting */
+static int tc_failures = 0;
+static int tc_checks = 0;
+static int tc_quiet_after = 20; /* print at most this many failures in detail */
+
+#define ENSURE(cond)                                                                       \
+    do {                                                                                   \
+        tc_checks++;                                                                       \
+        if (!(cond)) {                                                                     \
+            if (tc_failures++ < tc_quiet_after)                                            \
+                fprintf(stderr, "%s:%d: ENSURE failed: %s\n", __FILE__, __LINE__, #cond);  \
+        }                                                                                  \
+    } while (0)
+
+/* |got - want| <= tol; on failure prints both values and a printf-style context. */
+#define ENSURE_NEAR(got, want, tol, ...)                                                   \
+    do {                                                                                   \
+        double tc_g_ = (got), tc_w_ = (want), tc_t_ = (tol);                               \
+        tc_checks++;                                                                       \
+        if (!(fabs(tc_g_ - tc_w_) <= tc_t_)) {                                             \
+            if (tc_failures++ < tc_quiet_after) {                                          \
+                fprintf(stderr, "%s:%d: %s = %.17g, expected %s = %.17g (|diff| %.3g > tol %.3g): ", \
+                        __FILE__, __LINE__, #got, tc_g_, #want, tc_w_, fabs(tc_g_ - tc_w_), tc_t_); \
+                fprintf(stderr, __VA_ARGS__);                                              \
+                fprintf(stderr, "\n");                                                     \
+            }                                                                              \
+        }                                                                                  \
+    } while (0)
+
+static inline int tc_finish(const char *name)
+{
+    printf("%s: %d checks, %d failed\n", name, tc_checks, tc_failures);
+    return tc_failures ? 1 : 0;
+}
+
+/* ------------------------------------------------------------------ seeded RNG */
+typedef struct { uint64_t s; } tc_rng;
+
+/* splitmix64: a fixed, portable sequence for a given seed. */
+static inline uint64_t tc_next(tc_rng *r)
+{
+    uint64_t z = (r->s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+/* uniform in [a, b) */
+static inline double tc_uniform(tc_rng *r, double a, double b)
+{
+    return a + (b - a) * (double)(tc_next(r) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* ------------------------------------------------------------------ models, again */
+static inline int tc_nq(lag_model_kind k) { return k == LAG_MODEL_DIPC ? 3 : 2; }
+
+/* Random but physical parameters: masses 0.2..3 kg, lengths 0.2..2 m, g 1..20 m/s^2,
+ * inertias either the uniform-rod value or anything in 0.01..1 kg m^2, h0 0..1 m. */
+static inline void tc_random_model(tc_rng *r, lag_model_kind kind, lag_model *m)
+{
+    lag_model_default(m, kind);
+    bool rod = tc_uniform(r, 0, 1) < 0.5;
+    switch (kind) {
+    case LAG_MODEL_STICK:
+        m->p[LAG_STICK_M] = tc_uniform(r, 0.2, 3);
+        m->p[LAG_STICK_L] = tc_uniform(r, 0.2, 2);
+        m->p[LAG_STICK_I] = rod ? m->p[LAG_STICK_M] * m->p[LAG_STICK_L] * m->p[LAG_STICK_L] / 12
+                                : tc_uniform(r, 0.01, 1);
+        m->p[LAG_STICK_G] = tc_uniform(r, 1, 20);
+        break;
+    case LAG_MODEL_MANIPULATOR:
+        m->p[LAG_MANIP_M1] = tc_uniform(r, 0.2, 3);
+        m->p[LAG_MANIP_M2] = tc_uniform(r, 0.2, 3);
+        m->p[LAG_MANIP_L1] = tc_uniform(r, 0.2, 2);
+        m->p[LAG_MANIP_I1] = tc_uniform(r, 0.01, 1);
+        m->p[LAG_MANIP_I2] = tc_uniform(r, 0.01, 1);
+        m->p[LAG_MANIP_G] = tc_uniform(r, 1, 20);
+        break;
+    default:
+        m->p[LAG_DIPC_M0] = tc_uniform(r, 0.2, 3);
+        m->p[LAG_DIPC_M1] = tc_uniform(r, 0.2, 3);
+        m->p[LAG_DIPC_M2] = tc_uniform(r, 0.2, 3);
+        m->p[LAG_DIPC_L1] = tc_uniform(r, 0.2, 2);
+        m->p[LAG_DIPC_L2] = tc_uniform(r, 0.2, 2);
+        m->p[LAG_DIPC_I1] = rod ? m->p[LAG_DIPC_M1] * m->p[LAG_DIPC_L1] * m->p[LAG_DIPC_L1] / 12
+                                : tc_uniform(r, 0.01, 1);
+        m->p[LAG_DIPC_I2] = rod ? m->p[LAG_DIPC_M2] * m->p[LAG_DIPC_L2] * m->p[LAG_DIPC_L2] / 12
+                                : tc_uniform(r, 0.01, 1);
+        m->p[LAG_DIPC_G] = tc_uniform(r, 1, 20);
+        m->p[LAG_DIPC_H0] = tc_uniform(r, 0, 1);
+        break;
+    }
+}
+
+/* Random state: positions -2..2 m, angles -pi..pi, rates -5..5. */
+static inline void tc_random_state(tc_rng *r, const lag_model *m, double *q, double *qd)
+{
+    for (int i = 0; i < m->nq; ++i) {
+        q[i] = tc_uniform(r, -TC_PI, TC_PI);
+        qd[i] = tc_uniform(r, -5, 5);
+    }
+    if (m->kind == LAG_MODEL_STICK) q[0] = tc_uniform(r, -2, 2);
+    if (m->kind == LAG_MODEL_MANIPULATOR) q[1] = tc_uniform(r, -2, 2);
+    if (m->kind == LAG_MODEL_DIPC) q[0] = tc_uniform(r, -2, 2);
+}
+
+/* The bodies of a model, straight from the brief: centre of mass (x, y), its velocity
+ * (vx, vy) = d r_c / dt written out by the chain rule, angular velocity w, mass, inertia
+ * about the centre of mass. Complex arguments so that complex steps pass through. */
+typedef struct tc_bodies {
+    int nb;
+    double mass[3], inertia[3];
+    cplx x[3], y[3], vx[3], vy[3], w[3];
+} tc_bodies;
+
+static inline void tc_kinematics(const lag_model *m, const cplx *q, const cplx *qd, tc_bodies *b)
+{
+    const double *p = m->p;
+    memset(b, 0, sizeof *b);
+    switch (m->kind) {
+    case LAG_MODEL_STICK: {
+        /* r_c = (x, (l/2) sin phi), omega = phi_dot */
+        double l = p[LAG_STICK_L];
+        b->nb = 1;
+        b->mass[0] = p[LAG_STICK_M];
+        b->inertia[0] = p[LAG_STICK_I];
+        b->x[0] = q[0];
+        b->y[0] = 0.5 * l * csin(q[1]);
+        b->vx[0] = qd[0];
+        b->vy[0] = 0.5 * l * ccos(q[1]) * qd[1];
+        b->w[0] = qd[1];
+        break;
+    }
+    case LAG_MODEL_MANIPULATOR: {
+        /* r_c1 = l1 (cos q1, sin q1), r_c2 = q2 (cos q1, sin q1), omega = q1_dot (both) */
+        double l1 = p[LAG_MANIP_L1];
+        cplx c = ccos(q[0]), s = csin(q[0]);
+        b->nb = 2;
+        b->mass[0] = p[LAG_MANIP_M1];
+        b->mass[1] = p[LAG_MANIP_M2];
+        b->inertia[0] = p[LAG_MANIP_I1];
+        b->inertia[1] = p[LAG_MANIP_I2];
+        b->x[0] = l1 * c;
+        b->y[0] = l1 * s;
+        b->vx[0] = -l1 * s * qd[0];
+        b->vy[0] = l1 * c * qd[0];
+        b->w[0] = qd[0];
+        b->x[1] = q[1] * c;
+        b->y[1] = q[1] * s;
+        b->vx[1] = qd[1] * c - q[1] * s * qd[0];
+        b->vy[1] = qd[1] * s + q[1] * c * qd[0];
+        b->w[1] = qd[0];
+        break;
+    }
+    default: {
+        /* r_0 = (theta0, 0); r_1 = (theta0 + l1/2 sin th1, h0 + l1/2 cos th1);
+         * r_2 = (theta0 + l1 sin th1 + l2/2 sin th2, h0 + l1 cos th1 + l2/2 cos th2);
+         * the cart does not rotate, rod i turns at theta_i_dot. */
+        double l1 = p[LAG_DIPC_L1], l2 = p[LAG_DIPC_L2], h0 = p[LAG_DIPC_H0];
+        cplx s1 = csin(q[1]), c1 = ccos(q[1]), s2 = csin(q[2]), c2 = ccos(q[2]);
+        b->nb = 3;
+        b->mass[0] = p[LAG_DIPC_M0];
+        b->mass[1] = p[LAG_DIPC_M1];
+        b->mass[2] = p[LAG_DIPC_M2];
+        b->inertia[0] = 0;
+        b->inertia[1] = p[LAG_DIPC_I1];
+        b->inertia[2] = p[LAG_DIPC_I2];
+        b->x[0] = q[0];
+        b->y[0] = 0;
+        b->vx[0] = qd[0];
+        b->vy[0] = 0;
+        b->w[0] = 0;
+        b->x[1] = q[0] + 0.5 * l1 * s1;
+        b->y[1] = h0 + 0.5 * l1 * c1;
+        b->vx[1] = qd[0] + 0.5 * l1 * c1 * qd[1];
+        b->vy[1] = -0.5 * l1 * s1 * qd[1];
+        b->w[1] = qd[1];
+        b->x[2] = q[0] + l1 * s1 + 0.5 * l2 * s2;
+        b->y[2] = h0 + l1 * c1 + 0.5 * l2 * c2;
+        b->vx[2] = qd[0] + l1 * c1 * qd[1] + 0.5 * l2 * c2 * qd[2];
+        b->vy[2] = -l1 * s1 * qd[1] - 0.5 * l2 * s2 * qd[2];
+        b->w[2] = qd[2];
+        break;
+    }
+    }
+}
+
+static inline double tc_gravity_const(const lag_model *m)
+{
+    switch (m->kind) {
+    case LAG_MODEL_STICK: return m->p[LAG_STICK_G];
+    case LAG_MODEL_MANIPULATOR: return m->p[LAG_MANIP_G];
+    default: return m->p[LAG_DIPC_G];
+    }
+}
+
+/* T = sum 1/2 m v.v + 1/2 I w^2 (no conjugates: analytic in q and qd). */
+static inline cplx tc_T_c(const lag_model *m, const cplx *q, const cplx *qd)
+{
+    tc_bodies b;
+    tc_kinematics(m, q, qd, &b);
+    cplx T = 0;
+    for (int i = 0; i < b.nb; ++i)
+        T += 0.5 * b.mass[i] * (b.vx[i] * b.vx[i] + b.vy[i] * b.vy[i]) +
+             0.5 * b.inertia[i] * b.w[i] * b.w[i];
+    return T;
+}
+
+/* U = sum m g y_c. */
+static inline cplx tc_U_c(const lag_model *m, const cplx *q)
+{
+    cplx zero[3] = {0, 0, 0};
+    tc_bodies b;
+    tc_kinematics(m, q, zero, &b);
+    cplx U = 0;
+    double g = tc_gravity_const(m);
+    for (int i = 0; i < b.nb; ++i) U += b.mass[i] * g * b.y[i];
+    return U;
+}
+
+static inline void tc_to_c(int n, const double *x, cplx *z)
+{
+    for (int i = 0; i < n; ++i) z[i] = x[i];
+}
+
+static inline double tc_T(const lag_model *m, const double *q, const double *qd)
+{
+    cplx qc[3] = {0}, qdc[3] = {0};
+    tc_to_c(m->nq, q, qc);
+    tc_to_c(m->nq, qd, qdc);
+    return creal(tc_T_c(m, qc, qdc));
+}
+
+static inline double tc_U(const lag_model *m, const double *q)
+{
+    cplx qc[3] = {0};
+    tc_to_c(m->nq, q, qc);
+    return creal(tc_U_c(m, qc));
+}
+
+/* dT/dq_k (qd held) by complex step. OUT: out[n] */
+static inline void tc_dT_dq(const lag_model *m, const double *q, const double *qd, double *out)
+{
+    for (int k = 0; k < m->nq; ++k) {
+        cplx qc[3] = {0}, qdc[3] = {0};
+        tc_to_c(m->nq, q, qc);
+        tc_to_c(m->nq, qd, qdc);
+        qc[k] += CMPLX(0, TC_CSTEP);
+        out[k] = cimag(tc_T_c(m, qc, qdc)) / TC_CSTEP;
+    }
+}
+
+/* dT/dqd_k (q held) by complex step: the generalized momentum p. OUT: out[n] */
+static inline void tc_dT_dqd(const lag_model *m, const double *q, const double *qd, double *out)
+{
+    for (int k = 0; k < m->nq; ++k) {
+        cplx qc[3] = {0}, qdc[3] = {0};
+        tc_to_c(m->nq, q, qc);
+        tc_to_c(m->nq, qd, qdc);
+        qdc[k] += CMPLX(0, TC_CSTEP);
+        out[k] = cimag(tc_T_c(m, qc, qdc)) / TC_CSTEP;
+    }
+}
+
+/* dU/dq_k by complex step. OUT: out[n] */
+static inline void tc_dU_dq(const lag_model *m, const double *q, double *out)
+{
+    for (int k = 0; k < m->nq; ++k) {
+        cplx qc[3] = {0};
+        tc_to_c(m->nq, q, qc);
+        qc[k] += CMPLX(0, TC_CSTEP);
+        out[k] = cimag(tc_U_c(m, qc)) / TC_CSTEP;
+    }
+}
+
+/* M(q) as the Hessian of T in qd. T is exactly quadratic in qd, so polarization is exact:
+ * M_ii = 2 T(q, e_i), M_ij = T(q, e_i + e_j) - T(q, e_i) - T(q, e_j). Complex q allowed
+ * (for complex steps in q). OUT: M[n*n] */
+static inline void tc_mass_c(const lag_model *m, const cplx *q, cplx *M)
+{
+    int n = m->nq;
+    cplx Te[3];
+    for (int i = 0; i < n; ++i) {
+        cplx e[3] = {0, 0, 0};
+        e[i] = 1;
+        Te[i] = tc_T_c(m, q, e);
+        M[i * n + i] = 2 * Te[i];
+    }
+    for (int i = 0; i < n; ++i)
+        for (int j = i + 1; j < n; ++j) {
+            cplx e[3] = {0, 0, 0};
+            e[i] = 1;
+            e[j] = 1;
+            M[i * n + j] = M[j * n + i] = tc_T_c(m, q, e) - Te[i] - Te[j];
+        }
+}
+
+static inline void tc_mass(const lag_model *m, const double *q, double *M)
+{
+    cplx qc[3] = {0}, Mc[9] = {0};
+    tc_to_c(m->nq, q, qc);
+    tc_mass_c(m, qc, Mc);
+    for (int i = 0; i < m->nq * m->nq; ++i) M[i] = creal(Mc[i]);
+}
+
+/* dM_ij/dq_k by complex step on tc_mass_c, laid out as the core's: dM[k*n*n + i*n + j]. */
+static inline void tc_mass_deriv(const lag_model *m, const double *q, double *dM)
+{
+    int n = m->nq;
+    for (int k = 0; k < n; ++k) {
+        cplx qc[3] = {0}, Mc[9] = {0};
+        tc_to_c(n, q, qc);
+        qc[k] += CMPLX(0, TC_CSTEP);
+        tc_mass_c(m, qc, Mc);
+        for (int i = 0; i < n * n; ++i) dM[k * n * n + i] = cimag(Mc[i]) / TC_CSTEP;
+    }
+}
+
+/* C from the Christoffel formula with the dM above:
+ * C_kj = sum_i c_ijk qd_i, c_ijk = 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k). */
+static inline void tc_christoffel(int n, const double *dM, const double *qd, double *C)
+{
+#define TC_DM(k, i, j) dM[(k) * n * n + (i) * n + (j)]
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j) {
+            double s = 0;
+            for (int i = 0; i < n; ++i)
+                s += 0.5 * (TC_DM(i, k, j) + TC_DM(j, k, i) - TC_DM(k, i, j)) * qd[i];
+            C[k * n + j] = s;
+        }
+#undef TC_DM
+}
+
+/* Generalized momentum p(q, v) = dT/dqd at qd = v, for complex q. T is exactly quadratic in
+ * qd, so the central difference p_k = (T(q, v + c e_k) - T(q, v - c e_k)) / (2 c) is exact
+ * for any c (no truncation term); c = max(1, |v|) keeps the rounding at a few eps |M| |v|.
+ * Being linear in v, p(q, qdd) = M(q) qdd. OUT: out[n] */
+static inline void tc_momentum_c(const lag_model *m, const cplx *q, const double *v, cplx *out)
+{
+    int n = m->nq;
+    double c = 1;
+    for (int i = 0; i < n; ++i) c = fmax(c, fabs(v[i]));
+    for (int k = 0; k < n; ++k) {
+        cplx vp[3] = {0}, vm[3] = {0};
+        for (int i = 0; i < n; ++i) vp[i] = vm[i] = v[i];
+        vp[k] += c;
+        vm[k] -= c;
+        out[k] = (tc_T_c(m, q, vp) - tc_T_c(m, q, vm)) / (2 * c);
+    }
+}
+
+/* Lagrange's left side d/dt(dL/dqd) - dL/dq at (q, qd) for a given qdd, from T and U only.
+ * Along a motion, d/dt p(q, qd) = (dp/dq) qd + p(q, qdd) (p is linear in its second
+ * argument); the first term is a complex step of p in q along qd, the second is exact.
+ * dL/dq = dT/dq - dU/dq by complex steps. No truncation error anywhere: the result is
+ * exact to the rounding of a few dozen terms of the size of M qdd, |dM| |qd|^2 and g. OUT: out[n] */
+static inline void tc_lagrange_lhs(const lag_model *m, const double *q, const double *qd,
+                                   const double *qdd, double *out)
+{
+    int n = m->nq;
+    cplx qs[3] = {0}, qr[3] = {0}, pq[3] = {0}, pa[3] = {0};
+    for (int i = 0; i < n; ++i) {
+        qs[i] = CMPLX(q[i], TC_CSTEP * qd[i]);
+        qr[i] = q[i];
+    }
+    tc_momentum_c(m, qs, qd, pq);  /* Im / h = (dp/dq) qd */
+    tc_momentum_c(m, qr, qdd, pa); /* = M(q) qdd */
+    double dTq[3], dUq[3];
+    tc_dT_dq(m, q, qd, dTq);
+    tc_dU_dq(m, q, dUq);
+    for (int i = 0; i < n; ++i)
+        out[i] = cimag(pq[i]) / TC_CSTEP + creal(pa[i]) - (dTq[i] - dUq[i]);
+}
+
+/* ------------------------------------------------------------------ small linear algebra */
+static inline double tc_maxabs(int n, const double *x)
+{
+    double a = 0;
+    for (int i = 0; i < n; ++i) a = fmax(a, fabs(x[i]));
+    return a;
+}
+
+static inline void tc_matvec(int n, const double *A, const double *x, double *y)
+{
+    for (int i = 0; i < n; ++i) {
+        double s = 0;
+        for (int j = 0; j < n; ++j) s += A[i * n + j] * x[j];
+        y[i] = s;
+    }
+}
+
+/* Cholesky of a symmetric n x n matrix; returns the smallest pivot d_i of A = L D L^T
+ * (all > 0 iff A is positive definite), or -1 at the first non-positive one. */
+static inline double tc_min_pivot(int n, const double *A)
+{
+    double L[9] = {0};
+    double minp = INFINITY;
+    for (int j = 0; j < n; ++j) {
+        double d = A[j * n + j];
+        for (int k = 0; k < j; ++k) d -= L[j * n + k] * L[j * n + k];
+        if (!(d > 0)) return -1;
+        minp = fmin(minp, d);
+        double ljj = sqrt(d);
+        L[j * n + j] = ljj;
+        for (int i = j + 1; i < n; ++i) {
+            double s = A[i * n + j];
+            for (int k = 0; k < j; ++k) s -= L[i * n + k] * L[j * n + k];
+            L[i * n + j] = s / ljj;
+        }
+    }
+    return minp;
+}
+
+/* Least-squares slope of log(err) against log(h). */
+static inline double tc_slope(int k, const double *h, const double *err)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int i = 0; i < k; ++i) {
+        double x = log(h[i]), y = log(err[i]);
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+    }
+    return (k * sxy - sx * sy) / (k * sxx - sx * sx);
+}
+
+/* ------------------------------------------------------------------ simulations */
+/* A sim definition for a model, method and tick dt, starting from (q0, qd0). */
+static inline lag_sim_def tc_sim_def(const lag_model *m, lag_method method, double dt,
+                                     const double *q0, const double *qd0)
+{
+    lag_sim_def d = lag_default_sim_def(m->kind);
+    d.model = *m;
+    d.integrator.method = method;
+    d.integrator.dt = dt;
+    for (int i = 0; i < m->nq; ++i) {
+        d.q0[i] = q0[i];
+        d.qd0[i] = qd0[i];
+    }
+    return d;
+}
+
+/* Initializes s from d; reports and counts a failure if the core refuses. */
+static inline int tc_sim_init(lag_sim *s, const lag_sim_def *d)
+{
+    char err[256] = "";
+    lag_result r = lag_sim_init(s, d, err, sizeof err);
+    if (r != LAG_OK) {
+        tc_failures++;
+        fprintf(stderr, "lag_sim_init(%s, %s, dt %g) failed: %s (%s)\n",
+                lag_model_info_get(d->model.kind)->name, lag_method_name(d->integrator.method),
+                d->integrator.dt, lag_result_string(r), err);
+        return -1;
+    }
+    return 0;
+}
+
+/* Advances n ticks; reports and counts a failure on any error. */
+static inline int tc_advance(lag_sim *s, int64_t n, bool continuous)
+{
+    lag_result r = lag_sim_advance(s, n, continuous);
+    if (r != LAG_OK) {
+        tc_failures++;
+        fprintf(stderr, "lag_sim_advance(%s, %s) failed at tick %lld: %s\n",
+                lag_model_info_get(s->def.model.kind)->name,
+                lag_method_name(s->def.integrator.method), (long long)s->tick,
+                lag_result_string(r));
+        return -1;
+    }
+    return 0;
+}
+
+static const lag_method tc_all_methods[] = {LAG_EULER, LAG_SEMI_IMPLICIT_EULER, LAG_RK4,
+                                            LAG_DOPRI5, LAG_IMPLICIT_MIDPOINT, LAG_GAUSS4};
+#define TC_NMETHODS 6
+
+/* The smooth scene of the convergence tests: Bogdanov's DIPC (brief) hanging down and
+ * swinging, theta1 = pi + 0.3, theta2 = pi - 0.2, at rest, cart at 0. */
+static inline void tc_dipc_hanging(lag_model *m, double *q, double *qd)
+{
+    lag_model_default(m, LAG_MODEL_DIPC);
+    m->p[LAG_DIPC_M0] = 1.5;
+    m->p[LAG_DIPC_M1] = 0.5;
+    m->p[LAG_DIPC_M2] = 0.75;
+    m->p[LAG_DIPC_L1] = 0.5;
+    m->p[LAG_DIPC_L2] = 0.75;
+    m->p[LAG_DIPC_I1] = 0.5 * 0.5 * 0.5 / 12;
+    m->p[LAG_DIPC_I2] = 0.75 * 0.75 * 0.75 / 12;
+    m->p[LAG_DIPC_G] = 9.81;
+    q[0] = 0;
+    q[1] = TC_PI + 0.3;
+    q[2] = TC_PI - 0.2;
+    qd[0] = qd[1] = qd[2] = 0;
+}
+
+#endif

@@ -1,0 +1,284 @@
+/*
+ * Models against an independent computation from T and U (issue 2, tests 1).
+ *
+ * For each model, at NSTATES random states with random parameters (seeded), the core's
+ * M, dM/dq, C, g, bias, kinetic and potential energy and forward dynamics are compared
+ * with the same quantities derived here from the brief's body kinematics by complex steps
+ * (see test_core.h), and for the stick and the manipulator with the seed's closed forms.
+ *
+ * Usage: test_core_models [stick|manipulator|dipc]   (no argument: all three)
+ */
+#include "test_core.h"
+
+#define NSTATES 300
+
+static const char *kname(lag_model_kind k) { return lag_model_info_get(k)->name; }
+
+/* Prints the state of a failing check (printf-style context of ENSURE_NEAR). */
+#define CTXF "%s state %d q=(%.6g %.6g %.6g) qd=(%.6g %.6g %.6g)"
+#define CTXA kname(md.kind), it, q[0], q[1], md.nq > 2 ? q[2] : 0.0, qd[0], qd[1], \
+             md.nq > 2 ? qd[2] : 0.0
+
+/* v_c written by hand in test_core.h equals d r_c/dt, taken by a complex step of the
+ * positions along qd: r(q + i h qd) = r(q) + i h J(q) qd + O(h^2). Exact to rounding,
+ * so the tolerance is 1e-14 of the velocity scale |qd| (max(l, |q|) ~ 1). */
+static void check_kinematics(const lag_model *mdp, int it, const double *q, const double *qd)
+{
+    lag_model md = *mdp;
+    int n = md.nq;
+    cplx qc[3], qdc[3], zero[3] = {0, 0, 0};
+    for (int i = 0; i < n; ++i) {
+        qc[i] = CMPLX(q[i], TC_CSTEP * qd[i]);
+        qdc[i] = qd[i];
+    }
+    tc_bodies bstep, bhand;
+    tc_kinematics(&md, qc, zero, &bstep);
+    cplx qr[3];
+    tc_to_c(n, q, qr);
+    tc_kinematics(&md, qr, qdc, &bhand);
+    double vs = 10 * (1 + tc_maxabs(n, qd)) * (1 + tc_maxabs(n, q));
+    for (int b = 0; b < bhand.nb; ++b) {
+        ENSURE_NEAR(creal(bhand.vx[b]), cimag(bstep.x[b]) / TC_CSTEP, 1e-14 * vs, "vx body %d " CTXF, b, CTXA);
+        ENSURE_NEAR(creal(bhand.vy[b]), cimag(bstep.y[b]) / TC_CSTEP, 1e-14 * vs, "vy body %d " CTXF, b, CTXA);
+    }
+}
+
+/* The seed's closed forms (shared/seed/assignment8-lagrange.txt). */
+static void check_seed(const lag_model *mdp, int it, const double *q, const double *qd,
+                       const double *qdd, const double *Ml, const double *Cl, const double *gl,
+                       const double *hl)
+{
+    lag_model md = *mdp;
+    int n = md.nq;
+    double lhs[3];
+    tc_matvec(n, Ml, qdd, lhs);
+    for (int i = 0; i < n; ++i) lhs[i] += hl[i];
+    if (md.kind == LAG_MODEL_STICK) {
+        /* Problem 1 (d): d/dt(dL/dx_dot) - dL/dx = m x_ddot, and
+         * (m l^2/4 cos^2 phi + I) phi_ddot - m l^2/4 phi_dot^2 cos phi sin phi
+         *    + m g l/2 cos phi. Rounding of a handful of O(scale) terms: 1e-13. */
+        double m = md.p[LAG_STICK_M], l = md.p[LAG_STICK_L], Iz = md.p[LAG_STICK_I],
+               g = md.p[LAG_STICK_G];
+        double c = cos(q[1]), s = sin(q[1]);
+        double e0 = m * qdd[0];
+        double e1 = (m * l * l / 4 * c * c + Iz) * qdd[1] - m * l * l / 4 * qd[1] * qd[1] * c * s +
+                    m * g * l / 2 * c;
+        double sc = fabs(m * qdd[0]) + fabs((m * l * l / 4 + Iz) * qdd[1]) +
+                    m * l * l / 4 * qd[1] * qd[1] + m * g * l;
+        ENSURE_NEAR(lhs[0], e0, 1e-13 * sc, "seed stick (d) x " CTXF, CTXA);
+        ENSURE_NEAR(lhs[1], e1, 1e-13 * sc, "seed stick (d) phi " CTXF, CTXA);
+    } else if (md.kind == LAG_MODEL_MANIPULATOR) {
+        /* Problem 2: M (3), C (5), g(q) of part (d). */
+        double m1 = md.p[LAG_MANIP_M1], m2 = md.p[LAG_MANIP_M2], l1 = md.p[LAG_MANIP_L1],
+               I1 = md.p[LAG_MANIP_I1], I2 = md.p[LAG_MANIP_I2], g = md.p[LAG_MANIP_G];
+        double M[4] = {m1 * l1 * l1 + I1 + I2 + m2 * q[1] * q[1], 0, 0, m2};
+        double C[4] = {m2 * q[1] * qd[1], m2 * q[1] * qd[0], -m2 * q[1] * qd[0], 0};
+        double G[2] = {(m1 * l1 + m2 * q[1]) * g * cos(q[0]), m2 * g * sin(q[0])};
+        double sM = tc_maxabs(4, M), sC = tc_maxabs(4, C) + 1e-300, sG = (m1 * l1 + m2 * fabs(q[1]) + m2) * g;
+        for (int i = 0; i < 4; ++i) {
+            ENSURE_NEAR(Ml[i], M[i], 1e-13 * sM, "seed manipulator M(3) entry %d " CTXF, i, CTXA);
+            ENSURE_NEAR(Cl[i], C[i], 1e-13 * sC, "seed manipulator C(5) entry %d " CTXF, i, CTXA);
+        }
+        for (int i = 0; i < 2; ++i) ENSURE_NEAR(gl[i], G[i], 1e-13 * sG, "seed manipulator g entry %d " CTXF, i, CTXA);
+    }
+}
+
+static void check_model(lag_model_kind kind, uint64_t seed)
+{
+    tc_rng rng = {seed};
+    int f0 = tc_failures;
+    double worst_M = 0, worst_dM = 0, worst_C = 0, worst_g = 0, worst_lag = 0, worst_fwd = 0;
+    for (int it = 0; it < NSTATES; ++it) {
+        lag_model md;
+        tc_random_model(&rng, kind, &md);
+        int n = md.nq;
+        ENSURE(n == tc_nq(kind));
+        double q[3] = {0}, qd[3] = {0}, qdd[3] = {0}, tau[3] = {0};
+        tc_random_state(&rng, &md, q, qd);
+        for (int i = 0; i < n; ++i) {
+            qdd[i] = tc_uniform(&rng, -20, 20);
+            tau[i] = tc_uniform(&rng, -20, 20);
+        }
+        check_kinematics(&md, it, q, qd);
+
+        /* ---- the core's quantities */
+        double Ml[9], dMl[27], Cl[9], gl[3], hl[3];
+        lag_model_mass(&md, q, Ml);
+        lag_model_mass_deriv(&md, q, dMl);
+        lag_model_coriolis(&md, q, qd, Cl);
+        lag_model_gravity(&md, q, gl);
+        lag_model_bias(&md, q, qd, hl);
+
+        /* ---- the same from T and U */
+        double Mt[9], dMt[27], Ct[9], gt[3];
+        tc_mass(&md, q, Mt);
+        tc_mass_deriv(&md, q, dMt);
+        tc_christoffel(n, dMt, qd, Ct);
+        tc_dU_dq(&md, q, gt);
+
+        /* Scales. Both sides are closed forms / complex steps exact to rounding of a few
+         * dozen terms, each at most of the size below, so 1e-13 (~450 eps) of it is a
+         * generous bound; a wrong coefficient shows as an O(1e-2..1) relative error. */
+        double sM = tc_maxabs(n * n, Mt);
+        double sdM = tc_maxabs(n * n * n, dMt) + sM; /* complex-step terms are O(|M|) each */
+        double sC = sdM * tc_maxabs(n, qd) * n;
+        tc_bodies b;
+        cplx qc[3], zc[3] = {0, 0, 0};
+        tc_to_c(n, q, qc);
+        tc_kinematics(&md, qc, zc, &b);
+        double sg = 0;
+        for (int k = 0; k < b.nb; ++k)
+            sg += b.mass[k] * tc_gravity_const(&md) * (1 + cabs(b.x[k]) + cabs(b.y[k]));
+
+        for (int i = 0; i < n * n; ++i) {
+            ENSURE_NEAR(Ml[i], Mt[i], 1e-13 * sM, "M entry %d " CTXF, i, CTXA);
+            worst_M = fmax(worst_M, fabs(Ml[i] - Mt[i]) / sM);
+        }
+        for (int i = 0; i < n * n * n; ++i) {
+            ENSURE_NEAR(dMl[i], dMt[i], 1e-13 * sdM, "dM/dq_%d entry %d " CTXF, i / (n * n), i % (n * n), CTXA);
+            worst_dM = fmax(worst_dM, fabs(dMl[i] - dMt[i]) / sdM);
+        }
+        for (int i = 0; i < n * n; ++i) {
+            ENSURE_NEAR(Cl[i], Ct[i], 1e-13 * sC, "C (Christoffel) entry %d " CTXF, i, CTXA);
+            worst_C = fmax(worst_C, fabs(Cl[i] - Ct[i]) / sC);
+        }
+        for (int i = 0; i < n; ++i) {
+            ENSURE_NEAR(gl[i], gt[i], 1e-13 * sg, "g = dU/dq entry %d " CTXF, i, CTXA);
+            worst_g = fmax(worst_g, fabs(gl[i] - gt[i]) / sg);
+        }
+        /* bias = C qd + g (the core's own C and g): same rounding argument. */
+        double Cqd[3];
+        tc_matvec(n, Cl, qd, Cqd);
+        for (int i = 0; i < n; ++i)
+            ENSURE_NEAR(hl[i], Cqd[i] + gl[i], 1e-13 * (sC * tc_maxabs(n, qd) + sg), "bias entry %d " CTXF, i, CTXA);
+
+        /* Energies: kinetic equals T exactly (to rounding); potential up to a constant,
+         * so compare U(q) - U(q') with a second random state q'. */
+        double Tt = tc_T(&md, q, qd);
+        ENSURE_NEAR(lag_model_kinetic(&md, q, qd), Tt, 1e-13 * (Tt + sM * tc_maxabs(n, qd) * tc_maxabs(n, qd)),
+                    "kinetic " CTXF, CTXA);
+        double q2[3] = {0}, qd2[3] = {0};
+        tc_random_state(&rng, &md, q2, qd2);
+        double dUl = lag_model_potential(&md, q) - lag_model_potential(&md, q2);
+        double dUt = tc_U(&md, q) - tc_U(&md, q2);
+        ENSURE_NEAR(dUl, dUt, 1e-13 * sg * 4, "potential difference " CTXF, CTXA);
+
+        /* Lagrange's equations at a random qdd: d/dt(dL/dqd) - dL/dq (exact to rounding, see
+         * tc_lagrange_lhs) equals M qdd + C qd + g from the core. Tolerance 1e-12 of the
+         * largest term (~4500 eps: rounding of a few dozen terms, cancellations included). */
+        double lhs[3], Mqdd[3];
+        tc_lagrange_lhs(&md, q, qd, qdd, lhs);
+        tc_matvec(n, Ml, qdd, Mqdd);
+        double sL = sM * tc_maxabs(n, qdd) + sC * tc_maxabs(n, qd) + sg;
+        for (int i = 0; i < n; ++i) {
+            double rhs = Mqdd[i] + Cqd[i] + gl[i];
+            ENSURE_NEAR(rhs, lhs[i], 1e-12 * sL, "Lagrange eq %d (M qdd + C qd + g) " CTXF, i, CTXA);
+            worst_lag = fmax(worst_lag, fabs(rhs - lhs[i]) / sL);
+        }
+
+        /* Forward dynamics: qdd = forward(q, qd, tau) must satisfy Lagrange's equations
+         * with right side tau. The residual of a backward-stable solve is ~ n eps |M| |qdd|
+         * whatever the conditioning of M, so the same 1e-12 of the largest term holds. */
+        double qddf[3];
+        lag_result r = lag_model_forward(&md, q, qd, tau, qddf);
+        ENSURE(r == LAG_OK);
+        if (r == LAG_OK) {
+            tc_lagrange_lhs(&md, q, qd, qddf, lhs);
+            double sF = sM * tc_maxabs(n, qddf) + sC * tc_maxabs(n, qd) + sg + tc_maxabs(n, tau);
+            for (int i = 0; i < n; ++i) {
+                ENSURE_NEAR(lhs[i], tau[i], 1e-12 * sF, "forward: Lagrange residual eq %d " CTXF, i, CTXA);
+                worst_fwd = fmax(worst_fwd, fabs(lhs[i] - tau[i]) / sF);
+            }
+        }
+        /* NULL tau means zero input */
+        double qdd0[3], qdd0z[3];
+        double zero[3] = {0, 0, 0};
+        ENSURE(lag_model_forward(&md, q, qd, NULL, qdd0) == LAG_OK);
+        ENSURE(lag_model_forward(&md, q, qd, zero, qdd0z) == LAG_OK);
+        for (int i = 0; i < n; ++i) ENSURE(qdd0[i] == qdd0z[i]);
+
+        check_seed(&md, it, q, qd, qdd, Ml, Cl, gl, hl);
+    }
+    printf("%-12s %d states: worst relative |core - from T,U|: M %.1e  dM %.1e  C %.1e  g %.1e  "
+           "Lagrange %.1e  forward %.1e  (%s)\n",
+           kname(kind), NSTATES, worst_M, worst_dM, worst_C, worst_g, worst_lag, worst_fwd,
+           tc_failures == f0 ? "ok" : "FAILED");
+}
+
+/* Static facts: names, sizes, inputs, defaults as the brief and the issue give them. */
+static void check_info(void)
+{
+    static const char *joints[3][3] = {{"x", "phi", NULL}, {"q1", "q2", NULL}, {"theta0", "theta1", "theta2"}};
+    static const bool act[3][3] = {{true, true, false}, {true, true, false}, {true, false, false}};
+    static const char *models[3] = {"stick", "manipulator", "dipc"};
+    for (int k = 0; k < 3; ++k) {
+        const lag_model_info *inf = lag_model_info_get((lag_model_kind)k);
+        ENSURE(inf != NULL);
+        if (!inf) continue;
+        ENSURE(strcmp(inf->name, models[k]) == 0);
+        ENSURE(lag_model_kind_from_name(models[k]) == k);
+        ENSURE(inf->nq == tc_nq((lag_model_kind)k));
+        for (int j = 0; j < inf->nq; ++j) {
+            ENSURE(inf->joint_names[j] && strcmp(inf->joint_names[j], joints[k][j]) == 0);
+            ENSURE(inf->actuated[j] == act[k][j]);
+        }
+    }
+    ENSURE(lag_model_kind_from_name("pendulum") == -1);
+    /* Parameters named as in the brief. */
+    ENSURE(lag_model_param_index(LAG_MODEL_STICK, "m") == LAG_STICK_M);
+    ENSURE(lag_model_param_index(LAG_MODEL_STICK, "I") == LAG_STICK_I);
+    ENSURE(lag_model_param_index(LAG_MODEL_MANIPULATOR, "l1") == LAG_MANIP_L1);
+    ENSURE(lag_model_param_index(LAG_MODEL_MANIPULATOR, "I2") == LAG_MANIP_I2);
+    ENSURE(lag_model_param_index(LAG_MODEL_DIPC, "m0") == LAG_DIPC_M0);
+    ENSURE(lag_model_param_index(LAG_MODEL_DIPC, "h0") == LAG_DIPC_H0);
+    ENSURE(lag_model_param_index(LAG_MODEL_DIPC, "nope") == -1);
+    /* Uniform rods default to I = m l^2 / 12 (brief: stick, DIPC rods). */
+    lag_model m;
+    lag_model_default(&m, LAG_MODEL_STICK);
+    ENSURE_NEAR(m.p[LAG_STICK_I], m.p[LAG_STICK_M] * m.p[LAG_STICK_L] * m.p[LAG_STICK_L] / 12,
+                1e-15 * m.p[LAG_STICK_I], "stick default I");
+    lag_model_default(&m, LAG_MODEL_DIPC);
+    ENSURE_NEAR(m.p[LAG_DIPC_I1], m.p[LAG_DIPC_M1] * m.p[LAG_DIPC_L1] * m.p[LAG_DIPC_L1] / 12,
+                1e-15 * m.p[LAG_DIPC_I1], "dipc default I1");
+    ENSURE_NEAR(m.p[LAG_DIPC_I2], m.p[LAG_DIPC_M2] * m.p[LAG_DIPC_L2] * m.p[LAG_DIPC_L2] / 12,
+                1e-15 * m.p[LAG_DIPC_I2], "dipc default I2");
+    /* Not given: NaN until finished, then the rod value for the *changed* m and l. */
+    lag_model_default_unfinished(&m, LAG_MODEL_DIPC);
+    ENSURE(isnan(m.p[LAG_DIPC_I1]) && isnan(m.p[LAG_DIPC_I2]));
+    m.p[LAG_DIPC_M1] = 2.0;
+    m.p[LAG_DIPC_L1] = 0.9;
+    m.p[LAG_DIPC_I2] = 0.123;
+    lag_model_finish(&m);
+    ENSURE_NEAR(m.p[LAG_DIPC_I1], 2.0 * 0.81 / 12, 1e-15, "dipc I1 after finish");
+    ENSURE(m.p[LAG_DIPC_I2] == 0.123);
+    char err[128];
+    ENSURE(lag_model_validate(&m, err, sizeof err) == LAG_OK);
+    m.p[LAG_DIPC_M2] = -1;
+    ENSURE(lag_model_validate(&m, err, sizeof err) == LAG_ERR_ARG);
+    /* Orders as documented in the header. */
+    ENSURE(lag_method_order(LAG_EULER) == 1);
+    ENSURE(lag_method_order(LAG_SEMI_IMPLICIT_EULER) == 1);
+    ENSURE(lag_method_order(LAG_RK4) == 4);
+    ENSURE(lag_method_order(LAG_DOPRI5) == 5);
+    ENSURE(lag_method_order(LAG_IMPLICIT_MIDPOINT) == 2);
+    ENSURE(lag_method_order(LAG_GAUSS4) == 4);
+    static const char *mnames[6] = {"euler", "semi-implicit-euler", "rk4", "dopri5", "implicit-midpoint", "gauss4"};
+    for (int i = 0; i < 6; ++i) {
+        ENSURE(strcmp(lag_method_name((lag_method)i), mnames[i]) == 0);
+        ENSURE(lag_method_from_name(mnames[i]) == i);
+    }
+    ENSURE(lag_method_from_name("leapfrog") == -1);
+}
+
+int main(int argc, char **argv)
+{
+    int want = argc > 1 ? lag_model_kind_from_name(argv[1]) : -1;
+    if (argc > 1 && want < 0 && strcmp(argv[1], "info") != 0) {
+        fprintf(stderr, "usage: %s [stick|manipulator|dipc|info]\n", argv[0]);
+        return 2;
+    }
+    if (argc == 1 || strcmp(argv[1], "info") == 0) check_info();
+    for (int k = 0; k < LAG_MODEL_COUNT; ++k)
+        if (argc == 1 || want == k) check_model((lag_model_kind)k, 0x1234u + (uint64_t)k);
+    return tc_finish(argc > 1 ? argv[1] : "models");
+}
