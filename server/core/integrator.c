@@ -37,62 +37,59 @@ lag_integrator_def lag_default_integrator_def(void)
     return d;
 }
 
-/* Packs the public state into y = (q, qd). */
-static inline void load_y(const lag_sim *s, double *y)
-{
-    int n = s->nq;
-    memcpy(y, s->q, sizeof(double) * n);
-    memcpy(y + n, s->qd, sizeof(double) * n);
-}
-
 /* y1 = y0 + h f(y0) */
-lag_result lag_step_euler(lag_sim *s, double *q1, double *qd1)
+lag_result lag_step_euler(lag_sim *s, double h, const double *y0, double *y1)
 {
-    int n = s->nq, N = 2 * n;
-    double h = s->def.integrator.dt, y[LAG_MAX_STATE], f[LAG_MAX_STATE];
-    load_y(s, y);
-    lag_result r = lag_sim_rhs(s, y, f);
+    int N = 2 * s->nq;
+    double f[LAG_MAX_STATE];
+    lag_result r = lag_sim_rhs(s, y0, f);
     if (r != LAG_OK) return r;
-    for (int i = 0; i < N; i++) y[i] += h * f[i];
-    memcpy(q1, y, sizeof(double) * n);
-    memcpy(qd1, y + n, sizeof(double) * n);
+    for (int i = 0; i < N; i++) y1[i] = y0[i] + h * f[i];
     return LAG_OK;
 }
 
 /* qd1 = qd0 + h qdd(q0, qd0); q1 = q0 + h qd1 (velocity first). */
-lag_result lag_step_semi_implicit_euler(lag_sim *s, double *q1, double *qd1)
+lag_result lag_step_semi_implicit_euler(lag_sim *s, double h, const double *y0, double *y1)
 {
     int n = s->nq;
-    double h = s->def.integrator.dt, y[LAG_MAX_STATE], f[LAG_MAX_STATE];
-    load_y(s, y);
-    lag_result r = lag_sim_rhs(s, y, f);
+    double f[LAG_MAX_STATE];
+    lag_result r = lag_sim_rhs(s, y0, f);
     if (r != LAG_OK) return r;
     for (int i = 0; i < n; i++) {
-        qd1[i] = y[n + i] + h * f[n + i];
-        q1[i] = y[i] + h * qd1[i];
+        y1[n + i] = y0[n + i] + h * f[n + i];
+        y1[i] = y0[i] + h * y1[n + i];
     }
     return LAG_OK;
 }
 
 /* Classical fourth-order Runge-Kutta. */
-lag_result lag_step_rk4(lag_sim *s, double *q1, double *qd1)
+lag_result lag_step_rk4(lag_sim *s, double h, const double *y0, double *y1)
 {
-    int n = s->nq, N = 2 * n;
-    double h = s->def.integrator.dt;
-    double y[LAG_MAX_STATE], yt[LAG_MAX_STATE];
+    int N = 2 * s->nq;
+    double yt[LAG_MAX_STATE];
     double k1[LAG_MAX_STATE], k2[LAG_MAX_STATE], k3[LAG_MAX_STATE], k4[LAG_MAX_STATE];
     lag_result r;
-    load_y(s, y);
-    if ((r = lag_sim_rhs(s, y, k1)) != LAG_OK) return r;
-    for (int i = 0; i < N; i++) yt[i] = y[i] + 0.5 * h * k1[i];
+    if ((r = lag_sim_rhs(s, y0, k1)) != LAG_OK) return r;
+    for (int i = 0; i < N; i++) yt[i] = y0[i] + 0.5 * h * k1[i];
     if ((r = lag_sim_rhs(s, yt, k2)) != LAG_OK) return r;
-    for (int i = 0; i < N; i++) yt[i] = y[i] + 0.5 * h * k2[i];
+    for (int i = 0; i < N; i++) yt[i] = y0[i] + 0.5 * h * k2[i];
     if ((r = lag_sim_rhs(s, yt, k3)) != LAG_OK) return r;
-    for (int i = 0; i < N; i++) yt[i] = y[i] + h * k3[i];
+    for (int i = 0; i < N; i++) yt[i] = y0[i] + h * k3[i];
     if ((r = lag_sim_rhs(s, yt, k4)) != LAG_OK) return r;
     for (int i = 0; i < N; i++)
-        y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-    memcpy(q1, y, sizeof(double) * n);
-    memcpy(qd1, y + n, sizeof(double) * n);
+        y1[i] = y0[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
     return LAG_OK;
+}
+
+lag_result lag_step(lag_sim *s, double h, const double *y0, double *y1)
+{
+    switch (s->def.integrator.method) {
+    case LAG_EULER: return lag_step_euler(s, h, y0, y1);
+    case LAG_SEMI_IMPLICIT_EULER: return lag_step_semi_implicit_euler(s, h, y0, y1);
+    case LAG_RK4: return lag_step_rk4(s, h, y0, y1);
+    case LAG_DOPRI5: return lag_dopri5_span(s, h, y0, y1);
+    case LAG_IMPLICIT_MIDPOINT: return lag_step_gauss(s, 1, h, y0, y1);
+    case LAG_GAUSS4: return lag_step_gauss(s, 2, h, y0, y1);
+    default: return LAG_ERR_ARG;
+    }
 }

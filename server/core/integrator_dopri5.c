@@ -64,6 +64,105 @@ static void dense(const lag_sim *s, int N, double t, double *y)
                      th1 * (s->dp.rcont[2][i] + th * (s->dp.rcont[3][i] + th1 * s->dp.rcont[4][i])));
 }
 
+/* One Dormand-Prince attempt of size h from (y, k1 = f(y)). Writes y1, k7 = f(y1) and,
+ * when rc is not NULL, the dense-output coefficients. Returns the weighted error norm
+ * (NaN if the attempt failed; *res says why). */
+static double dp_try(lag_sim *s, double h, const double *y, const double *k1, double *y1,
+                     double *k7, double rc[5][LAG_MAX_STATE], lag_result *res)
+{
+    const int N = 2 * s->nq;
+    const lag_integrator_def *in = &s->def.integrator;
+    double k2[LAG_MAX_STATE], k3[LAG_MAX_STATE], k4[LAG_MAX_STATE], k5[LAG_MAX_STATE],
+        k6[LAG_MAX_STATE], yt[LAG_MAX_STATE] = {0}, err[LAG_MAX_STATE];
+    lag_result r;
+    *res = LAG_OK;
+    for (int i = 0; i < N; i++) yt[i] = y[i] + h * a21 * k1[i];
+    if ((r = lag_sim_rhs(s, yt, k2)) != LAG_OK) goto fail;
+    for (int i = 0; i < N; i++) yt[i] = y[i] + h * (a31 * k1[i] + a32 * k2[i]);
+    if ((r = lag_sim_rhs(s, yt, k3)) != LAG_OK) goto fail;
+    for (int i = 0; i < N; i++) yt[i] = y[i] + h * (a41 * k1[i] + a42 * k2[i] + a43 * k3[i]);
+    if ((r = lag_sim_rhs(s, yt, k4)) != LAG_OK) goto fail;
+    for (int i = 0; i < N; i++)
+        yt[i] = y[i] + h * (a51 * k1[i] + a52 * k2[i] + a53 * k3[i] + a54 * k4[i]);
+    if ((r = lag_sim_rhs(s, yt, k5)) != LAG_OK) goto fail;
+    for (int i = 0; i < N; i++)
+        yt[i] = y[i] + h * (a61 * k1[i] + a62 * k2[i] + a63 * k3[i] + a64 * k4[i] + a65 * k5[i]);
+    if ((r = lag_sim_rhs(s, yt, k6)) != LAG_OK) goto fail;
+    for (int i = 0; i < N; i++)
+        y1[i] = y[i] + h * (a71 * k1[i] + a73 * k3[i] + a74 * k4[i] + a75 * k5[i] + a76 * k6[i]);
+    if ((r = lag_sim_rhs(s, y1, k7)) != LAG_OK) goto fail;
+    for (int i = 0; i < N; i++)
+        err[i] = h * (e1 * k1[i] + e3 * k3[i] + e4 * k4[i] + e5 * k5[i] + e6 * k6[i] + e7 * k7[i]);
+    if (rc)
+        for (int i = 0; i < N; i++) {
+            double ydiff = y1[i] - y[i], bspl = h * k1[i] - ydiff;
+            rc[0][i] = y[i];
+            rc[1][i] = ydiff;
+            rc[2][i] = bspl;
+            rc[3][i] = ydiff - h * k7[i] - bspl;
+            rc[4][i] = h * (d1 * k1[i] + d3 * k3[i] + d4 * k4[i] + d5 * k5[i] + d6 * k6[i] +
+                            d7 * k7[i]);
+        }
+    return err_norm(N, err, y, y1, in->rtol, in->atol);
+fail:
+    *res = r;
+    return NAN;
+}
+
+/* Next step factor: 0.9 err^-1/5 bounded to [0.2, 10], no growth right after a reject. */
+static double step_factor(double en, bool last_rejected)
+{
+    double fac = en > 0.0 ? 0.9 * pow(en, -0.2) : 10.0;
+    return fmin(last_rejected ? 1.0 : 10.0, fmax(0.2, fac));
+}
+
+lag_result lag_dopri5_span(lag_sim *s, double H, const double *y0, double *yout)
+{
+    const int N = 2 * s->nq;
+    const lag_integrator_def *in = &s->def.integrator;
+    double y[LAG_MAX_STATE], k1[LAG_MAX_STATE], y1[LAG_MAX_STATE], k7[LAG_MAX_STATE];
+    lag_result r;
+    for (int i = 0; i < N; i++) y[i] = y0[i];
+    if (H <= 0.0) {
+        for (int i = 0; i < N; i++) yout[i] = y0[i];
+        return LAG_OK;
+    }
+    if ((r = lag_sim_rhs(s, y, k1)) != LAG_OK) return r;
+    if (!(s->dp.h > 0.0)) s->dp.h = initial_step(s, N, y, k1);
+    double t = 0.0;
+    bool last_rejected = false;
+    while (t < H) {
+        double h = s->dp.h;
+        bool lands = false;
+        if (t + h >= H) { h = H - t; lands = true; }
+        if (h < in->dt_min && !lands) return LAG_ERR_STEPSIZE;
+        double en = dp_try(s, h, y, k1, y1, k7, NULL, &r);
+        if (isnan(en)) {
+            if (r == LAG_OK) r = LAG_ERR_NONFINITE;
+            /* a failed evaluation (e.g. singular M far from y): shrink and retry */
+            s->dp.h = 0.25 * h;
+            s->stats.steps_rejected++;
+            if (s->dp.h < in->dt_min) return r;
+            last_rejected = true;
+            continue;
+        }
+        double fac = step_factor(en, last_rejected);
+        if (en <= 1.0) {
+            t = lands ? H : t + h;
+            for (int i = 0; i < N; i++) { y[i] = y1[i]; k1[i] = k7[i]; }
+            s->stats.steps_accepted++;
+            if (!lands || h * fac > s->dp.h) s->dp.h = h * fac;
+            last_rejected = false;
+        } else {
+            s->stats.steps_rejected++;
+            s->dp.h = h * fac;
+            last_rejected = true;
+        }
+    }
+    for (int i = 0; i < N; i++) yout[i] = y[i];
+    return LAG_OK;
+}
+
 lag_result lag_dopri5_advance(lag_sim *s, int64_t nticks, bool continuous)
 {
     const int n = s->nq, N = 2 * n;
@@ -84,9 +183,7 @@ lag_result lag_dopri5_advance(lag_sim *s, int64_t nticks, bool continuous)
         s->dp.valid = true;
     }
 
-    double k2[LAG_MAX_STATE], k3[LAG_MAX_STATE], k4[LAG_MAX_STATE], k5[LAG_MAX_STATE],
-        k6[LAG_MAX_STATE], k7[LAG_MAX_STATE], yt[LAG_MAX_STATE], y1[LAG_MAX_STATE],
-        err[LAG_MAX_STATE];
+    double y1[LAG_MAX_STATE], k7[LAG_MAX_STATE], rc[5][LAG_MAX_STATE];
     double *y = s->dp.y, *k1 = s->dp.k1;
     bool last_rejected = false;
 
@@ -97,47 +194,23 @@ lag_result lag_dopri5_advance(lag_sim *s, int64_t nticks, bool continuous)
             h = t_end - s->dp.t;
             lands = true;
         }
-        if (h < in->dt_min && !lands) return LAG_ERR_STEPSIZE;
-
-        for (int i = 0; i < N; i++) yt[i] = y[i] + h * a21 * k1[i];
-        if ((r = lag_sim_rhs(s, yt, k2)) != LAG_OK) goto fail;
-        for (int i = 0; i < N; i++) yt[i] = y[i] + h * (a31 * k1[i] + a32 * k2[i]);
-        if ((r = lag_sim_rhs(s, yt, k3)) != LAG_OK) goto fail;
-        for (int i = 0; i < N; i++) yt[i] = y[i] + h * (a41 * k1[i] + a42 * k2[i] + a43 * k3[i]);
-        if ((r = lag_sim_rhs(s, yt, k4)) != LAG_OK) goto fail;
-        for (int i = 0; i < N; i++)
-            yt[i] = y[i] + h * (a51 * k1[i] + a52 * k2[i] + a53 * k3[i] + a54 * k4[i]);
-        if ((r = lag_sim_rhs(s, yt, k5)) != LAG_OK) goto fail;
-        for (int i = 0; i < N; i++)
-            yt[i] = y[i] + h * (a61 * k1[i] + a62 * k2[i] + a63 * k3[i] + a64 * k4[i] + a65 * k5[i]);
-        if ((r = lag_sim_rhs(s, yt, k6)) != LAG_OK) goto fail;
-        for (int i = 0; i < N; i++)
-            y1[i] = y[i] + h * (a71 * k1[i] + a73 * k3[i] + a74 * k4[i] + a75 * k5[i] + a76 * k6[i]);
-        if ((r = lag_sim_rhs(s, y1, k7)) != LAG_OK) goto fail;
-        for (int i = 0; i < N; i++)
-            err[i] = h * (e1 * k1[i] + e3 * k3[i] + e4 * k4[i] + e5 * k5[i] + e6 * k6[i] + e7 * k7[i]);
-        double en = err_norm(N, err, y, y1, in->rtol, in->atol);
-        if (!isfinite(en)) { r = LAG_ERR_NONFINITE; goto fail_noshrink; }
-
-        /* Proposed next step: 0.9 err^-1/5, bounded to [0.2, 10] (no growth right after
-         * a rejection). */
-        double fac = en > 0.0 ? 0.9 * pow(en, -0.2) : 10.0;
-        fac = fmin(last_rejected ? 1.0 : 10.0, fmax(0.2, fac));
+        if (h < in->dt_min && !lands) { s->dp.valid = false; return LAG_ERR_STEPSIZE; }
+        double en = dp_try(s, h, y, k1, y1, k7, rc, &r);
+        if (isnan(en)) {
+            if (r == LAG_OK) r = LAG_ERR_NONFINITE;
+            s->dp.h = 0.25 * h;
+            s->stats.steps_rejected++;
+            if (s->dp.h < in->dt_min) { s->dp.valid = false; return r; }
+            last_rejected = true;
+            continue;
+        }
+        double fac = step_factor(en, last_rejected);
         if (en <= 1.0) {
             if (!lag_state_ok(N, y1, s->def.explode_limit)) {
-                r = lag_state_ok(N, y1, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
-                goto fail_noshrink;
+                s->dp.valid = false;
+                return lag_state_ok(N, y1, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
             }
-            /* dense output coefficients for [t, t + h] */
-            for (int i = 0; i < N; i++) {
-                double ydiff = y1[i] - y[i], bspl = h * k1[i] - ydiff;
-                s->dp.rcont[0][i] = y[i];
-                s->dp.rcont[1][i] = ydiff;
-                s->dp.rcont[2][i] = bspl;
-                s->dp.rcont[3][i] = ydiff - h * k7[i] - bspl;
-                s->dp.rcont[4][i] = h * (d1 * k1[i] + d3 * k3[i] + d4 * k4[i] + d5 * k5[i] +
-                                         d6 * k6[i] + d7 * k7[i]);
-            }
+            memcpy(s->dp.rcont, rc, sizeof rc);
             s->dp.t_prev = s->dp.t;
             s->dp.t = lands ? t_end : s->dp.t + h;
             memcpy(y, y1, sizeof(double) * N);
@@ -169,16 +242,4 @@ lag_result lag_dopri5_advance(lag_sim *s, int64_t nticks, bool continuous)
     }
     s->tick = tick_end;
     return LAG_OK;
-
-fail:
-    /* A singular or non-finite evaluation: try a smaller step before giving up. */
-    s->dp.h *= 0.25;
-    if (s->dp.h >= in->dt_min) {
-        s->stats.steps_rejected++;
-        /* restart the loop from the same internal state */
-        return lag_dopri5_advance(s, tick_end - s->tick, continuous);
-    }
-fail_noshrink:
-    s->dp.valid = false;
-    return r;
 }

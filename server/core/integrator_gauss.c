@@ -31,21 +31,20 @@ static void tableau(int stages, double A[MAX_STAGES][MAX_STAGES], double *b)
     }
 }
 
-lag_result lag_step_gauss(lag_sim *s, int stages, double *q1, double *qd1)
+lag_result lag_step_gauss(lag_sim *s, int stages, double h, const double *yin, double *yout)
 {
     const int n = s->nq, N = 2 * n, S = stages * N;
     const lag_integrator_def *in = &s->def.integrator;
-    const double h = in->dt;
     double A[MAX_STAGES][MAX_STAGES], b[MAX_STAGES];
     tableau(stages, A, b);
 
     /* y0 = (q0, M(q0) qd0) */
     double y0[LAG_MAX_STATE], M[LAG_MAX_DOF * LAG_MAX_DOF];
-    lag_model_mass(&s->def.model, s->q, M);
+    lag_model_mass(&s->def.model, yin, M);
     for (int i = 0; i < n; i++) {
-        y0[i] = s->q[i];
+        y0[i] = yin[i];
         double p = 0.0;
-        for (int j = 0; j < n; j++) p += M[i * n + j] * s->qd[j];
+        for (int j = 0; j < n; j++) p += M[i * n + j] * yin[n + j];
         y0[n + i] = p;
     }
 
@@ -129,9 +128,7 @@ lag_result lag_step_gauss(lag_sim *s, int stages, double *q1, double *qd1)
         if ((r = lag_sim_rhs_qp(s, y, F + bi * N)) != LAG_OK) return r;
         for (int i = 0; i < N; i++) y1[i] += h * b[bi] * F[bi * N + i];
     }
-    /* back to (q, qd): qd1 = M(q1)^-1 p1 */
-    memcpy(q1, y1, sizeof(double) * n);
-    lag_model_mass(&s->def.model, q1, M);
-    if (lag_spd_solve(n, M, y1 + n, qd1) != LAG_OK) return LAG_ERR_SINGULAR;
-    return LAG_OK;
+    /* back to (q, qd): qd1 = M(q1)^-1 p1 (on the free joints when some are locked) */
+    memcpy(yout, y1, sizeof(double) * n);
+    return lag_qd_from_p(s, yout, y1 + n, yout + n);
 }

@@ -22,6 +22,7 @@ const char *lag_result_string(lag_result r)
     case LAG_ERR_EXPLODE: return "state exceeded explode_limit";
     case LAG_ERR_NEWTON: return "implicit solver (Newton) did not converge";
     case LAG_ERR_STEPSIZE: return "adaptive step size fell below dt_min";
+    case LAG_ERR_LIFTOFF: return "stick lifted off the floor (normal force < 0)";
     }
     return "unknown result";
 }

@@ -11,6 +11,7 @@ lag_sim_def lag_default_sim_def(lag_model_kind kind)
     memset(&d, 0, sizeof d);
     lag_model_default(&d.model, kind);
     d.integrator = lag_default_integrator_def();
+    d.effects = lag_default_effects_def();
     d.explode_limit = 1e6;
     return d;
 }
@@ -19,6 +20,7 @@ lag_result lag_sim_def_validate(const lag_sim_def *def, char *err, size_t errlen
 {
     lag_result r = lag_model_validate(&def->model, err, errlen);
     if (r != LAG_OK) return r;
+    if ((r = lag_effects_validate(def, err, errlen)) != LAG_OK) return r;
     const lag_integrator_def *in = &def->integrator;
     if ((int)in->method < 0 || in->method >= LAG_METHOD_COUNT) {
         snprintf(err, errlen, "unknown integrator method %d", (int)in->method);
@@ -91,6 +93,10 @@ void lag_sim_reset(lag_sim *s, const double *q, const double *qd)
     s->tick = 0;
     s->dp.valid = false;
     s->dp.h = 0.0;
+    memset(&s->mode, 0, sizeof s->mode);
+    for (int i = 0; i < n; i++) s->tau_applied[i] = 0.0;
+    s->n_events = 0;
+    if (s->def.effects.enabled) lag_effects_init_modes(s);
 }
 
 void lag_sim_set_input(lag_sim *s, const double *tau)
@@ -102,6 +108,9 @@ void lag_sim_set_input(lag_sim *s, const double *tau)
         if (memcmp(&v, &s->tau[i], sizeof v) != 0) changed = true;
         s->tau[i] = v;
     }
+    /* Without actuator dynamics the applied effort is the command itself. */
+    if (!(s->def.effects.enabled & LAG_EFF_ACTUATOR))
+        for (int i = 0; i < s->nq; i++) s->tau_applied[i] = s->tau[i];
     /* dopri5 may have run ahead of the public state with the old input: restart it. */
     if (changed) s->dp.valid = false;
 }
@@ -114,87 +123,162 @@ double lag_sim_energy(const lag_sim *s)
          + lag_model_potential(&s->def.model, s->q);
 }
 
-/* The generalized forces acting besides gravity and inertia: the held input. */
-static inline void applied_forces(const lag_sim *s, const double *q, const double *qd,
-                                  double *Q)
+void lag_applied_forces(const lag_sim *s, const double *q, const double *qd, double *Q)
 {
-    (void)q; (void)qd;
-    for (int i = 0; i < s->nq; i++) Q[i] = s->tau[i];
+    (void)q;
+    const int n = s->nq;
+    const lag_effects_def *e = &s->def.effects;
+    for (int i = 0; i < n; i++) Q[i] = s->tau_applied[i];
+    if (e->enabled & LAG_EFF_DAMPING)
+        for (int i = 0; i < n; i++) Q[i] -= e->damping[i] * qd[i];
+    if (e->enabled & LAG_EFF_FRICTION)
+        for (int i = 0; i < n; i++) Q[i] -= e->friction_kinetic[i] * s->mode.slip_dir[i];
+    if (e->enabled & LAG_EFF_DISTURBANCE)
+        for (int i = 0; i < n; i++) Q[i] += s->mode.dist_force[i];
+}
+
+lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *qd,
+                              const double *Q, double *qdd, double *lambda)
+{
+    const int n = s->nq;
+    const uint32_t locked = s->mode.locked;
+    if (!locked) {
+        if (lambda)
+            for (int i = 0; i < n; i++) lambda[i] = 0.0;
+        return lag_model_forward(&s->def.model, q, qd, Q, qdd);
+    }
+    double M[LAG_MAX_DOF * LAG_MAX_DOF], h[LAG_MAX_DOF], r[LAG_MAX_DOF];
+    lag_model_vt(&s->def.model)->mass_bias(s->def.model.p, q, qd, M, h);
+    for (int i = 0; i < n; i++) r[i] = Q[i] - h[i];
+    /* M_ff qdd_f = r_f on the free joints; qdd_L = 0 */
+    int free_idx[LAG_MAX_DOF], nf = 0;
+    for (int i = 0; i < n; i++)
+        if (!(locked & (1u << i))) free_idx[nf++] = i;
+    double Mff[LAG_MAX_DOF * LAG_MAX_DOF], rf[LAG_MAX_DOF], xf[LAG_MAX_DOF];
+    for (int a = 0; a < nf; a++) {
+        rf[a] = r[free_idx[a]];
+        for (int b = 0; b < nf; b++) Mff[a * nf + b] = M[free_idx[a] * n + free_idx[b]];
+    }
+    for (int i = 0; i < n; i++) qdd[i] = 0.0;
+    if (nf > 0) {
+        lag_result res = lag_spd_solve(nf, Mff, rf, xf);
+        if (res != LAG_OK) return res;
+        for (int a = 0; a < nf; a++) qdd[free_idx[a]] = xf[a];
+    }
+    if (lambda) /* lambda = M qdd - r, the force each lock must supply */
+        for (int i = 0; i < n; i++) {
+            double acc = -r[i];
+            for (int j = 0; j < n; j++) acc += M[i * n + j] * qdd[j];
+            lambda[i] = (locked & (1u << i)) ? acc : 0.0;
+        }
+    return LAG_OK;
 }
 
 lag_result lag_sim_rhs(lag_sim *s, const double *y, double *ydot)
 {
     int n = s->nq;
     double Q[LAG_MAX_DOF];
-    applied_forces(s, y, y + n, Q);
+    lag_applied_forces(s, y, y + n, Q);
     s->stats.rhs_evals++;
     for (int i = 0; i < n; i++) ydot[i] = y[n + i];
-    return lag_model_forward(&s->def.model, y, y + n, Q, ydot + n);
+    return lag_forward_locked(s, y, y + n, Q, ydot + n, NULL);
+}
+
+lag_result lag_qd_from_p(const lag_sim *s, const double *q, const double *p, double *qd)
+{
+    const int n = s->nq;
+    const uint32_t locked = s->mode.locked;
+    double M[LAG_MAX_DOF * LAG_MAX_DOF];
+    lag_model_vt(&s->def.model)->mass(s->def.model.p, q, M);
+    if (!locked) return lag_spd_solve(n, M, p, qd);
+    int free_idx[LAG_MAX_DOF], nf = 0;
+    for (int i = 0; i < n; i++)
+        if (!(locked & (1u << i))) free_idx[nf++] = i;
+    double Mff[LAG_MAX_DOF * LAG_MAX_DOF], pf[LAG_MAX_DOF], xf[LAG_MAX_DOF];
+    for (int a = 0; a < nf; a++) {
+        pf[a] = p[free_idx[a]];
+        for (int b = 0; b < nf; b++) Mff[a * nf + b] = M[free_idx[a] * n + free_idx[b]];
+    }
+    for (int i = 0; i < n; i++) qd[i] = 0.0;
+    if (nf == 0) return LAG_OK;
+    lag_result r = lag_spd_solve(nf, Mff, pf, xf);
+    if (r != LAG_OK) return r;
+    for (int a = 0; a < nf; a++) qd[free_idx[a]] = xf[a];
+    return LAG_OK;
 }
 
 /* Canonical form y = (q, p), p = M(q) qd, H = T + U:
  *   q_dot = M^-1 p,  p_dot = dT/dq |_(qd fixed) - g(q) + Q,  dT/dq_k = 1/2 qd^T dM/dq_k qd.
- * (dH/dq at fixed p equals -dT/dq at fixed qd.) */
+ * (dH/dq at fixed p equals -dT/dq at fixed qd.) Locked joints: qd_i = 0 and p_i is
+ * not evolved (the reduced system on the free joints is Hamiltonian in (q_f, p_f)). */
 lag_result lag_sim_rhs_qp(lag_sim *s, const double *y, double *ydot)
 {
     int n = s->nq;
     const lag_model *m = &s->def.model;
     const lag_model_vtable *vt = lag_model_vt(m);
-    double M[LAG_MAX_DOF * LAG_MAX_DOF], dM[LAG_MAX_DOF * LAG_MAX_DOF * LAG_MAX_DOF];
+    double dM[LAG_MAX_DOF * LAG_MAX_DOF * LAG_MAX_DOF];
     double g[LAG_MAX_DOF], Q[LAG_MAX_DOF], qd[LAG_MAX_DOF];
     s->stats.rhs_evals++;
-    vt->mass(m->p, y, M);
-    lag_result r = lag_spd_solve(n, M, y + n, qd);
+    lag_result r = lag_qd_from_p(s, y, y + n, qd);
     if (r != LAG_OK) return r;
     vt->mass_deriv(m->p, y, dM);
     vt->gravity(m->p, y, g);
-    applied_forces(s, y, qd, Q);
+    lag_applied_forces(s, y, qd, Q);
     for (int k = 0; k < n; k++) {
         double t = 0.0;
         const double *dMk = dM + k * n * n;
         for (int i = 0; i < n; i++)
             for (int j = 0; j < n; j++) t += qd[i] * dMk[i * n + j] * qd[j];
         ydot[k] = qd[k];
-        ydot[n + k] = 0.5 * t - g[k] + Q[k];
+        ydot[n + k] = (s->mode.locked & (1u << k)) ? 0.0 : 0.5 * t - g[k] + Q[k];
     }
+    return LAG_OK;
+}
+
+#define TICK_EFFECTS (LAG_EFF_FRICTION | LAG_EFF_LIMITS | LAG_EFF_FLOOR | LAG_EFF_ACTUATOR | \
+                      LAG_EFF_DISTURBANCE)
+#define EVENT_EFFECTS (LAG_EFF_FRICTION | LAG_EFF_LIMITS | LAG_EFF_FLOOR)
+
+/* One tick without events: a step of dt, checked. OUT: y (in place) */
+static lag_result plain_tick(lag_sim *s, double *y)
+{
+    const int N = 2 * s->nq;
+    double y1[LAG_MAX_STATE];
+    lag_result r = lag_step(s, s->def.integrator.dt, y, y1);
+    if (r != LAG_OK) return r;
+    if (!lag_state_ok(N, y1, INFINITY)) return LAG_ERR_NONFINITE;
+    if (!lag_state_ok(N, y1, s->def.explode_limit)) return LAG_ERR_EXPLODE;
+    for (int i = 0; i < N; i++) y[i] = y1[i];
     return LAG_OK;
 }
 
 lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
 {
     if (nticks <= 0) return LAG_OK;
-    lag_method method = s->def.integrator.method;
-    if (method == LAG_DOPRI5) {
+    const int n = s->nq;
+    const uint32_t en = s->def.effects.enabled;
+    if (!(en & TICK_EFFECTS) && s->def.integrator.method == LAG_DOPRI5) {
         lag_result r = lag_dopri5_advance(s, nticks, continuous);
         if (r != LAG_OK) s->stats.faults++;
         return r;
     }
-    int n = s->nq;
-    double limit = s->def.explode_limit;
     for (int64_t k = 0; k < nticks; k++) {
-        double q1[LAG_MAX_DOF], qd1[LAG_MAX_DOF];
+        double y[LAG_MAX_STATE];
+        for (int i = 0; i < n; i++) { y[i] = s->q[i]; y[n + i] = s->qd[i]; }
         lag_result r;
-        switch (method) {
-        case LAG_EULER: r = lag_step_euler(s, q1, qd1); break;
-        case LAG_SEMI_IMPLICIT_EULER: r = lag_step_semi_implicit_euler(s, q1, qd1); break;
-        case LAG_RK4: r = lag_step_rk4(s, q1, qd1); break;
-        case LAG_IMPLICIT_MIDPOINT: r = lag_step_gauss(s, 1, q1, qd1); break;
-        case LAG_GAUSS4: r = lag_step_gauss(s, 2, q1, qd1); break;
-        default: r = LAG_ERR_ARG; break;
-        }
-        if (r == LAG_OK) {
-            bool finite = lag_state_ok(n, q1, INFINITY) && lag_state_ok(n, qd1, INFINITY);
-            if (!finite) r = LAG_ERR_NONFINITE;
-            else if (!lag_state_ok(n, q1, limit) || !lag_state_ok(n, qd1, limit)) r = LAG_ERR_EXPLODE;
+        if (en & TICK_EFFECTS) {
+            lag_effects_pre_tick(s);
+            r = (en & EVENT_EFFECTS) ? lag_effects_tick(s, y) : plain_tick(s, y);
+        } else {
+            r = plain_tick(s, y);
         }
         if (r != LAG_OK) {
             s->stats.faults++;
             return r; /* public state is still that of the last good tick */
         }
-        memcpy(s->q, q1, sizeof(double) * n);
-        memcpy(s->qd, qd1, sizeof(double) * n);
+        for (int i = 0; i < n; i++) { s->q[i] = y[i]; s->qd[i] = y[n + i]; }
         s->tick++;
-        s->stats.steps_accepted++;
+        if (s->def.integrator.method != LAG_DOPRI5) s->stats.steps_accepted++;
     }
     return LAG_OK;
 }

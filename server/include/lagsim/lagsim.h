@@ -32,7 +32,8 @@ typedef enum lag_result {
     LAG_ERR_NONFINITE, /* a step produced NaN or Inf: state left unchanged */
     LAG_ERR_EXPLODE,   /* |q| or |qd| exceeded lag_sim_def.explode_limit: state unchanged */
     LAG_ERR_NEWTON,    /* implicit method: Newton did not converge in max_iter */
-    LAG_ERR_STEPSIZE   /* dopri5: step size fell below dt_min */
+    LAG_ERR_STEPSIZE,  /* dopri5: step size fell below dt_min */
+    LAG_ERR_LIFTOFF    /* stick with a floor: the normal force went negative */
 } lag_result;
 
 const char *lag_result_string(lag_result r);
@@ -133,10 +134,86 @@ typedef struct lag_integrator_def {
 
 lag_integrator_def lag_default_integrator_def(void);
 
+/* ---------------------------------------------------------------- effects
+ * Each effect is off unless its bit is set in lag_effects_def.enabled; an effect that is
+ * off is never called (MuJoCo's enable flags). Gravity is the model parameter g (0 = off).
+ * Units: forces N on linear coordinates, N m on angles (the coordinate's generalized force).
+ */
+enum {
+    LAG_EFF_DAMPING = 1u << 0,     /* Q_i = -b_i qd_i                                       */
+    LAG_EFF_FRICTION = 1u << 1,    /* Coulomb per joint: stick while |force| <= mu_s, else   */
+                                   /* slide against the motion with mu_k (hybrid modes)      */
+    LAG_EFF_LIMITS = 1u << 2,      /* per-joint stops located in time, restitution impulse   */
+    LAG_EFF_FLOOR = 1u << 3,       /* stick only: impact at phi = 0 or pi, resting contact,  */
+                                   /* lift-off (normal force < 0) is a fault (LAG_ERR_LIFTOFF)*/
+    LAG_EFF_ACTUATOR = 1u << 4,    /* per-input saturation and first-order lag              */
+    LAG_EFF_DISTURBANCE = 1u << 5, /* scheduled impulses / forces                          */
+    LAG_EFF_NOISE = 1u << 6        /* Gaussian noise on the published state only            */
+};
+#define LAG_MAX_DISTURBANCES 16
+
+typedef struct lag_disturbance {
+    double t;        /* sim time it starts, s (applied at the tick boundary at or after t) */
+    int joint;       /* coordinate index */
+    bool impulse;    /* true: generalized impulse `value` (N s or N m s) at t;
+                        false: force `value` held over [t, t + duration) */
+    double value;
+    double duration; /* s, forces only */
+} lag_disturbance;
+
+typedef struct lag_effects_def {
+    uint32_t enabled;                       /* LAG_EFF_* bits */
+    double damping[LAG_MAX_DOF];            /* b_i >= 0 (N s/m or N m s/rad) */
+    double friction_static[LAG_MAX_DOF];    /* mu_s,i >= mu_k,i: largest holding force */
+    double friction_kinetic[LAG_MAX_DOF];   /* mu_k,i >= 0: sliding force magnitude */
+    bool limit_on[LAG_MAX_DOF];             /* which joints have stops */
+    double limit_lower[LAG_MAX_DOF];        /* m or rad */
+    double limit_upper[LAG_MAX_DOF];
+    double restitution[LAG_MAX_DOF];        /* e in [0, 1] at that joint's stops */
+    double floor_restitution;               /* stick: e in [0, 1] when the stick lands */
+    double rest_velocity;                   /* impacts slower than this (m/s, rad/s) end in
+                                               resting contact: the Zeno guard. default 1e-3 */
+    double actuator_max[LAG_MAX_DOF];       /* |effort_i| <= max (INFINITY: no saturation) */
+    double actuator_tau[LAG_MAX_DOF];       /* first-order lag time constant, s (0: none) */
+    int n_disturbances;
+    lag_disturbance disturbances[LAG_MAX_DISTURBANCES];
+    double noise_q[LAG_MAX_DOF];            /* std dev of noise on published q */
+    double noise_qd[LAG_MAX_DOF];           /* std dev of noise on published qd */
+    uint64_t noise_seed;
+} lag_effects_def;
+
+/* All effects off, neutral parameters (no saturation, no lag, rest_velocity 1e-3). */
+lag_effects_def lag_default_effects_def(void);
+
+/* Something the step noticed, recorded with its sim time (see lag_sim_poll_event). */
+typedef enum lag_event_kind {
+    LAG_EV_LIMIT = 1,    /* a stop was hit; value = impact velocity */
+    LAG_EV_IMPACT,       /* the stick landed on the floor; value = impact phi_dot */
+    LAG_EV_REST,         /* an impact slower than rest_velocity: resting contact begins */
+    LAG_EV_RELEASE,      /* a resting contact ends (the force pulls away) */
+    LAG_EV_STICK,        /* friction: the joint stopped and static friction holds it */
+    LAG_EV_SLIP,         /* friction: the joint starts or keeps sliding; value = direction */
+    LAG_EV_LIFTOFF,      /* stick: normal force reached zero; the model no longer holds */
+    LAG_EV_SATURATION,   /* an actuator hit its limit; value = commanded effort */
+    LAG_EV_DISTURBANCE,  /* a scheduled disturbance was applied; value = its value */
+    LAG_EV_EVENT_LIMIT   /* more events in one tick than the engine handles: rest of the
+                            tick taken without event location (a warning) */
+} lag_event_kind;
+
+typedef struct lag_event {
+    lag_event_kind kind;
+    int joint;      /* coordinate index, -1 if none */
+    double t;       /* sim time, s */
+    double value;
+} lag_event;
+
+const char *lag_event_kind_name(lag_event_kind k); /* "limit", "impact", ... */
+
 /* ---------------------------------------------------------------- simulation */
 typedef struct lag_sim_def {
     lag_model model;
     lag_integrator_def integrator;
+    lag_effects_def effects;
     double q0[LAG_MAX_DOF];   /* initial positions */
     double qd0[LAG_MAX_DOF];  /* initial velocities */
     double explode_limit;     /* a step whose |q_i| or |qd_i| exceeds this is a fault; 1e6 */
@@ -164,7 +241,23 @@ typedef struct lag_sim {
     double q[LAG_MAX_DOF];
     double qd[LAG_MAX_DOF];
     double tau[LAG_MAX_DOF];      /* input held over the next ticks (zero where unactuated) */
+    double tau_applied[LAG_MAX_DOF]; /* effort actually applied over the last tick (after
+                                        actuator lag and saturation, plus disturbance
+                                        forces); what joint_state_t.effort reports */
     lag_sim_stats stats;
+    /* effects' hybrid modes */
+    struct {
+        uint32_t locked;           /* bit i: joint i held (static friction or resting stop) */
+        int8_t lock_side[LAG_MAX_DOF]; /* -1 at lower stop, +1 at upper, 0 friction stick */
+        int8_t slip_dir[LAG_MAX_DOF];  /* friction: direction of sliding, 0 if stuck */
+        double act_state[LAG_MAX_DOF]; /* actuator lag state */
+        bool saturated[LAG_MAX_DOF];
+        double dist_force[LAG_MAX_DOF]; /* disturbance forces held over this tick */
+    } mode;
+    /* events recorded by the step, oldest first; lag_sim_poll_event drains them */
+    lag_event events[32];
+    int n_events;
+    int64_t events_dropped;
     /* dopri5 internals: internal time/state may run ahead of the public one in
      * continuous mode (dense output gives the public state). */
     struct {
@@ -196,6 +289,12 @@ double lag_sim_energy(const lag_sim *s); /* T + U at the public state */
 /* Right-hand side of the first-order system y = (q, qd): ydot = (qd, qdd) with the
  * sim's held input. Exposed for tests and benchmarks. OUT: ydot (2n) */
 lag_result lag_sim_rhs(lag_sim *s, const double *y, double *ydot);
+
+/* Pops the oldest recorded event into ev; returns false when there is none. */
+bool lag_sim_poll_event(lag_sim *s, lag_event *ev);
+/* The state as published: the true state plus the noise effect, if on (deterministic in
+ * (noise_seed, tick), so a replay reproduces it). OUT: q, qd */
+void lag_sim_observe(const lag_sim *s, double *q, double *qd);
 
 #ifdef __cplusplus
 }
