@@ -521,7 +521,8 @@ typedef struct conv {
     lag_scene *sc;
     const lag_model_info *info;
     /* nodes remembered for the final cross-checks (NULL if not given) */
-    const ynode *root, *parameters, *publish_hz, *dt, *integrator, *initial;
+    const ynode *root, *parameters, *publish_hz, *dt, *integrator, *initial, *dt_min;
+    const ynode *explode_limit;
 } conv;
 
 /* Joins "parent.key" into buf. */
@@ -807,13 +808,14 @@ static int key_atol(conv *cv, const ynode *nd, const char *path)
 
 static int key_dt_min(conv *cv, const ynode *nd, const char *path)
 {
+    cv->dt_min = nd;
     return get_positive(cv, nd, path, &cv->sc->sim.integrator.dt_min);
 }
 
 static int key_max_iter(conv *cv, const ynode *nd, const char *path)
 {
     long long v = 0;
-    if (get_int(cv, nd, path, 1, 1000000, &v) < 0)
+    if (get_int(cv, nd, path, 1, 1000, &v) < 0)
         return -1;
     cv->sc->sim.integrator.max_iter = (int)v;
     return 0;
@@ -821,7 +823,13 @@ static int key_max_iter(conv *cv, const ynode *nd, const char *path)
 
 static int key_newton_tol(conv *cv, const ynode *nd, const char *path)
 {
-    return get_positive(cv, nd, path, &cv->sc->sim.integrator.newton_tol);
+    double v = 0.0;
+    if (get_positive(cv, nd, path, &v) < 0)
+        return -1;
+    if (!(v < 1.0))
+        return fail(cv->err, nd, path, "expected a number in (0, 1), got %s", nd->text);
+    cv->sc->sim.integrator.newton_tol = v;
+    return 0;
 }
 
 static const keyrow k_integrator_keys[] = {
@@ -851,6 +859,7 @@ static int key_publish_hz(conv *cv, const ynode *nd, const char *path)
 
 static int key_explode_limit(conv *cv, const ynode *nd, const char *path)
 {
+    cv->explode_limit = nd;
     return get_positive(cv, nd, path, &cv->sc->sim.explode_limit);
 }
 
@@ -1048,6 +1057,22 @@ static int convert_scene(const ynode *root, const char *path, lag_scene *sc, err
                     "1/publish_hz = %.17g s must be an integer multiple of integrator.dt = "
                     "%.17g s (it is %.6g dt)", period, dt, r);
     sc->ticks_per_period = (int64_t)ticks;
+
+    /* dopri5's smallest step cannot exceed the tick. */
+    if (sc->sim.integrator.dt_min > dt)
+        return fail(err, cv.dt_min ? cv.dt_min : at, cv.dt_min ? "integrator.dt_min" : atpath,
+                    "expected a number <= integrator.dt = %.17g s, got %.17g",
+                    dt, sc->sim.integrator.dt_min);
+
+    /* The initial state must lie inside explode_limit. */
+    for (int i = 0; i < sc->sim.model.nq; i++) {
+        double lim = sc->sim.explode_limit;
+        if (fabs(sc->sim.q0[i]) > lim || fabs(sc->sim.qd0[i]) > lim) {
+            const ynode *bad = cv.initial ? cv.initial : cv.explode_limit;
+            return fail(err, bad, cv.initial ? "initial" : "explode_limit",
+                        "initial state exceeds explode_limit = %g", lim);
+        }
+    }
 
     /* Final check by the core (integrator settings, initial state). */
     if (lag_sim_def_validate(&sc->sim, msg, sizeof msg) != LAG_OK)

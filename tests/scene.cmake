@@ -1,0 +1,28 @@
+# Scene loader, lagsimd's command line and offline runs (issue 2).
+# Shell scripts in tests/scene/ drive the lagsimd binary; bad-scene fixtures in
+# tests/scene/bad/ carry their own expectations ("# expect-at: L:C", "# expect: ...").
+find_program(LAGSIM_BASH bash REQUIRED)
+set(scene_dir ${CMAKE_CURRENT_SOURCE_DIR}/scene)
+set(scene_cfg ${CMAKE_SOURCE_DIR}/config)
+
+file(GLOB scene_bad_fixtures CONFIGURE_DEPENDS ${scene_dir}/bad/*.yaml)
+list(SORT scene_bad_fixtures)
+foreach(f ${scene_bad_fixtures})
+  get_filename_component(name ${f} NAME_WE)
+  add_test(NAME scene_bad_${name}
+           COMMAND ${LAGSIM_BASH} ${scene_dir}/expect_error.sh $<TARGET_FILE:lagsimd> ${f})
+  set_tests_properties(scene_bad_${name} PROPERTIES TIMEOUT 20 LABELS scene)
+endforeach()
+
+add_test(NAME scene_set_overrides
+         COMMAND ${LAGSIM_BASH} ${scene_dir}/set_overrides.sh $<TARGET_FILE:lagsimd>
+                 ${scene_cfg} ${scene_dir}/expect_error.sh)
+add_test(NAME scene_offline_csv
+         COMMAND ${LAGSIM_BASH} ${scene_dir}/offline_csv.sh $<TARGET_FILE:lagsimd> ${scene_cfg})
+add_test(NAME scene_determinism
+         COMMAND ${LAGSIM_BASH} ${scene_dir}/determinism.sh $<TARGET_FILE:lagsimd>
+                 ${scene_cfg}/dipc.yaml)
+add_test(NAME scene_cli
+         COMMAND ${LAGSIM_BASH} ${scene_dir}/cli.sh $<TARGET_FILE:lagsimd> ${scene_cfg}/dipc.yaml)
+set_tests_properties(scene_set_overrides scene_offline_csv scene_determinism scene_cli
+                     PROPERTIES TIMEOUT 60 LABELS scene)

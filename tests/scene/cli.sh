@@ -1,0 +1,36 @@
+#!/bin/bash
+# lagsimd's command line: --help documents every option and exits 0, --version exits 0,
+# usage errors exit 2 with a message and run nothing. Usage: cli.sh LAGSIMD SCENE
+set -u
+lagsimd=$1 scene=$2
+fail=0
+help=$("$lagsimd" --help); rc=$?
+if [ $rc -ne 0 ]; then echo "FAIL: --help exit $rc"; fail=1; fi
+for opt in --config --set --duration --offline --csv --replay --quiet --help --version; do
+    if [[ "$help" != *"$opt"* ]]; then echo "FAIL: --help does not mention $opt"; fail=1; fi
+done
+v=$("$lagsimd" --version); rc=$?
+if [ $rc -ne 0 ] || [[ "$v" != "lagsimd "[0-9]* ]]; then echo "FAIL: --version ($rc): $v"; fail=1; fi
+
+usage() { # usage EXPECTED_FRAGMENT ARGS...
+    local want=$1; shift
+    local out err rc
+    err=$("$lagsimd" "$@" 2>&1 >/dev/null); rc=$?
+    out=$("$lagsimd" "$@" 2>/dev/null)
+    if [ $rc -ne 2 ]; then echo "FAIL: '$*' exit $rc, expected 2"; fail=1
+    elif [[ "$err" != *"$want"* ]]; then echo "FAIL: '$*': '$err' lacks '$want'"; fail=1
+    elif [ -n "$out" ]; then echo "FAIL: '$*' wrote to stdout"; fail=1
+    else echo "ok: $* -> $want"; fi
+}
+usage "--config FILE is required" --offline --duration 1
+usage "unknown option '--bogus'" --config "$scene" --bogus
+usage "option --duration needs a value" --config "$scene" --duration
+usage "--duration: expected a number of seconds, got 'abc'" --config "$scene" --offline --duration abc
+usage "--duration: expected a number of seconds, got 'nan'" --config "$scene" --offline --duration nan
+usage "--csv needs --offline" --config "$scene" --csv -
+usage "--offline needs --duration" --config "$scene" --offline --csv -
+usage "--offline and --replay exclude each other" --config "$scene" --offline --duration 1 --replay x.lcm
+usage "unexpected argument 'extra'" --config "$scene" --offline --duration 1 extra
+usage "--set x: expected key.path=value" --config "$scene" --offline --duration 1 --csv - --set x
+usage "cannot open scene file" --config /nonexistent/scene.yaml --offline --duration 1 --csv -
+exit $fail
