@@ -107,6 +107,25 @@ static void enter_fault(rt_server *s, lag_result r)
     rt_publish_status(s);
 }
 
+/* The effects' events of the last period (impact, limit, saturation, ...), with the sim
+ * time the step located them at. */
+static void publish_effect_events(rt_server *s)
+{
+    lag_event ev;
+    while (lag_sim_poll_event(&s->sim, &ev)) {
+        const char *joint = ev.joint >= 0 && ev.joint < s->nq ? s->info->joint_names[ev.joint] : "";
+        char detail[96];
+        snprintf(detail, sizeof detail, "%s at t = %.9g s", lag_event_kind_name(ev.kind), ev.t);
+        rt_publish_event_at(s, ev.t, lag_event_kind_name(ev.kind), joint, ev.value, detail);
+    }
+    if (s->sim.events_dropped > s->effect_events_dropped) {
+        eventf(s, "events_dropped", "", (double)(s->sim.events_dropped - s->effect_events_dropped),
+               "%lld effect events dropped (more than the step records per period)",
+               (long long)(s->sim.events_dropped - s->effect_events_dropped));
+        s->effect_events_dropped = s->sim.events_dropped;
+    }
+}
+
 /* ---------------------------------------------------------------- one control period */
 /* Watchdog, held input, ticks_per_period ticks, checks, state publication.
  * Returns false on a numeric fault (state not published). No allocation. */
@@ -135,6 +154,7 @@ static bool rt_period(rt_server *s)
     s->step_us_n++;
     s->ticks_since_status += sc->ticks_per_period;
 
+    publish_effect_events(s);
     if (r != LAG_OK || !state_finite(&s->sim)) {
         enter_fault(s, r);
         return false;
@@ -227,6 +247,7 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
 static void do_reset(rt_server *s, const double *q, const double *qd, const char *what)
 {
     lag_sim_reset(&s->sim, q, qd);
+    s->effect_events_dropped = s->sim.events_dropped;
     for (int i = 0; i < s->nq; i++) s->held[i] = 0.0;
     s->have_command = false;
     s->watchdog_tripped = false;

@@ -9,6 +9,10 @@
  * stops at period ends exactly as the server does, and compares q and qd. A state whose
  * step goes back (a reset), or that differs at the same step, starts over from it.
  *
+ * Published states carry the noise effect (lag_sim_observe) and the applied effort
+ * (tau_applied); the replay compares observed with observed. With actuator lag,
+ * disturbances or noise the log does not pin the run down exactly: the replay says so.
+ *
  * For a run of the same scene and build recorded from its start (logger started before
  * the daemon), every difference is exactly 0: the daemon and the replay make the same
  * floating-point operations in the same order.
@@ -70,8 +74,10 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         }
         int64_t dticks = have ? m.step - sim.tick : -1;
         bool same = dticks == 0;
+        double sq[LAG_MAX_DOF], sqd[LAG_MAX_DOF];
+        lag_sim_observe(&sim, sq, sqd);
         for (int i = 0; same && i < nq; i++)
-            same = sim.q[i] == m.position[i] && sim.qd[i] == m.velocity[i];
+            same = sq[i] == m.position[i] && sqd[i] == m.velocity[i];
         if (dticks < 0 || (dticks == 0 && !same)) {
             /* first state, or a reset: start over from the logged state */
             lag_sim_reset(&sim, m.position, m.velocity);
@@ -87,8 +93,10 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
                     r = lag_sim_advance(&sim, left < tpp ? left : tpp, false);
                 if (r != LAG_OK) errors++;
             }
+            double oq[LAG_MAX_DOF], oqd[LAG_MAX_DOF];
+            lag_sim_observe(&sim, oq, oqd); /* as the daemon published it (noise effect) */
             for (int i = 0; i < nq; i++) {
-                double a = fabs(sim.q[i] - m.position[i]), b = fabs(sim.qd[i] - m.velocity[i]);
+                double a = fabs(oq[i] - m.position[i]), b = fabs(oqd[i] - m.velocity[i]);
                 if (!(a <= max_dq)) max_dq = a; /* NaN propagates as the max */
                 if (!(b <= max_dqd)) max_dqd = b;
             }
@@ -103,6 +111,12 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         fprintf(stderr, "lagsimd: --replay: no %s messages in %s\n", channel, log_path);
         return LAGSIMD_EXIT_RUNTIME;
     }
+    uint32_t inexact = sc->sim.effects.enabled &
+                       (LAG_EFF_ACTUATOR | LAG_EFF_DISTURBANCE | LAG_EFF_NOISE);
+    if (inexact)
+        printf("note: this scene has actuator, disturbance or noise effects: the logged "
+               "effort (applied, after lag and disturbances) and the logged state (with "
+               "noise) do not determine the run exactly; the difference is approximate\n");
     double max_diff = max_dq > max_dqd || isnan(max_dq) ? max_dq : max_dqd;
     printf("replay %s: %lld states compared on %s (%lld restarts at resets, %lld gaps, "
            "%lld undecodable, %lld integrator errors)\n",

@@ -100,6 +100,7 @@ typedef struct rt_server {
     int64_t lockstep_timeouts;
     int64_t numeric_faults;
     int64_t states_published;
+    int64_t effect_events_dropped; /* sim.events_dropped already reported */
 
     /* timing */
     int64_t start_ns;
@@ -134,6 +135,9 @@ void rt_publish_state(rt_server *s);
 void rt_publish_status(rt_server *s);
 void rt_publish_event(rt_server *s, const char *kind, const char *joint, double value,
                       const char *detail);
+/* An event that happened at a given sim time (the effects' events, located in a tick). */
+void rt_publish_event_at(rt_server *s, double sim_time, const char *kind, const char *joint,
+                         double value, const char *detail);
 void rt_publish_scene(rt_server *s);
 const char *rt_run_name(rt_run r);
 

@@ -156,12 +156,17 @@ void rt_publish_state(rt_server *s)
     char *names[LAG_MAX_DOF];
     double pos[LAG_MAX_DOF], vel[LAG_MAX_DOF], eff[LAG_MAX_DOF];
     joint_names(s, names);
+    /* the state as published: plus the noise effect when the scene turns it on */
+    lag_sim_observe(&s->sim, pos, vel);
     for (int i = 0; i < s->nq; i++) {
         /* the caller checked finiteness (a non-finite state is a fault, never published);
          * fin() is the last line of defence */
-        pos[i] = fin(s->sim.q[i]);
-        vel[i] = fin(s->sim.qd[i]);
-        eff[i] = fin(s->sim.tau[i]);
+        pos[i] = fin(pos[i]);
+        vel[i] = fin(vel[i]);
+        /* the effort applied over the last tick: after actuator lag and saturation, plus
+         * disturbance forces, zero where unactuated; without those effects it is exactly
+         * the held command */
+        eff[i] = fin(s->sim.tau_applied[i]);
     }
     lagsim_joint_state_t m = {
         .utime = rt_wall_us(),
@@ -223,9 +228,15 @@ void rt_publish_status(rt_server *s)
 void rt_publish_event(rt_server *s, const char *kind, const char *joint, double value,
                       const char *detail)
 {
+    rt_publish_event_at(s, lag_sim_time(&s->sim), kind, joint, value, detail);
+}
+
+void rt_publish_event_at(rt_server *s, double sim_time, const char *kind, const char *joint,
+                         double value, const char *detail)
+{
     lagsim_event_t m = {
         .utime = rt_wall_us(),
-        .sim_time = fin(lag_sim_time(&s->sim)),
+        .sim_time = fin(sim_time),
         .step = s->sim.tick,
         .kind = (char *)kind,
         .joint = (char *)(joint ? joint : ""),

@@ -1,0 +1,839 @@
+/*
+ * End-to-end tests of the real-time LCM server (lagsimd) over real LCM (the default
+ * udpm URL, ttl=0: loopback only). Each case starts lagsimd as a child with a unique
+ * channel prefix, talks to it with the raw LCM C API and the generated types, and always
+ * kills it at the end (SIGKILL on our own death too: PR_SET_PDEATHSIG).
+ *
+ *   server_test LAGSIMD CASE      CASE: control hostile watchdog lockstep_timeout
+ *                                       two_daemons fault replay sigterm bad_scene
+ *
+ * Expected states are computed independently of the daemon's loop: a lag_sim of the same
+ * scene (loaded with lag_scene_load, as the daemon does) advanced from the published state
+ * with the efforts the test sent. Exits 0 on success, 1 with a message on the first
+ * failed ENSURE.
+ */
+#include <errno.h>
+#include <math.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <lcm/lcm.h>
+#include "scene.h"
+#include "lagsim/lagsim_control_t.h"
+#include "lagsim/lagsim_event_t.h"
+#include "lagsim/lagsim_joint_command_t.h"
+#include "lagsim/lagsim_joint_state_t.h"
+#include "lagsim/lagsim_scene_t.h"
+#include "lagsim/lagsim_status_t.h"
+
+static const char *g_case = "?";
+static pid_t g_children[4];
+static int g_nchildren;
+
+static void kill_children(void)
+{
+    for (int i = 0; i < g_nchildren; i++)
+        if (g_children[i] > 0) {
+            kill(g_children[i], SIGKILL);
+            waitpid(g_children[i], NULL, 0);
+        }
+}
+
+#define ENSURE(c) do { if (!(c)) fail(__LINE__, "%s", #c); } while (0)
+#define ENSUREF(c, ...) do { if (!(c)) fail(__LINE__, __VA_ARGS__); } while (0)
+static void fail(int line, const char *fmt, ...) __attribute__((format(printf, 2, 3), noreturn));
+static void fail(int line, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "server_test %s: FAIL line %d: ", g_case, line);
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "\n");
+    va_end(ap);
+    kill_children();
+    exit(1);
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---------------------------------------------------------------- children */
+static pid_t spawn(char *const argv[], bool quiet)
+{
+    pid_t pid = fork();
+    if (pid == 0) {
+        prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (quiet) {
+            FILE *f = freopen("/dev/null", "w", stdout);
+            (void)f;
+        }
+        execv(argv[0], argv);
+        execvp(argv[0], argv);
+        _exit(127);
+    }
+    ENSURE(pid > 0);
+    g_children[g_nchildren++] = pid;
+    return pid;
+}
+
+/* Waits up to timeout s for the child; returns its exit code, or -1 (then kills it). */
+static int reap(pid_t pid, double timeout)
+{
+    double t_end = now_s() + timeout;
+    int st;
+    for (;;) {
+        pid_t r = waitpid(pid, &st, WNOHANG);
+        if (r == pid) break;
+        if (now_s() > t_end) {
+            kill(pid, SIGKILL);
+            waitpid(pid, &st, 0);
+            st = -1;
+            break;
+        }
+        usleep(10000);
+    }
+    for (int i = 0; i < g_nchildren; i++)
+        if (g_children[i] == pid) g_children[i] = 0;
+    if (st == -1) return -1;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+}
+
+/* ---------------------------------------------------------------- a client */
+#define MAX_EVENTS 4096
+#define MAX_REC 4096
+typedef struct rec_state {
+    int64_t step;
+    double t, q[LAG_MAX_DOF], qd[LAG_MAX_DOF], eff[LAG_MAX_DOF];
+} rec_state;
+
+typedef struct client {
+    lcm_t *lcm;
+    char prefix[64];
+    char ch_state[96], ch_command[96], ch_control[96];
+    int nq;
+    /* latest state, all states ever non-finite? */
+    int64_t n_states;
+    rec_state last;
+    bool nonfinite_seen;
+    double max_abs; /* largest |q| or |qd| seen */
+    /* status */
+    int64_t n_status;
+    lagsim_status_t *status;
+    /* events */
+    int n_events;
+    char ev_kind[MAX_EVENTS][32];
+    double ev_time[MAX_EVENTS];
+    /* scene */
+    int64_t n_scene;
+    lagsim_scene_t *scene;
+    /* lockstep controller (replay case): answers each state, records it */
+    bool controller;
+    int n_rec;
+    rec_state rec[MAX_REC];
+} client;
+
+static void on_state(const lcm_recv_buf_t *rb, const char *ch, const lagsim_joint_state_t *m,
+                     void *u)
+{
+    (void)rb; (void)ch;
+    client *c = u;
+    c->n_states++;
+    rec_state r = {.step = m->step, .t = m->sim_time};
+    for (int i = 0; i < m->num_joints && i < LAG_MAX_DOF; i++) {
+        r.q[i] = m->position[i];
+        r.qd[i] = m->velocity[i];
+        r.eff[i] = m->effort[i];
+        if (!isfinite(r.q[i]) || !isfinite(r.qd[i]) || !isfinite(r.eff[i])) c->nonfinite_seen = true;
+        if (fabs(r.q[i]) > c->max_abs) c->max_abs = fabs(r.q[i]);
+        if (fabs(r.qd[i]) > c->max_abs) c->max_abs = fabs(r.qd[i]);
+    }
+    if (!isfinite(r.t)) c->nonfinite_seen = true;
+    c->last = r;
+    if (c->controller) {
+        if (c->n_rec < MAX_REC) c->rec[c->n_rec++] = r;
+        /* a deterministic controller: PD on the cart and the lower rod plus a sinusoid */
+        double u_eff = -2.0 * r.q[0] - 1.0 * r.qd[0] + 3.0 * r.q[1] + 0.5 * sin(7.0 * r.t);
+        char *names[1] = {"theta0"};
+        lagsim_joint_command_t cmd = {0, r.t, 1, names, &u_eff};
+        lagsim_joint_command_t_publish(c->lcm, c->ch_command, &cmd);
+    }
+}
+
+static void on_status(const lcm_recv_buf_t *rb, const char *ch, const lagsim_status_t *m, void *u)
+{
+    (void)rb; (void)ch;
+    client *c = u;
+    if (c->status) lagsim_status_t_destroy(c->status);
+    c->status = lagsim_status_t_copy(m);
+    c->n_status++;
+    if (!isfinite(m->sim_time) || !isfinite(m->rtf) || !isfinite(m->energy)) c->nonfinite_seen = true;
+}
+
+static void on_event(const lcm_recv_buf_t *rb, const char *ch, const lagsim_event_t *m, void *u)
+{
+    (void)rb; (void)ch;
+    client *c = u;
+    if (!isfinite(m->sim_time) || !isfinite(m->value)) c->nonfinite_seen = true;
+    if (c->n_events < MAX_EVENTS) {
+        snprintf(c->ev_kind[c->n_events], 32, "%s", m->kind);
+        c->ev_time[c->n_events] = m->sim_time;
+        c->n_events++;
+    }
+}
+
+static void on_scene(const lcm_recv_buf_t *rb, const char *ch, const lagsim_scene_t *m, void *u)
+{
+    (void)rb; (void)ch;
+    client *c = u;
+    if (c->scene) lagsim_scene_t_destroy(c->scene);
+    c->scene = lagsim_scene_t_copy(m);
+    c->n_scene++;
+}
+
+static void client_init(client *c, const char *prefix, int nq)
+{
+    memset(c, 0, sizeof *c);
+    c->lcm = lcm_create(NULL);
+    ENSUREF(c->lcm, "lcm_create(NULL) failed: no multicast on loopback?");
+    snprintf(c->prefix, sizeof c->prefix, "%s", prefix);
+    c->nq = nq;
+    char ch[96];
+    snprintf(c->ch_state, sizeof c->ch_state, "%s_STATE", prefix);
+    snprintf(c->ch_command, sizeof c->ch_command, "%s_COMMAND", prefix);
+    snprintf(c->ch_control, sizeof c->ch_control, "%s_CONTROL", prefix);
+    lagsim_joint_state_t_subscription_t *ss =
+        lagsim_joint_state_t_subscribe(c->lcm, c->ch_state, on_state, c);
+    lagsim_joint_state_t_subscription_set_queue_capacity(ss, 100000);
+    snprintf(ch, sizeof ch, "%s_STATUS", prefix);
+    lagsim_status_t_subscribe(c->lcm, ch, on_status, c);
+    snprintf(ch, sizeof ch, "%s_EVENT", prefix);
+    lagsim_event_t_subscription_t *es = lagsim_event_t_subscribe(c->lcm, ch, on_event, c);
+    lagsim_event_t_subscription_set_queue_capacity(es, 100000);
+    snprintf(ch, sizeof ch, "%s_SCENE", prefix);
+    lagsim_scene_t_subscribe(c->lcm, ch, on_scene, c);
+}
+
+static void pump(client *c, double seconds)
+{
+    double t_end = now_s() + seconds;
+    for (double t = now_s(); t < t_end; t = now_s()) {
+        int ms = (int)((t_end - t) * 1000) + 1;
+        lcm_handle_timeout(c->lcm, ms);
+    }
+}
+
+/* Pumps until cond(c, arg) or timeout; fails the test on timeout. */
+#define WAIT_FOR(c, cond, timeout)                                                  \
+    do {                                                                            \
+        double t_end_ = now_s() + (timeout);                                        \
+        while (!(cond)) {                                                           \
+            ENSUREF(now_s() < t_end_, "timed out waiting for %s", #cond);           \
+            lcm_handle_timeout((c)->lcm, 20);                                       \
+        }                                                                           \
+    } while (0)
+
+static int count_events(const client *c, const char *kind)
+{
+    int n = 0;
+    for (int i = 0; i < c->n_events; i++) n += strcmp(c->ev_kind[i], kind) == 0;
+    return n;
+}
+
+static void control(client *c, int req, int64_t count, int n, double *q, double *qd)
+{
+    lagsim_control_t m = {0, (int8_t)req, count, (int16_t)n, q, qd};
+    lagsim_control_t_publish(c->lcm, c->ch_control, &m);
+}
+
+static void command(client *c, double sim_time, int n, const char **names, double *eff)
+{
+    lagsim_joint_command_t m = {0, sim_time, (int16_t)n, (char **)names, eff};
+    lagsim_joint_command_t_publish(c->lcm, c->ch_command, &m);
+}
+
+/* Asks for a fresh status and waits for it. */
+static void fresh_status(client *c)
+{
+    int64_t n0 = c->n_status;
+    control(c, LAGSIM_CONTROL_T_STATUS, 0, 0, NULL, NULL);
+    WAIT_FOR(c, c->n_status > n0, 3.0);
+}
+
+/* ---------------------------------------------------------------- scenes */
+static char g_lagsimd[512];
+static char g_scene_path[256];
+static char g_prefix[64];
+
+static void write_scene(const char *text)
+{
+    snprintf(g_scene_path, sizeof g_scene_path, "/tmp/lagsim_server_test_%d_%s.yaml",
+             (int)getpid(), g_case);
+    FILE *f = fopen(g_scene_path, "w");
+    ENSURE(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* Starts lagsimd on g_scene_path with prefix and extra --set arguments (NULL-ended). */
+static pid_t start_daemon(const char *prefix, ...)
+{
+    char *argv[40];
+    static char sets[20][128];
+    int n = 0, k = 0;
+    argv[n++] = g_lagsimd;
+    argv[n++] = "--config";
+    argv[n++] = g_scene_path;
+    argv[n++] = "-q";
+    snprintf(sets[k], sizeof sets[k], "lcm.prefix=%s", prefix);
+    argv[n++] = "--set";
+    argv[n++] = sets[k++];
+    va_list ap;
+    va_start(ap, prefix);
+    for (const char *a = va_arg(ap, const char *); a && n < 38; a = va_arg(ap, const char *))
+        argv[n++] = (char *)a;
+    va_end(ap);
+    argv[n] = NULL;
+    return spawn(argv, false);
+}
+
+/* The same scene, loaded as the daemon loads it, for reference simulations. */
+static void load_ref(lag_scene *sc, const char *prefix)
+{
+    char err[512], set[128];
+    snprintf(set, sizeof set, "lcm.prefix=%s", prefix);
+    const char *sets[1] = {set};
+    ENSUREF(lag_scene_load(g_scene_path, sets, 1, sc, err, sizeof err) == 0, "%s", err);
+}
+
+/* Reference: from a published state, `periods` control periods with effort tau. */
+static void ref_advance(const lag_scene *sc, const rec_state *from, const double *tau,
+                        int periods, lag_sim *out)
+{
+    char err[256];
+    ENSURE(lag_sim_init(out, &sc->sim, err, sizeof err) == LAG_OK);
+    lag_sim_reset(out, from->q, from->qd);
+    out->tick = from->step;
+    for (int k = 0; k < periods; k++) {
+        lag_sim_set_input(out, tau);
+        ENSURE(lag_sim_advance(out, sc->ticks_per_period, false) == LAG_OK);
+    }
+}
+
+static void ensure_state_equals(const client *c, const lag_sim *ref)
+{
+    ENSUREF(c->last.step == ref->tick, "step %lld, expected %lld", (long long)c->last.step,
+            (long long)ref->tick);
+    for (int i = 0; i < c->nq; i++) {
+        ENSUREF(c->last.q[i] == ref->q[i] && c->last.qd[i] == ref->qd[i],
+                "joint %d: q %.17g qd %.17g, expected %.17g %.17g", i, c->last.q[i],
+                c->last.qd[i], ref->q[i], ref->qd[i]);
+        ENSUREF(c->last.eff[i] == ref->tau[i], "joint %d effort %g, expected %g", i,
+                c->last.eff[i], ref->tau[i]);
+    }
+}
+
+static const char *DIPC_MOVING =
+    "model: dipc\n"
+    "initial:\n"
+    "  q: [0, 0.1, -0.05]\n"
+    "publish_hz: 100\n";
+
+/* ---------------------------------------------------------------- cases */
+/* pause / step / reset / reset_to / resume / describe do what they say. */
+static void case_control(void)
+{
+    write_scene(DIPC_MOVING);
+    client c;
+    client_init(&c, g_prefix, 3);
+    pid_t d = start_daemon(g_prefix, NULL);
+    lag_scene sc;
+    load_ref(&sc, g_prefix);
+    WAIT_FOR(&c, c.n_scene > 0 && c.last.t > 0.1, 5.0);
+    ENSURE(strcmp(c.scene->model, "dipc") == 0 && c.scene->num_joints == 3);
+    ENSURE(strcmp(c.scene->joint_name[0], "theta0") == 0 && c.scene->actuated[0] &&
+           !c.scene->actuated[1] && !c.scene->actuated[2]);
+    ENSURE(fabs(c.scene->control_period - 0.01) < 1e-15 && c.scene->dt == sc.sim.integrator.dt);
+    ENSURE(count_events(&c, "start") == 1);
+
+    /* pause: sim time stops, the same state keeps being published */
+    control(&c, LAGSIM_CONTROL_T_PAUSE, 0, 0, NULL, NULL);
+    WAIT_FOR(&c, count_events(&c, "pause") == 1, 3.0);
+    pump(&c, 0.1);
+    rec_state held = c.last;
+    int64_t n0 = c.n_states;
+    pump(&c, 0.3);
+    ENSUREF(c.n_states >= n0 + 10, "paused: %lld states republished in 0.3 s",
+            (long long)(c.n_states - n0));
+    ENSURE(c.last.step == held.step && c.last.q[1] == held.q[1] && c.last.qd[1] == held.qd[1]);
+    fresh_status(&c);
+    ENSURE(strcmp(c.status->run_state, "paused") == 0 && c.status->rtf == 0);
+
+    /* step 5 while paused: exactly 5 periods, state = an independent re-simulation */
+    double zero[3] = {0, 0, 0};
+    lag_sim ref;
+    ref_advance(&sc, &held, zero, 5, &ref);
+    control(&c, LAGSIM_CONTROL_T_STEP, 5, 0, NULL, NULL);
+    WAIT_FOR(&c, count_events(&c, "step_done") == 1, 3.0);
+    pump(&c, 0.05);
+    ensure_state_equals(&c, &ref);
+    ENSURE(c.last.step == held.step + 5 * sc.ticks_per_period);
+
+    /* reset: back to the scene's initial state at t = 0 */
+    control(&c, LAGSIM_CONTROL_T_RESET, 0, 0, NULL, NULL);
+    WAIT_FOR(&c, count_events(&c, "reset") == 1, 3.0);
+    pump(&c, 0.05);
+    ENSURE(c.last.step == 0 && c.last.t == 0.0);
+    ENSURE(c.last.q[0] == 0.0 && c.last.q[1] == 0.1 && c.last.q[2] == -0.05);
+    ENSURE(c.last.qd[0] == 0.0 && c.last.qd[1] == 0.0 && c.last.qd[2] == 0.0);
+
+    /* reset_to a given state */
+    double q[3] = {0.2, -0.3, 0.4}, qd[3] = {0.1, 0.0, -0.2};
+    control(&c, LAGSIM_CONTROL_T_RESET_TO, 0, 3, q, qd);
+    WAIT_FOR(&c, count_events(&c, "reset") == 2, 3.0);
+    pump(&c, 0.05);
+    ENSURE(c.last.step == 0 && c.last.t == 0.0);
+    for (int i = 0; i < 3; i++) ENSURE(c.last.q[i] == q[i] && c.last.qd[i] == qd[i]);
+    ref_advance(&sc, &c.last, zero, 2, &ref);
+    control(&c, LAGSIM_CONTROL_T_STEP, 2, 0, NULL, NULL);
+    WAIT_FOR(&c, count_events(&c, "step_done") == 2, 3.0);
+    pump(&c, 0.05);
+    ensure_state_equals(&c, &ref);
+
+    /* nonsense is rejected and counted, and changes nothing */
+    rec_state before = c.last;
+    double qbad[3] = {0, NAN, 0};
+    control(&c, LAGSIM_CONTROL_T_RESET_TO, 0, 2, q, qd);     /* wrong length */
+    control(&c, LAGSIM_CONTROL_T_RESET_TO, 0, 3, qbad, qd);  /* NaN */
+    control(&c, LAGSIM_CONTROL_T_STEP, 0, 0, NULL, NULL);    /* count < 1 */
+    control(&c, 99, 0, 0, NULL, NULL);                       /* unknown request */
+    WAIT_FOR(&c, count_events(&c, "control_rejected") == 4, 3.0);
+    fresh_status(&c);
+    ENSURE(c.status->controls_rejected == 4);
+    ENSURE(c.last.step == before.step && c.last.q[1] == before.q[1]);
+
+    /* resume: time advances again; step is refused while running */
+    control(&c, LAGSIM_CONTROL_T_RESUME, 0, 0, NULL, NULL);
+    WAIT_FOR(&c, count_events(&c, "resume") == 1, 3.0);
+    WAIT_FOR(&c, c.last.step > before.step + 10 * sc.ticks_per_period, 3.0);
+    control(&c, LAGSIM_CONTROL_T_STEP, 3, 0, NULL, NULL);
+    WAIT_FOR(&c, count_events(&c, "control_rejected") == 5, 3.0);
+
+    /* describe: a fresh scene description */
+    int64_t ns = c.n_scene;
+    control(&c, LAGSIM_CONTROL_T_DESCRIBE, 0, 0, NULL, NULL);
+    WAIT_FOR(&c, c.n_scene > ns, 3.0);
+    ENSURE(!c.nonfinite_seen);
+    kill(d, SIGTERM);
+    ENSURE(reap(d, 5.0) == 0);
+}
+
+/* ---- raw payloads for hostile commands */
+static size_t put_be(uint8_t *b, size_t pos, uint64_t v, int n)
+{
+    for (int i = n - 1; i >= 0; i--) b[pos++] = (uint8_t)(v >> (8 * i));
+    return pos;
+}
+static size_t raw_header(uint8_t *b, int16_t num_joints)
+{
+    size_t p = put_be(b, 0, (uint64_t)__lagsim_joint_command_t_get_hash(), 8);
+    p = put_be(b, p, 0, 8);          /* utime */
+    p = put_be(b, p, 0, 8);          /* sim_time 0.0 */
+    return put_be(b, p, (uint16_t)num_joints, 2);
+}
+static void publish_raw(client *c, const uint8_t *b, size_t n)
+{
+    lcm_publish(c->lcm, c->ch_command, b, (unsigned)n);
+}
+
+/* Malformed and hostile commands are rejected and counted by reason; the state stays
+ * finite and is unchanged by them. */
+static void case_hostile(void)
+{
+    write_scene(DIPC_MOVING);
+    client c;
+    client_init(&c, g_prefix, 3);
+    pid_t d = start_daemon(g_prefix, "--set", "realtime.command_timeout=1000", NULL);
+    lag_scene sc;
+    load_ref(&sc, g_prefix);
+    WAIT_FOR(&c, c.n_states > 0, 5.0);
+    control(&c, LAGSIM_CONTROL_T_PAUSE, 0, 0, NULL, NULL);
+    WAIT_FOR(&c, count_events(&c, "pause") == 1, 3.0);
+
+    const char *n0[] = {"theta0"};
+    double e15[] = {1.5};
+    command(&c, 0, 1, n0, e15); /* the one good command */
+    pump(&c, 0.05);
+
+    int exp_unknown = 0, exp_unact = 0, exp_nonfin = 0, exp_len = 0, exp_undec = 0;
+#define SEND(stmt, counter) do { stmt; counter++; pump(&c, 0.005); } while (0)
+    const char *unk[] = {"theta9"}, *mix[] = {"theta0", "bogus"}, *un1[] = {"theta1"},
+               *un2[] = {"theta2"}, *four[] = {"theta0", "theta1", "theta2", "theta3"},
+               *dup[] = {"theta0", "theta0"}, *empty[] = {""};
+    double e1[] = {1.0}, e2[] = {9.0, 9.0}, e4[] = {1, 1, 1, 1};
+    double enan[] = {NAN}, einf[] = {INFINITY}, eninf[] = {-INFINITY};
+    SEND(command(&c, 0, 1, unk, e1), exp_unknown);
+    SEND(command(&c, 0, 2, mix, e2), exp_unknown);   /* one good name does not save it */
+    SEND(command(&c, 0, 1, empty, e1), exp_unknown);
+    SEND(command(&c, 0, 1, un1, e1), exp_unact);
+    SEND(command(&c, 0, 1, un2, e1), exp_unact);
+    SEND(command(&c, 0, 1, n0, enan), exp_nonfin);
+    SEND(command(&c, 0, 1, n0, einf), exp_nonfin);
+    SEND(command(&c, 0, 1, n0, eninf), exp_nonfin);
+    SEND(command(&c, 0, 4, four, e4), exp_len);
+    SEND(command(&c, 0, 2, dup, e2), exp_len);
+    uint8_t b[256];
+    size_t p;
+    p = raw_header(b, -1);
+    SEND(publish_raw(&c, b, p), exp_len);             /* negative num_joints */
+    p = raw_header(b, 30000);
+    SEND(publish_raw(&c, b, p), exp_len);             /* absurd num_joints */
+    SEND(publish_raw(&c, (const uint8_t *)"abc", 3), exp_undec);
+    memset(b, 0xA5, sizeof b);
+    SEND(publish_raw(&c, b, 200), exp_undec);         /* wrong fingerprint */
+    p = raw_header(b, 1);
+    SEND(publish_raw(&c, b, p), exp_undec);           /* truncated: no name */
+    p = raw_header(b, 1);
+    p = put_be(b, p, (uint32_t)-5, 4);                /* negative string length */
+    SEND(publish_raw(&c, b, p + 16), exp_undec);
+    p = raw_header(b, 1);
+    p = put_be(b, p, 0x7fffffff, 4);                  /* string longer than the payload */
+    SEND(publish_raw(&c, b, p + 16), exp_undec);
+    p = raw_header(b, 1);
+    p = put_be(b, p, 7, 4);
+    memcpy(b + p, "theta0X", 7);                      /* no terminating NUL */
+    p = put_be(b, p + 7, 0, 8);
+    SEND(publish_raw(&c, b, p), exp_undec);
+    p = raw_header(b, 1);
+    p = put_be(b, p, 7, 4);
+    memcpy(b + p, "theta0", 7);                       /* good name, effort cut short */
+    SEND(publish_raw(&c, b, p + 7 + 4), exp_undec);
+#undef SEND
+    pump(&c, 0.2);
+    fresh_status(&c);
+    lagsim_status_t *st = c.status;
+    ENSURE(st->commands_accepted == 1);
+    ENSUREF(st->rejected_unknown_joint == exp_unknown, "unknown %lld", (long long)st->rejected_unknown_joint);
+    ENSUREF(st->rejected_unactuated == exp_unact, "unact %lld", (long long)st->rejected_unactuated);
+    ENSUREF(st->rejected_nonfinite == exp_nonfin, "nonfin %lld", (long long)st->rejected_nonfinite);
+    ENSUREF(st->rejected_bad_length == exp_len, "len %lld", (long long)st->rejected_bad_length);
+    ENSUREF(st->rejected_undecodable == exp_undec, "undec %lld", (long long)st->rejected_undecodable);
+    ENSURE(count_events(&c, "command_rejected") >= 10); /* rate limited: 10 per second */
+
+    /* the state moved only by the good command */
+    double tau[3] = {1.5, 0, 0};
+    lag_sim ref;
+    ref_advance(&sc, &c.last, tau, 3, &ref);
+    control(&c, LAGSIM_CONTROL_T_STEP, 3, 0, NULL, NULL);
+    WAIT_FOR(&c, count_events(&c, "step_done") == 1, 3.0);
+    pump(&c, 0.05);
+    ensure_state_equals(&c, &ref);
+
+    /* a flood: thousands of bad commands as fast as we can send them */
+    int64_t rej0 = st->rejected_undecodable + st->rejected_nonfinite;
+    for (int i = 0; i < 3000; i++) {
+        publish_raw(&c, (const uint8_t *)"garbage!", 8);
+        command(&c, 0, 1, n0, enan);
+        if (i % 200 == 0) lcm_handle_timeout(c.lcm, 0);
+    }
+    pump(&c, 0.5);
+    fresh_status(&c);
+    st = c.status;
+    int64_t flood = st->rejected_undecodable + st->rejected_nonfinite - rej0;
+    ENSUREF(flood > 1000 && flood <= 6000, "flood: %lld of 6000 counted", (long long)flood);
+    ENSURE(st->commands_accepted == 1);
+    ref_advance(&sc, &c.last, tau, 2, &ref);
+    control(&c, LAGSIM_CONTROL_T_STEP, 2, 0, NULL, NULL);
+    WAIT_FOR(&c, count_events(&c, "step_done") == 2, 3.0);
+    pump(&c, 0.05);
+    ensure_state_equals(&c, &ref);
+    ENSURE(!c.nonfinite_seen);
+    printf("hostile: flood of 6000 bad commands: %lld counted (rest dropped by the socket)\n",
+           (long long)flood);
+    kill(d, SIGTERM);
+    ENSURE(reap(d, 5.0) == 0);
+}
+
+/* The watchdog zeroes a stale command's effort, with an event and a status flag; the next
+ * good command clears it. */
+static void case_watchdog(void)
+{
+    write_scene(DIPC_MOVING);
+    client c;
+    client_init(&c, g_prefix, 3);
+    pid_t d = start_daemon(g_prefix, "--set", "realtime.command_timeout=0.2", NULL);
+    WAIT_FOR(&c, c.n_states > 0, 5.0);
+    const char *n0[] = {"theta0"};
+    double e2[] = {2.0}, e3[] = {3.0};
+    command(&c, 0, 1, n0, e2);
+    WAIT_FOR(&c, c.last.eff[0] == 2.0, 3.0);
+    double t_applied = c.last.t;
+    WAIT_FOR(&c, count_events(&c, "watchdog_trip") == 1, 3.0);
+    int k = 0;
+    while (strcmp(c.ev_kind[k], "watchdog_trip") != 0) k++;
+    /* tripped after command_timeout of sim time, within one period more (+ arrival) */
+    double age = c.ev_time[k] - t_applied;
+    ENSUREF(age > 0.19 && age < 0.25, "watchdog tripped after %g s", age);
+    pump(&c, 0.1);
+    ENSURE(c.last.eff[0] == 0.0);
+    fresh_status(&c);
+    ENSURE(c.status->watchdog_tripped && c.status->watchdog_trips == 1);
+    command(&c, 0, 1, n0, e3);
+    WAIT_FOR(&c, count_events(&c, "watchdog_clear") == 1, 3.0);
+    WAIT_FOR(&c, c.last.eff[0] == 3.0, 3.0);
+    fresh_status(&c);
+    ENSURE(!c.status->watchdog_tripped && c.status->watchdog_trips == 1);
+    ENSURE(!c.nonfinite_seen);
+    kill(d, SIGTERM);
+    ENSURE(reap(d, 5.0) == 0);
+}
+
+/* Lockstep without a controller: each wait ends after lockstep_timeout with an event,
+ * and the sim goes on one period at a time. */
+static void case_lockstep_timeout(void)
+{
+    write_scene(DIPC_MOVING);
+    client c;
+    client_init(&c, g_prefix, 3);
+    pid_t d = start_daemon(g_prefix, "--set", "realtime.mode=lockstep", "--set",
+                           "realtime.lockstep_timeout=0.05", NULL);
+    WAIT_FOR(&c, count_events(&c, "lockstep_timeout") >= 4, 5.0);
+    fresh_status(&c);
+    ENSURE(c.status->lockstep_timeouts >= 4);
+    ENSURE(strcmp(c.status->mode, "lockstep") == 0);
+    /* one period per timeout: the step count follows the timeouts (+ the one pending) */
+    int64_t periods = c.status->step / 10; /* 10 ticks per period at 1 ms, 100 Hz */
+    ENSUREF(periods >= c.status->lockstep_timeouts - 1 && periods <= c.status->lockstep_timeouts + 1,
+            "%lld periods for %lld timeouts", (long long)periods, (long long)c.status->lockstep_timeouts);
+    kill(d, SIGTERM);
+    ENSURE(reap(d, 5.0) == 0);
+}
+
+/* Two daemons with different prefixes do not hear each other. */
+static void case_two_daemons(void)
+{
+    write_scene(DIPC_MOVING);
+    char pa[80], pb[80];
+    snprintf(pa, sizeof pa, "%sA", g_prefix);
+    snprintf(pb, sizeof pb, "%sB", g_prefix);
+    client a, b;
+    client_init(&a, pa, 3);
+    client_init(&b, pb, 3);
+    pid_t da = start_daemon(pa, NULL);
+    pid_t db = start_daemon(pb, NULL);
+    WAIT_FOR(&a, a.n_states > 0, 5.0);
+    WAIT_FOR(&b, b.n_states > 0, 5.0);
+    control(&a, LAGSIM_CONTROL_T_PAUSE, 0, 0, NULL, NULL);
+    WAIT_FOR(&a, count_events(&a, "pause") == 1, 3.0);
+    const char *n0[] = {"theta0"};
+    double e5[] = {5.0};
+    command(&a, 0, 1, n0, e5);
+    pump(&a, 0.1);
+    double tb0 = b.last.t;
+    rec_state ha = a.last;
+    pump(&b, 0.3);
+    pump(&a, 0.1);
+    ENSURE(b.last.t > tb0 + 0.2);          /* B was not paused by A's control */
+    ENSURE(b.last.eff[0] == 0.0);          /* nor driven by A's command */
+    ENSURE(a.last.step == ha.step);        /* A stays paused */
+    ENSURE(count_events(&b, "pause") == 0);
+    fresh_status(&a);
+    fresh_status(&b);
+    ENSURE(a.status->commands_accepted == 1 && b.status->commands_accepted == 0);
+    ENSURE(strcmp(a.status->run_state, "paused") == 0 && strcmp(b.status->run_state, "running") == 0);
+    kill(da, SIGTERM);
+    kill(db, SIGTERM);
+    ENSURE(reap(da, 5.0) == 0 && reap(db, 5.0) == 0);
+}
+
+/* A numeric fault pauses in the fault state with an event; no bad state is ever
+ * published; reset recovers. The cart starts at 20 m/s with explode_limit 30 (the rods
+ * upright at rest stay so): |theta0| passes 30 m after 1.5 s. */
+static void case_fault(void)
+{
+    write_scene("model: dipc\n"
+                "initial:\n"
+                "  qd: [20, 0, 0]\n"
+                "explode_limit: 30\n"
+                "publish_hz: 100\n");
+    client c;
+    client_init(&c, g_prefix, 3);
+    pid_t d = start_daemon(g_prefix, NULL);
+    WAIT_FOR(&c, count_events(&c, "numeric_fault") == 1, 5.0);
+    WAIT_FOR(&c, c.status && strcmp(c.status->run_state, "fault") == 0, 3.0);
+    ENSURE(c.status->numeric_faults == 1);
+    ENSUREF(c.max_abs <= 30.0 && c.last.q[0] <= 30.0, "published |x| up to %g, last x %g",
+            c.max_abs, c.last.q[0]);
+    ENSUREF(c.last.t >= 1.4 && c.last.t <= 1.5, "last state published at %g s", c.last.t);
+    int64_t n0 = c.n_states;
+    pump(&c, 0.3);
+    ENSURE(c.n_states == n0); /* nothing more is published in the fault state */
+    control(&c, LAGSIM_CONTROL_T_RESUME, 0, 0, NULL, NULL);
+    WAIT_FOR(&c, count_events(&c, "control_rejected") == 1, 3.0);
+    double q[3] = {0, 0, 0}, qd[3] = {0.5, 0, 0};
+    control(&c, LAGSIM_CONTROL_T_RESET_TO, 0, 3, q, qd);
+    WAIT_FOR(&c, count_events(&c, "reset") == 1, 3.0);
+    pump(&c, 0.05);
+    ENSURE(c.last.step == 0 && c.last.qd[0] == 0.5);
+    fresh_status(&c);
+    ENSURE(strcmp(c.status->run_state, "paused") == 0);
+    control(&c, LAGSIM_CONTROL_T_RESUME, 0, 0, NULL, NULL);
+    WAIT_FOR(&c, c.last.t >= 0.5, 3.0);
+    /* upright at rest with the cart coasting: x = 0.5 t exactly in theory */
+    ENSUREF(fabs(c.last.q[0] - 0.5 * c.last.t) < 1e-9, "x %.17g at t %g", c.last.q[0], c.last.t);
+    ENSURE(count_events(&c, "numeric_fault") == 1);
+    ENSURE(!c.nonfinite_seen);
+    kill(d, SIGTERM);
+    ENSURE(reap(d, 5.0) == 0);
+}
+
+/* Runs one lockstep run of 2 s sim time with the test's deterministic controller.
+ * Returns the number of states recorded into c->rec. */
+static void lockstep_run(client *c, const char *prefix, const char *method)
+{
+    char set_m[96];
+    snprintf(set_m, sizeof set_m, "integrator.method=%s", method);
+    pid_t d = start_daemon(prefix, "--set", "realtime.mode=lockstep", "--set", set_m,
+                           "--duration", "2", NULL);
+    double t_end = now_s() + 30;
+    while (waitpid(d, NULL, WNOHANG) == 0) {
+        ENSURE(now_s() < t_end);
+        lcm_handle_timeout(c->lcm, 20);
+    }
+    for (int i = 0; i < g_nchildren; i++)
+        if (g_children[i] == d) g_children[i] = 0;
+    pump(c, 0.1);
+}
+
+/* lcm-logger records a lockstep run; lagsimd --replay re-simulates it with difference
+ * exactly 0; a second run gives a bit-identical state stream. */
+static void case_replay(const char *logger, const char *method)
+{
+    write_scene(DIPC_MOVING);
+    char log_path[256], chan[96];
+    snprintf(log_path, sizeof log_path, "/tmp/lagsim_server_test_%d_%s.lcm", (int)getpid(), g_case);
+    snprintf(chan, sizeof chan, "%s_.*", g_prefix);
+    char *largv[] = {(char *)logger, "-q", "-f", "-c", chan, log_path, NULL};
+    static client c1, c2;
+    client_init(&c1, g_prefix, 3);
+    c1.controller = true;
+    pid_t lg = spawn(largv, true);
+    usleep(500000); /* the logger subscribes */
+    lockstep_run(&c1, g_prefix, method);
+    usleep(300000);
+    kill(lg, SIGINT);
+    ENSURE(reap(lg, 5.0) >= 0);
+    ENSUREF(c1.n_rec == 201, "%d states in 2 s lockstep at 100 Hz", c1.n_rec);
+    ENSURE(c1.status && c1.status->lockstep_timeouts == 0 && c1.status->commands_accepted == 200);
+    ENSURE(!c1.nonfinite_seen);
+
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "%s --config %s --set lcm.prefix=%s --set integrator.method=%s "
+             "--replay %s", g_lagsimd, g_scene_path, g_prefix, method, log_path);
+    FILE *p = popen(cmd, "r");
+    ENSURE(p);
+    char line[512];
+    long compared = -1;
+    double diff = -1;
+    while (fgets(line, sizeof line, p)) {
+        fputs(line, stdout);
+        char *s = strstr(line, "states compared");
+        if (s && strncmp(line, "replay ", 7) == 0) {
+            char *colon = strstr(line, ": ");
+            if (colon) compared = strtol(colon + 2, NULL, 10);
+        }
+        if (strncmp(line, "max difference = ", 17) == 0) diff = strtod(line + 17, NULL);
+    }
+    ENSURE(pclose(p) == 0);
+    ENSUREF(compared == 200, "replay compared %ld states", compared);
+    ENSUREF(diff == 0.0, "replay difference %.17g", diff);
+
+    /* the same again: bit-identical states */
+    client_init(&c2, g_prefix, 3);
+    c2.controller = true;
+    lockstep_run(&c2, g_prefix, method);
+    ENSURE(c2.n_rec == c1.n_rec);
+    for (int i = 0; i < c1.n_rec; i++)
+        ENSUREF(memcmp(&c1.rec[i], &c2.rec[i], sizeof c1.rec[i]) == 0, "state %d differs", i);
+    /* and the run did something: the controller moved the cart */
+    ENSURE(fabs(c1.rec[c1.n_rec - 1].q[0]) > 1e-3);
+    remove(log_path);
+}
+
+/* SIGTERM: a final status, exit 0. */
+static void case_sigterm(void)
+{
+    write_scene(DIPC_MOVING);
+    client c;
+    client_init(&c, g_prefix, 3);
+    pid_t d = start_daemon(g_prefix, NULL);
+    WAIT_FOR(&c, c.n_states > 5 && c.n_status > 0, 5.0);
+    pump(&c, 0.1);
+    int64_t ns = c.n_status;
+    kill(d, SIGTERM);
+    ENSURE(reap(d, 5.0) == 0);
+    pump(&c, 0.2);
+    ENSURE(c.n_status > ns);
+    ENSURE(count_events(&c, "stop") == 1);
+    ENSURE(c.status->sim_time > 0 && strcmp(c.status->run_state, "running") == 0);
+}
+
+/* A bad scene exits 2 before anything is published. */
+static void case_bad_scene(void)
+{
+    write_scene("model: dipc\nparameters:\n  m0: -1.5\n");
+    client c;
+    client_init(&c, g_prefix, 3);
+    int n_any = 0;
+    pid_t d = start_daemon(g_prefix, NULL);
+    ENSURE(reap(d, 10.0) == 2);
+    write_scene("model: dipc\nrealtime:\n  mode: sometimes\n");
+    d = start_daemon(g_prefix, NULL);
+    ENSURE(reap(d, 10.0) == 2);
+    pump(&c, 0.3);
+    n_any = (int)(c.n_states + c.n_status + c.n_events + c.n_scene);
+    ENSURE(n_any == 0);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 3) {
+        fprintf(stderr, "usage: server_test LAGSIMD CASE [LCM_LOGGER]\n");
+        return 2;
+    }
+    snprintf(g_lagsimd, sizeof g_lagsimd, "%s", argv[1]);
+    g_case = argv[2];
+    /* a prefix unique to this process and case: ctest -j never crosstalks */
+    snprintf(g_prefix, sizeof g_prefix, "LT%d_%.20s", (int)getpid(), g_case);
+    for (char *p = g_prefix; *p; p++)
+        if (*p >= 'a' && *p <= 'z') *p = (char)(*p - 'a' + 'A');
+    signal(SIGPIPE, SIG_IGN);
+    if (!strcmp(g_case, "control")) case_control();
+    else if (!strcmp(g_case, "hostile")) case_hostile();
+    else if (!strcmp(g_case, "watchdog")) case_watchdog();
+    else if (!strcmp(g_case, "lockstep_timeout")) case_lockstep_timeout();
+    else if (!strcmp(g_case, "two_daemons")) case_two_daemons();
+    else if (!strcmp(g_case, "fault")) case_fault();
+    else if (!strcmp(g_case, "replay")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "rk4");
+    else if (!strcmp(g_case, "replay_dopri5")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "dopri5");
+    else if (!strcmp(g_case, "sigterm")) case_sigterm();
+    else if (!strcmp(g_case, "bad_scene")) case_bad_scene();
+    else {
+        fprintf(stderr, "server_test: unknown case %s\n", g_case);
+        return 2;
+    }
+    kill_children();
+    remove(g_scene_path);
+    printf("server_test %s: ok\n", g_case);
+    return 0;
+}
