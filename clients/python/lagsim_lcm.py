@@ -1,0 +1,141 @@
+"""LCM from Python with the standard library only: ctypes over liblcm.so.1.
+
+Debian has no Python LCM module, but the C library is enough. Messages are encoded and
+decoded by the classes `lcm-gen --python` makes (they import only `struct`), e.g.
+PYTHONPATH=<build>/python gives `from lagsim import joint_state_t`.
+
+    lc = LCM()                     # LCM's default URL (honours LCM_DEFAULT_URL)
+    lc.subscribe("DIPC_STATE", lambda channel, data: print(joint_state_t.decode(data)))
+    lc.publish("DIPC_COMMAND", cmd.encode())
+    lc.handle_timeout(100)         # ms; 1 if a message was handled, 0 on timeout
+
+Not thread-safe, like lcm_t itself.
+"""
+import ctypes
+import ctypes.util
+import re
+
+__all__ = ["LCM", "LCMError"]
+
+
+class LCMError(RuntimeError):
+    pass
+
+
+class _RecvBuf(ctypes.Structure):
+    # struct _lcm_recv_buf_t from <lcm/lcm.h> (LCM 1.3)
+    _fields_ = [
+        ("data", ctypes.c_void_p),
+        ("data_size", ctypes.c_uint32),
+        ("recv_utime", ctypes.c_int64),
+        ("lcm", ctypes.c_void_p),
+    ]
+
+
+# void (*lcm_msg_handler_t)(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+_HANDLER = ctypes.CFUNCTYPE(None, ctypes.POINTER(_RecvBuf), ctypes.c_char_p, ctypes.c_void_p)
+
+
+def _load():
+    names = ["liblcm.so.1", ctypes.util.find_library("lcm") or "liblcm.so"]
+    last = None
+    for name in names:
+        try:
+            lib = ctypes.CDLL(name)
+            break
+        except OSError as e:  # try the next name
+            last = e
+    else:
+        raise LCMError("cannot load liblcm.so.1 (apt-get install liblcm1): %s" % last)
+    lib.lcm_create.argtypes = [ctypes.c_char_p]
+    lib.lcm_create.restype = ctypes.c_void_p
+    lib.lcm_destroy.argtypes = [ctypes.c_void_p]
+    lib.lcm_destroy.restype = None
+    lib.lcm_get_fileno.argtypes = [ctypes.c_void_p]
+    lib.lcm_get_fileno.restype = ctypes.c_int
+    lib.lcm_subscribe.argtypes = [ctypes.c_void_p, ctypes.c_char_p, _HANDLER, ctypes.c_void_p]
+    lib.lcm_subscribe.restype = ctypes.c_void_p
+    lib.lcm_unsubscribe.argtypes = [ctypes.c_void_p, ctypes.c_void_p]
+    lib.lcm_unsubscribe.restype = ctypes.c_int
+    lib.lcm_publish.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.c_void_p,
+                                ctypes.c_uint]
+    lib.lcm_publish.restype = ctypes.c_int
+    lib.lcm_handle_timeout.argtypes = [ctypes.c_void_p, ctypes.c_int]
+    lib.lcm_handle_timeout.restype = ctypes.c_int
+    return lib
+
+
+_lib = None
+
+
+class LCM(object):
+    """One lcm_t. url None or "" = LCM's default (LCM_DEFAULT_URL or udpm ttl=0)."""
+
+    def __init__(self, url=None):
+        global _lib
+        if _lib is None:
+            _lib = _load()
+        self._lib = _lib
+        self._lcm = _lib.lcm_create(url.encode() if url else None)
+        if not self._lcm:
+            raise LCMError("lcm_create(%r) failed" % (url or "default"))
+        # ctypes callbacks must outlive the subscription: keep every one here
+        self._subs = []
+        self.errors = 0  # exceptions raised by Python handlers (counted, not propagated)
+        self.last_error = None
+
+    def subscribe(self, channel, handler, exact=True):
+        """Calls handler(channel_str, payload_bytes) for each message on channel.
+        exact=True escapes regex characters (LCM subscribes by POSIX regex)."""
+        pattern = re.sub(r"([.\[\]{}()\\*+?^$|])", r"\\\1", channel) if exact else channel
+
+        def trampoline(rbuf, chan, user):
+            try:
+                data = ctypes.string_at(rbuf.contents.data, rbuf.contents.data_size)
+                handler(chan.decode("utf-8", "replace"), data)
+            except Exception as e:  # never let an exception unwind through C
+                self.errors += 1
+                self.last_error = e
+
+        cb = _HANDLER(trampoline)
+        sub = self._lib.lcm_subscribe(self._lcm, pattern.encode(), cb, None)
+        if not sub:
+            raise LCMError("lcm_subscribe(%r) failed" % channel)
+        self._subs.append((sub, cb, trampoline))
+        return sub
+
+    def publish(self, channel, data):
+        buf = bytes(data)
+        rc = self._lib.lcm_publish(self._lcm, channel.encode(), buf, len(buf))
+        if rc != 0:
+            raise LCMError("lcm_publish(%r) failed" % channel)
+
+    def handle_timeout(self, timeout_ms):
+        """Handles at most one message; 1 if handled, 0 on timeout."""
+        rc = self._lib.lcm_handle_timeout(self._lcm, int(max(0, timeout_ms)))
+        if rc < 0:
+            raise LCMError("lcm_handle_timeout failed")
+        return 1 if rc > 0 else 0
+
+    def fileno(self):
+        return self._lib.lcm_get_fileno(self._lcm)
+
+    def close(self):
+        if self._lcm:
+            for sub, _cb, _t in self._subs:
+                self._lib.lcm_unsubscribe(self._lcm, sub)
+            self._lib.lcm_destroy(self._lcm)
+            self._lcm = None
+            self._subs = []
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass

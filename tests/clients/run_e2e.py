@@ -1,0 +1,123 @@
+#!/usr/bin/env python3
+"""End-to-end harness: one lagsimd plus one controller on real LCM (loopback).
+
+    run_e2e.py --lagsimd BIN --config YAML --mode lockstep [--set k=v ...]
+               [--check EXPR ...] [--timeout S] -- CLIENT ARGS...
+
+The controller is started first (it waits for the scene description, so it sees the
+very first state), then the daemon, with a channel prefix unique to this run
+(--set lcm.prefix=<prefix>; "{prefix}" in the client's arguments is replaced by it) so
+that tests running in parallel never cross-talk. The controller must exit by itself
+within --timeout wall seconds; the daemon is always stopped (SIGTERM, then SIGKILL).
+The controller's last line "... summary key=value ..." is parsed and every --check
+expression (Python, over those keys) must hold.
+"""
+import argparse
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+
+
+def stop(proc, grace=3.0):
+    if proc is None or proc.poll() is not None:
+        return
+    proc.send_signal(signal.SIGTERM)
+    try:
+        proc.wait(grace)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+
+
+def parse_summary(text):
+    for line in reversed(text.splitlines()):
+        if " summary " in line:
+            vals = {}
+            for tok in line.split(" summary ", 1)[1].split():
+                if "=" in tok:
+                    k, v = tok.split("=", 1)
+                    try:
+                        vals[k] = float(v)
+                    except ValueError:
+                        vals[k] = v
+            return vals
+    return None
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--lagsimd", required=True)
+    ap.add_argument("--config", required=True)
+    ap.add_argument("--mode", default="lockstep")
+    ap.add_argument("--name", default="E2E")
+    ap.add_argument("--set", action="append", default=[])
+    ap.add_argument("--check", action="append", default=[])
+    ap.add_argument("--timeout", type=float, default=60.0)
+    ap.add_argument("client", nargs=argparse.REMAINDER)
+    a = ap.parse_args()
+    client = a.client[1:] if a.client and a.client[0] == "--" else a.client
+    if not client:
+        ap.error("no client command")
+    prefix = "%s_%d" % (a.name.upper(), os.getpid())
+    client = [c.replace("{prefix}", prefix) for c in client]
+    dcmd = [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
+            "--set", "realtime.mode=" + a.mode, "-q"]
+    for s in a.set:
+        dcmd += ["--set", s]
+    print("client:", " ".join(client))
+    print("daemon:", " ".join(dcmd), flush=True)
+
+    if not os.access(a.lagsimd, os.X_OK):
+        print("FAIL: no lagsimd executable at %s" % a.lagsimd)
+        return 1
+    cproc = dproc = None
+    out = err = ""
+    try:
+        cproc = subprocess.Popen(client, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                 universal_newlines=True)
+        time.sleep(0.3)
+        dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                 universal_newlines=True)
+        try:
+            out, err = cproc.communicate(timeout=a.timeout)
+        except subprocess.TimeoutExpired:
+            stop(cproc)
+            out, err = cproc.communicate()
+            print(out + err)
+            print("FAIL: the client did not finish within %g s" % a.timeout)
+            return 1
+    finally:
+        stop(cproc)
+        stop(dproc)
+    derr = dproc.stderr.read() if dproc and dproc.stderr else ""
+    sys.stdout.write(out)
+    if err:
+        sys.stdout.write("client stderr:\n" + err)
+    if derr.strip():
+        sys.stdout.write("daemon stderr:\n" + derr)
+    if cproc.returncode != 0:
+        print("FAIL: client exit status %d" % cproc.returncode)
+        return 1
+    vals = parse_summary(out)
+    if vals is None:
+        print("FAIL: no summary line from the client")
+        return 1
+    ok = True
+    env = dict(vals)
+    env["math"] = math
+    for expr in a.check:
+        try:
+            res = bool(eval(expr, {"__builtins__": {"abs": abs, "min": min, "max": max}}, env))
+        except Exception as e:  # a missing key is a failure, not a crash
+            res = False
+            print("check %s: %s" % (expr, e))
+        print("%s: %s" % ("ok  " if res else "FAIL", expr))
+        ok = ok and res
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
