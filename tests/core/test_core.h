@@ -411,6 +411,65 @@ static inline void tc_lagrange_lhs(const lag_model *m, const double *q, const do
         out[i] = cimag(pq[i]) / TC_CSTEP + creal(pa[i]) - (dTq[i] - dUq[i]);
 }
 
+/* Forward dynamics of our own, from T and U only: Lagrange's equations read
+ * M(q) qdd = tau - (dp/dq) qd + dT/dq - dU/dq, with M from tc_mass and the rest from
+ * tc_lagrange_lhs at qdd = 0; solved by Gaussian elimination with partial pivoting.
+ * Used for reference trajectories that share no code with the core. OUT: qdd[n] */
+static inline void tc_forward_own(const lag_model *m, const double *q, const double *qd,
+                                  const double *tau, double *qdd)
+{
+    int n = m->nq;
+    double A[3][4] = {{0}}, zero[3] = {0, 0, 0}, h[3];
+    double M[9];
+    tc_mass(m, q, M);
+    tc_lagrange_lhs(m, q, qd, zero, h);
+    for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) A[i][j] = M[i * n + j];
+        A[i][n] = (tau ? tau[i] : 0) - h[i];
+    }
+    for (int c = 0; c < n; ++c) {
+        int piv = c;
+        for (int r = c + 1; r < n; ++r)
+            if (fabs(A[r][c]) > fabs(A[piv][c])) piv = r;
+        for (int j = 0; j <= n; ++j) {
+            double t = A[c][j];
+            A[c][j] = A[piv][j];
+            A[piv][j] = t;
+        }
+        for (int r = c + 1; r < n; ++r) {
+            double f = A[r][c] / A[c][c];
+            for (int j = c; j <= n; ++j) A[r][j] -= f * A[c][j];
+        }
+    }
+    for (int i = n - 1; i >= 0; --i) {
+        double s = A[i][n];
+        for (int j = i + 1; j < n; ++j) s -= A[i][j] * qdd[j];
+        qdd[i] = s / A[i][i];
+    }
+}
+
+/* Classical RK4 with our own forward dynamics, unforced, from (q0, qd0) over nsteps of h;
+ * if rec is given, stores y = (q, qd) every `every` steps (rec[0] = initial). OUT: y[2n] */
+static inline void tc_reference_run(const lag_model *m, const double *q0, const double *qd0,
+                                    double h, int nsteps, double *y, double (*rec)[6], int every)
+{
+    int n = m->nq, ny = 2 * n;
+    double k[4][6], yt[6];
+    memcpy(y, q0, n * sizeof *y);
+    memcpy(y + n, qd0, n * sizeof *y);
+    if (rec) memcpy(rec[0], y, ny * sizeof *y);
+    static const double c[4] = {0, 0.5, 0.5, 1};
+    for (int s = 0; s < nsteps; ++s) {
+        for (int st = 0; st < 4; ++st) {
+            for (int i = 0; i < ny; ++i) yt[i] = y[i] + (st ? c[st] * h * k[st - 1][i] : 0);
+            for (int i = 0; i < n; ++i) k[st][i] = yt[n + i];
+            tc_forward_own(m, yt, yt + n, NULL, k[st] + n);
+        }
+        for (int i = 0; i < ny; ++i) y[i] += h / 6 * (k[0][i] + 2 * k[1][i] + 2 * k[2][i] + k[3][i]);
+        if (rec && (s + 1) % every == 0) memcpy(rec[(s + 1) / every], y, ny * sizeof *y);
+    }
+}
+
 /* ------------------------------------------------------------------ small linear algebra */
 static inline double tc_maxabs(int n, const double *x)
 {
