@@ -5,6 +5,13 @@ target_link_libraries(test_lqr PRIVATE lagsim_lqr lagsim_core m)
 add_test(NAME clients_lqr COMMAND test_lqr)
 set_tests_properties(clients_lqr PROPERTIES TIMEOUT 30)
 
+# Client library over real LCM (loopback, prefix unique per process): odd messages
+# dropped and counted, exact copies, commands/control as sent, DESCRIBE and timeouts.
+add_executable(test_client ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client.c)
+target_link_libraries(test_client PRIVATE lagsim_client m)
+add_test(NAME clients_library COMMAND test_client)
+set_tests_properties(clients_library PROPERTIES TIMEOUT 30)
+
 # ---- end to end: lagsimd + a controller on real LCM (default udpm URL, ttl=0), each run
 # with its own channel prefix (run_e2e.py makes it unique per process). The harness
 # starts the controller, then the daemon, always stops the daemon, and checks the
