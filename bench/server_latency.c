@@ -1,0 +1,343 @@
+/*
+ * server_latency: lagsimd's timing on this machine, beside this machine's floors measured
+ * in the same run.
+ *
+ *   server_latency LAGSIMD [--seconds S] [--lockstep-seconds S] [--hz HZ]
+ *
+ * 1. floor, paced publisher: a child process publishes a joint_state_t-sized message at
+ *    HZ with the daemon's clock call (timerfd, CLOCK_MONOTONIC, TFD_TIMER_ABSTIME, poll);
+ *    we measure the period error at the receiver: |arrival_k - arrival_k-1 - 1/HZ|.
+ * 2. floor, LCM ping-pong: a child echoes each ping; round-trip time.
+ * 3. lagsimd in real time at HZ (DIPC, rk4, 1 ms ticks) for S seconds with this process as
+ *    the controller: it answers every state at once with an effort that marks the state
+ *    it answers. Measured: state period error (as in 1.), command-to-applied latency =
+ *    utime of the first state whose effort carries the command's mark minus the command's
+ *    send time (both CLOCK_REALTIME on this host; includes by design the wait for the next
+ *    period deadline, see docs/readme/server.md "Timing"), the share of commands applied
+ *    to the very period that follows the state they answer, overruns (daemon status).
+ * 4. lockstep throughput: lagsimd in lockstep, this process answering every state;
+ *    control cycles per second, beside the ping-pong rate (1 / RTT).
+ *
+ * Prints a Markdown table. Timing figures are machine- and load-dependent: nothing here
+ * asserts them.
+ */
+#include <math.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/prctl.h>
+#include <sys/timerfd.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <lcm/lcm.h>
+#include "lagsim/lagsim_joint_command_t.h"
+#include "lagsim/lagsim_joint_state_t.h"
+#include "lagsim/lagsim_status_t.h"
+
+static int64_t mono_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+static int64_t wall_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
+/* ---------------------------------------------------------------- samples */
+typedef struct samples {
+    double *v;
+    size_t n, cap;
+} samples;
+static void add(samples *s, double x)
+{
+    if (s->n == s->cap) {
+        s->cap = s->cap ? 2 * s->cap : 4096;
+        s->v = realloc(s->v, s->cap * sizeof *s->v);
+        if (!s->v) abort();
+    }
+    s->v[s->n++] = x;
+}
+static int cmpd(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+/* p in [0, 1]: nearest-rank percentile; p = 1 is the max. */
+static double pct(samples *s, double p)
+{
+    if (s->n == 0) return NAN;
+    qsort(s->v, s->n, sizeof *s->v, cmpd);
+    size_t k = (size_t)ceil(p * (double)s->n);
+    if (k < 1) k = 1;
+    return s->v[k - 1];
+}
+
+/* ---------------------------------------------------------------- children */
+static pid_t child(void)
+{
+    pid_t p = fork();
+    if (p == 0) prctl(PR_SET_PDEATHSIG, SIGKILL);
+    return p;
+}
+
+/* Child: publishes a 3-joint state at hz for seconds, paced like the daemon. */
+static void paced_publisher(const char *chan, double hz, double seconds)
+{
+    lcm_t *lcm = lcm_create(NULL);
+    int tfd = timerfd_create(CLOCK_MONOTONIC, 0);
+    char *names[3] = {"theta0", "theta1", "theta2"};
+    double z[3] = {0, 0, 0};
+    lagsim_joint_state_t m = {0, 0, 0, 3, names, z, z, z};
+    int64_t base = mono_ns(), period = (int64_t)(1e9 / hz);
+    int64_t n = (int64_t)(seconds * hz);
+    for (int64_t k = 1; k <= n; k++) {
+        int64_t d = base + k * period;
+        struct itimerspec its = {{0, 0}, {d / 1000000000, d % 1000000000}};
+        timerfd_settime(tfd, TFD_TIMER_ABSTIME, &its, NULL);
+        struct pollfd pf = {tfd, POLLIN, 0};
+        poll(&pf, 1, -1);
+        uint64_t x;
+        if (read(tfd, &x, sizeof x) < 0) break;
+        m.utime = wall_us();
+        m.step = k;
+        lagsim_joint_state_t_publish(lcm, chan, &m);
+    }
+    lcm_destroy(lcm);
+    _exit(0);
+}
+
+static void on_echo(const lcm_recv_buf_t *rb, const char *ch, void *u)
+{
+    (void)ch;
+    lcm_publish(u, "LAGSIM_BENCH_PONG", rb->data, rb->data_size);
+}
+
+/* ---------------------------------------------------------------- measurement state */
+typedef struct bench {
+    lcm_t *lcm;
+    double period_s;
+    int64_t last_arrival_ns;
+    int64_t n_states;
+    samples period_err_us;
+    /* controller */
+    bool control;
+    char ch_command[96];
+    int64_t send_utime[1000];  /* by mark */
+    int64_t pending_mark;      /* mark of the last command sent, -1 none */
+    samples latency_us;
+    int64_t on_time, late, answered;
+    lagsim_status_t *status;
+    /* ping-pong */
+    int64_t pong_ns;
+} bench;
+
+static void on_state(const lcm_recv_buf_t *rb, const char *ch, const lagsim_joint_state_t *m,
+                     void *u)
+{
+    (void)ch; (void)rb;
+    bench *b = u;
+    int64_t now = mono_ns();
+    if (b->last_arrival_ns)
+        add(&b->period_err_us, fabs((double)(now - b->last_arrival_ns) * 1e-3 - b->period_s * 1e6));
+    b->last_arrival_ns = now;
+    b->n_states++;
+    if (!b->control) return;
+    /* effort mark: (k % 1000 + 1) mN, k = this state's period index */
+    double e = m->num_joints > 0 ? m->effort[0] : 0;
+    int mark = (int)lround(e * 1000.0) - 1;
+    if (mark >= 0 && mark < 1000 && b->send_utime[mark] > 0) {
+        add(&b->latency_us, (double)(m->utime - b->send_utime[mark]));
+        if (mark == b->pending_mark) b->on_time++;
+        else b->late++;
+        b->send_utime[mark] = 0;
+    }
+    int64_t k = (int64_t)llround(m->sim_time / b->period_s);
+    int newmark = (int)(k % 1000);
+    double eff = (newmark + 1) * 1e-3;
+    char *names[1] = {"theta0"};
+    lagsim_joint_command_t c = {wall_us(), m->sim_time, 1, names, &eff};
+    b->send_utime[newmark] = c.utime;
+    b->pending_mark = newmark;
+    lagsim_joint_command_t_publish(b->lcm, b->ch_command, &c);
+    b->answered++;
+}
+
+static void on_status(const lcm_recv_buf_t *rb, const char *ch, const lagsim_status_t *m, void *u)
+{
+    (void)rb; (void)ch;
+    bench *b = u;
+    if (b->status) lagsim_status_t_destroy(b->status);
+    b->status = lagsim_status_t_copy(m);
+}
+
+static void on_pong(const lcm_recv_buf_t *rb, const char *ch, void *u)
+{
+    (void)rb; (void)ch;
+    ((bench *)u)->pong_ns = mono_ns();
+}
+
+static void pump_until_exit(bench *b, pid_t pid)
+{
+    while (waitpid(pid, NULL, WNOHANG) == 0) lcm_handle_timeout(b->lcm, 50);
+    for (int i = 0; i < 20; i++) lcm_handle_timeout(b->lcm, 10);
+}
+
+static pid_t run_daemon(const char *lagsimd, const char *scene, const char *prefix,
+                        const char *mode, double hz, double seconds)
+{
+    char s_prefix[96], s_mode[64], s_hz[64], dur[32];
+    snprintf(s_prefix, sizeof s_prefix, "lcm.prefix=%s", prefix);
+    snprintf(s_mode, sizeof s_mode, "realtime.mode=%s", mode);
+    snprintf(s_hz, sizeof s_hz, "publish_hz=%g", hz);
+    snprintf(dur, sizeof dur, "%g", seconds);
+    pid_t p = child();
+    if (p == 0) {
+        execl(lagsimd, lagsimd, "--config", scene, "-q", "--set", s_prefix, "--set", s_mode,
+              "--set", s_hz, "--set", "realtime.command_timeout=10", "--set",
+              "realtime.status_hz=2", "--duration", dur, (char *)NULL);
+        _exit(127);
+    }
+    return p;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: server_latency LAGSIMD [--seconds S] [--lockstep-seconds S] [--hz HZ]\n");
+        return 2;
+    }
+    const char *lagsimd = argv[1];
+    double seconds = 60, ls_seconds = 10, hz = 1000;
+    for (int i = 2; i + 1 < argc; i += 2) {
+        if (!strcmp(argv[i], "--seconds")) seconds = atof(argv[i + 1]);
+        else if (!strcmp(argv[i], "--lockstep-seconds")) ls_seconds = atof(argv[i + 1]);
+        else if (!strcmp(argv[i], "--hz")) hz = atof(argv[i + 1]);
+    }
+    double floor_seconds = seconds < 10 ? seconds : 10;
+    char scene[128];
+    snprintf(scene, sizeof scene, "/tmp/lagsim_server_latency_%d.yaml", (int)getpid());
+    FILE *f = fopen(scene, "w");
+    if (!f) return 1;
+    fputs("model: dipc\nintegrator:\n  method: rk4\n  dt: 0.001\n", f);
+    fclose(f);
+
+    static bench b;
+    b.lcm = lcm_create(NULL);
+    if (!b.lcm) return 1;
+    b.period_s = 1.0 / hz;
+    char prefix[64], ch[96];
+    snprintf(prefix, sizeof prefix, "LAGSIM_BENCH%d", (int)getpid());
+
+    /* 1. paced publisher floor */
+    char pubchan[96];
+    snprintf(pubchan, sizeof pubchan, "%s_PACED", prefix);
+    lagsim_joint_state_t_subscription_t *ps = lagsim_joint_state_t_subscribe(b.lcm, pubchan, on_state, &b);
+    pid_t pp = child();
+    if (pp == 0) paced_publisher(pubchan, hz, floor_seconds);
+    pump_until_exit(&b, pp);
+    lagsim_joint_state_t_unsubscribe(b.lcm, ps);
+    samples floor_err = b.period_err_us;
+    int64_t floor_n = b.n_states;
+    memset(&b.period_err_us, 0, sizeof b.period_err_us);
+    b.last_arrival_ns = 0;
+    b.n_states = 0;
+
+    /* 2. ping-pong floor */
+    samples rtt = {0};
+    pid_t pe = child();
+    if (pe == 0) {
+        lcm_t *l = lcm_create(NULL);
+        lcm_subscribe(l, "LAGSIM_BENCH_PING", on_echo, l);
+        for (;;) lcm_handle(l);
+    }
+    lcm_subscription_t *pong = lcm_subscribe(b.lcm, "LAGSIM_BENCH_PONG", on_pong, &b);
+    usleep(300000);
+    uint8_t payload[120] = {0};
+    int64_t t_end = mono_ns() + (int64_t)(floor_seconds * 1e9);
+    while (mono_ns() < t_end) {
+        b.pong_ns = 0;
+        int64_t t0 = mono_ns();
+        lcm_publish(b.lcm, "LAGSIM_BENCH_PING", payload, sizeof payload);
+        while (b.pong_ns == 0 && mono_ns() - t0 < 100000000) lcm_handle_timeout(b.lcm, 100);
+        if (b.pong_ns) add(&rtt, (double)(b.pong_ns - t0) * 1e-3);
+    }
+    kill(pe, SIGKILL);
+    waitpid(pe, NULL, 0);
+    lcm_unsubscribe(b.lcm, pong);
+
+    /* 3. lagsimd in real time with this process as the controller */
+    snprintf(ch, sizeof ch, "%s_STATE", prefix);
+    lagsim_joint_state_t_subscription_t *ss = lagsim_joint_state_t_subscribe(b.lcm, ch, on_state, &b);
+    lagsim_joint_state_t_subscription_set_queue_capacity(ss, 100000);
+    snprintf(ch, sizeof ch, "%s_STATUS", prefix);
+    lagsim_status_t_subscribe(b.lcm, ch, on_status, &b);
+    snprintf(b.ch_command, sizeof b.ch_command, "%s_COMMAND", prefix);
+    b.control = true;
+    b.pending_mark = -1;
+    pid_t d = run_daemon(lagsimd, scene, prefix, "realtime", hz, seconds);
+    pump_until_exit(&b, d);
+    int64_t rt_states = b.n_states;
+    int64_t overruns = b.status ? b.status->overruns : -1;
+    double step_max = b.status ? b.status->step_time_max_us : NAN;
+    double rtf_mean = b.status && b.status->wall_time > 0 ? b.status->sim_time / seconds : NAN;
+    samples latency = b.latency_us;
+    int64_t on_time = b.on_time, late = b.late;
+    memset(&b.latency_us, 0, sizeof b.latency_us);
+
+    /* 4. lockstep throughput */
+    samples dummy = b.period_err_us;
+    memset(&b.period_err_us, 0, sizeof b.period_err_us);
+    int64_t n0 = b.n_states;
+    char lprefix[80];
+    snprintf(lprefix, sizeof lprefix, "%sL", prefix);
+    snprintf(ch, sizeof ch, "%s_STATE", lprefix);
+    lagsim_joint_state_t_unsubscribe(b.lcm, ss);
+    ss = lagsim_joint_state_t_subscribe(b.lcm, ch, on_state, &b);
+    snprintf(b.ch_command, sizeof b.ch_command, "%s_COMMAND", lprefix);
+    /* run long enough in sim time; we stop it after ls_seconds of wall time */
+    int64_t tl0 = mono_ns();
+    pid_t dl = run_daemon(lagsimd, scene, lprefix, "lockstep", hz, 1e6);
+    int64_t first_ns = 0, first_n = 0;
+    while (mono_ns() - tl0 < (int64_t)((ls_seconds + 1) * 1e9)) {
+        lcm_handle_timeout(b.lcm, 50);
+        if (!first_ns && b.n_states > n0 + 100) { first_ns = mono_ns(); first_n = b.n_states; }
+    }
+    int64_t last_ns = mono_ns(), last_n = b.n_states;
+    kill(dl, SIGTERM);
+    waitpid(dl, NULL, 0);
+    double cycles_per_s = first_ns ? (double)(last_n - first_n) / ((double)(last_ns - first_ns) * 1e-9) : 0;
+    samples period_err = dummy;
+
+    double f50 = pct(&floor_err, 0.5), f99 = pct(&floor_err, 0.99), fmx = pct(&floor_err, 1);
+    double d50 = pct(&period_err, 0.5), d99 = pct(&period_err, 0.99), dmx = pct(&period_err, 1);
+    double r50 = pct(&rtt, 0.5), r99 = pct(&rtt, 0.99), rmx = pct(&rtt, 1);
+    double l50 = pct(&latency, 0.5), l99 = pct(&latency, 0.99), lmx = pct(&latency, 1);
+    printf("## lagsimd timing at %g Hz, %g s real time (DIPC, rk4, dt 1 ms), floors over %g s\n\n",
+           hz, seconds, floor_seconds);
+    printf("| figure (us) | p50 | p99 | max | samples |\n|---|---:|---:|---:|---:|\n");
+    printf("| floor: bare paced publisher, period error | %.1f | %.1f | %.1f | %lld |\n", f50, f99, fmx, (long long)floor_n);
+    printf("| lagsimd state period error | %.1f | %.1f | %.1f | %lld |\n", d50, d99, dmx, (long long)rt_states);
+    printf("| ratio lagsimd / floor | %.2f | %.2f | %.2f | |\n", d50 / f50, d99 / f99, dmx / fmx);
+    printf("| floor: bare LCM ping-pong round trip | %.1f | %.1f | %.1f | %zu |\n", r50, r99, rmx, rtt.n);
+    printf("| lagsimd command-to-applied (send -> state that applied it) | %.1f | %.1f | %.1f | %zu |\n", l50, l99, lmx, latency.n);
+    printf("| ratio command-to-applied / (period + ping-pong RTT) | %.2f | %.2f | %.2f | |\n",
+           l50 / (b.period_s * 1e6 + r50), l99 / (b.period_s * 1e6 + r99), lmx / (b.period_s * 1e6 + rmx));
+    printf("\n- commands applied to the period right after the state they answer: %lld of %lld (%.3f%%); later: %lld\n",
+           (long long)on_time, (long long)(on_time + late),
+           100.0 * (double)on_time / (double)(on_time + late > 0 ? on_time + late : 1), (long long)late);
+    printf("- overruns over %g s: %lld (daemon status; worst period compute %.1f us; sim time / requested duration %.4f)\n",
+           seconds, (long long)overruns, step_max, rtf_mean);
+    printf("- lockstep throughput with this controller: %.0f control cycles/s (ping-pong rate 1/RTT p50: %.0f /s)\n",
+           cycles_per_s, 1e6 / r50);
+    remove(scene);
+    return 0;
+}
