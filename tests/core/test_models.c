@@ -270,6 +270,128 @@ static void check_info(void)
     ENSURE(lag_method_from_name("leapfrog") == -1);
 }
 
+/* ---------------------------------------------------------------- the seed's DIPC */
+/* The seed's Problem 3, transcribed as printed, with each error we found behind a flag.
+ * With every fix applied it must agree with our T and U and with the core; with any one
+ * fix left out it must not. That proves the list in docs/readme/models.md is complete for
+ * the printed (b) T_i, (c) U_i, (8) L and (12a-c), and that each item is a real error. */
+enum {
+    FIX_T0_SQUARE = 1 << 0,  /* (b) T0 = 1/2 m0 th0d  -> 1/2 m0 th0d^2 */
+    FIX_U2_L2 = 1 << 1,      /* (a), (c) r2_y, U2: 1/2 cos th2 -> 1/2 l2 cos th2 */
+    FIX_L8_J1 = 1 << 2,      /* (8) 1/2 m1 l1^2 th1d^2 -> 1/4 m1 l1^2 (inside 1/2 [...]) */
+    FIX_L8_J2 = 1 << 3,      /* (8) 1/2 m2 l2^2 th2d^2 -> 1/4 m2 l2^2 */
+    FIX_L8_K2 = 1 << 4,      /* (8) 1/2 m2 l2 th0d th2d cos th2 -> m2 l2 (inside 1/2 [...]) */
+    FIX_12A = 1 << 5,        /* (12a) (m1 + 2 m2 l1) -> (m1 + 2 m2) */
+    FIX_12B = 1 << 6,        /* (9)-(12b) 1/2 m1 l1^2 -> 1/4 m1 l1^2 */
+    FIX_12C = 1 << 7,        /* (9)-(12c) 1/2 m2 l2^2 -> 1/4 m2 l2^2 */
+    FIX_ALL = 0xff
+};
+
+/* Seed (b): T = T0 + T1 + T2 as printed. */
+static double seed_T(const double *p, const double *q, const double *qd, unsigned fix)
+{
+    double m0 = p[LAG_DIPC_M0], m1 = p[LAG_DIPC_M1], m2 = p[LAG_DIPC_M2], l1 = p[LAG_DIPC_L1],
+           l2 = p[LAG_DIPC_L2], I1 = p[LAG_DIPC_I1], I2 = p[LAG_DIPC_I2];
+    double T0 = (fix & FIX_T0_SQUARE) ? 0.5 * m0 * qd[0] * qd[0] : 0.5 * m0 * qd[0];
+    double T1 = 0.5 * m1 * (qd[0] * qd[0] + l1 * qd[0] * qd[1] * cos(q[1]) + 0.25 * l1 * l1 * qd[1] * qd[1]) +
+                0.5 * I1 * qd[1] * qd[1];
+    double T2 = 0.5 * m2 * (qd[0] * qd[0] + l1 * l1 * qd[1] * qd[1] + 0.25 * l2 * l2 * qd[2] * qd[2] +
+                            2 * l1 * qd[0] * qd[1] * cos(q[1]) + l2 * qd[0] * qd[2] * cos(q[2]) +
+                            l1 * l2 * qd[1] * qd[2] * cos(q[1] - q[2])) +
+                0.5 * I2 * qd[2] * qd[2];
+    return T0 + T1 + T2;
+}
+
+/* Seed (c): U = U0 + U1 + U2 as printed (U0 = m0 g (h0 - b0/2) is a constant: b0 = 0). */
+static double seed_U(const double *p, const double *q, unsigned fix)
+{
+    double m0 = p[LAG_DIPC_M0], m1 = p[LAG_DIPC_M1], m2 = p[LAG_DIPC_M2], l1 = p[LAG_DIPC_L1],
+           l2 = p[LAG_DIPC_L2], g = p[LAG_DIPC_G], h0 = p[LAG_DIPC_H0];
+    double a2 = (fix & FIX_U2_L2) ? 0.5 * l2 : 0.5;
+    return m0 * g * h0 + m1 * g * (h0 + 0.5 * l1 * cos(q[1])) + m2 * g * (h0 + l1 * cos(q[1]) + a2 * cos(q[2]));
+}
+
+/* Seed (8): the Lagrangian as printed. */
+static double seed_L(const double *p, const double *q, const double *qd, unsigned fix)
+{
+    double m0 = p[LAG_DIPC_M0], m1 = p[LAG_DIPC_M1], m2 = p[LAG_DIPC_M2], l1 = p[LAG_DIPC_L1],
+           l2 = p[LAG_DIPC_L2], I1 = p[LAG_DIPC_I1], I2 = p[LAG_DIPC_I2], g = p[LAG_DIPC_G],
+           h0 = p[LAG_DIPC_H0];
+    double c1 = (fix & FIX_L8_J1) ? 0.25 : 0.5, c2 = (fix & FIX_L8_J2) ? 0.25 : 0.5,
+           c02 = (fix & FIX_L8_K2) ? 1.0 : 0.5;
+    double br = (m0 + m1 + m2) * qd[0] * qd[0] + (c1 * m1 * l1 * l1 + m2 * l1 * l1 + I1) * qd[1] * qd[1] +
+                (c2 * m2 * l2 * l2 + I2) * qd[2] * qd[2] + (m1 * l1 + 2 * m2 * l1) * qd[0] * qd[1] * cos(q[1]) +
+                c02 * m2 * l2 * qd[0] * qd[2] * cos(q[2]) + m2 * l1 * l2 * qd[1] * qd[2] * cos(q[1] - q[2]);
+    return 0.5 * br - (0.5 * m1 + m2) * g * l1 * cos(q[1]) - 0.5 * m2 * g * l2 * cos(q[2]) - (m0 + m1 + m2) * h0 * g;
+}
+
+/* Seed (12a-c): left side minus right side's tau, i.e. what must equal M qdd + C qd + g. */
+static void seed_eom(const double *p, const double *q, const double *qd, const double *qdd, unsigned fix,
+                     double *out)
+{
+    double m0 = p[LAG_DIPC_M0], m1 = p[LAG_DIPC_M1], m2 = p[LAG_DIPC_M2], l1 = p[LAG_DIPC_L1],
+           l2 = p[LAG_DIPC_L2], I1 = p[LAG_DIPC_I1], I2 = p[LAG_DIPC_I2], g = p[LAG_DIPC_G];
+    double s1 = sin(q[1]), c1 = cos(q[1]), s2 = sin(q[2]), c2 = cos(q[2]), s12 = sin(q[1] - q[2]),
+           c12 = cos(q[1] - q[2]);
+    double k12a = (fix & FIX_12A) ? (m1 + 2 * m2) : (m1 + 2 * m2 * l1);
+    double j1 = (fix & FIX_12B) ? 0.25 : 0.5, j2 = (fix & FIX_12C) ? 0.25 : 0.5;
+    out[0] = (m0 + m1 + m2) * qdd[0] +
+             0.5 * (l1 * k12a * (qdd[1] * c1 - qd[1] * qd[1] * s1) + m2 * l2 * (qdd[2] * c2 - qd[2] * qd[2] * s2));
+    out[1] = (j1 * m1 * l1 * l1 + m2 * l1 * l1 + I1) * qdd[1] +
+             0.5 * (l1 * (m1 + 2 * m2) * qdd[0] * c1 + m2 * l1 * l2 * (qdd[2] * c12 + qd[2] * qd[2] * s12) -
+                    (m1 + 2 * m2) * g * l1 * s1);
+    out[2] = (j2 * m2 * l2 * l2 + I2) * qdd[2] +
+             0.5 * (m2 * l2 * qdd[0] * c2 + m2 * l1 * l2 * (qdd[1] * c12 - qd[1] * qd[1] * s12) - m2 * g * l2 * s2);
+}
+
+/* Largest relative mismatch of the seed's forms (with the given fixes) over random states:
+ * against our T, our U (differences), our T - U, and the core's M qdd + C qd + g. */
+static void seed_mismatch(unsigned fix, double *eT, double *eU, double *eL, double *eE)
+{
+    tc_rng rng = {0x5eedu};
+    *eT = *eU = *eL = *eE = 0;
+    for (int it = 0; it < 100; ++it) {
+        lag_model md;
+        tc_random_model(&rng, LAG_MODEL_DIPC, &md);
+        double q[3], qd[3], q2[3], qd2[3], qdd[3];
+        tc_random_state(&rng, &md, q, qd);
+        tc_random_state(&rng, &md, q2, qd2);
+        for (int i = 0; i < 3; ++i) qdd[i] = tc_uniform(&rng, -20, 20);
+        double T = tc_T(&md, q, qd), U = tc_U(&md, q), U2 = tc_U(&md, q2), T2 = tc_T(&md, q2, qd2);
+        double sc = fabs(T) + fabs(U) + fabs(U2) + fabs(T2) + 1;
+        *eT = fmax(*eT, fabs(seed_T(md.p, q, qd, fix) - T) / sc);
+        *eU = fmax(*eU, fabs((seed_U(md.p, q, fix) - seed_U(md.p, q2, fix)) - (U - U2)) / sc);
+        /* L up to a constant: compare L(q, qd) - L(q2, qd2) */
+        *eL = fmax(*eL, fabs((seed_L(md.p, q, qd, fix) - seed_L(md.p, q2, qd2, fix)) - ((T - U) - (T2 - U2))) / sc);
+        double M[9], h[3], Mq[3], e[3];
+        lag_model_mass(&md, q, M);
+        lag_model_bias(&md, q, qd, h);
+        tc_matvec(3, M, qdd, Mq);
+        seed_eom(md.p, q, qd, qdd, fix, e);
+        double sE = tc_maxabs(9, M) * 20 + tc_maxabs(3, h) + 1;
+        for (int i = 0; i < 3; ++i) *eE = fmax(*eE, fabs(e[i] - (Mq[i] + h[i])) / sE);
+    }
+}
+
+static void check_seed_dipc(void)
+{
+    double eT, eU, eL, eE;
+    /* all fixes: agreement to rounding (1e-13 of the scale) */
+    seed_mismatch(FIX_ALL, &eT, &eU, &eL, &eE);
+    printf("seed DIPC with all 8 fixes: max rel. mismatch T %.1e U %.1e L %.1e eqs(12) %.1e\n", eT, eU, eL, eE);
+    ENSURE(eT < 1e-13 && eU < 1e-13 && eL < 1e-13 && eE < 1e-13);
+    /* any one fix missing: a mismatch of at least 1e-3 of the scale in the form it touches */
+    static const char *names[8] = {"T0 square", "U2 l2", "L(8) m1 l1^2/4", "L(8) m2 l2^2/4",
+                                   "L(8) m2 l2 th0d th2d", "(12a) m1 + 2 m2", "(12b) m1 l1^2/4",
+                                   "(12c) m2 l2^2/4"};
+    for (int b = 0; b < 8; ++b) {
+        seed_mismatch(FIX_ALL & ~(1u << b), &eT, &eU, &eL, &eE);
+        double worst = fmax(fmax(eT, eU), fmax(eL, eE));
+        printf("  without fix %-22s: T %.1e U %.1e L %.1e eqs(12) %.1e\n", names[b], eT, eU, eL, eE);
+        ENSURE(worst > 1e-3);
+    }
+}
+
 int main(int argc, char **argv)
 {
     int want = argc > 1 ? lag_model_kind_from_name(argv[1]) : -1;
@@ -280,5 +402,6 @@ int main(int argc, char **argv)
     if (argc == 1 || strcmp(argv[1], "info") == 0) check_info();
     for (int k = 0; k < LAG_MODEL_COUNT; ++k)
         if (argc == 1 || want == k) check_model((lag_model_kind)k, 0x1234u + (uint64_t)k);
+    if (argc == 1 || want == LAG_MODEL_DIPC) check_seed_dipc();
     return tc_finish(argc > 1 ? argv[1] : "models");
 }
