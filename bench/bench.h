@@ -64,6 +64,8 @@ typedef struct bench_config {
     int method;     /* lag_method, BENCH_MJ_*, BENCH_SUN_* */
     double dt;      /* fixed step (s); for adaptive methods the output tick */
     double rtol;    /* adaptive methods (atol = rtol * BENCH_ATOL_FACTOR); 0 otherwise */
+    bool continuous;/* lagsim dopri5 only: lag_sim_advance(.., true), steps past period ends
+                     * and delivers the state by dense output (lagsimd's offline mode) */
 } bench_config;
 
 #define BENCH_ATOL_FACTOR 1e-2

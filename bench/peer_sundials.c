@@ -2,7 +2,8 @@
  * SUNDIALS peer (6.4): ARKODE and CVODE integrating lagsim's own right-hand side
  * y = (q, qd), ydot = (qd, qdd), qdd from lag_model_forward, on N_Vector serial.
  *  - ARKODE-DP5: ARKStep, explicit Dormand-Prince 5(4) (ARKODE_DORMAND_PRINCE_7_4_5),
- *    adaptive, rtol / atol = rtol * BENCH_ATOL_FACTOR, output by ARKODE's interpolant.
+ *    adaptive, rtol / atol = rtol * BENCH_ATOL_FACTOR; the state at each period end from
+ *    ARKODE's interpolant (ARK_NORMAL) when the scene is unforced.
  *  - ARKODE-RK4: ARKStep with the classical RK4 Butcher table (ARKodeButcherTable_Create)
  *    and ARKStepSetFixedStep. Not ERKStep: 6.4's ERKStep treats this table as FSAL
  *    (wrong order, silently).
@@ -10,7 +11,9 @@
  *    difference-quotient Jacobian), adaptive order and step.
  * When the scene's input changes at a period start, the integrator is re-initialized
  * there (ARKStepReset / CVodeReInit, with a stop time at the period end): the documented
- * way to cross a discontinuity of f. ARKODE keeps its last step size across the reset.
+ * way to cross a discontinuity of f. ARKODE-DP5 restarts with the largest step of the
+ * previous period (as lagsim's dopri5 keeps its step size); CVODE restarts at order 1
+ * with its own initial step estimate.
  * RHS evaluations are counted in the RHS itself (including difference quotients).
  */
 #include <math.h>
@@ -112,31 +115,44 @@ static int run_arkode(const bench_scene *sc, const bench_config *c, bench_sample
     }
     double *Y = N_VGetArrayPointer(y);
     record(out, 0, Y, nq);
-    realtype t = 0.0;
+    realtype t = 0.0, hmax = 0.0;
+    int64_t nst = 0;
     for (int k = 0; k < np && status == 0; k++) {
         realtype t0 = k * sc->period, tout = (k + 1) * sc->period;
         if (sc->input) {
             sc->input(&sc->model, t0, u->tau);
             if (k > 0) {
-                realtype hlast = 0;
-                ARKStepGetLastStep(mem, &hlast);
                 ARKStepReset(mem, t, y);
-                if (!fixed && hlast > 0) ARKStepSetInitStep(mem, hlast);
+                if (!fixed && hmax > 0) ARKStepSetInitStep(mem, hmax);
             }
             if (!fixed) ARKStepSetStopTime(mem, tout);
         }
         if (fixed) {
             /* Exactly `per` steps of dt per period (no interpolation, no tstop games). */
-            for (long s = 0; s < per && status == 0; s++)
+            for (long s = 0; s < per && status == 0; s++, nst++)
                 if (ARKStepEvolve(mem, tout, y, &t, ARK_ONE_STEP) < 0) status = -13;
-        } else if (ARKStepEvolve(mem, tout, y, &t, ARK_NORMAL) < 0) {
-            status = -14;
+        } else if (sc->input) {
+            /* Step by step to the stop time, noting the largest step for the restart. */
+            hmax = 0.0;
+            while (t < tout && status == 0) {
+                int f = ARKStepEvolve(mem, tout, y, &t, ARK_ONE_STEP);
+                if (f < 0) status = -14;
+                realtype h = 0;
+                ARKStepGetLastStep(mem, &h);
+                if (h > hmax) hmax = h;
+                nst++;
+                if (f == ARK_TSTOP_RETURN) break;
+            }
+        } else {
+            long n0 = 0, n1 = 0;
+            ARKStepGetNumSteps(mem, &n0);
+            if (ARKStepEvolve(mem, tout, y, &t, ARK_NORMAL) < 0) status = -14;
+            ARKStepGetNumSteps(mem, &n1);
+            nst += n1 - n0;
         }
         if (!finite_state(Y, 2 * nq)) status = -15;
         record(out, k + 1, Y, nq);
     }
-    long nst = 0;
-    ARKStepGetNumSteps(mem, &nst);
     *steps = nst;
     ARKStepFree(&mem);
     if (B) ARKodeButcherTable_Free(B);
@@ -171,11 +187,17 @@ static int run_cvode(const bench_scene *sc, const bench_config *c, bench_samples
     double *Y = N_VGetArrayPointer(y);
     record(out, 0, Y, nq);
     realtype t = 0.0;
+    int64_t nst0 = 0;
     for (int k = 0; k < np && status == 0; k++) {
         realtype t0 = k * sc->period, tout = (k + 1) * sc->period;
         if (sc->input) {
             sc->input(&sc->model, t0, u->tau);
-            if (k > 0) CVodeReInit(mem, t, y);
+            if (k > 0) {
+                long n = 0;
+                CVodeGetNumSteps(mem, &n); /* ReInit zeroes the counters */
+                nst0 += n;
+                CVodeReInit(mem, t, y);
+            }
             CVodeSetStopTime(mem, tout);
         }
         if (CVode(mem, tout, y, &t, CV_NORMAL) < 0) status = -24;
@@ -184,7 +206,7 @@ static int run_cvode(const bench_scene *sc, const bench_config *c, bench_samples
     }
     long nst = 0;
     CVodeGetNumSteps(mem, &nst);
-    *steps = nst;
+    *steps = nst0 + nst;
     CVodeFree(&mem);
     if (LS) SUNLinSolFree(LS);
     if (A) SUNMatDestroy(A);
