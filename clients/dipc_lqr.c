@@ -164,6 +164,9 @@ int main(int argc, char **argv)
     sigaction(SIGTERM, &sa, NULL);
 
     /* ---- scene -> model */
+    /* subscribed: from here on no state is missed (test harnesses wait for this line) */
+    printf("dipc_lqr: waiting for the scene description on %s_SCENE\n", prefix);
+    fflush(stdout);
     lag_client_scene sc;
     if (lag_client_wait_scene(c, timeout, &sc) != LAG_CLIENT_OK) {
         fprintf(stderr, "dipc_lqr: %s\n", lag_client_errmsg(c));

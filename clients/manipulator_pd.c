@@ -93,6 +93,9 @@ int main(int argc, char **argv)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
+    /* subscribed: from here on no state is missed (test harnesses wait for this line) */
+    printf("manipulator_pd: waiting for the scene description on %s_SCENE\n", prefix);
+    fflush(stdout);
     lag_client_scene sc;
     if (lag_client_wait_scene(c, timeout, &sc) != LAG_CLIENT_OK) {
         fprintf(stderr, "manipulator_pd: %s\n", lag_client_errmsg(c));

@@ -102,6 +102,9 @@ def main():
     lc.subscribe(a.prefix + "_SCENE", on_scene)
     lc.subscribe(a.prefix + "_STATE", on_state)
 
+    # subscribed: from here on no state is missed (test harnesses wait for this line)
+    print("manipulator_pd.py: waiting for the scene description on %s_SCENE" % a.prefix,
+          flush=True)
     # scene description: ask (DESCRIBE) every 0.25 s until it arrives
     deadline = time.monotonic() + a.timeout
     next_ask = 0.0

@@ -4,8 +4,8 @@
     run_e2e.py --lagsimd BIN --config YAML --mode lockstep [--set k=v ...]
                [--check EXPR ...] [--timeout S] -- CLIENT ARGS...
 
-The controller is started first (it waits for the scene description, so it sees the
-very first state), then the daemon, with a channel prefix unique to this run
+The controller is started first, then (once it prints that it is waiting for the scene
+description, i.e. it is subscribed and will see the very first state) the daemon, with a channel prefix unique to this run
 (--set lcm.prefix=<prefix>; "{prefix}" in the client's arguments is replaced by it) so
 that tests running in parallel never cross-talk. The controller must exit by itself
 within --timeout wall seconds; the daemon is always stopped (SIGTERM, then SIGKILL).
@@ -18,7 +18,7 @@ import os
 import signal
 import subprocess
 import sys
-import time
+import threading
 
 
 def stop(proc, grace=3.0):
@@ -74,24 +74,43 @@ def main():
         print("FAIL: no lagsimd executable at %s" % a.lagsimd)
         return 1
     cproc = dproc = None
-    out = err = ""
+    lines = []
     try:
         cproc = subprocess.Popen(client, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                  universal_newlines=True)
-        time.sleep(0.3)
+        # read the client's stdout in a thread; start the daemon once the client says it
+        # is subscribed ("waiting for the scene"), so that it sees the very first state
+        ready = threading.Event()
+
+        def reader():
+            for line in cproc.stdout:
+                lines.append(line)
+                if "waiting for the scene" in line:
+                    ready.set()
+            ready.set()
+
+        th = threading.Thread(target=reader, daemon=True)
+        th.start()
+        if not ready.wait(15.0) or cproc.poll() is not None:
+            print("".join(lines))
+            print("FAIL: the client did not get ready")
+            return 1
         dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                  universal_newlines=True)
         try:
-            out, err = cproc.communicate(timeout=a.timeout)
+            cproc.wait(timeout=a.timeout)
         except subprocess.TimeoutExpired:
             stop(cproc)
-            out, err = cproc.communicate()
-            print(out + err)
+            th.join(5.0)
+            print("".join(lines))
             print("FAIL: the client did not finish within %g s" % a.timeout)
             return 1
+        th.join(5.0)
+        err = cproc.stderr.read()
     finally:
         stop(cproc)
         stop(dproc)
+    out = "".join(lines)
     derr = dproc.stderr.read() if dproc and dproc.stderr else ""
     sys.stdout.write(out)
     if err:
