@@ -7,6 +7,7 @@
  */
 #include "lagsim_client.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -328,7 +329,9 @@ void lag_client_get_counters(const lag_client *c, lag_client_counters *out)
 int lag_client_handle(lag_client *c, int timeout_ms)
 {
     if (timeout_ms < 0) timeout_ms = 0;
+    errno = 0;
     int rc = lcm_handle_timeout(c->lcm, timeout_ms);
+    if (rc < 0 && errno == EINTR) return 0; /* a signal (e.g. SIGINT): like a timeout */
     if (rc < 0) {
         set_err(c, "lcm_handle_timeout failed");
         return LAG_CLIENT_ERR_LCM;
