@@ -13,15 +13,18 @@
 
 #include "daemon.h"
 
-/* One CSV row: t, q, qd, energy at the sim's public state. Returns <0 on write error. */
+/* One CSV row: t, q, qd as published (with the noise effect, if on), and the energy of
+ * the true state. Returns <0 on write error. */
 static int write_row(FILE *f, const lag_sim *sim)
 {
     char line[1024];
+    double q[LAG_MAX_DOF], qd[LAG_MAX_DOF];
+    lag_sim_observe(sim, q, qd);
     int n = snprintf(line, sizeof line, "%.17g", lag_sim_time(sim));
     for (int i = 0; i < sim->nq; i++)
-        n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g", sim->q[i]);
+        n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g", q[i]);
     for (int i = 0; i < sim->nq; i++)
-        n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g", sim->qd[i]);
+        n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g", qd[i]);
     n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g\n", lag_sim_energy(sim));
     return fwrite(line, 1, (size_t)n, f) == (size_t)n ? 0 : -1;
 }
@@ -78,8 +81,18 @@ int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)
     const double c0 = cpu_seconds();
     int rc = LAGSIMD_EXIT_OK;
     int64_t k = 0;
+    int64_t nevents = 0;
     for (; k < nperiods; k++) {
         lag_result r = lag_sim_advance(&sim, sc->ticks_per_period, true);
+        /* the effects' events (impacts, stops, stick/slip, ...): the first few on stderr */
+        lag_event ev;
+        while (lag_sim_poll_event(&sim, &ev)) {
+            if (!o->quiet && nevents < 20)
+                fprintf(stderr, "lagsimd: event %s at t = %.9f s, joint %s, value %g\n",
+                        lag_event_kind_name(ev.kind), ev.t,
+                        ev.joint >= 0 ? info->joint_names[ev.joint] : "-", ev.value);
+            nevents++;
+        }
         if (r != LAG_OK) {
             fprintf(stderr, "lagsimd: numeric fault at t = %.17g s (last good state): %s "
                             "(method %s, dt %g s)\n",
@@ -109,12 +122,12 @@ int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)
         double e1 = lag_sim_energy(&sim);
         fprintf(stderr,
                 "lagsimd: offline %s, %s dt %g s: %.6g s of sim time, %lld rows, "
-                "%lld steps (%lld rejected), %lld rhs evals, %.3g s CPU; "
+                "%lld steps (%lld rejected), %lld rhs evals, %lld events, %.3g s CPU; "
                 "energy %.17g -> %.17g J (change %.3g)\n",
                 info->name, lag_method_name(sc->sim.integrator.method),
                 sc->sim.integrator.dt, lag_sim_time(&sim), (long long)(k + 1),
                 (long long)sim.stats.steps_accepted, (long long)sim.stats.steps_rejected,
-                (long long)sim.stats.rhs_evals, cpu, e0, e1, e1 - e0);
+                (long long)sim.stats.rhs_evals, (long long)nevents, cpu, e0, e1, e1 - e0);
     }
     return rc;
 }

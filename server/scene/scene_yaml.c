@@ -523,6 +523,14 @@ typedef struct conv {
     /* nodes remembered for the final cross-checks (NULL if not given) */
     const ynode *root, *parameters, *publish_hz, *dt, *integrator, *initial, *dt_min;
     const ynode *explode_limit;
+    /* effects */
+    const ynode *effects, *limits_node, *floor_node, *gravity_g_node;
+    int gravity_enabled;  /* -1 not said, 0 off, 1 on */
+    double gravity_g;
+    int limit_seen;       /* bits: lower, upper given for the joint being read */
+    int cur_joint;        /* the joint whose sub-mapping is being read */
+    lag_disturbance *cur_dist; /* the disturbance being read */
+    int cur_dist_kind;    /* bits: impulse, force given */
 } conv;
 
 /* Joins "parent.key" into buf. */
@@ -967,8 +975,433 @@ static int key_lcm(conv *cv, const ynode *nd, const char *path)
 
 /* ---------------------------------------------------------------- effects */
 
-/* One row per effect (issue 4): {"damping", key_effect_damping}, ... */
+/* Effects (issue 4): each section present switches its effect on (lag_effects_def.enabled);
+ * per-joint sections are mappings from joint names to values. Values are checked where
+ * they are read, so errors point at the offending node. */
+
+static lag_effects_def *fx(conv *cv) { return &cv->sc->sim.effects; }
+
+/* A YAML boolean: true/false (also yes/no, on/off as YAML 1.1 spells them). */
+static int get_bool(conv *cv, const ynode *nd, const char *path, bool *out)
+{
+    static const char *const yes[] = {"true", "True", "TRUE", "yes", "Yes", "on", "On", NULL};
+    static const char *const no[] = {"false", "False", "FALSE", "no", "No", "off", "Off", NULL};
+    if (ynode_is_null(nd))
+        return fail(cv->err, nd, path, "missing value: expected true or false");
+    if (nd->kind != YN_SCALAR || nd->quoted)
+        return fail(cv->err, nd, path, "expected true or false, got %s", ynode_kind_name(nd));
+    for (int i = 0; yes[i]; i++)
+        if (strcmp(nd->text, yes[i]) == 0) { *out = true; return 0; }
+    for (int i = 0; no[i]; i++)
+        if (strcmp(nd->text, no[i]) == 0) { *out = false; return 0; }
+    return fail(cv->err, nd, path, "expected true or false, got '%s'", nd->text);
+}
+
+static int get_nonneg(conv *cv, const ynode *nd, const char *path, double *out)
+{
+    double v = 0.0;
+    if (get_number(cv, nd, path, &v) < 0)
+        return -1;
+    if (!(v >= 0.0))
+        return fail(cv->err, nd, path, "expected a number >= 0, got %s", nd->text);
+    *out = v;
+    return 0;
+}
+
+static int get_unit(conv *cv, const ynode *nd, const char *path, double *out)
+{
+    double v = 0.0;
+    if (get_number(cv, nd, path, &v) < 0)
+        return -1;
+    if (!(v >= 0.0 && v <= 1.0))
+        return fail(cv->err, nd, path, "expected a restitution coefficient in [0, 1], got %s",
+                    nd->text);
+    *out = v;
+    return 0;
+}
+
+/* "x, phi" for messages */
+static void joint_list(const conv *cv, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    for (int i = 0; i < cv->info->nq; i++) {
+        size_t used = strlen(buf);
+        snprintf(buf + used, len - used, "%s%s", i ? ", " : "", cv->info->joint_names[i]);
+    }
+}
+
+static int joint_index(const conv *cv, const char *name)
+{
+    for (int i = 0; i < cv->info->nq; i++)
+        if (strcmp(name, cv->info->joint_names[i]) == 0) return i;
+    return -1;
+}
+
+typedef int (*joint_fn)(conv *cv, int joint, const ynode *val, const char *path);
+
+/* Walks a mapping {joint name: value} and calls fn for each joint. */
+static int per_joint(conv *cv, const ynode *nd, const char *path, joint_fn fn)
+{
+    char names[128];
+    joint_list(cv, names, sizeof names);
+    if (nd->kind != YN_MAP) {
+        if (ynode_is_null(nd))
+            return fail(cv->err, nd, path, "missing value: expected a mapping of joints (%s)",
+                        names);
+        return fail(cv->err, nd, path, "expected a mapping of joints (%s), got %s", names,
+                    ynode_kind_name(nd));
+    }
+    for (int i = 0; i < nd->n; i++) {
+        const yentry *en = &nd->entries[i];
+        int j = joint_index(cv, en->key);
+        if (j < 0)
+            return fail_key(cv->err, en, "unknown joint '%s' in %s for model %s; allowed: %s",
+                            en->key, path, cv->info->name, names);
+        char sub[256];
+        if (fn(cv, j, en->val, join(sub, sizeof sub, path, en->key)) < 0)
+            return -1;
+    }
+    return 0;
+}
+
+/* gravity: {enabled: bool, g: m/s^2} -- applied after parameters (see convert_scene) */
+static int key_gravity_enabled(conv *cv, const ynode *nd, const char *path)
+{
+    bool b = true;
+    if (get_bool(cv, nd, path, &b) < 0)
+        return -1;
+    cv->gravity_enabled = b ? 1 : 0;
+    return 0;
+}
+
+static int key_gravity_g(conv *cv, const ynode *nd, const char *path)
+{
+    if (get_nonneg(cv, nd, path, &cv->gravity_g) < 0)
+        return -1;
+    cv->gravity_g_node = nd;
+    return 0;
+}
+
+static const keyrow k_gravity_keys[] = {
+    {"enabled", key_gravity_enabled}, /* false: g = 0 */
+    {"g", key_gravity_g},             /* m/s^2, replaces parameters.g */
+    {NULL, NULL},
+};
+
+static int key_effect_gravity(conv *cv, const ynode *nd, const char *path)
+{
+    if (nd->kind == YN_SCALAR && !ynode_is_null(nd))
+        return key_gravity_enabled(cv, nd, path); /* gravity: false */
+    return convert_map(cv, nd, path, k_gravity_keys, "key");
+}
+
+/* damping: {joint: b} */
+static int damping_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    return get_nonneg(cv, nd, path, &fx(cv)->damping[j]);
+}
+
+static int key_effect_damping(conv *cv, const ynode *nd, const char *path)
+{
+    fx(cv)->enabled |= LAG_EFF_DAMPING;
+    return per_joint(cv, nd, path, damping_joint);
+}
+
+/* friction: {joint: {static: mu_s, kinetic: mu_k}} */
+static int fr_static(conv *cv, const ynode *nd, const char *path)
+{
+    return get_nonneg(cv, nd, path, &fx(cv)->friction_static[cv->cur_joint]);
+}
+
+static int fr_kinetic(conv *cv, const ynode *nd, const char *path)
+{
+    return get_nonneg(cv, nd, path, &fx(cv)->friction_kinetic[cv->cur_joint]);
+}
+
+static const keyrow k_friction_keys[] = {
+    {"static", fr_static},   /* largest holding force, N or N m */
+    {"kinetic", fr_kinetic}, /* sliding force, N or N m */
+    {NULL, NULL},
+};
+
+static int friction_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    cv->cur_joint = j;
+    fx(cv)->friction_static[j] = NAN; /* "not given": defaults to kinetic below */
+    if (convert_map(cv, nd, path, k_friction_keys, "key") < 0)
+        return -1;
+    lag_effects_def *e = fx(cv);
+    if (isnan(e->friction_static[j])) e->friction_static[j] = e->friction_kinetic[j];
+    if (e->friction_static[j] < e->friction_kinetic[j])
+        return fail(cv->err, nd, path, "expected static (%g) >= kinetic (%g)",
+                    e->friction_static[j], e->friction_kinetic[j]);
+    return 0;
+}
+
+static int key_effect_friction(conv *cv, const ynode *nd, const char *path)
+{
+    fx(cv)->enabled |= LAG_EFF_FRICTION;
+    return per_joint(cv, nd, path, friction_joint);
+}
+
+/* limits: {joint: {lower, upper, restitution}}, plus rest_velocity for all */
+static int lim_lower(conv *cv, const ynode *nd, const char *path)
+{
+    cv->limit_seen |= 1;
+    return get_number(cv, nd, path, &fx(cv)->limit_lower[cv->cur_joint]);
+}
+
+static int lim_upper(conv *cv, const ynode *nd, const char *path)
+{
+    cv->limit_seen |= 2;
+    return get_number(cv, nd, path, &fx(cv)->limit_upper[cv->cur_joint]);
+}
+
+static int lim_restitution(conv *cv, const ynode *nd, const char *path)
+{
+    return get_unit(cv, nd, path, &fx(cv)->restitution[cv->cur_joint]);
+}
+
+static const keyrow k_limit_keys[] = {
+    {"lower", lim_lower},             /* m or rad */
+    {"upper", lim_upper},             /* m or rad */
+    {"restitution", lim_restitution}, /* [0, 1], default 0 */
+    {NULL, NULL},
+};
+
+static int key_rest_velocity(conv *cv, const ynode *nd, const char *path)
+{
+    return get_nonneg(cv, nd, path, &fx(cv)->rest_velocity);
+}
+
+static int key_effect_limits(conv *cv, const ynode *nd, const char *path)
+{
+    fx(cv)->enabled |= LAG_EFF_LIMITS;
+    if (nd->kind != YN_MAP)
+        return per_joint(cv, nd, path, NULL); /* reports the type error */
+    for (int i = 0; i < nd->n; i++) {
+        const yentry *en = &nd->entries[i];
+        char sub[256];
+        join(sub, sizeof sub, path, en->key);
+        if (strcmp(en->key, "rest_velocity") == 0) {
+            if (key_rest_velocity(cv, en->val, sub) < 0) return -1;
+            continue;
+        }
+        int j = joint_index(cv, en->key);
+        if (j < 0) {
+            char names[128];
+            joint_list(cv, names, sizeof names);
+            return fail_key(cv->err, en, "unknown joint '%s' in %s for model %s; allowed: %s, "
+                            "rest_velocity", en->key, path, cv->info->name, names);
+        }
+        cv->cur_joint = j;
+        cv->limit_seen = 0;
+        if (convert_map(cv, en->val, sub, k_limit_keys, "key") < 0)
+            return -1;
+        if (cv->limit_seen != 3)
+            return fail(cv->err, en->val, sub, "expected both lower and upper");
+        lag_effects_def *e = fx(cv);
+        if (!(e->limit_lower[j] < e->limit_upper[j]))
+            return fail(cv->err, en->val, sub, "expected lower (%g) < upper (%g)",
+                        e->limit_lower[j], e->limit_upper[j]);
+        e->limit_on[j] = true;
+        cv->limits_node = nd;
+    }
+    return 0;
+}
+
+/* floor (stick): {restitution, rest_velocity} */
+static int floor_restitution(conv *cv, const ynode *nd, const char *path)
+{
+    return get_unit(cv, nd, path, &fx(cv)->floor_restitution);
+}
+
+static const keyrow k_floor_keys[] = {
+    {"restitution", floor_restitution}, /* [0, 1], default 0 */
+    {"rest_velocity", key_rest_velocity}, /* rad/s, default 1e-3 */
+    {NULL, NULL},
+};
+
+static int key_effect_floor(conv *cv, const ynode *nd, const char *path)
+{
+    if (cv->sc->sim.model.kind != LAG_MODEL_STICK)
+        return fail(cv->err, nd, path, "the floor effect is for model stick only, not %s",
+                    cv->info->name);
+    fx(cv)->enabled |= LAG_EFF_FLOOR;
+    cv->floor_node = nd;
+    if (ynode_is_null(nd))
+        return 0; /* floor: with defaults */
+    return convert_map(cv, nd, path, k_floor_keys, "key");
+}
+
+/* actuator: {joint: {max, lag}} on actuated joints */
+static int act_max(conv *cv, const ynode *nd, const char *path)
+{
+    return get_positive(cv, nd, path, &fx(cv)->actuator_max[cv->cur_joint]);
+}
+
+static int act_lag(conv *cv, const ynode *nd, const char *path)
+{
+    return get_nonneg(cv, nd, path, &fx(cv)->actuator_tau[cv->cur_joint]);
+}
+
+static const keyrow k_actuator_keys[] = {
+    {"max", act_max}, /* |effort| bound, N or N m */
+    {"lag", act_lag}, /* first-order time constant, s */
+    {NULL, NULL},
+};
+
+static int actuator_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    if (!cv->info->actuated[j])
+        return fail(cv->err, nd, path, "joint %s of model %s takes no input",
+                    cv->info->joint_names[j], cv->info->name);
+    cv->cur_joint = j;
+    return convert_map(cv, nd, path, k_actuator_keys, "key");
+}
+
+static int key_effect_actuator(conv *cv, const ynode *nd, const char *path)
+{
+    fx(cv)->enabled |= LAG_EFF_ACTUATOR;
+    return per_joint(cv, nd, path, actuator_joint);
+}
+
+/* disturbance: [{t, joint, impulse | force + duration}, ...] */
+static int dist_t(conv *cv, const ynode *nd, const char *path)
+{
+    return get_nonneg(cv, nd, path, &cv->cur_dist->t);
+}
+
+static int dist_joint(conv *cv, const ynode *nd, const char *path)
+{
+    const char *name;
+    char names[128];
+    joint_list(cv, names, sizeof names);
+    char what[160];
+    snprintf(what, sizeof what, "a joint name (%s)", names);
+    if (get_string(cv, nd, path, what, &name) < 0)
+        return -1;
+    int j = joint_index(cv, name);
+    if (j < 0)
+        return fail(cv->err, nd, path, "unknown joint '%s'; allowed: %s", name, names);
+    cv->cur_dist->joint = j;
+    return 0;
+}
+
+static int dist_impulse(conv *cv, const ynode *nd, const char *path)
+{
+    cv->cur_dist_kind |= 1;
+    cv->cur_dist->impulse = true;
+    return get_number(cv, nd, path, &cv->cur_dist->value);
+}
+
+static int dist_force(conv *cv, const ynode *nd, const char *path)
+{
+    cv->cur_dist_kind |= 2;
+    cv->cur_dist->impulse = false;
+    return get_number(cv, nd, path, &cv->cur_dist->value);
+}
+
+static int dist_duration(conv *cv, const ynode *nd, const char *path)
+{
+    return get_positive(cv, nd, path, &cv->cur_dist->duration);
+}
+
+static const keyrow k_dist_keys[] = {
+    {"t", dist_t},               /* s */
+    {"joint", dist_joint},       /* joint name */
+    {"impulse", dist_impulse},   /* N s or N m s */
+    {"force", dist_force},       /* N or N m */
+    {"duration", dist_duration}, /* s, with force */
+    {NULL, NULL},
+};
+
+static int key_effect_disturbance(conv *cv, const ynode *nd, const char *path)
+{
+    lag_effects_def *e = fx(cv);
+    e->enabled |= LAG_EFF_DISTURBANCE;
+    if (nd->kind != YN_SEQ)
+        return fail(cv->err, nd, path,
+                    "expected a sequence of {t, joint, impulse} or {t, joint, force, duration}");
+    if (nd->n > LAG_MAX_DISTURBANCES)
+        return fail(cv->err, nd, path, "at most %d disturbances, got %d", LAG_MAX_DISTURBANCES,
+                    nd->n);
+    e->n_disturbances = nd->n;
+    for (int k = 0; k < nd->n; k++) {
+        char sub[256];
+        snprintf(sub, sizeof sub, "%s[%d]", path, k);
+        cv->cur_dist = &e->disturbances[k];
+        memset(cv->cur_dist, 0, sizeof *cv->cur_dist);
+        cv->cur_dist->joint = -1;
+        cv->cur_dist->t = NAN;
+        cv->cur_dist_kind = 0;
+        if (convert_map(cv, nd->items[k], sub, k_dist_keys, "key") < 0)
+            return -1;
+        const ynode *it = nd->items[k];
+        if (isnan(cv->cur_dist->t) || cv->cur_dist->joint < 0)
+            return fail(cv->err, it, sub, "expected both t and joint");
+        if (cv->cur_dist_kind != 1 && cv->cur_dist_kind != 2)
+            return fail(cv->err, it, sub, "expected exactly one of impulse or force");
+        if (cv->cur_dist_kind == 2 && !(cv->cur_dist->duration > 0))
+            return fail(cv->err, it, sub, "a force needs a duration > 0 (s)");
+        if (cv->cur_dist_kind == 1 && cv->cur_dist->duration != 0)
+            return fail(cv->err, it, sub, "an impulse takes no duration");
+    }
+    return 0;
+}
+
+/* noise: {seed, q: {joint: std}, qd: {joint: std}} */
+static int noise_q_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    return get_nonneg(cv, nd, path, &fx(cv)->noise_q[j]);
+}
+
+static int noise_qd_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    return get_nonneg(cv, nd, path, &fx(cv)->noise_qd[j]);
+}
+
+static int noise_q(conv *cv, const ynode *nd, const char *path)
+{
+    return per_joint(cv, nd, path, noise_q_joint);
+}
+
+static int noise_qd(conv *cv, const ynode *nd, const char *path)
+{
+    return per_joint(cv, nd, path, noise_qd_joint);
+}
+
+static int noise_seed(conv *cv, const ynode *nd, const char *path)
+{
+    long long v = 0;
+    if (get_int(cv, nd, path, 0, 9007199254740991LL, &v) < 0)
+        return -1;
+    fx(cv)->noise_seed = (uint64_t)v;
+    return 0;
+}
+
+static const keyrow k_noise_keys[] = {
+    {"seed", noise_seed}, /* integer, default 1 */
+    {"q", noise_q},       /* std dev per joint, m or rad */
+    {"qd", noise_qd},     /* std dev per joint, m/s or rad/s */
+    {NULL, NULL},
+};
+
+static int key_effect_noise(conv *cv, const ynode *nd, const char *path)
+{
+    fx(cv)->enabled |= LAG_EFF_NOISE;
+    return convert_map(cv, nd, path, k_noise_keys, "key");
+}
+
 static const keyrow k_effects[] = {
+    {"gravity", key_effect_gravity},
+    {"damping", key_effect_damping},
+    {"friction", key_effect_friction},
+    {"limits", key_effect_limits},
+    {"floor", key_effect_floor},
+    {"actuator", key_effect_actuator},
+    {"disturbance", key_effect_disturbance},
+    {"noise", key_effect_noise},
     {NULL, NULL},
 };
 
@@ -977,6 +1410,7 @@ static int key_effects(conv *cv, const ynode *nd, const char *path)
     /* `effects:` with nothing = no effects */
     if (ynode_is_null(nd))
         return 0;
+    cv->effects = nd;
     return convert_map(cv, nd, path, k_effects, "effect");
 }
 
@@ -997,7 +1431,7 @@ static const keyrow k_top_keys[] = {
 
 static int convert_scene(const ynode *root, const char *path, lag_scene *sc, errbuf *err)
 {
-    conv cv = {.err = err, .sc = sc, .root = root};
+    conv cv = {.err = err, .sc = sc, .root = root, .gravity_enabled = -1};
     if (root->kind != YN_MAP) {
         if (ynode_is_null(root))
             return fail(err, root, NULL,
@@ -1029,6 +1463,10 @@ static int convert_scene(const ynode *root, const char *path, lag_scene *sc, err
 
     if (convert_map(&cv, root, "", k_top_keys, "key") < 0)
         return -1;
+
+    /* effects.gravity overrides parameters.g (after both are read, whatever their order) */
+    if (cv.gravity_g_node) sc->sim.model.p[lag_model_param_index(sc->sim.model.kind, "g")] = cv.gravity_g;
+    if (cv.gravity_enabled == 0) sc->sim.model.p[lag_model_param_index(sc->sim.model.kind, "g")] = 0.0;
 
     /* Parameters: uniform-rod inertias not given -> m l^2 / 12; then the core's check. */
     char msg[256];
@@ -1073,6 +1511,22 @@ static int convert_scene(const ynode *root, const char *path, lag_scene *sc, err
                         "initial state exceeds explode_limit = %g", lim);
         }
     }
+
+    /* The initial state must lie within the stops and above the floor. */
+    const lag_effects_def *e = &sc->sim.effects;
+    for (int i = 0; i < sc->sim.model.nq; i++) {
+        if (!((e->enabled & LAG_EFF_LIMITS) && e->limit_on[i])) continue;
+        if (sc->sim.q0[i] < e->limit_lower[i] || sc->sim.q0[i] > e->limit_upper[i])
+            return fail(err, cv.initial ? cv.initial : cv.limits_node,
+                        cv.initial ? "initial" : "effects.limits",
+                        "initial %s = %g is outside its limits [%g, %g]",
+                        cv.info->joint_names[i], sc->sim.q0[i], e->limit_lower[i],
+                        e->limit_upper[i]);
+    }
+    if ((e->enabled & LAG_EFF_FLOOR) && (sc->sim.q0[1] < 0 || sc->sim.q0[1] > M_PI))
+        return fail(err, cv.initial ? cv.initial : cv.floor_node,
+                    cv.initial ? "initial" : "effects.floor",
+                    "initial phi = %g must be in [0, pi] with a floor", sc->sim.q0[1]);
 
     /* Final check by the core (integrator settings, initial state). */
     if (lag_sim_def_validate(&sc->sim, msg, sizeof msg) != LAG_OK)
