@@ -6,7 +6,7 @@ pkgs=(build-essential cmake pkg-config
       liblcm-dev liblcm-bin libglib2.0-dev libyaml-dev   # LCM (lcm.pc needs glib's dev package) and libyaml
       python3                                            # the stdlib-only Python client and some tests
       libmujoco-dev libsundials-dev gnuplot-nox          # benchmark peers and plots
-      liblcm-java default-jdk-headless)                  # lcm-spy with lagsim's types
+      liblcm-java libjchart2d-java default-jdk-headless) # lcm-spy with lagsim's types
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
