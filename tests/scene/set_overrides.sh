@@ -75,7 +75,8 @@ e --expect "--set publish_hz: expected a finite number, got .inf" -- --set publi
 e --expect "--set realtime.mode: unknown mode 'slow'" -- --set realtime.mode=slow
 e --expect "--set lcm.prefix: YAML syntax error" -- --set "lcm.prefix=[a"
 e --expect "--set integrator..dt: empty key in the dotted path" -- --set integrator..dt=1
-e --expect "--set effects.damping: unknown effect 'damping'" -- --set effects.damping=1
+e --expect "--set effects.damping: expected a mapping of joints (theta0, theta1, theta2), got a scalar" -- --set effects.damping=1
+e --expect "--set effects.drag: unknown effect 'drag' in effects" -- --set effects.drag=1
 qline=$(grep -n '^  q:' "$cfg/dipc.yaml" | cut -d: -f1)   # "  q: [...]": the sequence starts at column 6
 m0line=$(grep -n '^  m0:' "$cfg/dipc.yaml" | cut -d: -f1) # "  m0: ...": the key at column 3
 e --expect "$cfg/dipc.yaml:$m0line:3: unknown parameter 'm0' for model stick" -- --set model=stick
