@@ -12,6 +12,9 @@ typedef struct lag_model_vtable {
     void (*gravity)(const double *p, const double *q, double *g);
     /* M(q) and h = C qd + g together: what the step needs, sharing the trig. */
     void (*mass_bias)(const double *p, const double *q, const double *qd, double *M, double *h);
+    /* M qdd = tau - C qd - g, closed form (the step's hot path). tau is not NULL. */
+    lag_result (*forward)(const double *p, const double *q, const double *qd,
+                          const double *tau, double *qdd);
     double (*kinetic)(const double *p, const double *q, const double *qd);
     double (*potential)(const double *p, const double *q);
 } lag_model_vtable;
@@ -23,7 +26,45 @@ extern const lag_model_info lag_stick_info;
 extern const lag_model_info lag_manipulator_info;
 extern const lag_model_info lag_dipc_info;
 
-const lag_model_vtable *lag_model_vt(const lag_model *m);
+extern const lag_model_vtable *const lag_model_vtables[LAG_MODEL_COUNT];
+static inline const lag_model_vtable *lag_model_vt(const lag_model *m)
+{
+    return lag_model_vtables[m->kind];
+}
+
+/* Closed-form LDL^T solves for the sizes the models have (no sqrt, no loops): the
+ * forward dynamics spend most of their time here. A non-positive pivot (NaN included)
+ * means A is not numerically SPD. */
+static inline lag_result lag_spd_solve2(const double *A, const double *b, double *x)
+{
+    double d0 = A[0];
+    if (!(d0 > 0.0)) return LAG_ERR_SINGULAR;
+    double l10 = A[2] / d0;
+    double d1 = A[3] - l10 * A[2];
+    if (!(d1 > 0.0)) return LAG_ERR_SINGULAR;
+    double z1 = b[1] - l10 * b[0];
+    x[1] = z1 / d1;
+    x[0] = b[0] / d0 - l10 * x[1];
+    return LAG_OK;
+}
+
+static inline lag_result lag_spd_solve3(const double *A, const double *b, double *x)
+{
+    double d0 = A[0];
+    if (!(d0 > 0.0)) return LAG_ERR_SINGULAR;
+    double i0 = 1.0 / d0;
+    double l10 = A[3] * i0, l20 = A[6] * i0;
+    double d1 = A[4] - l10 * A[3];
+    if (!(d1 > 0.0)) return LAG_ERR_SINGULAR;
+    double l21 = (A[7] - l20 * A[3]) / d1;
+    double d2 = A[8] - l20 * A[6] - l21 * l21 * d1;
+    if (!(d2 > 0.0)) return LAG_ERR_SINGULAR;
+    double z0 = b[0], z1 = b[1] - l10 * z0, z2 = b[2] - l20 * z0 - l21 * z1;
+    x[2] = z2 / d2;
+    x[1] = z1 / d1 - l21 * x[2];
+    x[0] = z0 * i0 - l10 * x[1] - l20 * x[2];
+    return LAG_OK;
+}
 
 /* Solves A x = b for symmetric positive definite A (n <= LAG_MAX_STATE) by Cholesky.
  * A is not modified. Returns LAG_ERR_SINGULAR if a pivot is not positive. OUT: x */

@@ -8,7 +8,7 @@
 static const lag_model_info *const infos[LAG_MODEL_COUNT] = {
     &lag_stick_info, &lag_manipulator_info, &lag_dipc_info,
 };
-static const lag_model_vtable *const vtables[LAG_MODEL_COUNT] = {
+const lag_model_vtable *const lag_model_vtables[LAG_MODEL_COUNT] = {
     &lag_stick_vtable, &lag_manipulator_vtable, &lag_dipc_vtable,
 };
 
@@ -49,7 +49,6 @@ int lag_model_param_index(lag_model_kind kind, const char *name)
     return -1;
 }
 
-const lag_model_vtable *lag_model_vt(const lag_model *m) { return vtables[m->kind]; }
 
 void lag_model_default_unfinished(lag_model *m, lag_model_kind kind)
 {
@@ -122,42 +121,44 @@ lag_result lag_model_validate(const lag_model *m, char *err, size_t errlen)
 
 void lag_model_mass(const lag_model *m, const double *q, double *M)
 {
-    vtables[m->kind]->mass(m->p, q, M);
+    lag_model_vtables[m->kind]->mass(m->p, q, M);
 }
 
 void lag_model_mass_deriv(const lag_model *m, const double *q, double *dM)
 {
-    vtables[m->kind]->mass_deriv(m->p, q, dM);
+    lag_model_vtables[m->kind]->mass_deriv(m->p, q, dM);
 }
 
 void lag_model_coriolis(const lag_model *m, const double *q, const double *qd, double *C)
 {
-    vtables[m->kind]->coriolis(m->p, q, qd, C);
+    lag_model_vtables[m->kind]->coriolis(m->p, q, qd, C);
 }
 
 void lag_model_gravity(const lag_model *m, const double *q, double *g)
 {
-    vtables[m->kind]->gravity(m->p, q, g);
+    lag_model_vtables[m->kind]->gravity(m->p, q, g);
 }
 
 void lag_model_bias(const lag_model *m, const double *q, const double *qd, double *h)
 {
     double M[LAG_MAX_DOF * LAG_MAX_DOF];
-    vtables[m->kind]->mass_bias(m->p, q, qd, M, h);
+    lag_model_vtables[m->kind]->mass_bias(m->p, q, qd, M, h);
 }
 
 double lag_model_kinetic(const lag_model *m, const double *q, const double *qd)
 {
-    return vtables[m->kind]->kinetic(m->p, q, qd);
+    return lag_model_vtables[m->kind]->kinetic(m->p, q, qd);
 }
 
 double lag_model_potential(const lag_model *m, const double *q)
 {
-    return vtables[m->kind]->potential(m->p, q);
+    return lag_model_vtables[m->kind]->potential(m->p, q);
 }
 
 lag_result lag_spd_solve(int n, const double *A, const double *b, double *x)
 {
+    if (n == 3) return lag_spd_solve3(A, b, x);
+    if (n == 2) return lag_spd_solve2(A, b, x);
     double L[LAG_MAX_STATE * LAG_MAX_STATE];
     /* Cholesky A = L L^T, lower triangle only. */
     for (int j = 0; j < n; j++) {
@@ -218,11 +219,8 @@ lag_result lag_lu_solve_inplace(int n, double *A, double *b)
 lag_result lag_model_forward(const lag_model *m, const double *q, const double *qd,
                              const double *tau, double *qdd)
 {
-    double M[LAG_MAX_DOF * LAG_MAX_DOF], h[LAG_MAX_DOF], r[LAG_MAX_DOF];
-    int n = m->nq;
-    vtables[m->kind]->mass_bias(m->p, q, qd, M, h);
-    for (int i = 0; i < n; i++) r[i] = (tau ? tau[i] : 0.0) - h[i];
-    return lag_spd_solve(n, M, r, qdd);
+    static const double zero[LAG_MAX_DOF] = {0};
+    return lag_model_vtables[m->kind]->forward(m->p, q, qd, tau ? tau : zero, qdd);
 }
 
 bool lag_state_ok(int n, const double *x, double limit)

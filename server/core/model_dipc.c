@@ -80,8 +80,8 @@ static void dipc_gravity(const double *p, const double *q, double *g)
 }
 
 /* The step's hot path: M and h = C qd + g with one sincos per angle. */
-static void dipc_mass_bias(const double *p, const double *q, const double *qd, double *M,
-                           double *h)
+static inline __attribute__((always_inline)) void
+dipc_mass_bias_inl(const double *p, const double *q, const double *qd, double *M, double *h)
 {
     dipc_k k = dipc_coeffs(p);
     double s1, c1, s2, c2;
@@ -96,6 +96,23 @@ static void dipc_mass_bias(const double *p, const double *q, const double *qd, d
     h[0] = -k.k1 * s1 * w1 - k.k2 * s2 * w2;
     h[1] = k.k3 * s12 * w2 - k.k1 * gr * s1;
     h[2] = -k.k3 * s12 * w1 - k.k2 * gr * s2;
+}
+
+/* M qdd = tau - h with M and h as in dipc_mass_bias, solved by LDL^T written out for
+ * this M (M00 is constant). */
+static lag_result dipc_forward(const double *p, const double *q, const double *qd,
+                               const double *tau, double *qdd)
+{
+    double M[9], h[3];
+    dipc_mass_bias_inl(p, q, qd, M, h);
+    double r[3] = {tau[0] - h[0], tau[1] - h[1], tau[2] - h[2]};
+    return lag_spd_solve3(M, r, qdd);
+}
+
+static void dipc_mass_bias(const double *p, const double *q, const double *qd, double *M,
+                           double *h)
+{
+    dipc_mass_bias_inl(p, q, qd, M, h);
 }
 
 static double dipc_kinetic(const double *p, const double *q, const double *qd)
@@ -119,7 +136,7 @@ static double dipc_potential(const double *p, const double *q)
 
 const lag_model_vtable lag_dipc_vtable = {
     dipc_mass, dipc_mass_deriv, dipc_coriolis, dipc_gravity, dipc_mass_bias,
-    dipc_kinetic, dipc_potential,
+    dipc_forward, dipc_kinetic, dipc_potential,
 };
 
 const lag_model_info lag_dipc_info = {

@@ -55,6 +55,20 @@ static void manip_mass_bias(const double *p, const double *q, const double *qd, 
     h[1] = -a * qd[0] * qd[0] + P_M2 * P_G * s;
 }
 
+/* M is diagonal: the two equations decouple given q, qd. */
+static lag_result manip_forward(const double *p, const double *q, const double *qd,
+                                const double *tau, double *qdd)
+{
+    double s, c;
+    sincos(q[0], &s, &c);
+    double a = P_M2 * q[1];
+    double m00 = P_M1 * P_L1 * P_L1 + P_I1 + P_I2 + a * q[1];
+    if (!(m00 > 0.0)) return LAG_ERR_SINGULAR;
+    qdd[0] = (tau[0] - 2.0 * a * qd[0] * qd[1] - (P_M1 * P_L1 + a) * P_G * c) / m00;
+    qdd[1] = (tau[1] + a * qd[0] * qd[0] - P_M2 * P_G * s) / P_M2;
+    return LAG_OK;
+}
+
 static double manip_kinetic(const double *p, const double *q, const double *qd)
 {
     return 0.5 * P_M1 * P_L1 * P_L1 * qd[0] * qd[0]
@@ -69,7 +83,7 @@ static double manip_potential(const double *p, const double *q)
 
 const lag_model_vtable lag_manipulator_vtable = {
     manip_mass, manip_mass_deriv, manip_coriolis, manip_gravity, manip_mass_bias,
-    manip_kinetic, manip_potential,
+    manip_forward, manip_kinetic, manip_potential,
 };
 
 const lag_model_info lag_manipulator_info = {

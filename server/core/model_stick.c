@@ -55,6 +55,20 @@ static void stick_mass_bias(const double *p, const double *q, const double *qd, 
     h[1] = -a * s * c * qd[1] * qd[1] + 0.5 * P_M * P_G * P_L * c;
 }
 
+/* M is diagonal: x_ddot = F_x / m, phi_ddot = (tau_phi - h_phi) / M_11. */
+static lag_result stick_forward(const double *p, const double *q, const double *qd,
+                                const double *tau, double *qdd)
+{
+    double s, c;
+    sincos(q[1], &s, &c);
+    double a = 0.25 * P_M * P_L * P_L;
+    double m11 = a * c * c + P_I;
+    if (!(m11 > 0.0)) return LAG_ERR_SINGULAR;
+    qdd[0] = tau[0] / P_M;
+    qdd[1] = (tau[1] + a * s * c * qd[1] * qd[1] - 0.5 * P_M * P_G * P_L * c) / m11;
+    return LAG_OK;
+}
+
 static double stick_kinetic(const double *p, const double *q, const double *qd)
 {
     double c = cos(q[1]);
@@ -69,7 +83,7 @@ static double stick_potential(const double *p, const double *q)
 
 const lag_model_vtable lag_stick_vtable = {
     stick_mass, stick_mass_deriv, stick_coriolis, stick_gravity, stick_mass_bias,
-    stick_kinetic, stick_potential,
+    stick_forward, stick_kinetic, stick_potential,
 };
 
 const lag_model_info lag_stick_info = {

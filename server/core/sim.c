@@ -176,12 +176,17 @@ lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *q
 
 lag_result lag_sim_rhs(lag_sim *s, const double *y, double *ydot)
 {
-    int n = s->nq;
-    double Q[LAG_MAX_DOF];
-    lag_applied_forces(s, y, y + n, Q);
+    const int n = s->nq;
     s->stats.rhs_evals++;
     for (int i = 0; i < n; i++) ydot[i] = y[n + i];
-    return lag_forward_locked(s, y, y + n, Q, ydot + n, NULL);
+    if (s->def.effects.enabled || s->mode.locked) {
+        double Q[LAG_MAX_DOF];
+        lag_applied_forces(s, y, y + n, Q);
+        return lag_forward_locked(s, y, y + n, Q, ydot + n, NULL);
+    }
+    /* The bare model, the hot path: the model's closed-form forward dynamics. */
+    return lag_model_vt(&s->def.model)->forward(s->def.model.p, y, y + n, s->tau_applied,
+                                                ydot + n);
 }
 
 lag_result lag_qd_from_p(const lag_sim *s, const double *q, const double *p, double *qd)
@@ -246,8 +251,8 @@ static lag_result plain_tick(lag_sim *s, double *y)
     double y1[LAG_MAX_STATE];
     lag_result r = lag_step(s, s->def.integrator.dt, y, y1);
     if (r != LAG_OK) return r;
-    if (!lag_state_ok(N, y1, INFINITY)) return LAG_ERR_NONFINITE;
-    if (!lag_state_ok(N, y1, s->def.explode_limit)) return LAG_ERR_EXPLODE;
+    if (!lag_state_ok(N, y1, s->def.explode_limit))
+        return lag_state_ok(N, y1, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
     for (int i = 0; i < N; i++) y[i] = y1[i];
     return LAG_OK;
 }
