@@ -269,15 +269,20 @@ lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
     }
     for (int64_t k = 0; k < nticks; k++) {
         double y[LAG_MAX_STATE];
-        for (int i = 0; i < n; i++) { y[i] = s->q[i]; y[n + i] = s->qd[i]; }
         lag_result r;
+        /* pre_tick first: a scheduled impulse changes s->qd, so the copy comes after it
+         * (the velocities before it are kept to restore the last good tick on a fault) */
+        double qd_good[LAG_MAX_DOF];
+        memcpy(qd_good, s->qd, sizeof qd_good);
+        if (en & TICK_EFFECTS) lag_effects_pre_tick(s);
+        for (int i = 0; i < n; i++) { y[i] = s->q[i]; y[n + i] = s->qd[i]; }
         if (en & TICK_EFFECTS) {
-            lag_effects_pre_tick(s);
             r = (en & EVENT_EFFECTS) ? lag_effects_tick(s, y) : plain_tick(s, y);
         } else {
             r = plain_tick(s, y);
         }
         if (r != LAG_OK) {
+            memcpy(s->qd, qd_good, sizeof qd_good);
             s->stats.faults++;
             return r; /* public state is still that of the last good tick */
         }
