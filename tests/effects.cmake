@@ -14,3 +14,13 @@ if(TARGET test_effects)
     set_tests_properties(effects.${arg} PROPERTIES TIMEOUT 120 LABELS effects)
   endforeach()
 endif()
+
+# Hard cases. long_horizon (10^8 ticks, ~8 s here, minutes under the sanitizers) is
+# labelled slow so that the sanitizer pass of tests/run.sh skips it.
+if(TARGET test_hard)
+  foreach(arg chaos spin release tiny_inertia manip_limits stiff friction_driven long_horizon)
+    add_test(NAME hard.${arg} COMMAND test_hard ${arg})
+    set_tests_properties(hard.${arg} PROPERTIES TIMEOUT 300 LABELS effects)
+  endforeach()
+  set_tests_properties(hard.long_horizon PROPERTIES LABELS "effects;slow")
+endif()
