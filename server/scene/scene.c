@@ -9,7 +9,7 @@
 
 /* Defaults for a model kind: the core's lag_default_sim_def (rk4 at 1 ms, at rest at
  * q = 0, the model's default parameters) plus the daemon's defaults documented in
- * scene.h and docs/readme/scene.md. OUT: sc */
+ * scene.h and README.md ("Scenes"). OUT: sc */
 void lag_scene_default(lag_scene *sc, lag_model_kind kind)
 {
     memset(sc, 0, sizeof *sc);

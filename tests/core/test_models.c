@@ -273,7 +273,7 @@ static void check_info(void)
 /* ---------------------------------------------------------------- the seed's DIPC */
 /* The seed's Problem 3, transcribed as printed, with each error we found behind a flag.
  * With every fix applied it must agree with our T and U and with the core; with any one
- * fix left out it must not. That proves the list in docs/readme/models.md is complete for
+ * fix left out it must not. That proves the list in README.md ("The models") is complete for
  * the printed (b) T_i, (c) U_i, (8) L and (12a-c), and that each item is a real error. */
 enum {
     FIX_T0_SQUARE = 1 << 0,  /* (b) T0 = 1/2 m0 th0d  -> 1/2 m0 th0d^2 */
