@@ -116,30 +116,31 @@ static double step_factor(double en, bool last_rejected)
     return fmin(last_rejected ? 1.0 : 10.0, fmax(0.2, fac));
 }
 
-lag_result lag_dopri5_span(lag_sim *s, double H, const double *y0, double *yout)
+/* The adaptive loop shared by both drivers: from (*t, y, k1 = f(y)) up to t_end. In
+ * hard-stop mode the last step is shortened to land on t_end exactly; in continuous mode
+ * it may step past t_end. With `dense`, each accepted step leaves its dense-output
+ * coefficients (and start time) in s->dp for interpolation. An accepted state that is
+ * non-finite or beyond explode_limit is an error; y and *t then hold the last good step. */
+static lag_result dp_run(lag_sim *s, double *t, double t_end, double *y, double *k1,
+                         bool continuous, bool dense)
 {
     const int N = 2 * s->nq;
     const lag_integrator_def *in = &s->def.integrator;
-    double y[LAG_MAX_STATE], k1[LAG_MAX_STATE], y1[LAG_MAX_STATE], k7[LAG_MAX_STATE];
-    lag_result r;
-    for (int i = 0; i < N; i++) y[i] = y0[i];
-    if (H <= 0.0) {
-        for (int i = 0; i < N; i++) yout[i] = y0[i];
-        return LAG_OK;
-    }
-    if ((r = lag_sim_rhs(s, y, k1)) != LAG_OK) return r;
-    if (!(s->dp.h > 0.0)) s->dp.h = initial_step(s, N, y, k1);
-    double t = 0.0;
+    double y1[LAG_MAX_STATE], k7[LAG_MAX_STATE], rc[5][LAG_MAX_STATE];
     bool last_rejected = false;
-    while (t < H) {
+    lag_result r;
+    while (*t < t_end) {
         double h = s->dp.h;
         bool lands = false;
-        if (t + h >= H) { h = H - t; lands = true; }
+        if (!continuous && *t + h >= t_end) {
+            h = t_end - *t;
+            lands = true;
+        }
         if (h < in->dt_min && !lands) return LAG_ERR_STEPSIZE;
-        double en = dp_try(s, h, y, k1, y1, k7, NULL, &r);
+        double en = dp_try(s, h, y, k1, y1, k7, dense ? rc : NULL, &r);
         if (isnan(en)) {
-            if (r == LAG_OK) r = LAG_ERR_NONFINITE;
             /* a failed evaluation (e.g. singular M far from y): shrink and retry */
+            if (r == LAG_OK) r = LAG_ERR_NONFINITE;
             s->dp.h = 0.25 * h;
             s->stats.steps_rejected++;
             if (s->dp.h < in->dt_min) return r;
@@ -147,17 +148,39 @@ lag_result lag_dopri5_span(lag_sim *s, double H, const double *y0, double *yout)
             continue;
         }
         double fac = step_factor(en, last_rejected);
-        if (en <= 1.0) {
-            t = lands ? H : t + h;
-            for (int i = 0; i < N; i++) { y[i] = y1[i]; k1[i] = k7[i]; }
-            s->stats.steps_accepted++;
-            if (!lands || h * fac > s->dp.h) s->dp.h = h * fac;
-            last_rejected = false;
-        } else {
+        if (en > 1.0) {
             s->stats.steps_rejected++;
             s->dp.h = h * fac;
             last_rejected = true;
+            continue;
         }
+        if (!lag_state_ok(N, y1, s->def.explode_limit))
+            return lag_state_ok(N, y1, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
+        if (dense) {
+            memcpy(s->dp.rcont, rc, sizeof rc);
+            s->dp.t_prev = *t;
+        }
+        *t = lands ? t_end : *t + h;
+        memcpy(y, y1, sizeof(double) * N);
+        memcpy(k1, k7, sizeof(double) * N); /* FSAL */
+        s->stats.steps_accepted++;
+        /* A step shortened to land keeps the natural proposal for the next one. */
+        if (!lands || h * fac > s->dp.h) s->dp.h = h * fac;
+        last_rejected = false;
+    }
+    return LAG_OK;
+}
+
+lag_result lag_dopri5_span(lag_sim *s, double H, const double *y0, double *yout)
+{
+    const int N = 2 * s->nq;
+    double y[LAG_MAX_STATE], k1[LAG_MAX_STATE], t = 0.0;
+    lag_result r;
+    for (int i = 0; i < N; i++) y[i] = y0[i];
+    if (H > 0.0) {
+        if ((r = lag_sim_rhs(s, y, k1)) != LAG_OK) return r;
+        if (!(s->dp.h > 0.0)) s->dp.h = initial_step(s, N, y, k1);
+        if ((r = dp_run(s, &t, H, y, k1, false, false)) != LAG_OK) return r;
     }
     for (int i = 0; i < N; i++) yout[i] = y[i];
     return LAG_OK;
@@ -166,10 +189,9 @@ lag_result lag_dopri5_span(lag_sim *s, double H, const double *y0, double *yout)
 lag_result lag_dopri5_advance(lag_sim *s, int64_t nticks, bool continuous)
 {
     const int n = s->nq, N = 2 * n;
-    const lag_integrator_def *in = &s->def.integrator;
     const double t_start = lag_sim_time(s);
     const int64_t tick_end = s->tick + nticks;
-    const double t_end = (double)tick_end * in->dt;
+    const double t_end = (double)tick_end * s->def.integrator.dt;
     lag_result r;
 
     /* (Re)start from the public state when the internal one is not continuous with it. */
@@ -182,64 +204,24 @@ lag_result lag_dopri5_advance(lag_sim *s, int64_t nticks, bool continuous)
         s->dp.t_prev = s->dp.t;
         s->dp.valid = true;
     }
-
-    double y1[LAG_MAX_STATE], k7[LAG_MAX_STATE], rc[5][LAG_MAX_STATE];
-    double *y = s->dp.y, *k1 = s->dp.k1;
-    bool last_rejected = false;
-
-    while (s->dp.t < t_end) {
-        double h = s->dp.h;
-        bool lands = false;
-        if (!continuous && s->dp.t + h >= t_end) {
-            h = t_end - s->dp.t;
-            lands = true;
-        }
-        if (h < in->dt_min && !lands) { s->dp.valid = false; return LAG_ERR_STEPSIZE; }
-        double en = dp_try(s, h, y, k1, y1, k7, rc, &r);
-        if (isnan(en)) {
-            if (r == LAG_OK) r = LAG_ERR_NONFINITE;
-            s->dp.h = 0.25 * h;
-            s->stats.steps_rejected++;
-            if (s->dp.h < in->dt_min) { s->dp.valid = false; return r; }
-            last_rejected = true;
-            continue;
-        }
-        double fac = step_factor(en, last_rejected);
-        if (en <= 1.0) {
-            if (!lag_state_ok(N, y1, s->def.explode_limit)) {
-                s->dp.valid = false;
-                return lag_state_ok(N, y1, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
-            }
-            memcpy(s->dp.rcont, rc, sizeof rc);
-            s->dp.t_prev = s->dp.t;
-            s->dp.t = lands ? t_end : s->dp.t + h;
-            memcpy(y, y1, sizeof(double) * N);
-            memcpy(k1, k7, sizeof(double) * N); /* FSAL */
-            s->stats.steps_accepted++;
-            /* A step shortened to land keeps the natural proposal for the next one. */
-            if (!lands || h * fac > s->dp.h) s->dp.h = h * fac;
-            last_rejected = false;
-        } else {
-            s->stats.steps_rejected++;
-            s->dp.h = h * fac;
-            last_rejected = true;
-        }
+    if ((r = dp_run(s, &s->dp.t, t_end, s->dp.y, s->dp.k1, continuous, true)) != LAG_OK) {
+        s->dp.valid = false;
+        return r;
     }
 
     /* Public state at t_end: exact if landed, else from the dense output. */
+    double ye[LAG_MAX_STATE];
     if (s->dp.t == t_end) {
-        memcpy(s->q, y, sizeof(double) * n);
-        memcpy(s->qd, y + n, sizeof(double) * n);
+        memcpy(ye, s->dp.y, sizeof(double) * N);
     } else {
-        double ye[LAG_MAX_STATE];
         dense(s, N, t_end, ye);
         if (!lag_state_ok(N, ye, s->def.explode_limit)) {
             s->dp.valid = false;
             return lag_state_ok(N, ye, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
         }
-        memcpy(s->q, ye, sizeof(double) * n);
-        memcpy(s->qd, ye + n, sizeof(double) * n);
     }
+    memcpy(s->q, ye, sizeof(double) * n);
+    memcpy(s->qd, ye + n, sizeof(double) * n);
     s->tick = tick_end;
     return LAG_OK;
 }

@@ -137,6 +137,28 @@ void lag_applied_forces(const lag_sim *s, const double *q, const double *qd, dou
         for (int i = 0; i < n; i++) Q[i] += s->mode.dist_force[i];
 }
 
+/* Solves A x = b on the free joints of `locked` (a reduced SPD system); x is 0 on the
+ * locked joints. With nothing locked this is the full solve. OUT: x */
+static lag_result solve_free(int n, uint32_t locked, const double *A, const double *b,
+                             double *x)
+{
+    if (!locked) return lag_spd_solve(n, A, b, x);
+    int free_idx[LAG_MAX_DOF], nf = 0;
+    for (int i = 0; i < n; i++)
+        if (!(locked & (1u << i))) free_idx[nf++] = i;
+    double Aff[LAG_MAX_DOF * LAG_MAX_DOF], bf[LAG_MAX_DOF], xf[LAG_MAX_DOF];
+    for (int a = 0; a < nf; a++) {
+        bf[a] = b[free_idx[a]];
+        for (int c = 0; c < nf; c++) Aff[a * nf + c] = A[free_idx[a] * n + free_idx[c]];
+    }
+    for (int i = 0; i < n; i++) x[i] = 0.0;
+    if (nf == 0) return LAG_OK;
+    lag_result r = lag_spd_solve(nf, Aff, bf, xf);
+    if (r != LAG_OK) return r;
+    for (int a = 0; a < nf; a++) x[free_idx[a]] = xf[a];
+    return LAG_OK;
+}
+
 lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *qd,
                               const double *Q, double *qdd, double *lambda)
 {
@@ -151,20 +173,8 @@ lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *q
     lag_model_vt(&s->def.model)->mass_bias(s->def.model.p, q, qd, M, h);
     for (int i = 0; i < n; i++) r[i] = Q[i] - h[i];
     /* M_ff qdd_f = r_f on the free joints; qdd_L = 0 */
-    int free_idx[LAG_MAX_DOF], nf = 0;
-    for (int i = 0; i < n; i++)
-        if (!(locked & (1u << i))) free_idx[nf++] = i;
-    double Mff[LAG_MAX_DOF * LAG_MAX_DOF], rf[LAG_MAX_DOF], xf[LAG_MAX_DOF];
-    for (int a = 0; a < nf; a++) {
-        rf[a] = r[free_idx[a]];
-        for (int b = 0; b < nf; b++) Mff[a * nf + b] = M[free_idx[a] * n + free_idx[b]];
-    }
-    for (int i = 0; i < n; i++) qdd[i] = 0.0;
-    if (nf > 0) {
-        lag_result res = lag_spd_solve(nf, Mff, rf, xf);
-        if (res != LAG_OK) return res;
-        for (int a = 0; a < nf; a++) qdd[free_idx[a]] = xf[a];
-    }
+    lag_result res = solve_free(n, locked, M, r, qdd);
+    if (res != LAG_OK) return res;
     if (lambda) /* lambda = M qdd - r, the force each lock must supply */
         for (int i = 0; i < n; i++) {
             double acc = -r[i];
@@ -191,25 +201,9 @@ lag_result lag_sim_rhs(lag_sim *s, const double *y, double *ydot)
 
 lag_result lag_qd_from_p(const lag_sim *s, const double *q, const double *p, double *qd)
 {
-    const int n = s->nq;
-    const uint32_t locked = s->mode.locked;
     double M[LAG_MAX_DOF * LAG_MAX_DOF];
     lag_model_vt(&s->def.model)->mass(s->def.model.p, q, M);
-    if (!locked) return lag_spd_solve(n, M, p, qd);
-    int free_idx[LAG_MAX_DOF], nf = 0;
-    for (int i = 0; i < n; i++)
-        if (!(locked & (1u << i))) free_idx[nf++] = i;
-    double Mff[LAG_MAX_DOF * LAG_MAX_DOF], pf[LAG_MAX_DOF], xf[LAG_MAX_DOF];
-    for (int a = 0; a < nf; a++) {
-        pf[a] = p[free_idx[a]];
-        for (int b = 0; b < nf; b++) Mff[a * nf + b] = M[free_idx[a] * n + free_idx[b]];
-    }
-    for (int i = 0; i < n; i++) qd[i] = 0.0;
-    if (nf == 0) return LAG_OK;
-    lag_result r = lag_spd_solve(nf, Mff, pf, xf);
-    if (r != LAG_OK) return r;
-    for (int a = 0; a < nf; a++) qd[free_idx[a]] = xf[a];
-    return LAG_OK;
+    return solve_free(s->nq, s->mode.locked, M, p, qd);
 }
 
 /* Canonical form y = (q, p), p = M(q) qd, H = T + U:
