@@ -4,7 +4,7 @@ add_executable(server_test ${CMAKE_CURRENT_LIST_DIR}/server/server_test.c)
 target_link_libraries(server_test PRIVATE lagsim_scene lagsim_core lagsim_lcmtypes PkgConfig::LCM)
 find_program(LCM_LOGGER lcm-logger)
 set(LAGSIM_SERVER_CASES control hostile watchdog lockstep_timeout two_daemons fault sigterm
-    bad_scene)
+    bad_scene effects)
 if(LCM_LOGGER)
   list(APPEND LAGSIM_SERVER_CASES replay replay_dopri5)
 endif()

@@ -5,7 +5,7 @@
  * kills it at the end (SIGKILL on our own death too: PR_SET_PDEATHSIG).
  *
  *   server_test LAGSIMD CASE      CASE: control hostile watchdog lockstep_timeout
- *                                       two_daemons fault replay sigterm bad_scene
+ *                                       two_daemons fault replay sigterm bad_scene effects
  *
  * Expected states are computed independently of the daemon's loop: a lag_sim of the same
  * scene (loaded with lag_scene_load, as the daemon does) advanced from the published state
@@ -856,6 +856,89 @@ static void case_sigterm(void)
 }
 
 /* A bad scene exits 2 before anything is published. */
+/* The effects' events go out on _EVENT with the sim time the step located them at: the
+ * stick's floor impacts and its resting contact must be exactly those of the core run by
+ * itself on the same scene; a lift-off is an event and then a numeric fault. */
+static void ref_events(const lag_scene *sc, int periods, const char *kind, double *t, int *n,
+                       lag_result *last)
+{
+    char err[256];
+    static lag_sim ref;
+    ENSURE(lag_sim_init(&ref, &sc->sim, err, sizeof err) == LAG_OK);
+    *n = 0;
+    *last = LAG_OK;
+    for (int k = 0; k < periods && *last == LAG_OK; k++) {
+        *last = lag_sim_advance(&ref, sc->ticks_per_period, false);
+        lag_event ev;
+        while (lag_sim_poll_event(&ref, &ev))
+            if (!strcmp(lag_event_kind_name(ev.kind), kind) && *n < 64) t[(*n)++] = ev.t;
+    }
+}
+
+static void ensure_event_times(const client *c, const char *kind, const double *t, int n)
+{
+    int j = 0;
+    for (int i = 0; i < c->n_events; i++) {
+        if (strcmp(c->ev_kind[i], kind) != 0) continue;
+        ENSUREF(j < n, "more '%s' events than the core located (%d)", kind, n);
+        ENSUREF(c->ev_time[i] == t[j], "'%s' %d at %.17g s, the core located it at %.17g s",
+                kind, j, c->ev_time[i], t[j]);
+        j++;
+    }
+    ENSUREF(j == n, "%d '%s' events published, the core located %d", j, kind, n);
+}
+
+static void case_effects(void)
+{
+    write_scene("model: stick\n"
+                "initial:\n  q: [0, 1.2]\n"
+                "realtime:\n  mode: fast\n"
+                "effects:\n  floor: {restitution: 0.5}\n");
+    static client c;
+    client_init(&c, g_prefix, 2);
+    pid_t d = start_daemon(g_prefix, "--duration", "2", NULL);
+    ENSURE(reap(d, 20.0) == 0);
+    pump(&c, 0.5);
+    lag_scene sc;
+    load_ref(&sc, g_prefix);
+    double t_imp[64], t_rest[64];
+    int n_imp, n_rest;
+    lag_result r;
+    ref_events(&sc, 200, "impact", t_imp, &n_imp, &r);
+    ENSURE(r == LAG_OK);
+    ref_events(&sc, 200, "rest", t_rest, &n_rest, &r);
+    ENSURE(n_imp >= 3 && n_rest == 1);
+    ensure_event_times(&c, "impact", t_imp, n_imp);
+    ensure_event_times(&c, "rest", t_rest, n_rest);
+    ENSURE(!c.nonfinite_seen);
+    printf("effects: %d impacts (first at %.12f s) and a rest at %.12f s, as the core located them\n",
+           n_imp, t_imp[0], t_rest[0]);
+
+    /* spun fast enough to lift off: an event, then a fault; nothing bad published */
+    write_scene("model: stick\n"
+                "initial:\n  q: [0, 0.6]\n  qd: [0, 5]\n"
+                "realtime:\n  mode: fast\n"
+                "effects:\n  floor: {}\n");
+    char prefix2[80];
+    snprintf(prefix2, sizeof prefix2, "%s_L", g_prefix);
+    static client c2;
+    client_init(&c2, prefix2, 2);
+    start_daemon(prefix2, NULL);
+    WAIT_FOR(&c2, count_events(&c2, "numeric_fault") >= 1, 10.0);
+    pump(&c2, 0.2);
+    load_ref(&sc, prefix2);
+    double t_lift[64];
+    int n_lift;
+    ref_events(&sc, 100, "liftoff", t_lift, &n_lift, &r);
+    ENSURE(r == LAG_ERR_LIFTOFF && n_lift == 1);
+    ensure_event_times(&c2, "liftoff", t_lift, n_lift);
+    fresh_status(&c2);
+    ENSUREF(!strcmp(c2.status->run_state, "fault"), "run_state %s", c2.status->run_state);
+    ENSURE(!c2.nonfinite_seen && c2.last.t < t_lift[0]);
+    printf("effects: lift-off at %.12f s published, then the fault state; last state %.2f s\n",
+           t_lift[0], c2.last.t);
+}
+
 static void case_bad_scene(void)
 {
     write_scene("model: dipc\nparameters:\n  m0: -1.5\n");
@@ -895,6 +978,7 @@ int main(int argc, char **argv)
     else if (!strcmp(g_case, "replay_dopri5")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "dopri5");
     else if (!strcmp(g_case, "sigterm")) case_sigterm();
     else if (!strcmp(g_case, "bad_scene")) case_bad_scene();
+    else if (!strcmp(g_case, "effects")) case_effects();
     else {
         fprintf(stderr, "server_test: unknown case %s\n", g_case);
         return 2;
