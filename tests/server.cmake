@@ -6,7 +6,7 @@ find_program(LCM_LOGGER lcm-logger)
 set(LAGSIM_SERVER_CASES control hostile watchdog lockstep_timeout two_daemons fault sigterm
     bad_scene effects)
 if(LCM_LOGGER)
-  list(APPEND LAGSIM_SERVER_CASES replay replay_dopri5)
+  list(APPEND LAGSIM_SERVER_CASES replay replay_dopri5 replay_effects)
 endif()
 foreach(case ${LAGSIM_SERVER_CASES})
   add_test(NAME server_${case}

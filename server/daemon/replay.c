@@ -10,8 +10,13 @@
  * step goes back (a reset), or that differs at the same step, starts over from it.
  *
  * Published states carry the noise effect (lag_sim_observe) and the applied effort
- * (tau_applied); the replay compares observed with observed. With actuator lag,
- * disturbances or noise the log does not pin the run down exactly: the replay says so.
+ * (tau_applied); the replay compares observed with observed. Effects are re-simulated as
+ * the scene defines them (disturbances at their times, noise as a function of seed and
+ * tick), except the actuator: the logged effort is already its output, so the replay
+ * applies it directly. A run that starts from the scene's initial state starts from it
+ * (not from the logged, possibly noisy, first state). Only an actuator lag leaves the run
+ * undetermined by the log (the effort changes within a period; the log has its last
+ * value): the replay says so.
  *
  * For a run of the same scene and build recorded from its start (logger started before
  * the daemon), every difference is exactly 0: the daemon and the replay make the same
@@ -30,7 +35,18 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
     (void)o;
     char err[256];
     lag_sim sim;
-    if (lag_sim_init(&sim, &sc->sim, err, sizeof err) != LAG_OK) {
+    /* The logged effort is the actuator's output: apply it as it is. The actuator stays
+     * on with neither lag nor bound, so that the ticks are taken exactly as the daemon
+     * took them (an actuator makes every tick a separate step). */
+    lag_sim_def def = sc->sim;
+    bool lagged = false;
+    if (def.effects.enabled & LAG_EFF_ACTUATOR)
+        for (int i = 0; i < def.model.nq; i++) {
+            lagged |= def.effects.actuator_tau[i] > 0;
+            def.effects.actuator_tau[i] = 0.0;
+            def.effects.actuator_max[i] = INFINITY;
+        }
+    if (lag_sim_init(&sim, &def, err, sizeof err) != LAG_OK) {
         fprintf(stderr, "lagsimd: bad scene: %s\n", err);
         return LAGSIMD_EXIT_USAGE;
     }
@@ -79,8 +95,14 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         for (int i = 0; same && i < nq; i++)
             same = sq[i] == m.position[i] && sqd[i] == m.velocity[i];
         if (dticks < 0 || (dticks == 0 && !same)) {
-            /* first state, or a reset: start over from the logged state */
-            lag_sim_reset(&sim, m.position, m.velocity);
+            /* first state, or a reset: start over from the scene's initial state if that
+             * is what was published (a start or a plain reset), else from the logged one */
+            lag_sim_reset(&sim, NULL, NULL);
+            lag_sim_observe(&sim, sq, sqd);
+            bool initial = m.step == 0;
+            for (int i = 0; initial && i < nq; i++)
+                initial = sq[i] == m.position[i] && sqd[i] == m.velocity[i];
+            if (!initial) lag_sim_reset(&sim, m.position, m.velocity);
             sim.tick = m.step;
             if (have) restarts++;
             have = true;
@@ -111,12 +133,10 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         fprintf(stderr, "lagsimd: --replay: no %s messages in %s\n", channel, log_path);
         return LAGSIMD_EXIT_RUNTIME;
     }
-    uint32_t inexact = sc->sim.effects.enabled &
-                       (LAG_EFF_ACTUATOR | LAG_EFF_DISTURBANCE | LAG_EFF_NOISE);
-    if (inexact)
-        printf("note: this scene has actuator, disturbance or noise effects: the logged "
-               "effort (applied, after lag and disturbances) and the logged state (with "
-               "noise) do not determine the run exactly; the difference is approximate\n");
+    if (lagged)
+        printf("note: this scene has an actuator lag: the applied effort changes within a "
+               "control period and the log holds its last value, so the difference is "
+               "approximate\n");
     double max_diff = max_dq > max_dqd || isnan(max_dq) ? max_dq : max_dqd;
     printf("replay %s: %lld states compared on %s (%lld restarts at resets, %lld gaps, "
            "%lld undecodable, %lld integrator errors)\n",

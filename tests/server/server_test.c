@@ -831,7 +831,22 @@ static bool replay_attempt(const char *logger, const char *method, int attempt)
  * exactly 0; a second run gives a bit-identical state stream. */
 static void case_replay(const char *logger, const char *method)
 {
-    write_scene(DIPC_MOVING);
+    if (!strcmp(g_case, "replay_effects"))
+        /* effects the replay must re-simulate exactly: damping, a stop on the cart,
+         * scheduled disturbances, actuator saturation, noise on the published state */
+        write_scene("model: dipc\n"
+                    "initial:\n  q: [0, 0.1, -0.05]\n"
+                    "publish_hz: 100\n"
+                    "effects:\n"
+                    "  damping: {theta1: 0.01, theta2: 0.01}\n"
+                    "  limits: {theta0: {lower: -0.05, upper: 0.05, restitution: 0.5}}\n"
+                    "  disturbance:\n"
+                    "    - {t: 0.5, joint: theta1, impulse: 0.02}\n"
+                    "    - {t: 1.0, joint: theta0, force: 1.0, duration: 0.2}\n"
+                    "  actuator: {theta0: {max: 0.8}}\n"
+                    "  noise: {seed: 11, q: {theta1: 1e-3}, qd: {theta0: 1e-2}}\n");
+    else
+        write_scene(DIPC_MOVING);
     for (int attempt = 1; attempt <= 4; attempt++)
         if (replay_attempt(logger, method, attempt)) return;
     fail(__LINE__, "UDP lost messages in every attempt");
@@ -976,6 +991,7 @@ int main(int argc, char **argv)
     else if (!strcmp(g_case, "fault")) case_fault();
     else if (!strcmp(g_case, "replay")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "rk4");
     else if (!strcmp(g_case, "replay_dopri5")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "dopri5");
+    else if (!strcmp(g_case, "replay_effects")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "rk4");
     else if (!strcmp(g_case, "sigterm")) case_sigterm();
     else if (!strcmp(g_case, "bad_scene")) case_bad_scene();
     else if (!strcmp(g_case, "effects")) case_effects();
