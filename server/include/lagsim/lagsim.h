@@ -241,9 +241,10 @@ typedef struct lag_sim {
     double q[LAG_MAX_DOF];
     double qd[LAG_MAX_DOF];
     double tau[LAG_MAX_DOF];      /* input held over the next ticks (zero where unactuated) */
-    double tau_applied[LAG_MAX_DOF]; /* effort actually applied over the last tick (after
-                                        actuator lag and saturation, plus disturbance
-                                        forces); what joint_state_t.effort reports */
+    double tau_applied[LAG_MAX_DOF]; /* effort actually applied over the last tick: the
+                                        actuator's output after lag and saturation (not the
+                                        disturbance forces, which are external); what
+                                        joint_state_t.effort reports */
     lag_sim_stats stats;
     /* effects' hybrid modes */
     struct {
