@@ -12,10 +12,19 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build build -j"$(nproc)" --target lagsimd dipc_lqr >/dev/null
 
 # The controller first: it waits for the daemon's scene description, designs its LQR
-# gains from it, then answers every state.
-build/bin/dipc_lqr -q &
+# gains from it, then answers every state. Its output goes to a log, shown at the end, so
+# that lagsimd's live status line stays readable.
+log=build/dipc_lqr.log
+build/bin/dipc_lqr -q >"$log" 2>&1 &
 lqr=$!
-trap 'kill "$lqr" 2>/dev/null || true; wait "$lqr" 2>/dev/null || true' EXIT INT TERM
+finish() {
+    kill -INT "$lqr" 2>/dev/null || true
+    wait "$lqr" 2>/dev/null || true
+    printf '\n--- dipc_lqr (%s) ---\n' "$log"
+    cat "$log"
+}
+trap finish EXIT
+trap 'exit 0' INT TERM
 sleep 0.3
 echo "lagsimd: DIPC in real time, balanced by dipc_lqr (pid $lqr); Ctrl-C to stop" >&2
 build/bin/lagsimd --config config/dipc.yaml "$@"

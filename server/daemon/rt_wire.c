@@ -193,7 +193,9 @@ void rt_publish_status(rt_server *s)
         .sim_time = fin(lag_sim_time(&s->sim)),
         .step = s->sim.tick,
         .wall_time = fin((double)(now - s->start_ns) * 1e-9),
-        .rtf = (wall > 0 && s->run == RT_RUNNING) ? fin(sim_adv / wall) : 0.0,
+        /* a window shorter than 50 ms (a status on request, the final one) is too short
+         * to measure: it repeats the last figure */
+        .rtf = s->run != RT_RUNNING ? 0.0 : wall < 0.05 ? fin(s->rtf) : fin(sim_adv / wall),
         .overruns = s->overruns,
         .step_time_max_us = fin(s->step_us_max),
         .step_time_mean_us = s->step_us_n > 0 ? fin(s->step_us_sum / (double)s->step_us_n) : 0.0,
@@ -219,6 +221,7 @@ void rt_publish_status(rt_server *s)
     int n = lagsim_status_t_encode(s->buf, 0, RT_BUF_SIZE, &m);
     if (n > 0) lcm_publish(s->lcm, s->ch_status, s->buf, (unsigned)n);
     s->rtf = m.rtf;
+    if (wall < 0.05 && s->run == RT_RUNNING) return; /* the window goes on */
     s->last_status_ns = now;
     s->ticks_since_status = 0;
     s->step_us_sum = 0;
