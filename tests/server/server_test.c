@@ -34,7 +34,7 @@
 #include "lagsim/lagsim_status_t.h"
 
 static const char *g_case = "?";
-static pid_t g_children[4];
+static pid_t g_children[16];
 static int g_nchildren;
 
 static void kill_children(void)
@@ -83,7 +83,12 @@ static pid_t spawn(char *const argv[], bool quiet)
         _exit(127);
     }
     ENSURE(pid > 0);
-    g_children[g_nchildren++] = pid;
+    /* a slot freed by reap(), else a new one (retried cases spawn again) */
+    int slot = 0;
+    while (slot < g_nchildren && g_children[slot] > 0) slot++;
+    ENSUREF(slot < (int)(sizeof g_children / sizeof g_children[0]), "too many children");
+    g_children[slot] = pid;
+    if (slot == g_nchildren) g_nchildren++;
     return pid;
 }
 
@@ -847,7 +852,7 @@ static void case_replay(const char *logger, const char *method)
                     "  noise: {seed: 11, q: {theta1: 1e-3}, qd: {theta0: 1e-2}}\n");
     else
         write_scene(DIPC_MOVING);
-    for (int attempt = 1; attempt <= 4; attempt++)
+    for (int attempt = 1; attempt <= 6; attempt++)
         if (replay_attempt(logger, method, attempt)) return;
     fail(__LINE__, "UDP lost messages in every attempt");
 }
