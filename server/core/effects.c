@@ -444,9 +444,13 @@ static lag_result handle(lag_sim *s, const watcher *w, double *y, double t)
 }
 
 /* At the start of an interval: an event already due (at or past a stop and moving into
- * it, a hold that no longer holds, lift-off). Returns its index or -1. */
-static int due_now(const lag_sim *s, const watcher *w, int nw, const double *y,
-                   const double *val, const double *qdd, bool dyn)
+ * it, a hold that no longer holds, lift-off). Returns its index, -1 if none, or -2 with
+ * *err set if the dynamics needed to judge a joint at rest on a stop failed. qdd is the
+ * acceleration at y if `have_qdd`; otherwise it is computed here, and only for that case
+ * (a joint exactly at rest at or past a stop), so that ticks away from the stops do not
+ * pay for it. */
+static int due_now(lag_sim *s, const watcher *w, int nw, const double *y, const double *val,
+                   double *qdd, bool have_qdd, lag_result *err)
 {
     const int n = s->nq;
     for (int k = 0; k < nw; k++) {
@@ -454,8 +458,17 @@ static int due_now(const lag_sim *s, const watcher *w, int nw, const double *y,
         if (w[k].kind == W_LIMIT && val[k] <= 0) {
             /* moving into the stop (qd toward it, or at rest and accelerating toward it) */
             double v = y[n + i] * w[k].side; /* > 0: moving into the stop */
-            double a = dyn ? qdd[i] * w[k].side : 0.0;
-            if (v > 0 || (v == 0 && a > 0)) return k;
+            if (v > 0) return k;
+            if (v == 0) {
+                if (!have_qdd) {
+                    double Q[LAG_MAX_DOF];
+                    lag_applied_forces(s, y, y + n, Q);
+                    if ((*err = lag_forward_locked(s, y, y + n, Q, qdd, NULL)) != LAG_OK)
+                        return -2;
+                    have_qdd = true;
+                }
+                if (qdd[i] * w[k].side > 0) return k;
+            }
         } else if ((w[k].kind == W_RELEASE || w[k].kind == W_LIFTOFF) && val[k] < 0) {
             return k;
         }
@@ -486,17 +499,16 @@ lag_result lag_effects_tick(lag_sim *s, double *y)
             memcpy(y, y1, sizeof(double) * N);
             break;
         }
-        /* dynamics at the start are needed to judge a resting joint at a stop */
-        bool dyn = needs_dynamics(w, nw) || (s->def.effects.enabled & (LAG_EFF_LIMITS | LAG_EFF_FLOOR));
+        bool dyn = needs_dynamics(w, nw);
         double v0[4 * LAG_MAX_DOF + 2], qdd0[LAG_MAX_DOF] = {0};
         if ((r = eval_watchers(s, w, nw, dyn, y, v0, qdd0)) != LAG_OK) return r;
-        int k0 = due_now(s, w, nw, y, v0, qdd0, dyn);
+        int k0 = due_now(s, w, nw, y, v0, qdd0, dyn, &r);
+        if (k0 == -2) return r;
         if (k0 >= 0) {
             if ((r = handle(s, &w[k0], y, t_tick + tloc)) != LAG_OK) return r;
             events++;
             continue;
         }
-        dyn = needs_dynamics(w, nw);
 
         if ((r = lag_step(s, H, y, y1)) != LAG_OK) return r;
         if (!lag_state_ok(N, y1, INFINITY)) return LAG_ERR_NONFINITE;

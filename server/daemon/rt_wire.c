@@ -163,9 +163,9 @@ void rt_publish_state(rt_server *s)
          * fin() is the last line of defence */
         pos[i] = fin(pos[i]);
         vel[i] = fin(vel[i]);
-        /* the effort applied over the last tick: after actuator lag and saturation, plus
-         * disturbance forces, zero where unactuated; without those effects it is exactly
-         * the held command */
+        /* the effort applied over the last tick: the actuator's output (after its lag and
+         * saturation), zero where unactuated; without the actuator effect it is exactly
+         * the held command. Disturbance forces are external and not included. */
         eff[i] = fin(s->sim.tau_applied[i]);
     }
     lagsim_joint_state_t m = {
