@@ -560,18 +560,26 @@ static void list_keys(char *buf, size_t len, const keyrow *rows)
     }
 }
 
+/* nd must be a mapping; `what` describes it ("a mapping (keys: a, b)"). Returns 0, or
+ * fails with "missing value: expected <what>" or "expected <what>, got <kind>". */
+static int need_map(conv *cv, const ynode *nd, const char *path, const char *what)
+{
+    if (nd->kind == YN_MAP)
+        return 0;
+    if (ynode_is_null(nd))
+        return fail(cv->err, nd, path, "missing value: expected %s", what);
+    return fail(cv->err, nd, path, "expected %s, got %s", what, ynode_kind_name(nd));
+}
+
 /* Walks a mapping's entries in file order and dispatches each to its table row. */
 static int convert_map(conv *cv, const ynode *nd, const char *path, const keyrow *rows,
                        const char *what)
 {
     if (nd->kind != YN_MAP) {
-        char allowed[512];
+        char allowed[512], expected[600];
         list_keys(allowed, sizeof allowed, rows);
-        if (ynode_is_null(nd))
-            return fail(cv->err, nd, path, "missing value: expected a mapping (keys: %s)",
-                        allowed);
-        return fail(cv->err, nd, path, "expected a mapping (keys: %s), got %s", allowed,
-                    ynode_kind_name(nd));
+        snprintf(expected, sizeof expected, "a mapping (keys: %s)", allowed);
+        return need_map(cv, nd, path, expected);
     }
     for (int i = 0; i < nd->n; i++) {
         const yentry *en = &nd->entries[i];
@@ -688,13 +696,10 @@ static int key_parameters(conv *cv, const ynode *nd, const char *path)
         snprintf(allowed + used, sizeof allowed - used, "%s%s", i ? ", " : "",
                  info->param_names[i]);
     }
-    if (nd->kind != YN_MAP) {
-        if (ynode_is_null(nd))
-            return fail(cv->err, nd, path, "missing value: expected a mapping (keys: %s)",
-                        allowed);
-        return fail(cv->err, nd, path, "expected a mapping (keys: %s), got %s", allowed,
-                    ynode_kind_name(nd));
-    }
+    char what[300];
+    snprintf(what, sizeof what, "a mapping (keys: %s)", allowed);
+    if (need_map(cv, nd, path, what) < 0)
+        return -1;
     for (int i = 0; i < nd->n; i++) {
         const yentry *en = &nd->entries[i];
         int k = lag_model_param_index(m->kind, en->key);
@@ -1042,15 +1047,11 @@ typedef int (*joint_fn)(conv *cv, int joint, const ynode *val, const char *path)
 /* Walks a mapping {joint name: value} and calls fn for each joint. */
 static int per_joint(conv *cv, const ynode *nd, const char *path, joint_fn fn)
 {
-    char names[128];
+    char names[128], what[160];
     joint_list(cv, names, sizeof names);
-    if (nd->kind != YN_MAP) {
-        if (ynode_is_null(nd))
-            return fail(cv->err, nd, path, "missing value: expected a mapping of joints (%s)",
-                        names);
-        return fail(cv->err, nd, path, "expected a mapping of joints (%s), got %s", names,
-                    ynode_kind_name(nd));
-    }
+    snprintf(what, sizeof what, "a mapping of joints (%s)", names);
+    if (need_map(cv, nd, path, what) < 0)
+        return -1;
     for (int i = 0; i < nd->n; i++) {
         const yentry *en = &nd->entries[i];
         int j = joint_index(cv, en->key);
@@ -1177,8 +1178,8 @@ static int key_rest_velocity(conv *cv, const ynode *nd, const char *path)
 static int key_effect_limits(conv *cv, const ynode *nd, const char *path)
 {
     fx(cv)->enabled |= LAG_EFF_LIMITS;
-    if (nd->kind != YN_MAP)
-        return per_joint(cv, nd, path, NULL); /* reports the type error */
+    if (need_map(cv, nd, path, "a mapping of joints and rest_velocity") < 0)
+        return -1;
     for (int i = 0; i < nd->n; i++) {
         const yentry *en = &nd->entries[i];
         char sub[256];
