@@ -20,6 +20,17 @@
 #define LAGSIM_TEST_CORE_H
 
 #include <complex.h>
+/* glibc defines CMPLX only where the compiler has __builtin_complex (not clang 14). C11
+ * lays a double complex out as double[2], which this fallback fills exactly (x + I*y
+ * would not be exact for infinite or NaN parts). */
+#ifndef CMPLX
+static inline double complex lag_test_cmplx(double re, double im)
+{
+    union { double complex z; double d[2]; } u = {.d = {re, im}};
+    return u.z;
+}
+#define CMPLX(x, y) lag_test_cmplx((x), (y))
+#endif
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
