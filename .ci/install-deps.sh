@@ -2,7 +2,7 @@
 # Installs the Debian packages lagsim needs (build, tests, peers for benchmarks, plots).
 # Skips apt entirely when everything is already installed.
 set -euo pipefail
-pkgs=(build-essential cmake pkg-config
+pkgs=(build-essential cmake pkg-config clang libclang-rt-14-dev   # gcc pass; clang pass (sanitizers, libFuzzer)
       liblcm-dev liblcm-bin libglib2.0-dev libyaml-dev   # LCM (lcm.pc needs glib's dev package) and libyaml
       python3                                            # the stdlib-only Python client and some tests
       libmujoco-dev libsundials-dev gnuplot-nox          # benchmark peers and plots
