@@ -16,13 +16,13 @@
  * with margin; x(t) = x0 + x_dot0 t to 1e-12 (|x0| + |x_dot0| t + 1). */
 static void check_stick_momentum(void)
 {
-    tc_rng rng = {0x57u};
+    lt_rng rng = {0x57u};
     double worst_v = 0, worst_x = 0;
     for (int run = 0; run < 4; ++run) {
         lag_model md;
         tc_random_model(&rng, LAG_MODEL_STICK, &md);
-        double q0[3] = {tc_uniform(&rng, -2, 2), tc_uniform(&rng, 0.4, 1.2), 0};
-        double qd0[3] = {tc_uniform(&rng, -3, 3), tc_uniform(&rng, -1, 1), 0};
+        double q0[3] = {lt_uniform(&rng, -2, 2), lt_uniform(&rng, 0.4, 1.2), 0};
+        double qd0[3] = {lt_uniform(&rng, -3, 3), lt_uniform(&rng, -1, 1), 0};
         for (int mi = 0; mi < TC_NMETHODS; ++mi) {
             lag_method meth = tc_all_methods[mi];
             lag_sim_def def = tc_sim_def(&md, meth, meth == LAG_DOPRI5 ? 1e-2 : 1e-3, q0, qd0);
@@ -86,13 +86,13 @@ static double p0_drift(const lag_model *md, lag_method meth, double dt, const do
  * shrink like dt^p (two halvings: >= 2^(2p - 1)). dopri5 at rtol 1e-12: below 1e-9. */
 static void check_dipc_momentum(void)
 {
-    tc_rng rng = {0xd1bcu};
+    lt_rng rng = {0xd1bcu};
     double worst[TC_NMETHODS] = {0};
     for (int run = 0; run < 3; ++run) {
         lag_model md;
         tc_random_model(&rng, LAG_MODEL_DIPC, &md);
-        double q0[3] = {tc_uniform(&rng, -1, 1), tc_uniform(&rng, -TC_PI, TC_PI), tc_uniform(&rng, -TC_PI, TC_PI)};
-        double qd0[3] = {tc_uniform(&rng, -1, 1), tc_uniform(&rng, -2, 2), tc_uniform(&rng, -2, 2)};
+        double q0[3] = {lt_uniform(&rng, -1, 1), lt_uniform(&rng, -TC_PI, TC_PI), lt_uniform(&rng, -TC_PI, TC_PI)};
+        double qd0[3] = {lt_uniform(&rng, -1, 1), lt_uniform(&rng, -2, 2), lt_uniform(&rng, -2, 2)};
         for (int mi = 0; mi < TC_NMETHODS; ++mi) {
             lag_method meth = tc_all_methods[mi];
             double sc;
@@ -187,10 +187,16 @@ static void check_energy_order(void)
     }
 }
 
-int main(void)
+static void case_stick_momentum(int arg) { (void)arg; check_stick_momentum(); }
+static void case_dipc_momentum(int arg) { (void)arg; check_dipc_momentum(); }
+static void case_energy_order(int arg) { (void)arg; check_energy_order(); }
+
+int main(int argc, char **argv)
 {
-    check_stick_momentum();
-    check_dipc_momentum();
-    check_energy_order();
-    return tc_finish("conservation");
+    static const lt_case cases[] = {
+        {"stick_momentum", case_stick_momentum, 0, 0},
+        {"dipc_momentum", case_dipc_momentum, 0, 0},
+        {"energy_order", case_energy_order, 0, 0},
+    };
+    return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
 }

@@ -172,9 +172,14 @@ static void check_long_run(void)
     }
 }
 
-int main(void)
+static void case_orders(int arg) { (void)arg; check_orders(); }
+static void case_long_run(int arg) { (void)arg; check_long_run(); }
+
+int main(int argc, char **argv)
 {
-    check_orders();
-    check_long_run();
-    return tc_finish("convergence");
+    static const lt_case cases[] = {
+        {"orders", case_orders, 0, 0},
+        {"long_run", case_long_run, 0, 0},
+    };
+    return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
 }

@@ -13,8 +13,7 @@
  *     T = sum_b 1/2 m_b v_b . v_b + 1/2 I_b omega_b^2,   U = sum_b m_b g y_b,
  * and M, dM/dq, g, dL/dq, dL/dqd follow from T and U by complex steps alone.
  *
- * Test style (Box2D): plain C, no framework. ENSURE/ENSURE_NEAR print the failing
- * expression with its context and count the failure; main returns the failure count.
+ * Checks and cases: tests/common/lagsim_test.h.
  */
 #ifndef LAGSIM_TEST_CORE_H
 #define LAGSIM_TEST_CORE_H
@@ -39,6 +38,7 @@ static inline double complex lag_test_cmplx(double re, double im)
 #include <string.h>
 
 #include "lagsim/lagsim.h"
+#include "lagsim_test.h"
 
 /* complex.h defines I; the inertias are called I in the brief, so the macro must go. */
 #undef I
@@ -49,109 +49,57 @@ typedef double complex cplx;
 /* complex-step size: any h with h^2 * |f'''| far below eps |f'| works; 1e-20 does. */
 #define TC_CSTEP 1e-20
 
-/* ------------------------------------------------------------------ failure reporting */
-static int tc_failures = 0;
-static int tc_checks = 0;
-static int tc_quiet_after = 20; /* print at most this many failures in detail */
-
-#define ENSURE(cond)                                                                       \
-    do {                                                                                   \
-        tc_checks++;                                                                       \
-        if (!(cond)) {                                                                     \
-            if (tc_failures++ < tc_quiet_after)                                            \
-                fprintf(stderr, "%s:%d: ENSURE failed: %s\n", __FILE__, __LINE__, #cond);  \
-        }                                                                                  \
-    } while (0)
-
-/* |got - want| <= tol; on failure prints both values and a printf-style context. */
-#define ENSURE_NEAR(got, want, tol, ...)                                                   \
-    do {                                                                                   \
-        double tc_g_ = (got), tc_w_ = (want), tc_t_ = (tol);                               \
-        tc_checks++;                                                                       \
-        if (!(fabs(tc_g_ - tc_w_) <= tc_t_)) {                                             \
-            if (tc_failures++ < tc_quiet_after) {                                          \
-                fprintf(stderr, "%s:%d: %s = %.17g, expected %s = %.17g (|diff| %.3g > tol %.3g): ", \
-                        __FILE__, __LINE__, #got, tc_g_, #want, tc_w_, fabs(tc_g_ - tc_w_), tc_t_); \
-                fprintf(stderr, __VA_ARGS__);                                              \
-                fprintf(stderr, "\n");                                                     \
-            }                                                                              \
-        }                                                                                  \
-    } while (0)
-
-static inline int tc_finish(const char *name)
-{
-    printf("%s: %d checks, %d failed\n", name, tc_checks, tc_failures);
-    return tc_failures ? 1 : 0;
-}
-
-/* ------------------------------------------------------------------ seeded RNG */
-typedef struct { uint64_t s; } tc_rng;
-
-/* splitmix64: a fixed, portable sequence for a given seed. */
-static inline uint64_t tc_next(tc_rng *r)
-{
-    uint64_t z = (r->s += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-/* uniform in [a, b) */
-static inline double tc_uniform(tc_rng *r, double a, double b)
-{
-    return a + (b - a) * (double)(tc_next(r) >> 11) * (1.0 / 9007199254740992.0);
-}
-
 /* ------------------------------------------------------------------ models, again */
 static inline int tc_nq(lag_model_kind k) { return k == LAG_MODEL_DIPC ? 3 : 2; }
 
 /* Random but physical parameters: masses 0.2..3 kg, lengths 0.2..2 m, g 1..20 m/s^2,
  * inertias either the uniform-rod value or anything in 0.01..1 kg m^2, h0 0..1 m. */
-static inline void tc_random_model(tc_rng *r, lag_model_kind kind, lag_model *m)
+static inline void tc_random_model(lt_rng *r, lag_model_kind kind, lag_model *m)
 {
     lag_model_default(m, kind);
-    bool rod = tc_uniform(r, 0, 1) < 0.5;
+    bool rod = lt_uniform(r, 0, 1) < 0.5;
     switch (kind) {
     case LAG_MODEL_STICK:
-        m->p[LAG_STICK_M] = tc_uniform(r, 0.2, 3);
-        m->p[LAG_STICK_L] = tc_uniform(r, 0.2, 2);
+        m->p[LAG_STICK_M] = lt_uniform(r, 0.2, 3);
+        m->p[LAG_STICK_L] = lt_uniform(r, 0.2, 2);
         m->p[LAG_STICK_I] = rod ? m->p[LAG_STICK_M] * m->p[LAG_STICK_L] * m->p[LAG_STICK_L] / 12
-                                : tc_uniform(r, 0.01, 1);
-        m->p[LAG_STICK_G] = tc_uniform(r, 1, 20);
+                                : lt_uniform(r, 0.01, 1);
+        m->p[LAG_STICK_G] = lt_uniform(r, 1, 20);
         break;
     case LAG_MODEL_MANIPULATOR:
-        m->p[LAG_MANIP_M1] = tc_uniform(r, 0.2, 3);
-        m->p[LAG_MANIP_M2] = tc_uniform(r, 0.2, 3);
-        m->p[LAG_MANIP_L1] = tc_uniform(r, 0.2, 2);
-        m->p[LAG_MANIP_I1] = tc_uniform(r, 0.01, 1);
-        m->p[LAG_MANIP_I2] = tc_uniform(r, 0.01, 1);
-        m->p[LAG_MANIP_G] = tc_uniform(r, 1, 20);
+        m->p[LAG_MANIP_M1] = lt_uniform(r, 0.2, 3);
+        m->p[LAG_MANIP_M2] = lt_uniform(r, 0.2, 3);
+        m->p[LAG_MANIP_L1] = lt_uniform(r, 0.2, 2);
+        m->p[LAG_MANIP_I1] = lt_uniform(r, 0.01, 1);
+        m->p[LAG_MANIP_I2] = lt_uniform(r, 0.01, 1);
+        m->p[LAG_MANIP_G] = lt_uniform(r, 1, 20);
         break;
     default:
-        m->p[LAG_DIPC_M0] = tc_uniform(r, 0.2, 3);
-        m->p[LAG_DIPC_M1] = tc_uniform(r, 0.2, 3);
-        m->p[LAG_DIPC_M2] = tc_uniform(r, 0.2, 3);
-        m->p[LAG_DIPC_L1] = tc_uniform(r, 0.2, 2);
-        m->p[LAG_DIPC_L2] = tc_uniform(r, 0.2, 2);
+        m->p[LAG_DIPC_M0] = lt_uniform(r, 0.2, 3);
+        m->p[LAG_DIPC_M1] = lt_uniform(r, 0.2, 3);
+        m->p[LAG_DIPC_M2] = lt_uniform(r, 0.2, 3);
+        m->p[LAG_DIPC_L1] = lt_uniform(r, 0.2, 2);
+        m->p[LAG_DIPC_L2] = lt_uniform(r, 0.2, 2);
         m->p[LAG_DIPC_I1] = rod ? m->p[LAG_DIPC_M1] * m->p[LAG_DIPC_L1] * m->p[LAG_DIPC_L1] / 12
-                                : tc_uniform(r, 0.01, 1);
+                                : lt_uniform(r, 0.01, 1);
         m->p[LAG_DIPC_I2] = rod ? m->p[LAG_DIPC_M2] * m->p[LAG_DIPC_L2] * m->p[LAG_DIPC_L2] / 12
-                                : tc_uniform(r, 0.01, 1);
-        m->p[LAG_DIPC_G] = tc_uniform(r, 1, 20);
-        m->p[LAG_DIPC_H0] = tc_uniform(r, 0, 1);
+                                : lt_uniform(r, 0.01, 1);
+        m->p[LAG_DIPC_G] = lt_uniform(r, 1, 20);
+        m->p[LAG_DIPC_H0] = lt_uniform(r, 0, 1);
         break;
     }
 }
 
 /* Random state: positions -2..2 m, angles -pi..pi, rates -5..5. */
-static inline void tc_random_state(tc_rng *r, const lag_model *m, double *q, double *qd)
+static inline void tc_random_state(lt_rng *r, const lag_model *m, double *q, double *qd)
 {
     for (int i = 0; i < m->nq; ++i) {
-        q[i] = tc_uniform(r, -TC_PI, TC_PI);
-        qd[i] = tc_uniform(r, -5, 5);
+        q[i] = lt_uniform(r, -TC_PI, TC_PI);
+        qd[i] = lt_uniform(r, -5, 5);
     }
-    if (m->kind == LAG_MODEL_STICK) q[0] = tc_uniform(r, -2, 2);
-    if (m->kind == LAG_MODEL_MANIPULATOR) q[1] = tc_uniform(r, -2, 2);
-    if (m->kind == LAG_MODEL_DIPC) q[0] = tc_uniform(r, -2, 2);
+    if (m->kind == LAG_MODEL_STICK) q[0] = lt_uniform(r, -2, 2);
+    if (m->kind == LAG_MODEL_MANIPULATOR) q[1] = lt_uniform(r, -2, 2);
+    if (m->kind == LAG_MODEL_DIPC) q[0] = lt_uniform(r, -2, 2);
 }
 
 /* The bodies of a model, straight from the brief: centre of mass (x, y), its velocity
@@ -556,7 +504,7 @@ static inline int tc_sim_init(lag_sim *s, const lag_sim_def *d)
     char err[256] = "";
     lag_result r = lag_sim_init(s, d, err, sizeof err);
     if (r != LAG_OK) {
-        tc_failures++;
+        lt_failures++;
         fprintf(stderr, "lag_sim_init(%s, %s, dt %g) failed: %s (%s)\n",
                 lag_model_info_get(d->model.kind)->name, lag_method_name(d->integrator.method),
                 d->integrator.dt, lag_result_string(r), err);
@@ -570,7 +518,7 @@ static inline int tc_advance(lag_sim *s, int64_t n, bool continuous)
 {
     lag_result r = lag_sim_advance(s, n, continuous);
     if (r != LAG_OK) {
-        tc_failures++;
+        lt_failures++;
         fprintf(stderr, "lag_sim_advance(%s, %s) failed at tick %lld: %s\n",
                 lag_model_info_get(s->def.model.kind)->name,
                 lag_method_name(s->def.integrator.method), (long long)s->tick,

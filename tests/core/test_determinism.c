@@ -28,17 +28,18 @@ static int run(const lag_sim_def *def, lag_sim *s, bool fresh, bool continuous, 
     return 0;
 }
 
-int main(void)
+static void check_rerun(int arg)
 {
+    (void)arg;
     static trace a, b, c;
-    tc_rng rng = {0xde7u};
+    lt_rng rng = {0xde7u};
     int identical = 0, total = 0;
     for (int kind = 0; kind < LAG_MODEL_COUNT; ++kind) {
         lag_model md;
         tc_random_model(&rng, (lag_model_kind)kind, &md);
         double q0[3] = {0}, qd0[3] = {0};
         tc_random_state(&rng, &md, q0, qd0);
-        for (int i = 0; i < md.nq; ++i) qd0[i] = tc_uniform(&rng, -1, 1);
+        for (int i = 0; i < md.nq; ++i) qd0[i] = lt_uniform(&rng, -1, 1);
         if (kind == LAG_MODEL_STICK) q0[1] = 0.8;
         if (kind == LAG_MODEL_MANIPULATOR) q0[1] = 0.6;
         for (int mi = 0; mi < TC_NMETHODS; ++mi) {
@@ -66,5 +67,12 @@ int main(void)
     }
     printf("determinism: %d of %d (model, method, mode) runs bit-identical on rerun and after reset\n",
            identical, total);
-    return tc_finish("determinism");
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {
+        {"rerun", check_rerun, 0, 0},
+    };
+    return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
 }

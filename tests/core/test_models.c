@@ -6,7 +6,7 @@
  * with the same quantities derived here from the brief's body kinematics by complex steps
  * (see test_core.h), and for the stick and the manipulator with the seed's closed forms.
  *
- * Usage: test_core_models [stick|manipulator|dipc]   (no argument: all three)
+ * Usage: test_core_models [--list | info | MODEL | seed_dipc]   (no argument: all)
  */
 #include "test_core.h"
 
@@ -85,8 +85,8 @@ static void check_seed(const lag_model *mdp, int it, const double *q, const doub
 
 static void check_model(lag_model_kind kind, uint64_t seed)
 {
-    tc_rng rng = {seed};
-    int f0 = tc_failures;
+    lt_rng rng = {seed};
+    int f0 = lt_failures;
     double worst_M = 0, worst_dM = 0, worst_C = 0, worst_g = 0, worst_lag = 0, worst_fwd = 0;
     for (int it = 0; it < NSTATES; ++it) {
         lag_model md;
@@ -96,8 +96,8 @@ static void check_model(lag_model_kind kind, uint64_t seed)
         double q[3] = {0}, qd[3] = {0}, qdd[3] = {0}, tau[3] = {0};
         tc_random_state(&rng, &md, q, qd);
         for (int i = 0; i < n; ++i) {
-            qdd[i] = tc_uniform(&rng, -20, 20);
-            tau[i] = tc_uniform(&rng, -20, 20);
+            qdd[i] = lt_uniform(&rng, -20, 20);
+            tau[i] = lt_uniform(&rng, -20, 20);
         }
         check_kinematics(&md, it, q, qd);
 
@@ -202,7 +202,7 @@ static void check_model(lag_model_kind kind, uint64_t seed)
     printf("%-12s %d states: worst relative |core - from T,U|: M %.1e  dM %.1e  C %.1e  g %.1e  "
            "Lagrange %.1e  forward %.1e  (%s)\n",
            kname(kind), NSTATES, worst_M, worst_dM, worst_C, worst_g, worst_lag, worst_fwd,
-           tc_failures == f0 ? "ok" : "FAILED");
+           lt_failures == f0 ? "ok" : "FAILED");
 }
 
 /* Static facts: names, sizes, inputs, defaults as the brief and the issue give them. */
@@ -348,7 +348,7 @@ static void seed_eom(const double *p, const double *q, const double *qd, const d
  * against our T, our U (differences), our T - U, and the core's M qdd + C qd + g. */
 static void seed_mismatch(unsigned fix, double *eT, double *eU, double *eL, double *eE)
 {
-    tc_rng rng = {0x5eedu};
+    lt_rng rng = {0x5eedu};
     *eT = *eU = *eL = *eE = 0;
     for (int it = 0; it < 100; ++it) {
         lag_model md;
@@ -356,7 +356,7 @@ static void seed_mismatch(unsigned fix, double *eT, double *eU, double *eL, doub
         double q[3], qd[3], q2[3], qd2[3], qdd[3];
         tc_random_state(&rng, &md, q, qd);
         tc_random_state(&rng, &md, q2, qd2);
-        for (int i = 0; i < 3; ++i) qdd[i] = tc_uniform(&rng, -20, 20);
+        for (int i = 0; i < 3; ++i) qdd[i] = lt_uniform(&rng, -20, 20);
         double T = tc_T(&md, q, qd), U = tc_U(&md, q), U2 = tc_U(&md, q2), T2 = tc_T(&md, q2, qd2);
         double sc = fabs(T) + fabs(U) + fabs(U2) + fabs(T2) + 1;
         *eT = fmax(*eT, fabs(seed_T(md.p, q, qd, fix) - T) / sc);
@@ -392,16 +392,17 @@ static void check_seed_dipc(void)
     }
 }
 
+static void case_info(int arg) { (void)arg; check_info(); }
+static void case_model(int kind) { check_model((lag_model_kind)kind, 0x1234u + (uint64_t)kind); }
+static void case_seed_dipc(int arg) { (void)arg; check_seed_dipc(); }
+
+/* Cases: info, one per model of the core's table (by its name), seed_dipc. */
 int main(int argc, char **argv)
 {
-    int want = argc > 1 ? lag_model_kind_from_name(argv[1]) : -1;
-    if (argc > 1 && want < 0 && strcmp(argv[1], "info") != 0) {
-        fprintf(stderr, "usage: %s [stick|manipulator|dipc|info]\n", argv[0]);
-        return 2;
-    }
-    if (argc == 1 || strcmp(argv[1], "info") == 0) check_info();
+    lt_cases cs = {0};
+    lt_add(&cs, "info", case_info, 0, 0);
     for (int k = 0; k < LAG_MODEL_COUNT; ++k)
-        if (argc == 1 || want == k) check_model((lag_model_kind)k, 0x1234u + (uint64_t)k);
-    if (argc == 1 || want == LAG_MODEL_DIPC) check_seed_dipc();
-    return tc_finish(argc > 1 ? argv[1] : "models");
+        lt_add(&cs, lag_model_info_get((lag_model_kind)k)->name, case_model, k, 0);
+    lt_add(&cs, "seed_dipc", case_seed_dipc, 0, 0);
+    return lt_main(argc, argv, cs.c, cs.n);
 }

@@ -15,7 +15,7 @@ static const char *kname(lag_model_kind k) { return lag_model_info_get(k)->name;
 /* ---------------------------------------------------------------- SPD */
 static void check_spd(lag_model_kind kind)
 {
-    tc_rng rng = {0xabc0u + (uint64_t)kind};
+    lt_rng rng = {0xabc0u + (uint64_t)kind};
     double worst_asym = 0, min_rel_pivot = INFINITY;
     for (int it = 0; it < 300; ++it) {
         lag_model md;
@@ -53,7 +53,7 @@ static void check_spd(lag_model_kind kind)
  * ~ (rate dt)^5 ~ 1e-17. So |N + N^T| <= 1e-9 (|M| + |dM| |qd|) has a margin of ~300. */
 static void check_skew(lag_model_kind kind)
 {
-    tc_rng rng = {0x5e5eu + (uint64_t)kind};
+    lt_rng rng = {0x5e5eu + (uint64_t)kind};
     double worst = 0, biggest_N = 0;
     for (int run = 0; run < 10; ++run) {
         lag_model md;
@@ -61,8 +61,8 @@ static void check_skew(lag_model_kind kind)
         int n = md.nq;
         double q0[3] = {0}, qd0[3] = {0};
         tc_random_state(&rng, &md, q0, qd0);
-        for (int i = 0; i < n; ++i) qd0[i] = tc_uniform(&rng, -2, 2);
-        if (kind == LAG_MODEL_STICK) q0[1] = tc_uniform(&rng, 0.3, 1.3); /* away from cos = 0 */
+        for (int i = 0; i < n; ++i) qd0[i] = lt_uniform(&rng, -2, 2);
+        if (kind == LAG_MODEL_STICK) q0[1] = lt_uniform(&rng, 0.3, 1.3); /* away from cos = 0 */
         const double dt = 1e-4;
         enum { NT = 200 };
         static double qs[NT][3], qds[NT][3];
@@ -125,7 +125,7 @@ static void aug_rhs(const lag_model *md, const input_fn *u, double t, const doub
     double tau[3] = {0}, qdd[3] = {0};
     input_at(u, n, t, tau);
     if (lag_model_forward(md, y, y + n, tau, qdd) != LAG_OK) {
-        tc_failures++;
+        lt_failures++;
         fprintf(stderr, "forward failed at t = %g\n", t);
         memset(qdd, 0, sizeof qdd);
     }
@@ -167,7 +167,7 @@ static double power_mismatch(const lag_model *md, const input_fn *u, const doubl
 
 static void check_power(lag_model_kind kind)
 {
-    tc_rng rng = {0x9090u + (uint64_t)kind};
+    lt_rng rng = {0x9090u + (uint64_t)kind};
     const lag_model_info *inf = lag_model_info_get(kind);
     double worst_a = 0, worst_b[TC_NMETHODS] = {0};
     for (int run = 0; run < 5; ++run) {
@@ -176,14 +176,14 @@ static void check_power(lag_model_kind kind)
         int n = md.nq;
         double q0[3] = {0}, qd0[3] = {0};
         tc_random_state(&rng, &md, q0, qd0);
-        for (int i = 0; i < n; ++i) qd0[i] = tc_uniform(&rng, -1, 1);
-        if (kind == LAG_MODEL_STICK) q0[1] = tc_uniform(&rng, 0.3, 1.3);
-        if (kind == LAG_MODEL_MANIPULATOR) q0[1] = tc_uniform(&rng, 0.3, 1.0);
+        for (int i = 0; i < n; ++i) qd0[i] = lt_uniform(&rng, -1, 1);
+        if (kind == LAG_MODEL_STICK) q0[1] = lt_uniform(&rng, 0.3, 1.3);
+        if (kind == LAG_MODEL_MANIPULATOR) q0[1] = lt_uniform(&rng, 0.3, 1.0);
         input_fn u;
         for (int i = 0; i < 3; ++i) {
-            u.a[i] = tc_uniform(&rng, 0.5, 3);
-            u.w[i] = tc_uniform(&rng, 1, 6);
-            u.c[i] = tc_uniform(&rng, 0, 2 * TC_PI);
+            u.a[i] = lt_uniform(&rng, 0.5, 3);
+            u.w[i] = lt_uniform(&rng, 1, 6);
+            u.c[i] = lt_uniform(&rng, 0, 2 * TC_PI);
         }
         /* (a) RK4 of our own over 1 s at h = 1, 1/2, 1/4 ms. The mismatch
          * E(T) - E(0) - W(T) is RK4's global error, ~ T (rate h)^4 |E|, which for the fastest
@@ -251,12 +251,18 @@ static void check_power(lag_model_kind kind)
     printf("\n");
 }
 
-int main(void)
+static void case_model(int kind)
 {
-    for (int k = 0; k < LAG_MODEL_COUNT; ++k) {
-        check_spd((lag_model_kind)k);
-        check_skew((lag_model_kind)k);
-        check_power((lag_model_kind)k);
-    }
-    return tc_finish("structure");
+    check_spd((lag_model_kind)kind);
+    check_skew((lag_model_kind)kind);
+    check_power((lag_model_kind)kind);
+}
+
+/* One case per model of the core's table. */
+int main(int argc, char **argv)
+{
+    lt_cases cs = {0};
+    for (int k = 0; k < LAG_MODEL_COUNT; ++k)
+        lt_add(&cs, lag_model_info_get((lag_model_kind)k)->name, case_model, k, 0);
+    return lt_main(argc, argv, cs.c, cs.n);
 }

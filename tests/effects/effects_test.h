@@ -7,8 +7,7 @@
  * The generalized momentum p_i = dT/dqd_i is taken from our own T: T is quadratic in qd,
  * so (T(qd + e_i) - T(qd - e_i)) / 2 = (M qd)_i exactly, up to rounding.
  *
- * Style (Box2D): plain C, no framework. ENSURE/ENSURE_NEAR print the failing expression
- * with its context and count the failure; main returns non-zero when anything failed.
+ * Checks and cases: tests/common/lagsim_test.h.
  */
 #ifndef LAGSIM_EFFECTS_TEST_H
 #define LAGSIM_EFFECTS_TEST_H
@@ -21,41 +20,9 @@
 #include <string.h>
 
 #include "lagsim/lagsim.h"
+#include "lagsim_test.h"
 
 #define TE_PI 3.14159265358979323846
-
-static int te_failures = 0;
-static int te_checks = 0;
-
-#define ENSURE(cond)                                                                       \
-    do {                                                                                   \
-        te_checks++;                                                                       \
-        if (!(cond)) {                                                                     \
-            if (te_failures++ < 30)                                                        \
-                fprintf(stderr, "%s:%d: ENSURE failed: %s\n", __FILE__, __LINE__, #cond);  \
-        }                                                                                  \
-    } while (0)
-
-/* |got - want| <= tol; on failure prints both values and a printf-style context. */
-#define ENSURE_NEAR(got, want, tol, ...)                                                   \
-    do {                                                                                   \
-        double te_g_ = (got), te_w_ = (want), te_t_ = (tol);                               \
-        te_checks++;                                                                       \
-        if (!(fabs(te_g_ - te_w_) <= te_t_)) {                                             \
-            if (te_failures++ < 30) {                                                      \
-                fprintf(stderr, "%s:%d: %s = %.17g, expected %s = %.17g (|diff| %.3g > tol %.3g): ", \
-                        __FILE__, __LINE__, #got, te_g_, #want, te_w_, fabs(te_g_ - te_w_), te_t_); \
-                fprintf(stderr, __VA_ARGS__);                                              \
-                fprintf(stderr, "\n");                                                     \
-            }                                                                              \
-        }                                                                                  \
-    } while (0)
-
-static inline int te_finish(const char *name)
-{
-    printf("%s: %d checks, %d failed\n", name, te_checks, te_failures);
-    return te_failures ? 1 : 0;
-}
 
 /* ------------------------------------------------------------------ T and U, again */
 

@@ -670,17 +670,22 @@ static void off(void)
     ENSURE(identical == compared);
 }
 
+static void case_damping(int a) { (void)a; damping_power_converges(); damping_stick_x(); damping_pendulum(); }
+static void case_friction(int a) { (void)a; friction_block(); friction_dipc(); }
+static void case_limits(int a) { (void)a; limits_free(); limits_spin(1.0); limits_spin(0.6); }
+static void case_floor(int a) { (void)a; floor_bounces(); floor_liftoff(); }
+static void case_actuator(int a) { (void)a; actuator(); }
+static void case_disturbance(int a) { (void)a; disturbance(); }
+static void case_noise(int a) { (void)a; noise(); }
+static void case_off(int a) { (void)a; off(); }
+
 int main(int argc, char **argv)
 {
-    const char *w = argc > 1 ? argv[1] : "all";
-    bool all = strcmp(w, "all") == 0;
-    if (all || !strcmp(w, "damping")) { damping_power_converges(); damping_stick_x(); damping_pendulum(); }
-    if (all || !strcmp(w, "friction")) { friction_block(); friction_dipc(); }
-    if (all || !strcmp(w, "limits")) { limits_free(); limits_spin(1.0); limits_spin(0.6); }
-    if (all || !strcmp(w, "floor")) { floor_bounces(); floor_liftoff(); }
-    if (all || !strcmp(w, "actuator")) actuator();
-    if (all || !strcmp(w, "disturbance")) disturbance();
-    if (all || !strcmp(w, "noise")) noise();
-    if (all || !strcmp(w, "off")) off();
-    return te_finish(w);
+    static const lt_case cases[] = {
+        {"damping", case_damping, 0, 0},         {"friction", case_friction, 0, 0},
+        {"limits", case_limits, 0, 0},           {"floor", case_floor, 0, 0},
+        {"actuator", case_actuator, 0, 0},       {"disturbance", case_disturbance, 0, 0},
+        {"noise", case_noise, 0, 0},             {"off", case_off, 0, 0},
+    };
+    return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
 }
