@@ -1,5 +1,6 @@
 # cmake -D EXE=... -D OUT=... -D PREFIX=... -D LABEL=... -D TIMEOUT=... -P discover.cmake
-# Writes one add_test per line of `EXE --list` (see cases.cmake).
+# Writes one add_test per line of `EXE --list` (see cases.cmake). Exit code 77 of a case
+# means skipped (lt_skip in lagsim_test.h).
 execute_process(COMMAND ${EXE} --list OUTPUT_VARIABLE listing RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "${EXE} --list failed (${rc})")
@@ -19,7 +20,7 @@ foreach(line IN LISTS lines)
     set(labels "${LABEL}\\;${extra}")
   endif()
   string(APPEND body "add_test(${PREFIX}.${name} \"${EXE}\" ${name})\n")
-  string(APPEND body "set_tests_properties(${PREFIX}.${name} PROPERTIES TIMEOUT ${TIMEOUT} LABELS \"${labels}\")\n")
+  string(APPEND body "set_tests_properties(${PREFIX}.${name} PROPERTIES TIMEOUT ${TIMEOUT} SKIP_RETURN_CODE 77 LABELS \"${labels}\")\n")
 endforeach()
 if(body STREQUAL "")
   message(FATAL_ERROR "${EXE} --list printed no case")

@@ -13,7 +13,9 @@
  *     without anyone listing it again;
  *   - with a name runs that case; a name it does not know is an error (exit 2), never a
  *     pass;
- *   - fails when the cases run made no check at all ("0 checks" is not a pass).
+ *   - fails when the cases run made no check at all ("0 checks" is not a pass), unless a
+ *     case said why it could not run here (lt_skip): then it exits 77, which ctest
+ *     reports as skipped, not passed.
  * main returns non-zero when anything failed.
  */
 #ifndef LAGSIM_TEST_H
@@ -64,6 +66,16 @@ static int lt_checks = 0;
             fprintf(stderr, __VA_ARGS__);                                                  \
             fprintf(stderr, "\n");                                                         \
         }                                                                                  \
+    } while (0)
+
+static int lt_skipped = 0;
+/* The case cannot run on this machine (the caller returns after it); says why. */
+#define lt_skip(...)                                                                       \
+    do {                                                                                   \
+        lt_skipped++;                                                                      \
+        printf("skipped: ");                                                               \
+        printf(__VA_ARGS__);                                                               \
+        printf("\n");                                                                      \
     } while (0)
 
 /* ------------------------------------------------------------------ cases */
@@ -127,7 +139,10 @@ static inline int lt_main(int argc, char **argv, const lt_case *cases, int n)
         fprintf(stderr, "\n");
         return 2;
     }
-    printf("%s: %d checks, %d failed\n", label, lt_checks, lt_failures);
+    printf("%s: %d checks, %d failed%s\n", label, lt_checks, lt_failures,
+           lt_skipped ? ", some skipped" : "");
+    if (lt_failures) return 1;
+    if (lt_skipped) return 77;
     if (lt_checks == 0) {
         fprintf(stderr, "%s: case '%s' made no check: that is not a pass\n", prog, label);
         return 1;
