@@ -54,6 +54,29 @@ static int usage_error(const char *fmt, const char *arg)
     return LAGSIMD_EXIT_USAGE;
 }
 
+/* A scene without lcm.url leaves the choice to LCM, which reads LCM_DEFAULT_URL: that
+ * URL gets the scene's checks too (no file:// logs, no ttl above 0 without
+ * lcm.allow_lan) and becomes the scene's, so what runs is what was checked.
+ * Returns 0, or -1 after printing why (exit 2: nothing has run). */
+static int resolve_default_url(lag_scene *sc)
+{
+    const char *env = getenv("LCM_DEFAULT_URL");
+    if (sc->lcm.url[0] != '\0' || !env || env[0] == '\0')
+        return 0;
+    char err[512];
+    if (strlen(env) >= sizeof sc->lcm.url) {
+        fprintf(stderr, "lagsimd: LCM_DEFAULT_URL: longer than %zu characters\n",
+                sizeof sc->lcm.url - 1);
+        return -1;
+    }
+    if (lag_scene_check_url(env, sc->lcm.allow_lan, &sc->lcm.ttl, err, sizeof err) != 0) {
+        fprintf(stderr, "lagsimd: LCM_DEFAULT_URL: %s\n", err);
+        return -1;
+    }
+    snprintf(sc->lcm.url, sizeof sc->lcm.url, "%s", env);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY };
@@ -155,7 +178,7 @@ int main(int argc, char **argv)
             rc = lagsimd_offline(&sc, &opts);
         } else if (replay) {
             rc = lagsimd_replay(&sc, replay, &opts);
-        } else {
+        } else if (resolve_default_url(&sc) == 0) {
             rc = lagsimd_realtime(&sc, &opts);
         }
     }

@@ -25,12 +25,25 @@ typedef struct lag_scene {
         double command_timeout;  /* sim s; a command older than this is zeroed; default 0.5 */
         double lockstep_timeout; /* wall s; lockstep waits this long for a command; 1.0 */
         double status_hz;        /* status publication rate, Hz; default 5 */
+        /* N or N m per coordinate: a command whose |effort| on an actuated joint exceeds
+         * this is refused as a whole (counted like any bad command), never clamped:
+         * saturation that belongs to the plant is effects.actuator.<joint>.max.
+         * Default LAG_SCENE_EFFORT_LIMIT on actuated joints, 0 on the others. */
+        double effort_limit[LAG_MAX_DOF];
     } realtime;
     struct {
         char url[256];           /* "" = LCM's default (honours LCM_DEFAULT_URL) */
         char prefix[64];         /* channel prefix; default the model name in capitals */
+        bool allow_lan;          /* the scene means its traffic to leave this host: a
+                                    multicast ttl above 1 is accepted; default false */
+        int ttl;                 /* the multicast ttl the URL asks for (0 for "", memq://
+                                    or a URL without ttl=), checked by the loader */
     } lcm;
 } lag_scene;
+
+/* Default realtime.effort_limit, N or N m: far above what any controller of these models
+ * commands, far below where the arithmetic of a step stops being finite. */
+#define LAG_SCENE_EFFORT_LIMIT 1e6
 
 /* Defaults for a model kind: lag_default_sim_def plus the daemon defaults above. */
 void lag_scene_default(lag_scene *sc, lag_model_kind kind);
@@ -42,5 +55,14 @@ int lag_scene_load(const char *path, const char *const *sets, int nsets, lag_sce
                    char *err, size_t errlen);
 
 const char *lag_rt_mode_name(lag_rt_mode m);
+
+/* Checks an LCM URL the way the loader does for lcm.url (and lagsimd for
+ * LCM_DEFAULT_URL): "" (LCM's default), memq:// (in-process, for tests) or
+ * udpm://GROUP[:PORT][?ttl=N&recv_buf_size=BYTES] with GROUP a dotted IPv4 multicast
+ * address (224.0.0.0/4), PORT 1..65535, each option at most once, ttl 0..255 and above
+ * 0 only with allow_lan, recv_buf_size 4096..268435456. Every other provider (file://
+ * writes files, tcpq:// opens connections) is refused. Returns 0, or -1 with what was
+ * expected in err. OUT: ttl (0 when the URL does not set it) */
+int lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, size_t errlen);
 
 #endif

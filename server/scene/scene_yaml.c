@@ -522,7 +522,7 @@ typedef struct conv {
     const lag_model_info *info;
     /* nodes remembered for the final cross-checks (NULL if not given) */
     const ynode *root, *parameters, *publish_hz, *dt, *integrator, *initial, *dt_min;
-    const ynode *explode_limit;
+    const ynode *explode_limit, *url;
     /* effects */
     const ynode *effects, *limits_node, *floor_node, *gravity_g_node;
     int gravity_enabled;  /* -1 not said, 0 off, 1 on */
@@ -912,12 +912,31 @@ static int key_status_hz(conv *cv, const ynode *nd, const char *path)
     return get_positive(cv, nd, path, &cv->sc->realtime.status_hz);
 }
 
+typedef int (*joint_fn)(conv *cv, int joint, const ynode *val, const char *path);
+static int per_joint(conv *cv, const ynode *nd, const char *path, joint_fn fn);
+static int get_bool(conv *cv, const ynode *nd, const char *path, bool *out);
+
+/* effort_limit: {actuated joint: bound} */
+static int effort_limit_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    if (!cv->info->actuated[j])
+        return fail(cv->err, nd, path, "joint %s of model %s takes no input",
+                    cv->info->joint_names[j], cv->info->name);
+    return get_positive(cv, nd, path, &cv->sc->realtime.effort_limit[j]);
+}
+
+static int key_effort_limit(conv *cv, const ynode *nd, const char *path)
+{
+    return per_joint(cv, nd, path, effort_limit_joint);
+}
+
 static const keyrow k_realtime_keys[] = {
     {"mode", key_mode},                         /* realtime | fast | lockstep */
     {"rate", key_rate},                         /* sim s per wall s */
     {"command_timeout", key_command_timeout},   /* sim s */
     {"lockstep_timeout", key_lockstep_timeout}, /* wall s */
     {"status_hz", key_status_hz},               /* Hz */
+    {"effort_limit", key_effort_limit},         /* N or N m per actuated joint */
     {NULL, NULL},
 };
 
@@ -930,6 +949,7 @@ static int key_realtime(conv *cv, const ynode *nd, const char *path)
 
 static int key_url(conv *cv, const ynode *nd, const char *path)
 {
+    cv->url = nd;
     /* "" (quoted) is allowed: LCM's default URL */
     if (nd->kind == YN_SCALAR && nd->quoted && nd->text[0] == '\0') {
         cv->sc->lcm.url[0] = '\0';
@@ -942,7 +962,12 @@ static int key_url(conv *cv, const ynode *nd, const char *path)
         return fail(cv->err, nd, path, "URL longer than %zu characters",
                     sizeof cv->sc->lcm.url - 1);
     snprintf(cv->sc->lcm.url, sizeof cv->sc->lcm.url, "%s", s);
-    return 0;
+    return 0; /* checked with lcm.allow_lan once both are read (convert_scene) */
+}
+
+static int key_allow_lan(conv *cv, const ynode *nd, const char *path)
+{
+    return get_bool(cv, nd, path, &cv->sc->lcm.allow_lan);
 }
 
 static int key_prefix(conv *cv, const ynode *nd, const char *path)
@@ -970,6 +995,7 @@ static int key_prefix(conv *cv, const ynode *nd, const char *path)
 static const keyrow k_lcm_keys[] = {
     {"url", key_url},       /* "" = LCM's default */
     {"prefix", key_prefix}, /* channel prefix */
+    {"allow_lan", key_allow_lan}, /* bool: traffic may leave this host (ttl > 0) */
     {NULL, NULL},
 };
 
@@ -1041,8 +1067,6 @@ static int joint_index(const conv *cv, const char *name)
         if (strcmp(name, cv->info->joint_names[i]) == 0) return i;
     return -1;
 }
-
-typedef int (*joint_fn)(conv *cv, int joint, const ynode *val, const char *path);
 
 /* Walks a mapping {joint name: value} and calls fn for each joint. */
 static int per_joint(conv *cv, const ynode *nd, const char *path, joint_fn fn)
@@ -1528,6 +1552,10 @@ static int convert_scene(const ynode *root, const char *path, lag_scene *sc, err
         return fail(err, cv.initial ? cv.initial : cv.floor_node,
                     cv.initial ? "initial" : "effects.floor",
                     "initial phi = %g must be in [0, pi] with a floor", sc->sim.q0[1]);
+
+    /* lcm.url, with lcm.allow_lan wherever it was given */
+    if (lag_scene_check_url(sc->lcm.url, sc->lcm.allow_lan, &sc->lcm.ttl, msg, sizeof msg) < 0)
+        return fail(err, cv.url, "lcm.url", "%s", msg);
 
     /* Final check by the core (integrator settings, initial state). */
     if (lag_sim_def_validate(&sc->sim, msg, sizeof msg) != LAG_OK)

@@ -33,4 +33,15 @@ usage "--offline and --replay exclude each other" --config "$scene" --offline --
 usage "unexpected argument 'extra'" --config "$scene" --offline --duration 1 extra
 usage "--set x: expected key.path=value" --config "$scene" --offline --duration 1 --csv - --set x
 usage "cannot open scene file" --config /nonexistent/scene.yaml --offline --duration 1 --csv -
+
+# LCM_DEFAULT_URL gets the scene's checks when the scene has no lcm.url: a file:// URL
+# would make LCM write a log there. Refused before anything runs; the file is not created.
+victim=$(mktemp -u /tmp/lagsim-cli-XXXXXX)
+err=$(LCM_DEFAULT_URL="file://$victim?mode=w" "$lagsimd" --config "$scene" --duration 0.05 -q 2>&1); rc=$?
+if [ $rc -ne 2 ]; then echo "FAIL: LCM_DEFAULT_URL=file://: exit $rc, expected 2"; fail=1
+elif [[ "$err" != *"LCM_DEFAULT_URL: LCM provider 'file://' is not accepted"* ]]; then
+    echo "FAIL: LCM_DEFAULT_URL=file://: '$err'"; fail=1
+elif [ -e "$victim" ]; then echo "FAIL: $victim was written"; fail=1
+else echo "ok: LCM_DEFAULT_URL=file:// refused"; fi
+rm -f "$victim"
 exit $fail

@@ -62,6 +62,22 @@ if "$lagsimd" -q --config "$cfg/stick.yaml" --offline --duration 0 --set realtim
     ok "new section by --set accepted"
 else bad "--set realtime.mode=lockstep on stick.yaml refused"; fi
 
+# 6b. accepted transports and their options; ttl above 0 only when the scene says so
+for u in "" "memq://" "udpm://" "udpm://239.255.76.67" "udpm://224.0.0.251:1?recv_buf_size=4096" \
+         "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=2097152"; do
+    if "$lagsimd" -q --config "$cfg/dipc.yaml" --offline --duration 0 --set "lcm.url='$u'" > /dev/null; then
+        ok "lcm.url '$u' accepted"
+    else bad "lcm.url '$u' refused"; fi
+done
+if "$lagsimd" -q --config "$cfg/dipc.yaml" --offline --duration 0 --set lcm.allow_lan=true \
+       --set "lcm.url=udpm://239.255.76.67:7667?ttl=1" > /dev/null; then
+    ok "ttl=1 with lcm.allow_lan: true accepted"
+else bad "ttl=1 with lcm.allow_lan: true refused"; fi
+if "$lagsimd" -q --config "$cfg/dipc.yaml" --offline --duration 0 \
+       --set "realtime.effort_limit={theta0: 250}" > /dev/null; then
+    ok "realtime.effort_limit on the actuated joint accepted"
+else bad "realtime.effort_limit on the actuated joint refused"; fi
+
 # 7. errors name the --set; a file node keeps its file position after grafting
 e() { "$expect" "$lagsimd" "$cfg/dipc.yaml" "$@" || fail=1; }
 e --expect "--set integrator.dt: expected a positive number, got -1" -- --set integrator.dt=-1
@@ -77,6 +93,12 @@ e --expect "--set lcm.prefix: YAML syntax error" -- --set "lcm.prefix=[a"
 e --expect "--set integrator..dt: empty key in the dotted path" -- --set integrator..dt=1
 e --expect "--set effects.damping: expected a mapping of joints (theta0, theta1, theta2), got a scalar" -- --set effects.damping=1
 e --expect "--set effects.drag: unknown effect 'drag' in effects" -- --set effects.drag=1
+e --expect "--set lcm.url: ttl=1 sends every message beyond this host" -- --set "lcm.url=udpm://239.255.76.67:7667?ttl=1"
+e --expect "--set lcm.url: udpm option 'ttl' given twice" -- --set lcm.allow_lan=true --set "lcm.url=udpm://239.255.76.67?ttl=0&ttl=1"
+e --expect "--set lcm.url: memq:// takes no address or options" -- --set "lcm.url=memq://x"
+e --expect "--set lcm.url: expected ttl=<integer>" -- --set "lcm.url=udpm://239.255.76.67?ttl=010"
+e --expect "--set lcm.url: expected udpm://GROUP:PORT with GROUP a dotted IPv4 multicast address" -- --set "lcm.url=udpm://239.255.076.67"
+e --expect "--set realtime.effort_limit: unknown joint 'x' in realtime.effort_limit for model dipc" -- --set "realtime.effort_limit={x: 1}"
 qline=$(grep -n '^  q:' "$cfg/dipc.yaml" | cut -d: -f1)   # "  q: [...]": the sequence starts at column 6
 m0line=$(grep -n '^  m0:' "$cfg/dipc.yaml" | cut -d: -f1) # "  m0: ...": the key at column 3
 e --expect "$cfg/dipc.yaml:$m0line:3: unknown parameter 'm0' for model stick" -- --set model=stick
@@ -84,3 +106,4 @@ e --expect "$cfg/dipc.yaml:$qline:6: initial.q: expected a sequence of 2 numbers
   -- --set model=stick --set "parameters={m: 1}"
 e --expect "--set initial.q.x: cannot set a key inside 'initial.q', which is a sequence at $cfg/dipc.yaml:$qline:6" -- --set initial.q.x=1
 exit $fail
+
