@@ -193,20 +193,24 @@ static void reject(rt_server *s, rt_reject why, const char *joint, double value,
  * effort finite. */
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
 {
-    rt_command c;
-    rt_decode_result d = rt_decode_command(data, len, s->nq, &c);
-    if (d == RT_DEC_UNDECODABLE) {
-        reject(s, RT_REJ_UNDECODABLE, "", (double)len, "payload bytes in value");
+    lag_wire_joint_command c;
+    int d = lag_wire_decode_joint_command(data, len, s->nq, &c);
+    if (d == LAG_WIRE_ECOUNT) {
+        reject(s, RT_REJ_BAD_LENGTH, "", c.num_joints, "num_joints in value");
         return;
     }
-    if (d == RT_DEC_BAD_LENGTH) {
-        reject(s, RT_REJ_BAD_LENGTH, "", c.num_joints, "num_joints in value");
+    if (d == LAG_WIRE_ETOOLONG) { /* a well-formed name longer than any joint's */
+        reject(s, RT_REJ_UNKNOWN_JOINT, "", 0, "a name of 64 bytes or more");
+        return;
+    }
+    if (d != LAG_WIRE_OK) {
+        reject(s, RT_REJ_UNDECODABLE, "", (double)len, "payload bytes in value");
         return;
     }
     int idx[LAG_MAX_DOF];
     for (int i = 0; i < c.num_joints; i++) {
         idx[i] = -1;
-        for (int j = 0; j < s->nq && !c.name_too_long[i]; j++)
+        for (int j = 0; j < s->nq; j++)
             if (strcmp(c.name[i], s->info->joint_names[j]) == 0) idx[i] = j;
         if (idx[i] < 0) {
             reject(s, RT_REJ_UNKNOWN_JOINT, c.name[i], 0, NULL);
@@ -269,11 +273,11 @@ static void control_rejected(rt_server *s, const char *why)
 
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
 {
-    rt_control c;
-    rt_decode_result d = rt_decode_control(data, len, &c);
-    if (d != RT_DEC_OK) {
-        control_rejected(s, d == RT_DEC_BAD_LENGTH ? "control: num_joints out of range"
-                                                   : "control: undecodable payload");
+    lag_wire_control c;
+    int d = lag_wire_decode_control(data, len, LAG_MAX_DOF, &c);
+    if (d != LAG_WIRE_OK) {
+        control_rejected(s, d == LAG_WIRE_ECOUNT ? "control: num_joints out of range"
+                                                 : "control: undecodable payload");
         return;
     }
     switch (c.request) {

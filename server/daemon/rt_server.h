@@ -1,7 +1,7 @@
 /*
  * The real-time LCM server's private state, shared by realtime.c (the loop, pacing,
- * control requests) and rt_wire.c (bounded decoding of incoming messages, encoding and
- * publishing of outgoing ones).
+ * commands and control requests, decoded by the wire module) and rt_wire.c (encoding and
+ * publishing of outgoing messages).
  *
  * Everything the stepping path touches lives in this struct, allocated once (on the
  * stack of lagsimd_realtime): fixed-size arrays, one encode buffer, no malloc.
@@ -14,10 +14,10 @@
 #include <stdint.h>
 #include <lcm/lcm.h>
 #include "daemon.h"
+#include "lagsim_wire.h"
 
-#define RT_NAME_MAX 64        /* longest joint name a command may carry (with NUL) */
 #define RT_CHANNEL_MAX 96     /* prefix (< 64) + "_COMMAND" */
-#define RT_BUF_SIZE 8192      /* encode buffer: the scene description is the largest */
+#define RT_BUF_SIZE LAG_WIRE_BUF_SIZE /* encode buffer: holds any message */
 
 typedef enum rt_run { RT_RUNNING = 0, RT_PAUSED, RT_FAULT } rt_run;
 
@@ -31,30 +31,6 @@ typedef enum rt_reject {
     RT_REJ_STALE,             /* lockstep: answers a state other than the one waited on */
     RT_REJ_COUNT
 } rt_reject;
-
-/* A decoded joint_command_t, fixed size (rt_decode_command). */
-typedef struct rt_command {
-    double sim_time;
-    int num_joints;
-    char name[LAG_MAX_DOF][RT_NAME_MAX];
-    bool name_too_long[LAG_MAX_DOF];
-    double effort[LAG_MAX_DOF];
-} rt_command;
-
-/* A decoded control_t, fixed size (rt_decode_control). */
-typedef struct rt_control {
-    int request;
-    int64_t count;
-    int num_joints;
-    double q[LAG_MAX_DOF];
-    double qd[LAG_MAX_DOF];
-} rt_control;
-
-typedef enum rt_decode_result {
-    RT_DEC_OK = 0,
-    RT_DEC_UNDECODABLE,   /* wrong fingerprint, truncated, bad string */
-    RT_DEC_BAD_LENGTH     /* num_joints < 0 or > the model's joints */
-} rt_decode_result;
 
 typedef struct rt_server {
     const lag_scene *sc;
@@ -125,10 +101,6 @@ typedef struct rt_server {
 /* Time helpers (ns). */
 int64_t rt_mono_ns(void);
 int64_t rt_wall_us(void);
-
-/* rt_wire.c: decoding (bounded, no allocation; hostile input safe). OUT: out */
-rt_decode_result rt_decode_command(const uint8_t *data, size_t len, int nq, rt_command *out);
-rt_decode_result rt_decode_control(const uint8_t *data, size_t len, rt_control *out);
 
 /* rt_wire.c: publishing. Every double is checked; a non-finite one is never sent. */
 void rt_publish_state(rt_server *s);
