@@ -102,8 +102,14 @@ lag_result lag_qd_from_p(const lag_sim *s, const double *q, const double *p, dou
 void lag_effects_pre_tick(lag_sim *s);
 lag_result lag_effects_tick(lag_sim *s, double *y);
 void lag_effects_init_modes(lag_sim *s);
-lag_result lag_effects_validate(const lag_sim_def *def, char *err, size_t errlen);
+lag_result lag_effects_check(const lag_sim_def *def, lag_diag *d);
 void lag_sim_record_event(lag_sim *s, lag_event_kind kind, int joint, double t, double value);
+
+/* Fills d with field and a printf-style message; returns LAG_ERR_ARG. d may be NULL. */
+lag_result lag_diag_fail(lag_diag *d, const char *field, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+/* Writes "field: message" (or the message alone) into err[errlen]. */
+void lag_diag_format(const lag_diag *d, char *err, size_t errlen);
 
 /* True if every entry is finite and |x_i| <= limit. */
 bool lag_state_ok(int n, const double *x, double limit);

@@ -77,67 +77,109 @@ bool lag_sim_poll_event(lag_sim *s, lag_event *ev)
 
 /* ------------------------------------------------------------------ validation */
 #include <stdio.h>
-lag_result lag_effects_validate(const lag_sim_def *def, char *err, size_t errlen)
+
+/* field = "effects.<effect>.<joint>[.<key>]" */
+static const char *jfield(char *buf, const char *effect, const char *joint, const char *key)
+{
+    snprintf(buf, LAG_FIELD_MAX, "effects.%s.%s%s%s", effect, joint, key ? "." : "", key ? key : "");
+    return buf;
+}
+
+lag_result lag_effects_check(const lag_sim_def *def, lag_diag *d)
 {
     const lag_effects_def *e = &def->effects;
     const int n = def->model.nq;
     const uint32_t known = LAG_EFF_DAMPING | LAG_EFF_FRICTION | LAG_EFF_LIMITS | LAG_EFF_FLOOR |
                            LAG_EFF_ACTUATOR | LAG_EFF_DISTURBANCE | LAG_EFF_NOISE;
     const lag_model_info *info = lag_model_info_get(def->model.kind);
-#define FAIL(...) do { snprintf(err, errlen, __VA_ARGS__); return LAG_ERR_ARG; } while (0)
-    if (e->enabled & ~known) FAIL("unknown effect bits 0x%x", (unsigned)(e->enabled & ~known));
+    char f[LAG_FIELD_MAX];
+    if (e->enabled & ~known)
+        return lag_diag_fail(d, "effects", "unknown effect bits 0x%x", (unsigned)(e->enabled & ~known));
     if (!(isfinite(e->rest_velocity) && e->rest_velocity >= 0))
-        FAIL("effects rest_velocity must be a finite number >= 0");
+        return lag_diag_fail(d, (e->enabled & LAG_EFF_LIMITS) || !(e->enabled & LAG_EFF_FLOOR)
+                                    ? "effects.limits.rest_velocity" : "effects.floor.rest_velocity",
+                             "expected a finite number >= 0, got %g", e->rest_velocity);
     for (int i = 0; i < n; i++) {
         const char *j = info->joint_names[i];
         if ((e->enabled & LAG_EFF_DAMPING) && !(isfinite(e->damping[i]) && e->damping[i] >= 0))
-            FAIL("damping of %s must be a finite number >= 0", j);
+            return lag_diag_fail(d, jfield(f, "damping", j, NULL),
+                                 "expected a finite number >= 0, got %g", e->damping[i]);
         if (e->enabled & LAG_EFF_FRICTION) {
             double ms = e->friction_static[i], mk = e->friction_kinetic[i];
-            if (!(isfinite(mk) && mk >= 0)) FAIL("friction kinetic of %s must be >= 0", j);
+            if (!(isfinite(mk) && mk >= 0))
+                return lag_diag_fail(d, jfield(f, "friction", j, "kinetic"),
+                                     "expected a finite number >= 0, got %g", mk);
             if (!(isfinite(ms) && ms >= mk))
-                FAIL("friction static of %s must be >= its kinetic value (%g)", j, mk);
+                return lag_diag_fail(d, jfield(f, "friction", j, "static"),
+                                     "expected a finite number >= the kinetic value %g, got %g", mk, ms);
         }
         if ((e->enabled & LAG_EFF_LIMITS) && e->limit_on[i]) {
             double lo = e->limit_lower[i], hi = e->limit_upper[i];
-            if (!(isfinite(lo) && isfinite(hi) && lo < hi))
-                FAIL("limits of %s: lower must be < upper, both finite", j);
+            if (!isfinite(lo))
+                return lag_diag_fail(d, jfield(f, "limits", j, "lower"), "expected a finite number, got %g", lo);
+            if (!(isfinite(hi) && lo < hi))
+                return lag_diag_fail(d, jfield(f, "limits", j, "upper"),
+                                     "expected a finite number > lower = %g, got %g", lo, hi);
             if (!(e->restitution[i] >= 0 && e->restitution[i] <= 1))
-                FAIL("limits of %s: restitution must be in [0, 1]", j);
-            if (def->q0[i] < lo || def->q0[i] > hi)
-                FAIL("initial %s = %g is outside its limits [%g, %g]", j, def->q0[i], lo, hi);
+                return lag_diag_fail(d, jfield(f, "limits", j, "restitution"),
+                                     "expected a number in [0, 1], got %g", e->restitution[i]);
+            if (def->q0[i] < lo || def->q0[i] > hi) {
+                snprintf(f, sizeof f, "initial.q[%d]", i);
+                return lag_diag_fail(d, f, "initial %s = %g is outside its limits [%g, %g]", j,
+                                     def->q0[i], lo, hi);
+            }
         }
         if (e->enabled & LAG_EFF_ACTUATOR) {
-            if (!(e->actuator_max[i] > 0)) FAIL("actuator max of %s must be > 0", j);
+            if (!(e->actuator_max[i] > 0))
+                return lag_diag_fail(d, jfield(f, "actuator", j, "max"),
+                                     "expected a number > 0, got %g", e->actuator_max[i]);
             if (!(isfinite(e->actuator_tau[i]) && e->actuator_tau[i] >= 0))
-                FAIL("actuator lag of %s must be a finite number >= 0 (s)", j);
+                return lag_diag_fail(d, jfield(f, "actuator", j, "lag"),
+                                     "expected a finite number >= 0 (s), got %g", e->actuator_tau[i]);
         }
         if (e->enabled & LAG_EFF_NOISE) {
-            if (!(isfinite(e->noise_q[i]) && e->noise_q[i] >= 0 && isfinite(e->noise_qd[i]) &&
-                  e->noise_qd[i] >= 0))
-                FAIL("noise of %s must be finite numbers >= 0", j);
+            if (!(isfinite(e->noise_q[i]) && e->noise_q[i] >= 0))
+                return lag_diag_fail(d, jfield(f, "noise.q", j, NULL),
+                                     "expected a finite number >= 0, got %g", e->noise_q[i]);
+            if (!(isfinite(e->noise_qd[i]) && e->noise_qd[i] >= 0))
+                return lag_diag_fail(d, jfield(f, "noise.qd", j, NULL),
+                                     "expected a finite number >= 0, got %g", e->noise_qd[i]);
         }
     }
     if (e->enabled & LAG_EFF_FLOOR) {
-        if (def->model.kind != LAG_MODEL_STICK) FAIL("the floor effect is for the stick model only");
+        if (def->model.kind != LAG_MODEL_STICK)
+            return lag_diag_fail(d, "effects.floor", "the floor effect is for the stick model only");
         if (!(e->floor_restitution >= 0 && e->floor_restitution <= 1))
-            FAIL("floor restitution must be in [0, 1]");
+            return lag_diag_fail(d, "effects.floor.restitution", "expected a number in [0, 1], got %g",
+                                 e->floor_restitution);
         if (def->q0[1] < 0 || def->q0[1] > M_PI)
-            FAIL("initial phi = %g must be in [0, pi] with a floor", def->q0[1]);
+            return lag_diag_fail(d, "initial.q[1]", "initial phi = %g must be in [0, pi] with a floor",
+                                 def->q0[1]);
     }
     if (e->enabled & LAG_EFF_DISTURBANCE) {
         if (e->n_disturbances < 0 || e->n_disturbances > LAG_MAX_DISTURBANCES)
-            FAIL("at most %d disturbances", LAG_MAX_DISTURBANCES);
+            return lag_diag_fail(d, "effects.disturbance", "expected at most %d disturbances, got %d",
+                                 LAG_MAX_DISTURBANCES, e->n_disturbances);
         for (int k = 0; k < e->n_disturbances; k++) {
-            const lag_disturbance *d = &e->disturbances[k];
-            if (!(isfinite(d->t) && d->t >= 0)) FAIL("disturbance %d: time must be >= 0", k);
-            if (d->joint < 0 || d->joint >= n) FAIL("disturbance %d: no such joint", k);
-            if (!isfinite(d->value)) FAIL("disturbance %d: value must be finite", k);
-            if (!d->impulse && !(isfinite(d->duration) && d->duration > 0))
-                FAIL("disturbance %d: a force needs a duration > 0", k);
+            const lag_disturbance *dk = &e->disturbances[k];
+            if (!(isfinite(dk->t) && dk->t >= 0)) {
+                snprintf(f, sizeof f, "effects.disturbance[%d].t", k);
+                return lag_diag_fail(d, f, "expected a finite time >= 0 (s), got %g", dk->t);
+            }
+            if (dk->joint < 0 || dk->joint >= n) {
+                snprintf(f, sizeof f, "effects.disturbance[%d].joint", k);
+                return lag_diag_fail(d, f, "no joint %d in model %s", dk->joint, info->name);
+            }
+            if (!isfinite(dk->value)) {
+                snprintf(f, sizeof f, "effects.disturbance[%d].%s", k, dk->impulse ? "impulse" : "force");
+                return lag_diag_fail(d, f, "expected a finite number, got %g", dk->value);
+            }
+            if (!dk->impulse && !(isfinite(dk->duration) && dk->duration > 0)) {
+                snprintf(f, sizeof f, "effects.disturbance[%d].duration", k);
+                return lag_diag_fail(d, f, "expected a finite number > 0 (s), got %g", dk->duration);
+            }
         }
     }
-#undef FAIL
     return LAG_OK;
 }
 

@@ -1,6 +1,7 @@
 /* Model kinds: the info table, parameter defaults and validation, public dispatch, and
  * forward dynamics (M qdd = tau - C qd - g solved by Cholesky). */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 #include "core_internal.h"
@@ -82,41 +83,57 @@ void lag_model_default(lag_model *m, lag_model_kind kind)
     lag_model_finish(m);
 }
 
-lag_result lag_model_validate(const lag_model *m, char *err, size_t errlen)
+lag_result lag_diag_fail(lag_diag *d, const char *field, const char *fmt, ...)
+{
+    if (!d) return LAG_ERR_ARG;
+    snprintf(d->field, sizeof d->field, "%s", field ? field : "");
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(d->message, sizeof d->message, fmt, ap);
+    va_end(ap);
+    return LAG_ERR_ARG;
+}
+
+void lag_diag_format(const lag_diag *d, char *err, size_t errlen)
+{
+    if (!err || errlen == 0) return;
+    if (d->field[0]) snprintf(err, errlen, "%s: %s", d->field, d->message);
+    else snprintf(err, errlen, "%s", d->message);
+}
+
+lag_result lag_model_check(const lag_model *m, lag_diag *d)
 {
     const lag_model_info *info = lag_model_info_get(m->kind);
-    if (!info) {
-        snprintf(err, errlen, "unknown model kind %d", (int)m->kind);
-        return LAG_ERR_ARG;
-    }
-    if (m->nq != info->nq) {
-        snprintf(err, errlen, "model %s has %d coordinates, not %d", info->name, info->nq, m->nq);
-        return LAG_ERR_ARG;
-    }
+    if (!info) return lag_diag_fail(d, "model", "unknown model kind %d", (int)m->kind);
+    if (m->nq != info->nq)
+        return lag_diag_fail(d, "model", "%s has %d coordinates, not %d", info->name,
+                             info->nq, m->nq);
     for (int i = 0; i < info->np; i++) {
         const char *name = info->param_names[i];
         double v = m->p[i];
-        if (!isfinite(v)) {
-            snprintf(err, errlen, "parameter %s must be a finite number", name);
-            return LAG_ERR_ARG;
-        }
+        char field[LAG_FIELD_MAX];
+        snprintf(field, sizeof field, "parameters.%s", name);
+        if (!isfinite(v)) return lag_diag_fail(d, field, "expected a finite number, got %g", v);
         /* h0 may be any height; g may be 0 (no gravity) but not negative (flip the
          * coordinates instead); every mass, length and inertia must be positive. */
         if (strcmp(name, "h0") == 0) continue;
         if (strcmp(name, "g") == 0) {
-            if (v < 0) {
-                snprintf(err, errlen, "parameter g must be >= 0 (m/s^2), got %g", v);
-                return LAG_ERR_ARG;
-            }
+            if (v < 0) return lag_diag_fail(d, field, "expected a number >= 0 (m/s^2), got %g", v);
             continue;
         }
-        if (v <= 0) {
-            snprintf(err, errlen, "parameter %s must be > 0 (%s), got %g", name,
-                     info->param_units[i], v);
-            return LAG_ERR_ARG;
-        }
+        if (v <= 0)
+            return lag_diag_fail(d, field, "expected a number > 0 (%s), got %g",
+                                 info->param_units[i], v);
     }
     return LAG_OK;
+}
+
+lag_result lag_model_validate(const lag_model *m, char *err, size_t errlen)
+{
+    lag_diag d;
+    lag_result r = lag_model_check(m, &d);
+    if (r != LAG_OK) lag_diag_format(&d, err, errlen);
+    return r;
 }
 
 void lag_model_mass(const lag_model *m, const double *q, double *M)

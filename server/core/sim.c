@@ -16,59 +16,56 @@ lag_sim_def lag_default_sim_def(lag_model_kind kind)
     return d;
 }
 
-lag_result lag_sim_def_validate(const lag_sim_def *def, char *err, size_t errlen)
+lag_result lag_sim_def_check(const lag_sim_def *def, lag_diag *d)
 {
-    lag_result r = lag_model_validate(&def->model, err, errlen);
+    lag_result r = lag_model_check(&def->model, d);
     if (r != LAG_OK) return r;
-    if ((r = lag_effects_validate(def, err, errlen)) != LAG_OK) return r;
     const lag_integrator_def *in = &def->integrator;
-    if ((int)in->method < 0 || in->method >= LAG_METHOD_COUNT) {
-        snprintf(err, errlen, "unknown integrator method %d", (int)in->method);
-        return LAG_ERR_ARG;
-    }
-    if (!(isfinite(in->dt) && in->dt > 0)) {
-        snprintf(err, errlen, "integrator.dt must be a finite number > 0 (s), got %g", in->dt);
-        return LAG_ERR_ARG;
-    }
-    if (!(isfinite(in->rtol) && in->rtol > 0) || !(isfinite(in->atol) && in->atol > 0)) {
-        snprintf(err, errlen, "integrator.rtol and atol must be finite numbers > 0");
-        return LAG_ERR_ARG;
-    }
-    if (!(isfinite(in->dt_min) && in->dt_min > 0 && in->dt_min <= in->dt)) {
-        snprintf(err, errlen, "integrator.dt_min must be > 0 and <= dt, got %g", in->dt_min);
-        return LAG_ERR_ARG;
-    }
-    if (in->max_iter < 1 || in->max_iter > 1000) {
-        snprintf(err, errlen, "integrator.max_iter must be in 1..1000, got %d", in->max_iter);
-        return LAG_ERR_ARG;
-    }
-    if (!(isfinite(in->newton_tol) && in->newton_tol > 0 && in->newton_tol < 1)) {
-        snprintf(err, errlen, "integrator.newton_tol must be in (0, 1), got %g", in->newton_tol);
-        return LAG_ERR_ARG;
-    }
-    if (!(isfinite(def->explode_limit) && def->explode_limit > 0)) {
-        snprintf(err, errlen, "explode_limit must be a finite number > 0, got %g",
-                 def->explode_limit);
-        return LAG_ERR_ARG;
-    }
+    if ((int)in->method < 0 || in->method >= LAG_METHOD_COUNT)
+        return lag_diag_fail(d, "integrator.method", "unknown integrator method %d", (int)in->method);
+    if (!(isfinite(in->dt) && in->dt > 0))
+        return lag_diag_fail(d, "integrator.dt", "expected a finite number > 0 (s), got %g", in->dt);
+    if (!(isfinite(in->rtol) && in->rtol > 0))
+        return lag_diag_fail(d, "integrator.rtol", "expected a finite number > 0, got %g", in->rtol);
+    if (!(isfinite(in->atol) && in->atol > 0))
+        return lag_diag_fail(d, "integrator.atol", "expected a finite number > 0, got %g", in->atol);
+    if (!(isfinite(in->dt_min) && in->dt_min > 0 && in->dt_min <= in->dt))
+        return lag_diag_fail(d, "integrator.dt_min", "expected a number > 0 and <= dt = %g s, got %g",
+                             in->dt, in->dt_min);
+    if (in->max_iter < 1 || in->max_iter > 1000)
+        return lag_diag_fail(d, "integrator.max_iter", "expected an integer in 1..1000, got %d",
+                             in->max_iter);
+    if (!(isfinite(in->newton_tol) && in->newton_tol > 0 && in->newton_tol < 1))
+        return lag_diag_fail(d, "integrator.newton_tol", "expected a number in (0, 1), got %g",
+                             in->newton_tol);
+    if (!(isfinite(def->explode_limit) && def->explode_limit > 0))
+        return lag_diag_fail(d, "explode_limit", "expected a finite number > 0, got %g",
+                             def->explode_limit);
     int n = def->model.nq;
     for (int i = 0; i < n; i++) {
-        if (!isfinite(def->q0[i]) || !isfinite(def->qd0[i])) {
-            snprintf(err, errlen, "initial q and qd must be finite");
-            return LAG_ERR_ARG;
-        }
-        if (fabs(def->q0[i]) > def->explode_limit || fabs(def->qd0[i]) > def->explode_limit) {
-            snprintf(err, errlen, "initial state exceeds explode_limit %g", def->explode_limit);
-            return LAG_ERR_ARG;
+        char field[LAG_FIELD_MAX];
+        for (int v = 0; v < 2; v++) {
+            double x = v ? def->qd0[i] : def->q0[i];
+            snprintf(field, sizeof field, "initial.%s[%d]", v ? "qd" : "q", i);
+            if (!isfinite(x)) return lag_diag_fail(d, field, "expected a finite number, got %g", x);
+            if (fabs(x) > def->explode_limit)
+                return lag_diag_fail(d, field, "%g exceeds explode_limit = %g", x, def->explode_limit);
         }
     }
+    if ((r = lag_effects_check(def, d)) != LAG_OK) return r;
     double M[LAG_MAX_DOF * LAG_MAX_DOF], b[LAG_MAX_DOF] = {0}, x[LAG_MAX_DOF];
     lag_model_mass(&def->model, def->q0, M);
-    if (lag_spd_solve(n, M, b, x) != LAG_OK) {
-        snprintf(err, errlen, "mass matrix is not positive definite at the initial q");
-        return LAG_ERR_ARG;
-    }
+    if (lag_spd_solve(n, M, b, x) != LAG_OK)
+        return lag_diag_fail(d, "initial.q", "the mass matrix is not positive definite there");
     return LAG_OK;
+}
+
+lag_result lag_sim_def_validate(const lag_sim_def *def, char *err, size_t errlen)
+{
+    lag_diag d;
+    lag_result r = lag_sim_def_check(def, &d);
+    if (r != LAG_OK) lag_diag_format(&d, err, errlen);
+    return r;
 }
 
 lag_result lag_sim_init(lag_sim *s, const lag_sim_def *def, char *err, size_t errlen)

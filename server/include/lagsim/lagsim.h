@@ -38,6 +38,34 @@ typedef enum lag_result {
 
 const char *lag_result_string(lag_result r);
 
+/* What is wrong with a definition, for a loader to point at (SQLite's habit of a message
+ * on the caller's side, plus where): `field` is the path of the offending value in the
+ * scene file's own terms, so a loader that keeps the position of each key can attach its
+ * file:line:column to the core's message instead of checking the value twice. Grammar:
+ * keys joined by '.', a sequence index as [i]; values kept per joint are named by the
+ * joint's name (lag_model_info.joint_names):
+ *   model                               the model kind, or its number of coordinates
+ *   parameters.<name>                   lag_model_info.param_names, e.g. parameters.m1
+ *   initial.q[i], initial.qd[i]         initial.q when the fault is of the whole vector
+ *   integrator.<key>                    method, dt, rtol, atol, dt_min, max_iter, newton_tol
+ *   explode_limit
+ *   effects                             the set of effects itself (unknown bits)
+ *   effects.damping.<joint>
+ *   effects.friction.<joint>.static | .kinetic
+ *   effects.limits.<joint>.lower | .upper | .restitution,  effects.limits.rest_velocity
+ *   effects.floor.restitution | .rest_velocity
+ *   effects.actuator.<joint>.max | .lag
+ *   effects.disturbance[k].t | .joint | .impulse | .force | .duration
+ *   effects.noise.q.<joint> | effects.noise.qd.<joint>
+ * `field` is "" when no single value is at fault. `message` says what is expected and
+ * what was found, without repeating the field. */
+#define LAG_FIELD_MAX 64
+#define LAG_MESSAGE_MAX 192
+typedef struct lag_diag {
+    char field[LAG_FIELD_MAX];
+    char message[LAG_MESSAGE_MAX];
+} lag_diag;
+
 /* ---------------------------------------------------------------- models */
 typedef enum lag_model_kind {
     LAG_MODEL_STICK = 0,       /* q = (x, phi)                  */
@@ -84,7 +112,9 @@ void lag_model_default(lag_model *m, lag_model_kind kind);
 void lag_model_default_unfinished(lag_model *m, lag_model_kind kind);
 void lag_model_finish(lag_model *m);
 /* Checks every parameter (finite; masses, lengths, inertias > 0; g >= 0 finite).
- * Returns LAG_ERR_ARG with a message naming the parameter. */
+ * Returns LAG_ERR_ARG and fills d (see lag_diag; field "parameters.<name>"). OUT: d */
+lag_result lag_model_check(const lag_model *m, lag_diag *d);
+/* The same, with "field: message" written into err. */
 lag_result lag_model_validate(const lag_model *m, char *err, size_t errlen);
 /* Index of parameter `name` for this kind, or -1. */
 int lag_model_param_index(lag_model_kind kind, const char *name);
@@ -221,7 +251,10 @@ typedef struct lag_sim_def {
 
 /* Model kind's defaults, rk4 at 1 ms, at rest at q = 0. */
 lag_sim_def lag_default_sim_def(lag_model_kind kind);
-/* Validates the whole definition (model, integrator, initial state). */
+/* Validates the whole definition (model, integrator, effects, initial state). Returns
+ * LAG_ERR_ARG and fills d with the first fault found (see lag_diag). OUT: d */
+lag_result lag_sim_def_check(const lag_sim_def *def, lag_diag *d);
+/* The same, with "field: message" written into err (what lag_sim_init reports). */
 lag_result lag_sim_def_validate(const lag_sim_def *def, char *err, size_t errlen);
 
 /* Counters, for status and benchmarks. */
