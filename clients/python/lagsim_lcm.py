@@ -1,19 +1,31 @@
 """LCM from Python with the standard library only: ctypes over liblcm.so.1.
 
 Debian has no Python LCM module, but the C library is enough. Messages are encoded and
-decoded by the classes `lcm-gen --python` makes (they import only `struct`), e.g.
-PYTHONPATH=<build>/python gives `from lagsim import joint_state_t`.
+decoded by the classes `lcm-gen --python` makes (they import only `struct`); the build
+puts them and this module in <build>/python, `cmake --install` in Python's site
+directory, so with PYTHONPATH=<build>/python (or after installing) this works anywhere:
 
+    from lagsim_lcm import LCM
+    from lagsim import joint_state_t
     lc = LCM()                     # LCM's default URL (honours LCM_DEFAULT_URL)
     lc.subscribe("DIPC_STATE", lambda channel, data: print(joint_state_t.decode(data)))
     lc.publish("DIPC_COMMAND", cmd.encode())
-    lc.handle_timeout(100)         # ms; 1 if a message was handled, 0 on timeout
+    lc.handle_timeout(100)         # ms; True if a message was handled, False on timeout
 
-Not thread-safe, like lcm_t itself.
+The methods follow LCM's own Python binding:
+- subscribe(channel, handler) takes a POSIX extended regular expression, anchored at both
+  ends, like every LCM binding ("DIPC_.*" receives every channel of the prefix; a plain
+  channel name matches itself). Returns a subscription for unsubscribe().
+- An exception raised by a handler stops that dispatch and is raised again by the
+  handle() or handle_timeout() call that ran the handler, with its traceback: it never
+  unwinds through C and is never swallowed.
+- handle() blocks until one message has been handled; handle_timeout(ms) waits at most
+  ms milliseconds; fileno() gives the socket for select()/poll().
+
+Not thread-safe, like lcm_t itself: use one LCM per thread.
 """
 import ctypes
 import ctypes.util
-import re
 
 __all__ = ["LCM", "LCMError"]
 
@@ -60,6 +72,8 @@ def _load():
     lib.lcm_publish.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.c_void_p,
                                 ctypes.c_uint]
     lib.lcm_publish.restype = ctypes.c_int
+    lib.lcm_handle.argtypes = [ctypes.c_void_p]
+    lib.lcm_handle.restype = ctypes.c_int
     lib.lcm_handle_timeout.argtypes = [ctypes.c_void_p, ctypes.c_int]
     lib.lcm_handle_timeout.restype = ctypes.c_int
     return lib
@@ -80,29 +94,35 @@ class LCM(object):
         if not self._lcm:
             raise LCMError("lcm_create(%r) failed" % (url or "default"))
         # ctypes callbacks must outlive the subscription: keep every one here
-        self._subs = []
-        self.errors = 0  # exceptions raised by Python handlers (counted, not propagated)
-        self.last_error = None
+        self._subs = {}
+        self._pending = None  # exception raised by a handler, raised again by handle*()
 
-    def subscribe(self, channel, handler, exact=True):
-        """Calls handler(channel_str, payload_bytes) for each message on channel.
-        exact=True escapes regex characters (LCM subscribes by POSIX regex)."""
-        pattern = re.sub(r"([.\[\]{}()\\*+?^$|])", r"\\\1", channel) if exact else channel
+    def subscribe(self, channel, handler):
+        """Calls handler(channel_str, payload_bytes) for each message whose channel
+        matches the regular expression `channel` (anchored, as in LCM)."""
 
         def trampoline(rbuf, chan, user):
+            if self._pending is not None:  # an earlier handler failed: stop this dispatch
+                return
             try:
                 data = ctypes.string_at(rbuf.contents.data, rbuf.contents.data_size)
                 handler(chan.decode("utf-8", "replace"), data)
-            except Exception as e:  # never let an exception unwind through C
-                self.errors += 1
-                self.last_error = e
+            except BaseException as e:  # never unwind through C: kept, raised by handle*()
+                self._pending = e
 
         cb = _HANDLER(trampoline)
-        sub = self._lib.lcm_subscribe(self._lcm, pattern.encode(), cb, None)
+        sub = self._lib.lcm_subscribe(self._lcm, channel.encode(), cb, None)
         if not sub:
             raise LCMError("lcm_subscribe(%r) failed" % channel)
-        self._subs.append((sub, cb, trampoline))
+        self._subs[sub] = cb
         return sub
+
+    def unsubscribe(self, sub):
+        if sub not in self._subs:
+            raise LCMError("not a subscription of this LCM")
+        if self._lib.lcm_unsubscribe(self._lcm, sub) != 0:
+            raise LCMError("lcm_unsubscribe failed")
+        del self._subs[sub]
 
     def publish(self, channel, data):
         buf = bytes(data)
@@ -110,23 +130,37 @@ class LCM(object):
         if rc != 0:
             raise LCMError("lcm_publish(%r) failed" % channel)
 
+    def _raise_pending(self):
+        e, self._pending = self._pending, None
+        if e is not None:
+            raise e
+
+    def handle(self):
+        """Waits for one message and runs its handlers."""
+        rc = self._lib.lcm_handle(self._lcm)
+        self._raise_pending()
+        if rc != 0:
+            raise LCMError("lcm_handle failed")
+
     def handle_timeout(self, timeout_ms):
-        """Handles at most one message; 1 if handled, 0 on timeout."""
+        """Handles at most one message, waiting up to timeout_ms milliseconds.
+        True if a message was handled, False on timeout."""
         rc = self._lib.lcm_handle_timeout(self._lcm, int(max(0, timeout_ms)))
+        self._raise_pending()
         if rc < 0:
             raise LCMError("lcm_handle_timeout failed")
-        return 1 if rc > 0 else 0
+        return rc > 0
 
     def fileno(self):
         return self._lib.lcm_get_fileno(self._lcm)
 
     def close(self):
         if self._lcm:
-            for sub, _cb, _t in self._subs:
+            for sub in list(self._subs):
                 self._lib.lcm_unsubscribe(self._lcm, sub)
             self._lib.lcm_destroy(self._lcm)
             self._lcm = None
-            self._subs = []
+            self._subs = {}
 
     def __enter__(self):
         return self

@@ -2,6 +2,7 @@
 """End-to-end harness: one lagsimd plus one controller on real LCM (loopback).
 
     run_e2e.py --lagsimd BIN --config YAML --mode lockstep [--set k=v ...]
+               [--daemon-arg ARG ...] [--kill-daemon-after S]
                [--check EXPR ...] [--timeout S] -- CLIENT ARGS...
 
 The controller is started first, then (once it prints that it is waiting for the scene
@@ -9,8 +10,11 @@ description, i.e. it is subscribed and will see the very first state) the daemon
 (--set lcm.prefix=<prefix>; "{prefix}" in the client's arguments is replaced by it) so
 that tests running in parallel never cross-talk. The controller must exit by itself
 within --timeout wall seconds; the daemon is always stopped (SIGTERM, then SIGKILL).
-The controller's last line "... summary key=value ..." is parsed and every --check
-expression (Python, over those keys) must hold.
+--daemon-arg adds an argument to the daemon's command line (e.g. --duration 2: the daemon
+stops by itself and announces it); --kill-daemon-after S kills it with SIGKILL after S
+wall seconds (it goes silent without a word). The controller's last line
+"... summary key=value ..." is parsed and every --check expression (Python, over those
+keys; `wall` is the controller's wall time after the daemon ended, s) must hold.
 """
 import argparse
 import math
@@ -19,6 +23,7 @@ import signal
 import subprocess
 import sys
 import threading
+import time
 
 
 def stop(proc, grace=3.0):
@@ -54,6 +59,8 @@ def main():
     ap.add_argument("--mode", default="lockstep")
     ap.add_argument("--name", default="E2E")
     ap.add_argument("--set", action="append", default=[])
+    ap.add_argument("--daemon-arg", action="append", default=[])
+    ap.add_argument("--kill-daemon-after", type=float, default=None)
     ap.add_argument("--check", action="append", default=[])
     ap.add_argument("--timeout", type=float, default=60.0)
     ap.add_argument("client", nargs=argparse.REMAINDER)
@@ -67,6 +74,7 @@ def main():
             "--set", "realtime.mode=" + a.mode, "-q"]
     for s in a.set:
         dcmd += ["--set", s]
+    dcmd += a.daemon_arg
     print("client:", " ".join(client))
     print("daemon:", " ".join(dcmd), flush=True)
 
@@ -74,6 +82,7 @@ def main():
         print("FAIL: no lagsimd executable at %s" % a.lagsimd)
         return 1
     cproc = dproc = None
+    t_daemon_end = t_client_end = None
     lines = []
     try:
         cproc = subprocess.Popen(client, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
@@ -97,7 +106,18 @@ def main():
             return 1
         dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                  universal_newlines=True)
+        t_daemon_end = None
+        if a.kill_daemon_after is not None:
+            try:
+                dproc.wait(a.kill_daemon_after)
+            except subprocess.TimeoutExpired:
+                dproc.kill()
+                dproc.wait()
+            t_daemon_end = time.monotonic()
         try:
+            if t_daemon_end is None and any(x == "--duration" for x in a.daemon_arg):
+                dproc.wait(timeout=a.timeout)
+                t_daemon_end = time.monotonic()
             cproc.wait(timeout=a.timeout)
         except subprocess.TimeoutExpired:
             stop(cproc)
@@ -105,6 +125,7 @@ def main():
             print("".join(lines))
             print("FAIL: the client did not finish within %g s" % a.timeout)
             return 1
+        t_client_end = time.monotonic()
         th.join(5.0)
         err = cproc.stderr.read()
     finally:
@@ -126,6 +147,8 @@ def main():
         return 1
     ok = True
     env = dict(vals)
+    if t_daemon_end is not None:
+        env["wall"] = t_client_end - t_daemon_end
     env["math"] = math
     for expr in a.check:
         try:

@@ -1,0 +1,191 @@
+"""What every Python example controller shares: options, connect, wait for the scene,
+answer states until the run ends, a summary line.
+
+    from lagsim_controller import Controller
+    ctl = Controller("dipc_balance.py", default_prefix="DIPC", model="dipc")
+    ctl.parser.add_argument(...)                 # the example's own options
+    a = ctl.start()                              # parses argv, connects, waits for the scene
+    for st in ctl.states():                      # each newest state once, until the end
+        ctl.command(st.sim_time, ["theta0"], [u])
+    ctl.finish("states=%d ..." % n)              # prints "<name>: summary end=... states=..."
+
+A run ends (and states() returns) when the daemon publishes its `stop` event, when
+nothing came from the daemon (no state, status or event) for --timeout wall seconds, when
+--duration seconds of sim time have passed since the first state, or on SIGINT/SIGTERM.
+ctl.end says which: stop, silence, duration or signal. --trace FILE writes one line per
+answered state: sim time, positions, velocities, efforts sent, each as %.17g. Exit status: 0 for all of these;
+1 when no scene came within --timeout or the scene is another model's; 2 bad usage.
+"""
+import argparse
+import math
+import os
+import signal
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from lagsim_lcm import LCM  # noqa: E402
+
+
+def _import_types(types_dir, name):
+    if types_dir:
+        sys.path.insert(0, types_dir)
+    try:
+        import lagsim
+        return lagsim
+    except ImportError:
+        sys.stderr.write("%s: cannot import the lcm-gen Python types 'lagsim'; set "
+                         "PYTHONPATH=<build>/python or pass --types DIR\n" % name)
+        sys.exit(2)
+
+
+class Controller(object):
+    def __init__(self, name, default_prefix, model, description=""):
+        self.name = name
+        self.model = model
+        p = argparse.ArgumentParser(prog=name, description=description)
+        p.add_argument("--prefix", default=default_prefix,
+                       help="channel prefix (default %s)" % default_prefix)
+        p.add_argument("--url", default=None, help="LCM URL (default: LCM's default)")
+        p.add_argument("--duration", type=float, default=0.0,
+                       help="stop after S s of sim time from the first state (default 0: "
+                            "until the daemon stops)")
+        p.add_argument("--timeout", type=float, default=5.0,
+                       help="wall s without a scene, or without any message from the "
+                            "daemon once running, before ending (default 5)")
+        p.add_argument("--types", default=None,
+                       help="directory holding the lagsim Python types")
+        p.add_argument("--trace", default=None,
+                       help="write each answered state and the efforts sent to this file")
+        p.add_argument("-q", action="store_true", help="quiet: summary only")
+        self.parser = p
+        self.end = None
+        self.dropped = 0
+        self.scene = None
+
+    def start(self):
+        a = self.parser.parse_args()
+        if not (a.timeout > 0 and a.duration >= 0 and math.isfinite(a.duration)):
+            self.parser.error("--timeout must be > 0 and --duration a number >= 0")
+        self.args = a
+        self.t = _import_types(a.types, self.name)
+        self._trace = open(a.trace, "w") if a.trace else None
+        self._current = None
+        self._stop = False
+
+        def on_signal(signum, frame):
+            self._stop = True
+
+        signal.signal(signal.SIGINT, on_signal)
+        signal.signal(signal.SIGTERM, on_signal)
+        self.lc = LCM(a.url)
+        self._state = None
+        self._stopped = False
+        self._heard = time.monotonic()
+        ch = a.prefix + "_"
+        self.lc.subscribe(ch + "SCENE", self._on_scene)
+        self.lc.subscribe(ch + "STATE", self._on_state)
+        self.lc.subscribe(ch + "EVENT", self._on_event)
+        self.lc.subscribe(ch + "STATUS", self._on_status)
+        # subscribed: from here on no state is missed (test harnesses wait for this line)
+        print("%s: waiting for the scene description on %sSCENE" % (self.name, ch), flush=True)
+        deadline = time.monotonic() + a.timeout
+        next_ask = 0.0
+        while self.scene is None and not self._stop:
+            now = time.monotonic()
+            if now >= deadline:
+                sys.stderr.write("%s: no scene on %sSCENE within %g s (is lagsimd running "
+                                 "with this prefix?)\n" % (self.name, ch, a.timeout))
+                sys.exit(1)
+            if now >= next_ask:  # DESCRIBE every 0.25 s until the scene comes
+                req = self.t.control_t()
+                req.utime = int(time.time() * 1e6)
+                req.request = self.t.control_t.DESCRIBE
+                self.lc.publish(ch + "CONTROL", req.encode())
+                next_ask = now + 0.25
+            self.lc.handle_timeout(50)
+        if self.scene is None:
+            sys.exit(1)
+        if self.scene.model != self.model:
+            sys.stderr.write("%s: prefix %s runs model %r, not %s\n"
+                             % (self.name, a.prefix, self.scene.model, self.model))
+            sys.exit(1)
+        self.params = dict(zip(self.scene.param_name, self.scene.param_value))
+        return a
+
+    def _on_scene(self, channel, data):
+        self._heard = time.monotonic()
+        try:
+            self.scene = self.t.scene_t.decode(data)
+        except Exception:
+            self.dropped += 1
+
+    def _on_state(self, channel, data):
+        self._heard = time.monotonic()
+        try:
+            self._state = self.t.joint_state_t.decode(data)
+        except Exception:
+            self.dropped += 1
+
+    def _on_status(self, channel, data):
+        self._heard = time.monotonic()
+
+    def _on_event(self, channel, data):
+        self._heard = time.monotonic()
+        try:
+            ev = self.t.event_t.decode(data)
+        except Exception:
+            self.dropped += 1
+            return
+        if ev.kind == "stop":
+            self._stopped = True
+
+    def states(self):
+        """Yields each newest state once until the run ends (self.end says why)."""
+        a = self.args
+        t_first = None
+        while True:
+            while self._state is None:
+                if self._stop:
+                    self.end = "signal"
+                    return
+                if self._stopped:
+                    self.end = "stop"
+                    return
+                if time.monotonic() - self._heard > a.timeout:
+                    self.end = "silence"
+                    return
+                self.lc.handle_timeout(50)
+            while self.lc.handle_timeout(0):  # drain what is queued: answer the newest
+                pass
+            st, self._state = self._state, None
+            self._current = st
+            if t_first is None:
+                t_first = st.sim_time
+            yield st
+            if a.duration > 0 and \
+                    st.sim_time - t_first >= a.duration - 0.5 * self.scene.control_period:
+                self.end = "duration"
+                return
+
+    def command(self, sim_time, names, efforts):
+        cmd = self.t.joint_command_t()
+        cmd.utime = int(time.time() * 1e6)
+        cmd.sim_time = sim_time
+        cmd.num_joints = len(names)
+        cmd.name = list(names)
+        cmd.effort = [x if math.isfinite(x) else 0.0 for x in efforts]  # never send NaN
+        self.lc.publish(self.args.prefix + "_COMMAND", cmd.encode())
+        st = self._current
+        if self._trace and st is not None and st.sim_time == sim_time:
+            # sim_time, positions, velocities, efforts sent: %.17g reads back to the same double
+            f = [st.sim_time] + list(st.position) + list(st.velocity) + cmd.effort
+            self._trace.write(" ".join("%.17g" % x for x in f) + "\n")
+
+    def finish(self, summary):
+        if self._trace:
+            self._trace.close()
+        print("%s: summary end=%s %s dropped=%d" % (self.name, self.end, summary, self.dropped),
+              flush=True)
+        self.lc.close()
+        return 0

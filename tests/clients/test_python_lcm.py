@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+"""The Python LCM binding (clients/python/lagsim_lcm.py) behaves as LCM's bindings do.
+
+In-process (memq://), no network:
+  - subscribe() takes LCM's regular expressions: "RX_.*" receives RX_A and RX_B, not QX_A;
+    a plain name matches only itself (anchored: "RX_A" does not receive "RX_AB");
+  - an exception in a handler is raised again by the handle_timeout() / handle() call
+    that ran it (type and message intact), and the LCM works afterwards;
+  - unsubscribe() stops delivery.
+usage: test_python_lcm.py CLIENTS_PYTHON_DIR
+"""
+import sys
+
+sys.path.insert(0, sys.argv[1])
+from lagsim_lcm import LCM  # noqa: E402
+
+fails = 0
+
+
+def check(cond, what):
+    global fails
+    print("%s: %s" % ("ok  " if cond else "FAIL", what))
+    if not cond:
+        fails += 1
+
+
+def drain(lc):
+    n = 0
+    while lc.handle_timeout(0):
+        n += 1
+    return n
+
+
+lc = LCM("memq://")
+got = []
+sub = lc.subscribe("RX_.*", lambda ch, data: got.append((ch, data)))
+exact = []
+lc.subscribe("RX_A", lambda ch, data: exact.append(ch))
+for ch in ("RX_A", "RX_B", "QX_A", "RX_AB"):
+    lc.publish(ch, ch.encode())
+drain(lc)
+check(sorted(c for c, _ in got) == ["RX_A", "RX_AB", "RX_B"],
+      "'RX_.*' receives RX_A, RX_AB, RX_B and not QX_A (got %s)" % [c for c, _ in got])
+check(got and all(d == c.encode() for c, d in got), "payloads arrive intact")
+check(exact == ["RX_A"], "'RX_A' receives RX_A only (got %s)" % exact)
+
+
+class Boom(Exception):
+    pass
+
+
+def bad(ch, data):
+    raise Boom("handler failed on " + ch)
+
+
+bad_sub = lc.subscribe("BAD", bad)
+lc.publish("BAD", b"x")
+try:
+    lc.handle_timeout(100)
+    check(False, "an exception in a handler reaches the caller of handle_timeout()")
+except Boom as e:
+    check(str(e) == "handler failed on BAD",
+          "an exception in a handler reaches the caller of handle_timeout() (%s)" % e)
+lc.publish("BAD", b"x")
+try:
+    lc.handle()
+    check(False, "an exception in a handler reaches the caller of handle()")
+except Boom:
+    check(True, "an exception in a handler reaches the caller of handle()")
+lc.unsubscribe(bad_sub)
+got.clear()
+lc.publish("RX_C", b"y")
+lc.publish("BAD", b"x")
+n = drain(lc)
+check(got == [("RX_C", b"y")] and n >= 1, "after a failed handler the LCM keeps working")
+
+lc.unsubscribe(sub)
+got.clear()
+lc.publish("RX_D", b"z")
+drain(lc)
+check(got == [], "unsubscribe() stops delivery")
+lc.close()
+print("%d failure(s)" % fails)
+sys.exit(1 if fails else 0)

@@ -1,0 +1,79 @@
+# Controllers in Python, Lua and Java (clients/<language>/): their LCM layers, each
+# example end to end against lagsimd, the clean end of a run (the daemon's stop, a
+# silent daemon), and the cross-language check (the same law in every language gives the
+# same states). Every run has a channel prefix of its own (run_e2e.py).
+find_program(LAGSIM_PYTHON3 python3)
+find_program(LAGSIM_LUA52 lua5.2)
+if(NOT LAGSIM_PYTHON3)
+  message(WARNING "python3 not found: the language clients' tests are not registered")
+  return()
+endif()
+if(LAGSIM_CLIENTS_LAGSIMD)
+  set(lang_lagsimd ${LAGSIM_CLIENTS_LAGSIMD})
+else()
+  set(lang_lagsimd $<TARGET_FILE:lagsimd>)
+endif()
+set(lang_e2e ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/run_e2e.py --lagsimd ${lang_lagsimd})
+set(lang_xl ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/cross_language.py
+            --lagsimd ${lang_lagsimd})
+set(py_dir ${PROJECT_SOURCE_DIR}/clients/python)
+set(lua_dir ${PROJECT_SOURCE_DIR}/clients/lua)
+set(py_types --types ${CMAKE_BINARY_DIR}/python)
+set(lua_types --types ${CMAKE_BINARY_DIR}/lua)
+set(java_run java -cp /usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${CMAKE_BINARY_DIR}/lagsim_examples.jar)
+
+set(lang_dipc_cfg --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml
+                  --set "initial.q=[0,0.05,-0.03]" --set "initial.qd=[0,0,0]")
+set(lang_manip_cfg --config ${PROJECT_SOURCE_DIR}/config/manipulator.yaml
+                   --set "initial.q=[0,0.5]" --set "initial.qd=[0,0]")
+# The DIPC balance bounds of clients_dipc_lqr_lockstep (tests/clients.cmake explains them):
+# the same design in another language must meet them.
+set(lang_dipc_checks
+    --check "states == 2001" --check "t_first == 0 and t_last >= 20 - 1e-9"
+    --check "max_abs_theta1 >= 0.0499"
+    --check "max_abs_theta1 <= 1.1 * pred_max_abs_theta1 + 0.002"
+    --check "max_abs_theta2 <= 1.1 * pred_max_abs_theta2 + 0.002"
+    --check "abs(end_theta1) < 1e-3 and abs(end_theta2) < 1e-3"
+    --check "max_abs_theta0 < 1.0" --check "dropped == 0" --check "end == 'duration'")
+# The manipulator tracking bounds of clients_c_manipulator_lockstep (tests/clients.cmake).
+set(lang_manip_checks
+    --check "states == 1001" --check "t_first == 0 and t_last >= 10 - 1e-9"
+    --check "max_abs_e1_all <= 1.2 * 0.15 / (10 * math.e)"
+    --check "max_abs_e2_all <= 1.2 * 0.10 / (10 * math.e)"
+    --check "max_abs_e1 <= 1e-3 and max_abs_e2 <= 1e-3" --check "dropped == 0")
+
+# The lockstep gain every language applies in the cross-language check: the discrete LQR
+# of config/dipc.yaml at 100 Hz as these examples design it, printed with 17 digits.
+set(lang_K "1.6694583928302438,-396.39056793948237,448.3588751018973,6.1658933666759363,-16.300150118837529,68.37501477471632")
+
+# ---- Python
+add_test(NAME clients_python_lcm
+  COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_python_lcm.py ${py_dir})
+add_test(NAME clients_python_dipc_lockstep
+  COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLPYDIPC --timeout 60 ${lang_dipc_checks}
+    -- ${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py ${py_types} --prefix {prefix} --duration 20 -q)
+set(lang_tests clients_python_lcm clients_python_dipc_lockstep)
+
+# How a run ends: the daemon stops by itself (--duration 1: 101 states, then its stop
+# event) and the controller ends with end=stop within 3 wall s; or the daemon is killed
+# (SIGKILL: no stop event) and the controller, run with --timeout 2, ends with
+# end=silence between 2 and 2 + 3 wall s later. 3 s covers a loaded machine's scheduling.
+function(lang_end_tests lang example cfg)
+  add_test(NAME clients_${lang}_${example}_ends_on_stop
+    COMMAND ${lang_e2e} ${cfg} --mode lockstep --name CLEND${lang} --timeout 30
+      --daemon-arg=--duration --daemon-arg=1
+      --check "end == 'stop'" --check "states == 101" --check "wall < 3"
+      -- ${ARGN} --prefix {prefix} -q)
+  add_test(NAME clients_${lang}_${example}_ends_on_silence
+    COMMAND ${lang_e2e} ${cfg} --mode realtime --name CLSIL${lang} --timeout 30
+      --kill-daemon-after 1
+      --check "end == 'silence'" --check "states >= 50" --check "wall >= 2 and wall < 2 + 3"
+      -- ${ARGN} --prefix {prefix} -q --timeout 2)
+  set(lang_tests ${lang_tests} clients_${lang}_${example}_ends_on_stop
+      clients_${lang}_${example}_ends_on_silence PARENT_SCOPE)
+endfunction()
+lang_end_tests(python dipc "${lang_dipc_cfg}" ${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py ${py_types})
+lang_end_tests(python manipulator "${lang_manip_cfg}"
+               ${LAGSIM_PYTHON3} ${py_dir}/manipulator_pd.py ${py_types})
+
+set_tests_properties(${lang_tests} PROPERTIES TIMEOUT 90 LABELS clients)
