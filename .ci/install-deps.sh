@@ -5,8 +5,9 @@ set -euo pipefail
 pkgs=(build-essential cmake pkg-config clang libclang-rt-14-dev   # gcc pass; clang pass (sanitizers, libFuzzer)
       liblcm-dev liblcm-bin libglib2.0-dev libyaml-dev   # LCM (lcm.pc needs glib's dev package) and libyaml
       python3                                            # the stdlib-only Python client and some tests
+      lua5.2 liblcm-lua                                  # the Lua 5.2 clients (liblcm-lua is built for 5.2 only)
       libmujoco-dev libsundials-dev gnuplot-nox          # benchmark peers and plots
-      liblcm-java libjchart2d-java default-jdk-headless) # lcm-spy with lagsim's types
+      liblcm-java libjchart2d-java default-jdk-headless) # the Java clients; lcm-spy with lagsim's types
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -76,4 +76,26 @@ lang_end_tests(python dipc "${lang_dipc_cfg}" ${LAGSIM_PYTHON3} ${py_dir}/dipc_b
 lang_end_tests(python manipulator "${lang_manip_cfg}"
                ${LAGSIM_PYTHON3} ${py_dir}/manipulator_pd.py ${py_types})
 
+# ---- Lua 5.2
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
+  add_test(NAME clients_lua_lcm
+    COMMAND ${LAGSIM_LUA52} ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_lua_lcm.lua ${lua_dir})
+  add_test(NAME clients_lua_manipulator_lockstep
+    COMMAND ${lang_e2e} ${lang_manip_cfg} --mode lockstep --name CLLUAMAN --timeout 60
+      ${lang_manip_checks} --check "end == 'duration'"
+      -- ${LAGSIM_LUA52} ${lua_dir}/manipulator_pd.lua ${lua_types} --prefix {prefix} --duration 10 -q)
+  list(APPEND lang_tests clients_lua_lcm clients_lua_manipulator_lockstep)
+  lang_end_tests(lua manipulator "${lang_manip_cfg}" ${LAGSIM_LUA52} ${lua_dir}/manipulator_pd.lua ${lua_types})
+  lang_end_tests(lua dipc "${lang_dipc_cfg}" ${LAGSIM_LUA52} ${lua_dir}/dipc_balance.lua ${lua_types})
+  # Python and Lua write the manipulator's computed torque with the same operations in the
+  # same order over the same libm: bit for bit.
+  add_test(NAME clients_cross_language_manipulator
+    COMMAND ${lang_xl} ${lang_manip_cfg} --states 1001
+      --run python 0 "${LAGSIM_PYTHON3} ${py_dir}/manipulator_pd.py --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --duration 10 -q --trace {trace}"
+      --run lua 0 "${LAGSIM_LUA52} ${lua_dir}/manipulator_pd.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} --duration 10 -q --trace {trace}")
+  list(APPEND lang_tests clients_cross_language_manipulator)
+else()
+  message(WARNING "lua5.2 or liblcm-lua missing: the Lua clients' tests are not registered")
+endif()
+
 set_tests_properties(${lang_tests} PROPERTIES TIMEOUT 90 LABELS clients)

@@ -1,0 +1,235 @@
+--[[
+lagsim_controller: what every Lua example controller shares (Lua 5.2): options, connect,
+wait for the scene, answer states until the run ends, a summary line.
+
+    local Controller = require('lagsim_controller')
+    local ctl = Controller.new('manipulator_pd.lua', 'MANIPULATOR', 'manipulator')
+    ctl:option('wn', 10, 'PD bandwidth, rad/s')       -- the example's own options
+    ctl:start(arg)                                    -- parses, connects, waits for the scene
+    for st in ctl:states() do                          -- each newest state once
+      ctl:command(st.sim_time, {'q1', 'q2'}, {tau1, tau2})
+    end
+    ctl:finish('states=' .. n)                        -- "<name>: summary end=... states=..."
+
+A run ends when the daemon publishes its `stop` event, when nothing came from the daemon
+(no state, status or event) for --timeout s of waiting, or after --duration s of sim
+time from the first state; ctl.end_reason says which (stop, silence, duration). Exit
+status: 0 for these; 1 when no scene came within --timeout or it is another model's;
+2 bad usage. Common options: --prefix, --url, --duration, --timeout, --types DIR (where
+the lcm-gen Lua package `lagsim` is), --trace FILE (one line per answered state: sim time,
+positions, velocities, efforts sent, each as %.17g), -q, --help.
+]]
+local lagsim_lcm = require('lagsim_lcm')
+
+local Controller = {}
+Controller.__index = Controller
+
+local WAIT_MS = 50
+
+function Controller.new(name, default_prefix, model, description)
+  local self = setmetatable({ name = name, model = model, description = description or '',
+                              opts = {}, order = {}, o = {}, dropped = 0 }, Controller)
+  self:option('prefix', default_prefix, 'channel prefix', 'string')
+  self:option('url', '', "LCM URL (default: LCM's default)", 'string')
+  self:option('duration', 0, 'stop after S s of sim time from the first state (0: until the daemon stops)')
+  self:option('timeout', 5, 'wall s without a scene, or without any message once running, before ending')
+  self:option('types', '', 'directory holding the lcm-gen Lua package lagsim', 'string')
+  self:option('trace', '', 'write each answered state and the efforts sent to this file', 'string')
+  return self
+end
+
+-- kind: 'number' (default), 'string' or 'list' (comma-separated numbers)
+function Controller:option(key, default, help, kind)
+  self.opts[key] = { default = default, help = help, kind = kind or 'number' }
+  table.insert(self.order, key)
+  self.o[key] = default
+end
+
+function Controller:usage(f)
+  f:write(string.format('usage: lua5.2 %s [options]\n%s\n', self.name, self.description))
+  for _, k in ipairs(self.order) do
+    local op = self.opts[k]
+    f:write(string.format('  --%-10s %s (default %s)\n', k, op.help, tostring(op.default)))
+  end
+  f:write('  -q           quiet: summary only\n  --help       this text\n')
+end
+
+local function fail(self, code, msg)
+  io.stderr:write(self.name .. ': ' .. msg .. '\n')
+  os.exit(code)
+end
+
+function Controller:parse(argv)
+  local i = 1
+  while i <= #argv do
+    local a = argv[i]
+    if a == '--help' or a == '-h' then
+      self:usage(io.stdout)
+      os.exit(0)
+    elseif a == '-q' then
+      self.o.quiet = true
+    else
+      local key = a:match('^%-%-(.+)$')
+      local op = key and self.opts[key]
+      local v = argv[i + 1]
+      if not op or v == nil then
+        self:usage(io.stderr)
+        fail(self, 2, "unknown or incomplete option '" .. a .. "'")
+      end
+      if op.kind == 'number' then
+        local x = tonumber(v)
+        if not x or x ~= x or x == math.huge or x == -math.huge then
+          fail(self, 2, '--' .. key .. ' wants a number, not ' .. v)
+        end
+        self.o[key] = x
+      elseif op.kind == 'list' then
+        local t = {}
+        for s in (v .. ','):gmatch('([^,]*),') do
+          local x = tonumber(s)
+          if not x or x ~= x or x == math.huge or x == -math.huge then
+            fail(self, 2, '--' .. key .. ' wants comma-separated numbers, not ' .. v)
+          end
+          t[#t + 1] = x
+        end
+        self.o[key] = t
+      else
+        self.o[key] = v
+      end
+      i = i + 1
+    end
+    i = i + 1
+  end
+  if not (self.o.timeout > 0) or not (self.o.duration >= 0) then
+    fail(self, 2, '--timeout must be > 0 and --duration >= 0')
+  end
+  return self.o
+end
+
+function Controller:start(argv)
+  local o = self:parse(argv or {})
+  if o.types ~= '' then
+    package.path = o.types .. '/?.lua;' .. o.types .. '/?/init.lua;' .. package.path
+  end
+  local ok, t = pcall(require, 'lagsim')
+  if not ok then
+    fail(self, 2, "cannot load the lcm-gen Lua types 'lagsim': pass --types <build>/lua or set LUA_PATH")
+  end
+  self.t = t
+  if o.trace ~= '' then
+    self.trace = io.open(o.trace, 'w')
+    if not self.trace then fail(self, 2, 'cannot write ' .. o.trace) end
+  end
+  self.lc = lagsim_lcm.new(o.url ~= '' and o.url or nil)
+  local ch = o.prefix .. '_'
+  self.silent_ms = 0
+  self.lc:subscribe(ch .. 'SCENE', function(_, data)
+    self.silent_ms = 0
+    local okd, sc = pcall(t.scene_t.decode, data)
+    if okd then self.scene = sc else self.dropped = self.dropped + 1 end
+  end)
+  self.lc:subscribe(ch .. 'STATE', function(_, data)
+    self.silent_ms = 0
+    local okd, st = pcall(t.joint_state_t.decode, data)
+    if okd then self.state = st else self.dropped = self.dropped + 1 end
+  end)
+  self.lc:subscribe(ch .. 'STATUS', function() self.silent_ms = 0 end)
+  self.lc:subscribe(ch .. 'EVENT', function(_, data)
+    self.silent_ms = 0
+    local okd, ev = pcall(t.event_t.decode, data)
+    if not okd then
+      self.dropped = self.dropped + 1
+    elseif ev.kind == 'stop' then
+      self.stopped = true
+    end
+  end)
+  -- subscribed: from here on no state is missed (test harnesses wait for this line)
+  print(string.format('%s: waiting for the scene description on %sSCENE', self.name, ch))
+  io.stdout:flush()
+  local waited, next_ask = 0, 0
+  while not self.scene do
+    if waited >= o.timeout * 1000 then
+      fail(self, 1, string.format('no scene on %sSCENE within %g s (is lagsimd running with this prefix?)',
+                                  ch, o.timeout))
+    end
+    if waited >= next_ask then -- DESCRIBE every 0.25 s until the scene comes
+      local req = t.control_t:new()
+      req.request = t.control_t.DESCRIBE
+      self.lc:publish(ch .. 'CONTROL', req:encode())
+      next_ask = next_ask + 250
+    end
+    if not self.lc:handle_timeout(WAIT_MS) then waited = waited + WAIT_MS end
+  end
+  if self.scene.model ~= self.model then
+    fail(self, 1, string.format('prefix %s runs model %s, not %s', o.prefix, self.scene.model, self.model))
+  end
+  self.params = {}
+  for k = 1, self.scene.num_params do
+    self.params[self.scene.param_name[k]] = self.scene.param_value[k]
+  end
+  return o
+end
+
+-- Iterator over states: each newest state once, until the run ends.
+function Controller:states()
+  local o = self.o
+  local t_first
+  return function()
+    if self.end_reason then return nil end
+    while not self.state do
+      if self.stopped then self.end_reason = 'stop' return nil end
+      if self.silent_ms >= o.timeout * 1000 then self.end_reason = 'silence' return nil end
+      if not self.lc:handle_timeout(WAIT_MS) then self.silent_ms = self.silent_ms + WAIT_MS end
+    end
+    while self.lc:handle_timeout(0) do end -- drain what is queued: answer the newest
+    local st = self.state
+    self.state = nil
+    self.current = st
+    t_first = t_first or st.sim_time
+    if o.duration > 0 and st.sim_time - t_first >= o.duration - 0.5 * self.scene.control_period then
+      self.end_reason = 'duration' -- this state is still answered; the next call ends
+    end
+    return st
+  end
+end
+
+function Controller:command(sim_time, names, efforts)
+  local cmd = self.t.joint_command_t:new()
+  cmd.utime = os.time() * 1000000 -- informational; Lua's clock has whole seconds
+  cmd.sim_time = sim_time
+  cmd.num_joints = #names
+  cmd.name = names
+  cmd.effort = {}
+  for k = 1, #efforts do
+    local u = efforts[k]
+    if u ~= u or u == math.huge or u == -math.huge then u = 0.0 end -- never send NaN
+    cmd.effort[k] = u
+  end
+  self.lc:publish(self.o.prefix .. '_COMMAND', cmd:encode())
+  local st = self.current
+  if self.trace and st and st.sim_time == sim_time then
+    -- sim_time, positions, velocities, efforts sent: %.17g reads back to the same double
+    local f = { string.format('%.17g', st.sim_time) }
+    for k = 1, st.num_joints do f[#f + 1] = string.format('%.17g', st.position[k]) end
+    for k = 1, st.num_joints do f[#f + 1] = string.format('%.17g', st.velocity[k]) end
+    for k = 1, #cmd.effort do f[#f + 1] = string.format('%.17g', cmd.effort[k]) end
+    self.trace:write(table.concat(f, ' '), '\n')
+  end
+end
+
+function Controller:finish(summary)
+  if self.trace then self.trace:close() end
+  print(string.format('%s: summary end=%s %s dropped=%d', self.name, tostring(self.end_reason),
+                      summary, self.dropped))
+  io.stdout:flush()
+  return 0
+end
+
+-- Index (1-based) of joint `name` in a state, or nil.
+function Controller.joint(st, name)
+  for k = 1, st.num_joints do
+    if st.name[k] == name then return k end
+  end
+  return nil
+end
+
+return Controller
