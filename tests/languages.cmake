@@ -98,4 +98,27 @@ else()
   message(WARNING "lua5.2 or liblcm-lua missing: the Lua clients' tests are not registered")
 endif()
 
+# ---- Java
+if(TARGET lagsim_examples_java)
+  add_test(NAME clients_java_dipc_lockstep
+    COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLJDIPC --timeout 60 ${lang_dipc_checks}
+      -- ${java_run} lagsim.examples.DipcBalance --prefix {prefix} --duration 20 -q)
+  list(APPEND lang_tests clients_java_dipc_lockstep)
+  lang_end_tests(java dipc "${lang_dipc_cfg}" ${java_run} lagsim.examples.DipcBalance)
+else()
+  message(WARNING "javac or liblcm-java missing: the Java clients' tests are not registered")
+endif()
+
+# ---- Cross-language: the DIPC balanced in lockstep for 10 s by u = -K x with the same K,
+# the product summed in the same order (0 - k0 x0 - ... - k5 x5) in every language, IEEE
+# doubles everywhere: the states must agree bit for bit.
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
+  add_test(NAME clients_cross_language_dipc
+    COMMAND ${lang_xl} ${lang_dipc_cfg} --states 1001
+      --run python 0 "${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}"
+      --run lua 0 "${LAGSIM_LUA52} ${lua_dir}/dipc_balance.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}"
+      --run java 0 "java -cp /usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${CMAKE_BINARY_DIR}/lagsim_examples.jar lagsim.examples.DipcBalance --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}")
+  list(APPEND lang_tests clients_cross_language_dipc)
+endif()
+
 set_tests_properties(${lang_tests} PROPERTIES TIMEOUT 90 LABELS clients)

@@ -1,0 +1,256 @@
+package lagsim.examples;
+
+import java.io.FileWriter;
+import java.io.IOException;
+import java.io.PrintWriter;
+import java.util.ArrayList;
+import java.util.HashMap;
+import java.util.LinkedHashMap;
+import java.util.List;
+import java.util.Map;
+
+import lagsim.control_t;
+import lagsim.event_t;
+import lagsim.joint_command_t;
+import lagsim.joint_state_t;
+import lagsim.scene_t;
+import lcm.lcm.LCM;
+import lcm.lcm.LCMDataInputStream;
+import lcm.lcm.LCMSubscriber;
+
+/**
+ * What a Java example controller needs: options, connect, wait for the scene, answer
+ * states until the run ends, a summary line.
+ *
+ * <pre>
+ *   Controller ctl = new Controller("DipcBalance", "DIPC", "dipc");
+ *   ctl.option("r", "1", "input weight");             // the example's own options
+ *   ctl.start(args);                                  // parses, connects, waits for the scene
+ *   joint_state_t st;
+ *   while ((st = ctl.nextState()) != null)            // each newest state once
+ *       ctl.command(st.sim_time, new String[] {"theta0"}, new double[] {u});
+ *   ctl.finish("states=" + n);                        // "DipcBalance: summary end=... states=..."
+ * </pre>
+ *
+ * LCM's Java library delivers messages on its own receive thread; the handlers here only
+ * keep the newest state and note the daemon's stop, and the caller's thread does the
+ * work. A run ends when the daemon publishes its stop event, when nothing came from the
+ * daemon (state, status or event) for --timeout wall seconds, or after --duration s of
+ * sim time from the first state; endReason says which (stop, silence, duration). Exit
+ * status: 0 for these; 1 when no scene came within --timeout or it is another model's;
+ * 2 bad usage.
+ */
+public final class Controller {
+    public final String name, model;
+    private final Map<String, String[]> opts = new LinkedHashMap<>(); // key -> {value, help}
+    public final Map<String, Double> params = new HashMap<>();
+    public boolean quiet;
+    public scene_t scene;
+    public String endReason;
+    public long dropped;
+
+    private LCM lcm;
+    private String prefix;
+    private double duration, timeout;
+    private PrintWriter trace;
+    private final Object lock = new Object();
+    private joint_state_t latest, current;
+    private boolean stopped;
+    private long heardNanos;
+    private double tFirst = Double.NaN;
+
+    public Controller(String name, String defaultPrefix, String model) {
+        this.name = name;
+        this.model = model;
+        option("prefix", defaultPrefix, "channel prefix");
+        option("url", "", "LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)");
+        option("duration", "0", "stop after S s of sim time from the first state (0: until the daemon stops)");
+        option("timeout", "5", "wall s without a scene, or without any message once running, before ending");
+        option("trace", "", "write each answered state and the efforts sent to this file");
+    }
+
+    public void option(String key, String def, String help) {
+        opts.put(key, new String[] {def, help});
+    }
+
+    public String get(String key) { return opts.get(key)[0]; }
+
+    /** A finite number, or exit 2 with a message. */
+    public double number(String key) {
+        try {
+            double v = Double.parseDouble(get(key));
+            if (Double.isFinite(v)) return v;
+        } catch (NumberFormatException e) { /* below */ }
+        return usageError("--" + key + " wants a number, not " + get(key));
+    }
+
+    /** n comma-separated finite numbers, or exit 2. */
+    public double[] list(String key, int n) {
+        String[] f = get(key).split(",", -1);
+        double[] v = new double[f.length];
+        try {
+            for (int i = 0; i < f.length; i++) {
+                v[i] = Double.parseDouble(f[i]);
+                if (!Double.isFinite(v[i])) throw new NumberFormatException();
+            }
+        } catch (NumberFormatException e) {
+            f = new String[0];
+        }
+        if (f.length != n) usageError("--" + key + " wants " + n + " comma-separated numbers");
+        return v;
+    }
+
+    public double usageError(String msg) {
+        System.err.println(name + ": " + msg);
+        System.exit(2);
+        return 0;
+    }
+
+    private void usage() {
+        System.out.println("usage: " + name + " [options]");
+        for (Map.Entry<String, String[]> e : opts.entrySet())
+            System.out.printf("  --%-10s %s (default %s)%n", e.getKey(), e.getValue()[1],
+                              e.getValue()[0].isEmpty() ? "none" : e.getValue()[0]);
+        System.out.println("  -q           quiet: summary only");
+    }
+
+    private void fail(String msg) {
+        System.err.println(name + ": " + msg);
+        System.exit(1);
+    }
+
+    /** Parses args, connects, subscribes, waits for the scene description. */
+    public void start(String[] args) throws IOException, InterruptedException {
+        for (int i = 0; i < args.length; i++) {
+            String a = args[i];
+            if (a.equals("--help") || a.equals("-h")) {
+                usage();
+                System.exit(0);
+            } else if (a.equals("-q")) {
+                quiet = true;
+            } else if (a.startsWith("--") && opts.containsKey(a.substring(2)) && i + 1 < args.length) {
+                opts.get(a.substring(2))[0] = args[++i];
+            } else {
+                usage();
+                usageError("unknown or incomplete option '" + a + "'");
+            }
+        }
+        prefix = get("prefix");
+        duration = number("duration");
+        timeout = number("timeout");
+        if (!(timeout > 0) || !(duration >= 0)) usageError("--timeout must be > 0 and --duration >= 0");
+        if (!get("trace").isEmpty()) trace = new PrintWriter(new FileWriter(get("trace")));
+
+        lcm = get("url").isEmpty() ? new LCM() : new LCM(get("url"));
+        heardNanos = System.nanoTime();
+        // one subscriber for the daemon's channels; runs on LCM's receive thread
+        LCMSubscriber sub = new LCMSubscriber() {
+            @Override
+            public void messageReceived(LCM l, String channel, LCMDataInputStream ins) {
+                synchronized (lock) {
+                    heardNanos = System.nanoTime();
+                    try {
+                        if (channel.endsWith("_STATE")) {
+                            latest = new joint_state_t(ins);
+                        } else if (channel.endsWith("_SCENE")) {
+                            scene = new scene_t(ins);
+                        } else if (channel.endsWith("_EVENT")) {
+                            if (new event_t(ins).kind.equals("stop")) stopped = true;
+                        }
+                    } catch (IOException | RuntimeException e) { // not one of ours, or cut short
+                        dropped++;
+                    }
+                    lock.notifyAll();
+                }
+            }
+        };
+        String ch = prefix + "_";
+        lcm.subscribe(java.util.regex.Pattern.quote(ch) + "(STATE|SCENE|EVENT|STATUS)", sub);
+        // subscribed: from here on no state is missed (test harnesses wait for this line)
+        System.out.println(name + ": waiting for the scene description on " + ch + "SCENE");
+        System.out.flush();
+        long deadline = System.nanoTime() + (long) (timeout * 1e9);
+        long nextAsk = System.nanoTime();
+        synchronized (lock) {
+            while (scene == null) {
+                long now = System.nanoTime();
+                if (now >= deadline)
+                    fail(String.format("no scene on %sSCENE within %g s (is lagsimd running with this prefix?)",
+                                       ch, timeout));
+                if (now >= nextAsk) { // DESCRIBE every 0.25 s until the scene comes
+                    control_t req = new control_t();
+                    req.utime = System.currentTimeMillis() * 1000;
+                    req.request = control_t.DESCRIBE;
+                    req.q = new double[0];
+                    req.qd = new double[0];
+                    lcm.publish(ch + "CONTROL", req);
+                    nextAsk = now + 250_000_000L;
+                }
+                lock.wait(50);
+            }
+        }
+        if (!scene.model.equals(model)) fail("prefix " + prefix + " runs model " + scene.model + ", not " + model);
+        for (int k = 0; k < scene.num_params; k++) params.put(scene.param_name[k], scene.param_value[k]);
+    }
+
+    /** The newest state not yet returned, or null when the run has ended (see endReason). */
+    public joint_state_t nextState() throws InterruptedException {
+        synchronized (lock) {
+            if (endReason != null) return null;
+            while (latest == null) {
+                if (stopped) { endReason = "stop"; return null; }
+                if (System.nanoTime() - heardNanos > (long) (timeout * 1e9)) {
+                    endReason = "silence";
+                    return null;
+                }
+                lock.wait(50);
+            }
+            joint_state_t st = latest;
+            latest = null;
+            current = st;
+            if (Double.isNaN(tFirst)) tFirst = st.sim_time;
+            if (duration > 0 && st.sim_time - tFirst >= duration - 0.5 * scene.control_period)
+                endReason = "duration"; // this state is still answered; the next call ends
+            return st;
+        }
+    }
+
+    /** Publishes efforts for the named joints, answering the state at simTime. */
+    public void command(double simTime, String[] names, double[] efforts) {
+        joint_command_t cmd = new joint_command_t();
+        cmd.utime = System.currentTimeMillis() * 1000;
+        cmd.sim_time = simTime;
+        cmd.num_joints = (short) names.length;
+        cmd.name = names.clone();
+        cmd.effort = new double[efforts.length];
+        for (int k = 0; k < efforts.length; k++) // never send NaN
+            cmd.effort[k] = Double.isFinite(efforts[k]) ? efforts[k] : 0.0;
+        lcm.publish(prefix + "_COMMAND", cmd);
+        joint_state_t st = current;
+        if (trace != null && st != null && st.sim_time == simTime) {
+            // sim_time, positions, velocities, efforts sent: Double.toString reads back exactly
+            List<String> f = new ArrayList<>();
+            f.add(Double.toString(st.sim_time));
+            for (double v : st.position) f.add(Double.toString(v));
+            for (double v : st.velocity) f.add(Double.toString(v));
+            for (double v : cmd.effort) f.add(Double.toString(v));
+            trace.println(String.join(" ", f));
+        }
+    }
+
+    /** Index of joint `joint` in a state, or -1. */
+    public static int joint(joint_state_t st, String joint) {
+        for (int k = 0; k < st.num_joints; k++)
+            if (st.name[k].equals(joint)) return k;
+        return -1;
+    }
+
+    /** Prints the summary line; returns the exit status (0). The LCM stays open until the
+     *  process exits (closing it makes its receive thread print a socket exception). */
+    public int finish(String summary) {
+        System.out.println(name + ": summary end=" + endReason + " " + summary + " dropped=" + dropped);
+        System.out.flush();
+        if (trace != null) trace.close();
+        return 0;
+    }
+}
