@@ -103,7 +103,8 @@ static lag_log *log_new(FILE *f, bool own, const char *name, size_t max_data, ch
 {
     if (err && errlen) err[0] = '\0';
     struct stat sb;
-    if (fstat(fileno(f), &sb) != 0) {
+    memset(&sb, 0, sizeof sb); /* a stream without a descriptor (fmemopen): not regular */
+    if (fileno(f) >= 0 && fstat(fileno(f), &sb) != 0) {
         if (err) snprintf(err, errlen, "%s: %s", name, strerror(errno));
         return NULL;
     }
@@ -192,6 +193,16 @@ static int at_end(lag_log *lg, int64_t cut)
     return LAG_LOG_END;
 }
 
+/* More than LAG_LOG_SCAN_MAX bytes passed over since the last record (which ended
+ * `searched` bytes ago): the log is hopeless. */
+static int too_far(lag_log *lg, int64_t searched)
+{
+    set_err(lg, "%s: no LCM log record in the %d bytes after byte %lld: not an LCM log, or "
+                "damaged beyond repair",
+            lg->name, LAG_LOG_SCAN_MAX, (long long)(lg->pos - searched));
+    return LAG_LOG_ERROR;
+}
+
 int lag_log_next(lag_log *lg, lag_log_record *rec)
 {
     memset(rec, 0, sizeof *rec);
@@ -221,12 +232,8 @@ int lag_log_next(lag_log *lg, lag_log_record *rec)
             w = (w << 8) | (uint32_t)c;
             have++;
             if (have >= 4 && w == SYNC) break;
-            if (searched + have - 4 > LAG_LOG_SCAN_MAX) {
-                set_err(lg, "%s: no LCM log record in the %d bytes after byte %lld: not an "
-                            "LCM log, or damaged beyond repair",
-                        lg->name, LAG_LOG_SCAN_MAX, (long long)(lg->pos - searched - have));
-                return LAG_LOG_ERROR;
-            }
+            /* all but the last 3 bytes read cannot start a sync word any more */
+            if (searched + have - 3 > LAG_LOG_SCAN_MAX) return too_far(lg, searched + have);
         }
         searched += have - 4;
         if (have > 4) damaged = true;
@@ -264,6 +271,7 @@ int lag_log_next(lag_log *lg, lag_log_record *rec)
             src_unread(lg, h, nread);
             searched += 4;
             damaged = true;
+            if (searched > LAG_LOG_SCAN_MAX) return too_far(lg, searched);
             continue;
         }
 

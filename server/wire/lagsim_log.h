@@ -18,6 +18,8 @@
  *     then, nothing after); a larger record is passed over and returned with data NULL;
  *   - ends cleanly on a last record cut short (a logger stopped while writing), counting
  *     its bytes in lag_log_stats.truncated_bytes.
+ * On a stream that is not a regular file (a pipe), a record cannot be checked against the
+ * file's size: a damaged but plausible data length is read as a last record cut short.
  */
 #ifndef LAGSIM_LOG_H
 #define LAGSIM_LOG_H
