@@ -1,4 +1,4 @@
-# Scene loader, lagsimd's command line and offline runs (issue 2).
+# Scene loader, lagsimd's command line and offline runs.
 # Shell scripts in tests/scene/ drive the lagsimd binary; bad-scene fixtures in
 # tests/scene/bad/ carry their own expectations ("# expect-at: L:C", "# expect: ...").
 find_program(LAGSIM_BASH bash REQUIRED)
@@ -22,7 +22,9 @@ add_test(NAME scene_offline_csv
 add_test(NAME scene_determinism
          COMMAND ${LAGSIM_BASH} ${scene_dir}/determinism.sh $<TARGET_FILE:lagsimd>
                  ${scene_cfg}/dipc.yaml)
+add_test(NAME scene_limits
+         COMMAND ${LAGSIM_BASH} ${scene_dir}/limits.sh $<TARGET_FILE:lagsimd> ${scene_dir}/expect_error.sh)
 add_test(NAME scene_cli
          COMMAND ${LAGSIM_BASH} ${scene_dir}/cli.sh $<TARGET_FILE:lagsimd> ${scene_cfg}/dipc.yaml)
-set_tests_properties(scene_set_overrides scene_offline_csv scene_determinism scene_cli
+set_tests_properties(scene_set_overrides scene_offline_csv scene_determinism scene_cli scene_limits
                      PROPERTIES TIMEOUT 60 LABELS scene)

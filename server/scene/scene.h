@@ -1,7 +1,8 @@
 /*
  * A scene: everything a YAML scene file says. The core part (lag_sim_def) plus the
- * daemon's settings (output rate, real-time pacing, LCM). Pure C: scene_yaml.c fills it
- * with libyaml; nothing else here depends on libyaml.
+ * daemon's settings (output rate, real-time pacing, LCM). Pure C: scene_load.c reads it
+ * with libyaml (scene_yaml.c: the YAML tree; scene_schema.c: the keys, their ranges and
+ * relations); nothing in this header depends on libyaml.
  */
 #ifndef LAGSIM_SCENE_H
 #define LAGSIM_SCENE_H
@@ -41,6 +42,16 @@ typedef struct lag_scene {
     } lcm;
 } lag_scene;
 
+/* What a scene may be, at most. A scene file is a few hundred bytes and about a hundred
+ * nodes; these limits are far above that and keep a hostile file's cost small: it is
+ * refused after at most LAG_SCENE_MAX_BYTES read and LAG_SCENE_MAX_NODES nodes built,
+ * with an error that names the limit. */
+#define LAG_SCENE_MAX_BYTES (1024 * 1024) /* file (or one --set value), bytes */
+#define LAG_SCENE_MAX_NODES 10000         /* scalars, mappings and sequences in one source */
+#define LAG_SCENE_MAX_ITEMS 1000          /* keys of one mapping, items of one sequence */
+#define LAG_SCENE_MAX_DEPTH 32            /* nesting of mappings and sequences */
+#define LAG_SCENE_MAX_SCALAR 4096         /* bytes of one scalar (key or value) */
+
 /* Default realtime.effort_limit, N or N m: far above what any controller of these models
  * commands, far below where the arithmetic of a step stops being finite. */
 #define LAG_SCENE_EFFORT_LIMIT 1e6
@@ -53,6 +64,12 @@ void lag_scene_default(lag_scene *sc, lag_model_kind kind);
  * "file:line:column: what was expected" (or "--set key: ...") into err. OUT: sc */
 int lag_scene_load(const char *path, const char *const *sets, int nsets, lag_scene *sc,
                    char *err, size_t errlen);
+
+/* The same for a scene already in memory: `name` stands for the file in messages, `text`
+ * holds `len` bytes (not NUL-terminated; at most LAG_SCENE_MAX_BYTES). OUT: sc */
+int lag_scene_load_buffer(const char *name, const char *text, size_t len,
+                          const char *const *sets, int nsets, lag_scene *sc, char *err,
+                          size_t errlen);
 
 const char *lag_rt_mode_name(lag_rt_mode m);
 

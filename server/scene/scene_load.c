@@ -1,0 +1,178 @@
+/*
+ * lag_scene_load: read the scene file (at most LAG_SCENE_MAX_BYTES), parse it and each
+ * --set into YAML trees (scene_yaml.c), graft the --sets onto the file's tree in order,
+ * and read the result through the schema (scene_schema.c), once.
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "scene.h"
+#include "scene_schema.h"
+#include "scene_yaml.h"
+
+/* Reads at most LAG_SCENE_MAX_BYTES of `path` into a new buffer (plain files, pipes and
+ * character devices alike: the bound is on what is read, not on what stat says). */
+static int read_scene_file(const char *path, char **out, size_t *outlen, errbuf *e)
+{
+    *out = NULL;
+    *outlen = 0;
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return yfail(e, NULL, NULL, "%s: cannot open scene file: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) == 0 && S_ISDIR(st.st_mode)) {
+        close(fd);
+        return yfail(e, NULL, NULL, "%s: is a directory, not a scene file", path);
+    }
+    size_t cap = 4096, len = 0;
+    char *buf = malloc(cap);
+    for (;;) {
+        if (!buf) {
+            close(fd);
+            return yfail(e, NULL, NULL, "%s: out of memory", path);
+        }
+        if (len == cap) {
+            if (cap > LAG_SCENE_MAX_BYTES) {
+                free(buf);
+                close(fd);
+                return yfail(e, NULL, NULL, "%s: larger than %d bytes, the limit for a scene "
+                             "file", path, LAG_SCENE_MAX_BYTES);
+            }
+            size_t ncap = cap * 2 > (size_t)LAG_SCENE_MAX_BYTES + 1
+                              ? (size_t)LAG_SCENE_MAX_BYTES + 1 : cap * 2;
+            char *bigger = realloc(buf, ncap);
+            if (!bigger) free(buf);
+            buf = bigger;
+            cap = ncap;
+            continue;
+        }
+        ssize_t n = read(fd, buf + len, cap - len);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0) {
+            int en = errno;
+            free(buf);
+            close(fd);
+            return yfail(e, NULL, NULL, "%s: cannot read scene file: %s", path, strerror(en));
+        }
+        if (n == 0)
+            break;
+        len += (size_t)n;
+    }
+    close(fd);
+    *out = buf;
+    *outlen = len;
+    return 0;
+}
+
+int lag_scene_load_buffer(const char *name, const char *text, size_t len,
+                          const char *const *sets, int nsets, lag_scene *sc, char *err,
+                          size_t errlen)
+{
+    char dummy[8];
+    errbuf e = {.buf = err ? err : dummy, .len = err ? errlen : sizeof dummy};
+    if (e.len)
+        e.buf[0] = '\0';
+    if (!name || (!text && len) || !sc || nsets < 0 || (nsets > 0 && !sets)) {
+        snprintf(e.buf, e.len, "lag_scene_load: invalid arguments");
+        return -1;
+    }
+    memset(sc, 0, sizeof *sc);
+
+    /* Sources live until the tree is freed: the file, then one per --set. */
+    ysrc *srcs = calloc((size_t)nsets + 1, sizeof *srcs);
+    char **names = calloc((size_t)nsets + 1, sizeof *names);
+    ynode *root = NULL;
+    int rc = -1;
+    if (!srcs || !names) {
+        snprintf(e.buf, e.len, "%s: out of memory", name);
+        goto done;
+    }
+    srcs[0].name = name;
+    srcs[0].is_set = false;
+    if (ytree_parse(text ? text : "", len, &srcs[0], &e, &root) < 0)
+        goto done;
+
+    for (int i = 0; i < nsets; i++) {
+        const char *s = sets[i];
+        const char *eq = s ? strchr(s, '=') : NULL;
+        if (!eq) {
+            snprintf(e.buf, e.len, "--set %.200s: expected key.path=value", s ? s : "(null)");
+            goto done;
+        }
+        size_t klen = (size_t)(eq - s);
+        if (klen == 0) {
+            snprintf(e.buf, e.len, "--set %.200s: expected key.path=value, the key is empty", s);
+            goto done;
+        }
+        if (klen > 255) {
+            snprintf(e.buf, e.len, "--set %.40s...: a key path of %zu characters: at most 255",
+                     s, klen);
+            goto done;
+        }
+        names[i + 1] = malloc(klen + 1);
+        if (!names[i + 1]) {
+            snprintf(e.buf, e.len, "--set: out of memory");
+            goto done;
+        }
+        memcpy(names[i + 1], s, klen);
+        names[i + 1][klen] = '\0';
+        srcs[i + 1].name = names[i + 1];
+        srcs[i + 1].is_set = true;
+        ynode *val;
+        if (ytree_parse(eq + 1, strlen(eq + 1), &srcs[i + 1], &e, &val) < 0)
+            goto done;
+        /* a root that is not a mapping (e.g. an empty file) is reported by the schema */
+        if (root->kind != YN_MAP && ynode_is_null(root)) {
+            ynode *m = calloc(1, sizeof *m);
+            if (!m) {
+                ynode_free(val);
+                snprintf(e.buf, e.len, "--set: out of memory");
+                goto done;
+            }
+            m->kind = YN_MAP;
+            m->line = m->col = 1;
+            m->src = &srcs[0];
+            ynode_free(root);
+            root = m;
+        }
+        if (ytree_graft(root, &srcs[i + 1], val, &e) < 0)
+            goto done;
+    }
+
+    rc = scene_schema_convert(root, name, sc, &e) < 0 ? -1 : 0;
+done:
+    ynode_free(root);
+    if (names)
+        for (int i = 0; i <= nsets; i++)
+            free(names[i]);
+    free(names);
+    free(srcs);
+    return rc;
+}
+
+int lag_scene_load(const char *path, const char *const *sets, int nsets, lag_scene *sc,
+                   char *err, size_t errlen)
+{
+    char dummy[8];
+    errbuf e = {.buf = err ? err : dummy, .len = err ? errlen : sizeof dummy};
+    if (e.len)
+        e.buf[0] = '\0';
+    if (!path || !sc) {
+        snprintf(e.buf, e.len, "lag_scene_load: invalid arguments");
+        return -1;
+    }
+    memset(sc, 0, sizeof *sc);
+    char *text;
+    size_t len;
+    if (read_scene_file(path, &text, &len, &e) < 0)
+        return -1;
+    int rc = lag_scene_load_buffer(path, text, len, sets, nsets, sc, err, errlen);
+    free(text);
+    return rc;
+}

@@ -1,0 +1,1254 @@
+/*
+ * The scene schema: the merged YAML tree -> lag_scene, checked once.
+ *
+ * Every key is a row of a small table (k_top_keys, k_integrator_keys, ...) whose handler
+ * reads its node; adding a key is one row and one handler. Every number has a range,
+ * written next to its key as a `range` (with its unit and the reason for its bounds), and
+ * relations between keys (1/publish_hz a multiple of dt, a stop inside explode_limit, a
+ * force lasting at least one tick...) are checked where the second value is read. Errors
+ * name the node: "file:line:column: key.path: what was expected" for the file, "--set
+ * key: ..." for an override. Nothing is guessed: unknown keys, wrong types, missing
+ * values, numbers written any other way than plain decimals, and values out of range
+ * are errors.
+ *
+ * Order: `model` first (parameters, joint names and the length of q depend on it), then
+ * the keys other values are measured against (integrator, publish_hz, explode_limit),
+ * then every other key in file order. Models, their parameters and their joints come from
+ * the core's lag_model_info; integrators from lag_method_name.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene_schema.h"
+
+/* ================================================================ ranges */
+
+/* The longest sim time a scene may refer to (a disturbance's t and duration, the
+ * watchdog's command_timeout, lagsimd --duration): about 31.7 years. With dt >= 1e-6 s
+ * every such time is at most 1e15 ticks, an exact integer in a double and far from
+ * int64's limit, so no conversion to ticks can overflow. */
+#define T_MAX 1e9
+/* The largest force-like value (N or N m, N s or N m s, N s/m): far beyond any load
+ * these models are meant for (a 1e6 kg mass under 1e3 m/s^2 weighs 1e9 N) and small
+ * enough that accelerations and energies computed from it stay finite. */
+#define F_MAX 1e12
+/* Fewest and most integrator ticks in one control period: one period is one call into
+ * the core (fast mode runs periods back to back), so it must stay short. */
+#define TICKS_MAX 100000
+/* Control periods per wall second at most in real-time mode (publish_hz * rate). */
+#define PERIODS_PER_S_MAX 10000.0
+
+typedef struct range {
+    double lo, hi;
+    bool lo_open;      /* lo excluded ("> 0") */
+    const char *unit;  /* shown in messages; NULL for none */
+} range;
+
+static const range R_DT = {1e-6, 1.0, false, "s"};           /* above: resolves no motion of these models; below: see T_MAX */
+static const range R_RTOL = {1e-14, 0.1, false, NULL};      /* below ~50 eps no step can meet it */
+static const range R_ATOL = {1e-14, 1.0, false, "m, rad, m/s or rad/s"};
+static const range R_DT_MIN = {1e-15, 1.0, false, "s"};      /* and <= dt */
+static const range R_NEWTON_TOL = {1e-15, 0.1, false, NULL}; /* scaled update: ~5 eps at best */
+static const range R_PUBLISH_HZ = {0.01, 10000.0, false, "Hz"}; /* and 1/publish_hz = k dt, k <= TICKS_MAX */
+static const range R_EXPLODE = {1e-6, 1e9, false, "m, rad, m/s or rad/s"};
+static const range R_RATE = {1e-3, 1e3, false, "sim s per wall s"};
+static const range R_LOCKSTEP_TIMEOUT = {1e-3, 3600.0, false, "wall s"};
+static const range R_STATUS_HZ = {0.1, 100.0, false, "Hz"};
+static const range R_EFFORT = {0.0, F_MAX, true, "N or N m"};
+static const range R_DAMPING = {0.0, F_MAX, false, "N s/m or N m s/rad"};
+static const range R_FRICTION = {0.0, F_MAX, false, "N or N m"};
+static const range R_UNIT = {0.0, 1.0, false, "a coefficient of restitution"};
+static const range R_TIME = {0.0, T_MAX, false, "s"};
+static const range R_GRAVITY = {0.0, 1e3, false, "m/s^2"}; /* 100 g; 0 switches gravity off */
+
+/* Physical parameters by unit (a new model with these units needs no code here): masses
+ * from a milligram to a thousand tonnes, lengths from a micrometre to a thousand km,
+ * inertias spanning m l^2 / 12 of those. Parameters that may be zero or negative: g
+ * (>= 0, 0 = no gravity) and h0 (a height, any sign). Other units: (0, F_MAX]. */
+static const struct {
+    const char *unit;
+    double lo, hi;
+} k_param_windows[] = {
+    {"kg", 1e-6, 1e6},
+    {"m", 1e-6, 1e6},
+    {"kg m^2", 1e-20, 1e18},
+    {"m/s^2", 0.0, 1e3},
+};
+
+/* ================================================================ conversion state */
+
+typedef struct conv {
+    errbuf *err;
+    lag_scene *sc;
+    const lag_model_info *info;
+    /* nodes remembered for the final cross-checks (NULL if not given) */
+    const ynode *root, *parameters, *publish_hz, *dt, *integrator, *initial, *dt_min;
+    const ynode *explode_limit, *url, *command_timeout, *rate, *mode;
+    /* effects */
+    const ynode *limits_node, *floor_node, *gravity_g_node;
+    int gravity_enabled;  /* -1 not said, 0 off, 1 on */
+    double gravity_g;
+    int limit_seen;       /* bits: lower, upper given for the joint being read */
+    int cur_joint;        /* the joint whose sub-mapping is being read */
+    lag_disturbance *cur_dist; /* the disturbance being read */
+    int cur_dist_kind;    /* bits: impulse, force given */
+} conv;
+
+/* Joins "parent.key" into buf. */
+static const char *join(char *buf, size_t len, const char *parent, const char *key)
+{
+    if (parent && parent[0])
+        snprintf(buf, len, "%s.%s", parent, key);
+    else
+        snprintf(buf, len, "%s", key);
+    return buf;
+}
+
+/* Key tables: a NULL-terminated list of {name, handler}. */
+typedef struct keyrow keyrow;
+typedef int (*key_fn)(conv *cv, const ynode *val, const char *path);
+struct keyrow {
+    const char *name;
+    key_fn fn;
+};
+
+/* Lists the names of a key table: "a, b, c". */
+static void list_keys(char *buf, size_t len, const keyrow *rows)
+{
+    buf[0] = '\0';
+    for (const keyrow *r = rows; r->name; r++) {
+        size_t used = strlen(buf);
+        snprintf(buf + used, len - used, "%s%s", r == rows ? "" : ", ", r->name);
+    }
+}
+
+/* nd must be a mapping; `what` describes it ("a mapping (keys: a, b)"). */
+static int need_map(conv *cv, const ynode *nd, const char *path, const char *what)
+{
+    if (nd->kind == YN_MAP)
+        return 0;
+    if (ynode_is_null(nd))
+        return yfail(cv->err, nd, path, "missing value: expected %s", what);
+    return yfail(cv->err, nd, path, "expected %s, got %s", what, ynode_kind_name(nd));
+}
+
+/* Walks a mapping's entries in file order and dispatches each to its table row, skipping
+ * the keys listed in `skip` (read before). */
+static int convert_map_skip(conv *cv, const ynode *nd, const char *path, const keyrow *rows,
+                            const char *what, const char *const *skip)
+{
+    if (nd->kind != YN_MAP) {
+        char allowed[512], expected[600];
+        list_keys(allowed, sizeof allowed, rows);
+        snprintf(expected, sizeof expected, "a mapping (keys: %s)", allowed);
+        return need_map(cv, nd, path, expected);
+    }
+    for (int i = 0; i < nd->n; i++) {
+        const yentry *en = &nd->entries[i];
+        bool skipped = false;
+        for (int k = 0; skip && skip[k]; k++)
+            skipped |= strcmp(skip[k], en->key) == 0;
+        if (skipped)
+            continue;
+        const keyrow *r = rows;
+        while (r->name && strcmp(r->name, en->key) != 0)
+            r++;
+        if (!r->name) {
+            char allowed[512];
+            list_keys(allowed, sizeof allowed, rows);
+            return yfail_key(cv->err, en, "unknown %s '%s'%s%s; allowed: %s", what, en->key,
+                             path[0] ? " in " : "", path, allowed);
+        }
+        char sub[256];
+        if (r->fn(cv, en->val, join(sub, sizeof sub, path, en->key)) < 0)
+            return -1;
+    }
+    return 0;
+}
+
+static int convert_map(conv *cv, const ynode *nd, const char *path, const keyrow *rows,
+                       const char *what)
+{
+    return convert_map_skip(cv, nd, path, rows, what, NULL);
+}
+
+/* ================================================================ scalars */
+
+/* A plain decimal number as YAML's core schema writes one: [-+]? (digits [. digits?] |
+ * . digits) ([eE] [-+]? digits)?. Hexadecimal, "inf", "nan", "1_000" are not numbers
+ * here, whatever strtod would make of them. */
+static bool is_decimal(const char *t)
+{
+    const char *p = t;
+    if (*p == '+' || *p == '-')
+        p++;
+    int digits = 0;
+    while (*p >= '0' && *p <= '9') { p++; digits++; }
+    if (*p == '.') {
+        p++;
+        while (*p >= '0' && *p <= '9') { p++; digits++; }
+    }
+    if (digits == 0)
+        return false;
+    if (*p == 'e' || *p == 'E') {
+        p++;
+        if (*p == '+' || *p == '-')
+            p++;
+        if (!(*p >= '0' && *p <= '9'))
+            return false;
+        while (*p >= '0' && *p <= '9')
+            p++;
+    }
+    return *p == '\0';
+}
+
+/* A finite number written as a plain decimal scalar. */
+static int get_number(conv *cv, const ynode *nd, const char *path, double *out)
+{
+    if (ynode_is_null(nd))
+        return yfail(cv->err, nd, path, "missing value: expected a number");
+    if (nd->kind != YN_SCALAR)
+        return yfail(cv->err, nd, path, "expected a number, got %s", ynode_kind_name(nd));
+    if (nd->quoted)
+        return yfail(cv->err, nd, path, "expected a number, got the quoted string \"%s\"",
+                     nd->text);
+    const char *t = nd->text;
+    const char *u = (t[0] == '+' || t[0] == '-') ? t + 1 : t;
+    /* YAML's own spellings of infinity and NaN */
+    if (strcmp(u, ".inf") == 0 || strcmp(u, ".Inf") == 0 || strcmp(u, ".INF") == 0 ||
+        strcmp(t, ".nan") == 0 || strcmp(t, ".NaN") == 0 || strcmp(t, ".NAN") == 0)
+        return yfail(cv->err, nd, path, "expected a finite number, got %s", t);
+    if (!is_decimal(t))
+        return yfail(cv->err, nd, path, "expected a number, got '%s'", t);
+    double v = strtod(t, NULL);
+    if (!isfinite(v))
+        return yfail(cv->err, nd, path, "expected a finite number, got %s", t);
+    *out = v;
+    return 0;
+}
+
+/* "from 1e-06 to 1 (s)" or "> 0 and <= 1e+12 (N)" */
+static void describe_range(char *buf, size_t len, double lo, double hi, bool lo_open,
+                           const char *unit)
+{
+    char u[64] = "";
+    if (unit)
+        snprintf(u, sizeof u, " (%s)", unit);
+    if (lo_open)
+        snprintf(buf, len, "> %.6g and <= %.6g%s", lo, hi, u);
+    else
+        snprintf(buf, len, "from %.6g to %.6g%s", lo, hi, u);
+}
+
+/* A number in [lo, hi] (or (lo, hi]). */
+static int get_in(conv *cv, const ynode *nd, const char *path, double lo, double hi,
+                  bool lo_open, const char *unit, double *out)
+{
+    double v = 0.0;
+    if (get_number(cv, nd, path, &v) < 0)
+        return -1;
+    if (!(lo_open ? v > lo : v >= lo) || !(v <= hi)) {
+        char r[160];
+        describe_range(r, sizeof r, lo, hi, lo_open, unit);
+        return yfail(cv->err, nd, path, "expected a number %s, got %s", r, nd->text);
+    }
+    *out = v;
+    return 0;
+}
+
+static int get_range(conv *cv, const ynode *nd, const char *path, const range *r,
+                     double *out)
+{
+    return get_in(cv, nd, path, r->lo, r->hi, r->lo_open, r->unit, out);
+}
+
+/* An integer in [lo, hi], written as plain decimal digits. */
+static int get_int(conv *cv, const ynode *nd, const char *path, long long lo, long long hi,
+                   long long *out)
+{
+    if (ynode_is_null(nd))
+        return yfail(cv->err, nd, path, "missing value: expected an integer");
+    if (nd->kind != YN_SCALAR)
+        return yfail(cv->err, nd, path, "expected an integer, got %s", ynode_kind_name(nd));
+    if (nd->quoted)
+        return yfail(cv->err, nd, path, "expected an integer, got the quoted string \"%s\"",
+                     nd->text);
+    const char *t = nd->text, *d = (t[0] == '+' || t[0] == '-') ? t + 1 : t;
+    bool digits = d[0] != '\0';
+    for (const char *p = d; *p; p++)
+        digits &= *p >= '0' && *p <= '9';
+    if (!digits)
+        return yfail(cv->err, nd, path, "expected an integer, got '%s'", t);
+    errno = 0;
+    long long v = strtoll(t, NULL, 10);
+    if (errno == ERANGE || v < lo || v > hi)
+        return yfail(cv->err, nd, path, "expected an integer from %lld to %lld, got %s", lo,
+                     hi, t);
+    *out = v;
+    return 0;
+}
+
+/* A string scalar (quoted or plain). */
+static int get_string(conv *cv, const ynode *nd, const char *path, const char *what,
+                      const char **out)
+{
+    if (ynode_is_null(nd))
+        return yfail(cv->err, nd, path, "missing value: expected %s", what);
+    if (nd->kind != YN_SCALAR)
+        return yfail(cv->err, nd, path, "expected %s, got %s", what, ynode_kind_name(nd));
+    *out = nd->text;
+    return 0;
+}
+
+/* A YAML boolean: true/false (also yes/no, on/off as YAML 1.1 spells them), plain. */
+static int get_bool(conv *cv, const ynode *nd, const char *path, bool *out)
+{
+    static const char *const yes[] = {"true", "True", "TRUE", "yes", "Yes", "on", "On", NULL};
+    static const char *const no[] = {"false", "False", "FALSE", "no", "No", "off", "Off", NULL};
+    if (ynode_is_null(nd))
+        return yfail(cv->err, nd, path, "missing value: expected true or false");
+    if (nd->kind != YN_SCALAR)
+        return yfail(cv->err, nd, path, "expected true or false, got %s", ynode_kind_name(nd));
+    if (nd->quoted)
+        return yfail(cv->err, nd, path, "expected true or false, got the quoted string \"%s\"",
+                     nd->text);
+    for (int i = 0; yes[i]; i++)
+        if (strcmp(nd->text, yes[i]) == 0) { *out = true; return 0; }
+    for (int i = 0; no[i]; i++)
+        if (strcmp(nd->text, no[i]) == 0) { *out = false; return 0; }
+    return yfail(cv->err, nd, path, "expected true or false, got '%s'", nd->text);
+}
+
+/* ================================================================ joints */
+
+/* "x, phi" for messages */
+static void joint_list(const conv *cv, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    for (int i = 0; i < cv->info->nq; i++) {
+        size_t used = strlen(buf);
+        snprintf(buf + used, len - used, "%s%s", i ? ", " : "", cv->info->joint_names[i]);
+    }
+}
+
+static int joint_index(const conv *cv, const char *name)
+{
+    for (int i = 0; i < cv->info->nq; i++)
+        if (strcmp(name, cv->info->joint_names[i]) == 0) return i;
+    return -1;
+}
+
+typedef int (*joint_fn)(conv *cv, int joint, const ynode *val, const char *path);
+
+/* Walks a mapping {joint name: value} and calls fn for each joint. */
+static int per_joint(conv *cv, const ynode *nd, const char *path, joint_fn fn)
+{
+    char names[128], what[160];
+    joint_list(cv, names, sizeof names);
+    snprintf(what, sizeof what, "a mapping of joints (%s)", names);
+    if (need_map(cv, nd, path, what) < 0)
+        return -1;
+    for (int i = 0; i < nd->n; i++) {
+        const yentry *en = &nd->entries[i];
+        int j = joint_index(cv, en->key);
+        if (j < 0)
+            return yfail_key(cv->err, en, "unknown joint '%s' in %s for model %s; allowed: %s",
+                             en->key, path, cv->info->name, names);
+        char sub[256];
+        if (fn(cv, j, en->val, join(sub, sizeof sub, path, en->key)) < 0)
+            return -1;
+    }
+    return 0;
+}
+
+/* Joint j takes an input (a command, an actuator). */
+static int need_actuated(conv *cv, int j, const ynode *nd, const char *path)
+{
+    if (!cv->info->actuated[j])
+        return yfail(cv->err, nd, path, "joint %s of model %s takes no input",
+                     cv->info->joint_names[j], cv->info->name);
+    return 0;
+}
+
+/* The scene's explode_limit (read in the first pass), as a bound on a position,
+ * velocity or noise amplitude: a value beyond it can never be part of a valid state. */
+static int get_within_explode(conv *cv, const ynode *nd, const char *path, bool nonneg,
+                              double *out)
+{
+    double lim = cv->sc->sim.explode_limit;
+    double v = 0.0;
+    if (get_number(cv, nd, path, &v) < 0)
+        return -1;
+    if (!(v <= lim) || !(nonneg ? v >= 0.0 : v >= -lim))
+        return yfail(cv->err, nd, path, "expected a number from %.6g to %.6g (explode_limit%s), "
+                     "got %s", nonneg ? 0.0 : -lim, lim,
+                     cv->explode_limit ? "" : ", default", nd->text);
+    *out = v;
+    return 0;
+}
+
+/* ================================================================ model, parameters */
+
+static int key_model(conv *cv, const ynode *val, const char *path)
+{
+    (void)cv; (void)val; (void)path; /* read first: see scene_schema_convert */
+    return 0;
+}
+
+static int key_parameters(conv *cv, const ynode *nd, const char *path)
+{
+    const lag_model_info *info = cv->info;
+    lag_model *m = &cv->sc->sim.model;
+    cv->parameters = nd;
+    char allowed[256] = "";
+    for (int i = 0; i < info->np; i++) {
+        size_t used = strlen(allowed);
+        snprintf(allowed + used, sizeof allowed - used, "%s%s", i ? ", " : "",
+                 info->param_names[i]);
+    }
+    char what[300];
+    snprintf(what, sizeof what, "a mapping (keys: %s)", allowed);
+    if (need_map(cv, nd, path, what) < 0)
+        return -1;
+    for (int i = 0; i < nd->n; i++) {
+        const yentry *en = &nd->entries[i];
+        int k = lag_model_param_index(m->kind, en->key);
+        if (k < 0)
+            return yfail_key(cv->err, en, "unknown parameter '%s' for model %s; allowed: %s",
+                             en->key, info->name, allowed);
+        char sub[256];
+        join(sub, sizeof sub, path, en->key);
+        const char *unit = info->param_units[k] ? info->param_units[k] : "SI";
+        double lo = 0.0, hi = F_MAX;
+        bool lo_open = true;
+        for (size_t w = 0; w < sizeof k_param_windows / sizeof k_param_windows[0]; w++) {
+            if (strcmp(unit, k_param_windows[w].unit) == 0) {
+                lo = k_param_windows[w].lo;
+                hi = k_param_windows[w].hi;
+                lo_open = false;
+            }
+        }
+        if (strcmp(en->key, "g") == 0) { /* 0 switches gravity off */
+            lo = 0.0;
+            lo_open = false;
+        } else if (strcmp(en->key, "h0") == 0) { /* a height: any sign */
+            lo = -hi;
+            lo_open = false;
+        }
+        if (get_in(cv, en->val, sub, lo, hi, lo_open, unit, &m->p[k]) < 0)
+            return -1;
+    }
+    return 0;
+}
+
+/* ================================================================ initial */
+
+static int get_vector(conv *cv, const ynode *nd, const char *path, double *out)
+{
+    const lag_model_info *info = cv->info;
+    int nq = info->nq;
+    char names[128];
+    joint_list(cv, names, sizeof names);
+    if (ynode_is_null(nd))
+        return yfail(cv->err, nd, path, "missing value: expected a sequence of %d numbers (%s)",
+                     nq, names);
+    if (nd->kind != YN_SEQ)
+        return yfail(cv->err, nd, path, "expected a sequence of %d numbers (%s), got %s", nq,
+                     names, ynode_kind_name(nd));
+    if (nd->n != nq)
+        return yfail(cv->err, nd, path,
+                     "expected a sequence of %d numbers (%s) for model %s, got %d", nq, names,
+                     info->name, nd->n);
+    for (int i = 0; i < nq; i++) {
+        char sub[256];
+        snprintf(sub, sizeof sub, "%s[%d]", path, i);
+        if (get_within_explode(cv, nd->items[i], sub, false, &out[i]) < 0)
+            return -1;
+    }
+    return 0;
+}
+
+static int key_q(conv *cv, const ynode *nd, const char *path)
+{
+    return get_vector(cv, nd, path, cv->sc->sim.q0);
+}
+
+static int key_qd(conv *cv, const ynode *nd, const char *path)
+{
+    return get_vector(cv, nd, path, cv->sc->sim.qd0);
+}
+
+static const keyrow k_initial_keys[] = {
+    {"q", key_q},   /* rad or m, per coordinate, within explode_limit */
+    {"qd", key_qd}, /* rad/s or m/s, within explode_limit */
+    {NULL, NULL},
+};
+
+static int key_initial(conv *cv, const ynode *nd, const char *path)
+{
+    cv->initial = nd;
+    return convert_map(cv, nd, path, k_initial_keys, "key");
+}
+
+/* ================================================================ integrator */
+
+static int key_method(conv *cv, const ynode *nd, const char *path)
+{
+    char allowed[256] = "";
+    for (int i = 0; i < LAG_METHOD_COUNT; i++) {
+        size_t used = strlen(allowed);
+        snprintf(allowed + used, sizeof allowed - used, "%s%s", i ? ", " : "",
+                 lag_method_name((lag_method)i));
+    }
+    char what[300];
+    snprintf(what, sizeof what, "a method (%s)", allowed);
+    const char *s;
+    if (get_string(cv, nd, path, what, &s) < 0)
+        return -1;
+    int m = lag_method_from_name(s);
+    if (m < 0)
+        return yfail(cv->err, nd, path, "unknown method '%s'; allowed: %s", s, allowed);
+    cv->sc->sim.integrator.method = (lag_method)m;
+    return 0;
+}
+
+static int key_dt(conv *cv, const ynode *nd, const char *path)
+{
+    cv->dt = nd;
+    return get_range(cv, nd, path, &R_DT, &cv->sc->sim.integrator.dt);
+}
+
+static int key_rtol(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_RTOL, &cv->sc->sim.integrator.rtol);
+}
+
+static int key_atol(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_ATOL, &cv->sc->sim.integrator.atol);
+}
+
+static int key_dt_min(conv *cv, const ynode *nd, const char *path)
+{
+    cv->dt_min = nd;
+    return get_range(cv, nd, path, &R_DT_MIN, &cv->sc->sim.integrator.dt_min);
+}
+
+static int key_max_iter(conv *cv, const ynode *nd, const char *path)
+{
+    long long v = 0;
+    if (get_int(cv, nd, path, 1, 1000, &v) < 0)
+        return -1;
+    cv->sc->sim.integrator.max_iter = (int)v;
+    return 0;
+}
+
+static int key_newton_tol(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_NEWTON_TOL, &cv->sc->sim.integrator.newton_tol);
+}
+
+static const keyrow k_integrator_keys[] = {
+    {"method", key_method},         /* euler | semi-implicit-euler | rk4 | dopri5 | ... */
+    {"dt", key_dt},                 /* s */
+    {"rtol", key_rtol},             /* dopri5 */
+    {"atol", key_atol},             /* dopri5 */
+    {"dt_min", key_dt_min},         /* dopri5, s, <= dt */
+    {"max_iter", key_max_iter},     /* implicit methods, 1..1000 */
+    {"newton_tol", key_newton_tol}, /* implicit methods */
+    {NULL, NULL},
+};
+
+static int key_integrator(conv *cv, const ynode *nd, const char *path)
+{
+    cv->integrator = nd;
+    return convert_map(cv, nd, path, k_integrator_keys, "key");
+}
+
+/* ================================================================ rates, limits */
+
+static int key_publish_hz(conv *cv, const ynode *nd, const char *path)
+{
+    cv->publish_hz = nd;
+    return get_range(cv, nd, path, &R_PUBLISH_HZ, &cv->sc->publish_hz);
+}
+
+static int key_explode_limit(conv *cv, const ynode *nd, const char *path)
+{
+    cv->explode_limit = nd;
+    return get_range(cv, nd, path, &R_EXPLODE, &cv->sc->sim.explode_limit);
+}
+
+/* ================================================================ realtime */
+
+static int key_mode(conv *cv, const ynode *nd, const char *path)
+{
+    const char *s;
+    cv->mode = nd;
+    if (get_string(cv, nd, path, "a mode (realtime, fast, lockstep)", &s) < 0)
+        return -1;
+    for (int m = LAG_RT_REALTIME; m <= LAG_RT_LOCKSTEP; m++) {
+        if (strcmp(s, lag_rt_mode_name((lag_rt_mode)m)) == 0) {
+            cv->sc->realtime.mode = (lag_rt_mode)m;
+            return 0;
+        }
+    }
+    return yfail(cv->err, nd, path, "unknown mode '%s'; allowed: realtime, fast, lockstep", s);
+}
+
+static int key_rate(conv *cv, const ynode *nd, const char *path)
+{
+    cv->rate = nd;
+    return get_range(cv, nd, path, &R_RATE, &cv->sc->realtime.rate);
+}
+
+/* At least one control period: a shorter timeout would zero the command of a controller
+ * that answers every period before its next answer can arrive. */
+static int key_command_timeout(conv *cv, const ynode *nd, const char *path)
+{
+    cv->command_timeout = nd;
+    double period = (double)cv->sc->ticks_per_period * cv->sc->sim.integrator.dt;
+    if (get_number(cv, nd, path, &cv->sc->realtime.command_timeout) < 0)
+        return -1;
+    double v = cv->sc->realtime.command_timeout;
+    if (!(v >= period * (1.0 - 1e-9)) || !(v <= T_MAX))
+        return yfail(cv->err, nd, path, "expected a number from %.6g (one control period, "
+                     "1/publish_hz) to %.6g (sim s), got %s", period, T_MAX, nd->text);
+    return 0;
+}
+
+static int key_lockstep_timeout(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_LOCKSTEP_TIMEOUT, &cv->sc->realtime.lockstep_timeout);
+}
+
+static int key_status_hz(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_STATUS_HZ, &cv->sc->realtime.status_hz);
+}
+
+/* effort_limit: {actuated joint: bound} */
+static int effort_limit_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    if (need_actuated(cv, j, nd, path) < 0)
+        return -1;
+    return get_range(cv, nd, path, &R_EFFORT, &cv->sc->realtime.effort_limit[j]);
+}
+
+static int key_effort_limit(conv *cv, const ynode *nd, const char *path)
+{
+    return per_joint(cv, nd, path, effort_limit_joint);
+}
+
+static const keyrow k_realtime_keys[] = {
+    {"mode", key_mode},                         /* realtime | fast | lockstep */
+    {"rate", key_rate},                         /* sim s per wall s */
+    {"command_timeout", key_command_timeout},   /* sim s */
+    {"lockstep_timeout", key_lockstep_timeout}, /* wall s */
+    {"status_hz", key_status_hz},               /* wall Hz */
+    {"effort_limit", key_effort_limit},         /* N or N m per actuated joint */
+    {NULL, NULL},
+};
+
+static int key_realtime(conv *cv, const ynode *nd, const char *path)
+{
+    return convert_map(cv, nd, path, k_realtime_keys, "key");
+}
+
+/* ================================================================ lcm */
+
+static int key_url(conv *cv, const ynode *nd, const char *path)
+{
+    cv->url = nd;
+    /* "" (quoted) is allowed: LCM's default URL */
+    if (nd->kind == YN_SCALAR && nd->quoted && nd->text[0] == '\0') {
+        cv->sc->lcm.url[0] = '\0';
+        return 0;
+    }
+    const char *s;
+    if (get_string(cv, nd, path, "an LCM URL (e.g. udpm://239.255.76.67:7667?ttl=0)", &s) < 0)
+        return -1;
+    if (strlen(s) >= sizeof cv->sc->lcm.url)
+        return yfail(cv->err, nd, path, "URL longer than %zu characters",
+                     sizeof cv->sc->lcm.url - 1);
+    snprintf(cv->sc->lcm.url, sizeof cv->sc->lcm.url, "%s", s);
+    return 0; /* checked with lcm.allow_lan once both are read (scene_schema_convert) */
+}
+
+static int key_prefix(conv *cv, const ynode *nd, const char *path)
+{
+    const char *s;
+    if (get_string(cv, nd, path, "a channel prefix of [A-Za-z0-9_]", &s) < 0)
+        return -1;
+    size_t n = strlen(s);
+    if (n == 0 || n >= sizeof cv->sc->lcm.prefix)
+        return yfail(cv->err, nd, path, "expected a channel prefix of 1 to %zu characters",
+                     sizeof cv->sc->lcm.prefix - 1);
+    for (size_t i = 0; i < n; i++) {
+        char c = s[i];
+        bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') ||
+                  (c >= '0' && c <= '9') || c == '_';
+        if (!ok)
+            return yfail(cv->err, nd, path,
+                         "expected a channel prefix of [A-Za-z0-9_], got '%s' "
+                         "(character %zu is '%c')", s, i + 1, c);
+    }
+    memcpy(cv->sc->lcm.prefix, s, n + 1);
+    return 0;
+}
+
+static int key_allow_lan(conv *cv, const ynode *nd, const char *path)
+{
+    return get_bool(cv, nd, path, &cv->sc->lcm.allow_lan);
+}
+
+static const keyrow k_lcm_keys[] = {
+    {"url", key_url},             /* "" = LCM's default; udpm:// or memq:// */
+    {"prefix", key_prefix},       /* channel prefix */
+    {"allow_lan", key_allow_lan}, /* bool: traffic may leave this host (ttl > 0) */
+    {NULL, NULL},
+};
+
+static int key_lcm(conv *cv, const ynode *nd, const char *path)
+{
+    return convert_map(cv, nd, path, k_lcm_keys, "key");
+}
+
+/* ================================================================ effects */
+
+/* Each section present switches its effect on (lag_effects_def.enabled); per-joint
+ * sections are mappings from joint names to values. Values are checked where they are
+ * read, so errors point at the offending node. */
+
+static lag_effects_def *fx(conv *cv) { return &cv->sc->sim.effects; }
+
+/* gravity: {enabled: bool, g: m/s^2} -- applied after parameters (see the end) */
+static int key_gravity_enabled(conv *cv, const ynode *nd, const char *path)
+{
+    bool b = true;
+    if (get_bool(cv, nd, path, &b) < 0)
+        return -1;
+    cv->gravity_enabled = b ? 1 : 0;
+    return 0;
+}
+
+static int key_gravity_g(conv *cv, const ynode *nd, const char *path)
+{
+    if (get_range(cv, nd, path, &R_GRAVITY, &cv->gravity_g) < 0)
+        return -1;
+    cv->gravity_g_node = nd;
+    return 0;
+}
+
+static const keyrow k_gravity_keys[] = {
+    {"enabled", key_gravity_enabled}, /* false: g = 0 */
+    {"g", key_gravity_g},             /* m/s^2, replaces parameters.g */
+    {NULL, NULL},
+};
+
+static int key_effect_gravity(conv *cv, const ynode *nd, const char *path)
+{
+    if (nd->kind == YN_SCALAR && !ynode_is_null(nd))
+        return key_gravity_enabled(cv, nd, path); /* gravity: false */
+    return convert_map(cv, nd, path, k_gravity_keys, "key");
+}
+
+/* damping: {joint: b}, N s/m or N m s/rad */
+static int damping_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_DAMPING, &fx(cv)->damping[j]);
+}
+
+static int key_effect_damping(conv *cv, const ynode *nd, const char *path)
+{
+    fx(cv)->enabled |= LAG_EFF_DAMPING;
+    return per_joint(cv, nd, path, damping_joint);
+}
+
+/* friction: {joint: {static: mu_s, kinetic: mu_k}}, N or N m */
+static int fr_static(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_FRICTION, &fx(cv)->friction_static[cv->cur_joint]);
+}
+
+static int fr_kinetic(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_FRICTION, &fx(cv)->friction_kinetic[cv->cur_joint]);
+}
+
+static const keyrow k_friction_keys[] = {
+    {"static", fr_static},   /* largest holding force, N or N m */
+    {"kinetic", fr_kinetic}, /* sliding force, N or N m */
+    {NULL, NULL},
+};
+
+static int friction_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    cv->cur_joint = j;
+    fx(cv)->friction_static[j] = NAN; /* "not given": defaults to kinetic below */
+    if (convert_map(cv, nd, path, k_friction_keys, "key") < 0)
+        return -1;
+    lag_effects_def *e = fx(cv);
+    if (isnan(e->friction_static[j])) e->friction_static[j] = e->friction_kinetic[j];
+    if (e->friction_static[j] < e->friction_kinetic[j])
+        return yfail(cv->err, nd, path, "expected static (%g) >= kinetic (%g)",
+                     e->friction_static[j], e->friction_kinetic[j]);
+    return 0;
+}
+
+static int key_effect_friction(conv *cv, const ynode *nd, const char *path)
+{
+    fx(cv)->enabled |= LAG_EFF_FRICTION;
+    return per_joint(cv, nd, path, friction_joint);
+}
+
+/* limits: {joint: {lower, upper, restitution}}, plus rest_velocity for all */
+static int lim_lower(conv *cv, const ynode *nd, const char *path)
+{
+    cv->limit_seen |= 1;
+    return get_within_explode(cv, nd, path, false, &fx(cv)->limit_lower[cv->cur_joint]);
+}
+
+static int lim_upper(conv *cv, const ynode *nd, const char *path)
+{
+    cv->limit_seen |= 2;
+    return get_within_explode(cv, nd, path, false, &fx(cv)->limit_upper[cv->cur_joint]);
+}
+
+static int lim_restitution(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_UNIT, &fx(cv)->restitution[cv->cur_joint]);
+}
+
+static const keyrow k_limit_keys[] = {
+    {"lower", lim_lower},             /* m or rad, within explode_limit */
+    {"upper", lim_upper},             /* m or rad, within explode_limit */
+    {"restitution", lim_restitution}, /* [0, 1], default 0 */
+    {NULL, NULL},
+};
+
+/* m/s or rad/s: an impact slower than this ends in resting contact */
+static int key_rest_velocity(conv *cv, const ynode *nd, const char *path)
+{
+    return get_within_explode(cv, nd, path, true, &fx(cv)->rest_velocity);
+}
+
+static int key_effect_limits(conv *cv, const ynode *nd, const char *path)
+{
+    fx(cv)->enabled |= LAG_EFF_LIMITS;
+    if (need_map(cv, nd, path, "a mapping of joints and rest_velocity") < 0)
+        return -1;
+    for (int i = 0; i < nd->n; i++) {
+        const yentry *en = &nd->entries[i];
+        char sub[256];
+        join(sub, sizeof sub, path, en->key);
+        if (strcmp(en->key, "rest_velocity") == 0) {
+            if (key_rest_velocity(cv, en->val, sub) < 0) return -1;
+            continue;
+        }
+        int j = joint_index(cv, en->key);
+        if (j < 0) {
+            char names[128];
+            joint_list(cv, names, sizeof names);
+            return yfail_key(cv->err, en, "unknown joint '%s' in %s for model %s; allowed: %s, "
+                             "rest_velocity", en->key, path, cv->info->name, names);
+        }
+        cv->cur_joint = j;
+        cv->limit_seen = 0;
+        if (convert_map(cv, en->val, sub, k_limit_keys, "key") < 0)
+            return -1;
+        if (cv->limit_seen != 3)
+            return yfail(cv->err, en->val, sub, "expected both lower and upper");
+        lag_effects_def *e = fx(cv);
+        if (!(e->limit_lower[j] < e->limit_upper[j]))
+            return yfail(cv->err, en->val, sub, "expected lower (%g) < upper (%g)",
+                         e->limit_lower[j], e->limit_upper[j]);
+        e->limit_on[j] = true;
+        cv->limits_node = nd;
+    }
+    return 0;
+}
+
+/* floor (stick): {restitution, rest_velocity} */
+static int floor_restitution(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_UNIT, &fx(cv)->floor_restitution);
+}
+
+static const keyrow k_floor_keys[] = {
+    {"restitution", floor_restitution}, /* [0, 1], default 0 */
+    {"rest_velocity", key_rest_velocity}, /* rad/s, default 1e-3 */
+    {NULL, NULL},
+};
+
+static int key_effect_floor(conv *cv, const ynode *nd, const char *path)
+{
+    if (cv->sc->sim.model.kind != LAG_MODEL_STICK)
+        return yfail(cv->err, nd, path, "the floor effect is for model stick only, not %s",
+                     cv->info->name);
+    fx(cv)->enabled |= LAG_EFF_FLOOR;
+    cv->floor_node = nd;
+    if (ynode_is_null(nd))
+        return 0; /* floor: with defaults */
+    return convert_map(cv, nd, path, k_floor_keys, "key");
+}
+
+/* actuator: {joint: {max, lag}} on actuated joints */
+static int act_max(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_EFFORT, &fx(cv)->actuator_max[cv->cur_joint]);
+}
+
+/* The lag is advanced exactly (exp(-dt/lag)) and is stable for any value. */
+static int act_lag(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_TIME, &fx(cv)->actuator_tau[cv->cur_joint]);
+}
+
+static const keyrow k_actuator_keys[] = {
+    {"max", act_max}, /* |effort| bound, N or N m */
+    {"lag", act_lag}, /* first-order time constant, s */
+    {NULL, NULL},
+};
+
+static int actuator_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    if (need_actuated(cv, j, nd, path) < 0)
+        return -1;
+    cv->cur_joint = j;
+    return convert_map(cv, nd, path, k_actuator_keys, "key");
+}
+
+static int key_effect_actuator(conv *cv, const ynode *nd, const char *path)
+{
+    fx(cv)->enabled |= LAG_EFF_ACTUATOR;
+    return per_joint(cv, nd, path, actuator_joint);
+}
+
+/* disturbance: [{t, joint, impulse | force + duration}, ...] */
+static int dist_t(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_TIME, &cv->cur_dist->t);
+}
+
+static int dist_joint(conv *cv, const ynode *nd, const char *path)
+{
+    const char *name;
+    char names[128];
+    joint_list(cv, names, sizeof names);
+    char what[160];
+    snprintf(what, sizeof what, "a joint name (%s)", names);
+    if (get_string(cv, nd, path, what, &name) < 0)
+        return -1;
+    int j = joint_index(cv, name);
+    if (j < 0)
+        return yfail(cv->err, nd, path, "unknown joint '%s'; allowed: %s", name, names);
+    cv->cur_dist->joint = j;
+    return 0;
+}
+
+static int dist_impulse(conv *cv, const ynode *nd, const char *path)
+{
+    cv->cur_dist_kind |= 1;
+    cv->cur_dist->impulse = true;
+    return get_in(cv, nd, path, -F_MAX, F_MAX, false, "N s or N m s", &cv->cur_dist->value);
+}
+
+static int dist_force(conv *cv, const ynode *nd, const char *path)
+{
+    cv->cur_dist_kind |= 2;
+    cv->cur_dist->impulse = false;
+    return get_in(cv, nd, path, -F_MAX, F_MAX, false, "N or N m", &cv->cur_dist->value);
+}
+
+/* A force acts over whole ticks: at least one dt (a shorter push is an impulse). */
+static int dist_duration(conv *cv, const ynode *nd, const char *path)
+{
+    double dt = cv->sc->sim.integrator.dt;
+    if (get_number(cv, nd, path, &cv->cur_dist->duration) < 0)
+        return -1;
+    double v = cv->cur_dist->duration;
+    if (!(v >= dt) || !(v <= T_MAX))
+        return yfail(cv->err, nd, path, "expected a number from %.6g (integrator.dt: a force "
+                     "acts for whole ticks; a shorter push is an impulse) to %.6g (s), got %s",
+                     dt, T_MAX, nd->text);
+    return 0;
+}
+
+static const keyrow k_dist_keys[] = {
+    {"t", dist_t},               /* s */
+    {"joint", dist_joint},       /* joint name */
+    {"impulse", dist_impulse},   /* N s or N m s */
+    {"force", dist_force},       /* N or N m */
+    {"duration", dist_duration}, /* s, with force */
+    {NULL, NULL},
+};
+
+static int key_effect_disturbance(conv *cv, const ynode *nd, const char *path)
+{
+    lag_effects_def *e = fx(cv);
+    e->enabled |= LAG_EFF_DISTURBANCE;
+    if (nd->kind != YN_SEQ)
+        return yfail(cv->err, nd, path,
+                     "expected a sequence of {t, joint, impulse} or {t, joint, force, duration}");
+    if (nd->n > LAG_MAX_DISTURBANCES)
+        return yfail(cv->err, nd, path, "at most %d disturbances, got %d",
+                     LAG_MAX_DISTURBANCES, nd->n);
+    e->n_disturbances = nd->n;
+    for (int k = 0; k < nd->n; k++) {
+        char sub[256];
+        snprintf(sub, sizeof sub, "%s[%d]", path, k);
+        cv->cur_dist = &e->disturbances[k];
+        memset(cv->cur_dist, 0, sizeof *cv->cur_dist);
+        cv->cur_dist->joint = -1;
+        cv->cur_dist->t = NAN;
+        cv->cur_dist_kind = 0;
+        if (convert_map(cv, nd->items[k], sub, k_dist_keys, "key") < 0)
+            return -1;
+        const ynode *it = nd->items[k];
+        if (isnan(cv->cur_dist->t) || cv->cur_dist->joint < 0)
+            return yfail(cv->err, it, sub, "expected both t and joint");
+        if (cv->cur_dist_kind != 1 && cv->cur_dist_kind != 2)
+            return yfail(cv->err, it, sub, "expected exactly one of impulse or force");
+        if (cv->cur_dist_kind == 2 && !(cv->cur_dist->duration > 0))
+            return yfail(cv->err, it, sub, "a force needs a duration (s)");
+        if (cv->cur_dist_kind == 1 && cv->cur_dist->duration != 0)
+            return yfail(cv->err, it, sub, "an impulse takes no duration");
+    }
+    return 0;
+}
+
+/* noise: {seed, q: {joint: std}, qd: {joint: std}}; the published state stays within a
+ * few explode_limits (the normal deviates are bounded by about 8.6). */
+static int noise_q_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    return get_within_explode(cv, nd, path, true, &fx(cv)->noise_q[j]);
+}
+
+static int noise_qd_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    return get_within_explode(cv, nd, path, true, &fx(cv)->noise_qd[j]);
+}
+
+static int noise_q(conv *cv, const ynode *nd, const char *path)
+{
+    return per_joint(cv, nd, path, noise_q_joint);
+}
+
+static int noise_qd(conv *cv, const ynode *nd, const char *path)
+{
+    return per_joint(cv, nd, path, noise_qd_joint);
+}
+
+static int noise_seed(conv *cv, const ynode *nd, const char *path)
+{
+    long long v = 0;
+    if (get_int(cv, nd, path, 0, 9007199254740991LL, &v) < 0) /* 2^53 - 1: exact in JSON */
+        return -1;
+    fx(cv)->noise_seed = (uint64_t)v;
+    return 0;
+}
+
+static const keyrow k_noise_keys[] = {
+    {"seed", noise_seed}, /* integer, default 1 */
+    {"q", noise_q},       /* std dev per joint, m or rad */
+    {"qd", noise_qd},     /* std dev per joint, m/s or rad/s */
+    {NULL, NULL},
+};
+
+static int key_effect_noise(conv *cv, const ynode *nd, const char *path)
+{
+    fx(cv)->enabled |= LAG_EFF_NOISE;
+    return convert_map(cv, nd, path, k_noise_keys, "key");
+}
+
+static const keyrow k_effects[] = {
+    {"gravity", key_effect_gravity},
+    {"damping", key_effect_damping},
+    {"friction", key_effect_friction},
+    {"limits", key_effect_limits},
+    {"floor", key_effect_floor},
+    {"actuator", key_effect_actuator},
+    {"disturbance", key_effect_disturbance},
+    {"noise", key_effect_noise},
+    {NULL, NULL},
+};
+
+static int key_effects(conv *cv, const ynode *nd, const char *path)
+{
+    /* `effects:` with nothing = no effects */
+    if (ynode_is_null(nd))
+        return 0;
+    return convert_map(cv, nd, path, k_effects, "effect");
+}
+
+/* ================================================================ the scene */
+
+static const keyrow k_top_keys[] = {
+    {"model", key_model},                 /* from lag_model_info (required) */
+    {"parameters", key_parameters},       /* named as in lag_model_info */
+    {"initial", key_initial},             /* q, qd */
+    {"integrator", key_integrator},       /* method, dt, tolerances */
+    {"publish_hz", key_publish_hz},       /* Hz */
+    {"explode_limit", key_explode_limit}, /* |q_i|, |qd_i| bound */
+    {"realtime", key_realtime},           /* pacing of the real-time server */
+    {"lcm", key_lcm},                     /* transport */
+    {"effects", key_effects},             /* per-scene effects */
+    {NULL, NULL},
+};
+
+/* Read before the others, in this order: what other values are measured against. */
+static const char *const k_first_keys[] = {"model", "integrator", "publish_hz",
+                                           "explode_limit", NULL};
+
+/* "stick, manipulator, dipc" from the core's table */
+static void model_list(char *buf, size_t len)
+{
+    buf[0] = '\0';
+    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
+        const lag_model_info *info = lag_model_info_get((lag_model_kind)k);
+        size_t used = strlen(buf);
+        snprintf(buf + used, len - used, "%s%s", k ? ", " : "", info ? info->name : "?");
+    }
+}
+
+/* After the first keys: 1/publish_hz = k dt with 1 <= k <= TICKS_MAX, and dt_min <= dt. */
+static int check_period(conv *cv)
+{
+    lag_scene *sc = cv->sc;
+    double dt = sc->sim.integrator.dt;
+    double period = 1.0 / sc->publish_hz;
+    double r = period / dt;
+    const ynode *at = cv->publish_hz ? cv->publish_hz
+                    : cv->dt ? cv->dt
+                    : cv->integrator ? cv->integrator : cv->root;
+    const char *atpath = cv->publish_hz ? "publish_hz"
+                       : cv->dt ? "integrator.dt"
+                       : cv->integrator ? "integrator" : NULL;
+    if (!(r >= 1.0 - 1e-9))
+        return yfail(cv->err, at, atpath,
+                     "1/publish_hz = %.17g s must be an integer multiple (>= 1) of "
+                     "integrator.dt = %.17g s", period, dt);
+    double ticks = floor(r + 0.5);
+    if (fabs(r - ticks) > 1e-9 * r)
+        return yfail(cv->err, at, atpath,
+                     "1/publish_hz = %.17g s must be an integer multiple of integrator.dt = "
+                     "%.17g s (it is %.6g dt)", period, dt, r);
+    if (ticks > TICKS_MAX)
+        return yfail(cv->err, at, atpath,
+                     "1/publish_hz = %.17g s is %.0f ticks of integrator.dt = %.17g s: at most "
+                     "%d ticks per control period (one period is one uninterrupted call)",
+                     period, ticks, dt, TICKS_MAX);
+    sc->ticks_per_period = (int64_t)ticks;
+
+    if (sc->sim.integrator.dt_min > dt)
+        return yfail(cv->err, cv->dt_min ? cv->dt_min : at,
+                     cv->dt_min ? "integrator.dt_min" : atpath,
+                     "expected a number <= integrator.dt = %.17g s, got %.17g",
+                     dt, sc->sim.integrator.dt_min);
+    return 0;
+}
+
+int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, errbuf *err)
+{
+    conv cv = {.err = err, .sc = sc, .root = root, .gravity_enabled = -1};
+    if (root->kind != YN_MAP) {
+        if (ynode_is_null(root))
+            return yfail(err, root, NULL,
+                         "expected a mapping with the scene's keys (at least 'model'), "
+                         "got an empty document");
+        return yfail(err, root, NULL,
+                     "expected a mapping with the scene's keys (at least 'model'), got %s",
+                     ynode_kind_name(root));
+    }
+
+    /* The model comes first: parameters, the length of q and the defaults depend on it. */
+    char models[256];
+    model_list(models, sizeof models);
+    const yentry *me = ymap_find(root, "model");
+    if (!me)
+        return yfail(err, root, NULL, "missing required key 'model' (%s)", models);
+    const char *mname;
+    char what[300];
+    snprintf(what, sizeof what, "a model (%s)", models);
+    if (get_string(&cv, me->val, "model", what, &mname) < 0)
+        return -1;
+    int kind = lag_model_kind_from_name(mname);
+    if (kind < 0)
+        return yfail(err, me->val, "model", "unknown model '%s'; allowed: %s", mname, models);
+
+    lag_scene_default(sc, (lag_model_kind)kind);
+    snprintf(sc->path, sizeof sc->path, "%s", path ? path : "");
+    lag_model_default_unfinished(&sc->sim.model, (lag_model_kind)kind);
+    cv.info = lag_model_info_get((lag_model_kind)kind);
+
+    /* Then what the other values are measured against, then the rest in file order. */
+    for (int k = 1; k_first_keys[k]; k++) {
+        const yentry *en = ymap_find(root, k_first_keys[k]);
+        if (!en)
+            continue;
+        const keyrow *r = k_top_keys;
+        while (strcmp(r->name, en->key) != 0)
+            r++;
+        if (r->fn(&cv, en->val, en->key) < 0)
+            return -1;
+    }
+    if (check_period(&cv) < 0)
+        return -1;
+    /* the watchdog default: 0.5 s, but never shorter than two control periods */
+    double period = (double)sc->ticks_per_period * sc->sim.integrator.dt;
+    if (sc->realtime.command_timeout < 2.0 * period)
+        sc->realtime.command_timeout = 2.0 * period;
+    if (convert_map_skip(&cv, root, "", k_top_keys, "key", k_first_keys) < 0)
+        return -1;
+
+    /* effects.gravity overrides parameters.g (after both are read, whatever their order) */
+    int gi = lag_model_param_index(sc->sim.model.kind, "g");
+    if (gi >= 0 && cv.gravity_g_node) sc->sim.model.p[gi] = cv.gravity_g;
+    if (gi >= 0 && cv.gravity_enabled == 0) sc->sim.model.p[gi] = 0.0;
+
+    /* Parameters: uniform-rod inertias not given -> m l^2 / 12; then the core's check. */
+    char msg[256];
+    lag_model_finish(&sc->sim.model);
+    if (lag_model_validate(&sc->sim.model, msg, sizeof msg) != LAG_OK)
+        return yfail(err, cv.parameters ? cv.parameters : me->val,
+                     cv.parameters ? "parameters" : NULL, "%s", msg);
+
+    /* Real time: at most PERIODS_PER_S_MAX control periods per wall second. */
+    if (sc->realtime.mode == LAG_RT_REALTIME &&
+        sc->publish_hz * sc->realtime.rate > PERIODS_PER_S_MAX * (1.0 + 1e-12)) {
+        const ynode *at = cv.rate ? cv.rate : cv.publish_hz;
+        return yfail(err, at, cv.rate ? "realtime.rate" : "publish_hz",
+                     "publish_hz * realtime.rate = %.6g control periods per wall second: at "
+                     "most %.0f in realtime mode (mode: fast runs as fast as it can)",
+                     sc->publish_hz * sc->realtime.rate, PERIODS_PER_S_MAX);
+    }
+
+    /* The initial state must lie within the stops and above the floor. */
+    const lag_effects_def *e = &sc->sim.effects;
+    for (int i = 0; i < sc->sim.model.nq; i++) {
+        if (!((e->enabled & LAG_EFF_LIMITS) && e->limit_on[i])) continue;
+        if (sc->sim.q0[i] < e->limit_lower[i] || sc->sim.q0[i] > e->limit_upper[i])
+            return yfail(err, cv.initial ? cv.initial : cv.limits_node,
+                         cv.initial ? "initial" : "effects.limits",
+                         "initial %s = %g is outside its limits [%g, %g]",
+                         cv.info->joint_names[i], sc->sim.q0[i], e->limit_lower[i],
+                         e->limit_upper[i]);
+    }
+    if ((e->enabled & LAG_EFF_FLOOR) && (sc->sim.q0[1] < 0 || sc->sim.q0[1] > M_PI))
+        return yfail(err, cv.initial ? cv.initial : cv.floor_node,
+                     cv.initial ? "initial" : "effects.floor",
+                     "initial phi = %g must be in [0, pi] with a floor", sc->sim.q0[1]);
+
+    /* lcm.url, with lcm.allow_lan wherever it was given */
+    if (lag_scene_check_url(sc->lcm.url, sc->lcm.allow_lan, &sc->lcm.ttl, msg, sizeof msg) < 0)
+        return yfail(err, cv.url, "lcm.url", "%s", msg);
+
+    /* Final check by the core (integrator settings, initial state). */
+    if (lag_sim_def_validate(&sc->sim, msg, sizeof msg) != LAG_OK)
+        return yfail(err, root, NULL, "invalid scene: %s", msg);
+    return 0;
+}
