@@ -121,4 +121,19 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_ja
   list(APPEND lang_tests clients_cross_language_dipc)
 endif()
 
+# ---- README.md's controller blocks, run as written (tests/clients/readme_snippets.py)
+set(readme_run ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_snippets.py
+    --lagsimd ${lang_lagsimd} --build ${CMAKE_BINARY_DIR} --readme ${PROJECT_SOURCE_DIR}/README.md
+    --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml)
+add_test(NAME clients_readme_python COMMAND ${readme_run} python-dipc)
+list(APPEND lang_tests clients_readme_python)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
+  add_test(NAME clients_readme_lua COMMAND ${readme_run} lua-dipc)
+  list(APPEND lang_tests clients_readme_lua)
+endif()
+if(TARGET lagsim_lcmtypes_java)
+  add_test(NAME clients_readme_java COMMAND ${readme_run} java-dipc)
+  list(APPEND lang_tests clients_readme_java)
+endif()
+
 set_tests_properties(${lang_tests} PROPERTIES TIMEOUT 90 LABELS clients)

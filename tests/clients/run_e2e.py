@@ -149,6 +149,7 @@ def main():
     env = dict(vals)
     if t_daemon_end is not None:
         env["wall"] = t_client_end - t_daemon_end
+        print("wall = %.3f s from the daemon's end to the controller's" % env["wall"])
     env["math"] = math
     for expr in a.check:
         try:

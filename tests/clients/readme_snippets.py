@@ -1,0 +1,156 @@
+#!/usr/bin/env python3
+"""Runs the controllers that README.md shows, exactly as written there.
+
+    readme_snippets.py --lagsimd BIN --build DIR --readme README.md NAME...
+
+README.md marks each runnable block with an HTML comment on the line before its fence,
+<!-- snippet: NAME -->. For each NAME given, the block is written to a fresh temporary
+directory (so it runs from any directory, as the README promises), its channel prefix
+DIPC is replaced by one unique to this run, and it is started the way the README says
+(PYTHONPATH=<build>/python; LUA_PATH=<build>/lua/...; java -cp lcm.jar:types.jar
+File.java). Once it answers a probe state (sim time -1) it is subscribed; then lagsimd runs config/dipc.yaml in lockstep for 2 s of sim time and stops.
+The snippet must exit by itself with status 0 once the daemon announces its stop; the
+daemon's final status must show every state before t = 2 s answered (200
+commands_accepted, no lockstep timeout), and every state heard must keep both rods within 0.1 rad of
+upright (the shipped scene starts at 0.05 rad).
+"""
+import argparse
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+RUNNERS = {
+    "python": ("balance.py", lambda b, f: ["python3", f],
+               lambda b: {"PYTHONPATH": os.path.join(b, "python")}),
+    "lua": ("balance.lua", lambda b, f: ["lua5.2", f],
+            lambda b: {"LUA_PATH": "%s/lua/?.lua;%s/lua/?/init.lua;;" % (b, b)}),
+    "java": ("Balance.java",
+             lambda b, f: ["java", "-cp", "/usr/share/java/lcm.jar:%s/lagsim_types.jar" % b, f],
+             lambda b: {}),
+}
+
+
+def snippets(readme):
+    text = open(readme).read()
+    found = {}
+    for m in re.finditer(r"<!-- snippet: (\S+) -->\s*\n```[a-z]*\n(.*?)\n```", text, re.S):
+        found[m.group(1)] = m.group(2) + "\n"
+    return found
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--lagsimd", required=True)
+    ap.add_argument("--build", required=True)
+    ap.add_argument("--readme", required=True)
+    ap.add_argument("--config", required=True)
+    ap.add_argument("names", nargs="+")
+    a = ap.parse_args()
+    build = os.path.abspath(a.build)
+    sys.path.insert(0, os.path.join(build, "python"))
+    from lagsim_lcm import LCM
+    from lagsim import joint_command_t, joint_state_t, status_t
+
+    found = snippets(a.readme)
+    fails = 0
+    for name in a.names:
+        lang = name.split("-")[0]
+        if name not in found or lang not in RUNNERS:
+            print("FAIL: no block marked <!-- snippet: %s --> in %s" % (name, a.readme))
+            fails += 1
+            continue
+        fname, cmd, env_extra = RUNNERS[lang]
+        prefix = "RDME%s_%d" % (lang.upper(), os.getpid())
+        tmp = tempfile.mkdtemp(prefix="lagsim_readme_")
+        path = os.path.join(tmp, fname)
+        with open(path, "w") as f:
+            f.write(found[name].replace('"DIPC_', '"%s_' % prefix).replace("'DIPC_", "'%s_" % prefix))
+        env = dict(os.environ)
+        env.update(env_extra(build))
+        lc = LCM()
+        heard = {"states": 0, "max_th": 0.0, "t": -1.0, "status": None}
+
+        def on_state(ch, data):
+            st = joint_state_t.decode(data)
+            if st.sim_time < 0:
+                return
+            heard["states"] += 1
+            heard["t"] = max(heard["t"], st.sim_time)
+            heard["max_th"] = max([heard["max_th"]] + [abs(x) for x in st.position[1:3]])
+
+        def on_status(ch, data):
+            heard["status"] = status_t.decode(data)
+
+        def on_command(ch, data):
+            if joint_command_t.decode(data).sim_time == -1.0:
+                heard["ready"] = True
+
+        lc.subscribe(prefix + "_STATE", on_state)
+        lc.subscribe(prefix + "_STATUS", on_status)
+        lc.subscribe(prefix + "_COMMAND", on_command)
+        heard["ready"] = False
+        listening = [True]
+
+        def listen():  # its own thread: the daemon in lockstep outruns a late reader
+            while listening[0]:
+                lc.handle_timeout(50)
+
+        th = threading.Thread(target=listen)
+        th.start()
+        snip = subprocess.Popen(cmd(build, path), cwd=tmp, env=env, stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT, universal_newlines=True)
+        # Ready when it answers: a probe state at sim time -1, every 0.2 s, until a command
+        # for it comes back (java compiles the file first). Then the daemon starts.
+        probe = joint_state_t()
+        probe.sim_time, probe.num_joints = -1.0, 3
+        probe.name = ["theta0", "theta1", "theta2"]
+        probe.position = probe.velocity = probe.effort = [0.0, 0.0, 0.0]
+        deadline = time.monotonic() + 30
+        while not heard["ready"] and time.monotonic() < deadline and snip.poll() is None:
+            lc.publish(prefix + "_STATE", probe.encode())
+            time.sleep(0.2)
+        heard["states"] = 0
+        daemon = subprocess.run(
+            [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
+             "--set", "realtime.mode=lockstep", "--duration", "2", "-q"],
+            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
+            timeout=60)
+        try:
+            out, _ = snip.communicate(timeout=20)
+        except subprocess.TimeoutExpired:
+            snip.kill()
+            out, _ = snip.communicate()
+            out += "\n(killed: did not exit after the daemon's stop)"
+        time.sleep(0.5)
+        listening[0] = False
+        th.join()
+        lc.close()
+        st = heard["status"]
+        acc = st.commands_accepted if st else -1
+        lto = st.lockstep_timeouts if st else -1
+        checks = [
+            (daemon.returncode == 0, "lagsimd ran 2 s and exited 0"),
+            (snip.returncode == 0, "the snippet exited 0 after the daemon's stop"),
+            (acc == 200 and lto == 0,
+             "answered %d of the 200 states before t = 2 s, %d lockstep timeout(s)"
+             % (acc, lto)),
+            (heard["states"] > 0 and heard["max_th"] < 0.1 and math.isfinite(heard["max_th"]),
+             "balanced: %d states heard, largest |theta1|, |theta2| %.4f rad"
+             % (heard["states"], heard["max_th"])),
+        ]
+        print("---- %s (%s)" % (name, path))
+        if out.strip():
+            print(out.rstrip())
+        for good, what in checks:
+            print("%s: %s" % ("ok  " if good else "FAIL", what))
+            fails += 0 if good else 1
+    return 1 if fails else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
