@@ -172,7 +172,22 @@ void rt_publish_scene(rt_server *s)
         m.actuated[i] = s->info->actuated[i];
         m.initial_q[i] = fin(d->q0[i]);
         m.initial_qd[i] = fin(d->qd0[i]);
+        m.limit_on[i] = (d->effects.enabled & LAG_EFF_LIMITS) && d->effects.limit_on[i];
+        m.limit_lower[i] = m.limit_on[i] ? fin(d->effects.limit_lower[i]) : 0.0;
+        m.limit_upper[i] = m.limit_on[i] ? fin(d->effects.limit_upper[i]) : 0.0;
     }
+    /* the effects that are on, by their scene-file names */
+    static const struct { uint32_t bit; const char *name; } fx[] = {
+        {LAG_EFF_DAMPING, "damping"},   {LAG_EFF_FRICTION, "friction"},
+        {LAG_EFF_LIMITS, "limits"},     {LAG_EFF_FLOOR, "floor"},
+        {LAG_EFF_ACTUATOR, "actuator"}, {LAG_EFF_DISTURBANCE, "disturbance"},
+        {LAG_EFF_NOISE, "noise"},
+    };
+    size_t ne = 0;
+    for (size_t k = 0; k < sizeof fx / sizeof fx[0]; k++)
+        if (d->effects.enabled & fx[k].bit)
+            ne += (size_t)snprintf(m.effects + ne, sizeof m.effects - ne, "%s%s", ne ? "," : "",
+                                   fx[k].name);
     m.dt = fin(d->integrator.dt);
     m.control_period = fin((double)s->sc->ticks_per_period * d->integrator.dt);
     PUT(m.integrator, lag_method_name(d->integrator.method));

@@ -123,6 +123,10 @@ static const lag_wire_field scene_fields[] = {
     STRING(SC, mode),
     SCALAR(SC, LAG_WIRE_DOUBLE, rate),
     SCALAR(SC, LAG_WIRE_DOUBLE, command_timeout),
+    STRING(SC, effects),
+    ARRAY(SC, LAG_WIRE_BOOLEAN, limit_on, 6),
+    ARRAY(SC, LAG_WIRE_DOUBLE, limit_lower, 6),
+    ARRAY(SC, LAG_WIRE_DOUBLE, limit_upper, 6),
 };
 
 /* The C storage of each kind must be what the decoder writes. */

@@ -169,6 +169,10 @@ typedef struct lag_wire_scene {
     char mode[LAG_WIRE_NAME_LEN];
     double rate;
     double command_timeout;
+    char effects[LAG_WIRE_NAME_LEN];                 /* effects on, comma-separated */
+    bool limit_on[LAG_WIRE_MAX_JOINTS];              /* the joint has stops */
+    double limit_lower[LAG_WIRE_MAX_JOINTS];         /* m or rad, 0 where no stops */
+    double limit_upper[LAG_WIRE_MAX_JOINTS];
 } lag_wire_scene;
 
 /* ---------------------------------------------------------------- per type */

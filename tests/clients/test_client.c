@@ -149,13 +149,15 @@ int main(void)
     snprintf(ch, sizeof ch, "%s_SCENE", prefix);
     char *pn[2] = {"m1", "g"}, *jn[2] = {"q1", "q2"};
     double pv[2] = {2.0, 9.81}, iq[2] = {0.0, 0.5}, iqd[2] = {0, 0};
-    int8_t act[2] = {1, 0};
+    int8_t act[2] = {1, 0}, lim_on[2] = {0, 0};
+    double lim[2] = {0, 0};
     lagsim_scene_t s = {.utime = 1, .model = "manipulator", .prefix = prefix, .num_params = 2,
                         .param_name = pn, .param_value = pv, .num_joints = 2,
                         .joint_name = jn, .actuated = act, .initial_q = iq,
                         .initial_qd = iqd, .dt = 0.001, .control_period = 0.01,
                         .integrator = "rk4", .mode = "lockstep", .rate = 1.0,
-                        .command_timeout = 0.5};
+                        .command_timeout = 0.5, .effects = "", .limit_on = lim_on,
+                        .limit_lower = lim, .limit_upper = lim};
     lagsim_scene_t_publish(peer, ch, &s);
     ENSURE(lag_client_wait_scene(c, 2.0, &sc) == LAG_CLIENT_OK);
     ENSURE(strcmp(sc.model, "manipulator") == 0 && strcmp(sc.mode, "lockstep") == 0);

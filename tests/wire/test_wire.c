@@ -302,13 +302,15 @@ static void check_agreement(void)
     {
         char *pn[3] = {"m0", "l1", "g"}, *jn[3] = {"theta0", "theta1", "theta2"};
         double pv[3] = {1.5, 0.5, 9.81}, q0[3] = {0, 0.1, -0.05}, qd0[3] = {0, 0, 1};
-        int8_t act[3] = {1, 0, 0};
+        int8_t act[3] = {1, 0, 0}, lon[3] = {1, 0, 0};
+        double llo[3] = {-0.5, 0, 0}, lhi[3] = {0.5, 0, 0};
         lagsim_scene_t g = {.utime = 99, .model = "dipc", .prefix = "DIPC", .num_params = 3,
                             .param_name = pn, .param_value = pv, .num_joints = 3,
                             .joint_name = jn, .actuated = act, .initial_q = q0,
                             .initial_qd = qd0, .dt = 0.001, .control_period = 0.01,
                             .integrator = "rk4", .mode = "realtime", .rate = 1.0,
-                            .command_timeout = 0.5};
+                            .command_timeout = 0.5, .effects = "limits,noise",
+                            .limit_on = lon, .limit_lower = llo, .limit_upper = lhi};
         int nt = lagsim_scene_t_encode(theirs, 0, sizeof theirs, &g);
         lag_wire_scene w;
         memset(&w, 0, sizeof w);
@@ -324,7 +326,11 @@ static void check_agreement(void)
             w.actuated[i] = act[i] != 0;
             w.initial_q[i] = q0[i];
             w.initial_qd[i] = qd0[i];
+            w.limit_on[i] = lon[i] != 0;
+            w.limit_lower[i] = llo[i];
+            w.limit_upper[i] = lhi[i];
         }
+        strcpy(w.effects, "limits,noise");
         w.dt = 0.001;
         w.control_period = 0.01;
         strcpy(w.integrator, "rk4");
@@ -427,9 +433,11 @@ static void check_hostile(void)
     char *jn[1] = {"x"};
     int8_t act[1] = {2};
     double one[1] = {1};
+    int8_t nolim[1] = {0};
     lagsim_scene_t s = {.model = "m", .prefix = "P", .num_joints = 1, .joint_name = jn,
                         .actuated = act, .initial_q = one, .initial_qd = one,
-                        .integrator = "rk4", .mode = "fast"};
+                        .integrator = "rk4", .mode = "fast", .effects = "",
+                        .limit_on = nolim, .limit_lower = one, .limit_upper = one};
     nt = lagsim_scene_t_encode(b, 0, sizeof b, &s);
     lag_wire_scene sc;
     ENSURE(decode_exact(LAG_WIRE_SCENE, b, (size_t)nt, 8, &sc) == LAG_WIRE_EVALUE);
@@ -494,8 +502,8 @@ static void check_encoder(void)
     memset(&s, 'a', sizeof s);
     s.num_params = LAG_WIRE_MAX_PARAMS;
     s.num_joints = LAG_WIRE_MAX_JOINTS;
-    char *strs[] = {s.model, s.prefix, s.integrator, s.mode};
-    for (int k = 0; k < 4; k++) strs[k][LAG_WIRE_NAME_LEN - 1] = '\0';
+    char *strs[] = {s.model, s.prefix, s.integrator, s.mode, s.effects};
+    for (int k = 0; k < 5; k++) strs[k][LAG_WIRE_NAME_LEN - 1] = '\0';
     for (int i = 0; i < LAG_WIRE_MAX_PARAMS; i++) {
         s.param_name[i][LAG_WIRE_NAME_LEN - 1] = '\0';
         s.param_value[i] = i;
@@ -503,7 +511,9 @@ static void check_encoder(void)
     for (int i = 0; i < LAG_WIRE_MAX_JOINTS; i++) {
         s.joint_name[i][LAG_WIRE_NAME_LEN - 1] = '\0';
         s.actuated[i] = true;
+        s.limit_on[i] = true;
         s.initial_q[i] = s.initial_qd[i] = 0;
+        s.limit_lower[i] = s.limit_upper[i] = 0;
     }
     s.utime = 0;
     s.dt = s.control_period = s.rate = s.command_timeout = 1;
