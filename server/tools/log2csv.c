@@ -1,0 +1,613 @@
+/*
+ * lagsim-log2csv's conversion (see log2csv.h).
+ *
+ * One pass over the log. Each channel takes the lagsim type of its first decodable
+ * message; its CSV is opened then, with a header from that message (a state's joint
+ * names). A later message of another type or other joints on the same channel is not
+ * written, only counted. Every number is written "%.17g" (a reread gives the same
+ * double); strings are quoted, control characters replaced by spaces.
+ *
+ * Per-channel facts for the summary: counts, log-time span and rate, undecodable
+ * messages; for states the step sequence (gaps: a step increase other than one control
+ * period, with the states missing; resets: the step going back; repeats: the same step
+ * again, as while paused); for status the last counters; for events a count per kind.
+ */
+#include "log2csv.h"
+
+#include <errno.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define L2C_MAX_CHANNELS 256
+#define L2C_MAX_KINDS 48
+#define L2C_NAME LAG_WIRE_NAME_LEN
+#define L2C_JOINTS LAG_WIRE_MAX_JOINTS
+#define L2C_NONE (-1)               /* a channel's type before a lagsim message decodes */
+
+typedef struct chan {
+    char name[LAG_LOG_CHANNEL_MAX + 1];
+    int type;                   /* lag_wire_type, or L2C_NONE */
+    bool selected;
+    FILE *csv;
+    int64_t messages, rows, undecodable, mismatched;
+    int64_t first_ts, last_ts;
+    /* states */
+    int nj;
+    char joint[L2C_JOINTS][L2C_NAME];
+    bool have_prev;
+    int64_t prev_step, first_step, last_step;
+    int64_t period_ticks;       /* 0 = unknown yet */
+    bool period_from_scene;
+    int64_t gaps, missing, resets, repeats;
+    double first_sim, last_sim;
+    /* status */
+    lag_wire_status last_status;
+    bool have_status;
+    /* events */
+    int n_kinds;
+    char kind[L2C_MAX_KINDS][L2C_NAME];
+    int64_t kind_count[L2C_MAX_KINDS];
+    int64_t kinds_other;
+    /* scenes: ticks per control period of the latest one */
+    int64_t scene_period_ticks;
+} chan;
+
+typedef struct l2c {
+    const l2c_opts *o;
+    chan *ch;
+    int n_ch, cap_ch;
+    FILE *discard;              /* /dev/null, shared by every channel when outdir is NULL */
+    int64_t untracked;          /* messages on channels beyond L2C_MAX_CHANNELS */
+    char used[L2C_MAX_CHANNELS][LAG_LOG_CHANNEL_MAX + 24]; /* CSV file names taken */
+    int n_used;
+    char *err;
+    size_t errlen;
+    bool write_failed;
+} l2c;
+
+/* ---------------------------------------------------------------- CSV helpers */
+static void put_d(FILE *f, double x) { fprintf(f, ",%.17g", x); }
+static void put_i(FILE *f, int64_t x) { fprintf(f, ",%" PRId64, x); }
+static void put_s(FILE *f, const char *s)
+{
+    fputs(",\"", f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"') fputs("\"\"", f);
+        else if (c < 0x20 || c == 0x7f) fputc(' ', f);
+        else fputc(c, f);
+    }
+    fputc('"', f);
+}
+/* Log timestamp and utime in seconds since the epoch (us resolution). */
+static void put_us(FILE *f, int64_t us, bool first)
+{
+    /* exact: integer seconds and microseconds, no rounding through a double */
+    int64_t s = us / 1000000, r = us % 1000000;
+    if (r < 0) {
+        r += 1000000;
+        s -= 1;
+    }
+    fprintf(f, "%s%" PRId64 ".%06" PRId64, first ? "" : ",", s, r);
+}
+
+/* A channel name as a file name: [A-Za-z0-9_.-], no leading dot, unique. */
+static void file_name(l2c *c, const char *channel, char *out, size_t cap)
+{
+    char base[LAG_LOG_CHANNEL_MAX + 1];
+    size_t n = 0;
+    for (const char *p = channel; *p && n + 1 < sizeof base; p++) {
+        char k = *p;
+        bool ok = (k >= 'A' && k <= 'Z') || (k >= 'a' && k <= 'z') || (k >= '0' && k <= '9') ||
+                  k == '_' || k == '-' || (k == '.' && n > 0);
+        base[n++] = ok ? k : '_';
+    }
+    base[n] = '\0';
+    for (int k = 1;; k++) {
+        if (k == 1) snprintf(out, cap, "%s.csv", base);
+        else snprintf(out, cap, "%s.%d.csv", base, k);
+        bool taken = false;
+        for (int i = 0; i < c->n_used && !taken; i++) taken = strcmp(c->used[i], out) == 0;
+        if (!taken) break;
+    }
+    if (c->n_used < L2C_MAX_CHANNELS) {
+        snprintf(c->used[c->n_used], sizeof c->used[0], "%s", out);
+        c->n_used++;
+    }
+}
+
+static FILE *open_csv(l2c *c, chan *h)
+{
+    FILE *f;
+    if (!c->o->outdir) {
+        if (!c->discard && !(c->discard = fopen("/dev/null", "w"))) {
+            snprintf(c->err, c->errlen, "cannot open /dev/null: %s", strerror(errno));
+            c->write_failed = true;
+        }
+        return c->discard;
+    } else {
+        char fname[LAG_LOG_CHANNEL_MAX + 24], path[4096];
+        file_name(c, h->name, fname, sizeof fname);
+        snprintf(path, sizeof path, "%s/%s", c->o->outdir, fname);
+        f = fopen(path, "w");
+        if (!f) {
+            snprintf(c->err, c->errlen, "cannot write %s: %s", path, strerror(errno));
+            c->write_failed = true;
+            return NULL;
+        }
+        if (c->o->listing)
+            fprintf(c->o->listing, "%s  (%s, %s)\n", path, h->name,
+                    lag_wire_type_name((lag_wire_type)h->type));
+    }
+    return f;
+}
+
+/* ---------------------------------------------------------------- channels */
+static chan *find_chan(l2c *c, const char *name)
+{
+    for (int i = 0; i < c->n_ch; i++)
+        if (strcmp(c->ch[i].name, name) == 0) return &c->ch[i];
+    if (c->n_ch >= L2C_MAX_CHANNELS) return NULL;
+    if (c->n_ch == c->cap_ch) {
+        int cap = c->cap_ch ? 2 * c->cap_ch : 8;
+        chan *nc = realloc(c->ch, (size_t)cap * sizeof *nc);
+        if (!nc) return NULL;
+        c->ch = nc;
+        c->cap_ch = cap;
+    }
+    chan *h = &c->ch[c->n_ch++];
+    memset(h, 0, sizeof *h);
+    snprintf(h->name, sizeof h->name, "%s", name);
+    h->type = L2C_NONE;
+    h->selected = c->o->n_select == 0;
+    for (int i = 0; i < c->o->n_select; i++)
+        if (strcmp(c->o->select[i], name) == 0) h->selected = true;
+    return h;
+}
+
+/* The scene channel that goes with a state channel: "<PREFIX>_STATE" -> "<PREFIX>_SCENE". */
+static chan *scene_of(l2c *c, const chan *state)
+{
+    size_t n = strlen(state->name);
+    if (n < 6 || strcmp(state->name + n - 6, "_STATE") != 0) return NULL;
+    char name[LAG_LOG_CHANNEL_MAX + 1];
+    snprintf(name, sizeof name, "%.*s_SCENE", (int)(n - 6), state->name);
+    for (int i = 0; i < c->n_ch; i++)
+        if (strcmp(c->ch[i].name, name) == 0) return &c->ch[i];
+    return NULL;
+}
+
+/* ---------------------------------------------------------------- one type each */
+static void header_state(FILE *f, const lag_wire_joint_state *m)
+{
+    fputs("t,wall_time,log_time,step", f);
+    for (int i = 0; i < m->num_joints; i++) fprintf(f, ",%s", m->name[i]);
+    for (int i = 0; i < m->num_joints; i++) fprintf(f, ",%s_dot", m->name[i]);
+    for (int i = 0; i < m->num_joints; i++) fprintf(f, ",%s_effort", m->name[i]);
+    fputc('\n', f);
+}
+
+/* Step bookkeeping of a state channel (gaps, resets, repeats). */
+static void track_steps(l2c *c, chan *h, const lag_wire_joint_state *m)
+{
+    chan *sc = scene_of(c, h);
+    if (sc && sc->scene_period_ticks > 0) {
+        h->period_ticks = sc->scene_period_ticks;
+        h->period_from_scene = true;
+    }
+    if (!h->have_prev) {
+        h->first_step = m->step;
+        h->first_sim = m->sim_time;
+    } else {
+        /* differences of hostile steps may overflow: compare before subtracting */
+        if (m->step < h->prev_step) {
+            h->resets++;
+        } else if (m->step == h->prev_step) {
+            h->repeats++;
+        } else {
+            uint64_t d = (uint64_t)m->step - (uint64_t)h->prev_step;
+            if (h->period_ticks == 0) h->period_ticks = d > INT64_MAX ? INT64_MAX : (int64_t)d;
+            uint64_t p = (uint64_t)h->period_ticks;
+            if (d != p) {
+                h->gaps++;
+                if (d > p && d % p == 0) {
+                    uint64_t miss = d / p - 1;
+                    h->missing = (uint64_t)h->missing + miss > INT64_MAX ? INT64_MAX
+                                                                       : h->missing + (int64_t)miss;
+                }
+            }
+        }
+    }
+    h->have_prev = true;
+    h->prev_step = m->step;
+    h->last_step = m->step;
+    h->last_sim = m->sim_time;
+}
+
+static bool write_state(l2c *c, chan *h, const lag_log_record *r, const lag_wire_joint_state *m)
+{
+    if (!h->csv) {
+        h->nj = m->num_joints;
+        for (int i = 0; i < m->num_joints; i++) snprintf(h->joint[i], L2C_NAME, "%s", m->name[i]);
+        if (!(h->csv = open_csv(c, h))) return false;
+        header_state(h->csv, m);
+    }
+    bool same = m->num_joints == h->nj;
+    for (int i = 0; same && i < h->nj; i++) same = strcmp(m->name[i], h->joint[i]) == 0;
+    if (!same) {
+        h->mismatched++;
+        return true;
+    }
+    track_steps(c, h, m);
+    FILE *f = h->csv;
+    fprintf(f, "%.17g", m->sim_time);
+    put_us(f, m->utime, false);
+    put_us(f, r->timestamp, false);
+    put_i(f, m->step);
+    for (int i = 0; i < m->num_joints; i++) put_d(f, m->position[i]);
+    for (int i = 0; i < m->num_joints; i++) put_d(f, m->velocity[i]);
+    for (int i = 0; i < m->num_joints; i++) put_d(f, m->effort[i]);
+    fputc('\n', f);
+    return true;
+}
+
+static bool write_status(l2c *c, chan *h, const lag_log_record *r, const lag_wire_status *m)
+{
+    if (!h->csv) {
+        if (!(h->csv = open_csv(c, h))) return false;
+        fputs("t,wall_time,log_time,step,daemon_wall_time,rtf,overruns,step_time_max_us,"
+              "step_time_mean_us,energy,integrator,mode,run_state,commands_accepted,"
+              "rejected_unknown_joint,rejected_unactuated,rejected_nonfinite,"
+              "rejected_bad_length,rejected_undecodable,controls_rejected,watchdog_tripped,"
+              "watchdog_trips,lockstep_timeouts,numeric_faults,rejected_stale,overrun_bursts,"
+              "states_published\n", h->csv);
+    }
+    FILE *f = h->csv;
+    fprintf(f, "%.17g", m->sim_time);
+    put_us(f, m->utime, false);
+    put_us(f, r->timestamp, false);
+    put_i(f, m->step);
+    put_d(f, m->wall_time);
+    put_d(f, m->rtf);
+    put_i(f, m->overruns);
+    put_d(f, m->step_time_max_us);
+    put_d(f, m->step_time_mean_us);
+    put_d(f, m->energy);
+    put_s(f, m->integrator);
+    put_s(f, m->mode);
+    put_s(f, m->run_state);
+    put_i(f, m->commands_accepted);
+    put_i(f, m->rejected_unknown_joint);
+    put_i(f, m->rejected_unactuated);
+    put_i(f, m->rejected_nonfinite);
+    put_i(f, m->rejected_bad_length);
+    put_i(f, m->rejected_undecodable);
+    put_i(f, m->controls_rejected);
+    put_i(f, m->watchdog_tripped ? 1 : 0);
+    put_i(f, m->watchdog_trips);
+    put_i(f, m->lockstep_timeouts);
+    put_i(f, m->numeric_faults);
+    put_i(f, m->rejected_stale);
+    put_i(f, m->overrun_bursts);
+    put_i(f, m->states_published);
+    fputc('\n', f);
+    h->last_status = *m;
+    h->have_status = true;
+    return true;
+}
+
+static bool write_event(l2c *c, chan *h, const lag_log_record *r, const lag_wire_event *m)
+{
+    if (!h->csv) {
+        if (!(h->csv = open_csv(c, h))) return false;
+        fputs("t,wall_time,log_time,step,kind,joint,value,detail\n", h->csv);
+    }
+    FILE *f = h->csv;
+    fprintf(f, "%.17g", m->sim_time);
+    put_us(f, m->utime, false);
+    put_us(f, r->timestamp, false);
+    put_i(f, m->step);
+    put_s(f, m->kind);
+    put_s(f, m->joint);
+    put_d(f, m->value);
+    put_s(f, m->detail);
+    fputc('\n', f);
+    int k = 0;
+    while (k < h->n_kinds && strcmp(h->kind[k], m->kind) != 0) k++;
+    if (k == h->n_kinds && k < L2C_MAX_KINDS) {
+        snprintf(h->kind[k], L2C_NAME, "%s", m->kind);
+        h->kind_count[k] = 0;
+        h->n_kinds++;
+    }
+    if (k < h->n_kinds) h->kind_count[k]++;
+    else h->kinds_other++;
+    return true;
+}
+
+static bool write_scene(l2c *c, chan *h, const lag_log_record *r, const lag_wire_scene *m)
+{
+    if (!h->csv) {
+        if (!(h->csv = open_csv(c, h))) return false;
+        fputs("wall_time,log_time,model,prefix,dt,control_period,integrator,mode,rate,"
+              "command_timeout,effects,parameters,joints\n", h->csv);
+    }
+    FILE *f = h->csv;
+    char params[LAG_WIRE_MAX_PARAMS * (L2C_NAME + 32)], joints[L2C_JOINTS * (L2C_NAME + 160)];
+    size_t n = 0;
+    params[0] = joints[0] = '\0';
+    for (int i = 0; i < m->num_params; i++)
+        n += (size_t)snprintf(params + n, sizeof params - n, "%s%s=%.17g", i ? " " : "",
+                              m->param_name[i], m->param_value[i]);
+    n = 0;
+    for (int i = 0; i < m->num_joints; i++) {
+        n += (size_t)snprintf(joints + n, sizeof joints - n, "%s%s:%s:q0=%.17g:qd0=%.17g",
+                              i ? " " : "", m->joint_name[i],
+                              m->actuated[i] ? "actuated" : "free", m->initial_q[i],
+                              m->initial_qd[i]);
+        if (m->limit_on[i])
+            n += (size_t)snprintf(joints + n, sizeof joints - n, ":limits=%.17g..%.17g",
+                                  m->limit_lower[i], m->limit_upper[i]);
+    }
+    put_us(f, m->utime, true);
+    put_us(f, r->timestamp, false);
+    put_s(f, m->model);
+    put_s(f, m->prefix);
+    put_d(f, m->dt);
+    put_d(f, m->control_period);
+    put_s(f, m->integrator);
+    put_s(f, m->mode);
+    put_d(f, m->rate);
+    put_d(f, m->command_timeout);
+    put_s(f, m->effects);
+    put_s(f, params);
+    put_s(f, joints);
+    fputc('\n', f);
+    return true;
+}
+
+static bool write_command(l2c *c, chan *h, const lag_log_record *r,
+                          const lag_wire_joint_command *m)
+{
+    if (!h->csv) {
+        if (!(h->csv = open_csv(c, h))) return false;
+        fputs("t,wall_time,log_time,joint,effort\n", h->csv);
+    }
+    FILE *f = h->csv;
+    /* one row per named joint (a command with no joint: one row, joint and effort empty) */
+    for (int i = 0; i < (m->num_joints > 0 ? m->num_joints : 1); i++) {
+        fprintf(f, "%.17g", m->sim_time);
+        put_us(f, m->utime, false);
+        put_us(f, r->timestamp, false);
+        if (m->num_joints > 0) {
+            put_s(f, m->name[i]);
+            put_d(f, m->effort[i]);
+        } else {
+            fputs(",,", f);
+        }
+        fputc('\n', f);
+    }
+    return true;
+}
+
+static const char *request_name(int r)
+{
+    static const char *const names[] = {"", "pause", "resume", "step", "reset", "reset_to",
+                                        "status", "describe"};
+    return r >= 1 && r <= 7 ? names[r] : "unknown";
+}
+
+static bool write_control(l2c *c, chan *h, const lag_log_record *r, const lag_wire_control *m)
+{
+    if (!h->csv) {
+        if (!(h->csv = open_csv(c, h))) return false;
+        fputs("wall_time,log_time,request,name,count,q,qd\n", h->csv);
+    }
+    FILE *f = h->csv;
+    char q[L2C_JOINTS * 26] = "", qd[L2C_JOINTS * 26] = "";
+    size_t nq = 0, nqd = 0;
+    for (int i = 0; i < m->num_joints; i++) {
+        nq += (size_t)snprintf(q + nq, sizeof q - nq, "%s%.17g", i ? " " : "", m->q[i]);
+        nqd += (size_t)snprintf(qd + nqd, sizeof qd - nqd, "%s%.17g", i ? " " : "", m->qd[i]);
+    }
+    put_us(f, m->utime, true);
+    put_us(f, r->timestamp, false);
+    put_i(f, m->request);
+    put_s(f, request_name(m->request));
+    put_i(f, m->count);
+    put_s(f, q);
+    put_s(f, qd);
+    fputc('\n', f);
+    return true;
+}
+
+/* Ticks per control period of a scene (0 if it makes no sense). */
+static int64_t period_ticks(const lag_wire_scene *m)
+{
+    double tpp = m->dt > 0 ? m->control_period / m->dt : 0;
+    return isfinite(tpp) && tpp >= 0.5 && tpp < 1e15 ? (int64_t)llround(tpp) : 0;
+}
+
+/* One record: decode as the channel's type (the first that decodes fixes it). */
+static bool record(l2c *c, const lag_log_record *r)
+{
+    chan *h = find_chan(c, r->channel);
+    if (!h) {
+        c->untracked++;
+        return true;
+    }
+    h->messages++;
+    if (h->messages == 1) h->first_ts = r->timestamp;
+    h->last_ts = r->timestamp;
+    if (!r->data) { /* larger than any lagsim message: not one */
+        if (h->type != L2C_NONE) h->undecodable++;
+        return true;
+    }
+    int t = lag_wire_identify(r->data, r->size);
+    if (h->type == L2C_NONE) {
+        if (t < 0) return true; /* not lagsim's (yet): counted as other */
+        h->type = t;
+    }
+    if (t != h->type) {
+        h->undecodable++;
+        return true;
+    }
+    if (!h->selected && t != LAG_WIRE_SCENE) return true; /* scenes always: they give periods */
+    union {
+        lag_wire_joint_state st;
+        lag_wire_status ss;
+        lag_wire_event ev;
+        lag_wire_scene sc;
+        lag_wire_joint_command cm;
+        lag_wire_control ct;
+    } m;
+    int d = lag_wire_decode((lag_wire_type)t, r->data, r->size, LAG_WIRE_MAX_JOINTS, &m);
+    /* an event's over-long detail is kept, cut (the rest of the event decoded) */
+    if (d == LAG_WIRE_ETOOLONG && t == LAG_WIRE_EVENT) d = LAG_WIRE_OK;
+    if (d != LAG_WIRE_OK) {
+        h->undecodable++;
+        return true;
+    }
+    bool ok = true;
+    switch ((lag_wire_type)t) {
+    case LAG_WIRE_JOINT_STATE: ok = write_state(c, h, r, &m.st); break;
+    case LAG_WIRE_STATUS: ok = write_status(c, h, r, &m.ss); break;
+    case LAG_WIRE_EVENT: ok = write_event(c, h, r, &m.ev); break;
+    case LAG_WIRE_SCENE:
+        h->scene_period_ticks = period_ticks(&m.sc);
+        if (h->selected) ok = write_scene(c, h, r, &m.sc);
+        break;
+    case LAG_WIRE_JOINT_COMMAND: ok = write_command(c, h, r, &m.cm); break;
+    case LAG_WIRE_CONTROL: ok = write_control(c, h, r, &m.ct); break;
+    default: break;
+    }
+    if (h->selected) h->rows++;
+    return ok;
+}
+
+/* ---------------------------------------------------------------- summary */
+static void summarize(l2c *c, const lag_log_stats *ls, FILE *f)
+{
+    fprintf(f, "records: %" PRId64 " (%" PRId64 " larger than %d bytes passed over; %" PRId64
+               " damaged places, %" PRId64 " bytes skipped; last record cut short by %" PRId64
+               " bytes)\n",
+            ls->records, ls->too_large, L2C_MAX_DATA, ls->damaged, ls->bytes_skipped,
+            ls->truncated_bytes);
+    int other = 0;
+    for (int i = 0; i < c->n_ch; i++) {
+        chan *h = &c->ch[i];
+        if (h->type == L2C_NONE) {
+            other++;
+            continue;
+        }
+        if (!h->selected) continue;
+        double span = ((double)h->last_ts - (double)h->first_ts) * 1e-6; /* hostile: no int overflow */
+        fprintf(f, "%s: %s, %" PRId64 " messages", h->name,
+                lag_wire_type_name((lag_wire_type)h->type), h->messages);
+        if (h->messages > 1 && span > 0)
+            fprintf(f, " over %.3f s of log time (%.4g /s)", span, (double)(h->messages - 1) / span);
+        if (h->undecodable) fprintf(f, ", %" PRId64 " undecodable", h->undecodable);
+        if (h->mismatched) fprintf(f, ", %" PRId64 " with other joints (not written)", h->mismatched);
+        fputc('\n', f);
+        switch ((lag_wire_type)h->type) {
+        case LAG_WIRE_JOINT_STATE:
+            if (h->have_prev)
+                fprintf(f, "  sim time %.9g .. %.9g s, step %" PRId64 " .. %" PRId64
+                           "; gaps %" PRId64 " (%" PRId64 " states missing; period %" PRId64
+                           " ticks%s), resets %" PRId64 ", repeats %" PRId64 "\n",
+                        h->first_sim, h->last_sim, h->first_step, h->last_step, h->gaps,
+                        h->missing, h->period_ticks,
+                        h->period_from_scene ? ", from the scene" : ", inferred",
+                        h->resets, h->repeats);
+            break;
+        case LAG_WIRE_STATUS:
+            if (h->have_status) {
+                const lag_wire_status *s = &h->last_status;
+                /* counters from the bus: summed in unsigned arithmetic (a hostile sum wraps,
+                 * it does not overflow) */
+                int64_t rej = (int64_t)((uint64_t)s->rejected_unknown_joint +
+                                        (uint64_t)s->rejected_unactuated +
+                                        (uint64_t)s->rejected_nonfinite +
+                                        (uint64_t)s->rejected_bad_length +
+                                        (uint64_t)s->rejected_undecodable +
+                                        (uint64_t)s->rejected_stale);
+                fprintf(f, "  last: run state %s, commands accepted %" PRId64
+                           ", rejected %" PRId64 " (unknown joint %" PRId64
+                           ", unactuated %" PRId64 ", non-finite %" PRId64
+                           ", bad length %" PRId64 ", undecodable %" PRId64 ", stale %" PRId64
+                           "), controls rejected %" PRId64 ", watchdog trips %" PRId64
+                           ", lockstep timeouts %" PRId64 ", numeric faults %" PRId64
+                           ", overruns %" PRId64 ", states published %" PRId64 "\n",
+                        s->run_state, s->commands_accepted, rej, s->rejected_unknown_joint,
+                        s->rejected_unactuated, s->rejected_nonfinite, s->rejected_bad_length,
+                        s->rejected_undecodable, s->rejected_stale, s->controls_rejected,
+                        s->watchdog_trips, s->lockstep_timeouts, s->numeric_faults,
+                        s->overruns, s->states_published);
+            }
+            break;
+        case LAG_WIRE_EVENT:
+            fputs("  events:", f);
+            for (int k = 0; k < h->n_kinds; k++)
+                fprintf(f, " %s %" PRId64, h->kind[k], h->kind_count[k]);
+            if (h->kinds_other) fprintf(f, " (other kinds %" PRId64 ")", h->kinds_other);
+            fputc('\n', f);
+            break;
+        default:
+            break;
+        }
+    }
+    if (other) {
+        fprintf(f, "other channels (not lagsim's):");
+        for (int i = 0; i < c->n_ch; i++)
+            if (c->ch[i].type == L2C_NONE)
+                fprintf(f, " %s (%" PRId64 ")", c->ch[i].name, c->ch[i].messages);
+        fputc('\n', f);
+    }
+    if (c->untracked)
+        fprintf(f, "messages on channels beyond the first %d: %" PRId64 "\n", L2C_MAX_CHANNELS,
+                c->untracked);
+}
+
+int l2c_convert(lag_log *lg, const l2c_opts *o, FILE *summary, char *err, size_t errlen)
+{
+    l2c c;
+    memset(&c, 0, sizeof c);
+    c.o = o;
+    c.err = err;
+    c.errlen = errlen;
+    int rc = 0;
+    lag_log_record r;
+    int got;
+    while ((got = lag_log_next(lg, &r)) == LAG_LOG_OK) {
+        if (!record(&c, &r)) {
+            rc = 2;
+            break;
+        }
+    }
+    lag_log_stats ls;
+    lag_log_get_stats(lg, &ls);
+    if (got == LAG_LOG_ERROR) {
+        snprintf(err, errlen, "%s", lag_log_errmsg(lg));
+        rc = 1;
+    } else if (rc == 0 && ls.records == 0 && (ls.damaged > 0 || ls.truncated_bytes > 0)) {
+        /* bytes, and not one whole record among them */
+        snprintf(err, errlen, "no complete LCM log record in its %lld bytes: not an LCM log",
+                 (long long)(ls.bytes_skipped + ls.truncated_bytes));
+        rc = 1;
+    }
+    for (int i = 0; i < c.n_ch; i++)
+        if (c.ch[i].csv && c.ch[i].csv != c.discard) {
+            if (ferror(c.ch[i].csv) || fclose(c.ch[i].csv) != 0) {
+                if (rc == 0) {
+                    snprintf(err, errlen, "write error on the CSV of %s", c.ch[i].name);
+                    rc = 2;
+                }
+            }
+            c.ch[i].csv = NULL;
+        }
+    if (summary) summarize(&c, &ls, summary);
+    if (c.discard) fclose(c.discard);
+    free(c.ch);
+    return rc;
+}

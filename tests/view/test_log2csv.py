@@ -1,0 +1,168 @@
+#!/usr/bin/env python3
+"""lagsim-log2csv against logs built here by lcm-gen's Python encoder (an encoder the C
+decoder under test shares nothing with), and against hostile logs.
+
+    test_log2csv.py --log2csv BIN --types DIR CASE     (CASE: exact | hostile)
+"""
+import argparse
+import csv
+import os
+import subprocess
+import sys
+import tempfile
+
+import lcmlog
+
+failures = 0
+
+
+def check(cond, what):
+    global failures
+    if not cond:
+        failures += 1
+        print("FAIL:", what)
+    else:
+        print("ok:", what)
+
+
+def run(binary, *args, timeout=20):
+    p = subprocess.run([binary, *args], capture_output=True, text=True, timeout=timeout)
+    check(p.returncode >= 0 and p.returncode < 128,
+          f"{' '.join(args)}: no crash (exit {p.returncode})")
+    return p
+
+
+def rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def case_exact(a, t, tmp):
+    logf = os.path.join(tmp, "run.lcm")
+    with open(logf, "wb") as f:
+        f.write(lcmlog.log(lcmlog.sample_run(t, "T")))
+    out = os.path.join(tmp, "out")
+    p = run(a.log2csv, logf, "-o", out)
+    print(p.stdout, p.stderr)
+    check(p.returncode == 0, "a valid log converts, exit 0")
+    files = sorted(os.listdir(out))
+    check(files == ["T_COMMAND.csv", "T_CONTROL.csv", "T_EVENT.csv", "T_SCENE.csv", "T_STATE.csv",
+                    "T_STATUS.csv"], f"one CSV per lagsim channel, none for others: {files}")
+
+    st = rows(os.path.join(out, "T_STATE.csv"))
+    check(list(st[0].keys()) == ["t", "wall_time", "log_time", "step", "theta0", "theta1", "theta2",
+                                 "theta0_dot", "theta1_dot", "theta2_dot", "theta0_effort",
+                                 "theta1_effort", "theta2_effort"], "state columns: joints by name")
+    check(len(st) == 6, f"6 states written ({len(st)})")
+    exact = True
+    for r, k in zip(st, (0, 1, 2, 4)):
+        exact &= float(r["t"]) == k * 0.01 and int(r["step"]) == k * 10
+        exact &= float(r["theta0"]) == k * 0.1 and float(r["theta1"]) == -k * 0.2
+        exact &= float(r["theta2"]) == 1e-300 and float(r["theta0_dot"]) == k * 1.5
+        exact &= float(r["theta2_dot"]) == -2.5 and float(r["theta0_effort"]) == k * 0.25
+    check(exact, "every state value reread bit for bit (%.17g)")
+    check(st[0]["wall_time"] == "1700000000.000000", "wall_time: utime in s, exact")
+    check(st[0]["log_time"] == "1700000000.010000", "log_time: the record's timestamp in s")
+
+    cm = rows(os.path.join(out, "T_COMMAND.csv"))
+    check(len(cm) == 5 and cm[3]["joint"] == "theta0" and float(cm[3]["effort"]) == 1.0 and
+          cm[4]["joint"] == "" and cm[4]["effort"] == "", "commands: one row per joint; a heartbeat one empty row")
+    ct = rows(os.path.join(out, "T_CONTROL.csv"))
+    check(len(ct) == 1 and ct[0]["name"] == "reset_to" and ct[0]["q"] == "0 0.10000000000000001 0.20000000000000001",
+          "control: request by name, q")
+    ev = rows(os.path.join(out, "T_EVENT.csv"))
+    check(len(ev) == 3 and ev[0]["detail"] == 'say "hi", newline' and ev[1]["kind"] == "limit" and
+          float(ev[1]["value"]) == -0.5, "events: quoted detail, control characters replaced")
+    sc = rows(os.path.join(out, "T_SCENE.csv"))
+    check(len(sc) == 1 and sc[0]["effects"] == "limits" and "theta0:actuated:q0=0:qd0=0:limits=-1..1" in sc[0]["joints"]
+          and "m0=1.5" in sc[0]["parameters"], "scene: effects, limits, parameters")
+    ss = rows(os.path.join(out, "T_STATUS.csv"))
+    check(len(ss) == 1 and float(ss[0]["energy"]) == 7.25 and ss[0]["run_state"] == "running",
+          "status: every field")
+
+    s = p.stdout
+    check("T_STATE: joint_state_t, 6 messages" in s, "summary: state count")
+    check("gaps 1 (1 states missing; period 10 ticks, from the scene), resets 1, repeats 1" in s,
+          "summary: one gap with one state missing, one reset, one repeat")
+    check("rejected 3 (unknown joint 2," in s and "stale 1)" in s, "summary: rejected commands")
+    check("events: start 1 limit 2" in s, "summary: events by kind")
+    check("other channels (not lagsim's): OTHER_CHANNEL (1)" in s, "summary: other channels")
+
+    # --channel selects; the rest is not written
+    out2 = os.path.join(tmp, "out2")
+    p = run(a.log2csv, logf, "-o", out2, "--channel", "T_STATE", "-q")
+    check(p.returncode == 0 and p.stdout == "" and sorted(os.listdir(out2)) == ["T_STATE.csv"],
+          "--channel T_STATE -q: that CSV only, nothing printed")
+
+    # lagsim-plot draws it (columns by name) and refuses what is not a state CSV
+    plot = os.path.join(os.path.dirname(a.log2csv), "lagsim-plot")
+    p = subprocess.run([plot, os.path.join(out, "T_STATE.csv"), "-o", os.path.join(tmp, "p.png")],
+                       capture_output=True, text=True, timeout=60)
+    png = os.path.join(tmp, "p.png")
+    check(p.returncode == 0 and os.path.exists(png) and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n",
+          f"lagsim-plot draws a PNG from a log's state CSV ({p.stderr.strip()})")
+    p = subprocess.run([plot, os.path.join(out, "T_EVENT.csv")], capture_output=True, text=True, timeout=60)
+    check(p.returncode == 2 and "no joint columns" in p.stderr, "lagsim-plot: an event CSV is refused, exit 2")
+
+
+def case_hostile(a, t, tmp):
+    seeds = lcmlog.seeds(t, os.path.join(tmp, "seeds"))
+    expect = {  # name: (exit code, text in stderr or stdout)
+        "valid-run.lcm": (0, "T_STATE: joint_state_t, 6 messages"),
+        "empty.lcm": (0, "records: 0"),
+        "truncated-mid-record.lcm": (0, "ends inside a record (44 bytes cut short"),
+        "huge-data-length.lcm": (1, "no complete LCM log record in its 43 bytes: not an LCM log"),
+        "negative-data-length.lcm": (1, "no complete LCM log record in its 35 bytes"),
+        "huge-channel-length.lcm": (1, "no complete LCM log record in its 35 bytes"),
+        "zeros.lcm": (1, "no complete LCM log record in its 256 bytes: not an LCM log"),
+        "bad-sync-then-record.lcm": (0, "damaged in 1 place(s): 7 bytes passed over"),
+        "state-negative-name-length.lcm": (0, "T_STATE: joint_state_t, 1 messages, 1 undecodable"),
+        "state-name-without-nul.lcm": (0, "1 undecodable"),
+        "state-huge-num-joints.lcm": (0, "1 undecodable"),
+        "step-jump-2e62.lcm": (0, "resets 1"),
+    }
+    for name, (rc, text) in expect.items():
+        out = os.path.join(tmp, "o-" + name)
+        p = run(a.log2csv, os.path.join(tmp, "seeds", name), "-o", out)
+        both = p.stdout + p.stderr
+        check(p.returncode == rc and text in both, f"{name}: exit {rc} and '{text}' (got {p.returncode}: {both.strip()[-300:]})")
+    p = run(a.log2csv, "/dev/zero", "-o", os.path.join(tmp, "oz"), timeout=10)
+    check(p.returncode == 1 and "not an LCM log" in p.stderr, "/dev/zero: not an LCM log, after a bounded search")
+    p = run(a.log2csv, tmp, "-o", os.path.join(tmp, "od"))
+    check(p.returncode == 2 and "is a directory" in p.stderr, "a directory: exit 2, said so")
+    p = run(a.log2csv, os.path.join(tmp, "nope.lcm"), "-o", os.path.join(tmp, "on"))
+    check(p.returncode == 2 and "No such file" in p.stderr, "a missing file: exit 2")
+    p = run(a.log2csv, os.path.join(tmp, "seeds", "valid-run.lcm"), "-o", "/proc/self/nope/x")
+    check(p.returncode == 2 and "cannot create" in p.stderr, "an unwritable output: exit 2")
+    # 2 MiB of junk after a good record: the scan for a sync word gives up, bounded
+    junk = os.path.join(tmp, "junk.lcm")
+    with open(junk, "wb") as f:
+        f.write(lcmlog.log(lcmlog.sample_run(t)[:1]) + b"\x55" * (2 << 20))
+    p = run(a.log2csv, junk, "-o", os.path.join(tmp, "oj"))
+    check(p.returncode == 1 and "no LCM log record in the 1048576 bytes after byte" in p.stderr,
+          "2 MiB without a sync word: bounded scan, exit 1")
+    # a record over 1 MiB on another channel is passed over; what follows is read
+    big = os.path.join(tmp, "big.lcm")
+    recs = lcmlog.sample_run(t)
+    with open(big, "wb") as f:
+        f.write(lcmlog.log(recs[:1] + [("BIG", b"\0" * ((1 << 20) + 1))] + recs[1:]))
+    p = run(a.log2csv, big, "-o", os.path.join(tmp, "ob"))
+    check(p.returncode == 0 and "1 larger than 65536 bytes passed over" in p.stdout and "T_STATE: joint_state_t, 6 messages" in p.stdout,
+          "a 1 MiB + 1 record is skipped, the rest read")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--log2csv", required=True)
+    ap.add_argument("--types", required=True)
+    ap.add_argument("case", choices=["exact", "hostile"])
+    a = ap.parse_args()
+    t = lcmlog.Types(a.types)
+    with tempfile.TemporaryDirectory(prefix="lagsim-log2csv-") as tmp:
+        {"exact": case_exact, "hostile": case_hostile}[a.case](a, t, tmp)
+    print(f"{'FAILED' if failures else 'passed'}: {failures} failure(s)")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
