@@ -2,7 +2,7 @@
 # convergence orders, determinism. Plain C programs, see tests/core/; one ctest per case of
 # each program (core.<program>.<case>), the cases listed by the programs themselves.
 include(${CMAKE_CURRENT_LIST_DIR}/common/cases.cmake)
-foreach(t models structure conservation convergence determinism validate)
+foreach(t models structure conservation convergence determinism validate faults)
   add_executable(test_core_${t} ${CMAKE_CURRENT_SOURCE_DIR}/core/test_${t}.c)
   target_include_directories(test_core_${t} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/core
                                                     ${CMAKE_CURRENT_SOURCE_DIR}/common)

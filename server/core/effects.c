@@ -207,7 +207,7 @@ static lag_result joint_impulse(lag_sim *s, double *y, int i, double e)
     return LAG_OK;
 }
 
-static double sgn(double v) { return (v > 0) - (v < 0); }
+static int sgn(double v) { return (v > 0) - (v < 0); }
 
 /* Constraint forces with the current locks at state y. OUT: lambda */
 static lag_result lock_forces(lag_sim *s, const double *y, double *lambda)
@@ -296,8 +296,9 @@ void lag_effects_pre_tick(lag_sim *s)
         for (int i = 0; i < n; i++) { s->mode.dist_force[i] = 0.0; y[i] = s->q[i]; y[n + i] = s->qd[i]; }
         for (int k = 0; k < e->n_disturbances; k++) {
             const lag_disturbance *d = &e->disturbances[k];
-            /* the first tick boundary at or after d->t (1e-9 dt guards t = k dt exactly) */
-            int64_t kd = (int64_t)ceil(d->t / dt - 1e-9);
+            /* the first tick boundary at or after d->t (saturated: a time past the last
+             * tick is never reached) */
+            int64_t kd = lag_ticks_ceil(d->t, dt);
             if (d->impulse) {
                 if (s->tick != kd) continue;
                 double x[LAG_MAX_DOF];

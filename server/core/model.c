@@ -24,6 +24,7 @@ const char *lag_result_string(lag_result r)
     case LAG_ERR_NEWTON: return "implicit solver (Newton) did not converge";
     case LAG_ERR_STEPSIZE: return "adaptive step size fell below dt_min";
     case LAG_ERR_LIFTOFF: return "stick lifted off the floor (normal force < 0)";
+    case LAG_ERR_FORCE: return "applied force or impulse too large for one tick";
     }
     return "unknown result";
 }
@@ -237,7 +238,14 @@ lag_result lag_model_forward(const lag_model *m, const double *q, const double *
                              const double *tau, double *qdd)
 {
     static const double zero[LAG_MAX_DOF] = {0};
-    return lag_model_vtables[m->kind]->forward(m->p, q, qd, tau ? tau : zero, qdd);
+    if (!tau) tau = zero;
+    lag_result r = lag_model_vtables[m->kind]->forward(m->p, q, qd, tau, qdd);
+    /* a NaN or Inf argument also fails the pivot test: say which it was */
+    if (r == LAG_ERR_SINGULAR && !(lag_state_ok(m->nq, q, INFINITY) &&
+                                   lag_state_ok(m->nq, qd, INFINITY) &&
+                                   lag_state_ok(m->nq, tau, INFINITY)))
+        r = LAG_ERR_NONFINITE;
+    return r;
 }
 
 bool lag_state_ok(int n, const double *x, double limit)

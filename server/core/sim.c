@@ -91,6 +91,7 @@ void lag_sim_reset(lag_sim *s, const double *q, const double *qd)
     s->dp.valid = false;
     s->dp.h = 0.0;
     memset(&s->mode, 0, sizeof s->mode);
+    memset(&s->fault, 0, sizeof s->fault);
     for (int i = 0; i < n; i++) s->tau_applied[i] = 0.0;
     s->n_events = 0;
     if (s->def.effects.enabled) lag_effects_init_modes(s);
@@ -113,6 +114,14 @@ void lag_sim_set_input(lag_sim *s, const double *tau)
 }
 
 double lag_sim_time(const lag_sim *s) { return (double)s->tick * s->def.integrator.dt; }
+
+int64_t lag_ticks_ceil(double t, double dt)
+{
+    double x = ceil(t / dt - 1e-9);
+    if (!(x < 0x1p63)) return INT64_MAX; /* also NaN: a double >= 2^63 has no int64_t */
+    if (!(x > 0)) return 0;
+    return (int64_t)x;
+}
 
 double lag_sim_energy(const lag_sim *s)
 {
@@ -181,19 +190,29 @@ lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *q
     return LAG_OK;
 }
 
+/* A solve failed at stage state y: a mass matrix of a non-finite q (a stage that
+ * overflowed) is not a singular one. */
+static lag_result stage_fault(int N, const double *y, lag_result r)
+{
+    return (r == LAG_ERR_SINGULAR && !lag_state_ok(N, y, INFINITY)) ? LAG_ERR_NONFINITE : r;
+}
+
 lag_result lag_sim_rhs(lag_sim *s, const double *y, double *ydot)
 {
     const int n = s->nq;
+    lag_result r;
     s->stats.rhs_evals++;
     for (int i = 0; i < n; i++) ydot[i] = y[n + i];
     if (s->def.effects.enabled || s->mode.locked) {
         double Q[LAG_MAX_DOF];
         lag_applied_forces(s, y, y + n, Q);
-        return lag_forward_locked(s, y, y + n, Q, ydot + n, NULL);
+        r = lag_forward_locked(s, y, y + n, Q, ydot + n, NULL);
+    } else {
+        /* The bare model, the hot path: the model's closed-form forward dynamics. */
+        r = lag_model_vt(&s->def.model)->forward(s->def.model.p, y, y + n, s->tau_applied,
+                                                 ydot + n);
     }
-    /* The bare model, the hot path: the model's closed-form forward dynamics. */
-    return lag_model_vt(&s->def.model)->forward(s->def.model.p, y, y + n, s->tau_applied,
-                                                ydot + n);
+    return r == LAG_OK ? r : stage_fault(2 * n, y, r);
 }
 
 lag_result lag_qd_from_p(const lag_sim *s, const double *q, const double *p, double *qd)
@@ -216,7 +235,7 @@ lag_result lag_sim_rhs_qp(lag_sim *s, const double *y, double *ydot)
     double g[LAG_MAX_DOF], Q[LAG_MAX_DOF], qd[LAG_MAX_DOF];
     s->stats.rhs_evals++;
     lag_result r = lag_qd_from_p(s, y, y + n, qd);
-    if (r != LAG_OK) return r;
+    if (r != LAG_OK) return stage_fault(2 * n, y, r);
     vt->mass_deriv(m->p, y, dM);
     vt->gravity(m->p, y, g);
     lag_applied_forces(s, y, qd, Q);
@@ -248,6 +267,100 @@ static lag_result plain_tick(lag_sim *s, double *y)
     return LAG_OK;
 }
 
+/* A tick starting at the public state (q, qd) was refused with r. When what the scene
+ * applies from outside is what made the step fail, the fault is LAG_ERR_FORCE, whatever
+ * the integrator then ran into (a state that overflowed inside the step shows up as a
+ * "singular" mass matrix of cos(inf), a diverging Newton iteration or a vanishing dopri5
+ * step, none of which says what happened). From outside means: the effort applied
+ * (tau_applied) and the disturbance forces, whose acceleration M^-1 Q alone takes a
+ * coordinate past explode_limit within one tick (or is not finite), or this tick's
+ * impulse, which left a velocity past explode_limit (qd_before: the velocities before the
+ * tick's impulses). A state that grows by itself (an unstable method on a stiff scene,
+ * damping at an exploding velocity) keeps its own code. Records s->fault. Only on the
+ * failure path: a good tick pays nothing for it. */
+static lag_result classify_fault(lag_sim *s, lag_result r, const double *qd_before)
+{
+    const int n = s->nq;
+    const double dt = s->def.integrator.dt, lim = s->def.explode_limit;
+    lag_fault f = {r, s->tick, -1, 0.0, 0.0, -1, 0.0};
+    if (r != LAG_ERR_LIFTOFF && r != LAG_ERR_ARG) {
+        double Q[LAG_MAX_DOF] = {0}, a[LAG_MAX_DOF] = {0};
+        const bool dist = s->def.effects.enabled & LAG_EFF_DISTURBANCE;
+        bool finite = true;
+        for (int i = 0; i < n; i++) {
+            Q[i] = s->tau_applied[i] + (dist ? s->mode.dist_force[i] : 0.0);
+            finite = finite && isfinite(Q[i]);
+        }
+        if (finite && lag_qd_from_p(s, s->q, Q, a) != LAG_OK)
+            for (int i = 0; i < n; i++) a[i] = 0.0;
+        double worst = 1.0; /* a cause must go past explode_limit */
+        for (int i = 0; i < n; i++) {
+            double ai = finite ? fabs(a[i]) : INFINITY;
+            double v = fabs(s->qd[i]) > lim && fabs(qd_before[i]) <= lim ? fabs(s->qd[i]) : 0.0;
+            double reach = fmax(fmax(ai * dt, v), 0.5 * ai * dt * dt) / lim;
+            if (!isfinite(reach)) reach = INFINITY;
+            if (reach > worst) {
+                worst = reach;
+                f.code = LAG_ERR_FORCE;
+                f.joint = i;
+                f.accel = finite ? a[i] : NAN;
+                f.velocity = s->qd[i];
+            }
+        }
+        /* The applied force that contributes most to that acceleration: Q_j contributes
+         * (M^-1 e_j)_i Q_j to joint i's (a non-finite one is the cause outright). */
+        double most = 0.0;
+        for (int j = 0; j < n && f.code == LAG_ERR_FORCE; j++) {
+            double e[LAG_MAX_DOF] = {0}, x[LAG_MAX_DOF];
+            e[j] = 1.0;
+            if (Q[j] == 0.0) continue;
+            double c = !isfinite(Q[j]) ? INFINITY
+                     : lag_qd_from_p(s, s->q, e, x) == LAG_OK ? fabs(x[f.joint] * Q[j]) : 0.0;
+            if (c > most) { most = c; f.cause = j; f.force = Q[j]; }
+        }
+    }
+    s->fault = f;
+    s->stats.faults++;
+    return f.code;
+}
+
+void lag_sim_fault_describe(const lag_sim *s, char *buf, size_t len)
+{
+    if (!buf || len == 0) return;
+    buf[0] = '\0';
+    const lag_fault *f = &s->fault;
+    if (f->code == LAG_OK) return;
+    const double dt = s->def.integrator.dt, t = (double)f->tick * dt, lim = s->def.explode_limit;
+    if (f->code != LAG_ERR_FORCE || f->joint < 0) {
+        snprintf(buf, len, "%s, at t = %.9g s (tick %lld)", lag_result_string(f->code), t,
+                 (long long)f->tick);
+        return;
+    }
+    const lag_model_info *info = lag_model_info_get(s->def.model.kind);
+    const char *j = info->joint_names[f->joint];
+    const bool ang = info->angular[f->joint];
+    const char *vu = ang ? "rad/s" : "m/s", *au = ang ? "rad/s^2" : "m/s^2";
+    if (!(fabs(f->velocity) <= lim)) {
+        snprintf(buf, len, "applied impulse too large: %s has a velocity of %g %s, past "
+                 "explode_limit = %g, at t = %.9g s", j, f->velocity, vu, lim, t);
+    } else if (f->cause >= 0) {
+        const char *c = info->joint_names[f->cause];
+        const char *fu = info->angular[f->cause] ? "N m" : "N";
+        if (f->cause == f->joint)
+            snprintf(buf, len, "applied force too large: %s %g %s, an acceleration of %g %s "
+                     "that takes it past explode_limit = %g within one tick (dt = %g s), at "
+                     "t = %.9g s", c, f->force, fu, f->accel, au, lim, dt, t);
+        else
+            snprintf(buf, len, "applied force too large: %s %g %s gives %s an acceleration "
+                     "of %g %s that takes it past explode_limit = %g within one tick (dt = "
+                     "%g s), at t = %.9g s", c, f->force, fu, j, f->accel, au, lim, dt, t);
+    } else {
+        snprintf(buf, len, "forces too large for one tick: %s has an acceleration of %g %s "
+                 "at a velocity of %g %s, past explode_limit = %g within dt = %g s, at "
+                 "t = %.9g s", j, f->accel, au, f->velocity, vu, lim, dt, t);
+    }
+}
+
 lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
 {
     if (nticks <= 0) return LAG_OK;
@@ -255,8 +368,7 @@ lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
     const uint32_t en = s->def.effects.enabled;
     if (!(en & TICK_EFFECTS) && s->def.integrator.method == LAG_DOPRI5) {
         lag_result r = lag_dopri5_advance(s, nticks, continuous);
-        if (r != LAG_OK) s->stats.faults++;
-        return r;
+        return r == LAG_OK ? r : classify_fault(s, r, s->qd);
     }
     for (int64_t k = 0; k < nticks; k++) {
         double y[LAG_MAX_STATE];
@@ -273,8 +385,8 @@ lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
             r = plain_tick(s, y);
         }
         if (r != LAG_OK) {
+            r = classify_fault(s, r, qd_good); /* at the tick's start, after its impulses */
             memcpy(s->qd, qd_good, sizeof qd_good);
-            s->stats.faults++;
             return r; /* public state is still that of the last good tick */
         }
         for (int i = 0; i < n; i++) { s->q[i] = y[i]; s->qd[i] = y[n + i]; }

@@ -214,11 +214,41 @@ static void check_model_fields(int arg)
     }
 }
 
+/* Times to tick counts: ceil(t / dt) within 1e-9 dt, saturated at both ends. */
+static void check_ticks_ceil(int arg)
+{
+    (void)arg;
+    struct { double t, dt; int64_t want; } c[] = {
+        {0.0, 1e-3, 0},
+        {-5.0, 1e-3, 0},
+        {-INFINITY, 1e-3, 0},
+        {1.0, 1e-3, 1000},
+        {1.0 + 1e-13, 1e-3, 1000},     /* 1e-10 dt above: counted as on the boundary */
+        {1.0 + 1e-11, 1e-3, 1001},     /* 1e-8 dt above: the next one */
+        {0.0015, 1e-3, 2},
+        {9.2e15, 1e-3, 9200000000000000000},
+        {9.3e15, 1e-3, INT64_MAX},     /* 9.3e18 ticks: past INT64_MAX */
+        {1e300, 1e-3, INT64_MAX},
+        {DBL_MAX, 1e-6, INT64_MAX},
+        {INFINITY, 1e-3, INT64_MAX},
+        {NAN, 1e-3, INT64_MAX},
+    };
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; ++i) {
+        int64_t got = lag_ticks_ceil(c[i].t, c[i].dt);
+        if (got != c[i].want)
+            LT_FAIL("lag_ticks_ceil(%g, %g) = %lld, expected %lld", c[i].t, c[i].dt, (long long)got,
+                    (long long)c[i].want);
+        else
+            ENSURE(got == c[i].want);
+    }
+}
+
 int main(int argc, char **argv)
 {
     static const lt_case cases[] = {
         {"fields", check_fields, 0, 0},
         {"model_fields", check_model_fields, 0, 0},
+        {"ticks_ceil", check_ticks_ceil, 0, 0},
     };
     return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
 }

@@ -33,7 +33,13 @@ typedef enum lag_result {
     LAG_ERR_EXPLODE,   /* |q| or |qd| exceeded lag_sim_def.explode_limit: state unchanged */
     LAG_ERR_NEWTON,    /* implicit method: Newton did not converge in max_iter */
     LAG_ERR_STEPSIZE,  /* dopri5: step size fell below dt_min */
-    LAG_ERR_LIFTOFF    /* stick with a floor: the normal force went negative */
+    LAG_ERR_LIFTOFF,   /* stick with a floor: the normal force went negative */
+    LAG_ERR_FORCE      /* the applied forces (or an impulse) are too large for one tick:
+                          at the tick's start they give an acceleration that takes the state
+                          past explode_limit within dt, or a non-finite one. Reported
+                          instead of what the step then ran into (a non-finite state, a
+                          mass matrix evaluated at an overflowed q, Newton or dopri5
+                          failing); see lag_sim_fault_describe. State unchanged */
 } lag_result;
 
 const char *lag_result_string(lag_result r);
@@ -257,6 +263,19 @@ lag_result lag_sim_def_check(const lag_sim_def *def, lag_diag *d);
 /* The same, with "field: message" written into err (what lag_sim_init reports). */
 lag_result lag_sim_def_validate(const lag_sim_def *def, char *err, size_t errlen);
 
+/* What the last refused tick ran into (see lag_sim_fault_describe). */
+typedef struct lag_fault {
+    lag_result code;  /* LAG_OK until a tick is refused */
+    int64_t tick;     /* the tick that was refused (the state is that of its start) */
+    int joint;        /* LAG_ERR_FORCE: the coordinate that one tick takes furthest past
+                         explode_limit; else -1 */
+    double accel;     /* LAG_ERR_FORCE: its acceleration at the tick's start (m/s^2, rad/s^2) */
+    double velocity;  /* LAG_ERR_FORCE: its velocity there (after any impulse) */
+    int cause;        /* LAG_ERR_FORCE: the coordinate whose applied force contributes most
+                         to that acceleration, -1 if none does (an impulse's velocity) */
+    double force;     /* LAG_ERR_FORCE: that generalized force (N, N m) */
+} lag_fault;
+
 /* Counters, for status and benchmarks. */
 typedef struct lag_sim_stats {
     int64_t rhs_evals;        /* forward-dynamics evaluations */
@@ -279,6 +298,7 @@ typedef struct lag_sim {
                                         disturbance forces, which are external); what
                                         joint_state_t.effort reports */
     lag_sim_stats stats;
+    lag_fault fault;              /* the last refused tick, if any */
     /* effects' hybrid modes */
     struct {
         uint32_t locked;           /* bit i: joint i held (static friction or resting stop) */
@@ -318,7 +338,19 @@ void lag_sim_set_input(lag_sim *s, const double *tau);
  * step is shortened to land on the end exactly. Fixed-step methods ignore it. */
 lag_result lag_sim_advance(lag_sim *s, int64_t n, bool continuous);
 double lag_sim_time(const lag_sim *s);
+/* The first tick boundary at or after time t for a tick of dt > 0: ceil(t / dt), with t
+ * within 1e-9 dt above a boundary counted as on it (rounding of t = k dt). Saturated: a t
+ * whose tick is past INT64_MAX (t = 1e300, or NaN) gives INT64_MAX, a tick never reached;
+ * t <= 0 gives 0. The core converts times to tick counts only through this. */
+int64_t lag_ticks_ceil(double t, double dt);
 double lag_sim_energy(const lag_sim *s); /* T + U at the public state */
+
+/* One line on the last refused tick: the result, the sim time, and for LAG_ERR_FORCE the
+ * joint, its force, acceleration and what one tick of it would do, e.g.
+ *   "applied force too large: theta0 has 1e+308 N, an acceleration of 3.6e+307 m/s^2 that
+ *    takes it past explode_limit = 1e+06 within one tick (dt = 0.001 s), at t = 0.5 s"
+ * Writes "" when no tick was refused. */
+void lag_sim_fault_describe(const lag_sim *s, char *buf, size_t len);
 
 /* Right-hand side of the first-order system y = (q, qd): ydot = (qd, qdd) with the
  * sim's held input. Exposed for tests and benchmarks. OUT: ydot (2n) */

@@ -1,0 +1,153 @@
+/*
+ * A refused tick names its cause.
+ *
+ * absurd_effort: an effort of 1e308 (or 1e200, 1e30) used to be reported as whatever the
+ *   integrator then ran into ("mass matrix not positive definite" for rk4, Newton for the
+ *   Gauss methods, a vanishing step for dopri5). For every model of the table and every
+ *   method it must be LAG_ERR_FORCE, blaming an actuated joint, with the state left at
+ *   the last good tick and a description naming the joint and explode_limit.
+ * not_force: faults that are not the forces' keep their own code: a DIPC falling past a
+ *   small explode_limit is LAG_ERR_EXPLODE; a moderate effort runs.
+ * impulse: a scheduled impulse that leaves a velocity past explode_limit is LAG_ERR_FORCE
+ *   and described as an impulse.
+ * singular: lag_model_forward tells a singular mass matrix at a finite state
+ *   (LAG_ERR_SINGULAR) from a non-finite argument (LAG_ERR_NONFINITE).
+ */
+#include "test_core.h"
+
+static void check_absurd_effort(int arg)
+{
+    (void)arg;
+    const double efforts[] = {1e308, 1e200, 1e30};
+    int named = 0, total = 0;
+    for (int k = 0; k < LAG_MODEL_COUNT; ++k) {
+        const lag_model_info *inf = lag_model_info_get((lag_model_kind)k);
+        for (int m = 0; m < LAG_METHOD_COUNT; ++m)
+            for (size_t e = 0; e < sizeof efforts / sizeof efforts[0]; ++e) {
+                lag_sim_def d = lag_default_sim_def((lag_model_kind)k);
+                d.integrator.method = (lag_method)m;
+                for (int i = 0; i < inf->nq; ++i) d.q0[i] = inf->angular[i] ? 0.5 : 0.3;
+                lag_sim s;
+                if (tc_sim_init(&s, &d)) continue;
+                ENSURE(tc_advance(&s, 3, false) == 0);
+                double q[LAG_MAX_DOF], qd[LAG_MAX_DOF], tau[LAG_MAX_DOF];
+                memcpy(q, s.q, sizeof q);
+                memcpy(qd, s.qd, sizeof qd);
+                for (int i = 0; i < LAG_MAX_DOF; ++i) tau[i] = efforts[e];
+                lag_sim_set_input(&s, tau);
+                lag_result r = lag_sim_advance(&s, 1, false);
+                char text[256];
+                lag_sim_fault_describe(&s, text, sizeof text);
+                total++;
+                bool ok = r == LAG_ERR_FORCE && s.fault.code == LAG_ERR_FORCE &&
+                          s.fault.joint >= 0 && s.fault.joint < inf->nq && s.fault.cause >= 0 &&
+                          s.fault.cause < inf->nq && inf->actuated[s.fault.cause] &&
+                          s.fault.force == efforts[e] &&
+                          s.tick == 3 && s.fault.tick == 3 &&
+                          memcmp(q, s.q, sizeof q) == 0 && memcmp(qd, s.qd, sizeof qd) == 0 &&
+                          strstr(text, "applied force too large") &&
+                          strstr(text, inf->joint_names[s.fault.cause]) &&
+                          strstr(text, "explode_limit");
+                if (!ok)
+                    LT_FAIL("%s %s effort %g: %s (%s); tick %lld; '%s'", inf->name,
+                            lag_method_name((lag_method)m), efforts[e], lag_result_string(r),
+                            r == LAG_ERR_FORCE ? "as expected" : "expected: applied force too large",
+                            (long long)s.tick, text);
+                else
+                    ENSURE(ok);
+                named += ok;
+            }
+    }
+    char text[256];
+    lag_sim_def d = lag_default_sim_def(LAG_MODEL_DIPC);
+    lag_sim s;
+    if (tc_sim_init(&s, &d) == 0) {
+        double tau[3] = {1e308, 0, 0};
+        lag_sim_set_input(&s, tau);
+        lag_sim_advance(&s, 1, false);
+        lag_sim_fault_describe(&s, text, sizeof text);
+        printf("absurd_effort: %d of %d (model, method, effort) named as the applied force; e.g. \"%s\"\n",
+               named, total, text);
+    }
+}
+
+static void check_not_force(int arg)
+{
+    (void)arg;
+    for (int m = 0; m < LAG_METHOD_COUNT; ++m) {
+        /* the upright DIPC falls: theta1 passes 0.5 rad after a fraction of a second */
+        lag_sim_def d = lag_default_sim_def(LAG_MODEL_DIPC);
+        d.integrator.method = (lag_method)m;
+        d.q0[1] = 0.1;
+        d.explode_limit = 0.5;
+        lag_sim s;
+        if (tc_sim_init(&s, &d)) continue;
+        lag_result r = LAG_OK;
+        for (int k = 0; k < 5000 && r == LAG_OK; ++k) r = lag_sim_advance(&s, 1, false);
+        if (r != LAG_ERR_EXPLODE)
+            LT_FAIL("dipc %s falling past explode_limit 0.5: %s, expected %s",
+                    lag_method_name((lag_method)m), lag_result_string(r),
+                    lag_result_string(LAG_ERR_EXPLODE));
+        else
+            ENSURE(s.fault.code == LAG_ERR_EXPLODE && s.fault.joint == -1);
+        /* a moderate effort: runs */
+        lag_sim_def d2 = lag_default_sim_def(LAG_MODEL_DIPC);
+        d2.integrator.method = (lag_method)m;
+        lag_sim s2;
+        if (tc_sim_init(&s2, &d2)) continue;
+        double tau[3] = {50, 0, 0};
+        lag_sim_set_input(&s2, tau);
+        ENSURE(lag_sim_advance(&s2, 100, false) == LAG_OK && s2.fault.code == LAG_OK);
+    }
+}
+
+static void check_impulse(int arg)
+{
+    (void)arg;
+    lag_sim_def d = lag_default_sim_def(LAG_MODEL_STICK);
+    d.q0[1] = 1.0;
+    d.effects.enabled = LAG_EFF_DISTURBANCE;
+    d.effects.n_disturbances = 1;
+    d.effects.disturbances[0] = (lag_disturbance){0.005, 0, true, 1e300, 0};
+    lag_sim s;
+    if (tc_sim_init(&s, &d)) return;
+    lag_result r = LAG_OK;
+    int k = 0;
+    for (; k < 20 && r == LAG_OK; ++k) r = lag_sim_advance(&s, 1, false);
+    char text[256];
+    lag_sim_fault_describe(&s, text, sizeof text);
+    printf("impulse: %s after %d ticks: \"%s\"\n", lag_result_string(r), k, text);
+    ENSURE(r == LAG_ERR_FORCE && s.tick == 5 && s.fault.joint == 0 && s.fault.cause == -1);
+    ENSURE(strstr(text, "impulse") != NULL);
+    ENSURE(isfinite(s.qd[0]) && isfinite(s.qd[1])); /* the last good tick, before the impulse */
+}
+
+static void check_singular(int arg)
+{
+    (void)arg;
+    /* manipulator with l1 = I1 = I2 = 0 and the slider on the axis: M_00 = 0 */
+    lag_model m;
+    lag_model_default(&m, LAG_MODEL_MANIPULATOR);
+    m.p[LAG_MANIP_L1] = 0;
+    m.p[LAG_MANIP_I1] = 0;
+    m.p[LAG_MANIP_I2] = 0;
+    double q[2] = {0.3, 0.0}, qd[2] = {0.1, 0.2}, qdd[2];
+    ENSURE(lag_model_forward(&m, q, qd, NULL, qdd) == LAG_ERR_SINGULAR);
+    lag_model_default(&m, LAG_MODEL_DIPC);
+    double q3[3] = {0, NAN, 0.1}, qd3[3] = {0}, qdd3[3];
+    ENSURE(lag_model_forward(&m, q3, qd3, NULL, qdd3) == LAG_ERR_NONFINITE);
+    q3[1] = INFINITY;
+    ENSURE(lag_model_forward(&m, q3, qd3, NULL, qdd3) == LAG_ERR_NONFINITE);
+    ENSURE(strcmp(lag_result_string(LAG_ERR_FORCE), lag_result_string(LAG_ERR_SINGULAR)) != 0);
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {
+        {"absurd_effort", check_absurd_effort, 0, 0},
+        {"not_force", check_not_force, 0, 0},
+        {"impulse", check_impulse, 0, 0},
+        {"singular", check_singular, 0, 0},
+    };
+    return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
+}
