@@ -9,3 +9,8 @@ foreach(t models structure conservation convergence determinism validate faults)
   target_link_libraries(test_core_${t} PRIVATE lagsim_core m)
   lagsim_add_test_cases(test_core_${t} core.${t} core 120)
 endforeach()
+
+# The core from definitions made of arbitrary bytes (tests/fuzz/fuzz_sim.c): its seed
+# inputs and every input that once crashed or hung it, each build; fuzzed for a bounded
+# time under LAGSIM_FUZZ=ON (tests/fuzz/fuzz.cmake).
+lagsim_fuzz_target(sim LIBS lagsim_core m)

@@ -33,6 +33,7 @@ lag_integrator_def lag_default_integrator_def(void)
     d.atol = 1e-10;
     d.dt_min = 1e-12;
     d.max_iter = 20;
+    d.max_steps = 100000;
     d.newton_tol = 1e-13;
     return d;
 }

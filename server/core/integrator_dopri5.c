@@ -116,20 +116,22 @@ static double step_factor(double en, bool last_rejected)
     return fmin(last_rejected ? 1.0 : 10.0, fmax(0.2, fac));
 }
 
-/* The adaptive loop shared by both drivers: from (*t, y, k1 = f(y)) up to t_end. In
- * hard-stop mode the last step is shortened to land on t_end exactly; in continuous mode
- * it may step past t_end. With `dense`, each accepted step leaves its dense-output
- * coefficients (and start time) in s->dp for interpolation. An accepted state that is
- * non-finite or beyond explode_limit is an error; y and *t then hold the last good step. */
+/* The adaptive loop shared by both drivers: from (*t, y, k1 = f(y)) up to t_end, in at
+ * most max_steps attempts (accepted or rejected; then LAG_ERR_MAX_STEPS). In hard-stop
+ * mode the last step is shortened to land on t_end exactly; in continuous mode it may
+ * step past t_end. With `dense`, each accepted step leaves its dense-output coefficients
+ * (and start time) in s->dp for interpolation. An accepted state that is non-finite or
+ * beyond explode_limit is an error; y and *t then hold the last good step. */
 static lag_result dp_run(lag_sim *s, double *t, double t_end, double *y, double *k1,
-                         bool continuous, bool dense)
+                         bool continuous, bool dense, int64_t max_steps)
 {
     const int N = 2 * s->nq;
     const lag_integrator_def *in = &s->def.integrator;
     double y1[LAG_MAX_STATE], k7[LAG_MAX_STATE], rc[5][LAG_MAX_STATE];
     bool last_rejected = false;
     lag_result r;
-    while (*t < t_end) {
+    for (int64_t attempts = 0; *t < t_end; attempts++) {
+        if (attempts >= max_steps) return LAG_ERR_MAX_STEPS;
         double h = s->dp.h;
         bool lands = false;
         if (!continuous && *t + h >= t_end) {
@@ -180,7 +182,8 @@ lag_result lag_dopri5_span(lag_sim *s, double H, const double *y0, double *yout)
     if (H > 0.0) {
         if ((r = lag_sim_rhs(s, y, k1)) != LAG_OK) return r;
         if (!(s->dp.h > 0.0)) s->dp.h = initial_step(s, N, y, k1);
-        if ((r = dp_run(s, &t, H, y, k1, false, false)) != LAG_OK) return r;
+        if ((r = dp_run(s, &t, H, y, k1, false, false, s->def.integrator.max_steps)) != LAG_OK)
+            return r;
     }
     for (int i = 0; i < N; i++) yout[i] = y[i];
     return LAG_OK;
@@ -204,7 +207,10 @@ lag_result lag_dopri5_advance(lag_sim *s, int64_t nticks, bool continuous)
         s->dp.t_prev = s->dp.t;
         s->dp.valid = true;
     }
-    if ((r = dp_run(s, &s->dp.t, t_end, s->dp.y, s->dp.k1, continuous, true)) != LAG_OK) {
+    /* max_steps per tick over the n ticks (saturated) */
+    const int64_t budget = nticks > INT64_MAX / s->def.integrator.max_steps
+                               ? INT64_MAX : nticks * s->def.integrator.max_steps;
+    if ((r = dp_run(s, &s->dp.t, t_end, s->dp.y, s->dp.k1, continuous, true, budget)) != LAG_OK) {
         s->dp.valid = false;
         return r;
     }

@@ -23,6 +23,7 @@ const char *lag_result_string(lag_result r)
     case LAG_ERR_EXPLODE: return "state exceeded explode_limit";
     case LAG_ERR_NEWTON: return "implicit solver (Newton) did not converge";
     case LAG_ERR_STEPSIZE: return "adaptive step size fell below dt_min";
+    case LAG_ERR_MAX_STEPS: return "adaptive method needed more than max_steps steps for one tick";
     case LAG_ERR_LIFTOFF: return "stick lifted off the floor (normal force < 0)";
     case LAG_ERR_FORCE: return "applied force or impulse too large for one tick";
     }

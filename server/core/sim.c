@@ -35,6 +35,9 @@ lag_result lag_sim_def_check(const lag_sim_def *def, lag_diag *d)
     if (in->max_iter < 1 || in->max_iter > 1000)
         return lag_diag_fail(d, "integrator.max_iter", "expected an integer in 1..1000, got %d",
                              in->max_iter);
+    if (in->max_steps < 1 || in->max_steps > 100000000)
+        return lag_diag_fail(d, "integrator.max_steps", "expected an integer in 1..1e8, got %d",
+                             in->max_steps);
     if (!(isfinite(in->newton_tol) && in->newton_tol > 0 && in->newton_tol < 1))
         return lag_diag_fail(d, "integrator.newton_tol", "expected a number in (0, 1), got %g",
                              in->newton_tol);

@@ -10,6 +10,10 @@
  *   small explode_limit is LAG_ERR_EXPLODE; a moderate effort runs.
  * impulse: a scheduled impulse that leaves a velocity past explode_limit is LAG_ERR_FORCE
  *   and described as an impulse.
+ * max_steps: dopri5's work per tick is bounded: a stick spinning at 8 rad/s with a tick
+ *   of 640 s (several hundred thousand steps at rtol 1e-8) stops after max_steps steps
+ *   with LAG_ERR_MAX_STEPS, the state left at the tick's start; with a budget that
+ *   suffices the same tick completes.
  * singular: lag_model_forward tells a singular mass matrix at a finite state
  *   (LAG_ERR_SINGULAR) from a non-finite argument (LAG_ERR_NONFINITE).
  */
@@ -141,12 +145,41 @@ static void check_singular(int arg)
     ENSURE(strcmp(lag_result_string(LAG_ERR_FORCE), lag_result_string(LAG_ERR_SINGULAR)) != 0);
 }
 
+static void check_max_steps(int arg)
+{
+    (void)arg;
+    lag_sim_def d = lag_default_sim_def(LAG_MODEL_STICK);
+    d.integrator.method = LAG_DOPRI5;
+    d.integrator.dt = 640;
+    d.q0[0] = 8.2; d.q0[1] = 8.2; d.qd0[0] = 8.2; d.qd0[1] = 8.2;
+    d.integrator.max_steps = 1000;
+    for (int cont = 0; cont < 2; ++cont) {
+        lag_sim s;
+        if (tc_sim_init(&s, &d)) return;
+        lag_result r = lag_sim_advance(&s, 1, cont);
+        int64_t steps = s.stats.steps_accepted + s.stats.steps_rejected;
+        printf("max_steps: dopri5 tick of 640 s (%s) with max_steps 1000: %s after %lld steps\n",
+               cont ? "continuous" : "hard stop", lag_result_string(r), (long long)steps);
+        ENSURE(r == LAG_ERR_MAX_STEPS && s.tick == 0 && s.q[1] == 8.2 && s.qd[1] == 8.2);
+        ENSURE(steps <= 1000);
+    }
+    /* a tick of 6.4 s fits in the default budget */
+    d.integrator.dt = 6.4;
+    d.integrator.max_steps = lag_default_integrator_def().max_steps;
+    lag_sim s;
+    if (tc_sim_init(&s, &d)) return;
+    ENSURE(lag_sim_advance(&s, 1, false) == LAG_OK);
+    printf("max_steps: a tick of 6.4 s took %lld steps (default max_steps %d)\n",
+           (long long)(s.stats.steps_accepted + s.stats.steps_rejected), d.integrator.max_steps);
+}
+
 int main(int argc, char **argv)
 {
     static const lt_case cases[] = {
         {"absurd_effort", check_absurd_effort, 0, 0},
         {"not_force", check_not_force, 0, 0},
         {"impulse", check_impulse, 0, 0},
+        {"max_steps", check_max_steps, 0, 0},
         {"singular", check_singular, 0, 0},
     };
     return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));

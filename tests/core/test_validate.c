@@ -22,6 +22,7 @@ static void bad_method(lag_sim_def *d) { d->integrator.method = LAG_METHOD_COUNT
 static void big_dtmin(lag_sim_def *d) { d->integrator.dt_min = 1.0; }
 static void bad_iter(lag_sim_def *d) { d->integrator.max_iter = 0; }
 static void bad_ntol(lag_sim_def *d) { d->integrator.newton_tol = 1; }
+static void bad_steps(lag_sim_def *d) { d->integrator.max_steps = 0; }
 static void bad_rtol(lag_sim_def *d) { d->integrator.rtol = -1; }
 static void bad_explode(lag_sim_def *d) { d->explode_limit = INFINITY; }
 static void nan_q1(lag_sim_def *d) { d->q0[1] = NAN; }
@@ -131,6 +132,7 @@ static const bad_case bad_cases[] = {
     {LAG_MODEL_DIPC, "integrator.dt_min", "<= dt", big_dtmin},
     {LAG_MODEL_DIPC, "integrator.max_iter", "1..1000", bad_iter},
     {LAG_MODEL_DIPC, "integrator.newton_tol", "(0, 1)", bad_ntol},
+    {LAG_MODEL_DIPC, "integrator.max_steps", "1..1e8", bad_steps},
     {LAG_MODEL_DIPC, "integrator.rtol", "> 0", bad_rtol},
     {LAG_MODEL_DIPC, "explode_limit", "finite", bad_explode},
     {LAG_MODEL_DIPC, "initial.q[1]", "finite", nan_q1},

@@ -33,6 +33,7 @@ typedef enum lag_result {
     LAG_ERR_EXPLODE,   /* |q| or |qd| exceeded lag_sim_def.explode_limit: state unchanged */
     LAG_ERR_NEWTON,    /* implicit method: Newton did not converge in max_iter */
     LAG_ERR_STEPSIZE,  /* dopri5: step size fell below dt_min */
+    LAG_ERR_MAX_STEPS, /* dopri5: more than max_steps steps for one tick (bounded work) */
     LAG_ERR_LIFTOFF,   /* stick with a floor: the normal force went negative */
     LAG_ERR_FORCE      /* the applied forces (or an impulse) are too large for one tick:
                           at the tick's start they give an acceleration that takes the state
@@ -53,7 +54,8 @@ const char *lag_result_string(lag_result r);
  *   model                               the model kind, or its number of coordinates
  *   parameters.<name>                   lag_model_info.param_names, e.g. parameters.m1
  *   initial.q[i], initial.qd[i]         initial.q when the fault is of the whole vector
- *   integrator.<key>                    method, dt, rtol, atol, dt_min, max_iter, newton_tol
+ *   integrator.<key>                    method, dt, rtol, atol, dt_min, max_iter, max_steps,
+ *                                       newton_tol
  *   explode_limit
  *   effects                             the set of effects itself (unknown bits)
  *   effects.damping.<joint>
@@ -165,6 +167,9 @@ typedef struct lag_integrator_def {
     double atol;       /* dopri5 absolute tolerance, default 1e-10 */
     double dt_min;     /* dopri5 smallest step before LAG_ERR_STEPSIZE, default 1e-12 */
     int max_iter;      /* implicit methods: Newton iterations per step, default 20 */
+    int max_steps;     /* dopri5: steps (accepted or rejected) per tick before
+                          LAG_ERR_MAX_STEPS, so that a tick's work is bounded whatever dt
+                          and the tolerances ask for (Hairer's NMAX); default 100000 */
     double newton_tol; /* implicit methods: convergence on the scaled update, default 1e-13 */
 } lag_integrator_def;
 
