@@ -33,14 +33,14 @@ typedef enum lag_result {
     LAG_ERR_EXPLODE,   /* |q| or |qd| exceeded lag_sim_def.explode_limit: state unchanged */
     LAG_ERR_NEWTON,    /* implicit method: Newton did not converge in max_iter */
     LAG_ERR_STEPSIZE,  /* dopri5: step size fell below dt_min */
-    LAG_ERR_MAX_STEPS, /* dopri5: more than max_steps steps for one tick (bounded work) */
     LAG_ERR_LIFTOFF,   /* stick with a floor: the normal force went negative */
-    LAG_ERR_FORCE      /* the applied forces (or an impulse) are too large for one tick:
+    LAG_ERR_FORCE,     /* the applied forces (or an impulse) are too large for one tick:
                           at the tick's start they give an acceleration that takes the state
                           past explode_limit within dt, or a non-finite one. Reported
                           instead of what the step then ran into (a non-finite state, a
                           mass matrix evaluated at an overflowed q, Newton or dopri5
                           failing); see lag_sim_fault_describe. State unchanged */
+    LAG_ERR_MAX_STEPS  /* dopri5: more than max_steps steps for one tick (bounded work) */
 } lag_result;
 
 const char *lag_result_string(lag_result r);
