@@ -1,0 +1,85 @@
+# `cmake --install <build> [--prefix /usr/local]`: everything a user of lagsim needs, laid
+# out as a Debian tool's files (GNUInstallDirs):
+#   bin/                     lagsimd, lagsimctl, lagsim-view, lagsim-log2csv and the C
+#                            example controllers (each installed when the build has it)
+#   include/lagsim/          lagsim.h (the core), lagsim_client.h, the generated C types
+#   lib/                     liblagsim_client.a and what it links; lagsim-client.pc
+#   lib/python3.X/dist-packages/   lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
+#                            (on Debian's sys.path for prefix /usr/local)
+#   share/lua/5.2/           lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
+#                            (on lua5.2's default path for prefix /usr/local)
+#   share/java/              lagsim_types.jar, lagsim_examples.jar
+#   share/lagsim/            config/*.yaml, lcmtypes/*.lcm, examples/{python,lua}/
+#   share/man/man1/          lagsimd.1
+# lagsim-client.pc finds its prefix from its own place, so the tree can be moved.
+# Included last from the top-level CMakeLists.txt, so every target exists already.
+include(GNUInstallDirs)
+
+set(_programs lagsimd lagsimctl lagsim-view lagsim-log2csv
+              dipc_lqr manipulator_pd stick_push)
+foreach(t ${_programs})
+  if(TARGET ${t})
+    install(TARGETS ${t} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  endif()
+endforeach()
+foreach(s lagsim-plot)  # scripts, where the build has them
+  if(EXISTS ${PROJECT_SOURCE_DIR}/tools/${s})
+    install(PROGRAMS ${PROJECT_SOURCE_DIR}/tools/${s} DESTINATION ${CMAKE_INSTALL_BINDIR})
+  endif()
+endforeach()
+
+# C: the client library, the libraries it and the examples link, their headers.
+set(_libs "")
+foreach(t lagsim_client lagsim_wire lagsim_lcmtypes lagsim_core)
+  if(TARGET ${t})
+    install(TARGETS ${t} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+    string(REPLACE "lagsim_" "-llagsim_" _l ${t})
+    string(APPEND _libs " ${_l}")
+  endif()
+endforeach()
+install(FILES ${PROJECT_SOURCE_DIR}/server/include/lagsim/lagsim.h
+              ${PROJECT_SOURCE_DIR}/clients/lagsim_client.h
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/lagsim)
+install(DIRECTORY ${CMAKE_BINARY_DIR}/lcmtypes/c/lagsim/
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/lagsim FILES_MATCHING PATTERN "*.h")
+set(LAGSIM_PC_LIBS "${_libs}")
+configure_file(${CMAKE_CURRENT_LIST_DIR}/lagsim-client.pc.in
+               ${CMAKE_BINARY_DIR}/lagsim-client.pc @ONLY)
+install(FILES ${CMAKE_BINARY_DIR}/lagsim-client.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
+# Message definitions, scenes, man page.
+file(GLOB _lcm ${PROJECT_SOURCE_DIR}/lcmtypes/*.lcm)
+install(FILES ${_lcm} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/lcmtypes)
+file(GLOB _cfg ${PROJECT_SOURCE_DIR}/config/*.yaml)
+install(FILES ${_cfg} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/config)
+install(FILES ${PROJECT_SOURCE_DIR}/docs/man/lagsimd.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+
+# Python: types and helpers in the site directory, examples in share/lagsim/examples.
+find_program(LAGSIM_PYTHON3 python3)
+if(LAGSIM_PYTHON3)
+  execute_process(COMMAND ${LAGSIM_PYTHON3} -c "import sys; print('%d.%d' % sys.version_info[:2])"
+                  OUTPUT_VARIABLE _pyver OUTPUT_STRIP_TRAILING_WHITESPACE)
+  set(LAGSIM_INSTALL_PYTHONDIR "${CMAKE_INSTALL_LIBDIR}/python${_pyver}/dist-packages"
+      CACHE STRING "where the Python types and helpers go, relative to the prefix")
+  install(DIRECTORY ${CMAKE_BINARY_DIR}/python/
+          DESTINATION ${LAGSIM_INSTALL_PYTHONDIR} FILES_MATCHING PATTERN "*.py"
+          PATTERN "__pycache__" EXCLUDE)
+  install(PROGRAMS ${PROJECT_SOURCE_DIR}/clients/python/dipc_balance.py
+                   ${PROJECT_SOURCE_DIR}/clients/python/manipulator_pd.py
+          DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/examples/python)
+endif()
+
+# Lua 5.2: types and helpers where lua5.2 looks, examples in share/lagsim/examples.
+install(DIRECTORY ${CMAKE_BINARY_DIR}/lua/ DESTINATION ${CMAKE_INSTALL_DATADIR}/lua/5.2
+        FILES_MATCHING PATTERN "*.lua")
+install(FILES ${PROJECT_SOURCE_DIR}/clients/lua/dipc_balance.lua
+              ${PROJECT_SOURCE_DIR}/clients/lua/manipulator_pd.lua
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/examples/lua)
+
+# Java: the types jar and the examples jar, beside Debian's lcm.jar.
+if(TARGET lagsim_lcmtypes_java)
+  install(FILES ${CMAKE_BINARY_DIR}/lagsim_types.jar DESTINATION ${CMAKE_INSTALL_DATADIR}/java)
+endif()
+if(TARGET lagsim_examples_java)
+  install(FILES ${CMAKE_BINARY_DIR}/lagsim_examples.jar DESTINATION ${CMAKE_INSTALL_DATADIR}/java)
+endif()

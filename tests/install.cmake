@@ -1,0 +1,18 @@
+# `cmake --install` into a temporary prefix, then the installed daemon with the installed
+# controllers (C, a C program built through pkg-config, Python, Lua, Java).
+find_program(LAGSIM_PYTHON3 python3)
+if(LAGSIM_PYTHON3)
+  # a sanitizer build's libraries need the same runtime when the test links against them
+  set(inst_flags "")
+  if(LAGSIM_SANITIZE)
+    set(inst_flags "-fsanitize=address,undefined,float-cast-overflow")
+  endif()
+  if(LAGSIM_FUZZ)
+    string(APPEND inst_flags " -fsanitize=fuzzer-no-link")
+  endif()
+  add_test(NAME install_and_run
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/install/check_install.py
+            --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} --cc ${CMAKE_C_COMPILER}
+            "--cflags=${inst_flags}")
+  set_tests_properties(install_and_run PROPERTIES TIMEOUT 180 LABELS clients)
+endif()

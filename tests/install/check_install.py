@@ -1,0 +1,139 @@
+#!/usr/bin/env python3
+"""Installs the build into a temporary prefix and runs what was installed.
+
+    check_install.py --build DIR --source DIR
+
+1. `cmake --install DIR --prefix TMP`; every file a user needs is there (programs, C
+   headers and libraries with lagsim-client.pc, the .lcm files, the scenes, the Python,
+   Lua and Java types and helpers, the example controllers, the man page, which man
+   renders without a warning and which names every option of `lagsimd --help`).
+2. The installed lagsimd runs the installed config/dipc.yaml in lockstep with the
+   installed dipc_lqr, then with the installed Python, Lua and Java examples, each from a
+   directory of its own and finding its modules the way an installed tree is found
+   (PYTHONPATH=TMP/lib/python3.X/dist-packages, which is on Debian's sys.path for
+   /usr/local; lua5.2's default path shape; the jars in TMP/share/java). Every run must
+   answer all 201 states of 2 s and balance.
+3. A C controller (clients/manipulator_pd.c) compiles and links against the installed
+   headers and libraries through pkg-config, and drives the installed lagsimd.
+"""
+import argparse
+import glob
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", required=True)
+    ap.add_argument("--source", required=True)
+    ap.add_argument("--cc", default="cc")
+    ap.add_argument("--cflags", default="", help="extra compiler flags (a sanitizer build's)")
+    a = ap.parse_args()
+    build, src = os.path.abspath(a.build), os.path.abspath(a.source)
+    tmp = tempfile.mkdtemp(prefix="lagsim_install_")
+    prefix = os.path.join(tmp, "prefix")
+    fails = 0
+
+    def check(cond, what):
+        nonlocal fails
+        print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
+        fails += 0 if cond else 1
+        return cond
+
+    r = subprocess.run(["cmake", "--install", build, "--prefix", prefix],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    if not check(r.returncode == 0, "cmake --install into %s" % prefix):
+        print(r.stdout)
+        return 1
+    pydirs = glob.glob(os.path.join(prefix, "lib", "python3*", "dist-packages"))
+    pydir = pydirs[0] if pydirs else os.path.join(prefix, "lib", "python3", "dist-packages")
+    want = ["bin/lagsimd", "bin/dipc_lqr", "bin/manipulator_pd",
+            "include/lagsim/lagsim.h", "include/lagsim/lagsim_client.h",
+            "include/lagsim/lagsim_joint_state_t.h", "lib/liblagsim_client.a",
+            "lib/pkgconfig/lagsim-client.pc", "share/man/man1/lagsimd.1",
+            "share/lagsim/config/dipc.yaml", "share/lagsim/lcmtypes/joint_state_t.lcm",
+            "share/lua/5.2/lagsim/init.lua", "share/lua/5.2/lagsim_lcm.lua",
+            "share/lagsim/examples/python/dipc_balance.py",
+            "share/lagsim/examples/lua/dipc_balance.lua",
+            "share/java/lagsim_types.jar", "share/java/lagsim_examples.jar"]
+    for w in want:
+        check(os.path.exists(os.path.join(prefix, w)), "installed %s" % w)
+    for w in ("lagsim/__init__.py", "lagsim_lcm.py", "lagsim_controller.py"):
+        check(os.path.exists(os.path.join(pydir, w)), "installed %s" % os.path.join(
+            os.path.relpath(pydir, prefix), w))
+    check(len(glob.glob(os.path.join(prefix, "share/lagsim/lcmtypes/*.lcm"))) ==
+          len(glob.glob(os.path.join(src, "lcmtypes/*.lcm"))), "every .lcm file installed")
+    man = subprocess.run(["man", "--warnings", "-l", os.path.join(prefix, "share/man/man1/lagsimd.1")],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True,
+                         env=dict(os.environ, MANPAGER="cat", MANWIDTH="80"))
+    check(man.returncode == 0 and "lagsimd" in man.stdout and not man.stderr.strip(),
+          "man -l lagsimd.1 renders without warnings%s" % (": " + man.stderr.strip() if man.stderr.strip() else ""))
+
+    # every option lagsimd --help lists is in the man page (so the two cannot drift apart)
+    hlp = subprocess.run([os.path.join(prefix, "bin", "lagsimd"), "--help"], stdout=subprocess.PIPE,
+                         stderr=subprocess.STDOUT, universal_newlines=True).stdout
+    opts = sorted(set(re.findall(r"(?<![\w-])--[a-z][a-z-]*", hlp)))
+    missing = [o for o in opts if o not in man.stdout]
+    check(opts and not missing, "the man page documents every option of lagsimd --help (%d%s)"
+          % (len(opts), "; missing " + " ".join(missing) if missing else ""))
+
+    # a C controller built against the installed tree through pkg-config
+    env_pc = dict(os.environ, PKG_CONFIG_PATH=os.path.join(prefix, "lib", "pkgconfig"))
+    pc = subprocess.run(["pkg-config", "--cflags", "--libs", "lagsim-client"], env=env_pc,
+                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+    cbin = os.path.join(tmp, "manipulator_pd_installed")
+    if check(pc.returncode == 0, "pkg-config lagsim-client: %s" % (pc.stdout.strip() or pc.stderr.strip())):
+        cc = subprocess.run([a.cc, "-std=c11", "-D_GNU_SOURCE"] + a.cflags.split() + ["-o", cbin,
+                             os.path.join(src, "clients/manipulator_pd.c")] + pc.stdout.split(),
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+        if not check(cc.returncode == 0, "clients/manipulator_pd.c builds against the installed tree"):
+            print(cc.stdout)
+
+    lagsimd = os.path.join(prefix, "bin", "lagsimd")
+    cfg = os.path.join(prefix, "share/lagsim/config")
+    e2e = [sys.executable, os.path.join(src, "tests/clients/run_e2e.py"), "--lagsimd", lagsimd,
+           "--mode", "lockstep", "--timeout", "60", "--daemon-arg=--duration", "--daemon-arg=2"]
+    dipc = ["--config", os.path.join(cfg, "dipc.yaml"), "--check", "states == 201",
+            "--check", "max_abs_theta1 < 0.1"]
+    manip = ["--config", os.path.join(cfg, "manipulator.yaml"), "--check", "states == 201"]
+    lua_path = "%s/?.lua;%s/?/init.lua;;" % ((os.path.join(prefix, "share/lua/5.2"),) * 2)
+    jars = ":".join(["/usr/share/java/lcm.jar"] + [os.path.join(prefix, "share/java", j)
+                    for j in ("lagsim_types.jar", "lagsim_examples.jar")])
+    runs = [
+        ("C dipc_lqr", dipc, [os.path.join(prefix, "bin/dipc_lqr"), "-q", "--duration", "2"], {}),
+        ("C controller built with pkg-config", manip, [cbin, "-q", "--duration", "2"], {}),
+        ("Python dipc_balance.py", dipc,
+         [sys.executable, os.path.join(prefix, "share/lagsim/examples/python/dipc_balance.py"), "-q"],
+         {"PYTHONPATH": pydir}),
+        ("Lua dipc_balance.lua", dipc,
+         ["lua5.2", os.path.join(prefix, "share/lagsim/examples/lua/dipc_balance.lua"), "-q"],
+         {"LUA_PATH": lua_path}),
+        ("Java DipcBalance", dipc, ["java", "-cp", jars, "lagsim.examples.DipcBalance", "-q"], {}),
+    ]
+    elsewhere = tempfile.mkdtemp(prefix="lagsim_cwd_")
+    for name, checks, client, env_extra in runs:
+        if not os.path.exists(client[0]) and client[0] not in ("lua5.2", "java", sys.executable):
+            check(False, "%s: %s missing" % (name, client[0]))
+            continue
+        env = dict(os.environ)
+        env.pop("PYTHONPATH", None)
+        env.pop("LUA_PATH", None)
+        env.update(env_extra)
+        r = subprocess.run(e2e + ["--name", "INST" + name.split()[0].upper()] + checks +
+                           ["--"] + client + ["--prefix", "{prefix}"],
+                           cwd=elsewhere, env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, universal_newlines=True)
+        if not check(r.returncode == 0, "installed lagsimd with the installed %s" % name):
+            print(r.stdout)
+    if fails == 0:
+        shutil.rmtree(tmp, ignore_errors=True)
+    print("%d failure(s)" % fails)
+    return 1 if fails else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
