@@ -29,8 +29,8 @@ static void usage(FILE *f)
         "                         is read; VALUE is YAML, e.g. --set integrator.method=dopri5\n"
         "                         --set initial.q=[0,0.1,-0.1]; repeatable, applied in order,\n"
         "                         validated like the file\n"
-        "  -d, --duration S       sim seconds to run (real-time: <= 0 or absent = until\n"
-        "                         stopped; offline: required, >= 0)\n"
+        "  -d, --duration S       sim seconds to run, 0 to 1e9 (real-time: 0 or absent =\n"
+        "                         until stopped; offline: required)\n"
         "      --offline          no LCM: simulate as fast as possible, write CSV rows at\n"
         "                         t = 0 and every 1/publish_hz: t,q...,q_dot...,energy\n"
         "      --csv PATH|-       offline CSV destination (- = stdout; absent = no CSV,\n"
@@ -52,6 +52,47 @@ static int usage_error(const char *fmt, const char *arg)
     fprintf(stderr, fmt, arg);
     fputs("\n(try lagsimd --help)\n", stderr);
     return LAGSIMD_EXIT_USAGE;
+}
+
+/* Names what getopt_long refused. argv[at] is the element it was reading when it answered
+ * c ('?' unknown, ':' value missing): options are not permuted ('+'), so that is the
+ * option's own element, even inside a cluster like -zq (where argv[optind - 1] is not). */
+static int option_error(const struct option *longopts, char **argv, int at, int c)
+{
+    char msg[256];
+    const char *arg = argv[at];
+    if (arg[0] == '-' && arg[1] == '-') {
+        const char *name = arg + 2;
+        int len = (int)strcspn(name, "=");
+        int exact = -1, matches = 0, last = -1;
+        char cands[160] = "";
+        for (int i = 0; longopts[i].name; i++) {
+            if (strncmp(longopts[i].name, name, (size_t)len) != 0)
+                continue;
+            if ((int)strlen(longopts[i].name) == len)
+                exact = i;
+            matches++;
+            last = i;
+            size_t used = strlen(cands);
+            snprintf(cands + used, sizeof cands - used, "%s--%s", used ? ", " : "",
+                     longopts[i].name);
+        }
+        int known = exact >= 0 ? exact : matches == 1 ? last : -1;
+        if (known >= 0 && c == ':')
+            snprintf(msg, sizeof msg, "option --%s needs a value", longopts[known].name);
+        else if (known >= 0)
+            snprintf(msg, sizeof msg, "option --%s takes no value", longopts[known].name);
+        else if (matches > 1)
+            snprintf(msg, sizeof msg, "ambiguous option '--%.*s' (%s)", len > 64 ? 64 : len,
+                     name, cands);
+        else
+            snprintf(msg, sizeof msg, "unknown option '--%.*s'", len > 64 ? 64 : len, name);
+    } else if (c == ':') {
+        snprintf(msg, sizeof msg, "option -%c needs a value", optopt);
+    } else {
+        snprintf(msg, sizeof msg, "unknown option '-%c'", optopt);
+    }
+    return usage_error("%s", msg);
 }
 
 /* A scene without lcm.url leaves the choice to LCM, which reads LCM_DEFAULT_URL: that
@@ -104,8 +145,10 @@ int main(int argc, char **argv)
     }
 
     opterr = 0; /* our own messages */
-    int c;
-    while ((c = getopt_long(argc, argv, ":c:s:d:qhV", longopts, NULL)) != -1) {
+    int c, at = optind;
+    /* '+': stop at the first argument that is not an option (reported below), so that
+     * argv[at] is always the element an error concerns */
+    while ((c = getopt_long(argc, argv, "+:c:s:d:qhV", longopts, NULL)) != -1) {
         switch (c) {
         case 'c':
             config = optarg;
@@ -114,12 +157,14 @@ int main(int argc, char **argv)
             sets[nsets++] = optarg;
             break;
         case 'd': {
-            char *end;
-            double d = strtod(optarg, &end);
-            if (end == optarg || *end != '\0' || !isfinite(d)) {
+            /* a plain decimal; at most LAG_SCENE_MAX_TIME, so that the run's tick count
+             * is exact and cannot overflow */
+            double d = 0.0;
+            if (lag_scene_read_decimal(optarg, &d) != 0 || !(d >= 0.0) ||
+                !(d <= LAG_SCENE_MAX_TIME)) {
                 free(sets);
-                return usage_error("--duration: expected a number of seconds, got '%s'",
-                                   optarg);
+                return usage_error("--duration: expected a number of seconds from 0 to "
+                                   "1e9, got '%s'", optarg);
             }
             opts.duration = d;
             have_duration = true;
@@ -145,13 +190,11 @@ int main(int argc, char **argv)
             printf("lagsimd %s\n", LAGSIMD_VERSION);
             free(sets);
             return LAGSIMD_EXIT_OK;
-        case ':':
+        default: /* '?' or ':' */
             free(sets);
-            return usage_error("option %s needs a value", argv[optind - 1]);
-        default:
-            free(sets);
-            return usage_error("unknown option '%s'", argv[optind - 1]);
+            return option_error(longopts, argv, at, c);
         }
+        at = optind;
     }
     if (optind < argc) {
         free(sets);
@@ -166,8 +209,6 @@ int main(int argc, char **argv)
         rc = usage_error("%s", "--csv needs --offline");
     } else if (offline && !have_duration) {
         rc = usage_error("%s", "--offline needs --duration SECONDS");
-    } else if (offline && opts.duration < 0.0) {
-        rc = usage_error("%s", "--duration: expected seconds >= 0");
     } else {
         static lag_scene sc;
         char err[1024];

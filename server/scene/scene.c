@@ -2,7 +2,9 @@
  * Scene defaults and names: the part of the scene that needs no YAML.
  */
 #include <ctype.h>
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "scene.h"
@@ -40,6 +42,37 @@ void lag_scene_default(lag_scene *sc, lag_model_kind kind)
     for (; name[i] && i + 1 < sizeof sc->lcm.prefix; i++)
         sc->lcm.prefix[i] = (char)toupper((unsigned char)name[i]);
     sc->lcm.prefix[i] = '\0';
+}
+
+int lag_scene_read_decimal(const char *t, double *v)
+{
+    const char *p = t;
+    if (*p == '+' || *p == '-')
+        p++;
+    int digits = 0;
+    while (*p >= '0' && *p <= '9') { p++; digits++; }
+    if (*p == '.') {
+        p++;
+        while (*p >= '0' && *p <= '9') { p++; digits++; }
+    }
+    if (digits == 0)
+        return -1;
+    if (*p == 'e' || *p == 'E') {
+        p++;
+        if (*p == '+' || *p == '-')
+            p++;
+        if (!(*p >= '0' && *p <= '9'))
+            return -1;
+        while (*p >= '0' && *p <= '9')
+            p++;
+    }
+    if (*p != '\0')
+        return -1;
+    double x = strtod(t, NULL);
+    if (!isfinite(x))
+        return -2;
+    *v = x;
+    return 0;
 }
 
 const char *lag_rt_mode_name(lag_rt_mode m)

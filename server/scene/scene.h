@@ -52,6 +52,12 @@ typedef struct lag_scene {
 #define LAG_SCENE_MAX_DEPTH 32            /* nesting of mappings and sequences */
 #define LAG_SCENE_MAX_SCALAR 4096         /* bytes of one scalar (key or value) */
 
+/* The longest sim time a scene or the command line may name (a disturbance's t, a
+ * force's duration, realtime.command_timeout, lagsimd --duration): about 31.7 years.
+ * With integrator.dt >= 1e-6 s any such time is at most 1e15 ticks: an exact integer in
+ * a double, far from int64's limit, so no conversion to ticks can overflow. */
+#define LAG_SCENE_MAX_TIME 1e9
+
 /* Default realtime.effort_limit, N or N m: far above what any controller of these models
  * commands, far below where the arithmetic of a step stops being finite. */
 #define LAG_SCENE_EFFORT_LIMIT 1e6
@@ -72,6 +78,13 @@ int lag_scene_load_buffer(const char *name, const char *text, size_t len,
                           size_t errlen);
 
 const char *lag_rt_mode_name(lag_rt_mode m);
+
+/* Reads a number written as a plain decimal, the only way a scene (or lagsimd's command
+ * line) writes one: [-+]? (digits [. digits?] | . digits) ([eE] [-+]? digits)?, finite.
+ * Not "0x1p-10", "inf", "nan", "1_000" or "1e999", whatever strtod makes of them.
+ * Returns 0, -1 if s is not a plain decimal, -2 if it is one too large for a double
+ * (1e999). OUT: v */
+int lag_scene_read_decimal(const char *s, double *v);
 
 /* Checks an LCM URL the way the loader does for lcm.url (and lagsimd for
  * LCM_DEFAULT_URL): "" (LCM's default), memq:// (in-process, for tests) or

@@ -26,11 +26,8 @@
 
 /* ================================================================ ranges */
 
-/* The longest sim time a scene may refer to (a disturbance's t and duration, the
- * watchdog's command_timeout, lagsimd --duration): about 31.7 years. With dt >= 1e-6 s
- * every such time is at most 1e15 ticks, an exact integer in a double and far from
- * int64's limit, so no conversion to ticks can overflow. */
-#define T_MAX 1e9
+/* The longest sim time (scene.h explains the bound). */
+#define T_MAX LAG_SCENE_MAX_TIME
 /* The largest force-like value (N or N m, N s or N m s, N s/m): far beyond any load
  * these models are meant for (a 1e6 kg mass under 1e3 m/s^2 weighs 1e9 N) and small
  * enough that accelerations and energies computed from it stay finite. */
@@ -177,34 +174,6 @@ static int convert_map(conv *cv, const ynode *nd, const char *path, const keyrow
 
 /* ================================================================ scalars */
 
-/* A plain decimal number as YAML's core schema writes one: [-+]? (digits [. digits?] |
- * . digits) ([eE] [-+]? digits)?. Hexadecimal, "inf", "nan", "1_000" are not numbers
- * here, whatever strtod would make of them. */
-static bool is_decimal(const char *t)
-{
-    const char *p = t;
-    if (*p == '+' || *p == '-')
-        p++;
-    int digits = 0;
-    while (*p >= '0' && *p <= '9') { p++; digits++; }
-    if (*p == '.') {
-        p++;
-        while (*p >= '0' && *p <= '9') { p++; digits++; }
-    }
-    if (digits == 0)
-        return false;
-    if (*p == 'e' || *p == 'E') {
-        p++;
-        if (*p == '+' || *p == '-')
-            p++;
-        if (!(*p >= '0' && *p <= '9'))
-            return false;
-        while (*p >= '0' && *p <= '9')
-            p++;
-    }
-    return *p == '\0';
-}
-
 /* A finite number written as a plain decimal scalar. */
 static int get_number(conv *cv, const ynode *nd, const char *path, double *out)
 {
@@ -221,11 +190,12 @@ static int get_number(conv *cv, const ynode *nd, const char *path, double *out)
     if (strcmp(u, ".inf") == 0 || strcmp(u, ".Inf") == 0 || strcmp(u, ".INF") == 0 ||
         strcmp(t, ".nan") == 0 || strcmp(t, ".NaN") == 0 || strcmp(t, ".NAN") == 0)
         return yfail(cv->err, nd, path, "expected a finite number, got %s", t);
-    if (!is_decimal(t))
+    double v;
+    int r = lag_scene_read_decimal(t, &v);
+    if (r == -2)
+        return yfail(cv->err, nd, path, "expected a finite number, got %s", t); /* 1e999 */
+    if (r < 0)
         return yfail(cv->err, nd, path, "expected a number, got '%s'", t);
-    double v = strtod(t, NULL);
-    if (!isfinite(v))
-        return yfail(cv->err, nd, path, "expected a finite number, got %s", t);
     *out = v;
     return 0;
 }

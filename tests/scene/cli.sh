@@ -15,8 +15,9 @@ if [ $rc -ne 0 ] || [[ "$v" != "lagsimd "[0-9]* ]]; then echo "FAIL: --version (
 usage() { # usage EXPECTED_FRAGMENT ARGS...
     local want=$1; shift
     local out err rc
-    err=$("$lagsimd" "$@" 2>&1 >/dev/null); rc=$?
-    out=$("$lagsimd" "$@" 2>/dev/null)
+    # a bounded wait: an argument that is wrongly accepted may start a server
+    err=$(timeout 10 "$lagsimd" "$@" 2>&1 >/dev/null); rc=$?
+    out=$(timeout 10 "$lagsimd" "$@" 2>/dev/null)
     if [ $rc -ne 2 ]; then echo "FAIL: '$*' exit $rc, expected 2"; fail=1
     elif [[ "$err" != *"$want"* ]]; then echo "FAIL: '$*': '$err' lacks '$want'"; fail=1
     elif [ -n "$out" ]; then echo "FAIL: '$*' wrote to stdout"; fail=1
@@ -25,8 +26,24 @@ usage() { # usage EXPECTED_FRAGMENT ARGS...
 usage "--config FILE is required" --offline --duration 1
 usage "unknown option '--bogus'" --config "$scene" --bogus
 usage "option --duration needs a value" --config "$scene" --duration
-usage "--duration: expected a number of seconds, got 'abc'" --config "$scene" --offline --duration abc
-usage "--duration: expected a number of seconds, got 'nan'" --config "$scene" --offline --duration nan
+usage "--duration: expected a number of seconds from 0 to 1e9, got 'abc'" --config "$scene" --offline --duration abc
+usage "--duration: expected a number of seconds from 0 to 1e9, got 'nan'" --config "$scene" --offline --duration nan
+# durations whose tick count would overflow or lose its last digits, and numbers strtod
+# takes but a scene would not
+for d in 1e300 1e16 -1 0x10 inf 1e999 "5 " ""; do
+    usage "--duration: expected a number of seconds from 0 to 1e9, got '$d'" --config "$scene" --offline --duration "$d"
+    usage "--duration: expected a number of seconds from 0 to 1e9, got '$d'" --config "$scene" --duration "$d"
+done
+# the option at fault is named, also inside a cluster of short options
+usage "unknown option '-z'" -zq --config "$scene"
+usage "unknown option '-z'" -qz --config "$scene"
+usage "unknown option '-z'" --config "$scene" -qz --offline
+usage "option -c needs a value" -qc
+usage "option --config needs a value" --conf
+usage "ambiguous option '--c' (--config, --csv)" --c "$scene"
+usage "option --help takes no value" --help=yes
+usage "option --offline takes no value" --config "$scene" --offline=1 --duration 1
+usage "unknown option '--bogus'" --config "$scene" --bogus=1
 usage "--csv needs --offline" --config "$scene" --csv -
 usage "--offline needs --duration" --config "$scene" --offline --csv -
 usage "--offline and --replay exclude each other" --config "$scene" --offline --duration 1 --replay x.lcm
