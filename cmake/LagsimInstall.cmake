@@ -1,7 +1,7 @@
 # `cmake --install <build> [--prefix /usr/local]`: everything a user of lagsim needs, laid
 # out as a Debian tool's files (GNUInstallDirs):
-#   bin/                     lagsimd, lagsimctl, lagsim-view, lagsim-log2csv and the C
-#                            example controllers (each installed when the build has it)
+#   bin/                     lagsimd, lagsimctl, lagsim-view, lagsim-log2csv, lagsim-plot
+#                            and the C example controllers (each when the build has it)
 #   include/lagsim/          lagsim.h (the core), lagsim_client.h, the generated C types
 #   lib/                     liblagsim_client.a and what it links; lagsim-client.pc
 #   lib/python3.X/dist-packages/   lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
@@ -22,9 +22,9 @@ foreach(t ${_programs})
     install(TARGETS ${t} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
   endif()
 endforeach()
-foreach(s lagsim-plot)  # scripts, where the build has them
-  if(EXISTS ${PROJECT_SOURCE_DIR}/tools/${s})
-    install(PROGRAMS ${PROJECT_SOURCE_DIR}/tools/${s} DESTINATION ${CMAKE_INSTALL_BINDIR})
+foreach(s server/tools/lagsim-plot)  # scripts, where the tree has them
+  if(EXISTS ${PROJECT_SOURCE_DIR}/${s})
+    install(PROGRAMS ${PROJECT_SOURCE_DIR}/${s} DESTINATION ${CMAKE_INSTALL_BINDIR})
   endif()
 endforeach()
 

@@ -60,6 +60,10 @@ def main():
             "share/lagsim/examples/python/dipc_balance.py",
             "share/lagsim/examples/lua/dipc_balance.lua",
             "share/java/lagsim_types.jar", "share/java/lagsim_examples.jar"]
+    # the other programs, each where the build made it
+    for prog in ("lagsimctl", "lagsim-view", "lagsim-log2csv", "lagsim-plot", "stick_push"):
+        if os.path.exists(os.path.join(build, "bin", prog)):
+            want.append("bin/" + prog)
     for w in want:
         check(os.path.exists(os.path.join(prefix, w)), "installed %s" % w)
     for w in ("lagsim/__init__.py", "lagsim_lcm.py", "lagsim_controller.py"):
