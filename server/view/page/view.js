@@ -1,0 +1,386 @@
+// lagsim view: draws the model from the scene description and animates it from the
+// newest state at the display's frame rate (a state that arrives between two frames
+// replaces the previous one: nothing queues). Strip charts of q, qd, effort (from the
+// states) and energy (from the status), the status, the events, control buttons.
+// Served by lagsim-view; uses no library.
+"use strict";
+
+const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf"];
+const CHART_MAX = 6000;          // samples kept per chart (latest win)
+const EVENTS_MAX = 300;          // lines kept in the event list
+
+const view = {
+  scene: null, state: null, status: null, connected: false,
+  dirty: true, frames: 0, statesReceived: 0, camX: null,
+  charts: { q: [], qd: [], effort: [], energy: [] },   // [t, values[]] per sample
+  drawn: null,                                         // what the last frame drew
+};
+window.lagsimView = view;   // read by tests (DevTools) and handy in the console
+
+const $ = (id) => document.getElementById(id);
+
+// ---------------------------------------------------------------- stream
+function connect() {
+  const es = new EventSource("/events");
+  es.addEventListener("open", () => { view.connected = true; showConn(); });
+  es.addEventListener("error", () => { view.connected = false; showConn(); });
+  es.addEventListener("bridge", (e) => { const b = JSON.parse(e.data); $("title").textContent = "lagsim view: " + b.prefix; });
+  es.addEventListener("scene", (e) => { view.scene = JSON.parse(e.data); view.camX = null; view.dirty = true; });
+  es.addEventListener("state", (e) => onState(JSON.parse(e.data)));
+  es.addEventListener("status", (e) => onStatus(JSON.parse(e.data)));
+  es.addEventListener("events", (e) => onEvents(JSON.parse(e.data)));
+}
+
+function showConn() {
+  const c = $("conn");
+  c.textContent = view.connected ? "connected" : "disconnected (retrying)";
+  c.className = view.connected ? "ok" : "bad";
+}
+
+function push(list, t, v) {
+  if (list.length && t < list[list.length - 1][0]) list.length = 0;   // a reset: start over
+  if (list.length && t === list[list.length - 1][0]) list[list.length - 1] = [t, v];
+  else list.push([t, v]);
+  if (list.length > CHART_MAX) list.splice(0, list.length - CHART_MAX);
+}
+
+function onState(s) {
+  view.state = s;
+  view.statesReceived++;
+  if (s.sim_time !== null) {
+    push(view.charts.q, s.sim_time, s.q);
+    push(view.charts.qd, s.sim_time, s.qd);
+    push(view.charts.effort, s.sim_time, s.effort);
+  }
+  view.dirty = true;
+}
+
+function onStatus(s) {
+  view.status = s;
+  if (s.sim_time !== null && s.energy !== null) push(view.charts.energy, s.sim_time, [s.energy]);
+  view.dirty = true;
+}
+
+function onEvents(batch) {
+  const ol = $("events");
+  if (batch.missed > 0) addEvent(ol, "missed", batch.missed + " events not shown (the view fell behind)");
+  for (const e of batch.events) {
+    const t = e.sim_time === null ? "?" : e.sim_time.toFixed(3);
+    addEvent(ol, e.kind, `t=${t}  ${e.kind}${e.joint ? " [" + e.joint + "]" : ""}  ${e.detail}`);
+  }
+}
+
+function addEvent(ol, cls, text) {
+  const li = document.createElement("li");
+  li.className = cls.replace(/[^a-z_]/g, "");
+  li.textContent = text;            // text only: event details come from the bus
+  ol.insertBefore(li, ol.firstChild);
+  while (ol.childNodes.length > EVENTS_MAX) ol.removeChild(ol.lastChild);
+}
+
+// ---------------------------------------------------------------- controls
+async function control(request) {
+  let url = "/api/control?request=" + request;
+  if (request === "step") url += "&count=" + encodeURIComponent($("stepcount").value || "1");
+  try {
+    const r = await fetch(url, { method: "POST", headers: { "X-Lagsim": "1" } });
+    const j = await r.json();
+    $("ctlmsg").textContent = request + ": " + j.message;
+  } catch (err) {
+    $("ctlmsg").textContent = request + ": " + err;
+  }
+}
+for (const id of ["pause", "resume", "step", "reset"]) $(id).addEventListener("click", () => control(id));
+
+// ---------------------------------------------------------------- drawing helpers
+function fit(canvas) {
+  const r = window.devicePixelRatio || 1;
+  const w = Math.max(1, Math.round(canvas.clientWidth * r)), h = Math.max(1, Math.round(canvas.clientHeight * r));
+  if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
+  const g = canvas.getContext("2d");
+  g.setTransform(r, 0, 0, r, 0, 0);
+  return { g, w: canvas.clientWidth, h: canvas.clientHeight };
+}
+
+const P = (name) => (view.scene && view.scene.params && Number.isFinite(view.scene.params[name])) ? view.scene.params[name] : NaN;
+function joint(name) {
+  if (!view.scene || !view.state) return NaN;
+  const i = view.state.name.indexOf(name);
+  return i >= 0 && view.state.q[i] !== null ? view.state.q[i] : NaN;
+}
+function limitOf(name) {
+  if (!view.scene) return null;
+  const i = view.scene.joints.indexOf(name);
+  return i >= 0 ? view.scene.limits[i] : null;
+}
+const hasEffect = (e) => !!view.scene && view.scene.effects.split(",").includes(e);
+
+// A world-to-canvas map: meters, y up; scale in px per m.
+function worldMap(w, h, cx, cy, scale) {
+  return { scale, X: (x) => w / 2 + (x - cx) * scale, Y: (y) => h / 2 - (y - cy) * scale };
+}
+
+function line(g, m, x0, y0, x1, y1) { g.beginPath(); g.moveTo(m.X(x0), m.Y(y0)); g.lineTo(m.X(x1), m.Y(y1)); g.stroke(); }
+function dot(g, m, x, y, r) { g.beginPath(); g.arc(m.X(x), m.Y(y), r, 0, 2 * Math.PI); g.fill(); }
+
+function scaleBar(g, m, w, h) {
+  const cands = [0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10];
+  let len = cands[0];
+  for (const c of cands) if (c * m.scale <= w * 0.25) len = c;
+  const x0 = 14, y0 = h - 14, px = len * m.scale;
+  g.strokeStyle = "#333"; g.lineWidth = 2;
+  g.beginPath(); g.moveTo(x0, y0); g.lineTo(x0 + px, y0); g.moveTo(x0, y0 - 4); g.lineTo(x0, y0 + 4);
+  g.moveTo(x0 + px, y0 - 4); g.lineTo(x0 + px, y0 + 4); g.stroke();
+  g.fillStyle = "#333"; g.font = "12px DejaVu Sans, sans-serif";
+  g.fillText(len + " m (to scale)", x0 + px + 6, y0 + 4);
+}
+
+function ground(g, m, w, y, hatched, label) {
+  g.strokeStyle = "#555"; g.lineWidth = 2;
+  g.beginPath(); g.moveTo(0, m.Y(y)); g.lineTo(w, m.Y(y)); g.stroke();
+  if (hatched) {
+    g.lineWidth = 1; g.strokeStyle = "#999";
+    for (let x = -20; x < w + 20; x += 12) { g.beginPath(); g.moveTo(x, m.Y(y)); g.lineTo(x - 8, m.Y(y) + 8); g.stroke(); }
+  }
+  if (label) { g.fillStyle = "#777"; g.font = "11px DejaVu Sans, sans-serif"; g.fillText(label, 8, m.Y(y) + 22); }
+}
+
+// Keeps the camera on x, moving it only when x nears the edge.
+function follow(x, halfWidth) {
+  if (view.camX === null || !Number.isFinite(view.camX)) view.camX = 0;
+  if (Math.abs(x - view.camX) > 0.6 * halfWidth) view.camX = x;
+  return view.camX;
+}
+
+// ---------------------------------------------------------------- the models
+// DIPC: cart on a track (theta0), rods l1, l2 at absolute angles from the upward vertical.
+function drawDipc(g, w, h) {
+  const l1 = P("l1"), l2 = P("l2"), h0 = Number.isFinite(P("h0")) ? P("h0") : 0;
+  const x = joint("theta0"), t1 = joint("theta1"), t2 = joint("theta2");
+  const L = l1 + l2, span = 2 * L + 0.4;
+  const scale = Math.min(h / span, w / (span * 1.6));
+  const cx = follow(x, w / (2 * scale));
+  const m = worldMap(w, h, cx, h0, scale);
+  ground(g, m, w, 0, false, "track");
+  // ruler on the track every 0.1 m, numbered every 0.5 m
+  g.strokeStyle = "#aaa"; g.fillStyle = "#888"; g.font = "10px DejaVu Sans, sans-serif"; g.lineWidth = 1;
+  const x0 = Math.ceil((cx - w / (2 * scale)) * 10) / 10;
+  for (let k = x0; k < cx + w / (2 * scale); k += 0.1) {
+    const major = Math.abs(k * 2 - Math.round(k * 2)) < 1e-6;
+    line(g, m, k, 0, k, major ? -0.04 : -0.02);
+    if (major) g.fillText(k.toFixed(1), m.X(k) - 8, m.Y(-0.09));
+  }
+  const lim = limitOf("theta0");
+  if (lim) {
+    g.strokeStyle = "#c62828"; g.lineWidth = 4;
+    for (const s of lim) line(g, m, s, -0.05, s, 0.12);
+  }
+  for (const [name, t] of [["theta1", t1], ["theta2", t2]]) {   // stops of a rod: dashed rays
+    const l = limitOf(name);
+    if (!l) continue;
+    g.strokeStyle = "#ef9a9a"; g.lineWidth = 1; g.setLineDash([4, 4]);
+    for (const a of l) line(g, m, x, h0, x + 0.35 * L * Math.sin(a), h0 + 0.35 * L * Math.cos(a));
+    g.setLineDash([]);
+    void t;
+  }
+  if (![x, t1, t2, l1, l2].every(Number.isFinite)) return null;
+  const p1 = [x + l1 * Math.sin(t1), h0 + l1 * Math.cos(t1)];
+  const p2 = [p1[0] + l2 * Math.sin(t2), p1[1] + l2 * Math.cos(t2)];
+  // the cart: its size is not a model parameter (drawn 0.3 m x 0.12 m); its centre is
+  // at theta0, the pivot h0 above the track
+  g.fillStyle = "#90a4ae"; g.strokeStyle = "#37474f"; g.lineWidth = 1.5;
+  g.fillRect(m.X(x - 0.15), m.Y(h0 + 0.06), 0.3 * scale, 0.12 * scale);
+  g.strokeRect(m.X(x - 0.15), m.Y(h0 + 0.06), 0.3 * scale, 0.12 * scale);
+  g.lineCap = "round";
+  g.strokeStyle = COLORS[0]; g.lineWidth = Math.max(4, 0.03 * scale); line(g, m, x, h0, p1[0], p1[1]);
+  g.strokeStyle = COLORS[1]; line(g, m, p1[0], p1[1], p2[0], p2[1]);
+  g.fillStyle = "#222"; dot(g, m, x, h0, 4); dot(g, m, p1[0], p1[1], 4);
+  return { m, points: [[x, h0], p1, p2] };
+}
+
+// Stick: centre of mass at x, angle phi from the floor, length l, lower end on the floor
+// (y = 0) unless the scene publishes a height: a joint "y" (centre of mass height) or any
+// other third joint (height of the lower end above the floor).
+function drawStick(g, w, h) {
+  const l = P("l"), x = joint("x"), phi = joint("phi");
+  let yc = NaN;
+  if (view.state && view.state.name.includes("y")) yc = joint("y");
+  else if (view.state && view.state.name.length > 2) {
+    const hh = view.state.q[2];
+    yc = (hh === null ? 0 : hh) + 0.5 * l * Math.abs(Math.sin(phi));
+  } else yc = 0.5 * l * Math.sin(phi);
+  const top = Math.max(1.15 * l, Number.isFinite(yc) ? yc + 0.65 * l : 0);
+  const scale = Math.min(h / (top + 0.25 * l), w / (2.6 * l));
+  const cx = follow(Number.isFinite(x) ? x : 0, w / (2 * scale));
+  const m = worldMap(w, h, cx, (top - 0.25 * l) / 2, scale);
+  ground(g, m, w, 0, hasEffect("floor"),
+         hasEffect("floor") ? "floor (impacts on)" : "floor: the model keeps the lower end on it");
+  const lim = limitOf("x");
+  if (lim) { g.strokeStyle = "#c62828"; g.lineWidth = 4; for (const s of lim) line(g, m, s, 0, s, 0.3 * l); }
+  if (![l, x, phi, yc].every(Number.isFinite)) return null;
+  const dx = 0.5 * l * Math.cos(phi), dy = 0.5 * l * Math.sin(phi);
+  const a = [x - dx, yc - dy], b = [x + dx, yc + dy];
+  g.lineCap = "round"; g.strokeStyle = COLORS[0]; g.lineWidth = Math.max(5, 0.04 * scale);
+  line(g, m, a[0], a[1], b[0], b[1]);
+  g.fillStyle = "#222"; dot(g, m, x, yc, 4);
+  return { m, points: [a, [x, yc], b] };
+}
+
+// Manipulator: arm 1 about the axis at the origin at angle q1 from the horizontal (drawn
+// 2 l1 long: a uniform arm whose centre of mass is at l1), the sliding link with its
+// centre of mass at q2 along it.
+function drawManipulator(g, w, h) {
+  const l1 = P("l1"), q1 = joint("q1"), q2 = joint("q2");
+  const lim2 = limitOf("q2"), lim1 = limitOf("q1");
+  let R = 2 * l1;
+  if (Number.isFinite(q2)) R = Math.max(R, Math.abs(q2) + 0.3 * l1);
+  if (lim2) R = Math.max(R, Math.abs(lim2[0]), Math.abs(lim2[1]));
+  const scale = Math.min(w, h) / (2 * R + 0.4 * l1);
+  const m = worldMap(w, h, 0, 0, scale);
+  g.strokeStyle = "#ddd"; g.lineWidth = 1; line(g, m, -R, 0, R, 0);
+  if (lim1) {
+    g.strokeStyle = "#ef9a9a"; g.setLineDash([4, 4]);
+    for (const a of lim1) line(g, m, 0, 0, 1.05 * R * Math.cos(a), 1.05 * R * Math.sin(a));
+    g.setLineDash([]);
+  }
+  if (![l1, q1, q2].every(Number.isFinite)) return null;
+  const c = Math.cos(q1), s = Math.sin(q1);
+  g.lineCap = "round"; g.strokeStyle = "#78909c"; g.lineWidth = Math.max(5, 0.03 * scale);
+  line(g, m, 0, 0, 2 * l1 * c, 2 * l1 * s);
+  if (lim2) {
+    g.fillStyle = "#c62828";
+    for (const d of lim2) dot(g, m, d * c, d * s, 4);
+  }
+  const half = 0.25 * l1;   // the sliding link's length is not a parameter: drawn 0.5 l1
+  g.strokeStyle = COLORS[1]; g.lineWidth = Math.max(9, 0.06 * scale);
+  line(g, m, (q2 - half) * c, (q2 - half) * s, (q2 + half) * c, (q2 + half) * s);
+  g.fillStyle = "#222"; dot(g, m, 0, 0, 5); dot(g, m, q2 * c, q2 * s, 4); dot(g, m, l1 * c, l1 * s, 3);
+  return { m, points: [[0, 0], [2 * l1 * c, 2 * l1 * s], [q2 * c, q2 * s]] };
+}
+
+const DRAW = { dipc: drawDipc, stick: drawStick, manipulator: drawManipulator };
+
+function drawModel() {
+  const { g, w, h } = fit($("model"));
+  g.clearRect(0, 0, w, h);
+  g.fillStyle = "#666"; g.font = "13px DejaVu Sans, sans-serif";
+  if (!view.scene) { g.fillText("waiting for the scene description (is lagsimd running with this prefix?)", 14, 24); return null; }
+  const f = DRAW[view.scene.model];
+  if (!f) { g.fillText("unknown model: " + view.scene.model, 14, 24); return null; }
+  const r = f(g, w, h);
+  if (r) scaleBar(g, r.m, w, h);
+  g.fillStyle = "#333"; g.font = "13px DejaVu Sans Mono, monospace";
+  const st = view.state;
+  if (st && st.sim_time !== null) g.fillText("t = " + st.sim_time.toFixed(3) + " s", w - 130, 20);
+  return r;
+}
+
+// ---------------------------------------------------------------- charts
+function drawChart(canvas, samples, names) {
+  const { g, w, h } = fit(canvas);
+  g.clearRect(0, 0, w, h);
+  const win = Number($("window").value) || 10;
+  const tEnd = samples.length ? samples[samples.length - 1][0] : 0;
+  const t0 = samples.length ? Math.max(tEnd - win, samples[0][0]) : 0, span = Math.max(tEnd - t0, 1e-9);
+  let lo = Infinity, hi = -Infinity, first = samples.length;
+  for (let i = samples.length - 1; i >= 0 && samples[i][0] >= t0; i--) {
+    first = i;
+    for (const v of samples[i][1]) if (v !== null) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+  }
+  g.fillStyle = "#555"; g.font = "11px DejaVu Sans, sans-serif";
+  g.fillText(canvas.dataset.title, 6, 12);
+  if (!(hi >= lo)) return;
+  if (hi - lo < 1e-12 * Math.max(1, Math.abs(hi))) { const d = Math.max(0.5, 1e-6 * Math.abs(hi)); hi += d; lo -= d; }
+  const pad = 0.08 * (hi - lo); lo -= pad; hi += pad;
+  // enough digits to tell the bounds apart (energy drifts in its 7th digit)
+  const digits = Math.min(12, Math.max(4, 2 + Math.ceil(Math.log10(Math.max(Math.abs(hi), Math.abs(lo)) / (hi - lo)))));
+  const L = 86, R = 86, T = 16, B = 14;
+  const X = (t) => L + (t - t0) / span * (w - L - R), Y = (v) => T + (hi - v) / (hi - lo) * (h - T - B);
+  g.strokeStyle = "#eee"; g.lineWidth = 1;
+  g.beginPath(); g.moveTo(L, Y(0)); g.lineTo(w - R, Y(0)); g.stroke();
+  g.fillStyle = "#777";
+  g.fillText(hi.toPrecision(digits), 2, T + 8); g.fillText(lo.toPrecision(digits), 2, h - B);
+  g.fillText(t0.toFixed(1) + " s", L, h - 2); g.fillText(tEnd.toFixed(1) + " s", w - R - 40, h - 2);
+  const n = samples.length ? samples[samples.length - 1][1].length : 0;
+  for (let k = 0; k < n; k++) {
+    g.strokeStyle = COLORS[k % COLORS.length]; g.lineWidth = 1.5; g.beginPath();
+    let pen = false;
+    for (let i = first; i < samples.length; i++) {
+      const v = samples[i][1][k];
+      if (v === null || v === undefined) { pen = false; continue; }
+      if (pen) g.lineTo(X(samples[i][0]), Y(v)); else g.moveTo(X(samples[i][0]), Y(v));
+      pen = true;
+    }
+    g.stroke();
+    g.fillStyle = COLORS[k % COLORS.length];
+    g.fillText(names[k] || "", w - R + 6, T + 10 + 13 * k);
+  }
+}
+
+function drawCharts() {
+  const names = view.state ? view.state.name : [];
+  drawChart($("chart_q"), view.charts.q, names);
+  drawChart($("chart_qd"), view.charts.qd, names.map((n) => n + "_dot"));
+  drawChart($("chart_effort"), view.charts.effort, names);
+  drawChart($("chart_energy"), view.charts.energy, ["E"]);
+}
+
+// ---------------------------------------------------------------- status
+function fmt(x, d) { return x === null || x === undefined ? "–" : Number(x).toFixed(d); }
+function drawStatus() {
+  const s = view.status, sc = view.scene, rows = [];
+  if (sc) rows.push(["model", `${sc.model}, ${sc.integrator}, dt ${sc.dt} s, period ${sc.control_period} s` +
+                     (sc.effects ? `, effects: ${sc.effects}` : ", no effects")]);
+  if (s) {
+    const rej = s.rejected_unknown_joint + s.rejected_unactuated + s.rejected_nonfinite +
+                s.rejected_bad_length + s.rejected_undecodable + s.rejected_stale;
+    rows.push(["run state", s.run_state, s.run_state !== "running"]);
+    rows.push(["mode", s.mode + (sc && s.mode === "realtime" ? ` at rate ${sc.rate}` : "")]);
+    rows.push(["real-time factor", fmt(s.rtf, 3)]);
+    rows.push(["overruns", `${s.overruns} (bursts ${s.overrun_bursts})`, s.overruns > 0]);
+    rows.push(["step time", `mean ${fmt(s.step_time_mean_us, 1)} us, max ${fmt(s.step_time_max_us, 1)} us`]);
+    rows.push(["commands", `${s.commands_accepted} accepted, ${rej} rejected` +
+               (rej ? ` (unknown ${s.rejected_unknown_joint}, unactuated ${s.rejected_unactuated}, non-finite ${s.rejected_nonfinite}, length ${s.rejected_bad_length}, undecodable ${s.rejected_undecodable}, stale ${s.rejected_stale})` : ""), rej > 0]);
+    rows.push(["controls rejected", String(s.controls_rejected)]);
+    rows.push(["watchdog", (s.watchdog_tripped ? "TRIPPED: efforts zeroed" : "ok") + `, ${s.watchdog_trips} trips`, s.watchdog_tripped]);
+    rows.push(["lockstep timeouts", String(s.lockstep_timeouts), s.lockstep_timeouts > 0]);
+    rows.push(["numeric faults", String(s.numeric_faults), s.numeric_faults > 0]);
+    rows.push(["energy", fmt(s.energy, 6) + " J"]);
+    rows.push(["states published", String(s.states_published)]);
+  } else rows.push(["status", "none yet"]);
+  const tb = $("status").tBodies[0];
+  tb.textContent = "";
+  for (const [k, v, warn] of rows) {
+    const tr = tb.insertRow(), a = tr.insertCell(), b = tr.insertCell();
+    a.textContent = k; b.textContent = v;
+    if (warn) b.className = "warn";
+  }
+}
+
+// ---------------------------------------------------------------- frame loop
+function frame() {
+  if (view.dirty) {
+    view.dirty = false;
+    const r = drawModel();
+    drawCharts();
+    drawStatus();
+    const st = view.state;
+    if (st && st.sim_time !== null) $("simtime").textContent = "t = " + st.sim_time.toFixed(3) + " s";
+    view.frames++;
+    view.drawn = {
+      frame: view.frames,
+      model: view.scene ? view.scene.model : null,
+      sim_time: st ? st.sim_time : null,
+      q: st ? st.q.slice() : null,
+      points: r ? r.points : null,            // world coordinates (m) of what was drawn
+      run_state: view.status ? view.status.run_state : null,
+    };
+    document.body.dataset.drawnSimTime = st && st.sim_time !== null ? String(st.sim_time) : "";
+  }
+  requestAnimationFrame(frame);
+}
+
+$("window").addEventListener("change", () => { view.dirty = true; });
+window.addEventListener("resize", () => { view.dirty = true; });
+connect();
+requestAnimationFrame(frame);

@@ -1,0 +1,141 @@
+/*
+ * lagsim-view: a bridge from a daemon's LCM channels to browsers.
+ *
+ * One thread, one poll loop (view_main.c) over the LCM socket, libmicrohttpd's epoll
+ * descriptor, a timerfd and a signalfd. LCM messages are decoded by the shared bounded
+ * wire module into the latest snapshot (view_bridge.c); nothing queues: the newest state
+ * replaces the previous one, events go into a fixed ring. Browsers read the page, the
+ * snapshot as JSON (GET /api/state) and a stream of server-sent events (GET /events):
+ * each stream holds one fixed buffer, refilled with the newest snapshot at most `hz`
+ * times a second and only when the previous frame has left (view_http.c), so a slow or
+ * vanished client never makes the bridge hold more than that buffer.
+ */
+#ifndef LAGSIM_VIEW_H
+#define LAGSIM_VIEW_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <lcm/lcm.h>
+
+#include "lagsim_wire.h"
+
+#define VIEW_EVENTS 256            /* events kept for streams and /api/state */
+#define VIEW_EVENTS_PER_FRAME 16   /* at most this many in one stream frame */
+#define VIEW_EVENTS_IN_STATE 32    /* the newest ones in /api/state */
+#define VIEW_STREAM_BUF 32768      /* one stream's frame buffer */
+#define VIEW_CONTROLS_PER_S 10     /* control requests forwarded per second at most */
+#define VIEW_CHANNEL_MAX 96
+
+/* ---------------------------------------------------------------- JSON (view_json.c) */
+/* A bounded JSON builder: everything appended past cap is dropped and `overflow` set,
+ * so the caller throws the piece away instead of sending half of it. */
+typedef struct jbuf {
+    char *p;
+    size_t cap, len;
+    bool overflow;
+} jbuf;
+
+void jb_init(jbuf *b, char *mem, size_t cap);
+void jb_raw(jbuf *b, const char *s);
+void jb_fmt(jbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* A JSON string from bytes off the bus: quotes, backslashes and control characters
+ * escaped, invalid UTF-8 replaced by U+FFFD. */
+void jb_str(jbuf *b, const char *s);
+/* A number, or null when it is not finite (JSON has no NaN). */
+void jb_num(jbuf *b, double x);
+void jb_key(jbuf *b, const char *key, bool first); /* ,"key": */
+
+void view_json_state(jbuf *b, const lag_wire_joint_state *m);
+void view_json_status(jbuf *b, const lag_wire_status *m);
+void view_json_event(jbuf *b, const lag_wire_event *m, int64_t seq);
+void view_json_scene(jbuf *b, const lag_wire_scene *m);
+
+/* ---------------------------------------------------------------- bridge (view_bridge.c) */
+typedef struct view_event {
+    int64_t seq;                   /* 1, 2, ... */
+    lag_wire_event ev;
+} view_event;
+
+typedef struct view_bridge {
+    lcm_t *lcm;
+    char prefix[64];
+    char url[256];
+    char ch_state[VIEW_CHANNEL_MAX], ch_status[VIEW_CHANNEL_MAX], ch_event[VIEW_CHANNEL_MAX],
+        ch_scene[VIEW_CHANNEL_MAX], ch_control[VIEW_CHANNEL_MAX];
+
+    /* the latest of each, with a sequence number that grows on every update */
+    lag_wire_joint_state state;
+    int64_t state_seq;
+    lag_wire_status status;
+    int64_t status_seq;
+    lag_wire_scene scene;
+    int64_t scene_seq;
+    view_event events[VIEW_EVENTS]; /* ring: events[seq % VIEW_EVENTS] */
+    int64_t event_seq;              /* of the newest */
+    int64_t last_msg_ns;            /* CLOCK_MONOTONIC of the last decoded message */
+    int64_t last_describe_ns;       /* when a DESCRIBE was last sent */
+
+    /* counters for /api/state */
+    int64_t n_state, n_status, n_event, n_scene, n_undecodable;
+    int64_t controls_sent, controls_refused;
+    int64_t ctl_window_ns;
+    int ctl_in_window;
+} view_bridge;
+
+int64_t view_mono_ns(void);
+int64_t view_wall_us(void);
+/* Connects and subscribes. Returns false with a message in err. */
+bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, char *err,
+                      size_t errlen);
+void view_bridge_close(view_bridge *vb);
+/* Handles the LCM messages waiting (at most a bounded number); sends a DESCRIBE while
+ * no scene is known (once a second). */
+void view_bridge_poll(view_bridge *vb);
+/* Sends a control request: "pause", "resume", "step" (count >= 1), "reset", "status",
+ * "describe". Returns 0, or an HTTP status with a reason in why: 400 unknown request or
+ * bad count, 429 over VIEW_CONTROLS_PER_S, 500 LCM refused it. */
+int view_bridge_control(view_bridge *vb, const char *request, const char *count,
+                        const char **why);
+
+/* ---------------------------------------------------------------- HTTP (view_http.c) */
+typedef struct view_http view_http;
+
+typedef struct view_http_opts {
+    const char *listen;            /* numeric IPv4 or IPv6 address */
+    unsigned port;                 /* 0: any free port */
+    unsigned hz;                   /* stream frames per second at most */
+    unsigned max_streams;          /* concurrent /events streams */
+    unsigned max_connections;      /* all connections */
+    bool check_host;               /* loopback: the Host header must name it (DNS rebinding) */
+} view_http_opts;
+
+view_http *view_http_start(view_bridge *vb, const view_http_opts *o, char *err, size_t errlen);
+/* The port bound (useful with port 0). */
+unsigned view_http_port(const view_http *h);
+/* The descriptor to poll for readability (libmicrohttpd's epoll set). */
+int view_http_fd(const view_http *h);
+/* How long the loop may sleep, ms (-1: no limit from HTTP). */
+int view_http_timeout_ms(view_http *h);
+/* Runs libmicrohttpd once; wakes the streams that are due a frame. */
+void view_http_run(view_http *h);
+/* Streams open now. */
+unsigned view_http_streams(const view_http *h);
+/* Stops: resumes every stream first (libmicrohttpd requires it), then closes. */
+void view_http_stop(view_http *h);
+
+/* The snapshot as JSON (GET /api/state). Returns the length, 0 if it did not fit. */
+size_t view_json_snapshot(const view_bridge *vb, const view_http *h, char *out, size_t cap);
+
+/* ---------------------------------------------------------------- page (generated) */
+typedef struct view_asset {
+    const char *path;              /* "/", "/view.js", ... */
+    const char *type;              /* Content-Type */
+    const unsigned char *data;
+    size_t size;
+} view_asset;
+
+extern const view_asset view_assets[];
+extern const size_t view_asset_count;
+
+#endif

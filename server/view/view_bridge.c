@@ -1,0 +1,221 @@
+/*
+ * The bridge's LCM side: the daemon's STATE, STATUS, EVENT and SCENE channels decoded by
+ * the shared bounded wire module into the latest snapshot, and control requests sent on
+ * CONTROL. Nothing is queued: LCM's own queue per subscription is capped, each poll
+ * handles a bounded number of messages, a newer state replaces the older one, events go
+ * into a fixed ring.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "view.h"
+#include "lagsim/lagsim_control_t.h"
+
+#define VIEW_DRAIN_MAX 512        /* messages handled per poll at most */
+#define VIEW_LCM_QUEUE 200        /* LCM's queue per subscription */
+#define VIEW_DESCRIBE_NS 1000000000
+
+int64_t view_mono_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+int64_t view_wall_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
+static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)ch;
+    view_bridge *vb = user;
+    lag_wire_joint_state m;
+    if (lag_wire_decode_joint_state(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) {
+        vb->n_undecodable++;
+        return;
+    }
+    vb->state = m;
+    vb->state_seq++;
+    vb->n_state++;
+    vb->last_msg_ns = view_mono_ns();
+}
+
+static void on_status(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)ch;
+    view_bridge *vb = user;
+    lag_wire_status m;
+    if (lag_wire_decode_status(rb->data, rb->data_size, &m) != LAG_WIRE_OK) {
+        vb->n_undecodable++;
+        return;
+    }
+    vb->status = m;
+    vb->status_seq++;
+    vb->n_status++;
+    vb->last_msg_ns = view_mono_ns();
+}
+
+static void on_event(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)ch;
+    view_bridge *vb = user;
+    lag_wire_event m;
+    int r = lag_wire_decode_event(rb->data, rb->data_size, &m);
+    /* an over-long detail is kept, cut; the rest of the event decoded */
+    if (r != LAG_WIRE_OK && r != LAG_WIRE_ETOOLONG) {
+        vb->n_undecodable++;
+        return;
+    }
+    vb->event_seq++;
+    vb->events[vb->event_seq % VIEW_EVENTS].seq = vb->event_seq;
+    vb->events[vb->event_seq % VIEW_EVENTS].ev = m;
+    vb->n_event++;
+    vb->last_msg_ns = view_mono_ns();
+}
+
+static void on_scene(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)ch;
+    view_bridge *vb = user;
+    lag_wire_scene m;
+    if (lag_wire_decode_scene(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) {
+        vb->n_undecodable++;
+        return;
+    }
+    vb->scene = m;
+    vb->scene_seq++;
+    vb->n_scene++;
+    vb->last_msg_ns = view_mono_ns();
+}
+
+bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, char *err,
+                      size_t errlen)
+{
+    memset(vb, 0, sizeof *vb);
+    size_t n = strlen(prefix);
+    if (n == 0 || n >= sizeof vb->prefix) {
+        snprintf(err, errlen, "--prefix: 1 to %zu characters", sizeof vb->prefix - 1);
+        return false;
+    }
+    for (size_t i = 0; i < n; i++) {
+        char c = prefix[i];
+        if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+              c == '_' || c == '-')) {
+            snprintf(err, errlen, "--prefix '%s': letters, digits, '_' and '-' only", prefix);
+            return false;
+        }
+    }
+    snprintf(vb->prefix, sizeof vb->prefix, "%s", prefix);
+    snprintf(vb->url, sizeof vb->url, "%s", url ? url : "");
+    snprintf(vb->ch_state, VIEW_CHANNEL_MAX, "%s_STATE", prefix);
+    snprintf(vb->ch_status, VIEW_CHANNEL_MAX, "%s_STATUS", prefix);
+    snprintf(vb->ch_event, VIEW_CHANNEL_MAX, "%s_EVENT", prefix);
+    snprintf(vb->ch_scene, VIEW_CHANNEL_MAX, "%s_SCENE", prefix);
+    snprintf(vb->ch_control, VIEW_CHANNEL_MAX, "%s_CONTROL", prefix);
+    vb->lcm = lcm_create(url && url[0] ? url : NULL);
+    if (!vb->lcm) {
+        snprintf(err, errlen, "cannot create LCM (url '%s')", url && url[0] ? url : "default");
+        return false;
+    }
+    lcm_subscription_t *subs[4] = {
+        lcm_subscribe(vb->lcm, vb->ch_state, on_state, vb),
+        lcm_subscribe(vb->lcm, vb->ch_status, on_status, vb),
+        lcm_subscribe(vb->lcm, vb->ch_event, on_event, vb),
+        lcm_subscribe(vb->lcm, vb->ch_scene, on_scene, vb),
+    };
+    for (int i = 0; i < 4; i++) {
+        if (!subs[i]) {
+            snprintf(err, errlen, "cannot subscribe to the %s channels", prefix);
+            lcm_destroy(vb->lcm);
+            vb->lcm = NULL;
+            return false;
+        }
+        lcm_subscription_set_queue_capacity(subs[i], VIEW_LCM_QUEUE);
+    }
+    return true;
+}
+
+void view_bridge_close(view_bridge *vb)
+{
+    if (vb->lcm) lcm_destroy(vb->lcm);
+    vb->lcm = NULL;
+}
+
+static bool send_control(view_bridge *vb, int request, int64_t count)
+{
+    lag_wire_control m;
+    memset(&m, 0, sizeof m);
+    m.utime = view_wall_us();
+    m.request = (int8_t)request;
+    m.count = count;
+    uint8_t buf[LAG_WIRE_BUF_SIZE];
+    int n = lag_wire_encode_control(&m, buf, sizeof buf);
+    return n > 0 && lcm_publish(vb->lcm, vb->ch_control, buf, (unsigned)n) == 0;
+}
+
+void view_bridge_poll(view_bridge *vb)
+{
+    for (int k = 0; k < VIEW_DRAIN_MAX; k++)
+        if (lcm_handle_timeout(vb->lcm, 0) <= 0) break;
+    int64_t now = view_mono_ns();
+    if (!vb->scene_seq && now - vb->last_describe_ns >= VIEW_DESCRIBE_NS) {
+        vb->last_describe_ns = now;
+        send_control(vb, LAGSIM_CONTROL_T_DESCRIBE, 0);
+    }
+}
+
+int view_bridge_control(view_bridge *vb, const char *request, const char *count,
+                        const char **why)
+{
+    static const struct { const char *name; int request; } reqs[] = {
+        {"pause", LAGSIM_CONTROL_T_PAUSE},   {"resume", LAGSIM_CONTROL_T_RESUME},
+        {"step", LAGSIM_CONTROL_T_STEP},     {"reset", LAGSIM_CONTROL_T_RESET},
+        {"status", LAGSIM_CONTROL_T_STATUS}, {"describe", LAGSIM_CONTROL_T_DESCRIBE},
+    };
+    int req = -1;
+    for (size_t i = 0; request && i < sizeof reqs / sizeof reqs[0]; i++)
+        if (strcmp(request, reqs[i].name) == 0) req = reqs[i].request;
+    if (req < 0) {
+        vb->controls_refused++;
+        *why = "request must be pause, resume, step, reset, status or describe";
+        return 400;
+    }
+    int64_t n = 0;
+    if (req == LAGSIM_CONTROL_T_STEP) {
+        char *end = NULL;
+        long long v = count ? strtoll(count, &end, 10) : 1;
+        if (count && (end == count || *end != '\0' || v < 1 || v > 1000000)) {
+            vb->controls_refused++;
+            *why = "step: count must be an integer from 1 to 1000000";
+            return 400;
+        }
+        n = v;
+    }
+    /* a page (or a script) cannot make the bridge flood the daemon */
+    int64_t now = view_mono_ns();
+    if (now - vb->ctl_window_ns >= 1000000000) {
+        vb->ctl_window_ns = now;
+        vb->ctl_in_window = 0;
+    }
+    if (vb->ctl_in_window >= VIEW_CONTROLS_PER_S) {
+        vb->controls_refused++;
+        *why = "too many control requests: at most 10 per second";
+        return 429;
+    }
+    vb->ctl_in_window++;
+    if (!send_control(vb, req, n)) {
+        vb->controls_refused++;
+        *why = "LCM publish failed";
+        return 500;
+    }
+    vb->controls_sent++;
+    *why = "sent";
+    return 0;
+}

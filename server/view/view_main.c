@@ -1,0 +1,186 @@
+/*
+ * lagsim-view [--prefix DIPC] [--port 8765] [--url LCM_URL] [--listen ADDR] [--hz N]
+ *
+ * Watches a lagsimd daemon in a browser: subscribes to its channels and serves one page
+ * that draws the model from the scene description, animates it from the states, charts
+ * coordinates, velocities, efforts and energy, shows status and events, and sends
+ * pause / resume / step / reset. See view.h for the design, docs/view.md for use.
+ * Exit codes: 0 stopped by a signal, 1 runtime failure, 2 usage.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/signalfd.h>
+#include <unistd.h>
+
+#include "view.h"
+
+static void usage(FILE *f)
+{
+    fputs("usage: lagsim-view [--prefix DIPC] [--port 8765] [--url LCM_URL] [--listen ADDR]\n"
+          "                   [--hz N] [--max-views N]\n"
+          "\n"
+          "Serves a live view of a lagsimd daemon to browsers: the model drawn to scale from\n"
+          "its scene description and animated from its states, strip charts, status, events,\n"
+          "and pause / resume / step / reset buttons.\n"
+          "\n"
+          "  -p, --prefix P     the daemon's channel prefix (default DIPC)\n"
+          "      --port N       TCP port (default 8765; 0: any free port, printed)\n"
+          "      --url URL      LCM URL (default: LCM's default, which honours LCM_DEFAULT_URL)\n"
+          "      --listen ADDR  address to listen on (default 127.0.0.1: this machine only).\n"
+          "                     Anything else lets every host that reaches it watch the run\n"
+          "                     and pause, step and reset it: there is no authentication\n"
+          "      --hz N         stream frames per second per browser at most (default 60)\n"
+          "      --max-views N  browsers streaming at once (default 16)\n"
+          "  -q, --quiet        print only the address\n"
+          "  -h, --help         this help\n"
+          "\n"
+          "HTTP: GET / (the page), GET /api/state (latest scene, state, status, events as\n"
+          "JSON), GET /events (server-sent events), POST /api/control?request=pause|resume|\n"
+          "step|reset[&count=N] with the header X-Lagsim: 1.\n",
+          f);
+}
+
+static bool parse_uint(const char *s, unsigned lo, unsigned hi, unsigned *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long v = strtoul(s, &end, 10);
+    if (errno || end == s || *end || s[0] == '-' || v < lo || v > hi) return false;
+    *out = (unsigned)v;
+    return true;
+}
+
+static bool is_loopback(const char *a)
+{
+    return strncmp(a, "127.", 4) == 0 || strcmp(a, "::1") == 0;
+}
+
+int main(int argc, char **argv)
+{
+    enum { OPT_PORT = 256, OPT_URL, OPT_LISTEN, OPT_HZ, OPT_MAX_VIEWS };
+    static const struct option longopts[] = {
+        {"prefix", required_argument, NULL, 'p'},
+        {"port", required_argument, NULL, OPT_PORT},
+        {"url", required_argument, NULL, OPT_URL},
+        {"listen", required_argument, NULL, OPT_LISTEN},
+        {"hz", required_argument, NULL, OPT_HZ},
+        {"max-views", required_argument, NULL, OPT_MAX_VIEWS},
+        {"quiet", no_argument, NULL, 'q'},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
+    };
+    const char *prefix = "DIPC", *url = NULL;
+    view_http_opts ho = {.listen = "127.0.0.1", .port = 8765, .hz = 60, .max_streams = 16,
+                         .max_connections = 64, .check_host = true};
+    bool quiet = false;
+    opterr = 0;
+    int c;
+    while ((c = getopt_long(argc, argv, ":p:qh", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'p': prefix = optarg; break;
+        case OPT_URL: url = optarg; break;
+        case OPT_LISTEN: ho.listen = optarg; break;
+        case OPT_PORT:
+            if (!parse_uint(optarg, 0, 65535, &ho.port)) {
+                fprintf(stderr, "lagsim-view: --port: expected 0 to 65535, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case OPT_HZ:
+            if (!parse_uint(optarg, 1, 240, &ho.hz)) {
+                fprintf(stderr, "lagsim-view: --hz: expected 1 to 240, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case OPT_MAX_VIEWS:
+            if (!parse_uint(optarg, 1, 256, &ho.max_streams)) {
+                fprintf(stderr, "lagsim-view: --max-views: expected 1 to 256, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case 'q': quiet = true; break;
+        case 'h': usage(stdout); return 0;
+        case ':':
+            fprintf(stderr, "lagsim-view: option %s needs a value\n", argv[optind - 1]);
+            return 2;
+        default:
+            fprintf(stderr, "lagsim-view: unknown option '%s' (try --help)\n", argv[optind - 1]);
+            return 2;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "lagsim-view: unexpected argument '%s' (try --help)\n", argv[optind]);
+        return 2;
+    }
+    ho.max_connections = ho.max_streams + 240;
+    ho.check_host = is_loopback(ho.listen);
+
+    /* signals through a signalfd, blocked before LCM starts any thread */
+    sigset_t sigs;
+    sigemptyset(&sigs);
+    sigaddset(&sigs, SIGINT);
+    sigaddset(&sigs, SIGTERM);
+    sigaddset(&sigs, SIGHUP);
+    sigprocmask(SIG_BLOCK, &sigs, NULL);
+    signal(SIGPIPE, SIG_IGN);
+    int sig_fd = signalfd(-1, &sigs, SFD_CLOEXEC | SFD_NONBLOCK);
+    if (sig_fd < 0) {
+        perror("lagsim-view: signalfd");
+        return 1;
+    }
+
+    char err[512];
+    static view_bridge vb; /* large (rings): static, one bridge per process */
+    if (!view_bridge_open(&vb, url, prefix, err, sizeof err)) {
+        fprintf(stderr, "lagsim-view: %s\n", err);
+        return strstr(err, "--prefix") ? 2 : 1;
+    }
+    view_http *h = view_http_start(&vb, &ho, err, sizeof err);
+    if (!h) {
+        fprintf(stderr, "lagsim-view: %s\n", err);
+        view_bridge_close(&vb);
+        return strstr(err, "--listen") ? 2 : 1;
+    }
+    bool v6 = strchr(ho.listen, ':') != NULL;
+    printf("lagsim-view: http://%s%s%s:%u/  (prefix %s)\n", v6 ? "[" : "", ho.listen,
+           v6 ? "]" : "", view_http_port(h), prefix);
+    fflush(stdout);
+    if (!ho.check_host)
+        fprintf(stderr,
+                "lagsim-view: WARNING: listening on %s, not on this machine only: anyone who "
+                "reaches port %u sees the run and can pause, step and reset the simulation "
+                "(there is no authentication)\n",
+                ho.listen, view_http_port(h));
+    else if (!quiet)
+        fprintf(stderr, "lagsim-view: this machine only (--listen ADDR to open it wider); "
+                        "Ctrl-C stops\n");
+
+    int lcm_fd = lcm_get_fileno(vb.lcm), http_fd = view_http_fd(h);
+    int rc = 0;
+    for (;;) {
+        int timeout = view_http_timeout_ms(h);
+        /* streams waiting for a frame: wake at the frame rate; otherwise once a second
+         * (DESCRIBE while no scene is known, keep-alives) */
+        int tick = view_http_streams(h) ? (int)(1000 / ho.hz) : 1000;
+        if (timeout < 0 || timeout > tick) timeout = tick;
+        struct pollfd pf[3] = {{lcm_fd, POLLIN, 0}, {http_fd, POLLIN, 0}, {sig_fd, POLLIN, 0}};
+        int n = poll(pf, 3, timeout);
+        if (n < 0 && errno != EINTR) {
+            perror("lagsim-view: poll");
+            rc = 1;
+            break;
+        }
+        if (n > 0 && (pf[2].revents & POLLIN)) break;
+        view_bridge_poll(&vb);
+        view_http_run(h);
+    }
+    view_http_stop(h);
+    view_bridge_close(&vb);
+    close(sig_fd);
+    return rc;
+}

@@ -1,0 +1,301 @@
+#!/usr/bin/env python3
+"""lagsim-view tested as a person uses it: lagsimd runs a DIPC released from 0.3 rad
+(no controller: it falls and swings), lagsim-view bridges it, and pages are opened in
+headless Chromium (DevTools protocol over a pipe).
+
+    test_view.py --lagsimd BIN --view BIN --config dipc.yaml CASE [--screenshot PNG]
+
+CASE browser: the drawn sim time advances and the drawn model moves between two looks;
+              two tabs stream at once, a closed tab is dropped by the bridge; pause,
+              step, resume and reset buttons act on the daemon; /api/state agrees.
+CASE hostile: garbage, oversized headers, a connection flood, a slow reader, vanished
+              clients, foreign Host headers, control floods; afterwards the bridge
+              answers at once, holds no stream, and its memory stayed bounded.
+"""
+import argparse
+import json
+import os
+import re
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cdp  # noqa: E402
+
+failures = 0
+
+
+def check(cond, what):
+    global failures
+    print(("ok:   " if cond else "FAIL: ") + what, flush=True)
+    if not cond:
+        failures += 1
+    return cond
+
+
+def stop(p):
+    if p and p.poll() is None:
+        p.send_signal(signal.SIGTERM)
+        try:
+            p.wait(5)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait()
+
+
+class Rig:
+    """lagsimd + lagsim-view with a channel prefix unique to this process."""
+
+    def __init__(self, a, name):
+        self.prefix = "%s%d" % (name, os.getpid())
+        self.daemon = subprocess.Popen(
+            [a.lagsimd, "--config", a.config, "-q", "--set", "lcm.prefix=" + self.prefix,
+             "--set", "initial.q=[0,0.3,-0.2]", "--set", "initial.qd=[0,0,0]"],
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        self.view = subprocess.Popen([a.view, "--prefix", self.prefix, "--port", "0"],
+                                     stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, text=True)
+        line = self.view.stdout.readline()
+        m = re.search(r"http://127\.0\.0\.1:(\d+)/", line)
+        if not m:
+            raise RuntimeError("lagsim-view did not print its address: %r" % line)
+        self.port = int(m.group(1))
+        self.base = "http://127.0.0.1:%d" % self.port
+        check(True, "lagsim-view prints its address: " + line.strip())
+
+    def api(self, timeout=5):
+        with urllib.request.urlopen(self.base + "/api/state", timeout=timeout) as r:
+            return json.loads(r.read())
+
+    def wait_api(self, pred, timeout=10.0, what=""):
+        deadline = time.monotonic() + timeout
+        s = None
+        while time.monotonic() < deadline:
+            try:
+                s = self.api(timeout=max(0.1, min(2.0, deadline - time.monotonic())))
+            except OSError:
+                continue
+            if pred(s):
+                return s
+            time.sleep(0.05)
+        check(False, "waited %.0f s for %s; last /api/state bridge: %s" % (timeout, what, s and s["bridge"]))
+        return s
+
+    def close(self):
+        stop(self.view)
+        stop(self.daemon)
+
+
+def drawn(c, sid):
+    return c.eval(sid, "JSON.stringify(window.lagsimView.drawn)") and json.loads(
+        c.eval(sid, "JSON.stringify(window.lagsimView.drawn)"))
+
+
+def moved(p, q):
+    return max(abs(a - b) for pa, pb in zip(p, q) for a, b in zip(pa, pb))
+
+
+def case_browser(a):
+    rig = Rig(a, "VIEWB")
+    chrome = None
+    try:
+        s = rig.wait_api(lambda s: s["scene"] and s["state"] and s["status"], what="scene, state, status")
+        check(s["scene"]["model"] == "dipc" and s["scene"]["params"]["l1"] == 0.5 and
+              s["scene"]["joints"] == ["theta0", "theta1", "theta2"],
+              "/api/state: the scene as the daemon describes it")
+        t0 = s["state"]["sim_time"]
+        s = rig.wait_api(lambda s: s["state"]["sim_time"] > t0 + 0.2, what="sim time to advance")
+        check(s["state"]["sim_time"] > t0, "/api/state: the state advances")
+
+        chrome = cdp.Chrome()
+        ta, sa = chrome.open(rig.base + "/")
+        chrome.wait_for(sa, "window.lagsimView.drawn && window.lagsimView.drawn.points", 15,
+                        "tab A: a drawn model")
+        tb, sb = chrome.open(rig.base + "/")
+        chrome.wait_for(sb, "window.lagsimView.drawn && window.lagsimView.drawn.points", 15,
+                        "tab B: a drawn model")
+        chrome.front(sa)
+        time.sleep(0.2)
+        d1 = drawn(chrome, sa)
+        check(d1["model"] == "dipc" and len(d1["points"]) == 3, "tab A draws the DIPC (cart, two rod ends)")
+        # to scale: the rods as drawn are l1 and l2 long
+        (x0, y0), (x1, y1), (x2, y2) = d1["points"]
+        l1 = ((x1 - x0) ** 2 + (y1 - y0) ** 2) ** 0.5
+        l2 = ((x2 - x1) ** 2 + (y2 - y1) ** 2) ** 0.5
+        check(abs(l1 - 0.5) < 1e-9 and abs(l2 - 0.75) < 1e-9, "rods drawn %.12g m and %.12g m long (l1, l2)" % (l1, l2))
+        # the page drew what the daemon published: its drawn cart is at theta0
+        check(d1["points"][0][0] == d1["q"][0], "the cart is drawn at the published theta0")
+        time.sleep(1.0)
+        d2 = drawn(chrome, sa)
+        check(d2["sim_time"] > d1["sim_time"] + 0.5,
+              "second look: drawn sim time advanced %.3f -> %.3f s" % (d1["sim_time"], d2["sim_time"]))
+        check(moved(d1["points"], d2["points"]) > 0.01,
+              "second look: the drawn model moved (%.3f m)" % moved(d1["points"], d2["points"]))
+        check(d2["frame"] > d1["frame"] + 10, "frames drawn between the looks: %d" % (d2["frame"] - d1["frame"]))
+        chrome.front(sb)
+        time.sleep(0.3)
+        db = drawn(chrome, sb)
+        check(db["sim_time"] > d2["sim_time"], "tab B, brought to the front, animates too")
+        st = rig.api()["bridge"]
+        check(st["streams"] == 2, "two tabs: two streams (%d)" % st["streams"])
+        chrome.close_tab(tb)
+        rig.wait_api(lambda s: s["bridge"]["streams"] == 1, 5, "the closed tab's stream to go")
+        check(rig.api()["bridge"]["streams"] == 1, "a closed tab: its stream is dropped")
+
+        # buttons
+        chrome.front(sa)
+        chrome.eval(sa, "document.getElementById('pause').click()")
+        chrome.wait_for(sa, "window.lagsimView.drawn.run_state === 'paused'", 5, "paused")
+        p1 = drawn(chrome, sa)["sim_time"]
+        time.sleep(0.5)
+        p2 = drawn(chrome, sa)["sim_time"]
+        check(p1 == p2, "pause button: the drawn sim time stops (%.3f, %.3f)" % (p1, p2))
+        chrome.eval(sa, "document.getElementById('stepcount').value = '25'")
+        chrome.eval(sa, "document.getElementById('step').click()")
+        chrome.wait_for(sa, "window.lagsimView.drawn.sim_time >= %r + 0.25 - 1e-9" % p2, 5, "25 steps")
+        p3 = drawn(chrome, sa)["sim_time"]
+        check(abs(p3 - (p2 + 0.25)) < 1e-9, "step 25: exactly 25 control periods later (%.3f)" % p3)
+        chrome.eval(sa, "document.getElementById('resume').click()")
+        chrome.wait_for(sa, "window.lagsimView.drawn.sim_time > %r + 0.3" % p3, 5, "running again")
+        check(True, "resume button: the drawn sim time advances again")
+        chrome.eval(sa, "document.getElementById('reset').click()")
+        chrome.wait_for(sa, "window.lagsimView.drawn.sim_time < 0.3", 5, "a reset")
+        ev = chrome.eval(sa, "document.getElementById('events').textContent")
+        check("pause" in ev and "step_done" in ev and "resume" in ev and "reset" in ev,
+              "the event list shows pause, step_done, resume, reset")
+        if a.screenshot:
+            time.sleep(2.5)   # let the charts fill
+            chrome.screenshot(sa, a.screenshot)
+            check(os.path.getsize(a.screenshot) > 10000, "screenshot written: " + a.screenshot)
+    finally:
+        if chrome:
+            chrome.quit()
+        rig.close()
+
+
+def raw(port, data, read=True, timeout=3.0):
+    s = socket.create_connection(("127.0.0.1", port), timeout=timeout)
+    try:
+        s.sendall(data)
+        if not read:
+            return b""
+        out = b""
+        while True:
+            try:
+                chunk = s.recv(65536)
+            except socket.timeout:
+                break
+            if not chunk:
+                break
+            out += chunk
+        return out
+    finally:
+        s.close()
+
+
+def rss_kb(pid):
+    with open("/proc/%d/status" % pid) as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1])
+    return 0
+
+
+def case_hostile(a):
+    rig = Rig(a, "VIEWH")
+    try:
+        rig.wait_api(lambda s: s["state"] is not None, what="a state")
+        port = rig.port
+        rss0 = rss_kb(rig.view.pid)
+        host = b"Host: 127.0.0.1:%d\r\n" % port
+        r = raw(port, b"\x00\xff garbage \r\n\r\n")
+        check(r == b"" or r.startswith(b"HTTP/1.1 400"), "garbage: 400 or closed")
+        r = raw(port, b"GET / HTTP/1.1\r\n" + host + b"X-Big: " + b"a" * 100000 + b"\r\n\r\n")
+        check(r == b"" or re.match(rb"HTTP/1\.1 4\d\d", r) is not None, "a 100 kB header: refused")
+        r = raw(port, b"GET /api/state HTTP/1.1\r\nHost: evil.example:80\r\n\r\n")
+        check(r.startswith(b"HTTP/1.1 421"), "a foreign Host header (DNS rebinding): 421")
+        r = raw(port, b"POST /api/control?request=pause HTTP/1.1\r\n" + host + b"Content-Length: 0\r\n\r\n")
+        check(r.startswith(b"HTTP/1.1 403"), "control without X-Lagsim: 403")
+        r = raw(port, b"POST /api/control?request=format HTTP/1.1\r\n" + host + b"X-Lagsim: 1\r\nContent-Length: 0\r\n\r\n")
+        check(r.startswith(b"HTTP/1.1 400"), "an unknown control request: 400")
+        r = raw(port, b"POST /api/control?request=step&count=-5 HTTP/1.1\r\n" + host + b"X-Lagsim: 1\r\n\r\n")
+        check(r.startswith(b"HTTP/1.1 400"), "step with a negative count: 400")
+        r = raw(port, b"GET /../../etc/passwd HTTP/1.1\r\n" + host + b"\r\n")
+        check(r.startswith(b"HTTP/1.1 404"), "path traversal: 404")
+        r = raw(port, b"DELETE / HTTP/1.1\r\n" + host + b"\r\n")
+        check(r.startswith(b"HTTP/1.1 405"), "DELETE: 405")
+        # a control flood: at most 10 a second reach the daemon
+        codes = []
+        for _ in range(40):
+            r = raw(port, b"POST /api/control?request=status HTTP/1.1\r\n" + host + b"X-Lagsim: 1\r\n\r\n")
+            codes.append(r[9:12])
+        check(codes.count(b"202") <= 20 and codes.count(b"429") >= 20,
+              "40 control requests at once: %d forwarded, %d refused with 429" % (codes.count(b"202"), codes.count(b"429")))
+        # a connection flood beyond the bridge's limit (256), half of them slowloris (a
+        # header never finished); they hold every slot, then go away
+        socks = []
+        for i in range(300):
+            try:
+                s = socket.create_connection(("127.0.0.1", port), timeout=2)
+                s.sendall(b"GET / HTTP/1.1\r\n" + host + (b"X-Slow: 1\r\n" if i % 2 else b""))
+                socks.append(s)
+            except OSError:
+                pass
+        check(len(socks) > 256, "opened %d connections at once" % len(socks))
+        for s in socks:
+            s.close()
+        # idle connections are closed after 5 s: the bridge serves again well before 15 s
+        t = time.monotonic()
+        rig.wait_api(lambda s: True, 15, "the bridge to serve again after the flood")
+        check(time.monotonic() - t < 15, "after the flood the bridge serves again in %.1f s" % (time.monotonic() - t))
+        # streams that never read, and streams that vanish
+        sleepers, vanishers = [], []
+        for i in range(20):
+            try:
+                s = socket.create_connection(("127.0.0.1", port), timeout=2)
+                s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+                s.sendall(b"GET /events HTTP/1.1\r\n" + host + b"\r\n")
+                (sleepers if i % 2 else vanishers).append(s)
+            except OSError:
+                pass
+        for s in vanishers:
+            s.close()
+        time.sleep(3.0)   # the sleepers' buffers fill; the bridge must not queue for them
+        t = time.monotonic()
+        st = rig.api()
+        check(time.monotonic() - t < 1.0, "after the flood /api/state answers at once")
+        rss1 = rss_kb(rig.view.pid)
+        check(rss1 - rss0 < 20000, "memory stayed bounded: RSS %d -> %d kB" % (rss0, rss1))
+        for s in sleepers:
+            s.close()
+        st = rig.wait_api(lambda s: s["bridge"]["streams"] == 0, 20, "every stream to be gone")
+        check(st["bridge"]["streams"] == 0, "closed and vanished clients hold no stream")
+        check(rig.view.poll() is None, "lagsim-view still running")
+        r = raw(port, b"GET / HTTP/1.1\r\n" + host + b"Connection: close\r\n\r\n")
+        check(r.startswith(b"HTTP/1.1 200") and b"Content-Security-Policy: default-src 'self'" in r,
+              "the page is still served, with its Content-Security-Policy")
+    finally:
+        rig.close()
+    err = rig.view.stderr.read()
+    check(rig.view.returncode == 0, "lagsim-view stopped cleanly on SIGTERM (exit %s) %s" % (rig.view.returncode, err[-300:]))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--lagsimd", required=True)
+    ap.add_argument("--view", required=True)
+    ap.add_argument("--config", required=True)
+    ap.add_argument("--screenshot")
+    ap.add_argument("case", choices=["browser", "hostile"])
+    a = ap.parse_args()
+    {"browser": case_browser, "hostile": case_hostile}[a.case](a)
+    print("%s: %d failure(s)" % ("FAILED" if failures else "passed", failures))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
