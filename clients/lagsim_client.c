@@ -1,9 +1,10 @@
 /*
  * lagsim client library: see lagsim_client.h.
  *
- * Subscriptions are raw lcm_subscribe() handlers that decode the payload themselves, so
- * that a payload which does not decode (wrong type on the channel, truncated, hostile)
- * is counted and dropped silently instead of making the generated code print.
+ * Subscriptions are raw lcm_subscribe() handlers that pass the payload to one dispatch
+ * function (also behind lag_client_feed), which decodes it with the bounded wire module
+ * into scratch structs on the handle, so that a message is kept only whole and valid.
+ * Nothing is allocated after lag_client_create.
  */
 #include "lagsim_client.h"
 
@@ -18,11 +19,6 @@
 #include <lcm/lcm.h>
 
 #include "lagsim/lagsim_control_t.h"
-#include "lagsim/lagsim_event_t.h"
-#include "lagsim/lagsim_joint_command_t.h"
-#include "lagsim/lagsim_joint_state_t.h"
-#include "lagsim/lagsim_scene_t.h"
-#include "lagsim/lagsim_status_t.h"
 
 struct lag_client {
     lcm_t *lcm;
@@ -38,6 +34,15 @@ struct lag_client {
     lag_client_status status;
     bool have_status;
     lag_client_counters counters;
+
+    /* decoding scratch: a message is copied to the fields above only when valid */
+    union {
+        lag_wire_joint_state state;
+        lag_wire_scene scene;
+        lag_wire_status status;
+        lag_wire_event event;
+    } tmp;
+    uint8_t buf[LAG_WIRE_BUF_SIZE]; /* encoding of outgoing messages */
 
     lag_client_state_fn on_state;
     void *on_state_user;
@@ -97,148 +102,62 @@ static void regex_escape(char *dst, size_t cap, const char *src)
     dst[j] = '\0';
 }
 
-/* ---------------------------------------------------------------- handlers */
+/* ---------------------------------------------------------------- receiving */
 
-static void handle_state(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+/* Decodes a message of type t into c->tmp; false (counted as dropped) unless it decodes
+ * whole, fits the structs and every number in it is finite. */
+static bool decode(lag_client *c, lag_wire_type t, const void *data, size_t len)
 {
-    (void)channel;
-    lag_client *c = user;
-    lagsim_joint_state_t m;
-    if (lagsim_joint_state_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) < 0) {
-        c->counters.dropped++;
-        return;
-    }
-    lag_client_state st;
-    bool ok = m.num_joints >= 0 && m.num_joints <= LAG_CLIENT_MAX_JOINTS;
-    if (ok) {
-        st.utime = m.utime;
-        st.sim_time = m.sim_time;
-        st.step = m.step;
-        st.num_joints = m.num_joints;
-        for (int i = 0; i < m.num_joints && ok; i++) {
-            ok = copy_str(st.name[i], sizeof st.name[i], m.name[i]);
-            st.position[i] = m.position[i];
-            st.velocity[i] = m.velocity[i];
-            st.effort[i] = m.effort[i];
-        }
-    }
-    lagsim_joint_state_t_decode_cleanup(&m);
-    if (!ok) {
-        c->counters.dropped++;
-        return;
-    }
-    c->state = st;
-    c->have_state = c->new_state = true;
-    c->counters.states++;
-    if (c->on_state) c->on_state(&c->state, c->on_state_user);
+    if (lag_wire_decode(t, data, len, LAG_WIRE_MAX_JOINTS, &c->tmp) == LAG_WIRE_OK &&
+        lag_wire_all_finite(t, &c->tmp))
+        return true;
+    c->counters.dropped++;
+    return false;
 }
 
-static void handle_scene(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+/* One message from `channel`: decoded, kept, passed to the callback. */
+static int dispatch(lag_client *c, const char *channel, const void *data, size_t len)
 {
-    (void)channel;
-    lag_client *c = user;
-    lagsim_scene_t m;
-    if (lagsim_scene_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) < 0) {
-        c->counters.dropped++;
-        return;
-    }
-    lag_client_scene *sc = malloc(sizeof *sc); /* ~2.5 kB: keep it off small stacks */
-    bool ok = sc != NULL && m.num_params >= 0 && m.num_params <= LAG_CLIENT_MAX_PARAMS &&
-              m.num_joints >= 0 && m.num_joints <= LAG_CLIENT_MAX_JOINTS;
-    if (ok) {
-        memset(sc, 0, sizeof *sc);
-        sc->utime = m.utime;
-        ok = copy_str(sc->model, sizeof sc->model, m.model) &&
-             copy_str(sc->prefix, sizeof sc->prefix, m.prefix) &&
-             copy_str(sc->integrator, sizeof sc->integrator, m.integrator) &&
-             copy_str(sc->mode, sizeof sc->mode, m.mode);
-        sc->num_params = m.num_params;
-        for (int i = 0; i < m.num_params && ok; i++) {
-            ok = copy_str(sc->param_name[i], sizeof sc->param_name[i], m.param_name[i]);
-            sc->param_value[i] = m.param_value[i];
-        }
-        sc->num_joints = m.num_joints;
-        for (int i = 0; i < m.num_joints && ok; i++) {
-            ok = copy_str(sc->joint_name[i], sizeof sc->joint_name[i], m.joint_name[i]);
-            sc->actuated[i] = m.actuated[i] != 0;
-            sc->initial_q[i] = m.initial_q[i];
-            sc->initial_qd[i] = m.initial_qd[i];
-        }
-        sc->dt = m.dt;
-        sc->control_period = m.control_period;
-        sc->rate = m.rate;
-        sc->command_timeout = m.command_timeout;
-    }
-    lagsim_scene_t_decode_cleanup(&m);
-    if (ok) {
-        c->scene = *sc;
+    if (!strcmp(channel, c->ch_state)) {
+        if (!decode(c, LAG_WIRE_JOINT_STATE, data, len)) return LAG_CLIENT_OK;
+        c->state = c->tmp.state;
+        c->have_state = c->new_state = true;
+        c->counters.states++;
+        if (c->on_state) c->on_state(&c->state, c->on_state_user);
+    } else if (!strcmp(channel, c->ch_scene)) {
+        if (!decode(c, LAG_WIRE_SCENE, data, len)) return LAG_CLIENT_OK;
+        c->scene = c->tmp.scene;
         c->have_scene = true;
         c->counters.scenes++;
+    } else if (!strcmp(channel, c->ch_status)) {
+        if (!decode(c, LAG_WIRE_STATUS, data, len)) return LAG_CLIENT_OK;
+        c->status = c->tmp.status;
+        c->have_status = true;
+        c->counters.statuses++;
+        if (c->on_status) c->on_status(&c->status, c->on_status_user);
+    } else if (!strcmp(channel, c->ch_event)) {
+        if (!decode(c, LAG_WIRE_EVENT, data, len)) return LAG_CLIENT_OK;
+        c->counters.events++;
+        if (c->on_event) c->on_event(&c->tmp.event, c->on_event_user);
     } else {
-        c->counters.dropped++;
+        set_err(c, "feed: %s is not one of this handle's channels (%s_*)", channel, c->prefix);
+        return LAG_CLIENT_ERR_ARG;
     }
-    free(sc);
+    return LAG_CLIENT_OK;
 }
 
-static void handle_status(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+static void on_message(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
-    (void)channel;
-    lag_client *c = user;
-    lagsim_status_t m;
-    if (lagsim_status_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) < 0) {
-        c->counters.dropped++;
-        return;
-    }
-    lag_client_status *s = &c->status;
-    s->utime = m.utime;
-    s->sim_time = m.sim_time;
-    s->step = m.step;
-    s->wall_time = m.wall_time;
-    s->rtf = m.rtf;
-    s->overruns = m.overruns;
-    s->step_time_max_us = m.step_time_max_us;
-    s->step_time_mean_us = m.step_time_mean_us;
-    s->energy = m.energy;
-    copy_str(s->integrator, sizeof s->integrator, m.integrator);
-    copy_str(s->mode, sizeof s->mode, m.mode);
-    copy_str(s->run_state, sizeof s->run_state, m.run_state);
-    s->commands_accepted = m.commands_accepted;
-    s->rejected_unknown_joint = m.rejected_unknown_joint;
-    s->rejected_unactuated = m.rejected_unactuated;
-    s->rejected_nonfinite = m.rejected_nonfinite;
-    s->rejected_bad_length = m.rejected_bad_length;
-    s->rejected_undecodable = m.rejected_undecodable;
-    s->controls_rejected = m.controls_rejected;
-    s->watchdog_tripped = m.watchdog_tripped != 0;
-    s->watchdog_trips = m.watchdog_trips;
-    s->lockstep_timeouts = m.lockstep_timeouts;
-    s->numeric_faults = m.numeric_faults;
-    lagsim_status_t_decode_cleanup(&m);
-    c->have_status = true;
-    c->counters.statuses++;
-    if (c->on_status) c->on_status(s, c->on_status_user);
+    dispatch(user, channel, rbuf->data, rbuf->data_size);
 }
 
-static void handle_event(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+int lag_client_feed(lag_client *c, const char *channel, const void *data, size_t len)
 {
-    (void)channel;
-    lag_client *c = user;
-    lagsim_event_t m;
-    if (lagsim_event_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) < 0) {
-        c->counters.dropped++;
-        return;
+    if (!channel || (!data && len > 0)) {
+        set_err(c, "feed: NULL channel or data");
+        return LAG_CLIENT_ERR_ARG;
     }
-    lag_client_event ev;
-    ev.utime = m.utime;
-    ev.sim_time = m.sim_time;
-    ev.step = m.step;
-    copy_str(ev.kind, sizeof ev.kind, m.kind);
-    copy_str(ev.joint, sizeof ev.joint, m.joint);
-    ev.value = m.value;
-    copy_str(ev.detail, sizeof ev.detail, m.detail);
-    lagsim_event_t_decode_cleanup(&m);
-    c->counters.events++;
-    if (c->on_event) c->on_event(&ev, c->on_event_user);
+    return dispatch(c, channel, data ? data : "", len);
 }
 
 /* ---------------------------------------------------------------- life cycle */
@@ -276,10 +195,10 @@ lag_client *lag_client_create(const char *url, const char *prefix, char *err, si
     char re[4][200];
     const char *chans[4] = {c->ch_state, c->ch_status, c->ch_event, c->ch_scene};
     for (int k = 0; k < 4; k++) regex_escape(re[k], sizeof re[k], chans[k]);
-    lcm_subscription_t *s1 = lcm_subscribe(c->lcm, re[0], handle_state, c);
-    lcm_subscription_t *s2 = lcm_subscribe(c->lcm, re[1], handle_status, c);
-    lcm_subscription_t *s3 = lcm_subscribe(c->lcm, re[2], handle_event, c);
-    lcm_subscription_t *s4 = lcm_subscribe(c->lcm, re[3], handle_scene, c);
+    lcm_subscription_t *s1 = lcm_subscribe(c->lcm, re[0], on_message, c);
+    lcm_subscription_t *s2 = lcm_subscribe(c->lcm, re[1], on_message, c);
+    lcm_subscription_t *s3 = lcm_subscribe(c->lcm, re[2], on_message, c);
+    lcm_subscription_t *s4 = lcm_subscribe(c->lcm, re[3], on_message, c);
     if (!s1 || !s2 || !s3 || !s4) {
         if (err) snprintf(err, errlen, "cannot subscribe to %s_*", prefix);
         lcm_destroy(c->lcm);
@@ -324,34 +243,33 @@ void lag_client_get_counters(const lag_client *c, lag_client_counters *out)
     *out = c->counters;
 }
 
-/* ---------------------------------------------------------------- receiving */
+/* ---------------------------------------------------------------- waiting */
 
 int lag_client_handle(lag_client *c, int timeout_ms)
 {
     if (timeout_ms < 0) timeout_ms = 0;
     errno = 0;
     int rc = lcm_handle_timeout(c->lcm, timeout_ms);
-    if (rc < 0 && errno == EINTR) return 0; /* a signal (e.g. SIGINT): like a timeout */
+    if (rc < 0 && errno == EINTR) return LAG_CLIENT_TIMEOUT; /* a signal (e.g. SIGINT) */
     if (rc < 0) {
         set_err(c, "lcm_handle_timeout failed");
         return LAG_CLIENT_ERR_LCM;
     }
-    return rc > 0 ? 1 : 0;
+    return rc > 0 ? LAG_CLIENT_OK : LAG_CLIENT_TIMEOUT;
 }
 
 /* Handles messages until `flag` becomes true or the deadline (monotonic s) passes.
- * Returns 1 if flag, 0 on timeout, < 0 on error. */
+ * Returns LAG_CLIENT_OK if flag, LAG_CLIENT_TIMEOUT, or an error. */
 static int handle_until(lag_client *c, const bool *flag, double deadline)
 {
     while (!*flag) {
         double left = deadline - lag_client_now();
-        if (left <= 0.0) return 0;
-        int ms = (int)ceil(left * 1000.0);
-        if (ms > 100) ms = 100;
+        if (!(left > 0.0)) return LAG_CLIENT_TIMEOUT;
+        int ms = left < 0.1 ? (int)ceil(left * 1000.0) : 100;
         int rc = lag_client_handle(c, ms);
         if (rc < 0) return rc;
     }
-    return 1;
+    return LAG_CLIENT_OK;
 }
 
 int lag_client_wait_scene(lag_client *c, double timeout_s, lag_client_scene *sc)
@@ -377,19 +295,20 @@ int lag_client_wait_scene(lag_client *c, double timeout_s, lag_client_scene *sc)
 int lag_client_wait_state(lag_client *c, double timeout_s, lag_client_state *st)
 {
     int rc = handle_until(c, &c->new_state, lag_client_now() + timeout_s);
-    if (rc <= 0) {
-        if (rc == 0) set_err(c, "no state on %s within %.3f s", c->ch_state, timeout_s);
+    if (rc != LAG_CLIENT_OK) {
+        if (rc == LAG_CLIENT_TIMEOUT)
+            set_err(c, "no state on %s within %.3f s", c->ch_state, timeout_s);
         return rc;
     }
     /* drain what is already queued so that the newest state is returned */
     for (int i = 0; i < 1000; i++) {
         rc = lag_client_handle(c, 0);
         if (rc < 0) return rc;
-        if (rc == 0) break;
+        if (rc == LAG_CLIENT_TIMEOUT) break;
     }
     c->new_state = false;
     if (st) *st = c->state;
-    return 1;
+    return LAG_CLIENT_OK;
 }
 
 bool lag_client_latest_state(const lag_client *c, lag_client_state *st)
@@ -406,6 +325,21 @@ bool lag_client_latest_status(const lag_client *c, lag_client_status *st)
 
 /* ---------------------------------------------------------------- sending */
 
+/* Encodes message m of type t and publishes it on channel. */
+static int publish(lag_client *c, const char *channel, lag_wire_type t, const void *m)
+{
+    int n = lag_wire_encode(t, m, c->buf, sizeof c->buf);
+    if (n < 0) {
+        set_err(c, "%s: %s", lag_wire_type_name(t), lag_wire_result_string(n));
+        return LAG_CLIENT_ERR_ARG;
+    }
+    if (lcm_publish(c->lcm, channel, c->buf, (unsigned)n) != 0) {
+        set_err(c, "publish on %s failed", channel);
+        return LAG_CLIENT_ERR_LCM;
+    }
+    return LAG_CLIENT_OK;
+}
+
 int lag_client_send_command(lag_client *c, double sim_time, int n, const char *const *names,
                             const double *effort)
 {
@@ -414,41 +348,48 @@ int lag_client_send_command(lag_client *c, double sim_time, int n, const char *c
                 LAG_CLIENT_MAX_JOINTS);
         return LAG_CLIENT_ERR_ARG;
     }
-    for (int i = 0; i < n; i++)
-        if (!names[i]) {
-            set_err(c, "send_command: joint name %d is NULL", i);
-            return LAG_CLIENT_ERR_ARG;
-        }
-    lagsim_joint_command_t m;
+    lag_wire_joint_command m;
+    memset(&m, 0, sizeof m);
     m.utime = wall_utime();
     m.sim_time = sim_time;
     m.num_joints = (int16_t)n;
-    m.name = (char **)names;       /* encode only reads through these */
-    m.effort = (double *)effort;
-    if (lagsim_joint_command_t_publish(c->lcm, c->ch_command, &m) != 0) {
-        set_err(c, "publish on %s failed", c->ch_command);
-        return LAG_CLIENT_ERR_LCM;
+    for (int i = 0; i < n; i++) {
+        if (!names[i] || !copy_str(m.name[i], sizeof m.name[i], names[i])) {
+            set_err(c, "send_command: joint name %d is %s", i,
+                    names[i] ? "64 bytes or longer" : "NULL");
+            return LAG_CLIENT_ERR_ARG;
+        }
+        m.effort[i] = effort[i];
     }
-    c->counters.commands_sent++;
-    return LAG_CLIENT_OK;
+    if (!lag_wire_all_finite(LAG_WIRE_JOINT_COMMAND, &m)) {
+        set_err(c, "send_command: a NaN or infinite effort or sim_time is never sent");
+        return LAG_CLIENT_ERR_ARG;
+    }
+    int rc = publish(c, c->ch_command, LAG_WIRE_JOINT_COMMAND, &m);
+    if (rc == LAG_CLIENT_OK) c->counters.commands_sent++;
+    return rc;
 }
 
 static int send_control(lag_client *c, int8_t request, int64_t count, int n, const double *q,
                         const double *qd)
 {
-    lagsim_control_t m;
+    lag_wire_control m;
+    memset(&m, 0, sizeof m);
     m.utime = wall_utime();
     m.request = request;
     m.count = count;
     m.num_joints = (int16_t)n;
-    m.q = (double *)q;
-    m.qd = (double *)qd;
-    if (lagsim_control_t_publish(c->lcm, c->ch_control, &m) != 0) {
-        set_err(c, "publish on %s failed", c->ch_control);
-        return LAG_CLIENT_ERR_LCM;
+    for (int i = 0; i < n; i++) {
+        m.q[i] = q[i];
+        m.qd[i] = qd[i];
     }
-    c->counters.controls_sent++;
-    return LAG_CLIENT_OK;
+    if (!lag_wire_all_finite(LAG_WIRE_CONTROL, &m)) {
+        set_err(c, "reset_to: a NaN or infinite q or qd is never sent");
+        return LAG_CLIENT_ERR_ARG;
+    }
+    int rc = publish(c, c->ch_control, LAG_WIRE_CONTROL, &m);
+    if (rc == LAG_CLIENT_OK) c->counters.controls_sent++;
+    return rc;
 }
 
 int lag_client_pause(lag_client *c) { return send_control(c, LAGSIM_CONTROL_T_PAUSE, 0, 0, NULL, NULL); }

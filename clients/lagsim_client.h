@@ -6,18 +6,26 @@
  *   lag_client_scene sc;
  *   lag_client_wait_scene(c, 5.0, &sc);          // sends DESCRIBE until the scene arrives
  *   lag_client_state st;
- *   while (lag_client_wait_state(c, 2.0, &st) == 1) {  // each new state, once
+ *   while (lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK) { // each new state, once
  *       double u = ...;
  *       const char *name = "theta0";
  *       lag_client_send_command(c, st.sim_time, 1, &name, &u); // answers this state
  *   }
  *   lag_client_destroy(c);
  *
- * Messages are copied into fixed-size structs (no LCM memory leaks into user code).
- * Odd messages (undecodable payloads, too many joints, over-long names) are dropped and
- * counted in lag_client_counters, never fatal. Like SQLite, functions return result codes
- * and the last error message is kept on the handle (lag_client_errmsg); the library
- * never prints and never exits. Not thread-safe: use one handle per thread.
+ * One return convention (SQLite's): every function returning int returns LAG_CLIENT_OK
+ * (0) on success, LAG_CLIENT_TIMEOUT (> 0) when nothing arrived in time (not an error),
+ * or a negative error code, with a message kept on the handle (lag_client_errmsg). The
+ * library never prints and never exits. Not thread-safe: use one handle per thread.
+ *
+ * Messages are decoded by lagsim's bounded wire module (lagsim_wire.h) into its
+ * fixed-size structs, which are this library's message types: every field of every
+ * message reaches the caller, no length from the bus is trusted, nothing is allocated
+ * per message. A message that does not decode (wrong type, truncated, hostile), holds
+ * more joints or longer names than the structs, or carries a NaN or an infinity is
+ * dropped and counted in lag_client_counters, never returned. Commands and control
+ * requests are encoded by the same module: a NaN or infinite effort, or a name of 64
+ * bytes or more, is refused (LAG_CLIENT_ERR_ARG), never sent.
  *
  * Lockstep contract (realtime.mode: lockstep): the daemon advances one control period
  * only when a command whose sim_time equals the last published state's sim_time arrives,
@@ -30,83 +38,33 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "lagsim_wire.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define LAG_CLIENT_MAX_JOINTS 8
-#define LAG_CLIENT_MAX_PARAMS 16
-#define LAG_CLIENT_NAME_LEN 32
+#define LAG_CLIENT_MAX_JOINTS LAG_WIRE_MAX_JOINTS   /* 8 */
+#define LAG_CLIENT_MAX_PARAMS LAG_WIRE_MAX_PARAMS   /* 16 */
+#define LAG_CLIENT_NAME_LEN LAG_WIRE_NAME_LEN       /* 64: 63 bytes + NUL */
 
 /* Result codes. */
 enum {
     LAG_CLIENT_OK = 0,
-    LAG_CLIENT_TIMEOUT = 1,      /* nothing arrived in time (not an error of the bus) */
+    LAG_CLIENT_TIMEOUT = 2,      /* nothing arrived in time (not an error); a positive
+                                  * value other than 1, so that it never reads as "true" */
     LAG_CLIENT_ERR_ARG = -1,     /* bad argument (message says which) */
     LAG_CLIENT_ERR_LCM = -2,     /* LCM could not be created, publish or handle failed */
     LAG_CLIENT_ERR_NOMEM = -3
 };
 
-/* The daemon's scene description (lagsim_scene_t), copied. */
-typedef struct lag_client_scene {
-    int64_t utime;
-    char model[LAG_CLIENT_NAME_LEN];       /* stick, manipulator or dipc */
-    char prefix[64];
-    int num_params;
-    char param_name[LAG_CLIENT_MAX_PARAMS][LAG_CLIENT_NAME_LEN];
-    double param_value[LAG_CLIENT_MAX_PARAMS];
-    int num_joints;
-    char joint_name[LAG_CLIENT_MAX_JOINTS][LAG_CLIENT_NAME_LEN];
-    bool actuated[LAG_CLIENT_MAX_JOINTS];
-    double initial_q[LAG_CLIENT_MAX_JOINTS];
-    double initial_qd[LAG_CLIENT_MAX_JOINTS];
-    double dt;                             /* integrator tick, s */
-    double control_period;                 /* state period = lockstep period, s */
-    char integrator[LAG_CLIENT_NAME_LEN];
-    char mode[LAG_CLIENT_NAME_LEN];        /* realtime, fast or lockstep */
-    double rate;
-    double command_timeout;                /* s of sim time */
-} lag_client_scene;
+/* The messages, as the wire module decodes them (every field of the .lcm types; the
+ * field meanings are in lcmtypes/<type>.lcm and docs/messages.md). */
+typedef lag_wire_scene lag_client_scene;        /* scene_t */
+typedef lag_wire_joint_state lag_client_state;  /* joint_state_t */
+typedef lag_wire_status lag_client_status;      /* status_t */
+typedef lag_wire_event lag_client_event;        /* event_t */
 
-/* One joint state (lagsim_joint_state_t), copied. */
-typedef struct lag_client_state {
-    int64_t utime;     /* daemon's wall clock at publication, us */
-    double sim_time;   /* s */
-    int64_t step;      /* integrator ticks since the last reset */
-    int num_joints;
-    char name[LAG_CLIENT_MAX_JOINTS][LAG_CLIENT_NAME_LEN];
-    double position[LAG_CLIENT_MAX_JOINTS];
-    double velocity[LAG_CLIENT_MAX_JOINTS];
-    double effort[LAG_CLIENT_MAX_JOINTS];
-} lag_client_state;
-
-/* The most useful fields of lagsim_status_t, copied. */
-typedef struct lag_client_status {
-    int64_t utime;
-    double sim_time, wall_time, rtf, energy;
-    int64_t step, overruns;
-    double step_time_max_us, step_time_mean_us;
-    char integrator[LAG_CLIENT_NAME_LEN], mode[LAG_CLIENT_NAME_LEN];
-    char run_state[LAG_CLIENT_NAME_LEN];   /* running, paused or fault */
-    int64_t commands_accepted;
-    int64_t rejected_unknown_joint, rejected_unactuated, rejected_nonfinite;
-    int64_t rejected_bad_length, rejected_undecodable, controls_rejected;
-    bool watchdog_tripped;
-    int64_t watchdog_trips, lockstep_timeouts, numeric_faults;
-} lag_client_status;
-
-/* One event (lagsim_event_t), copied; strings truncated to fit. */
-typedef struct lag_client_event {
-    int64_t utime;
-    double sim_time;
-    int64_t step;
-    char kind[LAG_CLIENT_NAME_LEN];
-    char joint[LAG_CLIENT_NAME_LEN];
-    double value;
-    char detail[256];
-} lag_client_event;
-
-/* What the handle has seen. */
 typedef struct lag_client_counters {
     int64_t states, scenes, statuses, events;  /* messages received and kept */
     int64_t dropped;                           /* undecodable or out-of-range messages */
@@ -131,9 +89,16 @@ const char *lag_client_errmsg(const lag_client *c);
 int lag_client_fileno(const lag_client *c);
 
 /* Handles at most one incoming message, waiting up to timeout_ms (0: do not wait).
- * Returns 1 if a message was handled, 0 on timeout, < 0 on error. Callbacks run from
+ * Returns LAG_CLIENT_OK if a message was handled (kept or dropped), LAG_CLIENT_TIMEOUT if
+ * none arrived (or a signal interrupted the wait), < 0 on error. Callbacks run from
  * inside this call. */
 int lag_client_handle(lag_client *c, int timeout_ms);
+
+/* Handles one message as if it had arrived on `channel` (one of this handle's
+ * <prefix>_STATE, _STATUS, _EVENT, _SCENE): decoding, counters, callbacks, as for the
+ * bus. For messages read elsewhere (a log file) and for tests. Returns LAG_CLIENT_OK
+ * (kept or dropped: the counters say which) or LAG_CLIENT_ERR_ARG for another channel. */
+int lag_client_feed(lag_client *c, const char *channel, const void *data, size_t len);
 
 /* Callbacks (NULL to remove), called for every kept message from lag_client_handle. */
 void lag_client_on_state(lag_client *c, lag_client_state_fn fn, void *user);
@@ -146,8 +111,8 @@ void lag_client_on_event(lag_client *c, lag_client_event_fn fn, void *user);
 int lag_client_wait_scene(lag_client *c, double timeout_s, lag_client_scene *sc);
 
 /* Waits up to timeout_s for a state not yet returned by this function (the newest one
- * if several arrived: a controller wants the latest). Returns 1 with *st filled,
- * 0 on timeout, < 0 on error. OUT: st */
+ * if several arrived: a controller wants the latest). Returns LAG_CLIENT_OK with *st
+ * filled, LAG_CLIENT_TIMEOUT, or an error. OUT: st */
 int lag_client_wait_state(lag_client *c, double timeout_s, lag_client_state *st);
 
 /* Polling: the latest state / status received, whether or not already returned.
@@ -157,7 +122,8 @@ bool lag_client_latest_status(const lag_client *c, lag_client_status *st);
 
 /* Publishes a command on <prefix>_COMMAND: efforts for n joints named in names (N or
  * N m), answering the state at sim_time (lockstep advances on it; pass the sim_time of
- * the state the effort was computed from). Joints not named keep their effort. */
+ * the state the effort was computed from). Joints not named keep their effort. A
+ * non-finite effort or sim_time, or a name of 64 bytes or more, is refused. */
 int lag_client_send_command(lag_client *c, double sim_time, int n, const char *const *names,
                             const double *effort);
 
@@ -166,7 +132,7 @@ int lag_client_pause(lag_client *c);
 int lag_client_resume(lag_client *c);
 int lag_client_step(lag_client *c, int64_t count);           /* control periods, >= 1 */
 int lag_client_reset(lag_client *c);                         /* scene's initial state */
-int lag_client_reset_to(lag_client *c, int n, const double *q, const double *qd);
+int lag_client_reset_to(lag_client *c, int n, const double *q, const double *qd); /* finite */
 int lag_client_request_status(lag_client *c);
 int lag_client_request_describe(lag_client *c);
 

@@ -1,5 +1,6 @@
-# Clients (issue 3): LQR design unit test, and end-to-end runs of lagsimd with the C
-# LQR client (lockstep and real time) and the Python manipulator controller.
+# Clients: LQR design unit test, the C client library (messages, status fields, forged
+# messages), end-to-end runs of lagsimd with the C controllers (lockstep and real time,
+# how a run ends, options) and the Python manipulator controller.
 add_executable(test_lqr ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_lqr.c)
 target_link_libraries(test_lqr PRIVATE lagsim_lqr lagsim_core m)
 add_test(NAME clients_lqr COMMAND test_lqr)
@@ -11,6 +12,44 @@ add_executable(test_client ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client.c)
 target_link_libraries(test_client PRIVATE lagsim_client m)
 add_test(NAME clients_library COMMAND test_client)
 set_tests_properties(clients_library PROPERTIES TIMEOUT 30)
+
+# Every field of status_t (read from lcmtypes/status_t.lcm) reaches lag_client_status.
+add_executable(test_client_status ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client_status.c)
+target_include_directories(test_client_status PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/wire)
+target_link_libraries(test_client_status PRIVATE lagsim_client)
+add_test(NAME clients_status_fields COMMAND test_client_status ${PROJECT_SOURCE_DIR}/lcmtypes)
+set_tests_properties(clients_status_fields PROPERTIES TIMEOUT 30)
+
+# Forged states, status, events and scenes (lengths of -1, 0x7fffffff, 32767 joints, a
+# name without its NUL) are dropped and counted, never a crash.
+add_executable(test_client_hostile ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client_hostile.c)
+target_link_libraries(test_client_hostile PRIVATE lagsim_client)
+add_test(NAME clients_hostile_messages COMMAND test_client_hostile)
+set_tests_properties(clients_hostile_messages PROPERTIES TIMEOUT 30)
+
+# The C controllers' options: a value that is not a number, out of range, an unknown
+# option, a stray argument: exit 2 with a message naming the option.
+set(expect_exit sh ${CMAKE_CURRENT_SOURCE_DIR}/clients/expect_exit.sh)
+foreach(bad "--duration;abc" "--timeout;0" "--duration;-1" "--duration;inf" "--q;1,2"
+            "--r;0" "--gain;foo" "--k;1,2,3" "-z" "stray" "--timeout")
+  string(REGEX REPLACE "^-+" "" bad_name "${bad}")
+  string(REPLACE ";" "_" bad_name "${bad_name}")
+  string(REGEX REPLACE "[^A-Za-z0-9_.-]" "" bad_name "${bad_name}")
+  add_test(NAME clients_dipc_lqr_usage_${bad_name}
+           COMMAND ${expect_exit} 2 "^dipc_lqr: .*(--|'-z'|'stray')" $<TARGET_FILE:dipc_lqr> ${bad})
+  set_tests_properties(clients_dipc_lqr_usage_${bad_name} PROPERTIES TIMEOUT 10)
+endforeach()
+foreach(bad "--wn;-1" "--settle;x" "--duration;1e999")
+  string(REGEX REPLACE "^-+" "" bad_name "${bad}")
+  string(REPLACE ";" "_" bad_name "${bad_name}")
+  string(REGEX REPLACE "[^A-Za-z0-9_.-]" "" bad_name "${bad_name}")
+  add_test(NAME clients_manipulator_pd_usage_${bad_name}
+           COMMAND ${expect_exit} 2 "^manipulator_pd: --" $<TARGET_FILE:manipulator_pd> ${bad})
+  set_tests_properties(clients_manipulator_pd_usage_${bad_name} PROPERTIES TIMEOUT 10)
+endforeach()
+# --help: exit 0, the options listed
+add_test(NAME clients_dipc_lqr_help
+         COMMAND ${expect_exit} 0 "--duration S" $<TARGET_FILE:dipc_lqr> --help)
 
 # ---- end to end: lagsimd + a controller on real LCM (default udpm URL, ttl=0), each run
 # with its own channel prefix (run_e2e.py makes it unique per process). The harness
@@ -44,15 +83,18 @@ if(LAGSIM_PYTHON3)
       --check "max_abs_theta1 <= 1.1 * pred_max_abs_theta1 + 0.002"
       --check "max_abs_theta2 <= 1.1 * pred_max_abs_theta2 + 0.002"
       --check "abs(end_theta1) < 1e-3 and abs(end_theta2) < 1e-3"
-      --check "max_abs_theta0 < 1.0" --check "dropped == 0"
+      --check "max_abs_theta0 < 1.0" --check "dropped == 0" --check "end == 'duration'"
       -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration 20 --timeout 5 -q)
   set_tests_properties(clients_dipc_lqr_lockstep PROPERTIES TIMEOUT 70)
   # Real time (20 s of wall time): the effort now reaches the daemon up to one tick after
-  # the state it answers and states may in principle be late, so the bounds get 25 % +
-  # 5 mrad and at least 99 % of the 2001 states must have been answered.
+  # the state it answers, so the bounds get 25 % + 5 mrad. A controller that is not
+  # scheduled within a period skips to the newest state: beside two busy processes on a
+  # 2-core machine, 1813 to 1936 of the 2001 states were answered and the angles met the
+  # bounds. The count only shows that the loop ran the whole run (half
+  # the states); the contract is the angles and the end time.
   add_test(NAME clients_dipc_lqr_realtime
     COMMAND ${e2e} ${dipc_cfg} --mode realtime --name CLLQRRT --timeout 50
-      --check "states >= 1981" --check "t_last - t_first >= 20 - 0.011"
+      --check "states >= 1000" --check "t_last - t_first >= 20 - 0.011"
       --check "max_abs_theta1 >= 0.0499"
       --check "max_abs_theta1 <= 1.25 * pred_max_abs_theta1 + 0.005"
       --check "max_abs_theta2 <= 1.25 * pred_max_abs_theta2 + 0.005"
@@ -84,6 +126,30 @@ if(LAGSIM_PYTHON3)
   set_tests_properties(clients_python_manipulator_lockstep PROPERTIES TIMEOUT 70)
   add_test(NAME clients_c_manipulator_lockstep
     COMMAND ${e2e} ${manip_cfg} --mode lockstep --name CLCMAN --timeout 50 ${manip_checks}
+      --check "dropped == 0 and end == 'duration'"
       -- $<TARGET_FILE:manipulator_pd> --prefix {prefix} --duration 10 --timeout 5 -q)
   set_tests_properties(clients_c_manipulator_lockstep PROPERTIES TIMEOUT 70)
+
+  # How a C controller's run ends (the contract of every language's examples): the daemon
+  # stops by itself (--duration 1: 101 states, then its stop event) and the controller
+  # ends with end=stop within 3 wall s; or the daemon is killed (SIGKILL: no stop event)
+  # and the controller, run with --timeout 2, ends with end=silence 2 to 2 + 3 wall s later.
+  foreach(ex dipc_lqr manipulator_pd)
+    if(ex STREQUAL dipc_lqr)
+      set(cfg ${dipc_cfg})
+    else()
+      set(cfg ${manip_cfg})
+    endif()
+    add_test(NAME clients_c_${ex}_ends_on_stop
+      COMMAND ${e2e} ${cfg} --mode lockstep --name CLENDC --timeout 30
+        --daemon-arg=--duration --daemon-arg=1
+        --check "end == 'stop'" --check "states == 101" --check "wall < 3"
+        -- $<TARGET_FILE:${ex}> --prefix {prefix} -q)
+    add_test(NAME clients_c_${ex}_ends_on_silence
+      COMMAND ${e2e} ${cfg} --mode realtime --name CLSILC --timeout 30 --kill-daemon-after 1
+        --check "end == 'silence'" --check "states >= 50" --check "wall >= 2 and wall < 2 + 3"
+        -- $<TARGET_FILE:${ex}> --prefix {prefix} -q --timeout 2)
+    set_tests_properties(clients_c_${ex}_ends_on_stop clients_c_${ex}_ends_on_silence
+                         PROPERTIES TIMEOUT 60)
+  endforeach()
 endif()

@@ -2,10 +2,12 @@
  * Unit test of the C client library (clients/lagsim_client.c) over real LCM on loopback
  * (default URL, ttl=0) with a channel prefix unique to this process. A second lcm_t
  * plays the daemon: it publishes odd and valid messages and decodes what the client
- * sends. Checks: odd messages (undecodable, too many joints, over-long names) are
- * dropped and counted, never returned; valid ones are copied exactly; commands and
- * control requests arrive as sent; bad arguments are refused with a message; the scene
- * wait sends DESCRIBE requests and times out cleanly when nobody answers.
+ * sends (with the wire module's decoders). Checks: odd messages (undecodable, too many
+ * joints, over-long names, NaN) are dropped and counted, never returned; valid ones are
+ * copied exactly, the status with all its fields; commands and control requests arrive
+ * as sent; bad arguments (NaN efforts, over-long names) are refused with a message and
+ * nothing is sent; the scene wait sends DESCRIBE requests and times out cleanly when
+ * nobody answers; every function follows one return convention.
  */
 #include <math.h>
 #include <stdio.h>
@@ -15,10 +17,11 @@
 #include <lcm/lcm.h>
 
 #include "lagsim/lagsim_control_t.h"
-#include "lagsim/lagsim_joint_command_t.h"
 #include "lagsim/lagsim_joint_state_t.h"
 #include "lagsim/lagsim_scene_t.h"
+#include "lagsim/lagsim_status_t.h"
 #include "lagsim_client.h"
+#include "lagsim_wire.h"
 
 static int failures = 0;
 #define ENSURE(cond)                                                                   \
@@ -29,32 +32,28 @@ static int failures = 0;
         }                                                                              \
     } while (0)
 
-static int describes = 0, commands = 0;
-static lagsim_joint_command_t last_cmd;
-static char last_names[4][32];
-static double last_effort[4];
+static int describes = 0, commands = 0, controls = 0;
+static lag_wire_joint_command last_cmd;
+static lag_wire_control last_ctl;
 
 static void on_control(const lcm_recv_buf_t *rbuf, const char *ch, void *u)
 {
     (void)ch; (void)u;
-    lagsim_control_t m;
-    if (lagsim_control_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) < 0) return;
+    lag_wire_control m;
+    if (lag_wire_decode_control(rbuf->data, rbuf->data_size, LAG_WIRE_MAX_JOINTS, &m)) return;
+    controls++;
+    last_ctl = m;
     if (m.request == LAGSIM_CONTROL_T_DESCRIBE) describes++;
-    lagsim_control_t_decode_cleanup(&m);
 }
 
 static void on_command(const lcm_recv_buf_t *rbuf, const char *ch, void *u)
 {
     (void)ch; (void)u;
-    lagsim_joint_command_t m;
-    if (lagsim_joint_command_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) < 0) return;
+    lag_wire_joint_command m;
+    if (lag_wire_decode_joint_command(rbuf->data, rbuf->data_size, LAG_WIRE_MAX_JOINTS, &m))
+        return;
     commands++;
     last_cmd = m;
-    for (int i = 0; i < m.num_joints && i < 4; i++) {
-        snprintf(last_names[i], sizeof last_names[i], "%s", m.name[i]);
-        last_effort[i] = m.effort[i];
-    }
-    lagsim_joint_command_t_decode_cleanup(&m);
 }
 
 /* Pumps both LCM instances for about `ms` milliseconds. */
@@ -67,13 +66,14 @@ static void pump(lcm_t *peer, lag_client *c, int ms)
     }
 }
 
-static void publish_state(lcm_t *peer, const char *ch, int n, const char *long_name, double t)
+static void publish_state(lcm_t *peer, const char *ch, int n, const char *long_name, double t,
+                          double p0)
 {
     char *names[20];
     double pos[20], vel[20], eff[20];
     for (int i = 0; i < n; i++) {
         names[i] = (char *)(i == 0 && long_name ? long_name : (i == 0 ? "theta0" : "x"));
-        pos[i] = 0.1 * (i + 1);
+        pos[i] = i == 0 ? p0 : 0.1 * (i + 1);
         vel[i] = -0.2 * (i + 1);
         eff[i] = 3.0 * i;
     }
@@ -112,24 +112,47 @@ int main(void)
     snprintf(ch, sizeof ch, "%s_STATE", prefix);
     const char junk[] = "not an LCM message at all";
     lcm_publish(peer, ch, junk, sizeof junk);
-    publish_state(peer, ch, 20, NULL, 1.0); /* too many joints */
+    publish_state(peer, ch, 20, NULL, 1.0, 0.1); /* too many joints */
     char longname[100];
     memset(longname, 'a', sizeof longname - 1);
     longname[sizeof longname - 1] = '\0';
-    publish_state(peer, ch, 3, longname, 2.0); /* name does not fit */
-    publish_state(peer, ch, 3, NULL, 3.0);     /* valid */
+    publish_state(peer, ch, 3, longname, 2.0, 0.1); /* name does not fit */
+    publish_state(peer, ch, 3, NULL, 2.5, NAN);     /* a NaN position */
+    publish_state(peer, ch, 3, NULL, 3.0, 0.1);     /* valid */
     lag_client_state st;
-    ENSURE(lag_client_wait_state(c, 2.0, &st) == 1);
+    ENSURE(lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK);
     pump(peer, c, 50);
     ENSURE(st.sim_time == 3.0 && st.step == 3000 && st.num_joints == 3 && st.utime == 42);
     ENSURE(strcmp(st.name[0], "theta0") == 0 && lag_client_state_joint(&st, "theta0") == 0);
     ENSURE(st.position[2] == 0.1 * 3 && st.velocity[1] == -0.2 * 2 && st.effort[2] == 6.0);
     lag_client_counters cnt;
     lag_client_get_counters(c, &cnt);
-    ENSURE(cnt.states == 1 && cnt.dropped == 3);
+    ENSURE(cnt.states == 1 && cnt.dropped == 4);
     /* no new state: wait_state times out, latest_state still has the valid one */
-    ENSURE(lag_client_wait_state(c, 0.1, &st) == 0);
+    ENSURE(lag_client_wait_state(c, 0.1, &st) == LAG_CLIENT_TIMEOUT);
+    ENSURE(strstr(lag_client_errmsg(c), "no state") != NULL);
     ENSURE(lag_client_latest_state(c, &st) && st.sim_time == 3.0);
+    ENSURE(lag_client_handle(c, 0) == LAG_CLIENT_TIMEOUT);
+
+    /* a status, every field different: every one of them reaches the client */
+    snprintf(ch, sizeof ch, "%s_STATUS", prefix);
+    lagsim_status_t gs = {1, 2.5, 3, 4.5, 5.5, 6, 7.5, 8.5, 9.5, "dopri5", "lockstep", "paused",
+                          13, 14, 15, 16, 17, 18, 19, 1, 21, 22, 23, 24, 25, 26};
+    lagsim_status_t_publish(peer, ch, &gs);
+    pump(peer, c, 100);
+    lag_client_status ss;
+    ENSURE(lag_client_latest_status(c, &ss));
+    ENSURE(ss.utime == 1 && ss.sim_time == 2.5 && ss.step == 3 && ss.wall_time == 4.5);
+    ENSURE(ss.rtf == 5.5 && ss.overruns == 6 && ss.step_time_max_us == 7.5);
+    ENSURE(ss.step_time_mean_us == 8.5 && ss.energy == 9.5);
+    ENSURE(!strcmp(ss.integrator, "dopri5") && !strcmp(ss.mode, "lockstep"));
+    ENSURE(!strcmp(ss.run_state, "paused") && ss.commands_accepted == 13);
+    ENSURE(ss.rejected_unknown_joint == 14 && ss.rejected_unactuated == 15);
+    ENSURE(ss.rejected_nonfinite == 16 && ss.rejected_bad_length == 17);
+    ENSURE(ss.rejected_undecodable == 18 && ss.controls_rejected == 19);
+    ENSURE(ss.watchdog_tripped && ss.watchdog_trips == 21 && ss.lockstep_timeouts == 22);
+    ENSURE(ss.numeric_faults == 23 && ss.rejected_stale == 24 && ss.overrun_bursts == 25);
+    ENSURE(ss.states_published == 26);
 
     /* commands */
     const char *names[2] = {"q1", "q2"};
@@ -137,13 +160,44 @@ int main(void)
     ENSURE(lag_client_send_command(c, 3.0, 2, names, eff) == LAG_CLIENT_OK);
     pump(peer, c, 100);
     ENSURE(commands == 1 && last_cmd.sim_time == 3.0 && last_cmd.num_joints == 2);
-    ENSURE(strcmp(last_names[1], "q2") == 0 && last_effort[0] == 1.5 && last_effort[1] == -2.25);
+    ENSURE(strcmp(last_cmd.name[1], "q2") == 0 && last_cmd.effort[0] == 1.5 &&
+           last_cmd.effort[1] == -2.25);
     ENSURE(lag_client_send_command(c, 3.0, -1, names, eff) == LAG_CLIENT_ERR_ARG);
     ENSURE(lag_client_send_command(c, 3.0, 2, NULL, eff) == LAG_CLIENT_ERR_ARG);
+    /* never a NaN on the bus; never a name the daemon could not read */
+    double enan[2] = {1.0, NAN}, einf[2] = {INFINITY, 0};
+    ENSURE(lag_client_send_command(c, 3.0, 2, names, enan) == LAG_CLIENT_ERR_ARG);
+    ENSURE(strstr(lag_client_errmsg(c), "NaN") != NULL);
+    ENSURE(lag_client_send_command(c, 3.0, 2, names, einf) == LAG_CLIENT_ERR_ARG);
+    ENSURE(lag_client_send_command(c, NAN, 2, names, eff) == LAG_CLIENT_ERR_ARG);
+    const char *longnames[1] = {longname};
+    ENSURE(lag_client_send_command(c, 3.0, 1, longnames, eff) == LAG_CLIENT_ERR_ARG);
     ENSURE(lag_client_step(c, 0) == LAG_CLIENT_ERR_ARG);
     ENSURE(strstr(lag_client_errmsg(c), "count") != NULL);
     ENSURE(lag_client_reset_to(c, 0, eff, eff) == LAG_CLIENT_ERR_ARG);
+    ENSURE(lag_client_reset_to(c, 2, enan, eff) == LAG_CLIENT_ERR_ARG);
+    pump(peer, c, 100);
+    ENSURE(commands == 1); /* none of the refused ones went out */
+    lag_client_get_counters(c, &cnt);
+    ENSURE(cnt.commands_sent == 1);
+    double q2[2] = {0.25, -0.5}, qd2[2] = {1.0, 2.0};
+    ENSURE(lag_client_reset_to(c, 2, q2, qd2) == LAG_CLIENT_OK);
+    pump(peer, c, 100);
+    ENSURE(last_ctl.request == LAGSIM_CONTROL_T_RESET_TO && last_ctl.num_joints == 2);
+    ENSURE(last_ctl.q[1] == -0.5 && last_ctl.qd[0] == 1.0);
+    ENSURE(lag_client_step(c, 7) == LAG_CLIENT_OK);
+    pump(peer, c, 100);
+    ENSURE(last_ctl.request == LAGSIM_CONTROL_T_STEP && last_ctl.count == 7);
     ENSURE(lag_client_pause(c) == LAG_CLIENT_OK && lag_client_resume(c) == LAG_CLIENT_OK);
+
+    /* lag_client_feed: the same path as the bus; another channel is refused */
+    ENSURE(lag_client_feed(c, "OTHER_STATE", junk, sizeof junk) == LAG_CLIENT_ERR_ARG);
+    snprintf(ch, sizeof ch, "%s_EVENT", prefix);
+    lag_client_get_counters(c, &cnt);
+    ENSURE(lag_client_feed(c, ch, junk, sizeof junk) == LAG_CLIENT_OK);
+    lag_client_counters cnt2;
+    lag_client_get_counters(c, &cnt2);
+    ENSURE(cnt2.dropped == cnt.dropped + 1 && cnt2.events == cnt.events);
 
     /* a scene description */
     snprintf(ch, sizeof ch, "%s_SCENE", prefix);
@@ -160,6 +214,7 @@ int main(void)
                         .limit_lower = lim, .limit_upper = lim};
     lagsim_scene_t_publish(peer, ch, &s);
     ENSURE(lag_client_wait_scene(c, 2.0, &sc) == LAG_CLIENT_OK);
+    ENSURE(strcmp(sc.prefix, prefix) == 0 && sc.num_params == 2 && sc.num_joints == 2);
     ENSURE(strcmp(sc.model, "manipulator") == 0 && strcmp(sc.mode, "lockstep") == 0);
     ENSURE(lag_client_scene_param(&sc, "g") == 9.81 && isnan(lag_client_scene_param(&sc, "zz")));
     ENSURE(lag_client_scene_joint(&sc, "q2") == 1 && sc.actuated[0] && !sc.actuated[1]);

@@ -1,0 +1,377 @@
+/*
+ * What every C example controller shares: see lagsim_controller.h.
+ */
+#include "lagsim_controller.h"
+
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CTL_MAX_OPTIONS 32
+
+static volatile sig_atomic_t g_signal = 0;
+static void on_signal(int sig) { g_signal = sig; }
+
+/* ---------------------------------------------------------------- setters */
+/* A finite double, the whole string. */
+static int parse_double(const char *v, double *x, char *err, size_t errlen)
+{
+    char *end;
+    errno = 0;
+    *x = v ? strtod(v, &end) : NAN;
+    if (!v || end == v || *end != '\0' || !isfinite(*x)) {
+        snprintf(err, errlen, "'%s' is not a finite number", v ? v : "");
+        return -1;
+    }
+    return 0;
+}
+
+int lag_ctl_number(const char *value, void *target, char *err, size_t errlen)
+{
+    return parse_double(value, target, err, errlen);
+}
+
+int lag_ctl_positive(const char *value, void *target, char *err, size_t errlen)
+{
+    double x;
+    if (parse_double(value, &x, err, errlen)) return -1;
+    if (!(x > 0)) {
+        snprintf(err, errlen, "must be > 0, got %s", value);
+        return -1;
+    }
+    *(double *)target = x;
+    return 0;
+}
+
+int lag_ctl_nonnegative(const char *value, void *target, char *err, size_t errlen)
+{
+    double x;
+    if (parse_double(value, &x, err, errlen)) return -1;
+    if (!(x >= 0)) {
+        snprintf(err, errlen, "must be >= 0, got %s", value);
+        return -1;
+    }
+    *(double *)target = x;
+    return 0;
+}
+
+int lag_ctl_flag(const char *value, void *target, char *err, size_t errlen)
+{
+    (void)value, (void)err, (void)errlen;
+    *(bool *)target = true;
+    return 0;
+}
+
+int lag_ctl_parse_list(const char *value, double *out, int n, char *err, size_t errlen)
+{
+    const char *s = value ? value : "";
+    for (int i = 0; i < n; i++) {
+        char *end;
+        out[i] = strtod(s, &end);
+        if (end == s || !isfinite(out[i]) || (i < n - 1 && *end != ',')) {
+            snprintf(err, errlen, "'%s' is not %d comma-separated finite numbers", value, n);
+            return -1;
+        }
+        s = end + (i < n - 1);
+    }
+    if (*s != '\0') {
+        snprintf(err, errlen, "'%s' is not %d comma-separated finite numbers", value, n);
+        return -1;
+    }
+    return 0;
+}
+
+static int set_string(const char *value, void *target, char *err, size_t errlen)
+{
+    if (!value || !value[0]) {
+        snprintf(err, errlen, "needs a non-empty value");
+        return -1;
+    }
+    *(const char **)target = value;
+    return 0;
+}
+
+/* ---------------------------------------------------------------- options */
+void lag_ctl_init(lag_ctl *ctl, const char *name, const char *default_prefix)
+{
+    memset(ctl, 0, sizeof *ctl);
+    ctl->name = name;
+    ctl->prefix = default_prefix;
+    ctl->timeout = 5.0;
+    ctl->t_first = NAN;
+}
+
+static void usage(const lag_ctl *ctl, FILE *f, const char *what, const lag_ctl_option *all,
+                  int n)
+{
+    fprintf(f, "usage: %s [options]\n%s\n", ctl->name, what);
+    for (int i = 0; i < n; i++) {
+        char head[64], letter[8] = "";
+        if (all[i].letter) snprintf(letter, sizeof letter, "-%c, ", all[i].letter);
+        snprintf(head, sizeof head, "%s--%s%s%s", letter, all[i].name,
+                 all[i].metavar ? " " : "", all[i].metavar ? all[i].metavar : "");
+        fprintf(f, "  %-20s %s\n", head, all[i].help);
+    }
+    fprintf(f, "A run ends on the daemon's stop event, after --timeout s of silence, after "
+               "--duration, or on SIGINT/SIGTERM.\n"
+               "Exit status: 0 done, 1 no scene, another model or a client error, 2 bad "
+               "usage.\n");
+}
+
+int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
+                  const lag_ctl_option *extra, int nextra)
+{
+    bool help = false;
+    char prefix_help[96];
+    snprintf(prefix_help, sizeof prefix_help, "channel prefix (default %s)", ctl->prefix);
+    const lag_ctl_option common[] = {
+        {"prefix", "P", prefix_help, set_string, &ctl->prefix},
+        {"url", "URL", "LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)",
+         set_string, &ctl->url},
+        {"duration", "S", "end after S s of sim time from the first state (default 0: "
+                          "until the daemon stops)", lag_ctl_nonnegative, &ctl->duration},
+        {"timeout", "S", "wall s without a scene, or without any message from the daemon, "
+                         "before ending (default 5)", lag_ctl_positive, &ctl->timeout},
+        {"trace", "FILE", "write each answered state and the efforts sent to FILE",
+         set_string, &ctl->trace_path},
+        {"quiet", NULL, "design and summary only", lag_ctl_flag, &ctl->quiet, 'q'},
+        {"help", NULL, "this text", lag_ctl_flag, &help, 'h'},
+    };
+    int ncommon = (int)(sizeof common / sizeof common[0]);
+    lag_ctl_option all[CTL_MAX_OPTIONS];
+    struct option longopts[CTL_MAX_OPTIONS + 1];
+    int n = 0;
+    for (int i = 0; i < ncommon + nextra && n < CTL_MAX_OPTIONS; i++)
+        all[n++] = i < ncommon ? common[i] : extra[i - ncommon];
+    char shorts[2 * CTL_MAX_OPTIONS + 2] = ":";
+    size_t ns = 1;
+    for (int i = 0; i < n; i++) {
+        longopts[i] = (struct option){all[i].name, all[i].metavar ? required_argument : no_argument,
+                                      NULL, 256 + i};
+        if (all[i].letter) {
+            shorts[ns++] = all[i].letter;
+            if (all[i].metavar) shorts[ns++] = ':';
+        }
+    }
+    longopts[n] = (struct option){NULL, 0, NULL, 0};
+    shorts[ns] = '\0';
+
+    opterr = 0;
+    optind = 1;
+    int c;
+    while ((c = getopt_long(argc, argv, shorts, longopts, NULL)) != -1) {
+        const lag_ctl_option *o = NULL;
+        if (c >= 256) o = &all[c - 256];
+        for (int i = 0; i < n && !o && c != '?' && c != ':'; i++)
+            if (all[i].letter == c) o = &all[i];
+        if (!o) {
+            if (c == ':' && optopt && optopt < 256)
+                fprintf(stderr, "%s: option -%c needs a value\n", ctl->name, optopt);
+            else if (c == ':')
+                fprintf(stderr, "%s: option %s needs a value\n", ctl->name, argv[optind - 1]);
+            else if (optopt)
+                fprintf(stderr, "%s: unknown option '-%c'\n", ctl->name, optopt);
+            else
+                fprintf(stderr, "%s: unknown option '%s'\n", ctl->name, argv[optind - 1]);
+            fprintf(stderr, "%s: --help lists the options\n", ctl->name);
+            return 2;
+        }
+        char err[256];
+        if (o->set(optarg, o->target, err, sizeof err) != 0) {
+            fprintf(stderr, "%s: --%s: %s\n", ctl->name, o->name, err);
+            return 2;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "%s: unexpected argument '%s' (--help lists the options)\n", ctl->name,
+                argv[optind]);
+        return 2;
+    }
+    if (help) {
+        usage(ctl, stdout, what, all, n);
+        return 0;
+    }
+    return -1;
+}
+
+/* ---------------------------------------------------------------- the run */
+static void heard_state(const lag_client_state *st, void *user)
+{
+    (void)st;
+    ((lag_ctl *)user)->heard = lag_client_now();
+}
+
+static void heard_status(const lag_client_status *st, void *user)
+{
+    (void)st;
+    ((lag_ctl *)user)->heard = lag_client_now();
+}
+
+static void heard_event(const lag_client_event *ev, void *user)
+{
+    lag_ctl *ctl = user;
+    ctl->heard = lag_client_now();
+    if (!strcmp(ev->kind, "stop")) ctl->stopped = true;
+}
+
+int lag_ctl_start(lag_ctl *ctl, const char *model)
+{
+    char err[256];
+    if (ctl->trace_path) {
+        ctl->trace = fopen(ctl->trace_path, "w");
+        if (!ctl->trace) {
+            fprintf(stderr, "%s: --trace %s: %s\n", ctl->name, ctl->trace_path, strerror(errno));
+            return 1;
+        }
+    }
+    ctl->client = lag_client_create(ctl->url, ctl->prefix, err, sizeof err);
+    if (!ctl->client) {
+        fprintf(stderr, "%s: %s\n", ctl->name, err);
+        return 1;
+    }
+    lag_client_on_state(ctl->client, heard_state, ctl);
+    lag_client_on_status(ctl->client, heard_status, ctl);
+    lag_client_on_event(ctl->client, heard_event, ctl);
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+
+    /* subscribed: from here on no state is missed (test harnesses wait for this line) */
+    printf("%s: waiting for the scene description on %s_SCENE\n", ctl->name, ctl->prefix);
+    fflush(stdout);
+    double deadline = lag_client_now() + ctl->timeout;
+    for (;;) {
+        double left = deadline - lag_client_now();
+        int rc = lag_client_wait_scene(ctl->client, left < 0.25 ? left : 0.25, &ctl->scene);
+        if (rc == LAG_CLIENT_OK) break;
+        if (rc < 0 || g_signal || !(left > 0.25)) {
+            if (g_signal)
+                fprintf(stderr, "%s: interrupted while waiting for the scene\n", ctl->name);
+            else if (rc < 0)
+                fprintf(stderr, "%s: %s\n", ctl->name, lag_client_errmsg(ctl->client));
+            else
+                fprintf(stderr, "%s: no scene description on %s_SCENE within %g s (is lagsimd "
+                                "running with lcm.prefix %s on the same LCM URL?)\n",
+                        ctl->name, ctl->prefix, ctl->timeout, ctl->prefix);
+            return 1;
+        }
+    }
+    if (strcmp(ctl->scene.model, model) != 0) {
+        fprintf(stderr, "%s: prefix %s runs model '%s', not %s\n", ctl->name, ctl->prefix,
+                ctl->scene.model, model);
+        return 1;
+    }
+    int kind = lag_model_kind_from_name(model);
+    if (kind < 0) {
+        fprintf(stderr, "%s: no model '%s' in this build\n", ctl->name, model);
+        return 1;
+    }
+    ctl->kind = (lag_model_kind)kind;
+    lag_model_default_unfinished(&ctl->model, ctl->kind);
+    for (int i = 0; i < ctl->scene.num_params; i++) {
+        int k = lag_model_param_index(ctl->kind, ctl->scene.param_name[i]);
+        if (k >= 0) ctl->model.p[k] = ctl->scene.param_value[i];
+        else
+            fprintf(stderr, "%s: ignoring unknown parameter %s\n", ctl->name,
+                    ctl->scene.param_name[i]);
+    }
+    lag_model_finish(&ctl->model);
+    if (lag_model_validate(&ctl->model, err, sizeof err) != LAG_OK) {
+        fprintf(stderr, "%s: scene parameters: %s\n", ctl->name, err);
+        return 1;
+    }
+    ctl->heard = lag_client_now();
+    return 0;
+}
+
+int lag_ctl_next_state(lag_ctl *ctl, lag_client_state *st)
+{
+    if (ctl->end) return LAG_CLIENT_TIMEOUT;
+    if (ctl->duration > 0 && ctl->states > 0 &&
+        ctl->current.sim_time - ctl->t_first >= ctl->duration - 0.5 * ctl->scene.control_period) {
+        ctl->end = "duration";
+        return LAG_CLIENT_TIMEOUT;
+    }
+    for (;;) {
+        if (g_signal) {
+            ctl->end = "signal";
+            return LAG_CLIENT_TIMEOUT;
+        }
+        int rc = lag_client_wait_state(ctl->client, 0.05, st);
+        if (rc == LAG_CLIENT_OK) {
+            if (ctl->states++ == 0) ctl->t_first = st->sim_time;
+            ctl->current = *st;
+            return LAG_CLIENT_OK;
+        }
+        if (rc < 0) {
+            fprintf(stderr, "%s: %s\n", ctl->name, lag_client_errmsg(ctl->client));
+            ctl->failed = true;
+            ctl->end = "error";
+            return rc;
+        }
+        if (ctl->stopped) {
+            ctl->end = "stop";
+            return LAG_CLIENT_TIMEOUT;
+        }
+        if (lag_client_now() - ctl->heard > ctl->timeout) {
+            ctl->end = "silence";
+            return LAG_CLIENT_TIMEOUT;
+        }
+    }
+}
+
+int lag_ctl_command(lag_ctl *ctl, const lag_client_state *st, int n, const char *const *names,
+                    const double *effort)
+{
+    double e[LAG_CLIENT_MAX_JOINTS];
+    if (n < 0 || n > LAG_CLIENT_MAX_JOINTS) n = -1; /* refused by the client, with a message */
+    for (int i = 0; i < n; i++) e[i] = isfinite(effort[i]) ? effort[i] : 0.0;
+    int rc = lag_client_send_command(ctl->client, st->sim_time, n, names, e);
+    if (rc < 0) {
+        fprintf(stderr, "%s: %s\n", ctl->name, lag_client_errmsg(ctl->client));
+        ctl->failed = true;
+        return rc;
+    }
+    if (ctl->trace) {
+        /* %.17g reads back to the same double */
+        fprintf(ctl->trace, "%.17g", st->sim_time);
+        for (int i = 0; i < st->num_joints; i++) fprintf(ctl->trace, " %.17g", st->position[i]);
+        for (int i = 0; i < st->num_joints; i++) fprintf(ctl->trace, " %.17g", st->velocity[i]);
+        for (int i = 0; i < n; i++) fprintf(ctl->trace, " %.17g", e[i]);
+        fputc('\n', ctl->trace);
+    }
+    return rc;
+}
+
+int lag_ctl_finish(lag_ctl *ctl, const char *fmt, ...)
+{
+    lag_client_counters cnt = {0};
+    if (ctl->client) lag_client_get_counters(ctl->client, &cnt);
+    printf("%s: summary end=%s ", ctl->name, ctl->end ? ctl->end : "none");
+    va_list ap;
+    va_start(ap, fmt);
+    vprintf(fmt, ap);
+    va_end(ap);
+    printf(" dropped=%lld\n", (long long)cnt.dropped);
+    fflush(stdout);
+    if (ctl->trace) fclose(ctl->trace);
+    ctl->trace = NULL;
+    lag_client_destroy(ctl->client);
+    ctl->client = NULL;
+    return ctl->failed ? 1 : 0;
+}
+
+int lag_ctl_fail(lag_ctl *ctl)
+{
+    if (ctl->trace) fclose(ctl->trace);
+    ctl->trace = NULL;
+    lag_client_destroy(ctl->client);
+    ctl->client = NULL;
+    return 1;
+}
