@@ -22,3 +22,13 @@ foreach(case ${LAGSIM_REPLAY_CASES})
            COMMAND test_replay $<TARGET_FILE:lagsimd> ${PROJECT_SOURCE_DIR}/config/dipc.yaml ${case})
   set_tests_properties(wire_replay_${case} PROPERTIES TIMEOUT 120)
 endforeach()
+
+# Fuzz targets (tests/fuzz/fuzz_<name>.c; seeds and kept crash inputs under tests/fuzz/<name>/,
+# written by tests/fuzz/make_seeds.py): the wire module's decoders and encoders, the log
+# reader, and --replay end to end.
+lagsim_fuzz_target(wire LIBS lagsim_wire)
+lagsim_fuzz_target(log LIBS lagsim_wire)
+lagsim_fuzz_target(replay SOURCES ${PROJECT_SOURCE_DIR}/server/daemon/replay.c
+                   LIBS lagsim_scene lagsim_core lagsim_wire)
+target_include_directories(fuzz_replay PRIVATE ${PROJECT_SOURCE_DIR}/server/daemon)
+target_compile_definitions(fuzz_replay PRIVATE LAGSIM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

@@ -9,6 +9,8 @@
  * another.
  *
  * usage: test_replay LAGSIMD SCENE.yaml CASE
+ *        test_replay LAGSIMD SCENE.yaml write_logs DIR   (each case's log into DIR/CASE.lcm,
+ *                                                          nothing run: fuzzing corpora)
  * Cases:
  *   valid                 a clean log: every state compared, difference 0, exit 0
  *   nothing_to_check      one state: nothing compared, exit 1
@@ -71,7 +73,8 @@ static int failures = 0;
     } while (0)
 
 static const char *g_lagsimd, *g_scene;
-static char g_log[256];
+static const char *g_write_dir; /* write_logs: keep the logs, run nothing */
+static char g_log[1024];
 static lag_scene g_sc;
 static char g_channel[96];
 
@@ -163,10 +166,11 @@ static double now_s(void)
 }
 
 /* Runs lagsimd --config SCENE --replay log_path, at most timeout_s seconds; as_limit > 0
- * limits its address space (bytes). */
-static void replay(const char *log_path, double timeout_s, long as_limit, result *r)
+ * limits its address space (bytes). False (nothing run) when only writing logs. */
+static bool replay(const char *log_path, double timeout_s, long as_limit, result *r)
 {
     memset(r, 0, sizeof *r);
+    if (g_write_dir) return false;
     int pfd[2];
     if (pipe(pfd) != 0) exit(1);
     double t0 = now_s();
@@ -209,6 +213,7 @@ static void replay(const char *log_path, double timeout_s, long as_limit, result
         r->status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     printf("---- lagsimd --replay %s: status %d after %.2f s\n%s", log_path, r->status,
            r->seconds, r->out);
+    return true;
 }
 
 /* N of the summary line "replay LOG: N states compared on ...", or -1. */
@@ -234,7 +239,7 @@ static void case_valid(void)
     run(f, 100, NULL);
     fclose(f);
     result r;
-    replay(g_log, 30, 0, &r);
+    if (!replay(g_log, 30, 0, &r)) return;
     ensure_checked(&r, 100);
     ENSURE(strstr(r.out, "0 gaps, 0 undecodable, 0 integrator errors") != NULL);
 }
@@ -245,7 +250,7 @@ static void case_nothing_to_check(void)
     run(f, 0, NULL);
     fclose(f);
     result r;
-    replay(g_log, 30, 0, &r);
+    if (!replay(g_log, 30, 0, &r)) return;
     ENSUREF(r.status == 1, "status %d", r.status);
     ENSURE(strstr(r.out, "nothing could be checked") != NULL);
     ENSURE(strstr(r.out, "max difference") == NULL);
@@ -289,7 +294,7 @@ static void case_negative_name_length(void)
     run(f, 100, hook_negative_name);
     fclose(f);
     result r;
-    replay(g_log, 30, 0, &r);
+    if (!replay(g_log, 30, 0, &r)) return;
     ensure_checked(&r, 100);
     ENSURE(strstr(r.out, "1 undecodable") != NULL);
 }
@@ -307,7 +312,7 @@ static void case_name_fills_buffer(void)
     run(f, 100, hook_name_fills);
     fclose(f);
     result r;
-    replay(g_log, 30, 0, &r);
+    if (!replay(g_log, 30, 0, &r)) return;
     ensure_checked(&r, 100);
     ENSURE(strstr(r.out, "1 undecodable") != NULL);
 }
@@ -336,7 +341,7 @@ static void case_huge_data_length(void)
     huge_header(f); /* and one at the end: a record cut short */
     fclose(f);
     result r;
-    replay(g_log, 30, 0, &r);
+    if (!replay(g_log, 30, 0, &r)) return;
     ensure_checked(&r, 100);
     ENSURE(strstr(r.out, "damaged in 1 place") != NULL);
     ENSURE(strstr(r.out, "cut short") != NULL);
@@ -355,7 +360,7 @@ static void case_step_jump(void)
     run(f, 60, hook_jump);
     fclose(f);
     result r;
-    replay(g_log, 30, 0, &r);
+    if (!replay(g_log, 30, 0, &r)) return;
     ENSUREF(r.status == 0, "status %d", r.status);
     /* 2^62 is out of range (skipped: state 20 still follows 19); 2^52 is a gap (restart
      * there), state 40 a step back (restart): states 1-39 and 41-60 are compared */
@@ -378,7 +383,7 @@ static void case_step_int64_min(void)
     run(f, 40, hook_min);
     fclose(f);
     result r;
-    replay(g_log, 30, 0, &r);
+    if (!replay(g_log, 30, 0, &r)) return;
     ensure_checked(&r, 40);
     ENSURE(strstr(r.out, "2 states with a non-finite number or a step outside") != NULL);
 }
@@ -386,7 +391,7 @@ static void case_step_int64_min(void)
 static void case_dev_zero(void)
 {
     result r;
-    replay("/dev/zero", 30, 0, &r);
+    if (!replay("/dev/zero", 30, 0, &r)) return;
     ENSUREF(r.status == 1, "status %d", r.status);
     ENSURE(strstr(r.out, "not an LCM log") != NULL);
     ENSURE(strstr(r.out, "max difference") == NULL);
@@ -395,7 +400,7 @@ static void case_dev_zero(void)
 static void case_not_a_log(void)
 {
     result r;
-    replay(g_scene, 30, 0, &r);
+    if (!replay(g_scene, 30, 0, &r)) return;
     ENSUREF(r.status == 1, "status %d", r.status);
     ENSURE(strstr(r.out, "no ") != NULL && strstr(r.out, "messages in") != NULL);
 }
@@ -424,7 +429,7 @@ static void case_undecodable_flood(void)
     fclose(f);
     result r;
     /* 2000 leaked blocks of 32767 pointers would need 524 MB */
-    replay(g_log, 60, SANITIZED ? 0 : 256L << 20, &r);
+    if (!replay(g_log, 60, SANITIZED ? 0 : 256L << 20, &r)) return;
     ensure_checked(&r, 20); /* state 10 follows the flood: 9 -> 10 is still one period */
     ENSURE(strstr(r.out, "2000 undecodable") != NULL);
 }
@@ -444,7 +449,7 @@ static void case_resim_failure(void)
     run(f, 21, hook_explode);
     fclose(f);
     result r;
-    replay(g_log, 30, 0, &r);
+    if (!replay(g_log, 30, 0, &r)) return;
     ENSUREF(r.status == 1, "status %d", r.status);
     ENSURE(strstr(r.out, "re-simulation failed") != NULL);
     ENSURE(strstr(r.out, "max difference") == NULL);
@@ -468,20 +473,21 @@ static void case_garbage_between(void)
     run(f, 100, hook_garbage);
     fclose(f);
     result r;
-    replay(g_log, 30, 0, &r);
+    if (!replay(g_log, 30, 0, &r)) return;
     ensure_checked(&r, 100);
     ENSURE(strstr(r.out, "damaged in 2 place") != NULL);
 }
 
 int main(int argc, char **argv)
 {
-    if (argc != 4) {
-        fprintf(stderr, "usage: test_replay LAGSIMD SCENE.yaml CASE\n");
+    if (argc != 4 && !(argc == 5 && !strcmp(argv[3], "write_logs"))) {
+        fprintf(stderr, "usage: test_replay LAGSIMD SCENE.yaml CASE | write_logs DIR\n");
         return 2;
     }
     g_lagsimd = argv[1];
     g_scene = argv[2];
     const char *c = argv[3];
+    if (argc == 5 && !strcmp(c, "write_logs")) g_write_dir = argv[4];
     char err[512];
     if (lag_scene_load(g_scene, NULL, 0, &g_sc, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
@@ -507,6 +513,13 @@ int main(int argc, char **argv)
         {"garbage_between", case_garbage_between},
     };
     bool found = false;
+    if (g_write_dir) {
+        for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+            snprintf(g_log, sizeof g_log, "%s/%s.lcm", g_write_dir, cases[i].name);
+            cases[i].fn();
+        }
+        return 0;
+    }
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
         if (!strcmp(c, cases[i].name)) {
             cases[i].fn();

@@ -1,0 +1,215 @@
+#!/usr/bin/env python3
+"""Writes the seed corpora of the wire, client, log and replay fuzz targets, and the kept
+inputs that crashed, hung or leaked in the client library and --replay before they read
+through the wire module.
+
+    tests/fuzz/make_seeds.py BUILD_DIR
+
+Messages are encoded by lcm-gen's Python types (BUILD_DIR/python), independently of the
+wire module; the replay logs come from `test_replay ... write_logs` (a core run of
+config/dipc.yaml written as lcm-logger writes it).
+"""
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+
+build = os.path.abspath(sys.argv[1])
+here = os.path.dirname(os.path.abspath(__file__))
+root = os.path.dirname(os.path.dirname(here))
+sys.path.insert(0, os.path.join(build, "python"))
+from lagsim import control_t, event_t, joint_command_t, joint_state_t, scene_t, status_t  # noqa
+
+SYNC = 0xEDA1DA01
+
+
+def write(target, kind, name, data):
+    d = os.path.join(here, target, kind)
+    os.makedirs(d, exist_ok=True)
+    with open(os.path.join(d, name), "wb") as f:
+        f.write(data)
+
+
+def state(n=3, names=("theta0", "theta1", "theta2"), t=0.01, step=10):
+    m = joint_state_t()
+    m.sim_time, m.step, m.num_joints = t, step, n
+    m.name = list(names[:n])
+    m.position = [0.1 * (i + 1) for i in range(n)]
+    m.velocity = [-0.2 * i for i in range(n)]
+    m.effort = [1.5 if i == 0 else 0.0 for i in range(n)]
+    return m.encode()
+
+
+def command():
+    m = joint_command_t()
+    m.sim_time, m.num_joints, m.name, m.effort = 0.01, 2, ["q1", "q2"], [1.5, -2.25]
+    return m.encode()
+
+
+def control(req=control_t.RESET_TO):
+    m = control_t()
+    m.request, m.count, m.num_joints = req, 3, 3
+    m.q, m.qd = [0.0, 0.05, -0.03], [0.0, 0.0, 1.0]
+    return m.encode()
+
+
+def event():
+    m = event_t()
+    m.sim_time, m.step, m.kind, m.joint, m.value = 1.25, 1250, "impact", "theta0", -0.5
+    m.detail = "impact at t = 1.25 s"
+    return m.encode()
+
+
+def status():
+    m = status_t()
+    for i, f in enumerate(status_t.__slots__):
+        v = getattr(m, f)
+        if isinstance(v, str):
+            setattr(m, f, "rk4" if f == "integrator" else "field%d" % i)
+        elif isinstance(v, bool):
+            setattr(m, f, True)
+        elif isinstance(v, float):
+            setattr(m, f, i + 0.5)
+        else:
+            setattr(m, f, i)
+    return m.encode()
+
+
+def scene(nparams=7, njoints=3):
+    m = scene_t()
+    m.model, m.prefix = "dipc", "DIPC"
+    m.num_params = nparams
+    m.param_name = ["p%d" % i for i in range(nparams)]
+    m.param_value = [1.0 + i for i in range(nparams)]
+    m.num_joints = njoints
+    m.joint_name = ["theta%d" % i for i in range(njoints)]
+    m.actuated = [i == 0 for i in range(njoints)]
+    m.initial_q = [0.0] * njoints
+    m.initial_qd = [0.0] * njoints
+    m.dt, m.control_period, m.integrator, m.mode = 0.001, 0.01, "rk4", "realtime"
+    m.rate, m.command_timeout = 1.0, 0.5
+    return m.encode()
+
+
+def forged_state(name_len, name_bytes, n=3, rest=True, pad_to=None):
+    """A joint_state_t whose first name is written as name_len then name_bytes."""
+    b = joint_state_t._get_packed_fingerprint() + struct.pack(">qdqh", 0, 0.0, 0, n)
+    b += struct.pack(">I", name_len & 0xFFFFFFFF) + name_bytes
+    if rest:
+        for nm in ("theta1", "theta2")[: n - 1]:
+            b += struct.pack(">I", len(nm) + 1) + nm.encode() + b"\0"
+        b += b"\0" * (24 * n)
+    if pad_to and len(b) < pad_to:
+        b += b"A" * (pad_to - len(b))
+    return b
+
+
+def record(channel, data, num=0, stamp=0):
+    c = channel.encode()
+    return struct.pack(">IqqII", SYNC, num, stamp, len(c), len(data)) + c + data
+
+
+# ---- wire: first byte = the bound on num_joints (9 -> 8)
+B8 = b"\x09"
+for name, data in [("joint-state.bin", state()), ("joint-command.bin", command()),
+                   ("control-reset-to.bin", control()), ("control-step.bin", control(control_t.STEP)),
+                   ("event.bin", event()), ("status.bin", status()), ("scene.bin", scene()),
+                   ("scene-full.bin", scene(16, 8)), ("joint-state-no-joints.bin", state(0))]:
+    write("wire", "seed", name, B8 + data)
+write("wire", "seed", "joint-state-bound-2.bin", b"\x03" + state())
+write("wire", "seed", "joint-state-negative-count.bin", B8 + state()[:34 - 2] + b"\xff\xff")
+
+# ---- client: first byte = channel (0 STATE, 1 STATUS, 2 EVENT, 3 SCENE)
+for name, data in [("state.bin", b"\x00" + state()), ("status.bin", b"\x01" + status()),
+                   ("event.bin", b"\x02" + event()), ("scene.bin", b"\x03" + scene())]:
+    write("client", "seed", name, data)
+# what crashed, overread or leaked in the client's lcm-gen decoders
+write("client", "crash", "state-negative-name-length.bin",
+      b"\x00" + forged_state(-1, b"", rest=False, pad_to=145))
+write("client", "crash", "state-name-without-nul.bin", b"\x00" + forged_state(6, b"theta0"))
+write("client", "crash", "state-32767-joints.bin",
+      b"\x00" + forged_state(7, b"theta0\0", n=32767, rest=False))
+st = status_t._get_packed_fingerprint() + b"\0" * 72 + struct.pack(">I", 0xFFFFFFFF) + b"B" * 100
+write("client", "crash", "status-negative-string-length.bin", b"\x01" + st)
+ev = event_t._get_packed_fingerprint() + b"\0" * 24 + struct.pack(">I", 0x7FFFFFFF) + b"C" * 40
+write("client", "crash", "event-string-length-7fffffff.bin", b"\x02" + ev)
+sc = (scene_t._get_packed_fingerprint() + struct.pack(">q", 0) + struct.pack(">I", 2) + b"m\0"
+      + struct.pack(">I", 2) + b"P\0" + struct.pack(">h", 32767) + struct.pack(">I", 3) + b"m0\0")
+write("client", "crash", "scene-32767-params.bin", b"\x03" + sc)
+
+# ---- log
+log = record("DIPC_STATE", state(), 0, 1000) + record("DIPC_STATUS", status(), 1, 2000) + \
+      record("OTHER", b"x" * 40, 2, 3000) + record("DIPC_EVENT", b"", 3, 4000)
+write("log", "seed", "three-channels.lcm", log)
+write("log", "seed", "junk-between.lcm", log[:60] + b"junk" + log[60:])
+write("log", "seed", "cut-short.lcm", log[:-5])
+huge = struct.pack(">IqqII", SYNC, 0, 0, 10, 0x7FFFFFFF) + b"DIPC_STATE" + b"0123456789abcdef"
+write("log", "crash", "data-length-7fffffff.lcm", record("DIPC_STATE", state()) + huge)
+
+# ---- replay: the test's logs (a core run of config/dipc.yaml), kept small
+tmp = tempfile.mkdtemp()
+try:
+    subprocess.check_call([os.path.join(build, "bin", "test_replay"),
+                           os.path.join(build, "bin", "lagsimd"),
+                           os.path.join(root, "config", "dipc.yaml"), "write_logs", tmp])
+
+    def records(path):
+        b = open(path, "rb").read()
+        out, p = [], 0
+        while p + 28 <= len(b):
+            sync, num, stamp, cl, dl = struct.unpack(">IqqII", b[p:p + 28])
+            if sync != SYNC or p + 28 + cl + dl > len(b):
+                out.append(b[p:])  # a damaged tail: kept as it is
+                break
+            out.append(b[p:p + 28 + cl + dl])
+            p += 28 + cl + dl
+        return out
+
+    def keep(name, target, kind, first=None, flood_max=None):
+        recs = records(os.path.join(tmp, name + ".lcm"))
+        if flood_max:  # fewer identical records
+            seen, kept = 0, []
+            for r in recs:
+                if sum(1 for x in recs if x[20:] == r[20:]) > 1:
+                    seen += 1
+                    if seen > flood_max:
+                        continue
+                kept.append(r)
+            recs = kept
+        if first:
+            recs = recs[:first]
+        write(target, kind, name.replace("_", "-") + ".lcm", b"".join(recs))
+
+    keep("valid", "replay", "seed", first=12)     # states 0 .. 11 of a core run
+    keep("step_jump", "replay", "seed", first=24)  # ... and a step of 2^62 after state 19
+finally:
+    shutil.rmtree(tmp)
+
+# Kept inputs of --replay (small logs: the bug is in how a record or a step is read, not in
+# the physics): a state, the hostile record(s), a state one period later.
+s0, s10 = record("DIPC_STATE", state(t=0.0, step=0)), record("DIPC_STATE", state(t=0.1, step=100))
+
+
+def at_step(step):
+    """The DIPC upright at rest, no effort: an equilibrium, so a re-simulation across a
+    huge step gap runs for ever instead of failing."""
+    m = joint_state_t()
+    m.sim_time, m.step, m.num_joints = 0.0, step, 3
+    m.name = ["theta0", "theta1", "theta2"]
+    m.position, m.velocity, m.effort = [0.0] * 3, [0.0] * 3, [0.0] * 3
+    return record("DIPC_STATE", m.encode())
+
+
+write("replay", "crash", "negative-name-length.lcm",       # crashed (SIGSEGV)
+      s0 + record("DIPC_STATE", forged_state(-1, b"theta0")) + s10)
+write("replay", "crash", "name-fills-buffer.lcm",          # heap overflow under ASan
+      s0 + record("DIPC_STATE", forged_state(6, b"theta0")) + s10)
+write("replay", "crash", "huge-data-length.lcm", s0 + huge + s10 + huge)  # crashed in liblcm
+write("replay", "crash", "step-jump.lcm", at_step(0) + at_step(1 << 52))  # hung
+write("replay", "crash", "step-int64-min.lcm",                             # overflow, hung
+      at_step(0) + at_step(10) + at_step(-(1 << 63)))
+flood = record("DIPC_STATE", forged_state(7, b"theta0\0", n=32767, rest=False))
+write("replay", "crash", "undecodable-flood.lcm", s0 + flood * 100 + s10)  # leaked 262 kB each
+print("seeds written under", here)
