@@ -2,8 +2,10 @@
 # out as a Debian tool's files (GNUInstallDirs):
 #   bin/                     lagsimd, lagsimctl, lagsim-view, lagsim-log2csv, lagsim-plot
 #                            and the C example controllers (each when the build has it)
-#   include/lagsim/          lagsim.h (the core), lagsim_client.h, the generated C types
-#   lib/                     liblagsim_client.a and what it links; lagsim-client.pc
+#   include/lagsim/          lagsim.h (the core), lagsim_client.h, lagsim_controller.h,
+#                            lagsim_wire.h, lagsim_log.h, the generated C types
+#   lib/                     liblagsim_client.a, liblagsim_controller.a and what they
+#                            link; lagsim-client.pc
 #   lib/python3.X/dist-packages/   lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
 #                            (on Debian's sys.path for prefix /usr/local)
 #   share/lua/5.2/           lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
@@ -30,7 +32,7 @@ endforeach()
 
 # C: the client library, the libraries it and the examples link, their headers.
 set(_libs "")
-foreach(t lagsim_client lagsim_wire lagsim_lcmtypes lagsim_core)
+foreach(t lagsim_controller lagsim_client lagsim_wire lagsim_lcmtypes lagsim_core)
   if(TARGET ${t})
     install(TARGETS ${t} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
     string(REPLACE "lagsim_" "-llagsim_" _l ${t})
@@ -39,6 +41,9 @@ foreach(t lagsim_client lagsim_wire lagsim_lcmtypes lagsim_core)
 endforeach()
 install(FILES ${PROJECT_SOURCE_DIR}/server/include/lagsim/lagsim.h
               ${PROJECT_SOURCE_DIR}/clients/lagsim_client.h
+              ${PROJECT_SOURCE_DIR}/clients/lagsim_controller.h
+              ${PROJECT_SOURCE_DIR}/server/wire/lagsim_wire.h
+              ${PROJECT_SOURCE_DIR}/server/wire/lagsim_log.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/lagsim)
 install(DIRECTORY ${CMAKE_BINARY_DIR}/lcmtypes/c/lagsim/
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/lagsim FILES_MATCHING PATTERN "*.h")
