@@ -57,14 +57,15 @@ static const range R_STATUS_HZ = {0.1, 100.0, false, "Hz"};
 static const range R_EFFORT = {0.0, F_MAX, true, "N or N m"};
 static const range R_DAMPING = {0.0, F_MAX, false, "N s/m or N m s/rad"};
 static const range R_FRICTION = {0.0, F_MAX, false, "N or N m"};
-static const range R_UNIT = {0.0, 1.0, false, "a coefficient of restitution"};
 static const range R_TIME = {0.0, T_MAX, false, "s"};
 static const range R_GRAVITY = {0.0, 1e3, false, "m/s^2"}; /* 100 g; 0 switches gravity off */
 
-/* Physical parameters by unit (a new model with these units needs no code here): masses
- * from a milligram to a thousand tonnes, lengths from a micrometre to a thousand km,
- * inertias spanning m l^2 / 12 of those. Parameters that may be zero or negative: g
- * (>= 0, 0 = no gravity) and h0 (a height, any sign). Other units: (0, F_MAX]. */
+/* The magnitude of a physical parameter, by its unit in lag_model_info (a new model with
+ * these units needs no code here): masses from a milligram to a thousand tonnes, lengths
+ * from a micrometre to a thousand km, inertias spanning m l^2 / 12 of those, gravity up to
+ * 100 g. A parameter may also be exactly 0. Which signs, and whether 0, a parameter may
+ * take is the core's rule (lag_model_check: masses > 0, g >= 0, a height h0 any...).
+ * Other units: magnitude at most F_MAX. */
 static const struct {
     const char *unit;
     double lo, hi;
@@ -72,7 +73,7 @@ static const struct {
     {"kg", 1e-6, 1e6},
     {"m", 1e-6, 1e6},
     {"kg m^2", 1e-20, 1e18},
-    {"m/s^2", 0.0, 1e3},
+    {"m/s^2", 1e-6, 1e3},
 };
 
 /* ================================================================ conversion state */
@@ -81,11 +82,10 @@ typedef struct conv {
     errbuf *err;
     lag_scene *sc;
     const lag_model_info *info;
-    /* nodes remembered for the final cross-checks (NULL if not given) */
-    const ynode *root, *parameters, *publish_hz, *dt, *integrator, *initial, *dt_min;
-    const ynode *explode_limit, *url, *command_timeout, *rate, *mode;
+    /* nodes remembered for the cross-checks (NULL if not given) */
+    const ynode *root, *publish_hz, *dt, *integrator, *explode_limit, *url, *rate;
     /* effects */
-    const ynode *limits_node, *floor_node, *gravity_g_node;
+    const ynode *gravity_g_node;
     int gravity_enabled;  /* -1 not said, 0 off, 1 on */
     double gravity_g;
     int limit_seen;       /* bits: lower, upper given for the joint being read */
@@ -372,7 +372,6 @@ static int key_parameters(conv *cv, const ynode *nd, const char *path)
 {
     const lag_model_info *info = cv->info;
     lag_model *m = &cv->sc->sim.model;
-    cv->parameters = nd;
     char allowed[256] = "";
     for (int i = 0; i < info->np; i++) {
         size_t used = strlen(allowed);
@@ -392,24 +391,20 @@ static int key_parameters(conv *cv, const ynode *nd, const char *path)
         char sub[256];
         join(sub, sizeof sub, path, en->key);
         const char *unit = info->param_units[k] ? info->param_units[k] : "SI";
-        double lo = 0.0, hi = F_MAX;
-        bool lo_open = true;
+        double lo = 0.0, hi = F_MAX, v = 0.0;
         for (size_t w = 0; w < sizeof k_param_windows / sizeof k_param_windows[0]; w++) {
             if (strcmp(unit, k_param_windows[w].unit) == 0) {
                 lo = k_param_windows[w].lo;
                 hi = k_param_windows[w].hi;
-                lo_open = false;
             }
         }
-        if (strcmp(en->key, "g") == 0) { /* 0 switches gravity off */
-            lo = 0.0;
-            lo_open = false;
-        } else if (strcmp(en->key, "h0") == 0) { /* a height: any sign */
-            lo = -hi;
-            lo_open = false;
-        }
-        if (get_in(cv, en->val, sub, lo, hi, lo_open, unit, &m->p[k]) < 0)
+        if (get_number(cv, en->val, sub, &v) < 0)
             return -1;
+        if (v != 0.0 && !(fabs(v) >= lo && fabs(v) <= hi))
+            return yfail(cv->err, en->val, sub,
+                         "expected a magnitude from %.6g to %.6g (%s), got %s", lo, hi, unit,
+                         en->val->text);
+        m->p[k] = v; /* sign and zero: the core's check */
     }
     return 0;
 }
@@ -459,7 +454,6 @@ static const keyrow k_initial_keys[] = {
 
 static int key_initial(conv *cv, const ynode *nd, const char *path)
 {
-    cv->initial = nd;
     return convert_map(cv, nd, path, k_initial_keys, "key");
 }
 
@@ -503,7 +497,6 @@ static int key_atol(conv *cv, const ynode *nd, const char *path)
 
 static int key_dt_min(conv *cv, const ynode *nd, const char *path)
 {
-    cv->dt_min = nd;
     return get_range(cv, nd, path, &R_DT_MIN, &cv->sc->sim.integrator.dt_min);
 }
 
@@ -513,6 +506,16 @@ static int key_max_iter(conv *cv, const ynode *nd, const char *path)
     if (get_int(cv, nd, path, 1, 1000, &v) < 0)
         return -1;
     cv->sc->sim.integrator.max_iter = (int)v;
+    return 0;
+}
+
+/* dopri5's work per tick is bounded by max_steps: at most 1e6 (about a second of CPU) */
+static int key_max_steps(conv *cv, const ynode *nd, const char *path)
+{
+    long long v = 0;
+    if (get_int(cv, nd, path, 1, 1000000, &v) < 0)
+        return -1;
+    cv->sc->sim.integrator.max_steps = (int)v;
     return 0;
 }
 
@@ -528,6 +531,7 @@ static const keyrow k_integrator_keys[] = {
     {"atol", key_atol},             /* dopri5 */
     {"dt_min", key_dt_min},         /* dopri5, s, <= dt */
     {"max_iter", key_max_iter},     /* implicit methods, 1..1000 */
+    {"max_steps", key_max_steps},   /* dopri5, steps per tick, 1..1e6 */
     {"newton_tol", key_newton_tol}, /* implicit methods */
     {NULL, NULL},
 };
@@ -557,7 +561,6 @@ static int key_explode_limit(conv *cv, const ynode *nd, const char *path)
 static int key_mode(conv *cv, const ynode *nd, const char *path)
 {
     const char *s;
-    cv->mode = nd;
     if (get_string(cv, nd, path, "a mode (realtime, fast, lockstep)", &s) < 0)
         return -1;
     for (int m = LAG_RT_REALTIME; m <= LAG_RT_LOCKSTEP; m++) {
@@ -579,7 +582,6 @@ static int key_rate(conv *cv, const ynode *nd, const char *path)
  * that answers every period before its next answer can arrive. */
 static int key_command_timeout(conv *cv, const ynode *nd, const char *path)
 {
-    cv->command_timeout = nd;
     double period = (double)cv->sc->ticks_per_period * cv->sc->sim.integrator.dt;
     if (get_number(cv, nd, path, &cv->sc->realtime.command_timeout) < 0)
         return -1;
@@ -763,10 +765,7 @@ static int friction_joint(conv *cv, int j, const ynode *nd, const char *path)
         return -1;
     lag_effects_def *e = fx(cv);
     if (isnan(e->friction_static[j])) e->friction_static[j] = e->friction_kinetic[j];
-    if (e->friction_static[j] < e->friction_kinetic[j])
-        return yfail(cv->err, nd, path, "expected static (%g) >= kinetic (%g)",
-                     e->friction_static[j], e->friction_kinetic[j]);
-    return 0;
+    return 0; /* static >= kinetic: the core's check */
 }
 
 static int key_effect_friction(conv *cv, const ynode *nd, const char *path)
@@ -788,9 +787,10 @@ static int lim_upper(conv *cv, const ynode *nd, const char *path)
     return get_within_explode(cv, nd, path, false, &fx(cv)->limit_upper[cv->cur_joint]);
 }
 
+/* in [0, 1]: the core's check */
 static int lim_restitution(conv *cv, const ynode *nd, const char *path)
 {
-    return get_range(cv, nd, path, &R_UNIT, &fx(cv)->restitution[cv->cur_joint]);
+    return get_number(cv, nd, path, &fx(cv)->restitution[cv->cur_joint]);
 }
 
 static const keyrow k_limit_keys[] = {
@@ -832,12 +832,7 @@ static int key_effect_limits(conv *cv, const ynode *nd, const char *path)
             return -1;
         if (cv->limit_seen != 3)
             return yfail(cv->err, en->val, sub, "expected both lower and upper");
-        lag_effects_def *e = fx(cv);
-        if (!(e->limit_lower[j] < e->limit_upper[j]))
-            return yfail(cv->err, en->val, sub, "expected lower (%g) < upper (%g)",
-                         e->limit_lower[j], e->limit_upper[j]);
-        e->limit_on[j] = true;
-        cv->limits_node = nd;
+        fx(cv)->limit_on[j] = true; /* lower < upper: the core's check */
     }
     return 0;
 }
@@ -845,7 +840,7 @@ static int key_effect_limits(conv *cv, const ynode *nd, const char *path)
 /* floor (stick): {restitution, rest_velocity} */
 static int floor_restitution(conv *cv, const ynode *nd, const char *path)
 {
-    return get_range(cv, nd, path, &R_UNIT, &fx(cv)->floor_restitution);
+    return get_number(cv, nd, path, &fx(cv)->floor_restitution);
 }
 
 static const keyrow k_floor_keys[] = {
@@ -854,13 +849,10 @@ static const keyrow k_floor_keys[] = {
     {NULL, NULL},
 };
 
+/* which models have a floor, and where the initial state must then be: the core's check */
 static int key_effect_floor(conv *cv, const ynode *nd, const char *path)
 {
-    if (cv->sc->sim.model.kind != LAG_MODEL_STICK)
-        return yfail(cv->err, nd, path, "the floor effect is for model stick only, not %s",
-                     cv->info->name);
     fx(cv)->enabled |= LAG_EFF_FLOOR;
-    cv->floor_node = nd;
     if (ynode_is_null(nd))
         return 0; /* floor: with defaults */
     return convert_map(cv, nd, path, k_floor_keys, "key");
@@ -1085,7 +1077,7 @@ static void model_list(char *buf, size_t len)
     }
 }
 
-/* After the first keys: 1/publish_hz = k dt with 1 <= k <= TICKS_MAX, and dt_min <= dt. */
+/* After the first keys: 1/publish_hz = k dt with 1 <= k <= TICKS_MAX. */
 static int check_period(conv *cv)
 {
     lag_scene *sc = cv->sc;
@@ -1113,13 +1105,7 @@ static int check_period(conv *cv)
                      "%d ticks per control period (one period is one uninterrupted call)",
                      period, ticks, dt, TICKS_MAX);
     sc->ticks_per_period = (int64_t)ticks;
-
-    if (sc->sim.integrator.dt_min > dt)
-        return yfail(cv->err, cv->dt_min ? cv->dt_min : at,
-                     cv->dt_min ? "integrator.dt_min" : atpath,
-                     "expected a number <= integrator.dt = %.17g s, got %.17g",
-                     dt, sc->sim.integrator.dt_min);
-    return 0;
+    return 0; /* dt_min <= dt: the core's check */
 }
 
 int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, errbuf *err)
@@ -1180,12 +1166,8 @@ int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, err
     if (gi >= 0 && cv.gravity_g_node) sc->sim.model.p[gi] = cv.gravity_g;
     if (gi >= 0 && cv.gravity_enabled == 0) sc->sim.model.p[gi] = 0.0;
 
-    /* Parameters: uniform-rod inertias not given -> m l^2 / 12; then the core's check. */
-    char msg[256];
+    /* Parameters: uniform-rod inertias not given -> m l^2 / 12 */
     lag_model_finish(&sc->sim.model);
-    if (lag_model_validate(&sc->sim.model, msg, sizeof msg) != LAG_OK)
-        return yfail(err, cv.parameters ? cv.parameters : me->val,
-                     cv.parameters ? "parameters" : NULL, "%s", msg);
 
     /* Real time: at most PERIODS_PER_S_MAX control periods per wall second. */
     if (sc->realtime.mode == LAG_RT_REALTIME &&
@@ -1197,28 +1179,18 @@ int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, err
                      sc->publish_hz * sc->realtime.rate, PERIODS_PER_S_MAX);
     }
 
-    /* The initial state must lie within the stops and above the floor. */
-    const lag_effects_def *e = &sc->sim.effects;
-    for (int i = 0; i < sc->sim.model.nq; i++) {
-        if (!((e->enabled & LAG_EFF_LIMITS) && e->limit_on[i])) continue;
-        if (sc->sim.q0[i] < e->limit_lower[i] || sc->sim.q0[i] > e->limit_upper[i])
-            return yfail(err, cv.initial ? cv.initial : cv.limits_node,
-                         cv.initial ? "initial" : "effects.limits",
-                         "initial %s = %g is outside its limits [%g, %g]",
-                         cv.info->joint_names[i], sc->sim.q0[i], e->limit_lower[i],
-                         e->limit_upper[i]);
-    }
-    if ((e->enabled & LAG_EFF_FLOOR) && (sc->sim.q0[1] < 0 || sc->sim.q0[1] > M_PI))
-        return yfail(err, cv.initial ? cv.initial : cv.floor_node,
-                     cv.initial ? "initial" : "effects.floor",
-                     "initial phi = %g must be in [0, pi] with a floor", sc->sim.q0[1]);
-
     /* lcm.url, with lcm.allow_lan wherever it was given */
+    char msg[256];
     if (lag_scene_check_url(sc->lcm.url, sc->lcm.allow_lan, &sc->lcm.ttl, msg, sizeof msg) < 0)
         return yfail(err, cv.url, "lcm.url", "%s", msg);
 
-    /* Final check by the core (integrator settings, initial state). */
-    if (lag_sim_def_validate(&sc->sim, msg, sizeof msg) != LAG_OK)
-        return yfail(err, root, NULL, "invalid scene: %s", msg);
+    /* The core's own checks (parameters, the integrator's settings against each other,
+     * the effects' values against each other and the initial state, which models have a
+     * floor...), made once, by the core: its diagnosis names the field in the scene's own
+     * terms, and the field's node gives the position. */
+    lag_diag d;
+    if (lag_sim_def_check(&sc->sim, &d) != LAG_OK)
+        return yfail(err, ytree_lookup(root, d.field), d.field[0] ? d.field : NULL, "%s",
+                     d.message);
     return 0;
 }

@@ -72,6 +72,35 @@ const yentry *ymap_find(const ynode *map, const char *key)
     return NULL;
 }
 
+const ynode *ytree_lookup(const ynode *root, const char *path)
+{
+    const ynode *nd = root;
+    const char *p = path;
+    while (*p) {
+        if (*p == '[') { /* [i] */
+            char *end;
+            long i = strtol(p + 1, &end, 10);
+            if (end == p + 1 || *end != ']' || nd->kind != YN_SEQ || i < 0 || i >= nd->n)
+                return nd;
+            nd = nd->items[i];
+            p = end + 1;
+        } else { /* key, up to '.', '[' or the end */
+            size_t len = strcspn(p, ".[");
+            const yentry *en = NULL;
+            for (int i = 0; nd->kind == YN_MAP && i < nd->n && !en; i++)
+                if (strlen(nd->entries[i].key) == len && strncmp(nd->entries[i].key, p, len) == 0)
+                    en = &nd->entries[i];
+            if (!en)
+                return nd;
+            nd = en->val;
+            p += len;
+        }
+        if (*p == '.')
+            p++;
+    }
+    return nd;
+}
+
 bool ynode_is_null(const ynode *nd)
 {
     if (nd->kind != YN_SCALAR || nd->quoted)

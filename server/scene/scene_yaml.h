@@ -55,6 +55,11 @@ bool ynode_is_null(const ynode *nd);
 /* "a mapping", "a sequence", "a scalar", "nothing" */
 const char *ynode_kind_name(const ynode *nd);
 
+/* The node at `path` ("effects.limits.q2.lower", "initial.q[1]": keys joined by '.',
+ * sequence items as [i]), or the deepest node on the way to it when the tree does not
+ * hold all of it (root if none). */
+const ynode *ytree_lookup(const ynode *root, const char *path);
+
 /* ---------------------------------------------------------------- errors */
 
 /* The caller's message buffer. */

@@ -86,7 +86,7 @@ e --expect "--set integrator: integrator.dt: expected a number from 1e-06 to 1 (
 e --expect "--set integrator.method: unknown method 'rk5'" -- --set integrator.method=rk5
 e --expect "--set initial.q: expected a sequence of 3 numbers (theta0, theta1, theta2) for model dipc, got 2" -- --set "initial.q=[0,0.1]"
 e --expect "--set parameters.m9: unknown parameter 'm9' for model dipc" -- --set parameters.m9=1
-e --expect "--set parameters.m0: expected a number from 1e-06 to 1e+06 (kg), got -1.5" -- --set parameters.m0=-1.5
+e --expect "--set parameters.m0: expected a number > 0 (kg), got -1.5" -- --set parameters.m0=-1.5
 e --expect "--set publish_hz: expected a finite number, got .inf" -- --set publish_hz=.inf
 e --expect "--set realtime.mode: unknown mode 'slow'" -- --set realtime.mode=slow
 e --expect "--set lcm.prefix: YAML syntax error" -- --set "lcm.prefix=[a"
