@@ -13,3 +13,23 @@ foreach(case ${LAGSIM_SERVER_CASES})
            COMMAND server_test $<TARGET_FILE:lagsimd> ${case} ${LCM_LOGGER})
   set_tests_properties(server_${case} PROPERTIES TIMEOUT 60 LABELS server)
 endforeach()
+
+# The loop's arithmetic (rt_pace.c) with made-up clocks, and the loop itself with a
+# made-up clock on LCM's in-process memq:// provider: exact, and independent of load.
+add_executable(test_pace ${CMAKE_CURRENT_LIST_DIR}/server/test_pace.c)
+target_link_libraries(test_pace PRIVATE lagsimd_internal)
+foreach(case convert ticks pace burst rebase skip limit)
+  add_test(NAME server_pace_${case} COMMAND test_pace ${case})
+  set_tests_properties(server_pace_${case} PROPERTIES TIMEOUT 30 LABELS server)
+endforeach()
+add_executable(test_loop ${CMAKE_CURRENT_LIST_DIR}/server/test_loop.c)
+target_link_libraries(test_loop PRIVATE lagsimd_internal)
+foreach(case pacing rate_huge status_hz lockstep_wait long_period chunks step_paced
+        control_flood command_flood duration signals fault_effort)
+  add_test(NAME server_loop_${case} COMMAND test_loop ${case})
+  set_tests_properties(server_loop_${case} PROPERTIES TIMEOUT 60 LABELS server)
+endforeach()
+
+# Fuzz target: the command and control handlers and the loop in every mode and run state,
+# on memq:// with a made-up clock (tests/fuzz/fuzz_rt.c; kept inputs in tests/fuzz/rt/).
+lagsim_fuzz_target(rt LIBS lagsimd_internal)

@@ -1,26 +1,46 @@
 /*
- * lagsimd's real-time LCM server: one loop that waits on the LCM socket, a timerfd armed
- * at absolute CLOCK_MONOTONIC deadlines and a signalfd together (poll, never a busy
- * spin), and advances the simulation one control period at a time.
+ * lagsimd's real-time LCM server. The loop is a few lines over three functions, as in
+ * redis's ae.c:
+ *
+ *     while not stopped:
+ *         wake = rt_next_wake(s)    the earliest thing due (a deadline, a status, an
+ *                                   answer the rate limit holds back); now if busy
+ *         wait(s, io, wake)         ppoll on the LCM socket, a signalfd and a timerfd
+ *                                   armed at `wake` (never a busy spin); then the
+ *                                   signals and LCM messages that arrived (bounded)
+ *         rt_process(s)             what is due at s->now: the mode's periods, answers,
+ *                                   the periodic status
  *
  *   control period  P = ticks_per_period * dt = 1 / publish_hz of sim time
  *   realtime        period j ends at wall deadline base + j * P / rate; at that deadline
  *                   the sim advances [t_j-1, t_j] with the efforts held then, and the
  *                   state at t_j is published. A command that answers state t_j within
  *                   one period is therefore applied over [t_j, t_j+1], as in lockstep.
+ *                   Which periods are due (deadlines, overruns, bursts, re-basing) is the
+ *                   pure arithmetic of rt_pace.c.
  *   fast            periods back to back, LCM served between every two.
  *   lockstep        publish t_j, wait for a command with sim_time == t_j (or for
  *                   lockstep_timeout wall seconds: event, and the step goes on under the
  *                   watchdog rule), advance one period.
  *
- * The stepping path (rt_period) allocates nothing: the server struct holds every buffer.
+ * STEP N while paused runs N periods at the mode's pace (realtime: at its deadlines;
+ * fast: back to back; lockstep: each waits for its answer). A period of many ticks runs
+ * in chunks of at most tick_budget ticks per wake-up, so signals and LCM are served in
+ * between however long a period is.
+ *
+ * Everything published in answer to what arrives is limited (rt_pace.h, rt_limit): each
+ * event kind has a token bucket, and statuses, scene descriptions and states asked for by
+ * control requests are coalesced (one answer for many requests) and limited too.
+ *
+ * The stepping path allocates nothing: the server struct holds every buffer.
  */
 #include <errno.h>
-#include <stdarg.h>
 #include <math.h>
 #include <poll.h>
 #include <signal.h>
+#include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/signalfd.h>
 #include <sys/timerfd.h>
@@ -29,12 +49,41 @@
 #include "rt_server.h"
 #include "lagsim/lagsim_control_t.h"
 
-#define RT_MAX_BURST 10           /* periods run back to back when catching up */
-#define RT_MAX_LAG_PERIODS 100    /* behind by more than this: re-base the clock, event */
-#define RT_MAX_LAG_NS 200000000   /* ... or by more than 0.2 s of wall time */
-#define RT_DRAIN_MAX 256          /* LCM messages handled per loop iteration at most */
-#define RT_REJ_EVENTS_PER_S 10    /* command_rejected events per second at most */
-#define RT_LINE_NS 250000000      /* live status line refresh */
+#define RT_DRAIN_MAX 256          /* LCM messages handled per wake-up at most */
+#define RT_TICK_BUDGET 4096       /* ticks advanced per wake-up at most */
+#define RT_LINE_NS 250000000LL    /* live status line refresh */
+#define RT_STATUS_NS_MIN 10000000LL /* periodic status at most every 10 ms (100 Hz) */
+#define RT_SIGNALS_PER_WAKE 16    /* signals read per wake-up at most */
+
+/* The buckets of the limited events (rt_ev): name, answers per second, burst. */
+static const struct {
+    const char *kind;
+    double per_s;
+    int burst;
+} ev_limits[RT_EV_COUNT] = {
+    [RT_EV_COMMAND_REJECTED] = {"command_rejected", 10, 10},
+    [RT_EV_CONTROL_REJECTED] = {"control_rejected", 10, 10},
+    [RT_EV_PAUSE] = {"pause", 10, 10},
+    [RT_EV_RESUME] = {"resume", 10, 10},
+    [RT_EV_STEP] = {"step", 10, 10},
+    [RT_EV_STEP_DONE] = {"step_done", 10, 10},
+    [RT_EV_RESET] = {"reset", 10, 10},
+    [RT_EV_WATCHDOG_TRIP] = {"watchdog_trip", 10, 10},
+    [RT_EV_WATCHDOG_CLEAR] = {"watchdog_clear", 10, 10},
+    [RT_EV_LOCKSTEP_TIMEOUT] = {"lockstep_timeout", 10, 10},
+    [RT_EV_OVERRUN_BURST] = {"overrun_burst", 1, 3},
+    [RT_EV_NUMERIC_FAULT] = {"numeric_fault", 10, 10},
+    [RT_EV_EVENTS_DROPPED] = {"events_dropped", 1, 3},
+};
+_Static_assert(sizeof ev_limits / sizeof ev_limits[0] == RT_EV_COUNT, "one bucket per rt_ev");
+
+/* Answers to control requests beyond events: per second and burst. */
+#define RT_STATUS_PER_S 20
+#define RT_STATUS_BURST 5
+#define RT_SCENE_PER_S 5
+#define RT_SCENE_BURST 2
+#define RT_STATE_PER_S 20  /* states published because of a reset (not the periods' own) */
+#define RT_STATE_BURST 5
 
 /* ---------------------------------------------------------------- small helpers */
 static bool state_finite(const lag_sim *sim)
@@ -45,69 +94,103 @@ static bool state_finite(const lag_sim *sim)
     return isfinite(lag_sim_time(sim));
 }
 
-static void eventf(rt_server *s, const char *kind, const char *joint, double value,
-                   const char *fmt, ...) __attribute__((format(printf, 5, 6)));
-static void eventf(rt_server *s, const char *kind, const char *joint, double value,
-                   const char *fmt, ...)
+static bool active(const rt_server *s)
+{
+    return s->run == RT_RUNNING || s->pending_steps > 0;
+}
+
+static int64_t min64(int64_t a, int64_t b) { return a < b ? a : b; }
+
+/* A state asked for (by a reset, or a lockstep resume) can go out: not in the fault
+ * state, and not in the middle of a period (whose end publishes one anyway). */
+static bool state_wanted(const rt_server *s)
+{
+    return s->want_state && s->run != RT_FAULT && s->period_left == 0;
+}
+
+/* An unlimited event (start, stop). */
+static void eventf(rt_server *s, const char *kind, double value, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static void eventf(rt_server *s, const char *kind, double value, const char *fmt, ...)
 {
     char detail[256];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(detail, sizeof detail, fmt, ap);
     va_end(ap);
-    rt_publish_event(s, kind, joint, value, detail);
+    rt_publish_event(s, kind, "", value, detail);
 }
 
-/* Restart realtime deadlines from now (after start, resume, reset, or a lost race). */
-static void rebase_clock(rt_server *s, int timer_fd)
+/* A limited event: published if its kind's bucket has a token, else counted as
+ * suppressed; the next one that gets through says how many were suppressed before it. */
+static void limited_event(rt_server *s, rt_ev ev, const char *joint, double value,
+                          const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+static void limited_event(rt_server *s, rt_ev ev, const char *joint, double value,
+                          const char *fmt, ...)
 {
-    s->base_ns = rt_mono_ns();
-    s->periods_done = 0;
-    s->late_mark = 0;
-    int64_t next = s->base_ns + (int64_t)s->period_ns;
-    struct itimerspec its = {{0, 0}, {next / 1000000000, next % 1000000000}};
-    timerfd_settime(timer_fd, TFD_TIMER_ABSTIME, &its, NULL);
+    rt_limit *l = &s->lim_event[ev];
+    int64_t suppressed = l->suppressed;
+    if (!rt_limit_take(l, s->now)) return;
+    l->suppressed = 0;
+    char detail[320];
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(detail, sizeof detail, fmt, ap);
+    va_end(ap);
+    if (suppressed > 0 && n >= 0 && (size_t)n < sizeof detail)
+        snprintf(detail + n, sizeof detail - (size_t)n, " (%lld more %s events suppressed before this one)",
+                 (long long)suppressed, ev_limits[ev].kind);
+    rt_publish_event(s, ev_limits[ev].kind, joint, value, detail);
 }
 
-/* Arms the timer for the end of the next period: base + (done + 1) * period. */
-static void arm_next(rt_server *s, int timer_fd)
-{
-    int64_t next = s->base_ns + (int64_t)((double)(s->periods_done + 1) * s->period_ns);
-    struct itimerspec its = {{0, 0}, {next / 1000000000, next % 1000000000}};
-    timerfd_settime(timer_fd, TFD_TIMER_ABSTIME, &its, NULL);
-}
-
-/* Lockstep: a state was just published; wait for its answer from now on. */
-static void begin_wait(rt_server *s)
-{
-    s->waiting = true;
-    s->answered = false;
-    s->waiting_time = lag_sim_time(&s->sim);
-    s->wait_start_ns = rt_mono_ns();
-}
-
+/* Every state goes out through here: in lockstep a published state is waited on. */
 static void publish_state(rt_server *s)
 {
     rt_publish_state(s);
-    if (s->sc->realtime.mode == LAG_RT_LOCKSTEP) begin_wait(s);
+    s->want_state = false;
+    if (s->sc->realtime.mode == LAG_RT_LOCKSTEP) {
+        s->waiting = true;
+        s->answered = false;
+        s->waiting_time = lag_sim_time(&s->sim);
+        s->wait_start_ns = s->now;
+    }
+}
+
+static void publish_status(rt_server *s)
+{
+    rt_publish_status(s);
+    s->want_status = false;
 }
 
 /* Numeric fault: pause in the fault state. The sim holds the last good tick (not a
- * period boundary); it is never published. Only reset leaves the fault state. */
+ * period boundary); it is never published. Only reset leaves the fault state. The event
+ * names the efforts that were held, which is what an absurd command shows as. */
 static void enter_fault(rt_server *s, lag_result r)
 {
     s->run = RT_FAULT;
     s->pending_steps = 0;
+    s->period_left = 0;
     s->waiting = false;
+    s->want_state = false;
     s->numeric_faults++;
-    eventf(s, "numeric_fault", "", lag_sim_time(&s->sim),
-           "%s at sim time %.9g s (tick %lld): paused in fault state; send reset or reset_to",
-           r == LAG_OK ? "non-finite state" : lag_result_string(r), lag_sim_time(&s->sim),
-           (long long)s->sim.tick);
-    rt_publish_status(s);
+    char eff[160] = "";
+    size_t n = 0;
+    for (int i = 0; i < s->nq && n < sizeof eff; i++) {
+        if (!s->info->actuated[i]) continue;
+        int k = snprintf(eff + n, sizeof eff - n, "%s%s = %.6g", n ? ", " : "",
+                         s->info->joint_names[i], s->held[i]);
+        if (k < 0) break;
+        n += (size_t)k;
+    }
+    limited_event(s, RT_EV_NUMERIC_FAULT, "", lag_sim_time(&s->sim),
+                  "%s at sim time %.9g s (tick %lld), efforts held: %s: paused in fault state; "
+                  "send reset or reset_to",
+                  r == LAG_OK ? "non-finite state" : lag_result_string(r), lag_sim_time(&s->sim),
+                  (long long)s->sim.tick, n ? eff : "none");
+    s->want_status = true;
 }
 
-/* The effects' events of the last period (impact, limit, saturation, ...), with the sim
+/* The effects' events of the last chunk (impact, limit, saturation, ...), with the sim
  * time the step located them at. */
 static void publish_effect_events(rt_server *s)
 {
@@ -119,49 +202,144 @@ static void publish_effect_events(rt_server *s)
         rt_publish_event_at(s, ev.t, lag_event_kind_name(ev.kind), joint, ev.value, detail);
     }
     if (s->sim.events_dropped > s->effect_events_dropped) {
-        eventf(s, "events_dropped", "", (double)(s->sim.events_dropped - s->effect_events_dropped),
-               "%lld effect events dropped (more than the step records per period)",
-               (long long)(s->sim.events_dropped - s->effect_events_dropped));
+        int64_t lost = s->sim.events_dropped - s->effect_events_dropped;
+        limited_event(s, RT_EV_EVENTS_DROPPED, "", (double)lost,
+                      "%lld effect events dropped (more than the step records per period)",
+                      (long long)lost);
         s->effect_events_dropped = s->sim.events_dropped;
     }
 }
 
 /* ---------------------------------------------------------------- one control period */
-/* Watchdog, held input, ticks_per_period ticks, checks, state publication.
- * Returns false on a numeric fault (state not published). No allocation. */
-static bool rt_period(rt_server *s)
+typedef enum rt_progress { RT_P_DONE, RT_P_MORE, RT_P_FAULT } rt_progress;
+
+/* Starts a control period: watchdog, then the held efforts become the sim's input for
+ * the whole period (zero-order hold). */
+static void period_begin(rt_server *s)
 {
     const lag_scene *sc = s->sc;
     double dt = sc->sim.integrator.dt;
-
     /* watchdog: the last good command is older than command_timeout sim seconds */
-    if (s->have_command && !s->watchdog_tripped &&
-        (double)(s->sim.tick - s->command_tick) * dt > sc->realtime.command_timeout) {
+    double age = (double)(s->sim.tick - s->command_tick) * dt;
+    if (s->have_command && !s->watchdog_tripped && age > sc->realtime.command_timeout) {
         s->watchdog_tripped = true;
         s->watchdog_trips++;
         for (int i = 0; i < s->nq; i++) s->held[i] = 0.0;
-        eventf(s, "watchdog_trip", "", (double)(s->sim.tick - s->command_tick) * dt,
-               "no command for %.6g s of sim time (command_timeout %.6g s): efforts zeroed",
-               (double)(s->sim.tick - s->command_tick) * dt, sc->realtime.command_timeout);
+        limited_event(s, RT_EV_WATCHDOG_TRIP, "", age,
+                      "no command for %.6g s of sim time (command_timeout %.6g s): efforts zeroed",
+                      age, sc->realtime.command_timeout);
     }
     lag_sim_set_input(&s->sim, s->held);
+    s->period_left = sc->ticks_per_period;
+    s->period_us = 0;
+}
 
-    int64_t t0 = rt_mono_ns();
-    lag_result r = lag_sim_advance(&s->sim, sc->ticks_per_period, false);
-    double us = (double)(rt_mono_ns() - t0) * 1e-3;
-    if (us > s->step_us_max) s->step_us_max = us;
-    s->step_us_sum += us;
+/* The period is complete: its state goes out; STEP and --duration are booked. */
+static void period_end(rt_server *s)
+{
+    if (s->period_us > s->step_us_max) s->step_us_max = s->period_us;
+    s->step_us_sum += s->period_us;
     s->step_us_n++;
-    s->ticks_since_status += sc->ticks_per_period;
+    publish_state(s);
+    if (s->pending_steps > 0 && --s->pending_steps == 0) {
+        limited_event(s, RT_EV_STEP_DONE, "", 0, "step done: paused");
+        s->want_status = true;
+    }
+    if (s->stop_tick > 0 && s->sim.tick >= s->stop_tick) {
+        s->stop = true;
+        s->stop_reason = RT_STOP_DURATION;
+    }
+}
 
+/* Runs the current control period (starting one if none is in progress) for at most
+ * *budget ticks (taken from it). No allocation. */
+static rt_progress period_run(rt_server *s, int64_t *budget)
+{
+    if (s->period_left == 0) period_begin(s);
+    int64_t n = s->period_left < *budget ? s->period_left : *budget;
+    if (n < 1) return RT_P_MORE;
+    *budget -= n;
+    /* dopri5: a chunk that does not end the period may step past its end (dense output
+     * gives the state there), so the steps taken are those of one call for the period */
+    bool last = n == s->period_left;
+    int64_t t0 = rt_mono_ns();
+    lag_result r = lag_sim_advance(&s->sim, n, !last);
+    s->period_us += (double)(rt_mono_ns() - t0) * 1e-3;
+    s->period_left -= n;
+    s->ticks_since_status += n;
     publish_effect_events(s);
     if (r != LAG_OK || !state_finite(&s->sim)) {
         enter_fault(s, r);
-        return false;
+        return RT_P_FAULT;
     }
-    publish_state(s);
-    if (s->stop_tick > 0 && s->sim.tick >= s->stop_tick) s->stop = true;
-    return true;
+    if (s->period_left > 0) return RT_P_MORE;
+    period_end(s);
+    return RT_P_DONE;
+}
+
+/* ---------------------------------------------------------------- the modes */
+/* Paused (realtime, fast): the held state is republished at each deadline, once however
+ * many deadlines the loop slept through. */
+static void paused_republish(rt_server *s)
+{
+    rt_due d = rt_pace_due(&s->pace, s->now);
+    if (d.due == 0) return;
+    if (s->run == RT_PAUSED) publish_state(s);
+    rt_pace_skip(&s->pace, s->now);
+}
+
+/* Realtime: the periods whose deadline has passed, in bursts of at most RT_MAX_BURST; too
+ * far behind, the clock re-bases (overrun_burst). */
+static void mode_realtime(rt_server *s)
+{
+    if (!active(s)) {
+        paused_republish(s);
+        return;
+    }
+    rt_due d = rt_pace_due(&s->pace, s->now);
+    if (d.due == 0) return;
+    s->overruns += d.overruns;
+    if (d.rebase) {
+        s->overrun_bursts++;
+        limited_event(s, RT_EV_OVERRUN_BURST, "", (double)d.due,
+                      "%lld periods behind wall clock: cannot catch up, re-basing the clock "
+                      "(sim time lags wall time by %.3g s more)",
+                      (long long)d.due, (double)d.due * (double)s->pace.period_ns * 1e-9);
+    }
+    rt_pace_apply(&s->pace, &d, s->now);
+    int64_t budget = s->tick_budget;
+    for (int64_t k = 0; k < d.run && budget > 0 && active(s) && !s->stop; k++) {
+        rt_pace_ran(&s->pace);
+        if (period_run(s, &budget) != RT_P_DONE) break;
+    }
+}
+
+/* Fast: one period per wake-up, LCM served between every two. */
+static void mode_fast(rt_server *s)
+{
+    if (!active(s)) {
+        paused_republish(s);
+        return;
+    }
+    int64_t budget = s->tick_budget;
+    period_run(s, &budget);
+}
+
+/* Lockstep: a period when the state waited on is answered, or its wait timed out. */
+static void mode_lockstep(rt_server *s)
+{
+    if (!active(s) || !s->waiting) return;
+    if (!s->answered && s->now - s->wait_start_ns >= s->lockstep_wait_ns) {
+        s->lockstep_timeouts++;
+        limited_event(s, RT_EV_LOCKSTEP_TIMEOUT, "", s->waiting_time,
+                      "no command answered sim time %.9g s within %.6g s: stepping on under "
+                      "the watchdog rule", s->waiting_time, s->sc->realtime.lockstep_timeout);
+        s->answered = true;
+    }
+    if (!s->answered) return;
+    s->waiting = false;
+    int64_t budget = s->tick_budget;
+    period_run(s, &budget);
 }
 
 /* ---------------------------------------------------------------- commands */
@@ -172,21 +350,9 @@ static void reject(rt_server *s, rt_reject why, const char *joint, double value,
         "unknown joint", "unactuated joint", "non-finite effort", "bad length",
         "undecodable payload", "stale (lockstep: answers another state)"};
     s->rejected[why]++;
-    /* events are rate limited: a flood is counted in status, not echoed one for one */
-    int64_t now = rt_mono_ns();
-    if (now - s->rej_window_ns > 1000000000) {
-        s->rej_window_ns = now;
-        s->rej_events_in_window = 0;
-    }
-    if (s->rej_events_in_window >= RT_REJ_EVENTS_PER_S) {
-        s->rej_suppressed++;
-        return;
-    }
-    s->rej_events_in_window++;
-    eventf(s, "command_rejected", joint, value, "command rejected: %s%s%s%s (%lld similar events suppressed before)",
-           why_name[why], what ? " (" : "", what ? what : "", what ? ")" : "",
-           (long long)s->rej_suppressed);
-    s->rej_suppressed = 0;
+    /* a flood is counted in status, not echoed one for one */
+    limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s%s%s%s",
+                  why_name[why], what ? " (" : "", what ? what : "", what ? ")" : "");
 }
 
 /* A command is applied whole or not at all: every name known, actuated, distinct; every
@@ -243,7 +409,7 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
     if (s->waiting && c.sim_time == s->waiting_time) s->answered = true;
     if (s->watchdog_tripped) {
         s->watchdog_tripped = false;
-        eventf(s, "watchdog_clear", "", 0, "a good command arrived: efforts held again");
+        limited_event(s, RT_EV_WATCHDOG_CLEAR, "", 0, "a good command arrived: efforts held again");
     }
 }
 
@@ -256,19 +422,30 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
     s->have_command = false;
     s->watchdog_tripped = false;
     s->pending_steps = 0;
+    s->period_left = 0;
+    s->waiting = false; /* lockstep: the new state is waited on once it is published */
     if (s->run == RT_FAULT) s->run = RT_PAUSED;
-    eventf(s, "reset", "", 0, "%s: sim time 0, efforts zero, %s", what,
-           s->run == RT_PAUSED ? "paused (resume to run)" : "running");
-    rt_publish_scene(s);
-    publish_state(s);
-    rt_publish_status(s);
+    limited_event(s, RT_EV_RESET, "", 0, "%s: sim time 0, efforts zero, %s", what,
+                  s->run == RT_PAUSED ? "paused (resume to run)" : "running");
+    s->want_scene = true;
+    s->want_state = true;
+    s->want_status = true;
 }
 
 static void control_rejected(rt_server *s, const char *why)
 {
     s->controls_rejected++;
-    rt_publish_event(s, "control_rejected", "", 0, why);
-    rt_publish_status(s);
+    limited_event(s, RT_EV_CONTROL_REJECTED, "", 0, "%s", why);
+    s->want_status = true;
+}
+
+/* Lockstep, when the run goes on (resume, step): the state already published is waited
+ * on afresh; if none is, it is published. */
+static void lockstep_rewait(rt_server *s)
+{
+    if (s->sc->realtime.mode != LAG_RT_LOCKSTEP) return;
+    if (s->waiting) s->wait_start_ns = s->now;
+    else if (s->period_left == 0) s->want_state = true;
 }
 
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
@@ -288,8 +465,8 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
         }
         s->run = RT_PAUSED;
         s->pending_steps = 0;
-        s->base_ns = 0; /* the loop re-arms the timer: the state is republished */
-        rt_publish_event(s, "pause", "", 0, "paused");
+        s->restart_pace = true; /* the held state is republished from now on */
+        limited_event(s, RT_EV_PAUSE, "", 0, "paused");
         break;
     case LAGSIM_CONTROL_T_RESUME:
         if (s->run == RT_FAULT) {
@@ -298,14 +475,9 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
         }
         s->run = RT_RUNNING;
         s->pending_steps = 0;
-        s->base_ns = 0; /* the loop re-bases the clock */
-        if (s->sc->realtime.mode == LAG_RT_LOCKSTEP && s->waiting) {
-            /* wait afresh for the state already published */
-            s->wait_start_ns = rt_mono_ns();
-        } else if (s->sc->realtime.mode == LAG_RT_LOCKSTEP) {
-            publish_state(s);
-        }
-        rt_publish_event(s, "resume", "", 0, "running");
+        s->restart_pace = true; /* deadlines restart from now */
+        lockstep_rewait(s);
+        limited_event(s, RT_EV_RESUME, "", 0, "running");
         break;
     case LAGSIM_CONTROL_T_STEP:
         if (s->run != RT_PAUSED) {
@@ -318,8 +490,11 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
             return;
         }
         s->pending_steps = c.count;
-        eventf(s, "step", "", (double)c.count, "stepping %lld control periods",
-               (long long)c.count);
+        s->restart_pace = true; /* realtime: the first period ends one period from now */
+        lockstep_rewait(s);
+        limited_event(s, RT_EV_STEP, "", (double)c.count,
+                      "stepping %lld control periods at the %s mode's pace", (long long)c.count,
+                      lag_rt_mode_name(s->sc->realtime.mode));
         return; /* step_done (and its status) follow when the steps are done */
     case LAGSIM_CONTROL_T_RESET:
         do_reset(s, NULL, NULL, "reset to the scene's initial state");
@@ -347,16 +522,16 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
     case LAGSIM_CONTROL_T_STATUS:
         break; /* the status below is the answer */
     case LAGSIM_CONTROL_T_DESCRIBE:
-        rt_publish_scene(s);
+        s->want_scene = true;
         return;
     default:
         control_rejected(s, "control: unknown request");
         return;
     }
-    rt_publish_status(s);
+    s->want_status = true;
 }
 
-/* ---------------------------------------------------------------- LCM glue */
+/* ---------------------------------------------------------------- the server in pieces */
 static void on_command(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     (void)ch;
@@ -378,29 +553,74 @@ static void live_line(rt_server *s, bool final)
     fflush(stderr);
 }
 
-/* ---------------------------------------------------------------- the server */
-int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
+static int open_error(char *err, size_t errlen, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static int open_error(char *err, size_t errlen, const char *fmt, ...)
 {
-    static rt_server srv; /* large (encode buffer): static, one server per process */
-    rt_server *s = &srv;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, errlen, fmt, ap);
+    va_end(ap);
+    return LAGSIMD_EXIT_USAGE;
+}
+
+int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t now, bool quiet,
+            char *err, size_t errlen)
+{
     memset(s, 0, sizeof *s);
     s->sc = sc;
     s->opts = o;
+    s->now = now;
     s->info = lag_model_info_get(sc->sim.model.kind);
 
-    /* everything that can fail on a bad scene fails before LCM is touched */
-    char err[256];
-    if (!s->info || lag_sim_init(&s->sim, &sc->sim, err, sizeof err) != LAG_OK) {
-        fprintf(stderr, "lagsimd: bad scene: %s\n", s->info ? err : "unknown model");
-        return LAGSIMD_EXIT_USAGE;
-    }
-    if (sc->publish_hz <= 0 || sc->ticks_per_period < 1 || !(sc->realtime.rate > 0) ||
-        !(sc->realtime.status_hz > 0) || strlen(sc->lcm.prefix) == 0 ||
-        strlen(sc->lcm.prefix) + 9 > RT_CHANNEL_MAX) {
-        fprintf(stderr, "lagsimd: bad scene: publish_hz, realtime.rate, realtime.status_hz "
-                        "must be > 0 and lcm.prefix non-empty\n");
-        return LAGSIMD_EXIT_USAGE;
-    }
+    /* everything that can fail on a bad scene fails before anything is published */
+    char serr[256];
+    if (!s->info) return open_error(err, errlen, "bad scene: unknown model");
+    if (lag_sim_init(&s->sim, &sc->sim, serr, sizeof serr) != LAG_OK)
+        return open_error(err, errlen, "bad scene: %s", serr);
+    const double dt = sc->sim.integrator.dt;
+    const double rate = sc->realtime.rate;
+    if (!(sc->publish_hz > 0) || !isfinite(sc->publish_hz) || sc->ticks_per_period < 1 ||
+        sc->ticks_per_period > RT_MAX_RUN_TICKS)
+        return open_error(err, errlen, "bad scene: publish_hz must be > 0 and finite, "
+                          "1/publish_hz a whole number of ticks (at most 2^53)");
+    if (!(rate > 0) || !isfinite(rate))
+        return open_error(err, errlen, "bad scene: realtime.rate must be > 0 and finite (got %g)", rate);
+    if (!(sc->realtime.status_hz > 0) || !isfinite(sc->realtime.status_hz))
+        return open_error(err, errlen, "bad scene: realtime.status_hz must be > 0 and finite (got %g)",
+                          sc->realtime.status_hz);
+    if (!(sc->realtime.lockstep_timeout >= 0) || !isfinite(sc->realtime.lockstep_timeout))
+        return open_error(err, errlen, "bad scene: realtime.lockstep_timeout must be >= 0 and "
+                          "finite (got %g)", sc->realtime.lockstep_timeout);
+    if (!(sc->realtime.command_timeout >= 0) || isnan(sc->realtime.command_timeout))
+        return open_error(err, errlen, "bad scene: realtime.command_timeout must be >= 0 (got %g)",
+                          sc->realtime.command_timeout);
+    size_t plen = strnlen(sc->lcm.prefix, sizeof sc->lcm.prefix);
+    if (plen == 0 || plen + 8 > LCM_MAX_CHANNEL_NAME_LENGTH)
+        return open_error(err, errlen, "bad scene: lcm.prefix must have 1 to %d characters "
+                          "(LCM channel names are at most %d, and the longest suffix is _COMMAND)",
+                          LCM_MAX_CHANNEL_NAME_LENGTH - 8, LCM_MAX_CHANNEL_NAME_LENGTH);
+    if (o && o->duration > 0 && !rt_ticks_for(o->duration, dt, &s->stop_tick))
+        return open_error(err, errlen, "--duration %g s is more than 2^53 ticks of dt %g s "
+                          "(the longest run whose sim time is exact)", o->duration, dt);
+
+    /* settings the loop cannot honour as given are clamped, and said so */
+    const double period_s = (double)sc->ticks_per_period * dt;
+    bool clamped = false;
+    s->period_ns = rt_pace_period_ns(period_s, rate, &clamped);
+    if (clamped && !quiet)
+        fprintf(stderr, "lagsimd: warning: a control period of %g s at realtime.rate %g is %g s of "
+                "wall time; the loop paces periods %g s apart at the %s\n", period_s, rate,
+                period_s / rate, (double)s->period_ns * 1e-9,
+                s->period_ns == RT_PERIOD_NS_MIN ? "fastest (it runs as fast as it can and "
+                "counts overruns)" : "slowest");
+    double status_ns = 1e9 / sc->realtime.status_hz;
+    s->status_period_ns = rt_clamp_ns(status_ns, RT_STATUS_NS_MIN, INT64_MAX);
+    if ((double)s->status_period_ns > status_ns + 0.5 && !quiet)
+        fprintf(stderr, "lagsimd: warning: realtime.status_hz %g: statuses go out at most "
+                "every %g s\n", sc->realtime.status_hz, (double)RT_STATUS_NS_MIN * 1e-9);
+    s->lockstep_wait_ns = rt_ns_from_s(sc->realtime.lockstep_timeout);
+
     s->nq = s->sim.nq;
     snprintf(s->ch_state, RT_CHANNEL_MAX, "%s_STATE", sc->lcm.prefix);
     snprintf(s->ch_command, RT_CHANNEL_MAX, "%s_COMMAND", sc->lcm.prefix);
@@ -408,190 +628,339 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
     snprintf(s->ch_event, RT_CHANNEL_MAX, "%s_EVENT", sc->lcm.prefix);
     snprintf(s->ch_control, RT_CHANNEL_MAX, "%s_CONTROL", sc->lcm.prefix);
     snprintf(s->ch_scene, RT_CHANNEL_MAX, "%s_SCENE", sc->lcm.prefix);
-    double dt = sc->sim.integrator.dt;
-    double period_s = (double)sc->ticks_per_period * dt;
-    s->period_ns = period_s / sc->realtime.rate * 1e9;
-    if (o && o->duration > 0) {
-        s->stop_tick = (int64_t)ceil(o->duration / dt - 1e-9);
-        if (s->stop_tick < 1) s->stop_tick = 1;
+    s->tick_budget = RT_TICK_BUDGET;
+    for (int k = 0; k < RT_EV_COUNT; k++)
+        rt_limit_init(&s->lim_event[k], ev_limits[k].per_s, ev_limits[k].burst, now);
+    rt_limit_init(&s->lim_status, RT_STATUS_PER_S, RT_STATUS_BURST, now);
+    rt_limit_init(&s->lim_scene, RT_SCENE_PER_S, RT_SCENE_BURST, now);
+    rt_limit_init(&s->lim_state, RT_STATE_PER_S, RT_STATE_BURST, now);
+
+    return LAGSIMD_EXIT_OK;
+}
+
+int rt_attach(rt_server *s, lcm_t *lcm, char *err, size_t errlen)
+{
+    s->lcm = lcm;
+    s->sub_command = lcm_subscribe(lcm, s->ch_command, on_command, s);
+    s->sub_control = lcm_subscribe(lcm, s->ch_control, on_control, s);
+    if (!s->sub_command || !s->sub_control) {
+        rt_close(s);
+        snprintf(err, errlen, "cannot subscribe to %s and %s", s->ch_command, s->ch_control);
+        return LAGSIMD_EXIT_RUNTIME;
     }
-    s->live_line = isatty(STDERR_FILENO) && !(o && o->quiet);
+    /* a flood must not queue up without bound: LCM drops beyond this */
+    lcm_subscription_set_queue_capacity(s->sub_command, 1000);
+    lcm_subscription_set_queue_capacity(s->sub_control, 1000);
+    return LAGSIMD_EXIT_OK;
+}
+
+void rt_close(rt_server *s)
+{
+    if (s->sub_command) lcm_unsubscribe(s->lcm, s->sub_command);
+    if (s->sub_control) lcm_unsubscribe(s->lcm, s->sub_control);
+    s->sub_command = s->sub_control = NULL;
+}
+
+void rt_begin(rt_server *s)
+{
+    const lag_scene *sc = s->sc;
+    s->start_ns = s->now;
+    s->last_status_ns = s->now;
+    s->next_status_ns = rt_sat_add(s->now, s->status_period_ns);
+    s->next_line_ns = s->now;
+    s->run = RT_RUNNING;
+    rt_publish_scene(s);
+    eventf(s, "start", 0, "%s, %s, dt %.6g s, control period %.6g s, mode %s, rate %.6g",
+           s->info->name, lag_method_name(sc->sim.integrator.method), sc->sim.integrator.dt,
+           (double)sc->ticks_per_period * sc->sim.integrator.dt,
+           lag_rt_mode_name(sc->realtime.mode), sc->realtime.rate);
+    publish_state(s); /* the initial state, t = 0 */
+    publish_status(s);
+    rt_pace_start(&s->pace, s->period_ns, s->now);
+}
+
+int64_t rt_next_wake(const rt_server *s)
+{
+    const int64_t now = s->now;
+    if (s->stop || s->restart_pace) return now;
+    bool act = active(s);
+    if (act && s->period_left > 0) return now; /* a long period goes on */
+    int64_t wake = s->next_status_ns;
+    switch (s->sc->realtime.mode) {
+    case LAG_RT_FAST:
+        if (act) return now;
+        if (s->run == RT_PAUSED) wake = min64(wake, rt_pace_next(&s->pace));
+        break;
+    case LAG_RT_REALTIME:
+        if (act || s->run == RT_PAUSED) wake = min64(wake, rt_pace_next(&s->pace));
+        break;
+    case LAG_RT_LOCKSTEP:
+        if (act && s->waiting) {
+            if (s->answered) return now;
+            wake = min64(wake, rt_sat_add(s->wait_start_ns, s->lockstep_wait_ns));
+        }
+        break;
+    }
+    if (state_wanted(s)) wake = min64(wake, rt_limit_ready(&s->lim_state, now));
+    if (s->want_scene) wake = min64(wake, rt_limit_ready(&s->lim_scene, now));
+    if (s->want_status) wake = min64(wake, rt_limit_ready(&s->lim_status, now));
+    if (s->live_line) wake = min64(wake, s->next_line_ns);
+    return wake;
+}
+
+/* Answers held back by their bucket go out when it allows, one for many requests. */
+static void flush_answers(rt_server *s)
+{
+    if (state_wanted(s) && rt_limit_ready(&s->lim_state, s->now) <= s->now) {
+        rt_limit_take(&s->lim_state, s->now);
+        publish_state(s);
+    }
+    if (s->want_scene && rt_limit_ready(&s->lim_scene, s->now) <= s->now) {
+        rt_limit_take(&s->lim_scene, s->now);
+        rt_publish_scene(s);
+        s->want_scene = false;
+    }
+    if (s->want_status && rt_limit_ready(&s->lim_status, s->now) <= s->now) {
+        rt_limit_take(&s->lim_status, s->now);
+        publish_status(s);
+    }
+}
+
+void rt_process(rt_server *s)
+{
+    if (s->restart_pace) {
+        rt_pace_start(&s->pace, s->period_ns, s->now);
+        s->restart_pace = false;
+    }
+    if (!s->stop) {
+        if (s->period_left > 0 && active(s)) {
+            int64_t budget = s->tick_budget;
+            period_run(s, &budget); /* a long period goes on, chunk by chunk */
+        } else {
+            switch (s->sc->realtime.mode) {
+            case LAG_RT_REALTIME: mode_realtime(s); break;
+            case LAG_RT_FAST: mode_fast(s); break;
+            case LAG_RT_LOCKSTEP: mode_lockstep(s); break;
+            }
+        }
+    }
+    flush_answers(s);
+    if (s->now >= s->next_status_ns) {
+        publish_status(s);
+        s->next_status_ns = rt_sat_add(s->next_status_ns, s->status_period_ns);
+        if (s->next_status_ns <= s->now) s->next_status_ns = rt_sat_add(s->now, s->status_period_ns);
+    }
+    if (s->live_line && s->now >= s->next_line_ns) {
+        live_line(s, false);
+        s->next_line_ns = rt_sat_add(s->now, RT_LINE_NS);
+    }
+    if (s->report_line) {
+        s->report_line = false;
+        if (s->opts && s->opts->quiet) return;
+        fprintf(stderr, "lagsimd: %s t=%.3f s RTF %.3f overruns %lld states %lld commands %lld "
+                "energy %+.6e J %s\n", s->sc->lcm.prefix, lag_sim_time(&s->sim), s->rtf,
+                (long long)s->overruns, (long long)s->states_published, (long long)s->accepted,
+                lag_sim_energy(&s->sim), rt_run_name(s->run));
+    }
+}
+
+void rt_signal(rt_server *s, int signo)
+{
+    if (signo == SIGUSR1 || signo == SIGUSR2) {
+        s->want_status = true;
+        s->report_line = true;
+        return;
+    }
+    if (!s->stop) {
+        s->stop = true;
+        s->stop_reason = RT_STOP_SIGNAL;
+        s->stop_signal = signo;
+    }
+}
+
+static const char *signal_name(int signo)
+{
+    switch (signo) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    case SIGQUIT: return "SIGQUIT";
+    case SIGUSR1: return "SIGUSR1";
+    case SIGUSR2: return "SIGUSR2";
+    }
+    return "signal";
+}
+
+void rt_finish(rt_server *s)
+{
+    switch (s->stop_reason) {
+    case RT_STOP_SIGNAL:
+        eventf(s, "stop", (double)s->stop_signal, "%s (%d): stopping", signal_name(s->stop_signal),
+               s->stop_signal);
+        break;
+    case RT_STOP_DURATION:
+        eventf(s, "stop", lag_sim_time(&s->sim), "duration reached");
+        break;
+    default:
+        eventf(s, "stop", 0, "stopping");
+        break;
+    }
+    publish_status(s);
+    if (s->live_line) live_line(s, true);
+}
+
+int rt_url_ttl(const char *url)
+{
+    if (strncmp(url, "udpm://", 7) != 0) return -1;
+    const char *q = strchr(url, '?');
+    while (q) {
+        q++;
+        if (strncmp(q, "ttl=", 4) == 0) {
+            char *end;
+            long v = strtol(q + 4, &end, 10);
+            return v < 0 ? 0 : v > 255 ? 255 : (int)v;
+        }
+        q = strchr(q, '&');
+    }
+    return 0;
+}
+
+/* ---------------------------------------------------------------- the loop */
+typedef struct rt_io {
+    int lcm_fd, timer_fd, sig_fd;
+    int64_t armed_ns; /* what the timer is armed at (INT64_MAX: disarmed) */
+} rt_io;
+
+/* Waits until `wake` (absolute), a signal or an LCM message, then handles the signals
+ * and the messages that arrived (at most RT_DRAIN_MAX). */
+static void wait_and_handle(rt_server *s, rt_io *io, int64_t wake)
+{
+    struct timespec zero = {0, 0}, *tmo = NULL;
+    if (wake <= rt_mono_ns()) {
+        tmo = &zero;
+    } else if (wake != io->armed_ns) {
+        struct itimerspec its = {{0, 0}, {0, 0}};
+        if (wake != INT64_MAX) {
+            its.it_value.tv_sec = (time_t)(wake / RT_NS_PER_S);
+            its.it_value.tv_nsec = (long)(wake % RT_NS_PER_S);
+        }
+        if (timerfd_settime(io->timer_fd, TFD_TIMER_ABSTIME, &its, NULL) == 0) io->armed_ns = wake;
+        else tmo = &zero; /* cannot arm: do not sleep past the deadline */
+    }
+    struct pollfd pf[3] = {{io->lcm_fd, POLLIN, 0}, {io->timer_fd, POLLIN, 0}, {io->sig_fd, POLLIN, 0}};
+    int np = ppoll(pf, 3, tmo, NULL);
+    s->now = rt_mono_ns();
+    if (np < 0) {
+        if (errno == EINTR) return;
+        perror("lagsimd: poll");
+        s->stop = true;
+        s->stop_reason = RT_STOP_ERROR;
+        return;
+    }
+    if (pf[2].revents & POLLIN) {
+        struct signalfd_siginfo si;
+        for (int k = 0; k < RT_SIGNALS_PER_WAKE; k++) {
+            if (read(io->sig_fd, &si, sizeof si) != (ssize_t)sizeof si) break;
+            rt_signal(s, (int)si.ssi_signo);
+        }
+    }
+    if (pf[1].revents & POLLIN) {
+        uint64_t expirations;
+        if (read(io->timer_fd, &expirations, sizeof expirations) < 0) expirations = 0;
+        io->armed_ns = INT64_MAX;
+    }
+    if (pf[0].revents & POLLIN) {
+        for (int k = 0; k < RT_DRAIN_MAX && !s->stop; k++)
+            if (lcm_handle_timeout(s->lcm, 0) <= 0) break;
+    }
+    s->now = rt_mono_ns();
+}
+
+/* Signals the daemon handles: these stop it cleanly (a stop event and a final status);
+ * SIGUSR1/SIGUSR2 ask for a status and a line on stderr. SIGPIPE is ignored. */
+static void handled_signals(sigset_t *set)
+{
+    sigemptyset(set);
+    sigaddset(set, SIGINT);
+    sigaddset(set, SIGTERM);
+    sigaddset(set, SIGHUP);
+    sigaddset(set, SIGQUIT);
+    sigaddset(set, SIGUSR1);
+    sigaddset(set, SIGUSR2);
+}
+
+/* The effective LCM URL: the scene's, else LCM_DEFAULT_URL, else LCM's default. */
+static const char *effective_url(const lag_scene *sc)
+{
+    if (sc->lcm.url[0]) return sc->lcm.url;
+    const char *env = getenv("LCM_DEFAULT_URL");
+    return env && env[0] ? env : "udpm://239.255.76.67:7667?ttl=0";
+}
+
+int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
+{
+    static rt_server srv; /* large (encode buffer): static, one server per process */
+    rt_server *s = &srv;
+    bool quiet = o && o->quiet;
+    char err[512];
 
     /* signals through a signalfd: blocked before LCM starts any thread */
     sigset_t sigs, old_mask;
-    sigemptyset(&sigs);
-    sigaddset(&sigs, SIGINT);
-    sigaddset(&sigs, SIGTERM);
+    handled_signals(&sigs);
     sigprocmask(SIG_BLOCK, &sigs, &old_mask);
-    int sig_fd = signalfd(-1, &sigs, SFD_CLOEXEC | SFD_NONBLOCK);
-    int timer_fd = timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC | TFD_NONBLOCK);
-    if (sig_fd < 0 || timer_fd < 0) {
+    struct sigaction ign = {.sa_handler = SIG_IGN}, old_pipe;
+    sigemptyset(&ign.sa_mask);
+    sigaction(SIGPIPE, &ign, &old_pipe);
+    rt_io io = {-1, -1, -1, INT64_MAX};
+    lcm_t *lcm = NULL;
+    int rc = LAGSIMD_EXIT_OK;
+
+    io.sig_fd = signalfd(-1, &sigs, SFD_CLOEXEC | SFD_NONBLOCK);
+    io.timer_fd = timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC | TFD_NONBLOCK);
+    if (io.sig_fd < 0 || io.timer_fd < 0) {
         perror("lagsimd: signalfd/timerfd");
-        sigprocmask(SIG_SETMASK, &old_mask, NULL);
-        return LAGSIMD_EXIT_RUNTIME;
+        rc = LAGSIMD_EXIT_RUNTIME;
+        goto out;
     }
-
-    s->lcm = lcm_create(sc->lcm.url[0] ? sc->lcm.url : NULL);
-    if (!s->lcm) {
-        fprintf(stderr, "lagsimd: cannot create LCM (url '%s')\n",
-                sc->lcm.url[0] ? sc->lcm.url : "default");
-        close(sig_fd);
-        close(timer_fd);
-        sigprocmask(SIG_SETMASK, &old_mask, NULL);
-        return LAGSIMD_EXIT_RUNTIME;
+    /* everything that can fail on a bad scene fails before LCM is touched */
+    rc = rt_open(s, sc, o, rt_mono_ns(), quiet, err, sizeof err);
+    if (rc != LAGSIMD_EXIT_OK) {
+        fprintf(stderr, "lagsimd: %s\n", err);
+        goto out;
     }
-    lcm_subscription_t *sub_cmd = lcm_subscribe(s->lcm, s->ch_command, on_command, s);
-    lcm_subscription_t *sub_ctl = lcm_subscribe(s->lcm, s->ch_control, on_control, s);
-    /* a flood must not queue up without bound: LCM drops beyond this */
-    lcm_subscription_set_queue_capacity(sub_cmd, 1000);
-    int lcm_fd = lcm_get_fileno(s->lcm);
+    const char *url = effective_url(sc);
+    lcm = lcm_create(sc->lcm.url[0] ? sc->lcm.url : NULL);
+    if (!lcm) {
+        fprintf(stderr, "lagsimd: cannot create LCM (url '%s')\n", url);
+        rc = LAGSIMD_EXIT_RUNTIME;
+        goto out;
+    }
+    rc = rt_attach(s, lcm, err, sizeof err);
+    if (rc != LAGSIMD_EXIT_OK) {
+        fprintf(stderr, "lagsimd: %s\n", err);
+        goto out;
+    }
+    int ttl = rt_url_ttl(url);
+    if (ttl > 0)
+        fprintf(stderr, "lagsimd: warning: LCM url '%s' has ttl=%d: states, status and events "
+                "leave this host (multicast to the local network%s)\n", url, ttl,
+                ttl > 1 ? " and beyond routers" : "");
+    s->live_line = isatty(STDERR_FILENO) && !quiet;
+    io.lcm_fd = lcm_get_fileno(lcm);
 
-    s->start_ns = rt_mono_ns();
-    s->last_status_ns = s->start_ns;
-    int64_t status_ns = (int64_t)(1e9 / sc->realtime.status_hz);
-    s->next_status_ns = s->start_ns + status_ns;
-    s->next_line_ns = s->start_ns;
-    s->run = RT_RUNNING;
-    lag_rt_mode mode = sc->realtime.mode;
-
-    rt_publish_scene(s);
-    eventf(s, "start", "", 0, "%s, %s, dt %.6g s, control period %.6g s, mode %s, rate %.6g",
-           s->info->name, lag_method_name(sc->sim.integrator.method), dt, period_s,
-           lag_rt_mode_name(mode), sc->realtime.rate);
-    publish_state(s); /* the initial state, t = 0 */
-    rt_publish_status(s);
-    rebase_clock(s, timer_fd);
-
+    s->now = rt_mono_ns();
+    rt_begin(s);
     while (!s->stop) {
-        int64_t now = rt_mono_ns();
-        /* how long poll may sleep: until the next status, live line, lockstep timeout;
-         * zero when there is work to do now (fast mode, STEP N) */
-        int64_t wake = s->next_status_ns;
-        if (s->live_line && s->next_line_ns < wake) wake = s->next_line_ns;
-        bool busy = s->pending_steps > 0 || (s->run == RT_RUNNING && mode == LAG_RT_FAST);
-        if (mode == LAG_RT_LOCKSTEP && s->run == RT_RUNNING && s->waiting) {
-            if (s->answered) busy = true;
-            int64_t lw = s->wait_start_ns + (int64_t)(sc->realtime.lockstep_timeout * 1e9);
-            if (lw < wake) wake = lw;
-        }
-        int64_t wait_ns = busy ? 0 : (wake > now ? wake - now : 0);
-        struct timespec ts = {wait_ns / 1000000000, wait_ns % 1000000000};
-        struct pollfd pf[3] = {{lcm_fd, POLLIN, 0}, {timer_fd, POLLIN, 0}, {sig_fd, POLLIN, 0}};
-        int np = ppoll(pf, 3, &ts, NULL);
-        if (np < 0 && errno != EINTR) {
-            perror("lagsimd: poll");
-            break;
-        }
-        if (np > 0 && (pf[2].revents & POLLIN)) {
-            struct signalfd_siginfo si;
-            if (read(sig_fd, &si, sizeof si) > 0) {
-                eventf(s, "stop", "", (double)si.ssi_signo, "signal %u: stopping",
-                       si.ssi_signo);
-                s->stop = true;
-                break;
-            }
-        }
-        if (np > 0 && (pf[0].revents & POLLIN)) {
-            for (int k = 0; k < RT_DRAIN_MAX; k++)
-                if (lcm_handle_timeout(s->lcm, 0) <= 0) break;
-        }
-        uint64_t expirations = 0;
-        if (np > 0 && (pf[1].revents & POLLIN)) {
-            if (read(timer_fd, &expirations, sizeof expirations) < 0) expirations = 0;
-        }
-        if (s->stop) break;
-        if (s->base_ns == 0) rebase_clock(s, timer_fd); /* after resume */
-        now = rt_mono_ns();
-
-        if (s->pending_steps > 0) {
-            /* STEP N while paused: one period per iteration, LCM served between */
-            if (rt_period(s) && --s->pending_steps == 0) {
-                rt_publish_event(s, "step_done", "", 0, "step done: paused");
-                rt_publish_status(s);
-            }
-        } else if (s->run == RT_RUNNING) {
-            switch (mode) {
-            case LAG_RT_FAST:
-                rt_period(s);
-                break;
-            case LAG_RT_LOCKSTEP:
-                if (s->waiting && !s->answered &&
-                    now - s->wait_start_ns >= (int64_t)(sc->realtime.lockstep_timeout * 1e9)) {
-                    s->lockstep_timeouts++;
-                    eventf(s, "lockstep_timeout", "", s->waiting_time,
-                           "no command answered sim time %.9g s within %.6g s: stepping "
-                           "on under the watchdog rule", s->waiting_time,
-                           sc->realtime.lockstep_timeout);
-                    s->answered = true;
-                }
-                if (s->waiting && s->answered) {
-                    s->waiting = false;
-                    rt_period(s);
-                }
-                break;
-            case LAG_RT_REALTIME:
-                if (expirations > 0) {
-                    /* periods whose deadline has passed */
-                    int64_t due = (int64_t)((double)(now - s->base_ns) / s->period_ns) -
-                                  s->periods_done;
-                    /* every due period but the last started late; count each once
-                     * (a burst may leave some for the next iteration) */
-                    int64_t last_late = s->periods_done + due - 1;
-                    if (last_late > s->late_mark) {
-                        s->overruns += last_late - (s->late_mark > s->periods_done
-                                                        ? s->late_mark : s->periods_done);
-                        s->late_mark = last_late;
-                    }
-                    if (due > RT_MAX_LAG_PERIODS ||
-                        (due > 1 && (double)due * s->period_ns > RT_MAX_LAG_NS)) {
-                        s->overrun_bursts++;
-                        eventf(s, "overrun_burst", "", (double)due,
-                               "%lld periods behind wall clock: cannot catch up, "
-                               "re-basing the clock (sim time lags wall time by %.3g s more)",
-                               (long long)due, (double)due * s->period_ns * 1e-9);
-                        due = 1;
-                        s->base_ns = now - (int64_t)s->period_ns;
-                        s->periods_done = 0;
-                        s->late_mark = 0;
-                    }
-                    int64_t burst = due < RT_MAX_BURST ? due : RT_MAX_BURST;
-                    for (int64_t k = 0; k < burst && s->run == RT_RUNNING && !s->stop; k++) {
-                        s->periods_done++;
-                        if (!rt_period(s)) break;
-                    }
-                    arm_next(s, timer_fd); /* if already past, fires at once: next burst */
-                }
-                break;
-            }
-        } else if (s->run == RT_PAUSED && mode != LAG_RT_LOCKSTEP && expirations > 0) {
-            /* paused: the current state keeps being published at publish_hz */
-            s->periods_done = (int64_t)((double)(now - s->base_ns) / s->period_ns);
-            rt_publish_state(s);
-            arm_next(s, timer_fd);
-        }
-
-        now = rt_mono_ns();
-        if (now >= s->next_status_ns) {
-            rt_publish_status(s);
-            s->next_status_ns += status_ns;
-            if (s->next_status_ns < now) s->next_status_ns = now + status_ns;
-        }
-        if (s->live_line && now >= s->next_line_ns) {
-            live_line(s, false);
-            s->next_line_ns = now + RT_LINE_NS;
-        }
+        wait_and_handle(s, &io, rt_next_wake(s));
+        rt_process(s);
     }
-
-    if (!s->stop) eventf(s, "stop", "", 0, "stopping");
-    else if (s->stop_tick > 0 && s->sim.tick >= s->stop_tick)
-        eventf(s, "stop", "", lag_sim_time(&s->sim), "duration reached");
-    rt_publish_status(s);
-    if (s->live_line) live_line(s, true);
-    lcm_unsubscribe(s->lcm, sub_cmd);
-    lcm_unsubscribe(s->lcm, sub_ctl);
-    lcm_destroy(s->lcm);
-    close(timer_fd);
-    close(sig_fd);
+    rt_finish(s);
+    rt_close(s);
+out:
+    if (lcm) lcm_destroy(lcm);
+    if (io.timer_fd >= 0) close(io.timer_fd);
+    if (io.sig_fd >= 0) close(io.sig_fd);
+    sigaction(SIGPIPE, &old_pipe, NULL);
     sigprocmask(SIG_SETMASK, &old_mask, NULL);
-    return LAGSIMD_EXIT_OK;
+    return rc;
 }

@@ -15,6 +15,7 @@
 #include <lcm/lcm.h>
 #include "daemon.h"
 #include "lagsim_wire.h"
+#include "rt_pace.h"
 
 #define RT_CHANNEL_MAX 96     /* prefix (< 64) + "_COMMAND" */
 #define RT_BUF_SIZE LAG_WIRE_BUF_SIZE /* encode buffer: holds any message */
@@ -32,21 +33,60 @@ typedef enum rt_reject {
     RT_REJ_COUNT
 } rt_reject;
 
+/* Events the daemon publishes in answer to what arrives or about its own pacing: each
+ * kind has its own token bucket (rt_limit), so that no input, however fast, makes the
+ * daemon publish more than a few of them per second. What a bucket suppressed is counted
+ * and said by the next event of that kind that gets through. `start`, `stop` and the
+ * effects' events (at most a fixed number per period, located by the core) are not
+ * limited. */
+typedef enum rt_ev {
+    RT_EV_COMMAND_REJECTED = 0,
+    RT_EV_CONTROL_REJECTED,
+    RT_EV_PAUSE,
+    RT_EV_RESUME,
+    RT_EV_STEP,
+    RT_EV_STEP_DONE,
+    RT_EV_RESET,
+    RT_EV_WATCHDOG_TRIP,
+    RT_EV_WATCHDOG_CLEAR,
+    RT_EV_LOCKSTEP_TIMEOUT,
+    RT_EV_OVERRUN_BURST,
+    RT_EV_NUMERIC_FAULT,
+    RT_EV_EVENTS_DROPPED,
+    RT_EV_COUNT
+} rt_ev;
+
+/* Why the server stopped. */
+typedef enum rt_stop { RT_STOP_NONE = 0, RT_STOP_SIGNAL, RT_STOP_DURATION, RT_STOP_ERROR } rt_stop;
+
 typedef struct rt_server {
     const lag_scene *sc;
     const lagsimd_opts *opts;
     const lag_model_info *info;
     lcm_t *lcm;
+    lcm_subscription_t *sub_command, *sub_control;
     lag_sim sim;
     int nq;
     char ch_state[RT_CHANNEL_MAX], ch_command[RT_CHANNEL_MAX], ch_status[RT_CHANNEL_MAX],
         ch_event[RT_CHANNEL_MAX], ch_control[RT_CHANNEL_MAX], ch_scene[RT_CHANNEL_MAX];
 
+    /* the loop's clock: CLOCK_MONOTONIC ns, read once per wake-up (tests set it by hand);
+     * every decision of the loop and the handlers uses it */
+    int64_t now;
+
     /* run state */
     rt_run run;
     int64_t pending_steps;     /* STEP N: periods still to advance while paused */
-    bool stop;                 /* signal or --duration reached */
+    bool stop;                 /* signal, --duration reached, or a fatal error */
+    rt_stop stop_reason;
+    int stop_signal;
     int64_t stop_tick;         /* --duration in ticks, 0 = none */
+
+    /* the control period in progress: a period of many ticks runs in chunks of at most
+     * tick_budget ticks per wake-up, so that signals and LCM are served in between */
+    int64_t period_left;       /* ticks of it still to run; 0 = between periods */
+    int64_t tick_budget;       /* ticks one wake-up may advance */
+    double period_us;          /* compute time of the period so far */
 
     /* commands: zero-order hold and watchdog */
     double held[LAG_MAX_DOF];  /* efforts the controller asked for */
@@ -58,13 +98,19 @@ typedef struct rt_server {
     double waiting_time;       /* sim_time of the state being waited on */
     bool waiting;              /* a state was published and not yet answered */
     bool answered;
-    int64_t wait_start_ns;     /* CLOCK_MONOTONIC when the wait began */
+    int64_t wait_start_ns;     /* when the wait began */
+    int64_t lockstep_wait_ns;  /* realtime.lockstep_timeout, saturated */
 
-    /* realtime pacing: deadline j = base_ns + j * period_ns (absolute) */
-    int64_t base_ns;
-    int64_t periods_done;      /* since base */
-    int64_t late_mark;         /* periods up to this index are already counted as overruns */
-    double period_ns;
+    /* pacing of periods (realtime mode) and of the paused republication (realtime, fast) */
+    rt_pace pace;
+    int64_t period_ns;         /* wall ns per control period */
+    bool restart_pace;         /* deadlines restart from now at the next wake-up */
+
+    /* answers: published once per wake-up at most, when their bucket allows (a flood of
+     * requests gets one answer, not one each) */
+    bool want_state, want_scene, want_status;
+    rt_limit lim_state, lim_scene, lim_status;
+    rt_limit lim_event[RT_EV_COUNT];
 
     /* counters published in status */
     int64_t overruns;
@@ -85,15 +131,12 @@ typedef struct rt_server {
     int64_t step_us_n;
     int64_t ticks_since_status;/* ticks advanced since the last status (resets included) */
     int64_t last_status_ns;
+    int64_t status_period_ns;
     int64_t next_status_ns;
     int64_t next_line_ns;
     double rtf;                /* real-time factor of the last status period */
     bool live_line;            /* stderr is a terminal and not -q */
-
-    /* rate limit of command_rejected events: at most RT_REJ_EVENTS_PER_S per second */
-    int64_t rej_window_ns;
-    int rej_events_in_window;
-    int64_t rej_suppressed;
+    bool report_line;          /* SIGUSR1/SIGUSR2: one status line on stderr */
 
     uint8_t buf[RT_BUF_SIZE];
 } rt_server;
@@ -113,8 +156,35 @@ void rt_publish_event_at(rt_server *s, double sim_time, const char *kind, const 
 void rt_publish_scene(rt_server *s);
 const char *rt_run_name(rt_run r);
 
-/* realtime.c: what the LCM handlers call. */
+/* realtime.c: the server in pieces (lagsimd_realtime strings them together; tests and
+ * the fuzz target drive them with their own clock and LCM, e.g. memq://). */
+/* Checks the scene's real-time settings and initializes the sim, at clock `now`; no LCM
+ * yet. Settings the loop clamps are said on stderr unless quiet. Returns 0, or an exit
+ * code (2: bad scene or --duration) with a message in err. */
+int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t now, bool quiet,
+            char *err, size_t errlen);
+/* Subscribes to _COMMAND and _CONTROL on lcm (which the caller owns and destroys after
+ * rt_close). Returns 0, or an exit code with a message in err. */
+int rt_attach(rt_server *s, lcm_t *lcm, char *err, size_t errlen);
+/* Publishes the scene, a start event, the initial state and a status; deadlines start. */
+void rt_begin(rt_server *s);
+/* When the loop must next wake up (absolute ns; <= s->now: at once). Pure. */
+int64_t rt_next_wake(const rt_server *s);
+/* Everything due at s->now: the mode's periods, pending answers, the periodic status. */
+void rt_process(rt_server *s);
+/* A signal arrived: SIGUSR1/SIGUSR2 ask for a status, any other stops the server. */
+void rt_signal(rt_server *s, int signo);
+/* A stop event and the final status. */
+void rt_finish(rt_server *s);
+/* Unsubscribes (the caller destroys its lcm). */
+void rt_close(rt_server *s);
+
+/* The LCM handlers' work: a command or a control request, at s->now. */
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len);
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len);
+
+/* The ttl of an LCM udpm URL ("udpm://239.255.76.67:7667?ttl=1" gives 1); 0 when the URL
+ * says none (LCM's default), -1 when it is not udpm://. */
+int rt_url_ttl(const char *url);
 
 #endif

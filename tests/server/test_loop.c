@@ -1,0 +1,594 @@
+/*
+ * The real-time server's loop with a made-up clock, on LCM's in-process memq:// provider:
+ * no sockets, no sleeping, no dependence on the machine's load. The test plays the loop
+ * (rt_next_wake, "sleep" by moving the clock, deliver messages, rt_process) and counts
+ * every message the server publishes, decoding each and checking that no number in it is
+ * NaN or Inf.
+ *
+ * Scenes are built in code, not loaded, so that settings a scene file would refuse
+ * (rate 1e25, status_hz 1e-300, lockstep_timeout 1e300, a period of 1e12 ticks) reach the
+ * server: it must stay bounded for any value.
+ *
+ *   test_loop CASE    CASE: pacing rate_huge status_hz lockstep_wait long_period chunks
+ *                           step_paced control_flood command_flood duration signals
+ *                           fault_effort
+ */
+#include <math.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rt_server.h"
+#include "lagsim/lagsim_control_t.h"
+#include "lagsim/lagsim_event_t.h"
+#include "lagsim/lagsim_joint_command_t.h"
+#include "lagsim/lagsim_joint_state_t.h"
+#include "lagsim/lagsim_scene_t.h"
+#include "lagsim/lagsim_status_t.h"
+
+static const char *g_case = "?";
+static int g_checks;
+#define ENSURE(c) do { g_checks++; if (!(c)) fail(__LINE__, "%s", #c); } while (0)
+#define ENSUREF(c, ...) do { g_checks++; if (!(c)) fail(__LINE__, __VA_ARGS__); } while (0)
+static void fail(int line, const char *fmt, ...) __attribute__((format(printf, 2, 3), noreturn));
+static void fail(int line, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "test_loop %s: FAIL line %d: ", g_case, line);
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "\n");
+    va_end(ap);
+    exit(1);
+}
+
+#define MS 1000000LL
+#define SEC 1000000000LL
+
+/* ---------------------------------------------------------------- what the server publishes */
+#define MAX_KINDS 40
+typedef struct outputs {
+    int64_t state, status, event, scene;
+    int nkinds;
+    char kind[MAX_KINDS][32];
+    int64_t kind_n[MAX_KINDS];
+    char kind_detail[MAX_KINDS][320]; /* the last detail of each kind */
+    double kind_value[MAX_KINDS];
+    int64_t kind_suppressed[MAX_KINDS]; /* the sum of "(N more ... suppressed ...)" */
+    bool nonfinite;
+    double last_t;                    /* sim_time of the last state */
+    int64_t last_step;
+    double last_q[LAG_MAX_DOF];
+    int64_t status_controls_rejected, status_states, status_overrun_bursts;
+    char status_run[16];
+} outputs;
+
+static outputs g_out;
+
+static bool finite_all(const double *x, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (!isfinite(x[i])) return false;
+    return true;
+}
+
+static int kind_index(const char *kind)
+{
+    for (int i = 0; i < g_out.nkinds; i++)
+        if (!strcmp(g_out.kind[i], kind)) return i;
+    if (g_out.nkinds == MAX_KINDS) fail(__LINE__, "too many event kinds");
+    snprintf(g_out.kind[g_out.nkinds], 32, "%s", kind);
+    return g_out.nkinds++;
+}
+
+static int64_t n_events(const char *kind)
+{
+    for (int i = 0; i < g_out.nkinds; i++)
+        if (!strcmp(g_out.kind[i], kind)) return g_out.kind_n[i];
+    return 0;
+}
+
+static int64_t n_suppressed(const char *kind)
+{
+    for (int i = 0; i < g_out.nkinds; i++)
+        if (!strcmp(g_out.kind[i], kind)) return g_out.kind_suppressed[i];
+    return 0;
+}
+
+static const char *last_detail(const char *kind)
+{
+    for (int i = 0; i < g_out.nkinds; i++)
+        if (!strcmp(g_out.kind[i], kind)) return g_out.kind_detail[i];
+    return "";
+}
+
+static const char *suffix(const char *ch)
+{
+    const char *u = strrchr(ch, '_');
+    return u ? u + 1 : ch;
+}
+
+/* Every message the server publishes (memq delivers them to this subscription). */
+static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)user;
+    const char *sfx = suffix(ch);
+    if (!strcmp(sfx, "STATE")) {
+        lagsim_joint_state_t m;
+        if (lagsim_joint_state_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) fail(__LINE__, "bad state");
+        g_out.state++;
+        if (!isfinite(m.sim_time) || !finite_all(m.position, m.num_joints) ||
+            !finite_all(m.velocity, m.num_joints) || !finite_all(m.effort, m.num_joints))
+            g_out.nonfinite = true;
+        g_out.last_t = m.sim_time;
+        g_out.last_step = m.step;
+        for (int i = 0; i < m.num_joints && i < LAG_MAX_DOF; i++) g_out.last_q[i] = m.position[i];
+        lagsim_joint_state_t_decode_cleanup(&m);
+    } else if (!strcmp(sfx, "STATUS")) {
+        lagsim_status_t m;
+        if (lagsim_status_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) fail(__LINE__, "bad status");
+        g_out.status++;
+        double d[] = {m.sim_time, m.wall_time, m.rtf, m.step_time_max_us, m.step_time_mean_us, m.energy};
+        if (!finite_all(d, 6)) g_out.nonfinite = true;
+        g_out.status_controls_rejected = m.controls_rejected;
+        g_out.status_states = m.states_published;
+        g_out.status_overrun_bursts = m.overrun_bursts;
+        snprintf(g_out.status_run, sizeof g_out.status_run, "%s", m.run_state);
+        lagsim_status_t_decode_cleanup(&m);
+    } else if (!strcmp(sfx, "EVENT")) {
+        lagsim_event_t m;
+        if (lagsim_event_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) fail(__LINE__, "bad event");
+        g_out.event++;
+        if (!isfinite(m.sim_time) || !isfinite(m.value)) g_out.nonfinite = true;
+        int k = kind_index(m.kind);
+        g_out.kind_n[k]++;
+        g_out.kind_value[k] = m.value;
+        snprintf(g_out.kind_detail[k], sizeof g_out.kind_detail[k], "%s", m.detail);
+        const char *sup = strstr(m.detail, " more ");
+        if (sup && strstr(sup, "suppressed")) {
+            const char *p = sup;
+            while (p > m.detail && p[-1] >= '0' && p[-1] <= '9') p--;
+            g_out.kind_suppressed[k] += strtoll(p, NULL, 10);
+        }
+        lagsim_event_t_decode_cleanup(&m);
+    } else if (!strcmp(sfx, "SCENE")) {
+        lagsim_scene_t m;
+        if (lagsim_scene_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) fail(__LINE__, "bad scene");
+        g_out.scene++;
+        lagsim_scene_t_decode_cleanup(&m);
+    }
+}
+
+
+/* ---------------------------------------------------------------- the server under test */
+static rt_server g_srv;
+static lcm_t *g_lcm;
+static lag_scene g_sc;
+static lagsimd_opts g_opts;
+static int64_t g_wakeups;
+
+static void drain(void)
+{
+    while (lcm_handle_timeout(g_lcm, 0) > 0) {
+    }
+}
+
+/* A DIPC scene (dt 1 ms, 100 Hz, realtime) to be changed by the case before start(). */
+static void scene(lag_rt_mode mode)
+{
+    lag_scene_default(&g_sc, LAG_MODEL_DIPC);
+    g_sc.sim.q0[1] = 0.1;
+    g_sc.sim.q0[2] = -0.05;
+    g_sc.realtime.mode = mode;
+    snprintf(g_sc.lcm.prefix, sizeof g_sc.lcm.prefix, "TL");
+    memset(&g_opts, 0, sizeof g_opts);
+    g_opts.quiet = true;
+}
+
+static int try_start(int64_t t0)
+{
+    char err[512];
+    memset(&g_out, 0, sizeof g_out);
+    g_wakeups = 0;
+    int rc = rt_open(&g_srv, &g_sc, &g_opts, t0, true, err, sizeof err);
+    if (rc != 0) return rc;
+    ENSUREF(rt_attach(&g_srv, g_lcm, err, sizeof err) == 0, "%s", err);
+    rt_begin(&g_srv);
+    drain();
+    return 0;
+}
+
+static void start(void) { ENSURE(try_start(1 * SEC) == 0); }
+
+static void stop_server(void)
+{
+    rt_finish(&g_srv);
+    rt_close(&g_srv);
+    drain();
+    ENSURE(!g_out.nonfinite);
+}
+
+/* Plays the loop until the clock reaches `until`: each wake-up costs `cost` ns; the loop
+ * sleeps until rt_next_wake. */
+static void run_until(int64_t until, int64_t cost)
+{
+    rt_server *s = &g_srv;
+    while (!s->stop && s->now < until) {
+        int64_t wake = rt_next_wake(s);
+        int64_t now = s->now + cost;
+        if (wake > now) now = wake;
+        if (now > until) {
+            s->now = until;
+            break;
+        }
+        s->now = now;
+        drain();            /* messages sent to the server are handled here, at s->now */
+        rt_process(s);
+        drain();
+        g_wakeups++;
+        if (g_wakeups > 50000000) fail(__LINE__, "the loop does not get anywhere");
+    }
+}
+
+static void control(int req, int64_t count)
+{
+    uint8_t buf[256];
+    lagsim_control_t m = {0, (int8_t)req, count, 0, NULL, NULL};
+    int n = lagsim_control_t_encode(buf, 0, sizeof buf, &m);
+    ENSURE(n > 0);
+    rt_handle_control(&g_srv, buf, (size_t)n);
+}
+
+static void command(double sim_time, const char *joint, double effort)
+{
+    uint8_t buf[256];
+    char *names[1] = {(char *)joint};
+    lagsim_joint_command_t m = {0, sim_time, 1, names, &effort};
+    int n = lagsim_joint_command_t_encode(buf, 0, sizeof buf, &m);
+    ENSURE(n > 0);
+    rt_handle_command(&g_srv, buf, (size_t)n);
+}
+
+/* ---------------------------------------------------------------- cases */
+/* Realtime at 100 Hz: one state per 10 ms deadline exactly, no overrun, sim time = wall
+ * time; a wake-up 25 ms late (deadline at T + 10 ms, woken at T + 35 ms) makes three
+ * periods due, two of which started late. */
+static void case_pacing(void)
+{
+    scene(LAG_RT_REALTIME);
+    start();
+    const int64_t t0 = g_srv.now;
+    run_until(t0 + 10 * SEC, 0);
+    ENSUREF(g_srv.sim.tick == 10000, "tick %lld", (long long)g_srv.sim.tick);
+    ENSURE(g_out.state == 1 + 1000 && g_srv.overruns == 0 && g_srv.overrun_bursts == 0);
+    ENSURE(g_out.last_t == 10.0);
+    /* statuses at 5 Hz: 50 plus the first */
+    ENSUREF(g_out.status == 51, "%lld statuses", (long long)g_out.status);
+    /* the stall */
+    g_srv.now = rt_pace_next(&g_srv.pace) + 25 * MS;
+    rt_process(&g_srv);
+    drain();
+    ENSURE(g_srv.overruns == 2 && g_srv.sim.tick == 10030);
+    run_until(t0 + 11 * SEC, 0);
+    ENSURE(g_srv.sim.tick == 11000 && g_srv.overruns == 2);
+    stop_server();
+}
+
+/* A rate so high that a period lasts nanoseconds (1e25: 1e-27 s; 1e6: 10 ns) runs as fast
+ * as the loop goes (here: 0.4 ms per wake-up), and sim time advances; the clock re-bases
+ * again and again, but overrun_burst events stay within their bucket (3, then 1/s). */
+static void case_rate_huge(void)
+{
+    const double rates[] = {1e25, 1e20, 1e6, 1e300};
+    for (size_t i = 0; i < sizeof rates / sizeof rates[0]; i++) {
+        scene(LAG_RT_REALTIME);
+        g_sc.realtime.rate = rates[i];
+        start();
+        run_until(g_srv.now + 2 * SEC, 400000);
+        ENSUREF(g_out.last_t > 10.0, "rate %g: sim time %g after 2 s", rates[i], g_out.last_t);
+        ENSURE(g_srv.overrun_bursts > 1000);
+        ENSUREF(n_events("overrun_burst") <= 3 + 2, "rate %g: %lld overrun_burst events",
+                rates[i], (long long)n_events("overrun_burst"));
+        ENSURE(g_out.status <= 1 + 10 + 1);
+        stop_server();
+        printf("rate %g: sim time %.1f s in 2 s, %lld re-bases, %lld overrun_burst events\n",
+               rates[i], g_out.last_t, (long long)g_srv.overrun_bursts,
+               (long long)n_events("overrun_burst"));
+    }
+}
+
+/* status_hz 1e-300: no periodic status (the first one only); 1e9: at most 100 per second. */
+static void case_status_hz(void)
+{
+    scene(LAG_RT_REALTIME);
+    g_sc.realtime.status_hz = 1e-300;
+    start();
+    run_until(g_srv.now + 10 * SEC, 10000);
+    ENSUREF(g_out.status == 1, "%lld statuses", (long long)g_out.status);
+    ENSURE(g_out.state == 1001);
+    stop_server();
+    scene(LAG_RT_FAST);
+    g_sc.realtime.status_hz = 1e9;
+    start();
+    run_until(g_srv.now + 1 * SEC, 100000);
+    ENSUREF(g_out.status <= 1 + 100, "%lld statuses", (long long)g_out.status);
+    ENSURE(g_out.status >= 90);
+    stop_server();
+}
+
+/* lockstep_timeout 1e10 or 1e300 s: the wait is (practically) for ever; no timeout event,
+ * no period, and the loop sleeps (a wake-up per status). lockstep_timeout 0: every wait
+ * times out at once; the events stay within their bucket. */
+static void case_lockstep_wait(void)
+{
+    const double waits[] = {1e10, 1e300, 9e9};
+    for (size_t i = 0; i < sizeof waits / sizeof waits[0]; i++) {
+        scene(LAG_RT_LOCKSTEP);
+        g_sc.realtime.lockstep_timeout = waits[i];
+        start();
+        run_until(g_srv.now + 10 * SEC, 10000);
+        ENSURE(g_srv.sim.tick == 0 && g_srv.lockstep_timeouts == 0);
+        ENSURE(n_events("lockstep_timeout") == 0 && g_out.state == 1);
+        ENSUREF(g_wakeups <= 60, "%lld wake-ups in 10 s", (long long)g_wakeups);
+        /* answered: it steps */
+        command(0.0, "theta0", 0.5);
+        run_until(g_srv.now + 1 * MS, 10000);
+        ENSURE(g_srv.sim.tick == 10 && g_out.state == 2);
+        stop_server();
+    }
+    scene(LAG_RT_LOCKSTEP);
+    g_sc.realtime.lockstep_timeout = 0.0;
+    start();
+    run_until(g_srv.now + 1 * SEC, 100000);
+    ENSURE(g_srv.lockstep_timeouts > 5000 && g_srv.sim.tick == 10 * g_srv.lockstep_timeouts);
+    ENSUREF(n_events("lockstep_timeout") <= 10 + 10, "%lld events",
+            (long long)n_events("lockstep_timeout"));
+    stop_server();
+}
+
+/* One period of 1e12 ticks (publish_hz 1e-9 at dt 1 ms, fast mode): each wake-up advances
+ * at most tick_budget ticks, so a signal stops it after the wake-up it arrives in. */
+static void case_long_period(void)
+{
+    scene(LAG_RT_FAST);
+    g_sc.publish_hz = 1e-9;
+    g_sc.ticks_per_period = 1000000000000LL;
+    g_sc.sim.integrator.method = LAG_EULER;
+    start();
+    for (int k = 0; k < 10; k++) {
+        ENSURE(rt_next_wake(&g_srv) <= g_srv.now); /* busy: no sleeping */
+        g_srv.now += 1 * MS;
+        rt_process(&g_srv);
+        drain();
+    }
+    ENSURE(g_srv.sim.tick == 10 * g_srv.tick_budget && g_out.state == 1);
+    rt_signal(&g_srv, SIGTERM);
+    ENSURE(g_srv.stop);
+    stop_server();
+    ENSURE(n_events("stop") == 1 && strstr(last_detail("stop"), "SIGTERM"));
+}
+
+/* A period longer than the budget runs in chunks; the state at its end is bit-identical
+ * to one call for the whole period (fixed-step and dopri5 alike). */
+static void case_chunks(void)
+{
+    const lag_method methods[] = {LAG_RK4, LAG_DOPRI5, LAG_GAUSS4};
+    for (size_t i = 0; i < sizeof methods / sizeof methods[0]; i++) {
+        scene(LAG_RT_FAST);
+        g_sc.sim.integrator.method = methods[i];
+        g_sc.publish_hz = 0.1; /* 10000 ticks */
+        g_sc.ticks_per_period = 10000;
+        g_sc.realtime.command_timeout = 1e9;
+        start();
+        static lag_sim ref;
+        char err[256];
+        ENSURE(lag_sim_init(&ref, &g_sc.sim, err, sizeof err) == LAG_OK);
+        double tau[LAG_MAX_DOF] = {0.3};
+        command(0.0, "theta0", 0.3);
+        for (int p = 0; p < 3; p++) {
+            lag_sim_set_input(&ref, tau);
+            ENSURE(lag_sim_advance(&ref, 10000, false) == LAG_OK);
+        }
+        while (g_out.state < 4) {
+            g_srv.now += 1 * MS;
+            rt_process(&g_srv);
+            drain();
+        }
+        ENSURE(g_srv.sim.tick == 30000 && ref.tick == 30000);
+        for (int k = 0; k < 3; k++)
+            ENSUREF(g_srv.sim.q[k] == ref.q[k] && g_srv.sim.qd[k] == ref.qd[k],
+                    "%s joint %d: %.17g vs %.17g", lag_method_name(methods[i]), k,
+                    g_srv.sim.q[k], ref.q[k]);
+        stop_server();
+    }
+}
+
+/* STEP 2^62 while paused runs at the mode's pace: realtime, one period per deadline (100
+ * in a second, not tens of thousands); lockstep, one per answer or timeout. */
+static void case_step_paced(void)
+{
+    scene(LAG_RT_REALTIME);
+    start();
+    run_until(g_srv.now + 100 * MS, 0);
+    control(LAGSIM_CONTROL_T_PAUSE, 0);
+    run_until(g_srv.now + 100 * MS, 0);
+    int64_t s0 = g_out.state, tick0 = g_srv.sim.tick;
+    control(LAGSIM_CONTROL_T_STEP, (int64_t)1 << 62);
+    run_until(g_srv.now + 1 * SEC, 0);
+    ENSUREF(g_out.state - s0 == 100, "%lld states in a second", (long long)(g_out.state - s0));
+    ENSURE(g_srv.sim.tick - tick0 == 1000);
+    control(LAGSIM_CONTROL_T_PAUSE, 0);
+    ENSURE(g_srv.pending_steps == 0);
+    stop_server();
+
+    scene(LAG_RT_LOCKSTEP);
+    g_sc.realtime.lockstep_timeout = 0.05;
+    start();
+    control(LAGSIM_CONTROL_T_PAUSE, 0);
+    run_until(g_srv.now + 100 * MS, 0);
+    ENSURE(g_srv.sim.tick == 0);
+    control(LAGSIM_CONTROL_T_STEP, (int64_t)1 << 62);
+    run_until(g_srv.now + 1 * SEC, 0);
+    ENSUREF(g_srv.sim.tick == 200, "lockstep: tick %lld after 1 s (a period per 50 ms wait)",
+            (long long)g_srv.sim.tick);
+    stop_server();
+}
+
+/* A flood on _CONTROL: 20 000 requests in a second, of every kind (undecodable, unknown,
+ * STATUS, DESCRIBE, RESET, refused STEP), against at most a few hundred messages out. The
+ * counters count everything; the next control_rejected event says how many were
+ * suppressed. */
+static void case_control_flood(void)
+{
+    scene(LAG_RT_REALTIME);
+    start();
+    run_until(g_srv.now + 100 * MS, 0);
+    outputs before = g_out;
+    const int64_t t_flood = g_srv.now;
+    int bad = 0;
+    for (int k = 0; k < 20000; k++) {
+        switch (k % 6) {
+        case 0: rt_handle_control(&g_srv, (const uint8_t *)"garbage", 7); bad++; break;
+        case 1: control(99, 0); bad++; break;
+        case 2: control(LAGSIM_CONTROL_T_STATUS, 0); break;
+        case 3: control(LAGSIM_CONTROL_T_DESCRIBE, 0); break;
+        case 4: control(LAGSIM_CONTROL_T_RESET, 0); break;
+        case 5: control(LAGSIM_CONTROL_T_STEP, 5); bad++; break; /* refused: running */
+        }
+        if (k % 20 == 19) run_until(t_flood + (k + 1) * 50000, 0); /* 50 us a message */
+    }
+    run_until(t_flood + 1 * SEC, 0);
+    int64_t ev = g_out.event - before.event, st = g_out.status - before.status,
+            sc = g_out.scene - before.scene, sa = g_out.state - before.state;
+    printf("control flood: 20000 requests in 1 s -> %lld events, %lld statuses, %lld scenes, "
+           "%lld states\n", (long long)ev, (long long)st, (long long)sc, (long long)sa);
+    /* each limited kind: its burst (10) + 10/s; statuses: burst 5 + 20/s + 5 periodic;
+     * scenes: 2 + 5/s; states: the 100 periods + resets' 5 + 20/s */
+    ENSURE(n_events("control_rejected") <= 20 && n_events("reset") <= 20);
+    ENSURE(ev <= 40);
+    ENSURE(st <= 5 + 20 + 5 + 1 && sc <= 2 + 5 + 1 && sa <= 100 + 5 + 20 + 1);
+    ENSURE(g_srv.controls_rejected == bad);
+    /* a while later one more: it says how many went unsaid since the last one, so that
+     * the events published plus those they say were suppressed are every rejection */
+    run_until(g_srv.now + 2 * SEC, 0);
+    int64_t published = n_events("control_rejected");
+    control(99, 0);
+    drain();
+    ENSURE(n_events("control_rejected") == published + 1);
+    ENSUREF(strstr(last_detail("control_rejected"), "more control_rejected events suppressed"),
+            "detail '%s'", last_detail("control_rejected"));
+    ENSUREF(n_events("control_rejected") + n_suppressed("control_rejected") == bad + 1,
+            "%lld events + %lld suppressed, %d rejected", (long long)n_events("control_rejected"),
+            (long long)n_suppressed("control_rejected"), bad + 1);
+    run_until(g_srv.now + 100 * MS, 0);
+    ENSURE(g_out.status_controls_rejected == bad + 1);
+    stop_server();
+}
+
+/* A flood on _COMMAND: rejections counted, their events limited. */
+static void case_command_flood(void)
+{
+    scene(LAG_RT_REALTIME);
+    start();
+    for (int k = 0; k < 10000; k++) {
+        command(0.0, k % 2 ? "bogus" : "theta1", 1.0);
+        if (k % 10 == 9) run_until(g_srv.now + 100000, 0);
+    }
+    ENSURE(g_srv.rejected[RT_REJ_UNKNOWN_JOINT] == 5000 && g_srv.rejected[RT_REJ_UNACTUATED] == 5000);
+    ENSUREF(n_events("command_rejected") <= 10 + 10 + 1, "%lld events",
+            (long long)n_events("command_rejected"));
+    stop_server();
+}
+
+/* --duration: 1e300 s or 1e16 s is refused (more ticks than a run counts exactly);
+ * 0.5 s stops after the period that reaches it. */
+static void case_duration(void)
+{
+    scene(LAG_RT_FAST);
+    g_opts.duration = 1e300;
+    ENSURE(try_start(0) == LAGSIMD_EXIT_USAGE);
+    g_opts.duration = 1e16;
+    ENSURE(try_start(0) == LAGSIMD_EXIT_USAGE);
+    g_opts.duration = 0.5;
+    ENSURE(try_start(0) == 0);
+    run_until(100 * SEC, 1000);
+    ENSURE(g_srv.stop && g_srv.stop_reason == RT_STOP_DURATION && g_srv.sim.tick == 500);
+    stop_server();
+    ENSURE(n_events("stop") == 1 && !strcmp(last_detail("stop"), "duration reached"));
+}
+
+/* Signals: SIGHUP, SIGQUIT, SIGINT and SIGTERM stop with a stop event naming the signal
+ * and a final status; SIGUSR1 and SIGUSR2 ask for a status and stop nothing. */
+static void case_signals(void)
+{
+    const int stops[] = {SIGHUP, SIGQUIT, SIGINT, SIGTERM};
+    const char *names[] = {"SIGHUP", "SIGQUIT", "SIGINT", "SIGTERM"};
+    for (int i = 0; i < 4; i++) {
+        scene(LAG_RT_REALTIME);
+        start();
+        run_until(g_srv.now + 50 * MS, 0);
+        int64_t st = g_out.status;
+        rt_signal(&g_srv, SIGUSR1);
+        rt_signal(&g_srv, SIGUSR2);
+        ENSURE(!g_srv.stop);
+        run_until(g_srv.now + 1 * MS, 0);
+        ENSURE(g_out.status == st + 1);
+        rt_signal(&g_srv, stops[i]);
+        ENSURE(g_srv.stop);
+        st = g_out.status;
+        stop_server();
+        ENSURE(g_out.status == st + 1 && n_events("stop") == 1);
+        ENSUREF(strstr(last_detail("stop"), names[i]) && g_out.kind_value[kind_index("stop")] == stops[i],
+                "stop event '%s'", last_detail("stop"));
+    }
+}
+
+/* An effort of 1e308: the fault event names the efforts that were held, so the cause is
+ * plain; nothing non-finite is published. */
+static void case_fault_effort(void)
+{
+    scene(LAG_RT_REALTIME);
+    start();
+    run_until(g_srv.now + 50 * MS, 0);
+    command(0.0, "theta0", 1e308);
+    run_until(g_srv.now + 200 * MS, 0);
+    ENSURE(g_srv.run == RT_FAULT && n_events("numeric_fault") == 1);
+    ENSUREF(strstr(last_detail("numeric_fault"), "theta0 = 1e+308"), "detail '%s'",
+            last_detail("numeric_fault"));
+    printf("fault: %s\n", last_detail("numeric_fault"));
+    stop_server();
+}
+
+int main(int argc, char **argv)
+{
+    static const struct {
+        const char *name;
+        void (*fn)(void);
+    } cases[] = {
+        {"pacing", case_pacing},           {"rate_huge", case_rate_huge},
+        {"status_hz", case_status_hz},     {"lockstep_wait", case_lockstep_wait},
+        {"long_period", case_long_period}, {"chunks", case_chunks},
+        {"step_paced", case_step_paced},   {"control_flood", case_control_flood},
+        {"command_flood", case_command_flood}, {"duration", case_duration},
+        {"signals", case_signals},         {"fault_effort", case_fault_effort},
+    };
+    if (argc != 2) {
+        fprintf(stderr, "usage: test_loop CASE\n");
+        return 2;
+    }
+    g_case = argv[1];
+    g_lcm = lcm_create("memq://");
+    ENSURE(g_lcm);
+    lcm_subscribe(g_lcm, "TL_.*", on_any, NULL);
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+        if (!strcmp(cases[i].name, argv[1])) {
+            cases[i].fn();
+            lcm_destroy(g_lcm);
+            printf("test_loop %s: ok (%d checks)\n", g_case, g_checks);
+            return 0;
+        }
+    fprintf(stderr, "test_loop: unknown case %s\n", argv[1]);
+    return 2;
+}
