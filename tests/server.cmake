@@ -4,7 +4,8 @@ add_executable(server_test ${CMAKE_CURRENT_LIST_DIR}/server/server_test.c)
 target_link_libraries(server_test PRIVATE lagsim_scene lagsim_core lagsim_lcmtypes PkgConfig::LCM)
 find_program(LCM_LOGGER lcm-logger)
 set(LAGSIM_SERVER_CASES control hostile watchdog lockstep_timeout two_daemons fault sigterm
-    bad_scene effects)
+    bad_scene effects control_flood step_flood lockstep_huge status_rate rate_huge long_period
+    duration_huge signals effort_absurd ttl_warning offline_signal)
 if(LCM_LOGGER)
   list(APPEND LAGSIM_SERVER_CASES replay replay_dopri5 replay_effects)
 endif()

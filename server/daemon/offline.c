@@ -3,15 +3,24 @@
  *
  * Rows at t = 0 and every output period (ticks_per_period * dt = 1/publish_hz) up to the
  * duration: t, q..., qd..., energy (T + U), every number "%.17g" so that a reread gives the
- * same double. A numeric fault stops the run: the rows so far stay, exit code 1.
+ * same double. A numeric fault stops the run: the rows so far stay, exit code 1. So does
+ * SIGINT, SIGTERM or SIGHUP: the run stops within one chunk of ticks, the rows so far are
+ * flushed and the summary says where it stopped.
  */
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
 
 #include "daemon.h"
+#include "rt_pace.h"
+
+#define OFFLINE_CHUNK_TICKS 65536 /* ticks between two looks at the stop flag */
+
+static volatile sig_atomic_t g_stop_signal;
+static void on_stop_signal(int signo) { g_stop_signal = signo; }
 
 /* One CSV row: t, q, qd as published (with the noise effect, if on), and the energy of
  * the true state. Returns <0 on write error. */
@@ -57,9 +66,17 @@ int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)
     const lag_model_info *info = lag_model_info_get(sc->sim.model.kind);
 
     /* Output periods in the duration: floor(duration / period), with a relative guard so
-     * that 1 s at 100 Hz is 100 periods, not 99.999... */
-    const double period = (double)sc->ticks_per_period * sc->sim.integrator.dt;
+     * that 1 s at 100 Hz is 100 periods, not 99.999... A duration of more ticks than a run
+     * counts exactly (2^53) is refused before anything is written. */
+    const double dt = sc->sim.integrator.dt;
+    const double period = (double)sc->ticks_per_period * dt;
     const double duration = o->duration > 0.0 ? o->duration : 0.0;
+    int64_t ticks = 0;
+    if (duration > 0.0 && !rt_ticks_for(duration, dt, &ticks)) {
+        fprintf(stderr, "lagsimd: --duration %g s is more than 2^53 ticks of dt %g s (the "
+                        "longest run whose sim time is exact)\n", o->duration, dt);
+        return LAGSIMD_EXIT_USAGE;
+    }
     const int64_t nperiods = (int64_t)floor(duration / period * (1.0 + 1e-12) + 1e-9);
 
     static char csvbuf[1 << 20]; /* the CSV is written in large blocks */
@@ -77,13 +94,27 @@ int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)
         write_row(f, &sim);
     }
 
+    /* a signal stops the run cleanly: the rows so far are flushed */
+    struct sigaction sa = {.sa_handler = on_stop_signal}, old[3];
+    sigemptyset(&sa.sa_mask);
+    const int sigs[3] = {SIGINT, SIGTERM, SIGHUP};
+    g_stop_signal = 0;
+    for (int i = 0; i < 3; i++) sigaction(sigs[i], &sa, &old[i]);
+
     const double e0 = lag_sim_energy(&sim);
     const double c0 = cpu_seconds();
     int rc = LAGSIMD_EXIT_OK;
     int64_t k = 0;
     int64_t nevents = 0;
-    for (; k < nperiods; k++) {
-        lag_result r = lag_sim_advance(&sim, sc->ticks_per_period, true);
+    for (; k < nperiods && !g_stop_signal; k++) {
+        /* a period of many ticks in chunks, so that a signal is seen within one chunk;
+         * continuous: dopri5 takes the same steps as in one call */
+        lag_result r = LAG_OK;
+        for (int64_t left = sc->ticks_per_period; left > 0 && r == LAG_OK && !g_stop_signal;) {
+            int64_t n = left < OFFLINE_CHUNK_TICKS ? left : OFFLINE_CHUNK_TICKS;
+            r = lag_sim_advance(&sim, n, true);
+            left -= n;
+        }
         /* the effects' events (impacts, stops, stick/slip, ...): the first few on stderr */
         lag_event ev;
         while (lag_sim_poll_event(&sim, &ev)) {
@@ -101,10 +132,17 @@ int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)
             rc = LAGSIMD_EXIT_RUNTIME;
             break;
         }
+        if (g_stop_signal) break; /* mid-period: no row */
         if (f && write_row(f, &sim) < 0)
             break; /* reported below by ferror */
     }
     const double cpu = cpu_seconds() - c0;
+    for (int i = 0; i < 3; i++) sigaction(sigs[i], &old[i], NULL);
+    if (g_stop_signal) {
+        fprintf(stderr, "lagsimd: stopped by signal %d at t = %.17g s (%lld of %lld periods)\n",
+                (int)g_stop_signal, lag_sim_time(&sim), (long long)k, (long long)nperiods);
+        rc = LAGSIMD_EXIT_RUNTIME;
+    }
 
     if (f) {
         if (fflush(f) != 0 || ferror(f)) {
