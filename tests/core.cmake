@@ -4,8 +4,11 @@
 include(${CMAKE_CURRENT_LIST_DIR}/common/cases.cmake)
 foreach(t models structure conservation convergence determinism validate faults)
   add_executable(test_core_${t} ${CMAKE_CURRENT_SOURCE_DIR}/core/test_${t}.c)
+  # server/core: the unit tests of the core's internals (tables, event engine) read its
+  # private header
   target_include_directories(test_core_${t} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/core
-                                                    ${CMAKE_CURRENT_SOURCE_DIR}/common)
+                                                    ${CMAKE_CURRENT_SOURCE_DIR}/common
+                                                    ${PROJECT_SOURCE_DIR}/server/core)
   target_link_libraries(test_core_${t} PRIVATE lagsim_core m)
   lagsim_add_test_cases(test_core_${t} core.${t} core 120)
 endforeach()

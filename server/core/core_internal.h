@@ -4,8 +4,11 @@
 
 #include "lagsim/lagsim.h"
 
-/* One model kind's closed forms. All arrays are n x n row-major (n = nq). */
-typedef struct lag_model_vtable {
+/* One model kind: its facts and its closed forms, one row of the core's model table
+ * (model.c). All arrays are n x n row-major (n = nq); p is lag_model.p. Every member is
+ * required (core.models.info checks that no row has a hole). */
+typedef struct lag_model_class {
+    const lag_model_info *info;
     void (*mass)(const double *p, const double *q, double *M);
     void (*mass_deriv)(const double *p, const double *q, double *dM);
     void (*coriolis)(const double *p, const double *q, const double *qd, double *C);
@@ -17,19 +20,13 @@ typedef struct lag_model_vtable {
                           const double *tau, double *qdd);
     double (*kinetic)(const double *p, const double *q, const double *qd);
     double (*potential)(const double *p, const double *q);
-} lag_model_vtable;
+} lag_model_class;
 
-extern const lag_model_vtable lag_stick_vtable;
-extern const lag_model_vtable lag_manipulator_vtable;
-extern const lag_model_vtable lag_dipc_vtable;
-extern const lag_model_info lag_stick_info;
-extern const lag_model_info lag_manipulator_info;
-extern const lag_model_info lag_dipc_info;
-
-extern const lag_model_vtable *const lag_model_vtables[LAG_MODEL_COUNT];
-static inline const lag_model_vtable *lag_model_vt(const lag_model *m)
+/* The model table, indexed by lag_model_kind (model.c). */
+extern const lag_model_class *const lag_models[LAG_MODEL_COUNT];
+static inline const lag_model_class *lag_model_vt(const lag_model *m)
 {
-    return lag_model_vtables[m->kind];
+    return lag_models[m->kind];
 }
 
 /* Closed-form LDL^T solves for the sizes the models have (no sqrt, no loops): the

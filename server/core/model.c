@@ -6,12 +6,17 @@
 #include <string.h>
 #include "core_internal.h"
 
-static const lag_model_info *const infos[LAG_MODEL_COUNT] = {
-    &lag_stick_info, &lag_manipulator_info, &lag_dipc_info,
+/* The model table: one row per lag_model_kind, defined in the model's own file. A kind
+ * added to the enum without its row breaks the build here; a row whose kind is missing
+ * from the enum does not compile. */
+extern const lag_model_class lag_stick_model, lag_manipulator_model, lag_dipc_model;
+const lag_model_class *const lag_models[] = {
+    [LAG_MODEL_STICK] = &lag_stick_model,
+    [LAG_MODEL_MANIPULATOR] = &lag_manipulator_model,
+    [LAG_MODEL_DIPC] = &lag_dipc_model,
 };
-const lag_model_vtable *const lag_model_vtables[LAG_MODEL_COUNT] = {
-    &lag_stick_vtable, &lag_manipulator_vtable, &lag_dipc_vtable,
-};
+_Static_assert(sizeof lag_models / sizeof lag_models[0] == LAG_MODEL_COUNT,
+               "the model table needs one row per lag_model_kind");
 
 const char *lag_result_string(lag_result r)
 {
@@ -33,14 +38,27 @@ const char *lag_result_string(lag_result r)
 const lag_model_info *lag_model_info_get(lag_model_kind kind)
 {
     if ((int)kind < 0 || kind >= LAG_MODEL_COUNT) return NULL;
-    return infos[kind];
+    return lag_models[kind]->info;
 }
 
 int lag_model_kind_from_name(const char *name)
 {
     for (int k = 0; k < LAG_MODEL_COUNT; k++)
-        if (name && strcmp(name, infos[k]->name) == 0) return k;
+        if (name && strcmp(name, lag_models[k]->info->name) == 0) return k;
     return -1;
+}
+
+const char *lag_model_names(char *buf, size_t len)
+{
+    size_t used = 0;
+    if (!buf || len == 0) return buf;
+    buf[0] = '\0';
+    for (int k = 0; k < LAG_MODEL_COUNT && used < len; k++) {
+        int w = snprintf(buf + used, len - used, "%s%s", k ? ", " : "", lag_models[k]->info->name);
+        if (w < 0) break;
+        used += (size_t)w;
+    }
+    return buf;
 }
 
 int lag_model_param_index(lag_model_kind kind, const char *name)
@@ -55,27 +73,22 @@ int lag_model_param_index(lag_model_kind kind, const char *name)
 
 void lag_model_default_unfinished(lag_model *m, lag_model_kind kind)
 {
-    const lag_model_info *info = infos[kind];
+    const lag_model_info *info = lag_models[kind]->info;
     memset(m, 0, sizeof *m);
     m->kind = kind;
     m->nq = info->nq;
     for (int i = 0; i < info->np; i++) m->p[i] = info->param_defaults[i];
 }
 
-/* Uniform rod inertia about its centre, m l^2 / 12, for each inertia still NaN. */
+/* Uniform rod inertia about its centre, m l^2 / 12, for each rod's inertia still NaN. */
 void lag_model_finish(lag_model *m)
 {
+    const lag_model_info *info = lag_model_info_get(m->kind);
+    if (!info) return;
     double *p = m->p;
-    switch (m->kind) {
-    case LAG_MODEL_STICK:
-        if (isnan(p[LAG_STICK_I])) p[LAG_STICK_I] = p[LAG_STICK_M] * p[LAG_STICK_L] * p[LAG_STICK_L] / 12.0;
-        break;
-    case LAG_MODEL_DIPC:
-        if (isnan(p[LAG_DIPC_I1])) p[LAG_DIPC_I1] = p[LAG_DIPC_M1] * p[LAG_DIPC_L1] * p[LAG_DIPC_L1] / 12.0;
-        if (isnan(p[LAG_DIPC_I2])) p[LAG_DIPC_I2] = p[LAG_DIPC_M2] * p[LAG_DIPC_L2] * p[LAG_DIPC_L2] / 12.0;
-        break;
-    default:
-        break;
+    for (int r = 0; r < info->n_rods; r++) {
+        const lag_rod *rod = &info->rods[r];
+        if (isnan(p[rod->inertia])) p[rod->inertia] = p[rod->mass] * p[rod->length] * p[rod->length] / 12.0;
     }
 }
 
@@ -111,21 +124,24 @@ lag_result lag_model_check(const lag_model *m, lag_diag *d)
         return lag_diag_fail(d, "model", "%s has %d coordinates, not %d", info->name,
                              info->nq, m->nq);
     for (int i = 0; i < info->np; i++) {
-        const char *name = info->param_names[i];
         double v = m->p[i];
         char field[LAG_FIELD_MAX];
-        snprintf(field, sizeof field, "parameters.%s", name);
+        snprintf(field, sizeof field, "parameters.%s", info->param_names[i]);
         if (!isfinite(v)) return lag_diag_fail(d, field, "expected a finite number, got %g", v);
-        /* h0 may be any height; g may be 0 (no gravity) but not negative (flip the
-         * coordinates instead); every mass, length and inertia must be positive. */
-        if (strcmp(name, "h0") == 0) continue;
-        if (strcmp(name, "g") == 0) {
-            if (v < 0) return lag_diag_fail(d, field, "expected a number >= 0 (m/s^2), got %g", v);
-            continue;
+        switch (info->param_rules[i]) {
+        case LAG_PARAM_POSITIVE:
+            if (!(v > 0))
+                return lag_diag_fail(d, field, "expected a number > 0 (%s), got %g",
+                                     info->param_units[i], v);
+            break;
+        case LAG_PARAM_NONNEGATIVE:
+            if (!(v >= 0))
+                return lag_diag_fail(d, field, "expected a number >= 0 (%s), got %g",
+                                     info->param_units[i], v);
+            break;
+        case LAG_PARAM_ANY:
+            break;
         }
-        if (v <= 0)
-            return lag_diag_fail(d, field, "expected a number > 0 (%s), got %g",
-                                 info->param_units[i], v);
     }
     return LAG_OK;
 }
@@ -140,38 +156,38 @@ lag_result lag_model_validate(const lag_model *m, char *err, size_t errlen)
 
 void lag_model_mass(const lag_model *m, const double *q, double *M)
 {
-    lag_model_vtables[m->kind]->mass(m->p, q, M);
+    lag_models[m->kind]->mass(m->p, q, M);
 }
 
 void lag_model_mass_deriv(const lag_model *m, const double *q, double *dM)
 {
-    lag_model_vtables[m->kind]->mass_deriv(m->p, q, dM);
+    lag_models[m->kind]->mass_deriv(m->p, q, dM);
 }
 
 void lag_model_coriolis(const lag_model *m, const double *q, const double *qd, double *C)
 {
-    lag_model_vtables[m->kind]->coriolis(m->p, q, qd, C);
+    lag_models[m->kind]->coriolis(m->p, q, qd, C);
 }
 
 void lag_model_gravity(const lag_model *m, const double *q, double *g)
 {
-    lag_model_vtables[m->kind]->gravity(m->p, q, g);
+    lag_models[m->kind]->gravity(m->p, q, g);
 }
 
 void lag_model_bias(const lag_model *m, const double *q, const double *qd, double *h)
 {
     double M[LAG_MAX_DOF * LAG_MAX_DOF];
-    lag_model_vtables[m->kind]->mass_bias(m->p, q, qd, M, h);
+    lag_models[m->kind]->mass_bias(m->p, q, qd, M, h);
 }
 
 double lag_model_kinetic(const lag_model *m, const double *q, const double *qd)
 {
-    return lag_model_vtables[m->kind]->kinetic(m->p, q, qd);
+    return lag_models[m->kind]->kinetic(m->p, q, qd);
 }
 
 double lag_model_potential(const lag_model *m, const double *q)
 {
-    return lag_model_vtables[m->kind]->potential(m->p, q);
+    return lag_models[m->kind]->potential(m->p, q);
 }
 
 lag_result lag_spd_solve(int n, const double *A, const double *b, double *x)
@@ -240,7 +256,7 @@ lag_result lag_model_forward(const lag_model *m, const double *q, const double *
 {
     static const double zero[LAG_MAX_DOF] = {0};
     if (!tau) tau = zero;
-    lag_result r = lag_model_vtables[m->kind]->forward(m->p, q, qd, tau, qdd);
+    lag_result r = lag_models[m->kind]->forward(m->p, q, qd, tau, qdd);
     /* a NaN or Inf argument also fails the pivot test: say which it was */
     if (r == LAG_ERR_SINGULAR && !(lag_state_ok(m->nq, q, INFINITY) &&
                                    lag_state_ok(m->nq, qd, INFINITY) &&

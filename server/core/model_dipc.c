@@ -134,19 +134,30 @@ static double dipc_potential(const double *p, const double *q)
     return m1 * gr * y1 + m2 * gr * y2;
 }
 
-const lag_model_vtable lag_dipc_vtable = {
-    dipc_mass, dipc_mass_deriv, dipc_coriolis, dipc_gravity, dipc_mass_bias,
-    dipc_forward, dipc_kinetic, dipc_potential,
-};
-
-const lag_model_info lag_dipc_info = {
+static const lag_model_info info = {
     .name = "dipc",
     .nq = 3,
     .np = LAG_DIPC_NP,
     .param_names = {"m0", "m1", "m2", "l1", "l2", "I1", "I2", "g", "h0"},
     .param_defaults = {1.5, 0.5, 0.75, 0.5, 0.75, NAN, NAN, 9.81, 0.0},
     .param_units = {"kg", "kg", "kg", "m", "m", "kg m^2", "kg m^2", "m/s^2", "m"},
+    .param_rules = {[LAG_DIPC_G] = LAG_PARAM_NONNEGATIVE, [LAG_DIPC_H0] = LAG_PARAM_ANY},
+    .n_rods = 2,
+    .rods = {{LAG_DIPC_I1, LAG_DIPC_M1, LAG_DIPC_L1}, {LAG_DIPC_I2, LAG_DIPC_M2, LAG_DIPC_L2}},
     .joint_names = {"theta0", "theta1", "theta2"},
     .actuated = {true, false, false},
     .angular = {false, true, true},
+};
+
+/* The model table's row (model.c). */
+const lag_model_class lag_dipc_model = {
+    .info = &info,
+    .mass = dipc_mass,
+    .mass_deriv = dipc_mass_deriv,
+    .coriolis = dipc_coriolis,
+    .gravity = dipc_gravity,
+    .mass_bias = dipc_mass_bias,
+    .forward = dipc_forward,
+    .kinetic = dipc_kinetic,
+    .potential = dipc_potential,
 };

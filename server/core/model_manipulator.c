@@ -81,19 +81,28 @@ static double manip_potential(const double *p, const double *q)
     return (P_M1 * P_L1 + P_M2 * q[1]) * P_G * sin(q[0]);
 }
 
-const lag_model_vtable lag_manipulator_vtable = {
-    manip_mass, manip_mass_deriv, manip_coriolis, manip_gravity, manip_mass_bias,
-    manip_forward, manip_kinetic, manip_potential,
-};
-
-const lag_model_info lag_manipulator_info = {
+static const lag_model_info info = {
     .name = "manipulator",
     .nq = 2,
     .np = LAG_MANIP_NP,
     .param_names = {"m1", "m2", "l1", "I1", "I2", "g"},
     .param_defaults = {2.0, 1.0, 0.3, 0.02, 0.05, 9.81},
     .param_units = {"kg", "kg", "m", "kg m^2", "kg m^2", "m/s^2"},
+    .param_rules = {[LAG_MANIP_G] = LAG_PARAM_NONNEGATIVE},
     .joint_names = {"q1", "q2"},
     .actuated = {true, true},
     .angular = {true, false},
+};
+
+/* The model table's row (model.c). */
+const lag_model_class lag_manipulator_model = {
+    .info = &info,
+    .mass = manip_mass,
+    .mass_deriv = manip_mass_deriv,
+    .coriolis = manip_coriolis,
+    .gravity = manip_gravity,
+    .mass_bias = manip_mass_bias,
+    .forward = manip_forward,
+    .kinetic = manip_kinetic,
+    .potential = manip_potential,
 };

@@ -81,19 +81,30 @@ static double stick_potential(const double *p, const double *q)
     return P_M * P_G * 0.5 * P_L * sin(q[1]);
 }
 
-const lag_model_vtable lag_stick_vtable = {
-    stick_mass, stick_mass_deriv, stick_coriolis, stick_gravity, stick_mass_bias,
-    stick_forward, stick_kinetic, stick_potential,
-};
-
-const lag_model_info lag_stick_info = {
+static const lag_model_info info = {
     .name = "stick",
     .nq = 2,
     .np = LAG_STICK_NP,
     .param_names = {"m", "l", "I", "g"},
     .param_defaults = {1.0, 1.0, NAN, 9.81},
     .param_units = {"kg", "m", "kg m^2", "m/s^2"},
+    .param_rules = {[LAG_STICK_G] = LAG_PARAM_NONNEGATIVE},
+    .n_rods = 1,
+    .rods = {{LAG_STICK_I, LAG_STICK_M, LAG_STICK_L}},
     .joint_names = {"x", "phi"},
     .actuated = {true, true},
     .angular = {false, true},
+};
+
+/* The model table's row (model.c). */
+const lag_model_class lag_stick_model = {
+    .info = &info,
+    .mass = stick_mass,
+    .mass_deriv = stick_mass_deriv,
+    .coriolis = stick_coriolis,
+    .gravity = stick_gravity,
+    .mass_bias = stick_mass_bias,
+    .forward = stick_forward,
+    .kinetic = stick_kinetic,
+    .potential = stick_potential,
 };

@@ -233,7 +233,7 @@ lag_result lag_sim_rhs_qp(lag_sim *s, const double *y, double *ydot)
 {
     int n = s->nq;
     const lag_model *m = &s->def.model;
-    const lag_model_vtable *vt = lag_model_vt(m);
+    const lag_model_class *vt = lag_model_vt(m);
     double dM[LAG_MAX_DOF * LAG_MAX_DOF * LAG_MAX_DOF];
     double g[LAG_MAX_DOF], Q[LAG_MAX_DOF], qd[LAG_MAX_DOF];
     s->stats.rhs_evals++;

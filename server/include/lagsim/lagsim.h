@@ -89,22 +89,46 @@ enum { LAG_MANIP_M1, LAG_MANIP_M2, LAG_MANIP_L1, LAG_MANIP_I1, LAG_MANIP_I2, LAG
 enum { LAG_DIPC_M0, LAG_DIPC_M1, LAG_DIPC_M2, LAG_DIPC_L1, LAG_DIPC_L2, LAG_DIPC_I1,
        LAG_DIPC_I2, LAG_DIPC_G, LAG_DIPC_H0, LAG_DIPC_NP };
 
-/* Static facts about a model kind. */
+/* What values a parameter may take; every parameter must be finite. The zero value is
+ * the strictest, so a rule left out of a table is "positive". */
+typedef enum lag_param_rule {
+    LAG_PARAM_POSITIVE = 0, /* > 0: masses, lengths, inertias */
+    LAG_PARAM_NONNEGATIVE,  /* >= 0: g (0 switches gravity off) */
+    LAG_PARAM_ANY           /* any finite number: heights, offsets */
+} lag_param_rule;
+
+/* A uniform rod: parameter `inertia` defaults to m l^2 / 12 of parameters `mass` and
+ * `length` (its inertia about its centre), computed when the model is finished. */
+typedef struct lag_rod {
+    int inertia, mass, length; /* parameter indices */
+} lag_rod;
+#define LAG_MAX_RODS LAG_MAX_DOF
+
+/* Static facts about a model kind: everything a loader, a client or a test needs to
+ * know about its coordinates and parameters, as data. */
 typedef struct lag_model_info {
     const char *name;                          /* "stick", "manipulator", "dipc" */
     int nq;                                    /* number of generalized coordinates */
     int np;                                    /* number of parameters */
     const char *param_names[LAG_MAX_PARAMS];   /* "m", "l", "I", "g", ... */
-    double param_defaults[LAG_MAX_PARAMS];     /* SI units; NaN = uniform rod m l^2/12 */
+    double param_defaults[LAG_MAX_PARAMS];     /* SI units; NaN: a rod's inertia (rods) */
     const char *param_units[LAG_MAX_PARAMS];   /* "kg", "m", "kg m^2", "m/s^2" */
+    lag_param_rule param_rules[LAG_MAX_PARAMS];
+    int n_rods;                                /* uniform-rod inertia defaults */
+    lag_rod rods[LAG_MAX_RODS];
     const char *joint_names[LAG_MAX_DOF];      /* "x", "phi", ... */
     bool actuated[LAG_MAX_DOF];                /* which coordinates take an input */
     bool angular[LAG_MAX_DOF];                 /* rad (true) or m (false) */
 } lag_model_info;
 
+/* The facts of a kind, or NULL for a kind outside 0..LAG_MODEL_COUNT-1. Loaders and
+ * tests iterate kinds 0..LAG_MODEL_COUNT-1: a model added to the core's table is then
+ * known to them by name without another list. */
 const lag_model_info *lag_model_info_get(lag_model_kind kind);
 /* Returns the kind for a name, or -1. */
 int lag_model_kind_from_name(const char *name);
+/* "stick, manipulator, dipc": every model's name, for messages. Returns buf. */
+const char *lag_model_names(char *buf, size_t len);
 
 typedef struct lag_model {
     lag_model_kind kind;
@@ -114,13 +138,14 @@ typedef struct lag_model {
 
 /* Fills m with the kind's defaults, finished (see lag_model_finish). */
 void lag_model_default(lag_model *m, lag_model_kind kind);
-/* Fills m with the kind's defaults but leaves the inertias of uniform rods (stick I,
- * DIPC I1, I2) as NaN = "not given": a loader overrides what the scene names, then
- * calls lag_model_finish, which sets each inertia still NaN to m l^2 / 12 of its rod. */
+/* Fills m with the kind's defaults but leaves the inertias of uniform rods (info.rods:
+ * stick I, DIPC I1, I2) as NaN = "not given": a loader overrides what the scene names,
+ * then calls lag_model_finish, which sets each inertia still NaN to m l^2 / 12 of its
+ * rod. */
 void lag_model_default_unfinished(lag_model *m, lag_model_kind kind);
 void lag_model_finish(lag_model *m);
-/* Checks every parameter (finite; masses, lengths, inertias > 0; g >= 0 finite).
- * Returns LAG_ERR_ARG and fills d (see lag_diag; field "parameters.<name>"). OUT: d */
+/* Checks every parameter against its rule (info.param_rules; all finite). Returns
+ * LAG_ERR_ARG and fills d (see lag_diag; field "parameters.<name>"). OUT: d */
 lag_result lag_model_check(const lag_model *m, lag_diag *d);
 /* The same, with "field: message" written into err. */
 lag_result lag_model_validate(const lag_model *m, char *err, size_t errlen);
