@@ -81,6 +81,11 @@ lag_result lag_step_semi_implicit_euler(lag_sim *s, double h, const double *y0, 
 lag_result lag_step_rk4(lag_sim *s, double h, const double *y0, double *y1);
 lag_result lag_step_gauss(lag_sim *s, int stages, double h, const double *y0, double *y1);
 lag_result lag_dopri5_span(lag_sim *s, double h, const double *y0, double *y1);
+/* An adaptive method's own advance of n ticks (its row's `advance`). */
+lag_result lag_adaptive_advance(lag_sim *s, int64_t n, bool continuous);
+/* The method table has no hole: a name, a step, an order for every row, an advance
+ * exactly for the adaptive ones, unique names (core.models.info checks it). */
+bool lag_method_table_ok(void);
 /* dopri5 without events: advances the public state to tick + n (see lag_sim_advance). */
 lag_result lag_dopri5_advance(lag_sim *s, int64_t n, bool continuous);
 

@@ -1,27 +1,73 @@
 /* Integrator names and defaults, and the explicit fixed-step methods on y = (q, qd). */
+#include <stdio.h>
 #include <string.h>
 #include "core_internal.h"
 
-static const char *const method_names[LAG_METHOD_COUNT] = {
-    "euler", "semi-implicit-euler", "rk4", "dopri5", "implicit-midpoint", "gauss4",
+/* The method table: one row per lag_method (designated initializers; the size is checked
+ * against LAG_METHOD_COUNT, so a method without its row does not build). */
+typedef struct method_class {
+    lag_method_info info;
+    /* one step of h from y0 (an adaptive method: sub-steps landing on h) */
+    lag_result (*step)(lag_sim *s, double h, const double *y0, double *y1);
+    /* adaptive methods: n ticks of the public state without stopping at each tick
+     * (lag_sim_advance's path when no effect needs the tick boundaries) */
+    lag_result (*advance)(lag_sim *s, int64_t n, bool continuous);
+} method_class;
+
+static lag_result step_midpoint(lag_sim *s, double h, const double *y0, double *y1)
+{
+    return lag_step_gauss(s, 1, h, y0, y1);
+}
+static lag_result step_gauss4(lag_sim *s, double h, const double *y0, double *y1)
+{
+    return lag_step_gauss(s, 2, h, y0, y1);
+}
+
+static const method_class methods[] = {
+    [LAG_EULER] = {{"euler", 1, false, false, false}, lag_step_euler},
+    [LAG_SEMI_IMPLICIT_EULER] = {{"semi-implicit-euler", 1, false, false, false},
+                                 lag_step_semi_implicit_euler},
+    [LAG_RK4] = {{"rk4", 4, false, false, false}, lag_step_rk4},
+    [LAG_DOPRI5] = {{"dopri5", 5, true, false, false}, lag_dopri5_span, lag_dopri5_advance},
+    [LAG_IMPLICIT_MIDPOINT] = {{"implicit-midpoint", 2, false, true, true}, step_midpoint},
+    [LAG_GAUSS4] = {{"gauss4", 4, false, true, true}, step_gauss4},
 };
-static const int method_orders[LAG_METHOD_COUNT] = {1, 1, 4, 5, 2, 4};
+_Static_assert(sizeof methods / sizeof methods[0] == LAG_METHOD_COUNT,
+               "the method table needs one row per lag_method");
+
+const lag_method_info *lag_method_info_get(lag_method m)
+{
+    return ((int)m >= 0 && m < LAG_METHOD_COUNT) ? &methods[m].info : NULL;
+}
 
 const char *lag_method_name(lag_method m)
 {
-    return ((int)m >= 0 && m < LAG_METHOD_COUNT) ? method_names[m] : "unknown";
+    return ((int)m >= 0 && m < LAG_METHOD_COUNT) ? methods[m].info.name : "unknown";
 }
 
 int lag_method_from_name(const char *name)
 {
     for (int i = 0; i < LAG_METHOD_COUNT; i++)
-        if (name && strcmp(name, method_names[i]) == 0) return i;
+        if (name && strcmp(name, methods[i].info.name) == 0) return i;
     return -1;
 }
 
 int lag_method_order(lag_method m)
 {
-    return ((int)m >= 0 && m < LAG_METHOD_COUNT) ? method_orders[m] : 0;
+    return ((int)m >= 0 && m < LAG_METHOD_COUNT) ? methods[m].info.order : 0;
+}
+
+const char *lag_method_names(char *buf, size_t len)
+{
+    size_t used = 0;
+    if (!buf || len == 0) return buf;
+    buf[0] = '\0';
+    for (int i = 0; i < LAG_METHOD_COUNT && used < len; i++) {
+        int w = snprintf(buf + used, len - used, "%s%s", i ? ", " : "", methods[i].info.name);
+        if (w < 0) break;
+        used += (size_t)w;
+    }
+    return buf;
 }
 
 lag_integrator_def lag_default_integrator_def(void)
@@ -84,13 +130,22 @@ lag_result lag_step_rk4(lag_sim *s, double h, const double *y0, double *y1)
 
 lag_result lag_step(lag_sim *s, double h, const double *y0, double *y1)
 {
-    switch (s->def.integrator.method) {
-    case LAG_EULER: return lag_step_euler(s, h, y0, y1);
-    case LAG_SEMI_IMPLICIT_EULER: return lag_step_semi_implicit_euler(s, h, y0, y1);
-    case LAG_RK4: return lag_step_rk4(s, h, y0, y1);
-    case LAG_DOPRI5: return lag_dopri5_span(s, h, y0, y1);
-    case LAG_IMPLICIT_MIDPOINT: return lag_step_gauss(s, 1, h, y0, y1);
-    case LAG_GAUSS4: return lag_step_gauss(s, 2, h, y0, y1);
-    default: return LAG_ERR_ARG;
+    return methods[s->def.integrator.method].step(s, h, y0, y1);
+}
+
+lag_result lag_adaptive_advance(lag_sim *s, int64_t n, bool continuous)
+{
+    return methods[s->def.integrator.method].advance(s, n, continuous);
+}
+
+bool lag_method_table_ok(void)
+{
+    for (int i = 0; i < LAG_METHOD_COUNT; i++) {
+        const method_class *c = &methods[i];
+        if (!c->info.name || !c->step || c->info.order < 1) return false;
+        if (c->info.adaptive != (c->advance != NULL)) return false;
+        for (int j = 0; j < i; j++)
+            if (strcmp(methods[j].info.name, c->info.name) == 0) return false;
     }
+    return true;
 }

@@ -369,8 +369,9 @@ lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
     if (nticks <= 0) return LAG_OK;
     const int n = s->nq;
     const uint32_t en = s->def.effects.enabled;
-    if (!(en & TICK_EFFECTS) && s->def.integrator.method == LAG_DOPRI5) {
-        lag_result r = lag_dopri5_advance(s, nticks, continuous);
+    const bool adaptive = lag_method_info_get(s->def.integrator.method)->adaptive;
+    if (!(en & TICK_EFFECTS) && adaptive) {
+        lag_result r = lag_adaptive_advance(s, nticks, continuous);
         return r == LAG_OK ? r : classify_fault(s, r, s->qd);
     }
     for (int64_t k = 0; k < nticks; k++) {
@@ -394,7 +395,7 @@ lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
         }
         for (int i = 0; i < n; i++) { s->q[i] = y[i]; s->qd[i] = y[n + i]; }
         s->tick++;
-        if (s->def.integrator.method != LAG_DOPRI5) s->stats.steps_accepted++;
+        if (!adaptive) s->stats.steps_accepted++; /* an adaptive method counts its own */
     }
     return LAG_OK;
 }

@@ -18,18 +18,6 @@
 #ifndef LAGSIM_TEST_CORE_H
 #define LAGSIM_TEST_CORE_H
 
-#include <complex.h>
-/* glibc defines CMPLX only where the compiler has __builtin_complex (not clang 14). C11
- * lays a double complex out as double[2], which this fallback fills exactly (x + I*y
- * would not be exact for infinite or NaN parts). */
-#ifndef CMPLX
-static inline double complex lag_test_cmplx(double re, double im)
-{
-    union { double complex z; double d[2]; } u = {.d = {re, im}};
-    return u.z;
-}
-#define CMPLX(x, y) lag_test_cmplx((x), (y))
-#endif
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
@@ -39,201 +27,59 @@ static inline double complex lag_test_cmplx(double re, double im)
 
 #include "lagsim/lagsim.h"
 #include "lagsim_test.h"
+#include "ref_models.h" /* the models written again: kinematics, T, U */
 
-/* complex.h defines I; the inertias are called I in the brief, so the macro must go. */
-#undef I
-typedef double complex cplx;
-
-#define TC_PI 3.14159265358979323846
 #define TC_EPS DBL_EPSILON
 /* complex-step size: any h with h^2 * |f'''| far below eps |f'| works; 1e-20 does. */
 #define TC_CSTEP 1e-20
 
-/* ------------------------------------------------------------------ models, again */
-static inline int tc_nq(lag_model_kind k) { return k == LAG_MODEL_DIPC ? 3 : 2; }
+/* ------------------------------------------------------------------ random models */
+static inline int tc_nq(lag_model_kind k) { return lag_model_info_get(k)->nq; }
 
-/* Random but physical parameters: masses 0.2..3 kg, lengths 0.2..2 m, g 1..20 m/s^2,
- * inertias either the uniform-rod value or anything in 0.01..1 kg m^2, h0 0..1 m. */
+/* Random but physical parameters, from the model's own table of units and rules: masses
+ * 0.2..3 kg, lengths 0.2..2 m, inertias 0.01..1 kg m^2 (or, one model in two, every rod's
+ * uniform-rod value m l^2 / 12), g 1..20 m/s^2, parameters that may take any value (h0)
+ * 0..1. A unit without a range stops the test: give it one here. */
 static inline void tc_random_model(lt_rng *r, lag_model_kind kind, lag_model *m)
 {
+    const lag_model_info *inf = lag_model_info_get(kind);
     lag_model_default(m, kind);
     bool rod = lt_uniform(r, 0, 1) < 0.5;
-    switch (kind) {
-    case LAG_MODEL_STICK:
-        m->p[LAG_STICK_M] = lt_uniform(r, 0.2, 3);
-        m->p[LAG_STICK_L] = lt_uniform(r, 0.2, 2);
-        m->p[LAG_STICK_I] = rod ? m->p[LAG_STICK_M] * m->p[LAG_STICK_L] * m->p[LAG_STICK_L] / 12
-                                : lt_uniform(r, 0.01, 1);
-        m->p[LAG_STICK_G] = lt_uniform(r, 1, 20);
-        break;
-    case LAG_MODEL_MANIPULATOR:
-        m->p[LAG_MANIP_M1] = lt_uniform(r, 0.2, 3);
-        m->p[LAG_MANIP_M2] = lt_uniform(r, 0.2, 3);
-        m->p[LAG_MANIP_L1] = lt_uniform(r, 0.2, 2);
-        m->p[LAG_MANIP_I1] = lt_uniform(r, 0.01, 1);
-        m->p[LAG_MANIP_I2] = lt_uniform(r, 0.01, 1);
-        m->p[LAG_MANIP_G] = lt_uniform(r, 1, 20);
-        break;
-    default:
-        m->p[LAG_DIPC_M0] = lt_uniform(r, 0.2, 3);
-        m->p[LAG_DIPC_M1] = lt_uniform(r, 0.2, 3);
-        m->p[LAG_DIPC_M2] = lt_uniform(r, 0.2, 3);
-        m->p[LAG_DIPC_L1] = lt_uniform(r, 0.2, 2);
-        m->p[LAG_DIPC_L2] = lt_uniform(r, 0.2, 2);
-        m->p[LAG_DIPC_I1] = rod ? m->p[LAG_DIPC_M1] * m->p[LAG_DIPC_L1] * m->p[LAG_DIPC_L1] / 12
-                                : lt_uniform(r, 0.01, 1);
-        m->p[LAG_DIPC_I2] = rod ? m->p[LAG_DIPC_M2] * m->p[LAG_DIPC_L2] * m->p[LAG_DIPC_L2] / 12
-                                : lt_uniform(r, 0.01, 1);
-        m->p[LAG_DIPC_G] = lt_uniform(r, 1, 20);
-        m->p[LAG_DIPC_H0] = lt_uniform(r, 0, 1);
-        break;
+    for (int i = 0; i < inf->np; ++i) {
+        const char *u = inf->param_units[i];
+        if (inf->param_rules[i] == LAG_PARAM_ANY) m->p[i] = lt_uniform(r, 0, 1);
+        else if (!strcmp(u, "kg")) m->p[i] = lt_uniform(r, 0.2, 3);
+        else if (!strcmp(u, "m")) m->p[i] = lt_uniform(r, 0.2, 2);
+        else if (!strcmp(u, "kg m^2")) m->p[i] = lt_uniform(r, 0.01, 1);
+        else if (!strcmp(u, "m/s^2")) m->p[i] = lt_uniform(r, 1, 20);
+        else {
+            fprintf(stderr, "test_core.h: no random range for unit '%s' (%s.%s)\n", u, inf->name,
+                    inf->param_names[i]);
+            abort();
+        }
     }
+    if (rod)
+        for (int k = 0; k < inf->n_rods; ++k) {
+            lag_rod rd = inf->rods[k];
+            m->p[rd.inertia] = m->p[rd.mass] * m->p[rd.length] * m->p[rd.length] / 12;
+        }
 }
 
-/* Random state: positions -2..2 m, angles -pi..pi, rates -5..5. */
+/* Random state: angles -pi..pi, positions -2..2, rates -5..5. */
 static inline void tc_random_state(lt_rng *r, const lag_model *m, double *q, double *qd)
 {
+    const lag_model_info *inf = lag_model_info_get(m->kind);
     for (int i = 0; i < m->nq; ++i) {
-        q[i] = lt_uniform(r, -TC_PI, TC_PI);
+        q[i] = inf->angular[i] ? lt_uniform(r, -TC_PI, TC_PI) : lt_uniform(r, -2, 2);
         qd[i] = lt_uniform(r, -5, 5);
     }
-    if (m->kind == LAG_MODEL_STICK) q[0] = lt_uniform(r, -2, 2);
-    if (m->kind == LAG_MODEL_MANIPULATOR) q[1] = lt_uniform(r, -2, 2);
-    if (m->kind == LAG_MODEL_DIPC) q[0] = lt_uniform(r, -2, 2);
 }
 
-/* The bodies of a model, straight from the brief: centre of mass (x, y), its velocity
- * (vx, vy) = d r_c / dt written out by the chain rule, angular velocity w, mass, inertia
- * about the centre of mass. Complex arguments so that complex steps pass through. */
-typedef struct tc_bodies {
-    int nb;
-    double mass[3], inertia[3];
-    cplx x[3], y[3], vx[3], vy[3], w[3];
-} tc_bodies;
-
-static inline void tc_kinematics(const lag_model *m, const cplx *q, const cplx *qd, tc_bodies *b)
+/* Random start of a motion for the structure tests: q_i in the reference's range. */
+static inline void tc_motion_start(lt_rng *r, const lag_model *m, double *q)
 {
-    const double *p = m->p;
-    memset(b, 0, sizeof *b);
-    switch (m->kind) {
-    case LAG_MODEL_STICK: {
-        /* r_c = (x, (l/2) sin phi), omega = phi_dot */
-        double l = p[LAG_STICK_L];
-        b->nb = 1;
-        b->mass[0] = p[LAG_STICK_M];
-        b->inertia[0] = p[LAG_STICK_I];
-        b->x[0] = q[0];
-        b->y[0] = 0.5 * l * csin(q[1]);
-        b->vx[0] = qd[0];
-        b->vy[0] = 0.5 * l * ccos(q[1]) * qd[1];
-        b->w[0] = qd[1];
-        break;
-    }
-    case LAG_MODEL_MANIPULATOR: {
-        /* r_c1 = l1 (cos q1, sin q1), r_c2 = q2 (cos q1, sin q1), omega = q1_dot (both) */
-        double l1 = p[LAG_MANIP_L1];
-        cplx c = ccos(q[0]), s = csin(q[0]);
-        b->nb = 2;
-        b->mass[0] = p[LAG_MANIP_M1];
-        b->mass[1] = p[LAG_MANIP_M2];
-        b->inertia[0] = p[LAG_MANIP_I1];
-        b->inertia[1] = p[LAG_MANIP_I2];
-        b->x[0] = l1 * c;
-        b->y[0] = l1 * s;
-        b->vx[0] = -l1 * s * qd[0];
-        b->vy[0] = l1 * c * qd[0];
-        b->w[0] = qd[0];
-        b->x[1] = q[1] * c;
-        b->y[1] = q[1] * s;
-        b->vx[1] = qd[1] * c - q[1] * s * qd[0];
-        b->vy[1] = qd[1] * s + q[1] * c * qd[0];
-        b->w[1] = qd[0];
-        break;
-    }
-    default: {
-        /* r_0 = (theta0, 0); r_1 = (theta0 + l1/2 sin th1, h0 + l1/2 cos th1);
-         * r_2 = (theta0 + l1 sin th1 + l2/2 sin th2, h0 + l1 cos th1 + l2/2 cos th2);
-         * the cart does not rotate, rod i turns at theta_i_dot. */
-        double l1 = p[LAG_DIPC_L1], l2 = p[LAG_DIPC_L2], h0 = p[LAG_DIPC_H0];
-        cplx s1 = csin(q[1]), c1 = ccos(q[1]), s2 = csin(q[2]), c2 = ccos(q[2]);
-        b->nb = 3;
-        b->mass[0] = p[LAG_DIPC_M0];
-        b->mass[1] = p[LAG_DIPC_M1];
-        b->mass[2] = p[LAG_DIPC_M2];
-        b->inertia[0] = 0;
-        b->inertia[1] = p[LAG_DIPC_I1];
-        b->inertia[2] = p[LAG_DIPC_I2];
-        b->x[0] = q[0];
-        b->y[0] = 0;
-        b->vx[0] = qd[0];
-        b->vy[0] = 0;
-        b->w[0] = 0;
-        b->x[1] = q[0] + 0.5 * l1 * s1;
-        b->y[1] = h0 + 0.5 * l1 * c1;
-        b->vx[1] = qd[0] + 0.5 * l1 * c1 * qd[1];
-        b->vy[1] = -0.5 * l1 * s1 * qd[1];
-        b->w[1] = qd[1];
-        b->x[2] = q[0] + l1 * s1 + 0.5 * l2 * s2;
-        b->y[2] = h0 + l1 * c1 + 0.5 * l2 * c2;
-        b->vx[2] = qd[0] + l1 * c1 * qd[1] + 0.5 * l2 * c2 * qd[2];
-        b->vy[2] = -l1 * s1 * qd[1] - 0.5 * l2 * s2 * qd[2];
-        b->w[2] = qd[2];
-        break;
-    }
-    }
-}
-
-static inline double tc_gravity_const(const lag_model *m)
-{
-    switch (m->kind) {
-    case LAG_MODEL_STICK: return m->p[LAG_STICK_G];
-    case LAG_MODEL_MANIPULATOR: return m->p[LAG_MANIP_G];
-    default: return m->p[LAG_DIPC_G];
-    }
-}
-
-/* T = sum 1/2 m v.v + 1/2 I w^2 (no conjugates: analytic in q and qd). */
-static inline cplx tc_T_c(const lag_model *m, const cplx *q, const cplx *qd)
-{
-    tc_bodies b;
-    tc_kinematics(m, q, qd, &b);
-    cplx T = 0;
-    for (int i = 0; i < b.nb; ++i)
-        T += 0.5 * b.mass[i] * (b.vx[i] * b.vx[i] + b.vy[i] * b.vy[i]) +
-             0.5 * b.inertia[i] * b.w[i] * b.w[i];
-    return T;
-}
-
-/* U = sum m g y_c. */
-static inline cplx tc_U_c(const lag_model *m, const cplx *q)
-{
-    cplx zero[3] = {0, 0, 0};
-    tc_bodies b;
-    tc_kinematics(m, q, zero, &b);
-    cplx U = 0;
-    double g = tc_gravity_const(m);
-    for (int i = 0; i < b.nb; ++i) U += b.mass[i] * g * b.y[i];
-    return U;
-}
-
-static inline void tc_to_c(int n, const double *x, cplx *z)
-{
-    for (int i = 0; i < n; ++i) z[i] = x[i];
-}
-
-static inline double tc_T(const lag_model *m, const double *q, const double *qd)
-{
-    cplx qc[3] = {0}, qdc[3] = {0};
-    tc_to_c(m->nq, q, qc);
-    tc_to_c(m->nq, qd, qdc);
-    return creal(tc_T_c(m, qc, qdc));
-}
-
-static inline double tc_U(const lag_model *m, const double *q)
-{
-    cplx qc[3] = {0};
-    tc_to_c(m->nq, q, qc);
-    return creal(tc_U_c(m, qc));
+    const tc_ref *ref = tc_ref_of(m->kind);
+    for (int i = 0; i < m->nq; ++i) q[i] = lt_uniform(r, ref->qlo[i], ref->qhi[i]);
 }
 
 /* dT/dq_k (qd held) by complex step. OUT: out[n] */
@@ -528,27 +374,15 @@ static inline int tc_advance(lag_sim *s, int64_t n, bool continuous)
     return 0;
 }
 
-static const lag_method tc_all_methods[] = {LAG_EULER, LAG_SEMI_IMPLICIT_EULER, LAG_RK4,
-                                            LAG_DOPRI5, LAG_IMPLICIT_MIDPOINT, LAG_GAUSS4};
-#define TC_NMETHODS 6
-
-/* The smooth scene of the convergence tests: Bogdanov's DIPC (brief) hanging down and
- * swinging, theta1 = pi + 0.3, theta2 = pi - 0.2, at rest, cart at 0. */
-static inline void tc_dipc_hanging(lag_model *m, double *q, double *qd)
+/* Facts of method m from the core's table (tests iterate 0..LAG_METHOD_COUNT-1). */
+static inline const lag_method_info *tc_method(int m)
 {
-    lag_model_default(m, LAG_MODEL_DIPC);
-    m->p[LAG_DIPC_M0] = 1.5;
-    m->p[LAG_DIPC_M1] = 0.5;
-    m->p[LAG_DIPC_M2] = 0.75;
-    m->p[LAG_DIPC_L1] = 0.5;
-    m->p[LAG_DIPC_L2] = 0.75;
-    m->p[LAG_DIPC_I1] = 0.5 * 0.5 * 0.5 / 12;
-    m->p[LAG_DIPC_I2] = 0.75 * 0.75 * 0.75 / 12;
-    m->p[LAG_DIPC_G] = 9.81;
-    q[0] = 0;
-    q[1] = TC_PI + 0.3;
-    q[2] = TC_PI - 0.2;
-    qd[0] = qd[1] = qd[2] = 0;
+    const lag_method_info *mi = lag_method_info_get((lag_method)m);
+    if (!mi) {
+        fprintf(stderr, "no method %d in the core's table\n", m);
+        abort();
+    }
+    return mi;
 }
 
 #endif

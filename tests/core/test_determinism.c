@@ -67,11 +67,10 @@ static void check_rerun(int arg)
         double q0[3] = {0}, qd0[3] = {0};
         tc_random_state(&rng, &md, q0, qd0);
         for (int i = 0; i < md.nq; ++i) qd0[i] = lt_uniform(&rng, -1, 1);
-        if (kind == LAG_MODEL_STICK) q0[1] = 0.8;
-        if (kind == LAG_MODEL_MANIPULATOR) q0[1] = 0.6;
-        for (int mi = 0; mi < TC_NMETHODS; ++mi) {
-            for (int cont = 0; cont < (tc_all_methods[mi] == LAG_DOPRI5 ? 2 : 1); ++cont) {
-                lag_sim_def def = tc_sim_def(&md, tc_all_methods[mi], 2e-3, q0, qd0);
+        tc_motion_start(&rng, &md, q0);
+        for (int mi = 0; mi < LAG_METHOD_COUNT; ++mi) {
+            for (int cont = 0; cont < (tc_method(mi)->adaptive ? 2 : 1); ++cont) {
+                lag_sim_def def = tc_sim_def(&md, (lag_method)mi, 2e-3, q0, qd0);
                 lag_sim s1, s2;
                 if (run(&def, &s1, true, cont, &a) || run(&def, &s2, true, cont, &b) ||
                     run(&def, &s1, false, cont, &c))

@@ -129,7 +129,7 @@ static void check_model(lag_model_kind kind, uint64_t seed)
         tc_kinematics(&md, qc, zc, &b);
         double sg = 0;
         for (int k = 0; k < b.nb; ++k)
-            sg += b.mass[k] * tc_gravity_const(&md) * (1 + cabs(b.x[k]) + cabs(b.y[k]));
+            sg += b.mass[k] * tc_p(&md, "g") * (1 + cabs(b.x[k]) + cabs(b.y[k]));
 
         for (int i = 0; i < n * n; ++i) {
             ENSURE_NEAR(Ml[i], Mt[i], 1e-13 * sM, "M entry %d " CTXF, i, CTXA);
@@ -338,17 +338,31 @@ static void check_info(void)
     ENSURE(lag_model_validate(&m, err, sizeof err) == LAG_OK);
     m.p[LAG_DIPC_M2] = -1;
     ENSURE(lag_model_validate(&m, err, sizeof err) == LAG_ERR_ARG);
-    /* Orders as documented in the header. */
-    ENSURE(lag_method_order(LAG_EULER) == 1);
-    ENSURE(lag_method_order(LAG_SEMI_IMPLICIT_EULER) == 1);
-    ENSURE(lag_method_order(LAG_RK4) == 4);
-    ENSURE(lag_method_order(LAG_DOPRI5) == 5);
-    ENSURE(lag_method_order(LAG_IMPLICIT_MIDPOINT) == 2);
-    ENSURE(lag_method_order(LAG_GAUSS4) == 4);
-    static const char *mnames[6] = {"euler", "semi-implicit-euler", "rk4", "dopri5", "implicit-midpoint", "gauss4"};
-    for (int i = 0; i < 6; ++i) {
-        ENSURE(strcmp(lag_method_name((lag_method)i), mnames[i]) == 0);
-        ENSURE(lag_method_from_name(mnames[i]) == i);
+    /* The method table: every row complete (lag_method_table_ok: name, step, order, an
+     * advance exactly for the adaptive ones, unique names), names found again, every
+     * method in lag_method_names. */
+    ENSURE(lag_method_table_ok());
+    char mlist[256];
+    lag_method_names(mlist, sizeof mlist);
+    for (int i = 0; i < LAG_METHOD_COUNT; ++i) {
+        const lag_method_info *mi = lag_method_info_get((lag_method)i);
+        ENSURE(mi && mi->name && strcmp(lag_method_name((lag_method)i), mi->name) == 0);
+        if (!mi) continue;
+        ENSURE(lag_method_from_name(mi->name) == i && strstr(mlist, mi->name) != NULL);
+        ENSURE(mi->order >= 1 && lag_method_order((lag_method)i) == mi->order);
+        ENSURE(!(mi->canonical && !mi->implicit)); /* (q, p) Gauss methods are implicit */
+    }
+    ENSURE(lag_method_info_get(LAG_METHOD_COUNT) == NULL && strcmp(lag_method_name(LAG_METHOD_COUNT), "unknown") == 0);
+    /* Facts of the methods documented in lagsim.h, by name. */
+    static const struct { const char *name; int order; bool adaptive, implicit, canonical; } facts[] = {
+        {"euler", 1, false, false, false},          {"semi-implicit-euler", 1, false, false, false},
+        {"rk4", 4, false, false, false},            {"dopri5", 5, true, false, false},
+        {"implicit-midpoint", 2, false, true, true}, {"gauss4", 4, false, true, true},
+    };
+    for (size_t i = 0; i < sizeof facts / sizeof facts[0]; ++i) {
+        const lag_method_info *mi = lag_method_info_get((lag_method)lag_method_from_name(facts[i].name));
+        ENSURE(mi && mi->order == facts[i].order && mi->adaptive == facts[i].adaptive &&
+               mi->implicit == facts[i].implicit && mi->canonical == facts[i].canonical);
     }
     ENSURE(lag_method_from_name("leapfrog") == -1);
 }

@@ -23,7 +23,10 @@ static void check_spd(lag_model_kind kind)
         int n = md.nq;
         double q[3] = {0}, qd[3] = {0}, M[9];
         tc_random_state(&rng, &md, q, qd);
-        if (it == 0 && kind == LAG_MODEL_STICK) q[1] = TC_PI / 2; /* cos phi = 0: M22 = I */
+        /* and at special configurations: every angle at pi/2 (the stick upright, M_11 = I),
+         * then at 0; positions at 0 (the manipulator's slider on the axis) */
+        if (it < 2)
+            for (int i = 0; i < n; ++i) q[i] = lag_model_info_get(kind)->angular[i] ? (1 - it) * TC_PI / 2 : 0.0;
         lag_model_mass(&md, q, M);
         double sM = tc_maxabs(n * n, M);
         for (int i = 0; i < n; ++i)
@@ -62,7 +65,7 @@ static void check_skew(lag_model_kind kind)
         double q0[3] = {0}, qd0[3] = {0};
         tc_random_state(&rng, &md, q0, qd0);
         for (int i = 0; i < n; ++i) qd0[i] = lt_uniform(&rng, -2, 2);
-        if (kind == LAG_MODEL_STICK) q0[1] = lt_uniform(&rng, 0.3, 1.3); /* away from cos = 0 */
+        tc_motion_start(&rng, &md, q0);
         const double dt = 1e-4;
         enum { NT = 200 };
         static double qs[NT][3], qds[NT][3];
@@ -169,7 +172,7 @@ static void check_power(lag_model_kind kind)
 {
     lt_rng rng = {0x9090u + (uint64_t)kind};
     const lag_model_info *inf = lag_model_info_get(kind);
-    double worst_a = 0, worst_b[TC_NMETHODS] = {0};
+    double worst_a = 0, worst_b[LAG_METHOD_COUNT] = {0};
     for (int run = 0; run < 5; ++run) {
         lag_model md;
         tc_random_model(&rng, kind, &md);
@@ -177,8 +180,7 @@ static void check_power(lag_model_kind kind)
         double q0[3] = {0}, qd0[3] = {0};
         tc_random_state(&rng, &md, q0, qd0);
         for (int i = 0; i < n; ++i) qd0[i] = lt_uniform(&rng, -1, 1);
-        if (kind == LAG_MODEL_STICK) q0[1] = lt_uniform(&rng, 0.3, 1.3);
-        if (kind == LAG_MODEL_MANIPULATOR) q0[1] = lt_uniform(&rng, 0.3, 1.0);
+        tc_motion_start(&rng, &md, q0);
         input_fn u;
         for (int i = 0; i < 3; ++i) {
             u.a[i] = lt_uniform(&rng, 0.5, 3);
@@ -209,8 +211,8 @@ static void check_power(lag_model_kind kind)
          * Asserted: halving dt divides it by >= 2^(p - 1/2) (p = 1: 1.4, 2: 2.8, 4: 11),
          * unless it is already at the rounding floor (1e-11 |E|). dopri5 (rtol 1e-11) is
          * not a dt method: its mismatch must stay below 1e-7 |E| (tolerance x 1e4 steps). */
-        for (int mi = 0; mi < TC_NMETHODS; ++mi) {
-            lag_method meth = tc_all_methods[mi];
+        for (int mi = 0; mi < LAG_METHOD_COUNT; ++mi) {
+            lag_method meth = (lag_method)mi;
             double mis[2], scb[2];
             for (int r = 0; r < 2; ++r) {
                 double dt = 1e-3 / (1 << r);
@@ -234,7 +236,7 @@ static void check_power(lag_model_kind kind)
                 mis[r] = lag_sim_energy(&s) - E0 - W;
                 scb[r] = scale;
             }
-            if (meth == LAG_DOPRI5) {
+            if (tc_method(mi)->adaptive) {
                 ENSURE_NEAR(mis[0], 0.0, 1e-7 * scb[0], "%s dopri5: E(1 s) - E(0) - work, run %d", kname(kind), run);
             } else if (fabs(mis[0]) > 1e-11 * scb[0]) {
                 double need = pow(2.0, lag_method_order(meth) - 0.5);
@@ -247,7 +249,7 @@ static void check_power(lag_model_kind kind)
         }
     }
     printf("%-12s dE/dt = qd.tau: own rk4 (h 0.25 ms) worst %.1e of |E|; lag_sim at 1 ms:", kname(kind), worst_a);
-    for (int mi = 0; mi < TC_NMETHODS; ++mi) printf(" %s %.1e", lag_method_name(tc_all_methods[mi]), worst_b[mi]);
+    for (int mi = 0; mi < LAG_METHOD_COUNT; ++mi) printf(" %s %.1e", lag_method_name((lag_method)mi), worst_b[mi]);
     printf("\n");
 }
 

@@ -21,62 +21,20 @@
 
 #include "lagsim/lagsim.h"
 #include "lagsim_test.h"
+#include "ref_models.h"
 
-#define TE_PI 3.14159265358979323846
+#define TE_PI TC_PI
 
 /* ------------------------------------------------------------------ T and U, again */
+/* The models of tests/common/ref_models.h (written from their body kinematics). */
 
-/* Kinetic energy from the brief's T of each model (J). */
 static inline double te_kinetic(const lag_model *m, const double *q, const double *qd)
 {
-    const double *p = m->p;
-    switch (m->kind) {
-    case LAG_MODEL_STICK: {
-        /* T = 1/2 m (x_dot^2 + (l^2/4) phi_dot^2 cos^2 phi) + 1/2 I phi_dot^2 */
-        double c = cos(q[1]), l = p[LAG_STICK_L];
-        return 0.5 * p[LAG_STICK_M] * (qd[0] * qd[0] + 0.25 * l * l * qd[1] * qd[1] * c * c) +
-               0.5 * p[LAG_STICK_I] * qd[1] * qd[1];
-    }
-    case LAG_MODEL_MANIPULATOR: {
-        /* T = 1/2 m1 l1^2 q1d^2 + 1/2 m2 (q2^2 q1d^2 + q2d^2) + 1/2 (I1 + I2) q1d^2 */
-        double l1 = p[LAG_MANIP_L1];
-        return 0.5 * p[LAG_MANIP_M1] * l1 * l1 * qd[0] * qd[0] +
-               0.5 * p[LAG_MANIP_M2] * (q[1] * q[1] * qd[0] * qd[0] + qd[1] * qd[1]) +
-               0.5 * (p[LAG_MANIP_I1] + p[LAG_MANIP_I2]) * qd[0] * qd[0];
-    }
-    default: {
-        /* body velocities from r_1, r_2 of the brief */
-        double l1 = p[LAG_DIPC_L1], l2 = p[LAG_DIPC_L2];
-        double c1 = cos(q[1]), s1 = sin(q[1]), c2 = cos(q[2]), s2 = sin(q[2]);
-        double v1x = qd[0] + 0.5 * l1 * c1 * qd[1], v1y = -0.5 * l1 * s1 * qd[1];
-        double v2x = qd[0] + l1 * c1 * qd[1] + 0.5 * l2 * c2 * qd[2];
-        double v2y = -l1 * s1 * qd[1] - 0.5 * l2 * s2 * qd[2];
-        return 0.5 * p[LAG_DIPC_M0] * qd[0] * qd[0] +
-               0.5 * p[LAG_DIPC_M1] * (v1x * v1x + v1y * v1y) +
-               0.5 * p[LAG_DIPC_M2] * (v2x * v2x + v2y * v2y) +
-               0.5 * p[LAG_DIPC_I1] * qd[1] * qd[1] + 0.5 * p[LAG_DIPC_I2] * qd[2] * qd[2];
-    }
-    }
+    return tc_T(m, q, qd);
 }
 
-/* Potential energy from the brief's U (J); the DIPC's includes the constant of h0. */
-static inline double te_potential(const lag_model *m, const double *q)
-{
-    const double *p = m->p;
-    switch (m->kind) {
-    case LAG_MODEL_STICK:
-        return p[LAG_STICK_M] * p[LAG_STICK_G] * 0.5 * p[LAG_STICK_L] * sin(q[1]);
-    case LAG_MODEL_MANIPULATOR:
-        return (p[LAG_MANIP_M1] * p[LAG_MANIP_L1] + p[LAG_MANIP_M2] * q[1]) * p[LAG_MANIP_G] *
-               sin(q[0]);
-    default: {
-        double l1 = p[LAG_DIPC_L1], l2 = p[LAG_DIPC_L2], h0 = p[LAG_DIPC_H0];
-        double y1 = h0 + 0.5 * l1 * cos(q[1]);
-        double y2 = h0 + l1 * cos(q[1]) + 0.5 * l2 * cos(q[2]);
-        return p[LAG_DIPC_G] * (p[LAG_DIPC_M1] * y1 + p[LAG_DIPC_M2] * y2);
-    }
-    }
-}
+/* The DIPC's includes the constant of h0. */
+static inline double te_potential(const lag_model *m, const double *q) { return tc_U(m, q); }
 
 static inline double te_energy(const lag_model *m, const double *q, const double *qd)
 {
@@ -86,14 +44,10 @@ static inline double te_energy(const lag_model *m, const double *q, const double
 /* Generalized momentum p_i = dT/dqd_i = (M qd)_i from our own T (exact for a quadratic). */
 static inline double te_momentum(const lag_model *m, const double *q, const double *qd, int i)
 {
-    double a[LAG_MAX_DOF], b[LAG_MAX_DOF];
-    for (int k = 0; k < m->nq; k++) { a[k] = qd[k]; b[k] = qd[k]; }
-    a[i] += 1.0;
-    b[i] -= 1.0;
-    return 0.5 * (te_kinetic(m, q, a) - te_kinetic(m, q, b));
+    return tc_momentum(m, q, qd, i);
 }
 
-/* (M^-1 e_i)_i, the inverse effective mass seen by joint i, from our own M = d2T/dqd2. */
+/* M = d2T/dqd2 from our own T, column by column of momenta. OUT: M */
 static inline void te_mass(const lag_model *m, const double *q, double *M)
 {
     int n = m->nq;

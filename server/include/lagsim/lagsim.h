@@ -181,9 +181,25 @@ typedef enum lag_method {
     LAG_METHOD_COUNT
 } lag_method;
 
-const char *lag_method_name(lag_method m); /* "euler", "semi-implicit-euler", ... */
+/* Static facts about a method: what a loader, a benchmark or a test may rely on without
+ * naming the method (tests iterate methods 0..LAG_METHOD_COUNT-1 and use these). */
+typedef struct lag_method_info {
+    const char *name;  /* "euler", "semi-implicit-euler", "rk4", ... */
+    int order;         /* global order of accuracy */
+    bool adaptive;     /* steps chosen by rtol, atol, dt_min, max_steps; dt is the tick */
+    bool implicit;     /* stage equations solved by Newton (max_iter, newton_tol) */
+    bool canonical;    /* steps (q, p), p = M(q) qd: symplectic, and a linear function of
+                          (q, p) that is invariant (the momentum of a cyclic coordinate)
+                          is kept to the Newton tolerance */
+} lag_method_info;
+
+/* NULL for a method outside 0..LAG_METHOD_COUNT-1. */
+const lag_method_info *lag_method_info_get(lag_method m);
+const char *lag_method_name(lag_method m); /* "euler", ...; "unknown" outside the table */
 int lag_method_from_name(const char *name); /* -1 if unknown */
-int lag_method_order(lag_method m);
+int lag_method_order(lag_method m);         /* 0 outside the table */
+/* "euler, semi-implicit-euler, ...": every method's name, for messages. Returns buf. */
+const char *lag_method_names(char *buf, size_t len);
 
 typedef struct lag_integrator_def {
     lag_method method; /* default rk4 */
