@@ -38,6 +38,7 @@
 #include "lagsim/lagsim_joint_command_t.h"
 #include "lagsim/lagsim_joint_state_t.h"
 #include "lagsim/lagsim_status_t.h"
+#include "lagsim_wire.h"
 
 static int64_t mono_ns(void)
 {
@@ -135,17 +136,22 @@ typedef struct bench {
     int64_t pending_mark;      /* mark of the last command sent, -1 none */
     samples latency_us;
     int64_t on_time, late, answered;
-    lagsim_status_t *status;
+    lag_wire_status *status;   /* NULL until the first, then &status_buf */
+    lag_wire_status status_buf;
     /* ping-pong */
     int64_t pong_ns;
 } bench;
 
-static void on_state(const lcm_recv_buf_t *rb, const char *ch, const lagsim_joint_state_t *m,
-                     void *u)
+/* States and status are decoded by the wire module (bounded, no allocation). */
+static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *u)
 {
-    (void)ch; (void)rb;
+    (void)ch;
     bench *b = u;
     int64_t now = mono_ns();
+    static lag_wire_joint_state mm;
+    const lag_wire_joint_state *m = &mm;
+    if (lag_wire_decode_joint_state(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &mm) != LAG_WIRE_OK)
+        return;
     if (b->last_arrival_ns)
         add(&b->period_err_us, fabs((double)(now - b->last_arrival_ns) * 1e-3 - b->period_s * 1e6));
     b->last_arrival_ns = now;
@@ -171,12 +177,12 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, const lagsim_join
     b->answered++;
 }
 
-static void on_status(const lcm_recv_buf_t *rb, const char *ch, const lagsim_status_t *m, void *u)
+static void on_status(const lcm_recv_buf_t *rb, const char *ch, void *u)
 {
-    (void)rb; (void)ch;
+    (void)ch;
     bench *b = u;
-    if (b->status) lagsim_status_t_destroy(b->status);
-    b->status = lagsim_status_t_copy(m);
+    if (lag_wire_decode_status(rb->data, rb->data_size, &b->status_buf) == LAG_WIRE_OK)
+        b->status = &b->status_buf;
 }
 
 static void on_pong(const lcm_recv_buf_t *rb, const char *ch, void *u)
@@ -240,11 +246,11 @@ int main(int argc, char **argv)
     /* 1. paced publisher floor */
     char pubchan[96];
     snprintf(pubchan, sizeof pubchan, "%s_PACED", prefix);
-    lagsim_joint_state_t_subscription_t *ps = lagsim_joint_state_t_subscribe(b.lcm, pubchan, on_state, &b);
+    lcm_subscription_t *ps = lcm_subscribe(b.lcm, pubchan, on_state, &b);
     pid_t pp = child();
     if (pp == 0) paced_publisher(pubchan, hz, floor_seconds);
     pump_until_exit(&b, pp);
-    lagsim_joint_state_t_unsubscribe(b.lcm, ps);
+    lcm_unsubscribe(b.lcm, ps);
     samples floor_err = b.period_err_us;
     int64_t floor_n = b.n_states;
     memset(&b.period_err_us, 0, sizeof b.period_err_us);
@@ -276,10 +282,10 @@ int main(int argc, char **argv)
 
     /* 3. lagsimd in real time with this process as the controller */
     snprintf(ch, sizeof ch, "%s_STATE", prefix);
-    lagsim_joint_state_t_subscription_t *ss = lagsim_joint_state_t_subscribe(b.lcm, ch, on_state, &b);
-    lagsim_joint_state_t_subscription_set_queue_capacity(ss, 100000);
+    lcm_subscription_t *ss = lcm_subscribe(b.lcm, ch, on_state, &b);
+    lcm_subscription_set_queue_capacity(ss, 100000);
     snprintf(ch, sizeof ch, "%s_STATUS", prefix);
-    lagsim_status_t_subscribe(b.lcm, ch, on_status, &b);
+    lcm_subscribe(b.lcm, ch, on_status, &b);
     snprintf(b.ch_command, sizeof b.ch_command, "%s_COMMAND", prefix);
     b.control = true;
     b.pending_mark = -1;
@@ -300,8 +306,8 @@ int main(int argc, char **argv)
     char lprefix[80];
     snprintf(lprefix, sizeof lprefix, "%sL", prefix);
     snprintf(ch, sizeof ch, "%s_STATE", lprefix);
-    lagsim_joint_state_t_unsubscribe(b.lcm, ss);
-    ss = lagsim_joint_state_t_subscribe(b.lcm, ch, on_state, &b);
+    lcm_unsubscribe(b.lcm, ss);
+    ss = lcm_subscribe(b.lcm, ch, on_state, &b);
     snprintf(b.ch_command, sizeof b.ch_command, "%s_COMMAND", lprefix);
     /* run long enough in sim time; we stop it after ls_seconds of wall time */
     int64_t tl0 = mono_ns();

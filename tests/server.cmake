@@ -1,7 +1,7 @@
 # The real-time LCM server (issue 3): end-to-end over real LCM (default udpm URL, ttl=0),
 # one lagsimd child per case with a unique channel prefix.
 add_executable(server_test ${CMAKE_CURRENT_LIST_DIR}/server/server_test.c)
-target_link_libraries(server_test PRIVATE lagsim_scene lagsim_core lagsim_lcmtypes PkgConfig::LCM)
+target_link_libraries(server_test PRIVATE lagsim_scene lagsim_core lagsim_wire lagsim_lcmtypes PkgConfig::LCM)
 find_program(LCM_LOGGER lcm-logger)
 set(LAGSIM_SERVER_CASES control hostile watchdog lockstep_timeout two_daemons fault sigterm
     bad_scene effects control_flood step_flood lockstep_huge status_rate rate_huge long_period

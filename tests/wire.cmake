@@ -28,7 +28,5 @@ endforeach()
 # reader, and --replay end to end.
 lagsim_fuzz_target(wire LIBS lagsim_wire)
 lagsim_fuzz_target(log LIBS lagsim_wire)
-lagsim_fuzz_target(replay SOURCES ${PROJECT_SOURCE_DIR}/server/daemon/replay.c
-                   LIBS lagsim_scene lagsim_core lagsim_wire)
-target_include_directories(fuzz_replay PRIVATE ${PROJECT_SOURCE_DIR}/server/daemon)
+lagsim_fuzz_target(replay LIBS lagsimd_internal)
 target_compile_definitions(fuzz_replay PRIVATE LAGSIM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

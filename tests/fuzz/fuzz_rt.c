@@ -103,24 +103,22 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
     (void)user;
     const char *sfx = suffix(ch);
     if (!strcmp(sfx, "STATE")) {
-        lagsim_joint_state_t m;
-        if (lagsim_joint_state_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) bad("undecodable state");
+        lag_wire_joint_state m;
+        if (lag_wire_decode_joint_state(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) bad("undecodable state");
         need_finite(&m.sim_time, 1, "state sim_time");
         need_finite(m.position, m.num_joints, "state position");
         need_finite(m.velocity, m.num_joints, "state velocity");
         need_finite(m.effort, m.num_joints, "state effort");
-        lagsim_joint_state_t_decode_cleanup(&m);
         g_c.state++;
     } else if (!strcmp(sfx, "STATUS")) {
-        lagsim_status_t m;
-        if (lagsim_status_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) bad("undecodable status");
+        lag_wire_status m;
+        if (lag_wire_decode_status(rb->data, rb->data_size, &m) != LAG_WIRE_OK) bad("undecodable status");
         double d[] = {m.sim_time, m.wall_time, m.rtf, m.step_time_max_us, m.step_time_mean_us, m.energy};
         need_finite(d, 6, "status number");
-        lagsim_status_t_decode_cleanup(&m);
         g_c.status++;
     } else if (!strcmp(sfx, "EVENT")) {
-        lagsim_event_t m;
-        if (lagsim_event_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) bad("undecodable event");
+        lag_wire_event m;
+        if (lag_wire_decode_event(rb->data, rb->data_size, &m) != LAG_WIRE_OK) bad("undecodable event");
         double d[] = {m.sim_time, m.value};
         need_finite(d, 2, "event number");
         int k = RT_EV_COUNT + 1;
@@ -128,16 +126,14 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
             if (!strcmp(m.kind, k_limited[i])) k = i;
         if (!strcmp(m.kind, "start") || !strcmp(m.kind, "stop")) k = RT_EV_COUNT;
         g_c.ev_kind[k]++;
-        lagsim_event_t_decode_cleanup(&m);
         g_c.event++;
     } else if (!strcmp(sfx, "SCENE")) {
-        lagsim_scene_t m;
-        if (lagsim_scene_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) bad("undecodable scene");
+        lag_wire_scene m;
+        if (lag_wire_decode_scene(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) bad("undecodable scene");
         need_finite(m.param_value, m.num_params, "scene parameter");
         need_finite(m.initial_q, m.num_joints, "scene q0");
         double d[] = {m.dt, m.control_period, m.rate, m.command_timeout};
         need_finite(d, 4, "scene number");
-        lagsim_scene_t_decode_cleanup(&m);
         g_c.scene++;
     }
 }

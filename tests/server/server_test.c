@@ -32,6 +32,7 @@
 #include "lagsim/lagsim_joint_state_t.h"
 #include "lagsim/lagsim_scene_t.h"
 #include "lagsim/lagsim_status_t.h"
+#include "lagsim_wire.h"
 
 static const char *g_case = "?";
 static const char *g_stderr_path; /* children's stderr goes there when set */
@@ -150,7 +151,8 @@ typedef struct client {
     double max_abs; /* largest |q| or |qd| seen */
     /* status */
     int64_t n_status;
-    lagsim_status_t *status;
+    lag_wire_status *status;        /* NULL until the first, then &status_buf */
+    lag_wire_status status_buf;
     /* events */
     int n_events;
     char ev_kind[MAX_EVENTS][32];
@@ -160,22 +162,25 @@ typedef struct client {
     int64_t n_events_total;         /* also those beyond MAX_EVENTS */
     /* scene */
     int64_t n_scene;
-    lagsim_scene_t *scene;
-    lagsim_joint_state_t_subscription_t *sub_state;
-    lagsim_status_t_subscription_t *sub_status;
-    lagsim_event_t_subscription_t *sub_event;
-    lagsim_scene_t_subscription_t *sub_scene;
+    lag_wire_scene *scene;          /* NULL until the first, then &scene_buf */
+    lag_wire_scene scene_buf;
+    lcm_subscription_t *sub_state, *sub_status, *sub_event, *sub_scene;
     /* lockstep controller (replay case): answers each state, records it */
     bool controller;
     int n_rec;
     rec_state rec[MAX_REC];
 } client;
 
-static void on_state(const lcm_recv_buf_t *rb, const char *ch, const lagsim_joint_state_t *m,
-                     void *u)
+/* What the daemon publishes is decoded by the wire module (never by lcm-gen's decoders);
+ * a message that does not decode fails the test. */
+static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *u)
 {
-    (void)rb; (void)ch;
+    (void)ch;
     client *c = u;
+    static lag_wire_joint_state mm;
+    const lag_wire_joint_state *m = &mm;
+    int rc = lag_wire_decode_joint_state(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &mm);
+    ENSUREF(rc == LAG_WIRE_OK, "a state from the daemon: %s", lag_wire_result_string(rc));
     c->n_states++;
     rec_state r = {.step = m->step, .t = m->sim_time};
     for (int i = 0; i < m->num_joints && i < LAG_MAX_DOF; i++) {
@@ -198,37 +203,43 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, const lagsim_join
     }
 }
 
-static void on_status(const lcm_recv_buf_t *rb, const char *ch, const lagsim_status_t *m, void *u)
+static void on_status(const lcm_recv_buf_t *rb, const char *ch, void *u)
 {
-    (void)rb; (void)ch;
+    (void)ch;
     client *c = u;
-    if (c->status) lagsim_status_t_destroy(c->status);
-    c->status = lagsim_status_t_copy(m);
+    int rc = lag_wire_decode_status(rb->data, rb->data_size, &c->status_buf);
+    ENSUREF(rc == LAG_WIRE_OK, "a status from the daemon: %s", lag_wire_result_string(rc));
+    const lag_wire_status *m = c->status = &c->status_buf;
     c->n_status++;
     if (!isfinite(m->sim_time) || !isfinite(m->rtf) || !isfinite(m->energy)) c->nonfinite_seen = true;
 }
 
-static void on_event(const lcm_recv_buf_t *rb, const char *ch, const lagsim_event_t *m, void *u)
+static void on_event(const lcm_recv_buf_t *rb, const char *ch, void *u)
 {
-    (void)rb; (void)ch;
+    (void)ch;
     client *c = u;
+    static lag_wire_event mm;
+    const lag_wire_event *m = &mm;
+    int rc = lag_wire_decode_event(rb->data, rb->data_size, &mm);
+    ENSUREF(rc == LAG_WIRE_OK, "an event from the daemon: %s", lag_wire_result_string(rc));
     if (!isfinite(m->sim_time) || !isfinite(m->value)) c->nonfinite_seen = true;
     c->n_events_total++;
     if (c->n_events < MAX_EVENTS) {
-        snprintf(c->ev_kind[c->n_events], 32, "%s", m->kind);
-        snprintf(c->ev_detail[c->n_events], sizeof c->ev_detail[0], "%s", m->detail);
+        snprintf(c->ev_kind[c->n_events], 32, "%.31s", m->kind);
+        snprintf(c->ev_detail[c->n_events], sizeof c->ev_detail[0], "%.191s", m->detail);
         c->ev_time[c->n_events] = m->sim_time;
         c->ev_value[c->n_events] = m->value;
         c->n_events++;
     }
 }
 
-static void on_scene(const lcm_recv_buf_t *rb, const char *ch, const lagsim_scene_t *m, void *u)
+static void on_scene(const lcm_recv_buf_t *rb, const char *ch, void *u)
 {
-    (void)rb; (void)ch;
+    (void)ch;
     client *c = u;
-    if (c->scene) lagsim_scene_t_destroy(c->scene);
-    c->scene = lagsim_scene_t_copy(m);
+    int rc = lag_wire_decode_scene(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &c->scene_buf);
+    ENSUREF(rc == LAG_WIRE_OK, "a scene from the daemon: %s", lag_wire_result_string(rc));
+    c->scene = &c->scene_buf;
     c->n_scene++;
 }
 
@@ -239,12 +250,10 @@ static void client_free_all(void)
 {
     for (int i = 0; i < g_nclients; i++) {
         client *c = g_clients[i];
-        if (c->status) lagsim_status_t_destroy(c->status);
-        if (c->scene) lagsim_scene_t_destroy(c->scene);
-        lagsim_joint_state_t_unsubscribe(c->lcm, c->sub_state);
-        lagsim_status_t_unsubscribe(c->lcm, c->sub_status);
-        lagsim_event_t_unsubscribe(c->lcm, c->sub_event);
-        lagsim_scene_t_unsubscribe(c->lcm, c->sub_scene);
+        lcm_unsubscribe(c->lcm, c->sub_state);
+        lcm_unsubscribe(c->lcm, c->sub_status);
+        lcm_unsubscribe(c->lcm, c->sub_event);
+        lcm_unsubscribe(c->lcm, c->sub_scene);
         lcm_destroy(c->lcm);
     }
     g_nclients = 0;
@@ -263,15 +272,15 @@ static void client_init(client *c, const char *prefix, int nq)
     snprintf(c->ch_state, sizeof c->ch_state, "%s_STATE", prefix);
     snprintf(c->ch_command, sizeof c->ch_command, "%s_COMMAND", prefix);
     snprintf(c->ch_control, sizeof c->ch_control, "%s_CONTROL", prefix);
-    c->sub_state = lagsim_joint_state_t_subscribe(c->lcm, c->ch_state, on_state, c);
-    lagsim_joint_state_t_subscription_set_queue_capacity(c->sub_state, 100000);
+    c->sub_state = lcm_subscribe(c->lcm, c->ch_state, on_state, c);
+    lcm_subscription_set_queue_capacity(c->sub_state, 100000);
     snprintf(ch, sizeof ch, "%s_STATUS", prefix);
-    c->sub_status = lagsim_status_t_subscribe(c->lcm, ch, on_status, c);
+    c->sub_status = lcm_subscribe(c->lcm, ch, on_status, c);
     snprintf(ch, sizeof ch, "%s_EVENT", prefix);
-    c->sub_event = lagsim_event_t_subscribe(c->lcm, ch, on_event, c);
-    lagsim_event_t_subscription_set_queue_capacity(c->sub_event, 100000);
+    c->sub_event = lcm_subscribe(c->lcm, ch, on_event, c);
+    lcm_subscription_set_queue_capacity(c->sub_event, 100000);
     snprintf(ch, sizeof ch, "%s_SCENE", prefix);
-    c->sub_scene = lagsim_scene_t_subscribe(c->lcm, ch, on_scene, c);
+    c->sub_scene = lcm_subscribe(c->lcm, ch, on_scene, c);
 }
 
 static void pump(client *c, double seconds)
@@ -576,7 +585,7 @@ static void case_hostile(void)
 #undef SEND
     pump(&c, 0.2);
     fresh_status(&c);
-    lagsim_status_t *st = c.status;
+    lag_wire_status *st = c.status;
     ENSURE(st->commands_accepted == 1);
     ENSUREF(st->rejected_unknown_joint == exp_unknown, "unknown %lld", (long long)st->rejected_unknown_joint);
     ENSUREF(st->rejected_unactuated == exp_unact, "unact %lld", (long long)st->rejected_unactuated);

@@ -116,8 +116,8 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
     (void)user;
     const char *sfx = suffix(ch);
     if (!strcmp(sfx, "STATE")) {
-        lagsim_joint_state_t m;
-        if (lagsim_joint_state_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) fail(__LINE__, "bad state");
+        lag_wire_joint_state m;
+        if (lag_wire_decode_joint_state(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) fail(__LINE__, "bad state");
         g_out.state++;
         if (!isfinite(m.sim_time) || !finite_all(m.position, m.num_joints) ||
             !finite_all(m.velocity, m.num_joints) || !finite_all(m.effort, m.num_joints))
@@ -125,21 +125,19 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         g_out.last_t = m.sim_time;
         g_out.last_step = m.step;
         for (int i = 0; i < m.num_joints && i < LAG_MAX_DOF; i++) g_out.last_q[i] = m.position[i];
-        lagsim_joint_state_t_decode_cleanup(&m);
     } else if (!strcmp(sfx, "STATUS")) {
-        lagsim_status_t m;
-        if (lagsim_status_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) fail(__LINE__, "bad status");
+        lag_wire_status m;
+        if (lag_wire_decode_status(rb->data, rb->data_size, &m) != LAG_WIRE_OK) fail(__LINE__, "bad status");
         g_out.status++;
         double d[] = {m.sim_time, m.wall_time, m.rtf, m.step_time_max_us, m.step_time_mean_us, m.energy};
         if (!finite_all(d, 6)) g_out.nonfinite = true;
         g_out.status_controls_rejected = m.controls_rejected;
         g_out.status_states = m.states_published;
         g_out.status_overrun_bursts = m.overrun_bursts;
-        snprintf(g_out.status_run, sizeof g_out.status_run, "%s", m.run_state);
-        lagsim_status_t_decode_cleanup(&m);
+        snprintf(g_out.status_run, sizeof g_out.status_run, "%.15s", m.run_state);
     } else if (!strcmp(sfx, "EVENT")) {
-        lagsim_event_t m;
-        if (lagsim_event_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) fail(__LINE__, "bad event");
+        lag_wire_event m;
+        if (lag_wire_decode_event(rb->data, rb->data_size, &m) != LAG_WIRE_OK) fail(__LINE__, "bad event");
         g_out.event++;
         if (!isfinite(m.sim_time) || !isfinite(m.value)) g_out.nonfinite = true;
         int k = kind_index(m.kind);
@@ -152,12 +150,10 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
             while (p > m.detail && p[-1] >= '0' && p[-1] <= '9') p--;
             g_out.kind_suppressed[k] += strtoll(p, NULL, 10);
         }
-        lagsim_event_t_decode_cleanup(&m);
     } else if (!strcmp(sfx, "SCENE")) {
-        lagsim_scene_t m;
-        if (lagsim_scene_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) fail(__LINE__, "bad scene");
+        lag_wire_scene m;
+        if (lag_wire_decode_scene(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) fail(__LINE__, "bad scene");
         g_out.scene++;
-        lagsim_scene_t_decode_cleanup(&m);
     }
 }
 
