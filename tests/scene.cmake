@@ -28,3 +28,8 @@ add_test(NAME scene_cli
          COMMAND ${LAGSIM_BASH} ${scene_dir}/cli.sh $<TARGET_FILE:lagsimd> ${scene_cfg}/dipc.yaml)
 set_tests_properties(scene_set_overrides scene_offline_csv scene_determinism scene_cli scene_limits
                      PROPERTIES TIMEOUT 60 LABELS scene)
+
+# The loader under libFuzzer (tests/fuzz/fuzz_scene.c): file bytes plus --set overrides,
+# then the core on what was accepted. Inputs: tests/fuzz/scene/{seed,crash}, written by
+# tests/fuzz/scene/make_inputs.sh.
+lagsim_fuzz_target(scene LIBS lagsim_scene)

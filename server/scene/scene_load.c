@@ -70,9 +70,45 @@ static int read_scene_file(const char *path, char **out, size_t *outlen, errbuf 
     return 0;
 }
 
+/* Messages quote what the user wrote (a key, a value, a --set): control characters in it
+ * are written as escapes (\n, \t, \r, \xHH), so that a message is always one line. */
+static void one_line(char *buf, size_t len)
+{
+    if (!buf || len == 0)
+        return;
+    char out[2048];
+    size_t o = 0;
+    for (const unsigned char *p = (const unsigned char *)buf; *p && o + 5 < sizeof out; p++) {
+        if (*p >= 0x20 && *p != 0x7F) {
+            out[o++] = (char)*p;
+        } else if (*p == '\n' || *p == '\t' || *p == '\r') {
+            out[o++] = '\\';
+            out[o++] = *p == '\n' ? 'n' : *p == '\t' ? 't' : 'r';
+        } else {
+            o += (size_t)snprintf(out + o, sizeof out - o, "\\x%02X", *p);
+        }
+    }
+    out[o] = '\0';
+    snprintf(buf, len, "%s", out);
+}
+
+static int load_buffer(const char *name, const char *text, size_t len,
+                       const char *const *sets, int nsets, lag_scene *sc, char *err,
+                       size_t errlen);
+
 int lag_scene_load_buffer(const char *name, const char *text, size_t len,
                           const char *const *sets, int nsets, lag_scene *sc, char *err,
                           size_t errlen)
+{
+    int rc = load_buffer(name, text, len, sets, nsets, sc, err, errlen);
+    if (rc != 0)
+        one_line(err, errlen);
+    return rc;
+}
+
+static int load_buffer(const char *name, const char *text, size_t len,
+                       const char *const *sets, int nsets, lag_scene *sc, char *err,
+                       size_t errlen)
 {
     char dummy[8];
     errbuf e = {.buf = err ? err : dummy, .len = err ? errlen : sizeof dummy};
@@ -170,8 +206,10 @@ int lag_scene_load(const char *path, const char *const *sets, int nsets, lag_sce
     memset(sc, 0, sizeof *sc);
     char *text;
     size_t len;
-    if (read_scene_file(path, &text, &len, &e) < 0)
+    if (read_scene_file(path, &text, &len, &e) < 0) {
+        one_line(err, errlen);
         return -1;
+    }
     int rc = lag_scene_load_buffer(path, text, len, sets, nsets, sc, err, errlen);
     free(text);
     return rc;

@@ -98,6 +98,9 @@ e --expect "--set lcm.url: udpm option 'ttl' given twice" -- --set lcm.allow_lan
 e --expect "--set lcm.url: memq:// takes no address or options" -- --set "lcm.url=memq://x"
 e --expect "--set lcm.url: expected ttl=<integer>" -- --set "lcm.url=udpm://239.255.76.67?ttl=010"
 e --expect "--set lcm.url: expected udpm://GROUP:PORT with GROUP a dotted IPv4 multicast address" -- --set "lcm.url=udpm://239.255.076.67"
+# what a message quotes is escaped: always one line
+e --expect "--set lcm.pre\\nfix: unknown key 'pre\\nfix' in lcm" -- --set $'lcm.pre\nfix=AB'
+e --expect "lcm.prefix: expected a channel prefix of [A-Za-z0-9_], got 'A\\tB'" -- --set $'lcm.prefix="A\tB"'
 e --expect "--set realtime.effort_limit: unknown joint 'x' in realtime.effort_limit for model dipc" -- --set "realtime.effort_limit={x: 1}"
 qline=$(grep -n '^  q:' "$cfg/dipc.yaml" | cut -d: -f1)   # "  q: [...]": the sequence starts at column 6
 m0line=$(grep -n '^  m0:' "$cfg/dipc.yaml" | cut -d: -f1) # "  m0: ...": the key at column 3
