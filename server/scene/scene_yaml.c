@@ -263,7 +263,11 @@ static int check_plain_node(parser *p, yaml_event_t *ev, const ynode *at)
     }
     if (tag) {
         char t[64];
-        snprintf(t, sizeof t, "%s", (const char *)tag);
+        const char *tg = (const char *)tag;
+        if (strncmp(tg, "tag:yaml.org,2002:", 18) == 0) /* as written: !!str */
+            snprintf(t, sizeof t, "!!%s", tg + 18);
+        else
+            snprintf(t, sizeof t, "%s", tg);
         yaml_event_delete(ev);
         return yfail(p->err, at, NULL,
                      "YAML tags (%s) are not supported in scenes: write a number plainly, "
