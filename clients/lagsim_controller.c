@@ -216,6 +216,7 @@ static void heard_event(const lag_client_event *ev, void *user)
     lag_ctl *ctl = user;
     ctl->heard = lag_client_now();
     if (!strcmp(ev->kind, "stop")) ctl->stopped = true;
+    if (ctl->on_event) ctl->on_event(ev, ctl->event_user);
 }
 
 int lag_ctl_start(lag_ctl *ctl, const char *model)

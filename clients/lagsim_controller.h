@@ -95,6 +95,11 @@ typedef struct lag_ctl {
     double heard;              /* monotonic s of the last message from the daemon */
     bool stopped;              /* the daemon's stop event arrived */
     lag_client_state current;  /* the state last returned */
+
+    /* optional, set before lag_ctl_start: called with every event from the daemon (from
+     * inside lag_ctl_next_state), after the setup has looked at it */
+    lag_client_event_fn on_event;
+    void *event_user;
 } lag_ctl;
 
 void lag_ctl_init(lag_ctl *ctl, const char *name, const char *default_prefix);

@@ -76,6 +76,29 @@ lang_end_tests(python dipc "${lang_dipc_cfg}" ${LAGSIM_PYTHON3} ${py_dir}/dipc_b
 lang_end_tests(python manipulator "${lang_manip_cfg}"
                ${LAGSIM_PYTHON3} ${py_dir}/manipulator_pd.py ${py_types})
 
+# ---- C: the stick pushed sideways (clients/stick_push.c), lockstep, 3 s. Checks from T and
+# U, not from the program: x is cyclic and uncoupled from phi, and the frictionless floor
+# pushes vertically, so x_dot ends at F T / m (100 ticks of a constant acceleration: a few
+# ulp, bound 1e-12 relative) through every impact; phi's motion is that of the stick
+# released from rest, whose first landing a quadrature of dphi/dt puts at 0.426664058881 s
+# (tests/effects.cmake, effects.floor; bound 1e-8 s: the event locator's tolerance is far
+# below); near phi = 0 each rebound comes back with the speed it left, so successive
+# impacts' phi_dot differ by the restitution 0.3 (bound 1e-8); it comes to rest, never
+# lifts off.
+add_test(NAME clients_c_stick_push_lockstep
+  COMMAND ${lang_e2e} --config ${PROJECT_SOURCE_DIR}/config/stick.yaml --mode lockstep
+    --name CLSTICK --timeout 60
+    --check "states == 301" --check "end == 'duration'" --check "pushed_periods == 10"
+    --check "abs(x_dot_end - x_dot_expected) <= 1e-12 * abs(x_dot_expected)"
+    --check "abs(x_dot_expected - 0.2) < 1e-15"
+    --check "impacts >= 3" --check "abs(first_impact - 0.426664058881) < 1e-8"
+    --check "abs(ratio_min - 0.3) < 1e-8 and abs(ratio_max - 0.3) < 1e-8"
+    --check "rest > last_impact" --check "liftoffs == 0" --check "dropped == 0"
+    -- $<TARGET_FILE:stick_push> --prefix {prefix} --duration 3 --force 2 --push-time 0.1 -q)
+list(APPEND lang_tests clients_c_stick_push_lockstep)
+set(lang_stick_cfg --config ${PROJECT_SOURCE_DIR}/config/stick.yaml)
+lang_end_tests(c stick "${lang_stick_cfg}" $<TARGET_FILE:stick_push>)
+
 # ---- Lua 5.2
 if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
   add_test(NAME clients_lua_lcm
