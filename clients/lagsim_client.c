@@ -50,6 +50,8 @@ struct lag_client {
     void *on_status_user;
     lag_client_event_fn on_event;
     void *on_event_user;
+    lag_client_scene_fn on_scene;
+    void *on_scene_user;
 };
 
 /* ---------------------------------------------------------------- helpers */
@@ -129,6 +131,7 @@ static int dispatch(lag_client *c, const char *channel, const void *data, size_t
         c->scene = c->tmp.scene;
         c->have_scene = true;
         c->counters.scenes++;
+        if (c->on_scene) c->on_scene(&c->scene, c->on_scene_user);
     } else if (!strcmp(channel, c->ch_status)) {
         if (!decode(c, LAG_WIRE_STATUS, data, len)) return LAG_CLIENT_OK;
         c->status = c->tmp.status;
@@ -236,6 +239,12 @@ void lag_client_on_event(lag_client *c, lag_client_event_fn fn, void *user)
 {
     c->on_event = fn;
     c->on_event_user = user;
+}
+
+void lag_client_on_scene(lag_client *c, lag_client_scene_fn fn, void *user)
+{
+    c->on_scene = fn;
+    c->on_scene_user = user;
 }
 
 void lag_client_get_counters(const lag_client *c, lag_client_counters *out)

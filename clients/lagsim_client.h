@@ -76,6 +76,7 @@ typedef struct lag_client lag_client;
 typedef void (*lag_client_state_fn)(const lag_client_state *st, void *user);
 typedef void (*lag_client_status_fn)(const lag_client_status *st, void *user);
 typedef void (*lag_client_event_fn)(const lag_client_event *ev, void *user);
+typedef void (*lag_client_scene_fn)(const lag_client_scene *sc, void *user);
 
 /* Connects to LCM at url (NULL or "": LCM's default, which honours LCM_DEFAULT_URL) and
  * subscribes to <prefix>_STATE, _STATUS, _EVENT, _SCENE. Returns NULL on failure with a
@@ -104,6 +105,7 @@ int lag_client_feed(lag_client *c, const char *channel, const void *data, size_t
 void lag_client_on_state(lag_client *c, lag_client_state_fn fn, void *user);
 void lag_client_on_status(lag_client *c, lag_client_status_fn fn, void *user);
 void lag_client_on_event(lag_client *c, lag_client_event_fn fn, void *user);
+void lag_client_on_scene(lag_client *c, lag_client_scene_fn fn, void *user);
 
 /* Waits up to timeout_s (wall seconds) for the scene description, sending a DESCRIBE
  * request at once and every 0.25 s until it arrives (a scene already received counts).

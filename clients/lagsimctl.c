@@ -1,0 +1,472 @@
+/*
+ * lagsimctl: the control requests of a running lagsimd from a shell.
+ *
+ *   lagsimctl [--prefix P] [--url URL] [--timeout S] COMMAND [ARGS...]
+ *
+ * Sends one control request on <P>_CONTROL and prints the daemon's answer as text lines
+ * (an event, a status, a scene), or with `watch` prints what the daemon publishes until
+ * it stops. Exit status: 0 the daemon did it; 1 the daemon refused (its reason on
+ * stderr); 2 bad usage; 3 no answer within --timeout (no daemon with that prefix?).
+ *
+ * Output lines, one message each, `key=value` tokens after a first word:
+ *   event <kind> t=<sim s> step=<ticks> [joint=<name>] value=<v> detail="<sentence>"
+ *   status t=... step=... <every field of status_t, in .lcm order>
+ * The fields come from the wire module's tables: a field added to a .lcm file shows up.
+ *   scene model=... prefix=... mode=... ...      then one line per parameter and joint:
+ *   param <name>=<value>
+ *   joint <name> actuated=... initial_q=... ...  (every per-joint field of scene_t)
+ *   state t=... step=... <joint>=<q> ... <joint>_dot=<qd> ... <joint>_effort=<effort> ...
+ * Numbers are printed with %.17g (they read back to the same double) unless --digits
+ * says otherwise.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lagsim_client.h"
+#include "lagsim_wire.h"
+
+enum { EXIT_OK = 0, EXIT_REFUSED = 1, EXIT_USAGE = 2, EXIT_NOANSWER = 3 };
+
+static volatile sig_atomic_t g_signal = 0;
+static void on_signal(int sig) { g_signal = sig; }
+
+static int g_digits = 17;
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: lagsimctl [options] COMMAND [ARGS...]\n"
+            "Sends a control request to a running lagsimd and prints its answer.\n"
+            "commands:\n"
+            "  status               the daemon's status\n"
+            "  describe             the scene description (model, parameters, joints, timing)\n"
+            "  pause | resume       stop / go on advancing sim time\n"
+            "  step N               while paused: advance N control periods, then pause\n"
+            "  reset                back to the scene's initial state at sim time 0\n"
+            "  reset-to Q... QD...  back to this state: all positions, then all velocities\n"
+            "  watch                print states, events and statuses until the daemon stops\n"
+            "options:\n"
+            "  -p, --prefix P       the daemon's channel prefix (default DIPC)\n"
+            "  -u, --url URL        LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)\n"
+            "  -t, --timeout S      wall s to wait for the answer (default 2)\n"
+            "  -d, --digits N       significant digits of numbers (default 17: exact)\n"
+            "  -h, --help           this text\n"
+            "exit status: 0 done, 1 the daemon refused (its reason on stderr), 2 bad usage,\n"
+            "3 no answer within the timeout (is lagsimd running with this prefix?)\n");
+}
+
+/* ---------------------------------------------------------------- printing */
+static void put_num(double x) { printf("%.*g", g_digits, x); }
+
+/* A string as a token: bare if it has no space, quote or '=', else in double quotes with
+ * '"' and '\' escaped. */
+static void put_str(const char *s)
+{
+    if (*s && !strpbrk(s, " \t\"=\\")) {
+        fputs(s, stdout);
+        return;
+    }
+    putchar('"');
+    for (; *s; s++) {
+        if (*s == '"' || *s == '\\') putchar('\\');
+        putchar(*s);
+    }
+    putchar('"');
+}
+
+/* Every scalar field of a message as " name=value", in .lcm order (arrays skipped). */
+static void put_fields(lag_wire_type t, const void *m, const char *const *skip)
+{
+    int n;
+    const lag_wire_field *f = lag_wire_fields(t, &n);
+    for (int i = 0; i < n; i++) {
+        if (f[i].count_field >= 0) continue;
+        bool skipped = false;
+        for (const char *const *s = skip; s && *s; s++)
+            if (!strcmp(*s, f[i].name)) skipped = true;
+        if (skipped) continue;
+        const char *p = (const char *)m + f[i].offset;
+        printf(" %s=", f[i].name);
+        switch (f[i].kind) {
+        case LAG_WIRE_INT8: printf("%d", *(const int8_t *)p); break;
+        case LAG_WIRE_INT16: printf("%d", *(const int16_t *)p); break;
+        case LAG_WIRE_INT64: printf("%lld", (long long)*(const int64_t *)p); break;
+        case LAG_WIRE_DOUBLE: put_num(*(const double *)p); break;
+        case LAG_WIRE_BOOLEAN: printf("%s", *(const bool *)p ? "true" : "false"); break;
+        case LAG_WIRE_STRING: put_str(p); break;
+        }
+    }
+}
+
+static void print_event(const lag_client_event *ev)
+{
+    printf("event %s t=", ev->kind);
+    put_num(ev->sim_time);
+    printf(" step=%lld", (long long)ev->step);
+    if (ev->joint[0]) printf(" joint=%s", ev->joint);
+    printf(" value=");
+    put_num(ev->value);
+    printf(" detail=");
+    put_str(ev->detail);
+    printf("\n");
+    fflush(stdout);
+}
+
+static void print_status(const lag_client_status *st)
+{
+    static const char *const skip[] = {"utime", "sim_time", "step", NULL};
+    printf("status t=");
+    put_num(st->sim_time);
+    printf(" step=%lld", (long long)st->step);
+    put_fields(LAG_WIRE_STATUS, st, skip);
+    printf("\n");
+    fflush(stdout);
+}
+
+static void print_state(const lag_client_state *st)
+{
+    printf("state t=");
+    put_num(st->sim_time);
+    printf(" step=%lld", (long long)st->step);
+    for (int i = 0; i < st->num_joints; i++) {
+        printf(" %s=", st->name[i]);
+        put_num(st->position[i]);
+    }
+    for (int i = 0; i < st->num_joints; i++) {
+        printf(" %s_dot=", st->name[i]);
+        put_num(st->velocity[i]);
+    }
+    for (int i = 0; i < st->num_joints; i++) {
+        printf(" %s_effort=", st->name[i]);
+        put_num(st->effort[i]);
+    }
+    printf("\n");
+    fflush(stdout);
+}
+
+/* One element of an array field as a value token. */
+static void put_elem(const lag_wire_field *f, const void *m, int i)
+{
+    const char *p = (const char *)m + f->offset + (size_t)i * f->size;
+    switch (f->kind) {
+    case LAG_WIRE_DOUBLE: put_num(*(const double *)p); break;
+    case LAG_WIRE_BOOLEAN: printf("%s", *(const bool *)p ? "true" : "false"); break;
+    case LAG_WIRE_STRING: put_str(p); break;
+    case LAG_WIRE_INT8: printf("%d", *(const int8_t *)p); break;
+    case LAG_WIRE_INT16: printf("%d", *(const int16_t *)p); break;
+    case LAG_WIRE_INT64: printf("%lld", (long long)*(const int64_t *)p); break;
+    }
+}
+
+/* The scene: a line of its scalar fields, then one line per parameter
+ * ("param <name>=<value>") and one per joint ("joint <name> <field>=<value>..." for every
+ * array counted by num_joints), so that fields added to scene_t show up by themselves. */
+static void print_scene(const lag_client_scene *sc)
+{
+    static const char *const skip[] = {"utime", NULL};
+    int n, i_params = -1, i_joints = -1;
+    const lag_wire_field *f = lag_wire_fields(LAG_WIRE_SCENE, &n);
+    for (int i = 0; i < n; i++) {
+        if (!strcmp(f[i].name, "num_params")) i_params = i;
+        if (!strcmp(f[i].name, "num_joints")) i_joints = i;
+    }
+    printf("scene");
+    put_fields(LAG_WIRE_SCENE, sc, skip);
+    printf("\n");
+    for (int k = 0; k < sc->num_params; k++) {
+        printf("param %s=", sc->param_name[k]);
+        put_num(sc->param_value[k]);
+        for (int i = 0; i < n; i++)
+            if (f[i].count_field == i_params && strcmp(f[i].name, "param_name") &&
+                strcmp(f[i].name, "param_value")) {
+                printf(" %s=", f[i].name);
+                put_elem(&f[i], sc, k);
+            }
+        printf("\n");
+    }
+    for (int k = 0; k < sc->num_joints; k++) {
+        printf("joint %s", sc->joint_name[k]);
+        for (int i = 0; i < n; i++)
+            if (f[i].count_field == i_joints && strcmp(f[i].name, "joint_name")) {
+                printf(" %s=", f[i].name);
+                put_elem(&f[i], sc, k);
+            }
+        printf("\n");
+    }
+    fflush(stdout);
+}
+
+/* ---------------------------------------------------------------- answers */
+typedef struct answer {
+    const char *want;          /* event kind that says "done" (NULL: none) */
+    const char *want2;         /* a second event expected after it (step: step_done) */
+    bool got_event, got_event2, refused, want_status, got_status;
+    lag_client_event ev;
+    bool watch;
+    double heard;              /* monotonic s of the last message */
+    bool stopped;              /* the daemon's stop event */
+} answer;
+
+static void on_event(const lag_client_event *ev, void *user)
+{
+    answer *a = user;
+    a->heard = lag_client_now();
+    if (a->watch) {
+        print_event(ev);
+        if (!strcmp(ev->kind, "stop")) a->stopped = true;
+        return;
+    }
+    if (!a->got_event && a->want &&
+        (!strcmp(ev->kind, a->want) || !strcmp(ev->kind, "control_rejected"))) {
+        a->got_event = true;
+        a->refused = !strcmp(ev->kind, "control_rejected");
+        a->ev = *ev;
+        print_event(ev);
+    } else if (a->got_event && a->want2 && !a->got_event2 &&
+               (!strcmp(ev->kind, a->want2) || !strcmp(ev->kind, "stop") ||
+                !strcmp(ev->kind, "numeric_fault"))) {
+        a->got_event2 = true;
+        print_event(ev);
+    }
+}
+
+static void on_status(const lag_client_status *st, void *user)
+{
+    answer *a = user;
+    a->heard = lag_client_now();
+    if (a->watch) {
+        print_status(st);
+        return;
+    }
+    /* the status that follows the event (or, for `status`, any status) */
+    if (a->want_status && !a->got_status && (a->got_event || !a->want) &&
+        (!a->want2 || a->got_event2)) {
+        a->got_status = true;
+        print_status(st);
+    }
+}
+
+static void on_state(const lag_client_state *st, void *user)
+{
+    answer *a = user;
+    a->heard = lag_client_now();
+    if (a->watch) print_state(st);
+}
+
+static void on_scene(const lag_client_scene *sc, void *user)
+{
+    answer *a = user;
+    a->heard = lag_client_now();
+    if (a->watch) print_scene(sc);
+}
+
+/* Handles messages until done(), or until `timeout` wall s have passed (since the
+ * start, or with `silence`, since the last message from the daemon). */
+static int wait_for(lag_client *c, answer *a, double timeout, bool silence,
+                    bool (*done)(const answer *))
+{
+    double t0 = lag_client_now();
+    while (!done(a) && !g_signal) {
+        if (lag_client_now() - (silence && a->heard > t0 ? a->heard : t0) >= timeout)
+            return LAG_CLIENT_TIMEOUT;
+        int rc = lag_client_handle(c, 50);
+        if (rc < 0) return rc;
+    }
+    return LAG_CLIENT_OK;
+}
+
+static bool event_and_status(const answer *a)
+{
+    return a->got_event && (a->refused || a->got_status);
+}
+static bool status_only(const answer *a) { return a->got_status; }
+static bool event_only(const answer *a) { return a->got_event; }
+static bool step_done(const answer *a) { return a->refused || (a->got_event2 && a->got_status); }
+
+/* ---------------------------------------------------------------- main */
+static int parse_count(const char *s, long long *out)
+{
+    char *end;
+    errno = 0;
+    long long v = strtoll(s, &end, 10);
+    if (end == s || *end || errno || v < 1) return -1;
+    *out = v;
+    return 0;
+}
+
+static int parse_doubles(char **argv, int n, double *out)
+{
+    for (int i = 0; i < n; i++) {
+        char *end;
+        out[i] = strtod(argv[i], &end);
+        if (end == argv[i] || *end || !isfinite(out[i])) return -1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *prefix = "DIPC", *url = NULL;
+    double timeout = 2.0;
+    static const struct option longopts[] = {
+        {"prefix", required_argument, NULL, 'p'}, {"url", required_argument, NULL, 'u'},
+        {"timeout", required_argument, NULL, 't'}, {"digits", required_argument, NULL, 'd'},
+        {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
+    int opt;
+    /* "+": options end at the command, so reset-to's negative numbers stay arguments */
+    while ((opt = getopt_long(argc, argv, "+p:u:t:d:h", longopts, NULL)) != -1) {
+        char *end;
+        switch (opt) {
+        case 'p': prefix = optarg; break;
+        case 'u': url = optarg; break;
+        case 't':
+            timeout = strtod(optarg, &end);
+            if (end == optarg || *end || !(timeout > 0) || !isfinite(timeout)) {
+                fprintf(stderr, "lagsimctl: --timeout wants a number of seconds > 0, not '%s'\n",
+                        optarg);
+                return EXIT_USAGE;
+            }
+            break;
+        case 'd': {
+            long d = strtol(optarg, &end, 10);
+            if (end == optarg || *end || d < 1 || d > 17) {
+                fprintf(stderr, "lagsimctl: --digits wants 1 to 17, not '%s'\n", optarg);
+                return EXIT_USAGE;
+            }
+            g_digits = (int)d;
+            break;
+        }
+        case 'h': usage(stdout); return EXIT_OK;
+        default: usage(stderr); return EXIT_USAGE;
+        }
+    }
+    if (optind >= argc) {
+        fprintf(stderr, "lagsimctl: which command? (status, describe, pause, resume, step N, "
+                        "reset, reset-to Q... QD..., watch)\n");
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    const char *cmd = argv[optind];
+    char **args = argv + optind + 1;
+    int nargs = argc - optind - 1;
+
+    /* check the command and its arguments before touching the bus */
+    long long count = 0;
+    double q[LAG_CLIENT_MAX_JOINTS], qd[LAG_CLIENT_MAX_JOINTS];
+    int nq = 0;
+    int want_args = 0;
+    if (!strcmp(cmd, "step")) {
+        want_args = 1;
+        if (nargs == 1 && parse_count(args[0], &count)) {
+            fprintf(stderr, "lagsimctl: step wants a whole number of periods >= 1, not '%s'\n",
+                    args[0]);
+            return EXIT_USAGE;
+        }
+    } else if (!strcmp(cmd, "reset-to")) {
+        if (nargs < 2 || nargs % 2 || nargs / 2 > LAG_CLIENT_MAX_JOINTS) {
+            fprintf(stderr, "lagsimctl: reset-to wants every position, then every velocity "
+                            "(2, 4 or 6 numbers for 1 to 3 joints), got %d\n", nargs);
+            return EXIT_USAGE;
+        }
+        nq = nargs / 2;
+        if (parse_doubles(args, nq, q) || parse_doubles(args + nq, nq, qd)) {
+            fprintf(stderr, "lagsimctl: reset-to wants finite numbers\n");
+            return EXIT_USAGE;
+        }
+        want_args = nargs;
+    } else if (strcmp(cmd, "status") && strcmp(cmd, "describe") && strcmp(cmd, "pause") &&
+               strcmp(cmd, "resume") && strcmp(cmd, "reset") && strcmp(cmd, "watch")) {
+        fprintf(stderr, "lagsimctl: unknown command '%s'\n", cmd);
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    if (nargs != want_args) {
+        fprintf(stderr, "lagsimctl: %s takes %d argument(s), got %d\n", cmd, want_args, nargs);
+        return EXIT_USAGE;
+    }
+
+    char err[256];
+    lag_client *c = lag_client_create(url, prefix, err, sizeof err);
+    if (!c) {
+        fprintf(stderr, "lagsimctl: %s\n", err);
+        return EXIT_NOANSWER;
+    }
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGPIPE, &sa, NULL);
+
+    answer a = {0};
+    a.heard = lag_client_now();
+    lag_client_on_event(c, on_event, &a);
+    lag_client_on_status(c, on_status, &a);
+    lag_client_on_state(c, on_state, &a);
+    lag_client_on_scene(c, on_scene, &a);
+
+    int rc = LAG_CLIENT_OK, code = EXIT_OK;
+    if (!strcmp(cmd, "describe")) {
+        lag_client_scene sc;
+        rc = lag_client_wait_scene(c, timeout, &sc);
+        if (rc == LAG_CLIENT_OK) print_scene(&sc);
+    } else if (!strcmp(cmd, "status")) {
+        a.want_status = true;
+        rc = lag_client_request_status(c);
+        if (rc == LAG_CLIENT_OK) rc = wait_for(c, &a, timeout, false, status_only);
+    } else if (!strcmp(cmd, "watch")) {
+        a.watch = true;
+        /* until the daemon's stop event or a signal; a daemon that is not there yet is
+         * waited for */
+        while (!a.stopped && !g_signal) {
+            rc = lag_client_handle(c, 100);
+            if (rc < 0) break;
+            rc = LAG_CLIENT_OK;
+        }
+    } else {
+        a.want_status = true;
+        if (!strcmp(cmd, "pause")) {
+            a.want = "pause";
+            rc = lag_client_pause(c);
+        } else if (!strcmp(cmd, "resume")) {
+            a.want = "resume";
+            rc = lag_client_resume(c);
+        } else if (!strcmp(cmd, "reset")) {
+            a.want = "reset";
+            rc = lag_client_reset(c);
+        } else if (!strcmp(cmd, "reset-to")) {
+            a.want = "reset";
+            rc = lag_client_reset_to(c, nq, q, qd);
+        } else { /* step */
+            a.want = "step";
+            a.want2 = "step_done";
+            rc = lag_client_step(c, count);
+        }
+        if (rc == LAG_CLIENT_OK && !a.want2) {
+            rc = wait_for(c, &a, timeout, false, event_and_status);
+        } else if (rc == LAG_CLIENT_OK) {
+            /* step: the "step" event within the timeout, then step_done (or the end of the
+             * run) however long the steps take, as long as the daemon is heard from */
+            rc = wait_for(c, &a, timeout, false, event_only);
+            if (rc == LAG_CLIENT_OK && !a.refused) rc = wait_for(c, &a, timeout, true, step_done);
+        }
+    }
+    if (rc < 0) {
+        fprintf(stderr, "lagsimctl: %s\n", lag_client_errmsg(c));
+        code = EXIT_NOANSWER;
+    } else if (rc == LAG_CLIENT_TIMEOUT && !g_signal) {
+        fprintf(stderr, "lagsimctl: no answer on %s_* within %g s (is lagsimd running with "
+                        "lcm.prefix %s?)\n", prefix, timeout, prefix);
+        code = EXIT_NOANSWER;
+    } else if (a.refused) {
+        fprintf(stderr, "lagsimctl: the daemon refused: %s\n", a.ev.detail);
+        code = EXIT_REFUSED;
+    }
+    lag_client_destroy(c);
+    return code;
+}

@@ -1,0 +1,188 @@
+#!/usr/bin/env python3
+"""lagsimctl against a running lagsimd: every command, its output, its exit status.
+
+    test_lagsimctl.py --lagsimctl BIN --lagsimd BIN --source DIR
+
+A real-time daemon on config/dipc.yaml with a prefix of its own; then, in order:
+  status      exit 0, one `status` line with every field of status_t.lcm (read from the
+              file) as key=value, run_state=running
+  describe    exit 0, the scene: model=dipc, one `param` line per parameter (m0 = 1.5 as
+              in the file), one `joint` line per joint
+  pause       exit 0, `event pause`, then a status with run_state=paused
+  step 3      exit 0, `event step ... value=3`, `event step_done`, and a status exactly
+              3 control periods (30 ticks) after the paused one
+  step 2 while running, after resume: exit 1, the daemon's reason on stderr
+  reset-to    (paused) exit 0; the next state is the one asked for, bit for bit
+  reset-to with 2 numbers for 3 joints: exit 1, the daemon's reason
+  reset       exit 0, `event reset`, status at step 0
+  usage       step 0, step abc, reset-to 1 2 3, an unknown command: exit 2, nothing sent
+  no daemon   another prefix: exit 3 within the timeout
+  watch       a daemon that runs 1 s and stops: states as lines, the stop event, exit 0
+"""
+import argparse
+import os
+import re
+import subprocess
+import sys
+import time
+
+fails = 0
+
+
+def check(cond, what):
+    global fails
+    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
+    if not cond:
+        fails += 1
+    return cond
+
+
+def tokens(line):
+    """key=value tokens of a line (values may be "quoted")."""
+    return dict(re.findall(r'(\w+)=("(?:[^"\\]|\\.)*"|\S+)', line))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--lagsimctl", required=True)
+    ap.add_argument("--lagsimd", required=True)
+    ap.add_argument("--source", required=True)
+    a = ap.parse_args()
+    cfg = os.path.join(a.source, "config", "dipc.yaml")
+    prefix = "CTL_%d" % os.getpid()
+
+    def ctl(*args, timeout=20):
+        r = subprocess.run([a.lagsimctl, "--prefix", prefix] + list(args),
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=timeout)
+        print("$ lagsimctl %s   -> exit %d" % (" ".join(args), r.returncode))
+        for line in r.stdout.splitlines()[:6]:
+            print("  " + line[:160])
+        if r.stderr.strip():
+            print("  stderr: " + r.stderr.strip()[:200])
+        return r
+
+    def lines(r, word):
+        return [l for l in r.stdout.splitlines() if l.split(" ", 1)[0] == word]
+
+    status_fields = []
+    with open(os.path.join(a.source, "lcmtypes", "status_t.lcm")) as f:
+        for line in f:
+            m = re.match(r"\s*(?:int8_t|int16_t|int64_t|double|boolean|string)\s+(\w+)\s*;", line)
+            if m:
+                status_fields.append(m.group(1))
+
+    d = subprocess.Popen([a.lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix, "-q"],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, universal_newlines=True)
+    try:
+        time.sleep(0.5)
+        r = ctl("status")
+        st = lines(r, "status")
+        check(r.returncode == 0 and len(st) == 1, "status: exit 0, one status line")
+        kv = tokens(st[0]) if st else {}
+        missing = [f for f in status_fields if f not in ("utime", "sim_time") and f not in kv]
+        check(status_fields and not missing,
+              "status: every field of status_t.lcm is printed (%d; missing %s)"
+              % (len(status_fields), missing))
+        check(kv.get("run_state") == "running" and kv.get("mode") == "realtime",
+              "status: run_state=running mode=realtime")
+
+        r = ctl("describe")
+        sc = lines(r, "scene")
+        params = dict(l.split(" ", 1)[1].split("=", 1) for l in lines(r, "param"))
+        joints = [l.split()[1] for l in lines(r, "joint")]
+        check(r.returncode == 0 and sc and tokens(sc[0]).get("model") == "dipc",
+              "describe: exit 0, scene model=dipc")
+        check(float(params.get("m0", "nan")) == 1.5 and len(params) >= 9,
+              "describe: the parameters (%d, m0 = %s)" % (len(params), params.get("m0")))
+        check(joints == ["theta0", "theta1", "theta2"], "describe: the joints %s" % joints)
+
+        r = ctl("pause")
+        ev, st = lines(r, "event"), lines(r, "status")
+        check(r.returncode == 0 and ev and ev[0].startswith("event pause ") and st and
+              tokens(st[0]).get("run_state") == "paused",
+              "pause: exit 0, event pause, status run_state=paused")
+        step0 = int(tokens(st[0]).get("step", -1)) if st else -1
+
+        r = ctl("step", "3")
+        ev, st = lines(r, "event"), lines(r, "status")
+        check(r.returncode == 0 and len(ev) == 2 and ev[0].startswith("event step ") and
+              float(tokens(ev[0]).get("value", 0)) == 3 and ev[1].startswith("event step_done"),
+              "step 3: exit 0, event step value=3, event step_done")
+        step1 = int(tokens(st[0]).get("step", -1)) if st else -1
+        check(st and step1 == step0 + 30 and tokens(st[0]).get("run_state") == "paused",
+              "step 3: the status after it is 30 ticks on (%d -> %d), paused" % (step0, step1))
+
+        r = ctl("reset-to", "0", "0.1", "-0.05", "0", "0", "0")
+        check(r.returncode == 0 and lines(r, "event") and
+              lines(r, "event")[0].startswith("event reset "), "reset-to: exit 0, event reset")
+        w = subprocess.Popen([a.lagsimctl, "--prefix", prefix, "watch"], stdout=subprocess.PIPE,
+                             universal_newlines=True)
+        first = None
+        t_end = time.monotonic() + 5
+        while time.monotonic() < t_end:
+            line = w.stdout.readline()
+            if line.startswith("state "):
+                first = tokens(line)
+                break
+        w.terminate()
+        w.wait()
+        check(first is not None and float(first["theta1"]) == 0.1 and
+              float(first["theta2"]) == -0.05 and float(first["t"]) == 0.0,
+              "reset-to: the paused daemon publishes the state asked for (%s)"
+              % ({k: first[k] for k in ("t", "theta1", "theta2")} if first else None))
+
+        r = ctl("reset-to", "0", "0")
+        check(r.returncode == 1 and "num_joints" in r.stderr and "refused" in r.stderr,
+              "reset-to with 1 joint of 3: exit 1, the daemon's reason on stderr")
+
+        r = ctl("resume")
+        st = lines(r, "status")
+        check(r.returncode == 0 and st and tokens(st[0]).get("run_state") == "running",
+              "resume: exit 0, run_state=running")
+        r = ctl("step", "2")
+        check(r.returncode == 1 and "only while paused" in r.stderr,
+              "step while running: exit 1, the daemon's reason on stderr")
+        r = ctl("reset")
+        ev, st = lines(r, "event"), lines(r, "status")
+        check(r.returncode == 0 and ev and ev[0].startswith("event reset ") and st,
+              "reset: exit 0, event reset, a status")
+
+        for bad in (["step", "0"], ["step", "abc"], ["reset-to", "1", "2", "3"], ["spin"],
+                    ["status", "extra"], ["--timeout", "-1", "status"]):
+            r = ctl(*bad)
+            check(r.returncode == 2 and r.stderr.startswith("lagsimctl: "),
+                  "usage error %s: exit 2 with a message" % bad)
+        t0 = time.monotonic()
+        r = subprocess.run([a.lagsimctl, "--prefix", prefix + "_NONE", "--timeout", "0.5",
+                            "status"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True)
+        dt = time.monotonic() - t0
+        check(r.returncode == 3 and "no answer" in r.stderr and dt < 3.0,
+              "no daemon on the prefix: exit 3 after %.2f s with a message" % dt)
+    finally:
+        d.terminate()
+        d.wait(5)
+
+    # watch: a daemon that runs 1 s of sim time, then stops by itself
+    w = subprocess.Popen([a.lagsimctl, "--prefix", prefix + "W", "watch"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, universal_newlines=True)
+    time.sleep(0.3)
+    subprocess.run([a.lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix + "W", "-q",
+                    "--duration", "1"], timeout=30)
+    try:
+        out, err = w.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        w.kill()
+        out, err = w.communicate()
+    states = [l for l in out.splitlines() if l.startswith("state ")]
+    stops = [l for l in out.splitlines() if l.startswith("event stop ")]
+    check(w.returncode == 0 and stops, "watch: exit 0 after the daemon's stop event")
+    check(len(states) >= 50 and all(len(tokens(s)) == 2 + 9 for s in states),
+          "watch: %d state lines, each with t, step and 3 x (q, qd, effort)" % len(states))
+    print("%d failure(s)" % fails)
+    return 1 if fails else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
