@@ -33,3 +33,10 @@ set_tests_properties(scene_set_overrides scene_offline_csv scene_determinism sce
 # then the core on what was accepted. Inputs: tests/fuzz/scene/{seed,crash}, written by
 # tests/fuzz/scene/make_inputs.sh.
 lagsim_fuzz_target(scene LIBS lagsim_scene)
+
+# Every numeric key of the loader's tables, for every model, refuses +-1e300 at its
+# file:line:column (tests/scene/test_ranges.c).
+add_executable(test_scene_ranges ${scene_dir}/test_ranges.c)
+target_link_libraries(test_scene_ranges PRIVATE lagsim_scene)
+add_test(NAME scene_ranges COMMAND test_scene_ranges)
+set_tests_properties(scene_ranges PROPERTIES TIMEOUT 60 LABELS scene)

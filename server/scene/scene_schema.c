@@ -18,6 +18,7 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -104,12 +105,26 @@ static const char *join(char *buf, size_t len, const char *parent, const char *k
     return buf;
 }
 
-/* Key tables: a NULL-terminated list of {name, handler}. */
+/* Key tables: a NULL-terminated list of {name, handler, what the value is}. The handler
+ * reads the value; the type (and the sub-table of a section) lets scene_schema_each_number
+ * list every numeric key, so that a test can check each one has a range. */
 typedef struct keyrow keyrow;
 typedef int (*key_fn)(conv *cv, const ynode *val, const char *path);
+typedef enum keytype {
+    K_OTHER = 0, /* a string, a name, a boolean */
+    K_NUMBER,    /* a number */
+    K_INTEGER,   /* an integer */
+    K_MAP,       /* a section: the keys of `sub` */
+    K_JOINTS,    /* {joint: number}, or {joint: {keys of sub}}; plus the keys of `extra` */
+    K_VECTOR,    /* a sequence of one number per coordinate */
+    K_LIST,      /* a sequence of mappings with the keys of `sub` */
+    K_PARAMS     /* the model's parameters (lag_model_info) */
+} keytype;
 struct keyrow {
     const char *name;
     key_fn fn;
+    keytype type;
+    const keyrow *sub, *extra;
 };
 
 /* Lists the names of a key table: "a, b, c". */
@@ -447,9 +462,9 @@ static int key_qd(conv *cv, const ynode *nd, const char *path)
 }
 
 static const keyrow k_initial_keys[] = {
-    {"q", key_q},   /* rad or m, per coordinate, within explode_limit */
-    {"qd", key_qd}, /* rad/s or m/s, within explode_limit */
-    {NULL, NULL},
+    {"q", key_q, K_VECTOR},   /* rad or m, per coordinate, within explode_limit */
+    {"qd", key_qd, K_VECTOR}, /* rad/s or m/s, within explode_limit */
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 static int key_initial(conv *cv, const ynode *nd, const char *path)
@@ -525,15 +540,15 @@ static int key_newton_tol(conv *cv, const ynode *nd, const char *path)
 }
 
 static const keyrow k_integrator_keys[] = {
-    {"method", key_method},         /* euler | semi-implicit-euler | rk4 | dopri5 | ... */
-    {"dt", key_dt},                 /* s */
-    {"rtol", key_rtol},             /* dopri5 */
-    {"atol", key_atol},             /* dopri5 */
-    {"dt_min", key_dt_min},         /* dopri5, s, <= dt */
-    {"max_iter", key_max_iter},     /* implicit methods, 1..1000 */
-    {"max_steps", key_max_steps},   /* dopri5, steps per tick, 1..1e6 */
-    {"newton_tol", key_newton_tol}, /* implicit methods */
-    {NULL, NULL},
+    {"method", key_method, K_OTHER},         /* euler | semi-implicit-euler | rk4 | dopri5 | ... */
+    {"dt", key_dt, K_NUMBER},                 /* s */
+    {"rtol", key_rtol, K_NUMBER},             /* dopri5 */
+    {"atol", key_atol, K_NUMBER},             /* dopri5 */
+    {"dt_min", key_dt_min, K_NUMBER},         /* dopri5, s, <= dt */
+    {"max_iter", key_max_iter, K_INTEGER},     /* implicit methods, 1..1000 */
+    {"max_steps", key_max_steps, K_INTEGER},   /* dopri5, steps per tick, 1..1e6 */
+    {"newton_tol", key_newton_tol, K_NUMBER}, /* implicit methods */
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 static int key_integrator(conv *cv, const ynode *nd, const char *path)
@@ -616,13 +631,13 @@ static int key_effort_limit(conv *cv, const ynode *nd, const char *path)
 }
 
 static const keyrow k_realtime_keys[] = {
-    {"mode", key_mode},                         /* realtime | fast | lockstep */
-    {"rate", key_rate},                         /* sim s per wall s */
-    {"command_timeout", key_command_timeout},   /* sim s */
-    {"lockstep_timeout", key_lockstep_timeout}, /* wall s */
-    {"status_hz", key_status_hz},               /* wall Hz */
-    {"effort_limit", key_effort_limit},         /* N or N m per actuated joint */
-    {NULL, NULL},
+    {"mode", key_mode, K_OTHER},                         /* realtime | fast | lockstep */
+    {"rate", key_rate, K_NUMBER},                         /* sim s per wall s */
+    {"command_timeout", key_command_timeout, K_NUMBER},   /* sim s */
+    {"lockstep_timeout", key_lockstep_timeout, K_NUMBER}, /* wall s */
+    {"status_hz", key_status_hz, K_NUMBER},               /* wall Hz */
+    {"effort_limit", key_effort_limit, K_JOINTS},         /* N or N m per actuated joint */
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 static int key_realtime(conv *cv, const ynode *nd, const char *path)
@@ -678,10 +693,10 @@ static int key_allow_lan(conv *cv, const ynode *nd, const char *path)
 }
 
 static const keyrow k_lcm_keys[] = {
-    {"url", key_url},             /* "" = LCM's default; udpm:// or memq:// */
-    {"prefix", key_prefix},       /* channel prefix */
-    {"allow_lan", key_allow_lan}, /* bool: traffic may leave this host (ttl > 0) */
-    {NULL, NULL},
+    {"url", key_url, K_OTHER},             /* "" = LCM's default; udpm:// or memq:// */
+    {"prefix", key_prefix, K_OTHER},       /* channel prefix */
+    {"allow_lan", key_allow_lan, K_OTHER}, /* bool: traffic may leave this host (ttl > 0) */
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 static int key_lcm(conv *cv, const ynode *nd, const char *path)
@@ -716,9 +731,9 @@ static int key_gravity_g(conv *cv, const ynode *nd, const char *path)
 }
 
 static const keyrow k_gravity_keys[] = {
-    {"enabled", key_gravity_enabled}, /* false: g = 0 */
-    {"g", key_gravity_g},             /* m/s^2, replaces parameters.g */
-    {NULL, NULL},
+    {"enabled", key_gravity_enabled, K_OTHER}, /* false: g = 0 */
+    {"g", key_gravity_g, K_NUMBER},             /* m/s^2, replaces parameters.g */
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 static int key_effect_gravity(conv *cv, const ynode *nd, const char *path)
@@ -752,9 +767,9 @@ static int fr_kinetic(conv *cv, const ynode *nd, const char *path)
 }
 
 static const keyrow k_friction_keys[] = {
-    {"static", fr_static},   /* largest holding force, N or N m */
-    {"kinetic", fr_kinetic}, /* sliding force, N or N m */
-    {NULL, NULL},
+    {"static", fr_static, K_NUMBER},   /* largest holding force, N or N m */
+    {"kinetic", fr_kinetic, K_NUMBER}, /* sliding force, N or N m */
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 static int friction_joint(conv *cv, int j, const ynode *nd, const char *path)
@@ -794,10 +809,10 @@ static int lim_restitution(conv *cv, const ynode *nd, const char *path)
 }
 
 static const keyrow k_limit_keys[] = {
-    {"lower", lim_lower},             /* m or rad, within explode_limit */
-    {"upper", lim_upper},             /* m or rad, within explode_limit */
-    {"restitution", lim_restitution}, /* [0, 1], default 0 */
-    {NULL, NULL},
+    {"lower", lim_lower, K_NUMBER},             /* m or rad, within explode_limit */
+    {"upper", lim_upper, K_NUMBER},             /* m or rad, within explode_limit */
+    {"restitution", lim_restitution, K_NUMBER}, /* [0, 1], default 0 */
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 /* m/s or rad/s: an impact slower than this ends in resting contact */
@@ -805,6 +820,12 @@ static int key_rest_velocity(conv *cv, const ynode *nd, const char *path)
 {
     return get_within_explode(cv, nd, path, true, &fx(cv)->rest_velocity);
 }
+
+/* the key of the limits section beside the joints */
+static const keyrow k_limits_extra[] = {
+    {"rest_velocity", key_rest_velocity, K_NUMBER, NULL, NULL},
+    {NULL, NULL, K_OTHER, NULL, NULL},
+};
 
 static int key_effect_limits(conv *cv, const ynode *nd, const char *path)
 {
@@ -815,8 +836,8 @@ static int key_effect_limits(conv *cv, const ynode *nd, const char *path)
         const yentry *en = &nd->entries[i];
         char sub[256];
         join(sub, sizeof sub, path, en->key);
-        if (strcmp(en->key, "rest_velocity") == 0) {
-            if (key_rest_velocity(cv, en->val, sub) < 0) return -1;
+        if (strcmp(en->key, k_limits_extra[0].name) == 0) {
+            if (k_limits_extra[0].fn(cv, en->val, sub) < 0) return -1;
             continue;
         }
         int j = joint_index(cv, en->key);
@@ -844,9 +865,9 @@ static int floor_restitution(conv *cv, const ynode *nd, const char *path)
 }
 
 static const keyrow k_floor_keys[] = {
-    {"restitution", floor_restitution}, /* [0, 1], default 0 */
-    {"rest_velocity", key_rest_velocity}, /* rad/s, default 1e-3 */
-    {NULL, NULL},
+    {"restitution", floor_restitution, K_NUMBER}, /* [0, 1], default 0 */
+    {"rest_velocity", key_rest_velocity, K_NUMBER}, /* rad/s, default 1e-3 */
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 /* which models have a floor, and where the initial state must then be: the core's check */
@@ -871,9 +892,9 @@ static int act_lag(conv *cv, const ynode *nd, const char *path)
 }
 
 static const keyrow k_actuator_keys[] = {
-    {"max", act_max}, /* |effort| bound, N or N m */
-    {"lag", act_lag}, /* first-order time constant, s */
-    {NULL, NULL},
+    {"max", act_max, K_NUMBER}, /* |effort| bound, N or N m */
+    {"lag", act_lag, K_NUMBER}, /* first-order time constant, s */
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 static int actuator_joint(conv *cv, int j, const ynode *nd, const char *path)
@@ -941,12 +962,12 @@ static int dist_duration(conv *cv, const ynode *nd, const char *path)
 }
 
 static const keyrow k_dist_keys[] = {
-    {"t", dist_t},               /* s */
-    {"joint", dist_joint},       /* joint name */
-    {"impulse", dist_impulse},   /* N s or N m s */
-    {"force", dist_force},       /* N or N m */
-    {"duration", dist_duration}, /* s, with force */
-    {NULL, NULL},
+    {"t", dist_t, K_NUMBER},               /* s */
+    {"joint", dist_joint, K_OTHER},       /* joint name */
+    {"impulse", dist_impulse, K_NUMBER},   /* N s or N m s */
+    {"force", dist_force, K_NUMBER},       /* N or N m */
+    {"duration", dist_duration, K_NUMBER}, /* s, with force */
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 static int key_effect_disturbance(conv *cv, const ynode *nd, const char *path)
@@ -1015,10 +1036,10 @@ static int noise_seed(conv *cv, const ynode *nd, const char *path)
 }
 
 static const keyrow k_noise_keys[] = {
-    {"seed", noise_seed}, /* integer, default 1 */
-    {"q", noise_q},       /* std dev per joint, m or rad */
-    {"qd", noise_qd},     /* std dev per joint, m/s or rad/s */
-    {NULL, NULL},
+    {"seed", noise_seed, K_INTEGER}, /* integer, default 1 */
+    {"q", noise_q, K_JOINTS},       /* std dev per joint, m or rad */
+    {"qd", noise_qd, K_JOINTS},     /* std dev per joint, m/s or rad/s */
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 static int key_effect_noise(conv *cv, const ynode *nd, const char *path)
@@ -1028,15 +1049,15 @@ static int key_effect_noise(conv *cv, const ynode *nd, const char *path)
 }
 
 static const keyrow k_effects[] = {
-    {"gravity", key_effect_gravity},
-    {"damping", key_effect_damping},
-    {"friction", key_effect_friction},
-    {"limits", key_effect_limits},
-    {"floor", key_effect_floor},
-    {"actuator", key_effect_actuator},
-    {"disturbance", key_effect_disturbance},
-    {"noise", key_effect_noise},
-    {NULL, NULL},
+    {"gravity", key_effect_gravity, K_MAP, k_gravity_keys},
+    {"damping", key_effect_damping, K_JOINTS},
+    {"friction", key_effect_friction, K_JOINTS, k_friction_keys},
+    {"limits", key_effect_limits, K_JOINTS, k_limit_keys, k_limits_extra},
+    {"floor", key_effect_floor, K_MAP, k_floor_keys},
+    {"actuator", key_effect_actuator, K_JOINTS, k_actuator_keys},
+    {"disturbance", key_effect_disturbance, K_LIST, k_dist_keys},
+    {"noise", key_effect_noise, K_MAP, k_noise_keys},
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 static int key_effects(conv *cv, const ynode *nd, const char *path)
@@ -1050,16 +1071,16 @@ static int key_effects(conv *cv, const ynode *nd, const char *path)
 /* ================================================================ the scene */
 
 static const keyrow k_top_keys[] = {
-    {"model", key_model},                 /* from lag_model_info (required) */
-    {"parameters", key_parameters},       /* named as in lag_model_info */
-    {"initial", key_initial},             /* q, qd */
-    {"integrator", key_integrator},       /* method, dt, tolerances */
-    {"publish_hz", key_publish_hz},       /* Hz */
-    {"explode_limit", key_explode_limit}, /* |q_i|, |qd_i| bound */
-    {"realtime", key_realtime},           /* pacing of the real-time server */
-    {"lcm", key_lcm},                     /* transport */
-    {"effects", key_effects},             /* per-scene effects */
-    {NULL, NULL},
+    {"model", key_model, K_OTHER},                 /* from lag_model_info (required) */
+    {"parameters", key_parameters, K_PARAMS},       /* named as in lag_model_info */
+    {"initial", key_initial, K_MAP, k_initial_keys},             /* q, qd */
+    {"integrator", key_integrator, K_MAP, k_integrator_keys},       /* method, dt, tolerances */
+    {"publish_hz", key_publish_hz, K_NUMBER},       /* Hz */
+    {"explode_limit", key_explode_limit, K_NUMBER}, /* |q_i|, |qd_i| bound */
+    {"realtime", key_realtime, K_MAP, k_realtime_keys},           /* pacing of the real-time server */
+    {"lcm", key_lcm, K_MAP, k_lcm_keys},                     /* transport */
+    {"effects", key_effects, K_MAP, k_effects},             /* per-scene effects */
+    {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
 /* Read before the others, in this order: what other values are measured against. */
@@ -1193,4 +1214,71 @@ int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, err
         return yfail(err, ytree_lookup(root, d.field), d.field[0] ? d.field : NULL, "%s",
                      d.message);
     return 0;
+}
+
+/* ================================================================ every numeric key */
+
+/* snprintf for key paths (at most 255 characters; longer ones are cut) */
+static void pathf(char *buf, size_t len, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static void pathf(char *buf, size_t len, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, len, fmt, ap);
+    va_end(ap);
+}
+
+static void walk(const lag_model_info *info, const keyrow *rows, const char *prefix,
+                 scene_number_fn fn, void *ctx)
+{
+    for (const keyrow *r = rows; r->name; r++) {
+        char p[256], q[256];
+        pathf(p, sizeof p, "%s%s%s", prefix, prefix[0] ? "." : "", r->name);
+        switch (r->type) {
+        case K_OTHER:
+            break;
+        case K_NUMBER:
+        case K_INTEGER:
+            fn(ctx, p, r->type == K_INTEGER);
+            break;
+        case K_MAP:
+            walk(info, r->sub, p, fn, ctx);
+            break;
+        case K_PARAMS:
+            for (int i = 0; i < info->np; i++)
+            {
+                pathf(q, sizeof q, "%s.%s", p, info->param_names[i]);
+                fn(ctx, q, false);
+            }
+            break;
+        case K_VECTOR:
+            for (int i = 0; i < info->nq; i++) {
+                pathf(q, sizeof q, "%s[%d]", p, i);
+                fn(ctx, q, false);
+            }
+            break;
+        case K_JOINTS:
+            for (int i = 0; i < info->nq; i++) {
+                pathf(q, sizeof q, "%s.%s", p, info->joint_names[i]);
+                if (r->sub)
+                    walk(info, r->sub, q, fn, ctx);
+                else
+                    fn(ctx, q, false);
+            }
+            if (r->extra)
+                walk(info, r->extra, p, fn, ctx);
+            break;
+        case K_LIST:
+            pathf(q, sizeof q, "%s[0]", p);
+            walk(info, r->sub, q, fn, ctx);
+            break;
+        }
+    }
+}
+
+void scene_schema_each_number(lag_model_kind kind, scene_number_fn fn, void *ctx)
+{
+    const lag_model_info *info = lag_model_info_get(kind);
+    if (info)
+        walk(info, k_top_keys, "", fn, ctx);
 }

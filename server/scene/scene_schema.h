@@ -13,4 +13,11 @@
  * error names its node ("file:line:column: key.path: what was expected"). OUT: sc */
 int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, errbuf *err);
 
+/* Calls fn for every numeric key a scene of this model may have, by its path
+ * ("integrator.dt", "effects.damping.theta1", "initial.q[2]", "effects.disturbance[0].t"),
+ * integer says whether it takes an integer. From the key tables themselves, so a key added
+ * there is listed here: tests/scene/test_ranges.c checks that each one has a range. */
+typedef void (*scene_number_fn)(void *ctx, const char *path, bool integer);
+void scene_schema_each_number(lag_model_kind kind, scene_number_fn fn, void *ctx);
+
 #endif

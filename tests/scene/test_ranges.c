@@ -1,0 +1,111 @@
+/*
+ * Every numeric scene key has a range that the loader (or the core, through the loader)
+ * enforces at the key's file:line:column.
+ *
+ * The keys come from the loader's own key tables (scene_schema_each_number), for every
+ * model of the core's table, so a numeric key added later is checked without editing
+ * this test. For each key, a scene with only that key set to a huge positive and a huge
+ * negative value (numbers: +-1e300; integers: +-1e20) must be refused, and the message
+ * must point into the file at that key (or at a section enclosing it, when the section
+ * itself is refused first, e.g. the floor effect on a model without a floor). The same
+ * scene with the model's defaults is accepted, which shows that the generated YAML is
+ * well formed and that the refusal is the value's.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene.h"
+#include "scene_schema.h"
+
+typedef struct ctx {
+    const char *model;
+    int nq;
+    int keys, failures;
+} ctx;
+
+/* Flow YAML for `path` = value: "effects.disturbance[0].t" -> "effects: {disturbance:
+ * [{t: V}]}"; a trailing "name[i]" is a vector of nq numbers with V at i, 0 elsewhere. */
+static void yaml_for(char *out, size_t len, const char *path, const char *value, int nq)
+{
+    const char *dot = strchr(path, '.');
+    size_t seg = dot ? (size_t)(dot - path) : strlen(path);
+    const char *br = memchr(path, '[', seg);
+    size_t name = br ? (size_t)(br - path) : seg;
+    char inner[512];
+    if (!dot && br) { /* a vector element */
+        int at = atoi(br + 1);
+        size_t u = 0;
+        u += (size_t)snprintf(inner + u, sizeof inner - u, "[");
+        for (int i = 0; i < nq; i++)
+            u += (size_t)snprintf(inner + u, sizeof inner - u, "%s%s", i ? ", " : "",
+                                  i == at ? value : "0");
+        snprintf(inner + u, sizeof inner - u, "]");
+    } else if (dot) {
+        char rest[512];
+        yaml_for(rest, sizeof rest, dot + 1, value, nq);
+        snprintf(inner, sizeof inner, br ? "[{%s}]" : "{%s}", rest);
+    } else {
+        snprintf(inner, sizeof inner, "%s", value);
+    }
+    snprintf(out, len, "%.*s: %s", (int)name, path, inner);
+}
+
+static void check_key(void *vc, const char *path, bool integer)
+{
+    ctx *c = vc;
+    c->keys++;
+    const char *values[2] = {integer ? "100000000000000000000" : "1e300",
+                             integer ? "-100000000000000000000" : "-1e300"};
+    for (int v = 0; v < 2; v++) {
+        char body[768], text[1024], err[1024];
+        yaml_for(body, sizeof body, path, values[v], c->nq);
+        snprintf(text, sizeof text, "model: %s\n%s\n", c->model, body);
+        static lag_scene sc;
+        if (lag_scene_load_buffer("t.yaml", text, strlen(text), NULL, 0, &sc, err,
+                                  sizeof err) == 0) {
+            printf("FAIL: %s: %s = %s accepted\n%s", c->model, path, values[v], text);
+            c->failures++;
+            continue;
+        }
+        /* "t.yaml:2:C: PATH: ..." with PATH the key or a section enclosing it */
+        const char *p = strstr(err, ": ");
+        const char *named = p ? p + 2 : "";
+        size_t nlen = strcspn(named, ":");
+        bool at_key = strncmp(err, "t.yaml:2:", 9) == 0 && nlen > 0 &&
+                      strncmp(named, path, nlen) == 0 &&
+                      (path[nlen] == '\0' || path[nlen] == '.' || path[nlen] == '[');
+        if (!at_key || strstr(err, "unknown")) {
+            printf("FAIL: %s: %s = %s: refused, but not at the key: %s\n", c->model, path,
+                   values[v], err);
+            c->failures++;
+        }
+    }
+}
+
+int main(void)
+{
+    int failures = 0, total = 0;
+    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
+        const lag_model_info *info = lag_model_info_get((lag_model_kind)k);
+        ctx c = {.model = info->name, .nq = info->nq};
+        char text[64], err[1024];
+        static lag_scene sc;
+        snprintf(text, sizeof text, "model: %s\n", info->name);
+        if (lag_scene_load_buffer("t.yaml", text, strlen(text), NULL, 0, &sc, err,
+                                  sizeof err) != 0) {
+            printf("FAIL: the defaults of %s are refused: %s\n", info->name, err);
+            failures++;
+        }
+        scene_schema_each_number((lag_model_kind)k, check_key, &c);
+        printf("%s: %d numeric keys, %d failures\n", info->name, c.keys, c.failures);
+        if (c.keys < 30) { /* the walk itself must not come back empty */
+            printf("FAIL: only %d numeric keys listed for %s\n", c.keys, info->name);
+            failures++;
+        }
+        failures += c.failures;
+        total += c.keys;
+    }
+    printf("%d numeric keys over %d models, %d failures\n", total, LAG_MODEL_COUNT, failures);
+    return failures ? 1 : 0;
+}
