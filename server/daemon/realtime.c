@@ -132,14 +132,18 @@ static void limited_event(rt_server *s, rt_ev ev, const char *joint, double valu
     int64_t suppressed = l->suppressed;
     if (!rt_limit_take(l, s->now)) return;
     l->suppressed = 0;
-    char detail[320];
+    /* the note on what was suppressed always fits: the sentence is cut first */
+    char note[96] = "", detail[LAG_WIRE_TEXT_LEN];
+    if (suppressed > 0)
+        snprintf(note, sizeof note, " (%lld more %s events suppressed before this one)",
+                 (long long)suppressed, ev_limits[ev].kind);
+    size_t room = sizeof detail - strlen(note);
     va_list ap;
     va_start(ap, fmt);
-    int n = vsnprintf(detail, sizeof detail, fmt, ap);
+    int n = vsnprintf(detail, room, fmt, ap);
     va_end(ap);
-    if (suppressed > 0 && n >= 0 && (size_t)n < sizeof detail)
-        snprintf(detail + n, sizeof detail - (size_t)n, " (%lld more %s events suppressed before this one)",
-                 (long long)suppressed, ev_limits[ev].kind);
+    if (n < 0) detail[0] = '\0';
+    strcat(detail, note);
     rt_publish_event(s, ev_limits[ev].kind, joint, value, detail);
 }
 
@@ -164,7 +168,8 @@ static void publish_status(rt_server *s)
 
 /* Numeric fault: pause in the fault state. The sim holds the last good tick (not a
  * period boundary); it is never published. Only reset leaves the fault state. The event
- * names the efforts that were held, which is what an absurd command shows as. */
+ * says what the core ran into (for a force too large, which joint and how large) and the
+ * efforts that were held. */
 static void enter_fault(rt_server *s, lag_result r)
 {
     s->run = RT_FAULT;
@@ -173,7 +178,12 @@ static void enter_fault(rt_server *s, lag_result r)
     s->waiting = false;
     s->want_state = false;
     s->numeric_faults++;
-    char eff[160] = "";
+    char why[LAG_WIRE_TEXT_LEN] = "";
+    if (r != LAG_OK) lag_sim_fault_describe(&s->sim, why, sizeof why);
+    if (!why[0])
+        snprintf(why, sizeof why, "%s at t = %.9g s",
+                 r == LAG_OK ? "non-finite state" : lag_result_string(r), lag_sim_time(&s->sim));
+    char eff[128] = "";
     size_t n = 0;
     for (int i = 0; i < s->nq && n < sizeof eff; i++) {
         if (!s->info->actuated[i]) continue;
@@ -183,10 +193,8 @@ static void enter_fault(rt_server *s, lag_result r)
         n += (size_t)k;
     }
     limited_event(s, RT_EV_NUMERIC_FAULT, "", lag_sim_time(&s->sim),
-                  "%s at sim time %.9g s (tick %lld), efforts held: %s: paused in fault state; "
-                  "send reset or reset_to",
-                  r == LAG_OK ? "non-finite state" : lag_result_string(r), lag_sim_time(&s->sim),
-                  (long long)s->sim.tick, n ? eff : "none");
+                  "fault (efforts held: %s): %s; paused until reset or reset_to",
+                  n ? eff : "none", why);
     s->want_status = true;
 }
 
@@ -348,7 +356,8 @@ static void reject(rt_server *s, rt_reject why, const char *joint, double value,
 {
     static const char *const why_name[RT_REJ_COUNT] = {
         "unknown joint", "unactuated joint", "non-finite effort", "bad length",
-        "undecodable payload", "stale (lockstep: answers another state)"};
+        "undecodable payload", "stale (lockstep: answers another state)",
+        "effort beyond realtime.effort_limit"};
     s->rejected[why]++;
     /* a flood is counted in status, not echoed one for one */
     limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s%s%s%s",
@@ -356,7 +365,7 @@ static void reject(rt_server *s, rt_reject why, const char *joint, double value,
 }
 
 /* A command is applied whole or not at all: every name known, actuated, distinct; every
- * effort finite. */
+ * effort finite and within the scene's realtime.effort_limit. */
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
 {
     lag_wire_joint_command c;
@@ -393,6 +402,15 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
         }
         if (!isfinite(c.effort[i])) {
             reject(s, RT_REJ_NONFINITE, c.name[i], 0, NULL);
+            return;
+        }
+        /* a bound on what a command may ask, not the plant's saturation (that is the
+         * actuator effect): an effort beyond it is a controller's bug, refused whole */
+        double lim = s->sc->realtime.effort_limit[idx[i]];
+        if (fabs(c.effort[i]) > lim) {
+            char what[64];
+            snprintf(what, sizeof what, "the effort in value, the limit %g", lim);
+            reject(s, RT_REJ_EFFORT_LIMIT, c.name[i], c.effort[i], what);
             return;
         }
     }
@@ -809,22 +827,6 @@ void rt_finish(rt_server *s)
     if (s->live_line) live_line(s, true);
 }
 
-int rt_url_ttl(const char *url)
-{
-    if (strncmp(url, "udpm://", 7) != 0) return -1;
-    const char *q = strchr(url, '?');
-    while (q) {
-        q++;
-        if (strncmp(q, "ttl=", 4) == 0) {
-            char *end;
-            long v = strtol(q + 4, &end, 10);
-            return v < 0 ? 0 : v > 255 ? 255 : (int)v;
-        }
-        q = strchr(q, '&');
-    }
-    return 0;
-}
-
 /* ---------------------------------------------------------------- the loop */
 typedef struct rt_io {
     int lcm_fd, timer_fd, sig_fd;
@@ -889,7 +891,8 @@ static void handled_signals(sigset_t *set)
     sigaddset(set, SIGUSR2);
 }
 
-/* The effective LCM URL: the scene's, else LCM_DEFAULT_URL, else LCM's default. */
+/* The effective LCM URL, for messages: the scene's, else LCM_DEFAULT_URL, else LCM's
+ * default. */
 static const char *effective_url(const lag_scene *sc)
 {
     if (sc->lcm.url[0]) return sc->lcm.url;
@@ -940,7 +943,7 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
         fprintf(stderr, "lagsimd: %s\n", err);
         goto out;
     }
-    int ttl = rt_url_ttl(url);
+    int ttl = sc->lcm.ttl; /* the loader's reading of the URL (LCM_DEFAULT_URL included) */
     if (ttl > 0)
         fprintf(stderr, "lagsimd: warning: LCM url '%s' has ttl=%d: states, status and events "
                 "leave this host (multicast to the local network%s)\n", url, ttl,

@@ -30,6 +30,7 @@ typedef enum rt_reject {
     RT_REJ_BAD_LENGTH,
     RT_REJ_UNDECODABLE,
     RT_REJ_STALE,             /* lockstep: answers a state other than the one waited on */
+    RT_REJ_EFFORT_LIMIT,      /* an |effort| beyond the scene's realtime.effort_limit */
     RT_REJ_COUNT
 } rt_reject;
 
@@ -183,8 +184,5 @@ void rt_close(rt_server *s);
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len);
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len);
 
-/* The ttl of an LCM udpm URL ("udpm://239.255.76.67:7667?ttl=1" gives 1); 0 when the URL
- * says none (LCM's default), -1 when it is not udpm://. */
-int rt_url_ttl(const char *url);
 
 #endif

@@ -123,6 +123,7 @@ void rt_publish_status(rt_server *s)
     m.rejected_stale = s->rejected[RT_REJ_STALE];
     m.overrun_bursts = s->overrun_bursts;
     m.states_published = s->states_published;
+    m.rejected_effort_limit = s->rejected[RT_REJ_EFFORT_LIMIT];
     publish(s, s->ch_status, LAG_WIRE_STATUS, &m);
     s->rtf = m.rtf;
     if (wall < 0.05 && s->run == RT_RUNNING) return; /* the window goes on */

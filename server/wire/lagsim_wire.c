@@ -102,6 +102,7 @@ static const lag_wire_field status_fields[] = {
     SCALAR(ST, LAG_WIRE_INT64, rejected_stale),
     SCALAR(ST, LAG_WIRE_INT64, overrun_bursts),
     SCALAR(ST, LAG_WIRE_INT64, states_published),
+    SCALAR(ST, LAG_WIRE_INT64, rejected_effort_limit),
 };
 
 typedef lag_wire_scene SC;

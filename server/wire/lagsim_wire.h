@@ -148,6 +148,7 @@ typedef struct lag_wire_status {
     int64_t rejected_stale;
     int64_t overrun_bursts;
     int64_t states_published;
+    int64_t rejected_effort_limit;
 } lag_wire_status;
 
 /* <PREFIX>_SCENE: the scene description. */

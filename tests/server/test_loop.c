@@ -541,11 +541,28 @@ static void case_signals(void)
     }
 }
 
-/* An effort of 1e308: the fault event names the efforts that were held, so the cause is
- * plain; nothing non-finite is published. */
+/* An effort of 1e308: refused whole by the scene's realtime.effort_limit (default 1e6),
+ * counted, the state untouched. With the limit raised, it drives the state past
+ * explode_limit: the fault event names the efforts that were held; nothing non-finite is
+ * published. */
 static void case_fault_effort(void)
 {
     scene(LAG_RT_REALTIME);
+    start();
+    run_until(g_srv.now + 50 * MS, 0);
+    command(0.0, "theta0", 1e308);
+    command(0.0, "theta0", -2e6);
+    run_until(g_srv.now + 200 * MS, 0);
+    ENSURE(g_srv.run == RT_RUNNING && n_events("numeric_fault") == 0);
+    ENSURE(g_srv.rejected[RT_REJ_EFFORT_LIMIT] == 2 && g_srv.accepted == 0 && g_srv.held[0] == 0.0);
+    ENSUREF(strstr(last_detail("command_rejected"), "effort_limit"), "detail '%s'",
+            last_detail("command_rejected"));
+    command(0.0, "theta0", 1e6); /* at the limit: accepted */
+    ENSURE(g_srv.accepted == 1 && g_srv.held[0] == 1e6);
+    stop_server();
+
+    scene(LAG_RT_REALTIME);
+    g_sc.realtime.effort_limit[0] = INFINITY;
     start();
     run_until(g_srv.now + 50 * MS, 0);
     command(0.0, "theta0", 1e308);

@@ -252,6 +252,7 @@ static void check_agreement(void)
         g.rejected_stale = w.rejected_stale = 24;
         g.overrun_bursts = w.overrun_bursts = 25;
         g.states_published = w.states_published = 26;
+        g.rejected_effort_limit = w.rejected_effort_limit = 27;
         int nt = lagsim_status_t_encode(theirs, 0, sizeof theirs, &g);
         agree(LAG_WIRE_STATUS, &w, nt);
     }
