@@ -69,12 +69,23 @@ def main():
     if not client:
         ap.error("no client command")
     prefix = "%s_%d" % (a.name.upper(), os.getpid())
+    # The daemon and the controller meet on LCM's default URL with a multicast port of
+    # this run's own (ttl=0: this host), through LCM_DEFAULT_URL, which every binding
+    # reads: on one port every socket gets every datagram, so a flood anywhere on the
+    # machine (a fast-mode daemon, a flood test) would fill this run's sockets and lose
+    # its states; the prefix stays unique as well. Receive buffers of 4 MB: each small
+    # datagram costs a socket about 1 kB of buffer, and a controller kept off a core by a
+    # loaded machine must not lose a lockstep burst.
+    env = dict(os.environ)
+    env["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
+                              % (20000 + os.getpid() % 12000))
     client = [c.replace("{prefix}", prefix) for c in client]
     dcmd = [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
             "--set", "realtime.mode=" + a.mode, "-q"]
     for s in a.set:
         dcmd += ["--set", s]
     dcmd += a.daemon_arg
+    print("LCM_DEFAULT_URL=%s" % env["LCM_DEFAULT_URL"])
     print("client:", " ".join(client))
     print("daemon:", " ".join(dcmd), flush=True)
 
@@ -86,7 +97,7 @@ def main():
     lines = []
     try:
         cproc = subprocess.Popen(client, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                 universal_newlines=True)
+                                 universal_newlines=True, env=env)
         # read the client's stdout in a thread; start the daemon once the client says it
         # is subscribed ("waiting for the scene"), so that it sees the very first state
         ready = threading.Event()
@@ -105,7 +116,7 @@ def main():
             print("FAIL: the client did not get ready")
             return 1
         dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                                 universal_newlines=True)
+                                 universal_newlines=True, env=env)
         t_daemon_end = None
         if a.kill_daemon_after is not None:
             try:
@@ -146,14 +157,14 @@ def main():
         print("FAIL: no summary line from the client")
         return 1
     ok = True
-    env = dict(vals)
+    names = dict(vals)
     if t_daemon_end is not None:
-        env["wall"] = t_client_end - t_daemon_end
-        print("wall = %.3f s from the daemon's end to the controller's" % env["wall"])
-    env["math"] = math
+        names["wall"] = t_client_end - t_daemon_end
+        print("wall = %.3f s from the daemon's end to the controller's" % names["wall"])
+    names["math"] = math
     for expr in a.check:
         try:
-            res = bool(eval(expr, {"__builtins__": {"abs": abs, "min": min, "max": max}}, env))
+            res = bool(eval(expr, {"__builtins__": {"abs": abs, "min": min, "max": max}}, names))
         except Exception as e:  # a missing key is a failure, not a crash
             res = False
             print("check %s: %s" % (expr, e))

@@ -1,11 +1,15 @@
 /*
- * End-to-end tests of the real-time LCM server (lagsimd) over real LCM (the default
- * udpm URL, ttl=0: loopback only). Each case starts lagsimd as a child with a unique
- * channel prefix, talks to it with the raw LCM C API and the generated types, and always
- * kills it at the end (SIGKILL on our own death too: PR_SET_PDEATHSIG).
+ * End-to-end tests of the real-time LCM server (lagsimd) over real LCM (udpm, ttl=0:
+ * this host only, on a multicast port of the test process's own, given to the daemons
+ * through LCM_DEFAULT_URL). Each case starts lagsimd as a child with a unique channel
+ * prefix, talks to it with the raw LCM C API and the generated types, and always kills it
+ * at the end (SIGKILL on our own death too: PR_SET_PDEATHSIG).
  *
- *   server_test LAGSIMD CASE      CASE: control hostile watchdog lockstep_timeout
- *                                       two_daemons fault replay sigterm bad_scene effects
+ *   server_test LAGSIMD CASE [LCM_LOGGER]
+ *     CASE: control hostile watchdog lockstep_timeout two_daemons fault replay
+ *           replay_dopri5 replay_effects sigterm bad_scene effects control_flood
+ *           step_flood lockstep_huge status_rate rate_huge long_period duration_huge
+ *           signals effort_absurd ttl_warning offline_signal
  *
  * Expected states are computed independently of the daemon's loop: a lag_sim of the same
  * scene (loaded with lag_scene_load, as the daemon does) advanced from the published state
@@ -36,17 +40,6 @@
 
 static const char *g_case = "?";
 static const char *g_stderr_path; /* children's stderr goes there when set */
-/* The LCM URL of the cases that flood the bus (NULL: LCM's default, ttl=0). Their floods
- * go to a multicast port of their own (ttl=0 too), so that the sockets of tests running
- * beside them never see the flood: on one port, every socket gets every datagram. */
-static const char *g_url;
-static char g_url_buf[96], g_url_set[128];
-static void private_url(void)
-{
-    snprintf(g_url_buf, sizeof g_url_buf, "udpm://239.255.76.67:%d?ttl=0", 7700 + (int)(getpid() % 500));
-    snprintf(g_url_set, sizeof g_url_set, "lcm.url=%s", g_url_buf);
-    g_url = g_url_buf;
-}
 static pid_t g_children[16];
 static int g_nchildren;
 
@@ -195,6 +188,11 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *u)
     c->last = r;
     if (c->controller) {
         if (c->n_rec < MAX_REC) c->rec[c->n_rec++] = r;
+        /* answered 3 ms later: lockstep would otherwise run a period in ~50 us, and
+         * lcm-logger, whose LCM queue holds a few dozen messages, lost some whenever a
+         * loaded machine kept it off a core for a millisecond or two; paced so, it may be
+         * kept off for ~40 ms */
+        usleep(3000);
         /* a deterministic controller: PD on the cart and the lower rod plus a sinusoid */
         double u_eff = -2.0 * r.q[0] - 1.0 * r.qd[0] + 3.0 * r.q[1] + 0.5 * sin(7.0 * r.t);
         char *names[1] = {"theta0"};
@@ -264,8 +262,8 @@ static void client_init(client *c, const char *prefix, int nq)
 {
     memset(c, 0, sizeof *c);
     g_clients[g_nclients++] = c;
-    c->lcm = lcm_create(g_url);
-    ENSUREF(c->lcm, "lcm_create(%s) failed: no multicast on loopback?", g_url ? g_url : "NULL");
+    c->lcm = lcm_create(NULL);
+    ENSUREF(c->lcm, "lcm_create(NULL) failed: no multicast on loopback?");
     snprintf(c->prefix, sizeof c->prefix, "%s", prefix);
     c->nq = nq;
     char ch[96];
@@ -357,10 +355,6 @@ static pid_t start_daemon(const char *prefix, ...)
     snprintf(sets[k], sizeof sets[k], "lcm.prefix=%s", prefix);
     argv[n++] = "--set";
     argv[n++] = sets[k++];
-    if (g_url) {
-        argv[n++] = "--set";
-        argv[n++] = g_url_set;
-    }
     va_list ap;
     va_start(ap, prefix);
     for (const char *a = va_arg(ap, const char *); a && n < 38; a = va_arg(ap, const char *))
@@ -436,7 +430,9 @@ static void case_control(void)
     rec_state held = c.last;
     int64_t n0 = c.n_states;
     pump(&c, 0.3);
-    ENSUREF(c.n_states >= n0 + 10, "paused: %lld states republished in 0.3 s",
+    /* 30 deadlines at 100 Hz; a loaded machine may keep the daemon off a core for a while
+     * (it then republishes once, not once per missed deadline): a few suffice to show it */
+    ENSUREF(c.n_states >= n0 + 5, "paused: %lld states republished in 0.3 s",
             (long long)(c.n_states - n0));
     ENSURE(c.last.step == held.step && c.last.q[1] == held.q[1] && c.last.qd[1] == held.qd[1]);
     fresh_status(&c);
@@ -523,7 +519,6 @@ static void publish_raw(client *c, const uint8_t *b, size_t n)
  * finite and is unchanged by them. */
 static void case_hostile(void)
 {
-    private_url();
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -707,7 +702,7 @@ static void case_two_daemons(void)
     rec_state ha = a.last;
     pump(&b, 0.3);
     pump(&a, 0.1);
-    ENSURE(b.last.t > tb0 + 0.2);          /* B was not paused by A's control */
+    ENSURE(b.last.t > tb0 + 0.05);         /* B was not paused by A's control (0.3 s) */
     ENSURE(b.last.eff[0] == 0.0);          /* nor driven by A's command */
     ENSURE(a.last.step == ha.step);        /* A stays paused */
     ENSURE(count_events(&b, "pause") == 0);
@@ -1074,7 +1069,6 @@ static bool refused_at_start(pid_t d, client *c)
  * limited. Everything is counted. */
 static void case_control_flood(void)
 {
-    private_url();
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1126,7 +1120,6 @@ static void case_control_flood(void)
  * second at 100 Hz), not as fast as the machine can publish; PAUSE ends it. */
 static void case_step_flood(void)
 {
-    private_url();
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1143,8 +1136,9 @@ static void case_step_flood(void)
     double wall = now_s() - t0;
     int64_t n = c.n_states - n0;
     printf("step 2^62: %lld states in %.2f s\n", (long long)n, wall);
-    /* at most one state per 10 ms deadline (+ one republished at the step) */
-    ENSUREF(n <= (int64_t)(wall * 100) + 2, "%lld states in %.2f s", (long long)n, wall);
+    /* at most one state per 10 ms deadline, counting those since the step began (up to
+     * 0.5 s before the window on a loaded machine), and the one republished at the step */
+    ENSUREF(n <= (int64_t)((wall + 0.5) * 100) + 2, "%lld states in %.2f s", (long long)n, wall);
     ENSURE(c.last.step > step0); /* and it does step */
     control(&c, LAGSIM_CONTROL_T_PAUSE, 0, 0, NULL, NULL);
     pump(&c, 0.2);
@@ -1190,7 +1184,6 @@ static void case_lockstep_huge(void)
 /* status_hz 1e9: at most 100 statuses a second; 1e-300: none but the first. */
 static void case_status_rate(void)
 {
-    private_url();
     const char *values[] = {"realtime.status_hz=1e9", "realtime.status_hz=1e-300"};
     const int64_t most[] = {100 + 5, 1};
     for (int i = 0; i < 2; i++) {
@@ -1222,7 +1215,6 @@ static void case_status_rate(void)
  * loop goes; the overrun_burst events stay within their bucket (3, then 1 per second). */
 static void case_rate_huge(void)
 {
-    private_url();
     const char *values[] = {"realtime.rate=1e25", "realtime.rate=1e6"};
     for (int i = 0; i < 2; i++) {
         write_scene(DIPC_MOVING);
@@ -1440,6 +1432,18 @@ int main(int argc, char **argv)
     for (char *p = g_prefix; *p; p++)
         if (*p >= 'a' && *p <= 'z') *p = (char)(*p - 'a' + 'A');
     signal(SIGPIPE, SIG_IGN);
+    /* LCM's default URL with a multicast port of this process's own (ttl=0: this host),
+     * for this test, its daemons and lcm-logger (all read LCM_DEFAULT_URL): on one port
+     * every socket gets every datagram, so a flood anywhere on the machine (a fast-mode
+     * daemon, a flood test) would fill these sockets and lose their messages. The prefix
+     * stays unique as well. Receive buffers of 4 MB (the kernel's rmem_max here; it caps
+     * larger requests): a lockstep run publishes hundreds of small datagrams in a few
+     * milliseconds, each costing the socket about 1 kB of buffer, and lcm-logger, kept off
+     * a core by a loaded machine, lost some with the default 208 kB. */
+    char url[128];
+    snprintf(url, sizeof url, "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304",
+             20000 + (int)(getpid() % 12000));
+    setenv("LCM_DEFAULT_URL", url, 1);
     if (!strcmp(g_case, "control")) case_control();
     else if (!strcmp(g_case, "hostile")) case_hostile();
     else if (!strcmp(g_case, "watchdog")) case_watchdog();
