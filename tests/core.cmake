@@ -2,7 +2,7 @@
 # convergence orders, determinism. Plain C programs, see tests/core/; one ctest per case of
 # each program (core.<program>.<case>), the cases listed by the programs themselves.
 include(${CMAKE_CURRENT_LIST_DIR}/common/cases.cmake)
-foreach(t models structure conservation convergence determinism validate faults)
+foreach(t models structure conservation convergence determinism validate faults events)
   add_executable(test_core_${t} ${CMAKE_CURRENT_SOURCE_DIR}/core/test_${t}.c)
   # server/core: the unit tests of the core's internals (tables, event engine) read its
   # private header

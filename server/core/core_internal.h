@@ -4,6 +4,12 @@
 
 #include "lagsim/lagsim.h"
 
+/* Internal invariants: checked where assert is on (the Debug builds of the sanitizer
+ * pass), free in release builds (NDEBUG). SQLite's assert(): what must hold whatever the
+ * input, never a check of the input (that is validation's, with a message). */
+#include <assert.h>
+#define LAG_ASSERT(cond) assert(cond)
+
 /* One model kind: its facts and its closed forms, one row of the core's model table
  * (model.c). All arrays are n x n row-major (n = nq); p is lag_model.p. Every member is
  * required (core.models.info checks that no row has a hole). */
@@ -26,6 +32,7 @@ typedef struct lag_model_class {
 extern const lag_model_class *const lag_models[LAG_MODEL_COUNT];
 static inline const lag_model_class *lag_model_vt(const lag_model *m)
 {
+    LAG_ASSERT((unsigned)m->kind < LAG_MODEL_COUNT && lag_models[m->kind]);
     return lag_models[m->kind];
 }
 
@@ -73,6 +80,30 @@ lag_result lag_lu_solve_inplace(int n, double *A, double *b);
 /* First-order right-hand side in (q, qd) and in canonical (q, p) coordinates. */
 lag_result lag_sim_rhs_qp(lag_sim *s, const double *y, double *ydot);
 
+void lag_effects_force(const lag_sim *s, const double *q, const double *qd, double *Q);
+lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *qd,
+                              const double *Q, double *qdd, double *lambda);
+
+/* lag_sim_rhs without naming its failure (the integrators' hot path: a tail call into the
+ * forward dynamics); a caller that gets an error passes it through lag_stage_fault. */
+static inline lag_result lag_rhs(lag_sim *s, const double *y, double *ydot)
+{
+    const int n = s->nq;
+    s->stats.rhs_evals++;
+    for (int i = 0; i < n; i++) ydot[i] = y[n + i];
+    if (s->def.effects.enabled || s->mode.locked) {
+        double Q[LAG_MAX_DOF];
+        lag_effects_force(s, y, y + n, Q);
+        return lag_forward_locked(s, y, y + n, Q, ydot + n, NULL);
+    }
+    /* The bare model, the hot path: the model's closed-form forward dynamics. */
+    return lag_models[s->def.model.kind]->forward(s->def.model.p, y, y + n, s->tau_applied, ydot + n);
+}
+/* A right-hand side failed with r at stage state y: a "singular" mass matrix of a
+ * non-finite q (a stage that overflowed: cos(inf)) is a non-finite state, not a singular
+ * configuration. For failure paths only. */
+lag_result lag_stage_fault(const lag_sim *s, const double *y, lag_result r);
+
 /* One step of size h from y0 = (q, qd) to y1 = (q, qd) with the sim's method (dopri5:
  * adaptive sub-steps landing exactly on h). Touches neither the public state nor tick. */
 lag_result lag_step(lag_sim *s, double h, const double *y0, double *y1);
@@ -93,19 +124,9 @@ lag_result lag_dopri5_advance(lag_sim *s, int64_t n, bool continuous);
  * constraint forces lambda_i (M qdd = Q - h + lambda) they need. lambda may be NULL. */
 lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *qd,
                               const double *Q, double *qdd, double *lambda);
-/* The generalized forces besides gravity and inertia: applied efforts, damping, sliding
- * friction, disturbance forces. OUT: Q */
-void lag_applied_forces(const lag_sim *s, const double *q, const double *qd, double *Q);
 
 /* qd from canonical momenta p at q: qd_f = M_ff^-1 p_f on free joints, 0 on locked. */
 lag_result lag_qd_from_p(const lag_sim *s, const double *q, const double *p, double *qd);
-
-/* effects.c: per-tick work before the step, the tick with event location, modes. */
-void lag_effects_pre_tick(lag_sim *s);
-lag_result lag_effects_tick(lag_sim *s, double *y);
-void lag_effects_init_modes(lag_sim *s);
-lag_result lag_effects_check(const lag_sim_def *def, lag_diag *d);
-void lag_sim_record_event(lag_sim *s, lag_event_kind kind, int joint, double t, double value);
 
 /* Fills d with field and a printf-style message; returns LAG_ERR_ARG. d may be NULL. */
 lag_result lag_diag_fail(lag_diag *d, const char *field, const char *fmt, ...)
@@ -115,5 +136,118 @@ void lag_diag_format(const lag_diag *d, char *err, size_t errlen);
 
 /* True if every entry is finite and |x_i| <= limit. */
 bool lag_state_ok(int n, const double *x, double limit);
+
+/* ================================================================ events.c: the engine */
+#define LAG_MAX_WATCHERS 16        /* watchers of one tick (checked: core.events.capacity) */
+#define LAG_MAX_EVENTS_PER_TICK 16 /* then LAG_EV_EVENT_LIMIT and no more location */
+
+typedef enum lag_watch_kind {
+    LAG_WATCH_POSITION,      /* q_joint against `bound` on `side` (-1 lower, +1 upper) */
+    LAG_WATCH_VELOCITY_ZERO, /* a sliding joint's velocity reaching zero */
+    LAG_WATCH_HOLD,          /* a held joint's constraint force (the engine's own) */
+    LAG_WATCH_CUSTOM         /* the owner's `value` with the dynamics (lift-off) */
+} lag_watch_kind;
+
+/* One event function of a tick: positive while nothing happens. */
+typedef struct lag_watcher {
+    uint8_t kind;   /* lag_watch_kind */
+    uint8_t owner;  /* the effect row whose on_event applies its map (not for HOLD) */
+    int8_t joint;
+    int8_t side;    /* POSITION: -1 lower bound, +1 upper */
+    bool strict;    /* fires on a > 0, b <= 0 (reaching a bound); else on a >= 0, b < 0 */
+    double bound;   /* POSITION: the stop's position */
+    double e;       /* POSITION: restitution */
+} lag_watcher;
+
+typedef struct lag_watch_set {
+    int n;
+    lag_watcher w[LAG_MAX_WATCHERS];
+} lag_watch_set;
+
+/* Adds w; false (and nothing written) when the set holds LAG_MAX_WATCHERS already. */
+static inline bool lag_watch_add(lag_watch_set *ws, lag_watcher w)
+{
+    if (ws->n >= LAG_MAX_WATCHERS) return false;
+    ws->w[ws->n++] = w;
+    return true;
+}
+/* Has w fired between values a (earlier) and b (later)? */
+static inline bool lag_watch_fired(const lag_watcher *w, double a, double b)
+{
+    if (w->strict) return a > 0 && b <= 0;
+    return a >= 0 && b < 0;
+}
+/* Cubic Hermite interpolant of a step of h from (y0, f0) to (y1, f1), at theta in [0, 1].
+ * Exact for cubics. OUT: y */
+void lag_hermite(int N, double h, const double *y0, const double *f0, const double *y1,
+                 const double *f1, double th, double *y);
+/* Event function values of the set at state y. OUT: vals[ws->n] */
+typedef lag_result (*lag_watch_eval_fn)(void *ctx, const double *y, double *vals);
+/* The earliest event of the set along the step y0 -> y1 (slopes f0, f1, length H; v0 the
+ * values at y0): the interpolant is sampled at 4 points for a sign change, then each
+ * watcher that fired in the first such segment is located by Illinois to 1e-15 s (at most
+ * 80 iterations) and the earliest kept. *which = its index (-1: none fired), *theta = the
+ * right end of its final bracket (the event has happened there; 1 if none). */
+lag_result lag_event_locate(int N, double H, const double *y0, const double *f0,
+                            const double *y1, const double *f1, const lag_watch_set *ws,
+                            const double *v0, lag_watch_eval_fn eval, void *ctx, int *which,
+                            double *theta);
+/* x = M^-1 e_i on the free joints. OUT: x */
+lag_result lag_minv_column(const lag_sim *s, const double *q, int i, double *x);
+/* The impulse at joint i that leaves J qd+ = -e J qd- (y = (q, qd), in place). */
+lag_result lag_impulse_map(lag_sim *s, double *y, int i, double e);
+/* Friction's modes: does joint i have friction; settle joint i at rest (held, or sliding
+ * against the force: returns LAG_EV_STICK or LAG_EV_SLIP); after an impulse, point each
+ * sliding joint's friction against its new velocity. */
+static inline bool lag_has_friction(const lag_sim *s, int i)
+{
+    const lag_effects_def *e = &s->def.effects;
+    return (e->enabled & LAG_EFF_FRICTION) &&
+           (e->friction_static[i] > 0 || e->friction_kinetic[i] > 0);
+}
+lag_event_kind lag_friction_settle(lag_sim *s, double *y, int i);
+void lag_refresh_slip(lag_sim *s, double *y);
+void lag_effects_init_modes(lag_sim *s);
+/* One tick with event location, from y (in place). */
+lag_result lag_events_tick(lag_sim *s, double *y);
+void lag_sim_record_event(lag_sim *s, lag_event_kind kind, int joint, double t, double value);
+
+/* ================================================================ effects.c: the table */
+/* One effect (see effects.c's header). validate is required; any other hook may be NULL,
+ * and what the effect takes part in follows from which are there. */
+typedef struct lag_effect_row {
+    uint32_t bit;
+    const char *name;
+    int max_watch_joint;  /* watchers it adds per free joint, at most */
+    int max_watch_global; /* watchers of no joint it adds, at most */
+    lag_result (*validate)(const lag_sim_def *def, lag_diag *d);
+    void (*force)(const lag_sim *s, const double *q, const double *qd, double *Q); /* adds */
+    double (*potential)(const lag_sim *s, const double *q);
+    void (*pre_tick)(lag_sim *s);
+    /* adds its watchers of `joint` (-1: those of no joint) as owner `self` */
+    bool (*watch)(const lag_sim *s, int joint, int self, lag_watch_set *ws);
+    double (*value)(lag_sim *s, const lag_watcher *w, const double *y, const double *qdd);
+    lag_result (*on_event)(lag_sim *s, const lag_watcher *w, double *y, double t);
+    void (*observe)(const lag_sim *s, double *q, double *qd);
+} lag_effect_row;
+
+extern const lag_effect_row lag_effect_rows[LAG_EFF_COUNT];
+
+lag_result lag_effects_check(const lag_sim_def *def, lag_diag *d);
+/* Fills s->fx (the rows the enabled effects use, per hook) from s->def. */
+void lag_effects_prepare(lag_sim *s);
+/* The generalized forces besides gravity and inertia: the applied effort plus each
+ * enabled effect's force (damping, sliding friction, disturbance forces, springs). OUT: Q */
+void lag_effects_force(const lag_sim *s, const double *q, const double *qd, double *Q);
+/* Energy stored by the enabled effects at q. */
+double lag_effects_potential(const lag_sim *s, const double *q);
+void lag_effects_pre_tick(lag_sim *s);
+/* Every enabled row's watchers of `joint` (-1: of no joint), in table order; false when
+ * the set is full. */
+bool lag_effects_watch(const lag_sim *s, int joint, lag_watch_set *ws);
+/* The bits of all rows; of the enabled ones that are per-tick; that have events. */
+uint32_t lag_effects_known(void);
+uint32_t lag_effects_per_tick(uint32_t enabled);
+uint32_t lag_effects_with_events(uint32_t enabled);
 
 #endif

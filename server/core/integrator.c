@@ -89,8 +89,8 @@ lag_result lag_step_euler(lag_sim *s, double h, const double *y0, double *y1)
 {
     int N = 2 * s->nq;
     double f[LAG_MAX_STATE];
-    lag_result r = lag_sim_rhs(s, y0, f);
-    if (r != LAG_OK) return r;
+    lag_result r = lag_rhs(s, y0, f);
+    if (r != LAG_OK) return lag_stage_fault(s, y0, r);
     for (int i = 0; i < N; i++) y1[i] = y0[i] + h * f[i];
     return LAG_OK;
 }
@@ -100,8 +100,8 @@ lag_result lag_step_semi_implicit_euler(lag_sim *s, double h, const double *y0, 
 {
     int n = s->nq;
     double f[LAG_MAX_STATE];
-    lag_result r = lag_sim_rhs(s, y0, f);
-    if (r != LAG_OK) return r;
+    lag_result r = lag_rhs(s, y0, f);
+    if (r != LAG_OK) return lag_stage_fault(s, y0, r);
     for (int i = 0; i < n; i++) {
         y1[n + i] = y0[n + i] + h * f[n + i];
         y1[i] = y0[i] + h * y1[n + i];
@@ -116,13 +116,13 @@ lag_result lag_step_rk4(lag_sim *s, double h, const double *y0, double *y1)
     double yt[LAG_MAX_STATE];
     double k1[LAG_MAX_STATE], k2[LAG_MAX_STATE], k3[LAG_MAX_STATE], k4[LAG_MAX_STATE];
     lag_result r;
-    if ((r = lag_sim_rhs(s, y0, k1)) != LAG_OK) return r;
+    if ((r = lag_rhs(s, y0, k1)) != LAG_OK) return lag_stage_fault(s, y0, r);
     for (int i = 0; i < N; i++) yt[i] = y0[i] + 0.5 * h * k1[i];
-    if ((r = lag_sim_rhs(s, yt, k2)) != LAG_OK) return r;
+    if ((r = lag_rhs(s, yt, k2)) != LAG_OK) return lag_stage_fault(s, yt, r);
     for (int i = 0; i < N; i++) yt[i] = y0[i] + 0.5 * h * k2[i];
-    if ((r = lag_sim_rhs(s, yt, k3)) != LAG_OK) return r;
+    if ((r = lag_rhs(s, yt, k3)) != LAG_OK) return lag_stage_fault(s, yt, r);
     for (int i = 0; i < N; i++) yt[i] = y0[i] + h * k3[i];
-    if ((r = lag_sim_rhs(s, yt, k4)) != LAG_OK) return r;
+    if ((r = lag_rhs(s, yt, k4)) != LAG_OK) return lag_stage_fault(s, yt, r);
     for (int i = 0; i < N; i++)
         y1[i] = y0[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
     return LAG_OK;

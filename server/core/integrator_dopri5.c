@@ -56,6 +56,7 @@ static double initial_step(const lag_sim *s, int N, const double *y, const doubl
 /* Interpolates the last accepted step at time t (t_prev <= t <= dp.t). OUT: y */
 static void dense(const lag_sim *s, int N, double t, double *y)
 {
+    LAG_ASSERT(t >= s->dp.t_prev && t <= s->dp.t); /* only within the last step */
     double h = s->dp.t - s->dp.t_prev;
     double th = (t - s->dp.t_prev) / h, th1 = 1.0 - th;
     for (int i = 0; i < N; i++)
@@ -77,20 +78,20 @@ static double dp_try(lag_sim *s, double h, const double *y, const double *k1, do
     lag_result r;
     *res = LAG_OK;
     for (int i = 0; i < N; i++) yt[i] = y[i] + h * a21 * k1[i];
-    if ((r = lag_sim_rhs(s, yt, k2)) != LAG_OK) goto fail;
+    if ((r = lag_rhs(s, yt, k2)) != LAG_OK) { r = lag_stage_fault(s, yt, r); goto fail; }
     for (int i = 0; i < N; i++) yt[i] = y[i] + h * (a31 * k1[i] + a32 * k2[i]);
-    if ((r = lag_sim_rhs(s, yt, k3)) != LAG_OK) goto fail;
+    if ((r = lag_rhs(s, yt, k3)) != LAG_OK) { r = lag_stage_fault(s, yt, r); goto fail; }
     for (int i = 0; i < N; i++) yt[i] = y[i] + h * (a41 * k1[i] + a42 * k2[i] + a43 * k3[i]);
-    if ((r = lag_sim_rhs(s, yt, k4)) != LAG_OK) goto fail;
+    if ((r = lag_rhs(s, yt, k4)) != LAG_OK) { r = lag_stage_fault(s, yt, r); goto fail; }
     for (int i = 0; i < N; i++)
         yt[i] = y[i] + h * (a51 * k1[i] + a52 * k2[i] + a53 * k3[i] + a54 * k4[i]);
-    if ((r = lag_sim_rhs(s, yt, k5)) != LAG_OK) goto fail;
+    if ((r = lag_rhs(s, yt, k5)) != LAG_OK) { r = lag_stage_fault(s, yt, r); goto fail; }
     for (int i = 0; i < N; i++)
         yt[i] = y[i] + h * (a61 * k1[i] + a62 * k2[i] + a63 * k3[i] + a64 * k4[i] + a65 * k5[i]);
-    if ((r = lag_sim_rhs(s, yt, k6)) != LAG_OK) goto fail;
+    if ((r = lag_rhs(s, yt, k6)) != LAG_OK) { r = lag_stage_fault(s, yt, r); goto fail; }
     for (int i = 0; i < N; i++)
         y1[i] = y[i] + h * (a71 * k1[i] + a73 * k3[i] + a74 * k4[i] + a75 * k5[i] + a76 * k6[i]);
-    if ((r = lag_sim_rhs(s, y1, k7)) != LAG_OK) goto fail;
+    if ((r = lag_rhs(s, y1, k7)) != LAG_OK) { r = lag_stage_fault(s, y1, r); goto fail; }
     for (int i = 0; i < N; i++)
         err[i] = h * (e1 * k1[i] + e3 * k3[i] + e4 * k4[i] + e5 * k5[i] + e6 * k6[i] + e7 * k7[i]);
     if (rc)

@@ -33,6 +33,7 @@ static void tableau(int stages, double A[MAX_STAGES][MAX_STAGES], double *b)
 
 lag_result lag_step_gauss(lag_sim *s, int stages, double h, const double *yin, double *yout)
 {
+    LAG_ASSERT(stages >= 1 && stages <= MAX_STAGES);
     const int n = s->nq, N = 2 * n, S = stages * N;
     const lag_integrator_def *in = &s->def.integrator;
     double A[MAX_STAGES][MAX_STAGES], b[MAX_STAGES];

@@ -192,6 +192,7 @@ double lag_model_potential(const lag_model *m, const double *q)
 
 lag_result lag_spd_solve(int n, const double *A, const double *b, double *x)
 {
+    LAG_ASSERT(n >= 1 && n <= LAG_MAX_STATE);
     if (n == 3) return lag_spd_solve3(A, b, x);
     if (n == 2) return lag_spd_solve2(A, b, x);
     double L[LAG_MAX_STATE * LAG_MAX_STATE];
@@ -224,6 +225,7 @@ lag_result lag_spd_solve(int n, const double *A, const double *b, double *x)
 
 lag_result lag_lu_solve_inplace(int n, double *A, double *b)
 {
+    LAG_ASSERT(n >= 1 && n <= 4 * LAG_MAX_STATE);
     for (int k = 0; k < n; k++) {
         int piv = k;
         double best = fabs(A[k * n + k]);

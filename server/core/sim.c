@@ -78,6 +78,7 @@ lag_result lag_sim_init(lag_sim *s, const lag_sim_def *def, char *err, size_t er
     memset(s, 0, sizeof *s);
     s->def = *def;
     s->nq = def->model.nq;
+    lag_effects_prepare(s);
     lag_sim_reset(s, NULL, NULL);
     return LAG_OK;
 }
@@ -103,6 +104,7 @@ void lag_sim_reset(lag_sim *s, const double *q, const double *qd)
 void lag_sim_set_input(lag_sim *s, const double *tau)
 {
     const lag_model_info *info = lag_model_info_get(s->def.model.kind);
+    LAG_ASSERT(info != NULL);
     bool changed = false;
     for (int i = 0; i < s->nq; i++) {
         double v = info->actuated[i] ? tau[i] : 0.0;
@@ -128,22 +130,8 @@ int64_t lag_ticks_ceil(double t, double dt)
 
 double lag_sim_energy(const lag_sim *s)
 {
-    return lag_model_kinetic(&s->def.model, s->q, s->qd)
-         + lag_model_potential(&s->def.model, s->q);
-}
-
-void lag_applied_forces(const lag_sim *s, const double *q, const double *qd, double *Q)
-{
-    (void)q;
-    const int n = s->nq;
-    const lag_effects_def *e = &s->def.effects;
-    for (int i = 0; i < n; i++) Q[i] = s->tau_applied[i];
-    if (e->enabled & LAG_EFF_DAMPING)
-        for (int i = 0; i < n; i++) Q[i] -= e->damping[i] * qd[i];
-    if (e->enabled & LAG_EFF_FRICTION)
-        for (int i = 0; i < n; i++) Q[i] -= e->friction_kinetic[i] * s->mode.slip_dir[i];
-    if (e->enabled & LAG_EFF_DISTURBANCE)
-        for (int i = 0; i < n; i++) Q[i] += s->mode.dist_force[i];
+    double E = lag_model_kinetic(&s->def.model, s->q, s->qd) + lag_model_potential(&s->def.model, s->q);
+    return s->fx.n_potential ? E + lag_effects_potential(s, s->q) : E;
 }
 
 /* Solves A x = b on the free joints of `locked` (a reduced SPD system); x is 0 on the
@@ -151,6 +139,7 @@ void lag_applied_forces(const lag_sim *s, const double *q, const double *qd, dou
 static lag_result solve_free(int n, uint32_t locked, const double *A, const double *b,
                              double *x)
 {
+    LAG_ASSERT(n >= 1 && n <= LAG_MAX_DOF && (locked >> n) == 0); /* locks only on joints */
     if (!locked) return lag_spd_solve(n, A, b, x);
     int free_idx[LAG_MAX_DOF], nf = 0;
     for (int i = 0; i < n; i++)
@@ -176,7 +165,7 @@ lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *q
     if (!locked) {
         if (lambda)
             for (int i = 0; i < n; i++) lambda[i] = 0.0;
-        return lag_model_forward(&s->def.model, q, qd, Q, qdd);
+        return lag_model_vt(&s->def.model)->forward(s->def.model.p, q, qd, Q, qdd);
     }
     double M[LAG_MAX_DOF * LAG_MAX_DOF], h[LAG_MAX_DOF], r[LAG_MAX_DOF];
     lag_model_vt(&s->def.model)->mass_bias(s->def.model.p, q, qd, M, h);
@@ -193,29 +182,15 @@ lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *q
     return LAG_OK;
 }
 
-/* A solve failed at stage state y: a mass matrix of a non-finite q (a stage that
- * overflowed) is not a singular one. */
-static lag_result stage_fault(int N, const double *y, lag_result r)
+lag_result lag_stage_fault(const lag_sim *s, const double *y, lag_result r)
 {
-    return (r == LAG_ERR_SINGULAR && !lag_state_ok(N, y, INFINITY)) ? LAG_ERR_NONFINITE : r;
+    return (r == LAG_ERR_SINGULAR && !lag_state_ok(2 * s->nq, y, INFINITY)) ? LAG_ERR_NONFINITE : r;
 }
 
 lag_result lag_sim_rhs(lag_sim *s, const double *y, double *ydot)
 {
-    const int n = s->nq;
-    lag_result r;
-    s->stats.rhs_evals++;
-    for (int i = 0; i < n; i++) ydot[i] = y[n + i];
-    if (s->def.effects.enabled || s->mode.locked) {
-        double Q[LAG_MAX_DOF];
-        lag_applied_forces(s, y, y + n, Q);
-        r = lag_forward_locked(s, y, y + n, Q, ydot + n, NULL);
-    } else {
-        /* The bare model, the hot path: the model's closed-form forward dynamics. */
-        r = lag_model_vt(&s->def.model)->forward(s->def.model.p, y, y + n, s->tau_applied,
-                                                 ydot + n);
-    }
-    return r == LAG_OK ? r : stage_fault(2 * n, y, r);
+    lag_result r = lag_rhs(s, y, ydot);
+    return r == LAG_OK ? r : lag_stage_fault(s, y, r);
 }
 
 lag_result lag_qd_from_p(const lag_sim *s, const double *q, const double *p, double *qd)
@@ -238,10 +213,10 @@ lag_result lag_sim_rhs_qp(lag_sim *s, const double *y, double *ydot)
     double g[LAG_MAX_DOF], Q[LAG_MAX_DOF], qd[LAG_MAX_DOF];
     s->stats.rhs_evals++;
     lag_result r = lag_qd_from_p(s, y, y + n, qd);
-    if (r != LAG_OK) return stage_fault(2 * n, y, r);
+    if (r != LAG_OK) return lag_stage_fault(s, y, r);
     vt->mass_deriv(m->p, y, dM);
     vt->gravity(m->p, y, g);
-    lag_applied_forces(s, y, qd, Q);
+    lag_effects_force(s, y, qd, Q);
     for (int k = 0; k < n; k++) {
         double t = 0.0;
         const double *dMk = dM + k * n * n;
@@ -253,9 +228,6 @@ lag_result lag_sim_rhs_qp(lag_sim *s, const double *y, double *ydot)
     return LAG_OK;
 }
 
-#define TICK_EFFECTS (LAG_EFF_FRICTION | LAG_EFF_LIMITS | LAG_EFF_FLOOR | LAG_EFF_ACTUATOR | \
-                      LAG_EFF_DISTURBANCE)
-#define EVENT_EFFECTS (LAG_EFF_FRICTION | LAG_EFF_LIMITS | LAG_EFF_FLOOR)
 
 /* One tick without events: a step of dt, checked. OUT: y (in place) */
 static lag_result plain_tick(lag_sim *s, double *y)
@@ -368,9 +340,15 @@ lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
 {
     if (nticks <= 0) return LAG_OK;
     const int n = s->nq;
-    const uint32_t en = s->def.effects.enabled;
+    LAG_ASSERT(n == s->def.model.nq && s->tick >= 0 && s->n_events >= 0);
+    /* the enabled effects that need each tick boundary, and whether some have events
+     * (from the effect table's hooks: an effect with per-tick work or watchers is
+     * per-tick by construction) */
+    LAG_ASSERT(s->fx.enabled == s->def.effects.enabled);
+    const uint32_t per_tick = s->fx.per_tick;
+    const bool events = s->fx.n_watch > 0;
     const bool adaptive = lag_method_info_get(s->def.integrator.method)->adaptive;
-    if (!(en & TICK_EFFECTS) && adaptive) {
+    if (!per_tick && adaptive) {
         lag_result r = lag_adaptive_advance(s, nticks, continuous);
         return r == LAG_OK ? r : classify_fault(s, r, s->qd);
     }
@@ -381,19 +359,18 @@ lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
          * (the velocities before it are kept to restore the last good tick on a fault) */
         double qd_good[LAG_MAX_DOF];
         memcpy(qd_good, s->qd, sizeof qd_good);
-        if (en & TICK_EFFECTS) lag_effects_pre_tick(s);
+        if (per_tick) lag_effects_pre_tick(s);
         for (int i = 0; i < n; i++) { y[i] = s->q[i]; y[n + i] = s->qd[i]; }
-        if (en & TICK_EFFECTS) {
-            r = (en & EVENT_EFFECTS) ? lag_effects_tick(s, y) : plain_tick(s, y);
-        } else {
-            r = plain_tick(s, y);
-        }
+        r = events ? lag_events_tick(s, y) : plain_tick(s, y);
         if (r != LAG_OK) {
             r = classify_fault(s, r, qd_good); /* at the tick's start, after its impulses */
             memcpy(s->qd, qd_good, sizeof qd_good);
             return r; /* public state is still that of the last good tick */
         }
         for (int i = 0; i < n; i++) { s->q[i] = y[i]; s->qd[i] = y[n + i]; }
+        /* a good tick is finite, within explode_limit, and still for held joints */
+        LAG_ASSERT(lag_state_ok(2 * n, y, s->def.explode_limit));
+        for (int i = 0; i < n; i++) LAG_ASSERT(!(s->mode.locked & (1u << i)) || s->qd[i] == 0.0);
         s->tick++;
         if (!adaptive) s->stats.steps_accepted++; /* an adaptive method counts its own */
     }

@@ -648,6 +648,70 @@ static void noise(void)
     ENSURE(memcmp(first, again, sizeof first) == 0);
 }
 
+/* ================================================================== spring */
+
+/* Stick with a spring on x: x is decoupled (M_00 = m, no bias), so m x'' = -k (x - r):
+ *   x(t) = r + (x0 - r) cos w t + v0 / w sin w t,  w = sqrt(k / m),
+ * with rk4 at 1 ms and with dopri5 (a force-only effect: no tick boundaries needed). */
+static void spring_stick_x(void)
+{
+    for (int meth = 0; meth < 2; meth++) {
+        lag_sim_def d = lag_default_sim_def(LAG_MODEL_STICK);
+        const double k = 4.0, r = 0.3, m = d.model.p[LAG_STICK_M], w = sqrt(k / m);
+        d.integrator.method = meth ? LAG_DOPRI5 : LAG_RK4;
+        d.integrator.rtol = 1e-12;
+        d.integrator.atol = 1e-14;
+        d.effects.enabled = LAG_EFF_SPRING;
+        d.effects.spring_k[0] = k;
+        d.effects.spring_rest[0] = r;
+        d.q0[0] = 1.0; d.q0[1] = 1.0; d.qd0[0] = -0.5;
+        lag_sim s;
+        te_init(&s, &d);
+        double maxe = 0.0;
+        for (int t = 1; t <= 3000; t++) {
+            ENSURE(lag_sim_advance(&s, 1, meth == 1) == LAG_OK);
+            double tt = lag_sim_time(&s);
+            double x = r + (1.0 - r) * cos(w * tt) - 0.5 / w * sin(w * tt);
+            maxe = fmax(maxe, fabs(s.q[0] - x));
+        }
+        printf("spring: stick x against r + (x0 - r) cos wt + v0/w sin wt over 3 s (%s): max error %.2e\n",
+               te_method(d.integrator.method), maxe);
+        ENSURE(maxe < 1e-10);
+    }
+}
+
+/* DIPC with a spring on every joint, unforced, gauss4 (symplectic): the energy the core
+ * reports (lag_sim_energy, what status and CSV print) is our own T + U plus the springs'
+ * 1/2 k (q - r)^2, and it is conserved; T + U alone is not (the springs trade energy with
+ * the motion), which is what a leak would look like without the springs' potential. */
+static void spring_energy(void)
+{
+    lag_sim_def d = lag_default_sim_def(LAG_MODEL_DIPC);
+    const double k[3] = {20.0, 3.0, 1.5}, r[3] = {0.1, 0.2, -0.3};
+    d.integrator.method = LAG_GAUSS4;
+    d.effects.enabled = LAG_EFF_SPRING;
+    for (int i = 0; i < 3; i++) { d.effects.spring_k[i] = k[i]; d.effects.spring_rest[i] = r[i]; }
+    d.q0[1] = TE_PI - 0.4; d.q0[2] = TE_PI + 0.3; d.qd0[0] = 0.5;
+    lag_sim s;
+    te_init(&s, &d);
+    double E0 = 0, TU0 = 0, max_hook = 0, max_drift = 0, max_tu = 0;
+    for (int t = 0; t <= 5000; t++) {
+        if (t) ENSURE(lag_sim_advance(&s, 1, false) == LAG_OK);
+        double Us = 0;
+        for (int i = 0; i < 3; i++) Us += 0.5 * k[i] * (s.q[i] - r[i]) * (s.q[i] - r[i]);
+        double TU = te_sim_energy(&s), E = TU + Us;
+        if (t == 0) { E0 = E; TU0 = TU; }
+        max_hook = fmax(max_hook, fabs(lag_sim_energy(&s) - E));
+        max_drift = fmax(max_drift, fabs(E - E0));
+        max_tu = fmax(max_tu, fabs(TU - TU0));
+    }
+    printf("spring: DIPC with springs, gauss4, 5 s: |lag_sim_energy - (T + U + springs)| <= %.1e J; "
+           "T + U + springs varies by %.1e J, T + U alone by %.3f J\n", max_hook, max_drift, max_tu);
+    ENSURE(max_hook < 1e-12 * fabs(E0) + 1e-12);
+    ENSURE(max_drift < 1e-8 * fabs(E0));
+    ENSURE(max_tu > 0.1);
+}
+
 /* ================================================================== off */
 
 /* An effect that is off costs nothing: a definition carrying every effect's parameters but
@@ -710,14 +774,30 @@ static void case_actuator(int a) { (void)a; actuator(); }
 static void case_disturbance(int a) { (void)a; disturbance(); disturbance_far(); }
 static void case_noise(int a) { (void)a; noise(); }
 static void case_off(int a) { (void)a; off(); }
+static void case_spring(int a) { (void)a; spring_stick_x(); spring_energy(); }
 
-int main(int argc, char **argv)
+static void case_coverage(int a);
+static const lt_case cases[] = {
+    {"damping", case_damping, 0, 0},         {"friction", case_friction, 0, 0},
+    {"limits", case_limits, 0, 0},           {"floor", case_floor, 0, 0},
+    {"actuator", case_actuator, 0, 0},       {"disturbance", case_disturbance, 0, 0},
+    {"noise", case_noise, 0, 0},             {"off", case_off, 0, 0},
+    {"spring", case_spring, 0, 0},           {"coverage", case_coverage, 0, 0},
+};
+#define NCASES ((int)(sizeof cases / sizeof cases[0]))
+
+/* Every effect of the core's table has a case of its name here: an effect added to the
+ * core without its test fails this. */
+static void case_coverage(int a)
 {
-    static const lt_case cases[] = {
-        {"damping", case_damping, 0, 0},         {"friction", case_friction, 0, 0},
-        {"limits", case_limits, 0, 0},           {"floor", case_floor, 0, 0},
-        {"actuator", case_actuator, 0, 0},       {"disturbance", case_disturbance, 0, 0},
-        {"noise", case_noise, 0, 0},             {"off", case_off, 0, 0},
-    };
-    return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
+    (void)a;
+    for (int k = 0; k < LAG_EFF_COUNT; k++) {
+        const char *name = lag_effect_info_get(k).name;
+        bool found = false;
+        for (int c = 0; c < NCASES; c++) found |= name && strcmp(name, cases[c].name) == 0;
+        if (!found) LT_FAIL("effect '%s' of the core's table has no case in test_effects", name ? name : "?");
+        else ENSURE(found);
+    }
 }
+
+int main(int argc, char **argv) { return lt_main(argc, argv, cases, NCASES); }

@@ -102,10 +102,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         def.qd0[i] = take_double(&b);
     }
 
-    /* A dopri5 tick may take max_steps steps (100000 by default): bounded, but a second
-     * or more under the sanitizers for a tick of minutes. A smaller budget keeps each
-     * input fast and still reaches the limit (LAG_ERR_MAX_STEPS). */
-    def.integrator.max_steps = 4096;
+    /* A dopri5 tick may take max_steps steps (100000 by default): bounded, but seconds
+     * under the sanitizers for ticks of minutes, and an input runs up to 128 ticks. A
+     * small budget keeps each input well under libFuzzer's timeout and still reaches the
+     * limit (LAG_ERR_MAX_STEPS). */
+    def.integrator.max_steps = 256;
 
     char err[256];
     if (lag_sim_def_validate(&def, err, sizeof err) != LAG_OK) return 0;

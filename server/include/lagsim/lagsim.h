@@ -65,6 +65,7 @@ const char *lag_result_string(lag_result r);
  *   effects.actuator.<joint>.max | .lag
  *   effects.disturbance[k].t | .joint | .impulse | .force | .duration
  *   effects.noise.q.<joint> | effects.noise.qd.<joint>
+ *   effects.spring.<joint>.k | .rest
  * `field` is "" when no single value is at fault. `message` says what is expected and
  * what was found, without repeating the field. */
 #define LAG_FIELD_MAX 64
@@ -220,6 +221,8 @@ lag_integrator_def lag_default_integrator_def(void);
  * Each effect is off unless its bit is set in lag_effects_def.enabled; an effect that is
  * off is never called (MuJoCo's enable flags). Gravity is the model parameter g (0 = off).
  * Units: forces N on linear coordinates, N m on angles (the coordinate's generalized force).
+ * The core keeps them in one table (lag_effect_info_get lists it, by row; a row's bit is
+ * its own, the rows' order is that in which the step applies them).
  */
 enum {
     LAG_EFF_DAMPING = 1u << 0,     /* Q_i = -b_i qd_i                                       */
@@ -230,8 +233,28 @@ enum {
                                    /* lift-off (normal force < 0) is a fault (LAG_ERR_LIFTOFF)*/
     LAG_EFF_ACTUATOR = 1u << 4,    /* per-input saturation and first-order lag              */
     LAG_EFF_DISTURBANCE = 1u << 5, /* scheduled impulses / forces                          */
-    LAG_EFF_NOISE = 1u << 6        /* Gaussian noise on the published state only            */
+    LAG_EFF_NOISE = 1u << 6,       /* Gaussian noise on the published state only            */
+    LAG_EFF_SPRING = 1u << 7       /* Q_i = -k_i (q_i - rest_i), storing 1/2 k_i (q_i -      */
+                                   /* rest_i)^2, which lag_sim_energy includes              */
 };
+#define LAG_EFF_COUNT 8
+
+/* Static facts about an effect, from the core's table: its bit, its name (the scene's
+ * key), and what it takes part in (which follows from what it does). */
+typedef struct lag_effect_info {
+    uint32_t bit;    /* LAG_EFF_*; 0 for an index outside the table */
+    const char *name; /* "damping", "friction", ...; NULL outside the table */
+    bool force;      /* adds a generalized force to the equations of motion */
+    bool potential;  /* stores energy: part of lag_sim_energy */
+    bool per_tick;   /* works at every tick boundary (the step stops at each) */
+    bool events;     /* has events located in time within a tick */
+    bool observe;    /* changes the published state only */
+} lag_effect_info;
+
+/* The table's row `index` of 0..LAG_EFF_COUNT-1 (a zeroed struct outside). */
+lag_effect_info lag_effect_info_get(int index);
+/* Index of the effect named `name`, or -1. */
+int lag_effect_from_name(const char *name);
 #define LAG_MAX_DISTURBANCES 16
 
 typedef struct lag_disturbance {
@@ -262,6 +285,8 @@ typedef struct lag_effects_def {
     double noise_q[LAG_MAX_DOF];            /* std dev of noise on published q */
     double noise_qd[LAG_MAX_DOF];           /* std dev of noise on published qd */
     uint64_t noise_seed;
+    double spring_k[LAG_MAX_DOF];           /* k_i >= 0 (N/m or N m/rad) */
+    double spring_rest[LAG_MAX_DOF];        /* rest position (m or rad) */
 } lag_effects_def;
 
 /* All effects off, neutral parameters (no saturation, no lag, rest_velocity 1e-3). */
@@ -354,6 +379,16 @@ typedef struct lag_sim {
         bool saturated[LAG_MAX_DOF];
         double dist_force[LAG_MAX_DOF]; /* disturbance forces held over this tick */
     } mode;
+    /* The effect table's rows that the enabled effects use, per hook, in table order: made
+     * once by lag_sim_init from def.effects.enabled, so that the step calls those rows
+     * only (the definition must not change after init). */
+    struct {
+        uint32_t enabled;   /* def.effects.enabled when made */
+        uint32_t per_tick;  /* enabled effects with per-tick work or watchers */
+        uint8_t n_force, n_pre_tick, n_watch, n_potential, n_observe;
+        uint8_t force[LAG_EFF_COUNT], pre_tick[LAG_EFF_COUNT], watch[LAG_EFF_COUNT],
+            potential[LAG_EFF_COUNT], observe[LAG_EFF_COUNT];
+    } fx;
     /* events recorded by the step, oldest first; lag_sim_poll_event drains them */
     lag_event events[32];
     int n_events;
@@ -389,7 +424,8 @@ double lag_sim_time(const lag_sim *s);
  * whose tick is past INT64_MAX (t = 1e300, or NaN) gives INT64_MAX, a tick never reached;
  * t <= 0 gives 0. The core converts times to tick counts only through this. */
 int64_t lag_ticks_ceil(double t, double dt);
-double lag_sim_energy(const lag_sim *s); /* T + U at the public state */
+/* T + U at the public state, plus the energy the scene's effects store (springs). */
+double lag_sim_energy(const lag_sim *s);
 
 /* One line on the last refused tick: the result, the sim time, and for LAG_ERR_FORCE the
  * joint, its force, acceleration and what one tick of it would do, e.g.
