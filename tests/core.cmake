@@ -10,7 +10,7 @@ foreach(t models structure conservation convergence determinism validate faults 
                                                     ${CMAKE_CURRENT_SOURCE_DIR}/common
                                                     ${PROJECT_SOURCE_DIR}/server/core)
   target_link_libraries(test_core_${t} PRIVATE lagsim_core m)
-  lagsim_add_test_cases(test_core_${t} core.${t} core 120)
+  lagsim_add_test_cases(test_core_${t} core.${t} core 300)
 endforeach()
 
 # The core from definitions made of arbitrary bytes (tests/fuzz/fuzz_sim.c): its seed
