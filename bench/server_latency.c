@@ -35,6 +35,7 @@
 #include <unistd.h>
 
 #include <lcm/lcm.h>
+#include "lagsim_bus.h"
 #include "lagsim/lagsim_joint_command_t.h"
 #include "lagsim/lagsim_joint_state_t.h"
 #include "lagsim/lagsim_status_t.h"
@@ -125,6 +126,7 @@ static void on_echo(const lcm_recv_buf_t *rb, const char *ch, void *u)
 /* ---------------------------------------------------------------- measurement state */
 typedef struct bench {
     lcm_t *lcm;
+    lcm_t *lcm_cmd;   /* the plant's command URL (lagsim_bus.h) */
     double period_s;
     int64_t last_arrival_ns;
     int64_t n_states;
@@ -173,7 +175,7 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *u)
     lagsim_joint_command_t c = {wall_us(), m->sim_time, 1, names, &eff};
     b->send_utime[newmark] = c.utime;
     b->pending_mark = newmark;
-    lagsim_joint_command_t_publish(b->lcm, b->ch_command, &c);
+    lagsim_joint_command_t_publish(b->lcm_cmd, b->ch_command, &c);
     b->answered++;
 }
 
@@ -237,8 +239,15 @@ int main(int argc, char **argv)
     fclose(f);
 
     static bench b;
-    b.lcm = lcm_create(NULL);
-    if (!b.lcm) return 1;
+    lag_bus bus;
+    char berr[256];
+    if (lag_bus_init(&bus, NULL, "BENCH", berr, sizeof berr) != 0) {
+        fprintf(stderr, "server_latency: %s\n", berr);
+        return 1;
+    }
+    b.lcm = lcm_create(bus.state_url);
+    b.lcm_cmd = lcm_create(bus.command_url);
+    if (!b.lcm || !b.lcm_cmd) return 1;
     b.period_s = 1.0 / hz;
     char prefix[64], ch[96];
     snprintf(prefix, sizeof prefix, "LAGSIM_BENCH%d", (int)getpid());

@@ -19,12 +19,18 @@
 #include <lcm/lcm.h>
 
 #include "lagsim/lagsim_control_t.h"
+#include "lagsim_bus.h"
 
 struct lag_client {
-    lcm_t *lcm;
+    lcm_t *lcm;                  /* the state URL: states, status, events, scene in */
+    lcm_t *lcm_cmd;              /* the command URL: commands and control out (publishing
+                                  * only: LCM opens no receive socket for it); the same
+                                  * lcm_t for memq:// */
+    lag_bus bus;
     char prefix[64];
-    char ch_state[96], ch_status[96], ch_event[96], ch_scene[96], ch_command[96],
-        ch_control[96];
+    char ch_state[LAG_BUS_CHANNEL_LEN], ch_status[LAG_BUS_CHANNEL_LEN],
+        ch_event[LAG_BUS_CHANNEL_LEN], ch_scene[LAG_BUS_CHANNEL_LEN],
+        ch_command[LAG_BUS_CHANNEL_LEN], ch_control[LAG_BUS_CHANNEL_LEN];
     char errmsg[256];
 
     lag_client_state state;      /* latest state */
@@ -177,22 +183,30 @@ lag_client *lag_client_create(const char *url, const char *prefix, char *err, si
         if (err) snprintf(err, errlen, "out of memory");
         return NULL;
     }
-    /* lcm_create(NULL) uses LCM_DEFAULT_URL if set, else udpm://239.255.76.67:7667?ttl=0 */
-    c->lcm = lcm_create(url && url[0] ? url : NULL);
-    if (!c->lcm) {
+    /* the plant's two URLs from url (NULL or "": LCM_DEFAULT_URL, else LCM's default) */
+    char berr[256];
+    if (lag_bus_init(&c->bus, url, prefix, berr, sizeof berr) != 0) {
+        if (err) snprintf(err, errlen, "%s", berr);
+        free(c);
+        return NULL;
+    }
+    c->lcm = lcm_create(c->bus.state_url);
+    c->lcm_cmd = !c->lcm ? NULL : c->bus.udpm ? lcm_create(c->bus.command_url) : c->lcm;
+    if (!c->lcm || !c->lcm_cmd) {
         if (err)
             snprintf(err, errlen, "cannot create LCM for %s",
-                     url && url[0] ? url : "the default URL (LCM_DEFAULT_URL or udpm)");
+                     c->lcm ? c->bus.command_url : c->bus.state_url);
+        if (c->lcm) lcm_destroy(c->lcm);
         free(c);
         return NULL;
     }
     copy_str(c->prefix, sizeof c->prefix, prefix);
-    snprintf(c->ch_state, sizeof c->ch_state, "%s_STATE", prefix);
-    snprintf(c->ch_status, sizeof c->ch_status, "%s_STATUS", prefix);
-    snprintf(c->ch_event, sizeof c->ch_event, "%s_EVENT", prefix);
-    snprintf(c->ch_scene, sizeof c->ch_scene, "%s_SCENE", prefix);
-    snprintf(c->ch_command, sizeof c->ch_command, "%s_COMMAND", prefix);
-    snprintf(c->ch_control, sizeof c->ch_control, "%s_CONTROL", prefix);
+    snprintf(c->ch_state, sizeof c->ch_state, "%s", c->bus.channel[LAG_BUS_STATE]);
+    snprintf(c->ch_status, sizeof c->ch_status, "%s", c->bus.channel[LAG_BUS_STATUS]);
+    snprintf(c->ch_event, sizeof c->ch_event, "%s", c->bus.channel[LAG_BUS_EVENT]);
+    snprintf(c->ch_scene, sizeof c->ch_scene, "%s", c->bus.channel[LAG_BUS_SCENE]);
+    snprintf(c->ch_command, sizeof c->ch_command, "%s", c->bus.channel[LAG_BUS_COMMAND]);
+    snprintf(c->ch_control, sizeof c->ch_control, "%s", c->bus.channel[LAG_BUS_CONTROL]);
     /* lcm_subscribe takes a POSIX regular expression: escape the channel names so that
      * a prefix with regex characters still matches only itself. */
     char re[4][200];
@@ -204,8 +218,7 @@ lag_client *lag_client_create(const char *url, const char *prefix, char *err, si
     lcm_subscription_t *s4 = lcm_subscribe(c->lcm, re[3], on_message, c);
     if (!s1 || !s2 || !s3 || !s4) {
         if (err) snprintf(err, errlen, "cannot subscribe to %s_*", prefix);
-        lcm_destroy(c->lcm);
-        free(c);
+        lag_client_destroy(c);
         return NULL;
     }
     /* The state subscription keeps a deeper queue: a slow controller still sees states
@@ -217,6 +230,7 @@ lag_client *lag_client_create(const char *url, const char *prefix, char *err, si
 void lag_client_destroy(lag_client *c)
 {
     if (!c) return;
+    if (c->lcm_cmd && c->lcm_cmd != c->lcm) lcm_destroy(c->lcm_cmd);
     if (c->lcm) lcm_destroy(c->lcm);
     free(c);
 }
@@ -342,7 +356,7 @@ static int publish(lag_client *c, const char *channel, lag_wire_type t, const vo
         set_err(c, "%s: %s", lag_wire_type_name(t), lag_wire_result_string(n));
         return LAG_CLIENT_ERR_ARG;
     }
-    if (lcm_publish(c->lcm, channel, c->buf, (unsigned)n) != 0) {
+    if (lcm_publish(c->lcm_cmd, channel, c->buf, (unsigned)n) != 0) {
         set_err(c, "publish on %s failed", channel);
         return LAG_CLIENT_ERR_LCM;
     }

@@ -78,9 +78,11 @@ typedef void (*lag_client_status_fn)(const lag_client_status *st, void *user);
 typedef void (*lag_client_event_fn)(const lag_client_event *ev, void *user);
 typedef void (*lag_client_scene_fn)(const lag_client_scene *sc, void *user);
 
-/* Connects to LCM at url (NULL or "": LCM's default, which honours LCM_DEFAULT_URL) and
- * subscribes to <prefix>_STATE, _STATUS, _EVENT, _SCENE. Returns NULL on failure with a
- * message in err (may be NULL). */
+/* Connects to the plant whose LCM URL is url (the daemon's lcm.url; NULL or "": LCM's
+ * default, which honours LCM_DEFAULT_URL) and prefix: subscribes to <prefix>_STATE,
+ * _STATUS, _EVENT, _SCENE on that (state) URL, and sends commands and control requests
+ * to the plant's command URL, the same group on the next port (lagsim_bus.h). Returns
+ * NULL on failure with a message in err (may be NULL). */
 lag_client *lag_client_create(const char *url, const char *prefix, char *err, size_t errlen);
 void lag_client_destroy(lag_client *c);
 /* Message of the last failure on this handle ("" if none). */

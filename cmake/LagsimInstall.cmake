@@ -3,7 +3,7 @@
 #   bin/                     lagsimd, lagsimctl, lagsim-view, lagsim-log2csv, lagsim-plot
 #                            and the C example controllers (each when the build has it)
 #   include/lagsim/          lagsim.h (the core), lagsim_client.h, lagsim_controller.h,
-#                            lagsim_wire.h, lagsim_log.h, the generated C types
+#                            lagsim_wire.h, lagsim_log.h, lagsim_bus.h, the generated C types
 #   lib/                     liblagsim_client.a, liblagsim_controller.a and what they
 #                            link; lagsim-client.pc
 #   lib/python3.X/dist-packages/   lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
@@ -44,6 +44,7 @@ install(FILES ${PROJECT_SOURCE_DIR}/server/include/lagsim/lagsim.h
               ${PROJECT_SOURCE_DIR}/clients/lagsim_controller.h
               ${PROJECT_SOURCE_DIR}/server/wire/lagsim_wire.h
               ${PROJECT_SOURCE_DIR}/server/wire/lagsim_log.h
+              ${PROJECT_SOURCE_DIR}/server/wire/lagsim_bus.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/lagsim)
 install(DIRECTORY ${CMAKE_BINARY_DIR}/lcmtypes/c/lagsim/
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/lagsim FILES_MATCHING PATTERN "*.h")

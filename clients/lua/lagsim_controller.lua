@@ -30,7 +30,7 @@ function Controller.new(name, default_prefix, model, description)
   local self = setmetatable({ name = name, model = model, description = description or '',
                               opts = {}, order = {}, o = {}, dropped = 0 }, Controller)
   self:option('prefix', default_prefix, 'channel prefix', 'string')
-  self:option('url', '', "LCM URL (default: LCM's default)", 'string')
+  self:option('url', '', "the plant's LCM URL, its lcm.url (default: LCM's default); commands go to the next port", 'string')
   self:option('duration', 0, 'stop after S s of sim time from the first state (0: until the daemon stops)')
   self:option('timeout', 5, 'wall s without a scene, or without any message once running, before ending')
   self:option('types', '', 'directory holding the lcm-gen Lua package lagsim', 'string')
@@ -119,7 +119,10 @@ function Controller:start(argv)
     self.trace = io.open(o.trace, 'w')
     if not self.trace then fail(self, 2, 'cannot write ' .. o.trace) end
   end
-  self.lc = lagsim_lcm.new(o.url ~= '' and o.url or nil)
+  local state_url, command_url = lagsim_lcm.plant_urls(o.url ~= '' and o.url or nil)
+  if not state_url then fail(self, 2, '--url: ' .. command_url) end
+  self.lc = lagsim_lcm.new(state_url) -- states, status, events, scene
+  self.lc_cmd = command_url ~= state_url and lagsim_lcm.new(command_url) or self.lc
   local ch = o.prefix .. '_'
   self.silent_ms = 0
   self.lc:subscribe(ch .. 'SCENE', function(_, data)
@@ -154,7 +157,7 @@ function Controller:start(argv)
     if waited >= next_ask then -- DESCRIBE every 0.25 s until the scene comes
       local req = t.control_t:new()
       req.request = t.control_t.DESCRIBE
-      self.lc:publish(ch .. 'CONTROL', req:encode())
+      self.lc_cmd:publish(ch .. 'CONTROL', req:encode())
       next_ask = next_ask + 250
     end
     if not self.lc:handle_timeout(WAIT_MS) then waited = waited + WAIT_MS end
@@ -204,7 +207,7 @@ function Controller:command(sim_time, names, efforts)
     if u ~= u or u == math.huge or u == -math.huge then u = 0.0 end -- never send NaN
     cmd.effort[k] = u
   end
-  self.lc:publish(self.o.prefix .. '_COMMAND', cmd:encode())
+  self.lc_cmd:publish(self.o.prefix .. '_COMMAND', cmd:encode())
   local st = self.current
   if self.trace and st and st.sim_time == sim_time then
     -- sim_time, positions, velocities, efforts sent: %.17g reads back to the same double

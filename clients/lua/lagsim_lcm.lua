@@ -16,12 +16,60 @@ under xpcall and raises its error, with the traceback, from the handle or handle
 call that ran it:
     local lagsim_lcm = require('lagsim_lcm')
     local lc = lagsim_lcm.new()
+A lagsim plant listens for commands on its own URL, the next port:
+    local state_url, command_url = lagsim_lcm.plant_urls(url)  -- nil, message if refused
+    local lc, lc_cmd = lagsim_lcm.new(state_url), lagsim_lcm.new(command_url)
 ]]
 local lcm = require('lcm')
 
 local M = {}
 local LCM = {}
 LCM.__index = LCM
+
+local DEFAULT_URL = 'udpm://239.255.76.67:7667?ttl=0' -- LCM's own default
+
+-- The two LCM URLs of a lagsim plant whose lcm.url is `url` (nil or '': the environment's
+-- LCM_DEFAULT_URL, else LCM's default): state_url, command_url. The daemon publishes
+-- <PREFIX>_STATE, _STATUS, _EVENT and _SCENE on the state URL (the URL itself) and
+-- listens for <PREFIX>_COMMAND and _CONTROL on the command URL: the same group and
+-- options on the next port; memq:// is both. The C library's rule (lagsim_bus.h), checked
+-- against the same cases (tests/net/plant_urls.txt). A URL a plant cannot have gives
+-- nil and a message.
+function M.plant_urls(url)
+  if url == nil or url == '' then
+    url = os.getenv('LCM_DEFAULT_URL')
+    if url == nil or url == '' then url = DEFAULT_URL end
+  end
+  if #url >= 256 then return nil, 'LCM URL longer than 255 characters' end
+  if url == 'memq://' then return url, url end
+  local rest = url:match('^udpm://(.*)$')
+  if not rest then
+    return nil, "a lagsim plant speaks udpm://GROUP:PORT (or memq:// in one process), not '" .. url .. "'"
+  end
+  local addr, query = rest:match('^([^?]*)(.*)$')
+  local group, port = '239.255.76.67', 7667
+  if addr ~= '' then
+    local a, b, c, d, p = addr:match('^(%d%d?%d?)%.(%d%d?%d?)%.(%d%d?%d?)%.(%d%d?%d?)(.*)$')
+    if not a then
+      return nil, "expected udpm://GROUP:PORT with GROUP a dotted IPv4 multicast address, got '" .. url .. "'"
+    end
+    local o = { tonumber(a), tonumber(b), tonumber(c), tonumber(d) }
+    for k = 1, 4 do
+      if o[k] > 255 then return nil, "the group of '" .. url .. "' is not a multicast address" end
+    end
+    if o[1] < 224 or o[1] > 239 then return nil, "the group of '" .. url .. "' is not a multicast address" end
+    group = string.format('%d.%d.%d.%d', o[1], o[2], o[3], o[4])
+    if p ~= '' then
+      local ps = p:match('^:(%d%d?%d?%d?%d?)$')
+      port = ps and tonumber(ps) or -1
+      if port < 1 or port > 65534 then
+        return nil, "expected a port from 1 to 65534 in '" .. url .. "' (commands go to the next port)"
+      end
+    end
+  end
+  return string.format('udpm://%s:%d%s', group, port, query),
+         string.format('udpm://%s:%d%s', group, port + 1, query)
+end
 
 function M.new(url)
   return setmetatable({ lc = lcm.lcm.new(url), pending = nil }, LCM)

@@ -24,7 +24,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from lagsim_lcm import LCM  # noqa: E402
+from lagsim_lcm import LCM, plant_urls  # noqa: E402
 
 
 def _import_types(types_dir, name):
@@ -46,7 +46,9 @@ class Controller(object):
         p = argparse.ArgumentParser(prog=name, description=description)
         p.add_argument("--prefix", default=default_prefix,
                        help="channel prefix (default %s)" % default_prefix)
-        p.add_argument("--url", default=None, help="LCM URL (default: LCM's default)")
+        p.add_argument("--url", default=None,
+                       help="the plant's LCM URL, its lcm.url (default: LCM's default); "
+                            "commands go to the next port")
         p.add_argument("--duration", type=float, default=0.0,
                        help="stop after S s of sim time from the first state (default 0: "
                             "until the daemon stops)")
@@ -78,7 +80,12 @@ class Controller(object):
 
         signal.signal(signal.SIGINT, on_signal)
         signal.signal(signal.SIGTERM, on_signal)
-        self.lc = LCM(a.url)
+        try:
+            state_url, command_url = plant_urls(a.url)
+        except ValueError as e:
+            self.parser.error("--url: %s" % e)
+        self.lc = LCM(state_url)                 # states, status, events, scene
+        self.lc_cmd = LCM(command_url) if command_url != state_url else self.lc
         self._state = None
         self._stopped = False
         self._heard = time.monotonic()
@@ -101,7 +108,7 @@ class Controller(object):
                 req = self.t.control_t()
                 req.utime = int(time.time() * 1e6)
                 req.request = self.t.control_t.DESCRIBE
-                self.lc.publish(ch + "CONTROL", req.encode())
+                self.lc_cmd.publish(ch + "CONTROL", req.encode())
                 next_ask = now + 0.25
             self.lc.handle_timeout(50)
         if self.scene is None:
@@ -175,7 +182,7 @@ class Controller(object):
         cmd.num_joints = len(names)
         cmd.name = list(names)
         cmd.effort = [x if math.isfinite(x) else 0.0 for x in efforts]  # never send NaN
-        self.lc.publish(self.args.prefix + "_COMMAND", cmd.encode())
+        self.lc_cmd.publish(self.args.prefix + "_COMMAND", cmd.encode())
         st = self._current
         if self._trace and st is not None and st.sim_time == sim_time:
             # sim_time, positions, velocities, efforts sent: %.17g reads back to the same double
@@ -187,5 +194,7 @@ class Controller(object):
             self._trace.close()
         print("%s: summary end=%s %s dropped=%d" % (self.name, self.end, summary, self.dropped),
               flush=True)
+        if self.lc_cmd is not self.lc:
+            self.lc_cmd.close()
         self.lc.close()
         return 0

@@ -9,8 +9,14 @@ directory, so with PYTHONPATH=<build>/python (or after installing) this works an
     from lagsim import joint_state_t
     lc = LCM()                     # LCM's default URL (honours LCM_DEFAULT_URL)
     lc.subscribe("DIPC_STATE", lambda channel, data: print(joint_state_t.decode(data)))
-    lc.publish("DIPC_COMMAND", cmd.encode())
     lc.handle_timeout(100)         # ms; True if a message was handled, False on timeout
+
+A lagsim plant listens for commands on its own URL, the next port (plant_urls):
+
+    from lagsim_lcm import LCM, plant_urls
+    state_url, command_url = plant_urls()      # from the daemon's lcm.url (None: default)
+    lc, lc_cmd = LCM(state_url), LCM(command_url)
+    lc_cmd.publish("DIPC_COMMAND", cmd.encode())
 
 The methods follow LCM's own Python binding:
 - subscribe(channel, handler) takes a POSIX extended regular expression, anchored at both
@@ -26,12 +32,53 @@ Not thread-safe, like lcm_t itself: use one LCM per thread.
 """
 import ctypes
 import ctypes.util
+import os
+import re
 
-__all__ = ["LCM", "LCMError"]
+__all__ = ["LCM", "LCMError", "plant_urls"]
 
 
 class LCMError(RuntimeError):
     pass
+
+
+_DEFAULT_URL = "udpm://239.255.76.67:7667?ttl=0"  # LCM's own default
+
+
+def plant_urls(url=None):
+    """The two LCM URLs of a lagsim plant whose lcm.url is `url` (None or "": the
+    environment's LCM_DEFAULT_URL, else LCM's default): (state URL, command URL).
+
+    The daemon publishes <PREFIX>_STATE, _STATUS, _EVENT and _SCENE on the state URL (the
+    URL itself) and listens for <PREFIX>_COMMAND and _CONTROL on the command URL: the
+    same group and options on the next port. memq:// is both. The rule is the C library's
+    (lagsim_bus.h), checked against the same cases (tests/net/plant_urls.txt).
+    Raises ValueError for a URL a plant cannot have."""
+    if not url:
+        url = os.environ.get("LCM_DEFAULT_URL") or _DEFAULT_URL
+    if len(url) >= 256:
+        raise ValueError("LCM URL longer than 255 characters")
+    if url == "memq://":
+        return url, url
+    m = re.match(r"^udpm://(?:((\d{1,3})\.(\d{1,3})\.(\d{1,3})\.(\d{1,3}))(:(\d{1,5}))?)?"
+                 r"(\?.*)?$", url)
+    if not m:
+        raise ValueError("a lagsim plant speaks udpm://GROUP:PORT (or memq:// in one "
+                         "process), not %r" % url)
+    if m.group(1):
+        octets = [int(m.group(k)) for k in range(2, 6)]
+        if max(octets) > 255 or not 224 <= octets[0] <= 239:
+            raise ValueError("the group of %r is not a multicast address" % url)
+        group = ".".join(str(o) for o in octets)
+    else:
+        group = "239.255.76.67"
+    port = int(m.group(7)) if m.group(6) else 7667
+    if not 1 <= port <= 65534:
+        raise ValueError("expected a port from 1 to 65534 in %r (commands go to the next "
+                         "port)" % url)
+    query = m.group(8) or ""
+    return ("udpm://%s:%d%s" % (group, port, query),
+            "udpm://%s:%d%s" % (group, port + 1, query))
 
 
 class _RecvBuf(ctypes.Structure):

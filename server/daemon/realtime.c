@@ -553,13 +553,15 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
 static void on_command(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     (void)ch;
-    rt_handle_command(user, rb->data, rb->data_size);
+    rt_server *s = user;
+    if (!s->discard) rt_handle_command(s, rb->data, rb->data_size);
 }
 
 static void on_control(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     (void)ch;
-    rt_handle_control(user, rb->data, rb->data_size);
+    rt_server *s = user;
+    if (!s->discard) rt_handle_control(s, rb->data, rb->data_size);
 }
 
 /* The one-line live status on a terminal: sim time, RTF, overruns, energy. */
@@ -640,12 +642,16 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     s->lockstep_wait_ns = rt_ns_from_s(sc->realtime.lockstep_timeout);
 
     s->nq = s->sim.nq;
-    snprintf(s->ch_state, RT_CHANNEL_MAX, "%s_STATE", sc->lcm.prefix);
-    snprintf(s->ch_command, RT_CHANNEL_MAX, "%s_COMMAND", sc->lcm.prefix);
-    snprintf(s->ch_status, RT_CHANNEL_MAX, "%s_STATUS", sc->lcm.prefix);
-    snprintf(s->ch_event, RT_CHANNEL_MAX, "%s_EVENT", sc->lcm.prefix);
-    snprintf(s->ch_control, RT_CHANNEL_MAX, "%s_CONTROL", sc->lcm.prefix);
-    snprintf(s->ch_scene, RT_CHANNEL_MAX, "%s_SCENE", sc->lcm.prefix);
+    /* the URLs and channels, by the rule every client follows (lagsim_bus.h) */
+    char berr[256];
+    if (lag_bus_init(&s->bus, sc->lcm.url, sc->lcm.prefix, berr, sizeof berr) != 0)
+        return open_error(err, errlen, "bad scene: lcm.url: %s", berr);
+    snprintf(s->ch_state, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_STATE]);
+    snprintf(s->ch_command, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_COMMAND]);
+    snprintf(s->ch_status, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_STATUS]);
+    snprintf(s->ch_event, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_EVENT]);
+    snprintf(s->ch_control, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_CONTROL]);
+    snprintf(s->ch_scene, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_SCENE]);
     s->tick_budget = RT_TICK_BUDGET;
     for (int k = 0; k < RT_EV_COUNT; k++)
         rt_limit_init(&s->lim_event[k], ev_limits[k].per_s, ev_limits[k].burst, now);
@@ -656,11 +662,12 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     return LAGSIMD_EXIT_OK;
 }
 
-int rt_attach(rt_server *s, lcm_t *lcm, char *err, size_t errlen)
+int rt_attach(rt_server *s, lcm_t *out, lcm_t *in, char *err, size_t errlen)
 {
-    s->lcm = lcm;
-    s->sub_command = lcm_subscribe(lcm, s->ch_command, on_command, s);
-    s->sub_control = lcm_subscribe(lcm, s->ch_control, on_control, s);
+    s->lcm = out;
+    s->lcm_in = in;
+    s->sub_command = lcm_subscribe(in, s->ch_command, on_command, s);
+    s->sub_control = lcm_subscribe(in, s->ch_control, on_control, s);
     if (!s->sub_command || !s->sub_control) {
         rt_close(s);
         snprintf(err, errlen, "cannot subscribe to %s and %s", s->ch_command, s->ch_control);
@@ -674,8 +681,8 @@ int rt_attach(rt_server *s, lcm_t *lcm, char *err, size_t errlen)
 
 void rt_close(rt_server *s)
 {
-    if (s->sub_command) lcm_unsubscribe(s->lcm, s->sub_command);
-    if (s->sub_control) lcm_unsubscribe(s->lcm, s->sub_control);
+    if (s->sub_command) lcm_unsubscribe(s->lcm_in, s->sub_command);
+    if (s->sub_control) lcm_unsubscribe(s->lcm_in, s->sub_control);
     s->sub_command = s->sub_control = NULL;
 }
 
@@ -829,7 +836,7 @@ void rt_finish(rt_server *s)
 
 /* ---------------------------------------------------------------- the loop */
 typedef struct rt_io {
-    int lcm_fd, timer_fd, sig_fd;
+    int in_fd, timer_fd, sig_fd;
     int64_t armed_ns; /* what the timer is armed at (INT64_MAX: disarmed) */
 } rt_io;
 
@@ -849,7 +856,7 @@ static void wait_and_handle(rt_server *s, rt_io *io, int64_t wake)
         if (timerfd_settime(io->timer_fd, TFD_TIMER_ABSTIME, &its, NULL) == 0) io->armed_ns = wake;
         else tmo = &zero; /* cannot arm: do not sleep past the deadline */
     }
-    struct pollfd pf[3] = {{io->lcm_fd, POLLIN, 0}, {io->timer_fd, POLLIN, 0}, {io->sig_fd, POLLIN, 0}};
+    struct pollfd pf[3] = {{io->in_fd, POLLIN, 0}, {io->timer_fd, POLLIN, 0}, {io->sig_fd, POLLIN, 0}};
     int np = ppoll(pf, 3, tmo, NULL);
     s->now = rt_mono_ns();
     if (np < 0) {
@@ -873,7 +880,7 @@ static void wait_and_handle(rt_server *s, rt_io *io, int64_t wake)
     }
     if (pf[0].revents & POLLIN) {
         for (int k = 0; k < RT_DRAIN_MAX && !s->stop; k++)
-            if (lcm_handle_timeout(s->lcm, 0) <= 0) break;
+            if (lcm_handle_timeout(s->lcm_in, 0) <= 0) break;
     }
     s->now = rt_mono_ns();
 }
@@ -891,15 +898,6 @@ static void handled_signals(sigset_t *set)
     sigaddset(set, SIGUSR2);
 }
 
-/* The effective LCM URL, for messages: the scene's, else LCM_DEFAULT_URL, else LCM's
- * default. */
-static const char *effective_url(const lag_scene *sc)
-{
-    if (sc->lcm.url[0]) return sc->lcm.url;
-    const char *env = getenv("LCM_DEFAULT_URL");
-    return env && env[0] ? env : "udpm://239.255.76.67:7667?ttl=0";
-}
-
 int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
 {
     static rt_server srv; /* large (encode buffer): static, one server per process */
@@ -915,8 +913,8 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
     sigemptyset(&ign.sa_mask);
     sigaction(SIGPIPE, &ign, &old_pipe);
     rt_io io = {-1, -1, -1, INT64_MAX};
-    lcm_t *lcm = NULL;
     int rc = LAGSIMD_EXIT_OK;
+    bool opened = false;
 
     io.sig_fd = signalfd(-1, &sigs, SFD_CLOEXEC | SFD_NONBLOCK);
     io.timer_fd = timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC | TFD_NONBLOCK);
@@ -931,36 +929,26 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
         fprintf(stderr, "lagsimd: %s\n", err);
         goto out;
     }
-    const char *url = effective_url(sc);
-    lcm = lcm_create(sc->lcm.url[0] ? sc->lcm.url : NULL);
-    if (!lcm) {
-        fprintf(stderr, "lagsimd: cannot create LCM (url '%s')\n", url);
-        rc = LAGSIMD_EXIT_RUNTIME;
-        goto out;
-    }
-    rc = rt_attach(s, lcm, err, sizeof err);
+    /* LCM: publishing on the state URL, receiving on the command URL */
+    opened = true;
+    rc = rt_bus_open(s, err, sizeof err);
     if (rc != LAGSIMD_EXIT_OK) {
         fprintf(stderr, "lagsimd: %s\n", err);
         goto out;
     }
-    int ttl = sc->lcm.ttl; /* the loader's reading of the URL (LCM_DEFAULT_URL included) */
-    if (ttl > 0)
-        fprintf(stderr, "lagsimd: warning: LCM url '%s' has ttl=%d: states, status and events "
-                "leave this host (multicast to the local network%s)\n", url, ttl,
-                ttl > 1 ? " and beyond routers" : "");
     s->live_line = isatty(STDERR_FILENO) && !quiet;
-    io.lcm_fd = lcm_get_fileno(lcm);
+    io.in_fd = lcm_get_fileno(s->lcm_in);
 
     s->now = rt_mono_ns();
+    s->discard = false;
     rt_begin(s);
     while (!s->stop) {
         wait_and_handle(s, &io, rt_next_wake(s));
         rt_process(s);
     }
     rt_finish(s);
-    rt_close(s);
 out:
-    if (lcm) lcm_destroy(lcm);
+    if (opened) rt_bus_close(s);
     if (io.timer_fd >= 0) close(io.timer_fd);
     if (io.sig_fd >= 0) close(io.sig_fd);
     sigaction(SIGPIPE, &old_pipe, NULL);

@@ -14,10 +14,11 @@
 #include <stdint.h>
 #include <lcm/lcm.h>
 #include "daemon.h"
+#include "lagsim_bus.h"
 #include "lagsim_wire.h"
 #include "rt_pace.h"
 
-#define RT_CHANNEL_MAX 96     /* prefix (< 64) + "_COMMAND" */
+#define RT_CHANNEL_MAX LAG_BUS_CHANNEL_LEN /* prefix (< 64) + "_COMMAND" */
 #define RT_BUF_SIZE LAG_WIRE_BUF_SIZE /* encode buffer: holds any message */
 
 typedef enum rt_run { RT_RUNNING = 0, RT_PAUSED, RT_FAULT } rt_run;
@@ -64,8 +65,13 @@ typedef struct rt_server {
     const lag_scene *sc;
     const lagsimd_opts *opts;
     const lag_model_info *info;
-    lcm_t *lcm;
+    lcm_t *lcm;                /* publishes on the state URL (never receives) */
+    lcm_t *lcm_in;             /* receives _COMMAND and _CONTROL on the command URL (the
+                                * same lcm_t as `lcm` for memq://) */
     lcm_subscription_t *sub_command, *sub_control;
+    lag_bus bus;               /* the URLs and channels (lagsim_bus.h) */
+    bool discard;              /* drop what arrives: before the start, LCM's queues may
+                                * hold datagrams that came in before the filter */
     lag_sim sim;
     int nq;
     char ch_state[RT_CHANNEL_MAX], ch_command[RT_CHANNEL_MAX], ch_status[RT_CHANNEL_MAX],
@@ -164,9 +170,10 @@ const char *rt_run_name(rt_run r);
  * code (2: bad scene or --duration) with a message in err. */
 int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t now, bool quiet,
             char *err, size_t errlen);
-/* Subscribes to _COMMAND and _CONTROL on lcm (which the caller owns and destroys after
- * rt_close). Returns 0, or an exit code with a message in err. */
-int rt_attach(rt_server *s, lcm_t *lcm, char *err, size_t errlen);
+/* Publishes on `out` and subscribes to _COMMAND and _CONTROL on `in` (the same lcm_t for
+ * memq://; the caller owns both and destroys them after rt_close). Returns 0, or an exit
+ * code with a message in err. */
+int rt_attach(rt_server *s, lcm_t *out, lcm_t *in, char *err, size_t errlen);
 /* Publishes the scene, a start event, the initial state and a status; deadlines start. */
 void rt_begin(rt_server *s);
 /* When the loop must next wake up (absolute ns; <= s->now: at once). Pure. */
@@ -183,6 +190,13 @@ void rt_close(rt_server *s);
 /* The LCM handlers' work: a command or a control request, at s->now. */
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len);
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len);
+
+/* rt_bus.c: the daemon's LCM instances: one publishing on the state URL, one receiving
+ * on the command URL (one lcm_t for memq://), and what the daemon says about them at
+ * start. Returns 0, or an exit code with a message in err; rt_bus_close destroys what
+ * rt_bus_open made. */
+int rt_bus_open(rt_server *s, char *err, size_t errlen);
+void rt_bus_close(rt_server *s);
 
 
 #endif

@@ -149,8 +149,10 @@ int lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, si
         if (*p == ':') {
             p++;
             long port;
-            if (!read_uint(&p, 5, &port) || port < 1 || port > 65535) {
-                snprintf(err, errlen, "expected a port from 1 to 65535 after the group in "
+            /* a plant's commands go to the next port (lagsim_bus.h) */
+            if (!read_uint(&p, 5, &port) || port < 1 || port > 65534) {
+                snprintf(err, errlen, "expected a port from 1 to 65534 (commands go to the "
+                         "next port) after the group in "
                          "'%s'", url);
                 return -1;
             }

@@ -89,8 +89,9 @@ int lag_scene_read_decimal(const char *s, double *v);
 /* Checks an LCM URL the way the loader does for lcm.url (and lagsimd for
  * LCM_DEFAULT_URL): "" (LCM's default), memq:// (in-process, for tests) or
  * udpm://GROUP[:PORT][?ttl=N&recv_buf_size=BYTES] with GROUP a dotted IPv4 multicast
- * address (224.0.0.0/4), PORT 1..65535, each option at most once, ttl 0..255 and above
- * 0 only with allow_lan, recv_buf_size 4096..268435456. Every other provider (file://
+ * address (224.0.0.0/4), PORT 1..65534 (a plant's commands go to PORT + 1), each
+ * option at most once, ttl 0..255 and above 0 only with allow_lan, recv_buf_size
+ * 4096..268435456. Every other provider (file://
  * writes files, tcpq:// opens connections) is refused. Returns 0, or -1 with what was
  * expected in err. OUT: ttl (0 when the URL does not set it) */
 int lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, size_t errlen);

@@ -58,7 +58,8 @@ typedef struct view_event {
 } view_event;
 
 typedef struct view_bridge {
-    lcm_t *lcm;
+    lcm_t *lcm;      /* the plant's state URL: states, status, events, scene */
+    lcm_t *lcm_cmd;  /* its command URL: control requests (lagsim_bus.h); = lcm for memq:// */
     char prefix[64];
     char url[256];
     char ch_state[VIEW_CHANNEL_MAX], ch_status[VIEW_CHANNEL_MAX], ch_event[VIEW_CHANNEL_MAX],

@@ -13,6 +13,7 @@
 
 #include "view.h"
 #include "lagsim/lagsim_control_t.h"
+#include "lagsim_bus.h"
 
 #define VIEW_DRAIN_MAX 512        /* messages handled per poll at most */
 #define VIEW_LCM_QUEUE 200        /* LCM's queue per subscription */
@@ -114,14 +115,23 @@ bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, char
     }
     snprintf(vb->prefix, sizeof vb->prefix, "%s", prefix);
     snprintf(vb->url, sizeof vb->url, "%s", url ? url : "");
-    snprintf(vb->ch_state, VIEW_CHANNEL_MAX, "%s_STATE", prefix);
-    snprintf(vb->ch_status, VIEW_CHANNEL_MAX, "%s_STATUS", prefix);
-    snprintf(vb->ch_event, VIEW_CHANNEL_MAX, "%s_EVENT", prefix);
-    snprintf(vb->ch_scene, VIEW_CHANNEL_MAX, "%s_SCENE", prefix);
-    snprintf(vb->ch_control, VIEW_CHANNEL_MAX, "%s_CONTROL", prefix);
-    vb->lcm = lcm_create(url && url[0] ? url : NULL);
-    if (!vb->lcm) {
-        snprintf(err, errlen, "cannot create LCM (url '%s')", url && url[0] ? url : "default");
+    lag_bus bus; /* the plant's URLs and channels, as the daemon derives them */
+    char berr[256];
+    if (lag_bus_init(&bus, url, prefix, berr, sizeof berr) != 0) {
+        snprintf(err, errlen, "--url: %s", berr);
+        return false;
+    }
+    snprintf(vb->ch_state, VIEW_CHANNEL_MAX, "%s", bus.channel[LAG_BUS_STATE]);
+    snprintf(vb->ch_status, VIEW_CHANNEL_MAX, "%s", bus.channel[LAG_BUS_STATUS]);
+    snprintf(vb->ch_event, VIEW_CHANNEL_MAX, "%s", bus.channel[LAG_BUS_EVENT]);
+    snprintf(vb->ch_scene, VIEW_CHANNEL_MAX, "%s", bus.channel[LAG_BUS_SCENE]);
+    snprintf(vb->ch_control, VIEW_CHANNEL_MAX, "%s", bus.channel[LAG_BUS_CONTROL]);
+    vb->lcm = lcm_create(bus.state_url);
+    vb->lcm_cmd = !vb->lcm ? NULL : bus.udpm ? lcm_create(bus.command_url) : vb->lcm;
+    if (!vb->lcm || !vb->lcm_cmd) {
+        snprintf(err, errlen, "cannot create LCM (url '%s')",
+                 vb->lcm ? bus.command_url : bus.state_url);
+        view_bridge_close(vb);
         return false;
     }
     lcm_subscription_t *subs[4] = {
@@ -133,8 +143,7 @@ bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, char
     for (int i = 0; i < 4; i++) {
         if (!subs[i]) {
             snprintf(err, errlen, "cannot subscribe to the %s channels", prefix);
-            lcm_destroy(vb->lcm);
-            vb->lcm = NULL;
+            view_bridge_close(vb);
             return false;
         }
         lcm_subscription_set_queue_capacity(subs[i], VIEW_LCM_QUEUE);
@@ -144,8 +153,9 @@ bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, char
 
 void view_bridge_close(view_bridge *vb)
 {
+    if (vb->lcm_cmd && vb->lcm_cmd != vb->lcm) lcm_destroy(vb->lcm_cmd);
     if (vb->lcm) lcm_destroy(vb->lcm);
-    vb->lcm = NULL;
+    vb->lcm = vb->lcm_cmd = NULL;
 }
 
 static bool send_control(view_bridge *vb, int request, int64_t count)
@@ -157,7 +167,7 @@ static bool send_control(view_bridge *vb, int request, int64_t count)
     m.count = count;
     uint8_t buf[LAG_WIRE_BUF_SIZE];
     int n = lag_wire_encode_control(&m, buf, sizeof buf);
-    return n > 0 && lcm_publish(vb->lcm, vb->ch_control, buf, (unsigned)n) == 0;
+    return n > 0 && lcm_publish(vb->lcm_cmd, vb->ch_control, buf, (unsigned)n) == 0;
 }
 
 void view_bridge_poll(view_bridge *vb)

@@ -7,8 +7,8 @@ README.md marks each runnable block with an HTML comment on the line before its 
 <!-- snippet: NAME -->. For each NAME given, the block is written to a fresh temporary
 directory (so it runs from any directory, as the README promises), its channel prefix
 DIPC is replaced by one unique to this run, and it is started the way the README says
-(PYTHONPATH=<build>/python; LUA_PATH=<build>/lua/...; java -cp lcm.jar:types.jar
-File.java). Once it answers a probe state (sim time -1) it is subscribed; then lagsimd runs config/dipc.yaml in lockstep for 2 s of sim time and stops.
+(PYTHONPATH=<build>/python; LUA_PATH=<build>/lua/...; java -cp
+lcm.jar:types.jar:examples.jar File.java). Once it answers a probe state (sim time -1) it is subscribed; then lagsimd runs config/dipc.yaml in lockstep for 2 s of sim time and stops.
 The snippet must exit by itself with status 0 once the daemon announces its stop; the
 daemon's final status must show every state before t = 2 s answered (200
 commands_accepted, no lockstep timeout), and every state heard must keep both rods within 0.1 rad of
@@ -30,7 +30,8 @@ RUNNERS = {
     "lua": ("balance.lua", lambda b, f: ["lua5.2", f],
             lambda b: {"LUA_PATH": "%s/lua/?.lua;%s/lua/?/init.lua;;" % (b, b)}),
     "java": ("Balance.java",
-             lambda b, f: ["java", "-cp", "/usr/share/java/lcm.jar:%s/lagsim_types.jar" % b, f],
+             lambda b, f: ["java", "-cp", "/usr/share/java/lcm.jar:%s/lagsim_types.jar:"
+                                          "%s/lagsim_examples.jar" % (b, b), f],
              lambda b: {}),
 }
 
@@ -53,7 +54,7 @@ def main():
     a = ap.parse_args()
     build = os.path.abspath(a.build)
     sys.path.insert(0, os.path.join(build, "python"))
-    from lagsim_lcm import LCM
+    from lagsim_lcm import LCM, plant_urls
     from lagsim import joint_command_t, joint_state_t, status_t
 
     found = snippets(a.readme)
@@ -72,7 +73,8 @@ def main():
             f.write(found[name].replace('"DIPC_', '"%s_' % prefix).replace("'DIPC_", "'%s_" % prefix))
         env = dict(os.environ)
         env.update(env_extra(build))
-        lc = LCM()
+        state_url, command_url = plant_urls()
+        lc, lc_cmd = LCM(state_url), LCM(command_url)
         heard = {"states": 0, "max_th": 0.0, "t": -1.0, "status": None}
 
         def on_state(ch, data):
@@ -92,13 +94,15 @@ def main():
 
         lc.subscribe(prefix + "_STATE", on_state)
         lc.subscribe(prefix + "_STATUS", on_status)
-        lc.subscribe(prefix + "_COMMAND", on_command)
+        lc_cmd.subscribe(prefix + "_COMMAND", on_command)
         heard["ready"] = False
         listening = [True]
 
         def listen():  # its own thread: the daemon in lockstep outruns a late reader
             while listening[0]:
-                lc.handle_timeout(50)
+                lc.handle_timeout(20)
+                while lc_cmd.handle_timeout(0):
+                    pass
 
         th = threading.Thread(target=listen)
         th.start()
@@ -130,6 +134,7 @@ def main():
         listening[0] = False
         th.join()
         lc.close()
+        lc_cmd.close()
         st = heard["status"]
         acc = st.commands_accepted if st else -1
         lto = st.lockstep_timeouts if st else -1

@@ -78,7 +78,7 @@ def main():
     # loaded machine must not lose a lockstep burst.
     env = dict(os.environ)
     env["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
-                              % (20000 + os.getpid() % 12000))
+                              % (20000 + 2 * (os.getpid() % 6000)))  # and the next port
     client = [c.replace("{prefix}", prefix) for c in client]
     dcmd = [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
             "--set", "realtime.mode=" + a.mode, "-q"]

@@ -7,7 +7,8 @@
  * copied exactly, the status with all its fields; commands and control requests arrive
  * as sent; bad arguments (NaN efforts, over-long names) are refused with a message and
  * nothing is sent; the scene wait sends DESCRIBE requests and times out cleanly when
- * nobody answers; every function follows one return convention.
+ * nobody answers; every function follows one return convention. Commands and control
+ * requests go to the plant's command URL (the next port), never to the state URL.
  */
 #include <math.h>
 #include <stdio.h>
@@ -20,6 +21,7 @@
 #include "lagsim/lagsim_joint_state_t.h"
 #include "lagsim/lagsim_scene_t.h"
 #include "lagsim/lagsim_status_t.h"
+#include "lagsim_bus.h"
 #include "lagsim_client.h"
 #include "lagsim_wire.h"
 
@@ -32,7 +34,7 @@ static int failures = 0;
         }                                                                              \
     } while (0)
 
-static int describes = 0, commands = 0, controls = 0;
+static int describes = 0, commands = 0, controls = 0, on_state_url = 0;
 static lag_wire_joint_command last_cmd;
 static lag_wire_control last_ctl;
 
@@ -56,12 +58,23 @@ static void on_command(const lcm_recv_buf_t *rbuf, const char *ch, void *u)
     last_cmd = m;
 }
 
-/* Pumps both LCM instances for about `ms` milliseconds. */
+/* Anything on _COMMAND or _CONTROL heard on the state URL. */
+static void on_wrong_url(const lcm_recv_buf_t *rbuf, const char *ch, void *u)
+{
+    (void)rbuf; (void)ch; (void)u;
+    on_state_url++;
+}
+
+/* The daemon's side: publishes on the state URL, listens on the command URL. */
+static lcm_t *peer_in;
+
+/* Pumps the LCM instances for about `ms` milliseconds. */
 static void pump(lcm_t *peer, lag_client *c, int ms)
 {
     double end = lag_client_now() + ms * 1e-3;
     while (lag_client_now() < end) {
-        lcm_handle_timeout(peer, 1);
+        lcm_handle_timeout(peer_in, 1);
+        lcm_handle_timeout(peer, 0);
         lag_client_handle(c, 1);
     }
 }
@@ -93,13 +106,16 @@ int main(void)
     ENSURE(strlen(err) > 0);
 
     lag_client *c = lag_client_create(NULL, prefix, err, sizeof err);
-    lcm_t *peer = lcm_create(NULL);
-    ENSURE(c != NULL && peer != NULL);
-    if (!c || !peer) return 1;
-    snprintf(ch, sizeof ch, "%s_CONTROL", prefix);
-    lcm_subscribe(peer, ch, on_control, NULL);
-    snprintf(ch, sizeof ch, "%s_COMMAND", prefix);
-    lcm_subscribe(peer, ch, on_command, NULL);
+    lag_bus bus;
+    ENSURE(lag_bus_init(&bus, NULL, prefix, err, sizeof err) == 0);
+    lcm_t *peer = lcm_create(bus.state_url);
+    peer_in = lcm_create(bus.command_url);
+    ENSURE(c != NULL && peer != NULL && peer_in != NULL && bus.udpm);
+    if (!c || !peer || !peer_in) return 1;
+    lcm_subscribe(peer_in, bus.channel[LAG_BUS_CONTROL], on_control, NULL);
+    lcm_subscribe(peer_in, bus.channel[LAG_BUS_COMMAND], on_command, NULL);
+    lcm_subscribe(peer, bus.channel[LAG_BUS_CONTROL], on_wrong_url, NULL);
+    lcm_subscribe(peer, bus.channel[LAG_BUS_COMMAND], on_wrong_url, NULL);
 
     /* nobody answers DESCRIBE: timeout, requests were sent, message names the prefix */
     lag_client_scene sc;
@@ -220,8 +236,12 @@ int main(void)
     ENSURE(lag_client_scene_joint(&sc, "q2") == 1 && sc.actuated[0] && !sc.actuated[1]);
     ENSURE(sc.initial_q[1] == 0.5 && sc.control_period == 0.01);
 
+    pump(peer, c, 100);
+    ENSURE(controls > 0 && commands > 0 && on_state_url == 0); /* each on its own port */
+
     lag_client_destroy(c);
     lcm_destroy(peer);
+    lcm_destroy(peer_in);
     if (failures) {
         fprintf(stderr, "test_client: %d failure(s)\n", failures);
         return 1;

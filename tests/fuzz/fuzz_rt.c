@@ -221,7 +221,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     char err[512];
     const int64_t t0 = 1000 * MS;
     if (rt_open(&g_s, &g_sc, &opts, t0, true, err, sizeof err) != 0) return 0;
-    if (rt_attach(&g_s, g_lcm, err, sizeof err) != 0) bad(err);
+    if (rt_attach(&g_s, g_lcm, g_lcm, err, sizeof err) != 0) bad(err);
     g_s.tick_budget = FZ_TICK_BUDGET;
     rt_begin(&g_s);
     drain();

@@ -29,6 +29,7 @@
 #include <unistd.h>
 
 #include <lcm/lcm.h>
+#include "lagsim_bus.h"
 #include "scene.h"
 #include "lagsim/lagsim_control_t.h"
 #include "lagsim/lagsim_event_t.h"
@@ -133,7 +134,8 @@ typedef struct rec_state {
 } rec_state;
 
 typedef struct client {
-    lcm_t *lcm;
+    lcm_t *lcm;      /* the plant's state URL: states, status, events, scene */
+    lcm_t *lcm_in;   /* its command URL: commands and control (lagsim_bus.h) */
     char prefix[64];
     char ch_state[96], ch_command[96], ch_control[96];
     int nq;
@@ -158,6 +160,11 @@ typedef struct client {
     lag_wire_scene *scene;          /* NULL until the first, then &scene_buf */
     lag_wire_scene scene_buf;
     lcm_subscription_t *sub_state, *sub_status, *sub_event, *sub_scene;
+    /* states missing between two received ones (steps not a period apart), counted when
+     * tpp (ticks per period) is set */
+    int64_t tpp, prev_step, missing;
+    /* messages on the state URL that are not this plant's output (".*" subscription) */
+    int64_t foreign_on_state_url;
     /* lockstep controller (replay case): answers each state, records it */
     bool controller;
     int n_rec;
@@ -185,6 +192,9 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *u)
         if (fabs(r.qd[i]) > c->max_abs) c->max_abs = fabs(r.qd[i]);
     }
     if (!isfinite(r.t)) c->nonfinite_seen = true;
+    if (c->tpp > 0 && c->n_states > 1 && m->step > c->prev_step)
+        c->missing += (m->step - c->prev_step) / c->tpp - 1;
+    c->prev_step = m->step;
     c->last = r;
     if (c->controller) {
         if (c->n_rec < MAX_REC) c->rec[c->n_rec++] = r;
@@ -197,7 +207,7 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *u)
         double u_eff = -2.0 * r.q[0] - 1.0 * r.qd[0] + 3.0 * r.q[1] + 0.5 * sin(7.0 * r.t);
         char *names[1] = {"theta0"};
         lagsim_joint_command_t cmd = {0, r.t, 1, names, &u_eff};
-        lagsim_joint_command_t_publish(c->lcm, c->ch_command, &cmd);
+        lagsim_joint_command_t_publish(c->lcm_in, c->ch_command, &cmd);
     }
 }
 
@@ -252,6 +262,7 @@ static void client_free_all(void)
         lcm_unsubscribe(c->lcm, c->sub_status);
         lcm_unsubscribe(c->lcm, c->sub_event);
         lcm_unsubscribe(c->lcm, c->sub_scene);
+        lcm_destroy(c->lcm_in);
         lcm_destroy(c->lcm);
     }
     g_nclients = 0;
@@ -262,14 +273,18 @@ static void client_init(client *c, const char *prefix, int nq)
 {
     memset(c, 0, sizeof *c);
     g_clients[g_nclients++] = c;
-    c->lcm = lcm_create(NULL);
-    ENSUREF(c->lcm, "lcm_create(NULL) failed: no multicast on loopback?");
+    lag_bus bus;
+    char berr[256];
+    ENSUREF(lag_bus_init(&bus, NULL, prefix, berr, sizeof berr) == 0, "%s", berr);
+    c->lcm = lcm_create(bus.state_url);
+    c->lcm_in = lcm_create(bus.command_url);
+    ENSUREF(c->lcm && c->lcm_in, "lcm_create(%s) failed: no multicast on loopback?", bus.state_url);
     snprintf(c->prefix, sizeof c->prefix, "%s", prefix);
     c->nq = nq;
     char ch[96];
-    snprintf(c->ch_state, sizeof c->ch_state, "%s_STATE", prefix);
-    snprintf(c->ch_command, sizeof c->ch_command, "%s_COMMAND", prefix);
-    snprintf(c->ch_control, sizeof c->ch_control, "%s_CONTROL", prefix);
+    snprintf(c->ch_state, sizeof c->ch_state, "%s", bus.channel[LAG_BUS_STATE]);
+    snprintf(c->ch_command, sizeof c->ch_command, "%s", bus.channel[LAG_BUS_COMMAND]);
+    snprintf(c->ch_control, sizeof c->ch_control, "%s", bus.channel[LAG_BUS_CONTROL]);
     c->sub_state = lcm_subscribe(c->lcm, c->ch_state, on_state, c);
     lcm_subscription_set_queue_capacity(c->sub_state, 100000);
     snprintf(ch, sizeof ch, "%s_STATUS", prefix);
@@ -310,13 +325,13 @@ static int count_events(const client *c, const char *kind)
 static void control(client *c, int req, int64_t count, int n, double *q, double *qd)
 {
     lagsim_control_t m = {0, (int8_t)req, count, (int16_t)n, q, qd};
-    lagsim_control_t_publish(c->lcm, c->ch_control, &m);
+    lagsim_control_t_publish(c->lcm_in, c->ch_control, &m);
 }
 
 static void command(client *c, double sim_time, int n, const char **names, double *eff)
 {
     lagsim_joint_command_t m = {0, sim_time, (int16_t)n, (char **)names, eff};
-    lagsim_joint_command_t_publish(c->lcm, c->ch_command, &m);
+    lagsim_joint_command_t_publish(c->lcm_in, c->ch_command, &m);
 }
 
 /* Asks for a fresh status and waits for it. */
@@ -512,7 +527,7 @@ static size_t raw_header(uint8_t *b, int16_t num_joints)
 }
 static void publish_raw(client *c, const uint8_t *b, size_t n)
 {
-    lcm_publish(c->lcm, c->ch_command, b, (unsigned)n);
+    lcm_publish(c->lcm_in, c->ch_command, b, (unsigned)n);
 }
 
 /* Malformed and hostile commands are rejected and counted by reason; the state stays
@@ -1081,7 +1096,7 @@ static void case_control_flood(void)
     int sent = 0, bad = 0;
     for (int k = 0; k < 4000; k++) {
         switch (k % 5) {
-        case 0: lcm_publish(c.lcm, c.ch_control, garbage, sizeof garbage); bad++; break;
+        case 0: lcm_publish(c.lcm_in, c.ch_control, garbage, sizeof garbage); bad++; break;
         case 1: control(&c, 99, 0, 0, NULL, NULL); bad++; break;
         case 2: control(&c, LAGSIM_CONTROL_T_STATUS, 0, 0, NULL, NULL); break;
         case 3: control(&c, LAGSIM_CONTROL_T_DESCRIBE, 0, 0, NULL, NULL); break;
@@ -1112,6 +1127,79 @@ static void case_control_flood(void)
     control(&c, LAGSIM_CONTROL_T_PAUSE, 0, 0, NULL, NULL);
     WAIT_FOR(&c, last_event(&c, "pause") >= 0, 3.0);
     ENSURE(!c.nonfinite_seen);
+    kill(d, SIGTERM);
+    ENSURE(reap(d, 5.0) == 0);
+}
+
+/* Anything on the state URL but the plant's four output channels (and LCM's self-test,
+ * which every lcm_t sends once on its own URL). */
+static void on_any_state_url(const lcm_recv_buf_t *rb, const char *ch, void *u)
+{
+    (void)rb;
+    client *c = u;
+    size_t n = strlen(c->prefix);
+    const char *outs[] = {"_STATE", "_STATUS", "_EVENT", "_SCENE"};
+    if (!strcmp(ch, "LCM_SELF_TEST")) return;
+    if (!strncmp(ch, c->prefix, n))
+        for (int k = 0; k < 4; k++)
+            if (!strcmp(ch + n, outs[k])) return;
+    c->foreign_on_state_url++;
+}
+
+/* A flood of commands (a child publishing valid heartbeats as fast as it can for 2 s)
+ * reaches the daemon on the command URL and never the sockets of those who listen on the
+ * state URL: a state subscriber receives none of it and misses no state meanwhile. */
+static void case_command_flood_ports(void)
+{
+    write_scene(DIPC_MOVING);
+    static client c;
+    client_init(&c, g_prefix, 3);
+    lag_scene sc;
+    load_ref(&sc, g_prefix);
+    c.tpp = sc.ticks_per_period;
+    lcm_subscription_t *all = lcm_subscribe(c.lcm, ".*", on_any_state_url, &c);
+    lcm_subscription_set_queue_capacity(all, 100000);
+    pid_t d = start_daemon(g_prefix, "--set", "realtime.command_timeout=100", NULL);
+    WAIT_FOR(&c, c.n_states > 5 && c.n_scene > 0, 5.0);
+    pump(&c, 0.2);
+    fresh_status(&c);
+    int64_t acc0 = c.status->commands_accepted, n0 = c.n_states, step0 = c.last.step;
+    c.missing = 0;
+    pid_t fl = fork();
+    if (fl == 0) {
+        prctl(PR_SET_PDEATHSIG, SIGKILL);
+        lag_bus bus;
+        char berr[256];
+        if (lag_bus_init(&bus, NULL, g_prefix, berr, sizeof berr) != 0) _exit(2);
+        lcm_t *in = lcm_create(bus.command_url);
+        if (!in) _exit(2);
+        lagsim_joint_command_t hb = {0, 0.0, 0, NULL, NULL}; /* valid: changes no effort */
+        long sent = 0;
+        for (double t_end = now_s() + 2.0; now_s() < t_end; sent++)
+            lagsim_joint_command_t_publish(in, bus.channel[LAG_BUS_COMMAND], &hb);
+        printf("command flood: %ld heartbeats in 2 s\n", sent);
+        fflush(stdout);
+        lcm_destroy(in);
+        _exit(0);
+    }
+    ENSURE(fl > 0);
+    pump(&c, 2.5);
+    int st;
+    ENSURE(waitpid(fl, &st, 0) == fl && WIFEXITED(st) && WEXITSTATUS(st) == 0);
+    pump(&c, 0.3);
+    fresh_status(&c);
+    int64_t acc = c.status->commands_accepted - acc0;
+    printf("command flood: daemon accepted %lld; state subscriber: %lld states (steps %lld to "
+           "%lld), %lld missing, %lld messages of other channels\n", (long long)acc,
+           (long long)(c.n_states - n0), (long long)step0, (long long)c.last.step,
+           (long long)c.missing, (long long)c.foreign_on_state_url);
+    ENSUREF(acc > 1000, "the daemon accepted only %lld of the flood's commands", (long long)acc);
+    ENSUREF(c.foreign_on_state_url == 0, "%lld commands reached a socket on the state URL",
+            (long long)c.foreign_on_state_url);
+    ENSUREF(c.missing == 0, "the state subscriber missed %lld states during the flood",
+            (long long)c.missing);
+    ENSURE(c.n_states - n0 >= 200 && !c.nonfinite_seen);
+    lcm_unsubscribe(c.lcm, all);
     kill(d, SIGTERM);
     ENSURE(reap(d, 5.0) == 0);
 }
@@ -1442,7 +1530,7 @@ int main(int argc, char **argv)
      * a core by a loaded machine, lost some with the default 208 kB. */
     char url[128];
     snprintf(url, sizeof url, "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304",
-             20000 + (int)(getpid() % 12000));
+             20000 + 2 * (int)(getpid() % 6000)); /* and the next port: the command URL */
     setenv("LCM_DEFAULT_URL", url, 1);
     if (!strcmp(g_case, "control")) case_control();
     else if (!strcmp(g_case, "hostile")) case_hostile();
@@ -1467,6 +1555,7 @@ int main(int argc, char **argv)
     else if (!strcmp(g_case, "effort_absurd")) case_effort_absurd();
     else if (!strcmp(g_case, "ttl_warning")) case_ttl_warning();
     else if (!strcmp(g_case, "offline_signal")) case_offline_signal();
+    else if (!strcmp(g_case, "command_flood_ports")) case_command_flood_ports();
     else {
         fprintf(stderr, "server_test: unknown case %s\n", g_case);
         return 2;

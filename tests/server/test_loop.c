@@ -190,7 +190,7 @@ static int try_start(int64_t t0)
     g_wakeups = 0;
     int rc = rt_open(&g_srv, &g_sc, &g_opts, t0, true, err, sizeof err);
     if (rc != 0) return rc;
-    ENSUREF(rt_attach(&g_srv, g_lcm, err, sizeof err) == 0, "%s", err);
+    ENSUREF(rt_attach(&g_srv, g_lcm, g_lcm, err, sizeof err) == 0, "%s", err);
     rt_begin(&g_srv);
     drain();
     return 0;

@@ -49,7 +49,8 @@ public final class Controller {
     public String endReason;
     public long dropped;
 
-    private LCM lcm;
+    private LCM lcm;      // the plant's state URL: states, status, events, scene
+    private LCM lcmCmd;   // its command URL: commands and control (PlantUrls)
     private String prefix;
     private double duration, timeout;
     private PrintWriter trace;
@@ -63,7 +64,8 @@ public final class Controller {
         this.name = name;
         this.model = model;
         option("prefix", defaultPrefix, "channel prefix");
-        option("url", "", "LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)");
+        option("url", "", "the plant's LCM URL, its lcm.url (default: LCM's default, honours "
+                          + "LCM_DEFAULT_URL); commands go to the next port");
         option("duration", "0", "stop after S s of sim time from the first state (0: until the daemon stops)");
         option("timeout", "5", "wall s without a scene, or without any message once running, before ending");
         option("trace", "", "write each answered state and the efforts sent to this file");
@@ -141,7 +143,15 @@ public final class Controller {
         if (!(timeout > 0) || !(duration >= 0)) usageError("--timeout must be > 0 and --duration >= 0");
         if (!get("trace").isEmpty()) trace = new PrintWriter(new FileWriter(get("trace")));
 
-        lcm = get("url").isEmpty() ? new LCM() : new LCM(get("url"));
+        String[] urls;
+        try {
+            urls = PlantUrls.both(get("url"));
+        } catch (IllegalArgumentException e) {
+            usageError("--url: " + e.getMessage());
+            return;
+        }
+        lcm = new LCM(urls[0]);
+        lcmCmd = urls[1].equals(urls[0]) ? lcm : new LCM(urls[1]);
         heardNanos = System.nanoTime();
         // one subscriber for the daemon's channels; runs on LCM's receive thread
         LCMSubscriber sub = new LCMSubscriber() {
@@ -183,7 +193,7 @@ public final class Controller {
                     req.request = control_t.DESCRIBE;
                     req.q = new double[0];
                     req.qd = new double[0];
-                    lcm.publish(ch + "CONTROL", req);
+                    lcmCmd.publish(ch + "CONTROL", req);
                     nextAsk = now + 250_000_000L;
                 }
                 lock.wait(50);
@@ -225,7 +235,7 @@ public final class Controller {
         cmd.effort = new double[efforts.length];
         for (int k = 0; k < efforts.length; k++) // never send NaN
             cmd.effort[k] = Double.isFinite(efforts[k]) ? efforts[k] : 0.0;
-        lcm.publish(prefix + "_COMMAND", cmd);
+        lcmCmd.publish(prefix + "_COMMAND", cmd);
         joint_state_t st = current;
         if (trace != null && st != null && st.sim_time == simTime) {
             // sim_time, positions, velocities, efforts sent: Double.toString reads back exactly

@@ -1,0 +1,75 @@
+/*
+ * Where a plant's messages go: the two LCM URLs and the six channels of a lagsimd daemon,
+ * derived from its LCM URL and channel prefix. The daemon, the C client library, the
+ * view and the tests all take them from here; the Python, Lua and Java helpers
+ * (clients/python/lagsim_lcm.py plant_urls, clients/lua/lagsim_lcm.lua plant_urls,
+ * clients/java/lagsim/examples/PlantUrls.java) follow the same rule and are checked
+ * against the same table of cases (tests/clients/plant_urls.txt).
+ *
+ * The rule (docs/network.md):
+ *   - the base URL is the scene's lcm.url, or LCM_DEFAULT_URL, or LCM's default
+ *     udpm://239.255.76.67:7667?ttl=0;
+ *   - the STATE URL is the base URL: the daemon publishes <PREFIX>_STATE, _STATUS,
+ *     _EVENT and _SCENE there, and controllers, the view and lcm-logger listen there;
+ *   - the COMMAND URL is the same group and options on the next port (PORT + 1):
+ *     controllers publish <PREFIX>_COMMAND and _CONTROL there, and only the daemon
+ *     listens;
+ *   - memq:// (one in-process bus, for tests) is both.
+ * Two ports, not two groups: a Linux socket bound to a port receives every group joined
+ * on that port by any socket of the host, so only the port keeps a flood of commands out
+ * of the sockets of those who only want states.
+ */
+#ifndef LAGSIM_BUS_H
+#define LAGSIM_BUS_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define LAG_BUS_URL_LEN 320       /* a derived URL: the scene's (< 256) and a longer port */
+#define LAG_BUS_CHANNEL_LEN 72    /* prefix (< 64) + "_COMMAND" */
+#define LAG_BUS_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0" /* LCM's own default */
+#define LAG_BUS_DEFAULT_GROUP "239.255.76.67"
+#define LAG_BUS_DEFAULT_PORT 7667
+
+/* The channels of one plant; the first four are the daemon's output. */
+typedef enum lag_bus_channel {
+    LAG_BUS_STATE = 0,
+    LAG_BUS_STATUS,
+    LAG_BUS_EVENT,
+    LAG_BUS_SCENE,
+    LAG_BUS_COMMAND,  /* input: on the command URL */
+    LAG_BUS_CONTROL,  /* input: on the command URL */
+    LAG_BUS_CHANNEL_COUNT
+} lag_bus_channel;
+
+typedef struct lag_bus {
+    char state_url[LAG_BUS_URL_LEN];   /* _STATE, _STATUS, _EVENT, _SCENE */
+    char command_url[LAG_BUS_URL_LEN]; /* _COMMAND, _CONTROL */
+    bool udpm;                         /* false: memq:// (one bus for both) */
+    char group[16];                    /* udpm: the multicast group, dotted */
+    int state_port, command_port;      /* udpm */
+    int ttl;                           /* udpm: the ttl= option (0 when absent) */
+    char channel[LAG_BUS_CHANNEL_COUNT][LAG_BUS_CHANNEL_LEN];
+} lag_bus;
+
+/* Derives the URLs and channels of the plant with LCM URL `url` (NULL or "": the
+ * environment's LCM_DEFAULT_URL, else LCM's default) and channel prefix `prefix`.
+ * Accepts memq:// and udpm://[GROUP[:PORT]][?OPTIONS] (GROUP dotted IPv4, PORT 1 to
+ * 65534: the command port is PORT + 1); anything else, or a prefix of 0 or more than 63
+ * characters, is refused with a message in err. Returns 0 or -1. OUT: b */
+int lag_bus_init(lag_bus *b, const char *url, const char *prefix, char *err, size_t errlen);
+
+/* The suffix of a channel ("_STATE", ...). */
+const char *lag_bus_suffix(lag_bus_channel ch);
+
+/* Whether the channel goes to the daemon (command URL) rather than from it. */
+bool lag_bus_is_input(lag_bus_channel ch);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
