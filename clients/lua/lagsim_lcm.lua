@@ -54,14 +54,17 @@ function M.plant_urls(url)
       return nil, "expected udpm://GROUP:PORT with GROUP a dotted IPv4 multicast address, got '" .. url .. "'"
     end
     local o = { tonumber(a), tonumber(b), tonumber(c), tonumber(d) }
-    for k = 1, 4 do
-      if o[k] > 255 then return nil, "the group of '" .. url .. "' is not a multicast address" end
+    for k, txt in ipairs({ a, b, c, d }) do
+      -- no leading zeros: LCM reads the group with inet_aton, which takes those as octal
+      if o[k] > 255 or (#txt > 1 and txt:sub(1, 1) == '0') then
+        return nil, "the group of '" .. url .. "' is not a multicast address written in decimal"
+      end
     end
     if o[1] < 224 or o[1] > 239 then return nil, "the group of '" .. url .. "' is not a multicast address" end
     group = string.format('%d.%d.%d.%d', o[1], o[2], o[3], o[4])
     if p ~= '' then
       local ps = p:match('^:(%d%d?%d?%d?%d?)$')
-      port = ps and tonumber(ps) or -1
+      port = (ps and not (#ps > 1 and ps:sub(1, 1) == '0')) and tonumber(ps) or -1
       if port < 1 or port > 65534 then
         return nil, "expected a port from 1 to 65534 in '" .. url .. "' (commands go to the next port)"
       end

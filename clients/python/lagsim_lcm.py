@@ -60,8 +60,9 @@ def plant_urls(url=None):
         raise ValueError("LCM URL longer than 255 characters")
     if url == "memq://":
         return url, url
-    m = re.match(r"^udpm://(?:((\d{1,3})\.(\d{1,3})\.(\d{1,3})\.(\d{1,3}))(:(\d{1,5}))?)?"
-                 r"(\?.*)?$", url)
+    num = r"(0|[1-9]\d{0,%d})"  # no leading zeros: LCM would read those as octal
+    m = re.match(r"^udpm://(?:(%s\.%s\.%s\.%s)(:%s)?)?(\?.*)?$"
+                 % (num % 2, num % 2, num % 2, num % 2, num % 4), url)
     if not m:
         raise ValueError("a lagsim plant speaks udpm://GROUP:PORT (or memq:// in one "
                          "process), not %r" % url)

@@ -24,7 +24,9 @@ bool lag_bus_is_input(lag_bus_channel ch)
     return ch == LAG_BUS_COMMAND || ch == LAG_BUS_CONTROL;
 }
 
-/* Reads 1 to maxdigits decimal digits at *p into *v; advances *p. */
+/* Reads 1 to maxdigits decimal digits at *p into *v, without leading zeros (LCM reads
+ * the group with inet_aton and the port with strtol(.., 0): both take those as octal);
+ * advances *p. */
 static bool read_digits(const char **p, int maxdigits, long *v)
 {
     const char *s = *p;
@@ -34,7 +36,7 @@ static bool read_digits(const char **p, int maxdigits, long *v)
         x = 10 * x + (*s++ - '0');
         n++;
     }
-    if (n == 0 || (*s >= '0' && *s <= '9')) return false;
+    if (n == 0 || (*s >= '0' && *s <= '9') || (n > 1 && **p == '0')) return false;
     *p = s;
     *v = x;
     return true;

@@ -19,8 +19,10 @@ import java.util.regex.Pattern;
  */
 public final class PlantUrls {
     private static final String DEFAULT_URL = "udpm://239.255.76.67:7667?ttl=0"; // LCM's own
+    private static final String N3 = "(0|[1-9]\\d{0,2})", N5 = "(0|[1-9]\\d{0,4})"; // no leading
+    // zeros: LCM reads the group with inet_aton and the port with strtol(.., 0), as octal
     private static final Pattern UDPM = Pattern.compile(
-        "^udpm://(?:((\\d{1,3})\\.(\\d{1,3})\\.(\\d{1,3})\\.(\\d{1,3}))(:(\\d{1,5}))?)?(\\?.*)?$");
+        "^udpm://(?:(" + N3 + "\\." + N3 + "\\." + N3 + "\\." + N3 + ")(:" + N5 + ")?)?(\\?.*)?$");
 
     private PlantUrls() {}
 
