@@ -108,7 +108,7 @@ int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)
     int64_t nevents = 0;
     for (; k < nperiods && !g_stop_signal; k++) {
         /* a period of many ticks in chunks, so that a signal is seen within one chunk;
-         * continuous: dopri5 takes the same steps as in one call */
+         * continuous, as the whole period was before: dopri5 steps across chunk ends */
         lag_result r = LAG_OK;
         for (int64_t left = sc->ticks_per_period; left > 0 && r == LAG_OK && !g_stop_signal;) {
             int64_t n = left < OFFLINE_CHUNK_TICKS ? left : OFFLINE_CHUNK_TICKS;

@@ -268,7 +268,8 @@ static rt_progress period_run(rt_server *s, int64_t *budget)
     if (n < 1) return RT_P_MORE;
     *budget -= n;
     /* dopri5: a chunk that does not end the period may step past its end (dense output
-     * gives the state there), so the steps taken are those of one call for the period */
+     * gives the state there), so the steps are those of one call for the period (but for
+     * the step after a rejected one at a chunk boundary: within the tolerances) */
     bool last = n == s->period_left;
     int64_t t0 = rt_mono_ns();
     lag_result r = lag_sim_advance(&s->sim, n, !last);
