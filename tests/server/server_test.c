@@ -1058,13 +1058,15 @@ static double cpu_of(pid_t pid)
     return (double)(ut + st) / (double)sysconf(_SC_CLK_TCK);
 }
 
-/* Whether the loader (or the daemon) refused a setting at start: exit 2 within a moment,
- * nothing published. Otherwise the daemon runs and the caller checks how. */
+/* Whether the loader (or the daemon) refused a setting at start: it exits with 2 before
+ * publishing anything. Otherwise its first state arrives and the caller checks how it
+ * runs. Waits for one or the other (a loaded machine may take seconds to start it). */
 static bool refused_at_start(pid_t d, client *c)
 {
-    double t_end = now_s() + 0.5;
+    double t_end = now_s() + 20.0;
     int st;
-    while (now_s() < t_end) {
+    while (c->n_states == 0) {
+        ENSUREF(now_s() < t_end, "the daemon neither exited nor published a state");
         pid_t r = waitpid(d, &st, WNOHANG);
         if (r == d) {
             for (int i = 0; i < g_nchildren; i++)
