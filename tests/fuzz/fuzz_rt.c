@@ -5,7 +5,7 @@
  *
  * The first bytes choose a model, a mode, an integrator and the real-time settings (from
  * tables that include absurd values a scene file would refuse: rate 1e25, status_hz
- * 1e-300, lockstep_timeout 1e300, ...); the rest is a sequence of operations: raw bytes
+ * 1e-300, lockstep_timeout 1e300, an effort limit of infinity, ...); the rest is a sequence of operations: raw bytes
  * to rt_handle_command / rt_handle_control, well-formed commands and controls with
  * arbitrary numbers, clock advances with loop wake-ups, signals.
  *
@@ -213,6 +213,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     g_sc.realtime.status_hz = PICK(k_status, &b);
     g_sc.realtime.lockstep_timeout = PICK(k_lockstep, &b);
     g_sc.realtime.command_timeout = PICK(k_cmdto, &b);
+    static const double k_effort_limit[] = {1e6, INFINITY, 1e12, 0.0};
+    double elim = PICK(k_effort_limit, &b);
+    for (int i = 0; i < LAG_MAX_DOF; i++)
+        if (g_sc.realtime.effort_limit[i] > 0) g_sc.realtime.effort_limit[i] = elim;
     snprintf(g_sc.lcm.prefix, sizeof g_sc.lcm.prefix, "FZ");
     lagsimd_opts opts = {.quiet = true, .duration = 0.0, .csv = NULL};
     if (u8(&b) % 4 == 0) opts.duration = dbl(&b);
@@ -330,6 +334,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
         }
     }
+    if (getenv("FUZZ_RT_VERBOSE"))
+        fprintf(stderr, "fuzz_rt: %s %s, %.3f s, tick %lld, %s, faults %lld, accepted %lld, "
+                "rejected %lld+%lld, out: %lld states %lld statuses %lld scenes %lld events\n",
+                g_s.info->name, lag_rt_mode_name(g_sc.realtime.mode),
+                (double)(g_s.now - t0) * 1e-9, (long long)g_s.sim.tick, rt_run_name(g_s.run),
+                (long long)g_s.numeric_faults, (long long)g_s.accepted,
+                (long long)g_s.rejected[RT_REJ_EFFORT_LIMIT], (long long)g_s.controls_rejected,
+                (long long)g_c.state, (long long)g_c.status, (long long)g_c.scene,
+                (long long)g_c.event);
     rt_finish(&g_s);
     rt_close(&g_s);
     drain();
