@@ -76,6 +76,23 @@ lang_end_tests(python dipc "${lang_dipc_cfg}" ${LAGSIM_PYTHON3} ${py_dir}/dipc_b
 lang_end_tests(python manipulator "${lang_manip_cfg}"
                ${LAGSIM_PYTHON3} ${py_dir}/manipulator_pd.py ${py_types})
 
+# ---- A late controller: the daemon starts first (config/dipc.yaml: realtime.start
+# first_command in real time, the default in lockstep), the controller 2 wall s later. It
+# must meet the DIPC at t = 0, as released, and balance it with the bounds above: with
+# `running` the rods would be on the floor by then.
+set(late_checks --check "t_first == 0" --check "max_abs_theta1 >= 0.0499"
+    --check "max_abs_theta1 <= 1.25 * pred_max_abs_theta1 + 0.005"
+    --check "abs(end_theta1) < 1e-3 and abs(end_theta2) < 1e-3")
+add_test(NAME clients_c_dipc_late_controller
+  COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode realtime --name CLLATEC --timeout 60
+    --daemon-first 2 ${late_checks} --check "states >= 1000"
+    -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration 20 -q)
+add_test(NAME clients_python_dipc_late_controller
+  COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLLATEPY --timeout 60
+    --daemon-first 2 ${late_checks} --check "states == 2001"
+    -- ${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py ${py_types} --prefix {prefix} --duration 20 -q)
+list(APPEND lang_tests clients_c_dipc_late_controller clients_python_dipc_late_controller)
+
 # ---- C: the stick pushed sideways (clients/stick_push.c), lockstep, 3 s. Checks from T and
 # U, not from the program: x is cyclic and uncoupled from phi, and the frictionless floor
 # pushes vertically, so x_dot ends at F T / m (100 ticks of a constant acceleration: a few
@@ -133,6 +150,11 @@ if(TARGET lagsim_examples_java)
       -- ${java_run} lagsim.examples.DipcBalance --prefix {prefix} --duration 20 -q)
   list(APPEND lang_tests clients_java_dipc_lockstep)
   lang_end_tests(java dipc "${lang_dipc_cfg}" ${java_run} lagsim.examples.DipcBalance)
+  add_test(NAME clients_java_dipc_late_controller
+    COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLLATEJ --timeout 60
+      --daemon-first 2 ${late_checks} --check "states == 2001"
+      -- ${java_run} lagsim.examples.DipcBalance --prefix {prefix} --duration 20 -q)
+  list(APPEND lang_tests clients_java_dipc_late_controller)
 else()
   message(WARNING "javac or liblcm-java missing: the Java clients' tests are not registered")
 endif()

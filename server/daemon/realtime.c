@@ -287,13 +287,13 @@ static rt_progress period_run(rt_server *s, int64_t *budget)
 }
 
 /* ---------------------------------------------------------------- the modes */
-/* Paused (realtime, fast): the held state is republished at each deadline, once however
- * many deadlines the loop slept through. */
+/* Paused or waiting (realtime, fast): the held state is republished at each deadline,
+ * once however many deadlines the loop slept through. */
 static void paused_republish(rt_server *s)
 {
     rt_due d = rt_pace_due(&s->pace, s->now);
     if (d.due == 0) return;
-    if (s->run == RT_PAUSED) publish_state(s);
+    if (s->run == RT_PAUSED || s->run == RT_WAITING) publish_state(s);
     rt_pace_skip(&s->pace, s->now);
 }
 
@@ -334,16 +334,33 @@ static void mode_fast(rt_server *s)
     period_run(s, &budget);
 }
 
-/* Lockstep: a period when the state waited on is answered, or its wait timed out. */
+/* Lockstep: a period when the state waited on is answered; nothing else advances it.
+ * A wait longer than lockstep_timeout means the controller is gone (or late): one
+ * lockstep_timeout event, then the daemon waits (RT_WAITING) and republishes the state
+ * every lockstep_timeout until a command answers it. It never steps without an answer, so
+ * a run that lost its controller for a while ends exactly as one that did not. */
 static void mode_lockstep(rt_server *s)
 {
+    if (s->run == RT_WAITING && s->pending_steps == 0) {
+        if (s->waiting && s->now - s->wait_start_ns >= s->lockstep_wait_ns)
+            s->want_state = true; /* the same state again, through the state bucket */
+        return;
+    }
     if (!active(s) || !s->waiting) return;
     if (!s->answered && s->now - s->wait_start_ns >= s->lockstep_wait_ns) {
-        s->lockstep_timeouts++;
-        limited_event(s, RT_EV_LOCKSTEP_TIMEOUT, "", s->waiting_time,
-                      "no command answered sim time %.9g s within %.6g s: stepping on under "
-                      "the watchdog rule", s->waiting_time, s->sc->realtime.lockstep_timeout);
-        s->answered = true;
+        if (s->pending_steps > 0) { /* STEP N: a period without a command, as asked */
+            s->answered = true;
+        } else {
+            s->lockstep_timeouts++;
+            s->run = RT_WAITING;
+            limited_event(s, RT_EV_LOCKSTEP_TIMEOUT, "", s->waiting_time,
+                          "no command answered sim time %.9g s within %.6g s: waiting for one "
+                          "(the state is published again every %.6g s)", s->waiting_time,
+                          s->sc->realtime.lockstep_timeout, s->sc->realtime.lockstep_timeout);
+            s->want_state = true;
+            s->want_status = true;
+            return;
+        }
     }
     if (!s->answered) return;
     s->waiting = false;
@@ -352,6 +369,8 @@ static void mode_lockstep(rt_server *s)
 }
 
 /* ---------------------------------------------------------------- commands */
+static void lockstep_rewait(rt_server *s);
+
 static void reject(rt_server *s, rt_reject why, const char *joint, double value,
                    const char *what)
 {
@@ -426,6 +445,15 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
     s->have_command = true;
     s->command_tick = s->sim.tick;
     if (s->waiting && c.sim_time == s->waiting_time) s->answered = true;
+    if (s->run == RT_WAITING) {
+        /* the command the run was waiting for: it goes on from here */
+        s->run = RT_RUNNING;
+        s->restart_pace = true; /* realtime: deadlines start now, not at the daemon's start */
+        if (s->sc->realtime.mode == LAG_RT_LOCKSTEP && !s->answered) lockstep_rewait(s);
+        limited_event(s, RT_EV_RESUME, "", lag_sim_time(&s->sim),
+                      "a command arrived at sim time %.9g s: running", lag_sim_time(&s->sim));
+        s->want_status = true;
+    }
     if (s->watchdog_tripped) {
         s->watchdog_tripped = false;
         limited_event(s, RT_EV_WATCHDOG_CLEAR, "", 0, "a good command arrived: efforts held again");
@@ -445,7 +473,9 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
     s->waiting = false; /* lockstep: the new state is waited on once it is published */
     if (s->run == RT_FAULT) s->run = RT_PAUSED;
     limited_event(s, RT_EV_RESET, "", 0, "%s: sim time 0, efforts zero, %s", what,
-                  s->run == RT_PAUSED ? "paused (resume to run)" : "running");
+                  s->run == RT_PAUSED    ? "paused (resume to run)"
+                  : s->run == RT_WAITING ? "waiting for a command"
+                                         : "running");
     s->want_scene = true;
     s->want_state = true;
     s->want_status = true;
@@ -499,7 +529,7 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
         limited_event(s, RT_EV_RESUME, "", 0, "running");
         break;
     case LAGSIM_CONTROL_T_STEP:
-        if (s->run != RT_PAUSED) {
+        if (s->run != RT_PAUSED && s->run != RT_WAITING) {
             control_rejected(s, s->run == RT_FAULT ? "step: in fault state (reset first)"
                                                    : "step: only while paused");
             return;
@@ -694,12 +724,17 @@ void rt_begin(rt_server *s)
     s->last_status_ns = s->now;
     s->next_status_ns = rt_sat_add(s->now, s->status_period_ns);
     s->next_line_ns = s->now;
-    s->run = RT_RUNNING;
+    s->run = sc->realtime.start == LAG_RT_START_PAUSED          ? RT_PAUSED
+             : sc->realtime.start == LAG_RT_START_FIRST_COMMAND ? RT_WAITING
+                                                                : RT_RUNNING;
     rt_publish_scene(s);
-    eventf(s, "start", 0, "%s, %s, dt %.6g s, control period %.6g s, mode %s, rate %.6g",
+    eventf(s, "start", 0, "%s, %s, dt %.6g s, control period %.6g s, mode %s, rate %.6g: %s",
            s->info->name, lag_method_name(sc->sim.integrator.method), sc->sim.integrator.dt,
            (double)sc->ticks_per_period * sc->sim.integrator.dt,
-           lag_rt_mode_name(sc->realtime.mode), sc->realtime.rate);
+           lag_rt_mode_name(sc->realtime.mode), sc->realtime.rate,
+           s->run == RT_PAUSED    ? "paused at t = 0 (resume to run)"
+           : s->run == RT_WAITING ? "waiting at t = 0 for the first command"
+                                  : "running");
     publish_state(s); /* the initial state, t = 0 */
     publish_status(s);
     rt_pace_start(&s->pace, s->period_ns, s->now);
@@ -715,14 +750,15 @@ int64_t rt_next_wake(const rt_server *s)
     switch (s->sc->realtime.mode) {
     case LAG_RT_FAST:
         if (act) return now;
-        if (s->run == RT_PAUSED) wake = min64(wake, rt_pace_next(&s->pace));
+        if (s->run == RT_PAUSED || s->run == RT_WAITING) wake = min64(wake, rt_pace_next(&s->pace));
         break;
     case LAG_RT_REALTIME:
-        if (act || s->run == RT_PAUSED) wake = min64(wake, rt_pace_next(&s->pace));
+        if (act || s->run == RT_PAUSED || s->run == RT_WAITING)
+            wake = min64(wake, rt_pace_next(&s->pace));
         break;
     case LAG_RT_LOCKSTEP:
-        if (act && s->waiting) {
-            if (s->answered) return now;
+        if ((act || s->run == RT_WAITING) && s->waiting && !s->want_state) {
+            if (act && s->answered) return now;
             wake = min64(wake, rt_sat_add(s->wait_start_ns, s->lockstep_wait_ns));
         }
         break;

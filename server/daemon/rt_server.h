@@ -21,7 +21,10 @@
 #define RT_CHANNEL_MAX LAG_BUS_CHANNEL_LEN /* prefix (< 64) + "_COMMAND" */
 #define RT_BUF_SIZE LAG_WIRE_BUF_SIZE /* encode buffer: holds any message */
 
-typedef enum rt_run { RT_RUNNING = 0, RT_PAUSED, RT_FAULT } rt_run;
+/* RT_WAITING: not advancing, waiting for a command that starts the run (realtime.start:
+ * first_command) or, in lockstep, for one that answers the state whose wait timed out; the
+ * state is republished meanwhile, and such a command (or RESUME) makes it RT_RUNNING. */
+typedef enum rt_run { RT_RUNNING = 0, RT_PAUSED, RT_FAULT, RT_WAITING } rt_run;
 
 /* Why a command was rejected; indexes rt_server.rejected. */
 typedef enum rt_reject {

@@ -34,6 +34,7 @@ const char *rt_run_name(rt_run r)
     switch (r) {
     case RT_RUNNING: return "running";
     case RT_PAUSED: return "paused";
+    case RT_WAITING: return "waiting";
     case RT_FAULT: return "fault";
     }
     return "?";

@@ -75,6 +75,16 @@ int lag_scene_read_decimal(const char *t, double *v)
     return 0;
 }
 
+const char *lag_rt_start_name(lag_rt_start s)
+{
+    switch (s) {
+    case LAG_RT_START_RUNNING: return "running";
+    case LAG_RT_START_PAUSED: return "paused";
+    case LAG_RT_START_FIRST_COMMAND: return "first_command";
+    }
+    return "?";
+}
+
 const char *lag_rt_mode_name(lag_rt_mode m)
 {
     switch (m) {

@@ -15,6 +15,14 @@ typedef enum lag_rt_mode {
     LAG_RT_LOCKSTEP      /* one control period per answering command */
 } lag_rt_mode;
 
+/* How the real-time server starts (realtime.start). */
+typedef enum lag_rt_start {
+    LAG_RT_START_RUNNING = 0,   /* sim time advances from the start */
+    LAG_RT_START_PAUSED,        /* paused at t = 0 until RESUME (or STEP) */
+    LAG_RT_START_FIRST_COMMAND  /* waiting at t = 0 until the first valid command (or
+                                   RESUME): the default in lockstep */
+} lag_rt_start;
+
 typedef struct lag_scene {
     char path[512];          /* file it was read from ("" if built in code) */
     lag_sim_def sim;         /* model, parameters, integrator, initial state */
@@ -22,6 +30,7 @@ typedef struct lag_scene {
     int64_t ticks_per_period;/* (1/publish_hz) / dt, an integer (validated) */
     struct {
         lag_rt_mode mode;        /* default realtime */
+        lag_rt_start start;      /* default: first_command in lockstep, else running */
         double rate;             /* sim seconds per wall second, default 1.0 */
         double command_timeout;  /* sim s; a command older than this is zeroed; default 0.5 */
         double lockstep_timeout; /* wall s; lockstep waits this long for a command; 1.0 */
@@ -78,6 +87,7 @@ int lag_scene_load_buffer(const char *name, const char *text, size_t len,
                           size_t errlen);
 
 const char *lag_rt_mode_name(lag_rt_mode m);
+const char *lag_rt_start_name(lag_rt_start s);  /* "running", "paused", "first_command" */
 
 /* Reads a number written as a plain decimal, the only way a scene (or lagsimd's command
  * line) writes one: [-+]? (digits [. digits?] | . digits) ([eE] [-+]? digits)?, finite.

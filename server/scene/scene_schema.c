@@ -84,7 +84,7 @@ typedef struct conv {
     lag_scene *sc;
     const lag_model_info *info;
     /* nodes remembered for the cross-checks (NULL if not given) */
-    const ynode *root, *publish_hz, *dt, *integrator, *explode_limit, *url, *rate;
+    const ynode *root, *publish_hz, *dt, *integrator, *explode_limit, *url, *rate, *start;
     /* effects */
     const ynode *gravity_g_node;
     int gravity_enabled;  /* -1 not said, 0 off, 1 on */
@@ -630,8 +630,11 @@ static int key_effort_limit(conv *cv, const ynode *nd, const char *path)
     return per_joint(cv, nd, path, effort_limit_joint);
 }
 
+static int key_start(conv *cv, const ynode *nd, const char *path);
+
 static const keyrow k_realtime_keys[] = {
     {"mode", key_mode, K_OTHER},                         /* realtime | fast | lockstep */
+    {"start", key_start, K_OTHER},                       /* running | paused | first_command */
     {"rate", key_rate, K_NUMBER},                         /* sim s per wall s */
     {"command_timeout", key_command_timeout, K_NUMBER},   /* sim s */
     {"lockstep_timeout", key_lockstep_timeout, K_NUMBER}, /* wall s */
@@ -639,6 +642,21 @@ static const keyrow k_realtime_keys[] = {
     {"effort_limit", key_effort_limit, K_JOINTS},         /* N or N m per actuated joint */
     {NULL, NULL, K_OTHER, NULL, NULL},
 };
+
+static int key_start(conv *cv, const ynode *nd, const char *path)
+{
+    const char *s;
+    if (get_string(cv, nd, path, "a start (running, paused, first_command)", &s) < 0)
+        return -1;
+    for (int k = LAG_RT_START_RUNNING; k <= LAG_RT_START_FIRST_COMMAND; k++) {
+        if (strcmp(s, lag_rt_start_name((lag_rt_start)k)) == 0) {
+            cv->sc->realtime.start = (lag_rt_start)k;
+            cv->start = nd;
+            return 0;
+        }
+    }
+    return yfail(cv->err, nd, path, "unknown start '%s'; allowed: running, paused, first_command", s);
+}
 
 static int key_realtime(conv *cv, const ynode *nd, const char *path)
 {
@@ -1186,6 +1204,13 @@ int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, err
     int gi = lag_model_param_index(sc->sim.model.kind, "g");
     if (gi >= 0 && cv.gravity_g_node) sc->sim.model.p[gi] = cv.gravity_g;
     if (gi >= 0 && cv.gravity_enabled == 0) sc->sim.model.p[gi] = 0.0;
+
+    /* realtime.start not given: a lockstep run waits for its controller's first command
+     * (it cannot advance without one anyway, and then no start order can lose the first
+     * state); realtime and fast run from the start, like a plant switched on */
+    if (!cv.start)
+        sc->realtime.start = sc->realtime.mode == LAG_RT_LOCKSTEP ? LAG_RT_START_FIRST_COMMAND
+                                                                  : LAG_RT_START_RUNNING;
 
     /* Parameters: uniform-rod inertias not given -> m l^2 / 12 */
     lag_model_finish(&sc->sim.model);

@@ -2,7 +2,7 @@
 """End-to-end harness: one lagsimd plus one controller on real LCM (loopback).
 
     run_e2e.py --lagsimd BIN --config YAML --mode lockstep [--set k=v ...]
-               [--daemon-arg ARG ...] [--kill-daemon-after S]
+               [--daemon-arg ARG ...] [--kill-daemon-after S] [--daemon-first S]
                [--check EXPR ...] [--timeout S] -- CLIENT ARGS...
 
 The controller is started first, then (once it prints that it is waiting for the scene
@@ -10,7 +10,9 @@ description, i.e. it is subscribed and will see the very first state) the daemon
 (--set lcm.prefix=<prefix>; "{prefix}" in the client's arguments is replaced by it) so
 that tests running in parallel never cross-talk. The controller must exit by itself
 within --timeout wall seconds; the daemon is always stopped (SIGTERM, then SIGKILL).
---daemon-arg adds an argument to the daemon's command line (e.g. --duration 2: the daemon
+--daemon-first S starts the daemon first and the controller S wall seconds later (a late
+controller: the scene's realtime.start decides what it meets). --daemon-arg adds an
+argument to the daemon's command line (e.g. --duration 2: the daemon
 stops by itself and announces it); --kill-daemon-after S kills it with SIGKILL after S
 wall seconds (it goes silent without a word). The controller's last line
 "... summary key=value ..." is parsed and every --check expression (Python, over those
@@ -61,6 +63,7 @@ def main():
     ap.add_argument("--set", action="append", default=[])
     ap.add_argument("--daemon-arg", action="append", default=[])
     ap.add_argument("--kill-daemon-after", type=float, default=None)
+    ap.add_argument("--daemon-first", type=float, default=None)
     ap.add_argument("--check", action="append", default=[])
     ap.add_argument("--timeout", type=float, default=60.0)
     ap.add_argument("client", nargs=argparse.REMAINDER)
@@ -96,6 +99,10 @@ def main():
     t_daemon_end = t_client_end = None
     lines = []
     try:
+        if a.daemon_first is not None:
+            dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                     universal_newlines=True, env=env)
+            time.sleep(a.daemon_first)
         cproc = subprocess.Popen(client, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                  universal_newlines=True, env=env)
         # read the client's stdout in a thread; start the daemon once the client says it
@@ -115,8 +122,9 @@ def main():
             print("".join(lines))
             print("FAIL: the client did not get ready")
             return 1
-        dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                                 universal_newlines=True, env=env)
+        if dproc is None:
+            dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                     universal_newlines=True, env=env)
         t_daemon_end = None
         if a.kill_daemon_after is not None:
             try:

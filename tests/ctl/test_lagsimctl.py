@@ -72,7 +72,8 @@ def main():
             if m:
                 status_fields.append(m.group(1))
 
-    d = subprocess.Popen([a.lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix, "-q"],
+    d = subprocess.Popen([a.lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix, "-q",
+                          "--set", "realtime.start=running"],
                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, universal_newlines=True)
     try:
         time.sleep(0.5)
@@ -169,7 +170,7 @@ def main():
                          stderr=subprocess.PIPE, universal_newlines=True)
     time.sleep(0.3)
     subprocess.run([a.lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix + "W", "-q",
-                    "--duration", "1"], timeout=30)
+                    "--set", "realtime.start=running", "--duration", "1"], timeout=30)
     try:
         out, err = w.communicate(timeout=10)
     except subprocess.TimeoutExpired:

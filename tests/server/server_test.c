@@ -672,8 +672,15 @@ static void case_watchdog(void)
     ENSURE(reap(d, 5.0) == 0);
 }
 
-/* Lockstep without a controller: each wait ends after lockstep_timeout with an event,
- * and the sim goes on one period at a time. */
+/* Lockstep waits for its controller and never steps without it.
+ * 1. Started with the loader's default for lockstep (realtime.start: first_command), it
+ *    waits at t = 0 (run_state waiting, no lockstep_timeout event however long), the
+ *    state republished every lockstep_timeout so a late controller gets it.
+ * 2. The first answer starts the run; five answered states are five periods.
+ * 3. The controller goes away: after lockstep_timeout one lockstep_timeout event, then the
+ *    daemon waits (waiting, sim time still), republishing that same state, never stepping:
+ *    no crawl of one period per timeout.
+ * 4. A command answering it resumes the run (a resume event, running). */
 static void case_lockstep_timeout(void)
 {
     write_scene(DIPC_MOVING);
@@ -681,14 +688,46 @@ static void case_lockstep_timeout(void)
     client_init(&c, g_prefix, 3);
     pid_t d = start_daemon(g_prefix, "--set", "realtime.mode=lockstep", "--set",
                            "realtime.lockstep_timeout=0.05", NULL);
-    WAIT_FOR(&c, count_events(&c, "lockstep_timeout") >= 4, 5.0);
+    WAIT_FOR(&c, c.n_states >= 4, 5.0);
     fresh_status(&c);
-    ENSURE(c.status->lockstep_timeouts >= 4);
     ENSURE(strcmp(c.status->mode, "lockstep") == 0);
-    /* one period per timeout: the step count follows the timeouts (+ the one pending) */
-    int64_t periods = c.status->step / 10; /* 10 ticks per period at 1 ms, 100 Hz */
-    ENSUREF(periods >= c.status->lockstep_timeouts - 1 && periods <= c.status->lockstep_timeouts + 1,
-            "%lld periods for %lld timeouts", (long long)periods, (long long)c.status->lockstep_timeouts);
+    ENSUREF(strcmp(c.status->run_state, "waiting") == 0 && c.status->step == 0 &&
+                c.status->lockstep_timeouts == 0,
+            "at start: %s, step %lld, %lld timeouts", c.status->run_state,
+            (long long)c.status->step, (long long)c.status->lockstep_timeouts);
+    ENSURE(count_events(&c, "lockstep_timeout") == 0 && c.last.t == 0.0);
+
+    const char *n0[] = {"theta0"};
+    double e[] = {0.5};
+    for (int k = 0; k < 5; k++) { /* answer t = 0, 0.01, ..., 0.04 */
+        double t = c.last.t;
+        command(&c, t, 1, n0, e);
+        WAIT_FOR(&c, c.last.t > t, 3.0);
+    }
+    double t_wait = c.last.t; /* 0.05: published, never answered */
+    ENSURE(c.last.step == 50);
+    WAIT_FOR(&c, count_events(&c, "lockstep_timeout") == 1, 3.0);
+    int64_t n0_states = c.n_states;
+    pump(&c, 0.5); /* ten timeouts' worth of waiting */
+    fresh_status(&c);
+    ENSUREF(count_events(&c, "lockstep_timeout") == 1 && c.status->lockstep_timeouts == 1,
+            "%d lockstep_timeout events, %lld counted", count_events(&c, "lockstep_timeout"),
+            (long long)c.status->lockstep_timeouts);
+    ENSUREF(strcmp(c.status->run_state, "waiting") == 0 && c.status->step == 50 &&
+                c.last.t == t_wait,
+            "after the timeout: %s at step %lld, last state at %g s", c.status->run_state,
+            (long long)c.status->step, c.last.t);
+    ENSUREF(c.n_states - n0_states >= 3, "the waited-on state republished %lld times in 0.5 s",
+            (long long)(c.n_states - n0_states));
+
+    int resumes = count_events(&c, "resume");
+    command(&c, t_wait, 1, n0, e);
+    WAIT_FOR(&c, c.last.t > t_wait, 3.0);
+    ENSURE(c.last.step == 60);
+    WAIT_FOR(&c, count_events(&c, "resume") == resumes + 1, 3.0);
+    fresh_status(&c);
+    ENSURE(strcmp(c.status->run_state, "running") == 0);
+    ENSURE(!c.nonfinite_seen);
     kill(d, SIGTERM);
     ENSURE(reap(d, 5.0) == 0);
 }

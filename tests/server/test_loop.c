@@ -9,7 +9,7 @@
  * (rate 1e25, status_hz 1e-300, lockstep_timeout 1e300, a period of 1e12 ticks) reach the
  * server: it must stay bounded for any value.
  *
- *   test_loop CASE    CASE: pacing rate_huge status_hz lockstep_wait long_period chunks
+ *   test_loop CASE    CASE: pacing rate_huge status_hz lockstep_wait start long_period chunks
  *                           step_paced control_flood command_flood duration signals
  *                           fault_effort
  */
@@ -44,6 +44,9 @@ static void fail(int line, const char *fmt, ...)
     exit(1);
 }
 
+/* states a second of republication may publish: the state bucket's rate and burst
+ * (realtime.c: RT_STATE_PER_S 20, RT_STATE_BURST 5) */
+#define RT_TEST_STATE_BUCKET (20 + 5)
 #define MS 1000000LL
 #define SEC 1000000000LL
 
@@ -315,8 +318,9 @@ static void case_status_hz(void)
 }
 
 /* lockstep_timeout 1e10 or 1e300 s: the wait is (practically) for ever; no timeout event,
- * no period, and the loop sleeps (a wake-up per status). lockstep_timeout 0: every wait
- * times out at once; the events stay within their bucket. */
+ * no period, and the loop sleeps (a wake-up per status). lockstep_timeout 0: the first
+ * wait times out at once, then the server waits without stepping (it never steps without
+ * an answer), republishing the state within the state bucket, and does not spin. */
 static void case_lockstep_wait(void)
 {
     const double waits[] = {1e10, 1e300, 9e9};
@@ -338,9 +342,90 @@ static void case_lockstep_wait(void)
     g_sc.realtime.lockstep_timeout = 0.0;
     start();
     run_until(g_srv.now + 1 * SEC, 100000);
-    ENSURE(g_srv.lockstep_timeouts > 5000 && g_srv.sim.tick == 10 * g_srv.lockstep_timeouts);
-    ENSUREF(n_events("lockstep_timeout") <= 10 + 10, "%lld events",
-            (long long)n_events("lockstep_timeout"));
+    ENSUREF(g_srv.lockstep_timeouts == 1 && g_srv.sim.tick == 0 && g_srv.run == RT_WAITING,
+            "%lld timeouts, tick %lld", (long long)g_srv.lockstep_timeouts,
+            (long long)g_srv.sim.tick);
+    ENSUREF(n_events("lockstep_timeout") == 1, "%lld events", (long long)n_events("lockstep_timeout"));
+    ENSUREF(g_out.state >= 2 && g_out.state <= 1 + RT_TEST_STATE_BUCKET,
+            "%lld states in 1 s", (long long)g_out.state);
+    ENSUREF(g_wakeups <= 200, "%lld wake-ups in 1 s", (long long)g_wakeups);
+    command(0.0, "theta0", 0.5); /* an answer: one period, then (timeout 0) waiting again */
+    run_until(g_srv.now + 1 * MS, 10000);
+    ENSUREF(g_srv.sim.tick == 10 && n_events("resume") == 1 && g_srv.lockstep_timeouts == 2,
+            "tick %lld, %lld resume events, %lld timeouts", (long long)g_srv.sim.tick,
+            (long long)n_events("resume"), (long long)g_srv.lockstep_timeouts);
+    stop_server();
+}
+
+/* realtime.start, in each mode:
+ *  - first_command (realtime, fast): the state at t = 0 is published every period while
+ *    nothing advances (run_state waiting) however long; the first valid command starts the
+ *    run, its deadlines counted from that moment (realtime: 50 periods in the next 0.5 s);
+ *  - paused: the same, but a command does not start it; RESUME does;
+ *  - first_command (lockstep): no lockstep_timeout however long the wait, the state
+ *    republished every lockstep_timeout; the first answer starts the run;
+ *  - running: the former behaviour (realtime: 100 periods in 1 s). */
+static void case_start(void)
+{
+    const lag_rt_mode modes[] = {LAG_RT_REALTIME, LAG_RT_FAST};
+    for (int i = 0; i < 2; i++) {
+        scene(modes[i]);
+        g_sc.realtime.start = LAG_RT_START_FIRST_COMMAND;
+        start();
+        run_until(g_srv.now + 3 * SEC, 1000);
+        ENSUREF(g_srv.sim.tick == 0 && g_srv.run == RT_WAITING && g_out.last_t == 0.0,
+                "%s: tick %lld, run %d", lag_rt_mode_name(modes[i]), (long long)g_srv.sim.tick,
+                g_srv.run);
+        ENSUREF(g_out.state >= 250 && g_out.state <= 302, "%s: %lld states while waiting 3 s",
+                lag_rt_mode_name(modes[i]), (long long)g_out.state);
+        ENSURE(strcmp(g_out.status_run, "waiting") == 0 && n_events("resume") == 0);
+        command(0.0, "theta0", 0.25);
+        ENSURE(g_srv.run == RT_RUNNING && n_events("resume") == 0); /* the event goes out below */
+        /* fast: a period per wake-up of 1 us, so 1 ms is plenty */
+        run_until(g_srv.now + (modes[i] == LAG_RT_REALTIME ? SEC / 2 + MS : MS), 1000);
+        ENSURE(n_events("resume") == 1 && strstr(last_detail("resume"), "a command arrived"));
+        if (modes[i] == LAG_RT_REALTIME)
+            ENSUREF(g_srv.sim.tick == 500, "realtime: tick %lld 0.5 s after the first command",
+                    (long long)g_srv.sim.tick);
+        else
+            ENSURE(g_srv.sim.tick >= 500);
+        stop_server();
+    }
+
+    scene(LAG_RT_REALTIME);
+    g_sc.realtime.start = LAG_RT_START_PAUSED;
+    start();
+    run_until(g_srv.now + 1 * SEC, 1000);
+    command(0.0, "theta0", 0.25);
+    run_until(g_srv.now + 1 * SEC, 1000);
+    ENSURE(g_srv.sim.tick == 0 && g_srv.run == RT_PAUSED && strcmp(g_out.status_run, "paused") == 0);
+    control(LAGSIM_CONTROL_T_RESUME, 0);
+    run_until(g_srv.now + SEC / 2 + MS, 1000);
+    ENSUREF(g_srv.sim.tick == 500 && g_srv.run == RT_RUNNING, "tick %lld after resume",
+            (long long)g_srv.sim.tick);
+    stop_server();
+
+    scene(LAG_RT_LOCKSTEP);
+    g_sc.realtime.start = LAG_RT_START_FIRST_COMMAND;
+    g_sc.realtime.lockstep_timeout = 0.5;
+    start();
+    run_until(g_srv.now + 10 * SEC, 1000);
+    ENSUREF(g_srv.sim.tick == 0 && g_srv.lockstep_timeouts == 0 && n_events("lockstep_timeout") == 0,
+            "lockstep: tick %lld, %lld timeouts", (long long)g_srv.sim.tick,
+            (long long)g_srv.lockstep_timeouts);
+    ENSUREF(g_out.state >= 19 && g_out.state <= 21, "lockstep: %lld states in 10 s of waiting",
+            (long long)g_out.state);
+    ENSUREF(g_wakeups <= 200, "lockstep: %lld wake-ups in 10 s", (long long)g_wakeups);
+    command(0.0, "theta0", 0.25);
+    run_until(g_srv.now + 1 * MS, 1000);
+    ENSURE(g_srv.sim.tick == 10 && g_srv.run == RT_RUNNING && g_out.last_t == 0.01);
+    stop_server();
+
+    scene(LAG_RT_REALTIME);
+    ENSURE(g_sc.realtime.start == LAG_RT_START_RUNNING);
+    start();
+    run_until(g_srv.now + 1 * SEC, 1000);
+    ENSURE(g_srv.sim.tick == 1000 && g_srv.run == RT_RUNNING);
     stop_server();
 }
 
@@ -593,6 +678,7 @@ int main(int argc, char **argv)
     } cases[] = {
         {"pacing", case_pacing},           {"rate_huge", case_rate_huge},
         {"status_hz", case_status_hz},     {"lockstep_wait", case_lockstep_wait},
+        {"start", case_start},
         {"long_period", case_long_period}, {"chunks", case_chunks},
         {"step_paced", case_step_paced},   {"control_flood", case_control_flood},
         {"command_flood", case_command_flood}, {"duration", case_duration},

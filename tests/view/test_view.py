@@ -54,7 +54,8 @@ class Rig:
         self.prefix = "%s%d" % (name, os.getpid())
         self.daemon = subprocess.Popen(
             [a.lagsimd, "--config", a.config, "-q", "--set", "lcm.prefix=" + self.prefix,
-             "--set", "initial.q=[0,0.3,-0.2]", "--set", "initial.qd=[0,0,0]"],
+             "--set", "initial.q=[0,0.3,-0.2]", "--set", "initial.qd=[0,0,0]",
+             "--set", "realtime.start=running"],  # no controller: it must move by itself
             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         self.view = subprocess.Popen([a.view, "--prefix", self.prefix, "--port", "0"],
                                      stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
