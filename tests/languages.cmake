@@ -56,8 +56,10 @@ set(lang_tests clients_python_lcm clients_python_dipc_lockstep)
 
 # How a run ends: the daemon stops by itself (--duration 1: 101 states, then its stop
 # event) and the controller ends with end=stop within 3 wall s; or the daemon is killed
-# (SIGKILL: no stop event) and the controller, run with --timeout 2, ends with
-# end=silence between 2 and 2 + 3 wall s later. 3 s covers a loaded machine's scheduling.
+# (SIGKILL: no stop event) 1 s after its start, when the controller has answered some
+# states (how many depends on how soon it answered the first: the scene waits for it), and
+# the controller, run with --timeout 2, ends with end=silence between 2 and 2 + 3 wall s
+# later. 3 s covers a loaded machine's scheduling.
 function(lang_end_tests lang example cfg)
   add_test(NAME clients_${lang}_${example}_ends_on_stop
     COMMAND ${lang_e2e} ${cfg} --mode lockstep --name CLEND${lang} --timeout 30
