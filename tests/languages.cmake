@@ -178,8 +178,21 @@ endif()
 set(readme_run ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_snippets.py
     --lagsimd ${lang_lagsimd} --build ${CMAKE_BINARY_DIR} --readme ${PROJECT_SOURCE_DIR}/README.md
     --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml)
+# the C block, built as a user would against the client library (and, in a sanitizer
+# build, its runtime)
+set(readme_c_flags "")
+if(LAGSIM_SANITIZE)
+  set(readme_c_flags "-fsanitize=address,undefined,float-cast-overflow")
+endif()
+if(LAGSIM_FUZZ)
+  string(APPEND readme_c_flags " -fsanitize=fuzzer-no-link")
+endif()
+string(REPLACE ";" " " readme_lcm_libs "${LCM_LINK_LIBRARIES}")
+add_test(NAME clients_readme_c COMMAND ${readme_run}
+  "--c-build=${CMAKE_C_COMPILER} -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror ${readme_c_flags} {src} -o {out} -I${PROJECT_SOURCE_DIR}/clients -I${PROJECT_SOURCE_DIR}/server/wire -I${CMAKE_BINARY_DIR}/lcmtypes/c $<TARGET_FILE:lagsim_client> $<TARGET_FILE:lagsim_wire> $<TARGET_FILE:lagsim_lcmtypes> ${readme_lcm_libs} -lm"
+  c-dipc)
 add_test(NAME clients_readme_python COMMAND ${readme_run} python-dipc)
-list(APPEND lang_tests clients_readme_python)
+list(APPEND lang_tests clients_readme_c clients_readme_python)
 if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
   add_test(NAME clients_readme_lua COMMAND ${readme_run} lua-dipc)
   list(APPEND lang_tests clients_readme_lua)
@@ -188,5 +201,13 @@ if(TARGET lagsim_lcmtypes_java)
   add_test(NAME clients_readme_java COMMAND ${readme_run} java-dipc)
   list(APPEND lang_tests clients_readme_java)
 endif()
+
+# ---- README.md's shell recipes, run as written (tests/clients/readme_recipes.py): by hand
+# (controller, server for 10 s, lagsimctl status, an offline CSV) and record (lcm-logger,
+# lagsim-log2csv, lagsim-plot).
+add_test(NAME clients_readme_recipes
+  COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_recipes.py
+          --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} by-hand record)
+set_tests_properties(clients_readme_recipes PROPERTIES TIMEOUT 200 LABELS clients)
 
 set_tests_properties(${lang_tests} PROPERTIES TIMEOUT 90 LABELS clients)

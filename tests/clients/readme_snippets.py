@@ -7,7 +7,8 @@ README.md marks each runnable block with an HTML comment on the line before its 
 <!-- snippet: NAME -->. For each NAME given, the block is written to a fresh temporary
 directory (so it runs from any directory, as the README promises), its channel prefix
 DIPC is replaced by one unique to this run, and it is started the way the README says
-(PYTHONPATH=<build>/python; LUA_PATH=<build>/lua/...; java -cp
+(C: built against the tree's client library with -Wall -Wextra -Werror;
+PYTHONPATH=<build>/python; LUA_PATH=<build>/lua/...; java -cp
 lcm.jar:types.jar:examples.jar File.java). Once it answers a probe state (sim time -1) it is subscribed; then lagsimd runs config/dipc.yaml in lockstep for 2 s of sim time and stops.
 The snippet must exit by itself with status 0 once the daemon announces its stop; the
 daemon's final status must show every state before t = 2 s answered (200
@@ -25,6 +26,7 @@ import threading
 import time
 
 RUNNERS = {
+    "c": ("balance.c", lambda b, f: [f[:-2]], lambda b: {}),
     "python": ("balance.py", lambda b, f: ["python3", f],
                lambda b: {"PYTHONPATH": os.path.join(b, "python")}),
     "lua": ("balance.lua", lambda b, f: ["lua5.2", f],
@@ -50,6 +52,8 @@ def main():
     ap.add_argument("--build", required=True)
     ap.add_argument("--readme", required=True)
     ap.add_argument("--config", required=True)
+    ap.add_argument("--c-build", default="",
+                    help="how to build the C block: a command line with {src} and {out}")
     ap.add_argument("names", nargs="+")
     a = ap.parse_args()
     build = os.path.abspath(a.build)
@@ -70,7 +74,16 @@ def main():
         tmp = tempfile.mkdtemp(prefix="lagsim_readme_")
         path = os.path.join(tmp, fname)
         with open(path, "w") as f:
-            f.write(found[name].replace('"DIPC_', '"%s_' % prefix).replace("'DIPC_", "'%s_" % prefix))
+            f.write(found[name].replace('"DIPC_', '"%s_' % prefix).replace("'DIPC_", "'%s_" % prefix)
+                    .replace('"DIPC"', '"%s"' % prefix))
+        if lang == "c":
+            cc = subprocess.run([w.replace("{src}", path).replace("{out}", path[:-2])
+                                 for w in a.c_build.split()], stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT, universal_newlines=True)
+            if cc.returncode != 0:
+                print("FAIL: the C block does not build:\n" + cc.stdout)
+                fails += 1
+                continue
         env = dict(os.environ)
         env.update(env_extra(build))
         state_url, command_url = plant_urls()
