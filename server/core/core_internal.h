@@ -29,7 +29,9 @@ typedef struct lag_model_class {
 } lag_model_class;
 
 /* The model table, indexed by lag_model_kind (model.c). */
-extern const lag_model_class *const lag_models[LAG_MODEL_COUNT];
+/* Declared without its size, so that the definition's own count of rows is what the
+ * _Static_assert there compares with LAG_MODEL_COUNT. */
+extern const lag_model_class *const lag_models[];
 static inline const lag_model_class *lag_model_vt(const lag_model *m)
 {
     LAG_ASSERT((unsigned)m->kind < LAG_MODEL_COUNT && lag_models[m->kind]);
@@ -231,7 +233,8 @@ typedef struct lag_effect_row {
     void (*observe)(const lag_sim *s, double *q, double *qd);
 } lag_effect_row;
 
-extern const lag_effect_row lag_effect_rows[LAG_EFF_COUNT];
+/* Without its size, as lag_models: effects.c's _Static_assert counts the rows. */
+extern const lag_effect_row lag_effect_rows[];
 
 lag_result lag_effects_check(const lag_sim_def *def, lag_diag *d);
 /* Fills s->fx (the rows the enabled effects use, per hook) from s->def. */
