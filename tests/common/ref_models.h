@@ -133,6 +133,29 @@ static inline void tc_kin_dipc(const lag_model *m, const cplx *q, const cplx *qd
     b->w[2] = qd[2];
 }
 
+/* Cart-pole: r_0 = (x, 0), the cart does not rotate; r_1 = (x + l1/2 sin th,
+ * l1/2 cos th), the rod turns at theta_dot. */
+static inline void tc_kin_cartpole(const lag_model *m, const cplx *q, const cplx *qd, tc_bodies *b)
+{
+    double a = 0.5 * tc_p(m, "l1");
+    cplx s = csin(q[1]), c = ccos(q[1]);
+    b->nb = 2;
+    b->mass[0] = tc_p(m, "m0");
+    b->mass[1] = tc_p(m, "m1");
+    b->inertia[0] = 0;
+    b->inertia[1] = tc_p(m, "I1");
+    b->x[0] = q[0];
+    b->y[0] = 0;
+    b->vx[0] = qd[0];
+    b->vy[0] = 0;
+    b->w[0] = 0;
+    b->x[1] = q[0] + a * s;
+    b->y[1] = a * c;
+    b->vx[1] = qd[0] + a * c * qd[1];
+    b->vy[1] = -a * s * qd[1];
+    b->w[1] = qd[1];
+}
+
 /* ------------------------------------------------------------------ the table */
 typedef struct tc_ref {
     void (*kinematics)(const lag_model *m, const cplx *q, const cplx *qd, tc_bodies *b);
@@ -152,6 +175,8 @@ static const tc_ref tc_refs[] = {
     /* both rods hanging and swinging, the cart free */
     [LAG_MODEL_DIPC] = {tc_kin_dipc, {0.0, TC_PI + 0.3, TC_PI - 0.2}, {0.0, 0.0, 0.0}, 1.0,
                         {-2, -TC_PI, -TC_PI}, {2, TC_PI, TC_PI}},
+    /* the pole hanging and swinging, the cart free */
+    [LAG_MODEL_CARTPOLE] = {tc_kin_cartpole, {0.0, TC_PI + 0.5}, {0.2, 0.0}, 1.0, {-2, -TC_PI}, {2, TC_PI}},
 };
 _Static_assert(sizeof tc_refs / sizeof tc_refs[0] == LAG_MODEL_COUNT,
                "tests/common/ref_models.h needs a reference row for every model of the core");

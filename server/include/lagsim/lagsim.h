@@ -80,6 +80,7 @@ typedef enum lag_model_kind {
     LAG_MODEL_STICK = 0,       /* q = (x, phi)                  */
     LAG_MODEL_MANIPULATOR = 1, /* q = (q1, q2)                  */
     LAG_MODEL_DIPC = 2,        /* q = (theta0, theta1, theta2)  */
+    LAG_MODEL_CARTPOLE = 3,    /* q = (x, theta)                */
     LAG_MODEL_COUNT
 } lag_model_kind;
 
