@@ -30,3 +30,22 @@ if(LAGSIM_NET_JAVA AND TARGET lagsim_examples_java)
             lagsim.examples.PlantUrls ${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.txt)
   set_tests_properties(net_plant_urls_java PROPERTIES TIMEOUT 60 LABELS net)
 endif()
+
+# The daemon's receive-socket filter, its sync marker and the route to the group, on this
+# host (tests/net/test_net.c); one ctest per case.
+include(${CMAKE_CURRENT_LIST_DIR}/common/cases.cmake)
+add_executable(test_net ${CMAKE_CURRENT_LIST_DIR}/net/test_net.c)
+target_include_directories(test_net PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
+target_link_libraries(test_net PRIVATE lagsimd_internal)
+lagsim_add_test_cases(test_net net.filter net 60)
+
+# Two hosts on one machine (tests/net/two_hosts.sh): network namespaces joined by a veth
+# pair, lagsimd in one, peers in the other, nftables for packet loss. Needs root; skipped
+# (exit 77) with the reason where namespaces cannot be made.
+set(LAGSIM_TWO_HOSTS_CASES host_local)
+foreach(case ${LAGSIM_TWO_HOSTS_CASES})
+  add_test(NAME net_two_hosts_${case}
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/net/two_hosts.sh ${case} ${CMAKE_BINARY_DIR}
+                   ${PROJECT_SOURCE_DIR})
+  set_tests_properties(net_two_hosts_${case} PROPERTIES TIMEOUT 300 LABELS net SKIP_RETURN_CODE 77)
+endforeach()

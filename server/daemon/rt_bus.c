@@ -3,13 +3,46 @@
  *   s->lcm        the state URL, publishing only: it never subscribes, so LCM never
  *                 opens a receive socket for it and the daemon never reads back its own
  *                 states (in fast mode, tens of thousands a second);
- *   s->lcm_in     the command URL: _COMMAND and _CONTROL;
+ *   s->lcm_in     the command URL: _COMMAND and _CONTROL. Its receive socket gets a
+ *                 filter (rt_net.h): only this plant's two channels, and unless
+ *                 lcm.allow_lan only datagrams sent from this host;
  * For memq:// (tests, one process) one lcm_t is both.
  */
 #include <stdio.h>
 #include <string.h>
 
+#include "rt_net.h"
 #include "rt_server.h"
+
+/* Filters the receive socket of the command URL's lcm_t, then reads until a marker sent
+ * after the filter comes back, discarding whatever came before it (it may have come in
+ * before the filter did). Returns 0, or an exit code with a message in err. */
+static int filter_input(rt_server *s, char *err, size_t errlen)
+{
+    const lag_bus *b = &s->bus;
+    bool host_only = !s->sc->lcm.allow_lan;
+    const char *with_marker[] = {s->ch_command, s->ch_control, RT_NET_MARKER_CHANNEL};
+    char ferr[256];
+    int n = rt_net_filter(b->command_port, host_only, with_marker, 3, ferr, sizeof ferr);
+    if (n <= 0) {
+        snprintf(err, errlen, "%s%s: cannot restrict the command URL %s to %s", n < 0 ? ferr :
+                 "LCM's receive socket for the command port was not found",
+                 host_only ? "" : " (lcm.allow_lan: true)", b->command_url,
+                 host_only ? "this host (lcm.allow_lan: false)" : "this plant's channels");
+        return LAGSIMD_EXIT_RUNTIME;
+    }
+    if (rt_net_sync(s->lcm_in, 3000) != 0) {
+        snprintf(err, errlen, "LCM on %s does not hear its own messages (is there a multicast "
+                 "route? docs/network.md)", b->command_url);
+        return LAGSIMD_EXIT_RUNTIME;
+    }
+    n = rt_net_filter(b->command_port, host_only, with_marker, 2, ferr, sizeof ferr);
+    if (n <= 0) {
+        snprintf(err, errlen, "%s", n < 0 ? ferr : "LCM's receive socket went away");
+        return LAGSIMD_EXIT_RUNTIME;
+    }
+    return LAGSIMD_EXIT_OK;
+}
 
 int rt_bus_open(rt_server *s, char *err, size_t errlen)
 {
@@ -34,13 +67,30 @@ int rt_bus_open(rt_server *s, char *err, size_t errlen)
                 b->state_url);
         return LAGSIMD_EXIT_OK;
     }
+    rc = filter_input(s, err, errlen);
+    if (rc != LAGSIMD_EXIT_OK) {
+        rt_bus_close(s);
+        return rc;
+    }
+    /* where the daemon listens, and who can reach it */
+    char ifname[64];
+    if (rt_net_group_iface(b->group, ifname, sizeof ifname) != 0)
+        snprintf(ifname, sizeof ifname, "no interface (no route to %s)", b->group);
     int ttl = s->sc->lcm.ttl; /* the loader's reading of the URL (LCM_DEFAULT_URL included) */
     if (ttl > 0)
         fprintf(stderr, "lagsimd: warning: LCM url '%s' has ttl=%d: states, status and events "
                 "leave this host (multicast to the local network%s)\n", b->state_url, ttl,
                 ttl > 1 ? " and beyond routers" : "");
-    fprintf(stderr, "lagsimd: %s: states on %s, commands and control on %s\n",
-            s->sc->lcm.prefix, b->state_url, b->command_url);
+    if (s->sc->lcm.allow_lan)
+        fprintf(stderr, "lagsimd: %s: listening on %s for commands and control from the "
+                "network (lcm.allow_lan: true: any host that reaches %s can command this "
+                "plant) on %s; states on %s\n", s->sc->lcm.prefix, ifname, ifname,
+                b->command_url, b->state_url);
+    else
+        fprintf(stderr, "lagsimd: %s: listening on %s for commands and control from this "
+                "host only (lcm.allow_lan: false) on %s; states on %s%s\n", s->sc->lcm.prefix,
+                ifname, b->command_url, b->state_url,
+                ttl == 0 ? ", which stay on this host (ttl=0)" : "");
     return LAGSIMD_EXIT_OK;
 }
 

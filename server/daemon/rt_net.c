@@ -1,0 +1,238 @@
+/*
+ * LCM's receive sockets: a filter for where datagrams come from and which channels they
+ * carry, and the interface a group is joined on. See rt_net.h.
+ */
+#include "rt_net.h"
+
+#include <arpa/inet.h>
+#include <dirent.h>
+#include <linux/filter.h>
+#include <linux/if_packet.h>
+#include <net/if.h>
+#include <netinet/in.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+/* Where an LCM datagram's fields are for a UDP socket filter: offset 0 is the UDP
+ * header, its payload starts at 8; an LCM short message is magic (4 bytes), sequence
+ * number (4), the channel name and its NUL, the payload. */
+#define OFF_MAGIC 8
+#define OFF_CHANNEL 16
+#define LCM_MAGIC_SHORT 0x4c433032u /* "LC02" */
+#define MAX_INSNS 512
+
+typedef struct prog {
+    struct sock_filter in[MAX_INSNS];
+    int n;
+} prog;
+
+static void emit(prog *p, uint16_t code, uint8_t jt, uint8_t jf, uint32_t k)
+{
+    if (p->n < MAX_INSNS) p->in[p->n++] = (struct sock_filter){code, jt, jf, k};
+}
+
+/* The compares of one channel name (with its NUL): words, then a half word, then a byte. */
+static int channel_compares(size_t len_with_nul)
+{
+    return (int)(len_with_nul / 4) + (len_with_nul % 4 >= 2) + (int)(len_with_nul % 2);
+}
+
+/* Emits: if the channel at OFF_CHANNEL is `name`, accept; else fall through to the next
+ * block. */
+static void emit_channel(prog *p, const char *name)
+{
+    size_t len = strlen(name) + 1;
+    const uint8_t *b = (const uint8_t *)name; /* b[len - 1] is the NUL */
+    int nc = channel_compares(len);
+    int block = 2 * nc + 1, at = 0;
+    size_t off = 0;
+    for (; off + 4 <= len; off += 4, at += 2) {
+        uint32_t w = (uint32_t)b[off] << 24 | (uint32_t)b[off + 1] << 16 |
+                     (uint32_t)b[off + 2] << 8 | b[off + 3];
+        emit(p, BPF_LD | BPF_W | BPF_ABS, 0, 0, (uint32_t)(OFF_CHANNEL + off));
+        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, (uint8_t)(block - at - 2), w);
+    }
+    if (len - off >= 2) {
+        uint32_t h = (uint32_t)b[off] << 8 | b[off + 1];
+        emit(p, BPF_LD | BPF_H | BPF_ABS, 0, 0, (uint32_t)(OFF_CHANNEL + off));
+        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, (uint8_t)(block - at - 2), h);
+        off += 2;
+        at += 2;
+    }
+    if (len - off == 1) {
+        emit(p, BPF_LD | BPF_B | BPF_ABS, 0, 0, (uint32_t)(OFF_CHANNEL + off));
+        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, (uint8_t)(block - at - 2), b[off]);
+    }
+    emit(p, BPF_RET | BPF_K, 0, 0, 0xffffffffu);
+}
+
+/* The whole program: [from this host] LC02, one of the channels; else drop. */
+static int build(prog *p, bool host_only, const char *const *channels, int n, char *err,
+                 size_t errlen)
+{
+    p->n = 0;
+    int total = 2 /* magic */ + 1 /* drop */ + (host_only ? 4 : 0);
+    for (int i = 0; i < n; i++) {
+        size_t len = strlen(channels[i]) + 1;
+        if (len > 64 + 8 + 1) {
+            snprintf(err, errlen, "channel name '%s' too long for the filter", channels[i]);
+            return -1;
+        }
+        total += 2 * channel_compares(len) + 1;
+    }
+    if (total > MAX_INSNS || total - 5 > 255) { /* the longest jump: to the drop at the end */
+        snprintf(err, errlen, "too many channels for the filter");
+        return -1;
+    }
+    if (host_only) {
+        unsigned lo = if_nametoindex("lo");
+        /* looped back from a local sender, or in on the loopback interface */
+        emit(p, BPF_LD | BPF_W | BPF_ABS, 0, 0, (uint32_t)(SKF_AD_OFF + SKF_AD_PKTTYPE));
+        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 2, 0, PACKET_LOOPBACK);
+        emit(p, BPF_LD | BPF_W | BPF_ABS, 0, 0, (uint32_t)(SKF_AD_OFF + SKF_AD_IFINDEX));
+        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, (uint8_t)(total - 4 - 1), lo ? lo : 1);
+    }
+    int here = p->n;
+    emit(p, BPF_LD | BPF_W | BPF_ABS, 0, 0, OFF_MAGIC);
+    emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, (uint8_t)(total - here - 2 - 1), LCM_MAGIC_SHORT);
+    for (int i = 0; i < n; i++) emit_channel(p, channels[i]);
+    emit(p, BPF_RET | BPF_K, 0, 0, 0);
+    if (p->n != total) {
+        snprintf(err, errlen, "filter program: %d instructions, expected %d", p->n, total);
+        return -1;
+    }
+    return 0;
+}
+
+int rt_net_filter(int port, bool host_only, const char *const *channels, int n, char *err,
+                  size_t errlen)
+{
+    if (n < 1 || n > RT_NET_MAX_FILTER_CHANNELS) {
+        snprintf(err, errlen, "filter: 1 to %d channels", RT_NET_MAX_FILTER_CHANNELS);
+        return -1;
+    }
+    static prog p; /* one daemon thread sets filters, at start */
+    if (build(&p, host_only, channels, n, err, errlen) < 0) return -1;
+    struct sock_fprog fp = {(unsigned short)p.n, p.in};
+
+    DIR *d = opendir("/proc/self/fd");
+    if (!d) {
+        snprintf(err, errlen, "cannot list /proc/self/fd to find LCM's receive socket");
+        return -1;
+    }
+    int found = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        char *end;
+        long fd = strtol(e->d_name, &end, 10);
+        if (*end != '\0' || fd < 0 || fd == dirfd(d)) continue;
+        struct stat st;
+        if (fstat((int)fd, &st) != 0 || !S_ISSOCK(st.st_mode)) continue;
+        int type = 0, domain = 0;
+        socklen_t sl = sizeof type;
+        if (getsockopt((int)fd, SOL_SOCKET, SO_TYPE, &type, &sl) != 0 || type != SOCK_DGRAM)
+            continue;
+        sl = sizeof domain;
+        if (getsockopt((int)fd, SOL_SOCKET, SO_DOMAIN, &domain, &sl) != 0 || domain != AF_INET)
+            continue;
+        struct sockaddr_in a;
+        sl = sizeof a;
+        if (getsockname((int)fd, (struct sockaddr *)&a, &sl) != 0 || ntohs(a.sin_port) != port)
+            continue;
+        if (setsockopt((int)fd, SOL_SOCKET, SO_ATTACH_FILTER, &fp, sizeof fp) != 0) {
+            snprintf(err, errlen, "cannot attach a socket filter to LCM's receive socket "
+                     "(port %d)", port);
+            closedir(d);
+            return -1;
+        }
+        found++;
+    }
+    closedir(d);
+    return found;
+}
+
+/* ---------------------------------------------------------------- sync */
+typedef struct marker {
+    char text[96];
+    bool seen;
+} marker;
+
+static void on_marker(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)ch;
+    marker *m = user;
+    size_t n = strlen(m->text);
+    if (rb->data_size == n && memcmp(rb->data, m->text, n) == 0) m->seen = true;
+}
+
+static int64_t mono_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+}
+
+int rt_net_sync(lcm_t *lcm, int timeout_ms)
+{
+    static unsigned counter;
+    marker m = {.seen = false};
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    snprintf(m.text, sizeof m.text, "lagsimd %ld sync %u %lld.%09ld", (long)getpid(), ++counter,
+             (long long)ts.tv_sec, ts.tv_nsec);
+    lcm_subscription_t *sub = lcm_subscribe(lcm, RT_NET_MARKER_CHANNEL, on_marker, &m);
+    if (!sub) return -1;
+    lcm_subscription_set_queue_capacity(sub, 1000);
+    int64_t end = mono_ms() + timeout_ms, next_send = 0;
+    while (!m.seen) {
+        int64_t now = mono_ms();
+        if (now >= end) break;
+        if (now >= next_send) { /* a marker lost on the way is sent again */
+            lcm_publish(lcm, RT_NET_MARKER_CHANNEL, m.text, (unsigned)strlen(m.text));
+            next_send = now + 100;
+        }
+        int64_t wait = next_send < end ? next_send - now : end - now;
+        lcm_handle_timeout(lcm, (int)(wait > 0 ? wait : 1));
+    }
+    lcm_unsubscribe(lcm, sub);
+    return m.seen ? 0 : -1;
+}
+
+/* ---------------------------------------------------------------- route */
+int rt_net_group_iface(const char *group, char *ifname, size_t len)
+{
+    snprintf(ifname, len, "?");
+    struct in_addr g;
+    if (inet_pton(AF_INET, group, &g) != 1) return -1;
+    FILE *f = fopen("/proc/net/route", "r");
+    if (!f) return 0; /* unknown, not absent */
+    char line[256], best[IF_NAMESIZE + 1] = "";
+    int best_bits = -1;
+    unsigned long best_metric = 0;
+    if (!fgets(line, sizeof line, f)) line[0] = '\0'; /* the header */
+    while (fgets(line, sizeof line, f)) {
+        char iface[IF_NAMESIZE + 1];
+        unsigned long dest, gw, flags, refcnt, use, metric, mask;
+        if (sscanf(line, "%16s %lx %lx %lx %lu %lu %lu %lx", iface, &dest, &gw, &flags, &refcnt,
+                   &use, &metric, &mask) != 8)
+            continue;
+        if (!(flags & 1UL)) continue; /* RTF_UP */
+        if ((g.s_addr & (uint32_t)mask) != (uint32_t)dest) continue;
+        int bits = __builtin_popcount((unsigned)mask);
+        if (bits > best_bits || (bits == best_bits && metric < best_metric)) {
+            best_bits = bits;
+            best_metric = metric;
+            snprintf(best, sizeof best, "%s", iface);
+        }
+    }
+    fclose(f);
+    if (best_bits < 0) return -1;
+    snprintf(ifname, len, "%s", best);
+    return 0;
+}
