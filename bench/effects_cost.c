@@ -1,5 +1,5 @@
 /*
- * Cost of effects (issue 4): ns per tick of each model with no effects and with each
+ * Cost of effects: ns per tick of each model with no effects and with each
  * effect on alone, measured in one run, printed as a Markdown table.
  *
  *   effects_cost [reps]      (default 9: the fastest of 9 repetitions is kept, the

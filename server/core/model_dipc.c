@@ -1,5 +1,5 @@
 /*
- * Double inverted pendulum on a cart (shared/BRIEF.md). q = (theta0, theta1, theta2):
+ * Double inverted pendulum on a cart (docs/models.md). q = (theta0, theta1, theta2):
  * cart position, and the two rods' absolute angles from the upward vertical.
  *   r_1 = (theta0 + a1 s1, h0 + a1 c1),  a1 = l1/2
  *   r_2 = (theta0 + l1 s1 + a2 s2, h0 + l1 c1 + a2 c2),  a2 = l2/2

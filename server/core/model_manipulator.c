@@ -1,11 +1,11 @@
 /*
- * Rotary/prismatic manipulator (shared/BRIEF.md). q = (q1, q2): q1 the angle of arm 1
+ * Rotary/prismatic manipulator (docs/models.md). q = (q1, q2): q1 the angle of arm 1
  * from the horizontal, q2 the distance of arm 2's centre of mass from the axis.
  *   r_c1 = l1 (cos q1, sin q1), r_c2 = q2 (cos q1, sin q1), omega = q1_dot for both
  *   T = 1/2 m1 l1^2 q1d^2 + 1/2 m2 (q2^2 q1d^2 + q2d^2) + 1/2 (I1 + I2) q1d^2
  *   U = (m1 l1 + m2 q2) g sin q1
  * Hence M = diag(m1 l1^2 + I1 + I2 + m2 q2^2, m2), dM_00/dq2 = 2 m2 q2 the only
- * derivative, and the Christoffel form (the seed's (5)):
+ * derivative, and the Christoffel form (the course assignment's (5)):
  *   C = [[m2 q2 q2d, m2 q2 q1d], [-m2 q2 q1d, 0]],
  *   g = ((m1 l1 + m2 q2) g cos q1, m2 g sin q1).
  */

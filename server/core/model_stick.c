@@ -1,5 +1,5 @@
 /*
- * Sliding stick on a frictionless floor (shared/BRIEF.md). q = (x, phi):
+ * Sliding stick on a frictionless floor (docs/models.md). q = (x, phi):
  * x the horizontal position of the centre of mass, phi the angle between stick and floor.
  *   r_c = (x, (l/2) sin phi),  omega = phi_dot
  *   T = 1/2 m (x_dot^2 + (l^2/4) phi_dot^2 cos^2 phi) + 1/2 I phi_dot^2
@@ -8,7 +8,7 @@
  * is non-zero, so the only Christoffel symbol is c_111 = 1/2 dM_11/dphi and
  *   C = [[0, 0], [0, -(m l^2/4) sin phi cos phi phi_dot]],
  *   g = (0, m g (l/2) cos phi).
- * (Index 1 = phi.) This matches the seed's equation of motion for Problem 1 (d).
+ * (Index 1 = phi.) This matches the course assignment's equation of motion for Problem 1 (d).
  */
 #include <math.h>
 #include "core_internal.h"

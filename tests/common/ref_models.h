@@ -37,7 +37,7 @@ static inline double complex lag_test_cmplx(double re, double im)
 
 #include "lagsim/lagsim.h"
 
-/* complex.h defines I; the inertias are called I in the brief, so the macro must go. */
+/* complex.h defines I; the inertias are called I, so the macro must go. */
 #undef I
 typedef double complex cplx;
 

@@ -2,7 +2,7 @@
  * Shared helpers of the core's physics tests (tests/core/test_*.c).
  *
  * The point of these tests is independence: nothing here reads the core's closed forms.
- * Each model is written again from the body kinematics of shared/BRIEF.md (centre-of-mass
+ * Each model is written again from the body kinematics of docs/models.md (centre-of-mass
  * positions r_c(q), their velocities v_c(q, qd), body angular velocities omega), in complex
  * arithmetic so that derivatives can be taken by the complex step
  *

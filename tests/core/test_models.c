@@ -1,12 +1,12 @@
 /*
- * Models against an independent computation from T and U (issue 2, tests 1).
+ * Models against an independent computation from T and U.
  *
  * For each model, at NSTATES random states with random parameters (seeded), the core's
  * M, dM/dq, C, g, bias, kinetic and potential energy and forward dynamics are compared
- * with the same quantities derived here from the brief's body kinematics by complex steps
- * (see test_core.h), and for the stick and the manipulator with the seed's closed forms.
+ * with the same quantities derived here from the body kinematics (tests/common/ref_models.h) by complex steps
+ * (see test_core.h), and for the stick and the manipulator with the course assignment's closed forms.
  *
- * Usage: test_core_models [--list | info | MODEL | seed_dipc]   (no argument: all)
+ * Usage: test_core_models [--list | info | MODEL | assignment_dipc]   (no argument: all)
  */
 #include "test_core.h"
 #include "core_internal.h" /* the model table itself */
@@ -44,8 +44,8 @@ static void check_kinematics(const lag_model *mdp, int it, const double *q, cons
     }
 }
 
-/* The seed's closed forms (shared/seed/assignment8-lagrange.txt). */
-static void check_seed(const lag_model *mdp, int it, const double *q, const double *qd,
+/* The course assignment's closed forms (TTK4130 assignment 8). */
+static void check_assignment(const lag_model *mdp, int it, const double *q, const double *qd,
                        const double *qdd, const double *Ml, const double *Cl, const double *gl,
                        const double *hl)
 {
@@ -66,8 +66,8 @@ static void check_seed(const lag_model *mdp, int it, const double *q, const doub
                     m * g * l / 2 * c;
         double sc = fabs(m * qdd[0]) + fabs((m * l * l / 4 + Iz) * qdd[1]) +
                     m * l * l / 4 * qd[1] * qd[1] + m * g * l;
-        ENSURE_NEAR(lhs[0], e0, 1e-13 * sc, "seed stick (d) x " CTXF, CTXA);
-        ENSURE_NEAR(lhs[1], e1, 1e-13 * sc, "seed stick (d) phi " CTXF, CTXA);
+        ENSURE_NEAR(lhs[0], e0, 1e-13 * sc, "assignment stick (d) x " CTXF, CTXA);
+        ENSURE_NEAR(lhs[1], e1, 1e-13 * sc, "assignment stick (d) phi " CTXF, CTXA);
     } else if (md.kind == LAG_MODEL_MANIPULATOR) {
         /* Problem 2: M (3), C (5), g(q) of part (d). */
         double m1 = md.p[LAG_MANIP_M1], m2 = md.p[LAG_MANIP_M2], l1 = md.p[LAG_MANIP_L1],
@@ -77,10 +77,10 @@ static void check_seed(const lag_model *mdp, int it, const double *q, const doub
         double G[2] = {(m1 * l1 + m2 * q[1]) * g * cos(q[0]), m2 * g * sin(q[0])};
         double sM = tc_maxabs(4, M), sC = tc_maxabs(4, C) + 1e-300, sG = (m1 * l1 + m2 * fabs(q[1]) + m2) * g;
         for (int i = 0; i < 4; ++i) {
-            ENSURE_NEAR(Ml[i], M[i], 1e-13 * sM, "seed manipulator M(3) entry %d " CTXF, i, CTXA);
-            ENSURE_NEAR(Cl[i], C[i], 1e-13 * sC, "seed manipulator C(5) entry %d " CTXF, i, CTXA);
+            ENSURE_NEAR(Ml[i], M[i], 1e-13 * sM, "assignment manipulator M(3) entry %d " CTXF, i, CTXA);
+            ENSURE_NEAR(Cl[i], C[i], 1e-13 * sC, "assignment manipulator C(5) entry %d " CTXF, i, CTXA);
         }
-        for (int i = 0; i < 2; ++i) ENSURE_NEAR(gl[i], G[i], 1e-13 * sG, "seed manipulator g entry %d " CTXF, i, CTXA);
+        for (int i = 0; i < 2; ++i) ENSURE_NEAR(gl[i], G[i], 1e-13 * sG, "assignment manipulator g entry %d " CTXF, i, CTXA);
     }
 }
 
@@ -198,7 +198,7 @@ static void check_model(lag_model_kind kind, uint64_t seed)
         ENSURE(lag_model_forward(&md, q, qd, zero, qdd0z) == LAG_OK);
         for (int i = 0; i < n; ++i) ENSURE(qdd0[i] == qdd0z[i]);
 
-        check_seed(&md, it, q, qd, qdd, Ml, Cl, gl, hl);
+        check_assignment(&md, it, q, qd, qdd, Ml, Cl, gl, hl);
     }
     printf("%-12s %d states: worst relative |core - from T,U|: M %.1e  dM %.1e  C %.1e  g %.1e  "
            "Lagrange %.1e  forward %.1e  (%s)\n",
@@ -287,7 +287,7 @@ static void check_table(void)
     ENSURE(lag_model_info_get(LAG_MODEL_COUNT) == NULL && lag_model_info_get((lag_model_kind)-1) == NULL);
 }
 
-/* Static facts: names, sizes, inputs, defaults as the brief gives them for its three
+/* Static facts: names, sizes, inputs, defaults as the course assignment gives them for its three
  * models (a model added later has its facts in its own file; check_table covers it). */
 static void check_info(void)
 {
@@ -307,7 +307,7 @@ static void check_info(void)
         }
     }
     ENSURE(lag_model_kind_from_name("pendulum") == -1);
-    /* Parameters named as in the brief. */
+    /* Parameters named as in the course assignment. */
     ENSURE(lag_model_param_index(LAG_MODEL_STICK, "m") == LAG_STICK_M);
     ENSURE(lag_model_param_index(LAG_MODEL_STICK, "I") == LAG_STICK_I);
     ENSURE(lag_model_param_index(LAG_MODEL_MANIPULATOR, "l1") == LAG_MANIP_L1);
@@ -315,7 +315,7 @@ static void check_info(void)
     ENSURE(lag_model_param_index(LAG_MODEL_DIPC, "m0") == LAG_DIPC_M0);
     ENSURE(lag_model_param_index(LAG_MODEL_DIPC, "h0") == LAG_DIPC_H0);
     ENSURE(lag_model_param_index(LAG_MODEL_DIPC, "nope") == -1);
-    /* Uniform rods default to I = m l^2 / 12 (brief: stick, DIPC rods). */
+    /* Uniform rods default to I = m l^2 / 12 (the stick and the DIPC's rods are uniform). */
     lag_model m;
     lag_model_default(&m, LAG_MODEL_STICK);
     ENSURE_NEAR(m.p[LAG_STICK_I], m.p[LAG_STICK_M] * m.p[LAG_STICK_L] * m.p[LAG_STICK_L] / 12,
@@ -367,8 +367,8 @@ static void check_info(void)
     ENSURE(lag_method_from_name("leapfrog") == -1);
 }
 
-/* ---------------------------------------------------------------- the seed's DIPC */
-/* The seed's Problem 3, transcribed as printed, with each error we found behind a flag.
+/* ---------------------------------------------------------------- the course assignment's DIPC */
+/* The course assignment's Problem 3, transcribed as printed, with each error we found behind a flag.
  * With every fix applied it must agree with our T and U and with the core; with any one
  * fix left out it must not. That proves the list in README.md ("The models") is complete for
  * the printed (b) T_i, (c) U_i, (8) L and (12a-c), and that each item is a real error. */
@@ -384,8 +384,8 @@ enum {
     FIX_ALL = 0xff
 };
 
-/* Seed (b): T = T0 + T1 + T2 as printed. */
-static double seed_T(const double *p, const double *q, const double *qd, unsigned fix)
+/* Assignment (b): T = T0 + T1 + T2 as printed. */
+static double asg_T(const double *p, const double *q, const double *qd, unsigned fix)
 {
     double m0 = p[LAG_DIPC_M0], m1 = p[LAG_DIPC_M1], m2 = p[LAG_DIPC_M2], l1 = p[LAG_DIPC_L1],
            l2 = p[LAG_DIPC_L2], I1 = p[LAG_DIPC_I1], I2 = p[LAG_DIPC_I2];
@@ -399,8 +399,8 @@ static double seed_T(const double *p, const double *q, const double *qd, unsigne
     return T0 + T1 + T2;
 }
 
-/* Seed (c): U = U0 + U1 + U2 as printed (U0 = m0 g (h0 - b0/2) is a constant: b0 = 0). */
-static double seed_U(const double *p, const double *q, unsigned fix)
+/* Assignment (c): U = U0 + U1 + U2 as printed (U0 = m0 g (h0 - b0/2) is a constant: b0 = 0). */
+static double asg_U(const double *p, const double *q, unsigned fix)
 {
     double m0 = p[LAG_DIPC_M0], m1 = p[LAG_DIPC_M1], m2 = p[LAG_DIPC_M2], l1 = p[LAG_DIPC_L1],
            l2 = p[LAG_DIPC_L2], g = p[LAG_DIPC_G], h0 = p[LAG_DIPC_H0];
@@ -408,8 +408,8 @@ static double seed_U(const double *p, const double *q, unsigned fix)
     return m0 * g * h0 + m1 * g * (h0 + 0.5 * l1 * cos(q[1])) + m2 * g * (h0 + l1 * cos(q[1]) + a2 * cos(q[2]));
 }
 
-/* Seed (8): the Lagrangian as printed. */
-static double seed_L(const double *p, const double *q, const double *qd, unsigned fix)
+/* Assignment (8): the Lagrangian as printed. */
+static double asg_L(const double *p, const double *q, const double *qd, unsigned fix)
 {
     double m0 = p[LAG_DIPC_M0], m1 = p[LAG_DIPC_M1], m2 = p[LAG_DIPC_M2], l1 = p[LAG_DIPC_L1],
            l2 = p[LAG_DIPC_L2], I1 = p[LAG_DIPC_I1], I2 = p[LAG_DIPC_I2], g = p[LAG_DIPC_G],
@@ -422,8 +422,8 @@ static double seed_L(const double *p, const double *q, const double *qd, unsigne
     return 0.5 * br - (0.5 * m1 + m2) * g * l1 * cos(q[1]) - 0.5 * m2 * g * l2 * cos(q[2]) - (m0 + m1 + m2) * h0 * g;
 }
 
-/* Seed (12a-c): left side minus right side's tau, i.e. what must equal M qdd + C qd + g. */
-static void seed_eom(const double *p, const double *q, const double *qd, const double *qdd, unsigned fix,
+/* Assignment (12a-c): left side minus right side's tau, i.e. what must equal M qdd + C qd + g. */
+static void asg_eom(const double *p, const double *q, const double *qd, const double *qdd, unsigned fix,
                      double *out)
 {
     double m0 = p[LAG_DIPC_M0], m1 = p[LAG_DIPC_M1], m2 = p[LAG_DIPC_M2], l1 = p[LAG_DIPC_L1],
@@ -441,9 +441,9 @@ static void seed_eom(const double *p, const double *q, const double *qd, const d
              0.5 * (m2 * l2 * qdd[0] * c2 + m2 * l1 * l2 * (qdd[1] * c12 - qd[1] * qd[1] * s12) - m2 * g * l2 * s2);
 }
 
-/* Largest relative mismatch of the seed's forms (with the given fixes) over random states:
+/* Largest relative mismatch of the assignment's forms (with the given fixes) over random states:
  * against our T, our U (differences), our T - U, and the core's M qdd + C qd + g. */
-static void seed_mismatch(unsigned fix, double *eT, double *eU, double *eL, double *eE)
+static void asg_mismatch(unsigned fix, double *eT, double *eU, double *eL, double *eE)
 {
     lt_rng rng = {0x5eedu};
     *eT = *eU = *eL = *eE = 0;
@@ -456,33 +456,33 @@ static void seed_mismatch(unsigned fix, double *eT, double *eU, double *eL, doub
         for (int i = 0; i < 3; ++i) qdd[i] = lt_uniform(&rng, -20, 20);
         double T = tc_T(&md, q, qd), U = tc_U(&md, q), U2 = tc_U(&md, q2), T2 = tc_T(&md, q2, qd2);
         double sc = fabs(T) + fabs(U) + fabs(U2) + fabs(T2) + 1;
-        *eT = fmax(*eT, fabs(seed_T(md.p, q, qd, fix) - T) / sc);
-        *eU = fmax(*eU, fabs((seed_U(md.p, q, fix) - seed_U(md.p, q2, fix)) - (U - U2)) / sc);
+        *eT = fmax(*eT, fabs(asg_T(md.p, q, qd, fix) - T) / sc);
+        *eU = fmax(*eU, fabs((asg_U(md.p, q, fix) - asg_U(md.p, q2, fix)) - (U - U2)) / sc);
         /* L up to a constant: compare L(q, qd) - L(q2, qd2) */
-        *eL = fmax(*eL, fabs((seed_L(md.p, q, qd, fix) - seed_L(md.p, q2, qd2, fix)) - ((T - U) - (T2 - U2))) / sc);
+        *eL = fmax(*eL, fabs((asg_L(md.p, q, qd, fix) - asg_L(md.p, q2, qd2, fix)) - ((T - U) - (T2 - U2))) / sc);
         double M[9], h[3], Mq[3], e[3];
         lag_model_mass(&md, q, M);
         lag_model_bias(&md, q, qd, h);
         tc_matvec(3, M, qdd, Mq);
-        seed_eom(md.p, q, qd, qdd, fix, e);
+        asg_eom(md.p, q, qd, qdd, fix, e);
         double sE = tc_maxabs(9, M) * 20 + tc_maxabs(3, h) + 1;
         for (int i = 0; i < 3; ++i) *eE = fmax(*eE, fabs(e[i] - (Mq[i] + h[i])) / sE);
     }
 }
 
-static void check_seed_dipc(void)
+static void check_assignment_dipc(void)
 {
     double eT, eU, eL, eE;
     /* all fixes: agreement to rounding (1e-13 of the scale) */
-    seed_mismatch(FIX_ALL, &eT, &eU, &eL, &eE);
-    printf("seed DIPC with all 8 fixes: max rel. mismatch T %.1e U %.1e L %.1e eqs(12) %.1e\n", eT, eU, eL, eE);
+    asg_mismatch(FIX_ALL, &eT, &eU, &eL, &eE);
+    printf("assignment DIPC with all 8 fixes: max rel. mismatch T %.1e U %.1e L %.1e eqs(12) %.1e\n", eT, eU, eL, eE);
     ENSURE(eT < 1e-13 && eU < 1e-13 && eL < 1e-13 && eE < 1e-13);
     /* any one fix missing: a mismatch of at least 1e-3 of the scale in the form it touches */
     static const char *names[8] = {"T0 square", "U2 l2", "L(8) m1 l1^2/4", "L(8) m2 l2^2/4",
                                    "L(8) m2 l2 th0d th2d", "(12a) m1 + 2 m2", "(12b) m1 l1^2/4",
                                    "(12c) m2 l2^2/4"};
     for (int b = 0; b < 8; ++b) {
-        seed_mismatch(FIX_ALL & ~(1u << b), &eT, &eU, &eL, &eE);
+        asg_mismatch(FIX_ALL & ~(1u << b), &eT, &eU, &eL, &eE);
         double worst = fmax(fmax(eT, eU), fmax(eL, eE));
         printf("  without fix %-22s: T %.1e U %.1e L %.1e eqs(12) %.1e\n", names[b], eT, eU, eL, eE);
         ENSURE(worst > 1e-3);
@@ -491,15 +491,15 @@ static void check_seed_dipc(void)
 
 static void case_info(int arg) { (void)arg; check_info(); }
 static void case_model(int kind) { check_model((lag_model_kind)kind, 0x1234u + (uint64_t)kind); }
-static void case_seed_dipc(int arg) { (void)arg; check_seed_dipc(); }
+static void case_assignment_dipc(int arg) { (void)arg; check_assignment_dipc(); }
 
-/* Cases: info, one per model of the core's table (by its name), seed_dipc. */
+/* Cases: info, one per model of the core's table (by its name), assignment_dipc. */
 int main(int argc, char **argv)
 {
     lt_cases cs = {0};
     lt_add(&cs, "info", case_info, 0, 0);
     for (int k = 0; k < LAG_MODEL_COUNT; ++k)
         lt_add(&cs, lag_model_info_get((lag_model_kind)k)->name, case_model, k, 0);
-    lt_add(&cs, "seed_dipc", case_seed_dipc, 0, 0);
+    lt_add(&cs, "assignment_dipc", case_assignment_dipc, 0, 0);
     return lt_main(argc, argv, cs.c, cs.n);
 }

@@ -1,5 +1,5 @@
 /*
- * Structural properties of the equations (issue 2, tests 2), per model:
+ * Structural properties of the equations, per model:
  *   - M(q) symmetric positive definite at random states (Cholesky pivots > 0);
  *   - M_dot - 2C skew-symmetric, with M_dot obtained by differencing the core's M along a
  *     trajectory simulated by the core (so M_dot is the true time derivative along a

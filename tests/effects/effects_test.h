@@ -1,7 +1,7 @@
 /*
  * Shared helpers of the effects and hard-case tests (tests/effects/test_*.c).
  *
- * Independence: the expectations of these tests come from the brief's T and U written
+ * Independence: the expectations of these tests come from the models' T and U written
  * again here (te_kinetic, te_potential), from closed-form solutions, conservation laws and
  * quadratures of our own; nothing here calls the core's energy or dynamics functions.
  * The generalized momentum p_i = dT/dqd_i is taken from our own T: T is quadratic in qd,

@@ -1,5 +1,5 @@
 /*
- * Each effect does what it says (issue 4), checked against expectations of our own:
+ * Each effect does what it says, checked against expectations of our own:
  * closed-form solutions, conservation laws, energy balances by quadrature.
  *
  *   test_effects damping|friction|limits|floor|actuator|disturbance|noise|off

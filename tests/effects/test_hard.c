@@ -1,5 +1,5 @@
 /*
- * Hard cases stay numerically stable (issue 4): chaotic, fast, near-singular, impact,
+ * Hard cases stay numerically stable: chaotic, fast, near-singular, impact,
  * stiff, long-horizon and stick/slip scenes, each against an expectation of our own.
  *
  *   test_hard chaos|spin|release|tiny_inertia|manip_limits|stiff|long_horizon|friction_driven
@@ -320,7 +320,7 @@ static void long_horizon(void)
     ENSURE(rss1 == rss0);
     ENSURE(te_finite_state(&s));
     /* The energy is printed, not asserted: with M(phi) the Hamiltonian is not separable
-     * and semi-implicit Euler is not symplectic (shared/BRIEF.md, numerics notes); here the
+     * and semi-implicit Euler is not symplectic (docs/models.md); here the
      * swing's 0.39 J above the bottom decays within the first 1000 s and then stays put. */
 }
 

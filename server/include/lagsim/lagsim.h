@@ -6,7 +6,7 @@
  * or exits. Errors are result codes; functions that can fail for a reason worth telling
  * write a message into a caller's buffer.
  *
- * Coordinates, T and U are those of shared/BRIEF.md; units are SI (m, kg, s, rad, N, N m).
+ * Coordinates, T and U are those of docs/models.md; units are SI (m, kg, s, rad, N, N m).
  * Matrices are row-major, n x n with n = model->nq (at most LAG_MAX_DOF).
  */
 #ifndef LAGSIM_LAGSIM_H
@@ -84,7 +84,7 @@ typedef enum lag_model_kind {
     LAG_MODEL_COUNT
 } lag_model_kind;
 
-/* Parameter indices into lag_model.p, named as in the brief. */
+/* Parameter indices into lag_model.p, named as in docs/models.md. */
 enum { LAG_STICK_M, LAG_STICK_L, LAG_STICK_I, LAG_STICK_G, LAG_STICK_NP };
 enum { LAG_MANIP_M1, LAG_MANIP_M2, LAG_MANIP_L1, LAG_MANIP_I1, LAG_MANIP_I2, LAG_MANIP_G,
        LAG_MANIP_NP };
