@@ -23,28 +23,32 @@
 #include "core_internal.h"
 
 /* ---------------------------------------------------------------- hermite */
+/* Step of H over x_i(t) = a + b t + c t^2 + d t^3 (two components). */
+static void cubic_step(double H, const double co[2][4], double *y0, double *f0, double *y1, double *f1)
+{
+    for (int i = 0; i < 2; ++i) {
+        const double *c = co[i];
+        y0[i] = c[0];
+        f0[i] = c[1];
+        y1[i] = c[0] + c[1] * H + c[2] * H * H + c[3] * H * H * H;
+        f1[i] = c[1] + 2 * c[2] * H + 3 * c[3] * H * H;
+    }
+}
+
+static double cubic_at(const double *c, double t) { return c[0] + c[1] * t + c[2] * t * t + c[3] * t * t * t; }
+
 static void check_hermite(int arg)
 {
     (void)arg;
     /* y(t) = a + b t + c t^2 + d t^3 per component over [0, h] */
     const double h = 0.37, co[2][4] = {{1.5, -2.0, 0.7, 3.1}, {-0.2, 0.9, -4.0, 1.25}};
     double y0[2], f0[2], y1[2], f1[2];
-    for (int i = 0; i < 2; ++i) {
-        const double *c = co[i];
-        y0[i] = c[0];
-        f0[i] = c[1];
-        y1[i] = c[0] + c[1] * h + c[2] * h * h + c[3] * h * h * h;
-        f1[i] = c[1] + 2 * c[2] * h + 3 * c[3] * h * h;
-    }
+    cubic_step(h, co, y0, f0, y1, f1);
     double worst = 0;
     for (int k = 0; k <= 100; ++k) {
         double th = k / 100.0, t = th * h, y[2];
         lag_hermite(2, h, y0, f0, y1, f1, th, y);
-        for (int i = 0; i < 2; ++i) {
-            const double *c = co[i];
-            double want = c[0] + c[1] * t + c[2] * t * t + c[3] * t * t * t;
-            worst = fmax(worst, fabs(y[i] - want));
-        }
+        for (int i = 0; i < 2; ++i) worst = fmax(worst, fabs(y[i] - cubic_at(co[i], t)));
     }
     printf("hermite: cubic reproduced to %.1e over 101 points\n", worst);
     ENSURE(worst < 1e-14);
@@ -130,20 +134,6 @@ static lag_result eval_cubic(void *vctx, const double *y, double *vals)
     }
     return LAG_OK;
 }
-
-/* Step of H over x_i(t) = a + b t + c t^2 + d t^3 (two components). */
-static void cubic_step(double H, const double co[2][4], double *y0, double *f0, double *y1, double *f1)
-{
-    for (int i = 0; i < 2; ++i) {
-        const double *c = co[i];
-        y0[i] = c[0];
-        f0[i] = c[1];
-        y1[i] = c[0] + c[1] * H + c[2] * H * H + c[3] * H * H * H;
-        f1[i] = c[1] + 2 * c[2] * H + 3 * c[3] * H * H;
-    }
-}
-
-static double cubic_at(const double *c, double t) { return c[0] + c[1] * t + c[2] * t * t + c[3] * t * t * t; }
 
 /* The root of c(t) = bound in [a, b] by bisection to the last bit (our own reference). */
 static double cubic_root(const double *c, double bound, double a, double b)
