@@ -8,7 +8,7 @@
  * gauss4 at a tiny step), then every method over a range of dt (or rtol): max position
  * error over the horizon, max energy error, RHS evaluations and CPU time per simulated
  * second (minimum of --reps runs). Prints Markdown tables (the numbers in
- * README.md "What accuracy costs in time"), the cross-checks against the peers, the cost ratios and the
+ * docs/benchmarks.md), the cross-checks against the peers, the cost ratios and the
  * real-time budget table; with --out writes DIR/bench_wp.csv and
  * DIR/bench_energy_long.csv (100 s chaotic DIPC, energy error vs time).
  *

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Work-precision benchmark (issue 5): builds lagsim_bench with -O2 in build-bench, runs
+# Work-precision benchmark: builds lagsim_bench with -O2 in build-bench, runs
 # the whole sweep (a few minutes on 2 cores), writes docs/bench_wp.csv,
 # docs/bench_energy_long.csv, the plots docs/bench_*.png and the printed tables
 # bench/results/report.md.

@@ -13,7 +13,7 @@
  *    it answers. Measured: state period error (as in 1.), command-to-applied latency =
  *    utime of the first state whose effort carries the command's mark minus the command's
  *    send time (both CLOCK_REALTIME on this host; includes by design the wait for the next
- *    period deadline, see README.md "Timing"), the share of commands applied
+ *    period deadline, see docs/server.md "Timing"), the share of commands applied
  *    to the very period that follows the state they answer, overruns (daemon status).
  * 4. lockstep throughput: lagsimd in lockstep, this process answering every state;
  *    control cycles per second, beside the ping-pong rate (1 / RTT).

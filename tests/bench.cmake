@@ -1,4 +1,4 @@
-# Work-precision benchmark, quick check (issue 5): short horizons, one coarse point per
+# Work-precision benchmark, quick check: short horizons, one coarse point per
 # method. Fails if the reference's two methods (dopri5 rtol 1e-13, gauss4 at period/200)
 # disagree by more than 1e-10, if at dt = 5e-3 a higher-order method is not more accurate
 # than a lower-order one on every scene, if dopri5's error does not fall with its

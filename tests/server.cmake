@@ -1,4 +1,4 @@
-# The real-time LCM server (issue 3): end-to-end over real LCM (default udpm URL, ttl=0),
+# The real-time LCM server: end-to-end over real LCM (default udpm URL, ttl=0),
 # one lagsimd child per case with a unique channel prefix.
 add_executable(server_test ${CMAKE_CURRENT_LIST_DIR}/server/server_test.c)
 target_link_libraries(server_test PRIVATE lagsim_scene lagsim_core lagsim_wire lagsim_lcmtypes PkgConfig::LCM)

@@ -1,6 +1,6 @@
 #!/bin/bash
 # --set overrides: they take effect (checked against energies computed here, independently,
-# from the brief's T and U), the last one wins, they are validated like the file and their
+# from the models' T and U (docs/models.md)), the last one wins, they are validated like the file and their
 # errors name the --set. Usage: set_overrides.sh LAGSIMD CONFIG_DIR EXPECT_ERROR_SH
 set -u
 lagsimd=$1 cfg=$2 expect=$3
