@@ -103,6 +103,8 @@ static const lag_wire_field status_fields[] = {
     SCALAR(ST, LAG_WIRE_INT64, overrun_bursts),
     SCALAR(ST, LAG_WIRE_INT64, states_published),
     SCALAR(ST, LAG_WIRE_INT64, rejected_effort_limit),
+    SCALAR(ST, LAG_WIRE_INT64, lockstep_retries),
+    SCALAR(ST, LAG_WIRE_INT64, commands_ignored),
 };
 
 typedef lag_wire_scene SC;

@@ -149,6 +149,8 @@ typedef struct lag_wire_status {
     int64_t overrun_bursts;
     int64_t states_published;
     int64_t rejected_effort_limit;
+    int64_t lockstep_retries;
+    int64_t commands_ignored;
 } lag_wire_status;
 
 /* <PREFIX>_SCENE: the scene description. */

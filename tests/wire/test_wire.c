@@ -253,6 +253,8 @@ static void check_agreement(void)
         g.overrun_bursts = w.overrun_bursts = 25;
         g.states_published = w.states_published = 26;
         g.rejected_effort_limit = w.rejected_effort_limit = 27;
+        g.lockstep_retries = w.lockstep_retries = 28;
+        g.commands_ignored = w.commands_ignored = 29;
         int nt = lagsim_status_t_encode(theirs, 0, sizeof theirs, &g);
         agree(LAG_WIRE_STATUS, &w, nt);
     }
