@@ -27,6 +27,7 @@ void lag_scene_default(lag_scene *sc, lag_model_kind kind)
     sc->realtime.rate = 1.0;
     sc->realtime.command_timeout = 0.5;
     sc->realtime.lockstep_timeout = 1.0;
+    sc->realtime.lockstep_retry = 0.02;
     sc->realtime.status_hz = 5.0;
     const lag_model_info *mi = lag_model_info_get(kind);
     for (int i = 0; mi && i < mi->nq; i++)

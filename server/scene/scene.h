@@ -34,6 +34,9 @@ typedef struct lag_scene {
         double rate;             /* sim seconds per wall second, default 1.0 */
         double command_timeout;  /* sim s; a command older than this is zeroed; default 0.5 */
         double lockstep_timeout; /* wall s; lockstep waits this long for a command; 1.0 */
+        double lockstep_retry;   /* wall s; lockstep publishes the state waited on again
+                                    this often until a command answers it (a lost state or
+                                    command costs one retry, not a timeout); 0.02 */
         double status_hz;        /* status publication rate, Hz; default 5 */
         /* N or N m per coordinate: a command whose |effort| on an actuated joint exceeds
          * this is refused as a whole (counted like any bad command), never clamped:

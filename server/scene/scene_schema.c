@@ -54,6 +54,7 @@ static const range R_PUBLISH_HZ = {0.01, 10000.0, false, "Hz"}; /* and 1/publish
 static const range R_EXPLODE = {1e-6, 1e9, false, "m, rad, m/s or rad/s"};
 static const range R_RATE = {1e-3, 1e3, false, "sim s per wall s"};
 static const range R_LOCKSTEP_TIMEOUT = {1e-3, 3600.0, false, "wall s"};
+static const range R_LOCKSTEP_RETRY = {1e-3, 3600.0, false, "wall s"}; /* as the timeout */
 static const range R_STATUS_HZ = {0.1, 100.0, false, "Hz"};
 static const range R_EFFORT = {0.0, F_MAX, true, "N or N m"};
 static const range R_DAMPING = {0.0, F_MAX, false, "N s/m or N m s/rad"};
@@ -612,6 +613,11 @@ static int key_lockstep_timeout(conv *cv, const ynode *nd, const char *path)
     return get_range(cv, nd, path, &R_LOCKSTEP_TIMEOUT, &cv->sc->realtime.lockstep_timeout);
 }
 
+static int key_lockstep_retry(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_LOCKSTEP_RETRY, &cv->sc->realtime.lockstep_retry);
+}
+
 static int key_status_hz(conv *cv, const ynode *nd, const char *path)
 {
     return get_range(cv, nd, path, &R_STATUS_HZ, &cv->sc->realtime.status_hz);
@@ -638,6 +644,7 @@ static const keyrow k_realtime_keys[] = {
     {"rate", key_rate, K_NUMBER},                         /* sim s per wall s */
     {"command_timeout", key_command_timeout, K_NUMBER},   /* sim s */
     {"lockstep_timeout", key_lockstep_timeout, K_NUMBER}, /* wall s */
+    {"lockstep_retry", key_lockstep_retry, K_NUMBER},     /* wall s */
     {"status_hz", key_status_hz, K_NUMBER},               /* wall Hz */
     {"effort_limit", key_effort_limit, K_JOINTS},         /* N or N m per actuated joint */
     {NULL, NULL, K_OTHER, NULL, NULL},
