@@ -54,6 +54,7 @@
 #define RT_LINE_NS 250000000LL    /* live status line refresh */
 #define RT_STATUS_NS_MIN 10000000LL /* periodic status at most every 10 ms (100 Hz) */
 #define RT_SIGNALS_PER_WAKE 16    /* signals read per wake-up at most */
+#define RT_RETRY_NS_MIN 1000000LL /* lockstep retries at most every millisecond */
 
 /* The buckets of the limited events (rt_ev): name, answers per second, burst. */
 static const struct {
@@ -157,7 +158,21 @@ static void publish_state(rt_server *s)
         s->answered = false;
         s->waiting_time = lag_sim_time(&s->sim);
         s->wait_start_ns = s->now;
+        s->next_retry_ns = rt_sat_add(s->now, s->lockstep_retry_ns);
     }
+}
+
+/* Lockstep, while a state is waited on and no answer has come: every lockstep_retry the
+ * same state goes out again, byte for byte (utime included), so that a state or a
+ * command lost on the way costs one retry instead of a timeout. A controller answers
+ * every state it receives; a second answer to a state already answered is ignored
+ * (commands_ignored), so the run does not depend on how many copies arrived. */
+static void lockstep_retry(rt_server *s)
+{
+    if (s->now < s->next_retry_ns || s->state_len == 0) return;
+    lcm_publish(s->lcm, s->ch_state, s->state_buf, s->state_len);
+    s->lockstep_retries++;
+    s->next_retry_ns = rt_sat_add(s->now, s->lockstep_retry_ns);
 }
 
 static void publish_status(rt_server *s)
@@ -362,7 +377,10 @@ static void mode_lockstep(rt_server *s)
             return;
         }
     }
-    if (!s->answered) return;
+    if (!s->answered) {
+        lockstep_retry(s);
+        return;
+    }
     s->waiting = false;
     int64_t budget = s->tick_budget;
     period_run(s, &budget);
@@ -434,17 +452,29 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
             return;
         }
     }
-    if (s->sc->realtime.mode == LAG_RT_LOCKSTEP &&
-        !(s->waiting && c.sim_time == s->waiting_time) &&
-        !(s->run != RT_RUNNING && c.sim_time == lag_sim_time(&s->sim))) {
-        reject(s, RT_REJ_STALE, "", c.sim_time, "its sim_time in value");
-        return;
+    if (s->sc->realtime.mode == LAG_RT_LOCKSTEP) {
+        bool waited_on = s->waiting && c.sim_time == s->waiting_time;
+        /* a second answer to a state already answered (the controller got it twice, a
+         * retry crossing its first answer): not applied, counted, no event */
+        if ((waited_on && s->answered) ||
+            (!waited_on && s->have_answered && c.sim_time == s->answered_time)) {
+            s->commands_ignored++;
+            return;
+        }
+        if (!waited_on && !(s->run != RT_RUNNING && c.sim_time == lag_sim_time(&s->sim))) {
+            reject(s, RT_REJ_STALE, "", c.sim_time, "its sim_time in value");
+            return;
+        }
     }
     for (int i = 0; i < c.num_joints; i++) s->held[idx[i]] = c.effort[i];
     s->accepted++;
     s->have_command = true;
     s->command_tick = s->sim.tick;
-    if (s->waiting && c.sim_time == s->waiting_time) s->answered = true;
+    if (s->waiting && c.sim_time == s->waiting_time) {
+        s->answered = true;
+        s->answered_time = c.sim_time;
+        s->have_answered = true;
+    }
     if (s->run == RT_WAITING) {
         /* the command the run was waiting for: it goes on from here */
         s->run = RT_RUNNING;
@@ -471,6 +501,7 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
     s->pending_steps = 0;
     s->period_left = 0;
     s->waiting = false; /* lockstep: the new state is waited on once it is published */
+    s->have_answered = false;
     if (s->run == RT_FAULT) s->run = RT_PAUSED;
     limited_event(s, RT_EV_RESET, "", 0, "%s: sim time 0, efforts zero, %s", what,
                   s->run == RT_PAUSED    ? "paused (resume to run)"
@@ -640,6 +671,9 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     if (!(sc->realtime.status_hz > 0) || !isfinite(sc->realtime.status_hz))
         return open_error(err, errlen, "bad scene: realtime.status_hz must be > 0 and finite (got %g)",
                           sc->realtime.status_hz);
+    if (!(sc->realtime.lockstep_retry >= 0) || !isfinite(sc->realtime.lockstep_retry))
+        return open_error(err, errlen, "bad scene: realtime.lockstep_retry must be >= 0 and "
+                          "finite (got %g)", sc->realtime.lockstep_retry);
     if (!(sc->realtime.lockstep_timeout >= 0) || !isfinite(sc->realtime.lockstep_timeout))
         return open_error(err, errlen, "bad scene: realtime.lockstep_timeout must be >= 0 and "
                           "finite (got %g)", sc->realtime.lockstep_timeout);
@@ -671,6 +705,11 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
         fprintf(stderr, "lagsimd: warning: realtime.status_hz %g: statuses go out at most "
                 "every %g s\n", sc->realtime.status_hz, (double)RT_STATUS_NS_MIN * 1e-9);
     s->lockstep_wait_ns = rt_ns_from_s(sc->realtime.lockstep_timeout);
+    /* a retry at most every millisecond (a scene built in code may say 0) */
+    s->lockstep_retry_ns = sc->realtime.lockstep_retry > 0
+                               ? rt_clamp_ns(sc->realtime.lockstep_retry * 1e9, RT_RETRY_NS_MIN,
+                                             INT64_MAX)
+                               : INT64_MAX;
 
     s->nq = s->sim.nq;
     /* the URLs and channels, by the rule every client follows (lagsim_bus.h) */
@@ -760,6 +799,7 @@ int64_t rt_next_wake(const rt_server *s)
         if ((act || s->run == RT_WAITING) && s->waiting && !s->want_state) {
             if (act && s->answered) return now;
             wake = min64(wake, rt_sat_add(s->wait_start_ns, s->lockstep_wait_ns));
+            if (s->run == RT_RUNNING || s->pending_steps > 0) wake = min64(wake, s->next_retry_ns);
         }
         break;
     }

@@ -110,6 +110,10 @@ typedef struct rt_server {
     bool answered;
     int64_t wait_start_ns;     /* when the wait began */
     int64_t lockstep_wait_ns;  /* realtime.lockstep_timeout, saturated */
+    int64_t lockstep_retry_ns; /* realtime.lockstep_retry, saturated */
+    int64_t next_retry_ns;     /* when the state waited on goes out again */
+    double answered_time;      /* sim_time of the last state a command answered */
+    bool have_answered;        /* answered_time holds one (since start or reset) */
 
     /* pacing of periods (realtime mode) and of the paused republication (realtime, fast) */
     rt_pace pace;
@@ -130,6 +134,8 @@ typedef struct rt_server {
     int64_t controls_rejected;
     int64_t watchdog_trips;
     int64_t lockstep_timeouts;
+    int64_t lockstep_retries;  /* states published again, no answer having come */
+    int64_t commands_ignored;  /* answers to a state already answered */
     int64_t numeric_faults;
     int64_t states_published;
     int64_t effect_events_dropped; /* sim.events_dropped already reported */
@@ -149,6 +155,8 @@ typedef struct rt_server {
     bool report_line;          /* SIGUSR1/SIGUSR2: one status line on stderr */
 
     uint8_t buf[RT_BUF_SIZE];
+    uint8_t state_buf[RT_BUF_SIZE]; /* the last state published, as sent (lockstep retries) */
+    unsigned state_len;
 } rt_server;
 
 /* Time helpers (ns). */

@@ -53,14 +53,15 @@ static void put(char *dst, size_t cap, const char *src)
 _Static_assert(LAG_MAX_DOF <= LAG_WIRE_MAX_JOINTS && LAG_MAX_PARAMS <= LAG_WIRE_MAX_PARAMS,
                "the wire structs hold every model");
 
-/* Encodes message m of type t into the server's buffer and hands it to LCM; false if it
- * could not be encoded (never: every double went through fin(), every name fits). */
-static bool publish(rt_server *s, const char *channel, lag_wire_type t, const void *m)
+/* Encodes message m of type t into the server's buffer and hands it to LCM. Returns the
+ * bytes sent, 0 if it could not be encoded (never: every double went through fin(),
+ * every name fits). */
+static int publish(rt_server *s, const char *channel, lag_wire_type t, const void *m)
 {
     int n = lag_wire_encode(t, m, s->buf, RT_BUF_SIZE);
-    if (n <= 0) return false;
+    if (n <= 0) return 0;
     lcm_publish(s->lcm, channel, s->buf, (unsigned)n);
-    return true;
+    return n;
 }
 
 /* ---------------------------------------------------------------- publishing */
@@ -86,7 +87,12 @@ void rt_publish_state(rt_server *s)
          * the held command. Disturbance forces are external and not included. */
         m.effort[i] = fin(s->sim.tau_applied[i]);
     }
-    if (publish(s, s->ch_state, LAG_WIRE_JOINT_STATE, &m)) s->states_published++;
+    int n = publish(s, s->ch_state, LAG_WIRE_JOINT_STATE, &m);
+    if (n > 0) {
+        s->states_published++;
+        memcpy(s->state_buf, s->buf, (size_t)n); /* as sent: a lockstep retry sends it again */
+        s->state_len = (unsigned)n;
+    }
 }
 
 void rt_publish_status(rt_server *s)
@@ -125,6 +131,8 @@ void rt_publish_status(rt_server *s)
     m.overrun_bursts = s->overrun_bursts;
     m.states_published = s->states_published;
     m.rejected_effort_limit = s->rejected[RT_REJ_EFFORT_LIMIT];
+    m.lockstep_retries = s->lockstep_retries;
+    m.commands_ignored = s->commands_ignored;
     publish(s, s->ch_status, LAG_WIRE_STATUS, &m);
     s->rtf = m.rtf;
     if (wall < 0.05 && s->run == RT_RUNNING) return; /* the window goes on */

@@ -11,7 +11,7 @@
  *
  *   test_loop CASE    CASE: pacing rate_huge status_hz lockstep_wait start long_period chunks
  *                           step_paced control_flood command_flood duration signals
- *                           fault_effort
+ *                           fault_effort lockstep_retry lockstep_loss
  */
 #include <math.h>
 #include <signal.h>
@@ -69,6 +69,62 @@ typedef struct outputs {
 } outputs;
 
 static outputs g_out;
+
+/* A lockstep controller played by the test (lockstep_retry, lockstep_loss): it answers
+ * every state it receives (duplicates included) with u = -K x, and a deterministic
+ * generator loses a share of the states on their way to it and of its commands on their
+ * way to the server. Every state it receives is recorded by step. */
+#define CTL_MAX_STEPS 4096
+typedef struct controller {
+    bool on;
+    double loss;                  /* each way */
+    uint64_t rng;
+    int64_t received, lost_states, sent, lost_commands;
+    int64_t steps;                /* distinct steps received */
+    bool have[CTL_MAX_STEPS];
+    double x[CTL_MAX_STEPS][2 * LAG_MAX_DOF];
+    int64_t last_step;
+} controller;
+static controller g_ctl;
+static void command(double sim_time, const char *joint, double effort);
+
+static bool ctl_lose(void)
+{
+    g_ctl.rng = g_ctl.rng * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(g_ctl.rng >> 11) * 0x1p-53 < g_ctl.loss;
+}
+
+static void ctl_state(const lag_wire_joint_state *m)
+{
+    if (ctl_lose()) {
+        g_ctl.lost_states++;
+        return;
+    }
+    g_ctl.received++;
+    int64_t k = m->step / 10; /* periods of 10 ticks */
+    if (k >= 0 && k < CTL_MAX_STEPS) {
+        double x[2 * LAG_MAX_DOF] = {0};
+        for (int i = 0; i < m->num_joints; i++) {
+            x[i] = m->position[i];
+            x[LAG_MAX_DOF + i] = m->velocity[i];
+        }
+        if (g_ctl.have[k] && memcmp(g_ctl.x[k], x, sizeof x) != 0)
+            fail(__LINE__, "step %lld received twice with different values", (long long)m->step);
+        if (!g_ctl.have[k]) g_ctl.steps++;
+        g_ctl.have[k] = true;
+        memcpy(g_ctl.x[k], x, sizeof x);
+    }
+    g_ctl.last_step = m->step;
+    /* a balancing law of the DIPC, from the state alone */
+    double u = 1.67 * m->position[0] - 396.4 * m->position[1] + 448.4 * m->position[2] +
+               6.17 * m->velocity[0] - 16.3 * m->velocity[1] + 68.4 * m->velocity[2];
+    if (ctl_lose()) {
+        g_ctl.lost_commands++;
+        return;
+    }
+    g_ctl.sent++;
+    command(m->sim_time, "theta0", -u);
+}
 
 static bool finite_all(const double *x, int n)
 {
@@ -128,6 +184,7 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         g_out.last_t = m.sim_time;
         g_out.last_step = m.step;
         for (int i = 0; i < m.num_joints && i < LAG_MAX_DOF; i++) g_out.last_q[i] = m.position[i];
+        if (g_ctl.on) ctl_state(&m);
     } else if (!strcmp(sfx, "STATUS")) {
         lag_wire_status m;
         if (lag_wire_decode_status(rb->data, rb->data_size, &m) != LAG_WIRE_OK) fail(__LINE__, "bad status");
@@ -327,6 +384,7 @@ static void case_lockstep_wait(void)
     for (size_t i = 0; i < sizeof waits / sizeof waits[0]; i++) {
         scene(LAG_RT_LOCKSTEP);
         g_sc.realtime.lockstep_timeout = waits[i];
+        g_sc.realtime.lockstep_retry = waits[i]; /* the wait alone (retries: lockstep_retry) */
         start();
         run_until(g_srv.now + 10 * SEC, 10000);
         ENSURE(g_srv.sim.tick == 0 && g_srv.lockstep_timeouts == 0);
@@ -670,6 +728,106 @@ static void case_fault_effort(void)
     stop_server();
 }
 
+/* Lockstep retries: a state not answered within lockstep_retry (20 ms) goes out again,
+ * byte for byte, every 20 ms, until an answer comes; the wait (and lockstep_timeout)
+ * still counts from the first publication. A second answer to the state is ignored and
+ * counted (commands_ignored), with no event, whether it comes before the period ran or
+ * after; an answer to an older state is still a stale rejection. */
+static void case_lockstep_retry(void)
+{
+    scene(LAG_RT_LOCKSTEP);
+    g_sc.realtime.start = LAG_RT_START_RUNNING;
+    g_sc.realtime.lockstep_timeout = 1.0;
+    g_sc.realtime.lockstep_retry = 0.02;
+    start();
+    const int64_t t0 = g_srv.now;
+    ENSURE(g_out.state == 1 && g_srv.waiting && !g_srv.answered);
+    uint8_t first[RT_BUF_SIZE];
+    unsigned first_len = g_srv.state_len;
+    memcpy(first, g_srv.state_buf, first_len);
+    run_until(t0 + 110 * MS, 1000);
+    ENSUREF(g_srv.lockstep_retries == 5 && g_out.state == 6, "%lld retries, %lld states in 110 ms",
+            (long long)g_srv.lockstep_retries, (long long)g_out.state);
+    ENSURE(g_srv.state_len == first_len && memcmp(first, g_srv.state_buf, first_len) == 0);
+    ENSURE(g_srv.sim.tick == 0 && g_srv.lockstep_timeouts == 0 && g_out.last_step == 0);
+    /* answered twice before the period runs: the second is ignored */
+    command(0.0, "theta0", 0.5);
+    command(0.0, "theta0", 9.0);
+    ENSURE(g_srv.accepted == 1 && g_srv.commands_ignored == 1 && g_srv.held[0] == 0.5);
+    run_until(g_srv.now + 1 * MS, 1000);
+    ENSURE(g_srv.sim.tick == 10 && g_out.state == 7 && g_out.last_step == 10);
+    /* a late copy of the answer to t = 0: ignored, counted, no event */
+    command(0.0, "theta0", 9.0);
+    ENSURE(g_srv.commands_ignored == 2 && g_srv.held[0] == 0.5);
+    ENSURE(g_srv.rejected[RT_REJ_STALE] == 0 && n_events("command_rejected") == 0);
+    /* an answer to a state that was never published: stale */
+    command(0.5, "theta0", 9.0);
+    ENSURE(g_srv.rejected[RT_REJ_STALE] == 1 && g_srv.held[0] == 0.5);
+    /* no answer for a second: 49 retries, then the timeout (no more 20 ms retries) */
+    int64_t r0 = g_srv.lockstep_retries;
+    run_until(g_srv.now + 1100 * MS, 1000);
+    ENSUREF(g_srv.lockstep_timeouts == 1 && g_srv.run == RT_WAITING, "%lld timeouts",
+            (long long)g_srv.lockstep_timeouts);
+    ENSUREF(g_srv.lockstep_retries - r0 == 49, "%lld retries before the timeout",
+            (long long)(g_srv.lockstep_retries - r0));
+    /* the status says it */
+    control(LAGSIM_CONTROL_T_STATUS, 0);
+    run_until(g_srv.now + 1 * MS, 1000);
+    stop_server();
+}
+
+/* Runs a lockstep DIPC for `periods` periods with the test's controller losing `loss` of
+ * the states and of the commands; returns the wall time (ns of the made-up clock). */
+static int64_t lockstep_run(double loss, int periods)
+{
+    scene(LAG_RT_LOCKSTEP);
+    g_sc.realtime.lockstep_timeout = 1.0;
+    g_sc.realtime.lockstep_retry = 0.02;
+    memset(&g_ctl, 0, sizeof g_ctl);
+    g_ctl.on = true;
+    g_ctl.loss = loss;
+    g_ctl.rng = 12345;
+    start();
+    const int64_t t0 = g_srv.now;
+    while (g_srv.sim.tick < 10 * (int64_t)periods && g_srv.now - t0 < 600 * SEC)
+        run_until(g_srv.now + 10 * MS, 1 * MS);
+    g_ctl.on = false;
+    ENSURE(g_srv.sim.tick == 10 * (int64_t)periods);
+    return g_srv.now - t0;
+}
+
+/* Lockstep under loss: with 10 % of the states and 10 % of the commands lost (and 30 %),
+ * the controller receives every state of the run and the states are those of a lossless
+ * run bit for bit; each loss costs a retry (20 ms), never a lockstep_timeout. */
+static void case_lockstep_loss(void)
+{
+    enum { N = 1000 };
+    lockstep_run(0.0, N);
+    ENSURE(g_srv.lockstep_retries == 0 && g_ctl.lost_states == 0 && g_ctl.steps == N + 1);
+    static controller ref;
+    ref = g_ctl;
+    stop_server();
+    const double losses[] = {0.1, 0.3};
+    for (int i = 0; i < 2; i++) {
+        int64_t wall = lockstep_run(losses[i], N);
+        printf("loss %.0f %% each way: %lld states and %lld commands lost, %lld retries, "
+               "%lld answers ignored, %lld timeouts, %.2f s of wall time for %d periods\n",
+               100 * losses[i], (long long)g_ctl.lost_states, (long long)g_ctl.lost_commands,
+               (long long)g_srv.lockstep_retries, (long long)g_srv.commands_ignored,
+               (long long)g_srv.lockstep_timeouts, (double)wall * 1e-9, N);
+        ENSURE(g_ctl.lost_states > 0 && g_ctl.lost_commands > 0);
+        ENSUREF(g_srv.lockstep_timeouts == 0, "%lld lockstep timeouts",
+                (long long)g_srv.lockstep_timeouts);
+        ENSURE(g_srv.lockstep_retries >= g_ctl.lost_states);
+        ENSURE(g_ctl.steps == N + 1);
+        for (int k = 0; k <= N; k++)
+            if (!g_ctl.have[k] || memcmp(g_ctl.x[k], ref.x[k], sizeof ref.x[k]) != 0)
+                fail(__LINE__, "loss %g: period %d differs from the lossless run", losses[i], k);
+        ENSURE(n_events("command_rejected") == 0 && n_events("lockstep_timeout") == 0);
+        stop_server();
+    }
+}
+
 int main(int argc, char **argv)
 {
     static const struct {
@@ -683,6 +841,7 @@ int main(int argc, char **argv)
         {"step_paced", case_step_paced},   {"control_flood", case_control_flood},
         {"command_flood", case_command_flood}, {"duration", case_duration},
         {"signals", case_signals},         {"fault_effort", case_fault_effort},
+        {"lockstep_retry", case_lockstep_retry}, {"lockstep_loss", case_lockstep_loss},
     };
     if (argc != 2) {
         fprintf(stderr, "usage: test_loop CASE\n");
