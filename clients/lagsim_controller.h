@@ -95,6 +95,16 @@ typedef struct lag_ctl {
     double heard;              /* monotonic s of the last message from the daemon */
     bool stopped;              /* the daemon's stop event arrived */
     lag_client_state current;  /* the state last returned */
+    /* the last command sent and the state it answered: a copy of that state (a lockstep
+     * retry, when the state or the answer was lost) is answered again with it, not
+     * returned */
+    int last_n;
+    char last_names[LAG_CLIENT_MAX_JOINTS][LAG_CLIENT_NAME_LEN];
+    double last_effort[LAG_CLIENT_MAX_JOINTS];
+    int64_t last_step;
+    double last_time;
+    bool have_last;
+    int64_t repeats;           /* copies answered again so */
 
     /* optional, set before lag_ctl_start: called with every event from the daemon (from
      * inside lag_ctl_next_state), after the setup has looked at it */
@@ -117,7 +127,10 @@ int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
 int lag_ctl_start(lag_ctl *ctl, const char *model);
 
 /* The newest state not yet returned: LAG_CLIENT_OK, or LAG_CLIENT_TIMEOUT when the run
- * has ended (ctl->end says why), or a negative error (message on stderr). OUT: st */
+ * has ended (ctl->end says why), or a negative error (message on stderr). A copy of the
+ * state answered last (same step and sim time: the daemon published it again because no
+ * answer reached it) is answered at once with the same command and not returned: every
+ * state received is answered, and the control law runs once per state. OUT: st */
 int lag_ctl_next_state(lag_ctl *ctl, lag_client_state *st);
 
 /* Answers state st with efforts for n named joints; a non-finite effort is sent as 0
@@ -125,7 +138,8 @@ int lag_ctl_next_state(lag_ctl *ctl, lag_client_state *st);
 int lag_ctl_command(lag_ctl *ctl, const lag_client_state *st, int n, const char *const *names,
                     const double *effort);
 
-/* Prints "<name>: summary end=<end> <fmt...> dropped=<n>" on stdout, closes the trace and
+/* Prints "<name>: summary end=<end> <fmt...> dropped=<n> repeats=<n>" on stdout (repeats:
+ * copies of a state answered again), closes the trace and
  * the client. Returns the exit status: 0, or 1 when a client error ended the run. */
 int lag_ctl_finish(lag_ctl *ctl, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 

@@ -28,7 +28,7 @@ local WAIT_MS = 50
 
 function Controller.new(name, default_prefix, model, description)
   local self = setmetatable({ name = name, model = model, description = description or '',
-                              opts = {}, order = {}, o = {}, dropped = 0 }, Controller)
+                              opts = {}, order = {}, o = {}, dropped = 0, repeats = 0 }, Controller)
   self:option('prefix', default_prefix, 'channel prefix', 'string')
   self:option('url', '', "the plant's LCM URL, its lcm.url (default: LCM's default); commands go to the next port", 'string')
   self:option('duration', 0, 'stop after S s of sim time from the first state (0: until the daemon stops)')
@@ -172,20 +172,32 @@ function Controller:start(argv)
   return o
 end
 
--- Iterator over states: each newest state once, until the run ends.
+-- Iterator over states: each newest state once, until the run ends. A copy of the state
+-- answered last (same step and sim time: the daemon published it again because no answer
+-- reached it) is answered at once with the same command and not returned: every state
+-- received is answered, the control law runs once per state.
 function Controller:states()
   local o = self.o
   local t_first
   return function()
     if self.end_reason then return nil end
-    while not self.state do
-      if self.stopped then self.end_reason = 'stop' return nil end
-      if self.silent_ms >= o.timeout * 1000 then self.end_reason = 'silence' return nil end
-      if not self.lc:handle_timeout(WAIT_MS) then self.silent_ms = self.silent_ms + WAIT_MS end
-    end
-    while self.lc:handle_timeout(0) do end -- drain what is queued: answer the newest
-    local st = self.state
-    self.state = nil
+    local st
+    repeat
+      while not self.state do
+        if self.stopped then self.end_reason = 'stop' return nil end
+        if self.silent_ms >= o.timeout * 1000 then self.end_reason = 'silence' return nil end
+        if not self.lc:handle_timeout(WAIT_MS) then self.silent_ms = self.silent_ms + WAIT_MS end
+      end
+      while self.lc:handle_timeout(0) do end -- drain what is queued: answer the newest
+      st = self.state
+      self.state = nil
+      local last = self.last
+      if last and st.step == last.step and st.sim_time == last.sim_time then
+        self.lc_cmd:publish(o.prefix .. '_COMMAND', last.data)
+        self.repeats = self.repeats + 1
+        st = nil
+      end
+    until st
     self.current = st
     t_first = t_first or st.sim_time
     if o.duration > 0 and st.sim_time - t_first >= o.duration - 0.5 * self.scene.control_period then
@@ -207,8 +219,12 @@ function Controller:command(sim_time, names, efforts)
     if u ~= u or u == math.huge or u == -math.huge then u = 0.0 end -- never send NaN
     cmd.effort[k] = u
   end
-  self.lc_cmd:publish(self.o.prefix .. '_COMMAND', cmd:encode())
+  local data = cmd:encode()
+  self.lc_cmd:publish(self.o.prefix .. '_COMMAND', data)
   local st = self.current
+  if st and st.sim_time == sim_time then
+    self.last = { step = st.step, sim_time = sim_time, data = data }
+  end
   if self.trace and st and st.sim_time == sim_time then
     -- sim_time, positions, velocities, efforts sent: %.17g reads back to the same double
     local f = { string.format('%.17g', st.sim_time) }
@@ -221,8 +237,8 @@ end
 
 function Controller:finish(summary)
   if self.trace then self.trace:close() end
-  print(string.format('%s: summary end=%s %s dropped=%d', self.name, tostring(self.end_reason),
-                      summary, self.dropped))
+  print(string.format('%s: summary end=%s %s dropped=%d repeats=%d', self.name,
+                      tostring(self.end_reason), summary, self.dropped, self.repeats))
   io.stdout:flush()
   return 0
 end

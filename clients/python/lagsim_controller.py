@@ -73,6 +73,8 @@ class Controller(object):
         self.t = _import_types(a.types, self.name)
         self._trace = open(a.trace, "w") if a.trace else None
         self._current = None
+        self._last = None  # (step, sim_time, encoded command) of the last answer
+        self.repeats = 0   # copies of a state answered again
         self._stop = False
 
         def on_signal(signum, frame):
@@ -148,7 +150,10 @@ class Controller(object):
             self._stopped = True
 
     def states(self):
-        """Yields each newest state once until the run ends (self.end says why)."""
+        """Yields each newest state once until the run ends (self.end says why). A copy of
+        the state answered last (same step and sim time: the daemon published it again
+        because no answer reached it) is answered at once with the same command and not
+        yielded: every state received is answered, the control law runs once per state."""
         a = self.args
         t_first = None
         while True:
@@ -166,6 +171,11 @@ class Controller(object):
             while self.lc.handle_timeout(0):  # drain what is queued: answer the newest
                 pass
             st, self._state = self._state, None
+            last = self._last
+            if last is not None and st.step == last[0] and st.sim_time == last[1]:
+                self.lc_cmd.publish(self.args.prefix + "_COMMAND", last[2])
+                self.repeats += 1
+                continue
             self._current = st
             if t_first is None:
                 t_first = st.sim_time
@@ -182,8 +192,11 @@ class Controller(object):
         cmd.num_joints = len(names)
         cmd.name = list(names)
         cmd.effort = [x if math.isfinite(x) else 0.0 for x in efforts]  # never send NaN
-        self.lc_cmd.publish(self.args.prefix + "_COMMAND", cmd.encode())
+        data = cmd.encode()
+        self.lc_cmd.publish(self.args.prefix + "_COMMAND", data)
         st = self._current
+        if st is not None and st.sim_time == sim_time:
+            self._last = (st.step, sim_time, data)
         if self._trace and st is not None and st.sim_time == sim_time:
             # sim_time, positions, velocities, efforts sent: %.17g reads back to the same double
             f = [st.sim_time] + list(st.position) + list(st.velocity) + cmd.effort
@@ -192,8 +205,8 @@ class Controller(object):
     def finish(self, summary):
         if self._trace:
             self._trace.close()
-        print("%s: summary end=%s %s dropped=%d" % (self.name, self.end, summary, self.dropped),
-              flush=True)
+        print("%s: summary end=%s %s dropped=%d repeats=%d"
+              % (self.name, self.end, summary, self.dropped, self.repeats), flush=True)
         if self.lc_cmd is not self.lc:
             self.lc_cmd.close()
         self.lc.close()

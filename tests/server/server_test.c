@@ -197,7 +197,11 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *u)
     c->prev_step = m->step;
     c->last = r;
     if (c->controller) {
-        if (c->n_rec < MAX_REC) c->rec[c->n_rec++] = r;
+        /* every state is answered; a copy of the last one (a lockstep retry) is not
+         * recorded again */
+        bool copy = c->n_rec > 0 && c->rec[c->n_rec - 1].step == r.step &&
+                    c->rec[c->n_rec - 1].t == r.t;
+        if (!copy && c->n_rec < MAX_REC) c->rec[c->n_rec++] = r;
         /* answered 3 ms later: lockstep would otherwise run a period in ~50 us, and
          * lcm-logger, whose LCM queue holds a few dozen messages, lost some whenever a
          * loaded machine kept it off a core for a millisecond or two; paced so, it may be

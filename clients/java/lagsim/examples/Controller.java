@@ -56,6 +56,12 @@ public final class Controller {
     private PrintWriter trace;
     private final Object lock = new Object();
     private joint_state_t latest, current;
+    // the last command sent and the state it answered (a copy of it is answered again)
+    private joint_command_t lastCmd;
+    private long lastStep;
+    private double lastTime;
+    /** Copies of a state answered again with the same command. */
+    public long repeats;
     private boolean stopped;
     private long heardNanos;
     private double tFirst = Double.NaN;
@@ -203,20 +209,29 @@ public final class Controller {
         for (int k = 0; k < scene.num_params; k++) params.put(scene.param_name[k], scene.param_value[k]);
     }
 
-    /** The newest state not yet returned, or null when the run has ended (see endReason). */
+    /** The newest state not yet returned, or null when the run has ended (see endReason).
+     *  A copy of the state answered last (same step and sim time: the daemon published it
+     *  again because no answer reached it) is answered at once with the same command and
+     *  not returned: every state received is answered, the law runs once per state. */
     public joint_state_t nextState() throws InterruptedException {
         synchronized (lock) {
             if (endReason != null) return null;
-            while (latest == null) {
-                if (stopped) { endReason = "stop"; return null; }
-                if (System.nanoTime() - heardNanos > (long) (timeout * 1e9)) {
-                    endReason = "silence";
-                    return null;
+            joint_state_t st;
+            for (;;) {
+                while (latest == null) {
+                    if (stopped) { endReason = "stop"; return null; }
+                    if (System.nanoTime() - heardNanos > (long) (timeout * 1e9)) {
+                        endReason = "silence";
+                        return null;
+                    }
+                    lock.wait(50);
                 }
-                lock.wait(50);
+                st = latest;
+                latest = null;
+                if (lastCmd == null || st.step != lastStep || st.sim_time != lastTime) break;
+                lcmCmd.publish(prefix + "_COMMAND", lastCmd);
+                repeats++;
             }
-            joint_state_t st = latest;
-            latest = null;
             current = st;
             if (Double.isNaN(tFirst)) tFirst = st.sim_time;
             if (duration > 0 && st.sim_time - tFirst >= duration - 0.5 * scene.control_period)
@@ -237,6 +252,13 @@ public final class Controller {
             cmd.effort[k] = Double.isFinite(efforts[k]) ? efforts[k] : 0.0;
         lcmCmd.publish(prefix + "_COMMAND", cmd);
         joint_state_t st = current;
+        if (st != null && st.sim_time == simTime) {
+            synchronized (lock) {
+                lastCmd = cmd;
+                lastStep = st.step;
+                lastTime = simTime;
+            }
+        }
         if (trace != null && st != null && st.sim_time == simTime) {
             // sim_time, positions, velocities, efforts sent: Double.toString reads back exactly
             List<String> f = new ArrayList<>();
@@ -258,7 +280,7 @@ public final class Controller {
     /** Prints the summary line; returns the exit status (0). The LCM stays open until the
      *  process exits (closing it makes its receive thread print a socket exception). */
     public int finish(String summary) {
-        System.out.println(name + ": summary end=" + endReason + " " + summary + " dropped=" + dropped);
+        System.out.println(name + ": summary end=" + endReason + " " + summary + " dropped=" + dropped + " repeats=" + repeats);
         System.out.flush();
         if (trace != null) trace.close();
         return 0;
