@@ -101,6 +101,46 @@ void lag_sim_reset(lag_sim *s, const double *q, const double *qd)
     if (s->def.effects.enabled) lag_effects_init_modes(s);
 }
 
+lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_t errlen)
+{
+    if (def->model.kind != s->def.model.kind || def->model.nq != s->nq ||
+        memcmp(&def->integrator, &s->def.integrator, sizeof def->integrator) != 0 ||
+        memcmp(&def->explode_limit, &s->def.explode_limit, sizeof def->explode_limit) != 0) {
+        if (err && errlen)
+            snprintf(err, errlen, "only the model's parameters and the effects change while "
+                                  "running (not the model, the integrator or explode_limit)");
+        return LAG_ERR_ARG;
+    }
+    /* checked as a definition that starts where the run is now */
+    lag_sim_def at = *def;
+    for (int i = 0; i < s->nq; i++) {
+        at.q0[i] = s->q[i];
+        at.qd0[i] = s->qd[i];
+    }
+    lag_diag d;
+    if (lag_sim_def_check(&at, &d) != LAG_OK) {
+        if (err && errlen) lag_diag_format(&d, err, errlen);
+        return LAG_ERR_ARG;
+    }
+    const uint32_t was = s->def.effects.enabled;
+    s->def.model = def->model;
+    s->def.effects = def->effects;
+    lag_effects_prepare(s);
+    s->dp.valid = false; /* dopri5's internal state was integrated with the old definition */
+    const uint32_t now = s->def.effects.enabled;
+    if ((was | now) & (LAG_EFF_FRICTION | LAG_EFF_LIMITS | LAG_EFF_FLOOR))
+        lag_effects_init_modes(s);
+    for (int i = 0; i < s->nq; i++) {
+        if ((now & LAG_EFF_ACTUATOR) && !(was & LAG_EFF_ACTUATOR))
+            s->mode.act_state[i] = s->tau_applied[i];
+        if (!(now & LAG_EFF_ACTUATOR)) {
+            s->tau_applied[i] = s->tau[i];
+            s->mode.saturated[i] = false;
+        }
+    }
+    return LAG_OK;
+}
+
 void lag_sim_set_input(lag_sim *s, const double *tau)
 {
     const lag_model_info *info = lag_model_info_get(s->def.model.kind);

@@ -410,6 +410,16 @@ typedef struct lag_sim {
 lag_result lag_sim_init(lag_sim *s, const lag_sim_def *def, char *err, size_t errlen);
 /* Resets to (q, qd) at tick 0 (NULL: the definition's initial state); input to zero. */
 void lag_sim_reset(lag_sim *s, const double *q, const double *qd);
+/* Changes the model's parameters and the effects' settings of a running simulation,
+ * keeping its state, tick, input and initial state: the run goes on as a run of the new
+ * definition started from the current state. def must have the same model kind,
+ * integrator settings and explode_limit (else LAG_ERR_ARG: those do not change while
+ * running) and must pass lag_sim_def_check with the current state as its initial state
+ * (a stop must not exclude where the joint is, ...): else LAG_ERR_ARG with "field:
+ * message" in err and nothing changed. The effects' holds (a joint at rest on a stop or
+ * held by static friction) are derived again from the state, as at a reset; a newly
+ * switched-on actuator starts from the effort applied now; dopri5 restarts its step. */
+lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_t errlen);
 /* Sets the held input tau (n entries; entries of unactuated coordinates are ignored
  * and stored as zero). */
 void lag_sim_set_input(lag_sim *s, const double *tau);
