@@ -12,6 +12,13 @@ typedef struct lagsimd_opts {
     bool quiet;          /* -q: no live status line */
     double duration;     /* --duration: sim seconds to run, <= 0 = until stopped */
     const char *csv;     /* --offline: CSV path, "-" = stdout, NULL = no CSV */
+    /* where the scene came from, for changes made while running (control_t SET): the
+     * file's bytes, its name and the --set overrides, in order */
+    const char *scene_name;
+    const char *scene_text;
+    size_t scene_len;
+    const char *const *sets;
+    int nsets;
 } lagsimd_opts;
 
 /* Exit codes of lagsimd. */

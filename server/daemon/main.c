@@ -212,16 +212,28 @@ int main(int argc, char **argv)
     } else {
         static lag_scene sc;
         char err[1024];
-        if (lag_scene_load(config, sets, nsets, &sc, err, sizeof err) != 0) {
+        /* the file is read once: the scene and any change made while running come from
+         * the same bytes */
+        char *text = NULL;
+        size_t len = 0;
+        if (lag_scene_read(config, &text, &len, err, sizeof err) != 0 ||
+            lag_scene_load_buffer(config, text, len, sets, nsets, &sc, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             rc = LAGSIMD_EXIT_USAGE;
-        } else if (offline) {
-            rc = lagsimd_offline(&sc, &opts);
-        } else if (replay) {
-            rc = lagsimd_replay(&sc, replay, &opts);
-        } else if (resolve_default_url(&sc) == 0) {
-            rc = lagsimd_realtime(&sc, &opts);
+        } else {
+            opts.scene_name = config;
+            opts.scene_text = text;
+            opts.scene_len = len;
+            opts.sets = sets;
+            opts.nsets = nsets;
+            if (offline)
+                rc = lagsimd_offline(&sc, &opts);
+            else if (replay)
+                rc = lagsimd_replay(&sc, replay, &opts);
+            else if (resolve_default_url(&sc) == 0)
+                rc = lagsimd_realtime(&sc, &opts);
         }
+        free(text);
     }
     free(sets);
     return rc;

@@ -83,6 +83,12 @@ void lag_scene_default(lag_scene *sc, lag_model_kind kind);
 int lag_scene_load(const char *path, const char *const *sets, int nsets, lag_scene *sc,
                    char *err, size_t errlen);
 
+/* Reads a scene file as lag_scene_load does (at most LAG_SCENE_MAX_BYTES, the same
+ * errors), so that a caller can keep the bytes a scene came from (lagsimd does, to
+ * validate a change made while running against the same source). On success *text is a
+ * new buffer of *len bytes (free it); else -1 with the message in err. OUT: text, len */
+int lag_scene_read(const char *path, char **text, size_t *len, char *err, size_t errlen);
+
 /* The same for a scene already in memory: `name` stands for the file in messages, `text`
  * holds `len` bytes (not NUL-terminated; at most LAG_SCENE_MAX_BYTES). OUT: sc */
 int lag_scene_load_buffer(const char *name, const char *text, size_t len,

@@ -192,6 +192,23 @@ done:
     return rc;
 }
 
+int lag_scene_read(const char *path, char **text, size_t *len, char *err, size_t errlen)
+{
+    char dummy[8];
+    errbuf e = {.buf = err ? err : dummy, .len = err ? errlen : sizeof dummy};
+    if (e.len)
+        e.buf[0] = '\0';
+    if (!path || !text || !len) {
+        snprintf(e.buf, e.len, "lag_scene_read: invalid arguments");
+        return -1;
+    }
+    if (read_scene_file(path, text, len, &e) < 0) {
+        one_line(err, errlen);
+        return -1;
+    }
+    return 0;
+}
+
 int lag_scene_load(const char *path, const char *const *sets, int nsets, lag_scene *sc,
                    char *err, size_t errlen)
 {
