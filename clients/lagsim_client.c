@@ -427,6 +427,25 @@ int lag_client_request_describe(lag_client *c)
     return send_control(c, LAGSIM_CONTROL_T_DESCRIBE, 0, 0, NULL, NULL);
 }
 
+int lag_client_set(lag_client *c, const char *key, const char *value)
+{
+    lag_wire_control m;
+    memset(&m, 0, sizeof m);
+    if (!key || !value || !key[0] || !value[0] || strlen(key) >= sizeof m.key ||
+        strlen(value) >= sizeof m.value) {
+        set_err(c, "set: key and value must be 1 to %zu and 1 to %zu bytes", sizeof m.key - 1,
+                sizeof m.value - 1);
+        return LAG_CLIENT_ERR_ARG;
+    }
+    m.utime = wall_utime();
+    m.request = LAGSIM_CONTROL_T_SET;
+    memcpy(m.key, key, strlen(key) + 1);
+    memcpy(m.value, value, strlen(value) + 1);
+    int rc = publish(c, c->ch_control, LAG_WIRE_CONTROL, &m);
+    if (rc == LAG_CLIENT_OK) c->counters.controls_sent++;
+    return rc;
+}
+
 int lag_client_step(lag_client *c, int64_t count)
 {
     if (count < 1) {

@@ -139,6 +139,10 @@ int lag_client_reset(lag_client *c);                         /* scene's initial 
 int lag_client_reset_to(lag_client *c, int n, const double *q, const double *qd); /* finite */
 int lag_client_request_status(lag_client *c);
 int lag_client_request_describe(lag_client *c);
+/* SET: changes a scene key under parameters or effects while running, e.g. ("parameters.m2",
+ * "1.25"), value in YAML; the daemon validates it as the scene file and answers with a
+ * `set` event (and the new scene) or `control_rejected` with the reason. */
+int lag_client_set(lag_client *c, const char *key, const char *value);
 
 void lag_client_get_counters(const lag_client *c, lag_client_counters *out);
 

@@ -2,6 +2,8 @@
  * lagsimctl: the control requests of a running lagsimd from a shell.
  *
  *   lagsimctl [--prefix P] [--url URL] [--timeout S] COMMAND [ARGS...]
+ *   COMMAND: status, describe, pause, resume, step N, reset, reset-to Q... QD...,
+ *            set KEY=VALUE, watch
  *
  * Sends one control request on <P>_CONTROL and prints the daemon's answer as text lines
  * (an event, a status, a scene), or with `watch` prints what the daemon publishes until
@@ -49,6 +51,8 @@ static void usage(FILE *f)
             "  step N               while paused: advance N control periods, then pause\n"
             "  reset                back to the scene's initial state at sim time 0\n"
             "  reset-to Q... QD...  back to this state: all positions, then all velocities\n"
+            "  set KEY=VALUE        change a parameter or an effect's setting while running,\n"
+            "                       e.g. set parameters.m2=1.5 (validated as the scene file)\n"
             "  watch                print states, events and statuses until the daemon stops\n"
             "options:\n"
             "  -p, --prefix P       the daemon's channel prefix (default DIPC)\n"
@@ -205,7 +209,7 @@ static void print_scene(const lag_client_scene *sc)
 typedef struct answer {
     const char *want;          /* event kind that says "done" (NULL: none) */
     const char *want2;         /* a second event expected after it (step: step_done) */
-    bool got_event, got_event2, refused, want_status, got_status;
+    bool got_event, got_event2, refused, want_status, got_status, want_scene, got_scene;
     lag_client_event ev;
     bool watch;
     double heard;              /* monotonic s of the last message */
@@ -263,6 +267,10 @@ static void on_scene(const lag_client_scene *sc, void *user)
     answer *a = user;
     a->heard = lag_client_now();
     if (a->watch) print_scene(sc);
+    else if (a->want_scene && a->got_event && !a->refused && !a->got_scene) {
+        a->got_scene = true; /* set: the scene with the change */
+        print_scene(sc);
+    }
 }
 
 /* Handles messages until done(), or until `timeout` wall s have passed (since the
@@ -285,6 +293,7 @@ static bool event_and_status(const answer *a)
     return a->got_event && (a->refused || a->got_status);
 }
 static bool status_only(const answer *a) { return a->got_status; }
+static bool event_and_scene(const answer *a) { return a->got_event && (a->refused || a->got_scene); }
 static bool event_only(const answer *a) { return a->got_event; }
 static bool step_done(const answer *a) { return a->refused || (a->got_event2 && a->got_status); }
 
@@ -347,7 +356,7 @@ int main(int argc, char **argv)
     }
     if (optind >= argc) {
         fprintf(stderr, "lagsimctl: which command? (status, describe, pause, resume, step N, "
-                        "reset, reset-to Q... QD..., watch)\n");
+                        "reset, reset-to Q... QD..., set KEY=VALUE, watch)\n");
         usage(stderr);
         return EXIT_USAGE;
     }
@@ -379,6 +388,14 @@ int main(int argc, char **argv)
             return EXIT_USAGE;
         }
         want_args = nargs;
+    } else if (!strcmp(cmd, "set")) {
+        want_args = 1;
+        const char *eq = nargs == 1 ? strchr(args[0], '=') : NULL;
+        if (nargs == 1 && (!eq || eq == args[0] || !eq[1])) {
+            fprintf(stderr, "lagsimctl: set wants KEY=VALUE, e.g. parameters.m2=1.5, not '%s'\n",
+                    args[0]);
+            return EXIT_USAGE;
+        }
     } else if (strcmp(cmd, "status") && strcmp(cmd, "describe") && strcmp(cmd, "pause") &&
                strcmp(cmd, "resume") && strcmp(cmd, "reset") && strcmp(cmd, "watch")) {
         fprintf(stderr, "lagsimctl: unknown command '%s'\n", cmd);
@@ -419,6 +436,25 @@ int main(int argc, char **argv)
         a.want_status = true;
         rc = lag_client_request_status(c);
         if (rc == LAG_CLIENT_OK) rc = wait_for(c, &a, timeout, false, status_only);
+    } else if (!strcmp(cmd, "set")) {
+        char key[LAG_WIRE_NAME_LEN];
+        size_t klen = (size_t)(strchr(args[0], '=') - args[0]);
+        if (klen >= sizeof key) {
+            fprintf(stderr, "lagsimctl: set: the key is longer than %zu bytes\n", sizeof key - 1);
+            lag_client_destroy(c);
+            return EXIT_USAGE;
+        }
+        memcpy(key, args[0], klen);
+        key[klen] = '\0';
+        a.want = "set";
+        a.want_scene = true;
+        rc = lag_client_set(c, key, args[0] + klen + 1);
+        if (rc == LAG_CLIENT_ERR_ARG) {
+            fprintf(stderr, "lagsimctl: %s\n", lag_client_errmsg(c));
+            lag_client_destroy(c);
+            return EXIT_USAGE;
+        }
+        if (rc == LAG_CLIENT_OK) rc = wait_for(c, &a, timeout, false, event_and_scene);
     } else if (!strcmp(cmd, "watch")) {
         a.watch = true;
         /* until the daemon's stop event or a signal; a daemon that is not there yet is

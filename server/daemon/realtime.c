@@ -83,6 +83,8 @@ _Static_assert(sizeof ev_limits / sizeof ev_limits[0] == RT_EV_COUNT, "one bucke
 #define RT_STATUS_BURST 5
 #define RT_SCENE_PER_S 5
 #define RT_SCENE_BURST 2
+#define RT_SET_PER_S 10     /* SET requests validated per second (each parses the scene) */
+#define RT_SET_BURST 10
 #define RT_STATE_PER_S 20  /* states published because of a reset (not the periods' own) */
 #define RT_STATE_BURST 5
 
@@ -519,6 +521,79 @@ static void control_rejected(rt_server *s, const char *why)
     s->want_status = true;
 }
 
+/* SET key=value: the change is validated by the scene loader itself, on the scene's own
+ * bytes with its --set overrides, the changes already made and this one after them (so
+ * every rule of a scene file holds, with its message), then by the core against the state
+ * the run is in; it takes effect before the next period. Only keys under parameters and
+ * effects change while running. The answer: a `set` event whose detail is exactly
+ * "key=value" (what --replay re-applies at the event's step) and the new scene. */
+static void handle_set(rt_server *s, const lag_wire_control *c)
+{
+    char kv[LAG_WIRE_TEXT_LEN];
+    bool under = !strncmp(c->key, "parameters", 10) || !strncmp(c->key, "effects", 7);
+    size_t root = !strncmp(c->key, "parameters", 10) ? 10 : 7;
+    if (!under || (c->key[root] != '\0' && c->key[root] != '.') || strchr(c->key, '=')) {
+        control_rejected(s, "set: only keys under parameters and effects change while running "
+                            "(e.g. parameters.m2, effects.friction.q2.kinetic)");
+        return;
+    }
+    if (!c->value[0] || snprintf(kv, sizeof kv, "%s=%s", c->key, c->value) >= (int)sizeof kv) {
+        control_rejected(s, "set: the value is empty, or key=value is longer than 255 bytes");
+        return;
+    }
+    if (!s->opts || !s->opts->scene_text) {
+        control_rejected(s, "set: this daemon has no scene source to validate a change against");
+        return;
+    }
+    if (!rt_limit_take(&s->lim_set, s->now)) {
+        control_rejected(s, "set: more than 10 changes a second; this one was not applied");
+        return;
+    }
+    /* the scene's sets, the changes so far, this one */
+    int nbase = s->opts->nsets;
+    const char **all = malloc(sizeof *all * (size_t)(nbase + s->n_live_sets + 1));
+    static lag_scene ns; /* large: not on the stack; used by this function only */
+    char err[512], why[1024];
+    if (!all) {
+        control_rejected(s, "set: out of memory");
+        return;
+    }
+    for (int i = 0; i < nbase; i++) all[i] = s->opts->sets[i];
+    for (int i = 0; i < s->n_live_sets; i++) all[nbase + i] = s->live_set[i];
+    all[nbase + s->n_live_sets] = kv;
+    int rc = lag_scene_load_buffer(s->opts->scene_name, s->opts->scene_text, s->opts->scene_len,
+                                   all, nbase + s->n_live_sets + 1, &ns, err, sizeof err);
+    free(all);
+    if (rc != 0) {
+        snprintf(why, sizeof why, "set %s: %s", kv, err);
+        control_rejected(s, why);
+        return;
+    }
+    if (lag_sim_redefine(&s->sim, &ns.sim, err, sizeof err) != LAG_OK) {
+        snprintf(why, sizeof why, "set %s: at the current state: %s", kv, err);
+        control_rejected(s, why);
+        return;
+    }
+    /* keep it: it overrides earlier changes of the same key and of keys below it */
+    size_t klen = strlen(c->key);
+    int k = 0;
+    for (int i = 0; i < s->n_live_sets; i++) {
+        const char *e = s->live_set[i];
+        bool overridden = !strncmp(e, c->key, klen) && (e[klen] == '=' || e[klen] == '.');
+        if (!overridden && k != i) memcpy(s->live_set[k], e, sizeof s->live_set[k]);
+        if (!overridden) k++;
+    }
+    s->n_live_sets = k;
+    if (s->n_live_sets == RT_MAX_LIVE_SETS) { /* cannot happen with the scene's few keys */
+        memmove(s->live_set[0], s->live_set[1], sizeof s->live_set[0] * (RT_MAX_LIVE_SETS - 1));
+        s->n_live_sets--;
+    }
+    memcpy(s->live_set[s->n_live_sets++], kv, sizeof kv);
+    rt_publish_event(s, "set", "", 0, kv);
+    s->want_scene = true;
+    s->want_status = true;
+}
+
 /* Lockstep, when the run goes on (resume, step): the state already published is waited
  * on afresh; if none is, it is published. */
 static void lockstep_rewait(rt_server *s)
@@ -603,6 +678,9 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
         break; /* the status below is the answer */
     case LAGSIM_CONTROL_T_DESCRIBE:
         s->want_scene = true;
+        return;
+    case LAGSIM_CONTROL_T_SET:
+        handle_set(s, &c);
         return;
     default:
         control_rejected(s, "control: unknown request");
@@ -728,6 +806,7 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     rt_limit_init(&s->lim_status, RT_STATUS_PER_S, RT_STATUS_BURST, now);
     rt_limit_init(&s->lim_scene, RT_SCENE_PER_S, RT_SCENE_BURST, now);
     rt_limit_init(&s->lim_state, RT_STATE_PER_S, RT_STATE_BURST, now);
+    rt_limit_init(&s->lim_set, RT_SET_PER_S, RT_SET_BURST, now);
 
     return LAGSIMD_EXIT_OK;
 }

@@ -20,6 +20,7 @@
 
 #define RT_CHANNEL_MAX LAG_BUS_CHANNEL_LEN /* prefix (< 64) + "_COMMAND" */
 #define RT_BUF_SIZE LAG_WIRE_BUF_SIZE /* encode buffer: holds any message */
+#define RT_MAX_LIVE_SETS 64   /* distinct keys changed while running */
 
 /* RT_WAITING: not advancing, waiting for a command that starts the run (realtime.start:
  * first_command) or, in lockstep, for one that answers the state whose wait timed out; the
@@ -124,6 +125,13 @@ typedef struct rt_server {
      * requests gets one answer, not one each) */
     bool want_state, want_scene, want_status;
     rt_limit lim_state, lim_scene, lim_status;
+    rt_limit lim_set;          /* SET requests validated per second */
+
+    /* changes made while running (control_t SET), in the order they were applied, each
+     * "key=value" as on the command line; a key set again replaces the entries it
+     * overrides (itself and the keys below it), so the list stays short */
+    char live_set[RT_MAX_LIVE_SETS][LAG_WIRE_TEXT_LEN];
+    int n_live_sets;
     rt_limit lim_event[RT_EV_COUNT];
 
     /* counters published in status */

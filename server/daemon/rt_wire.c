@@ -165,7 +165,7 @@ void rt_publish_event_at(rt_server *s, double sim_time, const char *kind, const 
 
 void rt_publish_scene(rt_server *s)
 {
-    const lag_sim_def *d = &s->sc->sim;
+    const lag_sim_def *d = &s->sim.def; /* the parameters and effects now (SET changes them) */
     lag_wire_scene m;
     memset(&m, 0, sizeof m);
     m.utime = rt_wall_us();

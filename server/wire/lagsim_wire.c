@@ -61,6 +61,8 @@ static const lag_wire_field control_fields[] = {
     COUNT(CT, num_joints, LAG_WIRE_MAX_JOINTS, true),           /* 3 */
     ARRAY(CT, LAG_WIRE_DOUBLE, q, 3),
     ARRAY(CT, LAG_WIRE_DOUBLE, qd, 3),
+    STRING(CT, key),
+    STRING(CT, value),
 };
 
 typedef lag_wire_event EV;

@@ -99,7 +99,7 @@ typedef struct lag_wire_joint_command {
     double effort[LAG_WIRE_MAX_JOINTS];
 } lag_wire_joint_command;
 
-/* <PREFIX>_CONTROL: pause, resume, step, reset, reset_to, status, describe. */
+/* <PREFIX>_CONTROL: pause, resume, step, reset, reset_to, status, describe, set. */
 typedef struct lag_wire_control {
     int64_t utime;
     int8_t request;                                  /* LAGSIM_CONTROL_T_* */
@@ -107,6 +107,8 @@ typedef struct lag_wire_control {
     int16_t num_joints;                              /* RESET_TO */
     double q[LAG_WIRE_MAX_JOINTS];
     double qd[LAG_WIRE_MAX_JOINTS];
+    char key[LAG_WIRE_NAME_LEN];                     /* SET: parameters.m2, effects.... */
+    char value[LAG_WIRE_TEXT_LEN];                   /* SET: YAML */
 } lag_wire_control;
 
 /* <PREFIX>_EVENT: something happened. */

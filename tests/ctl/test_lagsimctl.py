@@ -15,6 +15,8 @@ A real-time daemon on config/dipc.yaml with a prefix of its own; then, in order:
   reset-to    (paused) exit 0; the next state is the one asked for, bit for bit
   reset-to with 2 numbers for 3 joints: exit 1, the daemon's reason
   reset       exit 0, `event reset`, status at step 0
+  set         parameters.m0=2.5: exit 0, `event set`, the scene with the new value; a value
+              the loader refuses, or a key outside parameters and effects: exit 1, the reason
   usage       step 0, step abc, reset-to 1 2 3, an unknown command: exit 2, nothing sent
   no daemon   another prefix: exit 3 within the timeout
   watch       a daemon that runs 1 s and stops: states as lines, the stop event, exit 0
@@ -149,7 +151,20 @@ def main():
         check(r.returncode == 0 and ev and ev[0].startswith("event reset ") and st,
               "reset: exit 0, event reset, a status")
 
+        r = ctl("set", "parameters.m0=2.5")
+        ev, sc = lines(r, "event"), lines(r, "param")
+        check(r.returncode == 0 and ev and ev[0].startswith("event set ") and
+              'detail=parameters.m0=2.5' in ev[0].replace('"', '') and "param m0=2.5" in sc,
+              "set parameters.m0=2.5: exit 0, event set, the scene with m0 = 2.5")
+        r = ctl("set", "parameters.m0=-1")
+        check(r.returncode == 1 and "expected a number > 0" in r.stderr,
+              "set parameters.m0=-1: exit 1, the loader's reason on stderr")
+        r = ctl("set", "integrator.dt=0.002")
+        check(r.returncode == 1 and "only keys under parameters and effects" in r.stderr,
+              "set integrator.dt: exit 1, only parameters and effects change")
+
         for bad in (["step", "0"], ["step", "abc"], ["reset-to", "1", "2", "3"], ["spin"],
+                    ["set", "m0"], ["set", "=1"], ["set", "parameters.m0="],
                     ["status", "extra"], ["--timeout", "-1", "status"]):
             r = ctl(*bad)
             check(r.returncode == 2 and r.stderr.startswith("lagsimctl: "),

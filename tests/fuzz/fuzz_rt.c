@@ -266,7 +266,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 q[i] = dbl(&b);
                 qd[i] = dbl(&b);
             }
-            lagsim_control_t m = {0, (int8_t)req, count, (int16_t)nv, q, qd};
+            lagsim_control_t m = {0, (int8_t)req, count, (int16_t)nv, q, qd, "", ""};
             int n = lagsim_control_t_encode(buf, 0, sizeof buf, &m);
             if (n > 0) rt_handle_control(&g_s, buf, (size_t)n);
             handler_done(before);

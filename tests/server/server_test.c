@@ -328,7 +328,7 @@ static int count_events(const client *c, const char *kind)
 
 static void control(client *c, int req, int64_t count, int n, double *q, double *qd)
 {
-    lagsim_control_t m = {0, (int8_t)req, count, (int16_t)n, q, qd};
+    lagsim_control_t m = {0, (int8_t)req, count, (int16_t)n, q, qd, "", ""};
     lagsim_control_t_publish(c->lcm_in, c->ch_control, &m);
 }
 

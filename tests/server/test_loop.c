@@ -9,7 +9,7 @@
  * (rate 1e25, status_hz 1e-300, lockstep_timeout 1e300, a period of 1e12 ticks) reach the
  * server: it must stay bounded for any value.
  *
- *   test_loop CASE    CASE: pacing rate_huge status_hz lockstep_wait start long_period chunks
+ *   test_loop CASE    CASE: pacing rate_huge status_hz lockstep_wait start set long_period chunks
  *                           step_paced control_flood command_flood duration signals
  *                           fault_effort lockstep_retry lockstep_loss
  */
@@ -291,7 +291,7 @@ static void run_until(int64_t until, int64_t cost)
 static void control(int req, int64_t count)
 {
     uint8_t buf[256];
-    lagsim_control_t m = {0, (int8_t)req, count, 0, NULL, NULL};
+    lagsim_control_t m = {0, (int8_t)req, count, 0, NULL, NULL, "", ""};
     int n = lagsim_control_t_encode(buf, 0, sizeof buf, &m);
     ENSURE(n > 0);
     rt_handle_control(&g_srv, buf, (size_t)n);
@@ -484,6 +484,118 @@ static void case_start(void)
     start();
     run_until(g_srv.now + 1 * SEC, 1000);
     ENSURE(g_srv.sim.tick == 1000 && g_srv.run == RT_RUNNING);
+    stop_server();
+}
+
+/* A control request SET key=value, as lagsimctl sends it. */
+static void set_request(const char *key, const char *value)
+{
+    lag_wire_control m;
+    memset(&m, 0, sizeof m);
+    m.request = LAGSIM_CONTROL_T_SET;
+    snprintf(m.key, sizeof m.key, "%s", key);
+    snprintf(m.value, sizeof m.value, "%s", value);
+    uint8_t buf[LAG_WIRE_BUF_SIZE];
+    int n = lag_wire_encode_control(&m, buf, sizeof buf);
+    ENSURE(n > 0);
+    rt_handle_control(&g_srv, buf, (size_t)n);
+}
+
+/* Changes while running (control_t SET) on a manipulator scene given as text, paused, run
+ * by STEP in fast mode:
+ *  - parameters.m2 = 1.25 after 500 ticks: the `set` event's detail is exactly
+ *    "parameters.m2=1.25", the scene is published again, and the next 500 ticks equal, bit
+ *    for bit, a fresh simulation of the scene loaded with --set parameters.m2=1.25 and
+ *    started from the state at the change (no hidden state is carried over);
+ *  - a value the loader refuses is refused with the loader's own message for the same
+ *    --set on the same text, and nothing changes;
+ *  - keys outside parameters and effects are refused; so is a stop that excludes where
+ *    the joint is now (the core's check at the current state), though it includes the
+ *    initial state;
+ *  - a burst of 30 requests: 10 are validated, the rest refused (each is a scene parse). */
+static void case_set(void)
+{
+    static const char text[] =
+        "model: manipulator\n"
+        "parameters: {m1: 2.0, m2: 0.5, l1: 0.3, I1: 0.02, I2: 0.05, g: 9.81}\n"
+        "initial: {q: [0.3, 0.5], qd: [0, 0]}\n"
+        "realtime: {mode: fast, start: paused}\n"
+        "lcm: {prefix: TL}\n";
+    char err[1024];
+    ENSURE(lag_scene_load_buffer("set.yaml", text, sizeof text - 1, NULL, 0, &g_sc, err, sizeof err) == 0);
+    memset(&g_opts, 0, sizeof g_opts);
+    g_opts.quiet = true;
+    g_opts.scene_name = "set.yaml";
+    g_opts.scene_text = text;
+    g_opts.scene_len = sizeof text - 1;
+    start();
+    control(LAGSIM_CONTROL_T_STEP, 50);
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSURE(g_srv.sim.tick == 500);
+    double q[LAG_MAX_DOF], qd[LAG_MAX_DOF];
+    memcpy(q, g_srv.sim.q, sizeof q);
+    memcpy(qd, g_srv.sim.qd, sizeof qd);
+    int64_t scenes = g_out.scene;
+    set_request("parameters.m2", "1.25");
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("set") == 1 && !strcmp(last_detail("set"), "parameters.m2=1.25"),
+            "%lld set events, detail '%s'", (long long)n_events("set"), last_detail("set"));
+    ENSURE(g_out.scene == scenes + 1 && g_srv.sim.def.model.p[LAG_MANIP_M2] == 1.25);
+    control(LAGSIM_CONTROL_T_STEP, 50);
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSURE(g_srv.sim.tick == 1000);
+    /* the reference: the scene with the change, from the state at the change */
+    static lag_scene ref_sc;
+    const char *set1[] = {"parameters.m2=1.25"};
+    ENSURE(lag_scene_load_buffer("set.yaml", text, sizeof text - 1, set1, 1, &ref_sc, err, sizeof err) == 0);
+    static lag_sim ref;
+    ENSURE(lag_sim_init(&ref, &ref_sc.sim, err, sizeof err) == LAG_OK);
+    lag_sim_reset(&ref, q, qd);
+    for (int k = 0; k < 50; k++) ENSURE(lag_sim_advance(&ref, 10, false) == LAG_OK);
+    ENSUREF(!memcmp(ref.q, g_srv.sim.q, sizeof ref.q) && !memcmp(ref.qd, g_srv.sim.qd, sizeof ref.qd),
+            "after the change: q1 %.17g vs %.17g", g_srv.sim.q[0], ref.q[0]);
+
+    /* refused as the loader refuses it, with its message; nothing changes */
+    const char *bad[] = {"parameters.m2=-1"};
+    char lerr[1024], want[1200];
+    ENSURE(lag_scene_load_buffer("set.yaml", text, sizeof text - 1, bad, 1, &ref_sc, lerr, sizeof lerr) != 0);
+    snprintf(want, sizeof want, "set parameters.m2=-1: %s", lerr);
+    int64_t rejected = n_events("control_rejected");
+    set_request("parameters.m2", "-1");
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("control_rejected") == rejected + 1 && !strcmp(last_detail("control_rejected"), want),
+            "refusal '%s', the loader says '%s'", last_detail("control_rejected"), want);
+    ENSURE(g_srv.sim.def.model.p[LAG_MANIP_M2] == 1.25);
+
+    /* outside parameters and effects */
+    const char *keys[] = {"integrator.dt", "initial.q", "parametersx.m2", "effects_", "realtime.rate"};
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
+        rejected = n_events("control_rejected");
+        set_request(keys[i], "1");
+        run_until(g_srv.now + 10 * MS, 1000);
+        ENSUREF(n_events("control_rejected") == rejected + 1 &&
+                    strstr(last_detail("control_rejected"), "only keys under parameters and effects"),
+                "%s: '%s'", keys[i], last_detail("control_rejected"));
+    }
+    /* a stop around the initial q2 = 0.5 that leaves out where q2 is now */
+    ENSUREF(g_srv.sim.q[1] > 0.52 || g_srv.sim.q[1] < 0.48, "q2 = %g", g_srv.sim.q[1]);
+    rejected = n_events("control_rejected");
+    set_request("effects.limits", "{q2: {lower: 0.48, upper: 0.52}}");
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("control_rejected") == rejected + 1 &&
+                strstr(last_detail("control_rejected"), "at the current state"),
+            "'%s'", last_detail("control_rejected"));
+    ENSURE(!(g_srv.sim.def.effects.enabled & LAG_EFF_LIMITS));
+
+    /* a burst */
+    int64_t sets = n_events("set");
+    rejected = n_events("control_rejected");
+    run_until(g_srv.now + 2 * SEC, 1000); /* the bucket fills up again */
+    for (int k = 0; k < 30; k++) set_request("parameters.m1", k % 2 ? "2.5" : "2.0");
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("set") - sets == 10, "%lld of 30 applied", (long long)(n_events("set") - sets));
+    ENSURE(g_srv.controls_rejected >= 20);
+    ENSURE(g_srv.n_live_sets == 2); /* m2 and m1: a key set again replaces itself */
     stop_server();
 }
 
@@ -836,7 +948,7 @@ int main(int argc, char **argv)
     } cases[] = {
         {"pacing", case_pacing},           {"rate_huge", case_rate_huge},
         {"status_hz", case_status_hz},     {"lockstep_wait", case_lockstep_wait},
-        {"start", case_start},
+        {"start", case_start},             {"set", case_set},
         {"long_period", case_long_period}, {"chunks", case_chunks},
         {"step_paced", case_step_paced},   {"control_flood", case_control_flood},
         {"command_flood", case_command_flood}, {"duration", case_duration},

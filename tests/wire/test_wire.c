@@ -187,7 +187,7 @@ static void check_agreement(void)
     }
     {
         double q[2] = {0.1, 0.2}, qd[2] = {-0.3, 0.4};
-        lagsim_control_t g = {7, LAGSIM_CONTROL_T_RESET_TO, INT64_MAX, 2, q, qd};
+        lagsim_control_t g = {7, LAGSIM_CONTROL_T_RESET_TO, INT64_MAX, 2, q, qd, "", ""};
         int nt = lagsim_control_t_encode(theirs, 0, sizeof theirs, &g);
         lag_wire_control w;
         memset(&w, 0, sizeof w);
@@ -197,6 +197,18 @@ static void check_agreement(void)
         w.num_joints = 2;
         memcpy(w.q, q, sizeof q);
         memcpy(w.qd, qd, sizeof qd);
+        agree(LAG_WIRE_CONTROL, &w, nt);
+    }
+    {
+        lagsim_control_t g = {8, LAGSIM_CONTROL_T_SET, 0, 0, NULL, NULL, "effects.friction.q2",
+                              "{static: 0.3, kinetic: 0.2}"};
+        int nt = lagsim_control_t_encode(theirs, 0, sizeof theirs, &g);
+        lag_wire_control w;
+        memset(&w, 0, sizeof w);
+        w.utime = 8;
+        w.request = LAGSIM_CONTROL_T_SET;
+        snprintf(w.key, sizeof w.key, "effects.friction.q2");
+        snprintf(w.value, sizeof w.value, "{static: 0.3, kinetic: 0.2}");
         agree(LAG_WIRE_CONTROL, &w, nt);
     }
     {

@@ -199,6 +199,8 @@ public final class Controller {
                     req.request = control_t.DESCRIBE;
                     req.q = new double[0];
                     req.qd = new double[0];
+                    req.key = "";
+                    req.value = "";
                     lcmCmd.publish(ch + "CONTROL", req);
                     nextAsk = now + 250_000_000L;
                 }
