@@ -83,8 +83,6 @@ _Static_assert(sizeof ev_limits / sizeof ev_limits[0] == RT_EV_COUNT, "one bucke
 #define RT_STATUS_BURST 5
 #define RT_SCENE_PER_S 5
 #define RT_SCENE_BURST 2
-#define RT_SET_PER_S 10     /* SET requests validated per second (each parses the scene) */
-#define RT_SET_BURST 10
 #define RT_STATE_PER_S 20  /* states published because of a reset (not the periods' own) */
 #define RT_STATE_BURST 5
 

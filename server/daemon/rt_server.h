@@ -21,6 +21,11 @@
 #define RT_CHANNEL_MAX LAG_BUS_CHANNEL_LEN /* prefix (< 64) + "_COMMAND" */
 #define RT_BUF_SIZE LAG_WIRE_BUF_SIZE /* encode buffer: holds any message */
 #define RT_MAX_LIVE_SETS 64   /* distinct keys changed while running */
+/* SET requests validated per second and burst (each parses the scene): a SET is either
+ * applied and announced by its `set` event, which is never suppressed (replay re-applies
+ * it), or refused; so `set` events stay within this bucket */
+#define RT_SET_PER_S 10
+#define RT_SET_BURST 10
 
 /* RT_WAITING: not advancing, waiting for a command that starts the run (realtime.start:
  * first_command) or, in lockstep, for one that answers the state whose wait timed out; the

@@ -7,7 +7,8 @@
  * tables that include absurd values a scene file would refuse: rate 1e25, status_hz
  * 1e-300, lockstep_timeout 1e300, an effort limit of infinity, ...); the rest is a sequence of operations: raw bytes
  * to rt_handle_command / rt_handle_control, well-formed commands and controls with
- * arbitrary numbers, clock advances with loop wake-ups, signals.
+ * arbitrary numbers (SET with keys and values from a table, against a scene text of the
+ * same model and integrator), clock advances with loop wake-ups, signals.
  *
  * Checked for every input: no crash or undefined behaviour (ASan/UBSan), no number that
  * is NaN or Inf in any message published, the sim's state finite unless in the fault
@@ -72,7 +73,7 @@ static double dbl(bytes *b)
 /* ---------------------------------------------------------------- what is published */
 typedef struct counts {
     int64_t state, status, scene, event;
-    int64_t ev_kind[RT_EV_COUNT + 2]; /* limited kinds, then start/stop, then others */
+    int64_t ev_kind[RT_EV_COUNT + 3]; /* limited kinds, then start/stop, set, others */
 } counts;
 static counts g_c;
 static const char *const k_limited[RT_EV_COUNT] = {
@@ -125,6 +126,8 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         for (int i = 0; i < RT_EV_COUNT; i++)
             if (!strcmp(m.kind, k_limited[i])) k = i;
         if (!strcmp(m.kind, "start") || !strcmp(m.kind, "stop")) k = RT_EV_COUNT;
+        if (!strcmp(m.kind, "set")) k = RT_EV_COUNT + 1; /* never suppressed: SET's bucket */
+        if (k == RT_EV_COUNT + 2) fprintf(stderr, "fuzz_rt: event of kind %s\n", m.kind);
         g_c.ev_kind[k]++;
         g_c.event++;
     } else if (!strcmp(sfx, "SCENE")) {
@@ -218,7 +221,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (int i = 0; i < LAG_MAX_DOF; i++)
         if (g_sc.realtime.effort_limit[i] > 0) g_sc.realtime.effort_limit[i] = elim;
     snprintf(g_sc.lcm.prefix, sizeof g_sc.lcm.prefix, "FZ");
-    lagsimd_opts opts = {.quiet = true, .duration = 0.0, .csv = NULL};
+    /* the scene's source for SET: the same model and integrator as built above */
+    static char text[256];
+    int tlen = snprintf(text, sizeof text, "model: %s\nintegrator: {method: %s, dt: 0.001}\n",
+                        lag_model_info_get(g_sc.sim.model.kind)->name,
+                        lag_method_name(g_sc.sim.integrator.method));
+    lagsimd_opts opts = {.quiet = true, .duration = 0.0, .csv = NULL, .scene_name = "fuzz.yaml",
+                         .scene_text = text, .scene_len = (size_t)tlen};
     if (u8(&b) % 4 == 0) opts.duration = dbl(&b);
 
     memset(&g_c, 0, sizeof g_c);
@@ -266,7 +275,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 q[i] = dbl(&b);
                 qd[i] = dbl(&b);
             }
-            lagsim_control_t m = {0, (int8_t)req, count, (int16_t)nv, q, qd, "", ""};
+            /* SET: a key (parameters, damping: no effect that publishes events, which the
+             * bounds above do not count; and keys that are refused) and a value */
+            static const char *const k_keys[] = {"parameters.m", "parameters.m1", "parameters.g",
+                                                 "parameters.l2", "effects.damping", "effects",
+                                                 "integrator.dt", "parametersx", ""};
+            static const char *const k_values[] = {"1.5", "-1", "0", "1e300", "{}", "abc", "[1, 2]",
+                                                   "{theta0: 0.5}", "{q1: 0.2, q2: 1e9}", "{x: .nan}"};
+            char *key = (char *)PICK(k_keys, &b), *value = (char *)PICK(k_values, &b);
+            lagsim_control_t m = {0, (int8_t)req, count, (int16_t)nv, q, qd, key, value};
             int n = lagsim_control_t_encode(buf, 0, sizeof buf, &m);
             if (n > 0) rt_handle_control(&g_s, buf, (size_t)n);
             handler_done(before);
@@ -355,7 +372,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                     k_limited[k], secs);
             abort();
         }
-    if (g_c.ev_kind[RT_EV_COUNT] > 2 || g_c.ev_kind[RT_EV_COUNT + 1] > 0) bad("unexpected event kinds");
+    if (g_c.ev_kind[RT_EV_COUNT] > 2 || g_c.ev_kind[RT_EV_COUNT + 2] > 0) bad("unexpected event kinds");
+    /* a SET is applied (its set event) or refused (a control_rejected) within its bucket */
+    if ((double)g_c.ev_kind[RT_EV_COUNT + 1] > RT_SET_BURST + RT_SET_PER_S * secs + 1) bad("too many set events");
     /* statuses: the first and the last, bucket 5 + 20/s, periodic at most 100/s */
     if ((double)g_c.status > 2 + 5 + 20 * secs + 100 * secs + 1) bad("too many statuses");
     if ((double)g_c.scene > 1 + 2 + 5 * secs + 1) bad("too many scene descriptions");
