@@ -13,7 +13,8 @@ lcm.jar:types.jar:examples.jar File.java). Once it answers a probe state (sim ti
 The snippet must exit by itself with status 0 once the daemon announces its stop; the
 daemon's final status must show every state before t = 2 s answered (200
 commands_accepted, no lockstep timeout), and every state heard must keep both rods within 0.1 rad of
-upright (the shipped scene starts at 0.05 rad).
+upright (the shipped scene starts at 0.05 rad). Everything runs on a multicast port of this
+run's own (LCM_DEFAULT_URL): nothing of it may be heard on LCM's default URL.
 """
 import argparse
 import math
@@ -57,6 +58,16 @@ def main():
     ap.add_argument("names", nargs="+")
     a = ap.parse_args()
     build = os.path.abspath(a.build)
+    # The snippet, the daemon and this script meet on LCM's default URL with a multicast
+    # port of this run's own (ttl=0: this host), through LCM_DEFAULT_URL, which every
+    # binding reads (the snippets name no URL, as a user's controller would not): on one
+    # port every socket gets every datagram, so another run on the machine (a concurrent
+    # ctest of another snippet, a fast-mode daemon, a flood test) would be heard here and
+    # fill these sockets. The prefix stays unique as well. Receive buffers of 4 MB, as the
+    # other client tests (run_e2e.py).
+    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
+                                     % (20000 + 2 * (os.getpid() % 6000)))  # and the next port
+    print("LCM_DEFAULT_URL=%s" % os.environ["LCM_DEFAULT_URL"])
     sys.path.insert(0, os.path.join(build, "python"))
     from lagsim_lcm import LCM, plant_urls
     from lagsim import joint_command_t, joint_state_t, status_t
@@ -105,6 +116,14 @@ def main():
             if joint_command_t.decode(data).sim_time == -1.0:
                 heard["ready"] = True
 
+        # LCM's own default URL must hear nothing of this run: it is on its own port
+        stray = LCM("udpm://239.255.76.67:7667?ttl=0")
+        heard["stray"] = 0
+
+        def on_stray(ch, data):
+            heard["stray"] += 1
+
+        stray.subscribe(prefix + "_.*", on_stray)
         lc.subscribe(prefix + "_STATE", on_state)
         lc.subscribe(prefix + "_STATUS", on_status)
         lc_cmd.subscribe(prefix + "_COMMAND", on_command)
@@ -115,6 +134,8 @@ def main():
             while listening[0]:
                 lc.handle_timeout(20)
                 while lc_cmd.handle_timeout(0):
+                    pass
+                while stray.handle_timeout(0):
                     pass
 
         th = threading.Thread(target=listen)
@@ -148,6 +169,7 @@ def main():
         th.join()
         lc.close()
         lc_cmd.close()
+        stray.close()
         st = heard["status"]
         acc = st.commands_accepted if st else -1
         lto = st.lockstep_timeouts if st else -1
@@ -160,6 +182,9 @@ def main():
             (heard["states"] > 0 and heard["max_th"] < 0.1 and math.isfinite(heard["max_th"]),
              "balanced: %d states heard, largest |theta1|, |theta2| %.4f rad"
              % (heard["states"], heard["max_th"])),
+            (heard["stray"] == 0,
+             "on a port of its own: %d of its messages heard on LCM's default URL"
+             % heard["stray"]),
         ]
         print("---- %s (%s)" % (name, path))
         if out.strip():
