@@ -114,13 +114,14 @@ lag_result lag_step_semi_implicit_euler(lag_sim *s, double h, const double *y0, 
 lag_result lag_step_rk4(lag_sim *s, double h, const double *y0, double *y1);
 lag_result lag_step_gauss(lag_sim *s, int stages, double h, const double *y0, double *y1);
 lag_result lag_dopri5_span(lag_sim *s, double h, const double *y0, double *y1);
-/* An adaptive method's own advance of n ticks (its row's `advance`). */
-lag_result lag_adaptive_advance(lag_sim *s, int64_t n, bool continuous);
+/* An adaptive method's own advance of n ticks of a span that ends at tick `stop`, where the
+ * input may change (INT64_MAX: none; see lag_sim_advance_within). Its row's `advance`. */
+lag_result lag_adaptive_advance(lag_sim *s, int64_t n, int64_t stop);
 /* The method table has no hole: a name, a step, an order for every row, an advance
  * exactly for the adaptive ones, unique names (core.models.info checks it). */
 bool lag_method_table_ok(void);
 /* dopri5 without events: advances the public state to tick + n (see lag_sim_advance). */
-lag_result lag_dopri5_advance(lag_sim *s, int64_t n, bool continuous);
+lag_result lag_dopri5_advance(lag_sim *s, int64_t n, int64_t stop);
 
 /* Forward dynamics with the effects' locked joints held (qdd_i = qd_i = 0) and the
  * constraint forces lambda_i (M qdd = Q - h + lambda) they need. lambda may be NULL. */

@@ -11,7 +11,7 @@ typedef struct method_class {
     lag_result (*step)(lag_sim *s, double h, const double *y0, double *y1);
     /* adaptive methods: n ticks of the public state without stopping at each tick
      * (lag_sim_advance's path when no effect needs the tick boundaries) */
-    lag_result (*advance)(lag_sim *s, int64_t n, bool continuous);
+    lag_result (*advance)(lag_sim *s, int64_t n, int64_t stop);
 } method_class;
 
 static lag_result step_midpoint(lag_sim *s, double h, const double *y0, double *y1)
@@ -133,9 +133,9 @@ lag_result lag_step(lag_sim *s, double h, const double *y0, double *y1)
     return methods[s->def.integrator.method].step(s, h, y0, y1);
 }
 
-lag_result lag_adaptive_advance(lag_sim *s, int64_t n, bool continuous)
+lag_result lag_adaptive_advance(lag_sim *s, int64_t n, int64_t stop)
 {
-    return methods[s->def.integrator.method].advance(s, n, continuous);
+    return methods[s->def.integrator.method].advance(s, n, stop);
 }
 
 bool lag_method_table_ok(void)

@@ -2,9 +2,10 @@
  * Dormand-Prince 5(4) with the FSAL property, step-size control on the embedded 4th-order
  * error (Hairer, Norsett & Wanner, Solving ODEs I, II.4-II.6, code DOPRI5), and its
  * 4th-order dense output. The internal time/state (s->dp) may run ahead of the public
- * state in continuous mode; the public state at each tick boundary is then interpolated.
- * In hard-stop mode the last step is shortened to land on the end exactly (needed when the
- * input changes there: the right-hand side is discontinuous at that instant).
+ * state; the public state at each tick boundary is then interpolated. A step that would
+ * cross the stop (the end of the span over which the input holds) is shortened to land on
+ * it exactly (needed when the input changes there: the right-hand side is discontinuous
+ * at that instant); without a stop (continuous mode) steps run past the end.
  */
 #include <math.h>
 #include <string.h>
@@ -118,13 +119,15 @@ static double step_factor(double en, bool last_rejected)
 }
 
 /* The adaptive loop shared by both drivers: from (*t, y, k1 = f(y)) up to t_end, in at
- * most max_steps attempts (accepted or rejected; then LAG_ERR_MAX_STEPS). In hard-stop
- * mode the last step is shortened to land on t_end exactly; in continuous mode it may
- * step past t_end. With `dense`, each accepted step leaves its dense-output coefficients
- * (and start time) in s->dp for interpolation. An accepted state that is non-finite or
- * beyond explode_limit is an error; y and *t then hold the last good step. */
-static lag_result dp_run(lag_sim *s, double *t, double t_end, double *y, double *k1,
-                         bool continuous, bool dense, int64_t max_steps)
+ * most max_steps attempts (accepted or rejected; then LAG_ERR_MAX_STEPS). A step that
+ * would reach t_stop (>= t_end; INFINITY: none) is shortened to land on it exactly; other
+ * steps may step past t_end. Which steps are taken therefore depends on t_stop, not on
+ * t_end: a span to t_stop run in pieces takes the steps of one run. With `dense`, each
+ * accepted step leaves its dense-output coefficients (and start time) in s->dp for
+ * interpolation. An accepted state that is non-finite or beyond explode_limit is an error;
+ * y and *t then hold the last good step. */
+static lag_result dp_run(lag_sim *s, double *t, double t_end, double t_stop, double *y,
+                         double *k1, bool dense, int64_t max_steps)
 {
     const int N = 2 * s->nq;
     const lag_integrator_def *in = &s->def.integrator;
@@ -135,8 +138,8 @@ static lag_result dp_run(lag_sim *s, double *t, double t_end, double *y, double 
         if (attempts >= max_steps) return LAG_ERR_MAX_STEPS;
         double h = s->dp.h;
         bool lands = false;
-        if (!continuous && *t + h >= t_end) {
-            h = t_end - *t;
+        if (*t + h >= t_stop) {
+            h = t_stop - *t;
             lands = true;
         }
         if (h < in->dt_min && !lands) return LAG_ERR_STEPSIZE;
@@ -163,7 +166,7 @@ static lag_result dp_run(lag_sim *s, double *t, double t_end, double *y, double 
             memcpy(s->dp.rcont, rc, sizeof rc);
             s->dp.t_prev = *t;
         }
-        *t = lands ? t_end : *t + h;
+        *t = lands ? t_stop : *t + h;
         memcpy(y, y1, sizeof(double) * N);
         memcpy(k1, k7, sizeof(double) * N); /* FSAL */
         s->stats.steps_accepted++;
@@ -183,19 +186,20 @@ lag_result lag_dopri5_span(lag_sim *s, double H, const double *y0, double *yout)
     if (H > 0.0) {
         if ((r = lag_sim_rhs(s, y, k1)) != LAG_OK) return r;
         if (!(s->dp.h > 0.0)) s->dp.h = initial_step(s, N, y, k1);
-        if ((r = dp_run(s, &t, H, y, k1, false, false, s->def.integrator.max_steps)) != LAG_OK)
+        if ((r = dp_run(s, &t, H, H, y, k1, false, s->def.integrator.max_steps)) != LAG_OK)
             return r;
     }
     for (int i = 0; i < N; i++) yout[i] = y[i];
     return LAG_OK;
 }
 
-lag_result lag_dopri5_advance(lag_sim *s, int64_t nticks, bool continuous)
+lag_result lag_dopri5_advance(lag_sim *s, int64_t nticks, int64_t stop)
 {
     const int n = s->nq, N = 2 * n;
     const double t_start = lag_sim_time(s);
     const int64_t tick_end = s->tick + nticks;
     const double t_end = (double)tick_end * s->def.integrator.dt;
+    const double t_stop = stop == INT64_MAX ? INFINITY : (double)stop * s->def.integrator.dt;
     lag_result r;
 
     /* (Re)start from the public state when the internal one is not continuous with it. */
@@ -211,7 +215,7 @@ lag_result lag_dopri5_advance(lag_sim *s, int64_t nticks, bool continuous)
     /* max_steps per tick over the n ticks (saturated) */
     const int64_t budget = nticks > INT64_MAX / s->def.integrator.max_steps
                                ? INT64_MAX : nticks * s->def.integrator.max_steps;
-    if ((r = dp_run(s, &s->dp.t, t_end, s->dp.y, s->dp.k1, continuous, true, budget)) != LAG_OK) {
+    if ((r = dp_run(s, &s->dp.t, t_end, t_stop, s->dp.y, s->dp.k1, true, budget)) != LAG_OK) {
         s->dp.valid = false;
         return r;
     }

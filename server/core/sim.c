@@ -376,7 +376,7 @@ void lag_sim_fault_describe(const lag_sim *s, char *buf, size_t len)
     }
 }
 
-lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
+lag_result lag_sim_advance_within(lag_sim *s, int64_t nticks, int64_t stop)
 {
     if (nticks <= 0) return LAG_OK;
     const int n = s->nq;
@@ -389,7 +389,8 @@ lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
     const bool events = s->fx.n_watch > 0;
     const bool adaptive = lag_method_info_get(s->def.integrator.method)->adaptive;
     if (!per_tick && adaptive) {
-        lag_result r = lag_adaptive_advance(s, nticks, continuous);
+        if (stop < s->tick + nticks) stop = s->tick + nticks;
+        lag_result r = lag_adaptive_advance(s, nticks, stop);
         return r == LAG_OK ? r : classify_fault(s, r, s->qd);
     }
     for (int64_t k = 0; k < nticks; k++) {
@@ -415,4 +416,9 @@ lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
         if (!adaptive) s->stats.steps_accepted++; /* an adaptive method counts its own */
     }
     return LAG_OK;
+}
+
+lag_result lag_sim_advance(lag_sim *s, int64_t nticks, bool continuous)
+{
+    return lag_sim_advance_within(s, nticks, continuous ? INT64_MAX : s->tick + nticks);
 }

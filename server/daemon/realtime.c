@@ -282,12 +282,11 @@ static rt_progress period_run(rt_server *s, int64_t *budget)
     int64_t n = s->period_left < *budget ? s->period_left : *budget;
     if (n < 1) return RT_P_MORE;
     *budget -= n;
-    /* dopri5: a chunk that does not end the period may step past its end (dense output
-     * gives the state there), so the steps are those of one call for the period (but for
-     * the step after a rejected one at a chunk boundary: within the tolerances) */
-    bool last = n == s->period_left;
+    /* a chunk of the period, whose input holds to its end: dopri5 steps across the
+     * chunk's end (dense output gives the state there) and lands on the period's, so the
+     * period in chunks is bit-identical to one call for it */
     int64_t t0 = rt_mono_ns();
-    lag_result r = lag_sim_advance(&s->sim, n, !last);
+    lag_result r = lag_sim_advance_within(&s->sim, n, s->sim.tick + s->period_left);
     s->period_us += (double)(rt_mono_ns() - t0) * 1e-3;
     s->period_left -= n;
     s->ticks_since_status += n;

@@ -95,6 +95,79 @@ static void check_rerun(int arg)
            identical, total);
 }
 
+/* ---------------------------------------------------------------- chunks */
+
+/* A span of ticks advanced in chunks with lag_sim_advance_within (as the daemon runs a
+ * long control period) is bit-identical to one hard-stop call for the span, for every model
+ * and method, with the input changed between spans. dopri5 steps across the chunks' ends
+ * and must take the steps of one call, landing on the span's end; two tolerances (one
+ * loose enough that steps are rejected) and random spans and chunk lengths. The case fails
+ * if no dopri5 step ever crossed a chunk's end or none was rejected (it would show
+ * nothing). */
+static void check_chunks(int arg)
+{
+    (void)arg;
+    lt_rng rng = {0xc4u};
+    int identical = 0, total = 0;
+    int64_t crossed = 0, rejected = 0;
+    for (int kind = 0; kind < LAG_MODEL_COUNT; ++kind) {
+        lag_model md;
+        tc_random_model(&rng, (lag_model_kind)kind, &md);
+        double q0[3] = {0}, qd0[3] = {0};
+        tc_random_state(&rng, &md, q0, qd0);
+        tc_motion_start(&rng, &md, q0);
+        for (int mi = 0; mi < LAG_METHOD_COUNT; ++mi) {
+            const bool adaptive = tc_method(mi)->adaptive;
+            for (int tol = 0; tol < (adaptive ? 2 : 1); ++tol) {
+                lag_sim_def def = tc_sim_def(&md, (lag_method)mi, 1e-3, q0, qd0);
+                if (tol) { def.integrator.rtol = 1e-3; def.integrator.atol = 1e-5; }
+                static lag_sim one, chunked;
+                if (tc_sim_init(&one, &def) || tc_sim_init(&chunked, &def)) continue;
+                bool same = true;
+                for (int p = 0; p < 12 && same; ++p) {
+                    const int64_t span = 40 + (int64_t)(lt_next(&rng) % 200);
+                    const int64_t stop = chunked.tick + span;
+                    double tau[LAG_MAX_DOF] = {0};
+                    for (int i = 0; i < md.nq; ++i) tau[i] = lt_uniform(&rng, -0.5, 0.5);
+                    lag_sim_set_input(&one, tau);
+                    lag_sim_set_input(&chunked, tau);
+                    if (tc_advance(&one, span, false)) { same = false; break; }
+                    while (chunked.tick < stop) {
+                        int64_t n = 1 + (int64_t)(lt_next(&rng) % 70);
+                        if (n > stop - chunked.tick) n = stop - chunked.tick;
+                        lag_result r = lag_sim_advance_within(&chunked, n, stop);
+                        if (r != LAG_OK) {
+                            LT_FAIL("lag_sim_advance_within: %s", lag_result_string(r));
+                            same = false;
+                            break;
+                        }
+                        if (adaptive && chunked.tick < stop && chunked.dp.t > lag_sim_time(&chunked))
+                            crossed++;
+                    }
+                    same = same && one.tick == chunked.tick &&
+                           memcmp(one.q, chunked.q, sizeof one.q) == 0 &&
+                           memcmp(one.qd, chunked.qd, sizeof one.qd) == 0;
+                }
+                if (adaptive) rejected += one.stats.steps_rejected;
+                if (!same)
+                    LT_FAIL("%s %s rtol %g: chunked span differs from one call at tick %lld: "
+                            "q0 %.17g vs %.17g",
+                            lag_model_info_get(md.kind)->name, lag_method_name(def.integrator.method),
+                            def.integrator.rtol, (long long)one.tick, chunked.q[0], one.q[0]);
+                else
+                    ENSURE(same);
+                identical += same;
+                total++;
+            }
+        }
+    }
+    ENSURE(crossed > 0);  /* else no step crossed a chunk's end: the case shows nothing */
+    ENSURE(rejected > 0); /* else the loose tolerance does not bite */
+    printf("chunks: %d of %d (model, method, tolerance) runs bit-identical to one call; "
+           "%lld chunks ended inside a dopri5 step, %lld steps rejected\n",
+           identical, total, (long long)crossed, (long long)rejected);
+}
+
 /* ---------------------------------------------------------------- golden hashes */
 
 /* FNV-1a over 64-bit words: hashes values, so the result does not depend on byte order. */
@@ -253,12 +326,13 @@ static void check_golden(int kind)
     printf("golden %s: %d of %d (method, scene) hashes as recorded\n", model, matched, total);
 }
 
-/* Cases: rerun, and golden_<model> for each model of the core's table. */
+/* Cases: rerun, chunks, and golden_<model> for each model of the core's table. */
 int main(int argc, char **argv)
 {
     static char names[LAG_MODEL_COUNT][64];
     lt_cases cs = {0};
     lt_add(&cs, "rerun", check_rerun, 0, 0);
+    lt_add(&cs, "chunks", check_chunks, 0, 0);
     for (int k = 0; k < LAG_MODEL_COUNT; ++k) {
         snprintf(names[k], sizeof names[k], "golden_%s", lag_model_info_get((lag_model_kind)k)->name);
         lt_add(&cs, names[k], check_golden, k, 0);

@@ -429,6 +429,12 @@ void lag_sim_set_input(lag_sim *s, const double *tau);
  * end state by dense output (valid while the input stays the same); otherwise the last
  * step is shortened to land on the end exactly. Fixed-step methods ignore it. */
 lag_result lag_sim_advance(lag_sim *s, int64_t n, bool continuous);
+/* Advances n ticks of a span over which the input holds until tick `stop` (taken as
+ * tick + n when smaller): the steps are those of lag_sim_advance(s, stop - tick, false),
+ * so a span advanced in such chunks ends bit-identical to one call for it. dopri5 steps
+ * across the chunks' ends (dense output gives the state there) and lands on `stop`;
+ * other methods step tick by tick and do not need it. */
+lag_result lag_sim_advance_within(lag_sim *s, int64_t n, int64_t stop);
 double lag_sim_time(const lag_sim *s);
 /* The first tick boundary at or after time t for a tick of dt > 0: ceil(t / dt), with t
  * within 1e-9 dt above a boundary counted as on it (rounding of t = k dt). Saturated: a t
