@@ -101,11 +101,20 @@ void lag_sim_reset(lag_sim *s, const double *q, const double *qd)
     if (s->def.effects.enabled) lag_effects_init_modes(s);
 }
 
+/* Field by field: the struct has padding, whose bytes a copy need not keep. */
+static bool same_integrator(const lag_integrator_def *a, const lag_integrator_def *b)
+{
+    return a->method == b->method && a->dt == b->dt && a->rtol == b->rtol &&
+           a->atol == b->atol && a->dt_min == b->dt_min && a->max_iter == b->max_iter &&
+           a->max_steps == b->max_steps && a->newton_tol == b->newton_tol;
+}
+
 lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_t errlen)
 {
+    _Static_assert(sizeof(lag_integrator_def) == 8 * 7, "same_integrator compares every field");
     if (def->model.kind != s->def.model.kind || def->model.nq != s->nq ||
-        memcmp(&def->integrator, &s->def.integrator, sizeof def->integrator) != 0 ||
-        memcmp(&def->explode_limit, &s->def.explode_limit, sizeof def->explode_limit) != 0) {
+        !same_integrator(&def->integrator, &s->def.integrator) ||
+        def->explode_limit != s->def.explode_limit) {
         if (err && errlen)
             snprintf(err, errlen, "only the model's parameters and the effects change while "
                                   "running (not the model, the integrator or explode_limit)");
@@ -119,7 +128,13 @@ lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_
     }
     lag_diag d;
     if (lag_sim_def_check(&at, &d) != LAG_OK) {
-        if (err && errlen) lag_diag_format(&d, err, errlen);
+        /* the "initial" state checked is where the run is now: said so */
+        const char *m = d.message;
+        if (!strncmp(m, "initial ", 8)) m += 8;
+        if (err && errlen && !strncmp(d.field, "initial.", 8))
+            snprintf(err, errlen, "where the run is now, %s", m);
+        else if (err && errlen)
+            lag_diag_format(&d, err, errlen);
         return LAG_ERR_ARG;
     }
     const uint32_t was = s->def.effects.enabled;

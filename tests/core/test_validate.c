@@ -245,12 +245,64 @@ static void check_ticks_ceil(int arg)
     }
 }
 
+/* lag_sim_redefine: a definition equal in all but the model's parameters is accepted
+ * whatever the bytes of its padding (a copy need not keep them); one that changes the
+ * integrator or explode_limit is refused; a stop that leaves out where the run is now is
+ * refused in words that say so (not "initial"), and nothing changes. */
+static void check_redefine(int arg)
+{
+    (void)arg;
+    lag_sim_def d = lag_default_sim_def(LAG_MODEL_MANIPULATOR);
+    char err[LAG_FIELD_MAX + LAG_MESSAGE_MAX + 2];
+    static lag_sim s;
+    ENSURE(lag_sim_init(&s, &d, err, sizeof err) == LAG_OK);
+    ENSURE(lag_sim_advance(&s, 100, false) == LAG_OK);
+    static lag_sim_def n;
+    memset(&n, 0xA5, sizeof n); /* padding that differs from d's */
+    n.model = d.model;
+    memset(&n.integrator, 0x5A, sizeof n.integrator);
+    n.integrator.method = d.integrator.method;
+    n.integrator.dt = d.integrator.dt;
+    n.integrator.rtol = d.integrator.rtol;
+    n.integrator.atol = d.integrator.atol;
+    n.integrator.dt_min = d.integrator.dt_min;
+    n.integrator.max_iter = d.integrator.max_iter;
+    n.integrator.max_steps = d.integrator.max_steps;
+    n.integrator.newton_tol = d.integrator.newton_tol;
+    n.explode_limit = d.explode_limit;
+    n.effects = d.effects;
+    memcpy(n.q0, d.q0, sizeof n.q0);
+    memcpy(n.qd0, d.qd0, sizeof n.qd0);
+    n.model.p[LAG_MANIP_M2] = 2.5;
+    if (lag_sim_redefine(&s, &n, err, sizeof err) != LAG_OK)
+        LT_FAIL("a change of m2 alone was refused: %s", err);
+    ENSURE(s.def.model.p[LAG_MANIP_M2] == 2.5 && s.tick == 100);
+    lag_sim_def m = s.def;
+    m.integrator.dt *= 2;
+    ENSURE(lag_sim_redefine(&s, &m, err, sizeof err) == LAG_ERR_ARG && strstr(err, "integrator"));
+    m = s.def;
+    m.explode_limit = 10;
+    ENSURE(lag_sim_redefine(&s, &m, err, sizeof err) == LAG_ERR_ARG);
+    m = s.def;
+    m.effects.enabled |= LAG_EFF_LIMITS;
+    double q2 = s.q[1];
+    m.effects.limit_lower[1] = q2 + 1.0;
+    m.effects.limit_upper[1] = q2 + 2.0;
+    m.effects.limit_on[1] = true;
+    m.effects.restitution[1] = 0.5;
+    ENSURE(lag_sim_redefine(&s, &m, err, sizeof err) == LAG_ERR_ARG);
+    if (strncmp(err, "where the run is now, q2 = ", 27) != 0 || strstr(err, "initial"))
+        LT_FAIL("a stop that leaves out where q2 is now: '%s'", err);
+    ENSURE(!(s.def.effects.enabled & LAG_EFF_LIMITS) && s.q[1] == q2);
+}
+
 int main(int argc, char **argv)
 {
     static const lt_case cases[] = {
         {"fields", check_fields, 0, 0},
         {"model_fields", check_model_fields, 0, 0},
         {"ticks_ceil", check_ticks_ceil, 0, 0},
+        {"redefine", check_redefine, 0, 0},
     };
     return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
 }

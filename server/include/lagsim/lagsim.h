@@ -415,8 +415,9 @@ void lag_sim_reset(lag_sim *s, const double *q, const double *qd);
  * definition started from the current state. def must have the same model kind,
  * integrator settings and explode_limit (else LAG_ERR_ARG: those do not change while
  * running) and must pass lag_sim_def_check with the current state as its initial state
- * (a stop must not exclude where the joint is, ...): else LAG_ERR_ARG with "field:
- * message" in err and nothing changed. The effects' holds (a joint at rest on a stop or
+ * (a stop must not exclude where the joint is, ...): else LAG_ERR_ARG and nothing
+ * changed, with "where the run is now, <what is wrong>" in err for the state (e.g. "where
+ * the run is now, q2 = 0.7 is outside its limits [0.1, 0.5]") and "field: message" else. The effects' holds (a joint at rest on a stop or
  * held by static friction) are derived again from the state, as at a reset; a newly
  * switched-on actuator starts from the effort applied now; dopri5 restarts its step. */
 lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_t errlen);
