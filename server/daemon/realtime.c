@@ -46,6 +46,7 @@
 #include <sys/timerfd.h>
 #include <unistd.h>
 
+#include "live_set.h"
 #include "rt_server.h"
 #include "lagsim/lagsim_control_t.h"
 
@@ -520,72 +521,36 @@ static void control_rejected(rt_server *s, const char *why)
 
 /* SET key=value: the change is validated by the scene loader itself, on the scene's own
  * bytes with its --set overrides, the changes already made and this one after them (so
- * every rule of a scene file holds, with its message), then by the core against the state
- * the run is in; it takes effect before the next period. Only keys under parameters and
- * effects change while running. The answer: a `set` event whose detail is exactly
- * "key=value" (what --replay re-applies at the event's step) and the new scene. */
+ * every rule of a scene file holds, with its message: live_set.c), then by the core
+ * against the state the run is in; it takes effect at once, at the current tick. Only
+ * keys under parameters and effects change while running. The answer: a `set` event
+ * whose detail is exactly "key=value" and whose step is the tick it took effect at (what
+ * --replay re-applies), and the new scene. A refusal is a control_rejected whose detail
+ * names the change and the reason. */
 static void handle_set(rt_server *s, const lag_wire_control *c)
 {
-    char kv[LAG_WIRE_TEXT_LEN];
-    bool under = !strncmp(c->key, "parameters", 10) || !strncmp(c->key, "effects", 7);
-    size_t root = !strncmp(c->key, "parameters", 10) ? 10 : 7;
-    if (!under || (c->key[root] != '\0' && c->key[root] != '.') || strchr(c->key, '=')) {
-        control_rejected(s, "set: only keys under parameters and effects change while running "
-                            "(e.g. parameters.m2, effects.friction.q2.kinetic)");
-        return;
-    }
-    if (!c->value[0] || snprintf(kv, sizeof kv, "%s=%s", c->key, c->value) >= (int)sizeof kv) {
-        control_rejected(s, "set: the value is empty, or key=value is longer than 255 bytes");
-        return;
-    }
-    if (!s->opts || !s->opts->scene_text) {
-        control_rejected(s, "set: this daemon has no scene source to validate a change against");
+    char kv[LIVE_SET_LEN], err[512], why[1024];
+    if (live_set_parse(c->key, c->value, kv, why, sizeof why) != 0) {
+        control_rejected(s, why);
         return;
     }
     if (!rt_limit_take(&s->lim_set, s->now)) {
-        control_rejected(s, "set: more than 10 changes a second; this one was not applied");
+        snprintf(why, sizeof why, "set %s: more than %d changes a second; this one was not "
+                                  "applied", kv, RT_SET_PER_S);
+        control_rejected(s, why);
         return;
     }
-    /* the scene's sets, the changes so far, this one */
-    int nbase = s->opts->nsets;
-    const char **all = malloc(sizeof *all * (size_t)(nbase + s->n_live_sets + 1));
     static lag_scene ns; /* large: not on the stack; used by this function only */
-    char err[512], why[1024];
-    if (!all) {
-        control_rejected(s, "set: out of memory");
-        return;
-    }
-    for (int i = 0; i < nbase; i++) all[i] = s->opts->sets[i];
-    for (int i = 0; i < s->n_live_sets; i++) all[nbase + i] = s->live_set[i];
-    all[nbase + s->n_live_sets] = kv;
-    int rc = lag_scene_load_buffer(s->opts->scene_name, s->opts->scene_text, s->opts->scene_len,
-                                   all, nbase + s->n_live_sets + 1, &ns, err, sizeof err);
-    free(all);
-    if (rc != 0) {
-        snprintf(why, sizeof why, "set %s: %s", kv, err);
+    if (live_set_load(s->opts, &s->live, kv, &ns, why, sizeof why) != 0) {
         control_rejected(s, why);
         return;
     }
     if (lag_sim_redefine(&s->sim, &ns.sim, err, sizeof err) != LAG_OK) {
-        snprintf(why, sizeof why, "set %s: at the current state: %s", kv, err);
+        snprintf(why, sizeof why, "set %s: %s", kv, err);
         control_rejected(s, why);
         return;
     }
-    /* keep it: it overrides earlier changes of the same key and of keys below it */
-    size_t klen = strlen(c->key);
-    int k = 0;
-    for (int i = 0; i < s->n_live_sets; i++) {
-        const char *e = s->live_set[i];
-        bool overridden = !strncmp(e, c->key, klen) && (e[klen] == '=' || e[klen] == '.');
-        if (!overridden && k != i) memcpy(s->live_set[k], e, sizeof s->live_set[k]);
-        if (!overridden) k++;
-    }
-    s->n_live_sets = k;
-    if (s->n_live_sets == RT_MAX_LIVE_SETS) { /* cannot happen with the scene's few keys */
-        memmove(s->live_set[0], s->live_set[1], sizeof s->live_set[0] * (RT_MAX_LIVE_SETS - 1));
-        s->n_live_sets--;
-    }
-    memcpy(s->live_set[s->n_live_sets++], kv, sizeof kv);
+    live_set_keep(&s->live, kv);
     rt_publish_event(s, "set", "", 0, kv);
     s->want_scene = true;
     s->want_status = true;

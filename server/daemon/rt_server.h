@@ -14,13 +14,13 @@
 #include <stdint.h>
 #include <lcm/lcm.h>
 #include "daemon.h"
+#include "live_set.h"
 #include "lagsim_bus.h"
 #include "lagsim_wire.h"
 #include "rt_pace.h"
 
 #define RT_CHANNEL_MAX LAG_BUS_CHANNEL_LEN /* prefix (< 64) + "_COMMAND" */
 #define RT_BUF_SIZE LAG_WIRE_BUF_SIZE /* encode buffer: holds any message */
-#define RT_MAX_LIVE_SETS 64   /* distinct keys changed while running */
 /* SET requests validated per second and burst (each parses the scene): a SET is either
  * applied and announced by its `set` event, which is never suppressed (replay re-applies
  * it), or refused; so `set` events stay within this bucket */
@@ -132,11 +132,8 @@ typedef struct rt_server {
     rt_limit lim_state, lim_scene, lim_status;
     rt_limit lim_set;          /* SET requests validated per second */
 
-    /* changes made while running (control_t SET), in the order they were applied, each
-     * "key=value" as on the command line; a key set again replaces the entries it
-     * overrides (itself and the keys below it), so the list stays short */
-    char live_set[RT_MAX_LIVE_SETS][LAG_WIRE_TEXT_LEN];
-    int n_live_sets;
+    /* changes made while running (control_t SET), in the order they were applied */
+    live_sets live;
     rt_limit lim_event[RT_EV_COUNT];
 
     /* counters published in status */
