@@ -5,7 +5,7 @@
 # pass of tests/run.sh skips. Timeouts leave room for the sanitizer build on a loaded
 # 2-core machine (hard.spin alone takes some 130 s there).
 include(${CMAKE_CURRENT_LIST_DIR}/common/cases.cmake)
-foreach(t effects hard)
+foreach(t effects hard flight)
   add_executable(test_${t} ${CMAKE_CURRENT_SOURCE_DIR}/effects/test_${t}.c)
   target_include_directories(test_${t} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/effects
                                                ${CMAKE_CURRENT_SOURCE_DIR}/common)
@@ -13,3 +13,4 @@ foreach(t effects hard)
 endforeach()
 lagsim_add_test_cases(test_effects effects effects 300)
 lagsim_add_test_cases(test_hard hard effects 900)
+lagsim_add_test_cases(test_flight effects.flight effects 600)

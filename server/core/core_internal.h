@@ -99,7 +99,7 @@ static inline lag_result lag_rhs(lag_sim *s, const double *y, double *ydot)
         return lag_forward_locked(s, y, y + n, Q, ydot + n, NULL);
     }
     /* The bare model, the hot path: the model's closed-form forward dynamics. */
-    return lag_models[s->def.model.kind]->forward(s->def.model.p, y, y + n, s->tau_applied, ydot + n);
+    return lag_models[s->model.kind]->forward(s->model.p, y, y + n, s->tau_applied, ydot + n);
 }
 /* A right-hand side failed with r at stage state y: a "singular" mass matrix of a
  * non-finite q (a stage that overflowed: cos(inf)) is a non-finite state, not a singular
@@ -148,7 +148,10 @@ typedef enum lag_watch_kind {
     LAG_WATCH_POSITION,      /* q_joint against `bound` on `side` (-1 lower, +1 upper) */
     LAG_WATCH_VELOCITY_ZERO, /* a sliding joint's velocity reaching zero */
     LAG_WATCH_HOLD,          /* a held joint's constraint force (the engine's own) */
-    LAG_WATCH_CUSTOM         /* the owner's `value` with the dynamics (lift-off) */
+    LAG_WATCH_CUSTOM,        /* the owner's `value` with the dynamics (lift-off) */
+    LAG_WATCH_GAP            /* the owner's gap g(q) >= 0 (an end above the floor, `gap`):
+                                fires as a stop does; due at its start when closed (<= 0)
+                                and closing */
 } lag_watch_kind;
 
 /* One event function of a tick: positive while nothing happens. */
@@ -211,6 +214,15 @@ static inline bool lag_has_friction(const lag_sim *s, int i)
 lag_event_kind lag_friction_settle(lag_sim *s, double *y, int i);
 void lag_refresh_slip(lag_sim *s, double *y);
 void lag_effects_init_modes(lag_sim *s);
+/* The floor with flight (the flying stick, h held on the floor): is joint i its h? */
+static inline bool lag_floor_h(const lag_sim *s, int i)
+{
+    return i == 2 && s->model.kind == LAG_MODEL_FLYING_STICK &&
+           (s->def.effects.enabled & LAG_EFF_FLOOR);
+}
+/* Published (x, phi, h_lower) to the sim's: the end below the centre is h's end.
+ * IN/OUT: q, qd; sets s->model's end */
+void lag_floor_from_lower_end(lag_sim *s, double *q, double *qd);
 /* One tick with event location, from y (in place). */
 lag_result lag_events_tick(lag_sim *s, double *y);
 void lag_sim_record_event(lag_sim *s, lag_event_kind kind, int joint, double t, double value);
@@ -229,7 +241,12 @@ typedef struct lag_effect_row {
     void (*pre_tick)(lag_sim *s);
     /* adds its watchers of `joint` (-1: those of no joint) as owner `self` */
     bool (*watch)(const lag_sim *s, int joint, int self, lag_watch_set *ws);
+    /* a CUSTOM watcher's event function at y, with the accelerations qdd there */
     double (*value)(lag_sim *s, const lag_watcher *w, const double *y, const double *qdd);
+    /* a GAP watcher's gap at y = (q, qd) and its rate; with qdd (not NULL) also its second
+     * derivative (accel) */
+    double (*gap)(const lag_sim *s, const lag_watcher *w, const double *y, const double *qdd,
+                  double *rate, double *accel);
     lag_result (*on_event)(lag_sim *s, const lag_watcher *w, double *y, double t);
     void (*observe)(const lag_sim *s, double *q, double *qd);
 } lag_effect_row;

@@ -31,6 +31,7 @@ lag_effects_def lag_default_effects_def(void)
     e.rest_velocity = 1e-3;
     for (int i = 0; i < LAG_MAX_DOF; i++) e.actuator_max[i] = INFINITY;
     e.noise_seed = 1;
+    e.floor_flight = true;
     return e;
 }
 
@@ -47,6 +48,7 @@ const char *lag_event_kind_name(lag_event_kind k)
     case LAG_EV_SATURATION: return "saturation";
     case LAG_EV_DISTURBANCE: return "disturbance";
     case LAG_EV_EVENT_LIMIT: return "event_limit";
+    case LAG_EV_LANDING: return "landing";
     }
     return "unknown";
 }
@@ -89,7 +91,7 @@ static void damping_force(const lag_sim *s, const double *q, const double *qd, d
  * rest_velocity or the bounce would come back within one tick (the Zeno guard). */
 
 static lag_result stop_event(lag_sim *s, const lag_watcher *w, double *y, double t,
-                             lag_event_kind bounce)
+                             lag_event_kind bounce, lag_event_kind rest_kind)
 {
     const int n = s->nq, i = w->joint;
     lag_result r;
@@ -108,7 +110,18 @@ static lag_result stop_event(lag_sim *s, const lag_watcher *w, double *y, double
         s->mode.locked |= 1u << i;
         s->mode.lock_side[i] = (int8_t)w->side;
         s->mode.slip_dir[i] = 0;
-        lag_sim_record_event(s, LAG_EV_REST, i, t, v);
+        double lambda[LAG_MAX_DOF];
+        if (rest_kind == LAG_EV_LANDING &&
+            (r = lag_forward_locked(s, y, y + n, Q, qdd, lambda)) == LAG_OK &&
+            -w->side * lambda[i] < 0) {
+            /* the floor would have to pull: the end touches it and flies on */
+            s->mode.locked &= ~(1u << i);
+            s->mode.lock_side[i] = 0;
+            lag_sim_record_event(s, bounce, i, t, v);
+        } else {
+            if (r != LAG_OK) return r;
+            lag_sim_record_event(s, rest_kind, i, t, v);
+        }
     } else {
         if ((r = lag_impulse_map(s, y, i, w->e)) != LAG_OK) return r;
         lag_sim_record_event(s, bounce, i, t, v);
@@ -169,12 +182,28 @@ static bool limits_watch(const lag_sim *s, int joint, int self, lag_watch_set *w
 
 static lag_result limits_event(lag_sim *s, const lag_watcher *w, double *y, double t)
 {
-    return stop_event(s, w, y, t, LAG_EV_LIMIT);
+    return stop_event(s, w, y, t, LAG_EV_LIMIT, LAG_EV_REST);
 }
 
 /* ---------------------------------------------------------------- floor: the stick's */
-/* Stick only: its end on the floor; impacts at phi = 0 and pi (reported as impacts),
- * resting contact, and lift-off (the normal force reaching zero) is a fault. */
+/* Stick only. Without flight (floor_flight false): its end on the floor, impacts of the
+ * free end at phi = 0 and pi (reported as impacts), resting contact, and lift-off (the
+ * normal force reaching zero, a CUSTOM watcher) is a fault.
+ * With flight, the sim integrates the flying stick (x, phi, h), h the height of one end
+ * (model_flying_stick.c), and the floor is a stop of h at 0 on the lower side:
+ *   - in contact h is held (a resting stop): the stop's hold force is the normal force,
+ *     and when it would pull the hold lets go (events.c: a `liftoff`, the stick flies);
+ *     the free end's impacts are those of the stick without flight, at phi = k pi and
+ *     (k + 1) pi around the contact's interval of phi;
+ *   - in flight h's stop is watched (that end landing: a frictionless impact, the
+ *     vertical impulse at the end being a generalized impulse on h alone, J = e_h), and
+ *     the other end's height h + sigma l sin phi (a GAP watcher): when it reaches the
+ *     floor, h is made that end's height (a change of coordinates: x, phi, the velocities
+ *     and the energy unchanged) and it lands as h's end does;
+ *   - a landing ends in sliding contact (`landing`, h held) when it is slower than
+ *     rest_velocity or its bounce would come back within one tick (the Zeno guard), and
+ *     the floor then pushes (else the end touches and the stick flies on: `impact`);
+ *     otherwise the end bounces (`impact`), J qd+ = -e J qd-. */
 
 static lag_result floor_validate(const lag_sim_def *def, lag_diag *d)
 {
@@ -189,12 +218,63 @@ static lag_result floor_validate(const lag_sim_def *def, lag_diag *d)
     if (def->q0[1] < 0 || def->q0[1] > M_PI)
         return lag_diag_fail(d, "initial.q[1]", "initial phi = %g must be in [0, pi] with a floor",
                              def->q0[1]);
+    if (e->floor_flight) {
+        double h = def->q0[2], hd = def->qd0[2];
+        if (!(isfinite(h) && h >= 0 && h <= def->explode_limit))
+            return lag_diag_fail(d, "initial.q[2]",
+                                 "the stick's lower end is at height h = %g: expected a number "
+                                 "in [0, explode_limit]", h);
+        if (!(isfinite(hd) && fabs(hd) <= def->explode_limit))
+            return lag_diag_fail(d, "initial.qd[2]", "expected a finite number within "
+                                 "explode_limit, got %g", hd);
+    } else if (def->q0[2] != 0 || def->qd0[2] != 0) {
+        return lag_diag_fail(d, "initial.q[2]", "a height needs a floor the stick may leave "
+                             "(flight: true)");
+    }
     return LAG_OK;
+}
+
+/* sigma of the flying stick: +1 when h is end A's height, -1 for end B's */
+static double floor_sigma(const lag_sim *s)
+{
+    return s->model.p[LAG_FSTICK_END] != 0.0 ? -1.0 : 1.0;
+}
+
+/* In contact on h's end, the interval [k pi, (k + 1) pi] of phi in which the stick is
+ * above the floor: k even for end A (sin phi >= 0), odd for end B; the one whose middle
+ * is nearest phi (phi may lie a rounding outside it after a landing). */
+static double floor_k(const lag_sim *s, double phi)
+{
+    double off = s->model.p[LAG_FSTICK_END] != 0.0 ? 1.0 : 0.0;
+    return 2.0 * round((phi / M_PI - off - 0.5) / 2.0) + off;
 }
 
 static bool floor_watch(const lag_sim *s, int joint, int self, lag_watch_set *ws)
 {
     const double e = s->def.effects.floor_restitution;
+    if (s->model.kind == LAG_MODEL_FLYING_STICK) {
+        const bool contact = s->mode.locked & (1u << 2);
+        lag_watcher w = {.kind = LAG_WATCH_POSITION, .owner = (uint8_t)self, .strict = true,
+                         .e = e, .side = -1};
+        if (joint == 2) { /* h's end landing (h is free: a held joint has its hold only) */
+            w.joint = 2;
+            w.bound = 0.0;
+            return lag_watch_add(ws, w);
+        }
+        if (joint == 1 && contact) { /* the free end reaching the floor */
+            double k = floor_k(s, s->q[1]);
+            w.joint = 1;
+            w.bound = k * M_PI;
+            if (!lag_watch_add(ws, w)) return false;
+            w.side = +1;
+            w.bound = (k + 1.0) * M_PI;
+            return lag_watch_add(ws, w);
+        }
+        if (joint < 0 && !contact) /* the other end landing */
+            return lag_watch_add(ws, (lag_watcher){.kind = LAG_WATCH_GAP, .owner = (uint8_t)self,
+                                                   .joint = 2, .strict = true, .e = e});
+        return true;
+    }
     if (joint < 0) /* lift-off: the normal force, with the dynamics (value below) */
         return lag_watch_add(ws, (lag_watcher){.kind = LAG_WATCH_CUSTOM, .owner = (uint8_t)self,
                                                .joint = 1, .strict = false});
@@ -219,13 +299,63 @@ static double floor_normal(lag_sim *s, const lag_watcher *w, const double *y, co
     return p[LAG_STICK_G] + 0.5 * p[LAG_STICK_L] * (cos(ph) * qdd[1] - sin(ph) * phd * phd);
 }
 
+/* The other end's height h + sigma l sin phi, its rate and its second derivative. */
+static double floor_gap(const lag_sim *s, const lag_watcher *w, const double *y,
+                        const double *qdd, double *rate, double *accel)
+{
+    (void)w;
+    const int n = s->nq;
+    const double sl = floor_sigma(s) * s->model.p[LAG_STICK_L];
+    double sn = sin(y[1]), c = cos(y[1]), phd = y[n + 1];
+    if (rate) *rate = y[n + 2] + sl * c * phd;
+    if (accel && qdd) *accel = qdd[2] + sl * (c * qdd[1] - sn * phd * phd);
+    return y[2] + sl * sn;
+}
+
 static lag_result floor_event(lag_sim *s, const lag_watcher *w, double *y, double t)
 {
     if (w->kind == LAG_WATCH_CUSTOM) {
         lag_sim_record_event(s, LAG_EV_LIFTOFF, 1, t, 0.0);
         return LAG_ERR_LIFTOFF;
     }
-    return stop_event(s, w, y, t, LAG_EV_IMPACT);
+    if (w->kind == LAG_WATCH_GAP) {
+        /* h becomes the landing end's height: y = h + sigma a s = h' - sigma a s */
+        const int n = s->nq;
+        double rate, gap = floor_gap(s, w, y, NULL, &rate, NULL);
+        y[2] = gap;
+        y[n + 2] = rate;
+        s->model.p[LAG_FSTICK_END] = s->model.p[LAG_FSTICK_END] != 0.0 ? 0.0 : 1.0;
+        s->dp.valid = false;
+        lag_watcher h = {.kind = LAG_WATCH_POSITION, .owner = w->owner, .joint = 2, .side = -1,
+                         .strict = true, .bound = 0.0, .e = w->e};
+        return stop_event(s, &h, y, t, LAG_EV_IMPACT, LAG_EV_LANDING);
+    }
+    if (w->joint == 2) return stop_event(s, w, y, t, LAG_EV_IMPACT, LAG_EV_LANDING);
+    return stop_event(s, w, y, t, LAG_EV_IMPACT, LAG_EV_REST);
+}
+
+void lag_floor_from_lower_end(lag_sim *s, double *q, double *qd)
+{
+    (void)q; (void)qd;
+    /* h is the lower end's height: end B's when it is below the centre */
+    s->model.p[LAG_FSTICK_END] = sin(q[1]) < 0 ? 1.0 : 0.0;
+}
+
+/* The published h: the lower end's height and vertical velocity (0 in contact). */
+static void floor_publish(const lag_sim *s, double *q, double *qd)
+{
+    if (s->mode.locked & (1u << 2)) {
+        q[2] = 0.0;
+        qd[2] = 0.0;
+        return;
+    }
+    double rate, other = floor_gap(s, NULL, (const double[]){s->q[0], s->q[1], s->q[2],
+                                                             s->qd[0], s->qd[1], s->qd[2]},
+                                   NULL, &rate, NULL);
+    if (other < s->q[2]) {
+        q[2] = other;
+        qd[2] = rate;
+    }
 }
 
 /* ================================================================== friction */
@@ -362,7 +492,9 @@ static void disturbance_pre_tick(lag_sim *s)
         if (d->impulse) {
             if (s->tick != kd) continue;
             double x[LAG_MAX_DOF];
-            s->mode.locked = 0; /* an impulse breaks any hold; modes are re-settled */
+            /* an impulse breaks any hold but the floor's of h (which then pushes, or lets go
+             * at the tick's start); modes are re-settled */
+            s->mode.locked &= lag_floor_h(s, 2) ? (1u << 2) : 0u;
             if (lag_minv_column(s, y, d->joint, x) != LAG_OK) continue;
             for (int i = 0; i < n; i++) y[n + i] += x[i] * d->value;
             impulse = true;
@@ -376,7 +508,10 @@ static void disturbance_pre_tick(lag_sim *s)
         }
     }
     if (impulse) {
-        for (int i = 0; i < n; i++) { s->mode.lock_side[i] = 0; s->mode.slip_dir[i] = 0; }
+        for (int i = 0; i < n; i++) {
+            if (!(s->mode.locked & (1u << i))) s->mode.lock_side[i] = 0;
+            s->mode.slip_dir[i] = 0;
+        }
         lag_refresh_slip(s, y);
         for (int i = 0; i < n; i++) s->qd[i] = y[n + i];
     }
@@ -478,7 +613,8 @@ const lag_effect_row lag_effect_rows[] = {
     {.bit = LAG_EFF_LIMITS, .name = "limits", .validate = limits_validate, .watch = limits_watch,
      .on_event = limits_event, .max_watch_joint = 2},
     {.bit = LAG_EFF_FLOOR, .name = "floor", .validate = floor_validate, .watch = floor_watch,
-     .value = floor_normal, .on_event = floor_event, .max_watch_joint = 2, .max_watch_global = 1},
+     .value = floor_normal, .gap = floor_gap, .on_event = floor_event, .max_watch_joint = 2,
+     .max_watch_global = 1},
     {.bit = LAG_EFF_FRICTION, .name = "friction", .validate = friction_validate, .force = friction_force,
      .watch = friction_watch, .on_event = friction_event, .max_watch_joint = 1},
     {.bit = LAG_EFF_ACTUATOR, .name = "actuator", .validate = actuator_validate,
@@ -600,5 +736,6 @@ bool lag_effects_watch(const lag_sim *s, int joint, lag_watch_set *ws)
 void lag_sim_observe(const lag_sim *s, double *q, double *qd)
 {
     for (int i = 0; i < s->nq; i++) { q[i] = s->q[i]; qd[i] = s->qd[i]; }
+    if (lag_floor_h(s, 2)) floor_publish(s, q, qd);
     for (int k = 0; k < s->fx.n_observe; k++) lag_effect_rows[s->fx.observe[k]].observe(s, q, qd);
 }

@@ -207,6 +207,12 @@ void lag_effects_init_modes(lag_sim *s)
     for (int i = 0; i < n; i++) { s->mode.lock_side[i] = 0; s->mode.slip_dir[i] = 0; }
     lag_refresh_slip(s, y);
     for (int i = 0; i < n; i++) s->qd[i] = y[n + i];
+    /* a stick that can fly starts on the floor when h and h_dot are 0 (it lifts off at
+     * once if the floor would have to pull) */
+    if (lag_floor_h(s, 2) && s->q[2] == 0.0 && s->qd[2] == 0.0) {
+        s->mode.locked |= 1u << 2;
+        s->mode.lock_side[2] = -1;
+    }
 }
 
 /* A hold lets go (its watcher fired): a stop releases the joint (which friction may hold
@@ -221,7 +227,17 @@ static lag_result release_hold(lag_sim *s, int i, double *y, double t)
     s->mode.locked &= ~(1u << i);
     s->mode.lock_side[i] = 0;
     y[n + i] = 0.0;
-    if (stop) {
+    if (stop && lag_floor_h(s, i)) {
+        /* the floor's normal force reached zero: the stick flies (its free end, if held
+         * on the floor too, is released with it: no end is held in flight) */
+        lag_sim_record_event(s, LAG_EV_LIFTOFF, i, t, lambda[i]);
+        s->mode.released |= 1u << i;
+        if (s->mode.locked & (1u << 1)) {
+            s->mode.locked &= ~(1u << 1);
+            s->mode.lock_side[1] = 0;
+            y[n + 1] = 0.0;
+        }
+    } else if (stop) {
         lag_sim_record_event(s, LAG_EV_RELEASE, i, t, lambda[i]);
         if (lag_has_friction(s, i)) {
             lag_event_kind k = lag_friction_settle(s, y, i);
@@ -303,6 +319,10 @@ static lag_result eval_watchers(void *vctx, const double *y, double *val)
             LAG_ASSERT(c->dyn && w->owner < LAG_EFF_COUNT && lag_effect_rows[w->owner].value);
             val[k] = lag_effect_rows[w->owner].value(s, w, y, c->qdd);
             break;
+        case LAG_WATCH_GAP:
+            LAG_ASSERT(w->owner < LAG_EFF_COUNT && lag_effect_rows[w->owner].gap);
+            val[k] = lag_effect_rows[w->owner].gap(s, w, y, NULL, NULL, NULL);
+            break;
         }
     }
     return LAG_OK;
@@ -330,10 +350,17 @@ static int due_now(lag_sim *s, const lag_watch_set *ws, const double *y, const d
     for (int k = 0; k < ws->n; k++) {
         const lag_watcher *w = &ws->w[k];
         int i = w->joint;
-        if (w->kind == LAG_WATCH_POSITION && val[k] <= 0) {
+        if ((w->kind == LAG_WATCH_POSITION || w->kind == LAG_WATCH_GAP) && val[k] <= 0) {
             /* moving into the stop (qd toward it, or at rest and accelerating toward it) */
-            double v = y[n + i] * w->side; /* > 0: moving into the stop */
+            const lag_effect_row *row = &lag_effect_rows[w->owner];
+            double v, a = 0.0; /* v > 0: moving into the stop */
+            if (w->kind == LAG_WATCH_GAP) row->gap(s, w, y, NULL, &v, NULL), v = -v;
+            else v = y[n + i] * w->side;
             if (v > 0) return k;
+            /* at rest on the floor it just left: its acceleration into the floor is a
+             * rounding of the zero normal force (the hold let go as it would pull) */
+            if (v == 0 && w->kind == LAG_WATCH_POSITION && (s->mode.released & (1u << i)))
+                continue;
             if (v == 0) {
                 if (!have_qdd) {
                     double Q[LAG_MAX_DOF];
@@ -342,7 +369,9 @@ static int due_now(lag_sim *s, const lag_watch_set *ws, const double *y, const d
                         return -2;
                     have_qdd = true;
                 }
-                if (qdd[i] * w->side > 0) return k;
+                if (w->kind == LAG_WATCH_GAP) row->gap(s, w, y, qdd, NULL, &a), a = -a;
+                else a = qdd[i] * w->side;
+                if (a > 0) return k;
             }
         } else if ((w->kind == LAG_WATCH_HOLD || w->kind == LAG_WATCH_CUSTOM) && val[k] < 0) {
             return k;
@@ -355,6 +384,51 @@ static int due_now(lag_sim *s, const lag_watch_set *ws, const double *y, const d
 static lag_result checked(int N, const double *y, double limit)
 {
     if (!lag_state_ok(N, y, limit)) return lag_state_ok(N, y, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
+    return LAG_OK;
+}
+
+/* The floor's watchers with flight: the step redone up to the located instant ends where
+ * the method's own step puts it, which for a low-order method is off the interpolant the
+ * instant was found on (an end below the floor by O(h^2) with euler). Newton on the
+ * length of the redone step, with the watcher's rate, puts the end on the floor: at most
+ * 8 more steps, only at such events, keeping the best. IN/OUT: hs, ys */
+static double watch_rate(lag_sim *s, const lag_watcher *w, const double *y, double *val)
+{
+    const int n = s->nq;
+    if (w->kind == LAG_WATCH_GAP) {
+        double rate;
+        *val = lag_effect_rows[w->owner].gap(s, w, y, NULL, &rate, NULL);
+        return rate;
+    }
+    *val = w->side < 0 ? y[w->joint] - w->bound : w->bound - y[w->joint];
+    return -w->side * y[n + w->joint];
+}
+
+static lag_result land_on_floor(lag_sim *s, const lag_watcher *w, const double *y0, double H,
+                                double *hs, double *ys)
+{
+    if (w->kind != LAG_WATCH_POSITION && w->kind != LAG_WATCH_GAP) return LAG_OK;
+    const int N = 2 * s->nq;
+    const double tol = 1e-15 * (1.0 + s->def.model.p[LAG_STICK_L]);
+    double val, rate = watch_rate(s, w, ys, &val);
+    double h = *hs, best = fabs(val), hp = NAN, vp = NAN;
+    for (int it = 0; it < 12 && best > tol; it++) {
+        /* Newton with the end's rate first, then secant on the method's own steps */
+        double hn = (it == 0 || !(val != vp)) ? h - val / rate : h - val * (h - hp) / (val - vp);
+        if (!(hn > 0 && hn <= H) || hn == h) break;
+        double yt[LAG_MAX_STATE], vn;
+        lag_result r = lag_step(s, hn, y0, yt);
+        if (r != LAG_OK) return r;
+        if ((r = checked(N, yt, s->def.explode_limit)) != LAG_OK) return r;
+        rate = watch_rate(s, w, yt, &vn);
+        hp = h; vp = val;
+        h = hn; val = vn;
+        if (fabs(vn) < best) {
+            best = fabs(vn);
+            *hs = hn;
+            memcpy(ys, yt, sizeof(double) * (size_t)N);
+        }
+    }
     return LAG_OK;
 }
 
@@ -394,6 +468,7 @@ lag_result lag_events_tick(lag_sim *s, double *y)
             continue;
         }
 
+        s->mode.released = 0;
         if ((r = lag_step(s, H, y, y1)) != LAG_OK) return r;
         if (!lag_state_ok(N, y1, INFINITY)) return LAG_ERR_NONFINITE;
         if (!lag_state_ok(N, y1, s->def.explode_limit)) return LAG_ERR_EXPLODE;
@@ -421,7 +496,14 @@ lag_result lag_events_tick(lag_sim *s, double *y)
         } else {
             memcpy(ys, y, sizeof(double) * (size_t)N);
         }
-        tloc = (th_best >= 1.0) ? dt : tloc + hs;
+        bool landed = false;
+        if (hs > 0 && lag_floor_h(s, 2) && ws.w[k_best].kind != LAG_WATCH_HOLD &&
+            lag_effect_rows[ws.w[k_best].owner].bit == LAG_EFF_FLOOR) {
+            double hs0 = hs;
+            if ((r = land_on_floor(s, &ws.w[k_best], y, H, &hs, ys)) != LAG_OK) return r;
+            landed = hs != hs0;
+        }
+        tloc = (th_best >= 1.0 && !landed) ? dt : tloc + hs;
         if ((r = handle(s, &ws.w[k_best], ys, t_tick + tloc)) != LAG_OK) return r;
         memcpy(y, ys, sizeof(double) * (size_t)N);
         events++;

@@ -9,12 +9,14 @@
 /* The model table: one row per lag_model_kind, defined in the model's own file. A kind
  * added to the enum without its row breaks the build here; a row whose kind is missing
  * from the enum does not compile. */
-extern const lag_model_class lag_stick_model, lag_manipulator_model, lag_dipc_model, lag_cartpole_model;
+extern const lag_model_class lag_stick_model, lag_manipulator_model, lag_dipc_model, lag_cartpole_model,
+    lag_flying_stick_model;
 const lag_model_class *const lag_models[] = {
     [LAG_MODEL_STICK] = &lag_stick_model,
     [LAG_MODEL_MANIPULATOR] = &lag_manipulator_model,
     [LAG_MODEL_DIPC] = &lag_dipc_model,
     [LAG_MODEL_CARTPOLE] = &lag_cartpole_model,
+    [LAG_MODEL_FLYING_STICK] = &lag_flying_stick_model,
 };
 _Static_assert(sizeof lag_models / sizeof lag_models[0] == LAG_MODEL_COUNT,
                "the model table needs one row per lag_model_kind");

@@ -71,16 +71,34 @@ lag_result lag_sim_def_validate(const lag_sim_def *def, char *err, size_t errlen
     return r;
 }
 
+/* Does the sim fly the stick off its floor (the flying stick, h held in contact)? */
+static bool flies(const lag_sim_def *def)
+{
+    return def->model.kind == LAG_MODEL_STICK && (def->effects.enabled & LAG_EFF_FLOOR) &&
+           def->effects.floor_flight;
+}
+
 lag_result lag_sim_init(lag_sim *s, const lag_sim_def *def, char *err, size_t errlen)
 {
     lag_result r = lag_sim_def_validate(def, err, errlen);
     if (r != LAG_OK) return r;
     memset(s, 0, sizeof *s);
     s->def = *def;
-    s->nq = def->model.nq;
+    s->model = def->model;
+    if (flies(def)) {
+        s->model.kind = LAG_MODEL_FLYING_STICK;
+        s->model.nq = 3;
+        s->model.p[LAG_FSTICK_END] = 0.0;
+    }
+    s->nq = s->model.nq;
     lag_effects_prepare(s);
     lag_sim_reset(s, NULL, NULL);
     return LAG_OK;
+}
+
+const lag_model_info *lag_sim_info(const lag_sim *s)
+{
+    return lag_model_info_get(s->model.kind);
 }
 
 void lag_sim_reset(lag_sim *s, const double *q, const double *qd)
@@ -91,6 +109,7 @@ void lag_sim_reset(lag_sim *s, const double *q, const double *qd)
         s->qd[i] = qd ? qd[i] : s->def.qd0[i];
         s->tau[i] = 0.0;
     }
+    if (flies(&s->def)) lag_floor_from_lower_end(s, s->q, s->qd);
     s->tick = 0;
     s->dp.valid = false;
     s->dp.h = 0.0;
@@ -112,7 +131,7 @@ static bool same_integrator(const lag_integrator_def *a, const lag_integrator_de
 lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_t errlen)
 {
     _Static_assert(sizeof(lag_integrator_def) == 8 * 7, "same_integrator compares every field");
-    if (def->model.kind != s->def.model.kind || def->model.nq != s->nq ||
+    if (def->model.kind != s->def.model.kind || def->model.nq != s->def.model.nq ||
         !same_integrator(&def->integrator, &s->def.integrator) ||
         def->explode_limit != s->def.explode_limit) {
         if (err && errlen)
@@ -120,11 +139,23 @@ lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_
                                   "running (not the model, the integrator or explode_limit)");
         return LAG_ERR_ARG;
     }
+    if (flies(def) != flies(&s->def)) {
+        if (err && errlen)
+            snprintf(err, errlen, "the floor's flight (a stick that may leave its floor) does "
+                                  "not change while running");
+        return LAG_ERR_ARG;
+    }
     /* checked as a definition that starts where the run is now */
     lag_sim_def at = *def;
     for (int i = 0; i < s->nq; i++) {
         at.q0[i] = s->q[i];
         at.qd0[i] = s->qd[i];
+    }
+    if (flies(def)) {
+        /* a stick in the air or on either end is above its floor by construction: checked
+         * as standing on it at the same |sin phi| */
+        at.q0[1] = acos(cos(s->q[1]));
+        at.q0[2] = at.qd0[2] = 0.0;
     }
     lag_diag d;
     if (lag_sim_def_check(&at, &d) != LAG_OK) {
@@ -139,6 +170,8 @@ lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_
     }
     const uint32_t was = s->def.effects.enabled;
     s->def.model = def->model;
+    for (int i = 0; i < LAG_STICK_NP && flies(def); i++) s->model.p[i] = def->model.p[i];
+    if (!flies(def)) s->model = def->model;
     s->def.effects = def->effects;
     lag_effects_prepare(s);
     s->dp.valid = false; /* dopri5's internal state was integrated with the old definition */
@@ -156,9 +189,16 @@ lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_
     return LAG_OK;
 }
 
+const char *lag_sim_contact(const lag_sim *s)
+{
+    if (!flies(&s->def)) return "";
+    if (!(s->mode.locked & (1u << 2))) return "flight";
+    return (s->mode.locked & (1u << 1)) ? "flat" : "contact";
+}
+
 void lag_sim_set_input(lag_sim *s, const double *tau)
 {
-    const lag_model_info *info = lag_model_info_get(s->def.model.kind);
+    const lag_model_info *info = lag_sim_info(s);
     LAG_ASSERT(info != NULL);
     bool changed = false;
     for (int i = 0; i < s->nq; i++) {
@@ -185,7 +225,7 @@ int64_t lag_ticks_ceil(double t, double dt)
 
 double lag_sim_energy(const lag_sim *s)
 {
-    double E = lag_model_kinetic(&s->def.model, s->q, s->qd) + lag_model_potential(&s->def.model, s->q);
+    double E = lag_model_kinetic(&s->model, s->q, s->qd) + lag_model_potential(&s->model, s->q);
     return s->fx.n_potential ? E + lag_effects_potential(s, s->q) : E;
 }
 
@@ -220,10 +260,10 @@ lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *q
     if (!locked) {
         if (lambda)
             for (int i = 0; i < n; i++) lambda[i] = 0.0;
-        return lag_model_vt(&s->def.model)->forward(s->def.model.p, q, qd, Q, qdd);
+        return lag_model_vt(&s->model)->forward(s->model.p, q, qd, Q, qdd);
     }
     double M[LAG_MAX_DOF * LAG_MAX_DOF], h[LAG_MAX_DOF], r[LAG_MAX_DOF];
-    lag_model_vt(&s->def.model)->mass_bias(s->def.model.p, q, qd, M, h);
+    lag_model_vt(&s->model)->mass_bias(s->model.p, q, qd, M, h);
     for (int i = 0; i < n; i++) r[i] = Q[i] - h[i];
     /* M_ff qdd_f = r_f on the free joints; qdd_L = 0 */
     lag_result res = solve_free(n, locked, M, r, qdd);
@@ -251,7 +291,7 @@ lag_result lag_sim_rhs(lag_sim *s, const double *y, double *ydot)
 lag_result lag_qd_from_p(const lag_sim *s, const double *q, const double *p, double *qd)
 {
     double M[LAG_MAX_DOF * LAG_MAX_DOF];
-    lag_model_vt(&s->def.model)->mass(s->def.model.p, q, M);
+    lag_model_vt(&s->model)->mass(s->model.p, q, M);
     return solve_free(s->nq, s->mode.locked, M, p, qd);
 }
 
@@ -262,7 +302,7 @@ lag_result lag_qd_from_p(const lag_sim *s, const double *q, const double *p, dou
 lag_result lag_sim_rhs_qp(lag_sim *s, const double *y, double *ydot)
 {
     int n = s->nq;
-    const lag_model *m = &s->def.model;
+    const lag_model *m = &s->model;
     const lag_model_class *vt = lag_model_vt(m);
     double dM[LAG_MAX_DOF * LAG_MAX_DOF * LAG_MAX_DOF];
     double g[LAG_MAX_DOF], Q[LAG_MAX_DOF], qd[LAG_MAX_DOF];
@@ -366,7 +406,7 @@ void lag_sim_fault_describe(const lag_sim *s, char *buf, size_t len)
                  (long long)f->tick);
         return;
     }
-    const lag_model_info *info = lag_model_info_get(s->def.model.kind);
+    const lag_model_info *info = lag_sim_info(s);
     const char *j = info->joint_names[f->joint];
     const bool ang = info->angular[f->joint];
     const char *vu = ang ? "rad/s" : "m/s", *au = ang ? "rad/s^2" : "m/s^2";
@@ -395,7 +435,7 @@ lag_result lag_sim_advance_within(lag_sim *s, int64_t nticks, int64_t stop)
 {
     if (nticks <= 0) return LAG_OK;
     const int n = s->nq;
-    LAG_ASSERT(n == s->def.model.nq && s->tick >= 0 && s->n_events >= 0);
+    LAG_ASSERT(n == s->model.nq && s->tick >= 0 && s->n_events >= 0);
     /* the enabled effects that need each tick boundary, and whether some have events
      * (from the effect table's hooks: an effect with per-tick work or watchers is
      * per-tick by construction) */

@@ -883,15 +883,21 @@ static int key_effect_limits(conv *cv, const ynode *nd, const char *path)
     return 0;
 }
 
-/* floor (stick): {restitution, rest_velocity} */
+/* floor (stick): {restitution, rest_velocity, flight} */
 static int floor_restitution(conv *cv, const ynode *nd, const char *path)
 {
     return get_number(cv, nd, path, &fx(cv)->floor_restitution);
 }
 
+static int floor_flight(conv *cv, const ynode *nd, const char *path)
+{
+    return get_bool(cv, nd, path, &fx(cv)->floor_flight);
+}
+
 static const keyrow k_floor_keys[] = {
     {"restitution", floor_restitution, K_NUMBER}, /* [0, 1], default 0 */
     {"rest_velocity", key_rest_velocity, K_NUMBER}, /* rad/s, default 1e-3 */
+    {"flight", floor_flight, K_OTHER}, /* bool, default true: lift-off flies (else a fault) */
     {NULL, NULL, K_OTHER, NULL, NULL},
 };
 

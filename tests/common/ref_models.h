@@ -156,6 +156,23 @@ static inline void tc_kin_cartpole(const lag_model *m, const cplx *q, const cplx
     b->w[1] = qd[1];
 }
 
+/* Flying stick: the stick free in the plane; h is the height of one end E (end A at
+ * r_c - l/2 (cos phi, sin phi), sigma = +1, or end B at r_c + l/2 (cos phi, sin phi),
+ * sigma = -1, chosen by p[LAG_FSTICK_END]), so r_c = (x, h + sigma (l/2) sin phi):
+ * E's height plus the rise from E to the centre. omega = phi_dot. */
+static inline void tc_kin_flying_stick(const lag_model *m, const cplx *q, const cplx *qd, tc_bodies *b)
+{
+    double l = tc_p(m, "l"), sigma = m->p[LAG_FSTICK_END] != 0.0 ? -1.0 : 1.0;
+    b->nb = 1;
+    b->mass[0] = tc_p(m, "m");
+    b->inertia[0] = tc_p(m, "I");
+    b->x[0] = q[0];
+    b->y[0] = q[2] + sigma * 0.5 * l * csin(q[1]);
+    b->vx[0] = qd[0];
+    b->vy[0] = qd[2] + sigma * 0.5 * l * ccos(q[1]) * qd[1];
+    b->w[0] = qd[1];
+}
+
 /* ------------------------------------------------------------------ the table */
 typedef struct tc_ref {
     void (*kinematics)(const lag_model *m, const cplx *q, const cplx *qd, tc_bodies *b);
@@ -177,6 +194,9 @@ static const tc_ref tc_refs[] = {
                         {-2, -TC_PI, -TC_PI}, {2, TC_PI, TC_PI}},
     /* the pole hanging and swinging, the cart free */
     [LAG_MODEL_CARTPOLE] = {tc_kin_cartpole, {0.0, TC_PI + 0.5}, {0.2, 0.0}, 1.0, {-2, -TC_PI}, {2, TC_PI}},
+    /* thrown up spinning, no floor: the centre on its parabola, the angle turning */
+    [LAG_MODEL_FLYING_STICK] = {tc_kin_flying_stick, {0.0, 0.3, 1.0}, {0.5, 3.0, 2.0}, 1.0,
+                                {-2, -TC_PI, 0.0}, {2, TC_PI, 2.0}},
 };
 _Static_assert(sizeof tc_refs / sizeof tc_refs[0] == LAG_MODEL_COUNT,
                "tests/common/ref_models.h needs a reference row for every model of the core");

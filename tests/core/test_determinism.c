@@ -223,6 +223,7 @@ static lag_sim_def golden_def(lag_model_kind kind, lag_method meth, bool effects
     lag_sim_def f = d;
     f.effects.enabled |= LAG_EFF_FLOOR;
     f.effects.floor_restitution = 0.4;
+    f.effects.floor_flight = false; /* the flight rows are the flying stick's, and the floor scenes of test_flight */
     char err[256];
     if (lag_sim_def_validate(&f, err, sizeof err) == LAG_OK) return f;
     return d;

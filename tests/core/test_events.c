@@ -93,6 +93,7 @@ static void check_capacity(int arg)
     d.qd0[0] = 0.5;
     d.qd0[1] = 0.3;
     d.effects.enabled = LAG_EFF_LIMITS | LAG_EFF_FRICTION | LAG_EFF_FLOOR;
+    d.effects.floor_flight = false;
     for (int i = 0; i < 2; ++i) {
         d.effects.limit_on[i] = true;
         d.effects.limit_lower[i] = d.q0[i] - 1;
@@ -115,6 +116,30 @@ static void check_capacity(int arg)
     ENSURE(lag_effects_watch(&s, -1, &ws));
     printf("capacity: a stick with stops, friction and the floor has %d watchers\n", ws.n);
     ENSURE(ws.n == 2 * 2 + 2 + 2 * 1 + 1);
+
+    /* the floor with flight, the stick in the air: stops and friction on x and phi, the
+     * floor's stop of h and the other end's gap; on the floor, h's hold replaces both and
+     * the free end's two stops come back */
+    d.effects.floor_flight = true;
+    d.q0[2] = 0.5;
+    if (tc_sim_init(&s, &d)) return;
+    for (int j = -1; j < 3; ++j)
+        for (int k = 0; k < LAG_EFF_COUNT; ++k) {
+            const lag_effect_row *r = &lag_effect_rows[k];
+            if (!r->watch || !(d.effects.enabled & r->bit)) continue;
+            ws.n = 0;
+            ENSURE(r->watch(&s, j, k, &ws));
+            ENSURE(ws.n <= (j < 0 ? r->max_watch_global : r->max_watch_joint));
+        }
+    ws.n = 0;
+    for (int j = 0; j < 3; ++j) ENSURE(lag_effects_watch(&s, j, &ws));
+    ENSURE(lag_effects_watch(&s, -1, &ws));
+    printf("capacity: the same stick in flight has %d watchers\n", ws.n);
+    ENSURE(ws.n == 2 * 2 + 2 + 1 + 1);
+    ENSURE(s.nq == 3 && !(s.mode.locked & 4u) && strcmp(lag_sim_contact(&s), "flight") == 0);
+    d.q0[2] = 0.0;
+    if (tc_sim_init(&s, &d)) return;
+    ENSURE((s.mode.locked & 4u) && strcmp(lag_sim_contact(&s), "contact") == 0);
 }
 
 /* ---------------------------------------------------------------- locate */

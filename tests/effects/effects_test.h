@@ -61,7 +61,7 @@ static inline void te_mass(const lag_model *m, const double *q, double *M)
 
 static inline double te_sim_energy(const lag_sim *s)
 {
-    return te_energy(&s->def.model, s->q, s->qd);
+    return te_energy(&s->model, s->q, s->qd); /* the model integrated (a flying stick: its own) */
 }
 
 static inline bool te_finite_state(const lag_sim *s)

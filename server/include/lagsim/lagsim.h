@@ -81,11 +81,17 @@ typedef enum lag_model_kind {
     LAG_MODEL_MANIPULATOR = 1, /* q = (q1, q2)                  */
     LAG_MODEL_DIPC = 2,        /* q = (theta0, theta1, theta2)  */
     LAG_MODEL_CARTPOLE = 3,    /* q = (x, theta)                */
+    LAG_MODEL_FLYING_STICK = 4, /* q = (x, phi, h): the stick free in the plane, h the
+                                   height of one end (the stick's floor flies it) */
     LAG_MODEL_COUNT
 } lag_model_kind;
 
 /* Parameter indices into lag_model.p, named as in docs/models.md. */
 enum { LAG_STICK_M, LAG_STICK_L, LAG_STICK_I, LAG_STICK_G, LAG_STICK_NP };
+/* The flying stick has the stick's parameters; p[LAG_FSTICK_END] is not a parameter but
+ * which end h measures: 0 end A (at r_c - l/2 (cos phi, sin phi), the end the stick model
+ * stands on), 1 end B (the other). The sim switches it when end B lands. */
+enum { LAG_FSTICK_END = LAG_STICK_NP };
 enum { LAG_MANIP_M1, LAG_MANIP_M2, LAG_MANIP_L1, LAG_MANIP_I1, LAG_MANIP_I2, LAG_MANIP_G,
        LAG_MANIP_NP };
 enum { LAG_DIPC_M0, LAG_DIPC_M1, LAG_DIPC_M2, LAG_DIPC_L1, LAG_DIPC_L2, LAG_DIPC_I1,
@@ -230,8 +236,10 @@ enum {
     LAG_EFF_FRICTION = 1u << 1,    /* Coulomb per joint: stick while |force| <= mu_s, else   */
                                    /* slide against the motion with mu_k (hybrid modes)      */
     LAG_EFF_LIMITS = 1u << 2,      /* per-joint stops located in time, restitution impulse   */
-    LAG_EFF_FLOOR = 1u << 3,       /* stick only: impact at phi = 0 or pi, resting contact,  */
-                                   /* lift-off (normal force < 0) is a fault (LAG_ERR_LIFTOFF)*/
+    LAG_EFF_FLOOR = 1u << 3,       /* stick only: its ends on a frictionless floor at y = 0:  */
+                                   /* impacts, resting contact, lift-off into flight and     */
+                                   /* landing (floor_flight), or lift-off as a fault         */
+                                   /* (LAG_ERR_LIFTOFF) without flight                       */
     LAG_EFF_ACTUATOR = 1u << 4,    /* per-input saturation and first-order lag              */
     LAG_EFF_DISTURBANCE = 1u << 5, /* scheduled impulses / forces                          */
     LAG_EFF_NOISE = 1u << 6,       /* Gaussian noise on the published state only            */
@@ -277,6 +285,9 @@ typedef struct lag_effects_def {
     double limit_upper[LAG_MAX_DOF];
     double restitution[LAG_MAX_DOF];        /* e in [0, 1] at that joint's stops */
     double floor_restitution;               /* stick: e in [0, 1] when the stick lands */
+    bool floor_flight;                      /* stick: when the normal force reaches zero
+                                               the stick flies (true, the default) and
+                                               lands again; false: LAG_ERR_LIFTOFF */
     double rest_velocity;                   /* impacts slower than this (m/s, rad/s) end in
                                                resting contact: the Zeno guard. default 1e-3 */
     double actuator_max[LAG_MAX_DOF];       /* |effort_i| <= max (INFINITY: no saturation) */
@@ -290,22 +301,28 @@ typedef struct lag_effects_def {
     double spring_rest[LAG_MAX_DOF];        /* rest position (m or rad) */
 } lag_effects_def;
 
-/* All effects off, neutral parameters (no saturation, no lag, rest_velocity 1e-3). */
+/* All effects off, neutral parameters (no saturation, no lag, rest_velocity 1e-3, a
+ * floor the stick may leave). */
 lag_effects_def lag_default_effects_def(void);
 
 /* Something the step noticed, recorded with its sim time (see lag_sim_poll_event). */
 typedef enum lag_event_kind {
     LAG_EV_LIMIT = 1,    /* a stop was hit; value = impact velocity */
-    LAG_EV_IMPACT,       /* the stick landed on the floor; value = impact phi_dot */
+    LAG_EV_IMPACT,       /* the stick hit the floor and bounced: its free end (joint phi,
+                            value = impact phi_dot), or in flight an end (joint h, value =
+                            that end's vertical velocity, m/s) */
     LAG_EV_REST,         /* an impact slower than rest_velocity: resting contact begins */
     LAG_EV_RELEASE,      /* a resting contact ends (the force pulls away) */
     LAG_EV_STICK,        /* friction: the joint stopped and static friction holds it */
     LAG_EV_SLIP,         /* friction: the joint starts or keeps sliding; value = direction */
-    LAG_EV_LIFTOFF,      /* stick: normal force reached zero; the model no longer holds */
+    LAG_EV_LIFTOFF,      /* stick: normal force reached zero: it flies from here (joint
+                            h), or without flight the model no longer holds (a fault) */
     LAG_EV_SATURATION,   /* an actuator hit its limit; value = commanded effort */
     LAG_EV_DISTURBANCE,  /* a scheduled disturbance was applied; value = its value */
-    LAG_EV_EVENT_LIMIT   /* more events in one tick than the engine handles: rest of the
+    LAG_EV_EVENT_LIMIT,  /* more events in one tick than the engine handles: rest of the
                             tick taken without event location (a warning) */
+    LAG_EV_LANDING       /* stick: an end reached the floor from flight and stays on it
+                            (sliding contact); joint h, value = its vertical velocity */
 } lag_event_kind;
 
 typedef struct lag_event {
@@ -322,8 +339,10 @@ typedef struct lag_sim_def {
     lag_model model;
     lag_integrator_def integrator;
     lag_effects_def effects;
-    double q0[LAG_MAX_DOF];   /* initial positions */
-    double qd0[LAG_MAX_DOF];  /* initial velocities */
+    double q0[LAG_MAX_DOF];   /* initial positions, of the model's joints; a stick whose
+                                 floor lets it fly also has h = q0[2] >= 0, the height of
+                                 its lower end (0: on the floor) */
+    double qd0[LAG_MAX_DOF];  /* initial velocities (and h_dot = qd0[2]) */
     double explode_limit;     /* a step whose |q_i| or |qd_i| exceeds this is a fault; 1e6 */
 } lag_sim_def;
 
@@ -360,6 +379,10 @@ typedef struct lag_sim_stats {
 /* The mutable simulation. Sim time is tick * dt, computed, never accumulated. */
 typedef struct lag_sim {
     lag_sim_def def;
+    /* The model integrated and its coordinates q[0..nq-1]: def.model, except for a stick
+     * whose floor lets it fly: the flying stick (x, phi, h), h the height of the end of
+     * p[LAG_FSTICK_END], held at h = 0 (a resting stop) while that end is on the floor. */
+    lag_model model;
     int nq;
     int64_t tick;                 /* number of dt ticks taken */
     double q[LAG_MAX_DOF];
@@ -379,6 +402,8 @@ typedef struct lag_sim {
         double act_state[LAG_MAX_DOF]; /* actuator lag state */
         bool saturated[LAG_MAX_DOF];
         double dist_force[LAG_MAX_DOF]; /* disturbance forces held over this tick */
+        uint32_t released;         /* bit i: the floor's hold of joint i let go at this
+                                      instant (not a landing again before a step) */
     } mode;
     /* The effect table's rows that the enabled effects use, per hook, in table order: made
      * once by lag_sim_init from def.effects.enabled, so that the step calls those rows
@@ -408,7 +433,14 @@ typedef struct lag_sim {
 } lag_sim;
 
 lag_result lag_sim_init(lag_sim *s, const lag_sim_def *def, char *err, size_t errlen);
-/* Resets to (q, qd) at tick 0 (NULL: the definition's initial state); input to zero. */
+/* The joints the sim publishes, takes inputs on and is reset to: def.model's, or for a
+ * stick whose floor lets it fly the flying stick's (x, phi, h), in every contact mode. */
+const lag_model_info *lag_sim_info(const lag_sim *s);
+/* Resets to (q, qd) at tick 0 (NULL: the definition's initial state); input to zero.
+ * q and qd hold lag_sim_info's joints. A stick that can fly: h = q[2] is the height of
+ * its lower end (the one below the centre: end B when sin phi < 0); with h and h_dot 0
+ * that end is on the floor (sliding contact, left at once if the floor would have to
+ * pull), else the stick flies. */
 void lag_sim_reset(lag_sim *s, const double *q, const double *qd);
 /* Changes the model's parameters and the effects' settings of a running simulation,
  * keeping its state, tick, input and initial state: the run goes on as a run of the new
@@ -421,8 +453,12 @@ void lag_sim_reset(lag_sim *s, const double *q, const double *qd);
  * held by static friction) are derived again from the state, as at a reset; a newly
  * switched-on actuator starts from the effort applied now; dopri5 restarts its step. */
 lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_t errlen);
-/* Sets the held input tau (n entries; entries of unactuated coordinates are ignored
- * and stored as zero). */
+/* The stick's contact with its floor, for status: "flight" (no end on it), "contact" (an
+ * end on it, sliding), "flat" (lying on it: both ends held); "" without a floor that lets
+ * it fly. */
+const char *lag_sim_contact(const lag_sim *s);
+/* Sets the held input tau (s->nq entries, lag_sim_info's joints; entries of unactuated
+ * coordinates are ignored and stored as zero). */
 void lag_sim_set_input(lag_sim *s, const double *tau);
 /* Advances n ticks (n * dt) with the held input. On error the public state is that of
  * the last good tick and the error is returned; stats.faults counts it.
@@ -458,8 +494,10 @@ lag_result lag_sim_rhs(lag_sim *s, const double *y, double *ydot);
 
 /* Pops the oldest recorded event into ev; returns false when there is none. */
 bool lag_sim_poll_event(lag_sim *s, lag_event *ev);
-/* The state as published: the true state plus the noise effect, if on (deterministic in
- * (noise_seed, tick), so a replay reproduces it). OUT: q, qd */
+/* The state as published, lag_sim_info's joints (s->nq of them): the true state plus the
+ * noise effect, if on (deterministic in (noise_seed, tick), so a replay reproduces it).
+ * A stick that can fly publishes (x, phi, h), h the height of its lower end and h_dot
+ * that end's vertical velocity (both 0 while an end is on the floor). OUT: q, qd */
 void lag_sim_observe(const lag_sim *s, double *q, double *qd);
 
 #ifdef __cplusplus
