@@ -127,7 +127,11 @@ int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
 {
     bool help = false;
     char prefix_help[96];
-    snprintf(prefix_help, sizeof prefix_help, "channel prefix (default %s)", ctl->prefix);
+    if (ctl->prefix)
+        snprintf(prefix_help, sizeof prefix_help, "channel prefix (default %s)", ctl->prefix);
+    else
+        snprintf(prefix_help, sizeof prefix_help, "channel prefix (required: the plant's "
+                                                  "lcm.prefix)");
     const lag_ctl_option common[] = {
         {"prefix", "P", prefix_help, set_string, &ctl->prefix},
         {"url", "URL", "LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)",
@@ -194,6 +198,10 @@ int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
     if (help) {
         usage(ctl, stdout, what, all, n);
         return 0;
+    }
+    if (!ctl->prefix) {
+        fprintf(stderr, "%s: --prefix is required (the plant's lcm.prefix)\n", ctl->name);
+        return 2;
     }
     return -1;
 }
@@ -263,6 +271,7 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
             return 1;
         }
     }
+    if (!model) model = ctl->scene.model; /* any model this build knows */
     if (strcmp(ctl->scene.model, model) != 0) {
         fprintf(stderr, "%s: prefix %s runs model '%s', not %s\n", ctl->name, ctl->prefix,
                 ctl->scene.model, model);

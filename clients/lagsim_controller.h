@@ -112,6 +112,7 @@ typedef struct lag_ctl {
     void *event_user;
 } lag_ctl;
 
+/* default_prefix NULL: --prefix is required. */
 void lag_ctl_init(lag_ctl *ctl, const char *name, const char *default_prefix);
 
 /* Parses argv: the common options and the controller's own (`what` is the usage's
@@ -122,8 +123,8 @@ int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
 
 /* Connects, handles SIGINT and SIGTERM, prints "<name>: waiting for the scene description
  * on <prefix>_SCENE" once subscribed (test harnesses start the daemon on it), waits for
- * the scene, checks it runs `model` and builds ctl->model from its parameters. Returns 0,
- * or 1 with a message on stderr. */
+ * the scene, checks it runs `model` (NULL: any model of this build, the scene's) and builds
+ * ctl->model from its parameters. Returns 0, or 1 with a message on stderr. */
 int lag_ctl_start(lag_ctl *ctl, const char *model);
 
 /* The newest state not yet returned: LAG_CLIENT_OK, or LAG_CLIENT_TIMEOUT when the run

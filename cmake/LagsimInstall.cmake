@@ -18,7 +18,7 @@
 include(GNUInstallDirs)
 
 set(_programs lagsimd lagsimctl lagsim-view lagsim-log2csv
-              dipc_lqr manipulator_pd stick_push)
+              dipc_lqr lqr_balance manipulator_pd stick_push)
 foreach(t ${_programs})
   if(TARGET ${t})
     install(TARGETS ${t} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})

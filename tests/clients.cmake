@@ -50,6 +50,23 @@ endforeach()
 # --help: exit 0, the options listed
 add_test(NAME clients_dipc_lqr_help
          COMMAND ${expect_exit} 0 "--duration S" $<TARGET_FILE:dipc_lqr> --help)
+# lqr_balance takes its model from the scene, so it has no default prefix: --prefix is
+# required; its own options are checked as dipc_lqr's.
+foreach(bad "" "--prefix;P;--q;1,-2" "--prefix;P;--q;1,2,3,4,5,6,7" "--prefix;P;--r;0"
+            "--prefix;P;--gain;foo" "--prefix;P;--q0;x")
+  string(REPLACE "--prefix;P;" "" bad_name "${bad}")
+  string(REGEX REPLACE "^-+" "" bad_name "${bad_name}")
+  string(REPLACE ";" "_" bad_name "${bad_name}")
+  string(REGEX REPLACE "[^A-Za-z0-9_.-]" "" bad_name "${bad_name}")
+  if(bad_name STREQUAL "")
+    set(bad_name no_prefix)
+  endif()
+  add_test(NAME clients_lqr_balance_usage_${bad_name}
+           COMMAND ${expect_exit} 2 "^lqr_balance: --" $<TARGET_FILE:lqr_balance> ${bad})
+  set_tests_properties(clients_lqr_balance_usage_${bad_name} PROPERTIES TIMEOUT 10)
+endforeach()
+add_test(NAME clients_lqr_balance_help
+         COMMAND ${expect_exit} 0 "--prefix P +channel prefix \\(required" $<TARGET_FILE:lqr_balance> --help)
 
 # ---- end to end: lagsimd + a controller on real LCM (default udpm URL, ttl=0), each run
 # with its own channel prefix (run_e2e.py makes it unique per process). The harness
@@ -102,6 +119,53 @@ if(LAGSIM_PYTHON3)
       --check "max_abs_theta0 < 1.0"
       -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration 20 --timeout 5 -q)
   set_tests_properties(clients_dipc_lqr_realtime PROPERTIES TIMEOUT 70)
+
+  # The cart-pole balanced by lqr_balance, which takes the model, its parameters, joints
+  # and inputs from the scene (no cart-pole code in the controller), with
+  # config/cartpole.yaml as it is (released at theta = 0.05 rad). Default weights (Q = I,
+  # R = 1) at 100 Hz: continuous closed-loop poles -4.78, -3.32, -0.81 +- 0.50i 1/s. As
+  # for the DIPC, the daemon's peaks must lie within 10 % + 2 mm or mrad of the linearized
+  # sampled loop's (pred_*; the nonlinear terms are O(theta^2) ~ 0.1 % at 0.05 rad), and
+  # after 20 s the slowest pole has shrunk every mode by e^-16 (1e-7): both coordinates
+  # within 1e-4 rad, 1e-3 m of upright and centre. 20 s at 100 Hz = 2001 states.
+  set(cartpole_cfg --config ${PROJECT_SOURCE_DIR}/config/cartpole.yaml)
+  add_test(NAME clients_lqr_balance_cartpole_lockstep
+    COMMAND ${e2e} ${cartpole_cfg} --mode lockstep --name CLCPLS --timeout 50
+      --check "states == 2001" --check "t_first == 0 and t_last >= 20 - 1e-9"
+      --check "max_abs_theta >= 0.0499"
+      --check "max_abs_theta <= 1.1 * pred_max_abs_theta + 0.002"
+      --check "max_abs_x <= 1.1 * pred_max_abs_x + 0.002"
+      --check "abs(end_theta) < 1e-4 and abs(end_x) < 1e-3"
+      --check "dropped == 0" --check "end == 'duration'"
+      -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout 5 -q)
+  # A push: upright at rest, then at t = 5 s an impulse of 0.02 N m s on the pole (the
+  # scene's disturbance effect). Its velocity jump M(0)^-1 (0, 0.02) = (-0.0293 m/s,
+  # 0.644 rad/s) run through the linearized sampled loop peaks at theta 0.0567 rad,
+  # x 0.487 m (lqr_balance's pred_* from that initial velocity); the push lands inside a
+  # control period, so the loop answers up to 10 ms late: 25 % more is allowed. It must
+  # move the pole (>= 0.05 rad), and 15 s later (e^-12 of the slowest mode) the pole is
+  # upright within 1e-4 rad and the cart back within 1e-3 m.
+  add_test(NAME clients_lqr_balance_cartpole_push
+    COMMAND ${e2e} ${cartpole_cfg} --set "initial.q=[0,0]"
+      --set "effects={disturbance: [{t: 5.0, joint: theta, impulse: 0.02}]}"
+      --mode lockstep --name CLCPPU --timeout 50
+      --check "states == 2001" --check "t_first == 0 and t_last >= 20 - 1e-9"
+      --check "max_abs_theta >= 0.05 and max_abs_theta <= 1.25 * 0.0567"
+      --check "max_abs_x <= 1.25 * 0.487"
+      --check "abs(end_theta) < 1e-4 and abs(end_x) < 1e-3"
+      --check "dropped == 0" --check "end == 'duration'"
+      -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout 5 -q)
+  # Real time, as clients_dipc_lqr_realtime: 25 % + 5 mrad (or mm) of the prediction.
+  add_test(NAME clients_lqr_balance_cartpole_realtime
+    COMMAND ${e2e} ${cartpole_cfg} --mode realtime --name CLCPRT --timeout 50
+      --check "states >= 1000" --check "t_last - t_first >= 20 - 0.011"
+      --check "max_abs_theta >= 0.0499"
+      --check "max_abs_theta <= 1.25 * pred_max_abs_theta + 0.005"
+      --check "max_abs_x <= 1.25 * pred_max_abs_x + 0.005"
+      --check "abs(end_theta) < 1e-3 and abs(end_x) < 1e-2"
+      -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout 5 -q)
+  set_tests_properties(clients_lqr_balance_cartpole_lockstep clients_lqr_balance_cartpole_push
+                       clients_lqr_balance_cartpole_realtime PROPERTIES TIMEOUT 70)
 
   # Manipulator tracking (q1 = 0.3 sin 0.5t, q2 = 0.5 + 0.1 sin t from rest at q = (0, 0.5)),
   # computed torque with wn = 10 (Kp 100, Kd 20, critically damped). Bounds:
