@@ -4,6 +4,7 @@
 set -euo pipefail
 pkgs=(build-essential cmake pkg-config clang libclang-rt-14-dev   # gcc pass; clang pass (sanitizers, libFuzzer)
       liblcm-dev liblcm-bin libglib2.0-dev libyaml-dev   # LCM (lcm.pc needs glib's dev package) and libyaml
+      liblapacke-dev                                     # the example controllers' LQR design (LAPACK)
       python3                                            # the stdlib-only Python client and some tests
       lua5.2 liblcm-lua                                  # the Lua 5.2 clients (liblcm-lua is built for 5.2 only)
       libmujoco-dev libsundials-dev gnuplot-nox          # benchmark peers and plots

@@ -11,16 +11,18 @@
  *    bring the residual to round-off.
  *  - DARE: the structure-preserving doubling algorithm (Chu, Fan, Lin, Wang 2004):
  *    three matrix products and one inverse per step, quadratic convergence.
- *  - Eigenvalues: balancing + Hessenberg + Francis double-shift QR (the EISPACK hqr
- *    scheme), enough for 12 x 12 Hamiltonians.
+ * The dense kernels are LAPACK's (through LAPACKE): LU solves and inverses (dgesv), the
+ * least-squares step of the sign method (dgels), the Lyapunov equation of each
+ * Newton-Kleinman step by Bartels-Stewart (real Schur form, dgees, then the triangular
+ * Sylvester equation, dtrsyl), eigenvalues (dgeev, with balancing).
  */
 #include "lqr.h"
 
+#include <lapacke.h>
 #include <math.h>
 #include <string.h>
 
 #define NMAX (2 * LAG_LQR_MAX_N)              /* Hamiltonian size */
-#define KMAX (LAG_LQR_MAX_N * LAG_LQR_MAX_N)  /* Lyapunov equation as a linear system */
 
 /* ---------------------------------------------------------------- small helpers */
 
@@ -69,40 +71,23 @@ static void mat_symmetrize(int n, double *X)
         }
 }
 
-/* Solves A X = B for X (A: n x n, B: n x c, overwritten by X) by Gaussian elimination
- * with partial pivoting. A is destroyed. If logabsdet is not NULL, it receives
- * log|det A|. n <= KMAX. */
+/* Solves A X = B for X (A: n x n, B: n x c, overwritten by X) by LU with partial
+ * pivoting (LAPACK dgesv). A is destroyed (its LU factors). If logabsdet is not NULL, it
+ * receives log|det A|. n <= NMAX. */
 static int mat_solve(int n, double *A, int c, double *B, double *logabsdet)
 {
+    lapack_int ipiv[NMAX];
+    if (n < 1 || n > NMAX) return LAG_LQR_ERR_ARG;
+    if (LAPACKE_dgesv(LAPACK_ROW_MAJOR, n, c, A, n, ipiv, B, c) != 0)
+        return LAG_LQR_ERR_SINGULAR;
     double ld = 0.0;
     for (int k = 0; k < n; k++) {
-        int p = k;
-        for (int i = k + 1; i < n; i++)
-            if (fabs(A[i * n + k]) > fabs(A[p * n + k])) p = i;
-        double piv = A[p * n + k];
+        double piv = A[k * n + k];
         if (piv == 0.0 || !isfinite(piv)) return LAG_LQR_ERR_SINGULAR;
-        if (p != k) {
-            for (int j = 0; j < n; j++) {
-                double t = A[k * n + j]; A[k * n + j] = A[p * n + j]; A[p * n + j] = t;
-            }
-            for (int j = 0; j < c; j++) {
-                double t = B[k * c + j]; B[k * c + j] = B[p * c + j]; B[p * c + j] = t;
-            }
-        }
         ld += log(fabs(piv));
-        for (int i = k + 1; i < n; i++) {
-            double f = A[i * n + k] / piv;
-            if (f == 0.0) continue;
-            for (int j = k; j < n; j++) A[i * n + j] -= f * A[k * n + j];
-            for (int j = 0; j < c; j++) B[i * c + j] -= f * B[k * c + j];
-        }
     }
-    for (int k = n - 1; k >= 0; k--)
-        for (int j = 0; j < c; j++) {
-            double s = B[k * c + j];
-            for (int l = k + 1; l < n; l++) s -= A[k * n + l] * B[l * c + j];
-            B[k * c + j] = s / A[k * n + k];
-        }
+    for (int i = 0; i < n * c; i++)
+        if (!isfinite(B[i])) return LAG_LQR_ERR_SINGULAR;
     if (logabsdet) *logabsdet = ld;
     return LAG_LQR_OK;
 }
@@ -183,13 +168,13 @@ static int gain_matrix(int n, int m, const double *B, const double *R, double *G
     return LAG_LQR_OK;
 }
 
-double lag_lqr_care_residual(int n, int m, const double *A, const double *B, const double *Q,
-                             const double *R, const double *X)
+/* Res = A^T X + X A - X G X + Q, G = B R^-1 B^T. */
+static int care_residual_matrix(int n, int m, const double *A, const double *B,
+                                const double *Q, const double *R, const double *X, double *Res)
 {
-    double G[LAG_LQR_MAX_N * LAG_LQR_MAX_N], At[LAG_LQR_MAX_N * LAG_LQR_MAX_N];
+    double G[LAG_LQR_MAX_N * LAG_LQR_MAX_N], At[LAG_LQR_MAX_N * LAG_LQR_MAX_N] = {0};
     double T1[LAG_LQR_MAX_N * LAG_LQR_MAX_N], T2[LAG_LQR_MAX_N * LAG_LQR_MAX_N];
-    double Res[LAG_LQR_MAX_N * LAG_LQR_MAX_N];
-    if (!sizes_ok(n, m) || gain_matrix(n, m, B, R, G)) return NAN;
+    if (gain_matrix(n, m, B, R, G)) return LAG_LQR_ERR_SINGULAR;
     mat_transpose(n, n, A, At);
     mat_mul(n, n, n, At, X, T1);
     for (int i = 0; i < n * n; i++) Res[i] = T1[i] + Q[i];
@@ -198,6 +183,14 @@ double lag_lqr_care_residual(int n, int m, const double *A, const double *B, con
     mat_mul(n, n, n, X, G, T1);
     mat_mul(n, n, n, T1, X, T2);
     for (int i = 0; i < n * n; i++) Res[i] -= T2[i];
+    return LAG_LQR_OK;
+}
+
+double lag_lqr_care_residual(int n, int m, const double *A, const double *B, const double *Q,
+                             const double *R, const double *X)
+{
+    double Res[LAG_LQR_MAX_N * LAG_LQR_MAX_N];
+    if (!sizes_ok(n, m) || care_residual_matrix(n, m, A, B, Q, R, X, Res)) return NAN;
     return mat_norm_fro(n, n, Res) / mat_norm_fro(n, n, Q);
 }
 
@@ -213,24 +206,33 @@ static int care_gain(int n, int m, const double *B, const double *R, const doubl
     return LAG_LQR_OK;
 }
 
-/* Solves the Lyapunov equation Ac^T X + X Ac = -W for X (n x n) as an n^2 system
- * (row-major vec: X_ij at i n + j). */
+/* Solves the Lyapunov equation Ac^T X + X Ac = -W for X (n x n) by Bartels-Stewart:
+ * Ac = U T U^T (real Schur form, dgees), then T^T Y + Y T = -U^T W U (dtrsyl: T is quasi
+ * upper triangular) and X = U Y U^T. */
 static int lyapunov(int n, const double *Ac, const double *W, double *X)
 {
-    int nn = n * n;
-    if (nn > KMAX) return LAG_LQR_ERR_ARG;
-    double L[KMAX * KMAX];
-    memset(L, 0, sizeof(double) * (size_t)(nn * nn));
-    for (int i = 0; i < n; i++)
-        for (int j = 0; j < n; j++) {
-            int row = i * n + j;
-            for (int k = 0; k < n; k++) {
-                L[row * nn + k * n + j] += Ac[k * n + i]; /* (Ac^T X)_ij */
-                L[row * nn + i * n + k] += Ac[k * n + j]; /* (X Ac)_ij */
-            }
-            X[row] = -W[row];
-        }
-    return mat_solve(nn, L, 1, X, NULL);
+    double T[LAG_LQR_MAX_N * LAG_LQR_MAX_N], U[LAG_LQR_MAX_N * LAG_LQR_MAX_N];
+    double C[LAG_LQR_MAX_N * LAG_LQR_MAX_N], Tmp[LAG_LQR_MAX_N * LAG_LQR_MAX_N];
+    double Ut[LAG_LQR_MAX_N * LAG_LQR_MAX_N], wr[LAG_LQR_MAX_N], wi[LAG_LQR_MAX_N], scale;
+    lapack_int sdim;
+    memcpy(T, Ac, sizeof(double) * (size_t)(n * n));
+    if (LAPACKE_dgees(LAPACK_ROW_MAJOR, 'V', 'N', NULL, n, T, n, &sdim, wr, wi, U, n) != 0)
+        return LAG_LQR_ERR_NOCONV;
+    mat_transpose(n, n, U, Ut);
+    mat_mul(n, n, n, Ut, W, Tmp);
+    mat_mul(n, n, n, Tmp, U, C);
+    for (int i = 0; i < n * n; i++) C[i] = -C[i];
+    /* op(A) Y + isgn Y op(B) = scale C with op(A) = T^T, op(B) = T, isgn = +1; info 1
+     * means eigenvalues of T^T and -T (nearly) shared: the equation is singular */
+    if (LAPACKE_dtrsyl(LAPACK_ROW_MAJOR, 'T', 'N', 1, n, n, T, n, T, n, C, n, &scale) != 0 ||
+        !(scale > 0.0))
+        return LAG_LQR_ERR_SINGULAR;
+    for (int i = 0; i < n * n; i++) C[i] /= scale;
+    mat_mul(n, n, n, U, C, Tmp);
+    mat_mul(n, n, n, Tmp, Ut, X);
+    for (int i = 0; i < n * n; i++)
+        if (!isfinite(X[i])) return LAG_LQR_ERR_SINGULAR;
+    return LAG_LQR_OK;
 }
 
 int lag_lqr_care(int n, int m, const double *A, const double *B, const double *Q,
@@ -267,36 +269,37 @@ int lag_lqr_care(int n, int m, const double *A, const double *B, const double *Q
     }
     if (!converged) return LAG_LQR_ERR_NOCONV;
 
-    /* (sign H + I) [I; X] = 0  =>  [W12; W22 + I] X = -[W11 + I; W21], solved in the
-     * least-squares sense through the normal equations (refined below). */
+    /* (sign H + I) [I; X] = 0  =>  [W12; W22 + I] X = -[W11 + I; W21], a 2n x n system
+     * solved in the least-squares sense (QR, dgels; refined below). */
     double Mx[NMAX * LAG_LQR_MAX_N], rhs[NMAX * LAG_LQR_MAX_N];
     for (int i = 0; i < N; i++)
         for (int j = 0; j < n; j++) {
             Mx[i * n + j] = Z[i * N + n + j] + (i == n + j ? 1.0 : 0.0);
             rhs[i * n + j] = -(Z[i * N + j] + (i == j ? 1.0 : 0.0));
         }
-    double MtM[LAG_LQR_MAX_N * LAG_LQR_MAX_N], Mt[LAG_LQR_MAX_N * NMAX];
-    mat_transpose(N, n, Mx, Mt);
-    mat_mul(n, N, n, Mt, Mx, MtM);
-    mat_mul(n, N, n, Mt, rhs, X);
-    if (mat_solve(n, MtM, n, X, NULL)) return LAG_LQR_ERR_SINGULAR;
+    if (LAPACKE_dgels(LAPACK_ROW_MAJOR, 'N', N, n, n, Mx, n, rhs, n) != 0)
+        return LAG_LQR_ERR_SINGULAR;
+    memcpy(X, rhs, sizeof(double) * (size_t)(n * n)); /* the solution: rhs's first n rows */
+    for (int i = 0; i < n * n; i++)
+        if (!isfinite(X[i])) return LAG_LQR_ERR_SINGULAR;
     mat_symmetrize(n, X);
 
-    /* Newton-Kleinman refinement: K = R^-1 B^T X, solve
-     * (A - B K)^T X+ + X+ (A - B K) = -(Q + K^T R K). Keep a step only if it lowers the
-     * residual (it does from a stabilizing X; the guard makes round-off harmless). */
+    /* Newton-Kleinman refinement: K = R^-1 B^T X, X+ = X + D with
+     * (A - B K)^T D + D (A - B K) = -Res(X), the Riccati residual (the same step as
+     * solving for X+ with right-hand side Q + K^T R K, but D is small, so the Lyapunov
+     * solve's round-off is relative to the correction, not to X). Keep a step only if it
+     * lowers the residual (it does from a stabilizing X; the guard makes round-off
+     * harmless). */
     double res = lag_lqr_care_residual(n, m, A, B, Q, R, X);
     for (int it = 0; it < 8 && res > 1e-15; it++) {
         double Kt[LAG_LQR_MAX_M * LAG_LQR_MAX_N], Ac[LAG_LQR_MAX_N * LAG_LQR_MAX_N];
-        double W[LAG_LQR_MAX_N * LAG_LQR_MAX_N], RK[LAG_LQR_MAX_M * LAG_LQR_MAX_N];
-        double KtT[LAG_LQR_MAX_N * LAG_LQR_MAX_M], Xn[LAG_LQR_MAX_N * LAG_LQR_MAX_N];
+        double W[LAG_LQR_MAX_N * LAG_LQR_MAX_N], D[LAG_LQR_MAX_N * LAG_LQR_MAX_N];
+        double Xn[LAG_LQR_MAX_N * LAG_LQR_MAX_N];
         if (care_gain(n, m, B, R, X, Kt)) return LAG_LQR_ERR_SINGULAR;
         lag_lqr_closed_loop(n, m, A, B, Kt, Ac);
-        mat_mul(m, m, n, R, Kt, RK);
-        mat_transpose(m, n, Kt, KtT);
-        mat_mul(n, m, n, KtT, RK, W);
-        for (int i = 0; i < n * n; i++) W[i] += Q[i];
-        if (lyapunov(n, Ac, W, Xn)) break;
+        if (care_residual_matrix(n, m, A, B, Q, R, X, W)) return LAG_LQR_ERR_SINGULAR;
+        if (lyapunov(n, Ac, W, D)) break;
+        for (int i = 0; i < n * n; i++) Xn[i] = X[i] + D[i];
         mat_symmetrize(n, Xn);
         double rn = lag_lqr_care_residual(n, m, A, B, Q, R, Xn);
         if (!(rn < res)) break;
@@ -435,186 +438,6 @@ int lag_lqr_dare(int n, int m, const double *Ad, const double *Bd, const double 
 
 /* ---------------------------------------------------------------- eigenvalues */
 
-/* Balances a (n x n) by powers of 2 so that rows and columns have similar norms
- * (Parlett-Reinsch); eigenvalues are unchanged. */
-static void eig_balance(int n, double *a)
-{
-    const double radix = 2.0, sqrdx = radix * radix;
-    int done = 0;
-    while (!done) {
-        done = 1;
-        for (int i = 0; i < n; i++) {
-            double r = 0.0, c = 0.0;
-            for (int j = 0; j < n; j++)
-                if (j != i) {
-                    c += fabs(a[j * n + i]);
-                    r += fabs(a[i * n + j]);
-                }
-            if (c == 0.0 || r == 0.0) continue;
-            double g = r / radix, f = 1.0, s = c + r;
-            while (c < g) { f *= radix; c *= sqrdx; }
-            g = r * radix;
-            while (c > g) { f /= radix; c /= sqrdx; }
-            if ((c + r) / f < 0.95 * s) {
-                done = 0;
-                g = 1.0 / f;
-                for (int j = 0; j < n; j++) a[i * n + j] *= g;
-                for (int j = 0; j < n; j++) a[j * n + i] *= f;
-            }
-        }
-    }
-}
-
-/* Reduces a to upper Hessenberg form by stabilized elementary similarity transforms;
- * entries below the subdiagonal are set to zero. */
-static void eig_hessenberg(int n, double *a)
-{
-    for (int m = 1; m < n - 1; m++) {
-        double x = 0.0;
-        int i = m;
-        for (int j = m; j < n; j++)
-            if (fabs(a[j * n + m - 1]) > fabs(x)) { x = a[j * n + m - 1]; i = j; }
-        if (i != m) {
-            for (int j = m - 1; j < n; j++) {
-                double t = a[i * n + j]; a[i * n + j] = a[m * n + j]; a[m * n + j] = t;
-            }
-            for (int j = 0; j < n; j++) {
-                double t = a[j * n + i]; a[j * n + i] = a[j * n + m]; a[j * n + m] = t;
-            }
-        }
-        if (x == 0.0) continue;
-        for (i = m + 1; i < n; i++) {
-            double y = a[i * n + m - 1];
-            if (y == 0.0) continue;
-            y /= x;
-            a[i * n + m - 1] = 0.0;
-            for (int j = m; j < n; j++) a[i * n + j] -= y * a[m * n + j];
-            for (int j = 0; j < n; j++) a[j * n + m] += y * a[j * n + i];
-        }
-    }
-}
-
-static double sign_of(double a, double b) { return b >= 0.0 ? fabs(a) : -fabs(a); }
-
-/* Eigenvalues of an upper Hessenberg matrix a (destroyed) by the Francis double-shift QR
- * iteration with exceptional shifts (EISPACK hqr). */
-static int eig_hqr(int n, double *a, double *wr, double *wi)
-{
-#define A_(i, j) a[(i) * n + (j)]
-    double anorm = 0.0, p = 0.0, q = 0.0, r = 0.0, s, t = 0.0, u, v, w, x, y, z = 0.0;
-    for (int i = 0; i < n; i++)
-        for (int j = (i > 0 ? i - 1 : 0); j < n; j++) anorm += fabs(A_(i, j));
-    int nn = n - 1;
-    while (nn >= 0) {
-        int its = 0, l;
-        do {
-            for (l = nn; l >= 1; l--) {
-                s = fabs(A_(l - 1, l - 1)) + fabs(A_(l, l));
-                if (s == 0.0) s = anorm;
-                if (fabs(A_(l, l - 1)) + s == s) { A_(l, l - 1) = 0.0; break; }
-            }
-            x = A_(nn, nn);
-            if (l == nn) { /* one root found */
-                wr[nn] = x + t;
-                wi[nn--] = 0.0;
-            } else {
-                y = A_(nn - 1, nn - 1);
-                w = A_(nn, nn - 1) * A_(nn - 1, nn);
-                if (l == nn - 1) { /* two roots found */
-                    p = 0.5 * (y - x);
-                    q = p * p + w;
-                    z = sqrt(fabs(q));
-                    x += t;
-                    if (q >= 0.0) {
-                        z = p + sign_of(z, p);
-                        wr[nn - 1] = wr[nn] = x + z;
-                        if (z != 0.0) wr[nn] = x - w / z;
-                        wi[nn - 1] = wi[nn] = 0.0;
-                    } else {
-                        wr[nn - 1] = wr[nn] = x + p;
-                        wi[nn - 1] = -(wi[nn] = z);
-                    }
-                    nn -= 2;
-                } else { /* no roots yet: a double-shift QR sweep */
-                    if (its == 60) return LAG_LQR_ERR_NOCONV;
-                    if (its == 10 || its == 20) { /* exceptional shift */
-                        t += x;
-                        for (int i = 0; i <= nn; i++) A_(i, i) -= x;
-                        s = fabs(A_(nn, nn - 1)) + fabs(A_(nn - 1, nn - 2));
-                        y = x = 0.75 * s;
-                        w = -0.4375 * s * s;
-                    }
-                    ++its;
-                    int m;
-                    for (m = nn - 2; m >= l; m--) {
-                        z = A_(m, m);
-                        r = x - z;
-                        s = y - z;
-                        p = (r * s - w) / A_(m + 1, m) + A_(m, m + 1);
-                        q = A_(m + 1, m + 1) - z - r - s;
-                        r = A_(m + 2, m + 1);
-                        s = fabs(p) + fabs(q) + fabs(r);
-                        p /= s; q /= s; r /= s;
-                        if (m == l) break;
-                        u = fabs(A_(m, m - 1)) * (fabs(q) + fabs(r));
-                        v = fabs(p) * (fabs(A_(m - 1, m - 1)) + fabs(z) + fabs(A_(m + 1, m + 1)));
-                        if (u + v == v) break;
-                    }
-                    for (int i = m + 2; i <= nn; i++) {
-                        A_(i, i - 2) = 0.0;
-                        if (i != m + 2) A_(i, i - 3) = 0.0;
-                    }
-                    for (int k = m; k <= nn - 1; k++) {
-                        if (k != m) {
-                            p = A_(k, k - 1);
-                            q = A_(k + 1, k - 1);
-                            r = 0.0;
-                            if (k != nn - 1) r = A_(k + 2, k - 1);
-                            if ((x = fabs(p) + fabs(q) + fabs(r)) != 0.0) {
-                                p /= x; q /= x; r /= x;
-                            }
-                        }
-                        if ((s = sign_of(sqrt(p * p + q * q + r * r), p)) != 0.0) {
-                            if (k == m) {
-                                if (l != m) A_(k, k - 1) = -A_(k, k - 1);
-                            } else {
-                                A_(k, k - 1) = -s * x;
-                            }
-                            p += s;
-                            x = p / s;
-                            y = q / s;
-                            z = r / s;
-                            q /= p;
-                            r /= p;
-                            for (int j = k; j <= nn; j++) {
-                                p = A_(k, j) + q * A_(k + 1, j);
-                                if (k != nn - 1) {
-                                    p += r * A_(k + 2, j);
-                                    A_(k + 2, j) -= p * z;
-                                }
-                                A_(k + 1, j) -= p * y;
-                                A_(k, j) -= p * x;
-                            }
-                            int mmin = nn < k + 3 ? nn : k + 3;
-                            for (int i = l; i <= mmin; i++) {
-                                p = x * A_(i, k) + y * A_(i, k + 1);
-                                if (k != nn - 1) {
-                                    p += z * A_(i, k + 2);
-                                    A_(i, k + 2) -= p * r;
-                                }
-                                A_(i, k + 1) -= p * q;
-                                A_(i, k) -= p;
-                            }
-                        }
-                    }
-                }
-            }
-        } while (l < nn - 1);
-    }
-#undef A_
-    return LAG_LQR_OK;
-}
-
 int lag_lqr_eig(int n, const double *A, double *re, double *im)
 {
     if (n < 1 || n > NMAX) return LAG_LQR_ERR_ARG;
@@ -622,10 +445,10 @@ int lag_lqr_eig(int n, const double *A, double *re, double *im)
     memcpy(a, A, sizeof(double) * (size_t)(n * n));
     for (int i = 0; i < n * n; i++)
         if (!isfinite(a[i])) return LAG_LQR_ERR_ARG;
-    eig_balance(n, a);
-    eig_hessenberg(n, a);
-    int rc = eig_hqr(n, a, re, im);
-    if (rc) return rc;
+    /* balancing, Hessenberg reduction and the shifted QR iteration (dgeev) */
+    double vdummy[1];
+    if (LAPACKE_dgeev(LAPACK_ROW_MAJOR, 'N', 'N', n, a, n, re, im, vdummy, 1, vdummy, 1) != 0)
+        return LAG_LQR_ERR_NOCONV;
     /* insertion sort by (re, im) */
     for (int i = 1; i < n; i++) {
         double r0 = re[i], i0 = im[i];

@@ -3,8 +3,8 @@
  * equilibrium, the continuous (CARE) and discrete (DARE) algebraic Riccati equations,
  * zero-order-hold discretization, and eigenvalues of a real square matrix.
  *
- * Sizes are tiny (n <= LAG_LQR_MAX_N states, m <= LAG_LQR_MAX_M inputs), so everything
- * works on fixed-size scratch arrays on the stack: no allocation, no printing. Matrices
+ * Sizes are tiny (n <= LAG_LQR_MAX_N states, m <= LAG_LQR_MAX_M inputs): fixed-size
+ * scratch arrays on the stack, LAPACK (LAPACKE) for the dense kernels, no printing. Matrices
  * are row-major. Functions return 0 on success, a negative code on failure.
  */
 #ifndef LAGSIM_CLIENTS_LQR_H
@@ -34,7 +34,7 @@ int lag_lqr_linearize(const lag_model *model, const double *q0, const double *qd
 /* Continuous LQR: the stabilizing solution X of
  *   A^T X + X A - X B R^-1 B^T X + Q = 0
  * (matrix sign function of the Hamiltonian with determinant scaling, then
- * Newton-Kleinman refinement) and the gain K = R^-1 B^T X (m x n), so that u = -K x.
+ * Newton-Kleinman refinement, each step's Lyapunov equation by Bartels-Stewart) and the gain K = R^-1 B^T X (m x n), so that u = -K x.
  * OUT: X (n x n), K (m x n). */
 int lag_lqr_care(int n, int m, const double *A, const double *B, const double *Q,
                  const double *R, double *X, double *K);
@@ -64,8 +64,8 @@ double lag_lqr_dare_residual(int n, int m, const double *Ad, const double *Bd,
 void lag_lqr_closed_loop(int n, int m, const double *A, const double *B, const double *K,
                          double *Acl);
 
-/* Eigenvalues of a real n x n matrix (n <= 2 * LAG_LQR_MAX_N): balancing, reduction to
- * Hessenberg form, Francis double-shift QR. Sorted by real part, then imaginary part.
+/* Eigenvalues of a real n x n matrix (n <= 2 * LAG_LQR_MAX_N), by LAPACK's dgeev
+ * (balancing, Hessenberg form, shifted QR). Sorted by real part, then imaginary part.
  * OUT: re (n), im (n). */
 int lag_lqr_eig(int n, const double *A, double *re, double *im);
 
