@@ -78,6 +78,29 @@ lang_end_tests(python dipc "${lang_dipc_cfg}" ${LAGSIM_PYTHON3} ${py_dir}/dipc_b
 lang_end_tests(python manipulator "${lang_manip_cfg}"
                ${LAGSIM_PYTHON3} ${py_dir}/manipulator_pd.py ${py_types})
 
+# ---- Forged messages on a controller's channels: every kept crash input of the client's
+# fuzz target (tests/fuzz/client/crash: string lengths of -1, 1e9 and 2^31-1, names
+# without their NUL, 32767 joints or parameters), published three times before the daemon
+# starts and again every 20 ms while the controller runs. The controller must drop each
+# (counted) and balance the DIPC exactly as in clients_*_dipc_lockstep: the same states,
+# the same bounds. At least the 7 inputs on the state, event and scene channels published
+# before the daemon starts are dropped (21; the examples in Python, Lua and Java do not
+# decode status). The valid seeds are left out: a well-formed forged state is a state.
+set(lang_hostile_checks --hostile ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/client/crash
+    --check "states == 2001" --check "t_first == 0 and t_last >= 20 - 1e-9"
+    --check "max_abs_theta1 >= 0.0499"
+    --check "max_abs_theta1 <= 1.1 * pred_max_abs_theta1 + 0.002"
+    --check "max_abs_theta2 <= 1.1 * pred_max_abs_theta2 + 0.002"
+    --check "abs(end_theta1) < 1e-3 and abs(end_theta2) < 1e-3"
+    --check "end == 'duration'" --check "dropped >= 21")
+add_test(NAME clients_c_dipc_hostile
+  COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLHOSTC --timeout 60 ${lang_hostile_checks}
+    -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration 20 -q)
+add_test(NAME clients_python_dipc_hostile
+  COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLHOSTPY --timeout 60 ${lang_hostile_checks}
+    -- ${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py ${py_types} --prefix {prefix} --duration 20 -q)
+list(APPEND lang_tests clients_c_dipc_hostile clients_python_dipc_hostile)
+
 # ---- A late controller: the daemon starts first (config/dipc.yaml: realtime.start
 # first_command in real time, the default in lockstep), the controller 2 wall s later. It
 # must meet the DIPC at t = 0, as released, and balance it with the bounds above: with
@@ -129,6 +152,10 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
   list(APPEND lang_tests clients_lua_lcm clients_lua_manipulator_lockstep)
   lang_end_tests(lua manipulator "${lang_manip_cfg}" ${LAGSIM_LUA52} ${lua_dir}/manipulator_pd.lua ${lua_types})
   lang_end_tests(lua dipc "${lang_dipc_cfg}" ${LAGSIM_LUA52} ${lua_dir}/dipc_balance.lua ${lua_types})
+  add_test(NAME clients_lua_dipc_hostile
+    COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLHOSTLUA --timeout 60 ${lang_hostile_checks}
+      -- ${LAGSIM_LUA52} ${lua_dir}/dipc_balance.lua ${lua_types} --prefix {prefix} --duration 20 -q)
+  list(APPEND lang_tests clients_lua_dipc_hostile)
   # Python and Lua write the manipulator's computed torque with the same operations in the
   # same order over the same libm: bit for bit. The C example takes M(q) and the bias from
   # the core, whose sums run in another order: its efforts differ from Python's by rounding
@@ -152,6 +179,10 @@ if(TARGET lagsim_examples_java)
       -- ${java_run} lagsim.examples.DipcBalance --prefix {prefix} --duration 20 -q)
   list(APPEND lang_tests clients_java_dipc_lockstep)
   lang_end_tests(java dipc "${lang_dipc_cfg}" ${java_run} lagsim.examples.DipcBalance)
+  add_test(NAME clients_java_dipc_hostile
+    COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLHOSTJ --timeout 60 ${lang_hostile_checks}
+      -- ${java_run} lagsim.examples.DipcBalance --prefix {prefix} --duration 20 -q)
+  list(APPEND lang_tests clients_java_dipc_hostile)
   add_test(NAME clients_java_dipc_late_controller
     COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLLATEJ --timeout 60
       --daemon-first 2 ${late_checks} --check "states == 2001"

@@ -105,6 +105,28 @@ function Controller:parse(argv)
   return self.o
 end
 
+local function finite(v)
+  if type(v) == 'number' then return v == v and v ~= math.huge and v ~= -math.huge end
+  if type(v) == 'table' then
+    for _, x in pairs(v) do if not finite(x) then return false end end
+  end
+  return true
+end
+
+-- The message of type T in `data`, or nil (counted in self.dropped). Like the C client it
+-- keeps only a message that decodes whole: lcm-gen's decoder reads a string without its
+-- NUL, or with bytes left over, as if nothing were wrong, so the message must encode back
+-- to the very bytes that came; and every number in it must be finite.
+function Controller:decode(T, data)
+  local ok, m = pcall(T.decode, data)
+  if ok then
+    local oke, bytes = pcall(m.encode, m)
+    if oke and bytes == data and finite(m) then return m end
+  end
+  self.dropped = self.dropped + 1
+  return nil
+end
+
 function Controller:start(argv)
   local o = self:parse(argv or {})
   if o.types ~= '' then
@@ -127,23 +149,17 @@ function Controller:start(argv)
   self.silent_ms = 0
   self.lc:subscribe(ch .. 'SCENE', function(_, data)
     self.silent_ms = 0
-    local okd, sc = pcall(t.scene_t.decode, data)
-    if okd then self.scene = sc else self.dropped = self.dropped + 1 end
+    self.scene = self:decode(t.scene_t, data) or self.scene
   end)
   self.lc:subscribe(ch .. 'STATE', function(_, data)
     self.silent_ms = 0
-    local okd, st = pcall(t.joint_state_t.decode, data)
-    if okd then self.state = st else self.dropped = self.dropped + 1 end
+    self.state = self:decode(t.joint_state_t, data) or self.state
   end)
   self.lc:subscribe(ch .. 'STATUS', function() self.silent_ms = 0 end)
   self.lc:subscribe(ch .. 'EVENT', function(_, data)
     self.silent_ms = 0
-    local okd, ev = pcall(t.event_t.decode, data)
-    if not okd then
-      self.dropped = self.dropped + 1
-    elseif ev.kind == 'stop' then
-      self.stopped = true
-    end
+    local ev = self:decode(t.event_t, data)
+    if ev and ev.kind == 'stop' then self.stopped = true end
   end)
   -- subscribed: from here on no state is missed (test harnesses wait for this line)
   print(string.format('%s: waiting for the scene description on %sSCENE', self.name, ch))

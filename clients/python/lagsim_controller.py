@@ -39,6 +39,14 @@ def _import_types(types_dir, name):
         sys.exit(2)
 
 
+def _finite(v):
+    if isinstance(v, float):
+        return math.isfinite(v)
+    if isinstance(v, (list, tuple)):
+        return all(_finite(x) for x in v)
+    return True
+
+
 class Controller(object):
     def __init__(self, name, default_prefix, model, description=""):
         self.name = name
@@ -122,31 +130,44 @@ class Controller(object):
         self.params = dict(zip(self.scene.param_name, self.scene.param_value))
         return a
 
+    def _decode(self, cls, data):
+        """The message of type `cls` in `data`, or None (counted in `dropped`). Like the C
+        client, it keeps only a message that decodes whole: lcm-gen's decoder reads a
+        string without its NUL, or with bytes left over, as if nothing were wrong, so the
+        message must encode back to the very bytes that came; and every number in it must
+        be finite. (lcm-gen gives boolean arrays as one-shot `map` iterators: they become
+        lists.)"""
+        try:
+            m = cls.decode(data)
+            for k in m.__slots__:
+                if isinstance(getattr(m, k), map):
+                    setattr(m, k, list(getattr(m, k)))
+            if m.encode() == data and all(_finite(getattr(m, k)) for k in m.__slots__):
+                return m
+        except Exception:
+            pass
+        self.dropped += 1
+        return None
+
     def _on_scene(self, channel, data):
         self._heard = time.monotonic()
-        try:
-            self.scene = self.t.scene_t.decode(data)
-        except Exception:
-            self.dropped += 1
+        sc = self._decode(self.t.scene_t, data)
+        if sc is not None:
+            self.scene = sc
 
     def _on_state(self, channel, data):
         self._heard = time.monotonic()
-        try:
-            self._state = self.t.joint_state_t.decode(data)
-        except Exception:
-            self.dropped += 1
+        st = self._decode(self.t.joint_state_t, data)
+        if st is not None:
+            self._state = st
 
     def _on_status(self, channel, data):
         self._heard = time.monotonic()
 
     def _on_event(self, channel, data):
         self._heard = time.monotonic()
-        try:
-            ev = self.t.event_t.decode(data)
-        except Exception:
-            self.dropped += 1
-            return
-        if ev.kind == "stop":
+        ev = self._decode(self.t.event_t, data)
+        if ev is not None and ev.kind == "stop":
             self._stopped = True
 
     def states(self):

@@ -3,7 +3,7 @@
 
     run_e2e.py --lagsimd BIN --config YAML --mode lockstep [--set k=v ...]
                [--daemon-arg ARG ...] [--kill-daemon-after S] [--daemon-first S]
-               [--check EXPR ...] [--timeout S] -- CLIENT ARGS...
+               [--check EXPR ...] [--hostile DIR ...] [--timeout S] -- CLIENT ARGS...
 
 The controller is started first, then (once it prints that it is waiting for the scene
 description, i.e. it is subscribed and will see the very first state) the daemon, with a channel prefix unique to this run
@@ -17,6 +17,12 @@ stops by itself and announces it); --kill-daemon-after S kills it with SIGKILL a
 wall seconds (it goes silent without a word). The controller's last line
 "... summary key=value ..." is parsed and every --check expression (Python, over those
 keys; `wall` is the controller's wall time after the daemon ended, s) must hold.
+--hostile DIR (repeatable) publishes every file of DIR (the fuzz_client corpus layout: the
+first byte chooses the channel, _STATE, _STATUS, _EVENT or _SCENE, the rest is the payload)
+on the run's channels: three times once the controller is subscribed, before the daemon
+starts (a controller whose receive path dies on one never gets its scene), then once every
+20 ms for as long as the controller runs. The controller must drop them and run as if
+they had never come; `hostile` (messages published) joins the summary's keys.
 """
 import argparse
 import math
@@ -54,6 +60,26 @@ def parse_summary(text):
     return None
 
 
+def hostile_payloads(folders, prefix):
+    """(channel, payload) of every file of `folders`, in name order."""
+    out = []
+    for folder in folders:
+        for name in sorted(os.listdir(folder)):
+            with open(os.path.join(folder, name), "rb") as f:
+                data = f.read()
+            if data:
+                out.append((prefix + ("_STATE", "_STATUS", "_EVENT", "_SCENE")[data[0] % 4],
+                            data[1:]))
+    return out
+
+
+def hostile_lcm(url):
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                    "clients", "python"))
+    from lagsim_lcm import LCM
+    return LCM(url)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lagsimd", required=True)
@@ -65,6 +91,7 @@ def main():
     ap.add_argument("--kill-daemon-after", type=float, default=None)
     ap.add_argument("--daemon-first", type=float, default=None)
     ap.add_argument("--check", action="append", default=[])
+    ap.add_argument("--hostile", action="append", default=[])
     ap.add_argument("--timeout", type=float, default=60.0)
     ap.add_argument("client", nargs=argparse.REMAINDER)
     a = ap.parse_args()
@@ -95,7 +122,9 @@ def main():
     if not os.access(a.lagsimd, os.X_OK):
         print("FAIL: no lagsimd executable at %s" % a.lagsimd)
         return 1
-    cproc = dproc = None
+    cproc = dproc = fth = None
+    done = threading.Event()
+    n_hostile = 0
     t_daemon_end = t_client_end = None
     lines = []
     try:
@@ -122,6 +151,25 @@ def main():
             print("".join(lines))
             print("FAIL: the client did not get ready")
             return 1
+        if a.hostile:
+            forged = hostile_payloads(a.hostile, prefix)
+            hlc = hostile_lcm(env["LCM_DEFAULT_URL"])
+            for _ in range(3):
+                for channel, data in forged:
+                    hlc.publish(channel, data)
+                    n_hostile += 1
+            time.sleep(0.5)
+
+            def flood():
+                nonlocal n_hostile
+                while cproc.poll() is None and not done.is_set():
+                    for channel, data in forged:
+                        hlc.publish(channel, data)
+                        n_hostile += 1
+                    done.wait(0.02)
+
+            fth = threading.Thread(target=flood, daemon=True)
+            fth.start()
         if dproc is None:
             dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                      universal_newlines=True, env=env)
@@ -148,6 +196,9 @@ def main():
         th.join(5.0)
         err = cproc.stderr.read()
     finally:
+        done.set()
+        if fth:
+            fth.join(5.0)
         stop(cproc)
         stop(dproc)
     out = "".join(lines)
@@ -166,6 +217,9 @@ def main():
         return 1
     ok = True
     names = dict(vals)
+    if a.hostile:
+        names["hostile"] = n_hostile
+        print("hostile: %d forged messages published" % n_hostile)
     if t_daemon_end is not None:
         names["wall"] = t_client_end - t_daemon_end
         print("wall = %.3f s from the daemon's end to the controller's" % names["wall"])

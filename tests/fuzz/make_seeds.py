@@ -135,6 +135,14 @@ st = status_t._get_packed_fingerprint() + b"\0" * 72 + struct.pack(">I", 0xFFFFF
 write("client", "crash", "status-negative-string-length.bin", b"\x01" + st)
 ev = event_t._get_packed_fingerprint() + b"\0" * 24 + struct.pack(">I", 0x7FFFFFFF) + b"C" * 40
 write("client", "crash", "event-string-length-7fffffff.bin", b"\x02" + ev)
+# Java's decoder allocates a string's length first: 1e9 is 2 GB for a 77-byte message
+ev = event_t._get_packed_fingerprint() + b"\0" * 24 + struct.pack(">I", 10**9) + b"C" * 40
+write("client", "crash", "event-string-length-1e9.bin", b"\x02" + ev)
+# each name's NUL replaced: Python, Lua and Java read "theta0X" as "theta0", a whole state
+forged = state()
+for nm in (b"theta0", b"theta1", b"theta2"):
+    forged = forged.replace(nm + b"\0", nm + b"X")
+write("client", "crash", "state-name-nul-replaced-by-x.bin", b"\x00" + forged)
 sc = (scene_t._get_packed_fingerprint() + struct.pack(">q", 0) + struct.pack(">I", 2) + b"m\0"
       + struct.pack(">I", 2) + b"P\0" + struct.pack(">h", 32767) + struct.pack(">I", 3) + b"m0\0")
 write("client", "crash", "scene-32767-params.bin", b"\x03" + sc)

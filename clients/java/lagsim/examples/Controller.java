@@ -165,15 +165,15 @@ public final class Controller {
             public void messageReceived(LCM l, String channel, LCMDataInputStream ins) {
                 synchronized (lock) {
                     heardNanos = System.nanoTime();
-                    try {
+                    try { // only messages that decode whole, string lengths checked first
                         if (channel.endsWith("_STATE")) {
-                            latest = new joint_state_t(ins);
+                            latest = BoundedInput.decode(ins, joint_state_t::new);
                         } else if (channel.endsWith("_SCENE")) {
-                            scene = new scene_t(ins);
+                            scene = BoundedInput.decode(ins, scene_t::new);
                         } else if (channel.endsWith("_EVENT")) {
-                            if (new event_t(ins).kind.equals("stop")) stopped = true;
+                            if (BoundedInput.decode(ins, event_t::new).kind.equals("stop")) stopped = true;
                         }
-                    } catch (IOException | RuntimeException e) { // not one of ours, or cut short
+                    } catch (IOException | RuntimeException e) { // not one of ours, or damaged
                         dropped++;
                     }
                     lock.notifyAll();
