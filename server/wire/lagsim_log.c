@@ -13,8 +13,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#define SYNC 0xEDA1DA01u
-#define HEADER 24                                   /* after the sync word */
+#define SYNC LAG_LOG_SYNC
+#define HEADER (LAG_LOG_HEADER_SIZE - 4)            /* after the sync word */
 #define PUSHBACK (HEADER + LAG_LOG_CHANNEL_MAX)     /* most bytes ever pushed back */
 
 struct lag_log {
@@ -301,4 +301,23 @@ int lag_log_next(lag_log *lg, lag_log_record *rec)
         if (damaged) lg->st.damaged++;
         return LAG_LOG_OK;
     }
+}
+
+/* ---------------------------------------------------------------- writing */
+static void put_be(uint8_t *b, uint64_t v, int n)
+{
+    for (int i = n - 1; i >= 0; i--) {
+        b[i] = (uint8_t)(v & 0xff);
+        v >>= 8;
+    }
+}
+
+void lag_log_put_header(uint8_t out[LAG_LOG_HEADER_SIZE], int64_t event_number,
+                        int64_t timestamp, int32_t channel_len, int32_t data_len)
+{
+    put_be(out, SYNC, 4);
+    put_be(out + 4, (uint64_t)event_number, 8);
+    put_be(out + 12, (uint64_t)timestamp, 8);
+    put_be(out + 20, (uint32_t)channel_len, 4);
+    put_be(out + 24, (uint32_t)data_len, 4);
 }

@@ -36,6 +36,8 @@ extern "C" {
 #define LAG_LOG_CHANNEL_MAX 255        /* longest channel name accepted, bytes */
 #define LAG_LOG_SCAN_MAX (1 << 20)     /* bytes searched for a record before giving up */
 #define LAG_LOG_DATA_MAX (1 << 28)     /* largest max_data accepted at open */
+#define LAG_LOG_SYNC 0xEDA1DA01u       /* each record starts with this word */
+#define LAG_LOG_HEADER_SIZE 28         /* sync word and the four fields before the channel */
 
 /* Results: 0 a record, 1 the end, negative an error (message: lag_log_errmsg). */
 enum { LAG_LOG_OK = 0, LAG_LOG_END = 1, LAG_LOG_ERROR = -1 };
@@ -74,6 +76,12 @@ int lag_log_next(lag_log *lg, lag_log_record *rec);
 const char *lag_log_errmsg(const lag_log *lg);
 void lag_log_get_stats(const lag_log *lg, lag_log_stats *st);
 void lag_log_close(lag_log *lg);
+
+/* The writer's side: the header of one record (sync word, event number, timestamp in us,
+ * channel length, data length; big-endian), to be followed by the channel's bytes (no
+ * NUL) and the data. OUT: out */
+void lag_log_put_header(uint8_t out[LAG_LOG_HEADER_SIZE], int64_t event_number,
+                        int64_t timestamp, int32_t channel_len, int32_t data_len);
 
 #ifdef __cplusplus
 }
