@@ -19,6 +19,8 @@ typedef struct lagsimd_opts {
     size_t scene_len;
     const char *const *sets;
     int nsets;
+    const char *log;     /* --log: the real-time server's LCM log, NULL = none */
+    size_t log_ring;     /* --log-buffer: bytes between the loop and the writer, 0 = default */
 } lagsimd_opts;
 
 /* Exit codes of lagsimd. */

@@ -17,6 +17,7 @@ static void usage(FILE *f)
 {
     fputs(
         "usage: lagsimd --config FILE [--set KEY=VALUE ...] [-q] [--duration SECONDS]\n"
+        "               [--log FILE.lcm [--log-buffer MIB]]\n"
         "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|-] [--set ...]\n"
         "       lagsimd --config FILE --replay LOG.lcm [--set ...]\n"
         "\n"
@@ -35,9 +36,16 @@ static void usage(FILE *f)
         "                         t = 0 and every 1/publish_hz: t,q...,q_dot...,energy\n"
         "      --csv PATH|-       offline CSV destination (- = stdout; absent = no CSV,\n"
         "                         only the summary line on stderr)\n"
+        "      --log FILE.lcm     real-time server: write every message published and\n"
+        "                         received to FILE (LCM log format, replaced if it exists),\n"
+        "                         in order, from the first state; never makes the loop wait\n"
+        "                         in realtime mode (what a slow disk loses is counted and\n"
+        "                         said; exit 1 if anything was lost)\n"
+        "      --log-buffer MIB   memory between the loop and the log writer, 0.25 to 1024\n"
+        "                         (default 16)\n"
         "      --replay LOG.lcm   re-simulate a run recorded by lcm-logger from the efforts\n"
         "                         in its logged states; print the largest difference\n"
-        "  -q, --quiet            no live status line / offline summary\n"
+        "  -q, --quiet            no live status line or event lines / offline summary\n"
         "  -h, --help             this help\n"
         "  -V, --version          print the version\n"
         "\n"
@@ -120,7 +128,7 @@ static int resolve_default_url(lag_scene *sc)
 
 int main(int argc, char **argv)
 {
-    enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY };
+    enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER };
     static const struct option longopts[] = {
         {"config", required_argument, NULL, 'c'},
         {"set", required_argument, NULL, 's'},
@@ -128,6 +136,8 @@ int main(int argc, char **argv)
         {"offline", no_argument, NULL, OPT_OFFLINE},
         {"csv", required_argument, NULL, OPT_CSV},
         {"replay", required_argument, NULL, OPT_REPLAY},
+        {"log", required_argument, NULL, OPT_LOG},
+        {"log-buffer", required_argument, NULL, OPT_LOG_BUFFER},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {"version", no_argument, NULL, 'V'},
@@ -135,7 +145,7 @@ int main(int argc, char **argv)
     };
 
     const char *config = NULL, *replay = NULL;
-    bool offline = false, have_duration = false;
+    bool offline = false, have_duration = false, have_ring = false;
     lagsimd_opts opts = {.quiet = false, .duration = 0.0, .csv = NULL};
     const char **sets = calloc((size_t)argc + 1, sizeof *sets);
     int nsets = 0;
@@ -179,6 +189,20 @@ int main(int argc, char **argv)
         case OPT_REPLAY:
             replay = optarg;
             break;
+        case OPT_LOG:
+            opts.log = optarg;
+            break;
+        case OPT_LOG_BUFFER: {
+            double mib = 0.0;
+            if (lag_scene_read_decimal(optarg, &mib) != 0 || !(mib >= 0.25) || !(mib <= 1024)) {
+                free(sets);
+                return usage_error("--log-buffer: expected a number of MiB from 0.25 to 1024, "
+                                   "got '%s'", optarg);
+            }
+            opts.log_ring = (size_t)(mib * 1048576.0);
+            have_ring = true;
+            break;
+        }
         case 'q':
             opts.quiet = true;
             break;
@@ -209,6 +233,10 @@ int main(int argc, char **argv)
         rc = usage_error("%s", "--csv needs --offline");
     } else if (offline && !have_duration) {
         rc = usage_error("%s", "--offline needs --duration SECONDS");
+    } else if (opts.log && (offline || replay)) {
+        rc = usage_error("%s", "--log records the real-time server: not with --offline or --replay");
+    } else if (have_ring && !opts.log) {
+        rc = usage_error("%s", "--log-buffer needs --log FILE");
     } else {
         static lag_scene sc;
         char err[1024];

@@ -254,6 +254,7 @@ static void period_begin(rt_server *s)
                       age, sc->realtime.command_timeout);
     }
     lag_sim_set_input(&s->sim, s->held);
+    rt_log_input(s); /* --log with an actuator lag: the input this period runs with */
     s->period_left = sc->ticks_per_period;
     s->period_us = 0;
 }
@@ -286,9 +287,10 @@ static rt_progress period_run(rt_server *s, int64_t *budget)
     /* a chunk of the period, whose input holds to its end: dopri5 steps across the
      * chunk's end (dense output gives the state there) and lands on the period's, so the
      * period in chunks is bit-identical to one call for it */
-    int64_t t0 = rt_mono_ns();
+    int64_t t0 = rt_mono_ns(), tick0 = s->sim.tick;
     lag_result r = lag_sim_advance_within(&s->sim, n, s->sim.tick + s->period_left);
     s->period_us += (double)(rt_mono_ns() - t0) * 1e-3;
+    s->lg.ticks += s->sim.tick - tick0; /* the log's clock */
     s->period_left -= n;
     s->ticks_since_status += n;
     publish_effect_events(s);
@@ -338,6 +340,15 @@ static void mode_realtime(rt_server *s)
     }
 }
 
+/* --log in a mode without wall-clock deadlines (fast, lockstep): the next period waits
+ * while the log's ring is more than half full, so the run slows to the disk's pace
+ * instead of losing records (realtime never waits: rt_log.h). */
+static bool log_holds(const rt_server *s)
+{
+    return s->lg.log && s->sc->realtime.mode != LAG_RT_REALTIME && !rt_log_room(s->lg.log);
+}
+#define RT_LOG_HOLD_NS 1000000LL /* a held period looks at the ring again 1 ms later */
+
 /* Fast: one period per wake-up, LCM served between every two. */
 static void mode_fast(rt_server *s)
 {
@@ -345,6 +356,7 @@ static void mode_fast(rt_server *s)
         paused_republish(s);
         return;
     }
+    if (log_holds(s)) return;
     int64_t budget = s->tick_budget;
     period_run(s, &budget);
 }
@@ -381,6 +393,7 @@ static void mode_lockstep(rt_server *s)
         lockstep_retry(s);
         return;
     }
+    if (log_holds(s)) return;
     s->waiting = false;
     int64_t budget = s->tick_budget;
     period_run(s, &budget);
@@ -406,6 +419,7 @@ static void reject(rt_server *s, rt_reject why, const char *joint, double value,
  * effort finite and within the scene's realtime.effort_limit. */
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
 {
+    rt_log_record(s, RT_LOG_IN, s->ch_command, data, len); /* --log: as received */
     lag_wire_joint_command c;
     int d = lag_wire_decode_joint_command(data, len, s->nq, &c);
     if (d == LAG_WIRE_ECOUNT) {
@@ -567,6 +581,7 @@ static void lockstep_rewait(rt_server *s)
 
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
 {
+    rt_log_record(s, RT_LOG_IN, s->ch_control, data, len); /* --log: as received */
     lag_wire_control c;
     int d = lag_wire_decode_control(data, len, LAG_MAX_DOF, &c);
     if (d != LAG_WIRE_OK) {
@@ -769,7 +784,18 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     rt_limit_init(&s->lim_scene, RT_SCENE_PER_S, RT_SCENE_BURST, now);
     rt_limit_init(&s->lim_state, RT_STATE_PER_S, RT_STATE_BURST, now);
     rt_limit_init(&s->lim_set, RT_SET_PER_S, RT_SET_BURST, now);
+    rt_limit_init(&s->lg.lim_said, 1, 1, now);
 
+    /* --log, last: nothing after it can fail */
+    if (o && o->log) {
+        const lag_effects_def *fx = &sc->sim.effects;
+        for (int i = 0; (fx->enabled & LAG_EFF_ACTUATOR) && i < s->nq; i++)
+            if (fx->actuator_tau[i] > 0) s->lg.input = true;
+        snprintf(s->lg.ch_input, RT_CHANNEL_MAX, "%s_INPUT", sc->lcm.prefix);
+        s->lg.log = rt_log_open(o->log, o->log_ring ? o->log_ring : RT_LOG_RING_DEFAULT,
+                                err, errlen);
+        if (!s->lg.log) return LAGSIMD_EXIT_USAGE;
+    }
     return LAGSIMD_EXIT_OK;
 }
 
@@ -792,6 +818,7 @@ int rt_attach(rt_server *s, lcm_t *out, lcm_t *in, char *err, size_t errlen)
 
 void rt_close(rt_server *s)
 {
+    rt_log_end(s); /* a no-op when lagsimd_realtime has closed it already */
     if (s->sub_command) lcm_unsubscribe(s->lcm_in, s->sub_command);
     if (s->sub_control) lcm_unsubscribe(s->lcm_in, s->sub_control);
     s->sub_command = s->sub_control = NULL;
@@ -829,7 +856,8 @@ int64_t rt_next_wake(const rt_server *s)
     int64_t wake = s->next_status_ns;
     switch (s->sc->realtime.mode) {
     case LAG_RT_FAST:
-        if (act) return now;
+        if (act && !log_holds(s)) return now;
+        if (act) wake = min64(wake, rt_sat_add(now, RT_LOG_HOLD_NS));
         if (s->run == RT_PAUSED || s->run == RT_WAITING) wake = min64(wake, rt_pace_next(&s->pace));
         break;
     case LAG_RT_REALTIME:
@@ -838,9 +866,13 @@ int64_t rt_next_wake(const rt_server *s)
         break;
     case LAG_RT_LOCKSTEP:
         if ((act || s->run == RT_WAITING) && s->waiting && !s->want_state) {
-            if (act && s->answered) return now;
-            wake = min64(wake, rt_sat_add(s->wait_start_ns, s->lockstep_wait_ns));
-            if (s->run == RT_RUNNING || s->pending_steps > 0) wake = min64(wake, s->next_retry_ns);
+            if (act && s->answered && !log_holds(s)) return now;
+            if (act && s->answered) {
+                wake = min64(wake, rt_sat_add(now, RT_LOG_HOLD_NS));
+            } else {
+                wake = min64(wake, rt_sat_add(s->wait_start_ns, s->lockstep_wait_ns));
+                if (s->run == RT_RUNNING || s->pending_steps > 0) wake = min64(wake, s->next_retry_ns);
+            }
         }
         break;
     }
@@ -897,6 +929,7 @@ void rt_process(rt_server *s)
         live_line(s, false);
         s->next_line_ns = rt_sat_add(s->now, RT_LINE_NS);
     }
+    rt_log_check(s, active(s));
     if (s->report_line) {
         s->report_line = false;
         if (s->opts && s->opts->quiet) return;
@@ -1065,7 +1098,9 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
         rt_process(s);
     }
     rt_finish(s);
+    if (rt_log_end(s) != 0 && rc == LAGSIMD_EXIT_OK) rc = LAGSIMD_EXIT_RUNTIME; /* --log lost records */
 out:
+    rt_log_end(s); /* --log opened, then the start failed */
     if (opened) rt_bus_close(s);
     if (io.timer_fd >= 0) close(io.timer_fd);
     if (io.sig_fd >= 0) close(io.sig_fd);

@@ -17,6 +17,7 @@
 #include "live_set.h"
 #include "lagsim_bus.h"
 #include "lagsim_wire.h"
+#include "rt_log.h"
 #include "rt_pace.h"
 
 #define RT_CHANNEL_MAX LAG_BUS_CHANNEL_LEN /* prefix (< 64) + "_COMMAND" */
@@ -164,6 +165,25 @@ typedef struct rt_server {
     bool live_line;            /* stderr is a terminal and not -q */
     bool report_line;          /* SIGUSR1/SIGUSR2: one status line on stderr */
 
+    /* --log: every message published and received, in order (rt_log.h), on a clock of
+     * its own: the wall clock at start, plus the sim time advanced since (across resets),
+     * plus the wall time spent paused or in the fault state; so lcm-logplayer plays any
+     * run, lockstep and fast included, at the pace of its sim time */
+    struct {
+        rt_log *log;           /* NULL: not logging */
+        bool input;            /* the scene has an actuator lag: <PREFIX>_INPUT records */
+        char ch_input[RT_CHANNEL_MAX];
+        int64_t base_us;       /* wall clock at rt_begin */
+        int64_t ticks;         /* ticks advanced since rt_begin */
+        int64_t idle_ns;       /* wall time while not running */
+        int64_t prev_ns;       /* s->now at the last rt_process */
+        bool was_idle;         /* not running at the last rt_process */
+        int64_t last_us;       /* the last timestamp written: they never go back */
+        rt_log_stats seen;     /* counters already reported */
+        rt_limit lim_said;     /* lost records are said at most once a second */
+        bool error_said;
+    } lg;
+
     uint8_t buf[RT_BUF_SIZE];
     uint8_t state_buf[RT_BUF_SIZE]; /* the last state published, as sent (lockstep retries) */
     unsigned state_len;
@@ -183,6 +203,22 @@ void rt_publish_event_at(rt_server *s, double sim_time, const char *kind, const 
                          double value, const char *detail);
 void rt_publish_scene(rt_server *s);
 const char *rt_run_name(rt_run r);
+
+/* rt_record.c: --log (no-ops without it). A record of what was published (RT_LOG_OUT)
+ * or received (RT_LOG_IN) on `channel`, at the log's clock. */
+void rt_log_record(rt_server *s, rt_log_dir dir, const char *channel, const void *data,
+                   size_t len);
+/* The commanded input of the period that starts (with an actuator lag only), on
+ * <PREFIX>_INPUT as a joint_command_t: in the log, never on the bus. */
+void rt_log_input(rt_server *s);
+/* Once per wake-up, at its end: books the log's clock (running: the run advances sim
+ * time until the next wake-up) and checks the writer: records lost, a failed write (an
+ * event and a line on stderr, even with -q; lost records at most once a second). */
+void rt_log_check(rt_server *s, bool running);
+/* Closes the log once the writer has written everything (or made no progress for 5 s)
+ * and says so on stderr: a summary unless -q; what was lost, always. Returns 0 when the
+ * log is complete, -1 otherwise. */
+int rt_log_end(rt_server *s);
 
 /* realtime.c: the server in pieces (lagsimd_realtime strings them together; tests and
  * the fuzz target drive them with their own clock and LCM, e.g. memq://). */

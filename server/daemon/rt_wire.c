@@ -61,6 +61,7 @@ static int publish(rt_server *s, const char *channel, lag_wire_type t, const voi
     int n = lag_wire_encode(t, m, s->buf, RT_BUF_SIZE);
     if (n <= 0) return 0;
     lcm_publish(s->lcm, channel, s->buf, (unsigned)n);
+    rt_log_record(s, RT_LOG_OUT, channel, s->buf, (size_t)n); /* --log */
     return n;
 }
 

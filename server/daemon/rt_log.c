@@ -1,0 +1,267 @@
+/*
+ * lagsimd --log: the ring and its writer thread (see rt_log.h).
+ *
+ * Positions are byte counters that only grow (head: put by the loop; tail: written by the
+ * writer); the ring index is the counter modulo the ring's size, so a record may wrap
+ * around the end (it is copied in two parts, and written with two iovecs).
+ *
+ * Waking the writer without a lock: the writer sets `sleeping`, then looks at head once
+ * more before it waits on the semaphore; the loop publishes head, then looks at
+ * `sleeping` and posts when it is set. Both accesses are sequentially consistent, so at
+ * least one side sees the other's store: a record is never left unwritten while the
+ * writer sleeps (it also wakes every 200 ms on its own). sem_post never blocks.
+ */
+#include "rt_log.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <semaphore.h>
+#include <stdarg.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/uio.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "lagsim_log.h"
+
+struct rt_log {
+    int fd;
+    char path[256];
+    uint8_t *ring;
+    size_t cap;
+    _Atomic uint64_t head;     /* bytes put: written by the loop only */
+    _Atomic uint64_t tail;     /* bytes written to the file: by the writer only */
+    _Atomic int sleeping;      /* the writer waits on `wake` */
+    _Atomic int closing;       /* rt_log_close: write what is left, then end */
+    _Atomic int error;         /* errno of the failed write; the writer has ended */
+    sem_t wake;
+    pthread_t thread;
+    bool thread_started;
+    /* the loop's own counters */
+    int64_t records, dropped_full, dropped_in, dropped_failed, too_large;
+};
+
+/* ---------------------------------------------------------------- the writer thread */
+static void deadline_in(struct timespec *ts, long ms)
+{
+    clock_gettime(CLOCK_REALTIME, ts); /* sem_timedwait's clock */
+    ts->tv_sec += ms / 1000;
+    ts->tv_nsec += (ms % 1000) * 1000000L;
+    if (ts->tv_nsec >= 1000000000L) {
+        ts->tv_sec++;
+        ts->tv_nsec -= 1000000000L;
+    }
+}
+
+static void *writer(void *arg)
+{
+    rt_log *l = arg;
+    uint64_t tail = atomic_load(&l->tail);
+    for (;;) {
+        uint64_t head = atomic_load_explicit(&l->head, memory_order_acquire);
+        if (head == tail) {
+            if (atomic_load(&l->closing)) break;
+            atomic_store(&l->sleeping, 1);
+            head = atomic_load(&l->head);
+            if (head == tail && !atomic_load(&l->closing)) {
+                struct timespec ts;
+                deadline_in(&ts, 200);
+                sem_timedwait(&l->wake, &ts); /* a cancellation point */
+            }
+            atomic_store(&l->sleeping, 0);
+            continue;
+        }
+        size_t n = (size_t)(head - tail), off = (size_t)(tail % l->cap);
+        size_t first = n < l->cap - off ? n : l->cap - off;
+        struct iovec iov[2] = {{l->ring + off, first}, {l->ring, n - first}};
+        ssize_t w = writev(l->fd, iov, n > first ? 2 : 1); /* a cancellation point */
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) {
+            atomic_store(&l->error, w < 0 && errno != 0 ? errno : EIO);
+            break;
+        }
+        tail += (uint64_t)w;
+        atomic_store_explicit(&l->tail, tail, memory_order_release);
+    }
+    return NULL;
+}
+
+/* ---------------------------------------------------------------- open / close */
+static rt_log *fail_open(rt_log *l, char *err, size_t errlen, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static rt_log *fail_open(rt_log *l, char *err, size_t errlen, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, errlen, fmt, ap);
+    va_end(ap);
+    if (l) {
+        if (l->fd >= 0) close(l->fd);
+        free(l->ring);
+        free(l);
+    }
+    return NULL;
+}
+
+rt_log *rt_log_open(const char *path, size_t ring_bytes, char *err, size_t errlen)
+{
+    if (ring_bytes < RT_LOG_RING_MIN) ring_bytes = RT_LOG_RING_MIN;
+    if (ring_bytes > RT_LOG_RING_MAX) ring_bytes = RT_LOG_RING_MAX;
+    rt_log *l = calloc(1, sizeof *l);
+    if (!l) return fail_open(NULL, err, errlen, "--log %s: out of memory", path);
+    l->fd = -1;
+    snprintf(l->path, sizeof l->path, "%s", path);
+    /* O_NONBLOCK: a FIFO without a reader fails at once (ENXIO) instead of blocking the
+     * start; it is cleared afterwards, so that only the writer thread ever waits */
+    l->fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NONBLOCK, 0644);
+    if (l->fd < 0)
+        return fail_open(l, err, errlen, "--log %s: cannot open for writing: %s%s", path,
+                         strerror(errno), errno == ENXIO ? " (a FIFO that nobody reads)" : "");
+    int fl = fcntl(l->fd, F_GETFL);
+    if (fl < 0 || fcntl(l->fd, F_SETFL, fl & ~O_NONBLOCK) < 0)
+        return fail_open(l, err, errlen, "--log %s: %s", path, strerror(errno));
+    l->ring = malloc(ring_bytes);
+    if (!l->ring) return fail_open(l, err, errlen, "--log %s: cannot allocate a ring of %zu bytes",
+                                   path, ring_bytes);
+    l->cap = ring_bytes;
+    if (sem_init(&l->wake, 0, 0) != 0)
+        return fail_open(l, err, errlen, "--log %s: %s", path, strerror(errno));
+    int rc = pthread_create(&l->thread, NULL, writer, l);
+    if (rc != 0) {
+        sem_destroy(&l->wake);
+        return fail_open(l, err, errlen, "--log %s: cannot start the writer thread: %s", path,
+                         strerror(rc));
+    }
+    l->thread_started = true;
+    return l;
+}
+
+/* A log whose writer could not be stopped: kept reachable (the thread may still touch
+ * it) until the process ends. */
+static rt_log *g_abandoned;
+
+int rt_log_close(rt_log *l, int stall_ms, rt_log_stats *final)
+{
+    if (!l) return 0;
+    atomic_store(&l->closing, 1);
+    sem_post(&l->wake);
+    bool joined = false;
+    uint64_t seen = atomic_load(&l->tail);
+    struct timespec last;
+    clock_gettime(CLOCK_MONOTONIC, &last);
+    while (!joined) {
+        struct timespec ts;
+        deadline_in(&ts, 50);
+        if (pthread_timedjoin_np(l->thread, NULL, &ts) == 0) {
+            joined = true;
+            break;
+        }
+        struct timespec now;
+        clock_gettime(CLOCK_MONOTONIC, &now);
+        uint64_t t = atomic_load(&l->tail);
+        if (t != seen) { /* progress: the stall clock starts again */
+            seen = t;
+            last = now;
+            continue;
+        }
+        double idle_ms = (double)(now.tv_sec - last.tv_sec) * 1e3 +
+                         (double)(now.tv_nsec - last.tv_nsec) * 1e-6;
+        if (idle_ms < stall_ms) continue;
+        /* stalled: cancel it (it waits in writev or sem_timedwait, both cancellation
+         * points); what it still held is lost */
+        pthread_cancel(l->thread);
+        deadline_in(&ts, 1000);
+        joined = pthread_timedjoin_np(l->thread, NULL, &ts) == 0;
+        if (!joined) {
+            if (atomic_load(&l->error) == 0) atomic_store(&l->error, ETIMEDOUT);
+            rt_log_get_stats(l, final ? final : &(rt_log_stats){0});
+            g_abandoned = l;
+            return -1;
+        }
+        if (atomic_load(&l->error) == 0) atomic_store(&l->error, ETIMEDOUT);
+    }
+    rt_log_stats st;
+    rt_log_get_stats(l, &st);
+    if (close(l->fd) != 0 && st.error == 0) {
+        st.error = errno;
+        atomic_store(&l->error, errno);
+    }
+    sem_destroy(&l->wake);
+    free(l->ring);
+    free(l);
+    if (final) *final = st;
+    bool complete = st.error == 0 && st.written == st.bytes && st.dropped_full == 0 &&
+                    st.dropped_in == 0 && st.dropped_failed == 0 && st.too_large == 0;
+    return complete ? 0 : -1;
+}
+
+/* ---------------------------------------------------------------- the loop's side */
+static void ring_copy(rt_log *l, uint64_t pos, const void *src, size_t n)
+{
+    size_t off = (size_t)(pos % l->cap);
+    size_t first = n < l->cap - off ? n : l->cap - off;
+    memcpy(l->ring + off, src, first);
+    if (n > first) memcpy(l->ring, (const uint8_t *)src + first, n - first);
+}
+
+bool rt_log_put(rt_log *l, rt_log_dir dir, int64_t timestamp_us, const char *channel,
+                const void *data, size_t len)
+{
+    if (atomic_load_explicit(&l->error, memory_order_relaxed) != 0) {
+        l->dropped_failed++;
+        return false;
+    }
+    size_t chlen = strnlen(channel, LAG_LOG_CHANNEL_MAX + 1);
+    size_t need = LAG_LOG_HEADER_SIZE + chlen + len;
+    if (chlen < 1 || chlen > LAG_LOG_CHANNEL_MAX || len > l->cap / 4 || need > l->cap / 4) {
+        l->too_large++;
+        return false;
+    }
+    uint64_t head = atomic_load_explicit(&l->head, memory_order_relaxed);
+    uint64_t tail = atomic_load_explicit(&l->tail, memory_order_acquire);
+    size_t used = (size_t)(head - tail);
+    size_t limit = dir == RT_LOG_IN ? l->cap / 4 * 3 : l->cap;
+    if (used + need > limit) {
+        if (dir == RT_LOG_IN) l->dropped_in++;
+        else l->dropped_full++;
+        return false;
+    }
+    uint8_t h[LAG_LOG_HEADER_SIZE];
+    lag_log_put_header(h, l->records, timestamp_us, (int32_t)chlen, (int32_t)len);
+    ring_copy(l, head, h, sizeof h);
+    ring_copy(l, head + sizeof h, channel, chlen);
+    if (len) ring_copy(l, head + sizeof h + chlen, data, len);
+    atomic_store(&l->head, head + need); /* seq_cst: see the comment at the top */
+    if (atomic_load(&l->sleeping)) sem_post(&l->wake);
+    l->records++;
+    return true;
+}
+
+bool rt_log_room(const rt_log *l)
+{
+    uint64_t head = atomic_load_explicit(&l->head, memory_order_relaxed);
+    uint64_t tail = atomic_load_explicit(&l->tail, memory_order_acquire);
+    return (size_t)(head - tail) <= l->cap / 2 ||
+           atomic_load_explicit(&l->error, memory_order_relaxed) != 0;
+}
+
+void rt_log_get_stats(const rt_log *l, rt_log_stats *st)
+{
+    memset(st, 0, sizeof *st);
+    st->records = l->records;
+    st->bytes = (int64_t)atomic_load_explicit(&l->head, memory_order_relaxed);
+    st->written = (int64_t)atomic_load_explicit(&l->tail, memory_order_acquire);
+    st->dropped_full = l->dropped_full;
+    st->dropped_in = l->dropped_in;
+    st->dropped_failed = l->dropped_failed;
+    st->too_large = l->too_large;
+    st->error = atomic_load(&l->error);
+    st->ring = l->cap;
+}
+
+const char *rt_log_path(const rt_log *l) { return l->path; }

@@ -1,0 +1,126 @@
+/*
+ * lagsimd --log: what the real-time server puts in its log, and what it says about it.
+ *
+ * Every message published (rt_wire.c's publish) and every command and control request
+ * received (the handlers, before they decode it) is handed to the log writer (rt_log.c)
+ * as it happens, so the log holds them in the order the loop saw them. With an actuator
+ * lag the effort applied changes within a control period, and the state's `effort` holds
+ * only its last value; the log then also holds, at the start of every period, the
+ * commanded input the period runs with (<PREFIX>_INPUT, a joint_command_t whose sim_time
+ * is the period's start), from which --replay re-simulates the lag exactly.
+ *
+ * Timestamps (us) follow the log's own clock (rt_server.h, s->lg): a lockstep or fast run
+ * is stamped at the pace of its sim time, so lcm-logplayer plays it back at 1x instead of
+ * as one burst; each message's own utime still says when it was sent.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "rt_server.h"
+
+#define RT_LOG_STALL_MS 5000 /* at exit: a writer without progress this long is given up */
+
+/* The log's clock at s->now, in us since the epoch; never earlier than the last one. */
+static int64_t log_clock(rt_server *s)
+{
+    if (s->lg.base_us == 0) {
+        s->lg.base_us = rt_wall_us();
+        s->lg.prev_ns = s->now;
+    }
+    double sim_us = (double)s->lg.ticks * s->sc->sim.integrator.dt * 1e6;
+    int64_t idle = s->lg.idle_ns + (s->lg.was_idle ? s->now - s->lg.prev_ns : 0);
+    int64_t ts = rt_sat_add(rt_sat_add(s->lg.base_us, rt_sat_i64(sim_us + 0.5)), idle / 1000);
+    if (ts < s->lg.last_us) ts = s->lg.last_us;
+    s->lg.last_us = ts;
+    return ts;
+}
+
+void rt_log_record(rt_server *s, rt_log_dir dir, const char *channel, const void *data,
+                   size_t len)
+{
+    if (!s->lg.log) return;
+    rt_log_put(s->lg.log, dir, log_clock(s), channel, data, len);
+}
+
+void rt_log_input(rt_server *s)
+{
+    if (!s->lg.log || !s->lg.input) return;
+    lag_wire_joint_command m;
+    memset(&m, 0, sizeof m);
+    m.utime = rt_wall_us();
+    m.sim_time = lag_sim_time(&s->sim);
+    int k = 0;
+    for (int i = 0; i < s->nq && k < LAG_WIRE_MAX_JOINTS; i++) {
+        if (!s->info->actuated[i]) continue;
+        snprintf(m.name[k], sizeof m.name[k], "%s", s->info->joint_names[i]);
+        m.effort[k] = s->sim.tau[i];
+        k++;
+    }
+    m.num_joints = (int16_t)k;
+    uint8_t buf[LAG_WIRE_BUF_SIZE];
+    int n = lag_wire_encode(LAG_WIRE_JOINT_COMMAND, &m, buf, sizeof buf);
+    if (n > 0) rt_log_record(s, RT_LOG_OUT, s->lg.ch_input, buf, (size_t)n);
+}
+
+/* Records lost so far, but those refused after a failed write (said once, with it). */
+static int64_t lost(const rt_log_stats *st)
+{
+    return st->dropped_full + st->dropped_in + st->too_large;
+}
+
+void rt_log_check(rt_server *s, bool running)
+{
+    if (s->lg.was_idle) s->lg.idle_ns += s->now - s->lg.prev_ns;
+    s->lg.prev_ns = s->now;
+    s->lg.was_idle = !running;
+    if (!s->lg.log) return;
+    rt_log_stats st;
+    rt_log_get_stats(s->lg.log, &st);
+    const char *path = rt_log_path(s->lg.log);
+    char detail[320];
+    if (st.error != 0 && !s->lg.error_said) {
+        s->lg.error_said = true;
+        snprintf(detail, sizeof detail, "--log %s: writing failed after %lld bytes: %s; the rest "
+                 "of the run is not logged", path, (long long)st.written, strerror(st.error));
+        fprintf(stderr, "lagsimd: %s\n", detail);
+        rt_publish_event(s, "log_error", "", (double)st.error, detail);
+    }
+    if (lost(&st) > lost(&s->lg.seen) && rt_limit_take(&s->lg.lim_said, s->now)) {
+        snprintf(detail, sizeof detail, "--log %s: %lld records not written so far (%lld "
+                 "published and %lld received while the ring of %zu bytes was full, %lld too "
+                 "large): the disk is slower than the run", path, (long long)lost(&st),
+                 (long long)st.dropped_full, (long long)st.dropped_in, st.ring,
+                 (long long)st.too_large);
+        s->lg.seen = st;
+        fprintf(stderr, "lagsimd: %s\n", detail);
+        rt_publish_event(s, "log_dropped", "", (double)lost(&st), detail);
+    }
+}
+
+int rt_log_end(rt_server *s)
+{
+    if (!s->lg.log) return 0;
+    char path[256];
+    snprintf(path, sizeof path, "%s", rt_log_path(s->lg.log));
+    rt_log_stats st;
+    int rc = rt_log_close(s->lg.log, RT_LOG_STALL_MS, &st);
+    s->lg.log = NULL;
+    bool quiet = s->opts && s->opts->quiet;
+    if (rc == 0) {
+        if (!quiet)
+            fprintf(stderr, "lagsimd: --log %s: %lld records, %lld bytes, complete\n", path,
+                    (long long)st.records, (long long)st.bytes);
+        return 0;
+    }
+    fprintf(stderr, "lagsimd: --log %s is INCOMPLETE: %lld records put, %lld of their %lld "
+            "bytes written; %lld records not written (%lld published and %lld received while "
+            "the ring of %zu bytes was full, %lld too large, %lld after the write failed)%s%s\n",
+            path, (long long)st.records, (long long)st.written, (long long)st.bytes,
+            (long long)(lost(&st) + st.dropped_failed), (long long)st.dropped_full,
+            (long long)st.dropped_in, st.ring, (long long)st.too_large,
+            (long long)st.dropped_failed, st.error ? ": " : "",
+            st.error == ETIMEDOUT ? "the writer made no progress for 5 s and was stopped"
+            : st.error ? strerror(st.error) : "");
+    return -1;
+}
