@@ -7,3 +7,17 @@ foreach(case file clock realtime_stalled fast_stalled lockstep_stalled full floo
   set_tests_properties(log_rt_${case} PROPERTIES TIMEOUT 120 LABELS log)
 endforeach()
 
+# End to end: dipc_lqr in lockstep with lagsimd --log, the log read back by this test's own
+# reader, liblcm's, lcm.jar's and lcm-logplayer; --replay on it, on a changed copy and on
+# copies that lost states; the options; the README's record recipe as written.
+find_program(LAGSIM_LOG_PYTHON3 python3)
+if(LAGSIM_LOG_PYTHON3)
+  foreach(case lqr lqr_effects gaps readers cli readme)
+    add_test(NAME log_${case}
+             COMMAND ${LAGSIM_LOG_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/log/test_log.py
+                     --bin ${CMAKE_BINARY_DIR}/bin --types ${CMAKE_BINARY_DIR}/python
+                     --source ${PROJECT_SOURCE_DIR} ${case})
+    set_tests_properties(log_${case} PROPERTIES TIMEOUT 300 LABELS log)
+  endforeach()
+endif()
+

@@ -21,6 +21,7 @@ typedef struct lagsimd_opts {
     int nsets;
     const char *log;     /* --log: the real-time server's LCM log, NULL = none */
     size_t log_ring;     /* --log-buffer: bytes between the loop and the writer, 0 = default */
+    double tolerance;    /* --replay: the largest difference that passes (default 0) */
 } lagsimd_opts;
 
 /* Exit codes of lagsimd. */
@@ -30,8 +31,10 @@ enum { LAGSIMD_EXIT_OK = 0, LAGSIMD_EXIT_RUNTIME = 1, LAGSIMD_EXIT_USAGE = 2 };
 int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o);
 /* The real-time LCM server until SIGINT/SIGTERM (or opts->duration). Returns an exit code. */
 int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o);
-/* Re-simulates a run recorded by lcm-logger from the efforts in its logged states and
- * prints the largest difference from the logged states. Returns an exit code. */
+/* Re-simulates a run recorded by lagsimd --log or lcm-logger from the efforts in its
+ * logged states (and the commanded inputs, when the log has them) and prints the largest
+ * difference from the logged states. Returns an exit code: 0 when it is at most
+ * o->tolerance, 1 when it is larger or nothing could be checked. */
 int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts *o);
 
 #endif

@@ -19,7 +19,7 @@ static void usage(FILE *f)
         "usage: lagsimd --config FILE [--set KEY=VALUE ...] [-q] [--duration SECONDS]\n"
         "               [--log FILE.lcm [--log-buffer MIB]]\n"
         "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|-] [--set ...]\n"
-        "       lagsimd --config FILE --replay LOG.lcm [--set ...]\n"
+        "       lagsimd --config FILE --replay LOG.lcm [--tolerance X] [--set ...]\n"
         "\n"
         "Steps one Lagrangian model (stick, manipulator, dipc) described by a YAML scene.\n"
         "Default: the real-time LCM server (states out, effort commands in) until SIGINT.\n"
@@ -43,8 +43,10 @@ static void usage(FILE *f)
         "                         said; exit 1 if anything was lost)\n"
         "      --log-buffer MIB   memory between the loop and the log writer, 0.25 to 1024\n"
         "                         (default 16)\n"
-        "      --replay LOG.lcm   re-simulate a run recorded by lcm-logger from the efforts\n"
-        "                         in its logged states; print the largest difference\n"
+        "      --replay LOG.lcm   re-simulate a run recorded by --log or lcm-logger from the\n"
+        "                         efforts in its logged states; print the largest difference\n"
+        "      --tolerance X      --replay: exit 1 when the largest difference is above X\n"
+        "                         (default 0: a log of the same scene and build is exact)\n"
         "  -q, --quiet            no live status line or event lines / offline summary\n"
         "  -h, --help             this help\n"
         "  -V, --version          print the version\n"
@@ -128,7 +130,7 @@ static int resolve_default_url(lag_scene *sc)
 
 int main(int argc, char **argv)
 {
-    enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER };
+    enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE };
     static const struct option longopts[] = {
         {"config", required_argument, NULL, 'c'},
         {"set", required_argument, NULL, 's'},
@@ -138,6 +140,7 @@ int main(int argc, char **argv)
         {"replay", required_argument, NULL, OPT_REPLAY},
         {"log", required_argument, NULL, OPT_LOG},
         {"log-buffer", required_argument, NULL, OPT_LOG_BUFFER},
+        {"tolerance", required_argument, NULL, OPT_TOLERANCE},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {"version", no_argument, NULL, 'V'},
@@ -145,7 +148,7 @@ int main(int argc, char **argv)
     };
 
     const char *config = NULL, *replay = NULL;
-    bool offline = false, have_duration = false, have_ring = false;
+    bool offline = false, have_duration = false, have_tolerance = false, have_ring = false;
     lagsimd_opts opts = {.quiet = false, .duration = 0.0, .csv = NULL};
     const char **sets = calloc((size_t)argc + 1, sizeof *sets);
     int nsets = 0;
@@ -203,6 +206,16 @@ int main(int argc, char **argv)
             have_ring = true;
             break;
         }
+        case OPT_TOLERANCE: {
+            double tol = 0.0;
+            if (lag_scene_read_decimal(optarg, &tol) != 0 || !(tol >= 0.0) || !isfinite(tol)) {
+                free(sets);
+                return usage_error("--tolerance: expected a number >= 0, got '%s'", optarg);
+            }
+            opts.tolerance = tol;
+            have_tolerance = true;
+            break;
+        }
         case 'q':
             opts.quiet = true;
             break;
@@ -237,6 +250,8 @@ int main(int argc, char **argv)
         rc = usage_error("%s", "--log records the real-time server: not with --offline or --replay");
     } else if (have_ring && !opts.log) {
         rc = usage_error("%s", "--log-buffer needs --log FILE");
+    } else if (have_tolerance && !replay) {
+        rc = usage_error("%s", "--tolerance needs --replay LOG");
     } else {
         static lag_scene sc;
         char err[1024];

@@ -1,36 +1,49 @@
 /*
- * lagsimd --replay LOG: re-simulates a run recorded by lcm-logger and reports how far the
- * re-simulation is from the logged states.
+ * lagsimd --replay LOG: re-simulates a run recorded by lagsimd --log or by lcm-logger and
+ * reports how far the re-simulation is from the logged states; a check that fails (exit
+ * 1) when the largest difference is above --tolerance (default 0).
  *
  * Reads the <PREFIX>_STATE messages of the log in order. The first one sets the state
  * (q, qd) and the tick; each next one says which effort was applied over the ticks between
  * the two (joint_state_t.effort is the effort of the period that ended at its sim_time),
  * so the replay applies it for those ticks, in chunks of one control period with hard
- * stops at period ends exactly as the server does, and compares q and qd. A state whose
- * step goes back (a reset), or that differs at the same step, starts over from it.
+ * stops at period ends exactly as the server does, and compares q and qd.
  *
  * Published states carry the noise effect (lag_sim_observe) and the applied effort
  * (tau_applied); the replay compares observed with observed. Effects are re-simulated as
  * the scene defines them (disturbances at their times, noise as a function of seed and
  * tick), except the actuator: the logged effort is already its output, so the replay
- * applies it directly. A run that starts from the scene's initial state starts from it
- * (not from the logged, possibly noisy, first state). Only an actuator lag leaves the run
- * undetermined by the log (the effort changes within a period; the log has its last
- * value): the replay says so.
+ * applies it directly. An actuator lag makes the effort change within a period while the
+ * state holds its last value; lagsimd --log then also logs the commanded input of every
+ * period (<PREFIX>_INPUT, a joint_command_t at the period's start), and with those the
+ * replay runs the actuator itself, lag and saturation, from the inputs, and compares the
+ * efforts too. A log without them (lcm-logger records only the bus) leaves a lagged run
+ * approximate: the replay says so, and re-simulates each period from the logged state
+ * before it (an unstable plant would otherwise grow the error of each period without
+ * bound), so the difference is that of one period.
  *
- * For a run of the same scene and build recorded from its start (logger started before
- * the daemon), every difference is exactly 0: the daemon and the replay make the same
- * floating-point operations in the same order.
+ * Restarts. A state whose step goes back (a reset) starts the re-simulation over from it,
+ * as does a state after a gap (states missing from the log: lcm-logger loses datagrams
+ * under load; the effort in between is unknown), rather than running on with an unknown
+ * effort. Each gap is reported with where it is. A restart gives the daemon's numbers
+ * exactly when the logged state is all the run carried: always at the scene's initial
+ * state, at a reset (step 0) unless the state is noisy, and elsewhere only for a
+ * fixed-step method without noise, actuator lag, friction, stops or floor (dopri5 carries
+ * its step size from period to period; the effects keep contact modes and lag states the
+ * log does not hold). After an inexact restart the states are not compared until the
+ * next exact one: they are counted and the reason said.
  *
- * The log is untrusted input. It is read by the bounded log reader and the bounded state
- * decoder of the wire module (server/wire): no length from the file is trusted, nothing
+ * For a run of the same scene and build recorded from its start (lagsimd --log, or a
+ * logger started before the daemon), every difference is exactly 0: the daemon and the
+ * replay make the same floating-point operations in the same order.
+ *
+ * The log is untrusted input. It is read by the bounded log reader and the bounded
+ * decoders of the wire module (server/wire): no length from the file is trusted, nothing
  * is allocated per record, a damaged stretch is passed over and reported, a file with no
- * record in its first LAG_LOG_SCAN_MAX bytes (or after one) is an error. A state is
- * re-simulated only across exactly one control period: a state whose step is not one
- * period after the last (states missing from the log, or a step counter out of range)
- * cannot be checked, so the replay starts over from it and counts it. The replay says
- * "checked" (exit 0) only when at least one state was compared and every re-simulation
- * succeeded; otherwise it reports why it could not check and exits 1.
+ * record in its first LAG_LOG_SCAN_MAX bytes (or after one) is an error. The replay says
+ * "checked" (exit 0) only when at least one state was compared, every re-simulation
+ * succeeded and the largest difference is within the tolerance; otherwise it reports why
+ * and exits 1.
  */
 #include <math.h>
 #include <stdio.h>
@@ -42,11 +55,33 @@
 
 #define REPLAY_DATA_MAX 65536               /* a record larger than this is no state */
 #define REPLAY_STEP_MAX (INT64_C(1) << 53)  /* steps beyond this are not a run's */
+#define REPLAY_GAPS_SAID 10                 /* gaps reported one by one, then counted */
+
+/* Effects whose state is entirely in (q, qd, tick): a restart from a logged state of a
+ * fixed-step method reproduces the daemon's numbers. Every other effect (and any new one)
+ * is taken as keeping state of its own. */
+#define REPLAY_MEMORYLESS (LAG_EFF_DAMPING | LAG_EFF_DISTURBANCE | LAG_EFF_ACTUATOR)
+
+/* Why a restart away from the scene's initial state and from a reset cannot be exact for
+ * this scene, or NULL when it can. */
+static const char *restart_inexact(const lag_scene *sc, bool lagged)
+{
+    const lag_effects_def *fx = &sc->sim.effects;
+    const lag_method_info *mi = lag_method_info_get(sc->sim.integrator.method);
+    if (fx->enabled & LAG_EFF_NOISE)
+        return "the logged state carries the noise effect, not the true state";
+    if (mi && mi->adaptive)
+        return "the adaptive method carries its step size from period to period";
+    if (lagged) return "the actuator lag's state is not in the log";
+    if (fx->enabled & ~(uint32_t)REPLAY_MEMORYLESS)
+        return "friction, stops and the floor keep contact modes the log does not hold";
+    return NULL;
+}
 
 /* Starts over from logged state m: from the scene's initial state if that is what was
  * published (a start or a plain reset: the published one may carry noise), else from
- * the logged one. */
-static void restart(lag_sim *sim, const lag_wire_joint_state *m)
+ * the logged one. Returns true when it started from the scene's initial state. */
+static bool restart(lag_sim *sim, const lag_wire_joint_state *m)
 {
     double sq[LAG_MAX_DOF], sqd[LAG_MAX_DOF];
     lag_sim_reset(sim, NULL, NULL);
@@ -56,47 +91,100 @@ static void restart(lag_sim *sim, const lag_wire_joint_state *m)
         initial = sq[i] == m->position[i] && sqd[i] == m->velocity[i];
     if (!initial) lag_sim_reset(sim, m->position, m->velocity);
     sim->tick = m->step;
+    return initial;
+}
+
+/* Does the log hold a record on `channel`? (A first pass, for scenes with an actuator
+ * lag: the inputs decide how the replay runs the actuator.) */
+static bool log_has_channel(const char *path, const char *channel)
+{
+    char err[256];
+    lag_log *log = lag_log_open(path, REPLAY_DATA_MAX, err, sizeof err);
+    if (!log) return false;
+    lag_log_record rec;
+    bool found = false;
+    while (!found && lag_log_next(log, &rec) == LAG_LOG_OK)
+        found = strcmp(rec.channel, channel) == 0;
+    lag_log_close(log);
+    return found;
+}
+
+/* The commanded input a <PREFIX>_INPUT record holds, by joint (zero where it names
+ * none); false when it does not decode or names a joint the model lacks. OUT: u, t */
+static bool decode_input(const lag_log_record *rec, const lag_model_info *info, int nq,
+                         double *u, double *t)
+{
+    lag_wire_joint_command c;
+    if (!rec->data || lag_wire_decode_joint_command(rec->data, rec->size, nq, &c) != LAG_WIRE_OK ||
+        !lag_wire_all_finite(LAG_WIRE_JOINT_COMMAND, &c))
+        return false;
+    for (int i = 0; i < nq; i++) u[i] = 0.0;
+    for (int k = 0; k < c.num_joints; k++) {
+        int j = -1;
+        for (int i = 0; i < nq; i++)
+            if (strcmp(c.name[k], info->joint_names[i]) == 0) j = i;
+        if (j < 0) return false;
+        u[j] = c.effort[k];
+    }
+    *t = c.sim_time;
+    return true;
 }
 
 int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts *o)
 {
-    (void)o;
     char err[512];
-    lag_sim sim;
-    /* The logged effort is the actuator's output: apply it as it is. The actuator stays
-     * on with neither lag nor bound, so that the ticks are taken exactly as the daemon
-     * took them (an actuator makes every tick a separate step). */
+    const double tolerance = o ? o->tolerance : 0.0;
+    const lag_model_info *info = lag_model_info_get(sc->sim.model.kind);
+    char channel[96], ch_input[96];
+    snprintf(channel, sizeof channel, "%s_STATE", sc->lcm.prefix);
+    snprintf(ch_input, sizeof ch_input, "%s_INPUT", sc->lcm.prefix);
+
+    /* With an actuator lag and the inputs in the log, the replay runs the actuator from
+     * them. Otherwise the logged effort is the actuator's output, applied as it is: the
+     * actuator stays on with neither lag nor bound, so that the ticks are taken exactly as
+     * the daemon took them (an actuator makes every tick a separate step). */
     lag_sim_def def = sc->sim;
     bool lagged = false;
     if (def.effects.enabled & LAG_EFF_ACTUATOR)
+        for (int i = 0; i < def.model.nq; i++) lagged |= def.effects.actuator_tau[i] > 0;
+    const bool use_input = lagged && log_has_channel(log_path, ch_input);
+    const bool anchor = lagged && !use_input;
+    if ((def.effects.enabled & LAG_EFF_ACTUATOR) && !use_input)
         for (int i = 0; i < def.model.nq; i++) {
-            lagged |= def.effects.actuator_tau[i] > 0;
             def.effects.actuator_tau[i] = 0.0;
             def.effects.actuator_max[i] = INFINITY;
         }
+    lag_sim sim;
     if (lag_sim_init(&sim, &def, err, sizeof err) != LAG_OK) {
         fprintf(stderr, "lagsimd: bad scene: %s\n", err);
         return LAGSIMD_EXIT_USAGE;
     }
-    const lag_model_info *info = lag_model_info_get(sc->sim.model.kind);
     lag_log *log = lag_log_open(log_path, REPLAY_DATA_MAX, err, sizeof err);
     if (!log) {
         fprintf(stderr, "lagsimd: --replay: %s\n", err);
         return LAGSIMD_EXIT_RUNTIME;
     }
-    char channel[96];
-    snprintf(channel, sizeof channel, "%s_STATE", sc->lcm.prefix);
-    int nq = sim.nq;
-    int64_t tpp = sc->ticks_per_period;
+    const int nq = sim.nq;
+    const int64_t tpp = sc->ticks_per_period;
+    const double dt = sc->sim.integrator.dt;
+    const char *inexact = restart_inexact(sc, lagged);
 
     int64_t seen = 0, compared = 0, restarts = 0, gaps = 0, undecodable = 0, invalid = 0;
-    int64_t errors = 0, error_step = -1;
+    int64_t errors = 0, error_step = -1, unchecked = 0;
+    const char *unchecked_why = NULL;
     lag_result error_kind = LAG_OK;
-    double max_dq = 0, max_dqd = 0;
-    bool have = false;   /* the sim holds a logged state to go on from */
+    double max_dq = 0, max_dqd = 0, max_deff = 0;
+    bool have = false;       /* the sim holds a logged state to go on from */
+    bool checking = false;   /* the sim's history is the daemon's: states are compared */
+    bool have_u = false;     /* use_input: the input of the period starting at u_t */
+    double u[LAG_MAX_DOF], u_t = 0;
     lag_log_record rec;
     int rc;
     while ((rc = lag_log_next(log, &rec)) == LAG_LOG_OK) {
+        if (use_input && strcmp(rec.channel, ch_input) == 0) {
+            have_u = decode_input(&rec, info, nq, u, &u_t);
+            continue;
+        }
         if (strcmp(rec.channel, channel) != 0) continue;
         seen++;
         lag_wire_joint_state m;
@@ -127,21 +215,40 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         lag_sim_observe(&sim, oq, oqd);
         for (int i = 0; same && i < nq; i++)
             same = oq[i] == m.position[i] && oqd[i] == m.velocity[i];
-        if (!have || dticks < 0 || (dticks == 0 && !same)) {
-            /* first state, or a reset (the step went back, or the state changed in place) */
-            if (have) restarts++;
-            restart(&sim, &m);
+        /* a period with an actuator lag needs its logged input */
+        bool input_missing = use_input && dticks == tpp && !(have_u && u_t == lag_sim_time(&sim));
+        bool is_gap = have && dticks > 0 && (dticks != tpp || input_missing);
+        if (!have || dticks < 0 || (dticks == 0 && !same) || is_gap) {
+            /* the first state, a reset (the step went back, or the state changed in
+             * place), or a gap: start over from this state */
+            if (is_gap) {
+                gaps++;
+                if (gaps <= REPLAY_GAPS_SAID)
+                    printf("gap: %s between t = %.9g s and t = %.9g s (step %lld to %lld): "
+                           "restarted from t = %.9g s%s\n",
+                           input_missing ? "the period's logged input is missing"
+                                         : "states missing",
+                           lag_sim_time(&sim), (double)m.step * dt, (long long)sim.tick,
+                           (long long)m.step, (double)m.step * dt,
+                           checking && inexact ? ", not checked until the next reset" : "");
+                else if (gaps == REPLAY_GAPS_SAID + 1)
+                    printf("gap: more gaps follow, counted below\n");
+            } else if (have) {
+                restarts++;
+            }
+            bool initial = restart(&sim, &m);
+            checking = initial || (m.step == 0 && !(sc->sim.effects.enabled & LAG_EFF_NOISE)) ||
+                       !inexact;
+            if (!checking && !unchecked_why)
+                unchecked_why = m.step == 0 ? "the logged state carries the noise effect, not "
+                                              "the true state" : inexact;
             have = true;
-            continue;
-        }
-        if (dticks > 0 && dticks != tpp) {
-            /* states missing from the log: the efforts in between are unknown */
-            gaps++;
-            restart(&sim, &m);
+            have_u = false;
             continue;
         }
         if (dticks > 0) {
-            lag_sim_set_input(&sim, m.effort);
+            lag_sim_set_input(&sim, use_input ? u : m.effort);
+            have_u = false;
             lag_result r = lag_sim_advance(&sim, dticks, false);
             if (r != LAG_OK || sim.tick != m.step) {
                 if (errors++ == 0) {
@@ -149,16 +256,28 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
                     error_kind = r;
                 }
                 restart(&sim, &m); /* go on from the logged state */
+                checking = false;
                 continue;
             }
+        }
+        if (!checking) {
+            unchecked++;
+            continue;
         }
         lag_sim_observe(&sim, oq, oqd); /* as the daemon published it (noise effect) */
         for (int i = 0; i < nq; i++) {
             double a = fabs(oq[i] - m.position[i]), b = fabs(oqd[i] - m.velocity[i]);
             if (!(a <= max_dq)) max_dq = a; /* NaN propagates as the max */
             if (!(b <= max_dqd)) max_dqd = b;
+            if (use_input) {
+                double c = fabs(sim.tau_applied[i] - m.effort[i]);
+                if (!(c <= max_deff)) max_deff = c;
+            }
         }
         compared++;
+        /* a lag without its inputs: each period from the logged state before it, so that
+         * the difference is that of one period, not one grown by an unstable plant */
+        if (anchor) restart(&sim, &m);
     }
     lag_log_stats ls;
     lag_log_get_stats(log, &ls);
@@ -181,14 +300,21 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
                 channel, log_path, (long long)ls.records);
         return LAGSIMD_EXIT_RUNTIME;
     }
-    if (lagged)
-        printf("note: this scene has an actuator lag: the applied effort changes within a "
-               "control period and the log holds its last value, so the difference is "
-               "approximate\n");
+    if (use_input)
+        printf("actuator lag: re-simulated from the commanded inputs logged on %s\n", ch_input);
+    else if (lagged)
+        printf("note: this scene has an actuator lag and the log has no %s records (lagsimd "
+               "--log writes them; lcm-logger records only the bus): the applied effort "
+               "changes within a control period and the log holds its last value, so each "
+               "state is re-simulated from the logged one a period before it and the "
+               "difference is approximate (give --tolerance)\n", ch_input);
     printf("replay %s: %lld states compared on %s (%lld restarts at resets, %lld gaps, "
            "%lld undecodable, %lld integrator errors)\n",
            log_path, (long long)compared, channel, (long long)restarts, (long long)gaps,
            (long long)undecodable, (long long)errors);
+    if (unchecked > 0)
+        printf("%lld states after a restart were not compared: %s\n", (long long)unchecked,
+               unchecked_why ? unchecked_why : "the re-simulation failed before them");
     if (invalid > 0)
         printf("%lld states with a non-finite number or a step outside [0, 2^53] were "
                "not checked\n", (long long)invalid);
@@ -200,6 +326,7 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         return LAGSIMD_EXIT_RUNTIME;
     }
     double max_diff = max_dq > max_dqd || isnan(max_dq) ? max_dq : max_dqd;
+    if (max_deff > max_diff || isnan(max_deff)) max_diff = max_deff;
     if (isnan(max_diff)) {
         fprintf(stderr, "lagsimd: --replay: the re-simulation produced a non-finite state: "
                         "the log could not be checked\n");
@@ -207,11 +334,21 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
     }
     if (compared == 0) {
         fprintf(stderr, "lagsimd: --replay: %s: no state of %s follows another by one "
-                        "control period (%lld ticks): nothing could be checked\n",
+                        "control period (%lld ticks) from a state the re-simulation can "
+                        "start from exactly: nothing could be checked\n",
                 log_path, channel, (long long)tpp);
         return LAGSIMD_EXIT_RUNTIME;
     }
-    printf("max |q - q_log| = %.17g\nmax |qd - qd_log| = %.17g\nmax difference = %.17g\n",
-           max_dq, max_dqd, max_diff);
+    printf("max |q - q_log| = %.17g\nmax |qd - qd_log| = %.17g\n", max_dq, max_dqd);
+    if (use_input) printf("max |effort - effort_log| = %.17g\n", max_deff);
+    printf("max difference = %.17g\n", max_diff);
+    if (!(max_diff <= tolerance)) {
+        fprintf(stderr, "lagsimd: --replay: FAILED: the largest difference %.17g is above "
+                        "the tolerance %.17g: %s\n", max_diff, tolerance,
+                anchor ? "the replay of this log is approximate (see the note above)"
+                       : "the log does not match this scene and build (wrong --config or "
+                         "--set, another build, or a changed log)");
+        return LAGSIMD_EXIT_RUNTIME;
+    }
     return LAGSIMD_EXIT_OK;
 }
