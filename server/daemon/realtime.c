@@ -681,15 +681,6 @@ static void on_control(const lcm_recv_buf_t *rb, const char *ch, void *user)
     if (!s->discard) rt_handle_control(s, rb->data, rb->data_size);
 }
 
-/* The one-line live status on a terminal: sim time, RTF, overruns, energy. */
-static void live_line(rt_server *s, bool final)
-{
-    fprintf(stderr, "\r%s  t=%10.3f s  RTF %6.3f  overruns %-6lld  E=%+.6e J  %-7s%s",
-            s->sc->lcm.prefix, lag_sim_time(&s->sim), s->rtf, (long long)s->overruns,
-            lag_sim_energy(&s->sim), rt_run_name(s->run), final ? "\n" : "");
-    fflush(stderr);
-}
-
 static int open_error(char *err, size_t errlen, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 static int open_error(char *err, size_t errlen, const char *fmt, ...)
@@ -784,6 +775,7 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     rt_limit_init(&s->lim_scene, RT_SCENE_PER_S, RT_SCENE_BURST, now);
     rt_limit_init(&s->lim_state, RT_STATE_PER_S, RT_STATE_BURST, now);
     rt_limit_init(&s->lim_set, RT_SET_PER_S, RT_SET_BURST, now);
+    rt_limit_init(&s->term.lim_print, 20, 20, now);
     rt_limit_init(&s->lg.lim_said, 1, 1, now);
 
     /* --log, last: nothing after it can fail */
@@ -926,7 +918,7 @@ void rt_process(rt_server *s)
         if (s->next_status_ns <= s->now) s->next_status_ns = rt_sat_add(s->now, s->status_period_ns);
     }
     if (s->live_line && s->now >= s->next_line_ns) {
-        live_line(s, false);
+        rt_term_line(s, false);
         s->next_line_ns = rt_sat_add(s->now, RT_LINE_NS);
     }
     rt_log_check(s, active(s));
@@ -982,7 +974,7 @@ void rt_finish(rt_server *s)
         break;
     }
     publish_status(s);
-    if (s->live_line) live_line(s, true);
+    if (s->live_line) rt_term_line(s, true);
 }
 
 /* ---------------------------------------------------------------- the loop */

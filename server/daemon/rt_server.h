@@ -184,6 +184,15 @@ typedef struct rt_server {
         bool error_said;
     } lg;
 
+    /* the terminal (rt_term.c): commands per second and printed events */
+    struct {
+        int64_t snap_ns[8];    /* the commands-per-second window: (time, s->accepted) at */
+        int64_t snap_n[8];     /* the last redraws of the live line, a ring */
+        int nsnap, next_snap;
+        rt_limit lim_print;    /* event lines printed */
+        bool line_shown;       /* the live line is on screen (cleared before a print) */
+    } term;
+
     uint8_t buf[RT_BUF_SIZE];
     uint8_t state_buf[RT_BUF_SIZE]; /* the last state published, as sent (lockstep retries) */
     unsigned state_len;
@@ -219,6 +228,13 @@ void rt_log_check(rt_server *s, bool running);
  * and says so on stderr: a summary unless -q; what was lost, always. Returns 0 when the
  * log is complete, -1 otherwise. */
 int rt_log_end(rt_server *s);
+
+/* rt_term.c: the terminal. Without -q every event goes to stderr on its own line (at most
+ * 20 a second, the rest counted); on a terminal one live line below them: sim time, RTF,
+ * q, commands per second or "no controller", energy, overruns, run state. */
+void rt_term_event(rt_server *s, double sim_time, const char *kind, const char *joint,
+                   double value, const char *detail, bool effect);
+void rt_term_line(rt_server *s, bool final);
 
 /* realtime.c: the server in pieces (lagsimd_realtime strings them together; tests and
  * the fuzz target drive them with their own clock and LCM, e.g. memq://). */

@@ -143,14 +143,8 @@ void rt_publish_status(rt_server *s)
     s->step_us_n = 0;
 }
 
-void rt_publish_event(rt_server *s, const char *kind, const char *joint, double value,
-                      const char *detail)
-{
-    rt_publish_event_at(s, lag_sim_time(&s->sim), kind, joint, value, detail);
-}
-
-void rt_publish_event_at(rt_server *s, double sim_time, const char *kind, const char *joint,
-                         double value, const char *detail)
+static void publish_event(rt_server *s, double sim_time, const char *kind, const char *joint,
+                          double value, const char *detail, bool effect)
 {
     lag_wire_event m;
     memset(&m, 0, sizeof m);
@@ -162,6 +156,19 @@ void rt_publish_event_at(rt_server *s, double sim_time, const char *kind, const 
     m.value = fin(value);
     PUT(m.detail, detail); /* cut to 255 bytes if longer */
     publish(s, s->ch_event, LAG_WIRE_EVENT, &m);
+    rt_term_event(s, m.sim_time, m.kind, m.joint, m.value, m.detail, effect);
+}
+
+void rt_publish_event(rt_server *s, const char *kind, const char *joint, double value,
+                      const char *detail)
+{
+    publish_event(s, lag_sim_time(&s->sim), kind, joint, value, detail, false);
+}
+
+void rt_publish_event_at(rt_server *s, double sim_time, const char *kind, const char *joint,
+                         double value, const char *detail)
+{
+    publish_event(s, sim_time, kind, joint, value, detail, true);
 }
 
 void rt_publish_scene(rt_server *s)

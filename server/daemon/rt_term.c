@@ -1,0 +1,97 @@
+/*
+ * The real-time server on its terminal (stderr), as offline runs print their events:
+ *
+ *   lagsimd: event start at t = 0.000000000 s: dipc, rk4, dt 0.001 s, ...
+ *   lagsimd: event watchdog_trip at t = 3.210000000 s: no command for 0.51 s ...
+ *   lagsimd: event impact at t = 0.426664059 s, joint phi, value -1.234
+ *   DIPC t=12.340 s RTF 1.000 q=(+0.001 +0.050 -0.030) 100 cmd/s E=+7.661 J ovr 0 running
+ *
+ * Every event the daemon publishes gets a line (without -q, terminal or not), the
+ * limited kinds in their limited form (the published event says what its bucket
+ * suppressed); at most 20 lines a second get printed, and the next line says how many
+ * were not. On a terminal the live line (refreshed four times a second) is cleared
+ * before an event line and drawn again below it, cut to the terminal's width so that it
+ * never wraps: the coordinates, and the commands accepted per second over the last
+ * second, or "no controller" when no command is held (none yet since start or reset, or
+ * the watchdog tripped).
+ */
+#include <stdio.h>
+#include <string.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
+
+#include "rt_server.h"
+
+#define RT_TERM_WINDOW_NS RT_NS_PER_S /* commands per second: over the last second */
+
+static bool quiet(const rt_server *s) { return s->opts && s->opts->quiet; }
+
+/* Clears the live line, if it is on screen, so that what follows starts a fresh line. */
+static void clear_line(rt_server *s)
+{
+    if (s->term.line_shown) fputs("\r\033[K", stderr);
+    s->term.line_shown = false;
+}
+
+void rt_term_event(rt_server *s, double sim_time, const char *kind, const char *joint,
+                   double value, const char *detail, bool effect)
+{
+    if (quiet(s)) return;
+    int64_t suppressed = s->term.lim_print.suppressed;
+    if (!rt_limit_take(&s->term.lim_print, s->now)) return;
+    s->term.lim_print.suppressed = 0;
+    clear_line(s);
+    if (suppressed > 0)
+        fprintf(stderr, "lagsimd: (%lld more events not shown: at most 20 lines a second; "
+                "every event is on %s)\n", (long long)suppressed, s->ch_event);
+    if (effect)
+        fprintf(stderr, "lagsimd: event %s at t = %.9f s, joint %s, value %g\n", kind, sim_time,
+                joint && joint[0] ? joint : "-", value);
+    else
+        fprintf(stderr, "lagsimd: event %s at t = %.9f s%s%s: %s\n", kind, sim_time,
+                joint && joint[0] ? ", joint " : "", joint ? joint : "", detail ? detail : "");
+    if (s->live_line) rt_term_line(s, false);
+    else fflush(stderr);
+}
+
+void rt_term_line(rt_server *s, bool final)
+{
+    if (!s->live_line) return;
+    /* commands accepted per second: since the newest redraw at least a second ago (or
+     * the oldest one kept, when the line is younger than that) */
+    double rate = 0.0;
+    for (int k = 0; k < s->term.nsnap; k++) {
+        int i = (s->term.next_snap - 1 - k + 8) % 8;
+        int64_t span = s->now - s->term.snap_ns[i];
+        if (span > 0 && (span >= RT_TERM_WINDOW_NS || k == s->term.nsnap - 1))
+            rate = (double)(s->accepted - s->term.snap_n[i]) / ((double)span * 1e-9);
+        if (span >= RT_TERM_WINDOW_NS) break;
+    }
+    if (s->term.nsnap == 0 || s->now >= s->term.snap_ns[(s->term.next_snap + 7) % 8] + RT_NS_PER_S / 8) {
+        s->term.snap_ns[s->term.next_snap] = s->now;
+        s->term.snap_n[s->term.next_snap] = s->accepted;
+        s->term.next_snap = (s->term.next_snap + 1) % 8;
+        if (s->term.nsnap < 8) s->term.nsnap++;
+    }
+    char q[160] = "";
+    size_t n = 0;
+    for (int i = 0; i < s->nq && n < sizeof q; i++) {
+        int k = snprintf(q + n, sizeof q - n, "%s%+.3f", i ? " " : "", s->sim.q[i]);
+        if (k < 0) break;
+        n += (size_t)k;
+    }
+    char ctl[32];
+    if (!s->have_command || s->watchdog_tripped) snprintf(ctl, sizeof ctl, "no controller");
+    else snprintf(ctl, sizeof ctl, "%.0f cmd/s", rate);
+    char line[512];
+    snprintf(line, sizeof line, "%s t=%.3f s RTF %.3f q=(%s) %s E=%+.4g J ovr %lld %s",
+             s->sc->lcm.prefix, lag_sim_time(&s->sim), s->rtf, q, ctl, lag_sim_energy(&s->sim),
+             (long long)s->overruns, rt_run_name(s->run));
+    /* never wider than the terminal: a wrapped line cannot be redrawn in place */
+    struct winsize ws;
+    if (ioctl(STDERR_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 1 && ws.ws_col < sizeof line)
+        line[ws.ws_col - 1] = '\0';
+    fprintf(stderr, "\r\033[K%s%s", line, final ? "\n" : "");
+    fflush(stderr);
+    s->term.line_shown = !final;
+}

@@ -1,0 +1,246 @@
+#!/usr/bin/env python3
+"""lagsimd on a terminal, as a person sees it: its stderr is a pseudo-terminal this test
+reads (and sizes), a controller of this test's own sends commands, stops, sends a bad one.
+
+    test_term.py --bin BUILD/bin --python BUILD/python --source SRC CASE
+
+Cases:
+  live      the live line holds q (every joint), commands per second while commands come
+            (about 100/s from a 100 Hz sender) and "no controller" before the first and
+            after the watchdog trips (then cleared by new commands); each event (start, watchdog_trip, watchdog_clear,
+            command_rejected, stop) on its own line above it, the live line cleared
+            first; nothing wider than the terminal
+  effects   the stick on its floor: each impact (and the rest) on its own line, with the
+            sim time the core locates
+  quiet     -q: not one byte on the terminal
+  pipe      stderr not a terminal: event lines only, no live line, no control codes
+"""
+import argparse
+import fcntl
+import os
+import pty
+import re
+import select
+import signal
+import struct
+import subprocess
+import sys
+import termios
+import time
+
+failures = 0
+
+
+def check(cond, what):
+    global failures
+    print(("ok: " if cond else "FAIL: ") + what, flush=True)
+    if not cond:
+        failures += 1
+    return cond
+
+
+class Daemon:
+    """lagsimd with stdout and stderr on a pseudo-terminal of `cols` columns (or a pipe)."""
+
+    def __init__(self, a, config, prefix, *args, cols=200, tty=True):
+        self.out = b""
+        argv = [os.path.join(a.bin, "lagsimd"), "--config", config, "--set",
+                f"lcm.prefix={prefix}", *args]
+        if tty:
+            self.master, slave = pty.openpty()
+            fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 40, cols, 0, 0))
+            self.p = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=slave, stderr=slave)
+            os.close(slave)
+        else:
+            r, w = os.pipe()
+            self.master = r
+            self.p = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=w, stderr=w)
+            os.close(w)
+
+    def read(self, seconds):
+        end = time.monotonic() + seconds
+        while True:
+            left = end - time.monotonic()
+            if left <= 0:
+                return
+            r, _, _ = select.select([self.master], [], [], min(left, 0.05))
+            if r:
+                try:
+                    chunk = os.read(self.master, 65536)
+                except OSError:  # EIO: the terminal's other end closed
+                    return
+                if not chunk:
+                    return
+                self.out += chunk
+
+    def stop(self):
+        if self.p.poll() is None:
+            self.p.send_signal(signal.SIGTERM)
+        t_end = time.monotonic() + 10
+        while self.p.poll() is None and time.monotonic() < t_end:
+            self.read(0.1)
+        self.read(0.3)
+        if self.p.poll() is None:
+            self.p.kill()
+        os.close(self.master)
+        return self.p.wait()
+
+    def text(self):
+        # the terminal's line discipline writes \n as \r\n (onlcr): read it as \n
+        return self.out.decode(errors="replace").replace("\r\n", "\n")
+
+
+def live_lines(text, prefix):
+    """Every drawing of the live line (the text after a \\r\\x1b[K up to the next \\r or \\n)."""
+    return [m.group(1) for m in re.finditer(r"\r\x1b\[K(" + re.escape(prefix) + r" t=[^\r\n]*)", text)]
+
+
+def event_lines_alone(text):
+    """Each event line starts a line (at the start, after \\n, or after the live line was
+    cleared) and runs to its \\n without a \\r: (ok, lines)."""
+    ok, lines = True, []
+    for m in re.finditer(r"lagsimd: event ", text):
+        i = m.start()
+        before = text[max(0, i - 4):i]
+        starts = i == 0 or before.endswith("\n") or before.endswith("\r\x1b[K")
+        end = text.find("\n", i)
+        line = text[i:end if end >= 0 else len(text)]
+        ok &= starts and end >= 0 and "\r" not in line
+        lines.append(line)
+    return ok, lines
+
+
+class Sender:
+    def __init__(self, a, prefix):
+        sys.path.insert(0, a.python)
+        from lagsim_lcm import LCM
+        from lagsim import joint_command_t
+        self.lc, self.cmd_t, self.prefix = LCM(), joint_command_t, prefix
+
+    def command(self, name="theta0", effort=0.0):
+        c = self.cmd_t()
+        c.sim_time, c.num_joints, c.name, c.effort = 0.0, 1, [name], [effort]
+        self.lc.publish(self.prefix + "_COMMAND", c.encode())
+
+    def send_for(self, d, seconds, hz=100):
+        end = time.monotonic() + seconds
+        k = 0
+        while time.monotonic() < end:
+            self.command()
+            k += 1
+            d.read(1.0 / hz)
+        return k
+
+
+def case_live(a):
+    prefix = f"TT{os.getpid()}"
+    config = os.path.join(a.source, "config", "dipc.yaml")
+    d = Daemon(a, config, prefix, "--set", "realtime.command_timeout=0.3")
+    s = Sender(a, prefix)
+    d.read(1.0)                       # no controller yet
+    n0 = len(d.text())
+    s.send_for(d, 2.5)                # a controller at about 100 Hz
+    n1 = len(d.text())
+    d.read(1.5)                       # it is gone: the watchdog trips after 0.3 s
+    s.command(name="nope")            # a bad command: rejected, said
+    d.read(0.8)
+    n2 = len(d.text())
+    s.send_for(d, 0.5)                # it is back: the watchdog clears
+    rc = d.stop()
+    t = d.text()
+    print(t.replace("\r", "\\r\n").replace("\x1b", "\\e")[-4000:])
+    check(rc == 0, f"lagsimd exit {rc}")
+    lines = live_lines(t, prefix)
+    check(len(lines) >= 15, f"the live line is redrawn ({len(lines)} times in about 6 s)")
+    qs = [re.search(r" q=\(([^)]*)\) ", l) for l in lines]
+    check(all(q and len(q.group(1).split()) == 3 for q in qs), "every live line holds q: 3 joints")
+    before = live_lines(t[:n0], prefix)
+    check(before and all("no controller" in l for l in before), "no controller before the first command")
+    during = [l for l in live_lines(t[n0:n1], prefix) if "cmd/s" in l]
+    rates = [int(re.search(r" (\d+) cmd/s ", l).group(1)) for l in during]
+    print("commands per second shown:", rates)
+    # a 100 Hz sender in Python on a loaded machine: between 40 and 130 a second
+    check(len(rates) >= 4 and 40 <= max(rates) <= 130, f"commands per second while they come: {rates}")
+    after = live_lines(t[n1:n2], prefix)
+    check(after and "no controller" in after[-1], "no controller after the watchdog tripped")
+    ok, evs = event_lines_alone(t)
+    for e in evs:
+        print("  event line:", e)
+    check(ok, "each event on its own line, the live line cleared first")
+    kinds = [re.match(r"lagsimd: event (\S+)", e).group(1) for e in evs]
+    for k in ("start", "watchdog_clear", "watchdog_trip", "command_rejected", "stop"):
+        check(k in kinds, f"event line: {k}")
+    check(any("command rejected: unknown joint" in e for e in evs), "the reject says why")
+    check(re.search(prefix + r" t=[^\r\n]* running\n\Z", t) is not None,
+          "the final live line stays on screen")
+
+    # a narrow terminal: the live line is cut, never wrapped
+    d = Daemon(a, config, prefix + "N", cols=50)
+    d.read(1.2)
+    d.stop()
+    lines = live_lines(d.text(), prefix + "N")
+    check(lines and all(len(l) <= 49 for l in lines), f"50 columns: live lines of at most 49 "
+          f"characters ({max(len(l) for l in lines) if lines else None})")
+
+
+def case_effects(a):
+    prefix = f"TT{os.getpid()}S"
+    d = Daemon(a, os.path.join(a.source, "config", "stick.yaml"), prefix, "--set",
+               "realtime.mode=fast", "--duration", "5")
+    d.read(10)
+    rc = d.stop()
+    t = d.text()
+    check(rc == 0, f"lagsimd exit {rc}")
+    ok, evs = event_lines_alone(t)
+    for e in evs[:12]:
+        print("  event line:", e)
+    check(ok, "each event on its own line")
+    impacts = [e for e in evs if e.startswith("lagsimd: event impact ")]
+    check(len(impacts) >= 3, f"{len(impacts)} impact lines")
+    # the first impact's time as the core locates it (tests/server: server_effects)
+    check(impacts and impacts[0].startswith("lagsimd: event impact at t = 0.426664059 s, joint phi, value "),
+          "the first impact at the located sim time, with its joint")
+    check(any(e.startswith("lagsimd: event rest ") for e in evs), "the resting contact too")
+
+
+def case_quiet(a):
+    prefix = f"TT{os.getpid()}Q"
+    d = Daemon(a, os.path.join(a.source, "config", "dipc.yaml"), prefix, "-q")
+    s = Sender(a, prefix)
+    s.command(name="nope")
+    d.read(1.5)
+    rc = d.stop()
+    check(rc == 0 and d.out == b"", f"-q: nothing on the terminal ({d.out[:200]!r}), exit {rc}")
+
+
+def case_pipe(a):
+    prefix = f"TT{os.getpid()}P"
+    d = Daemon(a, os.path.join(a.source, "config", "dipc.yaml"), prefix, tty=False)
+    d.read(1.0)
+    rc = d.stop()
+    t = d.text()
+    print(t)
+    check(rc == 0, f"exit {rc}")
+    check("\r" not in t and "\x1b" not in t, "no live line, no control codes")
+    ok, evs = event_lines_alone(t)
+    check(ok and [e.split()[2] for e in evs] == ["start", "stop"], "the start and stop events, one line each")
+
+
+CASES = {"live": case_live, "effects": case_effects, "quiet": case_quiet, "pipe": case_pipe}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--bin", required=True)
+    ap.add_argument("--python", required=True)
+    ap.add_argument("--source", required=True)
+    ap.add_argument("case", choices=sorted(CASES))
+    a = ap.parse_args()
+    a.bin, a.python, a.source = (os.path.abspath(x) for x in (a.bin, a.python, a.source))
+    CASES[a.case](a)
+    print(f"{a.case}: {'FAILED' if failures else 'passed'} ({failures} failures)")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
