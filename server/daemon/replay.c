@@ -164,6 +164,14 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         fprintf(stderr, "lagsimd: --replay: %s\n", err);
         return LAGSIMD_EXIT_RUNTIME;
     }
+    if (use_input)
+        printf("actuator lag: re-simulated from the commanded inputs logged on %s\n", ch_input);
+    else if (lagged)
+        printf("note: this scene has an actuator lag and the log has no %s records (lagsimd "
+               "--log writes them; lcm-logger records only the bus): the applied effort "
+               "changes within a control period and the log holds its last value, so each "
+               "state is re-simulated from the logged one a period before it and the "
+               "difference is approximate (give --tolerance)\n", ch_input);
     const int nq = sim.nq;
     const int64_t tpp = sc->ticks_per_period;
     const double dt = sc->sim.integrator.dt;
@@ -300,14 +308,6 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
                 channel, log_path, (long long)ls.records);
         return LAGSIMD_EXIT_RUNTIME;
     }
-    if (use_input)
-        printf("actuator lag: re-simulated from the commanded inputs logged on %s\n", ch_input);
-    else if (lagged)
-        printf("note: this scene has an actuator lag and the log has no %s records (lagsimd "
-               "--log writes them; lcm-logger records only the bus): the applied effort "
-               "changes within a control period and the log holds its last value, so each "
-               "state is re-simulated from the logged one a period before it and the "
-               "difference is approximate (give --tolerance)\n", ch_input);
     printf("replay %s: %lld states compared on %s (%lld restarts at resets, %lld gaps, "
            "%lld undecodable, %lld integrator errors)\n",
            log_path, (long long)compared, channel, (long long)restarts, (long long)gaps,

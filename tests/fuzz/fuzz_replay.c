@@ -1,6 +1,7 @@
 /*
  * Fuzz target: lagsimd --replay end to end on an arbitrary log, with the scene of
- * config/dipc.yaml. The bytes are written to an anonymous in-memory file (memfd) whose
+ * config/dipc.yaml, and again with an actuator lag added to it (the replay then reads the
+ * log's <PREFIX>_INPUT records, in a first pass and among the states). The bytes are written to an anonymous in-memory file (memfd) whose
  * /proc/self/fd path is given to the replay, as a user would give a log's path.
  *
  * The replay must end with exit status 0 or 1 (never 2: the scene is valid), without
@@ -19,14 +20,17 @@
 /* In sanitizer builds: where their reports go (absent otherwise). */
 extern void __sanitizer_set_report_fd(void *fd) __attribute__((weak));
 
-static lag_scene g_scene;
+static lag_scene g_scene, g_lagged;
 static int g_null = -1, g_out = -1, g_err = -1;
 
 int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     (void)argc, (void)argv;
     char err[512];
+    const char *lag[] = {"effects.actuator={theta0: {lag: 0.004, max: 40}}"};
     if (lag_scene_load(LAGSIM_SOURCE_DIR "/config/dipc.yaml", NULL, 0, &g_scene, err,
+                       sizeof err) != 0 ||
+        lag_scene_load(LAGSIM_SOURCE_DIR "/config/dipc.yaml", lag, 1, &g_lagged, err,
                        sizeof err) != 0) {
         fprintf(stderr, "fuzz_replay: %s\n", err);
         exit(1);
@@ -58,11 +62,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     dup2(g_null, 1);
     dup2(g_null, 2);
     int rc = lagsimd_replay(&g_scene, path, &o);
+    int rc_lagged = lagsimd_replay(&g_lagged, path, &o);
     fflush(stdout);
     fflush(stderr);
     dup2(g_out, 1);
     dup2(g_err, 2);
     close(fd);
     if (rc != LAGSIMD_EXIT_OK && rc != LAGSIMD_EXIT_RUNTIME) abort();
+    if (rc_lagged != LAGSIMD_EXIT_OK && rc_lagged != LAGSIMD_EXIT_RUNTIME) abort();
     return 0;
 }

@@ -7,7 +7,7 @@ through the wire module.
 
 Messages are encoded by lcm-gen's Python types (BUILD_DIR/python), independently of the
 wire module; the replay logs come from `test_replay ... write_logs` (a core run of
-config/dipc.yaml written as lcm-logger writes it).
+config/dipc.yaml written as lcm-logger writes it) and from `lagsimd --log`.
 """
 import os
 import shutil
@@ -90,6 +90,10 @@ def scene(nparams=7, njoints=3):
     m.initial_qd = [0.0] * njoints
     m.dt, m.control_period, m.integrator, m.mode = 0.001, 0.01, "rk4", "realtime"
     m.rate, m.command_timeout = 1.0, 0.5
+    m.effects = "limits"
+    m.limit_on = [i == 0 for i in range(njoints)]
+    m.limit_lower = [-1.0 if i == 0 else 0.0 for i in range(njoints)]
+    m.limit_upper = [1.0 if i == 0 else 0.0 for i in range(njoints)]
     return m.encode()
 
 
@@ -192,6 +196,19 @@ try:
 
     keep("valid", "replay", "seed", first=12)     # states 0 .. 11 of a core run
     keep("step_jump", "replay", "seed", first=24)  # ... and a step of 2^62 after state 19
+
+    # a lagsimd --log log of 0.1 s with an actuator lag (its <PREFIX>_INPUT records, which
+    # fuzz_replay's lagged scene reads), and the same without its sixth state (a gap)
+    lagged = os.path.join(tmp, "lagged.lcm")
+    subprocess.check_call([os.path.join(build, "bin", "lagsimd"), "--config",
+                           os.path.join(root, "config", "dipc.yaml"), "--set",
+                           "effects.actuator={theta0: {lag: 0.004, max: 40}}", "--set",
+                           "realtime.mode=fast", "--set", "lcm.url=memq://", "--duration", "0.1",
+                           "-q", "--log", lagged])
+    recs = records(lagged)
+    write("replay", "seed", "lagged-inputs.lcm", b"".join(recs))
+    states = [k for k, r in enumerate(recs) if r[28:28 + 10] == b"DIPC_STATE"]
+    write("replay", "seed", "lagged-gap.lcm", b"".join(r for k, r in enumerate(recs) if k != states[5]))
 finally:
     shutil.rmtree(tmp)
 
