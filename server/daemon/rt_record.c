@@ -63,6 +63,9 @@ void rt_log_input(rt_server *s)
     if (n > 0) rt_log_record(s, RT_LOG_OUT, s->lg.ch_input, buf, (size_t)n);
 }
 
+/* -q: the terminal shows no event lines, but what the log lost is still said. */
+static bool quiet(const rt_server *s) { return s->opts && s->opts->quiet; }
+
 /* Records lost so far, but those refused after a failed write (said once, with it). */
 static int64_t lost(const rt_log_stats *st)
 {
@@ -83,7 +86,7 @@ void rt_log_check(rt_server *s, bool running)
         s->lg.error_said = true;
         snprintf(detail, sizeof detail, "--log %s: writing failed after %lld bytes: %s; the rest "
                  "of the run is not logged", path, (long long)st.written, strerror(st.error));
-        fprintf(stderr, "lagsimd: %s\n", detail);
+        if (quiet(s)) fprintf(stderr, "lagsimd: %s\n", detail); /* else: the event's line */
         rt_publish_event(s, "log_error", "", (double)st.error, detail);
     }
     if (lost(&st) > lost(&s->lg.seen) && rt_limit_take(&s->lg.lim_said, s->now)) {
@@ -93,7 +96,7 @@ void rt_log_check(rt_server *s, bool running)
                  (long long)st.dropped_full, (long long)st.dropped_in, st.ring,
                  (long long)st.too_large);
         s->lg.seen = st;
-        fprintf(stderr, "lagsimd: %s\n", detail);
+        if (quiet(s)) fprintf(stderr, "lagsimd: %s\n", detail); /* else: the event's line */
         rt_publish_event(s, "log_dropped", "", (double)lost(&st), detail);
     }
 }
@@ -106,17 +109,17 @@ int rt_log_end(rt_server *s)
     rt_log_stats st;
     int rc = rt_log_close(s->lg.log, RT_LOG_STALL_MS, &st);
     s->lg.log = NULL;
-    bool quiet = s->opts && s->opts->quiet;
     if (rc == 0) {
-        if (!quiet)
+        if (!quiet(s))
             fprintf(stderr, "lagsimd: --log %s: %lld records, %lld bytes, complete\n", path,
                     (long long)st.records, (long long)st.bytes);
         return 0;
     }
-    fprintf(stderr, "lagsimd: --log %s is INCOMPLETE: %lld records put, %lld of their %lld "
-            "bytes written; %lld records not written (%lld published and %lld received while "
-            "the ring of %zu bytes was full, %lld too large, %lld after the write failed)%s%s\n",
-            path, (long long)st.records, (long long)st.written, (long long)st.bytes,
+    fprintf(stderr, "lagsimd: --log %s is INCOMPLETE: %lld of the %lld bytes of the %lld "
+            "records handed to the writer reached the file; %lld more were refused (%lld "
+            "published and %lld received while the ring of %zu bytes was full, %lld too large, "
+            "%lld after the write failed)%s%s\n",
+            path, (long long)st.written, (long long)st.bytes, (long long)st.records,
             (long long)(lost(&st) + st.dropped_failed), (long long)st.dropped_full,
             (long long)st.dropped_in, st.ring, (long long)st.too_large,
             (long long)st.dropped_failed, st.error ? ": " : "",
