@@ -324,7 +324,7 @@ def case_readers(r, a, tmp):
         check(p.stdout.strip() == f"records {len(recs)} crc {crc} numbered true ordered true",
               "lcm.jar's reader (lcm-spy's log playback) reads every record, numbered and in order")
     # lcm-logplayer plays it on a private URL, lcm-logger records what it plays
-    url = f"udpm://239.255.76.67:{7700 + os.getpid() % 500}?ttl=0"
+    url = os.environ["LCM_DEFAULT_URL"]
     for attempt in range(1, 4):
         back = os.path.join(tmp, f"back{attempt}.lcm")
         lg = subprocess.Popen(["lcm-logger", "-q", "-f", f"--lcm-url={url}", "-c", prefix + "_.*", back])
@@ -381,8 +381,8 @@ def case_cli(r, a, tmp):
 
 def case_readme(r, a, tmp):
     """The README's record recipe, as written, in a scratch directory where build/bin and
-    config are the build's and the source's; on a private LCM URL (the recipe uses the
-    DIPC prefix, which other tests may be using)."""
+    config are the build's and the source's; on this test's own LCM port (the recipe uses
+    the DIPC prefix, which other tests may be using)."""
     with open(os.path.join(a.source, "README.md")) as f:
         text = f.read()
     m = re.search(r"<!-- recipe: record -->\n```sh\n(.*?)```", text, re.S)
@@ -395,7 +395,7 @@ def case_readme(r, a, tmp):
     os.makedirs(os.path.join(tmp, "build"))
     os.symlink(os.path.abspath(a.bin), os.path.join(tmp, "build", "bin"))
     os.symlink(os.path.join(a.source, "config"), os.path.join(tmp, "config"))
-    env = dict(os.environ, LCM_DEFAULT_URL=f"udpm://239.255.76.67:{7700 + os.getpid() % 500}?ttl=0")
+    env = dict(os.environ)  # LCM_DEFAULT_URL: this test's own port
     p = subprocess.run(["bash", "-euo", "pipefail", "-c", recipe + "\nwait\n"], cwd=tmp, env=env,
                        capture_output=True, text=True, timeout=120)
     print(p.stdout[-3000:], p.stderr[-3000:])
@@ -418,6 +418,11 @@ def main():
     ap.add_argument("--source", required=True)
     ap.add_argument("case", choices=sorted(CASES))
     a = ap.parse_args()
+    # a multicast port of this test's own (ttl=0: this host) for every process it starts,
+    # through LCM_DEFAULT_URL: on one port every socket gets every datagram, and another
+    # test's fast-mode daemon would flood this one's sockets; 4 MB receive buffers
+    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
+                                     % (20000 + os.getpid() % 12000))
     a.bin, a.types, a.source = (os.path.abspath(x) for x in (a.bin, a.types, a.source))
     tmp = tempfile.mkdtemp(prefix="lagsim_log_")
     try:

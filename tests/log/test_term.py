@@ -236,6 +236,11 @@ def main():
     ap.add_argument("--source", required=True)
     ap.add_argument("case", choices=sorted(CASES))
     a = ap.parse_args()
+    # a multicast port of this test's own (ttl=0: this host) for every process it starts,
+    # through LCM_DEFAULT_URL: on one port every socket gets every datagram, and another
+    # test's fast-mode daemon would flood this one's sockets; 4 MB receive buffers
+    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
+                                     % (20000 + os.getpid() % 12000))
     a.bin, a.python, a.source = (os.path.abspath(x) for x in (a.bin, a.python, a.source))
     CASES[a.case](a)
     print(f"{a.case}: {'FAILED' if failures else 'passed'} ({failures} failures)")
