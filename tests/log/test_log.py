@@ -374,7 +374,8 @@ def case_cli(r, a, tmp):
           "--log to a FIFO without a reader: exit 2 at once, not a hang")
     # a full disk: the run goes on, says so, exits 1
     p = r.lagsimd("--config", config, "--set", f"lcm.prefix=LG{os.getpid()}C", "--set",
-                  "realtime.mode=fast", "--log", "/dev/full", "--duration", "2", timeout=60)
+                  "realtime.mode=fast", "--set", "realtime.start=running", "--log", "/dev/full",
+                  "--duration", "2", timeout=60)
     check(p.returncode == 1 and "No space left on device" in p.stderr and "INCOMPLETE" in p.stderr,
           "--log /dev/full: said, the run ends, exit 1")
 
@@ -422,7 +423,7 @@ def main():
     # through LCM_DEFAULT_URL: on one port every socket gets every datagram, and another
     # test's fast-mode daemon would flood this one's sockets; 4 MB receive buffers
     os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
-                                     % (20000 + os.getpid() % 12000))
+                                     % (20000 + 2 * (os.getpid() % 6000)))  # and the next port: commands
     a.bin, a.types, a.source = (os.path.abspath(x) for x in (a.bin, a.types, a.source))
     tmp = tempfile.mkdtemp(prefix="lagsim_log_")
     try:
