@@ -162,7 +162,8 @@ def check_log_whole(r, log, prefix, n_states, period_ticks, commands):
     # every command received: what the daemon counted in its last status (a command that
     # UDP lost never reached it: lockstep then steps on after its timeout)
     last = r.t.status_t.decode([d for _, _, ch, d in recs if ch == prefix + "_STATUS"][-1])
-    counted = last.commands_accepted + sum(getattr(last, k) for k in dir(last) if k.startswith("rejected_"))
+    counted = (last.commands_accepted + last.commands_ignored  # ignored: a second answer to a retried state
+               + sum(getattr(last, k) for k in dir(last) if k.startswith("rejected_")))
     check(chans.count("COMMAND") == counted and counted >= commands - 10,
           f"{chans.count('COMMAND')} commands logged, {counted} received by the daemon "
           f"({commands} sent if UDP lost none)")
