@@ -81,7 +81,7 @@ static void command(double sim_time, double effort)
 static void control(int req)
 {
     uint8_t buf[256];
-    lagsim_control_t m = {0, (int8_t)req, 0, 0, NULL, NULL};
+    lagsim_control_t m = {0, (int8_t)req, 0, 0, NULL, NULL, "", ""};
     int n = lagsim_control_t_encode(buf, 0, sizeof buf, &m);
     ENSURE(n > 0);
     rt_handle_control(&g_srv, buf, (size_t)n);
