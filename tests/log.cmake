@@ -9,10 +9,10 @@ endforeach()
 
 # End to end: dipc_lqr in lockstep with lagsimd --log, the log read back by this test's own
 # reader, liblcm's, lcm.jar's and lcm-logplayer; --replay on it, on a changed copy and on
-# copies that lost states; the options; the README's record recipe as written.
+# copies that lost states; the options. (The README's record recipe: clients_readme_recipes.)
 find_program(LAGSIM_LOG_PYTHON3 python3)
 if(LAGSIM_LOG_PYTHON3)
-  foreach(case lqr lqr_effects gaps readers cli readme)
+  foreach(case lqr lqr_effects gaps readers cli)
     add_test(NAME log_${case}
              COMMAND ${LAGSIM_LOG_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/log/test_log.py
                      --bin ${CMAKE_BINARY_DIR}/bin --types ${CMAKE_BINARY_DIR}/python

@@ -51,11 +51,24 @@ def check_by_hand(out, tmp):
 
 
 def check_record(out, tmp):
-    """the log became one CSV per channel and a plot of the state"""
+    """--log kept every state of the 10 s run (at 100 Hz: t = 0 to 10 s, 1001 states, the one
+    at t = 0 maybe published again while the daemon waited for the controller's first
+    command), the replay found them exact, the log became one CSV per channel and a plot"""
     checks = []
+    m = re.search(r"replay run.lcm: (\d+) states compared on DIPC_STATE \(\d+ restarts at "
+                  r"resets, (\d+) gaps", out)
+    # each state re-simulated from the one before (a repeat from the one it repeats)
+    checks.append((m is not None and int(m.group(1)) >= 1000 and m.group(2) == "0"
+                   and "\nmax difference = 0\n" in out,
+                   "--replay: every state compared, 0 gaps, max difference 0 (%s)"
+                   % (m.group(0) if m else "no replay line")))
+    checks.append(("gaps 0 (0 states missing" in out and "sim time 0 .. 10 s, step 0 .. 10000" in out,
+                   "lagsim-log2csv's summary: states from 0 to 10 s, 0 gaps"))
     path = os.path.join(tmp, "run", "DIPC_STATE.csv")
     r = rows(path) if os.path.exists(path) else []
-    checks.append((len(r) > 900, "run/DIPC_STATE.csv: %d rows" % len(r)))
+    times = {row[0] for row in r[1:]}
+    checks.append((len(times) == 1001, "run/DIPC_STATE.csv: %d distinct sim times in %d rows"
+                   % (len(times), len(r) - 1 if r else 0)))
     png = os.path.join(tmp, "run", "DIPC_STATE.png")
     checks.append((os.path.exists(png) and os.path.getsize(png) > 1000, "run/DIPC_STATE.png drawn"))
     return checks

@@ -18,7 +18,6 @@ Cases:
                  memory, not compared (and said) for a scene whose restart cannot be exact
   readers        liblcm's reader, lcm.jar's reader and lcm-logplayer read the log whole
   cli            option errors: exit 2 with the option named, nothing run
-  readme         the README's record -> check -> CSV -> plot recipe, run as written
 """
 import argparse
 import ctypes
@@ -381,36 +380,8 @@ def case_cli(r, a, tmp):
           "--log /dev/full: said, the run ends, exit 1")
 
 
-def case_readme(r, a, tmp):
-    """The README's record recipe, as written, in a scratch directory where build/bin and
-    config are the build's and the source's; on this test's own LCM port (the recipe uses
-    the DIPC prefix, which other tests may be using)."""
-    with open(os.path.join(a.source, "README.md")) as f:
-        text = f.read()
-    m = re.search(r"<!-- recipe: record -->\n```sh\n(.*?)```", text, re.S)
-    if not check(m is not None, "README has the record recipe"):
-        return
-    recipe = m.group(1)
-    lines = [l for l in recipe.splitlines() if l.strip()]
-    check(len(lines) == 5, f"five commands ({len(lines)})")
-    check(any("--log run.lcm" in l for l in lines), "the recipe records with --log")
-    os.makedirs(os.path.join(tmp, "build"))
-    os.symlink(os.path.abspath(a.bin), os.path.join(tmp, "build", "bin"))
-    os.symlink(os.path.join(a.source, "config"), os.path.join(tmp, "config"))
-    env = dict(os.environ)  # LCM_DEFAULT_URL: this test's own port
-    p = subprocess.run(["bash", "-euo", "pipefail", "-c", recipe + "\nwait\n"], cwd=tmp, env=env,
-                       capture_output=True, text=True, timeout=120)
-    print(p.stdout[-3000:], p.stderr[-3000:])
-    check(p.returncode == 0, f"the recipe runs: exit {p.returncode}")
-    check("max difference = 0\n" in p.stdout, "its replay reports difference 0")
-    check("DIPC_STATE: joint_state_t, 1001 messages" in p.stdout and "gaps 0 (0 states missing" in p.stdout,
-          "its CSV summary: 1001 states, 0 gaps")
-    png = os.path.join(tmp, "run", "DIPC_STATE.png")
-    check(os.path.exists(png) and os.path.getsize(png) > 10000, "its plot is drawn")
-
-
 CASES = {"lqr": case_lqr, "lqr_effects": case_lqr_effects, "gaps": case_gaps,
-         "readers": case_readers, "cli": case_cli, "readme": case_readme}
+         "readers": case_readers, "cli": case_cli}
 
 
 def main():
