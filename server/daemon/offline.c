@@ -63,7 +63,7 @@ int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)
         fprintf(stderr, "lagsimd: %s: %s\n", sc->path, err);
         return LAGSIMD_EXIT_USAGE;
     }
-    const lag_model_info *info = lag_model_info_get(sc->sim.model.kind);
+    const lag_model_info *info = lag_sim_info(&sim); /* with a stick that may fly: h too */
 
     /* Output periods in the duration: floor(duration / period), with a relative guard so
      * that 1 s at 100 Hz is 100 periods, not 99.999... A duration of more ticks than a run
@@ -162,7 +162,7 @@ int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)
                 "lagsimd: offline %s, %s dt %g s: %.6g s of sim time, %lld rows, "
                 "%lld steps (%lld rejected), %lld rhs evals, %lld events, %.3g s CPU; "
                 "energy %.17g -> %.17g J (change %.3g)\n",
-                info->name, lag_method_name(sc->sim.integrator.method),
+                lag_model_info_get(sc->sim.model.kind)->name, lag_method_name(sc->sim.integrator.method),
                 sc->sim.integrator.dt, lag_sim_time(&sim), (long long)(k + 1),
                 (long long)sim.stats.steps_accepted, (long long)sim.stats.steps_rejected,
                 (long long)sim.stats.rhs_evals, (long long)nevents, cpu, e0, e1, e1 - e0);

@@ -644,8 +644,13 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
                 return;
             }
         double qdd[LAG_MAX_DOF];
-        if (lag_model_forward(&s->sim.def.model, c.q, c.qd, NULL, qdd) != LAG_OK) {
+        if (lag_model_forward(&s->sim.model, c.q, c.qd, NULL, qdd) != LAG_OK) {
             control_rejected(s, "reset_to: mass matrix not positive definite at q");
+            return;
+        }
+        if (lag_sim_contact(&s->sim)[0] && c.q[2] < 0) {
+            control_rejected(s, "reset_to: h, the stick's lower end, must not be below the "
+                                "floor (h >= 0)");
             return;
         }
         do_reset(s, c.q, c.qd, "reset to a given state");
@@ -758,6 +763,7 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
                                : INT64_MAX;
 
     s->nq = s->sim.nq;
+    s->info = lag_sim_info(&s->sim); /* the joints published: a stick that may fly has h */
     /* the URLs and channels, by the rule every client follows (lagsim_bus.h) */
     char berr[256];
     if (lag_bus_init(&s->bus, sc->lcm.url, sc->lcm.prefix, berr, sizeof berr) != 0)
@@ -828,7 +834,7 @@ void rt_begin(rt_server *s)
                                                                 : RT_RUNNING;
     rt_publish_scene(s);
     eventf(s, "start", 0, "%s, %s, dt %.6g s, control period %.6g s, mode %s, rate %.6g: %s",
-           s->info->name, lag_method_name(sc->sim.integrator.method), sc->sim.integrator.dt,
+           lag_model_info_get(sc->sim.model.kind)->name, lag_method_name(sc->sim.integrator.method), sc->sim.integrator.dt,
            (double)sc->ticks_per_period * sc->sim.integrator.dt,
            lag_rt_mode_name(sc->realtime.mode), sc->realtime.rate,
            s->run == RT_PAUSED    ? "paused at t = 0 (resume to run)"

@@ -134,7 +134,7 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
 {
     char err[512];
     const double tolerance = o ? o->tolerance : 0.0;
-    const lag_model_info *info = lag_model_info_get(sc->sim.model.kind);
+    const lag_model_info *info; /* the sim's joints (a stick that may fly: h too), below */
     char channel[96], ch_input[96];
     snprintf(channel, sizeof channel, "%s_STATE", sc->lcm.prefix);
     snprintf(ch_input, sizeof ch_input, "%s_INPUT", sc->lcm.prefix);
@@ -159,6 +159,7 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         fprintf(stderr, "lagsimd: bad scene: %s\n", err);
         return LAGSIMD_EXIT_USAGE;
     }
+    info = lag_sim_info(&sim);
     lag_log *log = lag_log_open(log_path, REPLAY_DATA_MAX, err, sizeof err);
     if (!log) {
         fprintf(stderr, "lagsimd: --replay: %s\n", err);
@@ -205,7 +206,8 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         for (int i = 0; ok && i < nq; i++) ok = strcmp(m.name[i], info->joint_names[i]) == 0;
         if (!ok) {
             fprintf(stderr, "lagsimd: --replay: a state on %s does not match this scene's "
-                            "joints (%s); wrong --config?\n", channel, info->name);
+                            "joints (%s); wrong --config?\n", channel,
+                    lag_model_info_get(sc->sim.model.kind)->name);
             lag_log_close(log);
             return LAGSIMD_EXIT_RUNTIME;
         }

@@ -177,7 +177,7 @@ void rt_publish_scene(rt_server *s)
     lag_wire_scene m;
     memset(&m, 0, sizeof m);
     m.utime = rt_wall_us();
-    PUT(m.model, s->info->name);
+    PUT(m.model, lag_model_info_get(s->sc->sim.model.kind)->name); /* the scene's model; its joints are s->info's */
     PUT(m.prefix, s->sc->lcm.prefix);
     m.num_params = (int16_t)s->info->np;
     for (int i = 0; i < s->info->np; i++) {

@@ -31,14 +31,30 @@ check "duration 0 -> 1 row" '[ $(wc -l < "$tmp/c.csv") -eq 2 ]'
 "$lagsimd" -q --config "$cfg/dipc.yaml" --offline --duration 0.5 --set publish_hz=20 --csv "$tmp/d.csv"
 check "0.5 s at 20 Hz -> 11 rows" '[ $(wc -l < "$tmp/d.csv") -eq 12 ]'
 
-# the stick: header, and x stays exactly 0 (no horizontal force, released from rest)
+# the stick (its floor lets it fly: a third joint h, the lower end's height): header, and
+# x stays exactly 0 (no horizontal force, released from rest), h stays 0 (it never lifts off)
 "$lagsimd" -q --config "$cfg/stick.yaml" --offline --duration 0.4 --csv "$tmp/s.csv"
 check "stick exit 0" "[ $? -eq 0 ]"
-check "stick header" '[ "$(head -1 "$tmp/s.csv")" = "t,x,phi,x_dot,phi_dot,energy" ]'
+check "stick header" '[ "$(head -1 "$tmp/s.csv")" = "t,x,phi,h,x_dot,phi_dot,h_dot,energy" ]'
 check "stick 41 rows" '[ $(($(wc -l < "$tmp/s.csv") - 1)) -eq 41 ]'
-check "stick x and x_dot stay exactly 0" '[ -z "$(awk -F, "NR > 1 && (\$2 != 0 || \$4 != 0)" "$tmp/s.csv")" ]'
+check "stick x, x_dot, h, h_dot stay exactly 0" \
+    '[ -z "$(awk -F, "NR > 1 && (\$2 != 0 || \$5 != 0 || \$4 != 0 || \$7 != 0)" "$tmp/s.csv")" ]'
 check "stick falls: phi decreases from 1.2" \
     '[ "$(awk -F, "NR == 2 { a = \$3 } END { print (a == 1.2 && \$3 < a) ? \"y\" : \"n\" }" "$tmp/s.csv")" = y ]'
+# spun up from the floor it flies: h > 0 on some rows, never below the floor, and the run
+# ends lying on it; on a floor it may not leave, the same scene is a fault (exit 1)
+"$lagsimd" --config "$cfg/stick.yaml" --offline --duration 3 --set initial.qd=[0.4,12] \
+    --csv "$tmp/t.csv" 2> "$tmp/t.err"
+check "thrown stick exit 0" "[ $? -eq 0 ]"
+check "thrown stick flies (h > 0.5 m on some row)" '[ -n "$(awk -F, "NR > 1 && \$4 > 0.5" "$tmp/t.csv")" ]'
+check "thrown stick: h >= 0 on every row" '[ -z "$(awk -F, "NR > 1 && \$4 < 0" "$tmp/t.csv")" ]'
+check "thrown stick: liftoff and landing events" \
+    'grep -q "event liftoff" "$tmp/t.err" && grep -q "event landing" "$tmp/t.err"'
+check "thrown stick lies still at 3 s (h, phi_dot, h_dot 0)" \
+    '[ "$(tail -1 "$tmp/t.csv" | cut -d, -f4,6,7)" = "0,0,0" ]'
+"$lagsimd" -q --config "$cfg/stick.yaml" --offline --duration 3 --set initial.qd=[0.4,12] \
+    --set effects.floor.flight=false --csv "$tmp/u.csv" 2> "$tmp/u.err"
+check "flight: false: lift-off is a fault (exit 1)" "[ $? -eq 1 ] && grep -qi \"lifted off\" \"$tmp/u.err\""
 
 "$lagsimd" -q --config "$cfg/manipulator.yaml" --offline --duration 1 --csv "$tmp/m.csv"
 check "manipulator exit 0" "[ $? -eq 0 ]"

@@ -1047,6 +1047,36 @@ static void case_effects(void)
     ENSURE(!c2.nonfinite_seen && c2.last.t < t_lift[0]);
     printf("effects: lift-off at %.12f s published, then the fault state; last state %.2f s\n",
            t_lift[0], c2.last.t);
+
+    /* the same spin on a floor it may leave: it flies and lands; the scene and the states
+     * carry the third joint h (the lower end's height), the events come at the core's
+     * instants, and it ends lying on the floor */
+    write_scene("model: stick\n"
+                "initial:\n  q: [0, 0.5]\n  qd: [0.4, 12]\n"
+                "realtime:\n  mode: fast\n"
+                "effects:\n  floor: {restitution: 0.5}\n");
+    char prefix3[80];
+    snprintf(prefix3, sizeof prefix3, "%s_F", g_prefix);
+    static client c3;
+    client_init(&c3, prefix3, 3);
+    d = start_daemon(prefix3, "--duration", "3", NULL);
+    ENSURE(reap(d, 20.0) == 0);
+    pump(&c3, 0.5);
+    load_ref(&sc, prefix3);
+    double t_land[64];
+    int n_land;
+    ref_events(&sc, 300, "liftoff", t_lift, &n_lift, &r);
+    ENSURE(r == LAG_OK && n_lift >= 1);
+    ref_events(&sc, 300, "landing", t_land, &n_land, &r);
+    ENSURE(r == LAG_OK && n_land >= 1);
+    ensure_event_times(&c3, "liftoff", t_lift, n_lift);
+    ensure_event_times(&c3, "landing", t_land, n_land);
+    ENSURE(c3.scene && strcmp(c3.scene->model, "stick") == 0 && c3.scene->num_joints == 3);
+    ENSURE(c3.scene && strcmp(c3.scene->joint_name[2], "h") == 0 && !c3.scene->actuated[2]);
+    ENSURE(!c3.nonfinite_seen && c3.last.t == 3.0 && c3.last.q[2] == 0.0 && c3.last.qd[1] == 0.0);
+    printf("effects: a stick spun up flies: lift-off at %.12f s, landing at %.12f s, as the core "
+           "located them; joints x, phi, h; at 3 s h = %g\n",
+           t_lift[0], t_land[0], c3.last.q[2]);
 }
 
 static void case_bad_scene(void)
