@@ -134,6 +134,7 @@ void rt_publish_status(rt_server *s)
     m.rejected_effort_limit = s->rejected[RT_REJ_EFFORT_LIMIT];
     m.lockstep_retries = s->lockstep_retries;
     m.commands_ignored = s->commands_ignored;
+    PUT(m.contact, lag_sim_contact(&s->sim));
     publish(s, s->ch_status, LAG_WIRE_STATUS, &m);
     s->rtf = m.rtf;
     if (wall < 0.05 && s->run == RT_RUNNING) return; /* the window goes on */

@@ -107,6 +107,7 @@ static const lag_wire_field status_fields[] = {
     SCALAR(ST, LAG_WIRE_INT64, rejected_effort_limit),
     SCALAR(ST, LAG_WIRE_INT64, lockstep_retries),
     SCALAR(ST, LAG_WIRE_INT64, commands_ignored),
+    STRING(ST, contact),
 };
 
 typedef lag_wire_scene SC;

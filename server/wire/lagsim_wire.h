@@ -153,6 +153,7 @@ typedef struct lag_wire_status {
     int64_t rejected_effort_limit;
     int64_t lockstep_retries;
     int64_t commands_ignored;
+    char contact[LAG_WIRE_NAME_LEN]; /* the stick's floor: flight, contact, flat or "" */
 } lag_wire_status;
 
 /* <PREFIX>_SCENE: the scene description. */

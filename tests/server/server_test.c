@@ -1044,6 +1044,7 @@ static void case_effects(void)
     ensure_event_times(&c2, "liftoff", t_lift, n_lift);
     fresh_status(&c2);
     ENSUREF(!strcmp(c2.status->run_state, "fault"), "run_state %s", c2.status->run_state);
+    ENSUREF(!strcmp(c2.status->contact, ""), "contact '%s' without flight", c2.status->contact);
     ENSURE(!c2.nonfinite_seen && c2.last.t < t_lift[0]);
     printf("effects: lift-off at %.12f s published, then the fault state; last state %.2f s\n",
            t_lift[0], c2.last.t);
@@ -1074,6 +1075,8 @@ static void case_effects(void)
     ENSURE(c3.scene && strcmp(c3.scene->model, "stick") == 0 && c3.scene->num_joints == 3);
     ENSURE(c3.scene && strcmp(c3.scene->joint_name[2], "h") == 0 && !c3.scene->actuated[2]);
     ENSURE(!c3.nonfinite_seen && c3.last.t == 3.0 && c3.last.q[2] == 0.0 && c3.last.qd[1] == 0.0);
+    ENSUREF(c3.status && !strcmp(c3.status->contact, "flat"), "contact '%s' in the last status",
+            c3.status ? c3.status->contact : "(none)");
     printf("effects: a stick spun up flies: lift-off at %.12f s, landing at %.12f s, as the core "
            "located them; joints x, phi, h; at 3 s h = %g\n",
            t_lift[0], t_land[0], c3.last.q[2]);

@@ -267,6 +267,8 @@ static void check_agreement(void)
         g.rejected_effort_limit = w.rejected_effort_limit = 27;
         g.lockstep_retries = w.lockstep_retries = 28;
         g.commands_ignored = w.commands_ignored = 29;
+        g.contact = "flight";
+        strcpy(w.contact, "flight");
         int nt = lagsim_status_t_encode(theirs, 0, sizeof theirs, &g);
         agree(LAG_WIRE_STATUS, &w, nt);
     }
