@@ -7,7 +7,7 @@ set(LAGSIM_SERVER_CASES control hostile watchdog lockstep_timeout two_daemons fa
     bad_scene effects control_flood step_flood lockstep_huge status_rate rate_huge long_period
     duration_huge signals effort_absurd ttl_warning offline_signal command_flood_ports)
 if(LCM_LOGGER)
-  list(APPEND LAGSIM_SERVER_CASES replay replay_dopri5 replay_effects)
+  list(APPEND LAGSIM_SERVER_CASES replay replay_dopri5 replay_effects replay_flight)
 endif()
 foreach(case ${LAGSIM_SERVER_CASES})
   add_test(NAME server_${case}

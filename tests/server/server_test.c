@@ -7,7 +7,7 @@
  *
  *   server_test LAGSIMD CASE [LCM_LOGGER]
  *     CASE: control hostile watchdog lockstep_timeout two_daemons fault replay
- *           replay_dopri5 replay_effects sigterm bad_scene effects control_flood
+ *           replay_dopri5 replay_effects replay_flight sigterm bad_scene effects control_flood
  *           step_flood lockstep_huge status_rate rate_huge long_period duration_huge
  *           signals effort_absurd ttl_warning offline_signal
  *
@@ -209,7 +209,8 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *u)
         usleep(3000);
         /* a deterministic controller: PD on the cart and the lower rod plus a sinusoid */
         double u_eff = -2.0 * r.q[0] - 1.0 * r.qd[0] + 3.0 * r.q[1] + 0.5 * sin(7.0 * r.t);
-        char *names[1] = {"theta0"};
+        /* (the stick of replay_flight takes it on x) */
+        char *names[1] = {strcmp(g_case, "replay_flight") ? "theta0" : "x"};
         lagsim_joint_command_t cmd = {0, r.t, 1, names, &u_eff};
         lagsim_joint_command_t_publish(c->lcm_in, c->ch_command, &cmd);
     }
@@ -939,6 +940,13 @@ static void case_replay(const char *logger, const char *method)
                     "    - {t: 1.0, joint: theta0, force: 1.0, duration: 0.2}\n"
                     "  actuator: {theta0: {max: 0.8}}\n"
                     "  noise: {seed: 11, q: {theta1: 1e-3}, qd: {theta0: 1e-2}}\n");
+    else if (!strcmp(g_case, "replay_flight"))
+        /* a stick that lifts off, flies, lands and slides, pushed along x: three joints
+         * published (x, phi, h), the floor's events located inside the ticks */
+        write_scene("model: stick\n"
+                    "initial:\n  q: [0, 0.5]\n  qd: [0.4, 12]\n"
+                    "publish_hz: 100\n"
+                    "effects:\n  floor: {restitution: 0.5}\n");
     else
         write_scene(DIPC_MOVING);
     for (int attempt = 1; attempt <= 6; attempt++)
@@ -1620,6 +1628,7 @@ int main(int argc, char **argv)
     else if (!strcmp(g_case, "replay")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "rk4");
     else if (!strcmp(g_case, "replay_dopri5")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "dopri5");
     else if (!strcmp(g_case, "replay_effects")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "rk4");
+    else if (!strcmp(g_case, "replay_flight")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "rk4");
     else if (!strcmp(g_case, "sigterm")) case_sigterm();
     else if (!strcmp(g_case, "bad_scene")) case_bad_scene();
     else if (!strcmp(g_case, "effects")) case_effects();
