@@ -20,7 +20,7 @@ P=LOGCOST$$
 SECONDS_SIM=100            # fast mode: 100 000 periods at 1000 Hz
 run_fast() { # $1 = extra args; prints "wall_s cpu_s"
     /usr/bin/time -f "%e %U %S" -o "$tmp/t" "$B/lagsimd" --config config/dipc.yaml -q \
-        --set lcm.prefix=$P --set realtime.mode=fast --set publish_hz=1000 \
+        --set lcm.prefix=$P --set realtime.mode=fast --set realtime.start=running --set publish_hz=1000 \
         --duration $SECONDS_SIM $1 >/dev/null 2>&1
     awk '{ printf "%s %.3f\n", $1, $2 + $3 }' "$tmp/t"
 }
@@ -55,7 +55,7 @@ if command -v valgrind >/dev/null 2>&1; then
     cg() { # $1 = out prefix, $2 = publish_hz, $3 = extra args
         valgrind --tool=callgrind --separate-threads=yes --callgrind-out-file="$tmp/$1" \
             "$B/lagsimd" --config config/dipc.yaml -q --set lcm.prefix=$P \
-            --set realtime.mode=fast --set publish_hz=$2 --duration 10 $3 >/dev/null 2>&1
+            --set realtime.mode=fast --set realtime.start=running --set publish_hz=$2 --duration 10 $3 >/dev/null 2>&1
     }
     total() { callgrind_annotate "$1" 2>/dev/null | awk '/PROGRAM TOTALS/ { gsub(",", "", $1); print $1; exit }'; }
     for hz in 1000 100; do
