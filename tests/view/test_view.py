@@ -8,12 +8,15 @@ headless Chromium (DevTools protocol over a pipe).
 CASE browser: the drawn sim time advances and the drawn model moves between two looks;
               two tabs stream at once, a closed tab is dropped by the bridge; pause,
               step, resume and reset buttons act on the daemon; /api/state agrees.
+CASE stick_flight: config/stick.yaml (beside --config) spun up from its floor: the page
+              draws it in the air at the published h, its third joint.
 CASE hostile: garbage, oversized headers, a connection flood, a slow reader, vanished
               clients, foreign Host headers, control floods; afterwards the bridge
               answers at once, holds no stream, and its memory stayed bounded.
 """
 import argparse
 import json
+import math
 import os
 import re
 import signal
@@ -50,12 +53,12 @@ def stop(p):
 class Rig:
     """lagsimd + lagsim-view with a channel prefix unique to this process."""
 
-    def __init__(self, a, name):
+    def __init__(self, a, name, config=None, sets=("initial.q=[0,0.3,-0.2]", "initial.qd=[0,0,0]")):
         self.prefix = "%s%d" % (name, os.getpid())
+        setargs = [x for v in sets for x in ("--set", v)]
         self.daemon = subprocess.Popen(
-            [a.lagsimd, "--config", a.config, "-q", "--set", "lcm.prefix=" + self.prefix,
-             "--set", "initial.q=[0,0.3,-0.2]", "--set", "initial.qd=[0,0,0]",
-             "--set", "realtime.start=running"],  # no controller: it must move by itself
+            [a.lagsimd, "--config", config or a.config, "-q", "--set", "lcm.prefix=" + self.prefix]
+            + setargs + ["--set", "realtime.start=running"],  # no controller: it moves by itself
             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         self.view = subprocess.Popen([a.view, "--prefix", self.prefix, "--port", "0"],
                                      stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
@@ -285,15 +288,55 @@ def case_hostile(a):
     check(rig.view.returncode == 0, "lagsim-view stopped cleanly on SIGTERM (exit %s) %s" % (rig.view.returncode, err[-300:]))
 
 
+def case_stick_flight(a):
+    """The stick spun up from its floor flies: the page draws it in the air, its lower end
+    at the published h (the third joint) and its centre l/2 |sin phi| above that."""
+    cfg = os.path.join(os.path.dirname(a.config), "stick.yaml")
+    # slowed down (1/20 of real time) so that the page sees it in the air
+    rig = Rig(a, "VIEWF", cfg, ("initial.qd=[0.4,12]", "effects.floor.restitution=0.5",
+                                "realtime.rate=0.05"))
+    chrome = None
+    try:
+        s = rig.wait_api(lambda s: s["scene"] and s["state"], what="scene, state")
+        check(s["scene"]["model"] == "stick" and s["scene"]["joints"] == ["x", "phi", "h"],
+              "/api/state: the stick with its third joint h (%s)" % s["scene"]["joints"])
+        chrome = cdp.Chrome()
+        _, sid = chrome.open(rig.base + "/")
+        chrome.wait_for(sid, "window.lagsimView.drawn && window.lagsimView.drawn.points", 15,
+                        "a drawn stick")
+        high = None
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline and high is None:
+            d = drawn(chrome, sid)
+            if d and d.get("q") and len(d["q"]) == 3 and d["q"][2] > 0.2:
+                high = d
+            time.sleep(0.01)
+        if not check(high is not None, "the stick is drawn in flight (a frame with h > 0.2 m)"):
+            return
+        l = s["scene"]["params"]["l"]
+        x, phi, h = high["q"]
+        a_, c_, b_ = high["points"]
+        low = min(a_[1], b_[1])
+        check(abs(low - h) < 1e-9 and abs(c_[1] - (h + 0.5 * l * abs(math.sin(phi)))) < 1e-9
+              and abs(c_[0] - x) < 1e-12,
+              "drawn at the published state: lower end %.6f m (h %.6f), centre %.6f m" % (low, h, c_[1]))
+        if a.screenshot:
+            chrome.screenshot(sid, a.screenshot)
+    finally:
+        if chrome:
+            chrome.quit()
+        rig.close()
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lagsimd", required=True)
     ap.add_argument("--view", required=True)
     ap.add_argument("--config", required=True)
     ap.add_argument("--screenshot")
-    ap.add_argument("case", choices=["browser", "hostile"])
+    ap.add_argument("case", choices=["browser", "hostile", "stick_flight"])
     a = ap.parse_args()
-    {"browser": case_browser, "hostile": case_hostile}[a.case](a)
+    {"browser": case_browser, "hostile": case_hostile, "stick_flight": case_stick_flight}[a.case](a)
     print("%s: %d failure(s)" % ("FAILED" if failures else "passed", failures))
     return 1 if failures else 0
 
