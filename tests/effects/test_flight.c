@@ -4,7 +4,7 @@
  * of our own: the free rigid body's closed form, the impact of a rigid rod at an end, and
  * conservation laws.
  *
- *   test_flight free|pushed|landing|impact|thrown|random|redefine
+ *   test_flight liftoff|free|pushed|landing|impact|thrown|random|redefine|noise
  *
  * The state is read as published (lag_sim_observe: x, phi and h, the height of the lower
  * end), and the centre of mass is found from it with our own geometry: the lower end is
@@ -178,6 +178,53 @@ static void pushed_flight(int arg)
         /* quadratics in t: exact for these methods up to rounding, and the implicit
          * ones' Newton tolerance for phi; y as in free flight */
         ENSURE(ex < 1e-12 && ephi < 1e-9 && ey < 1e-9);
+    }
+}
+
+/* ================================================================== lift-off */
+/* A stick on its floor rising fast (phi0 0.6, phid0 5 rad/s) lifts off where our normal
+ * force N(phi) on its energy curve reaches 0; the time to get there by quadrature of
+ * dt = dphi / phid(phi). Every method of order >= 4 locates it to 1e-9 s (the others are
+ * printed), and the stick then flies: the lower end rises. */
+typedef struct { const double *p; double phi0, phid0; } curve;
+static double inv_rate(double phi, const void *vc)
+{
+    const curve *c = (const curve *)vc;
+    return 1.0 / sqrt(te_stick_phid2(c->p, c->phi0, c->phid0, phi));
+}
+static void liftoff(int arg)
+{
+    (void)arg;
+    lag_sim_def d0 = flight_def(LAG_RK4, 0.0);
+    const double *p = d0.model.p;
+    const double phi0 = 0.6, phid0 = 5.0;
+    double a = phi0, b = TE_PI / 2;
+    for (int it = 0; it < 200; it++) {
+        double c = 0.5 * (a + b);
+        if (te_stick_normal(p, c, te_stick_phid2(p, phi0, phid0, c)) > 0) a = c; else b = c;
+    }
+    curve cv = {p, phi0, phid0};
+    double tq = te_gauss5(inv_rate, &cv, phi0, a, 400);
+    for (int mi = 0; mi < LAG_METHOD_COUNT; mi++) {
+        lag_sim_def d = flight_def((lag_method)mi, 0.0);
+        d.q0[1] = phi0;
+        d.qd0[1] = phid0;
+        lag_sim s;
+        te_init(&s, &d);
+        double t_lift = -1, hmax = 0;
+        lag_result r = LAG_OK;
+        for (int k = 0; k < 150 && r == LAG_OK; k++) {
+            r = lag_sim_advance(&s, 1, false);
+            lag_event ev;
+            while (lag_sim_poll_event(&s, &ev))
+                if (ev.kind == LAG_EV_LIFTOFF && t_lift < 0) t_lift = ev.t;
+            hmax = fmax(hmax, observe(&s).h);
+        }
+        printf("liftoff: %-19s at %.12f s (quadrature %.12f, %+.1e), then h up to %.4f m\n",
+               lag_method_name((lag_method)mi), t_lift, tq, t_lift - tq, hmax);
+        ENSURE(r == LAG_OK && t_lift > 0 && hmax > 5e-4);
+        if (lag_method_info_get((lag_method)mi)->order >= 4)
+            ENSURE_NEAR(t_lift, tq, 1e-9, "lift-off time, %s", lag_method_name((lag_method)mi));
     }
 }
 
@@ -408,6 +455,46 @@ static void random_throws(int arg)
     ENSURE(lifted > N / 4 && landed > N / 4); /* the throws did fly */
 }
 
+/* ================================================================== noise */
+/* Noise on the published x and phi of a thrown stick: the simulated state is bit for bit
+ * that of the run without noise (events included), the published h is the noiseless
+ * lower end's, and x, phi carry noise of the configured size. */
+static void noise(int arg)
+{
+    (void)arg;
+    lag_sim_def d = flight_def(LAG_RK4, 0.5);
+    d.q0[1] = 0.5;
+    d.qd0[0] = 0.4;
+    d.qd0[1] = 12.0;
+    lag_sim_def dn = d;
+    dn.effects.enabled |= LAG_EFF_NOISE;
+    dn.effects.noise_seed = 5;
+    dn.effects.noise_q[0] = dn.effects.noise_q[1] = 1e-3;
+    lag_sim a, b;
+    te_init(&a, &d);
+    te_init(&b, &dn);
+    int same = 1, h_same = 1, ea = 0, eb = 0;
+    double sum2 = 0;
+    const int n = 3000;
+    for (int k = 0; k < n; k++) {
+        ENSURE(lag_sim_advance(&a, 1, false) == LAG_OK && lag_sim_advance(&b, 1, false) == LAG_OK);
+        te_drain(&a, 0, &ea);
+        te_drain(&b, 0, &eb);
+        same &= memcmp(a.q, b.q, sizeof a.q) == 0 && memcmp(a.qd, b.qd, sizeof a.qd) == 0;
+        double qa[LAG_MAX_DOF], qda[LAG_MAX_DOF], qb[LAG_MAX_DOF], qdb[LAG_MAX_DOF];
+        lag_sim_observe(&a, qa, qda);
+        lag_sim_observe(&b, qb, qdb);
+        h_same &= qa[2] == qb[2] && qda[2] == qdb[2];
+        sum2 += (qb[1] - qa[1]) * (qb[1] - qa[1]);
+    }
+    double sd = sqrt(sum2 / n);
+    printf("noise: thrown stick, 3 s: true state %s, %d and %d events, published h %s, phi "
+           "noise std %.3e (want 1e-3)\n", same ? "bit-identical" : "DIFFERS", ea, eb,
+           h_same ? "identical" : "DIFFERS", sd);
+    ENSURE(same && h_same && ea == eb && ea > 5);
+    ENSURE(fabs(sd - 1e-3) < 5 * 1e-3 / sqrt(2.0 * n)); /* 5 sigma of a std estimate */
+}
+
 /* ================================================================== redefine */
 /* A running flying stick takes new parameters and a new restitution where it is (spun
  * past phi = 2 pi, in the air) and goes on from there; the floor's flight itself does
@@ -439,10 +526,11 @@ static void redefine(int arg)
 int main(int argc, char **argv)
 {
     static const lt_case cases[] = {
-        {"free", free_flight, 0, 0},   {"pushed", pushed_flight, 0, 0},
+        {"liftoff", liftoff, 0, 0},    {"free", free_flight, 0, 0},
+        {"pushed", pushed_flight, 0, 0},
         {"landing", landing, 0, 0},    {"impact", impact, 0, 0},
         {"thrown", thrown, 0, 0},      {"random", random_throws, 0, 0},
-        {"redefine", redefine, 0, 0},
+        {"redefine", redefine, 0, 0}, {"noise", noise, 0, 0},
     };
     return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
 }
