@@ -5,7 +5,7 @@ target_link_libraries(server_test PRIVATE lagsim_scene lagsim_core lagsim_wire l
 find_program(LCM_LOGGER lcm-logger)
 set(LAGSIM_SERVER_CASES control hostile watchdog lockstep_timeout two_daemons fault sigterm
     bad_scene effects control_flood step_flood lockstep_huge status_rate rate_huge long_period
-    duration_huge signals effort_absurd ttl_warning offline_signal command_flood_ports)
+    duration_huge signals effort_absurd ttl_warning offline_signal command_flood_ports same_prefix)
 if(LCM_LOGGER)
   list(APPEND LAGSIM_SERVER_CASES replay replay_dopri5 replay_effects replay_flight)
 endif()
@@ -26,7 +26,8 @@ endforeach()
 add_executable(test_loop ${CMAKE_CURRENT_LIST_DIR}/server/test_loop.c)
 target_link_libraries(test_loop PRIVATE lagsimd_internal)
 foreach(case pacing rate_huge status_hz lockstep_wait start set long_period chunks step_paced
-        control_flood command_flood duration signals fault_effort lockstep_retry lockstep_loss)
+        control_flood command_flood duration signals fault_effort lockstep_retry lockstep_loss
+        other_plant)
   add_test(NAME server_loop_${case} COMMAND test_loop ${case})
   set_tests_properties(server_loop_${case} PROPERTIES TIMEOUT 60 LABELS server)
 endforeach()

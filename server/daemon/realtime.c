@@ -671,7 +671,41 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
     s->want_status = true;
 }
 
+/* ---------------------------------------------------------------- one plant per prefix */
+uint64_t rt_hash(const uint8_t *data, size_t len)
+{
+    uint64_t h = 14695981039346656037ULL;
+    for (size_t i = 0; i < len; i++) h = (h ^ data[i]) * 1099511628211ULL;
+    return h;
+}
+
+void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len)
+{
+    uint64_t h = rt_hash(data, len);
+    for (int k = 0; k < RT_SCENES_KEPT; k++)
+        if (s->scene_sent[k] == h) return; /* this daemon's own */
+    if (s->other_plant[0]) return;         /* said already */
+    lag_wire_scene m;
+    if (lag_wire_decode_scene(data, len, LAG_WIRE_MAX_JOINTS, &m) == LAG_WIRE_OK)
+        snprintf(s->other_plant, sizeof s->other_plant, "a scene this daemon did not send "
+                 "(model %.20s, mode %.10s, dt %g s)", m.model, m.mode, m.dt);
+    else
+        snprintf(s->other_plant, sizeof s->other_plant, "a message on %.72s this daemon did "
+                 "not send", s->ch_scene);
+    if (s->discard) return; /* at start (rt_bus_open's look before publishing): refused there */
+    if (!s->stop) {
+        s->stop = true;
+        s->stop_reason = RT_STOP_OTHER_PLANT;
+    }
+}
+
 /* ---------------------------------------------------------------- the server in pieces */
+static void on_scene(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)ch;
+    rt_handle_scene(user, rb->data, rb->data_size);
+}
+
 static void on_command(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     (void)ch;
@@ -811,6 +845,16 @@ int rt_attach(rt_server *s, lcm_t *out, lcm_t *in, char *err, size_t errlen)
     /* a flood must not queue up without bound: LCM drops beyond this */
     lcm_subscription_set_queue_capacity(s->sub_command, 1000);
     lcm_subscription_set_queue_capacity(s->sub_control, 1000);
+    /* the plant watch: another daemon's scene on this prefix. For udpm this gives the
+     * state URL's lcm_t a receive socket, which rt_bus_open filters to _SCENE (the
+     * daemon's own states are dropped by the kernel, never read back) */
+    s->sub_scene = lcm_subscribe(out, s->ch_scene, on_scene, s);
+    if (!s->sub_scene) {
+        rt_close(s);
+        snprintf(err, errlen, "cannot subscribe to %s", s->ch_scene);
+        return LAGSIMD_EXIT_RUNTIME;
+    }
+    lcm_subscription_set_queue_capacity(s->sub_scene, 16);
     return LAGSIMD_EXIT_OK;
 }
 
@@ -819,7 +863,9 @@ void rt_close(rt_server *s)
     rt_log_end(s); /* a no-op when lagsimd_realtime has closed it already */
     if (s->sub_command) lcm_unsubscribe(s->lcm_in, s->sub_command);
     if (s->sub_control) lcm_unsubscribe(s->lcm_in, s->sub_control);
+    if (s->sub_scene) lcm_unsubscribe(s->lcm, s->sub_scene);
     s->sub_command = s->sub_control = NULL;
+    s->sub_scene = NULL;
 }
 
 void rt_begin(rt_server *s)
@@ -975,6 +1021,10 @@ void rt_finish(rt_server *s)
     case RT_STOP_DURATION:
         eventf(s, "stop", lag_sim_time(&s->sim), "duration reached");
         break;
+    case RT_STOP_OTHER_PLANT:
+        eventf(s, "stop", lag_sim_time(&s->sim), "another plant publishes on prefix %s (%s): "
+               "stopping; one plant per prefix", s->sc->lcm.prefix, s->other_plant);
+        break;
     default:
         eventf(s, "stop", 0, "stopping");
         break;
@@ -986,6 +1036,7 @@ void rt_finish(rt_server *s)
 /* ---------------------------------------------------------------- the loop */
 typedef struct rt_io {
     int in_fd, timer_fd, sig_fd;
+    int watch_fd; /* the state URL's receive socket (the plant watch); -1 for memq:// */
     int64_t armed_ns; /* what the timer is armed at (INT64_MAX: disarmed) */
 } rt_io;
 
@@ -1005,8 +1056,9 @@ static void wait_and_handle(rt_server *s, rt_io *io, int64_t wake)
         if (timerfd_settime(io->timer_fd, TFD_TIMER_ABSTIME, &its, NULL) == 0) io->armed_ns = wake;
         else tmo = &zero; /* cannot arm: do not sleep past the deadline */
     }
-    struct pollfd pf[3] = {{io->in_fd, POLLIN, 0}, {io->timer_fd, POLLIN, 0}, {io->sig_fd, POLLIN, 0}};
-    int np = ppoll(pf, 3, tmo, NULL);
+    struct pollfd pf[4] = {{io->in_fd, POLLIN, 0}, {io->timer_fd, POLLIN, 0},
+                           {io->sig_fd, POLLIN, 0}, {io->watch_fd, POLLIN, 0}};
+    int np = ppoll(pf, io->watch_fd >= 0 ? 4 : 3, tmo, NULL);
     s->now = rt_mono_ns();
     if (np < 0) {
         if (errno == EINTR) return;
@@ -1030,6 +1082,10 @@ static void wait_and_handle(rt_server *s, rt_io *io, int64_t wake)
     if (pf[0].revents & POLLIN) {
         for (int k = 0; k < RT_DRAIN_MAX && !s->stop; k++)
             if (lcm_handle_timeout(s->lcm_in, 0) <= 0) break;
+    }
+    if (io->watch_fd >= 0 && (pf[3].revents & POLLIN)) {
+        for (int k = 0; k < 16 && !s->stop; k++)
+            if (lcm_handle_timeout(s->lcm, 0) <= 0) break;
     }
     s->now = rt_mono_ns();
 }
@@ -1061,7 +1117,7 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
     struct sigaction ign = {.sa_handler = SIG_IGN}, old_pipe;
     sigemptyset(&ign.sa_mask);
     sigaction(SIGPIPE, &ign, &old_pipe);
-    rt_io io = {-1, -1, -1, INT64_MAX};
+    rt_io io = {-1, -1, -1, -1, INT64_MAX};
     int rc = LAGSIMD_EXIT_OK;
     bool opened = false;
 
@@ -1087,6 +1143,7 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
     }
     s->live_line = isatty(STDERR_FILENO) && !quiet;
     io.in_fd = lcm_get_fileno(s->lcm_in);
+    if (s->lcm != s->lcm_in) io.watch_fd = lcm_get_fileno(s->lcm);
 
     s->now = rt_mono_ns();
     s->discard = false;
@@ -1096,6 +1153,12 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
         rt_process(s);
     }
     rt_finish(s);
+    if (s->stop_reason == RT_STOP_OTHER_PLANT) {
+        fprintf(stderr, "lagsimd: another plant publishes on prefix %s (%s): stopped; one "
+                "plant per prefix (give this one another lcm.prefix)\n", sc->lcm.prefix,
+                s->other_plant);
+        rc = LAGSIMD_EXIT_RUNTIME;
+    }
     if (rt_log_end(s) != 0 && rc == LAGSIMD_EXIT_OK) rc = LAGSIMD_EXIT_RUNTIME; /* --log lost records */
 out:
     rt_log_end(s); /* --log opened, then the start failed */

@@ -7,12 +7,21 @@
  *                 filter (rt_net.h): only this plant's two channels, and unless
  *                 lcm.allow_lan only datagrams sent from this host;
  * For memq:// (tests, one process) one lcm_t is both.
+ *
+ * One plant per prefix: before it publishes anything, the daemon looks for another plant
+ * on its prefix (look_for_other_plant: a DESCRIBE request, and RT_LOOK_MS of listening
+ * for a scene, a state or a status) and refuses to start if it hears one. While it runs,
+ * the state URL's lcm_t subscribes to _SCENE only (its receive socket filtered to that
+ * channel, so the kernel drops the daemon's own states instead of handing them back),
+ * and a scene it did not send stops it (rt_handle_scene). Whom it hears follows the
+ * command URL's rule: this host only unless lcm.allow_lan.
  */
 #include <stdio.h>
 #include <string.h>
 
 #include "rt_net.h"
 #include "rt_server.h"
+#include "lagsim/lagsim_control_t.h"
 
 /* Filters the receive socket of the command URL's lcm_t, then reads until a marker sent
  * after the filter comes back, discarding whatever came before it (it may have come in
@@ -44,9 +53,64 @@ static int filter_input(rt_server *s, char *err, size_t errlen)
     return LAGSIMD_EXIT_OK;
 }
 
+#define RT_LOOK_MS 500 /* how long a starting daemon listens for another plant */
+
+static void on_other_output(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)rb;
+    rt_server *s = user;
+    if (!s->other_plant[0])
+        snprintf(s->other_plant, sizeof s->other_plant, "heard on %.72s", ch);
+}
+
+/* Before the daemon publishes anything: asks the prefix for its scene (DESCRIBE on the
+ * command URL; a daemon there answers on the state URL) and listens RT_LOOK_MS for a
+ * scene, a state or a status on the prefix. Then leaves the state URL's receive socket
+ * filtered to _SCENE (the plant watch). Returns 0, or an exit code with a message. */
+static int look_for_other_plant(rt_server *s, char *err, size_t errlen)
+{
+    const lag_bus *b = &s->bus;
+    bool host_only = !s->sc->lcm.allow_lan;
+    const char *out[] = {s->ch_scene, s->ch_state, s->ch_status};
+    char ferr[256];
+    int n = rt_net_filter(b->state_port, host_only, out, 3, ferr, sizeof ferr);
+    if (n <= 0) {
+        snprintf(err, errlen, "%s: cannot filter the state URL %s for the plant watch",
+                 n < 0 ? ferr : "LCM's receive socket for the state port was not found",
+                 b->state_url);
+        return LAGSIMD_EXIT_RUNTIME;
+    }
+    lcm_subscription_t *sub_state = lcm_subscribe(s->lcm, s->ch_state, on_other_output, s);
+    lcm_subscription_t *sub_status = lcm_subscribe(s->lcm, s->ch_status, on_other_output, s);
+    lag_wire_control c;
+    memset(&c, 0, sizeof c);
+    c.utime = rt_wall_us();
+    c.request = LAGSIM_CONTROL_T_DESCRIBE;
+    int len = lag_wire_encode(LAG_WIRE_CONTROL, &c, s->buf, RT_BUF_SIZE);
+    if (len > 0) lcm_publish(s->lcm_in, s->ch_control, s->buf, (unsigned)len);
+    int64_t end = rt_mono_ns() + RT_LOOK_MS * 1000000LL;
+    for (int64_t left; !s->other_plant[0] && (left = end - rt_mono_ns()) > 0;)
+        lcm_handle_timeout(s->lcm, (int)(left / 1000000) + 1);
+    if (sub_state) lcm_unsubscribe(s->lcm, sub_state);
+    if (sub_status) lcm_unsubscribe(s->lcm, sub_status);
+    if (s->other_plant[0]) {
+        snprintf(err, errlen, "another plant publishes on prefix %s (%s): refusing to start; "
+                 "one plant per prefix (give this one another lcm.prefix, or stop the other)",
+                 s->sc->lcm.prefix, s->other_plant);
+        return LAGSIMD_EXIT_RUNTIME;
+    }
+    n = rt_net_filter(b->state_port, host_only, out, 1, ferr, sizeof ferr);
+    if (n <= 0) {
+        snprintf(err, errlen, "%s", n < 0 ? ferr : "LCM's receive socket went away");
+        return LAGSIMD_EXIT_RUNTIME;
+    }
+    return LAGSIMD_EXIT_OK;
+}
+
 int rt_bus_open(rt_server *s, char *err, size_t errlen)
 {
     const lag_bus *b = &s->bus;
+    rt_net_note_inherited(); /* a parent's sockets are not filtered */
     lcm_t *out = lcm_create(b->state_url);
     lcm_t *in = !b->udpm ? out : out ? lcm_create(b->command_url) : NULL;
     if (!out || !in) {
@@ -67,7 +131,8 @@ int rt_bus_open(rt_server *s, char *err, size_t errlen)
                 b->state_url);
         return LAGSIMD_EXIT_OK;
     }
-    rc = filter_input(s, err, errlen);
+    rc = look_for_other_plant(s, err, errlen);
+    if (rc == LAGSIMD_EXIT_OK) rc = filter_input(s, err, errlen);
     if (rc != LAGSIMD_EXIT_OK) {
         rt_bus_close(s);
         return rc;

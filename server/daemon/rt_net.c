@@ -110,25 +110,23 @@ static int build(prog *p, bool host_only, const char *const *channels, int n, ch
     return 0;
 }
 
-int rt_net_filter(int port, bool host_only, const char *const *channels, int n, char *err,
-                  size_t errlen)
-{
-    if (n < 1 || n > RT_NET_MAX_FILTER_CHANNELS) {
-        snprintf(err, errlen, "filter: 1 to %d channels", RT_NET_MAX_FILTER_CHANNELS);
-        return -1;
-    }
-    static prog p; /* one daemon thread sets filters, at start */
-    if (build(&p, host_only, channels, n, err, errlen) < 0) return -1;
-    struct sock_fprog fp = {(unsigned short)p.n, p.in};
+/* The sockets this process had before it made its own (rt_net_note_inherited): a parent
+ * that forked the daemon without close-on-exec shares them, and a filter on one would
+ * filter the parent's traffic too. */
+#define RT_NET_INHERITED_MAX 64
+static int inherited[RT_NET_INHERITED_MAX];
+static int n_inherited;
 
+/* Calls fn(fd, user) for every AF_INET datagram socket of this process bound to `port`
+ * (any port when port < 0) until fn returns non-zero; returns what fn returned (0: all
+ * visited), or -1 if /proc/self/fd cannot be read. */
+static int each_udp_socket(int port, int (*fn)(int fd, void *user), void *user)
+{
     DIR *d = opendir("/proc/self/fd");
-    if (!d) {
-        snprintf(err, errlen, "cannot list /proc/self/fd to find LCM's receive socket");
-        return -1;
-    }
-    int found = 0;
+    if (!d) return -1;
+    int rc = 0;
     struct dirent *e;
-    while ((e = readdir(d)) != NULL) {
+    while (rc == 0 && (e = readdir(d)) != NULL) {
         char *end;
         long fd = strtol(e->d_name, &end, 10);
         if (*end != '\0' || fd < 0 || fd == dirfd(d)) continue;
@@ -143,18 +141,63 @@ int rt_net_filter(int port, bool host_only, const char *const *channels, int n, 
             continue;
         struct sockaddr_in a;
         sl = sizeof a;
-        if (getsockname((int)fd, (struct sockaddr *)&a, &sl) != 0 || ntohs(a.sin_port) != port)
-            continue;
-        if (setsockopt((int)fd, SOL_SOCKET, SO_ATTACH_FILTER, &fp, sizeof fp) != 0) {
-            snprintf(err, errlen, "cannot attach a socket filter to LCM's receive socket "
-                     "(port %d)", port);
-            closedir(d);
-            return -1;
-        }
-        found++;
+        if (getsockname((int)fd, (struct sockaddr *)&a, &sl) != 0) continue;
+        if (port >= 0 && ntohs(a.sin_port) != port) continue;
+        rc = fn((int)fd, user);
     }
     closedir(d);
-    return found;
+    return rc;
+}
+
+static int note_one(int fd, void *user)
+{
+    (void)user;
+    if (n_inherited < RT_NET_INHERITED_MAX) inherited[n_inherited++] = fd;
+    return 0;
+}
+
+void rt_net_note_inherited(void)
+{
+    n_inherited = 0;
+    each_udp_socket(-1, note_one, NULL);
+}
+
+typedef struct attach {
+    struct sock_fprog fp;
+    int found;
+} attach;
+
+static int attach_one(int fd, void *user)
+{
+    attach *a = user;
+    for (int k = 0; k < n_inherited; k++)
+        if (inherited[k] == fd) return 0; /* not ours */
+    if (setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &a->fp, sizeof a->fp) != 0) return 1;
+    a->found++;
+    return 0;
+}
+
+int rt_net_filter(int port, bool host_only, const char *const *channels, int n, char *err,
+                  size_t errlen)
+{
+    if (n < 1 || n > RT_NET_MAX_FILTER_CHANNELS) {
+        snprintf(err, errlen, "filter: 1 to %d channels", RT_NET_MAX_FILTER_CHANNELS);
+        return -1;
+    }
+    static prog p; /* one daemon thread sets filters, at start */
+    if (build(&p, host_only, channels, n, err, errlen) < 0) return -1;
+    attach a = {{(unsigned short)p.n, p.in}, 0};
+    int rc = each_udp_socket(port, attach_one, &a);
+    if (rc < 0) {
+        snprintf(err, errlen, "cannot list /proc/self/fd to find LCM's receive socket");
+        return -1;
+    }
+    if (rc > 0) {
+        snprintf(err, errlen, "cannot attach a socket filter to LCM's receive socket "
+                 "(port %d)", port);
+        return -1;
+    }
+    return a.found;
 }
 
 /* ---------------------------------------------------------------- sync */

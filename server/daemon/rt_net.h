@@ -27,13 +27,19 @@
 #define RT_NET_MAX_FILTER_CHANNELS 4
 #define RT_NET_MARKER_CHANNEL "LCM_SELF_TEST" /* the channel LCM's own self-test uses */
 
-/* Attaches the filter to every UDP socket of this process bound to `port` (LCM's receive
+/* Attaches the filter to every UDP socket of this process bound to `port`, but those
+ * noted by rt_net_note_inherited (LCM's receive
  * socket of an lcm_t for that port, once it has a subscription): keep only LCM short
  * messages on one of the n channels (exact names), and with host_only only those sent
  * from this host. Returns the number of sockets filtered (0: none found), or -1 with a
  * message in err. */
 int rt_net_filter(int port, bool host_only, const char *const *channels, int n, char *err,
                   size_t errlen);
+
+/* Notes the UDP sockets this process has now, before it creates its LCM instances:
+ * rt_net_filter leaves them alone (a parent that forked without close-on-exec shares
+ * them, and a filter would cut the parent's own traffic). */
+void rt_net_note_inherited(void);
 
 /* Sends a marker on RT_NET_MARKER_CHANNEL through lcm and handles lcm's messages until it
  * comes back (every message queued before it has then been handed to its handlers), at

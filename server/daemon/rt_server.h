@@ -69,7 +69,15 @@ typedef enum rt_ev {
 } rt_ev;
 
 /* Why the server stopped. */
-typedef enum rt_stop { RT_STOP_NONE = 0, RT_STOP_SIGNAL, RT_STOP_DURATION, RT_STOP_ERROR } rt_stop;
+typedef enum rt_stop {
+    RT_STOP_NONE = 0,
+    RT_STOP_SIGNAL,
+    RT_STOP_DURATION,
+    RT_STOP_ERROR,
+    RT_STOP_OTHER_PLANT, /* another plant publishes on this prefix (rt_handle_scene) */
+} rt_stop;
+
+#define RT_SCENES_KEPT 8 /* the last scenes published, to tell them from another plant's */
 
 typedef struct rt_server {
     const lag_scene *sc;
@@ -79,6 +87,7 @@ typedef struct rt_server {
     lcm_t *lcm_in;             /* receives _COMMAND and _CONTROL on the command URL (the
                                 * same lcm_t as `lcm` for memq://) */
     lcm_subscription_t *sub_command, *sub_control;
+    lcm_subscription_t *sub_scene; /* _SCENE on the state URL: another plant's (plant watch) */
     lag_bus bus;               /* the URLs and channels (lagsim_bus.h) */
     bool discard;              /* drop what arrives: before the start, LCM's queues may
                                 * hold datagrams that came in before the filter */
@@ -193,6 +202,12 @@ typedef struct rt_server {
         bool line_shown;       /* the live line is on screen (cleared before a print) */
     } term;
 
+    /* one plant per prefix: the scenes this daemon published (FNV-1a of their bytes, which
+     * include utime), and what was heard from another plant */
+    uint64_t scene_sent[RT_SCENES_KEPT];
+    int scene_next;
+    char other_plant[160];     /* what gave it away ("" = nothing) */
+
     uint8_t buf[RT_BUF_SIZE];
     uint8_t state_buf[RT_BUF_SIZE]; /* the last state published, as sent (lockstep retries) */
     unsigned state_len;
@@ -263,6 +278,11 @@ void rt_close(rt_server *s);
 /* The LCM handlers' work: a command or a control request, at s->now. */
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len);
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len);
+/* A scene heard on this prefix: one this daemon did not publish is another plant's; the
+ * daemon then stops (RT_STOP_OTHER_PLANT) and says so in its stop event. */
+void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len);
+/* FNV-1a, 64 bits: how a published scene is remembered. */
+uint64_t rt_hash(const uint8_t *data, size_t len);
 
 /* rt_bus.c: the daemon's LCM instances: one publishing on the state URL, one receiving
  * on the command URL (one lcm_t for memq://), and what the daemon says about them at

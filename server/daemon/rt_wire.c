@@ -213,5 +213,10 @@ void rt_publish_scene(rt_server *s)
     PUT(m.mode, lag_rt_mode_name(s->sc->realtime.mode));
     m.rate = fin(s->sc->realtime.rate);
     m.command_timeout = fin(s->sc->realtime.command_timeout);
-    publish(s, s->ch_scene, LAG_WIRE_SCENE, &m);
+    int n = publish(s, s->ch_scene, LAG_WIRE_SCENE, &m);
+    /* remembered, so that the plant watch knows it when it comes back (rt_handle_scene) */
+    if (n > 0) {
+        s->scene_sent[s->scene_next] = rt_hash(s->buf, (size_t)n);
+        s->scene_next = (s->scene_next + 1) % RT_SCENES_KEPT;
+    }
 }

@@ -9,7 +9,7 @@
  *     CASE: control hostile watchdog lockstep_timeout two_daemons fault replay
  *           replay_dopri5 replay_effects replay_flight sigterm bad_scene effects control_flood
  *           step_flood lockstep_huge status_rate rate_huge long_period duration_huge
- *           signals effort_absurd ttl_warning offline_signal
+ *           signals effort_absurd ttl_warning offline_signal same_prefix
  *
  * Expected states are computed independently of the daemon's loop: a lag_sim of the same
  * scene (loaded with lag_scene_load, as the daemon does) advanced from the published state
@@ -1559,6 +1559,44 @@ static void case_ttl_warning(void)
     ENSUREF(strstr(text, "ttl=1") && strstr(text, "leave this host"), "no warning: '%s'", text);
 }
 
+/* One plant per prefix: a second daemon on a prefix where one runs hears it before it
+ * publishes anything (its answer to a DESCRIBE, its states) and refuses to start, exit 1,
+ * saying why; the first runs on untouched (no stop, its states go on, nothing from the
+ * second on the prefix). */
+static void case_same_prefix(void)
+{
+    write_scene(DIPC_MOVING);
+    static client c;
+    client_init(&c, g_prefix, 3);
+    pid_t a = start_daemon(g_prefix, NULL);
+    WAIT_FOR(&c, c.n_states > 0, 5.0);
+    char err_path[256];
+    snprintf(err_path, sizeof err_path, "/tmp/lagsim_server_test_%d_%s.err", (int)getpid(), g_case);
+    g_stderr_path = err_path;
+    pid_t b = start_daemon(g_prefix, NULL);
+    g_stderr_path = NULL;
+    double t0 = now_s();
+    int rc = reap(b, 10.0);
+    double took = now_s() - t0;
+    FILE *f = fopen(err_path, "r");
+    ENSURE(f);
+    char text[4096];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    remove(err_path);
+    printf("second daemon: exit %d after %.2f s, stderr: %s", rc, took, text);
+    ENSUREF(rc == 1, "the second daemon on prefix %s: exit %d", g_prefix, rc);
+    ENSUREF(strstr(text, "another plant publishes on prefix") && strstr(text, "refusing to start"),
+            "no reason given: '%s'", text);
+    int64_t before = c.n_states;
+    pump(&c, 0.5);
+    ENSURE(c.n_states > before + 20);                    /* the first goes on */
+    ENSURE(count_events(&c, "stop") == 0 && count_events(&c, "start") == 1);
+    kill(a, SIGTERM);
+    ENSURE(reap(a, 5.0) == 0);
+}
+
 /* An offline run stopped by SIGINT (or SIGTERM, SIGHUP) flushes the rows it computed,
  * whole, says where it stopped and exits 1. */
 static void case_offline_signal(void)
@@ -1642,6 +1680,7 @@ int main(int argc, char **argv)
     else if (!strcmp(g_case, "signals")) case_signals();
     else if (!strcmp(g_case, "effort_absurd")) case_effort_absurd();
     else if (!strcmp(g_case, "ttl_warning")) case_ttl_warning();
+    else if (!strcmp(g_case, "same_prefix")) case_same_prefix();
     else if (!strcmp(g_case, "offline_signal")) case_offline_signal();
     else if (!strcmp(g_case, "command_flood_ports")) case_command_flood_ports();
     else {

@@ -11,7 +11,7 @@
  *
  *   test_loop CASE    CASE: pacing rate_huge status_hz lockstep_wait start set long_period chunks
  *                           step_paced control_flood command_flood duration signals
- *                           fault_effort lockstep_retry lockstep_loss
+ *                           fault_effort lockstep_retry lockstep_loss other_plant
  */
 #include <math.h>
 #include <signal.h>
@@ -66,6 +66,8 @@ typedef struct outputs {
     double last_q[LAG_MAX_DOF];
     int64_t status_controls_rejected, status_states, status_overrun_bursts;
     char status_run[16];
+    uint8_t scene_bytes[4096]; /* the last scene, as published */
+    size_t scene_len;
 } outputs;
 
 static outputs g_out;
@@ -214,6 +216,10 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         lag_wire_scene m;
         if (lag_wire_decode_scene(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) fail(__LINE__, "bad scene");
         g_out.scene++;
+        if (rb->data_size <= sizeof g_out.scene_bytes) {
+            memcpy(g_out.scene_bytes, rb->data, rb->data_size);
+            g_out.scene_len = rb->data_size;
+        }
     }
 }
 
@@ -959,6 +965,40 @@ static void case_lockstep_loss(void)
     }
 }
 
+/* One plant per prefix: the daemon's own scenes (at start, on DESCRIBE, after a reset)
+ * come back on its _SCENE subscription and are known as its own, a copy included; a
+ * scene it did not send (the same with another utime: another daemon's) stops it, and
+ * its stop event says why. */
+static void case_other_plant(void)
+{
+    scene(LAG_RT_REALTIME);
+    g_sc.realtime.start = LAG_RT_START_RUNNING;
+    start();
+    run_until(g_srv.now + 100 * MS, 0);
+    control(LAGSIM_CONTROL_T_DESCRIBE, 0);
+    run_until(g_srv.now + 500 * MS, 0);
+    control(LAGSIM_CONTROL_T_RESET, 0);
+    run_until(g_srv.now + 500 * MS, 0);
+    ENSUREF(g_out.scene == 3, "%lld scenes", (long long)g_out.scene);
+    uint8_t other[4096];
+    size_t len = g_out.scene_len;
+    memcpy(other, g_out.scene_bytes, len);
+    lcm_publish(g_lcm, "TL_SCENE", other, (unsigned)len); /* a copy of its own */
+    run_until(g_srv.now + 100 * MS, 0);
+    ENSURE(!g_srv.stop && g_srv.other_plant[0] == '\0' && g_srv.sim.tick > 0);
+    other[8 + 7] ^= 1; /* utime, after the fingerprint */
+    lcm_publish(g_lcm, "TL_SCENE", other, (unsigned)len);
+    int64_t states = g_out.state;
+    run_until(g_srv.now + 1 * SEC, 0);
+    ENSURE(g_srv.stop && g_srv.stop_reason == RT_STOP_OTHER_PLANT);
+    ENSUREF(g_out.state <= states + 1, "%lld states after the other plant's scene",
+            (long long)(g_out.state - states));
+    stop_server();
+    ENSUREF(n_events("stop") == 1 && strstr(last_detail("stop"), "another plant publishes on prefix TL") &&
+                strstr(last_detail("stop"), "model dipc"),
+            "stop event: '%s'", last_detail("stop"));
+}
+
 int main(int argc, char **argv)
 {
     static const struct {
@@ -973,6 +1013,7 @@ int main(int argc, char **argv)
         {"command_flood", case_command_flood}, {"duration", case_duration},
         {"signals", case_signals},         {"fault_effort", case_fault_effort},
         {"lockstep_retry", case_lockstep_retry}, {"lockstep_loss", case_lockstep_loss},
+        {"other_plant", case_other_plant},
     };
     if (argc != 2) {
         fprintf(stderr, "usage: test_loop CASE\n");
