@@ -10,10 +10,11 @@
         reads an LCM log (lcm-logger) and prints one JSON object: the states (one per step,
         duplicates counted), the events (kind, value, sim time), the last status, and
         how many numbers were not finite
-    netpeer.py compare TRACE_A TRACE_B
+    netpeer.py compare [--first N] TRACE_A TRACE_B
         two --trace files of a controller: one line per answered state (duplicates
         included); after dropping repeated lines of the same sim time, the two must be the
-        same text line for line (%.17g: the same bits). Prints the counts; exit 1 if not.
+        same text line for line (%.17g: the same bits); with --first, both must have at
+        least N states and their first N are compared. Prints the counts; exit 1 if not.
 """
 import argparse
 import json
@@ -126,6 +127,11 @@ def cmd_compare(a):
     da, db = dedup(a.a), dedup(a.b)
     print("trace %s: %d lines, %d states; trace %s: %d lines, %d states"
           % (a.a, len(ra), len(da), a.b, len(rb), len(db)))
+    if a.first:
+        if len(da) < a.first or len(db) < a.first:
+            print("fewer than %d states" % a.first)
+            return 1
+        da, db = da[:a.first], db[:a.first]
     if da != db:
         n = min(len(da), len(db))
         k = next((i for i in range(n) if da[i] != db[i]), n)
@@ -155,6 +161,7 @@ def main():
     m.add_argument("--prefix", required=True)
     m.add_argument("log")
     c = sub.add_parser("compare")
+    c.add_argument("--first", type=int, default=0)
     c.add_argument("a")
     c.add_argument("b")
     a = ap.parse_args()

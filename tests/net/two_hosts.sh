@@ -9,7 +9,20 @@
 #   CASE: host_local      the default scene (lcm.allow_lan false) accepts 0 of a peer's
 #                         commands and control requests; with allow_lan it accepts them;
 #                         with the route 224.0.0.0/4 dev lo it accepts this host's
+#         lockstep_loss   a lockstep DIPC in A, dipc_lqr and lcm-logger in B (allow_lan,
+#                         ttl=1): with 10 % of the datagrams lost each way the states the
+#                         controller answers are those of a lossless run, bit for bit
+#         realtime_loss   a realtime manipulator in A, manipulator_pd and a logger in B,
+#                         10 % lost each way and the commands cut for 1.5 s: the watchdog
+#                         trips and clears once each, its events say so, nothing non-finite
+#         two_daemons     a daemon in B on the prefix of a daemon in A (allow_lan, ttl=1)
+#                         refuses to start; with the host-local default both run
 #
+# Loss: nftables, in each namespace an input chain that drops `numgen random mod 10 == 0`
+# of the datagrams to the two ports coming from the other one (by source address). Input,
+# not output: a datagram an output chain drops makes the sender's sendto fail (EPERM),
+# which no network does; and what a host sends to itself (the daemon's start marker, its
+# own scene) is never lost.
 # Every run names its namespaces and veth ends after its PID and removes them in a trap.
 set -u
 case_name=${1:?usage: two_hosts.sh CASE BUILD_DIR SOURCE_DIR}
@@ -35,7 +48,7 @@ cleanup() {
     ip netns del "$nsA" 2>/dev/null
     ip netns del "$nsB" 2>/dev/null
     ip link del "$vA" 2>/dev/null
-    rm -rf "$work"
+    if [ -n "${LAGSIM_TWO_HOSTS_KEEP:-}" ]; then echo "kept $work"; else rm -rf "$work"; fi
 }
 trap cleanup EXIT
 trap 'exit 1' INT TERM
@@ -120,8 +133,146 @@ case_host_local() {
     ip -n "$nsA" route replace 224.0.0.0/4 dev "$vA"
 }
 
+# 10 % loss on the link, each way: in A what comes from B (commands, control), in B what
+# comes from A (states, events, status, scene).
+loss_on() {
+    local ns peer
+    for ns in "$nsA:10.77.0.2" "$nsB:10.77.0.1"; do
+        peer=${ns#*:} ns=${ns%%:*}
+        ip netns exec "$ns" nft add table inet loss
+        ip netns exec "$ns" nft add chain inet loss in '{ type filter hook input priority 0; }'
+        ip netns exec "$ns" nft add rule inet loss in ip saddr "$peer" udp dport '{ 7667, 7668 }' \
+            numgen random mod 10 == 0 drop
+    done
+}
+loss_off() {
+    $inA nft delete table inet loss 2>/dev/null
+    $inB nft delete table inet loss 2>/dev/null
+}
+
+# A lockstep DIPC in A for 5 s of sim time (500 periods), dipc_lqr in B with a trace.
+lockstep_run() { # tag
+    local tag=$1 prefix=LS$id url="udpm://239.255.76.67:7667?ttl=1"
+    $inB lcm-logger -q -f --lcm-url "$url" "$work/$tag.lcm" & pids+=($!); local logger=$!
+    $inA "$lagsimd" --config "$config" --set lcm.prefix=$prefix --set lcm.allow_lan=true \
+        --set "lcm.url=$url" --set realtime.mode=lockstep --set realtime.start=first_command \
+        -q --duration 5 2>"$work/$tag.err" & pids+=($!); local d=$!
+    sleep 1
+    $inB "$build/bin/dipc_lqr" --prefix $prefix --url "$url" --timeout 3 -q \
+        --trace "$work/$tag.trace" >"$work/$tag.out" 2>&1 & pids+=($!); local c=$!
+    wait $d; local rc=$?
+    wait $c
+    sleep 0.3
+    kill -INT $logger; wait $logger 2>/dev/null
+    cat "$work/$tag.err"
+    grep summary "$work/$tag.out"
+    $netpeer summary --types "$types" --prefix $prefix "$work/$tag.lcm" >"$work/$tag.json"
+    echo "$tag: lagsimd exit $rc; logged in B: $(field "$work/$tag.json" "d['states']") states," \
+         "$(field "$work/$tag.json" "d['duplicates']") copies, $(field "$work/$tag.json" "d['nonfinite']") non-finite"
+    [ $rc = 0 ]
+}
+
+case_lockstep_loss() {
+    lockstep_run lossless
+    check "lagsimd ran (lossless)" $?
+    loss_on
+    lockstep_run lossy
+    check "lagsimd ran (10 % lost each way)" $?
+    loss_off
+    # every state up to the last period (the final state may go out as the daemon stops)
+    $netpeer compare --first 500 "$work/lossless.trace" "$work/lossy.trace"
+    check "the 500 states the controller answered under loss are the lossless run's, bit for bit" $?
+    check "the controller answered copies (retries) under loss" \
+        $(grep -q "repeats=[1-9]" "$work/lossy.out"; echo $?)
+    check "the controller's commands all went out" $(! grep -q "failed" "$work/lossy.out"; echo $?)
+    check "nothing non-finite was logged" $([ "$(field "$work/lossy.json" "d['nonfinite']")" = 0 ]; echo $?)
+    check "no lockstep_timeout was logged" \
+        $([ "$(field "$work/lossy.json" "sum(e['kind'] == 'lockstep_timeout' for e in d['events'])")" = 0 ]; echo $?)
+}
+
+# A realtime manipulator in A, manipulator_pd in B, 10 % lost each way; after 2 s the
+# commands are cut for 1.5 s (command_timeout 0.5 s): the watchdog trips and clears.
+case_realtime_loss() {
+    local prefix=RL$id url="udpm://239.255.76.67:7667?ttl=1" mconfig=$src/config/manipulator.yaml
+    loss_on
+    $inA lcm-logger -q -f --lcm-url "$url" "$work/a.lcm" & pids+=($!); local la=$!
+    $inB lcm-logger -q -f --lcm-url "$url" "$work/b.lcm" & pids+=($!); local lb=$!
+    sleep 0.5
+    $inA "$lagsimd" --config "$mconfig" --set lcm.prefix=$prefix --set lcm.allow_lan=true \
+        --set "lcm.url=$url" --set realtime.mode=realtime --set realtime.start=first_command \
+        --set realtime.command_timeout=0.5 -q 2>"$work/rt.err" & pids+=($!); local d=$!
+    sleep 1
+    $inB "$build/bin/manipulator_pd" --prefix $prefix --url "$url" --timeout 3 -q \
+        >"$work/rt.out" 2>&1 & pids+=($!); local c=$!
+    sleep 2
+    $inA nft insert rule inet loss in ip saddr 10.77.0.2 udp dport 7668 drop
+    sleep 1.5
+    $inA nft flush chain inet loss in
+    $inA nft add rule inet loss in ip saddr 10.77.0.2 udp dport '{ 7667, 7668 }' \
+        numgen random mod 10 == 0 drop
+    sleep 2
+    kill -TERM $d; wait $d; local rc=$?
+    wait $c
+    sleep 0.3
+    kill -INT $la $lb; wait $la $lb 2>/dev/null
+    loss_off
+    cat "$work/rt.err"
+    grep summary "$work/rt.out"
+    check "lagsimd ran (realtime, 10 % lost each way, commands cut 1.5 s)" $([ $rc = 0 ]; echo $?)
+    $netpeer summary --types "$types" --prefix $prefix "$work/a.lcm" >"$work/a.json"
+    $netpeer summary --types "$types" --prefix $prefix "$work/b.lcm" >"$work/b.json"
+    local trips clears st_trips tripped nf_a nf_b
+    trips=$(field "$work/a.json" "sum(e['kind'] == 'watchdog_trip' for e in d['events'])")
+    clears=$(field "$work/a.json" "sum(e['kind'] == 'watchdog_clear' for e in d['events'])")
+    st_trips=$(field "$work/a.json" "d['status']['watchdog_trips']")
+    tripped=$(field "$work/a.json" "d['status']['watchdog_tripped']")
+    nf_a=$(field "$work/a.json" "d['nonfinite']")
+    nf_b=$(field "$work/b.json" "d['nonfinite']")
+    echo "events in A: $trips watchdog_trip, $clears watchdog_clear; status: watchdog_trips $st_trips," \
+         "tripped $tripped; states in A $(field "$work/a.json" "d['states']"), in B $(field "$work/b.json" "d['states']")"
+    field "$work/a.json" "'\n'.join(e['kind'] + ': ' + e['detail'] for e in d['events'] if e['kind'].startswith('watchdog'))"
+    check "the watchdog tripped and cleared (events: $trips trips, $clears clears; at least one each, as many of each)" \
+        $([ "$trips" -ge 1 ] && [ "$trips" = "$clears" ]; echo $?)
+    check "the status counts the trips its events said ($st_trips) and ends cleared ($tripped)" \
+        $([ "$st_trips" = "$trips" ] && [ "$tripped" = False ]; echo $?)
+    check "the events say why" \
+        $(field "$work/a.json" "'\n'.join(e['detail'] for e in d['events'])" | grep -q "no command for" &&
+          field "$work/a.json" "'\n'.join(e['detail'] for e in d['events'])" | grep -q "a good command arrived"; echo $?)
+    check "nothing non-finite, in A ($nf_a) or in B ($nf_b)" $([ "$nf_a" = 0 ] && [ "$nf_b" = 0 ]; echo $?)
+}
+
+# One plant per prefix across hosts (allow_lan, ttl=1): the second is refused.
+case_two_daemons() {
+    local prefix=TD$id url="udpm://239.255.76.67:7667?ttl=1"
+    $inA "$lagsimd" --config "$config" --set lcm.prefix=$prefix --set lcm.allow_lan=true \
+        --set "lcm.url=$url" --set realtime.start=running -q 2>"$work/a.err" & pids+=($!); local a=$!
+    sleep 1
+    $inB "$lagsimd" --config "$config" --set lcm.prefix=$prefix --set lcm.allow_lan=true \
+        --set "lcm.url=$url" --set realtime.start=running -q --duration 3 2>"$work/b.err"
+    local rc=$?
+    cat "$work/b.err"
+    check "a daemon in B on the prefix of a daemon in A refuses to start (exit $rc)" \
+        $([ $rc = 1 ] && grep -q "another plant publishes on prefix $prefix" "$work/b.err"; echo $?)
+    kill -0 $a 2>/dev/null
+    check "the daemon in A runs on" $?
+    kill -TERM $a; wait $a
+    check "the daemon in A stopped cleanly" $?
+    # the default on both: each plant on its own host, no conflict
+    $inA "$lagsimd" --config "$config" --set lcm.prefix=$prefix --set realtime.start=running \
+        -q 2>"$work/a2.err" & pids+=($!); a=$!
+    sleep 1
+    $inB "$lagsimd" --config "$config" --set lcm.prefix=$prefix --set realtime.start=running \
+        -q --duration 1 2>"$work/b2.err"
+    rc=$?
+    check "with the host-local default, the same prefix on another host runs (exit $rc)" $([ $rc = 0 ]; echo $?)
+    kill -TERM $a; wait $a
+}
+
 case "$case_name" in
 host_local) case_host_local ;;
+lockstep_loss) case_lockstep_loss ;;
+realtime_loss) case_realtime_loss ;;
+two_daemons) case_two_daemons ;;
 *) echo "unknown case $case_name"; exit 2 ;;
 esac
 [ $fail = 0 ] && echo "two_hosts $case_name: ok" || echo "two_hosts $case_name: FAILED"
