@@ -765,6 +765,9 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     if (!(sc->realtime.command_timeout >= 0) || isnan(sc->realtime.command_timeout))
         return open_error(err, errlen, "bad scene: realtime.command_timeout must be >= 0 (got %g)",
                           sc->realtime.command_timeout);
+    /* the loader bounds lcm.prefix (file:line:column); a scene built in code is checked here */
+    _Static_assert(LAG_SCENE_PREFIX_MAX + 8 == LCM_MAX_CHANNEL_NAME_LENGTH,
+                   "the loader's prefix bound leaves room for _COMMAND in an LCM channel name");
     size_t plen = strnlen(sc->lcm.prefix, sizeof sc->lcm.prefix);
     if (plen == 0 || plen + 8 > LCM_MAX_CHANNEL_NAME_LENGTH)
         return open_error(err, errlen, "bad scene: lcm.prefix must have 1 to %d characters "

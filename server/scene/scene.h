@@ -23,6 +23,10 @@ typedef enum lag_rt_start {
                                    RESUME): the default in lockstep */
 } lag_rt_start;
 
+/* The longest lcm.prefix: LCM channel names have at most 63 bytes, and the longest
+ * suffix of a plant's channels (_COMMAND, _CONTROL) has 8. */
+#define LAG_SCENE_PREFIX_MAX 55
+
 typedef struct lag_scene {
     char path[512];          /* file it was read from ("" if built in code) */
     lag_sim_def sim;         /* model, parameters, integrator, initial state */
@@ -46,7 +50,8 @@ typedef struct lag_scene {
     } realtime;
     struct {
         char url[256];           /* "" = LCM's default (honours LCM_DEFAULT_URL) */
-        char prefix[64];         /* channel prefix; default the model name in capitals */
+        char prefix[64];         /* channel prefix, 1 to LAG_SCENE_PREFIX_MAX characters;
+                                    default the model name in capitals */
         bool allow_lan;          /* the scene means its traffic to leave this host: a
                                     multicast ttl above 1 is accepted; default false */
         int ttl;                 /* the multicast ttl the URL asks for (0 for "", memq://

@@ -48,12 +48,15 @@ static int fail(char *err, size_t errlen, const char *fmt, const char *url)
     return -1;
 }
 
+_Static_assert(LAG_BUS_PREFIX_MAX == 55, "the message below says 55");
+
 int lag_bus_init(lag_bus *b, const char *url, const char *prefix, char *err, size_t errlen)
 {
     memset(b, 0, sizeof *b);
     if (err && errlen) err[0] = '\0';
-    if (!prefix || prefix[0] == '\0' || strlen(prefix) > 63)
-        return fail(err, errlen, "a channel prefix has 1 to 63 characters%s", "");
+    if (!prefix || prefix[0] == '\0' || strlen(prefix) > LAG_BUS_PREFIX_MAX)
+        return fail(err, errlen, "a channel prefix has 1 to 55 characters (LCM channel names "
+                    "have at most 63 bytes, and _COMMAND 8)%s", "");
     for (int k = 0; k < LAG_BUS_CHANNEL_COUNT; k++)
         snprintf(b->channel[k], LAG_BUS_CHANNEL_LEN, "%s%s", prefix, suffix[k]);
 
@@ -95,8 +98,6 @@ int lag_bus_init(lag_bus *b, const char *url, const char *prefix, char *err, siz
     if (*p != '\0' && *p != '?')
         return fail(err, errlen, "unexpected characters after the address in '%s'", url);
     const char *query = p; /* "" or "?options", kept as given */
-    for (const char *q = *query ? query + 1 : NULL; q; q = strchr(q, '&') ? strchr(q, '&') + 1 : NULL)
-        if (strncmp(q, "ttl=", 4) == 0) b->ttl = atoi(q + 4);
     b->udpm = true;
     b->state_port = (int)port;
     b->command_port = (int)port + 1;

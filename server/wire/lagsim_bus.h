@@ -31,6 +31,7 @@ extern "C" {
 
 #define LAG_BUS_URL_LEN 320       /* a derived URL: the scene's (< 256) and a longer port */
 #define LAG_BUS_CHANNEL_LEN 72    /* prefix (< 64) + "_COMMAND" */
+#define LAG_BUS_PREFIX_MAX 55     /* a channel name has at most 63 bytes; _COMMAND has 8 */
 #define LAG_BUS_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0" /* LCM's own default */
 #define LAG_BUS_DEFAULT_GROUP "239.255.76.67"
 #define LAG_BUS_DEFAULT_PORT 7667
@@ -52,14 +53,13 @@ typedef struct lag_bus {
     bool udpm;                         /* false: memq:// (one bus for both) */
     char group[16];                    /* udpm: the multicast group, dotted */
     int state_port, command_port;      /* udpm */
-    int ttl;                           /* udpm: the ttl= option (0 when absent) */
     char channel[LAG_BUS_CHANNEL_COUNT][LAG_BUS_CHANNEL_LEN];
 } lag_bus;
 
 /* Derives the URLs and channels of the plant with LCM URL `url` (NULL or "": the
  * environment's LCM_DEFAULT_URL, else LCM's default) and channel prefix `prefix`.
  * Accepts memq:// and udpm://[GROUP[:PORT]][?OPTIONS] (GROUP dotted IPv4, PORT 1 to
- * 65534: the command port is PORT + 1); anything else, or a prefix of 0 or more than 63
+ * 65534: the command port is PORT + 1); anything else, or a prefix of 0 or more than 55
  * characters, is refused with a message in err. Returns 0 or -1. OUT: b */
 int lag_bus_init(lag_bus *b, const char *url, const char *prefix, char *err, size_t errlen);
 
