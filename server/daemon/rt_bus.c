@@ -53,7 +53,7 @@ static int filter_input(rt_server *s, char *err, size_t errlen)
     return LAGSIMD_EXIT_OK;
 }
 
-#define RT_LOOK_MS 500 /* how long a starting daemon listens for another plant */
+#define RT_LOOK_MS 200 /* how long a starting daemon listens for another plant */
 
 static void on_other_output(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
