@@ -171,6 +171,8 @@ static void publish_state(rt_server *s)
 static void lockstep_retry(rt_server *s)
 {
     if (s->now < s->next_retry_ns || s->state_len == 0) return;
+    /* straight to LCM, not through rt_wire's publish: a copy for the network, which --log
+     * (the run's record, one state per period) does not keep */
     lcm_publish(s->lcm, s->ch_state, s->state_buf, s->state_len);
     s->lockstep_retries++;
     s->next_retry_ns = rt_sat_add(s->now, s->lockstep_retry_ns);
