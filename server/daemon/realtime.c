@@ -687,13 +687,14 @@ void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len)
     for (int k = 0; k < RT_SCENES_KEPT; k++)
         if (s->scene_sent[k] == h) return; /* this daemon's own */
     if (s->other_plant[0]) return;         /* said already */
-    lag_wire_scene m;
-    if (lag_wire_decode_scene(data, len, LAG_WIRE_MAX_JOINTS, &m) == LAG_WIRE_OK)
-        snprintf(s->other_plant, sizeof s->other_plant, "a scene this daemon did not send "
-                 "(model %.20s, mode %.10s, dt %g s)", m.model, m.mode, m.dt);
-    else
-        snprintf(s->other_plant, sizeof s->other_plant, "a message on %.72s this daemon did "
-                 "not send", s->ch_scene);
+    /* a plant's scene decodes and names its prefix; anything else on the channel is not a
+     * plant (junk, a forgery of no consequence) and is ignored */
+    static lag_wire_scene m; /* large: not on the stack of a handler */
+    if (lag_wire_decode_scene(data, len, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK ||
+        strcmp(m.prefix, s->sc->lcm.prefix) != 0)
+        return;
+    snprintf(s->other_plant, sizeof s->other_plant, "a scene this daemon did not send "
+             "(model %.20s, mode %.10s, dt %g s)", m.model, m.mode, m.dt);
     if (s->discard) return; /* at start (rt_bus_open's look before publishing): refused there */
     if (!s->stop) {
         s->stop = true;

@@ -8,12 +8,12 @@
  *                 lcm.allow_lan only datagrams sent from this host;
  * For memq:// (tests, one process) one lcm_t is both.
  *
- * One plant per prefix: before it publishes anything, the daemon looks for another plant
- * on its prefix (look_for_other_plant: a DESCRIBE request, and RT_LOOK_MS of listening
- * for a scene, a state or a status) and refuses to start if it hears one. While it runs,
- * the state URL's lcm_t subscribes to _SCENE only (its receive socket filtered to that
- * channel, so the kernel drops the daemon's own states instead of handing them back),
- * and a scene it did not send stops it (rt_handle_scene). Whom it hears follows the
+ * One plant per prefix: the state URL's lcm_t subscribes to _SCENE (its receive socket
+ * filtered to that channel, so the kernel drops the daemon's own states instead of
+ * handing them back). Before it publishes anything, the daemon asks its prefix for a
+ * scene (DESCRIBE) and listens RT_LOOK_MS (look_for_other_plant); another plant's scene
+ * (rt_handle_scene: one that decodes, names this prefix and is not one of the daemon's
+ * own) makes it refuse to start, and later makes it stop. Whom it hears follows the
  * command URL's rule: this host only unless lcm.allow_lan.
  */
 #include <stdio.h>
@@ -55,33 +55,23 @@ static int filter_input(rt_server *s, char *err, size_t errlen)
 
 #define RT_LOOK_MS 200 /* how long a starting daemon listens for another plant */
 
-static void on_other_output(const lcm_recv_buf_t *rb, const char *ch, void *user)
-{
-    (void)rb;
-    rt_server *s = user;
-    if (!s->other_plant[0])
-        snprintf(s->other_plant, sizeof s->other_plant, "heard on %.72s", ch);
-}
-
-/* Before the daemon publishes anything: asks the prefix for its scene (DESCRIBE on the
- * command URL; a daemon there answers on the state URL) and listens RT_LOOK_MS for a
- * scene, a state or a status on the prefix. Then leaves the state URL's receive socket
- * filtered to _SCENE (the plant watch). Returns 0, or an exit code with a message. */
+/* Before the daemon publishes anything: filters the state URL's receive socket to _SCENE
+ * (the plant watch), asks the prefix for its scene (DESCRIBE on the command URL; a daemon
+ * there answers on the state URL) and listens RT_LOOK_MS for another plant's. Returns 0,
+ * or an exit code with a message. */
 static int look_for_other_plant(rt_server *s, char *err, size_t errlen)
 {
     const lag_bus *b = &s->bus;
     bool host_only = !s->sc->lcm.allow_lan;
-    const char *out[] = {s->ch_scene, s->ch_state, s->ch_status};
+    const char *out[] = {s->ch_scene};
     char ferr[256];
-    int n = rt_net_filter(b->state_port, host_only, out, 3, ferr, sizeof ferr);
+    int n = rt_net_filter(b->state_port, host_only, out, 1, ferr, sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s: cannot filter the state URL %s for the plant watch",
                  n < 0 ? ferr : "LCM's receive socket for the state port was not found",
                  b->state_url);
         return LAGSIMD_EXIT_RUNTIME;
     }
-    lcm_subscription_t *sub_state = lcm_subscribe(s->lcm, s->ch_state, on_other_output, s);
-    lcm_subscription_t *sub_status = lcm_subscribe(s->lcm, s->ch_status, on_other_output, s);
     lag_wire_control c;
     memset(&c, 0, sizeof c);
     c.utime = rt_wall_us();
@@ -91,17 +81,10 @@ static int look_for_other_plant(rt_server *s, char *err, size_t errlen)
     int64_t end = rt_mono_ns() + RT_LOOK_MS * 1000000LL;
     for (int64_t left; !s->other_plant[0] && (left = end - rt_mono_ns()) > 0;)
         lcm_handle_timeout(s->lcm, (int)(left / 1000000) + 1);
-    if (sub_state) lcm_unsubscribe(s->lcm, sub_state);
-    if (sub_status) lcm_unsubscribe(s->lcm, sub_status);
     if (s->other_plant[0]) {
         snprintf(err, errlen, "another plant publishes on prefix %s (%s): refusing to start; "
                  "one plant per prefix (give this one another lcm.prefix, or stop the other)",
                  s->sc->lcm.prefix, s->other_plant);
-        return LAGSIMD_EXIT_RUNTIME;
-    }
-    n = rt_net_filter(b->state_port, host_only, out, 1, ferr, sizeof ferr);
-    if (n <= 0) {
-        snprintf(err, errlen, "%s", n < 0 ? ferr : "LCM's receive socket went away");
         return LAGSIMD_EXIT_RUNTIME;
     }
     return LAGSIMD_EXIT_OK;

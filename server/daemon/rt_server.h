@@ -278,8 +278,9 @@ void rt_close(rt_server *s);
 /* The LCM handlers' work: a command or a control request, at s->now. */
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len);
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len);
-/* A scene heard on this prefix: one this daemon did not publish is another plant's; the
- * daemon then stops (RT_STOP_OTHER_PLANT) and says so in its stop event. */
+/* A scene heard on this prefix: one that decodes, names this prefix and is not one this
+ * daemon published is another plant's; the daemon then stops (RT_STOP_OTHER_PLANT) and
+ * says so in its stop event. Anything else on the channel is ignored. */
 void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len);
 /* FNV-1a, 64 bits: how a published scene is remembered. */
 uint64_t rt_hash(const uint8_t *data, size_t len);

@@ -71,6 +71,7 @@ typedef struct outputs {
 } outputs;
 
 static outputs g_out;
+static bool g_junk_scenes; /* scenes that do not decode are the test's own */
 
 /* A lockstep controller played by the test (lockstep_retry, lockstep_loss): it answers
  * every state it receives (duplicates included) with u = -K x, and a deterministic
@@ -214,7 +215,11 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         }
     } else if (!strcmp(sfx, "SCENE")) {
         lag_wire_scene m;
-        if (lag_wire_decode_scene(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) fail(__LINE__, "bad scene");
+        if (lag_wire_decode_scene(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) {
+            if (g_junk_scenes) return; /* other_plant sends some */
+            fail(__LINE__, "bad scene");
+        }
+        if (strcmp(m.prefix, "TL") != 0) return; /* another prefix's (other_plant) */
         g_out.scene++;
         if (rb->data_size <= sizeof g_out.scene_bytes) {
             memcpy(g_out.scene_bytes, rb->data, rb->data_size);
@@ -966,9 +971,9 @@ static void case_lockstep_loss(void)
 }
 
 /* One plant per prefix: the daemon's own scenes (at start, on DESCRIBE, after a reset)
- * come back on its _SCENE subscription and are known as its own, a copy included; a
- * scene it did not send (the same with another utime: another daemon's) stops it, and
- * its stop event says why. */
+ * come back on its _SCENE subscription and are known as its own, a copy included; junk,
+ * a scene cut short and another prefix's scene are no plant's; a scene it did not send
+ * (the same with another utime: another daemon's) stops it, and its stop event says why. */
 static void case_other_plant(void)
 {
     scene(LAG_RT_REALTIME);
@@ -987,6 +992,17 @@ static void case_other_plant(void)
     run_until(g_srv.now + 100 * MS, 0);
     ENSURE(!g_srv.stop && g_srv.other_plant[0] == '\0' && g_srv.sim.tick > 0);
     other[8 + 7] ^= 1; /* utime, after the fingerprint */
+    /* not a plant's: junk, a scene cut short, another prefix's scene */
+    g_junk_scenes = true;
+    lcm_publish(g_lcm, "TL_SCENE", "junk", 4);
+    lcm_publish(g_lcm, "TL_SCENE", other, (unsigned)len - 1);
+    uint8_t *pfx = memmem(other, len, "TL", 3);
+    ENSURE(pfx != NULL);
+    pfx[0] = 'X';
+    lcm_publish(g_lcm, "TL_SCENE", other, (unsigned)len);
+    run_until(g_srv.now + 100 * MS, 0);
+    ENSURE(!g_srv.stop && g_srv.other_plant[0] == '\0');
+    pfx[0] = 'T';
     lcm_publish(g_lcm, "TL_SCENE", other, (unsigned)len);
     int64_t states = g_out.state;
     run_until(g_srv.now + 1 * SEC, 0);
