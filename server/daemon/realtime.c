@@ -979,7 +979,9 @@ void rt_process(rt_server *s)
         rt_term_line(s, false);
         s->next_line_ns = rt_sat_add(s->now, RT_LINE_NS);
     }
-    rt_log_check(s, active(s));
+    /* the log's clock stops while paused or in the fault state, not while waiting for a
+     * command (docs/server.md): a wake-up during the wait must not change the stamps */
+    rt_log_check(s, active(s) || s->run == RT_WAITING);
     if (s->report_line) {
         s->report_line = false;
         if (s->opts && s->opts->quiet) return;
