@@ -3,7 +3,9 @@
 inputs that crashed, hung or leaked in the client library and --replay before they read
 through the wire module.
 
-    tests/fuzz/make_seeds.py BUILD_DIR
+    tests/fuzz/make_seeds.py BUILD_DIR            writes them
+    tests/fuzz/make_seeds.py BUILD_DIR --check    writes nothing; exit 1 if a kept file
+                                                  differs from what it would write
 
 Messages are encoded by lcm-gen's Python types (BUILD_DIR/python), independently of the
 wire module; the replay logs come from `test_replay ... write_logs` (a core run of
@@ -17,6 +19,9 @@ import sys
 import tempfile
 
 build = os.path.abspath(sys.argv[1])
+check = sys.argv[2:] == ["--check"]
+stale = []
+n_written = [0]
 here = os.path.dirname(os.path.abspath(__file__))
 root = os.path.dirname(os.path.dirname(here))
 sys.path.insert(0, os.path.join(build, "python"))
@@ -25,8 +30,27 @@ from lagsim import control_t, event_t, joint_command_t, joint_state_t, scene_t, 
 SYNC = 0xEDA1DA01
 
 
-def write(target, kind, name, data):
+def log_shape(b):
+    """The channels of an LCM log, each with the fingerprints of its messages: what stays
+    of a log whose records carry wall-clock times (and whose statuses follow the wall
+    clock in number)."""
+    out, p = set(), 0
+    while p + 28 <= len(b):
+        cl, dl = struct.unpack(">II", b[p + 20:p + 28])
+        out.add((b[p + 28:p + 28 + cl], b[p + 28 + cl:p + 36 + cl]))
+        p += 28 + cl + dl
+    return out
+
+
+def write(target, kind, name, data, shape=None):
     d = os.path.join(here, target, kind)
+    n_written[0] += 1
+    if check:  # a message type that changed leaves its inputs behind: they stop at the
+        path = os.path.join(d, name)  # fingerprint and test nothing they are named for
+        key = shape or (lambda b: b)
+        if not os.path.exists(path) or key(open(path, "rb").read()) != key(data):
+            stale.append(os.path.relpath(path, here))
+        return
     os.makedirs(d, exist_ok=True)
     with open(os.path.join(d, name), "wb") as f:
         f.write(data)
@@ -203,12 +227,14 @@ try:
     subprocess.check_call([os.path.join(build, "bin", "lagsimd"), "--config",
                            os.path.join(root, "config", "dipc.yaml"), "--set",
                            "effects.actuator={theta0: {lag: 0.004, max: 40}}", "--set",
-                           "realtime.mode=fast", "--set", "lcm.url=memq://", "--duration", "0.1",
+                           "realtime.mode=fast", "--set", "realtime.start=running",
+                           "--set", "lcm.url=memq://", "--duration", "0.1",
                            "-q", "--log", lagged])
     recs = records(lagged)
-    write("replay", "seed", "lagged-inputs.lcm", b"".join(recs))
+    write("replay", "seed", "lagged-inputs.lcm", b"".join(recs), shape=log_shape)
     states = [k for k, r in enumerate(recs) if r[28:28 + 10] == b"DIPC_STATE"]
-    write("replay", "seed", "lagged-gap.lcm", b"".join(r for k, r in enumerate(recs) if k != states[5]))
+    write("replay", "seed", "lagged-gap.lcm", b"".join(r for k, r in enumerate(recs) if k != states[5]),
+          shape=log_shape)
 finally:
     shutil.rmtree(tmp)
 
@@ -237,4 +263,9 @@ write("replay", "crash", "step-int64-min.lcm",                             # ove
       at_step(0) + at_step(10) + at_step(-(1 << 63)))
 flood = record("DIPC_STATE", forged_state(7, b"theta0\0", n=32767, rest=False))
 write("replay", "crash", "undecodable-flood.lcm", s0 + flood * 100 + s10)  # leaked 262 kB each
+if check:
+    for path in stale:
+        print("stale: tests/fuzz/%s (run tests/fuzz/make_seeds.py BUILD_DIR)" % path)
+    print("%d kept inputs checked against the types, %d stale" % (n_written[0], len(stale)))
+    sys.exit(1 if stale else 0)
 print("seeds written under", here)
