@@ -40,13 +40,19 @@ public final class BoundedInput implements DataInput {
      * string lengths checked; IOException unless it decodes whole: lcm-gen's decoder reads
      * a string without its NUL, or with bytes left over, as if nothing were wrong, so the
      * message must encode back to the very bytes that came; and every double in it must
-     * be finite.
+     * be finite. Whatever the bytes, the only exception is IOException: one that escaped a
+     * handler would end LCM's receive thread.
      */
     public static <T extends LCMEncodable> T decode(LCMDataInputStream ins, Decoder<T> decoder)
             throws IOException {
         byte[] buf = ins.getBuffer();
         int off = ins.getBufferOffset(), len = ins.available();
-        T msg = decoder.decode(new BoundedInput(buf, off, len));
+        T msg;
+        try {
+            msg = decoder.decode(new BoundedInput(buf, off, len));
+        } catch (RuntimeException e) { // a negative count: NegativeArraySizeException, ...
+            throw new IOException("does not decode: " + e, e);
+        }
         LCMDataOutputStream out = new LCMDataOutputStream(len);
         msg.encode(out);
         if (out.size() != len || !Arrays.equals(out.getBuffer(), 0, len, buf, off, off + len))
