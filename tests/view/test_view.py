@@ -10,6 +10,10 @@ CASE browser: the drawn sim time advances and the drawn model moves between two 
               step, resume and reset buttons act on the daemon; /api/state agrees.
 CASE stick_flight: config/stick.yaml (beside --config) spun up from its floor: the page
               draws it in the air at the published h, its third joint.
+CASE cartpole: config/cartpole.yaml (beside --config) released from 0.3 rad between elastic
+              stops on x and theta: the page draws the cart at the published x and the pole l1
+              long at the published theta, both stops, and it animates; a model the page
+              cannot draw still shows a note, its coordinates and its charts.
 CASE hostile: garbage, oversized headers, a connection flood, a slow reader, vanished
               clients, foreign Host headers, control floods; afterwards the bridge
               answers at once, holds no stream, and its memory stayed bounded.
@@ -328,15 +332,79 @@ def case_stick_flight(a):
         rig.close()
 
 
+
+def case_cartpole(a):
+    """The cart-pole, drawn to scale from its scene: cart at x, the pole l1 long at theta
+    from the upward vertical, the stops of the limits effect; it animates. Then the page
+    is told of a model it has no drawing for: it says so and still shows the numbers."""
+    cfg = os.path.join(os.path.dirname(a.config), "cartpole.yaml")
+    rig = Rig(a, "VIEWC", cfg, ("initial.q=[0,0.3]", "initial.qd=[0,0]",
+                                "effects.limits.x.lower=-0.5", "effects.limits.x.upper=0.5",
+                                "effects.limits.theta.lower=-2", "effects.limits.theta.upper=2",
+                                # elastic stops: it keeps moving between the two looks
+                                "effects.limits.x.restitution=1", "effects.limits.theta.restitution=1"))
+    chrome = None
+    try:
+        s = rig.wait_api(lambda s: s["scene"] and s["state"], what="scene, state")
+        sc = s["scene"]
+        check(sc["model"] == "cartpole" and sc["joints"] == ["x", "theta"] and
+              sc["limits"] == [[-0.5, 0.5], [-2, 2]],
+              "/api/state: the cart-pole with its stops (%s, %s)" % (sc["joints"], sc["limits"]))
+        l1 = sc["params"]["l1"]
+        chrome = cdp.Chrome()
+        _, sid = chrome.open(rig.base + "/")
+        chrome.wait_for(sid, "window.lagsimView.drawn && window.lagsimView.drawn.points", 15,
+                        "a drawn cart-pole")
+        d1 = drawn(chrome, sid)
+        check(d1["model"] == "cartpole" and d1["note"] is None and len(d1["points"]) == 2,
+              "the page draws the cart-pole (cart, pole tip): %s" % d1["points"])
+        if len(d1["points"]) == 2:
+            x, th = d1["q"]
+            (cx, cy), (tx, ty) = d1["points"]
+            check(cx == x and cy == 0, "the cart is drawn at the published x (%.6f m)" % x)
+            check(abs(tx - (x + l1 * math.sin(th))) < 1e-12 and abs(ty - l1 * math.cos(th)) < 1e-12,
+                  "the pole is drawn %.12g m long (l1 = %g) at the published theta %.6f rad from the "
+                  "upward vertical" % (math.hypot(tx - cx, ty - cy), l1, th))
+        check(sorted(map(tuple, d1["stops"] or [])) == [("theta", -2), ("theta", 2), ("x", -0.5), ("x", 0.5)],
+              "the stops on x and theta are drawn: %s" % d1["stops"])
+        time.sleep(1.0)
+        d2 = drawn(chrome, sid)
+        check(d2["sim_time"] > d1["sim_time"] + 0.5,
+              "second look: drawn sim time advanced %.3f -> %.3f s" % (d1["sim_time"], d2["sim_time"]))
+        check(d2["points"] is not None and moved(d1["points"], d2["points"]) > 0.01,
+              "second look: the drawn cart-pole moved (%.3f m)" %
+              (moved(d1["points"], d2["points"]) if d2["points"] else float("nan")))
+        if a.screenshot:
+            chrome.screenshot(sid, a.screenshot)
+        # a model the page has no drawing for (a scene from a newer daemon): a note, the
+        # coordinates as numbers, the charts still growing
+        chrome.eval(sid, "window.lagsimView.scene.model = 'newmodel'; window.lagsimView.dirty = true; 0")
+        chrome.wait_for(sid, "window.lagsimView.drawn.model === 'newmodel'", 5, "a frame of the unknown model")
+        u1 = drawn(chrome, sid)
+        n1 = chrome.eval(sid, "window.lagsimView.charts.q.length")
+        time.sleep(0.5)
+        u2 = drawn(chrome, sid)
+        n2 = chrome.eval(sid, "window.lagsimView.charts.q.length")
+        check(u2["note"] is not None and "newmodel" in u2["note"] and u2["points"] is None,
+              "an unknown model: a note instead of a drawing (%r)" % u2["note"])
+        check(u2["sim_time"] > u1["sim_time"] and n2 > n1,
+              "an unknown model: the states still come and are charted (%d -> %d samples)" % (n1, n2))
+    finally:
+        if chrome:
+            chrome.quit()
+        rig.close()
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lagsimd", required=True)
     ap.add_argument("--view", required=True)
     ap.add_argument("--config", required=True)
     ap.add_argument("--screenshot")
-    ap.add_argument("case", choices=["browser", "hostile", "stick_flight"])
+    ap.add_argument("case", choices=["browser", "hostile", "stick_flight", "cartpole"])
     a = ap.parse_args()
-    {"browser": case_browser, "hostile": case_hostile, "stick_flight": case_stick_flight}[a.case](a)
+    {"browser": case_browser, "hostile": case_hostile, "stick_flight": case_stick_flight,
+     "cartpole": case_cartpole}[a.case](a)
     print("%s: %d failure(s)" % ("FAILED" if failures else "passed", failures))
     return 1 if failures else 0
 

@@ -153,13 +153,17 @@ function follow(x, halfWidth) {
 }
 
 // ---------------------------------------------------------------- the models
-// DIPC: cart on a track (theta0), rods l1, l2 at absolute angles from the upward vertical.
-function drawDipc(g, w, h) {
-  const l1 = P("l1"), l2 = P("l2"), h0 = Number.isFinite(P("h0")) ? P("h0") : 0;
-  const x = joint("theta0"), t1 = joint("theta1"), t2 = joint("theta2");
-  const L = l1 + l2, span = 2 * L + 0.4;
+// A cart on a track with a chain of rods on it: the DIPC (theta0; theta1, theta2; l1, l2;
+// the pivot h0 above the track) and the cart-pole (x; theta; l1; h0 = 0). The scene says
+// how many rods: every joint after the first (the cart's position) is a rod at its
+// absolute angle from the upward vertical, rod i being l<i> long.
+function drawCartRods(g, w, h) {
+  const names = view.scene.joints, rods = names.slice(1);
+  const ls = rods.map((_, i) => P("l" + (i + 1))), h0 = Number.isFinite(P("h0")) ? P("h0") : 0;
+  const x = joint(names[0]), ts = rods.map(joint);
+  const L = ls.reduce((a, b) => a + b, 0), span = 2 * L + 0.4;
   const scale = Math.min(h / span, w / (span * 1.6));
-  const cx = follow(x, w / (2 * scale));
+  const cx = follow(Number.isFinite(x) ? x : 0, w / (2 * scale));
   const m = worldMap(w, h, cx, h0, scale);
   ground(g, m, w, 0, false, "track");
   // ruler on the track every 0.1 m, numbered every 0.5 m
@@ -170,32 +174,40 @@ function drawDipc(g, w, h) {
     line(g, m, k, 0, k, major ? -0.04 : -0.02);
     if (major) g.fillText(k.toFixed(1), m.X(k) - 8, m.Y(-0.09));
   }
-  const lim = limitOf("theta0");
+  const stops = [];
+  const lim = limitOf(names[0]);
   if (lim) {
     g.strokeStyle = "#c62828"; g.lineWidth = 4;
-    for (const s of lim) line(g, m, s, -0.05, s, 0.12);
+    for (const s of lim) { line(g, m, s, -0.05, s, 0.12); stops.push([names[0], s]); }
   }
-  for (const [name, t] of [["theta1", t1], ["theta2", t2]]) {   // stops of a rod: dashed rays
-    const l = limitOf(name);
-    if (!l) continue;
-    g.strokeStyle = "#ef9a9a"; g.lineWidth = 1; g.setLineDash([4, 4]);
-    for (const a of l) line(g, m, x, h0, x + 0.35 * L * Math.sin(a), h0 + 0.35 * L * Math.cos(a));
-    g.setLineDash([]);
-    void t;
+  if (Number.isFinite(x)) {
+    for (const name of rods) {   // stops of a rod: dashed rays from the pivot
+      const l = limitOf(name);
+      if (!l) continue;
+      g.strokeStyle = "#ef9a9a"; g.lineWidth = 1; g.setLineDash([4, 4]);
+      for (const a of l) { line(g, m, x, h0, x + 0.35 * L * Math.sin(a), h0 + 0.35 * L * Math.cos(a)); stops.push([name, a]); }
+      g.setLineDash([]);
+    }
   }
-  if (![x, t1, t2, l1, l2].every(Number.isFinite)) return null;
-  const p1 = [x + l1 * Math.sin(t1), h0 + l1 * Math.cos(t1)];
-  const p2 = [p1[0] + l2 * Math.sin(t2), p1[1] + l2 * Math.cos(t2)];
+  if (!rods.length || ![x, L, ...ts].every(Number.isFinite)) return null;
+  const points = [[x, h0]];
+  for (let i = 0; i < rods.length; i++) {
+    const [px, py] = points[i];
+    points.push([px + ls[i] * Math.sin(ts[i]), py + ls[i] * Math.cos(ts[i])]);
+  }
   // the cart: its size is not a model parameter (drawn 0.3 m x 0.12 m); its centre is
-  // at theta0, the pivot h0 above the track
+  // at the cart's position, the pivot h0 above the track
   g.fillStyle = "#90a4ae"; g.strokeStyle = "#37474f"; g.lineWidth = 1.5;
   g.fillRect(m.X(x - 0.15), m.Y(h0 + 0.06), 0.3 * scale, 0.12 * scale);
   g.strokeRect(m.X(x - 0.15), m.Y(h0 + 0.06), 0.3 * scale, 0.12 * scale);
-  g.lineCap = "round";
-  g.strokeStyle = COLORS[0]; g.lineWidth = Math.max(4, 0.03 * scale); line(g, m, x, h0, p1[0], p1[1]);
-  g.strokeStyle = COLORS[1]; line(g, m, p1[0], p1[1], p2[0], p2[1]);
-  g.fillStyle = "#222"; dot(g, m, x, h0, 4); dot(g, m, p1[0], p1[1], 4);
-  return { m, points: [[x, h0], p1, p2] };
+  g.lineCap = "round"; g.lineWidth = Math.max(4, 0.03 * scale);
+  for (let i = 0; i < rods.length; i++) {
+    g.strokeStyle = COLORS[i % COLORS.length];
+    line(g, m, points[i][0], points[i][1], points[i + 1][0], points[i + 1][1]);
+  }
+  g.fillStyle = "#222";
+  for (let i = 0; i < rods.length; i++) dot(g, m, points[i][0], points[i][1], 4);
+  return { m, points, stops };
 }
 
 // Stick: centre of mass at x, angle phi from the floor, length l, lower end on the floor
@@ -258,7 +270,7 @@ function drawManipulator(g, w, h) {
   return { m, points: [[0, 0], [2 * l1 * c, 2 * l1 * s], [q2 * c, q2 * s]] };
 }
 
-const DRAW = { dipc: drawDipc, stick: drawStick, manipulator: drawManipulator };
+const DRAW = { dipc: drawCartRods, cartpole: drawCartRods, stick: drawStick, manipulator: drawManipulator };
 
 function drawModel() {
   const { g, w, h } = fit($("model"));
@@ -266,11 +278,24 @@ function drawModel() {
   g.fillStyle = "#666"; g.font = "13px DejaVu Sans, sans-serif";
   if (!view.scene) { g.fillText("waiting for the scene description (is lagsimd running with this prefix?)", 14, 24); return null; }
   const f = DRAW[view.scene.model];
-  if (!f) { g.fillText("unknown model: " + view.scene.model, 14, 24); return null; }
-  const r = f(g, w, h);
-  if (r) scaleBar(g, r.m, w, h);
-  g.fillStyle = "#333"; g.font = "13px DejaVu Sans Mono, monospace";
   const st = view.state;
+  let r = null;
+  if (f) {
+    r = f(g, w, h);
+    if (r) scaleBar(g, r.m, w, h);
+  } else {
+    // a model this page cannot draw: its coordinates as numbers (the charts go on below)
+    r = { note: "no drawing for model \"" + view.scene.model + "\": its coordinates are listed here and charted below" };
+    g.fillText(r.note, 14, 24);
+    g.fillStyle = "#333"; g.font = "13px DejaVu Sans Mono, monospace";
+    const names = st ? st.name : view.scene.joints;
+    names.forEach((n, i) => {
+      const v = st && st.q[i] !== null ? st.q[i].toFixed(6) : "–";
+      const vd = st && st.qd[i] !== null ? st.qd[i].toFixed(6) : "–";
+      g.fillText(`${n} = ${v}   ${n}_dot = ${vd}`, 14, 50 + 18 * i);
+    });
+  }
+  g.fillStyle = "#333"; g.font = "13px DejaVu Sans Mono, monospace";
   if (st && st.sim_time !== null) g.fillText("t = " + st.sim_time.toFixed(3) + " s", w - 130, 20);
   return r;
 }
@@ -372,7 +397,9 @@ function frame() {
       model: view.scene ? view.scene.model : null,
       sim_time: st ? st.sim_time : null,
       q: st ? st.q.slice() : null,
-      points: r ? r.points : null,            // world coordinates (m) of what was drawn
+      points: r && r.points ? r.points : null, // world coordinates (m) of what was drawn
+      stops: r && r.stops ? r.stops : null,      // [joint, value] of each stop drawn
+      note: r && r.note ? r.note : null,         // said instead of a drawing
       run_state: view.status ? view.status.run_state : null,
     };
     document.body.dataset.drawnSimTime = st && st.sim_time !== null ? String(st.sim_time) : "";
