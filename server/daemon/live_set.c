@@ -82,7 +82,7 @@ int live_set_load(const lagsimd_opts *o, const live_sets *ls, const char *kv, la
                   char *why, size_t whylen)
 {
     if (!o || !o->scene_text) {
-        snprintf(why, whylen, "set: this daemon has no scene source to validate a change against");
+        snprintf(why, whylen, "set: no scene source to validate a change against");
         return -1;
     }
     bool room = ls->n < LIVE_SET_MAX;

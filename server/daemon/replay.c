@@ -33,6 +33,14 @@
  * log does not hold). After an inexact restart the states are not compared until the
  * next exact one: they are counted and the reason said.
  *
+ * Changes made while running (control_t SET) are in the log as the daemon's `set` events
+ * on <PREFIX>_EVENT: detail "key=value", step the tick it took effect at. The replay
+ * validates each as the daemon did (live_set.c: the scene file with its --set overrides and
+ * the changes before it) and applies it at that tick: a change read before a state
+ * happened before it, so a period that holds one is advanced to its tick, changed
+ * (lag_sim_redefine), then to its end, as the daemon's chunks were; a restart applies
+ * every change read before it first.
+ *
  * For a run of the same scene and build recorded from its start (lagsimd --log, or a
  * logger started before the daemon), every difference is exactly 0: the daemon and the
  * replay make the same floating-point operations in the same order.
@@ -52,10 +60,12 @@
 #include "daemon.h"
 #include "lagsim_log.h"
 #include "lagsim_wire.h"
+#include "live_set.h"
 
 #define REPLAY_DATA_MAX 65536               /* a record larger than this is no state */
 #define REPLAY_STEP_MAX (INT64_C(1) << 53)  /* steps beyond this are not a run's */
 #define REPLAY_GAPS_SAID 10                 /* gaps reported one by one, then counted */
+#define REPLAY_SETS_PENDING 1024            /* changes read and not yet reached, at most */
 
 /* Effects whose state is entirely in (q, qd, tick): a restart from a logged state of a
  * fixed-step method reproduces the daemon's numbers. Every other effect (and any new one)
@@ -63,11 +73,11 @@
 #define REPLAY_MEMORYLESS (LAG_EFF_DAMPING | LAG_EFF_DISTURBANCE | LAG_EFF_ACTUATOR)
 
 /* Why a restart away from the scene's initial state and from a reset cannot be exact for
- * this scene, or NULL when it can. */
-static const char *restart_inexact(const lag_scene *sc, bool lagged)
+ * this definition (the scene's, or as changed while running), or NULL when it can. */
+static const char *restart_inexact(const lag_sim_def *def, bool lagged)
 {
-    const lag_effects_def *fx = &sc->sim.effects;
-    const lag_method_info *mi = lag_method_info_get(sc->sim.integrator.method);
+    const lag_effects_def *fx = &def->effects;
+    const lag_method_info *mi = lag_method_info_get(def->integrator.method);
     if (fx->enabled & LAG_EFF_NOISE)
         return "the logged state carries the noise effect, not the true state";
     if (mi && mi->adaptive)
@@ -130,14 +140,118 @@ static bool decode_input(const lag_log_record *rec, const lag_model_info *info, 
     return true;
 }
 
+/* The changes made while running, as the log's `set` events say. */
+typedef struct replay_sets {
+    live_sets live;                         /* applied so far: the validation source */
+    int64_t step[REPLAY_SETS_PENDING];      /* read, not yet applied: where, what */
+    char kv[REPLAY_SETS_PENDING][LIVE_SET_LEN];
+    int head, n;
+    int64_t applied;
+    bool failed;                            /* one could not be applied: said, exit 1 */
+} replay_sets;
+
+/* The replay's definition of a scene: with an actuator lag and the inputs in the log
+ * (use_input), the scene's own; otherwise the logged effort is the actuator's output,
+ * applied as it is: the actuator stays on with neither lag nor bound, so that the ticks
+ * are taken exactly as the daemon took them (an actuator makes every tick a separate
+ * step). */
+static void replay_def(lag_sim_def *def, bool use_input)
+{
+    if ((def->effects.enabled & LAG_EFF_ACTUATOR) && !use_input)
+        for (int i = 0; i < def->model.nq; i++) {
+            def->effects.actuator_tau[i] = 0.0;
+            def->effects.actuator_max[i] = INFINITY;
+        }
+}
+
+/* A `set` event of the log: queued until the replay reaches its step. */
+static void set_read(replay_sets *rs, const lag_log_record *rec)
+{
+    lag_wire_event ev;
+    if (!rec->data || lag_wire_decode_event(rec->data, rec->size, &ev) != LAG_WIRE_OK ||
+        strcmp(ev.kind, "set") != 0)
+        return;
+    if (rs->n == REPLAY_SETS_PENDING) {
+        if (!rs->failed)
+            fprintf(stderr, "lagsimd: --replay: more than %d changes (set events) between two "
+                            "states: the log could not be checked\n", REPLAY_SETS_PENDING);
+        rs->failed = true;
+        return;
+    }
+    int k = (rs->head + rs->n++) % REPLAY_SETS_PENDING;
+    rs->step[k] = ev.step;
+    snprintf(rs->kv[k], sizeof rs->kv[k], "%s", ev.detail);
+}
+
+/* Applies the oldest pending change to sim: validated as the daemon validated it, then
+ * lag_sim_redefine at the current state, as the daemon did (so whatever the run carries,
+ * dopri5's step size among it, goes on as in the daemon). Before a restart (restarting:
+ * the state is reset next), a state the change does not fit (the replay's, after states
+ * missing from the log, is not the daemon's) makes a fresh simulation of the changed scene
+ * instead. False (said once) when it cannot be applied. */
+static bool set_apply(replay_sets *rs, lag_sim *sim, const lagsimd_opts *o, bool use_input,
+                      bool restarting)
+{
+    const char *kv = rs->kv[rs->head];
+    int64_t step = rs->step[rs->head];
+    rs->head = (rs->head + 1) % REPLAY_SETS_PENDING;
+    rs->n--;
+    char key[LIVE_SET_LEN], checked[LIVE_SET_LEN], why[1024], err[512];
+    size_t klen = strcspn(kv, "=");
+    snprintf(key, sizeof key, "%.*s", (int)klen, kv);
+    static lag_scene ns; /* large: not on the stack */
+    int ok = kv[klen] == '=' && live_set_parse(key, kv + klen + 1, checked, why, sizeof why) == 0 &&
+             live_set_load(o, &rs->live, checked, &ns, why, sizeof why) == 0;
+    if (ok) {
+        replay_def(&ns.sim, use_input);
+        lag_result r = lag_sim_redefine(sim, &ns.sim, err, sizeof err);
+        if (r != LAG_OK && restarting) r = lag_sim_init(sim, &ns.sim, err, sizeof err);
+        if (r != LAG_OK) {
+            snprintf(why, sizeof why, "%s", err);
+            ok = 0;
+        }
+    }
+    if (!ok) {
+        if (!rs->failed)
+            fprintf(stderr, "lagsimd: --replay: the log's change '%s' (step %lld) cannot be "
+                            "applied to this scene: %s (wrong --config or --set?)\n",
+                    kv, (long long)step, why);
+        rs->failed = true;
+        return false;
+    }
+    live_set_keep(&rs->live, checked);
+    rs->applied++;
+    return true;
+}
+
+/* Advances sim by n ticks (hard stop at the end, as the daemon's period), applying the
+ * pending changes at their ticks on the way (one whose tick has passed: now). */
+static lag_result advance_with_sets(lag_sim *sim, int64_t n, replay_sets *rs,
+                                    const lagsimd_opts *o, bool use_input)
+{
+    const int64_t end = sim->tick + n;
+    while (rs->n > 0 && rs->step[rs->head] < end) {
+        int64_t k = rs->step[rs->head] - sim->tick;
+        if (k > 0) {
+            lag_result r = lag_sim_advance_within(sim, k, end);
+            if (r != LAG_OK) return r;
+        }
+        if (!set_apply(rs, sim, o, use_input, false)) return LAG_ERR_ARG;
+    }
+    return sim->tick < end ? lag_sim_advance_within(sim, end - sim->tick, end) : LAG_OK;
+}
+
 int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts *o)
 {
     char err[512];
     const double tolerance = o ? o->tolerance : 0.0;
     const lag_model_info *info; /* the sim's joints (a stick that may fly: h too), below */
-    char channel[96], ch_input[96];
+    char channel[96], ch_input[96], ch_event[96];
     snprintf(channel, sizeof channel, "%s_STATE", sc->lcm.prefix);
     snprintf(ch_input, sizeof ch_input, "%s_INPUT", sc->lcm.prefix);
+    snprintf(ch_event, sizeof ch_event, "%s_EVENT", sc->lcm.prefix);
+    static replay_sets sets;
+    memset(&sets, 0, sizeof sets);
 
     /* With an actuator lag and the inputs in the log, the replay runs the actuator from
      * them. Otherwise the logged effort is the actuator's output, applied as it is: the
@@ -149,11 +263,7 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         for (int i = 0; i < def.model.nq; i++) lagged |= def.effects.actuator_tau[i] > 0;
     const bool use_input = lagged && log_has_channel(log_path, ch_input);
     const bool anchor = lagged && !use_input;
-    if ((def.effects.enabled & LAG_EFF_ACTUATOR) && !use_input)
-        for (int i = 0; i < def.model.nq; i++) {
-            def.effects.actuator_tau[i] = 0.0;
-            def.effects.actuator_max[i] = INFINITY;
-        }
+    replay_def(&def, use_input);
     lag_sim sim;
     if (lag_sim_init(&sim, &def, err, sizeof err) != LAG_OK) {
         fprintf(stderr, "lagsimd: bad scene: %s\n", err);
@@ -176,7 +286,7 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
     const int nq = sim.nq;
     const int64_t tpp = sc->ticks_per_period;
     const double dt = sc->sim.integrator.dt;
-    const char *inexact = restart_inexact(sc, lagged);
+    const char *inexact = restart_inexact(&sim.def, lagged);
 
     int64_t seen = 0, compared = 0, restarts = 0, gaps = 0, undecodable = 0, invalid = 0;
     int64_t errors = 0, error_step = -1, unchecked = 0;
@@ -189,7 +299,11 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
     double u[LAG_MAX_DOF], u_t = 0;
     lag_log_record rec;
     int rc;
-    while ((rc = lag_log_next(log, &rec)) == LAG_LOG_OK) {
+    while ((rc = lag_log_next(log, &rec)) == LAG_LOG_OK && !sets.failed) {
+        if (strcmp(rec.channel, ch_event) == 0) {
+            set_read(&sets, &rec);
+            continue;
+        }
         if (use_input && strcmp(rec.channel, ch_input) == 0) {
             have_u = decode_input(&rec, info, nq, u, &u_t);
             continue;
@@ -229,6 +343,11 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         bool input_missing = use_input && dticks == tpp && !(have_u && u_t == lag_sim_time(&sim));
         bool is_gap = have && dticks > 0 && (dticks != tpp || input_missing);
         if (!have || dticks < 0 || (dticks == 0 && !same) || is_gap) {
+            /* changes read before this state happened before it */
+            while (sets.n > 0 && set_apply(&sets, &sim, o, use_input, true)) {
+            }
+            if (sets.failed) break;
+            inexact = restart_inexact(&sim.def, lagged);
             /* the first state, a reset (the step went back, or the state changed in
              * place), or a gap: start over from this state */
             if (is_gap) {
@@ -247,7 +366,7 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
                 restarts++;
             }
             bool initial = restart(&sim, &m);
-            checking = initial || (m.step == 0 && !(sc->sim.effects.enabled & LAG_EFF_NOISE)) ||
+            checking = initial || (m.step == 0 && !(sim.def.effects.enabled & LAG_EFF_NOISE)) ||
                        !inexact;
             if (!checking && !unchecked_why)
                 unchecked_why = m.step == 0 ? "the logged state carries the noise effect, not "
@@ -259,7 +378,10 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         if (dticks > 0) {
             lag_sim_set_input(&sim, use_input ? u : m.effort);
             have_u = false;
-            lag_result r = lag_sim_advance(&sim, dticks, false);
+            const int64_t applied = sets.applied;
+            lag_result r = advance_with_sets(&sim, dticks, &sets, o, use_input);
+            if (sets.failed) break;
+            if (sets.applied != applied) inexact = restart_inexact(&sim.def, lagged);
             if (r != LAG_OK || sim.tick != m.step) {
                 if (errors++ == 0) {
                     error_step = m.step;
@@ -297,6 +419,7 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
         return LAGSIMD_EXIT_RUNTIME;
     }
     lag_log_close(log);
+    if (sets.failed) return LAGSIMD_EXIT_RUNTIME;
     if (ls.damaged > 0)
         fprintf(stderr, "lagsimd: --replay: warning: %s is damaged in %lld place(s): %lld "
                         "bytes passed over\n",
@@ -314,6 +437,9 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
            "%lld undecodable, %lld integrator errors)\n",
            log_path, (long long)compared, channel, (long long)restarts, (long long)gaps,
            (long long)undecodable, (long long)errors);
+    if (sets.applied > 0)
+        printf("%lld change(s) made while running applied at their steps (set events on %s)\n",
+               (long long)sets.applied, ch_event);
     if (unchecked > 0)
         printf("%lld states after a restart were not compared: %s\n", (long long)unchecked,
                unchecked_why ? unchecked_why : "the re-simulation failed before them");

@@ -9,7 +9,8 @@
  * (rate 1e25, status_hz 1e-300, lockstep_timeout 1e300, a period of 1e12 ticks) reach the
  * server: it must stay bounded for any value.
  *
- *   test_loop CASE    CASE: pacing rate_huge status_hz lockstep_wait start set long_period chunks
+ *   test_loop CASE    CASE: pacing rate_huge status_hz lockstep_wait start set set_replay
+ *                           long_period chunks
  *                           step_paced control_flood command_flood duration signals
  *                           fault_effort lockstep_retry lockstep_loss other_plant
  */
@@ -18,7 +19,10 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <fcntl.h>
 #include <string.h>
+#include <unistd.h>
+#include <lcm/eventlog.h>
 
 #include "rt_server.h"
 #include "lagsim/lagsim_control_t.h"
@@ -173,10 +177,34 @@ static const char *suffix(const char *ch)
 }
 
 /* Every message the server publishes (memq delivers them to this subscription). */
+/* A recorder of the bus, as lcm-logger records it (every message published, in order):
+ * g_rec[0] all of it, g_rec[1] all but the `set` events. */
+static lcm_eventlog_t *g_rec[2];
+static int64_t g_rec_n;
+
+static void record(const lcm_recv_buf_t *rb, const char *ch, bool is_set)
+{
+    for (int k = 0; k < 2; k++) {
+        if (!g_rec[k] || (k == 1 && is_set)) continue;
+        lcm_eventlog_event_t ev = {.eventnum = 0, .timestamp = g_rec_n, .channellen = (int32_t)strlen(ch),
+                                   .datalen = (int32_t)rb->data_size, .channel = (char *)ch,
+                                   .data = rb->data};
+        if (lcm_eventlog_write_event(g_rec[k], &ev) != 0) fail(__LINE__, "cannot write the log");
+    }
+    g_rec_n++;
+}
+
 static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     (void)user;
     const char *sfx = suffix(ch);
+    bool is_set = false;
+    if (!strcmp(sfx, "EVENT")) {
+        lag_wire_event m;
+        is_set = lag_wire_decode_event(rb->data, rb->data_size, &m) == LAG_WIRE_OK &&
+                 !strcmp(m.kind, "set");
+    }
+    record(rb, ch, is_set);
     if (!strcmp(sfx, "STATE")) {
         lag_wire_joint_state m;
         if (lag_wire_decode_joint_state(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) fail(__LINE__, "bad state");
@@ -629,6 +657,126 @@ static void case_set(void)
 
 /* One period of 1e12 ticks (publish_hz 1e-9 at dt 1 ms, fast mode): each wake-up advances
  * at most tick_budget ticks, so a signal stops it after the wake-up it arrives in. */
+/* lagsimd --replay on a log (as lcm-logger records the bus) at tolerance 0; returns its
+ * exit status and the "max difference" it printed (-1 if none). */
+static int replay(const lag_scene *sc, const char *path, double *diff)
+{
+    char out_path[128];
+    snprintf(out_path, sizeof out_path, "/tmp/lagsim_test_loop_%d_replay.txt", (int)getpid());
+    fflush(stdout);
+    int saved = dup(1), fd = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    ENSURE(saved >= 0 && fd >= 0);
+    dup2(fd, 1);
+    close(fd);
+    int rc = lagsimd_replay(sc, path, &g_opts);
+    fflush(stdout);
+    dup2(saved, 1);
+    close(saved);
+    FILE *f = fopen(out_path, "r");
+    ENSURE(f);
+    char line[1024];
+    *diff = -1;
+    while (fgets(line, sizeof line, f)) {
+        printf("  replay: %s", line);
+        if (!strncmp(line, "max difference = ", 17)) *diff = strtod(line + 17, NULL);
+    }
+    fclose(f);
+    remove(out_path);
+    return rc;
+}
+
+/* Replay reproduces a run that changed parameters: a manipulator driven by commands, its
+ * periods (100 ticks) longer than a wake-up's budget (30 ticks), changed while running:
+ * parameters.m2 in the middle of a period, damping at a period's end, m1 just before a
+ * reset (which keeps the changes). The
+ * bus recorded as lcm-logger records it replays with difference exactly 0 (the `set`
+ * events say what changed and at which step); the same log without its `set` events does
+ * not (so the changes mattered and the check can fail). With rk4 and dopri5. */
+static void case_set_replay(void)
+{
+    static const char text[] =
+        "model: manipulator\n"
+        "parameters: {m1: 2.0, m2: 0.5, l1: 0.3, I1: 0.02, I2: 0.05, g: 9.81}\n"
+        "initial: {q: [0.3, 0.5], qd: [0, 0]}\n"
+        "publish_hz: 10\n"
+        "realtime: {mode: fast, command_timeout: 100}\n"
+        "lcm: {prefix: TL}\n";
+    static const char *const methods[] = {"integrator.method=rk4", "integrator.method=dopri5"};
+    for (int mth = 0; mth < 2; mth++) {
+        const char *sets[] = {methods[mth]};
+        char err[1024], path[2][128];
+        ENSURE(lag_scene_load_buffer("set.yaml", text, sizeof text - 1, sets, 1, &g_sc, err,
+                                     sizeof err) == 0);
+        memset(&g_opts, 0, sizeof g_opts);
+        g_opts.quiet = true;
+        g_opts.scene_name = "set.yaml";
+        g_opts.scene_text = text;
+        g_opts.scene_len = sizeof text - 1;
+        g_opts.sets = sets;
+        g_opts.nsets = 1;
+        for (int k = 0; k < 2; k++) {
+            snprintf(path[k], sizeof path[k], "/tmp/lagsim_test_loop_%d_%d.lcm", (int)getpid(), k);
+            g_rec[k] = lcm_eventlog_create(path[k], "w");
+            ENSURE(g_rec[k]);
+        }
+        start();
+        g_srv.tick_budget = 30;
+        command(0.0, "q1", 0.4);
+        command(0.0, "q2", -0.2);
+        /* into the third period, in its middle */
+        while (g_srv.sim.tick < 230) run_until(g_srv.now + 1, 1);
+        ENSUREF(g_srv.period_left > 0 && g_srv.sim.tick % 100 != 0, "tick %lld, %lld left",
+                (long long)g_srv.sim.tick, (long long)g_srv.period_left);
+        int64_t at = g_srv.sim.tick;
+        set_request("parameters.m2", "1.25");
+        drain();
+        ENSUREF(n_events("set") == 1, "%s", last_detail("control_rejected"));
+        while (g_srv.sim.tick < 600) run_until(g_srv.now + 1, 1);
+        while (g_srv.period_left > 0) run_until(g_srv.now + 1, 1);
+        ENSURE(g_srv.sim.tick % 100 == 0);
+        set_request("effects.damping", "{q1: 0.5, q2: 2}");
+        drain();
+        ENSUREF(n_events("set") == 2, "%s", last_detail("control_rejected"));
+        while (g_srv.sim.tick < 900) run_until(g_srv.now + 1, 1);
+        while (g_srv.period_left > 0) run_until(g_srv.now + 1, 1);
+        /* paused (so that the reset's state goes out before the next period: a fast run
+         * goes on at once), a change, then at once a reset: the reset keeps the changes */
+        control(LAGSIM_CONTROL_T_PAUSE, 0);
+        set_request("parameters.m1", "3");
+        control(LAGSIM_CONTROL_T_RESET, 0);
+        drain();
+        ENSUREF(n_events("set") == 3 && n_events("reset") == 1, "%s",
+                last_detail("control_rejected"));
+        run_until(g_srv.now + 100 * MS, 1);
+        ENSUREF(g_out.last_step == 0, "the reset's state: step %lld", (long long)g_out.last_step);
+        control(LAGSIM_CONTROL_T_RESUME, 0);
+        command(0.0, "q1", -0.3);
+        while (g_srv.sim.tick < 500) run_until(g_srv.now + 1, 1);
+        stop_server();
+        for (int k = 0; k < 2; k++) {
+            lcm_eventlog_destroy(g_rec[k]);
+            g_rec[k] = NULL;
+        }
+        printf("%s: changes at ticks %lld (mid-period), 600 and 900 (then a reset); %lld states\n", methods[mth],
+               (long long)at, (long long)g_out.state);
+        /* the replay starts from the scene as loaded, not as changed */
+        ENSURE(lag_scene_load_buffer("set.yaml", text, sizeof text - 1, sets, 1, &g_sc, err,
+                                     sizeof err) == 0);
+        double d_all, d_none;
+        int rc_all = replay(&g_sc, path[0], &d_all);
+        ENSUREF(rc_all == 0 && d_all == 0.0, "%s: replay exit %d, difference %.17g",
+                methods[mth], rc_all, d_all);
+        (void)replay(&g_sc, path[1], &d_none);
+        ENSUREF(d_none > 1e-6, "%s: without the set events the difference is %.17g",
+                methods[mth], d_none);
+        /* a change the replay cannot validate (no scene source): said, exit 1 */
+        g_opts.scene_text = NULL;
+        ENSURE(replay(&g_sc, path[0], &d_all) == LAGSIMD_EXIT_RUNTIME);
+        remove(path[0]);
+        remove(path[1]);
+    }
+}
+
 static void case_long_period(void)
 {
     scene(LAG_RT_FAST);
@@ -1024,6 +1172,7 @@ int main(int argc, char **argv)
         {"pacing", case_pacing},           {"rate_huge", case_rate_huge},
         {"status_hz", case_status_hz},     {"lockstep_wait", case_lockstep_wait},
         {"start", case_start},             {"set", case_set},
+        {"set_replay", case_set_replay},
         {"long_period", case_long_period}, {"chunks", case_chunks},
         {"step_paced", case_step_paced},   {"control_flood", case_control_flood},
         {"command_flood", case_command_flood}, {"duration", case_duration},
