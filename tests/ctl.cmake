@@ -8,3 +8,15 @@ if(LAGSIM_PYTHON3)
             --source ${PROJECT_SOURCE_DIR})
   set_tests_properties(ctl_lagsimctl PROPERTIES TIMEOUT 120 LABELS clients)
 endif()
+
+# A run whose parameters were changed while it ran (lagsimctl set), replayed from its logs
+# (lcm-logger's, and lagsimd --log's when it has one) with difference 0; without the set
+# events it is not (tests/ctl/test_set_replay.py).
+find_program(LCM_LOGGER lcm-logger)
+if(LAGSIM_PYTHON3)
+  add_test(NAME ctl_set_replay
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/ctl/test_set_replay.py
+            --bin $<TARGET_FILE_DIR:lagsimd> --source ${PROJECT_SOURCE_DIR}
+            --lcm-logger "${LCM_LOGGER}")
+  set_tests_properties(ctl_set_replay PROPERTIES TIMEOUT 120 LABELS clients)
+endif()

@@ -52,6 +52,11 @@ def main():
     a = ap.parse_args()
     cfg = os.path.join(a.source, "config", "dipc.yaml")
     prefix = "CTL_%d" % os.getpid()
+    # a multicast port of this run's own (ttl=0: this host), through LCM_DEFAULT_URL, which
+    # lagsimd and lagsimctl read: another run on the machine is not heard (nor floods these
+    # sockets), nothing of this one is heard elsewhere
+    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
+                                     % (20000 + 2 * (os.getpid() % 6000)))
 
     def ctl(*args, timeout=20):
         r = subprocess.run([a.lagsimctl, "--prefix", prefix] + list(args),
