@@ -21,17 +21,27 @@
 extern void __sanitizer_set_report_fd(void *fd) __attribute__((weak));
 
 static lag_scene g_scene, g_lagged;
+/* the scene file's bytes: the source the log's changes made while running (set events)
+ * are validated against, as lagsimd --replay has them */
+static char *g_text;
+static size_t g_len;
+static const char **g_lag_sets; /* g_lagged's --set */
 static int g_null = -1, g_out = -1, g_err = -1;
 
 int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     (void)argc, (void)argv;
     char err[512];
-    const char *lag[] = {"effects.actuator={theta0: {lag: 0.004, max: 40}}"};
+    static const char *lag[] = {"effects.actuator={theta0: {lag: 0.004, max: 40}}"};
+    g_lag_sets = lag;
     if (lag_scene_load(LAGSIM_SOURCE_DIR "/config/dipc.yaml", NULL, 0, &g_scene, err,
                        sizeof err) != 0 ||
         lag_scene_load(LAGSIM_SOURCE_DIR "/config/dipc.yaml", lag, 1, &g_lagged, err,
                        sizeof err) != 0) {
+        fprintf(stderr, "fuzz_replay: %s\n", err);
+        exit(1);
+    }
+    if (lag_scene_read(LAGSIM_SOURCE_DIR "/config/dipc.yaml", &g_text, &g_len, err, sizeof err) != 0) {
         fprintf(stderr, "fuzz_replay: %s\n", err);
         exit(1);
     }
@@ -56,13 +66,17 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     char path[64];
     snprintf(path, sizeof path, "/proc/self/fd/%d", fd);
-    lagsimd_opts o = {true, 0, NULL};
+    lagsimd_opts o = {.quiet = true, .scene_name = "dipc.yaml", .scene_text = g_text,
+                      .scene_len = g_len};
     fflush(stdout);
     fflush(stderr);
     dup2(g_null, 1);
     dup2(g_null, 2);
     int rc = lagsimd_replay(&g_scene, path, &o);
-    int rc_lagged = lagsimd_replay(&g_lagged, path, &o);
+    lagsimd_opts ol = o;
+    ol.sets = g_lag_sets;
+    ol.nsets = 1;
+    int rc_lagged = lagsimd_replay(&g_lagged, path, &ol);
     fflush(stdout);
     fflush(stderr);
     dup2(g_out, 1);

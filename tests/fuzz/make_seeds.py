@@ -235,6 +235,27 @@ try:
     states = [k for k, r in enumerate(recs) if r[28:28 + 10] == b"DIPC_STATE"]
     write("replay", "seed", "lagged-gap.lcm", b"".join(r for k, r in enumerate(recs) if k != states[5]),
           shape=log_shape)
+
+    # changes made while running: the valid log with `set` events (as the daemon publishes
+    # them) after its 4th state (at its step), inside the 7th period (3 ticks in), and one
+    # the scene loader refuses after the 10th
+    def set_event(step, kv):
+        e = event_t()
+        e.sim_time, e.step, e.kind, e.joint, e.value, e.detail = step * 1e-3, step, "set", "", 0.0, kv
+        return record("DIPC_EVENT", e.encode())
+
+    recs = records(os.path.join(tmp, "valid.lcm"))[:12]
+    st = [k for k, r in enumerate(recs) if r[28:28 + 10] == b"DIPC_STATE"]
+    out = []
+    for k, r in enumerate(recs):
+        out.append(r)
+        if len(st) > 3 and k == st[3]:
+            out.append(set_event(30, "parameters.m2=1.0"))
+        if len(st) > 6 and k == st[6]:
+            out.append(set_event(63, "effects.damping={theta1: 0.01}"))
+        if len(st) > 9 and k == st[9]:
+            out.append(set_event(90, "parameters.m2=-1"))
+    write("replay", "seed", "changes-while-running.lcm", b"".join(out))
 finally:
     shutil.rmtree(tmp)
 
