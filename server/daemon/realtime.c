@@ -535,6 +535,14 @@ static void control_rejected(rt_server *s, const char *why)
     s->want_status = true;
 }
 
+/* Does any joint's actuator have a lag? */
+static bool actuator_lagged(const lag_effects_def *fx, int nq)
+{
+    for (int i = 0; (fx->enabled & LAG_EFF_ACTUATOR) && i < nq; i++)
+        if (fx->actuator_tau[i] > 0) return true;
+    return false;
+}
+
 /* SET key=value: the change is validated by the scene loader itself, on the scene's own
  * bytes with its --set overrides, the changes already made and this one after them (so
  * every rule of a scene file holds, with its message: live_set.c), then by the core
@@ -558,6 +566,15 @@ static void handle_set(rt_server *s, const lag_wire_control *c)
     }
     static lag_scene ns; /* large: not on the stack; used by this function only */
     if (live_set_load(s->opts, &s->live, kv, &ns, why, sizeof why) != 0) {
+        control_rejected(s, why);
+        return;
+    }
+    /* A lag's actuator state lives within periods: --log records the commanded inputs
+     * that let --replay run it only when the scene starts with a lag. */
+    if (!actuator_lagged(&s->sc->sim.effects, s->nq) && actuator_lagged(&ns.sim.effects, s->nq)) {
+        snprintf(why, sizeof why, "set %s: an actuator lag cannot be switched on while "
+                                  "running (a replay could not reproduce the run); give the "
+                                  "scene's actuator a lag to start with", kv);
         control_rejected(s, why);
         return;
     }
@@ -826,9 +843,7 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
 
     /* --log, last: nothing after it can fail */
     if (o && o->log) {
-        const lag_effects_def *fx = &sc->sim.effects;
-        for (int i = 0; (fx->enabled & LAG_EFF_ACTUATOR) && i < s->nq; i++)
-            if (fx->actuator_tau[i] > 0) s->lg.input = true;
+        s->lg.input = actuator_lagged(&sc->sim.effects, s->nq);
         snprintf(s->lg.ch_input, RT_CHANNEL_MAX, "%s_INPUT", sc->lcm.prefix);
         s->lg.log = rt_log_open(o->log, o->log_ring ? o->log_ring : RT_LOG_RING_DEFAULT,
                                 err, errlen);
