@@ -224,5 +224,5 @@ if(LAGSIM_PYTHON3)
 endif()
 
 # Fuzz target: what arrives on a controller's channels, through the client library
-# (tests/fuzz/fuzz_client.c; seeds and kept crash inputs under tests/fuzz/client/).
+# (tests/fuzz/fuzz_client.c; corpora and kept crash inputs under tests/fuzz/client/).
 lagsim_fuzz_target(client LIBS lagsim_client)

@@ -13,7 +13,7 @@ foreach(t models structure conservation convergence determinism validate faults 
   lagsim_add_test_cases(test_core_${t} core.${t} core 300)
 endforeach()
 
-# The core from definitions made of arbitrary bytes (tests/fuzz/fuzz_sim.c): its seed
+# The core from definitions made of arbitrary bytes (tests/fuzz/fuzz_sim.c): its corpus
 # inputs and every input that once crashed or hung it, each build; fuzzed for a bounded
 # time under LAGSIM_FUZZ=ON (tests/fuzz/fuzz.cmake).
 lagsim_fuzz_target(sim LIBS lagsim_core m)

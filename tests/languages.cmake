@@ -88,7 +88,7 @@ lang_end_tests(python manipulator "${lang_manip_cfg}"
 # (counted) and balance the DIPC exactly as in clients_*_dipc_lockstep: the same states,
 # the same bounds. At least the 7 inputs on the state, event and scene channels published
 # before the daemon starts are dropped (21; the examples in Python, Lua and Java do not
-# decode status). The valid seeds are left out: a well-formed forged state is a state.
+# decode status). The valid corpus inputs are left out: a well-formed forged state is a state.
 set(lang_hostile_checks --hostile ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/client/crash
     --check "states == 2001" --check "t_first == 0 and t_last >= 20 - 1e-9"
     --check "max_abs_theta1 >= 0.0499"

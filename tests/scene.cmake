@@ -30,7 +30,7 @@ set_tests_properties(scene_set_overrides scene_offline_csv scene_determinism sce
                      PROPERTIES TIMEOUT 60 LABELS scene)
 
 # The loader under libFuzzer (tests/fuzz/fuzz_scene.c): file bytes plus --set overrides,
-# then the core on what was accepted. Inputs: tests/fuzz/scene/{seed,crash}, written by
+# then the core on what was accepted. Inputs: tests/fuzz/scene/{corpus,crash}, written by
 # tests/fuzz/scene/make_inputs.sh.
 lagsim_fuzz_target(scene LIBS lagsim_scene)
 

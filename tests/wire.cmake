@@ -23,8 +23,8 @@ foreach(case ${LAGSIM_REPLAY_CASES})
   set_tests_properties(wire_replay_${case} PROPERTIES TIMEOUT 120)
 endforeach()
 
-# Fuzz targets (tests/fuzz/fuzz_<name>.c; seeds and kept crash inputs under tests/fuzz/<name>/,
-# written by tests/fuzz/make_seeds.py): the wire module's decoders and encoders, the log
+# Fuzz targets (tests/fuzz/fuzz_<name>.c; corpora and kept crash inputs under tests/fuzz/<name>/,
+# written by tests/fuzz/make_corpora.py): the wire module's decoders and encoders, the log
 # reader, and --replay end to end.
 lagsim_fuzz_target(wire LIBS lagsim_wire)
 lagsim_fuzz_target(log LIBS lagsim_wire)
@@ -32,11 +32,11 @@ lagsim_fuzz_target(replay LIBS lagsimd_internal)
 target_compile_definitions(fuzz_replay PRIVATE LAGSIM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 # The kept inputs above are messages of today's types: a field added to a .lcm file changes
 # its fingerprint, and an input written before then stops at the fingerprint and tests
-# nothing it is named for. make_seeds.py --check encodes each again with the types of this
+# nothing it is named for. make_corpora.py --check encodes each again with the types of this
 # build and fails on every kept input that differs.
 find_program(LAGSIM_PYTHON3 python3)
 if(LAGSIM_PYTHON3)
   add_test(NAME fuzz_corpora_current
-           COMMAND ${LAGSIM_PYTHON3} ${LAGSIM_FUZZ_DIR}/make_seeds.py ${CMAKE_BINARY_DIR} --check)
+           COMMAND ${LAGSIM_PYTHON3} ${LAGSIM_FUZZ_DIR}/make_corpora.py ${CMAKE_BINARY_DIR} --check)
   set_tests_properties(fuzz_corpora_current PROPERTIES TIMEOUT 120 LABELS fuzz)
 endif()

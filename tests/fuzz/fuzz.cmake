@@ -1,6 +1,6 @@
 # Fuzz targets and their kept inputs (SQLite's habit: every input that once crashed stays a
 # regression test). A target is tests/fuzz/fuzz_<name>.c defining LLVMFuzzerTestOneInput;
-# its inputs are tests/fuzz/<name>/seed/ (seed corpus) and tests/fuzz/<name>/crash/
+# its inputs are tests/fuzz/<name>/corpus/ (starting corpus) and tests/fuzz/<name>/crash/
 # (inputs that once crashed, hung or leaked).
 #
 #   lagsim_fuzz_target(<name> [SOURCES extra.c ...] [LIBS target ...])
@@ -15,15 +15,15 @@ set(LAGSIM_FUZZ_SECONDS 20 CACHE STRING "seconds each fuzz_<name>_run test fuzze
 function(lagsim_fuzz_target name)
   cmake_parse_arguments(F "" "" "SOURCES;LIBS" ${ARGN})
   set(src ${LAGSIM_FUZZ_DIR}/fuzz_${name}.c)
-  set(seed ${LAGSIM_FUZZ_DIR}/${name}/seed)
+  set(corpus ${LAGSIM_FUZZ_DIR}/${name}/corpus)
   set(crash ${LAGSIM_FUZZ_DIR}/${name}/crash)
   if(NOT EXISTS ${src})
     message(FATAL_ERROR "lagsim_fuzz_target(${name}): ${src} does not exist")
   endif()
-  if(NOT EXISTS ${seed})
-    message(FATAL_ERROR "lagsim_fuzz_target(${name}): no seed corpus at ${seed}")
+  if(NOT EXISTS ${corpus})
+    message(FATAL_ERROR "lagsim_fuzz_target(${name}): no corpus at ${corpus}")
   endif()
-  set(dirs ${seed})
+  set(dirs ${corpus})
   if(EXISTS ${crash})
     list(APPEND dirs ${crash})
   endif()

@@ -1,7 +1,7 @@
 /*
  * Fuzz target: lagsim-log2csv's whole conversion (the shared bounded LCM log reader and
  * wire decoders, the CSV writers and the summary) on arbitrary bytes as a log file.
- * CSVs and the summary go to /dev/null. Seeds: tests/view/lcmlog.py --seeds.
+ * CSVs and the summary go to /dev/null. Corpus: tests/view/lcmlog.py --corpus.
  */
 #include <stddef.h>
 #include <stdint.h>

@@ -1,6 +1,6 @@
 /*
  * Runs a libFuzzer target's LLVMFuzzerTestOneInput on saved inputs, without libFuzzer:
- * what every build (gcc included) does with a target's seed corpus and its kept crash
+ * what every build (gcc included) does with a target's corpus and its kept crash
  * inputs, so that each input that once crashed stays a regression test for ever.
  *
  * usage: fuzz_NAME [-flags ignored] FILE|DIR ...

@@ -4,7 +4,7 @@ code under test: records in the stock LCM log format (lcm/eventlog.h), payloads 
 by lcm-gen's Python types (--types DIR, the build's python/ directory) or forged byte by
 byte where a test needs a hostile one.
 
-    python3 lcmlog.py --types build/python --seeds DIR   # (re)writes the fuzz seed corpus
+    python3 lcmlog.py --types build/python --corpus DIR   # (re)writes the fuzz corpus
 """
 import argparse
 import os
@@ -127,7 +127,7 @@ def sample_run(t, prefix="T"):
     return recs
 
 
-def seeds(t, d):
+def corpus_cases(t, d):
     os.makedirs(d, exist_ok=True)
     good = log(sample_run(t))
     cases = {
@@ -157,10 +157,10 @@ def seeds(t, d):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--types", required=True)
-    ap.add_argument("--seeds", required=True)
+    ap.add_argument("--corpus", required=True)
     a = ap.parse_args()
-    cases = seeds(Types(a.types), a.seeds)
-    print(f"{len(cases)} seeds in {a.seeds}")
+    cases = corpus_cases(Types(a.types), a.corpus)
+    print(f"{len(cases)} inputs in {a.corpus}")
 
 
 if __name__ == "__main__":

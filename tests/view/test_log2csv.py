@@ -106,7 +106,7 @@ def case_exact(a, t, tmp):
 
 
 def case_hostile(a, t, tmp):
-    seeds = lcmlog.seeds(t, os.path.join(tmp, "seeds"))
+    cases = lcmlog.corpus_cases(t, os.path.join(tmp, "corpus"))
     expect = {  # name: (exit code, text in stderr or stdout)
         "valid-run.lcm": (0, "T_STATE: joint_state_t, 6 messages"),
         "empty.lcm": (0, "records: 0"),
@@ -123,7 +123,7 @@ def case_hostile(a, t, tmp):
     }
     for name, (rc, text) in expect.items():
         out = os.path.join(tmp, "o-" + name)
-        p = run(a.log2csv, os.path.join(tmp, "seeds", name), "-o", out)
+        p = run(a.log2csv, os.path.join(tmp, "corpus", name), "-o", out)
         both = p.stdout + p.stderr
         check(p.returncode == rc and text in both, f"{name}: exit {rc} and '{text}' (got {p.returncode}: {both.strip()[-300:]})")
     p = run(a.log2csv, "/dev/zero", "-o", os.path.join(tmp, "oz"), timeout=10)
@@ -132,7 +132,7 @@ def case_hostile(a, t, tmp):
     check(p.returncode == 2 and "is a directory" in p.stderr, "a directory: exit 2, said so")
     p = run(a.log2csv, os.path.join(tmp, "nope.lcm"), "-o", os.path.join(tmp, "on"))
     check(p.returncode == 2 and "No such file" in p.stderr, "a missing file: exit 2")
-    p = run(a.log2csv, os.path.join(tmp, "seeds", "valid-run.lcm"), "-o", "/proc/self/nope/x")
+    p = run(a.log2csv, os.path.join(tmp, "corpus", "valid-run.lcm"), "-o", "/proc/self/nope/x")
     check(p.returncode == 2 and "cannot create" in p.stderr, "an unwritable output: exit 2")
     # 2 MiB of junk after a good record: the scan for a sync word gives up, bounded
     junk = os.path.join(tmp, "junk.lcm")

@@ -1,20 +1,20 @@
 #!/bin/bash
 # Writes the scene fuzz target's inputs (tests/fuzz/scene/, see tests/fuzz/fuzz_scene.c
 # for the format: the file, then one --set after each NUL byte).
-#   seed/   config/*.yaml and tests/scene/bad/*.yaml as they are, and a few of them
+#   corpus/   config/*.yaml and tests/scene/bad/*.yaml as they are, and a few of them
 #           with --set overrides
 #   crash/  small versions of files that once took minutes or gigabytes (kept for ever)
 # Usage: tests/fuzz/scene/make_inputs.sh   (from anywhere; rewrites both directories)
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../../.." && pwd)
-rm -rf "$here/seed" "$here/crash"
-mkdir -p "$here/seed" "$here/crash"
-for f in "$root"/config/*.yaml; do cp "$f" "$here/seed/config-$(basename "$f")"; done
-for f in "$root"/tests/scene/bad/*.yaml; do cp "$f" "$here/seed/bad-$(basename "$f")"; done
+rm -rf "$here/corpus" "$here/crash"
+mkdir -p "$here/corpus" "$here/crash"
+for f in "$root"/config/*.yaml; do cp "$f" "$here/corpus/config-$(basename "$f")"; done
+for f in "$root"/tests/scene/bad/*.yaml; do cp "$f" "$here/corpus/bad-$(basename "$f")"; done
 with_sets() { # NAME FILE SET...
     local name=$1 file=$2; shift 2
-    { cat "$file"; for s in "$@"; do printf '\0%s' "$s"; done; } > "$here/seed/$name"
+    { cat "$file"; for s in "$@"; do printf '\0%s' "$s"; done; } > "$here/corpus/$name"
 }
 with_sets set-dopri5.bin "$root/config/dipc.yaml" integrator.method=dopri5 integrator.rtol=1e-6 integrator.max_steps=500
 with_sets set-gauss4-lockstep.bin "$root/config/manipulator.yaml" integrator.method=gauss4 realtime.mode=lockstep "realtime.effort_limit={q1: 20, q2: 5}"

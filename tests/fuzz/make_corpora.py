@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""Writes the seed corpora of the wire, client, log and replay fuzz targets, and the kept
+"""Writes the corpora of the wire, client, log and replay fuzz targets, and the kept
 inputs that crashed, hung or leaked in the client library and --replay before they read
 through the wire module.
 
-    tests/fuzz/make_seeds.py BUILD_DIR            writes them
-    tests/fuzz/make_seeds.py BUILD_DIR --check    writes nothing; exit 1 if a kept file
+    tests/fuzz/make_corpora.py BUILD_DIR            writes them
+    tests/fuzz/make_corpora.py BUILD_DIR --check    writes nothing; exit 1 if a kept file
                                                   differs from what it would write
 
 Messages are encoded by lcm-gen's Python types (BUILD_DIR/python), independently of the
@@ -145,14 +145,14 @@ for name, data in [("joint-state.bin", state()), ("joint-command.bin", command()
                    ("control-reset-to.bin", control()), ("control-step.bin", control(control_t.STEP)),
                    ("event.bin", event()), ("status.bin", status()), ("scene.bin", scene()),
                    ("scene-full.bin", scene(16, 8)), ("joint-state-no-joints.bin", state(0))]:
-    write("wire", "seed", name, B8 + data)
-write("wire", "seed", "joint-state-bound-2.bin", b"\x03" + state())
-write("wire", "seed", "joint-state-negative-count.bin", B8 + state()[:34 - 2] + b"\xff\xff")
+    write("wire", "corpus", name, B8 + data)
+write("wire", "corpus", "joint-state-bound-2.bin", b"\x03" + state())
+write("wire", "corpus", "joint-state-negative-count.bin", B8 + state()[:34 - 2] + b"\xff\xff")
 
 # ---- client: first byte = channel (0 STATE, 1 STATUS, 2 EVENT, 3 SCENE)
 for name, data in [("state.bin", b"\x00" + state()), ("status.bin", b"\x01" + status()),
                    ("event.bin", b"\x02" + event()), ("scene.bin", b"\x03" + scene())]:
-    write("client", "seed", name, data)
+    write("client", "corpus", name, data)
 # what crashed, overread or leaked in the client's lcm-gen decoders
 write("client", "crash", "state-negative-name-length.bin",
       b"\x00" + forged_state(-1, b"", rest=False, pad_to=145))
@@ -178,9 +178,9 @@ write("client", "crash", "scene-32767-params.bin", b"\x03" + sc)
 # ---- log
 log = record("DIPC_STATE", state(), 0, 1000) + record("DIPC_STATUS", status(), 1, 2000) + \
       record("OTHER", b"x" * 40, 2, 3000) + record("DIPC_EVENT", b"", 3, 4000)
-write("log", "seed", "three-channels.lcm", log)
-write("log", "seed", "junk-between.lcm", log[:60] + b"junk" + log[60:])
-write("log", "seed", "cut-short.lcm", log[:-5])
+write("log", "corpus", "three-channels.lcm", log)
+write("log", "corpus", "junk-between.lcm", log[:60] + b"junk" + log[60:])
+write("log", "corpus", "cut-short.lcm", log[:-5])
 huge = struct.pack(">IqqII", SYNC, 0, 0, 10, 0x7FFFFFFF) + b"DIPC_STATE" + b"0123456789abcdef"
 write("log", "crash", "data-length-7fffffff.lcm", record("DIPC_STATE", state()) + huge)
 
@@ -218,8 +218,8 @@ try:
             recs = recs[:first]
         write(target, kind, name.replace("_", "-") + ".lcm", b"".join(recs))
 
-    keep("valid", "replay", "seed", first=12)     # states 0 .. 11 of a core run
-    keep("step_jump", "replay", "seed", first=24)  # ... and a step of 2^62 after state 19
+    keep("valid", "replay", "corpus", first=12)     # states 0 .. 11 of a core run
+    keep("step_jump", "replay", "corpus", first=24)  # ... and a step of 2^62 after state 19
 
     # a lagsimd --log log of 0.1 s with an actuator lag (its <PREFIX>_INPUT records, which
     # fuzz_replay's lagged scene reads), and the same without its sixth state (a gap)
@@ -231,9 +231,9 @@ try:
                            "--set", "lcm.url=memq://", "--duration", "0.1",
                            "-q", "--log", lagged])
     recs = records(lagged)
-    write("replay", "seed", "lagged-inputs.lcm", b"".join(recs), shape=log_shape)
+    write("replay", "corpus", "lagged-inputs.lcm", b"".join(recs), shape=log_shape)
     states = [k for k, r in enumerate(recs) if r[28:28 + 10] == b"DIPC_STATE"]
-    write("replay", "seed", "lagged-gap.lcm", b"".join(r for k, r in enumerate(recs) if k != states[5]),
+    write("replay", "corpus", "lagged-gap.lcm", b"".join(r for k, r in enumerate(recs) if k != states[5]),
           shape=log_shape)
 
     # changes made while running: the valid log with `set` events (as the daemon publishes
@@ -255,7 +255,7 @@ try:
             out.append(set_event(63, "effects.damping={theta1: 0.01}"))
         if len(st) > 9 and k == st[9]:
             out.append(set_event(90, "parameters.m2=-1"))
-    write("replay", "seed", "changes-while-running.lcm", b"".join(out))
+    write("replay", "corpus", "changes-while-running.lcm", b"".join(out))
 finally:
     shutil.rmtree(tmp)
 
@@ -286,7 +286,7 @@ flood = record("DIPC_STATE", forged_state(7, b"theta0\0", n=32767, rest=False))
 write("replay", "crash", "undecodable-flood.lcm", s0 + flood * 100 + s10)  # leaked 262 kB each
 if check:
     for path in stale:
-        print("stale: tests/fuzz/%s (run tests/fuzz/make_seeds.py BUILD_DIR)" % path)
+        print("stale: tests/fuzz/%s (run tests/fuzz/make_corpora.py BUILD_DIR)" % path)
     print("%d kept inputs checked against the types, %d stale" % (n_written[0], len(stale)))
     sys.exit(1 if stale else 0)
-print("seeds written under", here)
+print("corpora written under", here)
