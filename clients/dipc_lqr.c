@@ -73,18 +73,6 @@ static int set_weights(const char *v, void *target, char *err, size_t errlen)
     return 0;
 }
 
-/* --gain: discrete or continuous */
-static int set_gain(const char *v, void *target, char *err, size_t errlen)
-{
-    if (!strcmp(v, "continuous")) *(int *)target = 1;
-    else if (!strcmp(v, "discrete")) *(int *)target = 0;
-    else {
-        snprintf(err, errlen, "discrete or continuous, got '%s'", v);
-        return -1;
-    }
-    return 0;
-}
-
 /* --k: a given gain of six numbers */
 static int set_k(const char *v, void *target, char *err, size_t errlen)
 {
@@ -100,7 +88,7 @@ int main(int argc, char **argv)
     int continuous = 0;
     const lag_ctl_option mine[] = {
         {"gain", "G", "discrete (default: DARE at the control period) or continuous",
-         set_gain, &continuous},
+         lag_ctl_gain_kind, &continuous},
         {"q", "a,b,c,d,e,f", "state weights (default 5,50,50,20,700,700, Bogdanov 2004)",
          set_weights, qw},
         {"r", "R", "input weight (default 1)", lag_ctl_positive, &r_weight},

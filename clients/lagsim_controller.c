@@ -66,6 +66,17 @@ int lag_ctl_flag(const char *value, void *target, char *err, size_t errlen)
     return 0;
 }
 
+int lag_ctl_gain_kind(const char *value, void *target, char *err, size_t errlen)
+{
+    if (!strcmp(value, "continuous")) *(int *)target = 1;
+    else if (!strcmp(value, "discrete")) *(int *)target = 0;
+    else {
+        snprintf(err, errlen, "discrete or continuous, got '%s'", value);
+        return -1;
+    }
+    return 0;
+}
+
 int lag_ctl_parse_list(const char *value, double *out, int n, char *err, size_t errlen)
 {
     const char *s = value ? value : "";

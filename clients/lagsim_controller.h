@@ -67,6 +67,8 @@ int lag_ctl_positive(const char *value, void *target, char *err, size_t errlen);
 int lag_ctl_nonnegative(const char *value, void *target, char *err, size_t errlen);
 int lag_ctl_number(const char *value, void *target, char *err, size_t errlen);
 int lag_ctl_flag(const char *value, void *target, char *err, size_t errlen);
+/* An LQR's gain: "discrete" (0) or "continuous" (1) into an int. */
+int lag_ctl_gain_kind(const char *value, void *target, char *err, size_t errlen);
 /* n comma-separated finite numbers into double[n]: used by setters of lists. */
 int lag_ctl_parse_list(const char *value, double *out, int n, char *err, size_t errlen);
 

@@ -46,17 +46,6 @@ static int set_list(const char *v, void *target, char *err, size_t errlen)
     return 0;
 }
 
-static int set_gain(const char *v, void *target, char *err, size_t errlen)
-{
-    if (!strcmp(v, "continuous")) *(int *)target = 1;
-    else if (!strcmp(v, "discrete")) *(int *)target = 0;
-    else {
-        snprintf(err, errlen, "discrete or continuous, got '%s'", v);
-        return -1;
-    }
-    return 0;
-}
-
 static double eig_bound(int n, const double *M, int discrete)
 {
     double re[2 * NS], im[2 * NS], b = -INFINITY;
@@ -89,7 +78,7 @@ int main(int argc, char **argv)
         {"q0", "a,...", "the equilibrium's positions, nq of them (default 0 each)", set_list,
          &q0w},
         {"gain", "G", "discrete (default: DARE at the control period) or continuous",
-         set_gain, &continuous},
+         lag_ctl_gain_kind, &continuous},
     };
     lag_ctl ctl;
     lag_ctl_init(&ctl, "lqr_balance", NULL);
