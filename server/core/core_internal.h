@@ -32,6 +32,15 @@ typedef struct lag_model_class {
 /* Declared without its size, so that the definition's own count of rows is what the
  * _Static_assert there compares with LAG_MODEL_COUNT. */
 extern const lag_model_class *const lag_models[];
+/* The stick's parameters, one rod, as both its models (sliding, flying) describe them in
+ * their lag_model_info. */
+#define LAG_STICK_PARAMS_INFO                                                      \
+    .np = LAG_STICK_NP, .param_names = {"m", "l", "I", "g"},                       \
+    .param_defaults = {1.0, 1.0, NAN, 9.81},                                       \
+    .param_units = {"kg", "m", "kg m^2", "m/s^2"},                                 \
+    .param_rules = {[LAG_STICK_G] = LAG_PARAM_NONNEGATIVE}, .n_rods = 1,           \
+    .rods = {{LAG_STICK_I, LAG_STICK_M, LAG_STICK_L}}
+
 static inline const lag_model_class *lag_model_vt(const lag_model *m)
 {
     LAG_ASSERT((unsigned)m->kind < LAG_MODEL_COUNT && lag_models[m->kind]);
