@@ -1,8 +1,11 @@
-# Controller evaluation: the metrics library (server/eval) against closed forms of first-
-# and second-order responses, and the --require parser. One ctest per case (eval.metrics.<case>).
+# Controller evaluation (server/eval): reference signals against their closed forms and
+# their rates against differences; the metrics against closed forms of first- and
+# second-order responses; the --require parser. One ctest per case (eval.<program>.<case>).
 include(${CMAKE_CURRENT_LIST_DIR}/common/cases.cmake)
-add_executable(test_eval_metrics ${CMAKE_CURRENT_LIST_DIR}/eval/test_metrics.c)
-target_include_directories(test_eval_metrics PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
-target_compile_definitions(test_eval_metrics PRIVATE LAGSIM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-target_link_libraries(test_eval_metrics PRIVATE lagsim_metrics m)
-lagsim_add_test_cases(test_eval_metrics eval.metrics eval 60)
+foreach(t metrics reference)
+  add_executable(test_eval_${t} ${CMAKE_CURRENT_LIST_DIR}/eval/test_${t}.c)
+  target_include_directories(test_eval_${t} PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
+  target_compile_definitions(test_eval_${t} PRIVATE LAGSIM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  target_link_libraries(test_eval_${t} PRIVATE lagsim_eval m)
+  lagsim_add_test_cases(test_eval_${t} eval.${t} eval 60)
+endforeach()

@@ -1,0 +1,190 @@
+/*
+ * Reference signals (server/eval/reference.c): each kind's values at points where the
+ * formula gives them in closed form, its rate against a central difference of its values,
+ * continuity where the formula changes branch, and the checks of bad definitions.
+ *
+ * Tolerances: a central difference with step h of a signal whose third derivative is at
+ * most D3 is off by h^2 D3 / 6 plus rounding eps |r| / h; with h = 1e-5 and the signals
+ * below (|r| <= 3, D3 <= (2 pi 12)^3 * 2) that is under 2e-4 relative to the rate scale,
+ * checked at 1e-3 of the largest rate.
+ */
+#include "lagsim_test.h"
+#include "reference.h"
+
+static double value(const lag_reference *ref, double t)
+{
+    double r;
+    lag_reference_eval(ref, t, &r, NULL);
+    return r;
+}
+
+/* r' against a central difference at n times in [a, b], away from jumps (skip says). */
+static void check_rate(const lag_reference *ref, double a, double b, double scale,
+                       int (*skip)(const lag_reference *, double))
+{
+    lt_rng rng = {42};
+    const double h = 1e-5;
+    for (int i = 0; i < 400; i++) {
+        double t = lt_uniform(&rng, a, b);
+        if (skip && skip(ref, t)) continue;
+        double rd;
+        lag_reference_eval(ref, t, NULL, &rd);
+        double fd = (value(ref, t + h) - value(ref, t - h)) / (2 * h);
+        ENSURE_NEAR(rd, fd, 1e-3 * scale, "%s at t = %.9g", lag_ref_kind_table[ref->kind].name, t);
+    }
+}
+
+static int near_kink(const lag_reference *ref, double t)
+{
+    const double h = 2e-5;
+    double tau = t - ref->start;
+    if (fabs(tau) < h) return 1;
+    if ((ref->kind == LAG_REF_RAMP || ref->kind == LAG_REF_CHIRP) && fabs(tau - ref->duration) < h) return 1;
+    if (ref->kind == LAG_REF_WAYPOINTS)
+        for (int i = 0; i < ref->n_points; i++)
+            if (fabs(tau - ref->point_t[i]) < h) return 1;
+    return 0;
+}
+
+static void case_step(int arg)
+{
+    (void)arg;
+    lag_reference s = lag_reference_default(LAG_REF_STEP);
+    s.start = 1, s.amplitude = 0.2, s.offset = -0.1;
+    double r, rd;
+    lag_reference_eval(&s, 0.999, &r, &rd);
+    ENSURE(r == -0.1 && rd == 0);
+    lag_reference_eval(&s, 1.0, &r, &rd);
+    ENSURE_NEAR(r, 0.1, 1e-15, "step at its start");
+    ENSURE(rd == 0);
+    lag_reference_eval(&s, 1e6, &r, &rd);
+    ENSURE_NEAR(r, 0.1, 1e-15, "step held");
+}
+
+static void case_ramp(int arg)
+{
+    (void)arg;
+    lag_reference s = lag_reference_default(LAG_REF_RAMP);
+    s.start = 0.5, s.amplitude = 2, s.offset = 1, s.duration = 4;
+    ENSURE(value(&s, 0.5) == 1);
+    ENSURE_NEAR(value(&s, 2.5), 2, 1e-15, "half way");
+    ENSURE_NEAR(value(&s, 4.5), 3, 1e-15, "the end");
+    ENSURE_NEAR(value(&s, 100), 3, 0, "held");
+    double rd;
+    lag_reference_eval(&s, 3, NULL, &rd);
+    ENSURE_NEAR(rd, 0.5, 1e-15, "slope amplitude / duration");
+    check_rate(&s, 0, 6, 0.5, near_kink);
+}
+
+static void case_sine(int arg)
+{
+    (void)arg;
+    lag_reference s = lag_reference_default(LAG_REF_SINE);
+    s.start = 1, s.amplitude = 3, s.offset = 0.5, s.frequency = 2;
+    ENSURE_NEAR(value(&s, 1 + 0.125), 3.5, 1e-14, "a quarter period: offset + amplitude");
+    ENSURE_NEAR(value(&s, 1 + 0.375), -2.5, 1e-14, "three quarters: offset - amplitude");
+    ENSURE_NEAR(value(&s, 1 + 0.25 * 7), 0.5, 1e-13, "3.5 periods: offset");
+    ENSURE(value(&s, 0.9) == 0.5);
+    check_rate(&s, 0, 5, 2 * M_PI * 2 * 3, near_kink);
+}
+
+static void case_chirp(int arg)
+{
+    (void)arg;
+    lag_reference s = lag_reference_default(LAG_REF_CHIRP);
+    s.start = 0, s.amplitude = 1, s.offset = 0, s.frequency = 1, s.frequency_end = 11, s.duration = 2;
+    /* phi(tau) = 2 pi (tau + 2.5 tau^2): zero crossings where tau + 2.5 tau^2 = k / 2 */
+    for (int k = 1; k <= 23; k++) {
+        double tau = (-1 + sqrt(1 + 10.0 * k * 0.5)) / 5;
+        ENSURE_NEAR(value(&s, tau), 0, 1e-12, "zero crossing %d at %.9g s", k, tau);
+    }
+    /* crests where phi = pi/2 + 2 pi k */
+    for (int k = 0; k <= 10; k++) {
+        double c = 0.25 + k, tau = (-1 + sqrt(1 + 10.0 * c)) / 5;
+        ENSURE_NEAR(value(&s, tau), 1, 1e-12, "crest %d", k);
+    }
+    /* after the sweep: 11 Hz from phase 2 pi (1 + 11) / 2 * 2 = 2 pi 12 */
+    ENSURE_NEAR(value(&s, 2 + 1.0 / 44), 1, 1e-12, "a quarter period of 11 Hz after the sweep");
+    double r0, r1;
+    lag_reference_eval(&s, 2 - 1e-12, &r0, NULL);
+    lag_reference_eval(&s, 2 + 1e-12, &r1, NULL);
+    ENSURE_NEAR(r0, r1, 1e-9, "continuous at the sweep's end");
+    check_rate(&s, 0, 4, 2 * M_PI * 11, near_kink);
+}
+
+static void case_square(int arg)
+{
+    (void)arg;
+    lag_reference s = lag_reference_default(LAG_REF_SQUARE);
+    s.start = 0.25, s.amplitude = 2, s.offset = 1, s.frequency = 0.5;
+    ENSURE(value(&s, 0.2) == 1);
+    ENSURE(value(&s, 0.25) == 3);
+    ENSURE(value(&s, 1.2) == 3);
+    ENSURE(value(&s, 1.3) == -1);
+    ENSURE(value(&s, 2.2) == -1);
+    ENSURE(value(&s, 2.3) == 3);
+    double rd;
+    lag_reference_eval(&s, 1.0, NULL, &rd);
+    ENSURE(rd == 0);
+}
+
+static void case_waypoints(int arg)
+{
+    (void)arg;
+    lag_reference s = lag_reference_default(LAG_REF_WAYPOINTS);
+    s.start = 1, s.amplitude = 2, s.offset = 0.5;
+    double pt[] = {0, 2, 3, 5}, pw[] = {0.1, 0.3, -0.2, -0.2};
+    s.n_points = 4;
+    memcpy(s.point_t, pt, sizeof pt);
+    memcpy(s.point_w, pw, sizeof pw);
+    ENSURE_NEAR(value(&s, 0), 0.5 + 2 * 0.1, 1e-15, "held before the first point");
+    ENSURE_NEAR(value(&s, 2), 0.5 + 2 * 0.2, 1e-15, "half way to the second");
+    ENSURE_NEAR(value(&s, 3.5), 0.5 + 2 * 0.05, 1e-15, "half way to the third");
+    ENSURE_NEAR(value(&s, 10), 0.5 - 2 * 0.2, 1e-15, "held after the last");
+    double rd;
+    lag_reference_eval(&s, 3.5, NULL, &rd);
+    ENSURE_NEAR(rd, 2 * -0.5, 1e-15, "slope");
+    check_rate(&s, -1, 8, 1, near_kink);
+}
+
+static void case_check(int arg)
+{
+    (void)arg;
+    char key[32], msg[128];
+    for (int k = 0; k < LAG_REF_KIND_COUNT; k++) {
+        lag_reference s = lag_reference_default((lag_ref_kind)k);
+        if (k == LAG_REF_WAYPOINTS) s.n_points = 1;
+        ENSURE(lag_reference_check(&s, key, sizeof key, msg, sizeof msg) == 0);
+        ENSURE(lag_ref_kind_from_name(lag_ref_kind_table[k].name) == k);
+    }
+    ENSURE(lag_ref_kind_from_name("triangle") == -1);
+    lag_reference s = lag_reference_default(LAG_REF_SINE);
+    s.frequency = 0;
+    ENSURE(lag_reference_check(&s, key, sizeof key, msg, sizeof msg) == -1 && !strcmp(key, "frequency"));
+    s = lag_reference_default(LAG_REF_STEP);
+    s.frequency = 0; /* a key the kind does not take is not checked */
+    ENSURE(lag_reference_check(&s, key, sizeof key, msg, sizeof msg) == 0);
+    s.amplitude = NAN;
+    ENSURE(lag_reference_check(&s, key, sizeof key, msg, sizeof msg) == -1 && !strcmp(key, "amplitude"));
+    s = lag_reference_default(LAG_REF_CHIRP);
+    s.duration = -1;
+    ENSURE(lag_reference_check(&s, key, sizeof key, msg, sizeof msg) == -1 && !strcmp(key, "duration"));
+    s = lag_reference_default(LAG_REF_WAYPOINTS);
+    ENSURE(lag_reference_check(&s, key, sizeof key, msg, sizeof msg) == -1 && !strcmp(key, "points"));
+    s.n_points = 3;
+    s.point_t[0] = 0, s.point_t[1] = 1, s.point_t[2] = 1;
+    ENSURE(lag_reference_check(&s, key, sizeof key, msg, sizeof msg) == -1 && !strcmp(key, "points[2]"));
+    s.start = INFINITY;
+    ENSURE(lag_reference_check(&s, key, sizeof key, msg, sizeof msg) == -1 && !strcmp(key, "start"));
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {
+        {"step", case_step, 0, 0},       {"ramp", case_ramp, 0, 0},
+        {"sine", case_sine, 0, 0},       {"chirp", case_chirp, 0, 0},
+        {"square", case_square, 0, 0},   {"waypoints", case_waypoints, 0, 0},
+        {"check", case_check, 0, 0},
+    };
+    return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
+}
