@@ -15,7 +15,7 @@
 lag_cost_opts lag_cost_opts_default(void)
 {
     return (lag_cost_opts){.target = 1e-6, .horizon = 1, .period = 0.01, .safety = 4,
-                           .budget = 3, .clock = NULL, .clock_ctx = NULL};
+                           .budget = 3, .complete = false, .clock = NULL, .clock_ctx = NULL};
 }
 
 static double thread_cpu(void *ctx)
@@ -226,7 +226,8 @@ lag_result lag_cost_measure(const lag_sim_def *def, const lag_cost_opts *o,
             out->row[out->n++] = row;
             if (row.meets && row.cpu_per_sim_s < cheapest) cheapest = row.cpu_per_sim_s;
             if (row.meets) break;                          /* finer only costs more */
-            if (row.fault == LAG_OK && row.cpu_per_sim_s > cheapest) break; /* can't win */
+            if (!o->complete && row.fault == LAG_OK && row.cpu_per_sim_s > cheapest)
+                break; /* can no longer be chosen */
         }
     }
     for (int i = 0; i < out->n; i++) {

@@ -49,6 +49,9 @@ typedef struct lag_cost_opts {
     double period;      /* s: the scene's publish period; fixed dts divide it */
     double safety;      /* a setting meets the target when error * safety <= target (4) */
     double budget;      /* CPU seconds the whole calibration may take (3) */
+    bool complete;      /* refine every method until it meets the target (or the budget
+                           ends), not only while it could still be the cheapest: a whole
+                           work-precision curve per method (lagsimd --cost) */
     double (*clock)(void *ctx); /* CPU seconds; NULL: the process's CPU clock */
     void *clock_ctx;
 } lag_cost_opts;

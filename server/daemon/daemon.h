@@ -36,5 +36,22 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o);
  * difference from the logged states. Returns an exit code: 0 when it is at most
  * o->tolerance, 1 when it is larger or nothing could be checked. */
 int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts *o);
+/* The integrator a calibration chose, as scene overrides ("integrator.method=rk4",
+ * "integrator.dt=0.0025", dopri5's rtol and atol): applied after the scene's own --set,
+ * so that every reload of the scene (a change made while running) gives the same. */
+typedef struct lagsimd_choice {
+    int n;
+    char kv[4][64];
+} lagsimd_choice;
+/* A scene with integrator.error: measures the integrator settings on it and chooses the
+ * cheapest that meets the error (in a paced real-time run, one that also keeps a margin
+ * to real time), printing the choice in one line unless quiet. Offline, a scene no
+ * setting meets runs with the most accurate one and a warning; paced, it is refused.
+ * Returns an exit code (LAGSIMD_EXIT_OK when the scene may run); ch->n = 0 without
+ * integrator.error. OUT: ch */
+int lagsimd_choose_integrator(const lag_scene *sc, bool offline, bool quiet, lagsimd_choice *ch);
+/* --cost: the table of what each setting costs on this scene and machine, on stdout;
+ * with png, gnuplot's work-precision diagram too. Returns an exit code. */
+int lagsimd_cost(const lag_scene *sc, const char *png);
 
 #endif

@@ -20,6 +20,7 @@ static void usage(FILE *f)
         "               [--log FILE.lcm [--log-buffer MIB]]\n"
         "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|-] [--set ...]\n"
         "       lagsimd --config FILE --replay LOG.lcm [--tolerance X] [--set ...]\n"
+        "       lagsimd --config FILE --cost [--plot FILE.png] [--set ...]\n"
         "\n"
         "Steps one Lagrangian model (stick, manipulator, dipc) described by a YAML scene.\n"
         "Default: the real-time LCM server (states out, effort commands in) until SIGINT.\n"
@@ -47,6 +48,13 @@ static void usage(FILE *f)
         "                         efforts in its logged states; print the largest difference\n"
         "      --tolerance X      --replay: exit 1 when the largest difference is above X\n"
         "                         (default 0: a log of the same scene and build is exact)\n"
+        "      --cost             measure what accuracy costs on this scene and machine: each\n"
+        "                         integrator setting's error over integrator.horizon against\n"
+        "                         a tight reference, its CPU per sim-second, its margin to\n"
+        "                         real time; the error asked for is integrator.error (1e-6\n"
+        "                         if the scene gives none). A scene with integrator.error\n"
+        "                         runs with the cheapest setting that meets it\n"
+        "      --plot FILE.png    --cost: draw the work-precision diagram (gnuplot)\n"
         "  -q, --quiet            no live status line or event lines / offline summary\n"
         "  -h, --help             this help\n"
         "  -V, --version          print the version\n"
@@ -128,9 +136,33 @@ static int resolve_default_url(lag_scene *sc)
     return 0;
 }
 
+/* Whether the --set overrides give integrator.method (a scene's integrator.error then
+ * chooses nothing: the run is told). */
+static bool integrator_given(const char *const *sets, int nsets)
+{
+    for (int i = 0; i < nsets; i++)
+        if (strncmp(sets[i], "integrator.method=", 18) == 0) return true;
+    return false;
+}
+
+/* Appends the calibration's choice to the overrides (main made room for its 4) and
+ * loads the scene again with it. */
+static int reload_with(const char *config, const char *text, size_t len, const char **sets,
+                       int *nsets, const lagsimd_choice *ch, lag_scene *sc)
+{
+    char err[1024];
+    for (int i = 0; i < ch->n; i++) sets[(*nsets)++] = ch->kv[i];
+    if (lag_scene_load_buffer(config, text, len, sets, *nsets, sc, err, sizeof err) != 0) {
+        fprintf(stderr, "lagsimd: the integrator chosen for integrator.error: %s\n", err);
+        return -1;
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
-    enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE };
+    enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE,
+           OPT_COST, OPT_PLOT };
     static const struct option longopts[] = {
         {"config", required_argument, NULL, 'c'},
         {"set", required_argument, NULL, 's'},
@@ -141,16 +173,20 @@ int main(int argc, char **argv)
         {"log", required_argument, NULL, OPT_LOG},
         {"log-buffer", required_argument, NULL, OPT_LOG_BUFFER},
         {"tolerance", required_argument, NULL, OPT_TOLERANCE},
+        {"cost", no_argument, NULL, OPT_COST},
+        {"plot", required_argument, NULL, OPT_PLOT},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {"version", no_argument, NULL, 'V'},
         {NULL, 0, NULL, 0},
     };
 
-    const char *config = NULL, *replay = NULL;
+    const char *config = NULL, *replay = NULL, *plot = NULL;
+    bool cost = false;
     bool offline = false, have_duration = false, have_tolerance = false, have_ring = false;
     lagsimd_opts opts = {.quiet = false, .duration = 0.0, .csv = NULL};
-    const char **sets = calloc((size_t)argc + 1, sizeof *sets);
+    /* the --set overrides, and room for a calibration's choice (lagsimd_choice) */
+    const char **sets = calloc((size_t)argc + 1 + 4, sizeof *sets);
     int nsets = 0;
     if (!sets) {
         fputs("lagsimd: out of memory\n", stderr);
@@ -216,6 +252,12 @@ int main(int argc, char **argv)
             have_tolerance = true;
             break;
         }
+        case OPT_COST:
+            cost = true;
+            break;
+        case OPT_PLOT:
+            plot = optarg;
+            break;
         case 'q':
             opts.quiet = true;
             break;
@@ -252,6 +294,10 @@ int main(int argc, char **argv)
         rc = usage_error("%s", "--log-buffer needs --log FILE");
     } else if (have_tolerance && !replay) {
         rc = usage_error("%s", "--tolerance needs --replay LOG");
+    } else if (cost && (offline || replay || opts.log)) {
+        rc = usage_error("%s", "--cost measures the scene and exits: not with --offline, --replay or --log");
+    } else if (plot && !cost) {
+        rc = usage_error("%s", "--plot needs --cost");
     } else {
         static lag_scene sc;
         char err[1024];
@@ -259,9 +305,23 @@ int main(int argc, char **argv)
          * the same bytes */
         char *text = NULL;
         size_t len = 0;
+        static lagsimd_choice choice;
         if (lag_scene_read(config, &text, &len, err, sizeof err) != 0 ||
             lag_scene_load_buffer(config, text, len, sets, nsets, &sc, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
+            rc = LAGSIMD_EXIT_USAGE;
+        } else if (cost) {
+            rc = lagsimd_cost(&sc, plot);
+        } else if (replay && sc.accuracy.error > 0 && !integrator_given(sets, nsets)) {
+            fprintf(stderr, "lagsimd: %s: integrator.error: the recorded run chose its integrator "
+                    "when it started; give the same with --set integrator.method=... --set "
+                    "integrator.dt=... (and rtol, atol for dopri5), as the run printed them\n",
+                    config);
+            rc = LAGSIMD_EXIT_USAGE;
+        } else if (!replay &&
+                   (rc = lagsimd_choose_integrator(&sc, offline, opts.quiet, &choice)) != LAGSIMD_EXIT_OK) {
+            /* said why */
+        } else if (choice.n > 0 && reload_with(config, text, len, sets, &nsets, &choice, &sc) != 0) {
             rc = LAGSIMD_EXIT_USAGE;
         } else {
             opts.scene_name = config;

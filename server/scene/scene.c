@@ -17,6 +17,7 @@ void lag_scene_default(lag_scene *sc, lag_model_kind kind)
     memset(sc, 0, sizeof *sc);
     sc->sim = lag_default_sim_def(kind);
     sc->publish_hz = 100.0;
+    sc->accuracy.horizon = 1.0;
     /* 1/100 s at dt = 1 ms; the loader recomputes it from the scene's values. */
     sc->ticks_per_period = 10;
     if (sc->sim.integrator.dt > 0.0) {

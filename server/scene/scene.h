@@ -30,6 +30,13 @@ typedef enum lag_rt_start {
 typedef struct lag_scene {
     char path[512];          /* file it was read from ("" if built in code) */
     lag_sim_def sim;         /* model, parameters, integrator, initial state */
+    struct {
+        double error;        /* integrator.error: 0, or the largest difference from the
+                                exact q (m or rad) over `horizon` that the run may have:
+                                lagsimd then chooses sim.integrator's method and dt (and
+                                ticks_per_period) itself, measuring on this scene */
+        double horizon;      /* integrator.horizon, s of sim time; default 1 */
+    } accuracy;
     double publish_hz;       /* state output rate = control rate, Hz; default 100 */
     int64_t ticks_per_period;/* (1/publish_hz) / dt, an integer (validated) */
     struct {

@@ -50,6 +50,8 @@ static const range R_RTOL = {1e-14, 0.1, false, NULL};      /* below ~50 eps no 
 static const range R_ATOL = {1e-14, 1.0, false, "m, rad, m/s or rad/s"};
 static const range R_DT_MIN = {1e-15, 1.0, false, "s"};      /* and <= dt */
 static const range R_NEWTON_TOL = {1e-15, 0.1, false, NULL}; /* scaled update: ~5 eps at best */
+static const range R_ERROR = {1e-12, 0.1, false, "m or rad"}; /* below: the reference's own error */
+static const range R_HORIZON = {1e-3, 100.0, false, "s"};      /* and >= one period, <= 1e6 periods */
 static const range R_PUBLISH_HZ = {0.01, 10000.0, false, "Hz"}; /* and 1/publish_hz = k dt, k <= TICKS_MAX */
 static const range R_EXPLODE = {1e-6, 1e9, false, "m, rad, m/s or rad/s"};
 static const range R_RATE = {1e-3, 1e3, false, "sim s per wall s"};
@@ -540,6 +542,18 @@ static int key_newton_tol(conv *cv, const ynode *nd, const char *path)
     return get_range(cv, nd, path, &R_NEWTON_TOL, &cv->sc->sim.integrator.newton_tol);
 }
 
+/* integrator.error: the largest difference from the exact q over integrator.horizon that
+ * the run may have; the daemon then chooses method and dt itself (lagsimd's calibration) */
+static int key_error(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_ERROR, &cv->sc->accuracy.error);
+}
+
+static int key_horizon(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_HORIZON, &cv->sc->accuracy.horizon);
+}
+
 static const keyrow k_integrator_keys[] = {
     {"method", key_method, K_OTHER},         /* euler | semi-implicit-euler | rk4 | dopri5 | ... */
     {"dt", key_dt, K_NUMBER},                 /* s */
@@ -549,6 +563,8 @@ static const keyrow k_integrator_keys[] = {
     {"max_iter", key_max_iter, K_INTEGER},     /* implicit methods, 1..1000 */
     {"max_steps", key_max_steps, K_INTEGER},   /* dopri5, steps per tick, 1..1e6 */
     {"newton_tol", key_newton_tol, K_NUMBER}, /* implicit methods */
+    {"error", key_error, K_NUMBER},           /* m or rad over horizon: chooses method, dt */
+    {"horizon", key_horizon, K_NUMBER},       /* s, the error's horizon (1) */
     {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
@@ -1134,6 +1150,8 @@ static void model_list(char *buf, size_t len)
 static int check_period(conv *cv)
 {
     lag_scene *sc = cv->sc;
+    /* integrator.error chooses dt later (lagsimd); one that divides the period until then */
+    if (sc->accuracy.error > 0 && !cv->dt) sc->sim.integrator.dt = 1.0 / sc->publish_hz;
     double dt = sc->sim.integrator.dt;
     double period = 1.0 / sc->publish_hz;
     double r = period / dt;
