@@ -5,7 +5,8 @@
  * message; its CSV is opened then, with a header from that message (a state's joint
  * names). A later message of another type or other joints on the same channel is not
  * written, only counted. Every number is written "%.17g" (a reread gives the same
- * double); strings are quoted, control characters replaced by spaces.
+ * double); every string from the log (names, kinds, details, in headers and cells) is
+ * quoted and kept from reading as a spreadsheet formula (put_text).
  *
  * Per-channel facts for the summary: counts, log-time span and rate, undecodable
  * messages; for states the step sequence (gaps: a step increase other than one control
@@ -70,17 +71,37 @@ typedef struct l2c {
 /* ---------------------------------------------------------------- CSV helpers */
 static void put_d(FILE *f, double x) { fprintf(f, ",%.17g", x); }
 static void put_i(FILE *f, int64_t x) { fprintf(f, ",%" PRId64, x); }
-static void put_s(FILE *f, const char *s)
+/* One text field from a log (a name, a kind, a detail), RFC 4180: always in double quotes,
+ * a quote doubled; control characters become spaces, so one record is one line. A field
+ * whose first non-blank character would start a formula in a spreadsheet (=, +, -, @;
+ * tab and CR are spaces by then) is written as text: a leading apostrophe, as OWASP's
+ * CSV-injection guidance asks. `suffix` (may be NULL) is appended inside the quotes: a
+ * header's "<joint>_dot". Numbers never pass here: they stay numbers. */
+static void put_text(FILE *f, const char *s, const char *suffix)
 {
-    fputs(",\"", f);
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"') fputs("\"\"", f);
-        else if (c < 0x20 || c == 0x7f) fputc(' ', f);
-        else fputc(c, f);
-    }
+    const char *p = s;
+    while (*p == ' ' || ((unsigned char)*p < 0x20 && *p)) p++;
+    bool formula = *p == '=' || *p == '+' || *p == '-' || *p == '@';
+    fputc('"', f);
+    if (formula) fputc('\'', f);
+    for (int pass = 0; pass < 2; pass++)
+        for (const char *q = pass ? (suffix ? suffix : "") : s; *q; q++) {
+            unsigned char c = (unsigned char)*q;
+            if (c == '"') fputs("\"\"", f);
+            else if (c < 0x20 || c == 0x7f) fputc(' ', f);
+            else fputc(c, f);
+        }
     fputc('"', f);
 }
+static void put_s(FILE *f, const char *s)
+{
+    fputc(',', f);
+    put_text(f, s, NULL);
+}
+/* A list of numbers this tool formatted ("%.17g" joined by spaces): quoted, and not
+ * marked as text, a leading minus sign included (digits, signs, '.', 'e', "inf", "nan"
+ * and spaces make no formula that reaches anything). */
+static void put_numbers(FILE *f, const char *s) { fprintf(f, ",\"%s\"", s); }
 /* Log timestamp and utime in seconds since the epoch (us resolution). */
 static void put_us(FILE *f, int64_t us, bool first)
 {
@@ -182,10 +203,13 @@ static chan *scene_of(l2c *c, const chan *state)
 /* ---------------------------------------------------------------- one type each */
 static void header_state(FILE *f, const lag_wire_joint_state *m)
 {
+    static const char *const suffix[] = {"", "_dot", "_effort"};
     fputs("t,wall_time,log_time,step", f);
-    for (int i = 0; i < m->num_joints; i++) fprintf(f, ",%s", m->name[i]);
-    for (int i = 0; i < m->num_joints; i++) fprintf(f, ",%s_dot", m->name[i]);
-    for (int i = 0; i < m->num_joints; i++) fprintf(f, ",%s_effort", m->name[i]);
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < m->num_joints; i++) {
+            fputc(',', f);
+            put_text(f, m->name[i], suffix[k]);
+        }
     fputc('\n', f);
 }
 
@@ -416,8 +440,8 @@ static bool write_control(l2c *c, chan *h, const lag_log_record *r, const lag_wi
     put_i(f, m->request);
     put_s(f, request_name(m->request));
     put_i(f, m->count);
-    put_s(f, q);
-    put_s(f, qd);
+    put_numbers(f, q);
+    put_numbers(f, qd);
     fputc('\n', f);
     return true;
 }
