@@ -14,6 +14,7 @@
  * again, as while paused); for status the last counters; for events a count per kind.
  */
 #include "log2csv.h"
+#include "lagsim/lagsim.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -350,6 +351,20 @@ static bool write_event(l2c *c, chan *h, const lag_log_record *r, const lag_wire
     return true;
 }
 
+/* The core's model whose joints are the scene's, in order (a stick that may fly publishes
+ * the flying stick's x, phi, h), or NULL: where a joint's unit (m or rad) comes from. */
+static const lag_model_info *scene_model(const lag_wire_scene *m)
+{
+    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
+        const lag_model_info *info = lag_model_info_get((lag_model_kind)k);
+        bool same = info && info->nq == m->num_joints;
+        for (int i = 0; same && i < m->num_joints; i++)
+            same = strcmp(info->joint_names[i], m->joint_name[i]) == 0;
+        if (same) return info;
+    }
+    return NULL;
+}
+
 static bool write_scene(l2c *c, chan *h, const lag_log_record *r, const lag_wire_scene *m)
 {
     if (!h->csv) {
@@ -358,9 +373,10 @@ static bool write_scene(l2c *c, chan *h, const lag_log_record *r, const lag_wire
               "command_timeout,effects,parameters,joints\n", h->csv);
     }
     FILE *f = h->csv;
-    char params[LAG_WIRE_MAX_PARAMS * (L2C_NAME + 32)], joints[L2C_JOINTS * (L2C_NAME + 160)];
+    char params[LAG_WIRE_MAX_PARAMS * (L2C_NAME + 32)], joints[L2C_JOINTS * (L2C_NAME + 192)];
     size_t n = 0;
     params[0] = joints[0] = '\0';
+    const lag_model_info *info = scene_model(m);
     for (int i = 0; i < m->num_params; i++)
         n += (size_t)snprintf(params + n, sizeof params - n, "%s%s=%.17g", i ? " " : "",
                               m->param_name[i], m->param_value[i]);
@@ -373,6 +389,9 @@ static bool write_scene(l2c *c, chan *h, const lag_log_record *r, const lag_wire
         if (m->limit_on[i])
             n += (size_t)snprintf(joints + n, sizeof joints - n, ":limits=%.17g..%.17g",
                                   m->limit_lower[i], m->limit_upper[i]);
+        if (info)
+            n += (size_t)snprintf(joints + n, sizeof joints - n, ":unit=%s",
+                                  info->angular[i] ? "rad" : "m");
     }
     put_us(f, m->utime, true);
     put_us(f, r->timestamp, false);

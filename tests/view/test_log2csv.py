@@ -7,6 +7,7 @@ decoder under test shares nothing with), and against hostile logs.
 import argparse
 import csv
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -250,20 +251,113 @@ def case_injection(a, t, tmp):
     script = open(gp).read() if os.path.exists(gp) else ""
     for i, n in enumerate(j):
         title = as_text(n).replace("\\", "\\\\").replace('"', '\\"')
-        check(f'using 1:{5 + i} with lines lw 1.5 title "{title}"' in script and
-              f'using 1:{13 + i} with lines lw 1.5 title "{title}_dot"' in script,
+        check(re.search(r'using 1:%d (axes x1y1 )?with lines lw 1.5 title "%s"' % (5 + i, re.escape(title)), script) and
+              re.search(r'using 1:%d (axes x1y1 )?with lines lw 1.5 title "%s_dot"' % (13 + i, re.escape(title)), script),
               f"lagsim-plot: joint {i} ({n!r}) drawn from columns {5 + i} and {13 + i}")
+
+
+def plot_script(a, csv_path, tmp, name):
+    plot = os.path.join(os.path.dirname(a.log2csv), "lagsim-plot")
+    png, gp = os.path.join(tmp, name + ".png"), os.path.join(tmp, name + ".gp")
+    p = subprocess.run([plot, csv_path, "-o", png, "--gnuplot", gp], capture_output=True, text=True, timeout=60)
+    check(p.returncode == 0 and os.path.exists(png) and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n",
+          f"{name}: lagsim-plot draws a PNG ({p.stderr.strip()[-300:]})")
+    return open(gp).read() if os.path.exists(gp) else ""
+
+
+def panels(script):
+    """The script's panels: the lines from one 'set ylabel' to the next."""
+    out, cur = [], None
+    for line in script.splitlines():
+        if line.startswith("set ylabel"):
+            cur = []
+            out.append(cur)
+        if cur is not None:
+            cur.append(line)
+    return ["\n".join(p) for p in out]
+
+
+def case_plot(a, t, tmp):
+    """A cart-pole's log (x in m, actuated; theta in rad, free) and an energy that varies
+    by 3e-10 J: lagsim-plot draws metres and radians on their own axes, leaves out the
+    unactuated joint's effort (zero by definition), and gives the energy a span of at least
+    1e-6 of its size, so that round-off is drawn flat; a real motion is scaled to fit."""
+    import math
+    recs = [("T_SCENE", t.scene(model="cartpole", joints=("x", "theta"), params=(("m0", 1.0),)))]
+    energies = []
+    for k in range(101):
+        s = k * 0.01
+        recs.append(("T_STATE", t.state(s, k * 10, ("x", "theta"), [0.1 * math.sin(s), 0.05 * math.cos(s)],
+                                        [0.1 * math.cos(s), -0.05 * math.sin(s)], [math.sin(s), 0.0])))
+        if k % 10 == 0:
+            energies.append(1.234 + 3e-10 * math.sin(10 * s))
+            recs.append(("T_STATUS", _status_energy(t, s, k * 10, energies[-1])))
+    # a stick that may fly publishes the flying stick's joints: units from that model
+    recs.append(("S_SCENE", t.scene(model="stick", prefix="S", joints=("x", "phi", "h"))))
+    recs.append(("U_SCENE", t.scene(model="nope", prefix="U", joints=("a", "b"))))
+    logf = os.path.join(tmp, "cp.lcm")
+    with open(logf, "wb") as f:
+        f.write(lcmlog.log(recs))
+    out = os.path.join(tmp, "out")
+    p = run(a.log2csv, logf, "-o", out, "-q")
+    check(p.returncode == 0, "the cart-pole log converts")
+    sc = rows(os.path.join(out, "T_SCENE.csv"))
+    check(sc[0]["joints"] == "x:actuated:q0=0:qd0=0:unit=m theta:free:q0=0:qd0=0:unit=rad",
+          f"scene CSV: each joint's unit, m for the cart, rad for the pole ({sc[0]['joints']})")
+    check(rows(os.path.join(out, "S_SCENE.csv"))[0]["joints"].split(" ")[2].endswith(":unit=m") and
+          ":unit=rad" in rows(os.path.join(out, "S_SCENE.csv"))[0]["joints"].split(" ")[1],
+          "scene CSV: a stick that may fly: x m, phi rad, h m")
+    check("unit=" not in rows(os.path.join(out, "U_SCENE.csv"))[0]["joints"],
+          "scene CSV: joints of no model of the core's table: no unit")
+
+    script = plot_script(a, os.path.join(out, "T_STATE.csv"), tmp, "cp")
+    ps = panels(script)
+    check(len(ps) == 4, f"4 panels: q, q dot, effort, energy ({len(ps)})")
+    if len(ps) == 4:
+        q, qd, eff, en = ps
+        check("set ylabel 'q (m)'" in q and "set y2label 'q (rad)'" in q and
+              re.search(r"using 1:5 axes x1y1 .*title \"x\"", q) and re.search(r"using 1:6 axes x1y2 .*title \"theta", q),
+              "q: x on the left axis in m, theta on the right one in rad")
+        check("set ylabel 'q dot (m/s)'" in qd and "set y2label 'q dot (rad/s)'" in qd and
+              re.search(r"using 1:7 axes x1y1", qd) and re.search(r"using 1:8 axes x1y2", qd),
+              "q dot: m/s left, rad/s right")
+        check("using 1:9 " in eff and "using 1:10 " not in eff and "theta_effort" not in script and
+              "set ylabel 'effort (N)'" in eff, "effort: the cart's force (N); the free pole's zero effort not drawn")
+        check("yrange" not in q and "yrange" not in qd and "yrange" not in eff,
+              "a real motion (0.1 m, 0.05 rad, 1 N) is scaled by gnuplot, no span forced")
+        m = re.search(r"set yrange \[(\S+):(\S+)\]", en)
+        lo, hi = (float(m.group(1)), float(m.group(2))) if m else (0.0, 0.0)
+        check(m and hi - lo >= 1e-6 * 1.234 * (1 - 1e-9) and lo <= min(energies) and hi >= max(energies),
+              f"energy varying 3e-10 J: drawn over a span >= 1e-6 of 1.234 J that holds it ({lo!r}..{hi!r})")
+
+    # the state CSV alone (no scene beside it): one axis "m or rad"; a zero effort column left out
+    alone = os.path.join(tmp, "alone")
+    os.makedirs(alone)
+    with open(os.path.join(out, "T_STATE.csv")) as f, open(os.path.join(alone, "T_STATE.csv"), "w") as g:
+        g.write(f.read())
+    script = plot_script(a, os.path.join(alone, "T_STATE.csv"), tmp, "alone")
+    check("set ylabel 'q (m or rad)'" in script and "axes x1y2" not in script,
+          "without a scene: one axis, m or rad")
+    check("using 1:9 " in script and "using 1:10 " not in script,
+          "without a scene: the effort column that is zero throughout is not drawn")
+
+
+def _status_energy(t, sim_time, step, energy):
+    s = t.m.status_t.decode(t.status(sim_time, step))
+    s.energy = energy
+    return s.encode()
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--log2csv", required=True)
     ap.add_argument("--types", required=True)
-    ap.add_argument("case", choices=["exact", "hostile", "injection"])
+    ap.add_argument("case", choices=["exact", "hostile", "injection", "plot"])
     a = ap.parse_args()
     t = lcmlog.Types(a.types)
     with tempfile.TemporaryDirectory(prefix="lagsim-log2csv-") as tmp:
-        {"exact": case_exact, "hostile": case_hostile, "injection": case_injection}[a.case](a, t, tmp)
+        {"exact": case_exact, "hostile": case_hostile, "injection": case_injection,
+         "plot": case_plot}[a.case](a, t, tmp)
     print(f"{'FAILED' if failures else 'passed'}: {failures} failure(s)")
     return 1 if failures else 0
 
