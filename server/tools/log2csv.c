@@ -81,7 +81,7 @@ static void put_i(FILE *f, int64_t x) { fprintf(f, ",%" PRId64, x); }
 static void put_text(FILE *f, const char *s, const char *suffix)
 {
     const char *p = s;
-    while (*p == ' ' || ((unsigned char)*p < 0x20 && *p)) p++;
+    while (*p == ' ' || *p == 0x7f || ((unsigned char)*p < 0x20 && *p)) p++; /* all blank out */
     bool formula = *p == '=' || *p == '+' || *p == '-' || *p == '@';
     fputc('"', f);
     if (formula) fputc('\'', f);

@@ -185,7 +185,7 @@ def case_injection(a, t, tmp):
         recs.append(("T_COMMAND", t.command(k * 0.01, [j[1], j[6]], [-1.5, 2.5])))
     recs.append(("T_EVENT", t.event(0.01, 10, "=kind", "@joint", -0.5, "-1+1\r\n=x,\"y\"")))
     recs.append(("T_EVENT", t.event(0.02, 20, "\t+k", j[0], -0.25, j[7])))
-    recs.append(("T_STATUS", t.status(0.02, 20, run_state="=run")))
+    recs.append(("T_STATUS", t.status(0.02, 20, run_state="\x7f=run")))
     recs.append(("T_CONTROL", t.control(5, 0, [-0.5, 0.1] + [0.0] * 6, [-1.0] * 8)))
     logf = os.path.join(tmp, "evil.lcm")
     with open(logf, "wb") as f:
@@ -235,7 +235,7 @@ def case_injection(a, t, tmp):
               f"scene: model, effects, parameters, joints as text ({sc[1][2]}, {sc[1][11]})")
     ss = tables.get("T_STATUS.csv")
     if ss:
-        check(ss[1][ss[0].index("run_state")] == "'=run", "status: run state as text")
+        check(ss[1][ss[0].index("run_state")] == "' =run", "status: run state as text (DEL, then =)")
     ct = tables.get("T_CONTROL.csv")
     if ct:
         check(ct[1][5] == "-0.5 0.10000000000000001 0 0 0 0 0 0" and ct[1][6].startswith("-1 -1"),
