@@ -170,7 +170,8 @@ int main(int argc, char **argv)
         return lag_ctl_fail(&ctl);
     }
     for (int k = 0; k < m; k++) {
-        printf("applying the %s gain: %s = -K x, K =", continuous ? "continuous" : "discrete",
+        /* u, not the joint's name: a joint may be called x (the cart-pole's), the state's name */
+        printf("applying the %s gain on %s: u = -K x, K =", continuous ? "continuous" : "discrete",
                in_names[k]);
         for (int j = 0; j < n; j++) printf(" %.17g", K[k * n + j]);
         printf("\n");

@@ -12,7 +12,7 @@
 #                            (on lua5.2's default path for prefix /usr/local)
 #   share/java/              lagsim_types.jar, lagsim_examples.jar
 #   share/lagsim/            config/*.yaml, lcmtypes/*.lcm, examples/{python,lua}/
-#   share/man/man1/          lagsimd.1
+#   share/man/man1/          a page for each program of bin/
 # lagsim-client.pc finds its prefix from its own place, so the tree can be moved.
 # Included last from the top-level CMakeLists.txt, so every target exists already.
 include(GNUInstallDirs)
@@ -58,7 +58,9 @@ file(GLOB _lcm ${PROJECT_SOURCE_DIR}/lcmtypes/*.lcm)
 install(FILES ${_lcm} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/lcmtypes)
 file(GLOB _cfg ${PROJECT_SOURCE_DIR}/config/*.yaml)
 install(FILES ${_cfg} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/config)
-install(FILES ${PROJECT_SOURCE_DIR}/docs/man/lagsimd.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+# one page per program in bin/ (tests/install/check_man.py holds each to its --help)
+file(GLOB _man ${PROJECT_SOURCE_DIR}/docs/man/*.1)
+install(FILES ${_man} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
 
 # Python: types and helpers in the site directory, examples in share/lagsim/examples.
 find_program(LAGSIM_PYTHON3 python3)

@@ -137,6 +137,7 @@ if(LAGSIM_PYTHON3)
       --check "max_abs_x <= 1.1 * pred_max_abs_x + 0.002"
       --check "abs(end_theta) < 1e-4 and abs(end_x) < 1e-3"
       --check "dropped == 0" --check "end == 'duration'"
+      --check "'applying the discrete gain on x: u = -K x, K =' in out"
       -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout 5 -q)
   # A push: upright at rest, then at t = 5 s an impulse of 0.02 N m s on the pole (the
   # scene's disturbance effect). Its velocity jump M(0)^-1 (0, 0.02) = (-0.0293 m/s,

@@ -16,3 +16,17 @@ if(LAGSIM_PYTHON3)
             "--cflags=${inst_flags}")
   set_tests_properties(install_and_run PROPERTIES TIMEOUT 180 LABELS clients)
 endif()
+
+# Each installed program's man page against its --help; every list of models (--help, man
+# pages, .lcm comments) against the core's table.
+add_executable(lagsim_model_names ${CMAKE_CURRENT_SOURCE_DIR}/install/model_names.c)
+target_link_libraries(lagsim_model_names PRIVATE lagsim_core)
+if(LAGSIM_PYTHON3)
+  foreach(case pages models)
+    add_test(NAME install_man_${case}
+      COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/install/check_man.py
+              --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR}
+              --models $<TARGET_FILE:lagsim_model_names> ${case})
+    set_tests_properties(install_man_${case} PROPERTIES TIMEOUT 120 LABELS clients)
+  endforeach()
+endif()

@@ -52,7 +52,9 @@ add_test(NAME clients_python_lcm
 add_test(NAME clients_python_dipc_lockstep
   COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLPYDIPC --timeout 60 ${lang_dipc_checks}
     -- ${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py ${py_types} --prefix {prefix} --duration 20 -q)
-set(lang_tests clients_python_lcm clients_python_dipc_lockstep)
+add_test(NAME clients_python_types
+  COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_python_types.py ${CMAKE_BINARY_DIR}/python)
+set(lang_tests clients_python_lcm clients_python_types clients_python_dipc_lockstep)
 
 # How a run ends: the daemon stops by itself (--duration 1: 101 states, then its stop
 # event) and the controller ends with end=stop within 3 wall s; or the daemon is killed

@@ -5,7 +5,7 @@ lagsim_fuzz_target(log2csv LIBS lagsim_log2csv)
 
 find_program(LAGSIM_VIEW_PYTHON3 python3)
 if(LAGSIM_VIEW_PYTHON3)
-  foreach(case exact hostile)
+  foreach(case exact hostile injection plot)
     add_test(NAME view_log2csv_${case}
              COMMAND ${LAGSIM_VIEW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/view/test_log2csv.py
                      --log2csv $<TARGET_FILE:lagsim-log2csv> --types ${CMAKE_BINARY_DIR}/python

@@ -45,11 +45,24 @@ function Controller:option(key, default, help, kind)
   self.o[key] = default
 end
 
+-- A default as the user would type it: a list as 5,50,50 (tostring would print a
+-- table's address); none (false or '') not shown
+local function show_default(v)
+  if type(v) == 'table' then
+    local t = {}
+    for i, x in ipairs(v) do t[i] = string.format('%.17g', x) end
+    return ' (default ' .. table.concat(t, ',') .. ')'
+  elseif v == false or v == nil or v == '' then
+    return ''
+  end
+  return ' (default ' .. tostring(v) .. ')'
+end
+
 function Controller:usage(f)
   f:write(string.format('usage: lua5.2 %s [options]\n%s\n', self.name, self.description))
   for _, k in ipairs(self.order) do
     local op = self.opts[k]
-    f:write(string.format('  --%-10s %s (default %s)\n', k, op.help, tostring(op.default)))
+    f:write(string.format('  --%-10s %s%s\n', k, op.help, show_default(op.default)))
   end
   f:write('  -q           quiet: summary only\n  --help       this text\n')
 end

@@ -21,8 +21,12 @@ static void usage(FILE *f)
         "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|-] [--set ...]\n"
         "       lagsimd --config FILE --replay LOG.lcm [--tolerance X] [--set ...]\n"
         "       lagsimd --config FILE --cost [--plot FILE.png] [--set ...]\n"
-        "\n"
-        "Steps one Lagrangian model (stick, manipulator, dipc) described by a YAML scene.\n"
+        "\n",
+        f);
+    char models[256]; /* from the core's table: a model added there is named here */
+    fprintf(f, "Steps one Lagrangian model (%s)\ndescribed by a YAML scene.\n",
+            lag_model_names(models, sizeof models));
+    fputs(
         "Default: the real-time LCM server (states out, effort commands in) until SIGINT.\n"
         "\n"
         "options:\n"

@@ -5,7 +5,8 @@
  * message; its CSV is opened then, with a header from that message (a state's joint
  * names). A later message of another type or other joints on the same channel is not
  * written, only counted. Every number is written "%.17g" (a reread gives the same
- * double); strings are quoted, control characters replaced by spaces.
+ * double); every string from the log (names, kinds, details, in headers and cells) is
+ * quoted and kept from reading as a spreadsheet formula (put_text).
  *
  * Per-channel facts for the summary: counts, log-time span and rate, undecodable
  * messages; for states the step sequence (gaps: a step increase other than one control
@@ -13,6 +14,7 @@
  * again, as while paused); for status the last counters; for events a count per kind.
  */
 #include "log2csv.h"
+#include "lagsim/lagsim.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -70,17 +72,37 @@ typedef struct l2c {
 /* ---------------------------------------------------------------- CSV helpers */
 static void put_d(FILE *f, double x) { fprintf(f, ",%.17g", x); }
 static void put_i(FILE *f, int64_t x) { fprintf(f, ",%" PRId64, x); }
-static void put_s(FILE *f, const char *s)
+/* One text field from a log (a name, a kind, a detail), RFC 4180: always in double quotes,
+ * a quote doubled; control characters become spaces, so one record is one line. A field
+ * whose first non-blank character would start a formula in a spreadsheet (=, +, -, @;
+ * tab and CR are spaces by then) is written as text: a leading apostrophe, as OWASP's
+ * CSV-injection guidance asks. `suffix` (may be NULL) is appended inside the quotes: a
+ * header's "<joint>_dot". Numbers never pass here: they stay numbers. */
+static void put_text(FILE *f, const char *s, const char *suffix)
 {
-    fputs(",\"", f);
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"') fputs("\"\"", f);
-        else if (c < 0x20 || c == 0x7f) fputc(' ', f);
-        else fputc(c, f);
-    }
+    const char *p = s;
+    while (*p == ' ' || *p == 0x7f || ((unsigned char)*p < 0x20 && *p)) p++; /* all blank out */
+    bool formula = *p == '=' || *p == '+' || *p == '-' || *p == '@';
+    fputc('"', f);
+    if (formula) fputc('\'', f);
+    for (int pass = 0; pass < 2; pass++)
+        for (const char *q = pass ? (suffix ? suffix : "") : s; *q; q++) {
+            unsigned char c = (unsigned char)*q;
+            if (c == '"') fputs("\"\"", f);
+            else if (c < 0x20 || c == 0x7f) fputc(' ', f);
+            else fputc(c, f);
+        }
     fputc('"', f);
 }
+static void put_s(FILE *f, const char *s)
+{
+    fputc(',', f);
+    put_text(f, s, NULL);
+}
+/* A list of numbers this tool formatted ("%.17g" joined by spaces): quoted, and not
+ * marked as text, a leading minus sign included (digits, signs, '.', 'e', "inf", "nan"
+ * and spaces make no formula that reaches anything). */
+static void put_numbers(FILE *f, const char *s) { fprintf(f, ",\"%s\"", s); }
 /* Log timestamp and utime in seconds since the epoch (us resolution). */
 static void put_us(FILE *f, int64_t us, bool first)
 {
@@ -182,10 +204,13 @@ static chan *scene_of(l2c *c, const chan *state)
 /* ---------------------------------------------------------------- one type each */
 static void header_state(FILE *f, const lag_wire_joint_state *m)
 {
+    static const char *const suffix[] = {"", "_dot", "_effort"};
     fputs("t,wall_time,log_time,step", f);
-    for (int i = 0; i < m->num_joints; i++) fprintf(f, ",%s", m->name[i]);
-    for (int i = 0; i < m->num_joints; i++) fprintf(f, ",%s_dot", m->name[i]);
-    for (int i = 0; i < m->num_joints; i++) fprintf(f, ",%s_effort", m->name[i]);
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < m->num_joints; i++) {
+            fputc(',', f);
+            put_text(f, m->name[i], suffix[k]);
+        }
     fputc('\n', f);
 }
 
@@ -326,6 +351,20 @@ static bool write_event(l2c *c, chan *h, const lag_log_record *r, const lag_wire
     return true;
 }
 
+/* The core's model whose joints are the scene's, in order (a stick that may fly publishes
+ * the flying stick's x, phi, h), or NULL: where a joint's unit (m or rad) comes from. */
+static const lag_model_info *scene_model(const lag_wire_scene *m)
+{
+    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
+        const lag_model_info *info = lag_model_info_get((lag_model_kind)k);
+        bool same = info && info->nq == m->num_joints;
+        for (int i = 0; same && i < m->num_joints; i++)
+            same = strcmp(info->joint_names[i], m->joint_name[i]) == 0;
+        if (same) return info;
+    }
+    return NULL;
+}
+
 static bool write_scene(l2c *c, chan *h, const lag_log_record *r, const lag_wire_scene *m)
 {
     if (!h->csv) {
@@ -334,9 +373,10 @@ static bool write_scene(l2c *c, chan *h, const lag_log_record *r, const lag_wire
               "command_timeout,effects,parameters,joints\n", h->csv);
     }
     FILE *f = h->csv;
-    char params[LAG_WIRE_MAX_PARAMS * (L2C_NAME + 32)], joints[L2C_JOINTS * (L2C_NAME + 160)];
+    char params[LAG_WIRE_MAX_PARAMS * (L2C_NAME + 32)], joints[L2C_JOINTS * (L2C_NAME + 192)];
     size_t n = 0;
     params[0] = joints[0] = '\0';
+    const lag_model_info *info = scene_model(m);
     for (int i = 0; i < m->num_params; i++)
         n += (size_t)snprintf(params + n, sizeof params - n, "%s%s=%.17g", i ? " " : "",
                               m->param_name[i], m->param_value[i]);
@@ -349,6 +389,9 @@ static bool write_scene(l2c *c, chan *h, const lag_log_record *r, const lag_wire
         if (m->limit_on[i])
             n += (size_t)snprintf(joints + n, sizeof joints - n, ":limits=%.17g..%.17g",
                                   m->limit_lower[i], m->limit_upper[i]);
+        if (info)
+            n += (size_t)snprintf(joints + n, sizeof joints - n, ":unit=%s",
+                                  info->angular[i] ? "rad" : "m");
     }
     put_us(f, m->utime, true);
     put_us(f, r->timestamp, false);
@@ -416,8 +459,8 @@ static bool write_control(l2c *c, chan *h, const lag_log_record *r, const lag_wi
     put_i(f, m->request);
     put_s(f, request_name(m->request));
     put_i(f, m->count);
-    put_s(f, q);
-    put_s(f, qd);
+    put_numbers(f, q);
+    put_numbers(f, qd);
     fputc('\n', f);
     return true;
 }

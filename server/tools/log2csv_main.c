@@ -31,7 +31,8 @@ static void usage(FILE *f)
           "Columns: states  t (sim time, s), wall_time (publication, s since the epoch),\n"
           "log_time (as the log stored it), step, each joint's position, <joint>_dot,\n"
           "<joint>_effort; status, events, scenes, commands and control requests: every\n"
-          "field (see docs/view.md).\n"
+          "field (see docs/view.md). Text from the log is quoted (RFC 4180), and text that\n"
+          "would start a spreadsheet formula (=, +, -, @) gets a leading '.\n"
           "exit codes: 0 ok, 1 the log ends in an error (CSVs hold what came before),\n"
           "2 usage, unreadable log or unwritable CSV\n",
           f);

@@ -224,6 +224,7 @@ def main():
         names["wall"] = t_client_end - t_daemon_end
         print("wall = %.3f s from the daemon's end to the controller's" % names["wall"])
     names["math"] = math
+    names["out"] = out  # the client's stdout, for checks of what it prints
     for expr in a.check:
         try:
             res = bool(eval(expr, {"__builtins__": {"abs": abs, "min": min, "max": max}}, names))

@@ -147,6 +147,10 @@ def corpus_cases(t, d):
                                    ("T_STATE", t.state(1.0, 1 << 62, J3, [0] * 3, [0] * 3, [0] * 3)),
                                    ("T_STATE", t.state(1.0, -(1 << 63), J3, [0] * 3, [0] * 3, [0] * 3)),
                                    ("T_STATE", t.state(1.0, (1 << 63) - 1, J3, [0] * 3, [0] * 3, [0] * 3))]),
+        # every string a formula or a record breaker (the CSVs quote and neutralise them)
+        "strings-formulas.lcm": log([("T_STATE", t.state(0.0, 0, ('a,b\n=HYPERLINK("x")', "=1+1", '"\t-2'),
+                                                         [-0.5] * 3, [0] * 3, [0] * 3)),
+                                     ("T_EVENT", t.event(0.0, 0, "@kind", "+j", -0.5, "\r=d,\"\""))]),
     }
     for name, data in cases.items():
         with open(os.path.join(d, name), "wb") as f:

@@ -115,7 +115,7 @@ typedef struct lag_rod {
 /* Static facts about a model kind: everything a loader, a client or a test needs to
  * know about its coordinates and parameters, as data. */
 typedef struct lag_model_info {
-    const char *name;                          /* "stick", "manipulator", "dipc" */
+    const char *name;                          /* "stick", "manipulator", "dipc", ... */
     int nq;                                    /* number of generalized coordinates */
     int np;                                    /* number of parameters */
     const char *param_names[LAG_MAX_PARAMS];   /* "m", "l", "I", "g", ... */
@@ -135,7 +135,8 @@ typedef struct lag_model_info {
 const lag_model_info *lag_model_info_get(lag_model_kind kind);
 /* Returns the kind for a name, or -1. */
 int lag_model_kind_from_name(const char *name);
-/* "stick, manipulator, dipc": every model's name, for messages. Returns buf. */
+/* "stick, manipulator, dipc, ...": every model's name, in the table's order, for messages
+ * and --help. Returns buf. */
 const char *lag_model_names(char *buf, size_t len);
 
 typedef struct lag_model {
