@@ -26,7 +26,10 @@ add_test(NAME scene_limits
          COMMAND ${LAGSIM_BASH} ${scene_dir}/limits.sh $<TARGET_FILE:lagsimd> ${scene_dir}/expect_error.sh)
 add_test(NAME scene_cli
          COMMAND ${LAGSIM_BASH} ${scene_dir}/cli.sh $<TARGET_FILE:lagsimd> ${scene_cfg}/dipc.yaml)
+add_test(NAME scene_accuracy
+         COMMAND ${LAGSIM_BASH} ${scene_dir}/accuracy.sh $<TARGET_FILE:lagsimd> ${scene_cfg})
 set_tests_properties(scene_set_overrides scene_offline_csv scene_determinism scene_cli scene_limits
+                     scene_accuracy
                      PROPERTIES TIMEOUT 60 LABELS scene)
 
 # The loader under libFuzzer (tests/fuzz/fuzz_scene.c): file bytes plus --set overrides,

@@ -144,7 +144,7 @@ lag_result lag_cost_measure(const lag_sim_def *def, const lag_cost_opts *o,
                                  "budget > 0 expected", LAG_ERR_ARG);
     double nperd = floor(o->horizon / o->period * (1 + 1e-12) + 1e-9);
     if (!(nperd >= 1 && nperd <= MAX_PERIODS))
-        return fail(err, errlen, "the horizon holds no publish period, or more than 10^6",
+        return fail(err, errlen, "integrator.horizon holds no publish period, or more than 10^6",
                     LAG_ERR_ARG);
 
     cost_run c = {.def = def, .o = o, .clock = o->clock ? o->clock : thread_cpu,

@@ -322,9 +322,8 @@ int main(int argc, char **argv)
                     "integrator.dt=... (and rtol, atol for dopri5), as the run printed them\n",
                     config);
             rc = LAGSIMD_EXIT_USAGE;
-        } else if (!replay &&
-                   (rc = lagsimd_choose_integrator(&sc, offline, opts.quiet, &choice)) != LAGSIMD_EXIT_OK) {
-            /* said why */
+        } else if (!replay && lagsimd_choose_integrator(&sc, offline, opts.quiet, &choice) != LAGSIMD_EXIT_OK) {
+            rc = LAGSIMD_EXIT_USAGE; /* said why */
         } else if (choice.n > 0 && reload_with(config, text, len, sets, &nsets, &choice, &sc) != 0) {
             rc = LAGSIMD_EXIT_USAGE;
         } else {

@@ -40,7 +40,7 @@ usage "unknown option '-z'" -qz --config "$scene"
 usage "unknown option '-z'" --config "$scene" -qz --offline
 usage "option -c needs a value" -qc
 usage "option --config needs a value" --conf
-usage "ambiguous option '--c' (--config, --csv)" --c "$scene"
+usage "ambiguous option '--c' (--config, --csv, --cost)" --c "$scene"
 usage "option --help takes no value" --help=yes
 usage "option --offline takes no value" --config "$scene" --offline=1 --duration 1
 usage "unknown option '--bogus'" --config "$scene" --bogus=1
