@@ -2,7 +2,9 @@ package lagsim.examples;
 
 import java.io.DataInput;
 import java.io.IOException;
+import java.lang.reflect.Constructor;
 import java.lang.reflect.Field;
+import java.lang.reflect.InvocationTargetException;
 import java.util.Arrays;
 
 import lcm.lcm.LCMDataInputStream;
@@ -70,6 +72,32 @@ public final class BoundedInput implements DataInput {
             throw new IOException(e);
         }
         return msg;
+    }
+
+    /**
+     * The message of the lcm-gen type named {@code type} ("lagsim.joint_state_t") in the
+     * bytes {@code data}, checked as {@link #decode(LCMDataInputStream, Decoder)} checks it:
+     * for callers that cannot pass a decoder, such as MATLAB and GNU Octave, which hand
+     * over a received message's bytes ({@code lcm.lcm.MessageAggregator.Message.data}).
+     * IOException as there; IllegalArgumentException for a name that is no lcm-gen type.
+     */
+    public static LCMEncodable decode(byte[] data, String type) throws IOException {
+        Constructor<? extends LCMEncodable> make;
+        try {
+            make = Class.forName(type).asSubclass(LCMEncodable.class).getConstructor(DataInput.class);
+        } catch (ClassNotFoundException | ClassCastException | NoSuchMethodException e) {
+            throw new IllegalArgumentException("no lcm-gen type " + type, e);
+        }
+        return decode(new LCMDataInputStream(data), in -> {
+            try {
+                return make.newInstance(in);
+            } catch (InvocationTargetException e) { // the decoder's own exception
+                if (e.getCause() instanceof IOException) throw (IOException) e.getCause();
+                throw new IOException("does not decode: " + e.getCause(), e.getCause());
+            } catch (ReflectiveOperationException e) {
+                throw new IOException(e);
+            }
+        });
     }
 
     /** The unread bytes of {@code ins} (the stream LCM hands a subscriber). */
