@@ -12,9 +12,9 @@ function dipc_balance(varargin)
 %          -m2 l2 g / 2), so A = [0 I; -M0\G 0], B = [0; M0\e0];
 %     2. zero-order hold over the control period h (the daemon holds the effort over a
 %        period): expm([A B; 0 0] h);
-%     3. the discrete LQR with the Riemann sum of the continuous cost (Q h, R h): dlqr of
-%        the Control System Toolbox (MATLAB) or of octave-control (GNU Octave: pkg load
-%        control), else the DARE by the structure-preserving doubling algorithm below.
+%     3. the discrete LQR with the Riemann sum of the continuous cost (Q h, R h):
+%        lagsim_dlqr, i.e. dlqr of the Control System Toolbox (MATLAB) or of
+%        octave-control (GNU Octave), else the DARE by doubling.
 %   Weights default to Q = diag(5, 50, 50, 20, 700, 700), R = 1 (Bogdanov 2004). --k
 %   applies a given gain instead (the cross-language check gives every language the same
 %   numbers).
@@ -42,7 +42,7 @@ h = ctl.scene.control_period;
 E = expm([A B; zeros(1, n + 1)] * h);
 Ad = E(1:n, 1:n);
 Bd = E(1:n, n + 1);
-[K, solver] = discrete_lqr(Ad, Bd, diag(qw) * h, r * h);
+[K, solver] = lagsim_dlqr(Ad, Bd, diag(qw) * h, r * h);
 ctl.say('dipc_balance: discrete LQR (h = %g s, %s): K = [%s]\n', h, solver, ...
         strjoin(arrayfun(@(v) sprintf('%.17g', v), K, 'UniformOutput', false), ', '));
 if ~isempty(ctl.get('k'))
@@ -113,43 +113,4 @@ M0 = [p.m0 + p.m1 + p.m2, a, p.m2 * p.l2 / 2
 G = diag([0, -a * p.g, -p.m2 * p.l2 * p.g / 2]);
 A = [zeros(3), eye(3); -(M0 \ G), zeros(3)];
 B = [zeros(3, 1); M0 \ [1; 0; 0]];
-end
-
-function [K, solver] = discrete_lqr(Ad, Bd, Q, R)
-% The discrete LQR gain (u = -K x, a row) of x+ = Ad x + Bd u with cost x'Qx + u'Ru.
-if exist('OCTAVE_VERSION', 'builtin') && isempty(which('dlqr'))
-    try
-        pkg('load', 'control');
-    catch
-        % no octave-control: the doubling below
-    end
-end
-if ~isempty(which('dlqr'))
-    K = dlqr(Ad, Bd, Q, R);
-    solver = 'dlqr';
-    return;
-end
-% X = A'XA - A'XB (R + B'XB)^-1 B'XA + Q by the structure-preserving doubling algorithm
-n = size(Ad, 1);
-Ak = Ad;
-Gk = Bd * (R \ Bd');
-Hk = Q;
-for it = 1:100
-    W = eye(n) + Gk * Hk;
-    An = Ak * (W \ Ak);
-    Gn = Gk + Ak * (W \ (Gk * Ak'));
-    Hn = Hk + Ak' * (Hk * (W \ Ak));
-    done = max(abs(Hn(:) - Hk(:))) <= 1e-14 * max(abs(Hn(:)));
-    Ak = An;
-    Gk = Gn;
-    Hk = Hn;
-    if done
-        break;
-    end
-end
-if ~done
-    error('lagsim:design', 'dipc_balance: the Riccati doubling did not converge');
-end
-K = (R + Bd' * Hk * Bd) \ (Bd' * Hk * Ad);
-solver = 'doubling';
 end
