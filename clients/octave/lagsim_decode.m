@@ -11,12 +11,5 @@ function msg = lagsim_decode(data, type)
 %   length is checked before anything is allocated for it (lcm-gen's own decoder
 %   allocates a forged length of 2^31-1 first), and only a message that encodes back to
 %   the very bytes received, every number finite, is kept.
-try
-    msg = javaMethod('decode', 'lagsim.examples.BoundedInput', data, ['lagsim.' type]);
-catch err
-    if isempty(strfind(err.message, 'IOException'))
-        rethrow(err);   % not a damaged message: a wrong type name, no lagsim_setup
-    end
-    msg = [];
-end
+msg = javaMethod('tryDecode', 'lagsim.examples.BoundedInput', data, ['lagsim.' type]);
 end
