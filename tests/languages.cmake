@@ -303,6 +303,11 @@ if(TARGET lagsim_lcmtypes_java)
   add_test(NAME clients_readme_java COMMAND ${readme_run} java-dipc)
   list(APPEND lang_tests clients_readme_java)
 endif()
+# the MATLAB/Octave block by a plain octave --eval (the .m files of <build>/octave on the path)
+if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
+  add_test(NAME clients_readme_octave COMMAND ${readme_run} octave-dipc)
+  list(APPEND lang_tests clients_readme_octave)
+endif()
 
 # ---- README.md's shell recipes, run as written (tests/clients/readme_recipes.py): by hand
 # (controller, server for 10 s, lagsimctl status, an offline CSV) and record (lcm-logger,
