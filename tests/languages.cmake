@@ -200,6 +200,13 @@ endif()
 # independent of its speed. tests/clients/octave_run.sh runs a controller function with
 # command-line arguments (octave --eval "dipc_balance('--prefix', ...)").
 find_program(LAGSIM_OCTAVE octave)
+# They must run in MATLAB as well, which no test here has: no syntax that GNU Octave alone
+# accepts, in clients/octave/*.m and README.md's block (tests/clients/matlab_syntax.py).
+file(GLOB octave_m ${PROJECT_SOURCE_DIR}/clients/octave/*.m)
+add_test(NAME clients_octave_matlab_syntax
+  COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/matlab_syntax.py ${octave_m}
+          --readme ${PROJECT_SOURCE_DIR}/README.md)
+list(APPEND lang_tests clients_octave_matlab_syntax)
 if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
   set(octave_run ${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh ${CMAKE_BINARY_DIR}/octave)
   add_test(NAME clients_octave_dipc_lockstep
