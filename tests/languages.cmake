@@ -202,7 +202,7 @@ endif()
 find_program(LAGSIM_OCTAVE octave)
 # They must run in MATLAB as well, which no test here has: no syntax that GNU Octave alone
 # accepts, in clients/octave/*.m and README.md's block (tests/clients/matlab_syntax.py).
-file(GLOB octave_m ${PROJECT_SOURCE_DIR}/clients/octave/*.m)
+file(GLOB octave_m CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/clients/octave/*.m)
 add_test(NAME clients_octave_matlab_syntax
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/matlab_syntax.py ${octave_m}
           --readme ${PROJECT_SOURCE_DIR}/README.md)
