@@ -30,6 +30,14 @@ if(LAGSIM_NET_JAVA AND TARGET lagsim_examples_java)
             lagsim.examples.PlantUrls ${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.txt)
   set_tests_properties(net_plant_urls_java PROPERTIES TIMEOUT 60 LABELS net)
 endif()
+find_program(LAGSIM_NET_OCTAVE octave)
+if(LAGSIM_NET_OCTAVE AND TARGET lagsim_examples_java)   # MATLAB/Octave's lagsim_plant_urls
+  add_test(NAME net_plant_urls_octave
+    COMMAND ${CMAKE_COMMAND} -E env --unset=LCM_DEFAULT_URL ${LAGSIM_NET_OCTAVE} --no-gui --quiet --no-window-system
+            --no-init-file --path ${CMAKE_BINARY_DIR}/octave --path ${CMAKE_CURRENT_LIST_DIR}/net
+            --eval "plant_urls_octave('${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.txt')")
+  set_tests_properties(net_plant_urls_octave PROPERTIES TIMEOUT 60 LABELS net)
+endif()
 
 # The daemon's receive-socket filter, its sync marker and the route to the group, on this
 # host (tests/net/test_net.c); one ctest per case.
