@@ -205,10 +205,17 @@ find_program(LAGSIM_OCTAVE octave)
 file(GLOB octave_m CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/clients/octave/*.m)
 add_test(NAME clients_octave_matlab_syntax
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/matlab_syntax.py ${octave_m}
+          ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_octave_lqr.m ${CMAKE_CURRENT_SOURCE_DIR}/net/plant_urls_octave.m
           --readme ${PROJECT_SOURCE_DIR}/README.md)
 list(APPEND lang_tests clients_octave_matlab_syntax)
 if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
   set(octave_run ${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh ${CMAKE_BINARY_DIR}/octave)
+  # lagsim_dlqr by dlqr and by the doubling it falls back on, against the scalar DARE's
+  # closed form (1e-12) and each other (1e-9) (tests/clients/test_octave_lqr.m)
+  add_test(NAME clients_octave_lqr
+    COMMAND ${LAGSIM_OCTAVE} --no-gui --quiet --no-window-system --no-init-file
+            --path ${CMAKE_BINARY_DIR}/octave --path ${CMAKE_CURRENT_SOURCE_DIR}/clients
+            --eval test_octave_lqr)
   add_test(NAME clients_octave_dipc_lockstep
     COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLOCTDIPC --timeout 60 ${lang_dipc_checks}
       -- ${octave_run} dipc_balance --prefix {prefix} --duration 20 -q)
@@ -258,7 +265,7 @@ if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
     COMMAND ${lang_e2e} --config ${PROJECT_SOURCE_DIR}/config/cartpole.yaml --mode lockstep
       --name CLOCTCPC --timeout 60 ${octave_cartpole_checks} --check "abs(abs(k_x) - 1) <= 1e-9"
       -- ${octave_run} cartpole_balance --prefix {prefix} --duration 20 -q --gain continuous)
-  list(APPEND lang_tests clients_octave_dipc_lockstep clients_octave_dipc_hostile
+  list(APPEND lang_tests clients_octave_lqr clients_octave_dipc_lockstep clients_octave_dipc_hostile
        clients_octave_dipc_late_controller clients_octave_dipc_gain
        clients_octave_cartpole_lockstep clients_octave_cartpole_continuous)
 else()
