@@ -50,7 +50,7 @@ lagsim_add_test_cases(test_net net.filter net 60)
 # Two hosts on one machine (tests/net/two_hosts.sh): network namespaces joined by a veth
 # pair, lagsimd in one, peers in the other, nftables for packet loss. Needs root; skipped
 # (exit 77) with the reason where namespaces cannot be made.
-set(LAGSIM_TWO_HOSTS_CASES host_local lockstep_loss realtime_loss two_daemons)
+set(LAGSIM_TWO_HOSTS_CASES host_local lockstep_loss lockstep_loss_octave realtime_loss two_daemons)
 foreach(case ${LAGSIM_TWO_HOSTS_CASES})
   add_test(NAME net_two_hosts_${case}
            COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/net/two_hosts.sh ${case} ${CMAKE_BINARY_DIR}
