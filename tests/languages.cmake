@@ -210,6 +210,23 @@ add_test(NAME clients_octave_matlab_syntax
 list(APPEND lang_tests clients_octave_matlab_syntax)
 if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
   set(octave_run ${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh ${CMAKE_BINARY_DIR}/octave)
+  # Bad options (those checked before connecting: the design's own are checked once the
+  # scene came, as in Java): an error naming the option, octave --eval exits 1; --help
+  # lists the options and exits 0.
+  foreach(bad "--duration;abc" "--timeout;0" "--duration;-1" "--duration;inf" "-z" "stray"
+              "--timeout" "--url;tcpq://127.0.0.1:7700")
+    string(REGEX REPLACE "^-+" "" bad_name "${bad}")
+    string(REPLACE ";" "_" bad_name "${bad_name}")
+    string(REGEX REPLACE "[^A-Za-z0-9_.-]" "" bad_name "${bad_name}")
+    add_test(NAME clients_octave_usage_${bad_name}
+             COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/clients/expect_exit.sh 1
+                     "error: dipc_balance: .*(--|'-z'|'stray')" ${octave_run} dipc_balance ${bad})
+    list(APPEND lang_tests clients_octave_usage_${bad_name})
+  endforeach()
+  add_test(NAME clients_octave_help
+           COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/clients/expect_exit.sh 0 "--duration "
+                   ${octave_run} dipc_balance --help)
+  list(APPEND lang_tests clients_octave_help)
   # lagsim_dlqr by dlqr and by the doubling it falls back on, against the scalar DARE's
   # closed form (1e-12) and each other (1e-9) (tests/clients/test_octave_lqr.m)
   add_test(NAME clients_octave_lqr
