@@ -230,6 +230,7 @@ classdef lagsim_controller < handle
                     end
                     obj.pump(50);
                 end
+                obj.pump(0);   % what came meanwhile: the newest state is answered
                 s = obj.latest;
                 obj.latest = [];
                 if isempty(obj.current) || double(s.step) ~= obj.current.step ...
