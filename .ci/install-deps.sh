@@ -9,6 +9,7 @@ pkgs=(build-essential cmake pkg-config clang libclang-rt-14-dev   # gcc pass; cl
       lua5.2 liblcm-lua                                  # the Lua 5.2 clients (liblcm-lua is built for 5.2 only)
       libmujoco-dev libsundials-dev gnuplot-nox          # benchmark peers and plots
       liblcm-java libjchart2d-java default-jdk-headless  # the Java clients; lcm-spy with lagsim's types
+      octave octave-control                              # the MATLAB/Octave clients (dlqr, lqr) and their tests
       libmicrohttpd-dev chromium fonts-dejavu-core       # lagsim-view; its browser test and screenshot
       iproute2 nftables)                                 # two hosts on one machine: namespaces, veth, packet loss
 missing=()

@@ -12,6 +12,8 @@
 #                            (on lua5.2's default path for prefix /usr/local)
 #   share/java/              lagsim_types.jar, lagsim_examples.jar
 #   share/lagsim/            config/*.yaml, lcmtypes/*.lcm, examples/{python,lua}/
+#   share/lagsim/octave/     the MATLAB/Octave controllers (clients/octave/CMakeLists.txt:
+#                            LAGSIM_OCTAVE_INSTALL_DIR)
 #   share/man/man1/          a page for each program of bin/
 # lagsim-client.pc finds its prefix from its own place, so the tree can be moved.
 # Included last from the top-level CMakeLists.txt, so every target exists already.

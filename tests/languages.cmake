@@ -1,4 +1,4 @@
-# Controllers in Python, Lua and Java (clients/<language>/): their LCM layers, each
+# Controllers in Python, Lua, Java and MATLAB/Octave (clients/<language>/): their LCM layers, each
 # example end to end against lagsimd, the clean end of a run (the daemon's stop, a
 # silent daemon), and the cross-language check (the same law in every language gives the
 # same states). Every run has a channel prefix of its own (run_e2e.py).
@@ -197,16 +197,115 @@ else()
   message(WARNING "javac or liblcm-java missing: the Java clients' tests are not registered")
 endif()
 
+# ---- MATLAB/GNU Octave (clients/octave), run under GNU Octave 7 with octave-control (the
+# design's dlqr and lqr). Octave's JVM starts in about a second; lockstep makes the results
+# independent of its speed. tests/clients/octave_run.sh runs a controller function with
+# command-line arguments (octave --eval "dipc_balance('--prefix', ...)").
+find_program(LAGSIM_OCTAVE octave)
+# They must run in MATLAB as well, which no test here has: no syntax that GNU Octave alone
+# accepts, in clients/octave/*.m and README.md's block (tests/clients/matlab_syntax.py).
+file(GLOB octave_m CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/clients/octave/*.m)
+add_test(NAME clients_octave_matlab_syntax
+  COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/matlab_syntax.py ${octave_m}
+          ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_octave_lqr.m ${CMAKE_CURRENT_SOURCE_DIR}/net/plant_urls_octave.m
+          --readme ${PROJECT_SOURCE_DIR}/README.md)
+list(APPEND lang_tests clients_octave_matlab_syntax)
+if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
+  set(octave_run ${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh ${CMAKE_BINARY_DIR}/octave)
+  # Bad options (those checked before connecting: the design's own are checked once the
+  # scene came, as in Java): an error naming the option, octave --eval exits 1; --help
+  # lists the options and exits 0.
+  foreach(bad "--duration;abc" "--timeout;0" "--duration;-1" "--duration;inf" "-z" "stray"
+              "--timeout" "--url;tcpq://127.0.0.1:7700")
+    string(REGEX REPLACE "^-+" "" bad_name "${bad}")
+    string(REPLACE ";" "_" bad_name "${bad_name}")
+    string(REGEX REPLACE "[^A-Za-z0-9_.-]" "" bad_name "${bad_name}")
+    add_test(NAME clients_octave_usage_${bad_name}
+             COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/clients/expect_exit.sh 1
+                     "error: dipc_balance: .*(--|'-z'|'stray')" ${octave_run} dipc_balance ${bad})
+    list(APPEND lang_tests clients_octave_usage_${bad_name})
+  endforeach()
+  add_test(NAME clients_octave_help
+           COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/clients/expect_exit.sh 0 "--duration "
+                   ${octave_run} dipc_balance --help)
+  list(APPEND lang_tests clients_octave_help)
+  # lagsim_dlqr by dlqr and by the doubling it falls back on, against the scalar DARE's
+  # closed form (1e-12) and each other (1e-9) (tests/clients/test_octave_lqr.m)
+  add_test(NAME clients_octave_lqr
+    COMMAND ${LAGSIM_OCTAVE} --no-gui --quiet --no-window-system --no-init-file
+            --path ${CMAKE_BINARY_DIR}/octave --path ${CMAKE_CURRENT_SOURCE_DIR}/clients
+            --eval test_octave_lqr)
+  add_test(NAME clients_octave_dipc_lockstep
+    COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLOCTDIPC --timeout 60 ${lang_dipc_checks}
+      -- ${octave_run} dipc_balance --prefix {prefix} --duration 20 -q)
+  lang_end_tests(octave dipc "${lang_dipc_cfg}" ${octave_run} dipc_balance)
+  add_test(NAME clients_octave_dipc_hostile
+    COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLHOSTOCT --timeout 60 ${lang_hostile_checks}
+      -- ${octave_run} dipc_balance --prefix {prefix} --duration 20 -q)
+  add_test(NAME clients_octave_dipc_late_controller
+    COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLLATEOCT --timeout 60
+      --daemon-first 2 ${late_checks} --check "states == 2001"
+      -- ${octave_run} dipc_balance --prefix {prefix} --duration 20 -q)
+  # The gain dipc_balance designs with octave-control's dlqr (the Schur method of SLICOT's
+  # SB02OD on the closed-form linearization) against dipc_lqr's (central differences of
+  # the core's dynamics, DARE by doubling, lqr.c). Both solve the same DARE: they differ
+  # by the C linearization's round-off, O(eps / 1e-6) ~ 1e-10 relative in A and B
+  # (lqr.c), times the DARE's sensitivity, plus the two solvers' residuals (~1e-12).
+  # Allowed: 1e-8 relative on each entry (a condition number of 100 on that round-off);
+  # measured 2.5e-12. A design error is far outside: the continuous gain differs by 21 %,
+  # weights not scaled by h by orders of magnitude.
+  add_test(NAME clients_octave_dipc_gain
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/same_gain.py
+      --lagsimd ${lang_lagsimd} --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml --tol 1e-8
+      --run c "applying the discrete gain: .*K = \\[([^]]*)\\]"
+        "$<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration 0.05 -q"
+      --run octave "discrete LQR \\(h = [^)]*, dlqr\\): K = \\[([^]]*)\\]"
+        "${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh ${CMAKE_BINARY_DIR}/octave dipc_balance --prefix {prefix} --duration 0.05 -q")
+  # The cart-pole, config/cartpole.yaml as it is, with the bounds of
+  # clients_lqr_balance_cartpole_lockstep (tests/clients.cmake explains them): the
+  # discrete gain (dlqr) and the continuous one (lqr). For the continuous design the gain
+  # on x has a closed form: x is a double integrator of F alone at s = 0, so the return
+  # difference equality (1 + L(-s))(1 + L(s)) = 1 + G(-s)' Q G(s) / r, whose leading
+  # terms as s -> 0 are k_x^2 c^2 / s^4 and q_x c^2 / (r s^4), gives |k_x| = sqrt(q_x / r)
+  # = 1 (dipc_lqr's continuous gain shows the same: 2.2361 = sqrt(5)). Allowed 1e-9
+  # relative (the Schur method's residual is ~1e-14); measured 2.2e-14.
+  set(octave_cartpole_checks
+      --check "states == 2001" --check "t_first == 0 and t_last >= 20 - 1e-9"
+      --check "max_abs_theta >= 0.0499"
+      --check "max_abs_theta <= 1.1 * pred_max_abs_theta + 0.002"
+      --check "max_abs_x <= 1.1 * pred_max_abs_x + 0.002"
+      --check "abs(end_theta) < 1e-4 and abs(end_x) < 1e-3"
+      --check "dropped == 0" --check "end == 'duration'")
+  add_test(NAME clients_octave_cartpole_lockstep
+    COMMAND ${lang_e2e} --config ${PROJECT_SOURCE_DIR}/config/cartpole.yaml --mode lockstep
+      --name CLOCTCP --timeout 60 ${octave_cartpole_checks}
+      -- ${octave_run} cartpole_balance --prefix {prefix} --duration 20 -q)
+  add_test(NAME clients_octave_cartpole_continuous
+    COMMAND ${lang_e2e} --config ${PROJECT_SOURCE_DIR}/config/cartpole.yaml --mode lockstep
+      --name CLOCTCPC --timeout 60 ${octave_cartpole_checks} --check "abs(abs(k_x) - 1) <= 1e-9"
+      -- ${octave_run} cartpole_balance --prefix {prefix} --duration 20 -q --gain continuous)
+  list(APPEND lang_tests clients_octave_lqr clients_octave_dipc_lockstep clients_octave_dipc_hostile
+       clients_octave_dipc_late_controller clients_octave_dipc_gain
+       clients_octave_cartpole_lockstep clients_octave_cartpole_continuous)
+else()
+  message(WARNING "octave or the Java clients missing: the MATLAB/Octave clients' tests are not registered")
+endif()
+
 # ---- Cross-language: the DIPC balanced in lockstep for 10 s by u = -K x with the same K,
 # the product summed in the same order (0 - k0 x0 - ... - k5 x5) in C (dipc_lqr --k),
-# Python, Lua and Java, IEEE doubles everywhere: the states must agree bit for bit.
+# Python, Lua, Java and MATLAB/Octave (under GNU Octave), IEEE doubles everywhere: the states must agree bit for bit.
 if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
+  set(octave_xl "")
+  if(LAGSIM_OCTAVE)   # MATLAB/Octave too, under GNU Octave
+    set(octave_xl --run octave 0 "${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh ${CMAKE_BINARY_DIR}/octave dipc_balance --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}")
+  endif()
   add_test(NAME clients_cross_language_dipc
     COMMAND ${lang_xl} ${lang_dipc_cfg} --states 1001
       --run c 0 "$<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}"
       --run python 0 "${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}"
       --run lua 0 "${LAGSIM_LUA52} ${lua_dir}/dipc_balance.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}"
-      --run java 0 "java -cp /usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${CMAKE_BINARY_DIR}/lagsim_examples.jar lagsim.examples.DipcBalance --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}")
+      --run java 0 "java -cp /usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${CMAKE_BINARY_DIR}/lagsim_examples.jar lagsim.examples.DipcBalance --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}"
+      ${octave_xl})
   list(APPEND lang_tests clients_cross_language_dipc)
 endif()
 
@@ -236,6 +335,11 @@ endif()
 if(TARGET lagsim_lcmtypes_java)
   add_test(NAME clients_readme_java COMMAND ${readme_run} java-dipc)
   list(APPEND lang_tests clients_readme_java)
+endif()
+# the MATLAB/Octave block by a plain octave --eval (the .m files of <build>/octave on the path)
+if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
+  add_test(NAME clients_readme_octave COMMAND ${readme_run} octave-dipc)
+  list(APPEND lang_tests clients_readme_octave)
 endif()
 
 # ---- README.md's shell recipes, run as written (tests/clients/readme_recipes.py): by hand

@@ -30,6 +30,14 @@ if(LAGSIM_NET_JAVA AND TARGET lagsim_examples_java)
             lagsim.examples.PlantUrls ${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.txt)
   set_tests_properties(net_plant_urls_java PROPERTIES TIMEOUT 60 LABELS net)
 endif()
+find_program(LAGSIM_NET_OCTAVE octave)
+if(LAGSIM_NET_OCTAVE AND TARGET lagsim_examples_java)   # MATLAB/Octave's lagsim_plant_urls
+  add_test(NAME net_plant_urls_octave
+    COMMAND ${CMAKE_COMMAND} -E env --unset=LCM_DEFAULT_URL ${LAGSIM_NET_OCTAVE} --no-gui --quiet --no-window-system
+            --no-init-file --path ${CMAKE_BINARY_DIR}/octave --path ${CMAKE_CURRENT_LIST_DIR}/net
+            --eval "plant_urls_octave('${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.txt')")
+  set_tests_properties(net_plant_urls_octave PROPERTIES TIMEOUT 60 LABELS net)
+endif()
 
 # The daemon's receive-socket filter, its sync marker and the route to the group, on this
 # host (tests/net/test_net.c); one ctest per case.
@@ -42,7 +50,7 @@ lagsim_add_test_cases(test_net net.filter net 60)
 # Two hosts on one machine (tests/net/two_hosts.sh): network namespaces joined by a veth
 # pair, lagsimd in one, peers in the other, nftables for packet loss. Needs root; skipped
 # (exit 77) with the reason where namespaces cannot be made.
-set(LAGSIM_TWO_HOSTS_CASES host_local lockstep_loss realtime_loss two_daemons)
+set(LAGSIM_TWO_HOSTS_CASES host_local lockstep_loss lockstep_loss_octave realtime_loss two_daemons)
 foreach(case ${LAGSIM_TWO_HOSTS_CASES})
   add_test(NAME net_two_hosts_${case}
            COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/net/two_hosts.sh ${case} ${CMAKE_BINARY_DIR}

@@ -9,7 +9,8 @@ directory (so it runs from any directory, as the README promises), its channel p
 DIPC is replaced by one unique to this run, and it is started the way the README says
 (C: built against the tree's client library with -Wall -Wextra -Werror;
 PYTHONPATH=<build>/python; LUA_PATH=<build>/lua/...; java -cp
-lcm.jar:types.jar:examples.jar File.java). Once it answers a probe state (sim time -1) it is subscribed; then lagsimd runs config/dipc.yaml in lockstep for 2 s of sim time and stops.
+lcm.jar:types.jar:examples.jar File.java; octave --path <build>/octave --eval balance in
+the file's folder). Once it answers a probe state (sim time -1) it is subscribed; then lagsimd runs config/dipc.yaml in lockstep for 2 s of sim time and stops.
 The snippet must exit by itself with status 0 once the daemon announces its stop; the
 daemon's final status must show every state before t = 2 s answered (200
 commands_accepted, no lockstep timeout), and every state heard must keep both rods within 0.1 rad of
@@ -36,6 +37,11 @@ RUNNERS = {
              lambda b, f: ["java", "-cp", "/usr/share/java/lcm.jar:%s/lagsim_types.jar:"
                                           "%s/lagsim_examples.jar" % (b, b), f],
              lambda b: {}),
+    # a plain octave --eval of the script, from its folder, the .m files on the path
+    "octave": ("balance.m",
+               lambda b, f: ["octave", "--no-gui", "--quiet", "--no-init-file", "--path",
+                             os.path.join(b, "octave"), "--eval", "balance"],
+               lambda b: {}),
 }
 
 

@@ -8,10 +8,11 @@
    Lua and Java types and helpers, the example controllers, the man pages: check_man.py
    holds each to its program's --help).
 2. The installed lagsimd runs the installed config/dipc.yaml in lockstep with the
-   installed dipc_lqr, then with the installed Python, Lua and Java examples, each from a
+   installed dipc_lqr, then with the installed Python, Lua, Java and Octave examples, each from a
    directory of its own and finding its modules the way an installed tree is found
    (PYTHONPATH=TMP/lib/python3.X/dist-packages, which is on Debian's sys.path for
-   /usr/local; lua5.2's default path shape; the jars in TMP/share/java). Every run must
+   /usr/local; lua5.2's default path shape; the jars in TMP/share/java, found by
+   TMP/share/lagsim/octave/lagsim_setup.m). Every run must
    answer all 201 states of 2 s and balance.
 3. A C controller (clients/manipulator_pd.c) compiles and links against the installed
    headers and libraries through pkg-config, and drives the installed lagsimd.
@@ -58,7 +59,8 @@ def main():
             "share/lua/5.2/lagsim/init.lua", "share/lua/5.2/lagsim_lcm.lua",
             "share/lagsim/examples/python/dipc_balance.py",
             "share/lagsim/examples/lua/dipc_balance.lua",
-            "share/java/lagsim_types.jar", "share/java/lagsim_examples.jar"]
+            "share/java/lagsim_types.jar", "share/java/lagsim_examples.jar",
+            "share/lagsim/octave/lagsim_setup.m", "share/lagsim/octave/dipc_balance.m"]
     # the other programs, each where the build made it
     for prog in ("lagsimctl", "lagsim-view", "lagsim-log2csv", "lagsim-plot", "stick_push"):
         if os.path.exists(os.path.join(build, "bin", prog)):
@@ -103,6 +105,10 @@ def main():
          {"LUA_PATH": lua_path}),
         ("Java DipcBalance", dipc, ["java", "-cp", jars, "lagsim.examples.DipcBalance", "-q"], {}),
     ]
+    if shutil.which("octave"):  # lagsim_setup finds the jars from share/lagsim/octave
+        runs.append(("Octave dipc_balance.m", dipc,
+                     [os.path.join(src, "tests/clients/octave_run.sh"),
+                      os.path.join(prefix, "share/lagsim/octave"), "dipc_balance", "-q"], {}))
     elsewhere = tempfile.mkdtemp(prefix="lagsim_cwd_")
     for name, checks, client, env_extra in runs:
         if not os.path.exists(client[0]) and client[0] not in ("lua5.2", "java", sys.executable):

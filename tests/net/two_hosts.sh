@@ -12,6 +12,8 @@
 #         lockstep_loss   a lockstep DIPC in A, dipc_lqr and lcm-logger in B (allow_lan,
 #                         ttl=1): with 10 % of the datagrams lost each way the states the
 #                         controller answers are those of a lossless run, bit for bit
+#         lockstep_loss_octave   the same with the MATLAB/Octave dipc_balance under GNU
+#                         Octave: a lost answer is answered again from the copy
 #         realtime_loss   a realtime manipulator in A, manipulator_pd and a logger in B,
 #                         10 % lost each way and the commands cut for 1.5 s: the watchdog
 #                         trips and clears once each, its events say so, nothing non-finite
@@ -32,6 +34,7 @@ lagsimd=$build/bin/lagsimd
 types=$build/python
 netpeer="python3 $src/tests/net/netpeer.py"
 config=$src/config/dipc.yaml
+controller=("$build/bin/dipc_lqr")   # the lockstep cases' controller
 
 skip() { echo "SKIPPED: $*"; exit 77; }
 [ "$(id -u)" = 0 ] || skip "needs root (network namespaces, nftables)"
@@ -158,7 +161,7 @@ lockstep_run() { # tag
         --set "lcm.url=$url" --set realtime.mode=lockstep --set realtime.start=first_command \
         -q --duration 5 2>"$work/$tag.err" & pids+=($!); local d=$!
     sleep 1
-    $inB "$build/bin/dipc_lqr" --prefix $prefix --url "$url" --timeout 3 -q \
+    $inB "${controller[@]}" --prefix $prefix --url "$url" --timeout 3 -q \
         --trace "$work/$tag.trace" >"$work/$tag.out" 2>&1 & pids+=($!); local c=$!
     wait $d; local rc=$?
     wait $c
@@ -271,6 +274,11 @@ case_two_daemons() {
 case "$case_name" in
 host_local) case_host_local ;;
 lockstep_loss) case_lockstep_loss ;;
+lockstep_loss_octave)
+    command -v octave >/dev/null || skip "no octave"
+    [ -f "$build/lagsim_examples.jar" ] || skip "no lagsim_examples.jar (javac)"
+    controller=("$src/tests/clients/octave_run.sh" "$build/octave" dipc_balance)
+    case_lockstep_loss ;;
 realtime_loss) case_realtime_loss ;;
 two_daemons) case_two_daemons ;;
 *) echo "unknown case $case_name"; exit 2 ;;

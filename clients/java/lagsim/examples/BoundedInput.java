@@ -2,7 +2,9 @@ package lagsim.examples;
 
 import java.io.DataInput;
 import java.io.IOException;
+import java.lang.reflect.Constructor;
 import java.lang.reflect.Field;
+import java.lang.reflect.InvocationTargetException;
 import java.util.Arrays;
 
 import lcm.lcm.LCMDataInputStream;
@@ -70,6 +72,38 @@ public final class BoundedInput implements DataInput {
             throw new IOException(e);
         }
         return msg;
+    }
+
+    /**
+     * The message of the lcm-gen type named {@code type} ("lagsim.joint_state_t") in the
+     * bytes {@code data}, or null when they do not decode whole, checked as
+     * {@link #decode(LCMDataInputStream, Decoder)} checks them: for callers that cannot
+     * pass a decoder or catch an IOException by its class, such as MATLAB and GNU Octave,
+     * which hand over a received message's bytes
+     * ({@code lcm.lcm.MessageAggregator.Message.data}) and get [] for null.
+     * IllegalArgumentException for a name that is no lcm-gen type.
+     */
+    public static LCMEncodable tryDecode(byte[] data, String type) {
+        Constructor<? extends LCMEncodable> make;
+        try {
+            make = Class.forName(type).asSubclass(LCMEncodable.class).getConstructor(DataInput.class);
+        } catch (ClassNotFoundException | ClassCastException | NoSuchMethodException e) {
+            throw new IllegalArgumentException("no lcm-gen type " + type, e);
+        }
+        try {
+            return decode(new LCMDataInputStream(data), in -> {
+                try {
+                    return make.newInstance(in);
+                } catch (InvocationTargetException e) { // the decoder's own exception
+                    if (e.getCause() instanceof IOException) throw (IOException) e.getCause();
+                    throw new IOException("does not decode: " + e.getCause(), e.getCause());
+                } catch (ReflectiveOperationException e) {
+                    throw new IOException(e);
+                }
+            });
+        } catch (IOException e) {
+            return null;
+        }
     }
 
     /** The unread bytes of {@code ins} (the stream LCM hands a subscriber). */

@@ -1,0 +1,369 @@
+classdef lagsim_controller < handle
+%LAGSIM_CONTROLLER  What a MATLAB or GNU Octave controller of lagsim needs: options,
+%connect, wait for the scene, answer states until the run ends, a summary line. The
+%twin of the Python, Lua, Java and C controllers' shared setup (same options, same ends,
+%same summary).
+%
+%   ctl = lagsim_controller('dipc_balance', 'DIPC', 'dipc');
+%   ctl.option('r', '1', 'input weight');          % the example's own options
+%   if ~ctl.start(varargin{:}), return; end        % parses, connects, waits for the scene
+%   st = ctl.next_state();                         % each newest state once
+%   while ~isempty(st)
+%       ctl.command(st.sim_time, {'theta0'}, u);   % answers that state
+%       st = ctl.next_state();
+%   end
+%   ctl.finish(sprintf('states=%d', n));           % "dipc_balance: summary end=... states=..."
+%
+%   Options: --prefix P, --url URL (the plant's lcm.url; commands go to the next port),
+%   --duration S (s of sim time from the first state; 0: until the daemon stops),
+%   --timeout S (wall s without a scene, or without any message once running),
+%   --trace FILE (each answered state and the efforts sent, %.17g), -q, --help.
+%   A run ends (next_state returns []) when the daemon publishes its stop event, when
+%   nothing came from it (state, status or event) for --timeout wall s, or after
+%   --duration s of sim time; ctl.end_reason says which: stop, silence, duration.
+%   No scene within --timeout, or another model's, is an error (lagsim:noscene,
+%   lagsim:model); a bad option is lagsim:usage. Run from a shell, octave --eval exits 1
+%   on any of these and 0 after a run that ended.
+%
+%   Messages come through LCM's Java library (lcm.jar) into a MessageAggregator that
+%   queues them on LCM's receive thread; they are decoded here, one at a time, by lagsim's
+%   bounded Java decoder (lagsim.examples.BoundedInput), which refuses forged string
+%   lengths before they allocate and keeps only messages that encode back to the bytes
+%   received with every number finite; the rest are counted in ctl.dropped.
+
+    properties
+        name            % the program's name, at the start of its lines
+        model           % the model it controls ('dipc', 'cartpole', ...)
+        quiet = false   % -q
+        scene = []      % the scene description (a lagsim.scene_t)
+        params = struct()   % the scene's parameters by name: params.m0, params.l1, ...
+        end_reason = '' % stop, silence or duration, once the run has ended
+        dropped = 0     % messages on the plant's channels that did not decode whole
+        repeats = 0     % copies of the state answered last, answered again (see next_state)
+    end
+
+    properties (Access = private)
+        keys = {}
+        values = {}
+        helps = {}
+        lc = []         % the plant's state URL: states, status, events, scene
+        lc_cmd = []     % its command URL: commands and control requests
+        agg = []
+        prefix = ''
+        duration = 0
+        timeout = 5
+        trace = -1
+        latest = []     % the newest state received and not yet handled
+        current = []    % the state handed out last
+        last_cmd = []   % the command that answered it
+        stopped = false
+        heard = []      % tic of the last message from the daemon
+        t_first = NaN
+    end
+
+    methods
+        function obj = lagsim_controller(name, default_prefix, model)
+            obj.name = name;
+            obj.model = model;
+            obj.option('prefix', default_prefix, 'channel prefix');
+            obj.option('url', '', ['the plant''s LCM URL, its lcm.url (default: LCM''s ' ...
+                                   'default, honours LCM_DEFAULT_URL); commands go to the next port']);
+            obj.option('duration', '0', ['stop after S s of sim time from the first state ' ...
+                                         '(0: until the daemon stops)']);
+            obj.option('timeout', '5', ['wall s without a scene, or without any message ' ...
+                                        'once running, before ending']);
+            obj.option('trace', '', 'write each answered state and the efforts sent to this file');
+        end
+
+        function option(obj, key, default, help)
+            % Declares --KEY with a default value (a string) and a help line.
+            k = find(strcmp(obj.keys, key));
+            if isempty(k)
+                k = numel(obj.keys) + 1;
+            end
+            obj.keys{k} = key;
+            obj.values{k} = default;
+            obj.helps{k} = help;
+        end
+
+        function v = get(obj, key)
+            % The value of --KEY, a string.
+            v = obj.values{strcmp(obj.keys, key)};
+        end
+
+        function v = number(obj, key)
+            % The value of --KEY as a finite number, or a lagsim:usage error.
+            v = str2double(obj.get(key));
+            if ~isfinite(v) || ~isreal(v)
+                obj.usage_error(sprintf('--%s wants a number, not ''%s''', key, obj.get(key)));
+            end
+        end
+
+        function v = list(obj, key, n)
+            % The value of --KEY as N comma-separated finite numbers (a row), or lagsim:usage.
+            parts = strsplit(obj.get(key), ',');
+            v = str2double(parts);
+            if numel(v) ~= n || any(~isfinite(v)) || ~isreal(v)
+                obj.usage_error(sprintf('--%s wants %d comma-separated numbers', key, n));
+            end
+        end
+
+        function usage_error(obj, msg)
+            error('lagsim:usage', '%s: %s', obj.name, msg);
+        end
+
+        function ok = start(obj, varargin)
+            % Parses the options, connects, subscribes, waits for the scene description.
+            % False after --help (the usage was printed): the caller returns.
+            ok = false;
+            i = 1;
+            while i <= numel(varargin)
+                a = varargin{i};
+                if ~ischar(a)
+                    obj.usage_error('options are strings: ''--prefix'', ''DIPC'', ...');
+                elseif strcmp(a, '--help') || strcmp(a, '-h')
+                    obj.usage();
+                    return;
+                elseif strcmp(a, '-q')
+                    obj.quiet = true;
+                elseif numel(a) > 2 && strncmp(a, '--', 2) && any(strcmp(obj.keys, a(3:end))) ...
+                        && i < numel(varargin) && ischar(varargin{i + 1})
+                    obj.values{strcmp(obj.keys, a(3:end))} = varargin{i + 1};
+                    i = i + 1;
+                else
+                    obj.usage();
+                    obj.usage_error(sprintf('unknown or incomplete option ''%s''', a));
+                end
+                i = i + 1;
+            end
+            obj.prefix = obj.get('prefix');
+            obj.duration = obj.number('duration');
+            obj.timeout = obj.number('timeout');
+            if ~(obj.timeout > 0) || ~(obj.duration >= 0)
+                obj.usage_error('--timeout must be > 0 and --duration >= 0');
+            end
+            lagsim_setup();
+            try
+                [state_url, command_url] = lagsim_plant_urls(obj.get('url'));
+            catch err
+                obj.usage_error(['--url: ' err.message]);
+            end
+            if ~isempty(obj.get('trace'))
+                obj.trace = fopen(obj.get('trace'), 'w');
+                if obj.trace < 0
+                    obj.usage_error(['--trace: cannot write ' obj.get('trace')]);
+                end
+            end
+            obj.lc = lagsim_lcm(state_url);
+            if strcmp(command_url, state_url)
+                obj.lc_cmd = obj.lc;
+            else
+                obj.lc_cmd = lagsim_lcm(command_url);
+            end
+            % LCM's receive thread queues what comes (at most 10000 messages, 16 MB; beyond
+            % that the oldest go); this thread takes them out one at a time
+            obj.agg = javaObject('lcm.lcm.MessageAggregator');
+            obj.agg.setMaxMessages(10000);
+            obj.agg.setMaxBufferSize(16 * 1024 * 1024);
+            ch = [obj.prefix '_'];
+            obj.lc.subscribe([javaMethod('quote', 'java.util.regex.Pattern', ch) ...
+                              '(STATE|SCENE|EVENT|STATUS)'], obj.agg);
+            obj.heard = tic;
+            % subscribed: from here on no state is missed (test harnesses wait for this line)
+            obj.say('%s: waiting for the scene description on %sSCENE\n', obj.name, ch);
+            started = tic;
+            asked = -Inf;
+            while isempty(obj.scene)
+                if toc(started) >= obj.timeout
+                    error('lagsim:noscene', ['%s: no scene on %sSCENE within %g s (is lagsimd ' ...
+                          'running with this prefix?)'], obj.name, ch, obj.timeout);
+                end
+                if toc(started) - asked >= 0.25   % DESCRIBE every 0.25 s until the scene comes
+                    describe = javaObject('lagsim.control_t');
+                    obj.lc_cmd.publish([ch 'CONTROL'], ...
+                        javaMethod('control', 'lagsim.examples.Messages', describe.DESCRIBE));
+                    asked = toc(started);
+                end
+                obj.pump(50);
+            end
+            if ~strcmp(char(obj.scene.model), obj.model)
+                error('lagsim:model', '%s: prefix %s runs model %s, not %s', obj.name, ...
+                      obj.prefix, char(obj.scene.model), obj.model);
+            end
+            names = obj.scene.param_name;   % a Java array: copied before indexing
+            values = obj.scene.param_value;
+            for k = 1:numel(values)
+                if isvarname(char(names(k)))
+                    obj.params.(char(names(k))) = values(k);
+                end
+            end
+            ok = true;
+        end
+
+        function st = next_state(obj)
+            % The newest state not yet handled, as a struct (sim_time, step, name: a cell
+            % of joint names, position, velocity, effort: columns), or [] once the run has
+            % ended (obj.end_reason says why).
+            %
+            % Each sim_time is answered once by the control law, and only the newest state
+            % is: what queued behind a newer state is dropped unanswered. A controller that
+            % answers every message in the order it came, re-sent copies included, falls
+            % behind in lockstep: the daemon publishes a state again every
+            % realtime.lockstep_retry (20 ms) until an answer reaches it, so each answer
+            % that takes longer than that queues a copy, and answering the copies costs the
+            % time in which the next ones are sent. A copy of the state answered last that
+            % is still the newest message means that answer was lost on the way: the same
+            % command goes again, without running the law (counted in obj.repeats).
+            st = [];
+            if ~isempty(obj.end_reason)
+                return;
+            end
+            while true
+                while isempty(obj.latest)
+                    if obj.stopped
+                        obj.end_reason = 'stop';
+                        return;
+                    end
+                    if toc(obj.heard) > obj.timeout
+                        obj.end_reason = 'silence';
+                        return;
+                    end
+                    obj.pump(50);
+                end
+                obj.pump(0);   % what came meanwhile: the newest state is answered
+                s = obj.latest;
+                obj.latest = [];
+                if isempty(obj.current) || double(s.step) ~= obj.current.step ...
+                        || s.sim_time ~= obj.current.sim_time || isempty(obj.last_cmd)
+                    break;
+                end
+                obj.lc_cmd.publish([obj.prefix '_COMMAND'], obj.last_cmd);
+                obj.repeats = obj.repeats + 1;
+            end
+            % the Java arrays, copied to Octave/MATLAB values once
+            names = s.name;
+            position = s.position;
+            velocity = s.velocity;
+            effort = s.effort;
+            st = struct('sim_time', s.sim_time, 'step', double(s.step), ...
+                        'name', {cell(1, numel(names))}, 'position', double(position(:)), ...
+                        'velocity', double(velocity(:)), 'effort', double(effort(:)));
+            for k = 1:numel(names)
+                st.name{k} = char(names(k));
+            end
+            obj.current = st;
+            obj.last_cmd = [];
+            if isnan(obj.t_first)
+                obj.t_first = st.sim_time;
+            end
+            if obj.duration > 0 && ...
+                    st.sim_time - obj.t_first >= obj.duration - 0.5 * obj.scene.control_period
+                obj.end_reason = 'duration';   % this state is still answered; the next call ends
+            end
+        end
+
+        function command(obj, sim_time, names, efforts)
+            % Publishes EFFORTS (N or N m; a NaN or an infinity goes as 0) for the joints
+            % NAMES (a cell of strings), answering the state at SIM_TIME.
+            efforts = double(efforts(:));
+            efforts(~isfinite(efforts)) = 0;
+            if ischar(names)
+                names = {names};
+            end
+            if numel(names) == 1   % a one-element vector reaches Java as a scalar
+                cmd = javaMethod('command', 'lagsim.examples.Messages', sim_time, names{1}, efforts);
+            else
+                cmd = javaMethod('command', 'lagsim.examples.Messages', sim_time, names, efforts);
+            end
+            obj.lc_cmd.publish([obj.prefix '_COMMAND'], cmd);
+            st = obj.current;
+            if ~isempty(st) && st.sim_time == sim_time
+                obj.last_cmd = cmd;
+                if obj.trace >= 0
+                    % sim_time, positions, velocities, efforts sent: %.17g reads back exactly
+                    fprintf(obj.trace, '%s\n', strtrim(sprintf('%.17g ', ...
+                            [st.sim_time; st.position; st.velocity; efforts])));
+                end
+            end
+        end
+
+        function k = joint(obj, st, joint_name) %#ok<INUSL>
+            % The index of JOINT_NAME in a state's joints, or 0.
+            k = find(strcmp(st.name, joint_name), 1);
+            if isempty(k)
+                k = 0;
+            end
+        end
+
+        function finish(obj, summary)
+            % Prints the summary line: "<name>: summary end=<why> <summary> dropped=N repeats=N".
+            if obj.trace >= 0
+                fclose(obj.trace);
+                obj.trace = -1;
+            end
+            obj.say('%s: summary end=%s %s dropped=%d repeats=%d\n', obj.name, obj.end_reason, ...
+                    summary, obj.dropped, obj.repeats);
+        end
+
+        function say(obj, varargin) %#ok<INUSL>
+            % fprintf to the standard output, flushed (a pipe reads it at once in Octave).
+            fprintf(varargin{:});
+            if exist('OCTAVE_VERSION', 'builtin')
+                fflush(stdout);
+            end
+        end
+    end
+
+    methods (Access = private)
+        function usage(obj)
+            fprintf('usage: %s [options]\n', obj.name);
+            for k = 1:numel(obj.keys)
+                d = obj.values{k};
+                if isempty(d)
+                    d = 'none';
+                end
+                fprintf('  --%-10s %s (default %s)\n', obj.keys{k}, obj.helps{k}, d);
+            end
+            fprintf('  -q           quiet: summary only\n');
+        end
+
+        function pump(obj, wait_ms)
+            % Handles every queued message, waiting up to WAIT_MS ms for the first.
+            m = obj.agg.getNextMessage(wait_ms);
+            while ~isempty(m)
+                obj.handle(m);
+                if obj.agg.numMessagesAvailable() > 0
+                    m = obj.agg.getNextMessage(0);
+                else
+                    m = [];
+                end
+            end
+        end
+
+        function handle(obj, m)
+            obj.heard = tic;
+            channel = char(m.channel);
+            kind = channel(numel(obj.prefix) + 2:end);
+            if strcmp(kind, 'STATUS')
+                return;
+            end
+            switch kind
+                case 'STATE'
+                    msg = lagsim_decode(m.data, 'joint_state_t');
+                case 'SCENE'
+                    msg = lagsim_decode(m.data, 'scene_t');
+                otherwise
+                    msg = lagsim_decode(m.data, 'event_t');
+            end
+            if isempty(msg)
+                obj.dropped = obj.dropped + 1;
+            elseif strcmp(kind, 'STATE')
+                obj.latest = msg;
+            elseif strcmp(kind, 'SCENE')
+                obj.scene = msg;
+            elseif strcmp(kind, 'EVENT') && strcmp(char(msg.kind), 'stop')
+                obj.stopped = true;
+            end
+        end
+    end
+end
