@@ -451,6 +451,25 @@ int lag_client_set(lag_client *c, const char *key, const char *value)
     return rc;
 }
 
+int lag_client_kick(lag_client *c, const char *joint, double impulse, double duration)
+{
+    char key[LAG_WIRE_NAME_LEN], value[64];
+    if (!joint || !joint[0] || snprintf(key, sizeof key, "kick.%s", joint) >= (int)sizeof key ||
+        !isfinite(impulse) || !isfinite(duration) || duration < 0) {
+        set_err(c, "kick: a joint name, a finite impulse and a duration >= 0 (s)");
+        return LAG_CLIENT_ERR_ARG;
+    }
+    /* %.17g: the daemon reads back the same doubles */
+    if (duration > 0) snprintf(value, sizeof value, "%.17g,%.17g", impulse, duration);
+    else snprintf(value, sizeof value, "%.17g", impulse);
+    return lag_client_set(c, key, value);
+}
+
+int lag_client_reset_scene(lag_client *c)
+{
+    return send_control(c, LAGSIM_CONTROL_T_RESET, 1, 0, NULL, NULL);
+}
+
 int lag_client_step(lag_client *c, int64_t count)
 {
     if (count < 1) {

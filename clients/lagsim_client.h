@@ -145,6 +145,16 @@ int lag_client_request_describe(lag_client *c);
  * `set` event (and the new scene) or `control_rejected` with the reason. */
 int lag_client_set(lag_client *c, const char *key, const char *value);
 
+/* A kick: a disturbance on joint `joint` from the current sim time on, adding to the
+ * scene's disturbances and to earlier kicks: impulse N s (N m s on an angle) at once
+ * (duration 0), or spread as a force impulse/duration over duration s. Sent as SET
+ * "kick.<joint>" = "<impulse>[,<duration>]"; answered by a `kick` event (replayed exactly
+ * from a log) or control_rejected with the reason. */
+int lag_client_kick(lag_client *c, const char *joint, double impulse, double duration);
+/* RESET to the scene file's initial state and values: the changes made by SET and the
+ * kicks are undone (a `restore` event says which), then the `reset` event. */
+int lag_client_reset_scene(lag_client *c);
+
 void lag_client_get_counters(const lag_client *c, lag_client_counters *out);
 
 /* Index of joint `name` in the scene (or -1); value of parameter `name` (or NaN). */

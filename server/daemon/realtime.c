@@ -527,7 +527,7 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
                   : s->run == RT_WAITING ? "waiting for a command"
                                          : "running",
                   kept[0] ? "keeps the changes made while running: " : "the scene file's values",
-                  kept, kept[0] ? " (reset with count 1: the scene file's values)" : "");
+                  kept, kept[0] ? " (lagsimctl reset --scene, RESET count 1: the scene file's values)" : "");
     s->want_scene = true;
     s->want_state = true;
     s->want_status = true;
