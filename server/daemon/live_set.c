@@ -247,16 +247,13 @@ int live_kick_apply(live_sets *ls, lag_sim *sim, const char *kv, live_kick *k, c
     return 0;
 }
 
-void live_kicks_reset(live_sets *ls, lag_sim *sim)
+void live_kicks_clear(live_sets *ls, lag_sim *sim)
 {
     static live_sets next; /* large: not on the stack */
     next = *ls;
-    int n = 0;
-    for (int i = 0; i < next.nk; i++)
-        if (next.kick[i].step <= 0) next.kick[n++] = next.kick[i];
-    next.nk = n;
+    next.nk = 0;
     char why[256];
-    if (next.nk != ls->nk && redefine(ls, &next, sim, why, sizeof why) == 0) *ls = next;
+    if (ls->nk > 0 && redefine(ls, &next, sim, why, sizeof why) == 0) *ls = next;
 }
 
 void live_set_describe(const live_sets *ls, char *out, size_t outlen)

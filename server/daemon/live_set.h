@@ -69,9 +69,10 @@ int live_kick_apply(live_sets *ls, lag_sim *sim, const char *kv, live_kick *k, c
  * the scene keeps them). -1 with a reason when they do not fit. */
 int live_kicks_append(const live_sets *ls, lag_sim_def *def, char *why, size_t whylen);
 
-/* At a reset: drops the kicks that start after tick 0 (sim time starts over: they belong
- * to the run before it) from ls and from sim's definition. */
-void live_kicks_reset(live_sets *ls, lag_sim *sim);
+/* At a reset: drops every kick (sim time starts over: they belong to the run before it)
+ * from ls and from sim's definition. The daemon says so with a `kicks_cleared` event,
+ * which --replay applies where the log has it (a kick after the reset stays). */
+void live_kicks_clear(live_sets *ls, lag_sim *sim);
 
 /* The changes kept, "key=value, key=value" (kicks not counted), for a reset's answer. */
 void live_set_describe(const live_sets *ls, char *out, size_t outlen);

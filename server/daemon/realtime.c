@@ -509,7 +509,13 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
 /* ---------------------------------------------------------------- control requests */
 static void do_reset(rt_server *s, const double *q, const double *qd, const char *what)
 {
-    live_kicks_reset(&s->live, &s->sim); /* sim time starts over: the kicks are the old run's */
+    if (s->live.nk > 0) { /* sim time starts over: the kicks are the old run's */
+        char detail[96];
+        snprintf(detail, sizeof detail, "a reset ends the %d kick(s) of the run before it",
+                 s->live.nk);
+        live_kicks_clear(&s->live, &s->sim);
+        rt_publish_event(s, "kicks_cleared", "", 0, detail); /* --replay applies it here */
+    }
     lag_sim_reset(&s->sim, q, qd);
     s->effect_events_dropped = s->sim.events_dropped;
     for (int i = 0; i < s->nq; i++) s->held[i] = 0.0;

@@ -145,7 +145,8 @@ typedef struct replay_sets {
     live_sets live;                         /* applied so far: the validation source */
     int64_t step[REPLAY_SETS_PENDING];      /* read, not yet applied: where, what */
     char kv[REPLAY_SETS_PENDING][LIVE_SET_LEN];
-    char kind[REPLAY_SETS_PENDING];         /* 's' set, 'k' kick, 'r' restore */
+    char kind[REPLAY_SETS_PENDING];         /* 's' set, 'k' kick, 'c' kicks_cleared,
+                                             * 'r' restore */
     const lag_sim_def *base;                /* the scene's definition, as replayed */
     int head, n;
     int64_t applied;
@@ -171,7 +172,8 @@ static void set_read(replay_sets *rs, const lag_log_record *rec)
 {
     lag_wire_event ev;
     if (!rec->data || lag_wire_decode_event(rec->data, rec->size, &ev) != LAG_WIRE_OK ||
-        (strcmp(ev.kind, "set") && strcmp(ev.kind, "kick") && strcmp(ev.kind, "restore")))
+        (strcmp(ev.kind, "set") && strcmp(ev.kind, "kick") && strcmp(ev.kind, "restore") &&
+         strcmp(ev.kind, "kicks_cleared")))
         return;
     if (rs->n == REPLAY_SETS_PENDING) {
         if (!rs->failed)
@@ -182,7 +184,10 @@ static void set_read(replay_sets *rs, const lag_log_record *rec)
     }
     int k = (rs->head + rs->n++) % REPLAY_SETS_PENDING;
     rs->step[k] = ev.step;
-    rs->kind[k] = ev.kind[0] == 'k' ? 'k' : ev.kind[0] == 'r' ? 'r' : 's';
+    rs->kind[k] = !strcmp(ev.kind, "kick")            ? 'k'
+                  : !strcmp(ev.kind, "kicks_cleared") ? 'c'
+                  : !strcmp(ev.kind, "restore")       ? 'r'
+                                                      : 's';
     snprintf(rs->kv[k], sizeof rs->kv[k], "%s", ev.detail);
 }
 
@@ -207,6 +212,8 @@ static bool set_apply(replay_sets *rs, lag_sim *sim, const lagsimd_opts *o, bool
         int ok = 1;
         if (kind == 'k') {
             ok = live_kick_apply(&rs->live, sim, kv, &k, why, sizeof why) == 0;
+        } else if (kind == 'c') {
+            live_kicks_clear(&rs->live, sim);
         } else if (lag_sim_redefine(sim, rs->base, err, sizeof err) != LAG_OK &&
                    (!restarting || lag_sim_init(sim, rs->base, err, sizeof err) != LAG_OK)) {
             snprintf(why, sizeof why, "%s", err);
@@ -218,7 +225,8 @@ static bool set_apply(replay_sets *rs, lag_sim *sim, const lagsimd_opts *o, bool
             if (!rs->failed)
                 fprintf(stderr, "lagsimd: --replay: the log's %s '%s' (step %lld) cannot be "
                                 "applied to this scene: %s (wrong --config or --set?)\n",
-                        kind == 'k' ? "kick" : "restore", kv, (long long)step, why);
+                        kind == 'k' ? "kick" : kind == 'c' ? "kicks_cleared" : "restore", kv,
+                        (long long)step, why);
             rs->failed = true;
             return false;
         }
@@ -393,7 +401,6 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
                     printf("gap: more gaps follow, counted below\n");
             } else if (have) {
                 restarts++;
-                live_kicks_reset(&sets.live, &sim); /* a reset: as the daemon's */
             }
             bool initial = restart(&sim, &m);
             checking = initial || (m.step == 0 && !(sim.def.effects.enabled & LAG_EFF_NOISE)) ||
@@ -468,7 +475,8 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
            log_path, (long long)compared, channel, (long long)restarts, (long long)gaps,
            (long long)undecodable, (long long)errors);
     if (sets.applied > 0)
-        printf("%lld change(s) made while running applied at their steps (set, kick and restore events on %s)\n",
+        printf("%lld change(s) made while running applied at their steps (set, kick, "
+               "kicks_cleared and restore events on %s)\n",
                (long long)sets.applied, ch_event);
     if (unchecked > 0)
         printf("%lld states after a restart were not compared: %s\n", (long long)unchecked,
