@@ -801,7 +801,7 @@ int lag_client_pick_plant(const char *url, const char *model, double wait_s,
             snprintf(err, errlen, "no plant on %s within %.1f s (is lagsimd running on this "
                      "LCM URL?)", where, wait_s);
         else if (err)
-            snprintf(err, errlen, "no %s plant on %s; running: %s", model, where, names);
+            snprintf(err, errlen, "no %s plant on %s (heard: %s)", model, where, names);
         return LAG_CLIENT_TIMEOUT;
     }
     if (err) {

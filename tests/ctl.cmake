@@ -31,3 +31,13 @@ if(LAGSIM_PYTHON3)
             --bin $<TARGET_FILE_DIR:lagsimd> --source ${PROJECT_SOURCE_DIR})
   set_tests_properties(ctl_kick PROPERTIES TIMEOUT 120 LABELS clients)
 endif()
+
+# Tools find the plant: lagsimctl list (prefix, model, mode, run state, host, URL) and
+# lagsimctl, lqr_balance, dipc_lqr and lagsim-view without --prefix, with one plant on
+# the bus, with two, with none of the controller's model (tests/ctl/test_discover.py).
+if(LAGSIM_PYTHON3)
+  add_test(NAME ctl_discover
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/ctl/test_discover.py
+            --bin $<TARGET_FILE_DIR:lagsimd> --source ${PROJECT_SOURCE_DIR})
+  set_tests_properties(ctl_discover PROPERTIES TIMEOUT 120 LABELS clients)
+endif()
