@@ -33,8 +33,9 @@ if(LAGSIM_PYTHON3)
 endif()
 
 # Tools find the plant: lagsimctl list (prefix, model, mode, run state, host, URL) and
-# lagsimctl, lqr_balance, dipc_lqr and lagsim-view without --prefix, with one plant on
-# the bus, with two, with none of the controller's model (tests/ctl/test_discover.py).
+# lagsimctl, lqr_balance, dipc_lqr, manipulator_pd, the Python dipc_balance.py and
+# lagsim-view without --prefix, with one plant on the bus, with three, with none of the
+# controller's model (tests/ctl/test_discover.py).
 if(LAGSIM_PYTHON3)
   add_test(NAME ctl_discover
     COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/ctl/test_discover.py

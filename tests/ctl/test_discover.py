@@ -3,16 +3,19 @@
 
     test_discover.py --bin BUILD/bin --source SRC
 
-On a multicast port of this run's own, two daemons: a cart-pole waiting for its first
-command (prefix CP_<pid>) and a paused stick (ST_<pid>). Then:
-  lagsimctl list            exit 0, a table with both: prefix, model, mode, run state,
-                            host (this host's name), URL (the state URL)
+On a multicast port of this run's own, three daemons: a cart-pole waiting for its first
+command (prefix CP_<pid>), a paused stick (ST_<pid>) and a DIPC waiting for its first
+command (DP_<pid>). Then:
+  lagsimctl list            exit 0, a table with all three: prefix, model, mode, run
+                            state, host (this host's name), URL (the state URL)
   lagsimctl --json list     the same as JSON: cartpole waiting, stick paused, realtime
-  lagsimctl status          (no --prefix, two plants) exit 2, both named, "--prefix"
-  lqr_balance               (no --prefix, two plants) exit 2, both named
-  dipc_lqr --timeout 1      (no --prefix, no DIPC among them) says there is no dipc plant,
-                            names the cart-pole, waits on DIPC, exit 1 (no scene)
-The stick is stopped; then, one plant on the bus:
+  lagsimctl status          (no --prefix, three plants) exit 2, all named, "--prefix"
+  lqr_balance               (no --prefix, three plants) exit 2, all named
+  dipc_lqr --duration 0.2   (no --prefix) takes the only DIPC, exit 0
+  dipc_balance.py           (Python, no --prefix) the same
+  manipulator_pd --timeout 1  (no --prefix, no manipulator) says there is none, names
+                            the plants heard, waits on MANIPULATOR, exit 1 (no scene)
+The stick and the DIPC are stopped; then, one plant on the bus:
   lagsimctl status          exit 0: the cart-pole's status (run_state waiting)
   lqr_balance --duration 1  exit 0: it took the cart-pole (its design line names CP_<pid>)
   lagsim-view --port 0      serves the cart-pole: its address line names CP_<pid>
@@ -55,11 +58,12 @@ def main():
     a = ap.parse_args()
     b = lambda p: os.path.join(a.bin, p)
     pid = os.getpid()
-    cp, st = "CP_%d" % pid, "ST_%d" % pid
+    cp, st, dp = "CP_%d" % pid, "ST_%d" % pid, "DP_%d" % pid
     url = "udpm://239.255.76.67:%d?ttl=0" % (46000 + 2 * (pid % 6000))
     os.environ["LCM_DEFAULT_URL"] = url
     daemons = {}
-    for prefix, cfg, start in ((cp, "cartpole.yaml", "first_command"), (st, "stick.yaml", "paused")):
+    for prefix, cfg, start in ((cp, "cartpole.yaml", "first_command"), (st, "stick.yaml", "paused"),
+                               (dp, "dipc.yaml", "first_command")):
         daemons[prefix] = subprocess.Popen(
             [b("lagsimd"), "--config", os.path.join(a.source, "config", cfg), "-q",
              "--set", "lcm.prefix=" + prefix, "--set", "realtime.start=" + start],
@@ -69,35 +73,47 @@ def main():
         r = run([b("lagsimctl"), "list"])
         rows = {l.split()[0]: l.split() for l in r.stdout.splitlines()[1:] if l.split()}
         check(r.returncode == 0 and r.stdout.split()[:4] == ["PREFIX", "MODEL", "MODE", "RUN"]
-              and cp in rows and st in rows, "list: exit 0, a table with both plants")
+              and cp in rows and st in rows and dp in rows,
+              "list: exit 0, a table with the three plants")
         r = run([b("lagsimctl"), "--json", "list"])
         try:
             plants = {p["prefix"]: p for p in json.loads(r.stdout)}
         except ValueError:
             plants = {}
         host = socket.gethostname()
-        want = {cp: ("cartpole", "waiting"), st: ("stick", "paused")}
+        want = {cp: ("cartpole", "waiting"), st: ("stick", "paused"), dp: ("dipc", "waiting")}
         for prefix, (model, state) in want.items():
             p = plants.get(prefix, {})
             check(p.get("model") == model and p.get("run_state") == state and
                   p.get("mode") == "realtime" and p.get("host") == host and p.get("url") == url,
                   "list --json: %s is a %s, %s, realtime, on %s, at %s (%s)"
                   % (prefix, model, state, host, url, p))
-        check(len(plants) == 2, "list --json: exactly the two plants (%d)" % len(plants))
+        check(len(plants) == 3, "list --json: exactly the three plants (%d)" % len(plants))
 
         r = run([b("lagsimctl"), "status"])
-        check(r.returncode == 2 and cp in r.stderr and st in r.stderr and "--prefix" in r.stderr,
-              "status without --prefix, two plants: exit 2, both named, --prefix suggested")
+        check(r.returncode == 2 and all(p in r.stderr for p in (cp, st, dp)) and
+              "--prefix" in r.stderr,
+              "status without --prefix, three plants: exit 2, all named, --prefix suggested")
         r = run([b("lqr_balance"), "--duration", "0.5"])
-        check(r.returncode == 2 and cp in r.stderr and st in r.stderr,
-              "lqr_balance without --prefix, two plants: exit 2, both named")
-        r = run([b("dipc_lqr"), "--timeout", "1"])
-        check(r.returncode == 1 and "no dipc plant" in r.stdout and cp in r.stdout and
-              "waiting for prefix DIPC" in r.stdout,
-              "dipc_lqr without --prefix, no DIPC: says so, names the cart-pole, waits on DIPC")
+        check(r.returncode == 2 and all(p in r.stderr for p in (cp, st, dp)),
+              "lqr_balance without --prefix, three plants: exit 2, all named")
+        r = run([b("dipc_lqr"), "--duration", "0.2", "-q"])
+        check(r.returncode == 0 and ("prefix %s" % dp) in r.stdout and "end=duration" in r.stdout,
+              "dipc_lqr without --prefix: takes the only DIPC, %s" % dp)
+        py = os.path.join(a.source, "clients", "python", "dipc_balance.py")
+        r = run([sys.executable, py, "--types", os.path.join(os.path.dirname(a.bin), "python"),
+                 "--duration", "0.2", "-q"])
+        check(r.returncode == 0 and ("prefix %s" % dp) in r.stdout and "end=duration" in r.stdout,
+              "dipc_balance.py (Python) without --prefix: takes the only DIPC, %s" % dp)
+        r = run([b("manipulator_pd"), "--timeout", "1"])
+        check(r.returncode == 1 and "no manipulator plant" in r.stdout and cp in r.stdout and
+              "waiting for prefix MANIPULATOR" in r.stdout,
+              "manipulator_pd without --prefix, no manipulator: says so, names the plants "
+              "heard, waits on MANIPULATOR")
 
-        daemons[st].terminate()
-        daemons[st].wait(10)
+        for p in (st, dp):
+            daemons[p].terminate()
+            daemons[p].wait(10)
         time.sleep(0.3)
         r = run([b("lagsimctl"), "status"])
         check(r.returncode == 0 and any(l.split() == ["run_state", "waiting"]
