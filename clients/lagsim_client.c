@@ -784,9 +784,11 @@ int lag_client_pick_plant(const char *url, const char *model, double wait_s,
     lag_bus b;
     char berr[8];
     const char *where = lag_bus_init(&b, url, "X", berr, sizeof berr) == 0 ? b.state_url : "?";
+    /* a plant is what answers DESCRIBE with a scene: a channel that only looks like a
+     * plant's (another program's FOO_STATE) is not one to pick */
     int k = 0, match = -1;
     for (int i = 0; i < n; i++)
-        if (!model || !strcmp(all[i].model, model)) {
+        if (all[i].model[0] && (!model || !strcmp(all[i].model, model))) {
             k++;
             match = i;
         }
@@ -797,7 +799,9 @@ int lag_client_pick_plant(const char *url, const char *model, double wait_s,
         return LAG_CLIENT_OK;
     }
     if (k == 0) {
-        if (err && n == 0)
+        bool any = false;
+        for (int i = 0; i < n; i++) any |= all[i].model[0] != '\0';
+        if (err && !any)
             snprintf(err, errlen, "no plant on %s within %.1f s (is lagsimd running on this "
                      "LCM URL?)", where, wait_s);
         else if (err)
@@ -809,7 +813,7 @@ int lag_client_pick_plant(const char *url, const char *model, double wait_s,
         int m = 0;
         static lag_client_plant sel[LAG_CLIENT_MAX_PLANTS];
         for (int i = 0; i < n; i++)
-            if (!model || !strcmp(all[i].model, model)) sel[m++] = all[i];
+            if (all[i].model[0] && (!model || !strcmp(all[i].model, model))) sel[m++] = all[i];
         plant_names(sel, m, mine, sizeof mine);
         snprintf(err, errlen, "%d %s%splants on %s: %s; choose one with --prefix", k,
                  model ? model : "", model ? " " : "", where, mine);

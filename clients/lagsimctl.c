@@ -46,6 +46,7 @@ static void on_signal(int sig) { g_signal = sig; }
 static int g_digits = 17;
 static bool g_json = false;
 static bool g_digits_set = false;
+static const char *g_prefix = "";  /* the plant's, for the status's first line */
 static bool g_watch_lines = false; /* watch: a status is one key=value line among states */
 
 static void usage(FILE *f)
@@ -211,7 +212,7 @@ static void print_status_human(const lag_client_status *st)
     int digits = g_digits_set ? g_digits : 6;
     char zeros[1024] = "";
     size_t zl = 0;
-    printf("status\n");
+    printf("status of %s\n", g_prefix);
     for (int i = 0; i < n; i++) {
         if (f[i].count_field >= 0 || !strcmp(f[i].name, "utime")) continue;
         const char *p = (const char *)st + f[i].offset;
@@ -662,6 +663,7 @@ int main(int argc, char **argv)
         }
         prefix = chosen.prefix;
     }
+    g_prefix = prefix;
     lag_client *c = lag_client_create(url, prefix, err, sizeof err);
     if (!c) {
         fprintf(stderr, "lagsimctl: %s\n", err);

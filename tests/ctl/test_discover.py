@@ -15,8 +15,10 @@ command (DP_<pid>). Then:
   dipc_balance.py           (Python, no --prefix) the same
   manipulator_pd --timeout 1  (no --prefix, no manipulator) says there is none, names
                             the plants heard, waits on MANIPULATOR, exit 1 (no scene)
-The stick and the DIPC are stopped; then, one plant on the bus:
+The stick and the DIPC are stopped; then, one plant on the bus, and junk published on
+NOTAPLANT_<pid>_STATE (a channel that looks like a plant's):
   lagsimctl status          exit 0: the cart-pole's status (run_state waiting)
+  lagsimctl list            NOTAPLANT_<pid> listed without a model ('?')
   lqr_balance --duration 1  exit 0: it took the cart-pole (its design line names CP_<pid>)
   lagsim-view --port 0      serves the cart-pole: its address line names CP_<pid>
 and on a port with no plant, lagsimctl list exits 3 saying so.
@@ -27,6 +29,7 @@ import os
 import socket
 import subprocess
 import sys
+import threading
 import time
 
 fails = 0
@@ -115,10 +118,32 @@ def main():
             daemons[p].terminate()
             daemons[p].wait(10)
         time.sleep(0.3)
-        r = run([b("lagsimctl"), "status"])
-        check(r.returncode == 0 and any(l.split() == ["run_state", "waiting"]
-                                        for l in r.stdout.splitlines()),
-              "status without --prefix, one plant: exit 0, its status (waiting)")
+        # another program's channel that looks like a plant's, junk on it: not a plant
+        sys.path.insert(0, os.path.join(os.path.dirname(a.bin), "python"))
+        from lagsim_lcm import LCM
+        junk_stop = threading.Event()
+
+        def junk():
+            lc = LCM(url)
+            while not junk_stop.wait(0.05):
+                lc.publish("NOTAPLANT_%d_STATE" % pid, b"\x00" * 40)
+            lc.close()
+
+        jt = threading.Thread(target=junk)
+        jt.start()
+        try:
+            r = run([b("lagsimctl"), "status"])
+            check(r.returncode == 0 and any(l.split() == ["run_state", "waiting"]
+                                            for l in r.stdout.splitlines()),
+                  "status without --prefix, one plant (and junk on NOTAPLANT_STATE): exit 0, "
+                  "its status (waiting)")
+            r = run([b("lagsimctl"), "list"])
+            rows = {l.split()[0]: l.split() for l in r.stdout.splitlines()[1:] if l.split()}
+            check(rows.get("NOTAPLANT_%d" % pid, [None, None])[1] == "?" and cp in rows,
+                  "list: a channel that only looks like a plant's has no model ('?')")
+        finally:
+            junk_stop.set()
+            jt.join()
         r = run([b("lqr_balance"), "--duration", "1", "-q"])
         check(r.returncode == 0 and ("prefix %s" % cp) in r.stdout and "summary" in r.stdout,
               "lqr_balance without --prefix, one plant: balances the cart-pole %s" % cp)

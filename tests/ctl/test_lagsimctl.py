@@ -4,7 +4,7 @@
     test_lagsimctl.py --lagsimctl BIN --lagsimd BIN --source DIR
 
 A real-time daemon on config/dipc.yaml with a prefix of its own; then, in order:
-  status      exit 0, for people: a `status` block, one field a line (name, value, unit:
+  status      exit 0, for people: a block headed `status of <prefix>`, one field a line (name, value, unit:
               sim_time in s, energy in J), the names aligned, every non-zero field of
               status_t.lcm (read from the file) named, the zero counters on a `zero` line;
               --json: one JSON object with every field of status_t.lcm, run_state=running
@@ -104,7 +104,7 @@ def main():
         named = set(rows) | set(w.strip(",") for w in rows.get("zero", "").split()[1:])
         missing = [f for f in status_fields if f != "utime" and f not in named and
                    f not in ("contact",)]  # an empty word is left out
-        check(r.returncode == 0 and out and out[0] == "status" and not missing,
+        check(r.returncode == 0 and out and out[0] == "status of " + prefix and not missing,
               "status for people: exit 0, every field of status_t.lcm named (%d; missing %s)"
               % (len(status_fields), missing))
         cols = set(l.index(l.split()[1]) for l in out[1:] if len(l.split()) > 1)
