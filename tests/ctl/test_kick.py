@@ -17,7 +17,9 @@ changes only by the impulses given on x (T = 1/2 m x_dot^2 + ...: docs/models.md
   reset --scene                               -> a restore event; the scene says m = 1 again
 Then `lagsimd --replay` of the log applies every kick, the kicks_cleared and the restore
 at their steps and must give a largest difference of exactly 0; the same log without its
-events must not (the kicks mattered).
+events must not (the kicks mattered). The same for a run under control: the cart-pole of
+config/cartpole.yaml balanced by lqr_balance in real time for 3 s, kicked on theta (an
+impulse) and on x (a force over 0.3 s) while it runs, logged with --log.
 """
 import argparse
 import json
@@ -189,7 +191,10 @@ def main():
               "m x_dot after kick x -0.5 with m = 2: %r" % (None if v150b is None else 2 * v150b))
 
     def replay(path):
-        r = subprocess.run([lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix,
+        return replay_cfg(cfg, prefix, path)
+
+    def replay_cfg(config, pre, path):
+        r = subprocess.run([lagsimd, "--config", config, "--set", "lcm.prefix=" + pre,
                             "--replay", path], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                            universal_newlines=True, timeout=60)
         print("$ lagsimd --replay %s   -> exit %d" % (os.path.basename(path), r.returncode))
@@ -199,6 +204,46 @@ def main():
             if line.startswith("max difference = "):
                 diff = float(line.split("=", 1)[1])
         return r, diff
+
+    # a run under control: the cart-pole balanced by lqr_balance in real time, kicked
+    # twice while it runs (mid-run, efforts held), logged, then replayed
+    cfg_cp = os.path.join(a.source, "config", "cartpole.yaml")
+    log_cp = os.path.join(tmp, "cartpole.lcm")
+    pcp = prefix + "CP"
+    c = subprocess.Popen([os.path.join(a.bin, "lqr_balance"), "--prefix", pcp, "-q"],
+                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    c.stdout.readline()  # "waiting for the scene description": subscribed
+    d = subprocess.Popen([lagsimd, "--config", cfg_cp, "--set", "lcm.prefix=" + pcp, "-q",
+                          "--set", "realtime.start=first_command", "--duration", "3",
+                          "--log", log_cp], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        time.sleep(1.0)
+        r1 = subprocess.run([ctl_bin, "--prefix", pcp, "kick", "theta", "0.01"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+        time.sleep(0.5)
+        r2 = subprocess.run([ctl_bin, "--prefix", pcp, "kick", "x", "0.2", "--duration", "0.3"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+        check(r1.returncode == 0 and r2.returncode == 0,
+              "cart-pole under lqr_balance: kick theta 0.01 and kick x 0.2 --duration 0.3 while "
+              "it runs: exit 0 (%s; %s)" % (r1.stdout.split("\n")[0], r2.stdout.split("\n")[0]))
+        d.wait(30)
+        out = c.communicate(timeout=30)[0]
+        print("  " + out.strip().replace("\n", "\n  ")[-400:])
+    finally:
+        for p in (d, c):
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+    r, diff = replay_cfg(cfg_cp, pcp, log_cp)
+    check(r.returncode == 0 and diff == 0.0 and "2 change(s) made while running" in r.stdout,
+          "--replay of the controlled, kicked cart-pole: 2 kicks applied, difference exactly 0 "
+          "(%r)" % diff)
+    recs_cp = read_log(log_cp)
+    bare_cp = os.path.join(tmp, "cartpole_no_events.lcm")
+    write_log(bare_cp, [x for x in recs_cp if x[1] != pcp + "_EVENT"])
+    r, diff = replay_cfg(cfg_cp, pcp, bare_cp)
+    check(r.returncode == 1 and diff is not None and diff > 0,
+          "the same log without its events: difference %r, not 0" % diff)
 
     r, diff = replay(log)
     check(r.returncode == 0 and diff == 0.0 and "7 change(s) made while running" in r.stdout,
