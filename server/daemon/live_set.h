@@ -19,8 +19,6 @@
 #define LIVE_SET_MAX 64               /* distinct keys changed while running */
 #define LIVE_SET_LEN LAG_WIRE_TEXT_LEN /* "key=value" with its NUL, as an event's detail */
 
-/* The changes in the order they were applied, each "key=value"; a key set again replaces
- * the entries it overrides (itself and the keys below it), so the list stays short. */
 /* A kick: a disturbance applied at the tick it was asked for (control_t SET with key
  * "kick.<joint>"), added to the scene's own disturbances and to the other kicks. */
 typedef struct live_kick {
@@ -30,6 +28,9 @@ typedef struct live_kick {
     double duration;   /* s; 0: an impulse at that tick, else a force impulse/duration */
 } live_kick;
 
+/* The changes in the order they were applied, each "key=value"; a key set again replaces
+ * the entries it overrides (itself and the keys below it), so the list stays short. The
+ * kicks are kept beside them: they are not scene keys (live_kick_apply). */
 typedef struct live_sets {
     char kv[LIVE_SET_MAX][LIVE_SET_LEN];
     int n;

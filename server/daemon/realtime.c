@@ -528,12 +528,14 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
     if (s->run == RT_FAULT) s->run = RT_PAUSED;
     char kept[200];
     live_set_describe(&s->live, kept, sizeof kept);
+    /* which changes made while running the reset keeps (a reset with count 1 keeps none) */
     limited_event(s, RT_EV_RESET, "", 0, "%s: sim time 0, efforts zero, %s; %s%s%s", what,
                   s->run == RT_PAUSED    ? "paused (resume to run)"
                   : s->run == RT_WAITING ? "waiting for a command"
                                          : "running",
                   kept[0] ? "keeps the changes made while running: " : "the scene file's values",
-                  kept, kept[0] ? " (lagsimctl reset --scene, RESET count 1: the scene file's values)" : "");
+                  kept, kept[0] ? " (lagsimctl reset --scene, RESET count 1: the scene file's "
+                                  "values)" : "");
     s->want_scene = true;
     s->want_state = true;
     s->want_status = true;
@@ -554,14 +556,6 @@ static bool actuator_lagged(const lag_effects_def *fx, int nq)
     return false;
 }
 
-/* SET key=value: the change is validated by the scene loader itself, on the scene's own
- * bytes with its --set overrides, the changes already made and this one after them (so
- * every rule of a scene file holds, with its message: live_set.c), then by the core
- * against the state the run is in; it takes effect at once, at the current tick. Only
- * keys under parameters and effects change while running. The answer: a `set` event
- * whose detail is exactly "key=value" and whose step is the tick it took effect at (what
- * --replay re-applies), and the new scene. A refusal is a control_rejected whose detail
- * names the change and the reason. */
 /* A kick (SET key "kick.<joint>", value "<impulse>[,<duration>]"): a disturbance from
  * the current tick on, added to the scene's and to the kicks not over yet (live_set.c).
  * The answer: a `kick` event whose detail is exactly "kick.<joint>=<value>" and whose step
@@ -589,6 +583,14 @@ static void handle_kick(rt_server *s, const lag_wire_control *c)
     s->want_status = true;
 }
 
+/* SET key=value: the change is validated by the scene loader itself, on the scene's own
+ * bytes with its --set overrides, the changes already made and this one after them (so
+ * every rule of a scene file holds, with its message: live_set.c), then by the core
+ * against the state the run is in; it takes effect at once, at the current tick. Only
+ * keys under parameters and effects change while running. The answer: a `set` event
+ * whose detail is exactly "key=value" and whose step is the tick it took effect at (what
+ * --replay re-applies), and the new scene. A refusal is a control_rejected whose detail
+ * names the change and the reason. */
 static void handle_set(rt_server *s, const lag_wire_control *c)
 {
     char kv[LIVE_SET_LEN], err[512], why[1024];
