@@ -8,8 +8,13 @@
  */
 #include "lagsim_client.h"
 
+#include <arpa/inet.h>
 #include <errno.h>
+#include <ifaddrs.h>
 #include <math.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -446,6 +451,25 @@ int lag_client_set(lag_client *c, const char *key, const char *value)
     return rc;
 }
 
+int lag_client_kick(lag_client *c, const char *joint, double impulse, double duration)
+{
+    char key[LAG_WIRE_NAME_LEN], value[64];
+    if (!joint || !joint[0] || snprintf(key, sizeof key, "kick.%s", joint) >= (int)sizeof key ||
+        !isfinite(impulse) || !isfinite(duration) || duration < 0) {
+        set_err(c, "kick: a joint name, a finite impulse and a duration >= 0 (s)");
+        return LAG_CLIENT_ERR_ARG;
+    }
+    /* %.17g: the daemon reads back the same doubles */
+    if (duration > 0) snprintf(value, sizeof value, "%.17g,%.17g", impulse, duration);
+    else snprintf(value, sizeof value, "%.17g", impulse);
+    return lag_client_set(c, key, value);
+}
+
+int lag_client_reset_scene(lag_client *c)
+{
+    return send_control(c, LAGSIM_CONTROL_T_RESET, 1, 0, NULL, NULL);
+}
+
 int lag_client_step(lag_client *c, int64_t count)
 {
     if (count < 1) {
@@ -485,4 +509,314 @@ int lag_client_state_joint(const lag_client_state *st, const char *name)
     for (int i = 0; i < st->num_joints; i++)
         if (strcmp(st->name[i], name) == 0) return i;
     return -1;
+}
+
+/* ---------------------------------------------------------------- discovery */
+
+_Static_assert(sizeof(((lag_client_plant *)0)->url) == LAG_BUS_URL_LEN,
+               "lag_client_plant.url holds a state URL");
+
+/* What the discovery has heard so far. */
+typedef struct disc {
+    lag_client_plant *p;
+    int max, n, more;            /* more: plants heard beyond max */
+    bool scene[LAG_CLIENT_MAX_PLANTS], status[LAG_CLIENT_MAX_PLANTS];
+    double asked[LAG_CLIENT_MAX_PLANTS]; /* monotonic s of the last DESCRIBE + STATUS sent */
+    double first;                /* monotonic s when the first plant was heard (0: none) */
+    const char *url;
+    union {
+        lag_wire_scene scene;
+        lag_wire_status status;
+    } tmp;
+} disc;
+
+/* The plant of prefix `pre` (len bytes), added if new; NULL if there is no room. */
+static lag_client_plant *disc_plant(disc *d, const char *pre, size_t len)
+{
+    for (int i = 0; i < d->n; i++)
+        if (strlen(d->p[i].prefix) == len && !strncmp(d->p[i].prefix, pre, len)) return &d->p[i];
+    if (len == 0 || len >= sizeof d->p[0].prefix) return NULL;
+    if (d->n >= d->max) {
+        d->more++;
+        return NULL;
+    }
+    lag_client_plant *p = &d->p[d->n++];
+    memset(p, 0, sizeof *p);
+    memcpy(p->prefix, pre, len);
+    p->prefix[len] = '\0';
+    snprintf(p->url, sizeof p->url, "%s", d->url);
+    if (d->first == 0.0) d->first = lag_client_now();
+    return p;
+}
+
+/* Any message of a plant (<PREFIX>_STATE, _STATUS, _EVENT, _SCENE on the state URL)
+ * names its prefix; its scene and status say the rest. */
+static void on_disc(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    disc *d = user;
+    static const lag_bus_channel outs[] = {LAG_BUS_STATE, LAG_BUS_STATUS, LAG_BUS_EVENT,
+                                           LAG_BUS_SCENE};
+    size_t clen = strlen(channel);
+    for (size_t k = 0; k < sizeof outs / sizeof outs[0]; k++) {
+        const char *suf = lag_bus_suffix(outs[k]);
+        size_t slen = strlen(suf);
+        if (clen <= slen || strcmp(channel + clen - slen, suf)) continue;
+        lag_client_plant *p = disc_plant(d, channel, clen - slen);
+        if (!p) return;
+        int i = (int)(p - d->p);
+        if (outs[k] == LAG_BUS_SCENE &&
+            lag_wire_decode(LAG_WIRE_SCENE, rbuf->data, rbuf->data_size, LAG_WIRE_MAX_JOINTS,
+                            &d->tmp) == LAG_WIRE_OK &&
+            !strcmp(d->tmp.scene.prefix, p->prefix)) {
+            copy_str(p->model, sizeof p->model, d->tmp.scene.model);
+            copy_str(p->mode, sizeof p->mode, d->tmp.scene.mode);
+            d->scene[i] = true;
+        } else if (outs[k] == LAG_BUS_STATUS &&
+                   lag_wire_decode(LAG_WIRE_STATUS, rbuf->data, rbuf->data_size,
+                                   LAG_WIRE_MAX_JOINTS, &d->tmp) == LAG_WIRE_OK &&
+                   lag_wire_all_finite(LAG_WIRE_STATUS, &d->tmp)) {
+            copy_str(p->run_state, sizeof p->run_state, d->tmp.status.run_state);
+            if (!p->mode[0]) copy_str(p->mode, sizeof p->mode, d->tmp.status.mode);
+            p->sim_time = d->tmp.status.sim_time;
+            d->status[i] = true;
+        }
+        return;
+    }
+}
+
+/* Where a plant's messages come from, from a plain UDP socket beside LCM's on the state
+ * port (LCM does not say who sent a message): LCM's short-message header ("LC02", a
+ * sequence number, the channel) names the channel, recvfrom the sender. Best effort: a
+ * socket that cannot be opened leaves the hosts empty. */
+static int host_socket(const lag_bus *b)
+{
+    if (!b->udpm) return -1;
+    int fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    if (fd < 0) return -1;
+    int one = 1;
+    setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+#ifdef SO_REUSEPORT
+    setsockopt(fd, SOL_SOCKET, SO_REUSEPORT, &one, sizeof one);
+#endif
+    struct sockaddr_in a;
+    memset(&a, 0, sizeof a);
+    a.sin_family = AF_INET;
+    a.sin_port = htons((uint16_t)b->state_port);
+    a.sin_addr.s_addr = htonl(INADDR_ANY);
+    struct ip_mreq mr;
+    memset(&mr, 0, sizeof mr);
+    if (bind(fd, (struct sockaddr *)&a, sizeof a) != 0 ||
+        inet_pton(AF_INET, b->group, &mr.imr_multiaddr) != 1 ||
+        setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mr, sizeof mr) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+/* Is a one of this host's IPv4 addresses? */
+static bool address_is_local(struct in_addr a)
+{
+    if ((ntohl(a.s_addr) >> 24) == 127) return true;
+    struct ifaddrs *ifs;
+    if (getifaddrs(&ifs) != 0) return false;
+    bool local = false;
+    for (struct ifaddrs *i = ifs; i && !local; i = i->ifa_next)
+        if (i->ifa_addr && i->ifa_addr->sa_family == AF_INET &&
+            ((struct sockaddr_in *)i->ifa_addr)->sin_addr.s_addr == a.s_addr)
+            local = true;
+    freeifaddrs(ifs);
+    return local;
+}
+
+/* Reads what the host socket has: each short message's sender becomes its plant's host
+ * (this host's name, or the sender's IPv4 address). */
+static void read_hosts(disc *d, int fd)
+{
+    uint8_t pkt[2048];
+    for (int k = 0; fd >= 0 && k < 4096; k++) {
+        struct sockaddr_in from;
+        socklen_t fl = sizeof from;
+        ssize_t n = recvfrom(fd, pkt, sizeof pkt - 1, 0, (struct sockaddr *)&from, &fl);
+        if (n < 0) return;
+        if (n < 9 || memcmp(pkt, "LC02", 4)) continue; /* fragments' first part has it too,
+                                                        * but a plant's states are short */
+        pkt[n] = '\0';
+        const char *ch = (const char *)pkt + 8;
+        size_t clen = strnlen(ch, (size_t)n - 8);
+        for (int i = 0; i < d->n; i++) {
+            size_t plen = strlen(d->p[i].prefix);
+            if (d->p[i].host[0] || clen <= plen || strncmp(ch, d->p[i].prefix, plen) ||
+                ch[plen] != '_')
+                continue;
+            if (address_is_local(from.sin_addr)) {
+                if (gethostname(d->p[i].host, sizeof d->p[i].host) != 0) d->p[i].host[0] = '\0';
+                d->p[i].host[sizeof d->p[i].host - 1] = '\0';
+            }
+            if (!d->p[i].host[0])
+                inet_ntop(AF_INET, &from.sin_addr, d->p[i].host, sizeof d->p[i].host);
+        }
+    }
+}
+
+/* Sends DESCRIBE and STATUS to plant i on the command URL. */
+static void disc_ask(disc *d, lcm_t *cmd, int i, uint8_t *buf, size_t cap)
+{
+    char ch[LAG_BUS_CHANNEL_LEN];
+    snprintf(ch, sizeof ch, "%s%s", d->p[i].prefix, lag_bus_suffix(LAG_BUS_CONTROL));
+    static const int8_t req[2] = {LAGSIM_CONTROL_T_DESCRIBE, LAGSIM_CONTROL_T_STATUS};
+    for (int k = 0; k < 2; k++) {
+        if ((k == 0 && d->scene[i]) || (k == 1 && d->status[i])) continue;
+        lag_wire_control m;
+        memset(&m, 0, sizeof m);
+        m.utime = wall_utime();
+        m.request = req[k];
+        int len = lag_wire_encode(LAG_WIRE_CONTROL, &m, buf, cap);
+        if (len > 0) lcm_publish(cmd, ch, buf, (unsigned)len);
+    }
+    d->asked[i] = lag_client_now();
+}
+
+int lag_client_discover(const char *url, double wait_s, double settle_s,
+                        lag_client_plant *plants, int max, int *n, char *err, size_t errlen)
+{
+    if (n) *n = 0;
+    if (err && errlen) err[0] = '\0';
+    if (!plants || max < 1 || max > LAG_CLIENT_MAX_PLANTS || !n || !(wait_s >= 0) ||
+        !isfinite(wait_s) || !isfinite(settle_s)) {
+        if (err) snprintf(err, errlen, "discover: bad arguments");
+        return LAG_CLIENT_ERR_ARG;
+    }
+    lag_bus b;
+    char berr[256];
+    if (lag_bus_init(&b, url, "X", berr, sizeof berr) != 0) {
+        if (err) snprintf(err, errlen, "%s", berr);
+        return LAG_CLIENT_ERR_ARG;
+    }
+    lcm_t *in = lcm_create(b.state_url);
+    lcm_t *cmd = !in ? NULL : b.udpm ? lcm_create(b.command_url) : in;
+    if (!in || !cmd) {
+        if (err) snprintf(err, errlen, "cannot create LCM for %s", in ? b.command_url : b.state_url);
+        if (in) lcm_destroy(in);
+        return LAG_CLIENT_ERR_LCM;
+    }
+    static disc d; /* large: not on the stack; one discovery at a time (not thread-safe) */
+    memset(&d, 0, sizeof d);
+    d.p = plants;
+    d.max = max;
+    d.url = b.state_url;
+    lcm_subscription_t *sub = lcm_subscribe(in, ".*", on_disc, &d);
+    if (!sub) {
+        if (err) snprintf(err, errlen, "cannot subscribe on %s", b.state_url);
+        if (cmd != in) lcm_destroy(cmd);
+        lcm_destroy(in);
+        return LAG_CLIENT_ERR_LCM;
+    }
+    lcm_subscription_set_queue_capacity(sub, 256);
+    int hfd = host_socket(&b);
+    static uint8_t buf[LAG_WIRE_BUF_SIZE];
+    double t0 = lag_client_now(), end = t0 + wait_s;
+    for (;;) {
+        double now = lag_client_now();
+        bool all = d.n > 0;
+        for (int i = 0; i < d.n; i++) {
+            if (!d.scene[i] || !d.status[i]) all = false;
+            if ((!d.scene[i] || !d.status[i]) && now - d.asked[i] >= 0.25)
+                disc_ask(&d, cmd, i, buf, sizeof buf);
+        }
+        /* done: the time is up; or, once a plant was heard, settle_s later (every plant
+         * heard so far described) */
+        if (now >= end || (d.first > 0 && settle_s >= 0 && now >= d.first + settle_s && all))
+            break;
+        double left = end - now;
+        int ms = left < 0.05 ? (int)ceil(left * 1000.0) : 50;
+        errno = 0;
+        if (lcm_handle_timeout(in, ms) < 0 && errno != EINTR) break;
+        read_hosts(&d, hfd);
+    }
+    read_hosts(&d, hfd);
+    if (hfd >= 0) close(hfd);
+    lcm_unsubscribe(in, sub);
+    if (cmd != in) lcm_destroy(cmd);
+    lcm_destroy(in);
+    /* in the order of their prefixes, so that a listing does not depend on who spoke first */
+    for (int i = 1; i < d.n; i++)
+        for (int j = i; j > 0 && strcmp(plants[j - 1].prefix, plants[j].prefix) > 0; j--) {
+            lag_client_plant t = plants[j];
+            plants[j] = plants[j - 1];
+            plants[j - 1] = t;
+        }
+    *n = d.n;
+    if (d.more && err)
+        snprintf(err, errlen, "%d more plants on %s than the %d listed", d.more, b.state_url, max);
+    return LAG_CLIENT_OK;
+}
+
+/* "PREFIX (model, run state)" for each plant, comma-separated. */
+static void plant_names(const lag_client_plant *p, int n, char *out, size_t cap)
+{
+    size_t o = 0;
+    out[0] = '\0';
+    for (int i = 0; i < n && o + 1 < cap; i++) {
+        int w = snprintf(out + o, cap - o, "%s%s (%s%s%s)", i ? ", " : "", p[i].prefix,
+                         p[i].model[0] ? p[i].model : "model unknown",
+                         p[i].run_state[0] ? ", " : "", p[i].run_state);
+        if (w < 0) break;
+        o += (size_t)w;
+    }
+}
+
+int lag_client_pick_plant(const char *url, const char *model, double wait_s,
+                          lag_client_plant *out, char *err, size_t errlen)
+{
+    if (err && errlen) err[0] = '\0';
+    if (!out) {
+        if (err) snprintf(err, errlen, "pick_plant: NULL out");
+        return LAG_CLIENT_ERR_ARG;
+    }
+    memset(out, 0, sizeof *out);
+    static lag_client_plant all[LAG_CLIENT_MAX_PLANTS];
+    int n = 0;
+    /* 0.5 s after the first plant is heard: longer than a plant's state period at any
+     * publish_hz the shipped scenes use, so that a second plant is heard too */
+    int rc = lag_client_discover(url, wait_s, 0.5, all, LAG_CLIENT_MAX_PLANTS, &n, err, errlen);
+    if (rc != LAG_CLIENT_OK) return rc;
+    lag_bus b;
+    char berr[8];
+    const char *where = lag_bus_init(&b, url, "X", berr, sizeof berr) == 0 ? b.state_url : "?";
+    /* a plant is what answers DESCRIBE with a scene: a channel that only looks like a
+     * plant's (another program's FOO_STATE) is not one to pick */
+    int k = 0, match = -1;
+    for (int i = 0; i < n; i++)
+        if (all[i].model[0] && (!model || !strcmp(all[i].model, model))) {
+            k++;
+            match = i;
+        }
+    char names[1024];
+    plant_names(all, n, names, sizeof names);
+    if (k == 1) {
+        *out = all[match];
+        return LAG_CLIENT_OK;
+    }
+    if (k == 0) {
+        bool any = false;
+        for (int i = 0; i < n; i++) any |= all[i].model[0] != '\0';
+        if (err && !any)
+            snprintf(err, errlen, "no plant on %s within %.1f s (is lagsimd running on this "
+                     "LCM URL?)", where, wait_s);
+        else if (err)
+            snprintf(err, errlen, "no %s plant on %s (heard: %s)", model, where, names);
+        return LAG_CLIENT_TIMEOUT;
+    }
+    if (err) {
+        char mine[1024];
+        int m = 0;
+        static lag_client_plant sel[LAG_CLIENT_MAX_PLANTS];
+        for (int i = 0; i < n; i++)
+            if (all[i].model[0] && (!model || !strcmp(all[i].model, model))) sel[m++] = all[i];
+        plant_names(sel, m, mine, sizeof mine);
+        snprintf(err, errlen, "%d %s%splants on %s: %s; choose one with --prefix", k,
+                 model ? model : "", model ? " " : "", where, mine);
+    }
+    return LAG_CLIENT_ERR_AMBIGUOUS;
 }

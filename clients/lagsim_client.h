@@ -55,7 +55,8 @@ enum {
                                   * value other than 1, so that it never reads as "true" */
     LAG_CLIENT_ERR_ARG = -1,     /* bad argument (message says which) */
     LAG_CLIENT_ERR_LCM = -2,     /* LCM could not be created, publish or handle failed */
-    LAG_CLIENT_ERR_NOMEM = -3
+    LAG_CLIENT_ERR_NOMEM = -3,
+    LAG_CLIENT_ERR_AMBIGUOUS = -4 /* several plants could be meant (message names them) */
 };
 
 /* The messages, as the wire module decodes them (every field of the .lcm types; the
@@ -144,6 +145,16 @@ int lag_client_request_describe(lag_client *c);
  * `set` event (and the new scene) or `control_rejected` with the reason. */
 int lag_client_set(lag_client *c, const char *key, const char *value);
 
+/* A kick: a disturbance on joint `joint` from the current sim time on, adding to the
+ * scene's disturbances and to earlier kicks: impulse N s (N m s on an angle) at once
+ * (duration 0), or spread as a force impulse/duration over duration s. Sent as SET
+ * "kick.<joint>" = "<impulse>[,<duration>]"; answered by a `kick` event (replayed exactly
+ * from a log) or control_rejected with the reason. */
+int lag_client_kick(lag_client *c, const char *joint, double impulse, double duration);
+/* RESET to the scene file's initial state and values: the changes made by SET and the
+ * kicks are undone (a `restore` event says which), then the `reset` event. */
+int lag_client_reset_scene(lag_client *c);
+
 void lag_client_get_counters(const lag_client *c, lag_client_counters *out);
 
 /* Index of joint `name` in the scene (or -1); value of parameter `name` (or NaN). */
@@ -151,6 +162,41 @@ int lag_client_scene_joint(const lag_client_scene *sc, const char *name);
 double lag_client_scene_param(const lag_client_scene *sc, const char *name);
 /* Index of joint `name` in a state (or -1). */
 int lag_client_state_joint(const lag_client_state *st, const char *name);
+
+/* ---------------------------------------------------------------- finding plants */
+
+#define LAG_CLIENT_MAX_PLANTS 32
+
+/* One plant heard on the bus. */
+typedef struct lag_client_plant {
+    char prefix[LAG_CLIENT_NAME_LEN];    /* its channel prefix (lcm.prefix) */
+    char model[LAG_CLIENT_NAME_LEN];     /* from its scene ("" if none came) */
+    char mode[LAG_CLIENT_NAME_LEN];      /* realtime, fast or lockstep */
+    char run_state[LAG_CLIENT_NAME_LEN]; /* from its status: running, paused, waiting, fault */
+    char host[LAG_CLIENT_NAME_LEN];      /* who sends its messages: this host's name, or
+                                          * the sender's IPv4 address ("" if not seen) */
+    char url[320];                       /* its state URL (commands: the next port) */
+    double sim_time;                     /* s, from its status */
+} lag_client_plant;
+
+/* Lists the plants on the bus at url (NULL or "": LCM's default, honouring
+ * LCM_DEFAULT_URL): every <PREFIX>_STATE, _STATUS, _EVENT or _SCENE heard on the state
+ * URL names a plant, which is then asked for its scene (DESCRIBE) and status (STATUS)
+ * until they come. Listens at most wait_s wall seconds, and stops settle_s after the
+ * first plant was heard once every plant heard is described (settle_s < 0: the whole
+ * wait_s). Plants are sorted by prefix; at most max (<= LAG_CLIENT_MAX_PLANTS) are kept,
+ * the number in *n (a note in err if more were heard). Returns LAG_CLIENT_OK (also when
+ * none was heard: *n = 0) or an error with a message in err. OUT: plants, n */
+int lag_client_discover(const char *url, double wait_s, double settle_s,
+                        lag_client_plant *plants, int max, int *n, char *err, size_t errlen);
+
+/* The plant a program talks to when the user named none: the only plant on the bus (of
+ * `model`, unless NULL). Returns LAG_CLIENT_OK with *out; LAG_CLIENT_TIMEOUT when there is
+ * none within wait_s (err says so, naming the plants of other models heard);
+ * LAG_CLIENT_ERR_AMBIGUOUS when several run (err names them: prefix, model, run state);
+ * another error. OUT: out */
+int lag_client_pick_plant(const char *url, const char *model, double wait_s,
+                          lag_client_plant *out, char *err, size_t errlen);
 
 /* Wall clock (CLOCK_MONOTONIC) in seconds, for controllers' own timing. */
 double lag_client_now(void);

@@ -111,7 +111,7 @@ void lag_ctl_init(lag_ctl *ctl, const char *name, const char *default_prefix)
 {
     memset(ctl, 0, sizeof *ctl);
     ctl->name = name;
-    ctl->prefix = default_prefix;
+    ctl->default_prefix = default_prefix;
     ctl->timeout = 5.0;
     ctl->t_first = NAN;
 }
@@ -138,11 +138,12 @@ int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
 {
     bool help = false;
     char prefix_help[96];
-    if (ctl->prefix)
-        snprintf(prefix_help, sizeof prefix_help, "channel prefix (default %s)", ctl->prefix);
+    if (ctl->default_prefix)
+        snprintf(prefix_help, sizeof prefix_help, "channel prefix (default: the only plant "
+                 "of the model on the bus; none yet: %s)", ctl->default_prefix);
     else
-        snprintf(prefix_help, sizeof prefix_help, "channel prefix (required: the plant's "
-                                                  "lcm.prefix)");
+        snprintf(prefix_help, sizeof prefix_help, "channel prefix (default: the only plant "
+                                                  "on the bus)");
     const lag_ctl_option common[] = {
         {"prefix", "P", prefix_help, set_string, &ctl->prefix},
         {"url", "URL", "LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)",
@@ -210,10 +211,6 @@ int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
         usage(ctl, stdout, what, all, n);
         return 0;
     }
-    if (!ctl->prefix) {
-        fprintf(stderr, "%s: --prefix is required (the plant's lcm.prefix)\n", ctl->name);
-        return 2;
-    }
     return -1;
 }
 
@@ -246,6 +243,27 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
         if (!ctl->trace) {
             fprintf(stderr, "%s: --trace %s: %s\n", ctl->name, ctl->trace_path, strerror(errno));
             return 1;
+        }
+    }
+    if (!ctl->prefix) {
+        /* the only plant (of this model) on the bus; with a default prefix a controller
+         * may start before its plant: a short look, then that prefix is waited on */
+        char perr[1200];
+        lag_client_plant p;
+        double look = ctl->default_prefix ? 1.0 : ctl->timeout;
+        int rc = lag_client_pick_plant(ctl->url, model, look, &p, perr, sizeof perr);
+        if (rc == LAG_CLIENT_OK) {
+            snprintf(ctl->found_prefix, sizeof ctl->found_prefix, "%s", p.prefix);
+            ctl->prefix = ctl->found_prefix;
+            printf("%s: the only %s%splant on the bus: prefix %s (%s, %s)\n", ctl->name,
+                   model ? model : "", model ? " " : "", p.prefix, p.mode, p.run_state);
+        } else if (rc == LAG_CLIENT_TIMEOUT && ctl->default_prefix) {
+            ctl->prefix = ctl->default_prefix;
+            printf("%s: %s; waiting for prefix %s\n", ctl->name, perr, ctl->prefix);
+        } else {
+            fprintf(stderr, "%s: %s\n", ctl->name, perr);
+            ctl->fail_code = rc == LAG_CLIENT_ERR_AMBIGUOUS ? 2 : 1; /* several: --prefix */
+            return ctl->fail_code;
         }
     }
     ctl->client = lag_client_create(ctl->url, ctl->prefix, err, sizeof err);
@@ -414,5 +432,5 @@ int lag_ctl_fail(lag_ctl *ctl)
     ctl->trace = NULL;
     lag_client_destroy(ctl->client);
     ctl->client = NULL;
-    return 1;
+    return ctl->fail_code ? ctl->fail_code : 1;
 }

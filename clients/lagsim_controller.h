@@ -18,7 +18,9 @@
  * Options every controller takes (getopt_long; a value that is not a number where one
  * is expected, a number out of range, an unknown option or a stray argument is a usage
  * error: a message, exit 2):
- *   --prefix P      channel prefix (default: the controller's model in capitals)
+ *   --prefix P      channel prefix (default: the only plant of the controller's model on
+ *                   the bus; none yet: the model in capitals, waited for; several: they
+ *                   are named, exit 2)
  *   --url URL       LCM URL (default: LCM's default, which honours LCM_DEFAULT_URL)
  *   --duration S    end after S s of sim time from the first state (default 0: until the
  *                   daemon stops)
@@ -75,7 +77,10 @@ int lag_ctl_parse_list(const char *value, double *out, int n, char *err, size_t 
 typedef struct lag_ctl {
     /* the common options (lag_ctl_init sets the defaults) */
     const char *name;          /* program name in messages */
-    const char *prefix;
+    const char *prefix;        /* --prefix, or the plant found (lag_ctl_start) */
+    const char *default_prefix; /* when no plant is found (NULL: one must be) */
+    char found_prefix[64];
+    int fail_code;              /* lag_ctl_fail's exit status (0: 1) */
     const char *url;           /* NULL: LCM's default */
     double duration;           /* sim s, 0: until the run ends otherwise */
     double timeout;            /* wall s */
@@ -114,7 +119,9 @@ typedef struct lag_ctl {
     void *event_user;
 } lag_ctl;
 
-/* default_prefix NULL: --prefix is required. */
+/* Without --prefix, lag_ctl_start takes the only plant of the model on the bus
+ * (lag_client_pick_plant); if there is none yet, default_prefix (NULL: a plant must show
+ * up within --timeout). */
 void lag_ctl_init(lag_ctl *ctl, const char *name, const char *default_prefix);
 
 /* Parses argv: the common options and the controller's own (`what` is the usage's

@@ -1,18 +1,23 @@
 /*
  * lagsimctl: the control requests of a running lagsimd from a shell.
  *
- *   lagsimctl [--prefix P] [--url URL] [--timeout S] COMMAND [ARGS...]
- *   COMMAND: status, describe, pause, resume, step N, reset, reset-to Q... QD...,
- *            set KEY=VALUE, watch
+ *   lagsimctl [--prefix P] [--url URL] [--timeout S] [--json] COMMAND [ARGS...]
+ *   COMMAND: list, status, describe, pause, resume, step N, reset [--scene],
+ *            reset-to Q... QD..., set KEY=VALUE, kick JOINT IMPULSE [--duration S], watch
  *
  * Sends one control request on <P>_CONTROL and prints the daemon's answer as text lines
  * (an event, a status, a scene), or with `watch` prints what the daemon publishes until
- * it stops. Exit status: 0 the daemon did it; 1 the daemon refused (its reason on
- * stderr); 2 bad usage; 3 no answer within --timeout (no daemon with that prefix?).
+ * it stops; `list` shows every plant on the bus. Without --prefix: the only plant on the
+ * bus (lag_client_pick_plant; several: exit 2 naming them). Exit status: 0 the daemon did
+ * it; 1 the daemon refused (its reason on stderr); 2 bad usage; 3 no answer within
+ * --timeout (no daemon with that prefix?).
  *
- * Output lines, one message each, `key=value` tokens after a first word:
+ * Output, one message each:
  *   event <kind> t=<sim s> step=<ticks> [joint=<name>] value=<v> detail="<sentence>"
- *   status t=... step=... <every field of status_t, in .lcm order>
+ *   status: a block for people, one field a line, aligned, with units; the counters
+ *           that are 0 named on one line
+ * With --json every message is one JSON object on a line, {"type": "status", <every
+ * field of its .lcm type by name>}, for scripts. Key=value lines:
  * The fields come from the wire module's tables: a field added to a .lcm file shows up.
  *   scene model=... prefix=... mode=... ...      then one line per parameter and joint:
  *   param <name>=<value>
@@ -30,6 +35,7 @@
 #include <string.h>
 
 #include "lagsim_client.h"
+#include "lagsim_bus.h"
 #include "lagsim_wire.h"
 
 enum { EXIT_OK = 0, EXIT_REFUSED = 1, EXIT_USAGE = 2, EXIT_NOANSWER = 3 };
@@ -38,6 +44,10 @@ static volatile sig_atomic_t g_signal = 0;
 static void on_signal(int sig) { g_signal = sig; }
 
 static int g_digits = 17;
+static bool g_json = false;
+static bool g_digits_set = false;
+static const char *g_prefix = "";  /* the plant's, for the status's first line */
+static bool g_watch_lines = false; /* watch: a status is one key=value line among states */
 
 static void usage(FILE *f)
 {
@@ -45,23 +55,36 @@ static void usage(FILE *f)
             "usage: lagsimctl [options] COMMAND [ARGS...]\n"
             "Sends a control request to a running lagsimd and prints its answer.\n"
             "commands:\n"
-            "  status               the daemon's status\n"
+            "  list                 every plant on the bus: prefix, model, mode, run state,\n"
+            "                       sim time, host, URL (listens --timeout s, default 1)\n"
+            "  status               the daemon's status, one field a line with units\n"
             "  describe             the scene description (model, parameters, joints, timing)\n"
             "  pause | resume       stop / go on advancing sim time\n"
             "  step N               while paused: advance N control periods, then pause\n"
-            "  reset                back to the scene's initial state at sim time 0\n"
+            "  reset [--scene]      back to the scene's initial state at sim time 0, keeping\n"
+            "                       the changes made by set (it says which); --scene: back\n"
+            "                       to the scene file's values too\n"
             "  reset-to Q... QD...  back to this state: all positions, then all velocities\n"
             "  set KEY=VALUE        change a parameter or an effect's setting while running,\n"
             "                       e.g. set parameters.m2=1.5 (validated as the scene file)\n"
+            "  kick JOINT IMPULSE [--duration S]\n"
+            "                       a disturbance now: IMPULSE (N s, or N m s on an angle)\n"
+            "                       on JOINT at the current sim time, or spread as a force\n"
+            "                       over S s; kicks add to each other and to the scene's\n"
+            "                       disturbances\n"
             "  watch                print states, events and statuses until the daemon stops\n"
             "options:\n"
-            "  -p, --prefix P       the daemon's channel prefix (default DIPC)\n"
+            "  -p, --prefix P       the daemon's channel prefix (default: the only plant on\n"
+            "                       the bus; several: they are named, choose one)\n"
+            "  -j, --json           one JSON object a message (for scripts)\n"
             "  -u, --url URL        LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)\n"
             "  -t, --timeout S      wall s to wait for the answer (default 2)\n"
-            "  -d, --digits N       significant digits of numbers (default 17: exact)\n"
+            "  -d, --digits N       significant digits of numbers (default 17: exact; the\n"
+            "                       status for people: 6)\n"
             "  -h, --help           this text\n"
-            "exit status: 0 done, 1 the daemon refused (its reason on stderr), 2 bad usage,\n"
-            "3 no answer within the timeout (is lagsimd running with this prefix?)\n");
+            "exit status: 0 done, 1 the daemon refused (its reason on stderr), 2 bad usage\n"
+            "(several plants and no --prefix too), 3 no answer within the timeout (list: no\n"
+            "plant heard)\n");
 }
 
 /* ---------------------------------------------------------------- printing */
@@ -107,8 +130,124 @@ static void put_fields(lag_wire_type t, const void *m, const char *const *skip)
     }
 }
 
+/* A string as JSON. */
+static void put_json_str(const char *s)
+{
+    putchar('"');
+    for (; *s; s++) {
+        unsigned char ch = (unsigned char)*s;
+        if (ch == '"' || ch == '\\') printf("\\%c", ch);
+        else if (ch < 0x20) printf("\\u%04x", ch);
+        else putchar(ch);
+    }
+    putchar('"');
+}
+
+/* One value of a field as JSON (numbers: %.17g, exact; the decoder keeps only finite). */
+static void put_json_value(const lag_wire_field *f, const char *p)
+{
+    switch (f->kind) {
+    case LAG_WIRE_INT8: printf("%d", *(const int8_t *)p); break;
+    case LAG_WIRE_INT16: printf("%d", *(const int16_t *)p); break;
+    case LAG_WIRE_INT64: printf("%lld", (long long)*(const int64_t *)p); break;
+    case LAG_WIRE_DOUBLE: printf("%.17g", *(const double *)p); break;
+    case LAG_WIRE_BOOLEAN: printf("%s", *(const bool *)p ? "true" : "false"); break;
+    case LAG_WIRE_STRING: put_json_str(p); break;
+    }
+}
+
+/* A message as one JSON object: {"type": <type>, every field of the .lcm type by name},
+ * arrays as JSON arrays of their count's length. */
+static void print_json(const char *type, lag_wire_type t, const void *m)
+{
+    int n;
+    const lag_wire_field *f = lag_wire_fields(t, &n);
+    printf("{\"type\": ");
+    put_json_str(type);
+    for (int i = 0; i < n; i++) {
+        printf(", ");
+        put_json_str(f[i].name);
+        printf(": ");
+        const char *p = (const char *)m + f[i].offset;
+        if (f[i].count_field < 0) {
+            put_json_value(&f[i], p);
+            continue;
+        }
+        const lag_wire_field *cf = &f[f[i].count_field];
+        const char *cp = (const char *)m + cf->offset;
+        long long cnt = cf->kind == LAG_WIRE_INT16 ? *(const int16_t *)cp
+                        : cf->kind == LAG_WIRE_INT8 ? *(const int8_t *)cp
+                                                    : *(const int64_t *)cp;
+        if (cnt > f[i].capacity) cnt = f[i].capacity;
+        printf("[");
+        for (long long k = 0; k < cnt; k++) {
+            if (k) printf(", ");
+            put_json_value(&f[i], p + (size_t)k * f[i].size);
+        }
+        printf("]");
+    }
+    printf("}\n");
+    fflush(stdout);
+}
+
+/* The unit of a status field, for people ("" for counts and words). One table: a field
+ * added to status_t shows up without a unit until it gets one here. */
+static const char *status_unit(const char *name)
+{
+    static const struct { const char *name, *unit; } units[] = {
+        {"sim_time", "s"}, {"wall_time", "s"}, {"step", "ticks"}, {"rtf", "x real time"},
+        {"step_time_max_us", "us"}, {"step_time_mean_us", "us"}, {"energy", "J"},
+        {"overruns", "periods"}, {"states_published", "states"},
+    };
+    for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
+        if (!strcmp(units[i].name, name)) return units[i].unit;
+    return "";
+}
+
+/* The status for people: one field a line, names aligned, numbers with 6 significant
+ * digits (--digits N: N) and their units; the counters that are 0 on one line. */
+static void print_status_human(const lag_client_status *st)
+{
+    int n, width = 0;
+    const lag_wire_field *f = lag_wire_fields(LAG_WIRE_STATUS, &n);
+    for (int i = 0; i < n; i++)
+        if ((int)strlen(f[i].name) > width) width = (int)strlen(f[i].name);
+    int digits = g_digits_set ? g_digits : 6;
+    char zeros[1024] = "";
+    size_t zl = 0;
+    printf("status of %s\n", g_prefix);
+    for (int i = 0; i < n; i++) {
+        if (f[i].count_field >= 0 || !strcmp(f[i].name, "utime")) continue;
+        const char *p = (const char *)st + f[i].offset;
+        if (f[i].kind == LAG_WIRE_INT64 && strcmp(f[i].name, "step") &&
+            *(const int64_t *)p == 0) {
+            int w = snprintf(zeros + zl, sizeof zeros - zl, "%s%s", zl ? ", " : "", f[i].name);
+            if (w > 0 && (size_t)w < sizeof zeros - zl) zl += (size_t)w;
+            continue;
+        }
+        if (f[i].kind == LAG_WIRE_STRING && !*p) continue; /* an empty word: nothing to say */
+        printf("  %-*s  ", width, f[i].name);
+        switch (f[i].kind) {
+        case LAG_WIRE_DOUBLE: printf("%.*g", digits, *(const double *)p); break;
+        case LAG_WIRE_INT64: printf("%lld", (long long)*(const int64_t *)p); break;
+        case LAG_WIRE_INT16: printf("%d", *(const int16_t *)p); break;
+        case LAG_WIRE_INT8: printf("%d", *(const int8_t *)p); break;
+        case LAG_WIRE_BOOLEAN: printf("%s", *(const bool *)p ? "yes" : "no"); break;
+        case LAG_WIRE_STRING: printf("%s", p); break;
+        }
+        const char *u = status_unit(f[i].name);
+        printf("%s%s\n", *u ? " " : "", u);
+    }
+    if (zl) printf("  %-*s  %s\n", width, "zero", zeros);
+    fflush(stdout);
+}
+
 static void print_event(const lag_client_event *ev)
 {
+    if (g_json) {
+        print_json("event", LAG_WIRE_EVENT, ev);
+        return;
+    }
     printf("event %s t=", ev->kind);
     put_num(ev->sim_time);
     printf(" step=%lld", (long long)ev->step);
@@ -124,6 +263,14 @@ static void print_event(const lag_client_event *ev)
 static void print_status(const lag_client_status *st)
 {
     static const char *const skip[] = {"utime", "sim_time", "step", NULL};
+    if (g_json) {
+        print_json("status", LAG_WIRE_STATUS, st);
+        return;
+    }
+    if (!g_watch_lines) {
+        print_status_human(st);
+        return;
+    }
     printf("status t=");
     put_num(st->sim_time);
     printf(" step=%lld", (long long)st->step);
@@ -134,6 +281,10 @@ static void print_status(const lag_client_status *st)
 
 static void print_state(const lag_client_state *st)
 {
+    if (g_json) {
+        print_json("state", LAG_WIRE_JOINT_STATE, st);
+        return;
+    }
     printf("state t=");
     put_num(st->sim_time);
     printf(" step=%lld", (long long)st->step);
@@ -173,6 +324,10 @@ static void put_elem(const lag_wire_field *f, const void *m, int i)
 static void print_scene(const lag_client_scene *sc)
 {
     static const char *const skip[] = {"utime", NULL};
+    if (g_json) {
+        print_json("scene", LAG_WIRE_SCENE, sc);
+        return;
+    }
     int n, i_params = -1, i_joints = -1;
     const lag_wire_field *f = lag_wire_fields(LAG_WIRE_SCENE, &n);
     for (int i = 0; i < n; i++) {
@@ -223,6 +378,10 @@ static void on_event(const lag_client_event *ev, void *user)
     if (a->watch) {
         print_event(ev);
         if (!strcmp(ev->kind, "stop")) a->stopped = true;
+        return;
+    }
+    if (!strcmp(ev->kind, "restore")) { /* reset --scene: what it undid, before the reset */
+        print_event(ev);
         return;
     }
     if (!a->got_event && a->want &&
@@ -297,6 +456,60 @@ static bool event_and_scene(const answer *a) { return a->got_event && (a->refuse
 static bool event_only(const answer *a) { return a->got_event; }
 static bool step_done(const answer *a) { return a->refused || (a->got_event2 && a->got_status); }
 
+/* ---------------------------------------------------------------- list */
+/* Every plant on the bus, a table for people (or a JSON array): exit 0, or 3 if none. */
+static int list_plants(const char *url, double wait_s)
+{
+    static lag_client_plant p[LAG_CLIENT_MAX_PLANTS];
+    int n = 0;
+    char err[256];
+    int rc = lag_client_discover(url, wait_s, -1.0, p, LAG_CLIENT_MAX_PLANTS, &n, err, sizeof err);
+    if (rc != LAG_CLIENT_OK) {
+        fprintf(stderr, "lagsimctl: %s\n", err);
+        return EXIT_NOANSWER;
+    }
+    if (err[0]) fprintf(stderr, "lagsimctl: %s\n", err);
+    if (g_json) {
+        printf("[");
+        for (int i = 0; i < n; i++) {
+            const char *k[] = {"prefix", "model", "mode", "run_state", "host", "url"};
+            const char *v[] = {p[i].prefix, p[i].model, p[i].mode, p[i].run_state, p[i].host,
+                               p[i].url};
+            printf("%s{", i ? ", " : "");
+            for (int j = 0; j < 6; j++) {
+                printf("%s\"%s\": ", j ? ", " : "", k[j]);
+                put_json_str(v[j]);
+            }
+            printf(", \"sim_time\": %.17g}", p[i].sim_time);
+        }
+        printf("]\n");
+    } else if (n > 0) {
+        /* columns as wide as their widest entry */
+        int w[5] = {6, 5, 4, 9, 4};
+        for (int i = 0; i < n; i++) {
+            const char *v[] = {p[i].prefix, p[i].model, p[i].mode, p[i].run_state, p[i].host};
+            for (int j = 0; j < 5; j++)
+                if ((int)strlen(v[j]) > w[j]) w[j] = (int)strlen(v[j]);
+        }
+        printf("%-*s  %-*s  %-*s  %-*s  %12s  %-*s  %s\n", w[0], "PREFIX", w[1], "MODEL", w[2],
+               "MODE", w[3], "RUN STATE", "SIM TIME", w[4], "HOST", "URL");
+        for (int i = 0; i < n; i++)
+            printf("%-*s  %-*s  %-*s  %-*s  %10.3f s  %-*s  %s\n", w[0], p[i].prefix, w[1],
+                   p[i].model[0] ? p[i].model : "?", w[2], p[i].mode[0] ? p[i].mode : "?", w[3],
+                   p[i].run_state[0] ? p[i].run_state : "?", p[i].sim_time, w[4],
+                   p[i].host[0] ? p[i].host : "?", p[i].url);
+    }
+    fflush(stdout);
+    if (n == 0) {
+        lag_bus b;
+        char berr[8];
+        fprintf(stderr, "lagsimctl: no plant heard on %s within %g s\n",
+                lag_bus_init(&b, url, "X", berr, sizeof berr) == 0 ? b.state_url : "?", wait_s);
+        return EXIT_NOANSWER;
+    }
+    return EXIT_OK;
+}
+
 /* ---------------------------------------------------------------- main */
 static int parse_count(const char *s, long long *out)
 {
@@ -320,18 +533,21 @@ static int parse_doubles(char **argv, int n, double *out)
 
 int main(int argc, char **argv)
 {
-    const char *prefix = "DIPC", *url = NULL;
+    const char *prefix = NULL, *url = NULL;
     double timeout = 2.0;
+    bool timeout_set = false;
     static const struct option longopts[] = {
         {"prefix", required_argument, NULL, 'p'}, {"url", required_argument, NULL, 'u'},
         {"timeout", required_argument, NULL, 't'}, {"digits", required_argument, NULL, 'd'},
-        {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
+        {"json", no_argument, NULL, 'j'}, {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
     int opt;
     /* "+": options end at the command, so reset-to's negative numbers stay arguments */
-    while ((opt = getopt_long(argc, argv, "+p:u:t:d:h", longopts, NULL)) != -1) {
+    while ((opt = getopt_long(argc, argv, "+p:u:t:d:jh", longopts, NULL)) != -1) {
         char *end;
         switch (opt) {
         case 'p': prefix = optarg; break;
+        case 'j': g_json = true; break;
         case 'u': url = optarg; break;
         case 't':
             timeout = strtod(optarg, &end);
@@ -340,6 +556,7 @@ int main(int argc, char **argv)
                         optarg);
                 return EXIT_USAGE;
             }
+            timeout_set = true;
             break;
         case 'd': {
             long d = strtol(optarg, &end, 10);
@@ -348,6 +565,7 @@ int main(int argc, char **argv)
                 return EXIT_USAGE;
             }
             g_digits = (int)d;
+            g_digits_set = true;
             break;
         }
         case 'h': usage(stdout); return EXIT_OK;
@@ -355,8 +573,9 @@ int main(int argc, char **argv)
         }
     }
     if (optind >= argc) {
-        fprintf(stderr, "lagsimctl: which command? (status, describe, pause, resume, step N, "
-                        "reset, reset-to Q... QD..., set KEY=VALUE, watch)\n");
+        fprintf(stderr, "lagsimctl: which command? (list, status, describe, pause, resume, "
+                        "step N, reset [--scene], reset-to Q... QD..., set KEY=VALUE, kick "
+                        "JOINT IMPULSE [--duration S], watch)\n");
         usage(stderr);
         return EXIT_USAGE;
     }
@@ -369,6 +588,9 @@ int main(int argc, char **argv)
     double q[LAG_CLIENT_MAX_JOINTS], qd[LAG_CLIENT_MAX_JOINTS];
     int nq = 0;
     int want_args = 0;
+    const char *kick_joint = NULL;
+    double kick_impulse = 0, kick_duration = 0;
+    bool reset_scene = false;
     if (!strcmp(cmd, "step")) {
         want_args = 1;
         if (nargs == 1 && parse_count(args[0], &count)) {
@@ -396,8 +618,33 @@ int main(int argc, char **argv)
                     args[0]);
             return EXIT_USAGE;
         }
+    } else if (!strcmp(cmd, "kick")) {
+        /* JOINT IMPULSE [--duration S] */
+        want_args = nargs == 4 ? 4 : 2;
+        if (nargs == 2 || nargs == 4) {
+            kick_joint = args[0];
+            if (parse_doubles(args + 1, 1, &kick_impulse)) {
+                fprintf(stderr, "lagsimctl: kick wants a finite impulse (N s, or N m s on an "
+                                "angle), not '%s'\n", args[1]);
+                return EXIT_USAGE;
+            }
+            if (nargs == 4 && (strcmp(args[2], "--duration") ||
+                               parse_doubles(args + 3, 1, &kick_duration) ||
+                               !(kick_duration > 0))) {
+                fprintf(stderr, "lagsimctl: kick JOINT IMPULSE [--duration S]: S is a time > 0 "
+                                "(s), not '%s %s'\n", args[2], args[3]);
+                return EXIT_USAGE;
+            }
+        }
+    } else if (!strcmp(cmd, "reset")) {
+        want_args = nargs == 1 ? 1 : 0;
+        if (nargs == 1 && strcmp(args[0], "--scene")) {
+            fprintf(stderr, "lagsimctl: reset takes --scene or nothing, not '%s'\n", args[0]);
+            return EXIT_USAGE;
+        }
+        reset_scene = nargs == 1;
     } else if (strcmp(cmd, "status") && strcmp(cmd, "describe") && strcmp(cmd, "pause") &&
-               strcmp(cmd, "resume") && strcmp(cmd, "reset") && strcmp(cmd, "watch")) {
+               strcmp(cmd, "resume") && strcmp(cmd, "watch") && strcmp(cmd, "list")) {
         fprintf(stderr, "lagsimctl: unknown command '%s'\n", cmd);
         usage(stderr);
         return EXIT_USAGE;
@@ -407,7 +654,19 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     }
 
-    char err[256];
+    char err[1200];
+    if (!strcmp(cmd, "list")) return list_plants(url, timeout_set ? timeout : 1.0);
+    lag_client_plant chosen;
+    if (!prefix) {
+        /* the only plant on the bus */
+        int rc = lag_client_pick_plant(url, NULL, timeout, &chosen, err, sizeof err);
+        if (rc != LAG_CLIENT_OK) {
+            fprintf(stderr, "lagsimctl: %s\n", err);
+            return rc == LAG_CLIENT_ERR_AMBIGUOUS ? EXIT_USAGE : EXIT_NOANSWER;
+        }
+        prefix = chosen.prefix;
+    }
+    g_prefix = prefix;
     lag_client *c = lag_client_create(url, prefix, err, sizeof err);
     if (!c) {
         fprintf(stderr, "lagsimctl: %s\n", err);
@@ -455,8 +714,19 @@ int main(int argc, char **argv)
             return EXIT_USAGE;
         }
         if (rc == LAG_CLIENT_OK) rc = wait_for(c, &a, timeout, false, event_and_scene);
+    } else if (!strcmp(cmd, "kick")) {
+        a.want = "kick";
+        a.want_status = true;
+        rc = lag_client_kick(c, kick_joint, kick_impulse, kick_duration);
+        if (rc == LAG_CLIENT_ERR_ARG) {
+            fprintf(stderr, "lagsimctl: %s\n", lag_client_errmsg(c));
+            lag_client_destroy(c);
+            return EXIT_USAGE;
+        }
+        if (rc == LAG_CLIENT_OK) rc = wait_for(c, &a, timeout, false, event_and_status);
     } else if (!strcmp(cmd, "watch")) {
         a.watch = true;
+        g_watch_lines = true;
         /* until the daemon's stop event or a signal; a daemon that is not there yet is
          * waited for */
         while (!a.stopped && !g_signal) {
@@ -474,7 +744,7 @@ int main(int argc, char **argv)
             rc = lag_client_resume(c);
         } else if (!strcmp(cmd, "reset")) {
             a.want = "reset";
-            rc = lag_client_reset(c);
+            rc = reset_scene ? lag_client_reset_scene(c) : lag_client_reset(c);
         } else if (!strcmp(cmd, "reset-to")) {
             a.want = "reset";
             rc = lag_client_reset_to(c, nq, q, qd);

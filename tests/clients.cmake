@@ -50,23 +50,21 @@ endforeach()
 # --help: exit 0, the options listed
 add_test(NAME clients_dipc_lqr_help
          COMMAND ${expect_exit} 0 "--duration S" $<TARGET_FILE:dipc_lqr> --help)
-# lqr_balance takes its model from the scene, so it has no default prefix: --prefix is
-# required; its own options are checked as dipc_lqr's.
-foreach(bad "" "--prefix;P;--q;1,-2" "--prefix;P;--q;1,2,3,4,5,6,7" "--prefix;P;--r;0"
+# lqr_balance takes its model from the scene, so it has no default prefix: without
+# --prefix it takes the only plant on the bus (tests/ctl/test_discover.py); its own options
+# are checked as dipc_lqr's.
+foreach(bad "--prefix;P;--q;1,-2" "--prefix;P;--q;1,2,3,4,5,6,7" "--prefix;P;--r;0"
             "--prefix;P;--gain;foo" "--prefix;P;--q0;x")
   string(REPLACE "--prefix;P;" "" bad_name "${bad}")
   string(REGEX REPLACE "^-+" "" bad_name "${bad_name}")
   string(REPLACE ";" "_" bad_name "${bad_name}")
   string(REGEX REPLACE "[^A-Za-z0-9_.-]" "" bad_name "${bad_name}")
-  if(bad_name STREQUAL "")
-    set(bad_name no_prefix)
-  endif()
   add_test(NAME clients_lqr_balance_usage_${bad_name}
            COMMAND ${expect_exit} 2 "^lqr_balance: --" $<TARGET_FILE:lqr_balance> ${bad})
   set_tests_properties(clients_lqr_balance_usage_${bad_name} PROPERTIES TIMEOUT 10)
 endforeach()
 add_test(NAME clients_lqr_balance_help
-         COMMAND ${expect_exit} 0 "--prefix P +channel prefix \\(required" $<TARGET_FILE:lqr_balance> --help)
+         COMMAND ${expect_exit} 0 "--prefix P +channel prefix \\(default: the only plant on the bus" $<TARGET_FILE:lqr_balance> --help)
 
 # ---- end to end: lagsimd + a controller on real LCM (default udpm URL, ttl=0), each run
 # with its own channel prefix (run_e2e.py makes it unique per process). The harness

@@ -20,3 +20,25 @@ if(LAGSIM_PYTHON3)
             --lcm-logger "${LCM_LOGGER}")
   set_tests_properties(ctl_set_replay PROPERTIES TIMEOUT 120 LABELS clients)
 endif()
+
+# Kicks (lagsimctl kick) against the impulse-momentum theorem on the stick's free x: an
+# impulse changes m x_dot by itself, two kicks add, a reset ends them; reset names the
+# changes it keeps, reset --scene undoes them; --replay of the log gives difference 0 and
+# the log without its events does not (tests/ctl/test_kick.py).
+if(LAGSIM_PYTHON3)
+  add_test(NAME ctl_kick
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/ctl/test_kick.py
+            --bin $<TARGET_FILE_DIR:lagsimd> --source ${PROJECT_SOURCE_DIR})
+  set_tests_properties(ctl_kick PROPERTIES TIMEOUT 120 LABELS clients)
+endif()
+
+# Tools find the plant: lagsimctl list (prefix, model, mode, run state, host, URL) and
+# lagsimctl, lqr_balance, dipc_lqr, manipulator_pd, the Python dipc_balance.py and
+# lagsim-view without --prefix, with one plant on the bus, with three, with none of the
+# controller's model (tests/ctl/test_discover.py).
+if(LAGSIM_PYTHON3)
+  add_test(NAME ctl_discover
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/ctl/test_discover.py
+            --bin $<TARGET_FILE_DIR:lagsimd> --source ${PROJECT_SOURCE_DIR})
+  set_tests_properties(ctl_discover PROPERTIES TIMEOUT 120 LABELS clients)
+endif()

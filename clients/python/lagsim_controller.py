@@ -52,8 +52,10 @@ class Controller(object):
         self.name = name
         self.model = model
         p = argparse.ArgumentParser(prog=name, description=description)
-        p.add_argument("--prefix", default=default_prefix,
-                       help="channel prefix (default %s)" % default_prefix)
+        self.default_prefix = default_prefix
+        p.add_argument("--prefix", default=None,
+                       help="channel prefix (default: the only %s plant on the bus; none "
+                            "yet: %s; several: they are named, exit 2)" % (model, default_prefix))
         p.add_argument("--url", default=None,
                        help="the plant's LCM URL, its lcm.url (default: LCM's default); "
                             "commands go to the next port")
@@ -99,6 +101,8 @@ class Controller(object):
         self._state = None
         self._stopped = False
         self._heard = time.monotonic()
+        if a.prefix is None:
+            a.prefix = self._find_plant(state_url) or self.default_prefix
         ch = a.prefix + "_"
         self.lc.subscribe(ch + "SCENE", self._on_scene)
         self.lc.subscribe(ch + "STATE", self._on_state)
@@ -129,6 +133,61 @@ class Controller(object):
             sys.exit(1)
         self.params = dict(zip(self.scene.param_name, self.scene.param_value))
         return a
+
+    def _find_plant(self, state_url):
+        """The only plant of this model on the bus, by the C library's rule
+        (lag_client_pick_plant): every <PREFIX>_STATE, _STATUS, _EVENT or _SCENE heard on
+        the state URL names a plant, which is asked for its scene (DESCRIBE) until it
+        comes; listens 1 s at most, 0.5 s after the first plant once all are described.
+        Returns its prefix; None when there is none (the caller waits on its default: a
+        controller may start before its plant); several: named, exit 2."""
+        found, asked = {}, {}   # prefix -> model (None until its scene came); last ask
+
+        def on_any(channel, data):
+            for suf in ("_STATE", "_STATUS", "_EVENT", "_SCENE"):
+                if channel.endswith(suf) and len(channel) > len(suf):
+                    pre = channel[:-len(suf)]
+                    found.setdefault(pre, None)
+                    if suf == "_SCENE":
+                        sc = self._decode(self.t.scene_t, data)
+                        if sc is not None and sc.prefix == pre:
+                            found[pre] = sc.model
+                    return
+
+        dropped = self.dropped
+        sub = self.lc.subscribe(".*", on_any)
+        t0, first = time.monotonic(), None
+        while not self._stop:
+            now = time.monotonic()
+            if found and first is None:
+                first = now
+            for pre in [p for p, m in found.items() if m is None and now - asked.get(p, -1) >= 0.25]:
+                req = self.t.control_t()
+                req.utime = int(time.time() * 1e6)
+                req.request = self.t.control_t.DESCRIBE
+                self.lc_cmd.publish(pre + "_CONTROL", req.encode())
+                asked[pre] = now
+            if now - t0 >= 1.0 or (first is not None and now - first >= 0.5 and
+                                   all(m is not None for m in found.values())):
+                break
+            self.lc.handle_timeout(50)
+        self.lc.unsubscribe(sub)
+        self.dropped = dropped  # other plants' messages are not this run's
+        mine = sorted(p for p, m in found.items() if m == self.model)
+        heard = ", ".join("%s (%s)" % (p, found[p] or "model unknown") for p in sorted(found))
+        if len(mine) == 1:
+            print("%s: the only %s plant on the bus: prefix %s" % (self.name, self.model, mine[0]),
+                  flush=True)
+            return mine[0]
+        if len(mine) > 1:
+            sys.stderr.write("%s: %d %s plants on %s: %s; choose one with --prefix\n"
+                             % (self.name, len(mine), self.model, state_url,
+                                ", ".join(mine)))
+            sys.exit(2)
+        print("%s: no %s plant on %s%s; waiting for prefix %s"
+              % (self.name, self.model, state_url, " (heard: %s)" % heard if found else "",
+                 self.default_prefix), flush=True)
+        return None
 
     def _decode(self, cls, data):
         """The message of type `cls` in `data`, or None (counted in `dropped`). Like the C

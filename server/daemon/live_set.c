@@ -4,6 +4,8 @@
  */
 #include "live_set.h"
 
+#include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -113,6 +115,8 @@ int live_set_load(const lagsimd_opts *o, const live_sets *ls, const char *kv, la
         snprintf(why, whylen, "set %s: %s", kv, msg);
         return -1;
     }
+    /* the kicks not over yet stay: a change of the scene does not undo them */
+    if (live_kicks_append(ls, &out->sim, why, whylen) != 0) return -1;
     return 0;
 }
 
@@ -127,4 +131,138 @@ void live_set_keep(live_sets *ls, const char *kv)
     ls->n = k;
     if (ls->n < LIVE_SET_MAX) /* live_set_load made room sure */
         snprintf(ls->kv[ls->n++], sizeof ls->kv[0], "%s", kv);
+}
+
+/* ---------------------------------------------------------------- kicks */
+
+bool live_is_kick(const char *key) { return !strncmp(key, "kick.", 5); }
+
+/* The definition without the kicks the sim carries (the last ls->nk disturbances). */
+static void without_kicks(const live_sets *ls, lag_sim_def *def)
+{
+    int n = def->effects.n_disturbances - ls->nk;
+    def->effects.n_disturbances = n < 0 ? 0 : n;
+}
+
+int live_kicks_append(const live_sets *ls, lag_sim_def *def, char *why, size_t whylen)
+{
+    lag_effects_def *e = &def->effects;
+    if (ls->nk == 0) return 0;
+    if (e->n_disturbances + ls->nk > LAG_MAX_DISTURBANCES) {
+        snprintf(why, whylen, "kick: the scene's %d disturbances and %d kicks not over yet "
+                 "exceed %d", e->n_disturbances, ls->nk, LAG_MAX_DISTURBANCES);
+        return -1;
+    }
+    const double dt = def->integrator.dt;
+    for (int k = 0; k < ls->nk; k++) {
+        const live_kick *kk = &ls->kick[k];
+        lag_disturbance *d = &e->disturbances[e->n_disturbances++];
+        memset(d, 0, sizeof *d);
+        d->t = (double)kk->step * dt; /* lag_ticks_ceil gives kk->step back */
+        d->joint = kk->joint;
+        d->impulse = !(kk->duration > 0);
+        d->value = d->impulse ? kk->impulse : kk->impulse / kk->duration;
+        d->duration = d->impulse ? 0.0 : kk->duration;
+    }
+    e->enabled |= LAG_EFF_DISTURBANCE;
+    return 0;
+}
+
+/* Is the kick over at tick (an impulse: applied; a force: its last tick taken)? As
+ * disturbance_pre_tick decides, so that a kick is dropped only when it acts no more. */
+static bool kick_over(const live_kick *k, int64_t tick, double dt)
+{
+    if (!(k->duration > 0)) return tick > k->step;
+    double tend = (double)k->step * dt + k->duration;
+    return (double)tick * dt >= tend - 1e-9 * dt;
+}
+
+/* sim's definition with ls's kicks (after its own without those it carried before). */
+static int redefine(const live_sets *old, const live_sets *ls, lag_sim *sim, char *why,
+                    size_t whylen)
+{
+    static lag_sim_def def; /* large: not on the stack */
+    def = sim->def;
+    without_kicks(old, &def);
+    if (live_kicks_append(ls, &def, why, whylen) != 0) return -1;
+    char err[512];
+    if (lag_sim_redefine(sim, &def, err, sizeof err) != LAG_OK) {
+        snprintf(why, whylen, "kick: %s", err);
+        return -1;
+    }
+    return 0;
+}
+
+int live_kick_apply(live_sets *ls, lag_sim *sim, const char *kv, live_kick *k, char *why,
+                    size_t whylen)
+{
+    const lag_model_info *mi = lag_model_info_get(sim->def.model.kind);
+    const char *eq = strchr(kv, '=');
+    size_t jlen = eq ? (size_t)(eq - kv) - 5 : 0;
+    memset(k, 0, sizeof *k);
+    k->joint = -1;
+    for (int i = 0; eq && live_is_kick(kv) && i < mi->nq; i++)
+        if (strlen(mi->joint_names[i]) == jlen && !strncmp(kv + 5, mi->joint_names[i], jlen))
+            k->joint = i;
+    if (k->joint < 0) {
+        char names[256] = "";
+        for (int i = 0; i < mi->nq; i++)
+            snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s%s", i ? ", " : "",
+                     mi->joint_names[i], mi->actuated[i] ? " (actuated)" : "");
+        snprintf(why, whylen, "%s: unknown joint '%.*s' for model %s; joints: %s", kv, (int)jlen,
+                 eq ? kv + 5 : "", mi->name, names);
+        return -1;
+    }
+    char *end;
+    errno = 0;
+    k->impulse = strtod(eq + 1, &end);
+    bool ok = end != eq + 1 && !errno && isfinite(k->impulse);
+    if (ok && *end == ',') {
+        const char *p = end + 1;
+        k->duration = strtod(p, &end);
+        ok = end != p && !errno && isfinite(k->duration) && k->duration >= 0 &&
+             k->duration <= 1e9;
+    }
+    if (!ok || *end) {
+        snprintf(why, whylen, "%s: expected IMPULSE or IMPULSE,DURATION (finite numbers, N s "
+                 "or N m s, and s >= 0)", kv);
+        return -1;
+    }
+    k->step = sim->tick;
+    const double dt = sim->def.integrator.dt;
+    static live_sets next; /* large: not on the stack */
+    next = *ls;
+    int n = 0;
+    for (int i = 0; i < next.nk; i++)
+        if (!kick_over(&next.kick[i], sim->tick, dt)) next.kick[n++] = next.kick[i];
+    next.nk = n;
+    if (next.nk == LAG_MAX_DISTURBANCES) {
+        snprintf(why, whylen, "%s: %d kicks act already; wait until one is over", kv,
+                 LAG_MAX_DISTURBANCES);
+        return -1;
+    }
+    next.kick[next.nk++] = *k;
+    if (redefine(ls, &next, sim, why, whylen) != 0) return -1;
+    *ls = next;
+    return 0;
+}
+
+void live_kicks_clear(live_sets *ls, lag_sim *sim)
+{
+    static live_sets next; /* large: not on the stack */
+    next = *ls;
+    next.nk = 0;
+    char why[256];
+    if (ls->nk > 0 && redefine(ls, &next, sim, why, sizeof why) == 0) *ls = next;
+}
+
+void live_set_describe(const live_sets *ls, char *out, size_t outlen)
+{
+    size_t o = 0;
+    if (outlen) out[0] = '\0';
+    for (int i = 0; i < ls->n && o + 1 < outlen; i++) {
+        int w = snprintf(out + o, outlen - o, "%s%s", i ? ", " : "", ls->kv[i]);
+        if (w < 0) break;
+        o += (size_t)w;
+    }
 }

@@ -509,6 +509,13 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
 /* ---------------------------------------------------------------- control requests */
 static void do_reset(rt_server *s, const double *q, const double *qd, const char *what)
 {
+    if (s->live.nk > 0) { /* sim time starts over: the kicks are the old run's */
+        char detail[96];
+        snprintf(detail, sizeof detail, "a reset ends the %d kick(s) of the run before it",
+                 s->live.nk);
+        live_kicks_clear(&s->live, &s->sim);
+        rt_publish_event(s, "kicks_cleared", "", 0, detail); /* --replay applies it here */
+    }
     lag_sim_reset(&s->sim, q, qd);
     s->effect_events_dropped = s->sim.events_dropped;
     for (int i = 0; i < s->nq; i++) s->held[i] = 0.0;
@@ -519,10 +526,16 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
     s->waiting = false; /* lockstep: the new state is waited on once it is published */
     s->have_answered = false;
     if (s->run == RT_FAULT) s->run = RT_PAUSED;
-    limited_event(s, RT_EV_RESET, "", 0, "%s: sim time 0, efforts zero, %s", what,
+    char kept[200];
+    live_set_describe(&s->live, kept, sizeof kept);
+    /* which changes made while running the reset keeps (a reset with count 1 keeps none) */
+    limited_event(s, RT_EV_RESET, "", 0, "%s: sim time 0, efforts zero, %s; %s%s%s", what,
                   s->run == RT_PAUSED    ? "paused (resume to run)"
                   : s->run == RT_WAITING ? "waiting for a command"
-                                         : "running");
+                                         : "running",
+                  kept[0] ? "keeps the changes made while running: " : "the scene file's values",
+                  kept, kept[0] ? " (lagsimctl reset --scene, RESET count 1: the scene file's "
+                                  "values)" : "");
     s->want_scene = true;
     s->want_state = true;
     s->want_status = true;
@@ -543,6 +556,33 @@ static bool actuator_lagged(const lag_effects_def *fx, int nq)
     return false;
 }
 
+/* A kick (SET key "kick.<joint>", value "<impulse>[,<duration>]"): a disturbance from
+ * the current tick on, added to the scene's and to the kicks not over yet (live_set.c).
+ * The answer: a `kick` event whose detail is exactly "kick.<joint>=<value>" and whose step
+ * is the tick it starts at (what --replay re-applies), then a status. */
+static void handle_kick(rt_server *s, const lag_wire_control *c)
+{
+    char kv[LIVE_SET_LEN], why[1024];
+    if (snprintf(kv, sizeof kv, "%s=%s", c->key, c->value) >= (int)sizeof kv) {
+        control_rejected(s, "kick: key=value is too long");
+        return;
+    }
+    if (!rt_limit_take(&s->lim_set, s->now)) {
+        snprintf(why, sizeof why, "%s: more than %d changes a second; this one was not "
+                                  "applied", kv, RT_SET_PER_S);
+        control_rejected(s, why);
+        return;
+    }
+    live_kick k;
+    if (live_kick_apply(&s->live, &s->sim, kv, &k, why, sizeof why) != 0) {
+        control_rejected(s, why);
+        return;
+    }
+    rt_publish_event(s, "kick", lag_model_info_get(s->sim.def.model.kind)->joint_names[k.joint],
+                     k.impulse, kv);
+    s->want_status = true;
+}
+
 /* SET key=value: the change is validated by the scene loader itself, on the scene's own
  * bytes with its --set overrides, the changes already made and this one after them (so
  * every rule of a scene file holds, with its message: live_set.c), then by the core
@@ -554,6 +594,10 @@ static bool actuator_lagged(const lag_effects_def *fx, int nq)
 static void handle_set(rt_server *s, const lag_wire_control *c)
 {
     char kv[LIVE_SET_LEN], err[512], why[1024];
+    if (live_is_kick(c->key)) {
+        handle_kick(s, c);
+        return;
+    }
     if (live_set_parse(c->key, c->value, kv, why, sizeof why) != 0) {
         control_rejected(s, why);
         return;
@@ -648,7 +692,24 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
                       lag_rt_mode_name(s->sc->realtime.mode));
         return; /* step_done (and its status) follow when the steps are done */
     case LAGSIM_CONTROL_T_RESET:
-        do_reset(s, NULL, NULL, "reset to the scene's initial state");
+        if (c.count == 1 && (s->live.n > 0 || s->live.nk > 0)) {
+            /* count 1: the scene file's values too. A `restore` event (never suppressed:
+             * --replay undoes the changes where it says) before the reset's. */
+            char err[512], why[700];
+            if (lag_sim_redefine(&s->sim, &s->sc->sim, err, sizeof err) != LAG_OK) {
+                snprintf(why, sizeof why, "reset to the scene file's values: %s", err);
+                control_rejected(s, why);
+                return;
+            }
+            char undone[180], detail[LAG_WIRE_TEXT_LEN];
+            live_set_describe(&s->live, undone, sizeof undone);
+            snprintf(detail, sizeof detail, "the scene file's values again: undone %s%s%d "
+                     "kick(s)", undone, undone[0] ? ", " : "", s->live.nk);
+            rt_publish_event(s, "restore", "", (double)s->live.n, detail);
+            memset(&s->live, 0, sizeof s->live);
+        }
+        do_reset(s, NULL, NULL, c.count == 1 ? "reset to the scene file's initial state and "
+                                               "values" : "reset to the scene's initial state");
         return;
     case LAGSIM_CONTROL_T_RESET_TO: {
         if (c.num_joints != s->nq) {

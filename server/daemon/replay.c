@@ -145,6 +145,9 @@ typedef struct replay_sets {
     live_sets live;                         /* applied so far: the validation source */
     int64_t step[REPLAY_SETS_PENDING];      /* read, not yet applied: where, what */
     char kv[REPLAY_SETS_PENDING][LIVE_SET_LEN];
+    char kind[REPLAY_SETS_PENDING];         /* 's' set, 'k' kick, 'c' kicks_cleared,
+                                             * 'r' restore */
+    const lag_sim_def *base;                /* the scene's definition, as replayed */
     int head, n;
     int64_t applied;
     bool failed;                            /* one could not be applied: said, exit 1 */
@@ -169,7 +172,8 @@ static void set_read(replay_sets *rs, const lag_log_record *rec)
 {
     lag_wire_event ev;
     if (!rec->data || lag_wire_decode_event(rec->data, rec->size, &ev) != LAG_WIRE_OK ||
-        strcmp(ev.kind, "set") != 0)
+        (strcmp(ev.kind, "set") && strcmp(ev.kind, "kick") && strcmp(ev.kind, "restore") &&
+         strcmp(ev.kind, "kicks_cleared")))
         return;
     if (rs->n == REPLAY_SETS_PENDING) {
         if (!rs->failed)
@@ -180,6 +184,10 @@ static void set_read(replay_sets *rs, const lag_log_record *rec)
     }
     int k = (rs->head + rs->n++) % REPLAY_SETS_PENDING;
     rs->step[k] = ev.step;
+    rs->kind[k] = !strcmp(ev.kind, "kick")            ? 'k'
+                  : !strcmp(ev.kind, "kicks_cleared") ? 'c'
+                  : !strcmp(ev.kind, "restore")       ? 'r'
+                                                      : 's';
     snprintf(rs->kv[k], sizeof rs->kv[k], "%s", ev.detail);
 }
 
@@ -194,9 +202,37 @@ static bool set_apply(replay_sets *rs, lag_sim *sim, const lagsimd_opts *o, bool
 {
     const char *kv = rs->kv[rs->head];
     int64_t step = rs->step[rs->head];
+    char kind = rs->kind[rs->head];
     rs->head = (rs->head + 1) % REPLAY_SETS_PENDING;
     rs->n--;
     char key[LIVE_SET_LEN], checked[LIVE_SET_LEN], why[1024], err[512];
+    if (kind != 's') {
+        /* a kick, at this tick as the daemon's; a restore: the scene's own definition */
+        live_kick k;
+        int ok = 1;
+        if (kind == 'k') {
+            ok = live_kick_apply(&rs->live, sim, kv, &k, why, sizeof why) == 0;
+        } else if (kind == 'c') {
+            live_kicks_clear(&rs->live, sim);
+        } else if (lag_sim_redefine(sim, rs->base, err, sizeof err) != LAG_OK &&
+                   (!restarting || lag_sim_init(sim, rs->base, err, sizeof err) != LAG_OK)) {
+            snprintf(why, sizeof why, "%s", err);
+            ok = 0;
+        } else {
+            memset(&rs->live, 0, sizeof rs->live);
+        }
+        if (!ok) {
+            if (!rs->failed)
+                fprintf(stderr, "lagsimd: --replay: the log's %s '%s' (step %lld) cannot be "
+                                "applied to this scene: %s (wrong --config or --set?)\n",
+                        kind == 'k' ? "kick" : kind == 'c' ? "kicks_cleared" : "restore", kv,
+                        (long long)step, why);
+            rs->failed = true;
+            return false;
+        }
+        rs->applied++;
+        return true;
+    }
     size_t klen = strcspn(kv, "=");
     snprintf(key, sizeof key, "%.*s", (int)klen, kv);
     static lag_scene ns; /* large: not on the stack */
@@ -264,6 +300,7 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
     const bool use_input = lagged && log_has_channel(log_path, ch_input);
     const bool anchor = lagged && !use_input;
     replay_def(&def, use_input);
+    sets.base = &def;
     lag_sim sim;
     if (lag_sim_init(&sim, &def, err, sizeof err) != LAG_OK) {
         fprintf(stderr, "lagsimd: bad scene: %s\n", err);
@@ -438,7 +475,8 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
            log_path, (long long)compared, channel, (long long)restarts, (long long)gaps,
            (long long)undecodable, (long long)errors);
     if (sets.applied > 0)
-        printf("%lld change(s) made while running applied at their steps (set events on %s)\n",
+        printf("%lld change(s) made while running applied at their steps (set, kick, "
+               "kicks_cleared and restore events on %s)\n",
                (long long)sets.applied, ch_event);
     if (unchecked > 0)
         printf("%lld states after a restart were not compared: %s\n", (long long)unchecked,

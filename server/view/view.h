@@ -98,6 +98,11 @@ void view_bridge_poll(view_bridge *vb);
  * bad count, 429 over VIEW_CONTROLS_PER_S, 500 LCM refused it. */
 int view_bridge_control(view_bridge *vb, const char *request, const char *count,
                         const char **why);
+/* A kick (lagsimctl kick): impulse I (N s or N m s) on joint J now, or spread over S s as
+ * a force; sent as SET "kick.J" = "I[,S]" under the same rate limit as the controls.
+ * Returns 0 (sent) or an HTTP status with the reason in *why. */
+int view_bridge_kick(view_bridge *vb, const char *joint, const char *impulse,
+                     const char *duration, const char **why);
 
 /* ---------------------------------------------------------------- HTTP (view_http.c) */
 typedef struct view_http view_http;

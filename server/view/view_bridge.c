@@ -170,6 +170,59 @@ static bool send_control(view_bridge *vb, int request, int64_t count)
     return n > 0 && lcm_publish(vb->lcm_cmd, vb->ch_control, buf, (unsigned)n) == 0;
 }
 
+/* The window limit every control request of a page shares: false (counted) beyond it. */
+static bool control_allowed(view_bridge *vb)
+{
+    int64_t now = view_mono_ns();
+    if (now - vb->ctl_window_ns >= 1000000000) {
+        vb->ctl_window_ns = now;
+        vb->ctl_in_window = 0;
+    }
+    if (vb->ctl_in_window >= VIEW_CONTROLS_PER_S) return false;
+    vb->ctl_in_window++;
+    return true;
+}
+
+int view_bridge_kick(view_bridge *vb, const char *joint, const char *impulse,
+                     const char *duration, const char **why)
+{
+    lag_wire_control m;
+    memset(&m, 0, sizeof m);
+    char *end = NULL;
+    double j = impulse ? strtod(impulse, &end) : NAN;
+    bool ok = impulse && end != impulse && !*end && isfinite(j);
+    double d = 0;
+    if (ok && duration && duration[0]) {
+        d = strtod(duration, &end);
+        ok = end != duration && !*end && isfinite(d) && d > 0 && d <= 1e9;
+    }
+    if (!ok || !joint || !joint[0] ||
+        snprintf(m.key, sizeof m.key, "kick.%s", joint) >= (int)sizeof m.key) {
+        vb->controls_refused++;
+        *why = "kick: joint=NAME&impulse=N s[&duration=S s > 0], finite numbers";
+        return 400;
+    }
+    if (!control_allowed(vb)) {
+        vb->controls_refused++;
+        *why = "too many control requests: at most 10 per second";
+        return 429;
+    }
+    if (d > 0) snprintf(m.value, sizeof m.value, "%.17g,%.17g", j, d);
+    else snprintf(m.value, sizeof m.value, "%.17g", j);
+    m.utime = view_wall_us();
+    m.request = LAGSIM_CONTROL_T_SET;
+    uint8_t buf[LAG_WIRE_BUF_SIZE];
+    int n = lag_wire_encode_control(&m, buf, sizeof buf);
+    if (n <= 0 || lcm_publish(vb->lcm_cmd, vb->ch_control, buf, (unsigned)n) != 0) {
+        vb->controls_refused++;
+        *why = "LCM publish failed";
+        return 500;
+    }
+    vb->controls_sent++;
+    *why = "sent (the daemon's kick event, or its reason, follows in the events)";
+    return 0;
+}
+
 void view_bridge_poll(view_bridge *vb)
 {
     for (int k = 0; k < VIEW_DRAIN_MAX; k++)
@@ -209,17 +262,11 @@ int view_bridge_control(view_bridge *vb, const char *request, const char *count,
         n = v;
     }
     /* a page (or a script) cannot make the bridge flood the daemon */
-    int64_t now = view_mono_ns();
-    if (now - vb->ctl_window_ns >= 1000000000) {
-        vb->ctl_window_ns = now;
-        vb->ctl_in_window = 0;
-    }
-    if (vb->ctl_in_window >= VIEW_CONTROLS_PER_S) {
+    if (!control_allowed(vb)) {
         vb->controls_refused++;
         *why = "too many control requests: at most 10 per second";
         return 429;
     }
-    vb->ctl_in_window++;
     if (!send_control(vb, req, n)) {
         vb->controls_refused++;
         *why = "LCM publish failed";

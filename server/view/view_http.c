@@ -8,6 +8,7 @@
  *   GET  /events                  server-sent events: "scene", "state", "status",
  *                                 "events" (an array), "bridge" frames
  *   POST /api/control?request=pause|resume|step|reset[&count=N]   (header X-Lagsim: 1)
+ *   POST /api/kick?joint=J&impulse=I[&duration=S]                  (header X-Lagsim: 1)
  *
  * Bounds: libmicrohttpd caps connections (all and per address), the memory of one
  * request (headers), and idle time (5 s; 20 s for a stream that accepts no bytes). A
@@ -274,6 +275,18 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         int code = view_bridge_control(
             h->vb, MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "request"),
             MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "count"), &why);
+        return reply_json_msg(c, code ? (unsigned)code : 202, code == 0, why);
+    }
+    if (strcmp(url, "/api/kick") == 0) { /* a kick: a control request of its own */
+        if (!post) return reply_json_msg(c, 405, false, "POST only");
+        const char *tag = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "X-Lagsim");
+        if (!tag || strcmp(tag, "1") != 0)
+            return reply_json_msg(c, 403, false, "control requests need the header X-Lagsim: 1");
+        const char *why = "";
+        int code = view_bridge_kick(
+            h->vb, MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "joint"),
+            MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "impulse"),
+            MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "duration"), &why);
         return reply_json_msg(c, code ? (unsigned)code : 202, code == 0, why);
     }
     if (!get) return reply_text(c, 405, "GET only\n");

@@ -1,5 +1,5 @@
 /*
- * lagsim-view [--prefix DIPC] [--port 8765] [--url LCM_URL] [--listen ADDR] [--hz N]
+ * lagsim-view [--prefix P] [--port 8765] [--url LCM_URL] [--listen ADDR] [--hz N]
  *
  * Watches a lagsimd daemon in a browser: subscribes to its channels and serves one page
  * that draws the model from the scene description, animates it from the states, charts
@@ -17,18 +17,20 @@
 #include <sys/signalfd.h>
 #include <unistd.h>
 
+#include "lagsim_client.h"
 #include "view.h"
 
 static void usage(FILE *f)
 {
-    fputs("usage: lagsim-view [--prefix DIPC] [--port 8765] [--url LCM_URL] [--listen ADDR]\n"
+    fputs("usage: lagsim-view [--prefix P] [--port 8765] [--url LCM_URL] [--listen ADDR]\n"
           "                   [--hz N] [--max-views N]\n"
           "\n"
           "Serves a live view of a lagsimd daemon to browsers: the model drawn to scale from\n"
           "its scene description and animated from its states, strip charts, status, events,\n"
           "and pause / resume / step / reset buttons.\n"
           "\n"
-          "  -p, --prefix P     the daemon's channel prefix (default DIPC)\n"
+          "  -p, --prefix P     the daemon's channel prefix (default: the only plant on the\n"
+          "                     bus; several: they are named, exit 2; none: DIPC)\n"
           "      --port N       TCP port (default 8765; 0: any free port, printed)\n"
           "      --url URL      LCM URL (default: LCM's default, which honours LCM_DEFAULT_URL)\n"
           "      --listen ADDR  address to listen on (default 127.0.0.1: this machine only).\n"
@@ -74,7 +76,7 @@ int main(int argc, char **argv)
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
     };
-    const char *prefix = "DIPC", *url = NULL;
+    const char *prefix = NULL, *url = NULL;
     view_http_opts ho = {.listen = "127.0.0.1", .port = 8765, .hz = 60, .max_streams = 16,
                          .max_connections = 64, .check_host = true};
     bool quiet = false;
@@ -134,7 +136,22 @@ int main(int argc, char **argv)
         return 1;
     }
 
-    char err[512];
+    char err[1200];
+    static lag_client_plant found;
+    if (!prefix) {
+        /* the only plant on the bus; none yet: DIPC, watched until it comes */
+        int pr = lag_client_pick_plant(url, NULL, 2.0, &found, err, sizeof err);
+        if (pr == LAG_CLIENT_ERR_AMBIGUOUS) {
+            fprintf(stderr, "lagsim-view: %s\n", err);
+            return 2;
+        }
+        if (pr == LAG_CLIENT_OK) {
+            prefix = found.prefix;
+        } else {
+            prefix = "DIPC";
+            fprintf(stderr, "lagsim-view: %s; watching prefix %s\n", err, prefix);
+        }
+    }
     static view_bridge vb; /* large (rings): static, one bridge per process */
     if (!view_bridge_open(&vb, url, prefix, err, sizeof err)) {
         fprintf(stderr, "lagsim-view: %s\n", err);

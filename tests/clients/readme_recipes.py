@@ -41,8 +41,8 @@ def check_by_hand(out, tmp):
     checks.append((kv.get("t_first") == "0.000000" and abs(float(kv.get("end_theta1", "9"))) < 0.01,
                    "dipc_lqr balanced from t = 0 (t_first %s, theta1 at the end %s)"
                    % (kv.get("t_first"), kv.get("end_theta1"))))
-    st = [l for l in out.splitlines() if l.startswith("status ")]
-    checks.append((bool(st) and " run_state=running" in st[0], "lagsimctl status: running"))
+    st = [l for l in out.splitlines() if l.split() == ["run_state", "running"]]
+    checks.append((bool(st), "lagsimctl status: running (its run_state line)"))
     path = os.path.join(tmp, "run.csv")
     r = rows(path) if os.path.exists(path) else []
     checks.append((len(r) >= 1001 and float(r[-1][0]) == 10.0,

@@ -4,8 +4,10 @@
     test_lagsimctl.py --lagsimctl BIN --lagsimd BIN --source DIR
 
 A real-time daemon on config/dipc.yaml with a prefix of its own; then, in order:
-  status      exit 0, one `status` line with every field of status_t.lcm (read from the
-              file) as key=value, run_state=running
+  status      exit 0, for people: a block headed `status of <prefix>`, one field a line (name, value, unit:
+              sim_time in s, energy in J), the names aligned, every non-zero field of
+              status_t.lcm (read from the file) named, the zero counters on a `zero` line;
+              --json: one JSON object with every field of status_t.lcm, run_state=running
   describe    exit 0, the scene: model=dipc, one `param` line per parameter (m0 = 1.5 as
               in the file), one `joint` line per joint
   pause       exit 0, `event pause`, then a status with run_state=paused
@@ -17,11 +19,13 @@ A real-time daemon on config/dipc.yaml with a prefix of its own; then, in order:
   reset       exit 0, `event reset`, status at step 0
   set         parameters.m0=2.5: exit 0, `event set`, the scene with the new value; a value
               the loader refuses, or a key outside parameters and effects: exit 1, the reason
-  usage       step 0, step abc, reset-to 1 2 3, an unknown command: exit 2, nothing sent
+  usage       step 0, step abc, reset-to 1 2 3, an unknown command, kick without an
+              impulse or with a duration of 0, reset --sceen: exit 2, nothing sent
   no daemon   another prefix: exit 3 within the timeout
   watch       a daemon that runs 1 s and stops: states as lines, the stop event, exit 0
 """
 import argparse
+import json
 import os
 import re
 import subprocess
@@ -72,6 +76,16 @@ def main():
     def lines(r, word):
         return [l for l in r.stdout.splitlines() if l.split(" ", 1)[0] == word]
 
+    def statuses(r):
+        """the statuses of a --json answer, as dicts"""
+        out = []
+        for l in r.stdout.splitlines():
+            if l.startswith("{"):
+                m = json.loads(l)
+                if m.get("type") == "status":
+                    out.append(m)
+        return out
+
     status_fields = []
     with open(os.path.join(a.source, "lcmtypes", "status_t.lcm")) as f:
         for line in f:
@@ -85,15 +99,30 @@ def main():
     try:
         time.sleep(0.5)
         r = ctl("status")
-        st = lines(r, "status")
-        check(r.returncode == 0 and len(st) == 1, "status: exit 0, one status line")
-        kv = tokens(st[0]) if st else {}
-        missing = [f for f in status_fields if f not in ("utime", "sim_time") and f not in kv]
+        rj = statuses(ctl("--json", "status"))
+        out = r.stdout.splitlines()
+        rows = {l.split()[0]: l for l in out[1:] if l.startswith("  ") and l.split()}
+        named = set(rows) | set(w.strip(",") for w in rows.get("zero", "").split()[1:])
+        missing = [f for f in status_fields if f != "utime" and f not in named and
+                   not (rj and rj[0].get(f) == "")]  # an empty word is left out
+        check(r.returncode == 0 and out and out[0] == "status of " + prefix and not missing,
+              "status for people: exit 0, every field of status_t.lcm named (%d; missing %s)"
+              % (len(status_fields), missing))
+        cols = set(l.index(l.split()[1]) for l in out[1:] if len(l.split()) > 1)
+        check(len(cols) == 1, "status for people: the values start in one column %s" % cols)
+        check(rows.get("sim_time", "").endswith(" s") and rows.get("energy", "").endswith(" J")
+              and rows.get("run_state", "").split()[-1] == "running",
+              "status for people: sim_time in s, energy in J, run_state running")
+        r = ctl("--json", "status")
+        st = statuses(r)
+        check(r.returncode == 0 and len(st) == 1, "status --json: exit 0, one JSON status")
+        kv = st[0] if st else {}
+        missing = [f for f in status_fields if f not in kv]
         check(status_fields and not missing,
-              "status: every field of status_t.lcm is printed (%d; missing %s)"
+              "status --json: every field of status_t.lcm (%d; missing %s)"
               % (len(status_fields), missing))
         check(kv.get("run_state") == "running" and kv.get("mode") == "realtime",
-              "status: run_state=running mode=realtime")
+              "status --json: run_state=running mode=realtime")
 
         r = ctl("describe")
         sc = lines(r, "scene")
@@ -105,20 +134,21 @@ def main():
               "describe: the parameters (%d, m0 = %s)" % (len(params), params.get("m0")))
         check(joints == ["theta0", "theta1", "theta2"], "describe: the joints %s" % joints)
 
-        r = ctl("pause")
-        ev, st = lines(r, "event"), lines(r, "status")
-        check(r.returncode == 0 and ev and ev[0].startswith("event pause ") and st and
-              tokens(st[0]).get("run_state") == "paused",
-              "pause: exit 0, event pause, status run_state=paused")
-        step0 = int(tokens(st[0]).get("step", -1)) if st else -1
+        r = ctl("--json", "pause")
+        ev, st = [json.loads(l) for l in r.stdout.splitlines() if '"type": "event"' in l], statuses(r)
+        check(r.returncode == 0 and ev and ev[0]["kind"] == "pause" and st and
+              st[0].get("run_state") == "paused",
+              "pause --json: exit 0, event pause, status run_state=paused")
+        step0 = st[0].get("step", -1) if st else -1
 
         r = ctl("step", "3")
-        ev, st = lines(r, "event"), lines(r, "status")
+        ev = lines(r, "event")
         check(r.returncode == 0 and len(ev) == 2 and ev[0].startswith("event step ") and
               float(tokens(ev[0]).get("value", 0)) == 3 and ev[1].startswith("event step_done"),
               "step 3: exit 0, event step value=3, event step_done")
-        step1 = int(tokens(st[0]).get("step", -1)) if st else -1
-        check(st and step1 == step0 + 30 and tokens(st[0]).get("run_state") == "paused",
+        st = statuses(ctl("--json", "status"))
+        step1 = st[0].get("step", -1) if st else -1
+        check(st and step1 == step0 + 30 and st[0].get("run_state") == "paused",
               "step 3: the status after it is 30 ticks on (%d -> %d), paused" % (step0, step1))
 
         r = ctl("reset-to", "0", "0.1", "-0.05", "0", "0", "0")
@@ -144,9 +174,9 @@ def main():
         check(r.returncode == 1 and "num_joints" in r.stderr and "refused" in r.stderr,
               "reset-to with 1 joint of 3: exit 1, the daemon's reason on stderr")
 
-        r = ctl("resume")
-        st = lines(r, "status")
-        check(r.returncode == 0 and st and tokens(st[0]).get("run_state") == "running",
+        r = ctl("--json", "resume")
+        st = statuses(r)
+        check(r.returncode == 0 and st and st[0].get("run_state") == "running",
               "resume: exit 0, run_state=running")
         r = ctl("step", "2")
         check(r.returncode == 1 and "only while paused" in r.stderr,
@@ -170,7 +200,9 @@ def main():
 
         for bad in (["step", "0"], ["step", "abc"], ["reset-to", "1", "2", "3"], ["spin"],
                     ["set", "m0"], ["set", "=1"], ["set", "parameters.m0="],
-                    ["status", "extra"], ["--timeout", "-1", "status"]):
+                    ["status", "extra"], ["--timeout", "-1", "status"], ["kick", "x"],
+                    ["kick", "theta1", "abc"], ["kick", "theta1", "1", "--duration", "0"],
+                    ["kick", "theta1", "1", "--during", "1"], ["reset", "--sceen"]):
             r = ctl(*bad)
             check(r.returncode == 2 and r.stderr.startswith("lagsimctl: "),
                   "usage error %s: exit 2 with a message" % bad)

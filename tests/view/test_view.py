@@ -175,6 +175,16 @@ def case_browser(a):
         ev = chrome.eval(sa, "document.getElementById('events').textContent")
         check("pause" in ev and "step_done" in ev and "resume" in ev and "reset" in ev,
               "the event list shows pause, step_done, resume, reset")
+        # the kick control: the chosen joint (from the scene) and impulse reach the daemon,
+        # whose kick event comes back in the list
+        chrome.wait_for(sa, "document.getElementById('kickjoint').options.length === 3", 5,
+                        "the scene's joints to kick")
+        chrome.eval(sa, "document.getElementById('kickjoint').value = 'theta1'")
+        chrome.eval(sa, "document.getElementById('kickimpulse').value = '0.02'")
+        chrome.eval(sa, "document.getElementById('kick').click()")
+        chrome.wait_for(sa, "document.getElementById('events').textContent"
+                            ".includes('kick [theta1]  kick.theta1=0.02')", 5, "the kick event")
+        check(True, "kick button: the daemon's kick event on theta1, 0.02 N m s, in the list")
         if a.screenshot:
             time.sleep(2.5)   # let the charts fill
             chrome.screenshot(sa, a.screenshot)
@@ -232,6 +242,10 @@ def case_hostile(a):
         check(r.startswith(b"HTTP/1.1 400"), "an unknown control request: 400")
         r = raw(port, b"POST /api/control?request=step&count=-5 HTTP/1.1\r\n" + host + b"X-Lagsim: 1\r\n\r\n")
         check(r.startswith(b"HTTP/1.1 400"), "step with a negative count: 400")
+        r = raw(port, b"POST /api/kick?joint=theta1&impulse=abc HTTP/1.1\r\n" + host + b"X-Lagsim: 1\r\n\r\n")
+        check(r.startswith(b"HTTP/1.1 400"), "a kick with an impulse that is no number: 400")
+        r = raw(port, b"POST /api/kick?joint=theta1&impulse=1 HTTP/1.1\r\n" + host + b"\r\n")
+        check(r.startswith(b"HTTP/1.1 403"), "a kick without X-Lagsim: 403")
         r = raw(port, b"GET /../../etc/passwd HTTP/1.1\r\n" + host + b"\r\n")
         check(r.startswith(b"HTTP/1.1 404"), "path traversal: 404")
         r = raw(port, b"DELETE / HTTP/1.1\r\n" + host + b"\r\n")

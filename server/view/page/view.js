@@ -25,7 +25,7 @@ function connect() {
   es.addEventListener("open", () => { view.connected = true; showConn(); });
   es.addEventListener("error", () => { view.connected = false; showConn(); });
   es.addEventListener("bridge", (e) => { const b = JSON.parse(e.data); $("title").textContent = "lagsim view: " + b.prefix; });
-  es.addEventListener("scene", (e) => { view.scene = JSON.parse(e.data); view.camX = null; view.dirty = true; });
+  es.addEventListener("scene", (e) => { view.scene = JSON.parse(e.data); view.camX = null; view.dirty = true; kickJoints(); });
   es.addEventListener("state", (e) => onState(JSON.parse(e.data)));
   es.addEventListener("status", (e) => onStatus(JSON.parse(e.data)));
   es.addEventListener("events", (e) => onEvents(JSON.parse(e.data)));
@@ -91,6 +91,34 @@ async function control(request) {
   }
 }
 for (const id of ["pause", "resume", "step", "reset"]) $(id).addEventListener("click", () => control(id));
+
+// a kick: the impulse on the chosen joint at the current sim time (lagsimctl kick); the
+// daemon's kick event, or its reason, shows in the events
+async function kick() {
+  const j = $("kickjoint").value, imp = $("kickimpulse").value;
+  const url = "/api/kick?joint=" + encodeURIComponent(j) + "&impulse=" + encodeURIComponent(imp);
+  try {
+    const r = await fetch(url, { method: "POST", headers: { "X-Lagsim": "1" } });
+    const m = await r.json();
+    $("ctlmsg").textContent = "kick " + j + " " + imp + ": " + m.message;
+  } catch (err) {
+    $("ctlmsg").textContent = "kick: " + err;
+  }
+}
+$("kick").addEventListener("click", kick);
+// the joints of the scene, to choose from (kept when the scene is described again)
+function kickJoints() {
+  const sel = $("kickjoint"), names = view.scene ? view.scene.joints : [];
+  if ([...sel.options].map((o) => o.value).join() === names.join()) return;
+  const keep = sel.value;
+  sel.textContent = "";
+  for (const n of names) {
+    const o = document.createElement("option");
+    o.value = o.textContent = n;
+    sel.appendChild(o);
+  }
+  if (names.includes(keep)) sel.value = keep;
+}
 
 // ---------------------------------------------------------------- drawing helpers
 function fit(canvas) {

@@ -1,0 +1,262 @@
+#!/usr/bin/env python3
+"""Kicks (lagsimctl kick) against the impulse-momentum theorem, and replayed exactly.
+
+    test_kick.py --bin BUILD/bin --source SRC
+
+The stick of config/stick.yaml (m = 1 kg, a frictionless floor) runs paused in real time
+with --log; lagsimctl steps it and kicks it. Its x is cyclic and no force acts on it (no
+command is sent, the floor pushes vertically), so its generalized momentum p_x = m x_dot
+changes only by the impulses given on x (T = 1/2 m x_dot^2 + ...: docs/models.md):
+  kick x 0.5 at t = 0                        -> after 5 periods  m x_dot = 0.5
+  kick x 0.25 --duration 0.05 and kick x 0.125 --duration 0.05, both at t = 0.05 s (they
+    act together: neither replaces the other) -> 10 periods on  m x_dot = 0.875
+  kick cart 1                                 -> exit 1, the joints named
+  set parameters.m=2, reset                   -> the reset's answer names the change it keeps;
+    the kicks end (kicks_cleared): 10 periods on x_dot = 0 exactly
+  kick x -0.5 at t = 0 after the reset        -> 5 periods on m x_dot = -0.5 (m = 2 now)
+  reset --scene                               -> a restore event; the scene says m = 1 again
+Then `lagsimd --replay` of the log applies every kick, the kicks_cleared and the restore
+at their steps and must give a largest difference of exactly 0; the same log without its
+events must not (the kicks mattered). The same for a run under control: the cart-pole of
+config/cartpole.yaml balanced by lqr_balance in real time for 3 s, kicked on theta (an
+impulse) and on x (a force over 0.3 s) while it runs, logged with --log.
+"""
+import argparse
+import json
+import os
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+
+fails = 0
+SYNC = 0xEDA1DA01
+
+
+def check(cond, what):
+    global fails
+    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
+    if not cond:
+        fails += 1
+    return cond
+
+
+def read_log(path):
+    """[(timestamp, channel, data)] of a whole LCM log."""
+    out = []
+    with open(path, "rb") as f:
+        b = f.read()
+    i = 0
+    while i + 28 <= len(b):
+        sync, _, ts, clen, dlen = struct.unpack_from(">IqqII", b, i)
+        if sync != SYNC or i + 28 + clen + dlen > len(b):
+            break
+        out.append((ts, b[i + 28:i + 28 + clen].decode(), b[i + 28 + clen:i + 28 + clen + dlen]))
+        i += 28 + clen + dlen
+    return out
+
+
+def write_log(path, records):
+    with open(path, "wb") as f:
+        for k, (ts, ch, data) in enumerate(records):
+            c = ch.encode()
+            f.write(struct.pack(">IqqII", SYNC, k, ts, len(c), len(data)) + c + data)
+
+
+def decode_state(data):
+    """joint_state_t (lcmtypes/joint_state_t.lcm): {step, t, names, q, qd}."""
+    i = 8  # fingerprint
+    _utime, t, step, n = struct.unpack_from(">qdqh", data, i)
+    i += 8 + 8 + 8 + 2
+    names = []
+    for _ in range(n):
+        (ln,) = struct.unpack_from(">i", data, i)
+        names.append(data[i + 4:i + 4 + ln - 1].decode())
+        i += 4 + ln
+    q = struct.unpack_from(">%dd" % n, data, i)
+    qd = struct.unpack_from(">%dd" % n, data, i + 8 * n)
+    return {"step": step, "t": t, "names": names, "q": q, "qd": qd}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--bin", required=True)
+    ap.add_argument("--source", required=True)
+    a = ap.parse_args()
+    lagsimd, ctl_bin = (os.path.join(a.bin, p) for p in ("lagsimd", "lagsimctl"))
+    cfg = os.path.join(a.source, "config", "stick.yaml")
+    prefix = "KICK_%d" % os.getpid()
+    # a multicast port of this run's own (ttl=0: this host)
+    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0" %
+                                     (34000 + 2 * (os.getpid() % 6000)))
+    tmp = tempfile.mkdtemp(prefix="lagsim_kick_")
+    log = os.path.join(tmp, "kick.lcm")
+
+    def ctl(*args):
+        r = subprocess.run([ctl_bin, "--prefix", prefix, "--timeout", "5"] + list(args),
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=60)
+        print("$ lagsimctl %s   -> exit %d" % (" ".join(args), r.returncode))
+        for line in r.stdout.splitlines()[:4]:
+            print("  " + line[:200])
+        if r.stderr.strip():
+            print("  stderr: " + r.stderr.strip()[:300])
+        return r
+
+    def events(r):
+        return [json.loads(l) for l in r.stdout.splitlines()
+                if l.startswith("{") and json.loads(l)["type"] == "event"]
+
+    d = subprocess.Popen([lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix, "-q",
+                          "--set", "realtime.start=paused", "--log", log],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                         universal_newlines=True)
+    try:
+        time.sleep(0.5)
+        r = ctl("--json", "kick", "x", "0.5")
+        ev = events(r)
+        check(r.returncode == 0 and ev and ev[0]["kind"] == "kick" and ev[0]["step"] == 0 and
+              ev[0]["joint"] == "x" and ev[0]["value"] == 0.5,
+              "kick x 0.5 while paused at t = 0: exit 0, a kick event at step 0 on x, value 0.5")
+        check(ctl("step", "5").returncode == 0, "step 5")
+        r1 = ctl("--json", "kick", "x", "0.25", "--duration", "0.05")
+        r2 = ctl("--json", "kick", "x", "0.125", "--duration", "0.05")
+        e1, e2 = events(r1), events(r2)
+        check(r1.returncode == 0 and r2.returncode == 0 and e1 and e2 and
+              e1[0]["step"] == 50 and e2[0]["step"] == 50,
+              "two kicks with --duration 0.05 at step 50: exit 0 each")
+        check(ctl("step", "10").returncode == 0, "step 10")
+        r = ctl("kick", "cart", "1")
+        check(r.returncode == 1 and "unknown joint 'cart'" in r.stderr and
+              "x (actuated)" in r.stderr, "kick cart 1: exit 1, the joints named")
+        r = ctl("kick", "x")
+        check(r.returncode == 2, "kick x (no impulse): exit 2")
+        r = ctl("set", "parameters.m=2")
+        check(r.returncode == 0, "set parameters.m=2")
+        r = ctl("--json", "reset")
+        ev = events(r)
+        check(r.returncode == 0 and any(e["kind"] == "reset" and "parameters.m=2" in e["detail"]
+                                        for e in ev),
+              "reset: its answer names the change it keeps (parameters.m=2)")
+        check(ctl("step", "10").returncode == 0, "step 10 after the reset")
+        check(ctl("kick", "x", "-0.5").returncode == 0, "kick x -0.5 at t = 0 after the reset")
+        check(ctl("step", "5").returncode == 0, "step 5")
+        r = ctl("--json", "reset", "--scene")
+        ev = events(r)
+        check(r.returncode == 0 and [e["kind"] for e in ev][:2] == ["restore", "reset"] and
+              "parameters.m=2" in ev[0]["detail"],
+              "reset --scene: a restore event naming parameters.m=2, then the reset")
+        r = ctl("--json", "describe")
+        sc = [json.loads(l) for l in r.stdout.splitlines() if l.startswith("{")]
+        m = dict(zip(sc[0]["param_name"], sc[0]["param_value"])).get("m") if sc else None
+        check(m == 1.0, "describe after reset --scene: m = %s, the scene file's 1" % m)
+        check(ctl("step", "3").returncode == 0, "step 3")
+    finally:
+        d.terminate()
+        d.wait(10)
+
+    recs = read_log(log)
+    states = [decode_state(data) for _, ch, data in recs if ch == prefix + "_STATE"]
+    print("%d records, %d states in the log" % (len(recs), len(states)))
+    # the runs between resets: a step that goes back starts a new one
+    runs, cur = [], []
+    for s in states:
+        if cur and s["step"] < cur[-1]["step"]:
+            runs.append(cur)
+            cur = []
+        cur.append(s)
+    runs.append(cur)
+
+    def at(run, step):
+        for s in run:
+            if s["step"] == step:
+                return s["qd"][s["names"].index("x")]
+        return None
+
+    check(len(runs) == 3, "three runs in the log (start, reset, reset --scene): %d" % len(runs))
+    if len(runs) == 3:
+        m = 1.0  # kg, config/stick.yaml
+        v50, v150 = at(runs[0], 50), at(runs[0], 150)
+        check(v50 is not None and abs(m * v50 - 0.5) <= 1e-12,
+              "m x_dot after kick x 0.5: %r (impulse 0.5 N s)" % v50)
+        check(v150 is not None and abs(m * v150 - 0.875) <= 1e-12,
+              "m x_dot after two force kicks of 0.25 and 0.125 N s more: %r (0.875: they add)"
+              % v150)
+        v100 = at(runs[1], 100)
+        check(v100 == 0.0, "after the reset the kicks of the run before are over: x_dot = %r "
+              "at step 100 (exactly 0)" % v100)
+        v150b = at(runs[1], 150)
+        check(v150b is not None and abs(2.0 * v150b + 0.5) <= 1e-12,
+              "m x_dot after kick x -0.5 with m = 2: %r" % (None if v150b is None else 2 * v150b))
+
+    def replay(path):
+        return replay_cfg(cfg, prefix, path)
+
+    def replay_cfg(config, pre, path):
+        r = subprocess.run([lagsimd, "--config", config, "--set", "lcm.prefix=" + pre,
+                            "--replay", path], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                           universal_newlines=True, timeout=60)
+        print("$ lagsimd --replay %s   -> exit %d" % (os.path.basename(path), r.returncode))
+        print("  " + r.stdout.strip().replace("\n", "\n  "))
+        diff = None
+        for line in r.stdout.splitlines():
+            if line.startswith("max difference = "):
+                diff = float(line.split("=", 1)[1])
+        return r, diff
+
+    # a run under control: the cart-pole balanced by lqr_balance in real time, kicked
+    # twice while it runs (mid-run, efforts held), logged, then replayed
+    cfg_cp = os.path.join(a.source, "config", "cartpole.yaml")
+    log_cp = os.path.join(tmp, "cartpole.lcm")
+    pcp = prefix + "CP"
+    c = subprocess.Popen([os.path.join(a.bin, "lqr_balance"), "--prefix", pcp, "-q"],
+                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    c.stdout.readline()  # "waiting for the scene description": subscribed
+    d = subprocess.Popen([lagsimd, "--config", cfg_cp, "--set", "lcm.prefix=" + pcp, "-q",
+                          "--set", "realtime.start=first_command", "--duration", "3",
+                          "--log", log_cp], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        time.sleep(1.0)
+        r1 = subprocess.run([ctl_bin, "--prefix", pcp, "kick", "theta", "0.01"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+        time.sleep(0.5)
+        r2 = subprocess.run([ctl_bin, "--prefix", pcp, "kick", "x", "0.2", "--duration", "0.3"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+        check(r1.returncode == 0 and r2.returncode == 0,
+              "cart-pole under lqr_balance: kick theta 0.01 and kick x 0.2 --duration 0.3 while "
+              "it runs: exit 0 (%s; %s)" % (r1.stdout.split("\n")[0], r2.stdout.split("\n")[0]))
+        d.wait(30)
+        out = c.communicate(timeout=30)[0]
+        print("  " + out.strip().replace("\n", "\n  ")[-400:])
+    finally:
+        for p in (d, c):
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+    r, diff = replay_cfg(cfg_cp, pcp, log_cp)
+    check(r.returncode == 0 and diff == 0.0 and "2 change(s) made while running" in r.stdout,
+          "--replay of the controlled, kicked cart-pole: 2 kicks applied, difference exactly 0 "
+          "(%r)" % diff)
+    recs_cp = read_log(log_cp)
+    bare_cp = os.path.join(tmp, "cartpole_no_events.lcm")
+    write_log(bare_cp, [x for x in recs_cp if x[1] != pcp + "_EVENT"])
+    r, diff = replay_cfg(cfg_cp, pcp, bare_cp)
+    check(r.returncode == 1 and diff is not None and diff > 0,
+          "the same log without its events: difference %r, not 0" % diff)
+
+    r, diff = replay(log)
+    check(r.returncode == 0 and diff == 0.0 and "7 change(s) made while running" in r.stdout,
+          "--replay: 4 kicks, a set, a kicks_cleared and a restore applied (7), "
+          "difference exactly 0 (%r)" % diff)
+    bare = os.path.join(tmp, "no_events.lcm")
+    write_log(bare, [x for x in recs if x[1] != prefix + "_EVENT"])
+    r, diff = replay(bare)
+    check(r.returncode == 1, "the same log without its events does not replay exactly "
+          "(exit %d, difference %r)" % (r.returncode, diff))
+    print("%d failure(s)" % fails)
+    return 1 if fails else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
