@@ -110,6 +110,29 @@ static bool state_wanted(const rt_server *s)
     return s->want_state && s->run != RT_FAULT && s->period_left == 0;
 }
 
+/* The scene's model, as its scene names it. */
+static const char *model_name(const rt_server *s)
+{
+    const lag_model_info *mi = lag_model_info_get(s->sc->sim.model.kind);
+    return mi ? mi->name : "?";
+}
+
+/* The joints the daemon publishes, "theta0, theta1, theta2": what a count is checked
+ * against, named in the message that refuses it. */
+typedef struct joint_text { char text[LAG_MAX_DOF * (LAG_WIRE_NAME_LEN + 2)]; } joint_text;
+static joint_text joint_list(const rt_server *s)
+{
+    joint_text j = {""};
+    size_t n = 0;
+    for (int i = 0; i < s->nq && n < sizeof j.text; i++) {
+        int k = snprintf(j.text + n, sizeof j.text - n, "%s%s", i ? ", " : "",
+                         s->info->joint_names[i]);
+        if (k < 0) break;
+        n += (size_t)k;
+    }
+    return j;
+}
+
 /* An unlimited event (start, stop). */
 static void eventf(rt_server *s, const char *kind, double value, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
@@ -425,7 +448,10 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
     lag_wire_joint_command c;
     int d = lag_wire_decode_joint_command(data, len, s->nq, &c);
     if (d == LAG_WIRE_ECOUNT) {
-        reject(s, RT_REJ_BAD_LENGTH, "", c.num_joints, "num_joints in value");
+        char what[320];
+        snprintf(what, sizeof what, "num_joints %d in value: expected 0 to %d, the joints of "
+                 "model %s (%.160s)", c.num_joints, s->nq, model_name(s), joint_list(s).text);
+        reject(s, RT_REJ_BAD_LENGTH, "", c.num_joints, what);
         return;
     }
     if (d == LAG_WIRE_ETOOLONG) { /* a well-formed name longer than any joint's */
@@ -602,10 +628,17 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
 {
     rt_log_record(s, RT_LOG_IN, s->ch_control, data, len); /* --log: as received */
     lag_wire_control c;
-    int d = lag_wire_decode_control(data, len, LAG_MAX_DOF, &c);
+    /* any count a message may carry decodes; reset_to checks it against the model's */
+    int d = lag_wire_decode_control(data, len, LAG_WIRE_MAX_JOINTS, &c);
     if (d != LAG_WIRE_OK) {
-        control_rejected(s, d == LAG_WIRE_ECOUNT ? "control: num_joints out of range"
-                                                 : "control: undecodable payload");
+        char why[160];
+        if (d == LAG_WIRE_ECOUNT)
+            snprintf(why, sizeof why, "control: num_joints %d: expected 0 to %d (reset_to on "
+                     "model %s: %d)", c.num_joints, LAG_WIRE_MAX_JOINTS, model_name(s), s->nq);
+        else
+            snprintf(why, sizeof why, "control: undecodable payload (%s)",
+                     lag_wire_result_string(d));
+        control_rejected(s, why);
         return;
     }
     switch (c.request) {
@@ -637,7 +670,10 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
             return;
         }
         if (c.count < 1) {
-            control_rejected(s, "step: count must be >= 1");
+            char why[96];
+            snprintf(why, sizeof why, "step: count %lld: expected 1 or more control periods",
+                     (long long)c.count);
+            control_rejected(s, why);
             return;
         }
         s->pending_steps = c.count;
@@ -652,7 +688,11 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
         return;
     case LAGSIM_CONTROL_T_RESET_TO: {
         if (c.num_joints != s->nq) {
-            control_rejected(s, "reset_to: num_joints must equal the model's joint count");
+            char why[320];
+            snprintf(why, sizeof why, "reset_to: %d joints given; model %s has %d (%.160s): q and "
+                     "qd need %d values each", c.num_joints, model_name(s), s->nq,
+                     joint_list(s).text, s->nq);
+            control_rejected(s, why);
             return;
         }
         double lim = s->sc->sim.explode_limit;

@@ -1179,6 +1179,72 @@ static void case_other_plant(void)
             "stop event: '%s'", last_detail("stop"));
 }
 
+/* What a refusal says: a null mapping set while running does not poison later sets
+ * below it (effects=null, then effects.damping.* is applied, the damping on); every count
+ * check names the expected count and the model (reset_to with 4 joints on the 3-joint
+ * DIPC, a command of 4 joints, step 0). */
+static void case_messages(void)
+{
+    static const char text[] =
+        "model: dipc\n"
+        "initial: {q: [0, 0.1, -0.05]}\n"
+        "realtime: {mode: fast, start: paused}\n"
+        "effects: {}\n"
+        "lcm: {prefix: TL}\n";
+    char err[1024];
+    ENSURE(lag_scene_load_buffer("msg.yaml", text, sizeof text - 1, NULL, 0, &g_sc, err, sizeof err) == 0);
+    memset(&g_opts, 0, sizeof g_opts);
+    g_opts.quiet = true;
+    g_opts.scene_name = "msg.yaml";
+    g_opts.scene_text = text;
+    g_opts.scene_len = sizeof text - 1;
+    start();
+    set_request("effects", "null");
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("set") == 1 && n_events("control_rejected") == 0, "effects=null: %lld sets, "
+            "rejected '%s'", (long long)n_events("set"), last_detail("control_rejected"));
+    set_request("effects.damping.theta1", "0.25");
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("set") == 2 && n_events("control_rejected") == 0,
+            "effects.damping.theta1 after effects=null: refused: '%s'", last_detail("control_rejected"));
+    ENSURE(g_srv.sim.def.effects.enabled & LAG_EFF_DAMPING);
+    ENSURE(g_srv.sim.def.effects.damping[1] == 0.25);
+
+    /* reset_to with 4 joints: names the model and its 3 joints */
+    lag_wire_control m;
+    memset(&m, 0, sizeof m);
+    m.request = LAGSIM_CONTROL_T_RESET_TO;
+    m.num_joints = 4;
+    uint8_t buf[LAG_WIRE_BUF_SIZE];
+    int n = lag_wire_encode_control(&m, buf, sizeof buf);
+    ENSURE(n > 0);
+    rt_handle_control(&g_srv, buf, (size_t)n);
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("control_rejected") == 1 &&
+                strstr(last_detail("control_rejected"), "4 joints given; model dipc has 3 "
+                       "(theta0, theta1, theta2)"),
+            "reset_to with 4 joints: '%s'", last_detail("control_rejected"));
+    /* a command of 4 joints */
+    lag_wire_joint_command jc;
+    memset(&jc, 0, sizeof jc);
+    jc.num_joints = 4;
+    for (int i = 0; i < 4; i++) snprintf(jc.name[i], sizeof jc.name[i], "theta%d", i);
+    n = lag_wire_encode(LAG_WIRE_JOINT_COMMAND, &jc, buf, sizeof buf);
+    ENSURE(n > 0);
+    rt_handle_command(&g_srv, buf, (size_t)n);
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("command_rejected") == 1 &&
+                strstr(last_detail("command_rejected"), "num_joints 4 in value: expected 0 to 3, "
+                       "the joints of model dipc (theta0, theta1, theta2)"),
+            "command with 4 joints: '%s'", last_detail("command_rejected"));
+    control(LAGSIM_CONTROL_T_STEP, 0);
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("control_rejected") == 2 &&
+                strstr(last_detail("control_rejected"), "step: count 0: expected 1 or more"),
+            "step 0: '%s'", last_detail("control_rejected"));
+    stop_server();
+}
+
 int main(int argc, char **argv)
 {
     static const struct {
@@ -1194,7 +1260,7 @@ int main(int argc, char **argv)
         {"command_flood", case_command_flood}, {"duration", case_duration},
         {"signals", case_signals},         {"fault_effort", case_fault_effort},
         {"lockstep_retry", case_lockstep_retry}, {"lockstep_loss", case_lockstep_loss},
-        {"other_plant", case_other_plant},
+        {"other_plant", case_other_plant}, {"messages", case_messages},
     };
     if (argc != 2) {
         fprintf(stderr, "usage: test_loop CASE\n");
