@@ -5,9 +5,11 @@ target_link_libraries(server_test PRIVATE lagsim_scene lagsim_core lagsim_wire l
 find_program(LCM_LOGGER lcm-logger)
 set(LAGSIM_SERVER_CASES control hostile watchdog lockstep_timeout two_daemons fault sigterm
     bad_scene effects control_flood step_flood lockstep_huge status_rate rate_huge long_period
-    duration_huge signals effort_absurd ttl_warning offline_signal command_flood_ports same_prefix)
+    duration_huge signals effort_absurd ttl_warning offline_signal command_flood_ports same_prefix
+    plant_conflict)
 if(LCM_LOGGER)
-  list(APPEND LAGSIM_SERVER_CASES replay replay_dopri5 replay_effects replay_flight)
+  list(APPEND LAGSIM_SERVER_CASES replay replay_dopri5 replay_effects replay_flight
+       plant_conflict_logplayer)
 endif()
 foreach(case ${LAGSIM_SERVER_CASES})
   add_test(NAME server_${case}

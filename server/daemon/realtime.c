@@ -56,6 +56,7 @@
 #define RT_STATUS_NS_MIN 10000000LL /* periodic status at most every 10 ms (100 Hz) */
 #define RT_SIGNALS_PER_WAKE 16    /* signals read per wake-up at most */
 #define RT_RETRY_NS_MIN 1000000LL /* lockstep retries at most every millisecond */
+#define RT_CONFLICT_EVERY_S 5     /* another plant's scenes: said at most once in 5 s */
 
 /* The buckets of the limited events (rt_ev): name, answers per second, burst. */
 static const struct {
@@ -76,6 +77,8 @@ static const struct {
     [RT_EV_OVERRUN_BURST] = {"overrun_burst", 1, 3},
     [RT_EV_NUMERIC_FAULT] = {"numeric_fault", 10, 10},
     [RT_EV_EVENTS_DROPPED] = {"events_dropped", 1, 3},
+    /* one in RT_CONFLICT_EVERY_S however many scenes a forger or a log player sends */
+    [RT_EV_PLANT_CONFLICT] = {"plant_conflict", 1.0 / RT_CONFLICT_EVERY_S, 1},
 };
 _Static_assert(sizeof ev_limits / sizeof ev_limits[0] == RT_EV_COUNT, "one bucket per rt_ev");
 
@@ -743,7 +746,7 @@ void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len)
     uint64_t h = rt_hash(data, len);
     for (int k = 0; k < RT_SCENES_KEPT; k++)
         if (s->scene_sent[k] == h) return; /* this daemon's own */
-    if (s->other_plant[0]) return;         /* said already */
+    if (s->discard && s->other_plant[0]) return; /* at start: said already */
     /* a plant's scene decodes and names its prefix; anything else on the channel is not a
      * plant (junk, a forgery of no consequence) and is ignored */
     static lag_wire_scene m; /* large: not on the stack of a handler */
@@ -753,9 +756,21 @@ void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len)
     snprintf(s->other_plant, sizeof s->other_plant, "a scene this daemon did not send "
              "(model %.20s, mode %.10s, dt %g s)", m.model, m.mode, m.dt);
     if (s->discard) return; /* at start (rt_bus_open's look before publishing): refused there */
-    if (!s->stop) {
-        s->stop = true;
-        s->stop_reason = RT_STOP_OTHER_PLANT;
+    /* running: one datagram from any process must not stop a plant that may be driving an
+     * experiment; the conflict is counted and said, rate-limited, and the run goes on */
+    s->plant_conflicts++;
+    rt_limit *l = &s->lim_event[RT_EV_PLANT_CONFLICT];
+    limited_event(s, RT_EV_PLANT_CONFLICT, "", (double)s->plant_conflicts,
+                  "another plant publishes on prefix %s (%s): %lld such scenes so far (in "
+                  "value); running on; one plant per prefix: stop the other, or give one "
+                  "another lcm.prefix", s->sc->lcm.prefix, s->other_plant,
+                  (long long)s->plant_conflicts);
+    if (l->suppressed == 0) { /* the event went out: the terminal hears it too, even with -q */
+        if (s->opts && s->opts->quiet)
+            fprintf(stderr, "lagsimd: %s: another plant publishes on prefix %s (%s): %lld "
+                    "such scenes so far; running on\n", s->sc->lcm.prefix, s->sc->lcm.prefix,
+                    s->other_plant, (long long)s->plant_conflicts);
+        s->want_status = true;
     }
 }
 
@@ -1084,10 +1099,6 @@ void rt_finish(rt_server *s)
     case RT_STOP_DURATION:
         eventf(s, "stop", lag_sim_time(&s->sim), "duration reached");
         break;
-    case RT_STOP_OTHER_PLANT:
-        eventf(s, "stop", lag_sim_time(&s->sim), "another plant publishes on prefix %s (%s): "
-               "stopping; one plant per prefix", s->sc->lcm.prefix, s->other_plant);
-        break;
     default:
         eventf(s, "stop", 0, "stopping");
         break;
@@ -1216,12 +1227,6 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
         rt_process(s);
     }
     rt_finish(s);
-    if (s->stop_reason == RT_STOP_OTHER_PLANT) {
-        fprintf(stderr, "lagsimd: another plant publishes on prefix %s (%s): stopped; one "
-                "plant per prefix (give this one another lcm.prefix)\n", sc->lcm.prefix,
-                s->other_plant);
-        rc = LAGSIMD_EXIT_RUNTIME;
-    }
     if (rt_log_end(s) != 0 && rc == LAGSIMD_EXIT_OK) rc = LAGSIMD_EXIT_RUNTIME; /* --log lost records */
 out:
     rt_log_end(s); /* --log opened, then the start failed */

@@ -65,6 +65,7 @@ typedef enum rt_ev {
     RT_EV_OVERRUN_BURST,
     RT_EV_NUMERIC_FAULT,
     RT_EV_EVENTS_DROPPED,
+    RT_EV_PLANT_CONFLICT,     /* a scene of another plant heard on this prefix while running */
     RT_EV_COUNT
 } rt_ev;
 
@@ -74,7 +75,6 @@ typedef enum rt_stop {
     RT_STOP_SIGNAL,
     RT_STOP_DURATION,
     RT_STOP_ERROR,
-    RT_STOP_OTHER_PLANT, /* another plant publishes on this prefix (rt_handle_scene) */
 } rt_stop;
 
 #define RT_SCENES_KEPT 8 /* the last scenes published, to tell them from another plant's */
@@ -159,6 +159,7 @@ typedef struct rt_server {
     int64_t numeric_faults;
     int64_t states_published;
     int64_t effect_events_dropped; /* sim.events_dropped already reported */
+    int64_t plant_conflicts;   /* scenes of another plant heard on this prefix while running */
 
     /* timing */
     int64_t start_ns;
@@ -206,7 +207,7 @@ typedef struct rt_server {
      * include utime), and what was heard from another plant */
     uint64_t scene_sent[RT_SCENES_KEPT];
     int scene_next;
-    char other_plant[160];     /* what gave it away ("" = nothing) */
+    char other_plant[160];     /* what gave it away, the last one heard ("" = nothing) */
 
     uint8_t buf[RT_BUF_SIZE];
     uint8_t state_buf[RT_BUF_SIZE]; /* the last state published, as sent (lockstep retries) */
@@ -279,8 +280,11 @@ void rt_close(rt_server *s);
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len);
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len);
 /* A scene heard on this prefix: one that decodes, names this prefix and is not one this
- * daemon published is another plant's; the daemon then stops (RT_STOP_OTHER_PLANT) and
- * says so in its stop event. Anything else on the channel is ignored. */
+ * daemon published is another plant's (or a forgery, or an old log played back). At start
+ * (s->discard) it makes rt_bus_open refuse to start; while running the daemon runs on and
+ * reports the conflict: counted (status plant_conflicts), a plant_conflict event and a
+ * line on stderr (even with -q), both at most once per RT_CONFLICT_EVERY_S. Anything
+ * else on the channel is ignored. */
 void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len);
 /* FNV-1a, 64 bits: how a published scene is remembered. */
 uint64_t rt_hash(const uint8_t *data, size_t len);
