@@ -31,3 +31,14 @@ if(LAGSIM_LOG_PYTHON3)
     set_tests_properties(log_term_${case} PROPERTIES TIMEOUT 120 LABELS log)
   endforeach()
 endif()
+
+# Every output path by one set of rules (lagsim_out.h): no symbolic link followed, no input
+# written, no existing file replaced without --force.
+if(LAGSIM_LOG_PYTHON3)
+  foreach(writer lagsimd_log lagsimd_csv log2csv plot)
+    add_test(NAME log_outputs_${writer}
+             COMMAND ${LAGSIM_LOG_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/log/test_outputs.py
+                     --bin ${CMAKE_BINARY_DIR}/bin --source ${PROJECT_SOURCE_DIR} ${writer})
+    set_tests_properties(log_outputs_${writer} PROPERTIES TIMEOUT 120 LABELS log)
+  endforeach()
+endif()

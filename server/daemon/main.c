@@ -17,8 +17,9 @@ static void usage(FILE *f)
 {
     fputs(
         "usage: lagsimd --config FILE [--set KEY=VALUE ...] [-q] [--duration SECONDS]\n"
-        "               [--log FILE.lcm [--log-buffer MIB]]\n"
-        "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|-] [--set ...]\n"
+        "               [--log FILE.lcm [--log-buffer MIB] [--force]]\n"
+        "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|- [--force]]\n"
+        "               [--set ...]\n"
         "       lagsimd --config FILE --replay LOG.lcm [--tolerance X] [--set ...]\n"
         "\n"
         "Steps one Lagrangian model (stick, manipulator, dipc) described by a YAML scene.\n"
@@ -37,10 +38,13 @@ static void usage(FILE *f)
         "      --csv PATH|-       offline CSV destination (- = stdout; absent = no CSV,\n"
         "                         only the summary line on stderr)\n"
         "      --log FILE.lcm     real-time server: write every message published and\n"
-        "                         received to FILE (LCM log format, replaced if it exists),\n"
-        "                         in order, from the first state; never makes the loop wait\n"
-        "                         in realtime mode (what a slow disk loses is counted and\n"
-        "                         said; exit 1 if anything was lost)\n"
+        "                         received to FILE (LCM log format), in order, from the\n"
+        "                         first state; never makes the loop wait in realtime mode\n"
+        "                         (what a slow disk loses is counted and said; exit 1 if\n"
+        "                         anything was lost)\n"
+        "      --force            --log, --csv: replace FILE if it exists (else refused,\n"
+        "                         exit 2); never a symbolic link (not followed) nor the\n"
+        "                         scene file itself, --force or not\n"
         "      --log-buffer MIB   memory between the loop and the log writer, 0.25 to 1024\n"
         "                         (default 16)\n"
         "      --replay LOG.lcm   re-simulate a run recorded by --log or lcm-logger from the\n"
@@ -130,7 +134,8 @@ static int resolve_default_url(lag_scene *sc)
 
 int main(int argc, char **argv)
 {
-    enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE };
+    enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE,
+           OPT_FORCE };
     static const struct option longopts[] = {
         {"config", required_argument, NULL, 'c'},
         {"set", required_argument, NULL, 's'},
@@ -141,6 +146,7 @@ int main(int argc, char **argv)
         {"log", required_argument, NULL, OPT_LOG},
         {"log-buffer", required_argument, NULL, OPT_LOG_BUFFER},
         {"tolerance", required_argument, NULL, OPT_TOLERANCE},
+        {"force", no_argument, NULL, OPT_FORCE},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {"version", no_argument, NULL, 'V'},
@@ -216,6 +222,9 @@ int main(int argc, char **argv)
             have_tolerance = true;
             break;
         }
+        case OPT_FORCE:
+            opts.force = true;
+            break;
         case 'q':
             opts.quiet = true;
             break;
@@ -252,6 +261,8 @@ int main(int argc, char **argv)
         rc = usage_error("%s", "--log-buffer needs --log FILE");
     } else if (have_tolerance && !replay) {
         rc = usage_error("%s", "--tolerance needs --replay LOG");
+    } else if (opts.force && !opts.log && !opts.csv) {
+        rc = usage_error("%s", "--force replaces the file of --log or --csv: give one");
     } else {
         static lag_scene sc;
         char err[1024];

@@ -901,7 +901,7 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
         s->lg.input = actuator_lagged(&sc->sim.effects, s->nq);
         snprintf(s->lg.ch_input, RT_CHANNEL_MAX, "%s_INPUT", sc->lcm.prefix);
         s->lg.log = rt_log_open(o->log, o->log_ring ? o->log_ring : RT_LOG_RING_DEFAULT,
-                                err, errlen);
+                                o->force, o->scene_name, err, errlen);
         if (!s->lg.log) return LAGSIMD_EXIT_USAGE;
     }
     return LAGSIMD_EXIT_OK;
