@@ -438,16 +438,26 @@ static void reject(rt_server *s, rt_reject why, const char *joint, double value,
         "undecodable payload", "stale (lockstep: answers another state)",
         "effort beyond realtime.effort_limit"};
     s->rejected[why]++;
+    rt_log_rx_fate(s, why == RT_REJ_UNDECODABLE ? RT_RX_UNDECODABLE : RT_RX_REFUSED); /* --log */
     /* a flood is counted in status, not echoed one for one */
     limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s%s%s%s",
                   why_name[why], what ? " (" : "", what ? what : "", what ? ")" : "");
 }
 
-/* A command is applied whole or not at all: every name known, actuated, distinct; every
- * effort finite and within the scene's realtime.effort_limit. */
+static void handle_command(rt_server *s, const uint8_t *data, size_t len);
+
+/* --log: as received, once its fate is known (rt_log_rx_*) */
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
 {
-    rt_log_record(s, RT_LOG_IN, s->ch_command, data, len); /* --log: as received */
+    rt_log_rx_begin(s, s->ch_command, data, len);
+    handle_command(s, data, len);
+    rt_log_rx_end(s);
+}
+
+/* A command is applied whole or not at all: every name known, actuated, distinct; every
+ * effort finite and within the scene's realtime.effort_limit. */
+static void handle_command(rt_server *s, const uint8_t *data, size_t len)
+{
     lag_wire_joint_command c;
     int d = lag_wire_decode_joint_command(data, len, s->nq, &c);
     if (d == LAG_WIRE_ECOUNT) {
@@ -504,6 +514,7 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
         if ((waited_on && s->answered) ||
             (!waited_on && s->have_answered && c.sim_time == s->answered_time)) {
             s->commands_ignored++;
+            rt_log_rx_fate(s, RT_RX_REFUSED); /* --log: a sample of them */
             return;
         }
         if (!waited_on && !(s->run != RT_RUNNING && c.sim_time == lag_sim_time(&s->sim))) {
@@ -560,6 +571,7 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
 static void control_rejected(rt_server *s, const char *why)
 {
     s->controls_rejected++;
+    rt_log_rx_fate(s, RT_RX_REFUSED); /* --log: a sample of them */
     limited_event(s, RT_EV_CONTROL_REJECTED, "", 0, "%s", why);
     s->want_status = true;
 }
@@ -627,13 +639,23 @@ static void lockstep_rewait(rt_server *s)
     else if (s->period_left == 0) s->want_state = true;
 }
 
+static void handle_control(rt_server *s, const uint8_t *data, size_t len);
+
+/* --log: as received, once its fate is known (rt_log_rx_*) */
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
 {
-    rt_log_record(s, RT_LOG_IN, s->ch_control, data, len); /* --log: as received */
+    rt_log_rx_begin(s, s->ch_control, data, len);
+    handle_control(s, data, len);
+    rt_log_rx_end(s);
+}
+
+static void handle_control(rt_server *s, const uint8_t *data, size_t len)
+{
     lag_wire_control c;
     /* any count a message may carry decodes; reset_to checks it against the model's */
     int d = lag_wire_decode_control(data, len, LAG_WIRE_MAX_JOINTS, &c);
     if (d != LAG_WIRE_OK) {
+        if (d != LAG_WIRE_ECOUNT) rt_log_rx_fate(s, RT_RX_UNDECODABLE);
         char why[160];
         if (d == LAG_WIRE_ECOUNT)
             snprintf(why, sizeof why, "control: num_joints %d: expected 0 to %d (reset_to on "
@@ -719,8 +741,10 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
         return;
     }
     case LAGSIM_CONTROL_T_STATUS:
+        rt_log_rx_fate(s, RT_RX_QUERY); /* --log: changes nothing; a sample of them */
         break; /* the status below is the answer */
     case LAGSIM_CONTROL_T_DESCRIBE:
+        rt_log_rx_fate(s, RT_RX_QUERY);
         s->want_scene = true;
         return;
     case LAGSIM_CONTROL_T_SET:
@@ -895,6 +919,9 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     rt_limit_init(&s->lim_set, RT_SET_PER_S, RT_SET_BURST, now);
     rt_limit_init(&s->term.lim_print, 20, 20, now);
     rt_limit_init(&s->lg.lim_said, 1, 1, now);
+    rt_limit_init(&s->lg.lim_sample_said, 1, 1, now);
+    s->lg.sample_credit = RT_LOG_SAMPLE_BPS; /* a full bucket at start */
+    s->lg.sample_ns = now;
 
     /* --log, last: nothing after it can fail */
     if (o && o->log) {
