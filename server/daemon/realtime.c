@@ -791,9 +791,9 @@ void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len)
                   (long long)s->plant_conflicts);
     if (l->suppressed == 0) { /* the event went out: the terminal hears it too, even with -q */
         if (s->opts && s->opts->quiet)
-            fprintf(stderr, "lagsimd: %s: another plant publishes on prefix %s (%s): %lld "
-                    "such scenes so far; running on\n", s->sc->lcm.prefix, s->sc->lcm.prefix,
-                    s->other_plant, (long long)s->plant_conflicts);
+            fprintf(stderr, "lagsimd: another plant publishes on prefix %s (%s): %lld such "
+                    "scenes so far; running on\n", s->sc->lcm.prefix, s->other_plant,
+                    (long long)s->plant_conflicts);
         s->want_status = true;
     }
 }
