@@ -2,8 +2,11 @@
  * lagsimd --log: what the real-time server puts in its log, and what it says about it.
  *
  * Every message published (rt_wire.c's publish) and every command and control request
- * received (the handlers, before they decode it) is handed to the log writer (rt_log.c)
- * as it happens, so the log holds them in the order the loop saw them. With an actuator
+ * applied is handed to the log writer (rt_log.c) as it happens, so the log holds them in
+ * the order the loop saw them. A received message goes in, as received, once its handler
+ * knows its fate and before anything published in answer to it; refused and undecodable
+ * ones and queries (status, describe) are counted and go in only while the sample's byte
+ * bucket allows (RT_LOG_SAMPLE_BPS), so that a flood cannot fill the disk. With an actuator
  * lag the effort applied changes within a control period, and the state's `effort` holds
  * only its last value; the log then also holds, at the start of every period, the
  * commanded input the period runs with (<PREFIX>_INPUT, a joint_command_t whose sim_time
