@@ -2,6 +2,7 @@
  * What every C example controller shares: see lagsim_controller.h.
  */
 #include "lagsim_controller.h"
+#include "lagsim_out.h"
 
 #include <errno.h>
 #include <getopt.h>
@@ -10,6 +11,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #define CTL_MAX_OPTIONS 32
 
@@ -239,9 +241,17 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
 {
     char err[256];
     if (ctl->trace_path) {
-        ctl->trace = fopen(ctl->trace_path, "w");
+        /* replaced if it exists (a trace is rewritten run after run), but never written
+         * through a symbolic link (lagsim_out.h) */
+        char oerr[512];
+        int fd = lag_out_open("--trace", ctl->trace_path, true, NULL, 0, 0, oerr, sizeof oerr);
+        ctl->trace = fd >= 0 ? fdopen(fd, "w") : NULL;
         if (!ctl->trace) {
-            fprintf(stderr, "%s: --trace %s: %s\n", ctl->name, ctl->trace_path, strerror(errno));
+            if (fd >= 0) {
+                snprintf(oerr, sizeof oerr, "--trace %s: %s", ctl->trace_path, strerror(errno));
+                close(fd);
+            }
+            fprintf(stderr, "%s: %s\n", ctl->name, oerr);
             return 1;
         }
     }

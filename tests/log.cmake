@@ -2,7 +2,8 @@
 # that stalls, /dev/full for one that is full).
 add_executable(test_rt_log ${CMAKE_CURRENT_LIST_DIR}/log/test_rt_log.c)
 target_link_libraries(test_rt_log PRIVATE lagsimd_internal)
-foreach(case file clock realtime_stalled fast_stalled lockstep_stalled full flood_in)
+foreach(case file clock realtime_stalled fast_stalled lockstep_stalled full flood_in
+        flood_refused)
   add_test(NAME log_rt_${case} COMMAND test_rt_log ${case})
   set_tests_properties(log_rt_${case} PROPERTIES TIMEOUT 120 LABELS log)
 endforeach()
@@ -12,7 +13,7 @@ endforeach()
 # copies that lost states; the options. (The README's record recipe: clients_readme_recipes.)
 find_program(LAGSIM_LOG_PYTHON3 python3)
 if(LAGSIM_LOG_PYTHON3)
-  foreach(case lqr lqr_effects gaps readers cli)
+  foreach(case lqr lqr_effects gaps readers cli flood)
     add_test(NAME log_${case}
              COMMAND ${LAGSIM_LOG_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/log/test_log.py
                      --bin ${CMAKE_BINARY_DIR}/bin --types ${CMAKE_BINARY_DIR}/python
@@ -29,5 +30,16 @@ if(LAGSIM_LOG_PYTHON3)
                      --bin ${CMAKE_BINARY_DIR}/bin --python ${CMAKE_BINARY_DIR}/python
                      --source ${PROJECT_SOURCE_DIR} ${case})
     set_tests_properties(log_term_${case} PROPERTIES TIMEOUT 120 LABELS log)
+  endforeach()
+endif()
+
+# Every output path by one set of rules (lagsim_out.h): no symbolic link followed, no input
+# written, no existing file replaced without --force.
+if(LAGSIM_LOG_PYTHON3)
+  foreach(writer lagsimd_log lagsimd_csv log2csv plot)
+    add_test(NAME log_outputs_${writer}
+             COMMAND ${LAGSIM_LOG_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/log/test_outputs.py
+                     --bin ${CMAKE_BINARY_DIR}/bin --source ${PROJECT_SOURCE_DIR} ${writer})
+    set_tests_properties(log_outputs_${writer} PROPERTIES TIMEOUT 120 LABELS log)
   endforeach()
 endif()

@@ -5,9 +5,11 @@ target_link_libraries(server_test PRIVATE lagsim_scene lagsim_core lagsim_wire l
 find_program(LCM_LOGGER lcm-logger)
 set(LAGSIM_SERVER_CASES control hostile watchdog lockstep_timeout two_daemons fault sigterm
     bad_scene effects control_flood step_flood lockstep_huge status_rate rate_huge long_period
-    duration_huge signals effort_absurd ttl_warning offline_signal command_flood_ports same_prefix)
+    duration_huge signals effort_absurd ttl_warning offline_signal command_flood_ports same_prefix
+    plant_conflict)
 if(LCM_LOGGER)
-  list(APPEND LAGSIM_SERVER_CASES replay replay_dopri5 replay_effects replay_flight)
+  list(APPEND LAGSIM_SERVER_CASES replay replay_dopri5 replay_effects replay_flight
+       plant_conflict_logplayer)
 endif()
 foreach(case ${LAGSIM_SERVER_CASES})
   add_test(NAME server_${case}
@@ -27,7 +29,7 @@ add_executable(test_loop ${CMAKE_CURRENT_LIST_DIR}/server/test_loop.c)
 target_link_libraries(test_loop PRIVATE lagsimd_internal)
 foreach(case pacing rate_huge status_hz lockstep_wait start set long_period chunks step_paced
         control_flood command_flood duration signals fault_effort lockstep_retry lockstep_loss
-        other_plant set_replay)
+        other_plant set_replay messages)
   add_test(NAME server_loop_${case} COMMAND test_loop ${case})
   set_tests_properties(server_loop_${case} PROPERTIES TIMEOUT 60 LABELS server)
 endforeach()

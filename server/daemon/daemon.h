@@ -22,6 +22,7 @@ typedef struct lagsimd_opts {
     const char *log;     /* --log: the real-time server's LCM log, NULL = none */
     size_t log_ring;     /* --log-buffer: bytes between the loop and the writer, 0 = default */
     double tolerance;    /* --replay: the largest difference that passes (default 0) */
+    bool force;          /* --force: --log and --csv may replace an existing file */
 } lagsimd_opts;
 
 /* Exit codes of lagsimd. */

@@ -17,8 +17,9 @@ static void usage(FILE *f)
 {
     fputs(
         "usage: lagsimd --config FILE [--set KEY=VALUE ...] [-q] [--duration SECONDS]\n"
-        "               [--log FILE.lcm [--log-buffer MIB]]\n"
-        "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|-] [--set ...]\n"
+        "               [--log FILE.lcm [--log-buffer MIB] [--force]]\n"
+        "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|- [--force]]\n"
+        "               [--set ...]\n"
         "       lagsimd --config FILE --replay LOG.lcm [--tolerance X] [--set ...]\n"
         "       lagsimd --config FILE --cost [--plot FILE.png] [--set ...]\n"
         "\n",
@@ -42,10 +43,16 @@ static void usage(FILE *f)
         "      --csv PATH|-       offline CSV destination (- = stdout; absent = no CSV,\n"
         "                         only the summary line on stderr)\n"
         "      --log FILE.lcm     real-time server: write every message published and\n"
-        "                         received to FILE (LCM log format, replaced if it exists),\n"
-        "                         in order, from the first state; never makes the loop wait\n"
-        "                         in realtime mode (what a slow disk loses is counted and\n"
-        "                         said; exit 1 if anything was lost)\n"
+        "                         every command and control request applied to FILE (LCM\n"
+        "                         log format), in order, from the first state; refused and\n"
+        "                         undecodable ones and status/describe requests are counted\n"
+        "                         and a sample of them written (at most 64 KiB a second);\n"
+        "                         never makes the loop wait in realtime mode (what a slow\n"
+        "                         disk loses is counted and said; exit 1 if anything was\n"
+        "                         lost)\n"
+        "      --force            --log, --csv: replace FILE if it exists (else refused,\n"
+        "                         exit 2); never a symbolic link (not followed) nor the\n"
+        "                         scene file itself, --force or not\n"
         "      --log-buffer MIB   memory between the loop and the log writer, 0.25 to 1024\n"
         "                         (default 16)\n"
         "      --replay LOG.lcm   re-simulate a run recorded by --log or lcm-logger from the\n"
@@ -166,7 +173,7 @@ static int reload_with(const char *config, const char *text, size_t len, const c
 int main(int argc, char **argv)
 {
     enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE,
-           OPT_COST, OPT_PLOT };
+           OPT_COST, OPT_PLOT, OPT_FORCE };
     static const struct option longopts[] = {
         {"config", required_argument, NULL, 'c'},
         {"set", required_argument, NULL, 's'},
@@ -179,6 +186,7 @@ int main(int argc, char **argv)
         {"tolerance", required_argument, NULL, OPT_TOLERANCE},
         {"cost", no_argument, NULL, OPT_COST},
         {"plot", required_argument, NULL, OPT_PLOT},
+        {"force", no_argument, NULL, OPT_FORCE},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {"version", no_argument, NULL, 'V'},
@@ -262,6 +270,9 @@ int main(int argc, char **argv)
         case OPT_PLOT:
             plot = optarg;
             break;
+        case OPT_FORCE:
+            opts.force = true;
+            break;
         case 'q':
             opts.quiet = true;
             break;
@@ -302,6 +313,8 @@ int main(int argc, char **argv)
         rc = usage_error("%s", "--cost measures the scene and exits: not with --offline, --replay or --log");
     } else if (plot && !cost) {
         rc = usage_error("%s", "--plot needs --cost");
+    } else if (opts.force && !opts.log && !opts.csv) {
+        rc = usage_error("%s", "--force replaces the file of --log or --csv: give one");
     } else {
         static lag_scene sc;
         char err[1024];

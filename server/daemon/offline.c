@@ -13,8 +13,10 @@
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "daemon.h"
+#include "lagsim_out.h"
 #include "rt_pace.h"
 
 #define OFFLINE_CHUNK_TICKS 65536 /* ticks between two looks at the stop flag */
@@ -84,10 +86,21 @@ int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)
     bool to_stdout = false;
     if (o->csv) {
         to_stdout = strcmp(o->csv, "-") == 0;
-        f = to_stdout ? stdout : fopen(o->csv, "w");
-        if (!f) {
-            fprintf(stderr, "lagsimd: cannot write %s: %s\n", o->csv, strerror(errno));
-            return LAGSIMD_EXIT_RUNTIME;
+        if (!to_stdout) {
+            const char *inputs[1] = {o->scene_name};
+            char oerr[512];
+            int fd = lag_out_open("--csv", o->csv, o->force, inputs, 1, 0, oerr, sizeof oerr);
+            f = fd >= 0 ? fdopen(fd, "w") : NULL;
+            if (!f) {
+                if (fd >= 0) {
+                    snprintf(oerr, sizeof oerr, "--csv %s: %s", o->csv, strerror(errno));
+                    close(fd);
+                }
+                fprintf(stderr, "lagsimd: %s\n", oerr);
+                return fd == LAG_OUT_REFUSED ? LAGSIMD_EXIT_USAGE : LAGSIMD_EXIT_RUNTIME;
+            }
+        } else {
+            f = stdout;
         }
         setvbuf(f, csvbuf, _IOFBF, sizeof csvbuf);
         write_header(f, info);

@@ -56,6 +56,7 @@
 #define RT_STATUS_NS_MIN 10000000LL /* periodic status at most every 10 ms (100 Hz) */
 #define RT_SIGNALS_PER_WAKE 16    /* signals read per wake-up at most */
 #define RT_RETRY_NS_MIN 1000000LL /* lockstep retries at most every millisecond */
+#define RT_CONFLICT_EVERY_S 5     /* another plant's scenes: said at most once in 5 s */
 
 /* The buckets of the limited events (rt_ev): name, answers per second, burst. */
 static const struct {
@@ -76,6 +77,8 @@ static const struct {
     [RT_EV_OVERRUN_BURST] = {"overrun_burst", 1, 3},
     [RT_EV_NUMERIC_FAULT] = {"numeric_fault", 10, 10},
     [RT_EV_EVENTS_DROPPED] = {"events_dropped", 1, 3},
+    /* one in RT_CONFLICT_EVERY_S however many scenes a forger or a log player sends */
+    [RT_EV_PLANT_CONFLICT] = {"plant_conflict", 1.0 / RT_CONFLICT_EVERY_S, 1},
 };
 _Static_assert(sizeof ev_limits / sizeof ev_limits[0] == RT_EV_COUNT, "one bucket per rt_ev");
 
@@ -108,6 +111,29 @@ static int64_t min64(int64_t a, int64_t b) { return a < b ? a : b; }
 static bool state_wanted(const rt_server *s)
 {
     return s->want_state && s->run != RT_FAULT && s->period_left == 0;
+}
+
+/* The scene's model, as its scene names it. */
+static const char *model_name(const rt_server *s)
+{
+    const lag_model_info *mi = lag_model_info_get(s->sc->sim.model.kind);
+    return mi ? mi->name : "?";
+}
+
+/* The joints the daemon publishes, "theta0, theta1, theta2": what a count is checked
+ * against, named in the message that refuses it. */
+typedef struct joint_text { char text[LAG_MAX_DOF * (LAG_WIRE_NAME_LEN + 2)]; } joint_text;
+static joint_text joint_list(const rt_server *s)
+{
+    joint_text j = {""};
+    size_t n = 0;
+    for (int i = 0; i < s->nq && n < sizeof j.text; i++) {
+        int k = snprintf(j.text + n, sizeof j.text - n, "%s%s", i ? ", " : "",
+                         s->info->joint_names[i]);
+        if (k < 0) break;
+        n += (size_t)k;
+    }
+    return j;
 }
 
 /* An unlimited event (start, stop). */
@@ -412,20 +438,33 @@ static void reject(rt_server *s, rt_reject why, const char *joint, double value,
         "undecodable payload", "stale (lockstep: answers another state)",
         "effort beyond realtime.effort_limit"};
     s->rejected[why]++;
+    rt_log_rx_fate(s, why == RT_REJ_UNDECODABLE ? RT_RX_UNDECODABLE : RT_RX_REFUSED); /* --log */
     /* a flood is counted in status, not echoed one for one */
     limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s%s%s%s",
                   why_name[why], what ? " (" : "", what ? what : "", what ? ")" : "");
 }
 
-/* A command is applied whole or not at all: every name known, actuated, distinct; every
- * effort finite and within the scene's realtime.effort_limit. */
+static void handle_command(rt_server *s, const uint8_t *data, size_t len);
+
+/* --log: as received, once its fate is known (rt_log_rx_*) */
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
 {
-    rt_log_record(s, RT_LOG_IN, s->ch_command, data, len); /* --log: as received */
+    rt_log_rx_begin(s, s->ch_command, data, len);
+    handle_command(s, data, len);
+    rt_log_rx_end(s);
+}
+
+/* A command is applied whole or not at all: every name known, actuated, distinct; every
+ * effort finite and within the scene's realtime.effort_limit. */
+static void handle_command(rt_server *s, const uint8_t *data, size_t len)
+{
     lag_wire_joint_command c;
     int d = lag_wire_decode_joint_command(data, len, s->nq, &c);
     if (d == LAG_WIRE_ECOUNT) {
-        reject(s, RT_REJ_BAD_LENGTH, "", c.num_joints, "num_joints in value");
+        char what[320];
+        snprintf(what, sizeof what, "num_joints %d in value: expected 0 to %d, the joints of "
+                 "model %s (%.160s)", c.num_joints, s->nq, model_name(s), joint_list(s).text);
+        reject(s, RT_REJ_BAD_LENGTH, "", c.num_joints, what);
         return;
     }
     if (d == LAG_WIRE_ETOOLONG) { /* a well-formed name longer than any joint's */
@@ -475,6 +514,7 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
         if ((waited_on && s->answered) ||
             (!waited_on && s->have_answered && c.sim_time == s->answered_time)) {
             s->commands_ignored++;
+            rt_log_rx_fate(s, RT_RX_REFUSED); /* --log: a sample of them */
             return;
         }
         if (!waited_on && !(s->run != RT_RUNNING && c.sim_time == lag_sim_time(&s->sim))) {
@@ -544,6 +584,7 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
 static void control_rejected(rt_server *s, const char *why)
 {
     s->controls_rejected++;
+    rt_log_rx_fate(s, RT_RX_REFUSED); /* --log: a sample of them */
     limited_event(s, RT_EV_CONTROL_REJECTED, "", 0, "%s", why);
     s->want_status = true;
 }
@@ -642,14 +683,31 @@ static void lockstep_rewait(rt_server *s)
     else if (s->period_left == 0) s->want_state = true;
 }
 
+static void handle_control(rt_server *s, const uint8_t *data, size_t len);
+
+/* --log: as received, once its fate is known (rt_log_rx_*) */
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
 {
-    rt_log_record(s, RT_LOG_IN, s->ch_control, data, len); /* --log: as received */
+    rt_log_rx_begin(s, s->ch_control, data, len);
+    handle_control(s, data, len);
+    rt_log_rx_end(s);
+}
+
+static void handle_control(rt_server *s, const uint8_t *data, size_t len)
+{
     lag_wire_control c;
-    int d = lag_wire_decode_control(data, len, LAG_MAX_DOF, &c);
+    /* any count a message may carry decodes; reset_to checks it against the model's */
+    int d = lag_wire_decode_control(data, len, LAG_WIRE_MAX_JOINTS, &c);
     if (d != LAG_WIRE_OK) {
-        control_rejected(s, d == LAG_WIRE_ECOUNT ? "control: num_joints out of range"
-                                                 : "control: undecodable payload");
+        if (d != LAG_WIRE_ECOUNT) rt_log_rx_fate(s, RT_RX_UNDECODABLE);
+        char why[160];
+        if (d == LAG_WIRE_ECOUNT)
+            snprintf(why, sizeof why, "control: num_joints %d: expected 0 to %d (reset_to on "
+                     "model %s: %d)", c.num_joints, LAG_WIRE_MAX_JOINTS, model_name(s), s->nq);
+        else
+            snprintf(why, sizeof why, "control: undecodable payload (%s)",
+                     lag_wire_result_string(d));
+        control_rejected(s, why);
         return;
     }
     switch (c.request) {
@@ -681,7 +739,10 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
             return;
         }
         if (c.count < 1) {
-            control_rejected(s, "step: count must be >= 1");
+            char why[96];
+            snprintf(why, sizeof why, "step: count %lld: expected 1 or more control periods",
+                     (long long)c.count);
+            control_rejected(s, why);
             return;
         }
         s->pending_steps = c.count;
@@ -713,7 +774,11 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
         return;
     case LAGSIM_CONTROL_T_RESET_TO: {
         if (c.num_joints != s->nq) {
-            control_rejected(s, "reset_to: num_joints must equal the model's joint count");
+            char why[320];
+            snprintf(why, sizeof why, "reset_to: %d joints given; model %s has %d (%.160s): q and "
+                     "qd need %d values each", c.num_joints, model_name(s), s->nq,
+                     joint_list(s).text, s->nq);
+            control_rejected(s, why);
             return;
         }
         double lim = s->sc->sim.explode_limit;
@@ -737,8 +802,10 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
         return;
     }
     case LAGSIM_CONTROL_T_STATUS:
+        rt_log_rx_fate(s, RT_RX_QUERY); /* --log: changes nothing; a sample of them */
         break; /* the status below is the answer */
     case LAGSIM_CONTROL_T_DESCRIBE:
+        rt_log_rx_fate(s, RT_RX_QUERY);
         s->want_scene = true;
         return;
     case LAGSIM_CONTROL_T_SET:
@@ -764,7 +831,7 @@ void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len)
     uint64_t h = rt_hash(data, len);
     for (int k = 0; k < RT_SCENES_KEPT; k++)
         if (s->scene_sent[k] == h) return; /* this daemon's own */
-    if (s->other_plant[0]) return;         /* said already */
+    if (s->discard && s->other_plant[0]) return; /* at start: said already */
     /* a plant's scene decodes and names its prefix; anything else on the channel is not a
      * plant (junk, a forgery of no consequence) and is ignored */
     static lag_wire_scene m; /* large: not on the stack of a handler */
@@ -774,9 +841,21 @@ void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len)
     snprintf(s->other_plant, sizeof s->other_plant, "a scene this daemon did not send "
              "(model %.20s, mode %.10s, dt %g s)", m.model, m.mode, m.dt);
     if (s->discard) return; /* at start (rt_bus_open's look before publishing): refused there */
-    if (!s->stop) {
-        s->stop = true;
-        s->stop_reason = RT_STOP_OTHER_PLANT;
+    /* running: one datagram from any process must not stop a plant that may be driving an
+     * experiment; the conflict is counted and said, rate-limited, and the run goes on */
+    s->plant_conflicts++;
+    rt_limit *l = &s->lim_event[RT_EV_PLANT_CONFLICT];
+    limited_event(s, RT_EV_PLANT_CONFLICT, "", (double)s->plant_conflicts,
+                  "another plant publishes on prefix %s (%s): %lld such scenes so far (in "
+                  "value); running on; one plant per prefix: stop the other, or give one "
+                  "another lcm.prefix", s->sc->lcm.prefix, s->other_plant,
+                  (long long)s->plant_conflicts);
+    if (l->suppressed == 0) { /* the event went out: the terminal hears it too, even with -q */
+        if (s->opts && s->opts->quiet)
+            fprintf(stderr, "lagsimd: another plant publishes on prefix %s (%s): %lld such "
+                    "scenes so far; running on\n", s->sc->lcm.prefix, s->other_plant,
+                    (long long)s->plant_conflicts);
+        s->want_status = true;
     }
 }
 
@@ -901,13 +980,16 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     rt_limit_init(&s->lim_set, RT_SET_PER_S, RT_SET_BURST, now);
     rt_limit_init(&s->term.lim_print, 20, 20, now);
     rt_limit_init(&s->lg.lim_said, 1, 1, now);
+    rt_limit_init(&s->lg.lim_sample_said, 1, 1, now);
+    s->lg.sample_credit = RT_LOG_SAMPLE_BPS; /* a full bucket at start */
+    s->lg.sample_ns = now;
 
     /* --log, last: nothing after it can fail */
     if (o && o->log) {
         s->lg.input = actuator_lagged(&sc->sim.effects, s->nq);
         snprintf(s->lg.ch_input, RT_CHANNEL_MAX, "%s_INPUT", sc->lcm.prefix);
         s->lg.log = rt_log_open(o->log, o->log_ring ? o->log_ring : RT_LOG_RING_DEFAULT,
-                                err, errlen);
+                                o->force, o->scene_name, err, errlen);
         if (!s->lg.log) return LAGSIMD_EXIT_USAGE;
     }
     return LAGSIMD_EXIT_OK;
@@ -1105,10 +1187,6 @@ void rt_finish(rt_server *s)
     case RT_STOP_DURATION:
         eventf(s, "stop", lag_sim_time(&s->sim), "duration reached");
         break;
-    case RT_STOP_OTHER_PLANT:
-        eventf(s, "stop", lag_sim_time(&s->sim), "another plant publishes on prefix %s (%s): "
-               "stopping; one plant per prefix", s->sc->lcm.prefix, s->other_plant);
-        break;
     default:
         eventf(s, "stop", 0, "stopping");
         break;
@@ -1237,12 +1315,6 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
         rt_process(s);
     }
     rt_finish(s);
-    if (s->stop_reason == RT_STOP_OTHER_PLANT) {
-        fprintf(stderr, "lagsimd: another plant publishes on prefix %s (%s): stopped; one "
-                "plant per prefix (give this one another lcm.prefix)\n", sc->lcm.prefix,
-                s->other_plant);
-        rc = LAGSIMD_EXIT_RUNTIME;
-    }
     if (rt_log_end(s) != 0 && rc == LAGSIMD_EXIT_OK) rc = LAGSIMD_EXIT_RUNTIME; /* --log lost records */
 out:
     rt_log_end(s); /* --log opened, then the start failed */

@@ -31,6 +31,7 @@
 #include <unistd.h>
 
 #include "lagsim_log.h"
+#include "lagsim_out.h"
 
 #define RT_LOG_BATCH_MS 100 /* the writer's longest sleep with records waiting */
 
@@ -124,7 +125,8 @@ static rt_log *fail_open(rt_log *l, char *err, size_t errlen, const char *fmt, .
     return NULL;
 }
 
-rt_log *rt_log_open(const char *path, size_t ring_bytes, char *err, size_t errlen)
+rt_log *rt_log_open(const char *path, size_t ring_bytes, bool force, const char *input,
+                    char *err, size_t errlen)
 {
     if (ring_bytes < RT_LOG_RING_MIN) ring_bytes = RT_LOG_RING_MIN;
     if (ring_bytes > RT_LOG_RING_MAX) ring_bytes = RT_LOG_RING_MAX;
@@ -134,10 +136,10 @@ rt_log *rt_log_open(const char *path, size_t ring_bytes, char *err, size_t errle
     snprintf(l->path, sizeof l->path, "%s", path);
     /* O_NONBLOCK: a FIFO without a reader fails at once (ENXIO) instead of blocking the
      * start; it is cleared afterwards, so that only the writer thread ever waits */
-    l->fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NONBLOCK, 0644);
-    if (l->fd < 0)
-        return fail_open(l, err, errlen, "--log %s: cannot open for writing: %s%s", path,
-                         strerror(errno), errno == ENXIO ? " (a FIFO that nobody reads)" : "");
+    const char *inputs[1] = {input};
+    char oerr[512];
+    l->fd = lag_out_open("--log", path, force, inputs, 1, O_NONBLOCK, oerr, sizeof oerr);
+    if (l->fd < 0) return fail_open(l, err, errlen, "%s", oerr);
     int fl = fcntl(l->fd, F_GETFL);
     if (fl < 0 || fcntl(l->fd, F_SETFL, fl & ~O_NONBLOCK) < 0)
         return fail_open(l, err, errlen, "--log %s: %s", path, strerror(errno));

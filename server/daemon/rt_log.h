@@ -51,11 +51,13 @@ typedef struct rt_log_stats {
     size_t ring;             /* the ring's size, bytes */
 } rt_log_stats;
 
-/* Opens (creates or truncates) path, allocates a ring of ring_bytes (clamped to
- * [RT_LOG_RING_MIN, RT_LOG_RING_MAX]) and starts the writer thread, which inherits the
- * caller's signal mask. Opening never blocks (a FIFO without a reader is an error).
- * Returns NULL with a message in err on failure. */
-rt_log *rt_log_open(const char *path, size_t ring_bytes, char *err, size_t errlen);
+/* Opens path by lag_out_open's rules (lagsim_out.h: a symbolic link, the scene file
+ * `input` and, without force, an existing regular file are refused), allocates a ring of
+ * ring_bytes (clamped to [RT_LOG_RING_MIN, RT_LOG_RING_MAX]) and starts the writer
+ * thread, which inherits the caller's signal mask. Opening never blocks (a FIFO without a
+ * reader is an error). Returns NULL with a message in err on failure. */
+rt_log *rt_log_open(const char *path, size_t ring_bytes, bool force, const char *input,
+                    char *err, size_t errlen);
 /* Puts one record (timestamp in us) in the ring; false when it was not, counted in the
  * stats by reason. Never blocks, never allocates. The producer's only call besides
  * rt_log_room and rt_log_get_stats. */

@@ -65,6 +65,7 @@ typedef enum rt_ev {
     RT_EV_OVERRUN_BURST,
     RT_EV_NUMERIC_FAULT,
     RT_EV_EVENTS_DROPPED,
+    RT_EV_PLANT_CONFLICT,     /* a scene of another plant heard on this prefix while running */
     RT_EV_COUNT
 } rt_ev;
 
@@ -74,7 +75,6 @@ typedef enum rt_stop {
     RT_STOP_SIGNAL,
     RT_STOP_DURATION,
     RT_STOP_ERROR,
-    RT_STOP_OTHER_PLANT, /* another plant publishes on this prefix (rt_handle_scene) */
 } rt_stop;
 
 #define RT_SCENES_KEPT 8 /* the last scenes published, to tell them from another plant's */
@@ -159,6 +159,7 @@ typedef struct rt_server {
     int64_t numeric_faults;
     int64_t states_published;
     int64_t effect_events_dropped; /* sim.events_dropped already reported */
+    int64_t plant_conflicts;   /* scenes of another plant heard on this prefix while running */
 
     /* timing */
     int64_t start_ns;
@@ -191,6 +192,22 @@ typedef struct rt_server {
         rt_log_stats seen;     /* counters already reported */
         rt_limit lim_said;     /* lost records are said at most once a second */
         bool error_said;
+        /* the command or control request being handled (rt_log_rx_*), written when its
+         * fate is known: accepted ones always, refused and undecodable ones as a sample
+         * of at most RT_LOG_SAMPLE_BPS bytes a second (a byte bucket), the rest counted */
+        const char *rx_channel;
+        const void *rx_data;
+        size_t rx_len;
+        bool rx_pending;
+        double sample_credit;  /* bytes the sample may still take */
+        int64_t sample_ns;     /* when the credit was last brought up to date */
+        int64_t rx_refused;    /* refused (rejected, ignored) or undecodable, received */
+        int64_t rx_undecodable;/* of which undecodable */
+        int64_t rx_queries;    /* status and describe requests received */
+        int64_t rx_sampled;    /* refused and queries written (the sample) */
+        int64_t rx_sampled_bytes;
+        int64_t unsampled_said;/* refused ones not written, as last said by an event */
+        rt_limit lim_sample_said; /* the log_sampled event: at most once a second */
     } lg;
 
     /* the terminal (rt_term.c): commands per second and printed events */
@@ -206,7 +223,7 @@ typedef struct rt_server {
      * include utime), and what was heard from another plant */
     uint64_t scene_sent[RT_SCENES_KEPT];
     int scene_next;
-    char other_plant[160];     /* what gave it away ("" = nothing) */
+    char other_plant[160];     /* what gave it away, the last one heard ("" = nothing) */
 
     uint8_t buf[RT_BUF_SIZE];
     uint8_t state_buf[RT_BUF_SIZE]; /* the last state published, as sent (lockstep retries) */
@@ -232,6 +249,25 @@ const char *rt_run_name(rt_run r);
  * or received (RT_LOG_IN) on `channel`, at the log's clock. */
 void rt_log_record(rt_server *s, rt_log_dir dir, const char *channel, const void *data,
                    size_t len);
+/* The fate of a received message in the log: accepted ones are all written; refused
+ * (rejected, or ignored as a second answer), undecodable ones and queries (status,
+ * describe: they change nothing a replay needs) are counted and written
+ * only while the sample's byte bucket allows (RT_LOG_SAMPLE_BPS bytes a second, as much in
+ * a burst), so a flood cannot fill the disk. The handlers call rt_log_rx_begin with what
+ * arrived, rt_log_rx_fate once its fate is known (before publishing anything in answer:
+ * the log keeps the order), rt_log_rx_end at their end (still pending: accepted). A message
+ * the daemon publishes while one is pending was published in answer to an accepted one.
+ * No-ops without --log. */
+#define RT_LOG_SAMPLE_BPS (64 * 1024)
+typedef enum rt_rx_fate {
+    RT_RX_ACCEPTED = 0, /* a command applied, a control request that changes the run */
+    RT_RX_REFUSED,      /* rejected, or ignored (a second answer to a lockstep state) */
+    RT_RX_UNDECODABLE,  /* refused: not a message of its channel's type */
+    RT_RX_QUERY,        /* status and describe requests: they change nothing */
+} rt_rx_fate;
+void rt_log_rx_begin(rt_server *s, const char *channel, const void *data, size_t len);
+void rt_log_rx_fate(rt_server *s, rt_rx_fate fate);
+void rt_log_rx_end(rt_server *s);
 /* The commanded input of the period that starts (with an actuator lag only), on
  * <PREFIX>_INPUT as a joint_command_t: in the log, never on the bus. */
 void rt_log_input(rt_server *s);
@@ -279,8 +315,11 @@ void rt_close(rt_server *s);
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len);
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len);
 /* A scene heard on this prefix: one that decodes, names this prefix and is not one this
- * daemon published is another plant's; the daemon then stops (RT_STOP_OTHER_PLANT) and
- * says so in its stop event. Anything else on the channel is ignored. */
+ * daemon published is another plant's (or a forgery, or an old log played back). At start
+ * (s->discard) it makes rt_bus_open refuse to start; while running the daemon runs on and
+ * reports the conflict: counted (status plant_conflicts), a plant_conflict event and a
+ * line on stderr (even with -q), both at most once per RT_CONFLICT_EVERY_S. Anything
+ * else on the channel is ignored. */
 void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len);
 /* FNV-1a, 64 bits: how a published scene is remembered. */
 uint64_t rt_hash(const uint8_t *data, size_t len);

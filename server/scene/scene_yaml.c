@@ -567,15 +567,26 @@ int ytree_graft(ynode *root, const ysrc *src, ynode *val, errbuf *err)
         char key[256];
         memcpy(key, seg, len);
         key[len] = '\0';
+        if (map->kind == YN_SCALAR && ynode_is_null(map)) {
+            /* nothing (`effects:`, `effects=null`) is an empty mapping, as the schema
+             * reads it: a key set inside it starts one, so that a null set earlier never
+             * makes later sets below it fail */
+            free(map->text);
+            map->text = NULL;
+            map->quoted = false;
+            map->kind = YN_MAP;
+        }
         if (map->kind != YN_MAP) {
             ynode_free(val);
             if (map->src->is_set)
                 return yfail(err, &at, NULL,
-                             "cannot set a key inside '%s', which is %s (from --set %s)",
-                             pathsofar, ynode_kind_name(map), map->src->name);
+                             "cannot set a key inside '%s': it was set to %s by %s=..., not a "
+                             "mapping (set '%s' to a mapping, e.g. %s={}, first)",
+                             pathsofar, ynode_kind_name(map), map->src->name, pathsofar,
+                             pathsofar);
             return yfail(err, &at, NULL,
-                         "cannot set a key inside '%s', which is %s at %s:%d:%d", pathsofar,
-                         ynode_kind_name(map), map->src->name, map->line, map->col);
+                         "cannot set a key inside '%s', which is %s at %s:%d:%d, not a mapping",
+                         pathsofar, ynode_kind_name(map), map->src->name, map->line, map->col);
         }
         yentry *en = (yentry *)ymap_find(map, key);
         if (!en) {

@@ -21,6 +21,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+#include "lagsim_out.h"
 
 #define L2C_MAX_CHANNELS 256
 #define L2C_MAX_KINDS 48
@@ -153,9 +156,18 @@ static FILE *open_csv(l2c *c, chan *h)
         char fname[LAG_LOG_CHANNEL_MAX + 24], path[4096];
         file_name(c, h->name, fname, sizeof fname);
         snprintf(path, sizeof path, "%s/%s", c->o->outdir, fname);
-        f = fopen(path, "w");
+        /* never through a symbolic link, never over the log read, nor over an existing
+         * file without --force (lagsim_out.h) */
+        const char *inputs[1] = {c->o->input};
+        char oerr[512];
+        int fd = lag_out_open("cannot write", path, c->o->force, inputs, 1, 0, oerr, sizeof oerr);
+        f = fd >= 0 ? fdopen(fd, "w") : NULL;
         if (!f) {
-            snprintf(c->err, c->errlen, "cannot write %s: %s", path, strerror(errno));
+            if (fd >= 0) {
+                snprintf(oerr, sizeof oerr, "cannot write %.400s: %s", path, strerror(errno));
+                close(fd);
+            }
+            snprintf(c->err, c->errlen, "%s", oerr);
             c->write_failed = true;
             return NULL;
         }

@@ -19,6 +19,8 @@ typedef struct l2c_opts {
     int n_select;                       /* --channel: only these (0: every channel) */
     const char *select[L2C_MAX_SELECT];
     FILE *listing;                      /* one line per CSV written (NULL: none) */
+    bool force;                         /* --force: an existing CSV may be replaced */
+    const char *input;                  /* the log read: never written (lagsim_out.h) */
 } l2c_opts;
 
 /* Reads the whole log, writes the CSVs and the summary (to `summary`, may be NULL).

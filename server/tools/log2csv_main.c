@@ -1,5 +1,5 @@
 /*
- * lagsim-log2csv LOG [--channel CH ...] [-o DIR] [-q]
+ * lagsim-log2csv LOG [--channel CH ...] [-o DIR] [--force] [-q]
  *
  * Turns an LCM log (written by lagsimd --log or by lcm-logger) into one CSV per channel
  * that carries lagsim's messages, and prints a summary. Exit codes: 0 ok, 1 the log ends
@@ -16,7 +16,7 @@
 
 static void usage(FILE *f)
 {
-    fputs("usage: lagsim-log2csv LOG [--channel CHANNEL ...] [-o DIR] [-q]\n"
+    fputs("usage: lagsim-log2csv LOG [--channel CHANNEL ...] [-o DIR] [--force] [-q]\n"
           "\n"
           "Writes one CSV per channel of lagsim's messages found in LOG (an LCM log from\n"
           "lagsimd --log or lcm-logger) into DIR, named after the channel (DIPC_STATE.csv,\n"
@@ -25,6 +25,8 @@ static void usage(FILE *f)
           "\n"
           "  -c, --channel CH   only this channel (repeatable)\n"
           "  -o, --output DIR   directory for the CSVs (default: the current one; created)\n"
+          "  -f, --force        replace CSVs that exist (else refused, exit 2); a symbolic\n"
+          "                     link is never written through, nor the LOG itself\n"
           "  -q, --quiet        no summary, no list of files\n"
           "  -h, --help         this help\n"
           "\n"
@@ -43,13 +45,14 @@ int main(int argc, char **argv)
     static const struct option longopts[] = {
         {"channel", required_argument, NULL, 'c'}, {"output", required_argument, NULL, 'o'},
         {"quiet", no_argument, NULL, 'q'},         {"help", no_argument, NULL, 'h'},
+        {"force", no_argument, NULL, 'f'},
         {NULL, 0, NULL, 0},
     };
     l2c_opts o = {.outdir = ".", .n_select = 0, .listing = stdout};
     bool quiet = false;
     opterr = 0;
     int c;
-    while ((c = getopt_long(argc, argv, ":c:o:qh", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, ":c:o:qhf", longopts, NULL)) != -1) {
         switch (c) {
         case 'c':
             if (o.n_select >= L2C_MAX_SELECT) {
@@ -63,6 +66,9 @@ int main(int argc, char **argv)
             break;
         case 'q':
             quiet = true;
+            break;
+        case 'f':
+            o.force = true;
             break;
         case 'h':
             usage(stdout);
@@ -80,6 +86,7 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *path = argv[optind];
+    o.input = path;
     if (mkdir(o.outdir, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "lagsim-log2csv: cannot create %s: %s\n", o.outdir, strerror(errno));
         return 2;

@@ -187,6 +187,7 @@ void view_json_status(jbuf *b, const lag_wire_status *m)
     jb_int(b, "numeric_faults", m->numeric_faults);
     jb_int(b, "overrun_bursts", m->overrun_bursts);
     jb_int(b, "states_published", m->states_published);
+    jb_int(b, "plant_conflicts", m->plant_conflicts);
     jb_raw(b, "}");
 }
 

@@ -108,6 +108,7 @@ static const lag_wire_field status_fields[] = {
     SCALAR(ST, LAG_WIRE_INT64, lockstep_retries),
     SCALAR(ST, LAG_WIRE_INT64, commands_ignored),
     STRING(ST, contact),
+    SCALAR(ST, LAG_WIRE_INT64, plant_conflicts),
 };
 
 typedef lag_wire_scene SC;

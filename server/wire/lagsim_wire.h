@@ -154,6 +154,7 @@ typedef struct lag_wire_status {
     int64_t lockstep_retries;
     int64_t commands_ignored;
     char contact[LAG_WIRE_NAME_LEN]; /* the stick's floor: flight, contact, flat or "" */
+    int64_t plant_conflicts;
 } lag_wire_status;
 
 /* <PREFIX>_SCENE: the scene description. */

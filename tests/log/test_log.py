@@ -19,6 +19,8 @@ Cases:
   readers        liblcm's reader, lcm.jar's reader and lcm-logplayer (into LCM's file:// writer,
                  at the log's pace) read the log whole
   cli            option errors: exit 2 with the option named, nothing run
+  flood          3 s of refused commands on a logged realtime run: a bounded sample of them
+                 logged, every state, the counts in the log and the summary, replay exact
 """
 import argparse
 import ctypes
@@ -122,7 +124,7 @@ class Run:
             time.sleep(0.3)
             p = self.lagsimd("--config", config, "--set", f"lcm.prefix={prefix}", "--set",
                              "realtime.mode=lockstep", *sets, "--duration", str(duration),
-                             "-q", "--log", log)
+                             "-q", "--log", log, "--force")  # a case may record twice
             out, _ = lqr.communicate(timeout=30)
         finally:
             if lqr.poll() is None:
@@ -380,8 +382,79 @@ def case_cli(r, a, tmp):
           "--log /dev/full: said, the run ends, exit 1")
 
 
+def case_flood(r, a, tmp):
+    """A flood of refused commands (unknown joints, and undecodable bytes) for 3 s on a
+    realtime run logged with --log: the log keeps every state and every message the daemon
+    published, and of the flood only a sample of at most 64 KiB a second (the sample's
+    bucket: 64 KiB at start, 64 KiB more each second); the counts are in the log (the
+    last status's rejected_* fields, a log_sampled event) and in the summary on stderr;
+    --replay gives difference 0."""
+    sys.path.insert(0, a.types)
+    from lagsim_lcm import LCM, plant_urls
+    prefix = f"LG{os.getpid()}F"
+    log = os.path.join(tmp, "flood.lcm")
+    config = os.path.join(a.source, "config", "dipc.yaml")
+    run_s, flood_s = 5.0, 3.0
+    d = subprocess.Popen([os.path.join(r.bin, "lagsimd"), "--config", config, "--set",
+                          f"lcm.prefix={prefix}", "--set", "realtime.start=running",
+                          "--duration", str(run_s), "--log", log],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(0.8)
+    _, command_url = plant_urls()
+    lc = LCM(command_url)
+    bad = r.t.joint_command_t()
+    bad.num_joints, bad.name, bad.effort = 1, ["bogus"], [1.0]
+    payloads = [bad.encode(), b"\x00" * 40]  # an unknown joint; undecodable
+    sent, t_end = 0, time.time() + flood_s
+    while time.time() < t_end:
+        for _ in range(200):
+            lc.publish(prefix + "_COMMAND", payloads[sent % 7 == 0])
+            sent += 1
+    out, err = d.communicate(timeout=60)
+    print(err.strip())
+    check(d.returncode == 0, f"lagsimd: exit {d.returncode}")
+    size = os.path.getsize(log)
+    recs = read_log(log)
+    cmd_bytes = sum(28 + len(ch) + len(data) for _, _, ch, data in recs if ch == prefix + "_COMMAND")
+    rest = size - cmd_bytes
+    print(f"  log: {size} bytes, {cmd_bytes} of them commands, for {sent} refused commands sent")
+    last = r.t.status_t.decode([dt for _, _, ch, dt in recs if ch == prefix + "_STATUS"][-1])
+    received = last.rejected_unknown_joint + last.rejected_undecodable
+    each = 28 + len(prefix + "_COMMAND") + len(payloads[0])
+    print(f"  flood: {sent} sent in {flood_s} s, {received} received by the daemon "
+          f"({last.rejected_unknown_joint} unknown joint, {last.rejected_undecodable} undecodable); "
+          f"log {size} bytes: {cmd_bytes} of commands, {rest} of the rest; "
+          f"every refused one written would be {received * each} bytes")
+    # the bound: the sample's bucket can have given at most 64 KiB at start plus 64 KiB for
+    # each second of the run (the run is run_s of sim time at rate 1, plus the start)
+    bound = 64 * 1024 * (1 + run_s + 1)
+    check(received > 20000, f"the flood reached the daemon ({received} refused commands counted)")
+    check(cmd_bytes <= bound, f"commands in the log: {cmd_bytes} bytes <= {bound} (64 KiB a "
+          f"second of the run and one at start)")
+    check(size <= rest + bound and size < 2 * 1024 * 1024,
+          f"the log: {size} bytes (< 2 MiB; written whole it would be over {received * each})")
+    check(len(r.states(recs, prefix)) == 501, f"{len(r.states(recs, prefix))} states logged: every one")
+    sampled = [r.t.event_t.decode(dt) for _, _, ch, dt in recs if ch == prefix + "_EVENT"]
+    sampled = [e for e in sampled if e.kind == "log_sampled"]
+    check(sampled and "counted only" in sampled[-1].detail and sampled[-1].value > 0,
+          f"log_sampled events in the log ({len(sampled)}): "
+          f"'{sampled[-1].detail if sampled else ''}'")
+    m = re.search(r"received (\d+) refused commands and control requests \((\d+) undecodable\)"
+                  r" and \d+ status or describe requests: (\d+) written as a sample, (\d+) counted only", err)
+    check(m is not None and int(m.group(1)) == received
+          and int(m.group(2)) == last.rejected_undecodable
+          and int(m.group(3)) == sum(1 for _, _, ch, _ in recs if ch == prefix + "_COMMAND"),
+          "the summary on stderr: refused received (as the last status counts them), "
+          "undecodable, written as a sample (as the log holds), counted only")
+    rp = r.lagsimd("--config", config, "--set", f"lcm.prefix={prefix}", "--set",
+                   "realtime.start=running", "--replay", log)
+    n, gaps, diff, _ = replay_report(rp)
+    check(rp.returncode == 0 and n == 500 and gaps == 0 and diff == 0.0,
+          f"replay: {n} states compared, {gaps} gaps, difference {diff}, exit {rp.returncode}")
+
+
 CASES = {"lqr": case_lqr, "lqr_effects": case_lqr_effects, "gaps": case_gaps,
-         "readers": case_readers, "cli": case_cli}
+         "readers": case_readers, "cli": case_cli, "flood": case_flood}
 
 
 def main():

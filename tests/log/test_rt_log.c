@@ -6,7 +6,7 @@
  * reached the file is read back with the wire module's bounded reader.
  *
  *   test_rt_log CASE    CASE: file clock realtime_stalled fast_stalled lockstep_stalled
- *                             full flood_in
+ *                             full flood_in flood_refused
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -491,6 +491,86 @@ static void case_flood_in(void)
     ENSURE(f.numbered && f.states == 51 && f.gaps == 0);
 }
 
+/* A flood of refused messages cannot fill the disk: for 3 s of the made-up clock, every
+ * millisecond 10 commands for an unknown joint, 2 undecodable ones and a status request,
+ * and every 10 ms a good command answering the state. Every good command, state and event
+ * is logged; of the rest, counted exactly, a sample whose bytes are within the bucket:
+ * 64 KiB at start and 64 KiB a second after (<= 4 x 64 KiB over 3 s, and all of it used);
+ * the log's own log_sampled events say so; the replay of the log gives difference 0. */
+static void case_flood_refused(void)
+{
+    scene(LAG_RT_REALTIME, 100);
+    g_sc.realtime.start = LAG_RT_START_RUNNING;
+    snprintf(g_file, sizeof g_file, "/tmp/lagsim_rt_log_%d.lcm", (int)getpid());
+    unlink(g_file);
+    start(g_file, 0);
+    const int64_t t0 = g_srv.now;
+    uint8_t bad[256], junk[40];
+    memset(junk, 0xff, sizeof junk);
+    char *names[1] = {"bogus"};
+    double e = 1.0;
+    lagsim_joint_command_t m = {0, 0.0, 1, names, &e};
+    int nbad = lagsim_joint_command_t_encode(bad, 0, sizeof bad, &m);
+    ENSURE(nbad > 0);
+    int64_t good = 0;
+    for (int ms = 1; ms <= 3000; ms++) {
+        run_until(t0 + ms * MS, 1000);
+        for (int k = 0; k < 10; k++) rt_handle_command(&g_srv, bad, (size_t)nbad);
+        for (int k = 0; k < 2; k++) rt_handle_command(&g_srv, junk, sizeof junk);
+        control(LAGSIM_CONTROL_T_STATUS);
+        if (ms % 10 == 5) {
+            command(g_srv.waiting_time, 0.1 * sin(0.01 * ms));
+            good++;
+        }
+    }
+    run_until(t0 + 3500 * MS, 1000);
+    ENSURE(g_srv.lg.rx_refused == 36000 && g_srv.lg.rx_undecodable == 6000 &&
+           g_srv.lg.rx_queries == 3000);
+    int64_t sampled = g_srv.lg.rx_sampled, sampled_bytes = g_srv.lg.rx_sampled_bytes;
+    ENSURE(finish() == 0); /* complete: nothing lost, the rest was counted by design */
+    logfacts f;
+    read_log(g_file, &f);
+    /* the bytes of the sample: each refused command or query record in the file */
+    char err[256];
+    lag_log *lg = lag_log_open(g_file, 65536, err, sizeof err);
+    ENSUREF(lg, "%s", err);
+    lag_log_record r;
+    int64_t in_bytes = 0, in_good = 0, in_other = 0, ev_sampled = 0;
+    while (lag_log_next(lg, &r) == LAG_LOG_OK) {
+        const char *sfx = strrchr(r.channel, '_');
+        if (!strcmp(sfx, "_COMMAND")) {
+            lag_wire_joint_command c;
+            bool ok = lag_wire_decode_joint_command(r.data, r.size, 3, &c) == LAG_WIRE_OK &&
+                      !strcmp(c.name[0], "theta0");
+            if (ok) in_good++;
+            else {
+                in_other++;
+                in_bytes += LAG_LOG_HEADER_SIZE + (int64_t)strlen(r.channel) + (int64_t)r.size;
+            }
+        } else if (!strcmp(sfx, "_CONTROL")) {
+            in_other++;
+            in_bytes += LAG_LOG_HEADER_SIZE + (int64_t)strlen(r.channel) + (int64_t)r.size;
+        } else if (!strcmp(sfx, "_EVENT")) {
+            lag_wire_event ev;
+            ENSURE(lag_wire_decode_event(r.data, r.size, &ev) == LAG_WIRE_OK);
+            ev_sampled += !strcmp(ev.kind, "log_sampled");
+        }
+    }
+    lag_log_close(lg);
+    printf("flood: 45000 refused or queries and %lld good commands in 3 s: %lld good and %lld "
+           "others logged (%lld bytes of sample), %lld log_sampled events; log of %lld records\n",
+           (long long)good, (long long)in_good, (long long)in_other, (long long)in_bytes,
+           (long long)ev_sampled, (long long)f.records);
+    ENSURE(in_good == good && f.states == 351 && f.gaps == 0);
+    ENSURE(in_other == sampled && in_bytes == sampled_bytes);
+    ENSUREF(in_bytes <= 4 * RT_LOG_SAMPLE_BPS && in_bytes > 4 * RT_LOG_SAMPLE_BPS - 200,
+            "%lld bytes of sample (the bucket: 64 KiB + 3 s x 64 KiB/s)", (long long)in_bytes);
+    ENSURE(ev_sampled >= 3 && ev_sampled <= 5); /* at most one a second */
+    lagsimd_opts ro = g_opts;
+    ro.log = NULL;
+    ENSURE(lagsimd_replay(&g_sc, g_file, &ro) == 0);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -509,6 +589,7 @@ int main(int argc, char **argv)
     else if (!strcmp(g_case, "lockstep_stalled")) case_lockstep_stalled();
     else if (!strcmp(g_case, "full")) case_full();
     else if (!strcmp(g_case, "flood_in")) case_flood_in();
+    else if (!strcmp(g_case, "flood_refused")) case_flood_refused();
     else {
         fprintf(stderr, "unknown case %s\n", g_case);
         return 2;

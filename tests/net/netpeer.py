@@ -6,6 +6,9 @@
         publishes N commands (efforts E on the first actuated joint of the DIPC) and N
         STATUS requests on the plant's command URL (plant_urls(URL)), or with --raw on
         URL itself, S s apart
+    netpeer.py scene --types DIR --url URL --prefix P [--count N]
+        publishes N forged scenes of a DIPC on prefix P on URL itself (the state URL, where
+        plants announce themselves), 0.1 s apart
     netpeer.py summary --types DIR --prefix P LOG
         reads an LCM log (lcm-logger) and prints one JSON object: the states (one per step,
         duplicates counted), the events (kind, value, sim time), the last status, and
@@ -70,6 +73,26 @@ def cmd_send(a):
         time.sleep(a.interval)
     lc.close()
     print("sent %d commands and %d STATUS requests to %s" % (a.commands, a.controls, command_url))
+    return 0
+
+
+def cmd_scene(a):
+    lagsim, LCM, _ = load(a.types, a.clients)
+    lc = LCM(a.url)
+    for k in range(a.count):
+        s = lagsim.scene_t()
+        s.utime = int(time.time() * 1e6)
+        s.model, s.prefix = "dipc", a.prefix
+        s.num_params, s.param_name, s.param_value = 1, ["m0"], [1.5]
+        s.num_joints, s.joint_name = 3, ["theta0", "theta1", "theta2"]
+        s.actuated, s.initial_q, s.initial_qd = [True, False, False], [0.0] * 3, [0.0] * 3
+        s.dt, s.control_period, s.integrator, s.mode = 0.001, 0.01, "rk4", "realtime"
+        s.rate, s.command_timeout, s.effects = 1.0, 0.5, ""
+        s.limit_on, s.limit_lower, s.limit_upper = [False] * 3, [0.0] * 3, [0.0] * 3
+        lc.publish(a.prefix + "_SCENE", s.encode())
+        time.sleep(0.1)
+    lc.close()
+    print("sent %d forged scenes of prefix %s to %s" % (a.count, a.prefix, a.url))
     return 0
 
 
@@ -156,6 +179,11 @@ def main():
     s.add_argument("--effort", type=float, default=50.0)
     s.add_argument("--interval", type=float, default=0.05)
     s.add_argument("--raw", action="store_true", help="publish on URL, not its command URL")
+    f = sub.add_parser("scene")
+    f.add_argument("--types", required=True)
+    f.add_argument("--url", required=True)
+    f.add_argument("--prefix", required=True)
+    f.add_argument("--count", type=int, default=3)
     m = sub.add_parser("summary")
     m.add_argument("--types", required=True)
     m.add_argument("--prefix", required=True)
@@ -166,7 +194,8 @@ def main():
     c.add_argument("b")
     a = ap.parse_args()
     a.clients = clients
-    return {"send": cmd_send, "summary": cmd_summary, "compare": cmd_compare}[a.cmd](a)
+    return {"send": cmd_send, "scene": cmd_scene, "summary": cmd_summary,
+            "compare": cmd_compare}[a.cmd](a)
 
 
 if __name__ == "__main__":

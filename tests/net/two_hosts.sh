@@ -18,7 +18,8 @@
 #                         10 % lost each way and the commands cut for 1.5 s: the watchdog
 #                         trips and clears once each, its events say so, nothing non-finite
 #         two_daemons     a daemon in B on the prefix of a daemon in A (allow_lan, ttl=1)
-#                         refuses to start; with the host-local default both run
+#                         refuses to start; forged scenes from B: A runs on and says so;
+#                         with the host-local default both run, and B's scenes go unheard
 #
 # Loss: nftables, in each namespace an input chain that drops `numgen random mod 10 == 0`
 # of the datagrams to the two ports coming from the other one (by source address). Input,
@@ -258,6 +259,13 @@ case_two_daemons() {
         $([ $rc = 1 ] && grep -q "another plant publishes on prefix $prefix" "$work/b.err"; echo $?)
     kill -0 $a 2>/dev/null
     check "the daemon in A runs on" $?
+    # forged scenes of the prefix from B while A runs: counted and said, A runs on
+    $inB $netpeer scene --types "$types" --url "$url" --prefix $prefix --count 3
+    sleep 0.5
+    kill -0 $a 2>/dev/null
+    check "the daemon in A runs on after 3 forged scenes from B" $?
+    grep "another plant publishes on prefix $prefix" "$work/a.err"
+    check "... and says so (plant_conflict)" $(grep -q "running on" "$work/a.err"; echo $?)
     kill -TERM $a; wait $a
     check "the daemon in A stopped cleanly" $?
     # the default on both: each plant on its own host, no conflict
@@ -268,6 +276,10 @@ case_two_daemons() {
         -q --duration 1 2>"$work/b2.err"
     rc=$?
     check "with the host-local default, the same prefix on another host runs (exit $rc)" $([ $rc = 0 ]; echo $?)
+    $inB $netpeer scene --types "$types" --url "udpm://239.255.76.67:7667?ttl=1" --prefix $prefix --count 3
+    sleep 0.5
+    check "with the host-local default, forged scenes from B are not heard" \
+        $(! grep -q "another plant publishes" "$work/a2.err"; echo $?)
     kill -TERM $a; wait $a
 }
 

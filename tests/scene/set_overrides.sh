@@ -108,5 +108,13 @@ e --expect "$cfg/dipc.yaml:$m0line:3: unknown parameter 'm0' for model stick" --
 e --expect "$cfg/dipc.yaml:$qline:6: initial.q: expected a sequence of 2 numbers (x, phi) for model stick, got 3" \
   -- --set model=stick --set "parameters={m: 1}"
 e --expect "--set initial.q.x: cannot set a key inside 'initial.q', which is a sequence at $cfg/dipc.yaml:$qline:6" -- --set initial.q.x=1
+e --expect "--set initial.x.y: cannot set a key inside 'initial.x': it was set to a scalar by initial.x=..., not a mapping (set 'initial.x' to a mapping, e.g. initial.x={}, first)" -- --set initial.x=5 --set initial.x.y=1
+# nothing (null) below a key is an empty mapping: a key set inside it starts one
+if "$lagsimd" -q --config "$cfg/dipc.yaml" --offline --duration 0 --set effects=null \
+       --set effects.damping.theta1=0.1 >/dev/null; then
+    ok "effects=null, then effects.damping.theta1"
+else
+    bad "effects=null, then effects.damping.theta1: refused"
+fi
 exit $fail
 

@@ -9,7 +9,8 @@
  *     CASE: control hostile watchdog lockstep_timeout two_daemons fault replay
  *           replay_dopri5 replay_effects replay_flight sigterm bad_scene effects control_flood
  *           step_flood lockstep_huge status_rate rate_huge long_period duration_huge
- *           signals effort_absurd ttl_warning offline_signal same_prefix
+ *           signals effort_absurd ttl_warning offline_signal same_prefix plant_conflict
+ *           plant_conflict_logplayer
  *
  * Expected states are computed independently of the daemon's loop: a lag_sim of the same
  * scene (loaded with lag_scene_load, as the daemon does) advanced from the published state
@@ -147,7 +148,7 @@ typedef struct client {
     /* status */
     int64_t n_status;
     lag_wire_status *status;        /* NULL until the first, then &status_buf */
-    lag_wire_status status_buf;
+    lag_wire_status status_buf, status_live;
     /* events */
     int n_events;
     char ev_kind[MAX_EVENTS][32];
@@ -165,6 +166,9 @@ typedef struct client {
     int64_t tpp, prev_step, missing;
     /* messages on the state URL that are not this plant's output (".*" subscription) */
     int64_t foreign_on_state_url;
+    /* messages with a utime before this (us; 0: none) are not the live plant's: a log played
+     * back onto the bus (plant_conflict_logplayer); counted, not kept */
+    int64_t min_utime, n_old;
     /* lockstep controller (replay case): answers each state, records it */
     bool controller;
     int n_rec;
@@ -181,6 +185,10 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *u)
     const lag_wire_joint_state *m = &mm;
     int rc = lag_wire_decode_joint_state(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &mm);
     ENSUREF(rc == LAG_WIRE_OK, "a state from the daemon: %s", lag_wire_result_string(rc));
+    if (m->utime < c->min_utime) {
+        c->n_old++;
+        return;
+    }
     c->n_states++;
     rec_state r = {.step = m->step, .t = m->sim_time};
     for (int i = 0; i < m->num_joints && i < LAG_MAX_DOF; i++) {
@@ -222,6 +230,12 @@ static void on_status(const lcm_recv_buf_t *rb, const char *ch, void *u)
     client *c = u;
     int rc = lag_wire_decode_status(rb->data, rb->data_size, &c->status_buf);
     ENSUREF(rc == LAG_WIRE_OK, "a status from the daemon: %s", lag_wire_result_string(rc));
+    if (c->status_buf.utime < c->min_utime) { /* an old one played back: the live one again */
+        c->n_old++;
+        c->status_buf = c->status_live;
+        return;
+    }
+    c->status_live = c->status_buf;
     const lag_wire_status *m = c->status = &c->status_buf;
     c->n_status++;
     if (!isfinite(m->sim_time) || !isfinite(m->rtf) || !isfinite(m->energy)) c->nonfinite_seen = true;
@@ -235,6 +249,10 @@ static void on_event(const lcm_recv_buf_t *rb, const char *ch, void *u)
     const lag_wire_event *m = &mm;
     int rc = lag_wire_decode_event(rb->data, rb->data_size, &mm);
     ENSUREF(rc == LAG_WIRE_OK, "an event from the daemon: %s", lag_wire_result_string(rc));
+    if (m->utime < c->min_utime) {
+        c->n_old++;
+        return;
+    }
     if (!isfinite(m->sim_time) || !isfinite(m->value)) c->nonfinite_seen = true;
     c->n_events_total++;
     if (c->n_events < MAX_EVENTS) {
@@ -1597,6 +1615,156 @@ static void case_same_prefix(void)
     ENSURE(reap(a, 5.0) == 0);
 }
 
+static int64_t wall_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
+/* Reads a file whole into text[cap] (NUL-terminated). */
+static void slurp(const char *path, char *text, size_t cap)
+{
+    FILE *f = fopen(path, "r");
+    ENSURE(f);
+    size_t n = fread(text, 1, cap - 1, f);
+    fclose(f);
+    text[n] = '\0';
+}
+
+/* A forged scene on a running plant's prefix (any local process can send one): the plant
+ * runs on, its states continue, the conflict is counted in status and said once (an
+ * event, a line on stderr even with -q); then a flood of 2000 forged scenes as fast as this
+ * process publishes: still running, still one event (one in 5 s), the count grows (the
+ * daemon's scene queue holds 16: what it drops is never seen); SIGTERM ends it, exit 0. */
+static void case_plant_conflict(void)
+{
+    write_scene(DIPC_MOVING);
+    static client c;
+    client_init(&c, g_prefix, 3);
+    char err_path[256];
+    snprintf(err_path, sizeof err_path, "/tmp/lagsim_server_test_%d_%s.err", (int)getpid(), g_case);
+    g_stderr_path = err_path;
+    pid_t d = start_daemon(g_prefix, "--set", "realtime.start=running", NULL);
+    g_stderr_path = NULL;
+    WAIT_FOR(&c, c.n_states > 10 && c.scene, 5.0);
+    /* the forgery: the plant's own scene with another utime */
+    lagsim_scene_t f;
+    memset(&f, 0, sizeof f);
+    char *pn[1] = {"m0"}, *jn[3] = {"theta0", "theta1", "theta2"};
+    double pv[1] = {1.5}, z[3] = {0, 0, 0};
+    int8_t act[3] = {1, 0, 0}, off[3] = {0, 0, 0};
+    f.utime = 1;
+    f.model = "dipc";
+    f.prefix = g_prefix;
+    f.num_params = 1;
+    f.param_name = pn;
+    f.param_value = pv;
+    f.num_joints = 3;
+    f.joint_name = jn;
+    f.actuated = act;
+    f.initial_q = f.initial_qd = z;
+    f.dt = 0.001;
+    f.control_period = 0.01;
+    f.integrator = "rk4";
+    f.mode = "realtime";
+    f.rate = 1;
+    f.command_timeout = 0.5;
+    f.effects = "";
+    f.limit_on = off;
+    f.limit_lower = f.limit_upper = z;
+    char ch_scene[96];
+    snprintf(ch_scene, sizeof ch_scene, "%s_SCENE", g_prefix);
+    lagsim_scene_t_publish(c.lcm_in, ch_scene, &f); /* on the command URL: not heard */
+    lagsim_scene_t_publish(c.lcm, ch_scene, &f);    /* on the state URL, where plants speak */
+    int64_t states = c.n_states;
+    WAIT_FOR(&c, count_events(&c, "plant_conflict") == 1, 5.0);
+    pump(&c, 1.0);
+    ENSUREF(c.n_states > states + 50, "%lld states in the second after the forged scene",
+            (long long)(c.n_states - states));
+    fresh_status(&c);
+    ENSUREF(c.status->plant_conflicts == 1, "status plant_conflicts %lld",
+            (long long)c.status->plant_conflicts);
+    ENSURE(count_events(&c, "stop") == 0 && strcmp(c.status->run_state, "running") == 0);
+    /* a flood */
+    states = c.n_states;
+    double t0 = now_s();
+    for (int k = 0; k < 2000; k++) {
+        f.utime = 2 + k;
+        lagsim_scene_t_publish(c.lcm, ch_scene, &f);
+        if (k % 20 == 19) lcm_handle_timeout(c.lcm, 20);
+    }
+    pump(&c, 0.5);
+    double took = now_s() - t0;
+    fresh_status(&c);
+    printf("flood of 2000 forged scenes in %.2f s: %lld counted, %d plant_conflict events, "
+           "%lld states meanwhile\n", took, (long long)c.status->plant_conflicts,
+           count_events(&c, "plant_conflict"), (long long)(c.n_states - states));
+    ENSURE(c.status->plant_conflicts > 1 && c.status->plant_conflicts <= 2001);
+    ENSUREF(count_events(&c, "plant_conflict") <= 1 + (int)(took / 5.0) + 1,
+            "%d plant_conflict events in %.1f s", count_events(&c, "plant_conflict"), took);
+    ENSURE(c.n_states > states + (int64_t)(took * 50));
+    ENSURE(count_events(&c, "stop") == 0 && !c.nonfinite_seen);
+    kill(d, SIGTERM);
+    ENSURE(reap(d, 5.0) == 0);
+    char text[8192];
+    slurp(err_path, text, sizeof text);
+    remove(err_path);
+    printf("stderr: %s", text);
+    ENSUREF(strstr(text, "another plant publishes on prefix") && strstr(text, "running on"),
+            "no line on stderr: '%s'", text);
+    const char *first = strstr(text, "running on"); /* one line per event that went out */
+    ENSUREF(!strstr(first + 1, "running on") || count_events(&c, "plant_conflict") > 1,
+            "more lines than events: '%s'", text);
+}
+
+/* lcm-logger records a plant's run; a second plant on the same prefix runs while
+ * lcm-logplayer plays that log onto the live bus (its old scene, states, statuses and
+ * events, byte for byte): the live plant runs on, and counts and reports the conflict.
+ * The live plant's messages are told from the played ones by their utime. */
+static void case_plant_conflict_logplayer(const char *logger)
+{
+    write_scene(DIPC_MOVING);
+    char log_path[256], chan[96];
+    snprintf(log_path, sizeof log_path, "/tmp/lagsim_server_test_%d_%s.lcm", (int)getpid(), g_case);
+    remove(log_path);
+    snprintf(chan, sizeof chan, "%s_.*", g_prefix);
+    char *largv[] = {(char *)logger, "-q", "-f", "-c", chan, log_path, NULL};
+    static client c;
+    client_init(&c, g_prefix, 3);
+    pid_t lg = spawn(largv, true);
+    usleep(500000); /* the logger subscribes */
+    pid_t a = start_daemon(g_prefix, "--set", "realtime.start=running", "--duration", "1", NULL);
+    ENSURE(reap(a, 10.0) == 0);
+    usleep(300000);
+    kill(lg, SIGINT);
+    ENSURE(reap(lg, 5.0) >= 0);
+    /* the live plant */
+    c.min_utime = wall_us();
+    c.n_events = 0;
+    pid_t b = start_daemon(g_prefix, "--set", "realtime.start=running", NULL);
+    WAIT_FOR(&c, c.n_states > 10, 5.0);
+    char *pargv[] = {"lcm-logplayer", "-s", "4", log_path, NULL};
+    pid_t pl = spawn(pargv, true);
+    ENSURE(reap(pl, 10.0) == 0);
+    pump(&c, 0.5);
+    int64_t states = c.n_states;
+    pump(&c, 0.5);
+    fresh_status(&c);
+    printf("played %lld old messages; live plant: %lld conflicts counted, %d plant_conflict "
+           "events, %lld states in the last 0.5 s\n", (long long)c.n_old,
+           (long long)c.status->plant_conflicts, count_events(&c, "plant_conflict"),
+           (long long)(c.n_states - states));
+    ENSURE(c.n_old > 50);                        /* the log was played onto the bus */
+    ENSURE(c.status->plant_conflicts >= 1);      /* its scene heard, counted */
+    ENSURE(count_events(&c, "plant_conflict") == 1);
+    ENSURE(count_events(&c, "stop") == 0 && strcmp(c.status->run_state, "running") == 0);
+    ENSURE(c.n_states > states + 20);            /* the live plant runs on */
+    kill(b, SIGTERM);
+    ENSURE(reap(b, 5.0) == 0);
+    remove(log_path);
+}
+
 /* An offline run stopped by SIGINT (or SIGTERM, SIGHUP) flushes the rows it computed,
  * whole, says where it stopped and exits 1. */
 static void case_offline_signal(void)
@@ -1683,6 +1851,9 @@ int main(int argc, char **argv)
     else if (!strcmp(g_case, "same_prefix")) case_same_prefix();
     else if (!strcmp(g_case, "offline_signal")) case_offline_signal();
     else if (!strcmp(g_case, "command_flood_ports")) case_command_flood_ports();
+    else if (!strcmp(g_case, "plant_conflict")) case_plant_conflict();
+    else if (!strcmp(g_case, "plant_conflict_logplayer"))
+        case_plant_conflict_logplayer(argc > 3 ? argv[3] : "lcm-logger");
     else {
         fprintf(stderr, "server_test: unknown case %s\n", g_case);
         return 2;

@@ -68,7 +68,7 @@ typedef struct outputs {
     double last_t;                    /* sim_time of the last state */
     int64_t last_step;
     double last_q[LAG_MAX_DOF];
-    int64_t status_controls_rejected, status_states, status_overrun_bursts;
+    int64_t status_controls_rejected, status_states, status_overrun_bursts, status_conflicts;
     char status_run[16];
     uint8_t scene_bytes[4096]; /* the last scene, as published */
     size_t scene_len;
@@ -225,6 +225,7 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         g_out.status_controls_rejected = m.controls_rejected;
         g_out.status_states = m.states_published;
         g_out.status_overrun_bursts = m.overrun_bursts;
+        g_out.status_conflicts = m.plant_conflicts;
         snprintf(g_out.status_run, sizeof g_out.status_run, "%.15s", m.run_state);
     } else if (!strcmp(sfx, "EVENT")) {
         lag_wire_event m;
@@ -1137,7 +1138,9 @@ static void case_lockstep_loss(void)
 /* One plant per prefix: the daemon's own scenes (at start, on DESCRIBE, after a reset)
  * come back on its _SCENE subscription and are known as its own, a copy included; junk,
  * a scene cut short and another prefix's scene are no plant's; a scene it did not send
- * (the same with another utime: another daemon's) stops it, and its stop event says why. */
+ * (the same with another utime: another daemon's, or a forgery) while running is a
+ * conflict: counted, in status, said at most once in 5 s, and the plant runs on (a flood
+ * of them too); at start it is what makes the daemon refuse to start. */
 static void case_other_plant(void)
 {
     scene(LAG_RT_REALTIME);
@@ -1167,16 +1170,120 @@ static void case_other_plant(void)
     run_until(g_srv.now + 100 * MS, 0);
     ENSURE(!g_srv.stop && g_srv.other_plant[0] == '\0');
     pfx[0] = 'T';
-    lcm_publish(g_lcm, "TL_SCENE", other, (unsigned)len);
+    /* another plant's scene (a forgery, an old log played back) while running: the plant
+     * runs on, its states continue, the conflict is counted, published in status and said
+     * by one plant_conflict event */
     int64_t states = g_out.state;
+    lcm_publish(g_lcm, "TL_SCENE", other, (unsigned)len);
     run_until(g_srv.now + 1 * SEC, 0);
-    ENSURE(g_srv.stop && g_srv.stop_reason == RT_STOP_OTHER_PLANT);
-    ENSUREF(g_out.state <= states + 1, "%lld states after the other plant's scene",
+    ENSURE(!g_srv.stop);
+    ENSUREF(g_out.state >= states + 99, "%lld states in the second after the other plant's scene",
             (long long)(g_out.state - states));
+    ENSURE(g_srv.plant_conflicts == 1 && g_out.status_conflicts == 1);
+    ENSUREF(n_events("plant_conflict") == 1 &&
+                strstr(last_detail("plant_conflict"), "another plant publishes on prefix TL") &&
+                strstr(last_detail("plant_conflict"), "model dipc") &&
+                strstr(last_detail("plant_conflict"), "running on"),
+            "plant_conflict: %lld, '%s'", (long long)n_events("plant_conflict"),
+            last_detail("plant_conflict"));
+    /* a flood: 3000 forged scenes over 6 s (one every 2 ms): every one counted, events at
+     * the bucket's pace (one in 5 s: the first above, one more at 5 s), the states go on */
+    states = g_out.state;
+    for (int k = 0; k < 3000; k++) {
+        lcm_publish(g_lcm, "TL_SCENE", other, (unsigned)len);
+        run_until(g_srv.now + 2 * MS, 0);
+    }
+    ENSURE(!g_srv.stop && g_srv.plant_conflicts == 3001);
+    ENSUREF(g_out.state >= states + 599, "%lld states in the 6 s of the flood",
+            (long long)(g_out.state - states));
+    ENSUREF(n_events("plant_conflict") == 2, "%lld plant_conflict events for 3001 scenes",
+            (long long)n_events("plant_conflict"));
+    ENSUREF(n_events("plant_conflict") + n_suppressed("plant_conflict") +
+                    g_srv.lim_event[RT_EV_PLANT_CONFLICT].suppressed == 3001,
+            "said %lld + suppressed %lld + pending %lld", (long long)n_events("plant_conflict"),
+            (long long)n_suppressed("plant_conflict"),
+            (long long)g_srv.lim_event[RT_EV_PLANT_CONFLICT].suppressed);
+    control(LAGSIM_CONTROL_T_STATUS, 0);
+    run_until(g_srv.now + 100 * MS, 0);
+    ENSURE(g_out.status_conflicts == 3001);
     stop_server();
-    ENSUREF(n_events("stop") == 1 && strstr(last_detail("stop"), "another plant publishes on prefix TL") &&
-                strstr(last_detail("stop"), "model dipc"),
+    ENSUREF(n_events("stop") == 1 && !strstr(last_detail("stop"), "another plant"),
             "stop event: '%s'", last_detail("stop"));
+    /* at start (before the daemon publishes: rt_bus_open's look) the same scene is noted,
+     * not counted, for rt_bus_open to refuse the start */
+    start();
+    g_srv.discard = true;
+    lcm_publish(g_lcm, "TL_SCENE", other, (unsigned)len);
+    drain();
+    ENSURE(g_srv.other_plant[0] != '\0' && g_srv.plant_conflicts == 0 && n_events("plant_conflict") == 0);
+    g_srv.discard = false;
+    stop_server();
+}
+
+/* What a refusal says: a null mapping set while running does not poison later sets
+ * below it (effects=null, then effects.damping.* is applied, the damping on); every count
+ * check names the expected count and the model (reset_to with 4 joints on the 3-joint
+ * DIPC, a command of 4 joints, step 0). */
+static void case_messages(void)
+{
+    static const char text[] =
+        "model: dipc\n"
+        "initial: {q: [0, 0.1, -0.05]}\n"
+        "realtime: {mode: fast, start: paused}\n"
+        "effects: {}\n"
+        "lcm: {prefix: TL}\n";
+    char err[1024];
+    ENSURE(lag_scene_load_buffer("msg.yaml", text, sizeof text - 1, NULL, 0, &g_sc, err, sizeof err) == 0);
+    memset(&g_opts, 0, sizeof g_opts);
+    g_opts.quiet = true;
+    g_opts.scene_name = "msg.yaml";
+    g_opts.scene_text = text;
+    g_opts.scene_len = sizeof text - 1;
+    start();
+    set_request("effects", "null");
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("set") == 1 && n_events("control_rejected") == 0, "effects=null: %lld sets, "
+            "rejected '%s'", (long long)n_events("set"), last_detail("control_rejected"));
+    set_request("effects.damping.theta1", "0.25");
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("set") == 2 && n_events("control_rejected") == 0,
+            "effects.damping.theta1 after effects=null: refused: '%s'", last_detail("control_rejected"));
+    ENSURE(g_srv.sim.def.effects.enabled & LAG_EFF_DAMPING);
+    ENSURE(g_srv.sim.def.effects.damping[1] == 0.25);
+
+    /* reset_to with 4 joints: names the model and its 3 joints */
+    lag_wire_control m;
+    memset(&m, 0, sizeof m);
+    m.request = LAGSIM_CONTROL_T_RESET_TO;
+    m.num_joints = 4;
+    uint8_t buf[LAG_WIRE_BUF_SIZE];
+    int n = lag_wire_encode_control(&m, buf, sizeof buf);
+    ENSURE(n > 0);
+    rt_handle_control(&g_srv, buf, (size_t)n);
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("control_rejected") == 1 &&
+                strstr(last_detail("control_rejected"), "4 joints given; model dipc has 3 "
+                       "(theta0, theta1, theta2)"),
+            "reset_to with 4 joints: '%s'", last_detail("control_rejected"));
+    /* a command of 4 joints */
+    lag_wire_joint_command jc;
+    memset(&jc, 0, sizeof jc);
+    jc.num_joints = 4;
+    for (int i = 0; i < 4; i++) snprintf(jc.name[i], sizeof jc.name[i], "theta%d", i);
+    n = lag_wire_encode(LAG_WIRE_JOINT_COMMAND, &jc, buf, sizeof buf);
+    ENSURE(n > 0);
+    rt_handle_command(&g_srv, buf, (size_t)n);
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("command_rejected") == 1 &&
+                strstr(last_detail("command_rejected"), "num_joints 4 in value: expected 0 to 3, "
+                       "the joints of model dipc (theta0, theta1, theta2)"),
+            "command with 4 joints: '%s'", last_detail("command_rejected"));
+    control(LAGSIM_CONTROL_T_STEP, 0);
+    run_until(g_srv.now + 10 * MS, 1000);
+    ENSUREF(n_events("control_rejected") == 2 &&
+                strstr(last_detail("control_rejected"), "step: count 0: expected 1 or more"),
+            "step 0: '%s'", last_detail("control_rejected"));
+    stop_server();
 }
 
 int main(int argc, char **argv)
@@ -1194,7 +1301,7 @@ int main(int argc, char **argv)
         {"command_flood", case_command_flood}, {"duration", case_duration},
         {"signals", case_signals},         {"fault_effort", case_fault_effort},
         {"lockstep_retry", case_lockstep_retry}, {"lockstep_loss", case_lockstep_loss},
-        {"other_plant", case_other_plant},
+        {"other_plant", case_other_plant}, {"messages", case_messages},
     };
     if (argc != 2) {
         fprintf(stderr, "usage: test_loop CASE\n");

@@ -269,6 +269,7 @@ static void check_agreement(void)
         g.commands_ignored = w.commands_ignored = 29;
         g.contact = "flight";
         strcpy(w.contact, "flight");
+        g.plant_conflicts = w.plant_conflicts = 30;
         int nt = lagsim_status_t_encode(theirs, 0, sizeof theirs, &g);
         agree(LAG_WIRE_STATUS, &w, nt);
     }

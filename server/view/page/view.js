@@ -400,6 +400,8 @@ function drawStatus() {
     rows.push(["numeric faults", String(s.numeric_faults), s.numeric_faults > 0]);
     rows.push(["energy", fmt(s.energy, 6) + " J"]);
     rows.push(["states published", String(s.states_published)]);
+    if (s.plant_conflicts > 0)
+      rows.push(["prefix conflict", `${s.plant_conflicts} scenes of another plant on this prefix (running on; one plant per prefix)`, true]);
   } else rows.push(["status", "none yet"]);
   const tb = $("status").tBodies[0];
   tb.textContent = "";
