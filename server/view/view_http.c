@@ -86,7 +86,6 @@ struct view_http {
     stream *streams;         /* every open stream, suspended or not */
     unsigned n_streams;
     int64_t last_wake_ns;
-    int64_t woken_state, woken_status, woken_scene, woken_event;
     conn *conns;             /* every open connection */
     int64_t last_check_ns;
     int64_t n_header_timeouts, n_stalled, n_frames_cut, n_bad_host;
@@ -664,22 +663,19 @@ void view_http_run(view_http *h)
 {
     view_bridge *vb = h->vb;
     int64_t now = view_mono_ns();
-    /* wake the suspended streams: when the snapshot changed (at most hz times a second)
-     * and, for keep-alives, every VIEW_KEEPALIVE_NS */
-    bool changed = h->woken_state != vb->state_seq || h->woken_status != vb->status_seq ||
-                   h->woken_scene != vb->scene_seq || h->woken_event != vb->event_seq;
-    if ((changed && now - h->last_wake_ns >= h->frame_ns) ||
-        now - h->last_wake_ns >= VIEW_KEEPALIVE_NS) {
-        h->last_wake_ns = now;
-        h->woken_state = vb->state_seq;
-        h->woken_status = vb->status_seq;
-        h->woken_scene = vb->scene_seq;
-        h->woken_event = vb->event_seq;
-        for (stream *s = h->streams; s; s = s->next)
-            if (s->suspended) {
-                s->suspended = false;
-                MHD_resume_connection(s->conn);
-            }
+    /* wake a suspended stream when it is behind the snapshot (something changed, or a
+     * backlog of events remains) and its next frame is due, and every VIEW_KEEPALIVE_NS
+     * for a keep-alive */
+    bool keepalive = now - h->last_wake_ns >= VIEW_KEEPALIVE_NS;
+    if (keepalive) h->last_wake_ns = now;
+    for (stream *s = h->streams; s; s = s->next) {
+        if (!s->suspended) continue;
+        bool behind = s->state_seq != vb->state_seq || s->status_seq != vb->status_seq ||
+                      s->scene_seq != vb->scene_seq || s->event_seq != vb->event_seq;
+        if (keepalive || (behind && now >= s->next_frame_ns)) {
+            s->suspended = false;
+            MHD_resume_connection(s->conn);
+        }
     }
     if (now - h->last_check_ns >= VIEW_CHECK_NS) {
         h->last_check_ns = now;
