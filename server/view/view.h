@@ -142,6 +142,19 @@ unsigned view_http_streams(const view_http *h);
 /* Stops: resumes every stream first (libmicrohttpd requires it), then closes. */
 void view_http_stop(view_http *h);
 
+/* What one stream has been sent. */
+typedef struct view_cursor {
+    int64_t state_seq, status_seq, scene_seq, event_seq;
+    bool hello_sent;
+} view_cursor;
+/* A stream's next frame into buf[cap]: what is new since the cursor (which it advances),
+ * each of scene, state and status whole or left for the next frame, the events that fit
+ * (oldest first, at most VIEW_EVENTS_PER_FRAME). A part too big for an empty frame (the
+ * budgets rule it out) is sent as {"truncated":true} and counted in *cut, so that a stream
+ * never sticks. Returns the length (0: nothing new). */
+size_t view_frame(const view_bridge *vb, unsigned hz, view_cursor *c, char *buf, size_t cap,
+                  int64_t *cut);
+
 /* The snapshot as JSON (GET /api/state). A part that does not fit is null (counted in
  * parts_omitted); the newest events that fit are kept (the others counted in
  * events_omitted). Returns the length, 0 only if cap cannot hold the bridge's counters. */

@@ -71,8 +71,7 @@ typedef struct stream {
     bool suspended;
     int64_t next_frame_ns;   /* not before */
     int64_t last_write_ns;
-    int64_t state_seq, status_seq, scene_seq, event_seq; /* sent so far */
-    bool hello_sent;
+    view_cursor cur;         /* what it has been sent */
     size_t len, off;
     char buf[VIEW_STREAM_BUF];
 } stream;
@@ -141,7 +140,7 @@ static void stream_unlink(view_http *h, stream *s)
 /* A part that did not fit: it waits for the next frame, unless it was alone in this one
  * (it never fits, which the budgets rule out): then it is replaced by {"truncated":true}
  * and counted, so that the stream goes on. */
-static void part_too_big(view_http *h, jbuf *b, size_t keep, const char *name, int64_t *seq,
+static void part_too_big(int64_t *cut, jbuf *b, size_t keep, const char *name, int64_t *seq,
                          int64_t now_seq)
 {
     b->len = keep;
@@ -149,21 +148,19 @@ static void part_too_big(view_http *h, jbuf *b, size_t keep, const char *name, i
     if (keep != 0) return;
     jb_fmt(b, "event: %s\ndata: {\"truncated\":true}\n\n", name);
     *seq = now_seq;
-    h->n_frames_cut++;
+    (*cut)++;
 }
 
-/* Builds the next frame from what is new since the last one. Returns its length (0:
- * nothing to send). */
-static size_t build_frame(view_http *h, stream *s, int64_t now)
+size_t view_frame(const view_bridge *vb, unsigned hz, view_cursor *s, char *buf, size_t cap,
+                  int64_t *cut)
 {
-    view_bridge *vb = h->vb;
     jbuf b;
-    jb_init(&b, s->buf, sizeof s->buf);
+    jb_init(&b, buf, cap);
     size_t keep;
     if (!s->hello_sent) {
         jb_fmt(&b, "retry: 1000\nevent: bridge\ndata: {\"prefix\":");
         jb_str(&b, vb->prefix);
-        jb_fmt(&b, ",\"hz\":%u}\n\n", h->o.hz);
+        jb_fmt(&b, ",\"hz\":%u}\n\n", hz);
         s->hello_sent = true;
     }
     /* each part whole or not at all: a part that does not fit waits for the next frame */
@@ -172,7 +169,7 @@ static size_t build_frame(view_http *h, stream *s, int64_t now)
         jb_raw(&b, "event: scene\ndata: ");
         view_json_scene(&b, &vb->scene);
         jb_raw(&b, "\n\n");
-        if (b.overflow) part_too_big(h, &b, keep, "scene", &s->scene_seq, vb->scene_seq);
+        if (b.overflow) part_too_big(cut, &b, keep, "scene", &s->scene_seq, vb->scene_seq);
         else s->scene_seq = vb->scene_seq;
     }
     if (s->state_seq != vb->state_seq) {
@@ -180,7 +177,7 @@ static size_t build_frame(view_http *h, stream *s, int64_t now)
         jb_raw(&b, "event: state\ndata: ");
         view_json_state(&b, &vb->state);
         jb_raw(&b, "\n\n");
-        if (b.overflow) part_too_big(h, &b, keep, "state", &s->state_seq, vb->state_seq);
+        if (b.overflow) part_too_big(cut, &b, keep, "state", &s->state_seq, vb->state_seq);
         else s->state_seq = vb->state_seq;
     }
     if (s->status_seq != vb->status_seq) {
@@ -188,7 +185,7 @@ static size_t build_frame(view_http *h, stream *s, int64_t now)
         jb_raw(&b, "event: status\ndata: ");
         view_json_status(&b, &vb->status);
         jb_raw(&b, "\n\n");
-        if (b.overflow) part_too_big(h, &b, keep, "status", &s->status_seq, vb->status_seq);
+        if (b.overflow) part_too_big(cut, &b, keep, "status", &s->status_seq, vb->status_seq);
         else s->status_seq = vb->status_seq;
     }
     if (s->event_seq != vb->event_seq) {
@@ -214,11 +211,10 @@ static size_t build_frame(view_http *h, stream *s, int64_t now)
             jb_fmt(&b, "event: events\ndata: {\"missed\":%lld,\"events\":[]}\n\n",
                    (long long)(missed + 1));
             s->event_seq = first;
-            h->n_frames_cut++;
+            (*cut)++;
         }
     }
-    if (b.len == 0 && now - s->last_write_ns >= VIEW_KEEPALIVE_NS) jb_raw(&b, ": keep-alive\n\n");
-    return b.len;
+    return b.overflow ? 0 : b.len;
 }
 
 /* libmicrohttpd asks for the next bytes of a stream. */
@@ -231,7 +227,11 @@ static ssize_t stream_read(void *cls, uint64_t pos, char *buf, size_t max)
     if (s->off >= s->len) {
         s->len = s->off = 0;
         if (now >= s->next_frame_ns) {
-            s->len = build_frame(h, s, now);
+            s->len = view_frame(h->vb, h->o.hz, &s->cur, s->buf, sizeof s->buf, &h->n_frames_cut);
+            if (s->len == 0 && now - s->last_write_ns >= VIEW_KEEPALIVE_NS) {
+                memcpy(s->buf, ": keep-alive\n\n", 15);
+                s->len = 15;
+            }
             if (s->len) s->next_frame_ns = now + h->frame_ns;
         }
         if (s->len == 0) {
@@ -670,8 +670,8 @@ void view_http_run(view_http *h)
     if (keepalive) h->last_wake_ns = now;
     for (stream *s = h->streams; s; s = s->next) {
         if (!s->suspended) continue;
-        bool behind = s->state_seq != vb->state_seq || s->status_seq != vb->status_seq ||
-                      s->scene_seq != vb->scene_seq || s->event_seq != vb->event_seq;
+        bool behind = s->cur.state_seq != vb->state_seq || s->cur.status_seq != vb->status_seq ||
+                      s->cur.scene_seq != vb->scene_seq || s->cur.event_seq != vb->event_seq;
         if (keepalive || (behind && now >= s->next_frame_ns)) {
             s->suspended = false;
             MHD_resume_connection(s->conn);
