@@ -58,7 +58,8 @@ file(GLOB _lcm ${PROJECT_SOURCE_DIR}/lcmtypes/*.lcm)
 install(FILES ${_lcm} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/lcmtypes)
 file(GLOB _cfg ${PROJECT_SOURCE_DIR}/config/*.yaml)
 install(FILES ${_cfg} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/config)
-install(FILES ${PROJECT_SOURCE_DIR}/docs/man/lagsimd.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+file(GLOB _man ${PROJECT_SOURCE_DIR}/docs/man/*.1)
+install(FILES ${_man} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
 
 # Python: types and helpers in the site directory, examples in share/lagsim/examples.
 find_program(LAGSIM_PYTHON3 python3)

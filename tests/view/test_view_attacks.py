@@ -622,8 +622,14 @@ def case_lan(a):
 
 
 def helper_send(a):
-    types = load_types(a.types)
-    send_forged(a.port, a.prefix, forged_messages(types, a.count)[3:], ttl=1)
+    """Plain events (the case counts them; their text is not the point), ttl=1."""
+    event_t = load_types(a.types)[0]
+    msgs = []
+    for i in range(a.count):
+        e = event_t()
+        e.kind, e.joint, e.detail, e.step = "forged", "theta0", "from %s" % socket.gethostname(), i
+        msgs.append(("EVENT", e.encode()))
+    send_forged(a.port, a.prefix, msgs, ttl=1)
 
 
 def helper_get(a):
