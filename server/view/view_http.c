@@ -9,19 +9,22 @@
  *                                 "events" (an array), "bridge" frames
  *   POST /api/control?request=pause|resume|step|reset[&count=N]   (header X-Lagsim: 1)
  *
- * Bounds: libmicrohttpd caps connections (all and per address), the memory of one
- * request (headers), and idle time (5 s; 20 s for a stream that accepts no bytes). A
- * flood that holds every connection slot (slowloris) delays new clients until its
- * connections close or idle out; it cannot make the bridge use more than the caps. A stream owns one VIEW_STREAM_BUF buffer; when it
- * has sent its frame it builds the next one from the newest snapshot, at most `hz` times
- * a second, or, when there is nothing new or it is too early, suspends itself: the loop
- * resumes it when the snapshot changes (and every few seconds for a keep-alive comment,
- * which is also how a vanished client is found out). A client that stops reading keeps
- * its one frame, no more, until the idle timeout closes it.
+ * Bounds: libmicrohttpd caps connections (all, and an eighth of them per address), the
+ * memory of one request (headers), and idle time (5 s); the bridge adds deadlines
+ * (headers complete within 3 s, a request that is not a stream done within 30 s), so a
+ * slowloris from one address holds at most its share, and each of those for 3 s. A
+ * stream owns one VIEW_STREAM_BUF buffer; when it has sent its frame it builds the next
+ * one from the newest snapshot (view_frame), at most `hz` times a second, or, when there
+ * is nothing new or it is too early, suspends itself: the loop resumes it when it is
+ * behind the snapshot and due (and every few seconds for a keep-alive comment, which is
+ * also how a vanished client is found out). A client that stops reading keeps its one
+ * frame and a 32 kB socket send buffer, no more, until its TCP has acknowledged nothing
+ * for 20 s while bytes wait for it (check_connections): then it is dropped.
  *
- * Requests from other web pages: on loopback the Host header must name the bridge (a
- * rebound DNS name does not); a control request needs the X-Lagsim header, which a page
- * of another origin cannot send without a preflight the bridge never grants.
+ * Requests from other web pages: the Host header must be one and name the bridge (an
+ * allow-list from --listen and --allow-host: a rebound DNS name is not on it); a control
+ * request needs the X-Lagsim header, which a page of another origin cannot send without a
+ * preflight the bridge never grants.
  */
 #include <arpa/inet.h>
 #include <ctype.h>

@@ -357,7 +357,7 @@ size_t view_json_snapshot(const view_bridge *vb, const view_http *h, char *out, 
     int64_t omitted = 0;
     if (!b.overflow) {
         static char tmp[VIEW_STREAM_BUF]; /* one thread */
-        size_t room = b.cap - b.len, need = 64; /* the keys, brackets and counts around them */
+        size_t room = b.cap - b.len, need = 96; /* the keys, brackets and counts after them */
         for (int64_t q = vb->event_seq; q >= first; q--) {
             jbuf t;
             jb_init(&t, tmp, sizeof tmp);
@@ -373,7 +373,7 @@ size_t view_json_snapshot(const view_bridge *vb, const view_http *h, char *out, 
     jb_key(&b, "events", false);
     jb_raw(&b, "[");
     int64_t sent;
-    view_json_events(&b, vb, first, vb->event_seq, 48, &sent);
+    view_json_events(&b, vb, first, vb->event_seq, 96, &sent); /* the tail: < 70 bytes */
     jb_raw(&b, "]");
     jb_int(&b, "events_omitted", omitted + (vb->event_seq - sent));
     jb_int(&b, "parts_omitted", cut);
