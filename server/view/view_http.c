@@ -576,7 +576,15 @@ static void hosts_build(view_http *h, int family, const void *addr, bool wildcar
             host_add(h, name);
         }
     }
-    for (int i = 0; i < h->o.n_allow_hosts; i++) host_add(h, h->o.allow_hosts[i]);
+    for (int i = 0; i < h->o.n_allow_hosts; i++) {
+        const char *n = h->o.allow_hosts[i];
+        char v6[VIEW_HOST_LEN];
+        if (strchr(n, ':') && n[0] != '[' && strlen(n) + 2 < sizeof v6) { /* an IPv6 literal */
+            snprintf(v6, sizeof v6, "[%s]", n);
+            n = v6;
+        }
+        host_add(h, n);
+    }
 }
 
 /* ---------------------------------------------------------------- lifecycle */

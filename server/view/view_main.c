@@ -123,7 +123,8 @@ int main(int argc, char **argv)
                      (optarg[i] >= '0' && optarg[i] <= '9') || strchr("-._[]:", optarg[i]);
             if (!ok) {
                 fprintf(stderr, "lagsim-view: --allow-host: expected a host name or address "
-                        "(letters, digits, '-', '.', '_', IPv6 in [ ]; at most 16 of them), "
+                        "without a port (letters, digits, '-', '.', '_', an IPv6 address; at "
+                        "most 16 of them), "
                         "got '%s'\n", optarg);
                 return 2;
             }

@@ -541,12 +541,16 @@ def case_host(a):
         check(st.startswith(b"HTTP/1.1 200"), "a request to the printed address is answered: %s" % st.decode())
     finally:
         v.close()
-    v = View(a, prefix, ["--listen", "0.0.0.0", "--allow-host", "view.lab.example", *lurl])
+    r = subprocess.run([a.view, "--allow-host", "evil.example/x"], capture_output=True, text=True)
+    check(r.returncode == 2 and "--allow-host" in r.stderr, "--allow-host with a '/': usage error, exit 2")
+    v = View(a, prefix, ["--listen", "0.0.0.0", "--allow-host", "view.lab.example",
+                         "--allow-host", "fd00::99", *lurl])
     chrome = None
     try:
         for host, want in ((b"127.0.0.1", b"200"), (b"localhost", b"200"), (b"evil.example", b"421"),
                            (b"view.lab.example", b"200"), (b"View.Lab.Example.", b"200"),
-                           (b"view.lab.example.evil.example", b"421"), (b"0.0.0.0", b"200")):
+                           (b"view.lab.example.evil.example", b"421"), (b"0.0.0.0", b"200"),
+                           (b"[fd00::99]", b"200"), (b"[fd00::98]", b"421")):
             r = raw(v.port, b"GET /api/state HTTP/1.1\r\nHost: %s:%d\r\nConnection: close\r\n\r\n" % (host, v.port))
             check(r[9:12] == want, "--listen 0.0.0.0: Host %s -> %s (%r)" % (host.decode(), want.decode(), r[:12]))
         # a tab on an attacker's site whose name now resolves to this host (DNS rebinding)
