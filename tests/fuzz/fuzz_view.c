@@ -339,10 +339,12 @@ static void check_http(const uint8_t *d, size_t n)
     fcntl(fd, F_SETFL, O_NONBLOCK);
     size_t off = 0;
     char sink[65536];
-    for (int k = 0; k < 400; k++) {
+    /* until the bridge closes, or nothing moves for 20 rounds (a stream stays open) */
+    for (int k = 0, quiet = 0; k < 400 && quiet < 20; k++) {
+        bool moved = false;
         if (off < len) {
             ssize_t w = send(fd, req + off, len - off, MSG_NOSIGNAL);
-            if (w > 0) off += (size_t)w;
+            if (w > 0) off += (size_t)w, moved = true;
             else if (errno != EAGAIN) break;
             if (off == len) shutdown(fd, SHUT_WR);
         } else if (len == 0 && k == 0) {
@@ -351,6 +353,8 @@ static void check_http(const uint8_t *d, size_t n)
         run_once(1);
         ssize_t r = recv(fd, sink, sizeof sink, 0);
         if (r == 0 || (r < 0 && errno != EAGAIN)) break;
+        if (r > 0) moved = true;
+        quiet = moved ? 0 : quiet + 1;
     }
     close(fd);
     for (int k = 0; k < 20 && view_http_streams(http); k++) run_once(5);
