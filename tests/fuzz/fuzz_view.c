@@ -244,15 +244,17 @@ static void fill(src *s)
     su->rtf = num(s);
     vb.status_seq = byte(s) & 1;
     int n = 1 + (int)((byte(s) << 8 | byte(s)) % 300);
+    int whole = 0; /* the last event made of the input's bytes alone */
     for (int q = 1; q <= n; q++) {
         lag_wire_event *e = &vb.events[q % VIEW_EVENTS].ev;
-        if (s->n) { /* while bytes last; then the last one again */
+        if (s->n) { /* while bytes last; then copies of the last whole one */
             text(s, e->kind, sizeof e->kind);
             text(s, e->joint, sizeof e->joint);
             text(s, e->detail, sizeof e->detail);
             e->value = num(s);
-        } else {
-            *e = vb.events[(q - 1) % VIEW_EVENTS].ev;
+            if (s->n) whole = q;
+        } else if (whole) {
+            *e = vb.events[whole % VIEW_EVENTS].ev;
         }
     }
     vb.event_seq = n;
