@@ -2,6 +2,8 @@
 # Python encoder and against hostile logs; lagsim-plot; the log reader's fuzz target;
 # lagsim-view opened in headless Chromium beside a running lagsimd, and attacked.
 lagsim_fuzz_target(log2csv LIBS lagsim_log2csv)
+# lagsim-view's JSON and server-sent events from hostile text, its HTTP side, its Host check
+lagsim_fuzz_target(view LIBS lagsim_view_internal)
 
 find_program(LAGSIM_VIEW_PYTHON3 python3)
 if(LAGSIM_VIEW_PYTHON3)
@@ -30,5 +32,23 @@ if(LAGSIM_VIEW_PYTHON3)
   set_tests_properties(view_browser view_hostile view_stick_flight view_cartpole PROPERTIES TIMEOUT 180 LABELS view)
   if(NOT LAGSIM_CHROMIUM)
     set_tests_properties(view_browser view_stick_flight view_cartpole PROPERTIES ENVIRONMENT "PATH=/nonexistent")
+  endif()
+endif()
+
+# lagsim-view attacked by one local process, one LAN host and one browser tab
+# (tests/view/test_view_attacks.py): forged text at the wire's worst, streams that never
+# read, a slowloris, Host headers, other hosts' datagrams (network namespaces: root, else
+# skipped). Each starts its own lagsim-view on ports of its own.
+if(LAGSIM_VIEW_PYTHON3)
+  set(view_attacks ${LAGSIM_VIEW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/view/test_view_attacks.py
+      --view $<TARGET_FILE:lagsim-view> --lagsimd $<TARGET_FILE:lagsimd>
+      --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml --types ${CMAKE_BINARY_DIR}/python)
+  foreach(case forged stalled slowloris host lan)
+    add_test(NAME view_attack_${case} COMMAND ${view_attacks} ${case})
+    set_tests_properties(view_attack_${case} PROPERTIES TIMEOUT 180 LABELS view SKIP_RETURN_CODE 77)
+  endforeach()
+  if(NOT LAGSIM_CHROMIUM)
+    set_tests_properties(view_attack_forged view_attack_stalled view_attack_host PROPERTIES
+                         ENVIRONMENT "PATH=/nonexistent")
   endif()
 endif()

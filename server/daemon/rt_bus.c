@@ -4,7 +4,7 @@
  *                 opens a receive socket for it and the daemon never reads back its own
  *                 states (in fast mode, tens of thousands a second);
  *   s->lcm_in     the command URL: _COMMAND and _CONTROL. Its receive socket gets a
- *                 filter (rt_net.h): only this plant's two channels, and unless
+ *                 filter (lagsim_net.h): only this plant's two channels, and unless
  *                 lcm.allow_lan only datagrams sent from this host;
  * For memq:// (tests, one process) one lcm_t is both.
  *
@@ -19,7 +19,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "rt_net.h"
+#include "lagsim_net.h"
 #include "rt_server.h"
 #include "lagsim/lagsim_control_t.h"
 
@@ -30,9 +30,9 @@ static int filter_input(rt_server *s, char *err, size_t errlen)
 {
     const lag_bus *b = &s->bus;
     bool host_only = !s->sc->lcm.allow_lan;
-    const char *with_marker[] = {s->ch_command, s->ch_control, RT_NET_MARKER_CHANNEL};
+    const char *with_marker[] = {s->ch_command, s->ch_control, LAG_NET_MARKER_CHANNEL};
     char ferr[256];
-    int n = rt_net_filter(b->command_port, host_only, with_marker, 3, ferr, sizeof ferr);
+    int n = lag_net_filter(b->command_port, host_only, with_marker, 3, ferr, sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s%s: cannot restrict the command URL %s to %s", n < 0 ? ferr :
                  "LCM's receive socket for the command port was not found",
@@ -40,12 +40,12 @@ static int filter_input(rt_server *s, char *err, size_t errlen)
                  host_only ? "this host (lcm.allow_lan: false)" : "this plant's channels");
         return LAGSIMD_EXIT_RUNTIME;
     }
-    if (rt_net_sync(s->lcm_in, 3000) != 0) {
+    if (lag_net_sync(s->lcm_in, 3000) != 0) {
         snprintf(err, errlen, "LCM on %s does not hear its own messages (is there a multicast "
                  "route? docs/network.md)", b->command_url);
         return LAGSIMD_EXIT_RUNTIME;
     }
-    n = rt_net_filter(b->command_port, host_only, with_marker, 2, ferr, sizeof ferr);
+    n = lag_net_filter(b->command_port, host_only, with_marker, 2, ferr, sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s", n < 0 ? ferr : "LCM's receive socket went away");
         return LAGSIMD_EXIT_RUNTIME;
@@ -65,7 +65,7 @@ static int look_for_other_plant(rt_server *s, char *err, size_t errlen)
     bool host_only = !s->sc->lcm.allow_lan;
     const char *out[] = {s->ch_scene};
     char ferr[256];
-    int n = rt_net_filter(b->state_port, host_only, out, 1, ferr, sizeof ferr);
+    int n = lag_net_filter(b->state_port, host_only, out, 1, ferr, sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s: cannot filter the state URL %s for the plant watch",
                  n < 0 ? ferr : "LCM's receive socket for the state port was not found",
@@ -93,7 +93,7 @@ static int look_for_other_plant(rt_server *s, char *err, size_t errlen)
 int rt_bus_open(rt_server *s, char *err, size_t errlen)
 {
     const lag_bus *b = &s->bus;
-    rt_net_note_inherited(); /* a parent's sockets are not filtered */
+    lag_net_note_inherited(); /* a parent's sockets are not filtered */
     lcm_t *out = lcm_create(b->state_url);
     lcm_t *in = !b->udpm ? out : out ? lcm_create(b->command_url) : NULL;
     if (!out || !in) {
@@ -122,7 +122,7 @@ int rt_bus_open(rt_server *s, char *err, size_t errlen)
     }
     /* where the daemon listens, and who can reach it */
     char ifname[64];
-    if (rt_net_group_iface(b->group, ifname, sizeof ifname) != 0)
+    if (lag_net_group_iface(b->group, ifname, sizeof ifname) != 0)
         snprintf(ifname, sizeof ifname, "no interface (no route to %s)", b->group);
     int ttl = s->sc->lcm.ttl; /* the loader's reading of the URL (LCM_DEFAULT_URL included) */
     if (ttl > 0)

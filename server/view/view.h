@@ -26,6 +26,12 @@
 #define VIEW_STREAM_BUF 32768      /* one stream's frame buffer */
 #define VIEW_CONTROLS_PER_S 10     /* control requests forwarded per second at most */
 #define VIEW_CHANNEL_MAX 96
+/* Budgets for text off the bus, in bytes of JSON (escapes included): a name (63 bytes on
+ * the wire) or a detail (255) that needs more is cut and ends in "…[truncated N bytes]"
+ * (N: the bytes of the original left out). Twice the wire's length: text as the daemon
+ * writes it is never cut; only escapes (6 bytes for one control byte) can need more. */
+#define VIEW_JSON_NAME_MAX (2 * LAG_WIRE_NAME_LEN)
+#define VIEW_JSON_TEXT_MAX (2 * LAG_WIRE_TEXT_LEN)
 
 /* ---------------------------------------------------------------- JSON (view_json.c) */
 /* A bounded JSON builder: everything appended past cap is dropped and `overflow` set,
@@ -40,7 +46,9 @@ void jb_init(jbuf *b, char *mem, size_t cap);
 void jb_raw(jbuf *b, const char *s);
 void jb_fmt(jbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* A JSON string from bytes off the bus: quotes, backslashes and control characters
- * escaped, invalid UTF-8 replaced by U+FFFD. */
+ * escaped, invalid UTF-8 replaced by U+FFFD, at most `budget` bytes between the quotes
+ * (cut with the marker above when it needs more). jb_str: VIEW_JSON_NAME_MAX. */
+void jb_str_max(jbuf *b, const char *s, size_t budget);
 void jb_str(jbuf *b, const char *s);
 /* A number, or null when it is not finite (JSON has no NaN). */
 void jb_num(jbuf *b, double x);
@@ -76,6 +84,7 @@ typedef struct view_bridge {
     int64_t event_seq;              /* of the newest */
     int64_t last_msg_ns;            /* CLOCK_MONOTONIC of the last decoded message */
     int64_t last_describe_ns;       /* when a DESCRIBE was last sent */
+    bool discard;                   /* while the socket filter is put in place */
 
     /* counters for /api/state */
     int64_t n_state, n_status, n_event, n_scene, n_undecodable;
@@ -86,9 +95,10 @@ typedef struct view_bridge {
 
 int64_t view_mono_ns(void);
 int64_t view_wall_us(void);
-/* Connects and subscribes. Returns false with a message in err. */
-bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, char *err,
-                      size_t errlen);
+/* Connects and subscribes; on udpm keeps only the plant's channels and, unless allow_lan,
+ * only datagrams sent from this host. Returns false with a message in err. */
+bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, bool allow_lan,
+                      char *err, size_t errlen);
 void view_bridge_close(view_bridge *vb);
 /* Handles the LCM messages waiting (at most a bounded number); sends a DESCRIBE while
  * no scene is known (once a second). */
@@ -113,10 +123,17 @@ typedef struct view_http_opts {
     unsigned hz;                   /* stream frames per second at most */
     unsigned max_streams;          /* concurrent /events streams */
     unsigned max_connections;      /* all connections */
-    bool check_host;               /* loopback: the Host header must name it (DNS rebinding) */
+    const char *const *allow_hosts;  /* more names accepted in the Host header (--allow-host) */
+    int n_allow_hosts;
 } view_http_opts;
 
+#define VIEW_HOSTS_MAX 64           /* names on the Host allow-list */
+#define VIEW_HOST_LEN 256
+
 view_http *view_http_start(view_bridge *vb, const view_http_opts *o, char *err, size_t errlen);
+/* Whether a Host header's value names this bridge: a name on the allow-list built from
+ * --listen and --allow-host (see view_http.c), and the port bound. */
+bool view_host_ok(const view_http *h, const char *host);
 /* The port bound (useful with port 0). */
 unsigned view_http_port(const view_http *h);
 /* The descriptor to poll for readability (libmicrohttpd's epoll set). */
@@ -130,8 +147,29 @@ unsigned view_http_streams(const view_http *h);
 /* Stops: resumes every stream first (libmicrohttpd requires it), then closes. */
 void view_http_stop(view_http *h);
 
-/* The snapshot as JSON (GET /api/state). Returns the length, 0 if it did not fit. */
+/* What one stream has been sent. */
+typedef struct view_cursor {
+    int64_t state_seq, status_seq, scene_seq, event_seq;
+    bool hello_sent;
+} view_cursor;
+/* A stream's next frame into buf[cap]: what is new since the cursor (which it advances),
+ * each of scene, state and status whole or left for the next frame, the events that fit
+ * (oldest first, at most VIEW_EVENTS_PER_FRAME). A part too big for an empty frame (the
+ * budgets rule it out) is sent as {"truncated":true} and counted in *cut, so that a stream
+ * never sticks. Returns the length (0: nothing new). */
+size_t view_frame(const view_bridge *vb, unsigned hz, view_cursor *c, char *buf, size_t cap,
+                  int64_t *cut);
+
+/* The snapshot as JSON (GET /api/state). A part that does not fit is null (counted in
+ * parts_omitted); the newest events that fit are kept (the others counted in
+ * events_omitted). Returns the length, 0 only if cap cannot hold the bridge's counters. */
 size_t view_json_snapshot(const view_bridge *vb, const view_http *h, char *out, size_t cap);
+/* Events first..last of the ring, comma-separated, as many as fit while `reserve` bytes
+ * stay free; *sent: the last one written (first - 1: none). Returns how many. */
+size_t view_json_events(jbuf *b, const view_bridge *vb, int64_t first, int64_t last,
+                        size_t reserve, int64_t *sent);
+/* The HTTP side's counters as ,"key":value pairs (for the bridge object). */
+void view_http_counters(const view_http *h, jbuf *b);
 
 /* ---------------------------------------------------------------- page (generated) */
 typedef struct view_asset {

@@ -14,6 +14,7 @@
 #include "view.h"
 #include "lagsim/lagsim_control_t.h"
 #include "lagsim_bus.h"
+#include "lagsim_net.h"
 
 #define VIEW_DRAIN_MAX 512        /* messages handled per poll at most */
 #define VIEW_LCM_QUEUE 200        /* LCM's queue per subscription */
@@ -37,6 +38,7 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     (void)ch;
     view_bridge *vb = user;
+    if (vb->discard) return; /* came in before the socket filter */
     lag_wire_joint_state m;
     if (lag_wire_decode_joint_state(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) {
         vb->n_undecodable++;
@@ -52,6 +54,7 @@ static void on_status(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     (void)ch;
     view_bridge *vb = user;
+    if (vb->discard) return; /* came in before the socket filter */
     lag_wire_status m;
     if (lag_wire_decode_status(rb->data, rb->data_size, &m) != LAG_WIRE_OK) {
         vb->n_undecodable++;
@@ -67,6 +70,7 @@ static void on_event(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     (void)ch;
     view_bridge *vb = user;
+    if (vb->discard) return; /* came in before the socket filter */
     lag_wire_event m;
     int r = lag_wire_decode_event(rb->data, rb->data_size, &m);
     /* an over-long detail is kept, cut; the rest of the event decoded */
@@ -85,6 +89,7 @@ static void on_scene(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     (void)ch;
     view_bridge *vb = user;
+    if (vb->discard) return; /* came in before the socket filter */
     lag_wire_scene m;
     if (lag_wire_decode_scene(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) {
         vb->n_undecodable++;
@@ -96,8 +101,38 @@ static void on_scene(const lcm_recv_buf_t *rb, const char *ch, void *user)
     vb->last_msg_ns = view_mono_ns();
 }
 
-bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, char *err,
-                      size_t errlen)
+/* Keeps only this plant's four channels on the state URL's receive socket and, unless
+ * allow_lan, only datagrams from this host (lagsim_net.h, the daemon's filter); then reads
+ * until a marker sent after the filter comes back, discarding what came before it. */
+static bool filter_input(view_bridge *vb, const lag_bus *bus, bool allow_lan, char *err,
+                         size_t errlen)
+{
+    const char *chans[] = {vb->ch_state, vb->ch_status, vb->ch_event, vb->ch_scene,
+                           LAG_NET_MARKER_CHANNEL};
+    char ferr[256];
+    int n = lag_net_filter(bus->state_port, !allow_lan, chans, 5, ferr, sizeof ferr);
+    if (n > 0) {
+        vb->discard = true;
+        int synced = lag_net_sync(vb->lcm, 3000);
+        vb->discard = false;
+        if (synced != 0) {
+            snprintf(err, errlen, "LCM on %s does not hear its own messages (is there a "
+                     "multicast route? docs/network.md)", bus->state_url);
+            return false;
+        }
+        n = lag_net_filter(bus->state_port, !allow_lan, chans, 4, ferr, sizeof ferr);
+    }
+    if (n <= 0) {
+        snprintf(err, errlen, "%s: cannot restrict the state URL %s to %s", n < 0 ? ferr :
+                 "LCM's receive socket was not found", bus->state_url,
+                 allow_lan ? "this plant's channels" : "this host (--allow-lan opens it)");
+        return false;
+    }
+    return true;
+}
+
+bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, bool allow_lan,
+                      char *err, size_t errlen)
 {
     memset(vb, 0, sizeof *vb);
     size_t n = strlen(prefix);
@@ -126,6 +161,7 @@ bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, char
     snprintf(vb->ch_event, VIEW_CHANNEL_MAX, "%s", bus.channel[LAG_BUS_EVENT]);
     snprintf(vb->ch_scene, VIEW_CHANNEL_MAX, "%s", bus.channel[LAG_BUS_SCENE]);
     snprintf(vb->ch_control, VIEW_CHANNEL_MAX, "%s", bus.channel[LAG_BUS_CONTROL]);
+    lag_net_note_inherited(); /* a parent's sockets are not filtered */
     vb->lcm = lcm_create(bus.state_url);
     vb->lcm_cmd = !vb->lcm ? NULL : bus.udpm ? lcm_create(bus.command_url) : vb->lcm;
     if (!vb->lcm || !vb->lcm_cmd) {
@@ -147,6 +183,10 @@ bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, char
             return false;
         }
         lcm_subscription_set_queue_capacity(subs[i], VIEW_LCM_QUEUE);
+    }
+    if (bus.udpm && !filter_input(vb, &bus, allow_lan, err, errlen)) {
+        view_bridge_close(vb);
+        return false;
     }
     return true;
 }

@@ -10,45 +10,72 @@
  *   POST /api/control?request=pause|resume|step|reset[&count=N]   (header X-Lagsim: 1)
  *   POST /api/kick?joint=J&impulse=I[&duration=S]                  (header X-Lagsim: 1)
  *
- * Bounds: libmicrohttpd caps connections (all and per address), the memory of one
- * request (headers), and idle time (5 s; 20 s for a stream that accepts no bytes). A
- * flood that holds every connection slot (slowloris) delays new clients until its
- * connections close or idle out; it cannot make the bridge use more than the caps. A stream owns one VIEW_STREAM_BUF buffer; when it
- * has sent its frame it builds the next one from the newest snapshot, at most `hz` times
- * a second, or, when there is nothing new or it is too early, suspends itself: the loop
- * resumes it when the snapshot changes (and every few seconds for a keep-alive comment,
- * which is also how a vanished client is found out). A client that stops reading keeps
- * its one frame, no more, until the idle timeout closes it.
+ * Bounds: libmicrohttpd caps connections (all, and an eighth of them per address), the
+ * memory of one request (headers), and idle time (5 s); the bridge adds deadlines
+ * (headers complete within 3 s, a request that is not a stream done within 30 s), so a
+ * slowloris from one address holds at most its share, and each of those for 3 s. A
+ * stream owns one VIEW_STREAM_BUF buffer; when it has sent its frame it builds the next
+ * one from the newest snapshot (view_frame), at most `hz` times a second, or, when there
+ * is nothing new or it is too early, suspends itself: the loop resumes it when it is
+ * behind the snapshot and due (and every few seconds for a keep-alive comment, which is
+ * also how a vanished client is found out). A client that stops reading keeps its one
+ * frame and a 32 kB socket send buffer, no more, until its TCP has acknowledged nothing
+ * for 20 s while bytes wait for it (check_connections): then it is dropped.
  *
- * Requests from other web pages: on loopback the Host header must name the bridge (a
- * rebound DNS name does not); a control request needs the X-Lagsim header, which a page
- * of another origin cannot send without a preflight the bridge never grants.
+ * Requests from other web pages: the Host header must be one and name the bridge (an
+ * allow-list from --listen and --allow-host: a rebound DNS name is not on it); a control
+ * request needs the X-Lagsim header, which a page of another origin cannot send without a
+ * preflight the bridge never grants.
  */
 #include <arpa/inet.h>
+#include <ctype.h>
 #include <errno.h>
+#include <ifaddrs.h>
+#include <linux/sockios.h>
+#include <linux/tcp.h> /* struct tcp_info with tcpi_bytes_acked */
 #include <microhttpd.h>
 #include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include "view.h"
 
 #define VIEW_KEEPALIVE_NS 5000000000LL   /* a comment on an idle stream */
 #define VIEW_IDLE_TIMEOUT_S 5            /* libmicrohttpd closes connections idle this long */
-#define VIEW_STREAM_TIMEOUT_S 20         /* ... and streams that accept no bytes this long */
+#define VIEW_STREAM_TIMEOUT_S 20         /* a stream whose client takes no byte this long */
+#define VIEW_HEADER_DEADLINE_S 3         /* a request's headers complete within this */
+#define VIEW_REQUEST_DEADLINE_S 30       /* ... and a request that is not a stream, whole */
+#define VIEW_STREAM_SNDBUF 32768         /* a stream's socket send buffer (the kernel doubles it) */
+#define VIEW_CHECK_NS 250000000LL        /* deadlines and stalls looked at this often */
 #define VIEW_REQUEST_MEMORY (16 * 1024)  /* one request's headers and buffers */
 #define VIEW_STATE_JSON (64 * 1024)
+
+/* Every connection, from accept to close (libmicrohttpd's connection notifications): what
+ * it waits for and until when. */
+typedef struct conn {
+    struct conn *prev, *next;
+    int fd;
+    int64_t deadline_ns;     /* closed if not done by then (0: none, a stream) */
+    struct stream *stream;
+    bool dropped;
+} conn;
 
 typedef struct stream {
     struct view_http *h;
     struct MHD_Connection *conn;
+    struct conn *rec;
+    uint64_t acked;          /* bytes the client's TCP has acknowledged */
+    int64_t progress_ns;     /* when that last grew, or nothing was waiting for it */
     struct stream *prev, *next;
     bool suspended;
     int64_t next_frame_ns;   /* not before */
     int64_t last_write_ns;
-    int64_t state_seq, status_seq, scene_seq, event_seq; /* sent so far */
-    bool hello_sent;
+    view_cursor cur;         /* what it has been sent */
     size_t len, off;
     char buf[VIEW_STREAM_BUF];
 } stream;
@@ -62,8 +89,12 @@ struct view_http {
     stream *streams;         /* every open stream, suspended or not */
     unsigned n_streams;
     int64_t last_wake_ns;
-    int64_t woken_state, woken_status, woken_scene, woken_event;
-    char host_ok[3][64];     /* accepted Host headers on loopback */
+    conn *conns;             /* every open connection */
+    int64_t last_check_ns;
+    int64_t n_header_timeouts, n_stalled, n_frames_cut, n_bad_host;
+    /* Host header names accepted (lower case; IPv6 in brackets), the port apart */
+    char hosts[VIEW_HOSTS_MAX][VIEW_HOST_LEN];
+    int n_hosts;
     char json[VIEW_STATE_JSON];
 };
 
@@ -110,18 +141,30 @@ static void stream_unlink(view_http *h, stream *s)
     h->n_streams--;
 }
 
-/* Builds the next frame from what is new since the last one. Returns its length (0:
- * nothing to send). */
-static size_t build_frame(view_http *h, stream *s, int64_t now)
+/* A part that did not fit: it waits for the next frame, unless it was alone in this one
+ * (it never fits, which the budgets rule out): then it is replaced by {"truncated":true}
+ * and counted, so that the stream goes on. */
+static void part_too_big(int64_t *cut, jbuf *b, size_t keep, const char *name, int64_t *seq,
+                         int64_t now_seq)
 {
-    view_bridge *vb = h->vb;
+    b->len = keep;
+    b->overflow = false;
+    if (keep != 0) return;
+    jb_fmt(b, "event: %s\ndata: {\"truncated\":true}\n\n", name);
+    *seq = now_seq;
+    (*cut)++;
+}
+
+size_t view_frame(const view_bridge *vb, unsigned hz, view_cursor *s, char *buf, size_t cap,
+                  int64_t *cut)
+{
     jbuf b;
-    jb_init(&b, s->buf, sizeof s->buf);
+    jb_init(&b, buf, cap);
     size_t keep;
     if (!s->hello_sent) {
         jb_fmt(&b, "retry: 1000\nevent: bridge\ndata: {\"prefix\":");
         jb_str(&b, vb->prefix);
-        jb_fmt(&b, ",\"hz\":%u}\n\n", h->o.hz);
+        jb_fmt(&b, ",\"hz\":%u}\n\n", hz);
         s->hello_sent = true;
     }
     /* each part whole or not at all: a part that does not fit waits for the next frame */
@@ -130,7 +173,7 @@ static size_t build_frame(view_http *h, stream *s, int64_t now)
         jb_raw(&b, "event: scene\ndata: ");
         view_json_scene(&b, &vb->scene);
         jb_raw(&b, "\n\n");
-        if (b.overflow) b.len = keep, b.overflow = false;
+        if (b.overflow) part_too_big(cut, &b, keep, "scene", &s->scene_seq, vb->scene_seq);
         else s->scene_seq = vb->scene_seq;
     }
     if (s->state_seq != vb->state_seq) {
@@ -138,7 +181,7 @@ static size_t build_frame(view_http *h, stream *s, int64_t now)
         jb_raw(&b, "event: state\ndata: ");
         view_json_state(&b, &vb->state);
         jb_raw(&b, "\n\n");
-        if (b.overflow) b.len = keep, b.overflow = false;
+        if (b.overflow) part_too_big(cut, &b, keep, "state", &s->state_seq, vb->state_seq);
         else s->state_seq = vb->state_seq;
     }
     if (s->status_seq != vb->status_seq) {
@@ -146,7 +189,7 @@ static size_t build_frame(view_http *h, stream *s, int64_t now)
         jb_raw(&b, "event: status\ndata: ");
         view_json_status(&b, &vb->status);
         jb_raw(&b, "\n\n");
-        if (b.overflow) b.len = keep, b.overflow = false;
+        if (b.overflow) part_too_big(cut, &b, keep, "status", &s->status_seq, vb->status_seq);
         else s->status_seq = vb->status_seq;
     }
     if (s->event_seq != vb->event_seq) {
@@ -156,20 +199,26 @@ static size_t build_frame(view_http *h, stream *s, int64_t now)
             missed = vb->event_seq - VIEW_EVENTS + 1 - first;
             first = vb->event_seq - VIEW_EVENTS + 1;
         }
-        int64_t last = vb->event_seq;
+        int64_t last = vb->event_seq, sent;
         if (last - first + 1 > VIEW_EVENTS_PER_FRAME) last = first + VIEW_EVENTS_PER_FRAME - 1;
+        /* as many as fit, oldest first: the rest go in the next frame, so a frame of big
+         * events is cut, never stuck (one event always fits: VIEW_JSON_*_MAX) */
         keep = b.len;
         jb_fmt(&b, "event: events\ndata: {\"missed\":%lld,\"events\":[", (long long)missed);
-        for (int64_t q = first; q <= last; q++) {
-            if (q > first) jb_raw(&b, ",");
-            view_json_event(&b, &vb->events[q % VIEW_EVENTS].ev, q);
-        }
+        size_t n = view_json_events(&b, vb, first, last, 8, &sent);
         jb_raw(&b, "]}\n\n");
-        if (b.overflow) b.len = keep, b.overflow = false;
-        else s->event_seq = last;
+        if (b.overflow || n == 0) b.len = keep, b.overflow = false;
+        else s->event_seq = sent;
+        if (n == 0 && keep == 0) {
+            /* alone in a frame and still too big (cannot happen with the budgets): said,
+             * and skipped, so that the stream goes on */
+            jb_fmt(&b, "event: events\ndata: {\"missed\":%lld,\"events\":[]}\n\n",
+                   (long long)(missed + 1));
+            s->event_seq = first;
+            (*cut)++;
+        }
     }
-    if (b.len == 0 && now - s->last_write_ns >= VIEW_KEEPALIVE_NS) jb_raw(&b, ": keep-alive\n\n");
-    return b.len;
+    return b.overflow ? 0 : b.len;
 }
 
 /* libmicrohttpd asks for the next bytes of a stream. */
@@ -182,7 +231,11 @@ static ssize_t stream_read(void *cls, uint64_t pos, char *buf, size_t max)
     if (s->off >= s->len) {
         s->len = s->off = 0;
         if (now >= s->next_frame_ns) {
-            s->len = build_frame(h, s, now);
+            s->len = view_frame(h->vb, h->o.hz, &s->cur, s->buf, sizeof s->buf, &h->n_frames_cut);
+            if (s->len == 0 && now - s->last_write_ns >= VIEW_KEEPALIVE_NS) {
+                memcpy(s->buf, ": keep-alive\n\n", 15);
+                s->len = 15;
+            }
             if (s->len) s->next_frame_ns = now + h->frame_ns;
         }
         if (s->len == 0) {
@@ -204,10 +257,11 @@ static void stream_free(void *cls)
 {
     stream *s = cls;
     stream_unlink(s->h, s);
+    if (s->rec) s->rec->stream = NULL;
     free(s);
 }
 
-static enum MHD_Result open_stream(view_http *h, struct MHD_Connection *c)
+static enum MHD_Result open_stream(view_http *h, struct MHD_Connection *c, conn *rec)
 {
     if (h->n_streams >= h->o.max_streams)
         return reply_text(c, 503, "too many open views (see lagsim-view --max-views)\n");
@@ -215,7 +269,7 @@ static enum MHD_Result open_stream(view_http *h, struct MHD_Connection *c)
     if (!s) return reply_text(c, 503, "out of memory\n");
     s->h = h;
     s->conn = c;
-    s->last_write_ns = view_mono_ns();
+    s->last_write_ns = s->progress_ns = view_mono_ns();
     struct MHD_Response *r =
         MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 16384, stream_read, s, stream_free);
     if (!r) {
@@ -226,7 +280,17 @@ static enum MHD_Result open_stream(view_http *h, struct MHD_Connection *c)
     if (h->streams) h->streams->prev = s;
     h->streams = s;
     h->n_streams++;
+    /* the stall is judged by what the client takes (stall_check), libmicrohttpd's idle
+     * timeout stays as a backstop; a small send buffer keeps the kernel from queueing
+     * megabytes for a client that does not read */
     MHD_set_connection_option(c, MHD_CONNECTION_OPTION_TIMEOUT, (unsigned)VIEW_STREAM_TIMEOUT_S);
+    if (rec) {
+        rec->stream = s;
+        rec->deadline_ns = 0;
+        s->rec = rec;
+        int sndbuf = VIEW_STREAM_SNDBUF;
+        setsockopt(rec->fd, SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf);
+    }
     MHD_add_response_header(r, "Content-Type", "text/event-stream");
     MHD_add_response_header(r, "Cache-Control", "no-store");
     MHD_add_response_header(r, "X-Content-Type-Options", "nosniff");
@@ -236,14 +300,66 @@ static enum MHD_Result open_stream(view_http *h, struct MHD_Connection *c)
 }
 
 /* ---------------------------------------------------------------- requests */
-static bool host_allowed(view_http *h, struct MHD_Connection *c)
+/* Host: NAME[:PORT]. Accepted when NAME is on the allow-list (any case, one final dot
+ * ignored) and PORT is the bridge's (absent: 80). */
+bool view_host_ok(const view_http *h, const char *host)
 {
-    if (!h->o.check_host) return true;
-    const char *host = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Host");
     if (!host) return false;
-    for (int i = 0; i < 3; i++)
-        if (strcmp(host, h->host_ok[i]) == 0) return true;
+    size_t n = strlen(host), name_len;
+    const char *port = NULL;
+    if (host[0] == '[') {
+        const char *e = memchr(host, ']', n);
+        if (!e) return false;
+        name_len = (size_t)(e - host) + 1;
+        if (e[1] == ':') port = e + 2;
+        else if (e[1] != '\0') return false;
+    } else {
+        const char *colon = memchr(host, ':', n);
+        name_len = colon ? (size_t)(colon - host) : n;
+        if (colon) port = colon + 1;
+    }
+    if (name_len > 1 && host[name_len - 1] == '.') name_len--;
+    if (name_len == 0 || name_len >= VIEW_HOST_LEN) return false;
+    unsigned p = 80;
+    if (port) {
+        if (!*port || strlen(port) > 5) return false;
+        p = 0;
+        for (const char *c = port; *c; c++) {
+            if (*c < '0' || *c > '9') return false;
+            p = p * 10 + (unsigned)(*c - '0');
+        }
+    }
+    if (p != h->port) return false;
+    for (int i = 0; i < h->n_hosts; i++)
+        if (strlen(h->hosts[i]) == name_len && strncasecmp(host, h->hosts[i], name_len) == 0)
+            return true;
     return false;
+}
+
+static enum MHD_Result count_host(void *cls, enum MHD_ValueKind kind, const char *key,
+                                  const char *value)
+{
+    (void)kind;
+    (void)value;
+    if (strcasecmp(key, "Host") == 0) ++*(int *)cls;
+    return MHD_YES;
+}
+
+/* 0: fine; else the status to answer (400: no or several Host headers, 421: not ours) */
+static unsigned host_check(view_http *h, struct MHD_Connection *c)
+{
+    int n = 0;
+    MHD_get_connection_values(c, MHD_HEADER_KIND, count_host, &n);
+    if (n > 1) return 400;
+    if (!view_host_ok(h, MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Host"))) return 421;
+    return 0;
+}
+
+static conn *conn_of(struct MHD_Connection *c)
+{
+    const union MHD_ConnectionInfo *i =
+        MHD_get_connection_info(c, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+    return i ? i->socket_context : NULL;
 }
 
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const char *url,
@@ -262,7 +378,15 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         *upload_data_size = 0;
         return MHD_YES;
     }
-    if (!host_allowed(h, c)) return reply_text(c, 421, "unexpected Host header\n");
+    conn *rec = conn_of(c);
+    /* the headers are in: a request that is not a stream has VIEW_REQUEST_DEADLINE_S */
+    if (rec) rec->deadline_ns = view_mono_ns() + VIEW_REQUEST_DEADLINE_S * 1000000000LL;
+    unsigned bad = host_check(h, c);
+    if (bad) {
+        h->n_bad_host++;
+        return reply_text(c, bad, bad == 400 ? "one Host header, please\n"
+                                             : "unexpected Host header (see lagsim-view --allow-host)\n");
+    }
     bool get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
     bool post = strcmp(method, "POST") == 0;
 
@@ -290,10 +414,10 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         return reply_json_msg(c, code ? (unsigned)code : 202, code == 0, why);
     }
     if (!get) return reply_text(c, 405, "GET only\n");
-    if (strcmp(url, "/events") == 0) return open_stream(h, c);
+    if (strcmp(url, "/events") == 0) return open_stream(h, c, rec);
     if (strcmp(url, "/api/state") == 0) {
         size_t n = view_json_snapshot(h->vb, h, h->json, sizeof h->json);
-        if (n == 0) return reply_text(c, 500, "state too large\n");
+        if (n == 0) return reply_text(c, 500, "state too large\n"); /* the budgets rule it out */
         return reply(c, 200, "application/json", h->json, n, MHD_RESPMEM_MUST_COPY);
     }
     for (size_t i = 0; i < view_asset_count; i++)
@@ -303,6 +427,110 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     return reply_text(c, 404, "not found\n");
 }
 
+/* ---------------------------------------------------------------- connections */
+static void on_connection(void *cls, struct MHD_Connection *c, void **socket_context,
+                          enum MHD_ConnectionNotificationCode code)
+{
+    view_http *h = cls;
+    if (code == MHD_CONNECTION_NOTIFY_STARTED) {
+        conn *r = calloc(1, sizeof *r);
+        const union MHD_ConnectionInfo *i =
+            MHD_get_connection_info(c, MHD_CONNECTION_INFO_CONNECTION_FD);
+        if (!r || !i) { /* no record: no deadline; closed now rather than unguarded */
+            free(r);
+            if (i) shutdown(i->connect_fd, SHUT_RDWR);
+            *socket_context = NULL;
+            return;
+        }
+        r->fd = i->connect_fd;
+        r->deadline_ns = view_mono_ns() + VIEW_HEADER_DEADLINE_S * 1000000000LL;
+        r->next = h->conns;
+        if (h->conns) h->conns->prev = r;
+        h->conns = r;
+        *socket_context = r;
+    } else if (code == MHD_CONNECTION_NOTIFY_CLOSED) {
+        conn *r = *socket_context;
+        if (!r) return;
+        if (r->prev) r->prev->next = r->next;
+        else h->conns = r->next;
+        if (r->next) r->next->prev = r->prev;
+        if (r->stream) r->stream->rec = NULL;
+        free(r);
+        *socket_context = NULL;
+    }
+}
+
+/* A request answered on a connection kept alive: the next one's headers are due again
+ * within VIEW_HEADER_DEADLINE_S. */
+static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
+                         enum MHD_RequestTerminationCode toe)
+{
+    (void)cls;
+    (void)con_cls;
+    (void)toe;
+    conn *r = conn_of(c);
+    if (r && !r->stream) r->deadline_ns = view_mono_ns() + VIEW_HEADER_DEADLINE_S * 1000000000LL;
+}
+
+/* Ends a connection from outside libmicrohttpd's callbacks: the socket is shut down, the
+ * loop sees it hang up and libmicrohttpd closes it (and frees its stream). */
+static void drop(conn *r)
+{
+    if (r->dropped) return;
+    r->dropped = true;
+    shutdown(r->fd, SHUT_RDWR);
+    if (r->stream && r->stream->suspended) {
+        r->stream->suspended = false;
+        MHD_resume_connection(r->stream->conn);
+    }
+}
+
+/* Deadlines (headers, whole requests) and stalled streams. A stream is stalled when bytes
+ * wait in its socket (SIOCOUTQ: sent or not, not yet acknowledged) and its client's TCP
+ * has acknowledged nothing new (tcpi_bytes_acked) for VIEW_STREAM_TIMEOUT_S: what the
+ * client has taken, not what the kernel accepted from the bridge. */
+static void check_connections(view_http *h, int64_t now)
+{
+    for (conn *r = h->conns; r; r = r->next) {
+        if (r->dropped) continue;
+        if (r->deadline_ns && now >= r->deadline_ns) {
+            h->n_header_timeouts++;
+            drop(r);
+            continue;
+        }
+        stream *s = r->stream;
+        if (!s) continue;
+        int outq = 0;
+        struct tcp_info ti;
+        socklen_t tl = sizeof ti;
+        memset(&ti, 0, sizeof ti);
+        if (ioctl(r->fd, SIOCOUTQ, &outq) != 0 ||
+            getsockopt(r->fd, IPPROTO_TCP, TCP_INFO, &ti, &tl) != 0) {
+            drop(r); /* not a TCP socket any more: gone */
+            continue;
+        }
+        if (outq == 0 || ti.tcpi_bytes_acked != s->acked) {
+            s->acked = ti.tcpi_bytes_acked;
+            s->progress_ns = now;
+        } else if (now - s->progress_ns >= VIEW_STREAM_TIMEOUT_S * 1000000000LL) {
+            h->n_stalled++;
+            drop(r);
+        }
+    }
+}
+
+void view_http_counters(const view_http *h, jbuf *b)
+{
+    jb_key(b, "streams_dropped_stalled", false);
+    jb_fmt(b, "%lld", (long long)h->n_stalled);
+    jb_key(b, "connections_timed_out", false);
+    jb_fmt(b, "%lld", (long long)h->n_header_timeouts);
+    jb_key(b, "bad_host", false);
+    jb_fmt(b, "%lld", (long long)h->n_bad_host);
+    jb_key(b, "frames_cut", false);
+    jb_fmt(b, "%lld", (long long)h->n_frames_cut);
+}
+
 /* libmicrohttpd's own complaints (bad requests, limits): one line on stderr, bounded by
  * its own rate of connections. */
 static void on_log(void *cls, const char *fmt, va_list ap)
@@ -310,6 +538,66 @@ static void on_log(void *cls, const char *fmt, va_list ap)
     (void)cls;
     (void)fmt;
     (void)ap; /* silent: hostile clients must not fill the terminal */
+}
+
+/* ---------------------------------------------------------------- Host allow-list */
+static void host_add(view_http *h, const char *name)
+{
+    char v[VIEW_HOST_LEN];
+    size_t n = strlen(name);
+    if (n == 0 || n >= sizeof v) return;
+    for (size_t i = 0; i <= n; i++) v[i] = (char)tolower((unsigned char)name[i]);
+    if (n > 1 && v[n - 1] == '.') v[n - 1] = '\0';
+    for (int i = 0; i < h->n_hosts; i++)
+        if (strcmp(h->hosts[i], v) == 0) return;
+    if (h->n_hosts < VIEW_HOSTS_MAX) snprintf(h->hosts[h->n_hosts++], VIEW_HOST_LEN, "%s", v);
+}
+
+static void host_add_addr(view_http *h, int family, const void *addr)
+{
+    char a[INET6_ADDRSTRLEN], v[INET6_ADDRSTRLEN + 2];
+    if (!inet_ntop(family, addr, a, sizeof a)) return;
+    if (family == AF_INET6) snprintf(v, sizeof v, "[%s]", a);
+    else snprintf(v, sizeof v, "%s", a);
+    host_add(h, v);
+}
+
+/* The names a browser may put in Host: the address listened on; on a loopback address
+ * also localhost; on a wildcard address every address of this host's interfaces; off
+ * loopback this host's name; and every --allow-host. A rebound DNS name is none of them. */
+static void hosts_build(view_http *h, int family, const void *addr, bool wildcard, bool loopback)
+{
+    host_add_addr(h, family, addr); /* the address printed, 0.0.0.0 included */
+    if (loopback || wildcard) host_add(h, "localhost");
+    if (wildcard) {
+        struct ifaddrs *ifa = NULL;
+        if (getifaddrs(&ifa) == 0) {
+            for (struct ifaddrs *i = ifa; i; i = i->ifa_next) {
+                if (!i->ifa_addr) continue;
+                if (i->ifa_addr->sa_family == AF_INET)
+                    host_add_addr(h, AF_INET, &((struct sockaddr_in *)i->ifa_addr)->sin_addr);
+                else if (i->ifa_addr->sa_family == AF_INET6 && family == AF_INET6)
+                    host_add_addr(h, AF_INET6, &((struct sockaddr_in6 *)i->ifa_addr)->sin6_addr);
+            }
+            freeifaddrs(ifa);
+        }
+    }
+    if (!loopback) {
+        char name[256];
+        if (gethostname(name, sizeof name - 1) == 0) {
+            name[sizeof name - 1] = '\0';
+            host_add(h, name);
+        }
+    }
+    for (int i = 0; i < h->o.n_allow_hosts; i++) {
+        const char *n = h->o.allow_hosts[i];
+        char v6[VIEW_HOST_LEN];
+        if (strchr(n, ':') && n[0] != '[' && strlen(n) + 2 < sizeof v6) { /* an IPv6 literal */
+            snprintf(v6, sizeof v6, "[%s]", n);
+            n = v6;
+        }
+        host_add(h, n);
+    }
 }
 
 /* ---------------------------------------------------------------- lifecycle */
@@ -329,24 +617,41 @@ view_http *view_http_start(view_bridge *vb, const view_http_opts *o, char *err, 
     struct sockaddr_in *a4 = (struct sockaddr_in *)&ss;
     struct sockaddr_in6 *a6 = (struct sockaddr_in6 *)&ss;
     unsigned flags = MHD_USE_EPOLL | MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG;
+    int family;
+    const void *addr;
+    bool wildcard, loopback;
     if (inet_pton(AF_INET, o->listen, &a4->sin_addr) == 1) {
         a4->sin_family = AF_INET;
         a4->sin_port = htons((uint16_t)o->port);
+        family = AF_INET;
+        addr = &a4->sin_addr;
+        wildcard = a4->sin_addr.s_addr == htonl(INADDR_ANY);
+        loopback = (ntohl(a4->sin_addr.s_addr) >> 24) == 127;
     } else if (inet_pton(AF_INET6, o->listen, &a6->sin6_addr) == 1) {
         a6->sin6_family = AF_INET6;
         a6->sin6_port = htons((uint16_t)o->port);
         flags |= MHD_USE_IPv6;
+        family = AF_INET6;
+        addr = &a6->sin6_addr;
+        wildcard = IN6_IS_ADDR_UNSPECIFIED(&a6->sin6_addr);
+        loopback = IN6_IS_ADDR_LOOPBACK(&a6->sin6_addr);
     } else {
         snprintf(err, errlen, "--listen '%s': a numeric IPv4 or IPv6 address", o->listen);
         free(h);
         return NULL;
     }
+    /* one address holds at most an eighth of the connections (a slowloris from one
+     * address leaves the rest to others), and never fewer than a browser's needs */
+    unsigned per_address = o->max_connections / 8;
+    if (per_address < 32) per_address = 32;
     h->d = MHD_start_daemon(flags, (uint16_t)o->port, NULL, NULL, on_request, h,
                             MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&ss,
                             MHD_OPTION_CONNECTION_LIMIT, (unsigned)o->max_connections,
-                            MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)o->max_connections,
+                            MHD_OPTION_PER_IP_CONNECTION_LIMIT, per_address,
                             MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)VIEW_IDLE_TIMEOUT_S,
                             MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)VIEW_REQUEST_MEMORY,
+                            MHD_OPTION_NOTIFY_CONNECTION, on_connection, h,
+                            MHD_OPTION_NOTIFY_COMPLETED, on_completed, h,
                             MHD_OPTION_EXTERNAL_LOGGER, on_log, NULL,
                             MHD_OPTION_END);
     if (!h->d) {
@@ -357,9 +662,7 @@ view_http *view_http_start(view_bridge *vb, const view_http_opts *o, char *err, 
     }
     const union MHD_DaemonInfo *pi = MHD_get_daemon_info(h->d, MHD_DAEMON_INFO_BIND_PORT);
     h->port = pi ? pi->port : o->port;
-    snprintf(h->host_ok[0], sizeof h->host_ok[0], "127.0.0.1:%u", h->port);
-    snprintf(h->host_ok[1], sizeof h->host_ok[1], "localhost:%u", h->port);
-    snprintf(h->host_ok[2], sizeof h->host_ok[2], "[::1]:%u", h->port);
+    hosts_build(h, family, addr, wildcard, loopback);
     return h;
 }
 
@@ -384,22 +687,23 @@ void view_http_run(view_http *h)
 {
     view_bridge *vb = h->vb;
     int64_t now = view_mono_ns();
-    /* wake the suspended streams: when the snapshot changed (at most hz times a second)
-     * and, for keep-alives, every VIEW_KEEPALIVE_NS */
-    bool changed = h->woken_state != vb->state_seq || h->woken_status != vb->status_seq ||
-                   h->woken_scene != vb->scene_seq || h->woken_event != vb->event_seq;
-    if ((changed && now - h->last_wake_ns >= h->frame_ns) ||
-        now - h->last_wake_ns >= VIEW_KEEPALIVE_NS) {
-        h->last_wake_ns = now;
-        h->woken_state = vb->state_seq;
-        h->woken_status = vb->status_seq;
-        h->woken_scene = vb->scene_seq;
-        h->woken_event = vb->event_seq;
-        for (stream *s = h->streams; s; s = s->next)
-            if (s->suspended) {
-                s->suspended = false;
-                MHD_resume_connection(s->conn);
-            }
+    /* wake a suspended stream when it is behind the snapshot (something changed, or a
+     * backlog of events remains) and its next frame is due, and every VIEW_KEEPALIVE_NS
+     * for a keep-alive */
+    bool keepalive = now - h->last_wake_ns >= VIEW_KEEPALIVE_NS;
+    if (keepalive) h->last_wake_ns = now;
+    for (stream *s = h->streams; s; s = s->next) {
+        if (!s->suspended) continue;
+        bool behind = s->cur.state_seq != vb->state_seq || s->cur.status_seq != vb->status_seq ||
+                      s->cur.scene_seq != vb->scene_seq || s->cur.event_seq != vb->event_seq;
+        if (keepalive || (behind && now >= s->next_frame_ns)) {
+            s->suspended = false;
+            MHD_resume_connection(s->conn);
+        }
+    }
+    if (now - h->last_check_ns >= VIEW_CHECK_NS) {
+        h->last_check_ns = now;
+        check_connections(h, now);
     }
     MHD_run(h->d);
 }

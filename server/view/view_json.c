@@ -68,37 +68,65 @@ static int utf8_len(const unsigned char *s)
     return n;
 }
 
-void jb_str(jbuf *b, const char *s)
+/* The escaped form of the character at u: its bytes into e (up to 6), how many input
+ * bytes it takes in *used. */
+static size_t escape_one(const unsigned char *u, char e[8], size_t *used)
 {
-    jb_put(b, "\"", 1);
+    unsigned c = *u;
+    *used = 1;
+    if (c == '"' || c == '\\') {
+        e[0] = '\\';
+        e[1] = (char)c;
+        return 2;
+    }
+    if (c < 0x20 || c == 0x7f) {
+        snprintf(e, 8, "\\u%04x", c);
+        return 6;
+    }
+    if (c < 0x80) {
+        e[0] = (char)c;
+        return 1;
+    }
+    int n = utf8_len(u);
+    if (n == 0) {
+        memcpy(e, "\\ufffd", 6);
+        return 6;
+    }
+    memcpy(e, u, (size_t)n);
+    *used = (size_t)n;
+    return (size_t)n;
+}
+
+/* room kept for the marker "…[truncated N bytes]" */
+#define JB_MARK_MAX 48
+
+void jb_str_max(jbuf *b, const char *s, size_t budget)
+{
+    if (budget < 2 * JB_MARK_MAX) budget = 2 * JB_MARK_MAX;
     const unsigned char *u = (const unsigned char *)s;
+    size_t out = 0, used;
+    char e[8];
+    /* does it fit whole? */
+    for (const unsigned char *v = u; *v && out <= budget; v += used) out += escape_one(v, e, &used);
+    bool whole = out <= budget;
+    jb_put(b, "\"", 1);
+    out = 0;
     while (*u && !b->overflow) {
-        unsigned c = *u;
-        if (c == '"' || c == '\\') {
-            char e[2] = {'\\', (char)c};
-            jb_put(b, e, 2);
-            u++;
-        } else if (c < 0x20 || c == 0x7f) {
-            char e[8];
-            snprintf(e, sizeof e, "\\u%04x", c);
-            jb_put(b, e, 6);
-            u++;
-        } else if (c < 0x80) {
-            jb_put(b, (const char *)u, 1);
-            u++;
-        } else {
-            int n = utf8_len(u);
-            if (n == 0) {
-                jb_put(b, "\\ufffd", 6);
-                u++;
-            } else {
-                jb_put(b, (const char *)u, (size_t)n);
-                u += n;
-            }
-        }
+        size_t n = escape_one(u, e, &used);
+        if (!whole && out + n > budget - JB_MARK_MAX) break;
+        jb_put(b, e, n);
+        out += n;
+        u += used;
+    }
+    if (*u && !b->overflow) {
+        char m[JB_MARK_MAX + 1];
+        snprintf(m, sizeof m, "\xe2\x80\xa6[truncated %zu bytes]", strlen((const char *)u));
+        jb_raw(b, m);
     }
     jb_put(b, "\"", 1);
 }
+
+void jb_str(jbuf *b, const char *s) { jb_str_max(b, s, VIEW_JSON_NAME_MAX); }
 
 void jb_num(jbuf *b, double x)
 {
@@ -202,7 +230,8 @@ void view_json_event(jbuf *b, const lag_wire_event *m, int64_t seq)
     jb_s(b, "kind", m->kind);
     jb_s(b, "joint", m->joint);
     jb_dbl(b, "value", m->value);
-    jb_s(b, "detail", m->detail);
+    jb_key(b, "detail", false);
+    jb_str_max(b, m->detail, VIEW_JSON_TEXT_MAX);
     jb_raw(b, "}");
 }
 
@@ -254,16 +283,63 @@ void view_json_scene(jbuf *b, const lag_wire_scene *m)
     jb_raw(b, "]}");
 }
 
+/* One part of a document: whole, or (when it does not fit in what is left) `null`, counted
+ * in *cut, so that one oversized part never costs the others. */
+typedef void (*part_fn)(jbuf *b, const void *m);
+static void part(jbuf *b, const char *key, part_fn fn, const void *m, bool present, int *cut)
+{
+    jb_key(b, key, false);
+    size_t keep = b->len;
+    if (present) fn(b, m);
+    else jb_raw(b, "null");
+    if (b->overflow) {
+        b->len = keep;
+        b->overflow = false;
+        jb_raw(b, "null");
+        (*cut)++;
+    }
+}
+static void scene_part(jbuf *b, const void *m) { view_json_scene(b, m); }
+static void state_part(jbuf *b, const void *m) { view_json_state(b, m); }
+static void status_part(jbuf *b, const void *m) { view_json_status(b, m); }
+
+size_t view_json_events(jbuf *b, const view_bridge *vb, int64_t first, int64_t last,
+                        size_t reserve, int64_t *sent)
+{
+    size_t n = 0;
+    *sent = first - 1;
+    if (b->overflow || reserve >= b->cap - b->len) return 0;
+    size_t cap = b->cap;
+    b->cap -= reserve; /* what must follow still fits */
+    for (int64_t q = first; q <= last; q++) {
+        size_t keep = b->len;
+        if (q > first) jb_raw(b, ",");
+        view_json_event(b, &vb->events[q % VIEW_EVENTS].ev, q);
+        if (b->overflow) {
+            b->len = keep;
+            b->overflow = false;
+            break;
+        }
+        *sent = q;
+        n++;
+    }
+    b->cap = cap;
+    return n;
+}
+
 size_t view_json_snapshot(const view_bridge *vb, const view_http *h, char *out, size_t cap)
 {
     jbuf b;
     jb_init(&b, out, cap);
     int64_t now = view_mono_ns();
+    int cut = 0;
     jb_raw(&b, "{\"bridge\":{");
     jb_key(&b, "prefix", true);
     jb_str(&b, vb->prefix);
-    jb_s(&b, "url", vb->url[0] ? vb->url : "LCM default");
+    jb_key(&b, "url", false);
+    jb_str_max(&b, vb->url[0] ? vb->url : "LCM default", VIEW_JSON_TEXT_MAX);
     jb_int(&b, "streams", h ? (int64_t)view_http_streams(h) : 0);
+    if (h) view_http_counters(h, &b);
     jb_int(&b, "states", vb->n_state);
     jb_int(&b, "statuses", vb->n_status);
     jb_int(&b, "events", vb->n_event);
@@ -273,23 +349,35 @@ size_t view_json_snapshot(const view_bridge *vb, const view_http *h, char *out, 
     jb_int(&b, "controls_refused", vb->controls_refused);
     jb_dbl(&b, "last_message_age_s", vb->last_msg_ns ? (double)(now - vb->last_msg_ns) * 1e-9 : NAN);
     jb_raw(&b, "}");
-    jb_key(&b, "scene", false);
-    if (vb->scene_seq) view_json_scene(&b, &vb->scene);
-    else jb_raw(&b, "null");
-    jb_key(&b, "state", false);
-    if (vb->state_seq) view_json_state(&b, &vb->state);
-    else jb_raw(&b, "null");
-    jb_key(&b, "status", false);
-    if (vb->status_seq) view_json_status(&b, &vb->status);
-    else jb_raw(&b, "null");
-    jb_key(&b, "events", false);
-    jb_raw(&b, "[");
+    part(&b, "scene", scene_part, &vb->scene, vb->scene_seq != 0, &cut);
+    part(&b, "state", state_part, &vb->state, vb->state_seq != 0, &cut);
+    part(&b, "status", status_part, &vb->status, vb->status_seq != 0, &cut);
+    /* the newest events that fit: from the newest back, what the rest of the buffer holds */
     int64_t first = vb->event_seq - VIEW_EVENTS_IN_STATE + 1;
     if (first < 1) first = 1;
-    for (int64_t s = first; s <= vb->event_seq; s++) {
-        if (s > first) jb_raw(&b, ",");
-        view_json_event(&b, &vb->events[s % VIEW_EVENTS].ev, s);
+    int64_t omitted = 0;
+    if (!b.overflow) {
+        static char tmp[VIEW_STREAM_BUF]; /* one thread */
+        size_t room = b.cap - b.len, need = 96; /* the keys, brackets and counts after them */
+        for (int64_t q = vb->event_seq; q >= first; q--) {
+            jbuf t;
+            jb_init(&t, tmp, sizeof tmp);
+            view_json_event(&t, &vb->events[q % VIEW_EVENTS].ev, q);
+            need += t.len + 1;
+            if (t.overflow || need > room) {
+                omitted = q - first + 1;
+                first = q + 1;
+                break;
+            }
+        }
     }
-    jb_raw(&b, "]}\n");
+    jb_key(&b, "events", false);
+    jb_raw(&b, "[");
+    int64_t sent;
+    view_json_events(&b, vb, first, vb->event_seq, 96, &sent); /* the tail: < 70 bytes */
+    jb_raw(&b, "]");
+    jb_int(&b, "events_omitted", omitted + (vb->event_seq - sent));
+    jb_int(&b, "parts_omitted", cut);
+    jb_raw(&b, "}\n");
     return b.overflow ? 0 : b.len;
 }

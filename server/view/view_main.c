@@ -1,5 +1,6 @@
 /*
  * lagsim-view [--prefix P] [--port 8765] [--url LCM_URL] [--listen ADDR] [--hz N]
+ *             [--max-views N] [--allow-host NAME]... [--allow-lan]
  *
  * Watches a lagsimd daemon in a browser: subscribes to its channels and serves one page
  * that draws the model from the scene description, animates it from the states, charts
@@ -23,7 +24,7 @@
 static void usage(FILE *f)
 {
     fputs("usage: lagsim-view [--prefix P] [--port 8765] [--url LCM_URL] [--listen ADDR]\n"
-          "                   [--hz N] [--max-views N]\n"
+          "                   [--hz N] [--max-views N] [--allow-host NAME]... [--allow-lan]\n"
           "\n"
           "Serves a live view of a lagsimd daemon to browsers: the model drawn to scale from\n"
           "its scene description and animated from its states, strip charts, status, events,\n"
@@ -38,6 +39,12 @@ static void usage(FILE *f)
           "                     and pause, step and reset it: there is no authentication\n"
           "      --hz N         stream frames per second per browser at most (default 60)\n"
           "      --max-views N  browsers streaming at once (default 16)\n"
+          "      --allow-host NAME  a name browsers may reach the view by, besides the\n"
+          "                     --listen address (and localhost on loopback; this host's\n"
+          "                     name and, on 0.0.0.0 or ::, its addresses): any other Host\n"
+          "                     header gets 421 (DNS rebinding). Repeatable, up to 16\n"
+          "      --allow-lan    also take the plant's messages from other hosts (default:\n"
+          "                     this host's only, as lagsimd's lcm.allow_lan: false)\n"
           "  -q, --quiet        print only the address\n"
           "  -h, --help         this help\n"
           "\n"
@@ -64,7 +71,8 @@ static bool is_loopback(const char *a)
 
 int main(int argc, char **argv)
 {
-    enum { OPT_PORT = 256, OPT_URL, OPT_LISTEN, OPT_HZ, OPT_MAX_VIEWS };
+    enum { OPT_PORT = 256, OPT_URL, OPT_LISTEN, OPT_HZ, OPT_MAX_VIEWS, OPT_ALLOW_HOST,
+           OPT_ALLOW_LAN };
     static const struct option longopts[] = {
         {"prefix", required_argument, NULL, 'p'},
         {"port", required_argument, NULL, OPT_PORT},
@@ -72,14 +80,18 @@ int main(int argc, char **argv)
         {"listen", required_argument, NULL, OPT_LISTEN},
         {"hz", required_argument, NULL, OPT_HZ},
         {"max-views", required_argument, NULL, OPT_MAX_VIEWS},
+        {"allow-host", required_argument, NULL, OPT_ALLOW_HOST},
+        {"allow-lan", no_argument, NULL, OPT_ALLOW_LAN},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
     };
     const char *prefix = NULL, *url = NULL;
     view_http_opts ho = {.listen = "127.0.0.1", .port = 8765, .hz = 60, .max_streams = 16,
-                         .max_connections = 64, .check_host = true};
-    bool quiet = false;
+                         .max_connections = 64};
+    static const char *allow_hosts[16];
+    int n_allow_hosts = 0;
+    bool quiet = false, allow_lan = false;
     opterr = 0;
     int c;
     while ((c = getopt_long(argc, argv, ":p:qh", longopts, NULL)) != -1) {
@@ -105,6 +117,23 @@ int main(int argc, char **argv)
                 return 2;
             }
             break;
+        case OPT_ALLOW_HOST: {
+            size_t n = strlen(optarg);
+            bool ok = n > 0 && n < VIEW_HOST_LEN && n_allow_hosts < 16;
+            for (size_t i = 0; ok && i < n; i++) /* a DNS name or an address literal */
+                ok = (optarg[i] >= 'a' && optarg[i] <= 'z') || (optarg[i] >= 'A' && optarg[i] <= 'Z') ||
+                     (optarg[i] >= '0' && optarg[i] <= '9') || strchr("-._[]:", optarg[i]);
+            if (!ok) {
+                fprintf(stderr, "lagsim-view: --allow-host: expected a host name or address "
+                        "without a port (letters, digits, '-', '.', '_', an IPv6 address; at "
+                        "most 16 of them), "
+                        "got '%s'\n", optarg);
+                return 2;
+            }
+            allow_hosts[n_allow_hosts++] = optarg;
+            break;
+        }
+        case OPT_ALLOW_LAN: allow_lan = true; break;
         case 'q': quiet = true; break;
         case 'h': usage(stdout); return 0;
         case ':':
@@ -120,7 +149,9 @@ int main(int argc, char **argv)
         return 2;
     }
     ho.max_connections = ho.max_streams + 240;
-    ho.check_host = is_loopback(ho.listen);
+    ho.allow_hosts = allow_hosts;
+    ho.n_allow_hosts = n_allow_hosts;
+    bool local = is_loopback(ho.listen);
 
     /* signals through a signalfd, blocked before LCM starts any thread */
     sigset_t sigs;
@@ -153,7 +184,7 @@ int main(int argc, char **argv)
         }
     }
     static view_bridge vb; /* large (rings): static, one bridge per process */
-    if (!view_bridge_open(&vb, url, prefix, err, sizeof err)) {
+    if (!view_bridge_open(&vb, url, prefix, allow_lan, err, sizeof err)) {
         fprintf(stderr, "lagsim-view: %s\n", err);
         return strstr(err, "--prefix") ? 2 : 1;
     }
@@ -167,7 +198,7 @@ int main(int argc, char **argv)
     printf("lagsim-view: http://%s%s%s:%u/  (prefix %s)\n", v6 ? "[" : "", ho.listen,
            v6 ? "]" : "", view_http_port(h), prefix);
     fflush(stdout);
-    if (!ho.check_host)
+    if (!local)
         fprintf(stderr,
                 "lagsim-view: WARNING: listening on %s, not on this machine only: anyone who "
                 "reaches port %u sees the run and can pause, step and reset the simulation "

@@ -284,6 +284,27 @@ write("replay", "crash", "step-int64-min.lcm",                             # ove
       at_step(0) + at_step(10) + at_step(-(1 << 63)))
 flood = record("DIPC_STATE", forged_state(7, b"theta0\0", n=32767, rest=False))
 write("replay", "crash", "undecodable-flood.lcm", s0 + flood * 100 + s10)  # leaked 262 kB each
+# ---- view (tests/fuzz/fuzz_view.c): first byte 0 = messages' bytes, 1 = an HTTP request
+# ("@P": the port bound), 2 = a Host header's value
+worst_text = bytes(range(1, 32)) + b'\x7f"\\\xff\xc0\xed\xa0\x80'
+write("view", "corpus", "json-mixed.bin", b"\x00" + (b"\xff" + worst_text * 9) * 25)
+# every length the longest, every byte 0xff (not UTF-8: 6 bytes of JSON each), 136 events
+# (once the bytes run out, each a copy of the one before)
+write("view", "corpus", "json-worst.bin", b"\x00" + b"\xff" * 6000)
+write("view", "corpus", "json-plain.bin", b"\x00" + (b"\x06theta0" + b"\x3f\xf0" + b"\x00" * 6) * 60)
+for name, req in [
+        ("http-state.bin", b"GET /api/state HTTP/1.1\r\nHost: 127.0.0.1:@P\r\n\r\n"),
+        ("http-page.bin", b"GET / HTTP/1.1\r\nHost: localhost:@P\r\nConnection: close\r\n\r\n"),
+        ("http-events.bin", b"GET /events HTTP/1.1\r\nHost: 127.0.0.1:@P\r\n\r\n"),
+        ("http-two-hosts.bin", b"GET /api/state HTTP/1.1\r\nHost: 127.0.0.1:@P\r\nHost: evil.example\r\n\r\n"),
+        ("http-control.bin", b"POST /api/control?request=step&count=3 HTTP/1.1\r\nHost: 127.0.0.1:@P\r\n"
+                             b"X-Lagsim: 1\r\nContent-Length: 4\r\n\r\nbody"),
+        ("http-keepalive.bin", b"GET /view.js HTTP/1.1\r\nHost: 127.0.0.1:@P\r\n\r\n"
+                               b"GET /api/state HTTP/1.1\r\nHost: [::1]:@P\r\n\r\n")]:
+    write("view", "corpus", name, b"\x01" + req)
+for name, host in [("host-port.bin", b"127.0.0.1:8765"), ("host-v6.bin", b"[::1]:8765"),
+                   ("host-dot.bin", b"LOCALHOST.:8765"), ("host-noport.bin", b"localhost")]:
+    write("view", "corpus", name, b"\x02" + host)
 if check:
     for path in stale:
         print("stale: tests/fuzz/%s (run tests/fuzz/make_corpora.py BUILD_DIR)" % path)

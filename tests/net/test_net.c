@@ -1,5 +1,5 @@
 /*
- * The daemon's socket filter and network helpers (server/daemon/rt_net.c) on this host:
+ * The daemon's socket filter and network helpers (server/wire/lagsim_net.c) on this host:
  * which LCM datagrams the filter keeps (exact channel names of every length, short
  * messages only, from this host), that it finds LCM's own receive socket, that a marker
  * sent after the filter comes back (and does not when the filter keeps it out), and the
@@ -20,7 +20,7 @@
 #include <lcm/lcm.h>
 
 #include "lagsim_test.h"
-#include "rt_net.h"
+#include "lagsim_net.h"
 
 #define GROUP "239.255.76.67"
 
@@ -99,7 +99,7 @@ static void case_channels(int arg)
         snprintf(longer, sizeof longer, "%sQ", name);
         snprintf(shorter, sizeof shorter, "%.*s", len - 1, name);
         const char *chans[2] = {name, "SECOND_CHANNEL"};
-        int n = rt_net_filter(port, len % 2 == 0, chans, 2, err, sizeof err);
+        int n = lag_net_filter(port, len % 2 == 0, chans, 2, err, sizeof err);
         ENSURE(n == 1);
         if (n != 1) {
             fprintf(stderr, "filter: %s\n", n < 0 ? err : "no socket found");
@@ -139,9 +139,9 @@ static void case_lcm_socket(int arg)
     ENSURE(rx && tx);
     if (!rx || !tx) return;
     const char *keep[1] = {"NET_KEEP"};
-    ENSURE(rt_net_filter(port, true, keep, 1, err, sizeof err) == 0); /* no socket yet */
+    ENSURE(lag_net_filter(port, true, keep, 1, err, sizeof err) == 0); /* no socket yet */
     lcm_subscribe(rx, ".*", on_any, NULL);
-    ENSURE(rt_net_filter(port, true, keep, 1, err, sizeof err) == 1);
+    ENSURE(lag_net_filter(port, true, keep, 1, err, sizeof err) == 1);
     handled = 0;
     for (int k = 0; k < 5; k++) {
         lcm_publish(tx, "NET_KEEP", "x", 1);
@@ -157,7 +157,7 @@ static void case_lcm_socket(int arg)
 }
 
 /* A marker sent after the filter comes back when the filter keeps its channel; when it
- * does not, rt_net_sync says so after its timeout instead of waiting for ever. */
+ * does not, lag_net_sync says so after its timeout instead of waiting for ever. */
 static void case_sync(int arg)
 {
     (void)arg;
@@ -168,11 +168,11 @@ static void case_sync(int arg)
     ENSURE(lcm != NULL);
     if (!lcm) return;
     lcm_subscribe(lcm, "NET_X", on_any, NULL);
-    const char *with[2] = {"NET_X", RT_NET_MARKER_CHANNEL}, *without[1] = {"NET_X"};
-    ENSURE(rt_net_filter(port, true, with, 2, err, sizeof err) == 1);
-    ENSURE(rt_net_sync(lcm, 3000) == 0);
-    ENSURE(rt_net_filter(port, true, without, 1, err, sizeof err) == 1);
-    ENSURE(rt_net_sync(lcm, 300) == -1);
+    const char *with[2] = {"NET_X", LAG_NET_MARKER_CHANNEL}, *without[1] = {"NET_X"};
+    ENSURE(lag_net_filter(port, true, with, 2, err, sizeof err) == 1);
+    ENSURE(lag_net_sync(lcm, 3000) == 0);
+    ENSURE(lag_net_filter(port, true, without, 1, err, sizeof err) == 1);
+    ENSURE(lag_net_sync(lcm, 300) == -1);
     lcm_destroy(lcm);
 }
 
@@ -182,10 +182,10 @@ static void case_route(int arg)
 {
     (void)arg;
     char ifname[64];
-    int rc = rt_net_group_iface(GROUP, ifname, sizeof ifname);
+    int rc = lag_net_group_iface(GROUP, ifname, sizeof ifname);
     printf("route to " GROUP ": %s (%d)\n", ifname, rc);
     ENSURE(rc == 0 && if_nametoindex(ifname) > 0);
-    ENSURE(rt_net_group_iface("not an address", ifname, sizeof ifname) == -1);
+    ENSURE(lag_net_group_iface("not an address", ifname, sizeof ifname) == -1);
 }
 
 int main(int argc, char **argv)

@@ -1,8 +1,8 @@
 /*
  * LCM's receive sockets: a filter for where datagrams come from and which channels they
- * carry, and the interface a group is joined on. See rt_net.h.
+ * carry, and the interface a group is joined on. See lagsim_net.h.
  */
-#include "rt_net.h"
+#include "lagsim_net.h"
 
 #include <arpa/inet.h>
 #include <dirent.h>
@@ -110,11 +110,11 @@ static int build(prog *p, bool host_only, const char *const *channels, int n, ch
     return 0;
 }
 
-/* The sockets this process had before it made its own (rt_net_note_inherited): a parent
+/* The sockets this process had before it made its own (lag_net_note_inherited): a parent
  * that forked the daemon without close-on-exec shares them, and a filter on one would
  * filter the parent's traffic too. */
-#define RT_NET_INHERITED_MAX 64
-static int inherited[RT_NET_INHERITED_MAX];
+#define LAG_NET_INHERITED_MAX 64
+static int inherited[LAG_NET_INHERITED_MAX];
 static int n_inherited;
 
 /* Calls fn(fd, user) for every AF_INET datagram socket of this process bound to `port`
@@ -152,11 +152,11 @@ static int each_udp_socket(int port, int (*fn)(int fd, void *user), void *user)
 static int note_one(int fd, void *user)
 {
     (void)user;
-    if (n_inherited < RT_NET_INHERITED_MAX) inherited[n_inherited++] = fd;
+    if (n_inherited < LAG_NET_INHERITED_MAX) inherited[n_inherited++] = fd;
     return 0;
 }
 
-void rt_net_note_inherited(void)
+void lag_net_note_inherited(void)
 {
     n_inherited = 0;
     each_udp_socket(-1, note_one, NULL);
@@ -177,14 +177,14 @@ static int attach_one(int fd, void *user)
     return 0;
 }
 
-int rt_net_filter(int port, bool host_only, const char *const *channels, int n, char *err,
+int lag_net_filter(int port, bool host_only, const char *const *channels, int n, char *err,
                   size_t errlen)
 {
-    if (n < 1 || n > RT_NET_MAX_FILTER_CHANNELS) {
-        snprintf(err, errlen, "filter: 1 to %d channels", RT_NET_MAX_FILTER_CHANNELS);
+    if (n < 1 || n > LAG_NET_MAX_FILTER_CHANNELS) {
+        snprintf(err, errlen, "filter: 1 to %d channels", LAG_NET_MAX_FILTER_CHANNELS);
         return -1;
     }
-    static prog p; /* one daemon thread sets filters, at start */
+    static prog p; /* one thread sets filters, at start */
     if (build(&p, host_only, channels, n, err, errlen) < 0) return -1;
     attach a = {{(unsigned short)p.n, p.in}, 0};
     int rc = each_udp_socket(port, attach_one, &a);
@@ -221,15 +221,15 @@ static int64_t mono_ms(void)
     return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
 }
 
-int rt_net_sync(lcm_t *lcm, int timeout_ms)
+int lag_net_sync(lcm_t *lcm, int timeout_ms)
 {
     static unsigned counter;
     marker m = {.seen = false};
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
-    snprintf(m.text, sizeof m.text, "lagsimd %ld sync %u %lld.%09ld", (long)getpid(), ++counter,
+    snprintf(m.text, sizeof m.text, "lagsim %ld sync %u %lld.%09ld", (long)getpid(), ++counter,
              (long long)ts.tv_sec, ts.tv_nsec);
-    lcm_subscription_t *sub = lcm_subscribe(lcm, RT_NET_MARKER_CHANNEL, on_marker, &m);
+    lcm_subscription_t *sub = lcm_subscribe(lcm, LAG_NET_MARKER_CHANNEL, on_marker, &m);
     if (!sub) return -1;
     lcm_subscription_set_queue_capacity(sub, 1000);
     int64_t end = mono_ms() + timeout_ms, next_send = 0;
@@ -237,7 +237,7 @@ int rt_net_sync(lcm_t *lcm, int timeout_ms)
         int64_t now = mono_ms();
         if (now >= end) break;
         if (now >= next_send) { /* a marker lost on the way is sent again */
-            lcm_publish(lcm, RT_NET_MARKER_CHANNEL, m.text, (unsigned)strlen(m.text));
+            lcm_publish(lcm, LAG_NET_MARKER_CHANNEL, m.text, (unsigned)strlen(m.text));
             next_send = now + 100;
         }
         int64_t wait = next_send < end ? next_send - now : end - now;
@@ -248,7 +248,7 @@ int rt_net_sync(lcm_t *lcm, int timeout_ms)
 }
 
 /* ---------------------------------------------------------------- route */
-int rt_net_group_iface(const char *group, char *ifname, size_t len)
+int lag_net_group_iface(const char *group, char *ifname, size_t len)
 {
     snprintf(ifname, len, "?");
     struct in_addr g;
