@@ -7,12 +7,14 @@
 #   lib/                     liblagsim_client.a, liblagsim_controller.a and what they
 #                            link; lagsim-client.pc
 #   lib/python3.X/dist-packages/   lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
-#                            (on Debian's sys.path for prefix /usr/local)
+#                            (on Debian's sys.path for prefix /usr/local; for prefix /usr,
+#                            lib/python3/dist-packages)
 #   share/lua/5.2/           lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
 #                            (on lua5.2's default path for prefix /usr/local)
 #   share/java/              lagsim_types.jar, lagsim_examples.jar
 #   share/lagsim/            config/*.yaml, lcmtypes/*.lcm, examples/{python,lua}/
-#   share/man/man1/          lagsimd.1
+#   share/man/man1/          every docs/man/*.1
+#   lib/systemd/system/      lagsimd@.service (a plant per /etc/lagsim/NAME.yaml)
 # lagsim-client.pc finds its prefix from its own place, so the tree can be moved.
 # Included last from the top-level CMakeLists.txt, so every target exists already.
 include(GNUInstallDirs)
@@ -58,17 +60,39 @@ file(GLOB _lcm ${PROJECT_SOURCE_DIR}/lcmtypes/*.lcm)
 install(FILES ${_lcm} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/lcmtypes)
 file(GLOB _cfg ${PROJECT_SOURCE_DIR}/config/*.yaml)
 install(FILES ${_cfg} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/config)
-install(FILES ${PROJECT_SOURCE_DIR}/docs/man/lagsimd.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+file(GLOB _man CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/docs/man/*.1)
+install(FILES ${_man} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+
+# The systemd template unit lagsimd@NAME (/etc/lagsim/NAME.yaml), naming the lagsimd of
+# the prefix it is installed into: made at install time, since `cpack` installs into
+# /usr whatever the build was configured with. <prefix>/lib/systemd/system is on
+# systemd's unit path for /usr and /usr/local.
+install(CODE "set(LAGSIMD \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_BINDIR}/lagsimd\")
+  configure_file(\"${PROJECT_SOURCE_DIR}/server/daemon/lagsimd@.service.in\"
+                 \"${CMAKE_BINARY_DIR}/lagsimd@.service\" @ONLY)")
+install(FILES ${CMAKE_BINARY_DIR}/lagsimd@.service DESTINATION lib/systemd/system)
 
 # Python: types and helpers in the site directory, examples in share/lagsim/examples.
 find_program(LAGSIM_PYTHON3 python3)
 if(LAGSIM_PYTHON3)
   execute_process(COMMAND ${LAGSIM_PYTHON3} -c "import sys; print('%d.%d' % sys.version_info[:2])"
                   OUTPUT_VARIABLE _pyver OUTPUT_STRIP_TRAILING_WHITESPACE)
-  set(LAGSIM_INSTALL_PYTHONDIR "${CMAKE_INSTALL_LIBDIR}/python${_pyver}/dist-packages"
-      CACHE STRING "where the Python types and helpers go, relative to the prefix")
+  # Debian's sys.path: /usr/lib/python3/dist-packages for packaged modules (prefix /usr,
+  # as `cpack -G DEB` installs), <prefix>/lib/python3.X/dist-packages for /usr/local.
+  # Chosen at install time, as the prefix is; a value set here wins.
+  set(LAGSIM_PYTHON_SITEDIR "" CACHE STRING
+      "where the Python types and helpers go, relative to the prefix (empty: Debian's place for the prefix)")
+  if(LAGSIM_PYTHON_SITEDIR)
+    install(CODE "set(_lagsim_pydir \"${LAGSIM_PYTHON_SITEDIR}\")")
+  else()
+    install(CODE "if(CMAKE_INSTALL_PREFIX STREQUAL \"/usr\")
+        set(_lagsim_pydir lib/python3/dist-packages)
+      else()
+        set(_lagsim_pydir ${CMAKE_INSTALL_LIBDIR}/python${_pyver}/dist-packages)
+      endif()")
+  endif()
   install(DIRECTORY ${CMAKE_BINARY_DIR}/python/
-          DESTINATION ${LAGSIM_INSTALL_PYTHONDIR} FILES_MATCHING PATTERN "*.py"
+          DESTINATION "\${_lagsim_pydir}" FILES_MATCHING PATTERN "*.py"
           PATTERN "__pycache__" EXCLUDE)
   install(PROGRAMS ${PROJECT_SOURCE_DIR}/clients/python/dipc_balance.py
                    ${PROJECT_SOURCE_DIR}/clients/python/manipulator_pd.py
