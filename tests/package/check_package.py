@@ -297,13 +297,15 @@ def do_install(a):
                      os.path.join(a.source, "clients/manipulator_pd.c")] + pc.stdout.split(), env=env)
             check(r.returncode == 0, "a C controller builds against /usr/include and /usr/lib", r.stdout)
 
-        # what systemd makes for an instance with a state directory (DynamicUser)
+        # what systemd 252 makes for an instance's StateDirectory=lagsim/%i with DynamicUser
+        # (seen under systemd: /var/lib/lagsim/NAME -> ../private/lagsim/NAME)
         state = None
         if not os.path.lexists("/var/lib/lagsim") and not os.path.lexists("/var/lib/private/lagsim"):
             state = "/var/lib/private/lagsim/pkgtest"
             os.makedirs(state)
             open(os.path.join(state, "run.lcm"), "w").close()
-            os.symlink("private/lagsim", "/var/lib/lagsim")
+            os.makedirs("/var/lib/lagsim")
+            os.symlink("../private/lagsim/pkgtest", "/var/lib/lagsim/pkgtest")
     finally:
         if installed or installed_version():
             r = run(["dpkg", "--purge", "lagsim"], env=env)
@@ -315,7 +317,7 @@ def do_install(a):
           "directories is left%s" % (": " + " ".join(left + left_dirs) if left or left_dirs else ""))
     if state:
         check(not os.path.lexists("/var/lib/lagsim") and not os.path.lexists("/var/lib/private/lagsim"),
-              "the purge removed the instances' state (/var/lib/lagsim -> private/lagsim)")
+              "the purge removed the instances' state (/var/lib/lagsim, /var/lib/private/lagsim)")
     if fails == 0:
         shutil.rmtree(tmp, ignore_errors=True)
 
