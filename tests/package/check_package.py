@@ -298,6 +298,10 @@ def installed_checks(a, tmp, env):
     check(r.returncode == 0 and not r.stdout.strip(),
           "systemd-analyze verify lagsimd@pkgtest.service (the installed unit, /usr/bin/lagsimd, man page)",
           r.stdout)
+    r = run(["systemd-analyze", "security", "--offline=yes", "lagsimd@pkgtest.service"], env=env)
+    m = re.search(r"Overall exposure level for \S+: ([0-9.]+)", r.stdout)
+    check(m and float(m.group(1)) <= EXPOSURE_MAX, "systemd-analyze security --offline=yes "
+          "lagsimd@pkgtest.service (installed): %s" % (m.group(1) if m else "?"), r.stdout)
     r = run(["man", "-w", "lagsimd"], env=env)
     check(r.stdout.strip() == "/usr/share/man/man1/lagsimd.1.gz", "man -w lagsimd: %s" % r.stdout.strip())
 
