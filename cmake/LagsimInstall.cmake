@@ -67,10 +67,14 @@ install(FILES ${_man} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
 # the prefix it is installed into: made at install time, since `cpack` installs into
 # /usr whatever the build was configured with. <prefix>/lib/systemd/system is on
 # systemd's unit path for /usr and /usr/local.
+# Configured into a directory of its own per destination: `cpack` (into /usr) and a
+# `cmake --install --prefix` may run at the same time from one build directory.
 install(CODE "set(LAGSIMD \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_BINDIR}/lagsimd\")
+  string(MD5 _dest \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}\")
   configure_file(\"${PROJECT_SOURCE_DIR}/server/daemon/lagsimd@.service.in\"
-                 \"${CMAKE_BINARY_DIR}/lagsimd@.service\" @ONLY)")
-install(FILES ${CMAKE_BINARY_DIR}/lagsimd@.service DESTINATION lib/systemd/system)
+                 \"${CMAKE_BINARY_DIR}/systemd/\${_dest}/lagsimd@.service\" @ONLY)
+  file(INSTALL DESTINATION \"\${CMAKE_INSTALL_PREFIX}/lib/systemd/system\" TYPE FILE
+       FILES \"${CMAKE_BINARY_DIR}/systemd/\${_dest}/lagsimd@.service\")")
 
 # Python: types and helpers in the site directory, examples in share/lagsim/examples.
 find_program(LAGSIM_PYTHON3 python3)
