@@ -33,7 +33,8 @@ service (root only, else skipped; skipped too when this host cannot start system
   with no_new_privs and a seccomp filter; its events are in the journal; --log (from
   /etc/lagsim/NAME.env) writes into /var/lib/lagsim/NAME and replays exactly; a SIGKILL
   is followed by a restart, `systemctl stop` by exit 0; a bad scene fails with exit 2
-  and is not restarted. Then the purge, as in install.
+  and is not restarted; `dpkg --purge` run there stops an enabled, running instance and
+  removes its link. Then the checks after the purge, as in install.
 One run at a time on a host: a lock file (LOCK) is held for the whole of it.
 """
 import argparse
@@ -243,6 +244,12 @@ def installed_version():
     return r.returncode == 0 and "ok installed" in r.stdout
 
 
+def known_to_dpkg():
+    """Installed, half-installed or removed with its configuration left: purge it."""
+    r = run(["dpkg-query", "-W", "-f", "${Status}", "lagsim"], stderr=subprocess.DEVNULL)
+    return r.returncode == 0 and "not-installed" not in r.stdout
+
+
 def do_install(a, service=False):
     deb, _ = deb_path(a.build)
     if not check(os.path.exists(deb), "%s made (test package_build)" % deb):
@@ -276,7 +283,7 @@ def do_install(a, service=False):
                 os.makedirs("/var/lib/lagsim")
                 os.symlink("../private/lagsim/pkgtest", "/var/lib/lagsim/pkgtest")
     finally:
-        if installed or installed_version():
+        if known_to_dpkg():
             r = run(["dpkg", "--purge", "lagsim"], env=env)
             check(r.returncode == 0 and not installed_version(), "dpkg --purge lagsim", r.stdout)
     left = [p for p, existed in before.items() if not existed and os.path.lexists("/" + p)]
@@ -500,6 +507,22 @@ def service_checks(a, tmp):
               sd.show(ubad, "ActiveState") == "failed" and "%s.yaml:2:1: unknown key" % bad in jb,
               "a bad scene: exit %s, %s, not restarted (NRestarts %s), file:line:column in the journal"
               % (sd.show(ubad, "ExecMainStatus"), sd.show(ubad, "ActiveState"), sd.show(ubad, "NRestarts")), jb)
+        # removal where systemd runs: the prerm stops every instance, the purge removes the
+        # links of enabled ones (dpkg run inside the namespace, which has /run/systemd/system)
+        sd.ctl("enable", "--now", unit)
+        time.sleep(1)
+        link = "/etc/systemd/system/multi-user.target.wants/" + unit
+        was = (sd.show(unit, "ActiveState"), sd.sh(["test", "-L", link]).returncode == 0)
+        # in a mount namespace of its own under systemd's, without the unit directory shown
+        # to systemd, so that dpkg removes the host's files, not the copies systemd sees
+        r = sd.sh(["unshare", "--mount", "sh", "-c", "umount /usr/lib/systemd/system && "
+                   "exec dpkg --purge lagsim"])
+        now = (sd.show(unit, "ActiveState"), sd.sh(["test", "-L", link]).returncode == 0)
+        gone = not os.path.lexists("/var/lib/lagsim/" + name) and not os.path.lexists("/var/lib/private/lagsim")
+        check(r.returncode == 0 and was == ("active", True) and now == ("inactive", False) and gone,
+              "dpkg --purge under systemd: the enabled, running instance (%s, linked %s) is stopped "
+              "and unlinked (%s, linked %s); its state directory (the record) removed: %s"
+              % (was + now + (gone,)), r.stdout)
     finally:
         sd.stop()
         for p in ours:
