@@ -159,11 +159,12 @@ def do_build(a):
     absent = [p for p in places if p not in pkg]
     check(not absent, "in Debian's places: %d files (every man page, scene, .lcm)%s"
           % (len(places), "; absent " + " ".join(absent) if absent else ""))
-    octave = glob.glob(os.path.join(a.source, "clients/octave/**/*.m"), recursive=True)
-    if octave:
-        m = [p for p in pkg if p.endswith(".m") and p.startswith("usr/share/")]
-        check(len(m) >= len(octave), "the Octave files of clients/octave: %d of %d under /usr/share"
-              % (len(m), len(octave)))
+    octave = [os.path.relpath(m, os.path.join(a.source, "clients/octave")) for m in
+              glob.glob(os.path.join(a.source, "clients/octave/**/*.m"), recursive=True)]
+    if octave:   # MATLAB/Octave: LAGSIM_OCTAVE_INSTALL_DIR's default, share/lagsim/octave
+        absent = [m for m in octave if "usr/share/lagsim/octave/" + m not in pkg]
+        check(not absent, "the %d .m files of clients/octave in /usr/share/lagsim/octave%s"
+              % (len(octave), "; absent " + " ".join(absent) if absent else ""))
     pypath = run([DEBIAN_PYTHON, "-I", "-c", "import sys; print('\\n'.join(sys.path))"]).stdout.split()
     check("/usr/lib/python3/dist-packages" in pypath, "/usr/lib/python3/dist-packages is on python3's sys.path")
     lua = run(["lua5.2", "-e", "print(package.path)"], env=clean_env()).stdout
