@@ -20,7 +20,8 @@ install (root only, else skipped with exit 77; also skipped when a lagsim packag
   apt-get installs the .deb; `systemd-analyze verify` passes on the installed unit;
   the installed lagsimd runs offline, byte for byte as the build's; the installed
   dipc_lqr balances the installed lagsimd in real time, the installed Python example
-  (modules from /usr/lib/python3/dist-packages, no PYTHONPATH) in lockstep; a C program
+  (modules from /usr/lib/python3/dist-packages, no PYTHONPATH) in lockstep, and so does
+  the installed Octave dipc_balance.m when the package has it and octave is installed; a C program
   builds with `pkg-config lagsim-client`; then `dpkg --purge` leaves none of the
   package's files (dpkg -L, taken before) and no state directory behind.
 service (root only, else skipped; skipped too when this host cannot start systemd in a
@@ -345,6 +346,13 @@ def installed_checks(a, tmp, env):
           "--check", "states == 201", "--check", "max_abs_theta1 < 0.1"],
          [DEBIAN_PYTHON, "/usr/share/lagsim/examples/python/dipc_balance.py", "-q", "--prefix", "{prefix}"]),
     ]
+    if os.path.exists("/usr/share/lagsim/octave/dipc_balance.m") and shutil.which("octave", path=env["PATH"]):
+        # as docs/clients.md has a user run it: the installed folder on Octave's path
+        runs.append(("Octave dipc_balance.m in lockstep", ["--mode", "lockstep", "--name", "PKGOCT",
+                     "--daemon-arg=--duration", "--daemon-arg=2",
+                     "--check", "states == 201", "--check", "max_abs_theta1 < 0.1"],
+                     ["octave", "--no-gui", "--quiet", "--no-window-system", "--no-init-file", "--path",
+                      "/usr/share/lagsim/octave", "--eval", "dipc_balance --prefix {prefix} -q"]))
     for name, opts, client in runs:
         r = run(e2e + opts + ["--"] + client, cwd=tmp, env=env)
         check(r.returncode == 0, "installed lagsimd with the installed %s" % name, r.stdout)
