@@ -12,7 +12,9 @@ set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME lagsim)
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGE_VENDOR "lagsim")
-set(CPACK_PACKAGE_CONTACT "lagsim maintainers <maintainers@users.noreply.h-seed-120a95a9.example>")
+set(LAGSIM_DEB_MAINTAINER "lagsim maintainers <maintainers@lagsim.example>" CACHE STRING
+    "the .deb's Maintainer field: who builds it (e.g. a lab's admin)")
+set(CPACK_PACKAGE_CONTACT "${LAGSIM_DEB_MAINTAINER}")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)          # lagsim_0.1.0_amd64.deb
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "real-time simulation server for Lagrangian models over LCM")

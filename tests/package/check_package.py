@@ -555,7 +555,7 @@ def main():
     if a.what in ("install", "service"):
         if os.geteuid() != 0:
             print("SKIP: installing the package needs root (CI runs the suite as root on a "
-                  "throwaway machine); `sudo ctest -R package_install` runs it here")
+                  "throwaway machine); `sudo ctest -L package` runs it here")
             return SKIP
         if installed_version():
             print("SKIP: a lagsim package is installed on this host already; this test would "
