@@ -7,7 +7,8 @@
 #   lib/                     liblagsim_client.a, liblagsim_controller.a and what they
 #                            link; lagsim-client.pc
 #   lib/python3.X/dist-packages/   lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
-#                            (on Debian's sys.path for prefix /usr/local)
+#                            (on Debian's sys.path for prefix /usr/local; for prefix /usr,
+#                            lib/python3/dist-packages)
 #   share/lua/5.2/           lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
 #                            (on lua5.2's default path for prefix /usr/local)
 #   share/java/              lagsim_types.jar, lagsim_examples.jar
@@ -15,6 +16,7 @@
 #   share/lagsim/octave/     the MATLAB/Octave controllers (clients/octave/CMakeLists.txt:
 #                            LAGSIM_OCTAVE_INSTALL_DIR)
 #   share/man/man1/          a page for each program of bin/
+#   lib/systemd/system/      lagsimd@.service (a plant per /etc/lagsim/NAME.yaml)
 # lagsim-client.pc finds its prefix from its own place, so the tree can be moved.
 # Included last from the top-level CMakeLists.txt, so every target exists already.
 include(GNUInstallDirs)
@@ -61,18 +63,43 @@ install(FILES ${_lcm} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/lcmtypes)
 file(GLOB _cfg ${PROJECT_SOURCE_DIR}/config/*.yaml)
 install(FILES ${_cfg} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/config)
 # one page per program in bin/ (tests/install/check_man.py holds each to its --help)
-file(GLOB _man ${PROJECT_SOURCE_DIR}/docs/man/*.1)
+file(GLOB _man CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/docs/man/*.1)
 install(FILES ${_man} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+
+# The systemd template unit lagsimd@NAME (/etc/lagsim/NAME.yaml), naming the lagsimd of
+# the prefix it is installed into: made at install time, since `cpack` installs into
+# /usr whatever the build was configured with. <prefix>/lib/systemd/system is on
+# systemd's unit path for /usr and /usr/local.
+# Configured into a directory of its own per destination: `cpack` (into /usr) and a
+# `cmake --install --prefix` may run at the same time from one build directory.
+install(CODE "set(LAGSIMD \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_BINDIR}/lagsimd\")
+  string(MD5 _dest \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}\")
+  configure_file(\"${PROJECT_SOURCE_DIR}/server/daemon/lagsimd@.service.in\"
+                 \"${CMAKE_BINARY_DIR}/systemd/\${_dest}/lagsimd@.service\" @ONLY)
+  file(INSTALL DESTINATION \"\${CMAKE_INSTALL_PREFIX}/lib/systemd/system\" TYPE FILE
+       FILES \"${CMAKE_BINARY_DIR}/systemd/\${_dest}/lagsimd@.service\")")
 
 # Python: types and helpers in the site directory, examples in share/lagsim/examples.
 find_program(LAGSIM_PYTHON3 python3)
 if(LAGSIM_PYTHON3)
   execute_process(COMMAND ${LAGSIM_PYTHON3} -c "import sys; print('%d.%d' % sys.version_info[:2])"
                   OUTPUT_VARIABLE _pyver OUTPUT_STRIP_TRAILING_WHITESPACE)
-  set(LAGSIM_INSTALL_PYTHONDIR "${CMAKE_INSTALL_LIBDIR}/python${_pyver}/dist-packages"
-      CACHE STRING "where the Python types and helpers go, relative to the prefix")
+  # Debian's sys.path: /usr/lib/python3/dist-packages for packaged modules (prefix /usr,
+  # as `cpack -G DEB` installs), <prefix>/lib/python3.X/dist-packages for /usr/local.
+  # Chosen at install time, as the prefix is; a value set here wins.
+  set(LAGSIM_PYTHON_SITEDIR "" CACHE STRING
+      "where the Python types and helpers go, relative to the prefix (empty: Debian's place for the prefix)")
+  if(LAGSIM_PYTHON_SITEDIR)
+    install(CODE "set(_lagsim_pydir \"${LAGSIM_PYTHON_SITEDIR}\")")
+  else()
+    install(CODE "if(CMAKE_INSTALL_PREFIX STREQUAL \"/usr\")
+        set(_lagsim_pydir lib/python3/dist-packages)
+      else()
+        set(_lagsim_pydir ${CMAKE_INSTALL_LIBDIR}/python${_pyver}/dist-packages)
+      endif()")
+  endif()
   install(DIRECTORY ${CMAKE_BINARY_DIR}/python/
-          DESTINATION ${LAGSIM_INSTALL_PYTHONDIR} FILES_MATCHING PATTERN "*.py"
+          DESTINATION "\${_lagsim_pydir}" FILES_MATCHING PATTERN "*.py"
           PATTERN "__pycache__" EXCLUDE)
   install(PROGRAMS ${PROJECT_SOURCE_DIR}/clients/python/dipc_balance.py
                    ${PROJECT_SOURCE_DIR}/clients/python/manipulator_pd.py

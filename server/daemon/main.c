@@ -4,6 +4,7 @@
  * Exit codes: 0 ok, 1 runtime failure, 2 usage or scene error (nothing ran).
  */
 #include <getopt.h>
+#include <sys/stat.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,7 +18,7 @@ static void usage(FILE *f)
 {
     fputs(
         "usage: lagsimd --config FILE [--set KEY=VALUE ...] [-q] [--duration SECONDS]\n"
-        "               [--log FILE.lcm [--log-buffer MIB] [--force]]\n"
+        "               [--log FILE.lcm [--log-buffer MIB] [--force | --increment]]\n"
         "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|- [--force]]\n"
         "               [--set ...]\n"
         "       lagsimd --config FILE --replay LOG.lcm [--tolerance X] [--set ...]\n"
@@ -53,6 +54,9 @@ static void usage(FILE *f)
         "      --force            --log, --csv: replace FILE if it exists (else refused,\n"
         "                         exit 2); never a symbolic link (not followed) nor the\n"
         "                         scene file itself, --force or not\n"
+        "  -i, --increment        --log: if FILE exists, write FILE.00, FILE.01, ... (the\n"
+        "                         first free name), as lcm-logger -i: a service restarted\n"
+        "                         with the same --log keeps every run's record\n"
         "      --log-buffer MIB   memory between the loop and the log writer, 0.25 to 1024\n"
         "                         (default 16)\n"
         "      --replay LOG.lcm   re-simulate a run recorded by --log or lcm-logger from the\n"
@@ -147,6 +151,26 @@ static int resolve_default_url(lag_scene *sc)
     return 0;
 }
 
+/* --increment: *path, or when it exists the first of path.00 ... path.99 that does not
+ * (lstat: a dangling symbolic link is a name taken too). Returns 0, or -1 after saying why. */
+static int next_free_name(const char **path)
+{
+    static char name[4096];
+    struct stat st;
+    if (lstat(*path, &st) != 0) return 0;
+    for (int k = 0; k < 100; k++) {
+        if (snprintf(name, sizeof name, "%s.%02d", *path, k) >= (int)sizeof name) break;
+        if (lstat(name, &st) != 0) {
+            fprintf(stderr, "lagsimd: --log %s exists: writing %s\n", *path, name);
+            *path = name;
+            return 0;
+        }
+    }
+    fprintf(stderr, "lagsimd: --log %s and %s.00 to .99 exist: move them away or give --force\n",
+            *path, *path);
+    return -1;
+}
+
 /* Whether the --set overrides give integrator.method (a scene's integrator.error then
  * chooses nothing: the run is told). */
 static bool integrator_given(const char *const *sets, int nsets)
@@ -187,6 +211,7 @@ int main(int argc, char **argv)
         {"cost", no_argument, NULL, OPT_COST},
         {"plot", required_argument, NULL, OPT_PLOT},
         {"force", no_argument, NULL, OPT_FORCE},
+        {"increment", no_argument, NULL, 'i'},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {"version", no_argument, NULL, 'V'},
@@ -194,7 +219,7 @@ int main(int argc, char **argv)
     };
 
     const char *config = NULL, *replay = NULL, *plot = NULL;
-    bool cost = false;
+    bool cost = false, increment = false;
     bool offline = false, have_duration = false, have_tolerance = false, have_ring = false;
     lagsimd_opts opts = {.quiet = false, .duration = 0.0, .csv = NULL};
     /* the --set overrides, and room for a calibration's choice (lagsimd_choice) */
@@ -209,7 +234,7 @@ int main(int argc, char **argv)
     int c, at = optind;
     /* '+': stop at the first argument that is not an option (reported below), so that
      * argv[at] is always the element an error concerns */
-    while ((c = getopt_long(argc, argv, "+:c:s:d:qhV", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "+:c:s:d:iqhV", longopts, NULL)) != -1) {
         switch (c) {
         case 'c':
             config = optarg;
@@ -273,6 +298,9 @@ int main(int argc, char **argv)
         case OPT_FORCE:
             opts.force = true;
             break;
+        case 'i':
+            increment = true;
+            break;
         case 'q':
             opts.quiet = true;
             break;
@@ -313,6 +341,10 @@ int main(int argc, char **argv)
         rc = usage_error("%s", "--cost measures the scene and exits: not with --offline, --replay or --log");
     } else if (plot && !cost) {
         rc = usage_error("%s", "--plot needs --cost");
+    } else if (increment && (!opts.log || opts.force)) {
+        rc = usage_error("%s", "--increment picks a free name for --log FILE: give --log, and not --force");
+    } else if (increment && next_free_name(&opts.log) != 0) {
+        rc = LAGSIMD_EXIT_USAGE;
     } else if (opts.force && !opts.log && !opts.csv) {
         rc = usage_error("%s", "--force replaces the file of --log or --csv: give one");
     } else {

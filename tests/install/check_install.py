@@ -6,7 +6,7 @@
 1. `cmake --install DIR --prefix TMP`; every file a user needs is there (programs, C
    headers and libraries with lagsim-client.pc, the .lcm files, the scenes, the Python,
    Lua and Java types and helpers, the example controllers, the man pages: check_man.py
-   holds each to its program's --help).
+   holds each to its program's --help; the systemd unit naming the installed lagsimd).
 2. The installed lagsimd runs the installed config/dipc.yaml in lockstep with the
    installed dipc_lqr, then with the installed Python, Lua, Java and Octave examples, each from a
    directory of its own and finding its modules the way an installed tree is found
@@ -67,6 +67,10 @@ def main():
             want.append("bin/" + prog)
     for w in want:
         check(os.path.exists(os.path.join(prefix, w)), "installed %s" % w)
+    unit = os.path.join(prefix, "lib/systemd/system/lagsimd@.service")
+    execs = [l for l in open(unit)] if os.path.exists(unit) else []
+    check(any(l.startswith("ExecStart=%s/bin/lagsimd " % prefix) for l in execs),
+          "installed lib/systemd/system/lagsimd@.service, naming %s/bin/lagsimd" % prefix)
     for w in ("lagsim/__init__.py", "lagsim_lcm.py", "lagsim_controller.py"):
         check(os.path.exists(os.path.join(pydir, w)), "installed %s" % os.path.join(
             os.path.relpath(pydir, prefix), w))

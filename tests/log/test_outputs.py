@@ -15,7 +15,8 @@ WRITER is one of the outputs, each run through the same table of cases:
 The cases: FILE is the input itself (and a hard link to it), with and without --force:
 refused, the input unchanged; FILE is a symbolic link to a file whose content must
 survive, with --force: refused, the target unchanged; FILE exists: refused without
---force (unchanged), replaced with it; FILE is new: written.
+--force (unchanged), replaced with it; FILE is new: written. lagsimd --log --increment
+writes FILE.00, FILE.01, ... beside an existing FILE, which it keeps.
 """
 import argparse
 import hashlib
@@ -180,6 +181,26 @@ def main():
         p = w.run(new, False)
         check(p.returncode == 0 and w.wrote(new),
               f"{name}: a new file: exit {p.returncode} {p.stderr.strip()}")
+
+        # 5. lagsimd --log --increment: an existing record kept, the next free name written
+        #    (FILE.00, then FILE.01), a dangling symbolic link counted as a name taken
+        if a.writer == "lagsimd_log":
+            before = digest(new)
+            for k in ("00", "01"):
+                p = w.lagsimd("--log", new, "--increment")
+                nxt = f"{new}.{k}"
+                check(p.returncode == 0 and digest(new) == before and os.path.exists(nxt)
+                      and w.wrote(nxt) and f"writing {nxt}" in p.stderr,
+                      f"{name}: --increment with the record there: exit {p.returncode}, kept: "
+                      f"{digest(new) == before}, wrote {nxt}: {os.path.exists(nxt)}; {p.stderr.strip()}")
+            os.symlink(precious, f"{new}.02")
+            p = w.lagsimd("--log", new, "--increment")
+            check(p.returncode == 0 and os.path.exists(f"{new}.03") and
+                  open(precious).read() == "results of a week\n",
+                  f"{name}: --increment skips a symbolic link's name: exit {p.returncode}")
+            p = w.lagsimd("--log", new, "--increment", "--force")
+            check(p.returncode == 2 and "not --force" in p.stderr,
+                  f"{name}: --increment with --force refused: exit {p.returncode}")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     print(f"{failures} failure(s)")

@@ -1,0 +1,70 @@
+# `cpack -G DEB` (in the build directory): lagsim_<version>_<arch>.deb, the files of
+# `cmake --install` (cmake/LagsimInstall.cmake) under /usr, in Debian's places:
+#   /usr/bin, /usr/include/lagsim, /usr/lib (static libraries), /usr/lib/pkgconfig,
+#   /usr/lib/python3/dist-packages, /usr/share/lua/5.2, /usr/share/java,
+#   /usr/share/lagsim (scenes, .lcm files, examples), /usr/share/man/man1,
+#   /usr/lib/systemd/system/lagsimd@.service,
+# plus what debhelper would add (cmake/deb/staging.cmake): the man pages gzipped, and
+# /usr/share/doc/lagsim/{copyright,changelog.gz}. Depends: the shared libraries of the
+# programs (dpkg-shlibdeps) and the table below for what is not ELF. Checked by
+# tests/package/ (ctest -L package): contents, lintian, install, run, purge.
+set(CPACK_GENERATOR DEB)
+set(CPACK_PACKAGE_NAME lagsim)
+set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
+set(CPACK_PACKAGE_VENDOR "lagsim")
+set(LAGSIM_DEB_MAINTAINER "lagsim maintainers <maintainers@lagsim.example>" CACHE STRING
+    "the .deb's Maintainer field: who builds it (e.g. a lab's admin)")
+set(CPACK_PACKAGE_CONTACT "${LAGSIM_DEB_MAINTAINER}")
+set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)          # lagsim_0.1.0_amd64.deb
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "real-time simulation server for Lagrangian models over LCM")
+# Debian's extended description (the summary above is its first line)
+set(CPACK_DEBIAN_PACKAGE_DESCRIPTION "lagsimd steps a sliding stick, a rotary/prismatic manipulator, a double
+inverted pendulum on a cart or a cart-pole in real time, publishes its joint
+states on LCM channels and takes effort commands from controllers in C, Python,
+Lua, Java or Octave; runs are recorded whole and re-simulated bit for bit.
+.
+This package holds the daemon and its tools, the C client library with its
+headers and pkg-config file, the message types for C, Python, Lua and Java,
+example controllers, the shipped scenes, and a systemd template unit,
+lagsimd@NAME, that runs /etc/lagsim/NAME.yaml as a service.")
+set(CPACK_DEBIAN_PACKAGE_SECTION science)
+set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
+set(CPACK_STRIP_FILES ON)                         # the programs; debug info stays in the build
+set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+
+# What the package needs beyond the programs' shared libraries (found by dpkg-shlibdeps):
+# relation # Debian package(s) # for
+set(_lagsim_deb_needs
+  "Depends # python3 # the Python modules in dist-packages (lagsim_lcm loads liblcm.so.1 with ctypes)"
+  "Recommends # gnuplot-nox # lagsim-plot"
+  "Recommends # liblcm-bin # lcm-logger and lcm-logplayer, to record and replay the bus"
+  "Recommends # lua5.2, liblcm-lua # the Lua 5.2 modules in /usr/share/lua/5.2"
+  "Recommends # liblcm-java, default-jre-headless | java-runtime-headless # lagsim_types.jar and lagsim_examples.jar (Java, MATLAB, Octave)"
+  "Suggests # liblcm-dev, libglib2.0-dev # C controllers: lagsim-client.pc requires lcm.pc, which needs glib's"
+  "Suggests # octave # the Octave/MATLAB controllers")
+foreach(_rel Depends Recommends Suggests)
+  set(_l "")
+  foreach(_n ${_lagsim_deb_needs})
+    string(REGEX REPLACE " *# *" ";" _f "${_n}")
+    list(GET _f 0 _r)
+    list(GET _f 1 _p)
+    if(_r STREQUAL _rel)
+      list(APPEND _l "${_p}")
+    endif()
+  endforeach()
+  string(REPLACE ";" ", " _l "${_l}")
+  string(TOUPPER ${_rel} _REL)
+  set(CPACK_DEBIAN_PACKAGE_${_REL} "${_l}")
+endforeach()
+
+# maintainer scripts: systemd reloaded when it runs; instances stopped on removal; their
+# state directories (records written by --log) and enablement links removed on purge
+set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA ${CMAKE_CURRENT_LIST_DIR}/deb/postinst
+    ${CMAKE_CURRENT_LIST_DIR}/deb/prerm ${CMAKE_CURRENT_LIST_DIR}/deb/postrm)
+set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION TRUE)
+# after the install into the staging directory, before the archive is made
+set(CPACK_PRE_BUILD_SCRIPTS ${CMAKE_CURRENT_LIST_DIR}/deb/staging.cmake)
+set(CPACK_LAGSIM_SOURCE_DIR ${PROJECT_SOURCE_DIR})
+set(CPACK_LAGSIM_MAINTAINER "${CPACK_PACKAGE_CONTACT}")
+include(CPack)
