@@ -30,8 +30,10 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_log import read_log, write_log  # noqa: E402
+
 fails = 0
-SYNC = 0xEDA1DA01
 
 
 def check(cond, what):
@@ -40,28 +42,6 @@ def check(cond, what):
     if not cond:
         fails += 1
     return cond
-
-
-def read_log(path):
-    """[(timestamp, channel, data)] of a whole LCM log."""
-    out = []
-    with open(path, "rb") as f:
-        b = f.read()
-    i = 0
-    while i + 28 <= len(b):
-        sync, _, ts, clen, dlen = struct.unpack_from(">IqqII", b, i)
-        if sync != SYNC or i + 28 + clen + dlen > len(b):
-            break
-        out.append((ts, b[i + 28:i + 28 + clen].decode(), b[i + 28 + clen:i + 28 + clen + dlen]))
-        i += 28 + clen + dlen
-    return out
-
-
-def write_log(path, records):
-    with open(path, "wb") as f:
-        for k, (ts, ch, data) in enumerate(records):
-            c = ch.encode()
-            f.write(struct.pack(">IqqII", SYNC, k, ts, len(c), len(data)) + c + data)
 
 
 def decode_state(data):
