@@ -159,23 +159,32 @@ static void publish_state(rt_server *s)
         s->answered = false;
         s->waiting_time = lag_sim_time(&s->sim);
         s->wait_start_ns = s->now;
-        s->next_retry_ns = rt_sat_add(s->now, s->lockstep_retry_ns);
+        s->answer_heard = false;
+        s->retry_gap_ns = s->lockstep_retry_ns;
+        s->next_retry_ns = rt_sat_add(s->now, s->retry_gap_ns);
     }
 }
 
-/* Lockstep, while a state is waited on and no answer has come: every lockstep_retry the
- * same state goes out again, byte for byte (utime included), so that a state or a
- * command lost on the way costs one retry instead of a timeout. A controller answers
- * every state it receives; a second answer to a state already answered is ignored
- * (commands_ignored), so the run does not depend on how many copies arrived. */
+/* Lockstep, while a state is waited on and no answer to it has come: the same state goes
+ * out again, byte for byte (utime included), lockstep_retry after it was published, then
+ * at gaps that double up to retry_cap_ns (a sixteenth of lockstep_timeout: as many more
+ * chances before it), so that a state or a command lost on the way costs a retry instead
+ * of a timeout, and a controller that thinks long per state gets a copy every 62.5 ms at
+ * most (default scene), not one per lockstep_retry. Once any command for that sim_time arrived
+ * (applied or rejected) the controller has the state: no more copies. A controller answers
+ * each state once and a copy of it with the same answer; a second answer to a state
+ * already answered is ignored (commands_ignored), so the run does not depend on how many
+ * copies arrived. */
 static void lockstep_retry(rt_server *s)
 {
-    if (s->now < s->next_retry_ns || s->state_len == 0) return;
+    if (s->now < s->next_retry_ns || s->state_len == 0 || s->answer_heard) return;
     /* straight to LCM, not through rt_wire's publish: a copy for the network, which --log
      * (the run's record, one state per period) does not keep */
     lcm_publish(s->lcm, s->ch_state, s->state_buf, s->state_len);
     s->lockstep_retries++;
-    s->next_retry_ns = rt_sat_add(s->now, s->lockstep_retry_ns);
+    int64_t cap = s->retry_cap_ns;
+    s->retry_gap_ns = s->retry_gap_ns > cap / 2 ? cap : 2 * s->retry_gap_ns;
+    s->next_retry_ns = rt_sat_add(s->now, s->retry_gap_ns);
 }
 
 static void publish_status(rt_server *s)
@@ -436,6 +445,8 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
         reject(s, RT_REJ_UNDECODABLE, "", (double)len, "payload bytes in value");
         return;
     }
+    /* lockstep: an answer to the state waited on, good or not, came: it needs no copies */
+    if (s->waiting && c.sim_time == s->waiting_time) s->answer_heard = true;
     int idx[LAG_MAX_DOF];
     for (int i = 0; i < c.num_joints; i++) {
         idx[i] = -1;
@@ -818,6 +829,8 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
                                ? rt_clamp_ns(sc->realtime.lockstep_retry * 1e9, RT_RETRY_NS_MIN,
                                              INT64_MAX)
                                : INT64_MAX;
+    s->retry_cap_ns = s->lockstep_wait_ns / 16 > s->lockstep_retry_ns ? s->lockstep_wait_ns / 16
+                                                                     : s->lockstep_retry_ns;
 
     s->nq = s->sim.nq;
     s->info = lag_sim_info(&s->sim); /* the joints published: a stick that may fly has h */
@@ -936,7 +949,8 @@ int64_t rt_next_wake(const rt_server *s)
                 wake = min64(wake, rt_sat_add(now, RT_LOG_HOLD_NS));
             } else {
                 wake = min64(wake, rt_sat_add(s->wait_start_ns, s->lockstep_wait_ns));
-                if (s->run == RT_RUNNING || s->pending_steps > 0) wake = min64(wake, s->next_retry_ns);
+                if ((s->run == RT_RUNNING || s->pending_steps > 0) && !s->answer_heard)
+                    wake = min64(wake, s->next_retry_ns);
             }
         }
         break;

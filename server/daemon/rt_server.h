@@ -128,6 +128,10 @@ typedef struct rt_server {
     int64_t lockstep_wait_ns;  /* realtime.lockstep_timeout, saturated */
     int64_t lockstep_retry_ns; /* realtime.lockstep_retry, saturated */
     int64_t next_retry_ns;     /* when the state waited on goes out again */
+    int64_t retry_gap_ns;      /* the gap before that copy: doubles after each, up to */
+    int64_t retry_cap_ns;      /* lockstep_timeout / 16, at least lockstep_retry */
+    bool answer_heard;         /* a command for the state waited on came (applied or not):
+                                * no more copies of it */
     double answered_time;      /* sim_time of the last state a command answered */
     bool have_answered;        /* answered_time holds one (since start or reset) */
 
