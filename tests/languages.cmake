@@ -222,19 +222,31 @@ if(LAGSIM_FUZZ)
   string(APPEND readme_c_flags " -fsanitize=fuzzer-no-link")
 endif()
 string(REPLACE ";" " " readme_lcm_libs "${LCM_LINK_LIBRARIES}")
-add_test(NAME clients_readme_c COMMAND ${readme_run}
-  "--c-build=${CMAKE_C_COMPILER} -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror ${readme_c_flags} {src} -o {out} -I${PROJECT_SOURCE_DIR}/clients -I${PROJECT_SOURCE_DIR}/server/wire -I${CMAKE_BINARY_DIR}/lcmtypes/c $<TARGET_FILE:lagsim_client> $<TARGET_FILE:lagsim_wire> $<TARGET_FILE:lagsim_lcmtypes> ${readme_lcm_libs} -lm"
-  c-dipc)
-add_test(NAME clients_readme_python COMMAND ${readme_run} python-dipc)
-list(APPEND lang_tests clients_readme_c clients_readme_python)
+set(readme_c_build
+  "--c-build=${CMAKE_C_COMPILER} -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror ${readme_c_flags} {src} -o {out} -I${PROJECT_SOURCE_DIR}/clients -I${PROJECT_SOURCE_DIR}/server/wire -I${CMAKE_BINARY_DIR}/lcmtypes/c $<TARGET_FILE:lagsim_client> $<TARGET_FILE:lagsim_wire> $<TARGET_FILE:lagsim_lcmtypes> ${readme_lcm_libs} -lm")
+set(readme_langs c python)
 if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
-  add_test(NAME clients_readme_lua COMMAND ${readme_run} lua-dipc)
-  list(APPEND lang_tests clients_readme_lua)
+  list(APPEND readme_langs lua)
 endif()
 if(TARGET lagsim_lcmtypes_java)
-  add_test(NAME clients_readme_java COMMAND ${readme_run} java-dipc)
-  list(APPEND lang_tests clients_readme_java)
+  list(APPEND readme_langs java)
 endif()
+# each block as written; then beside a run of it as written, the same block with a law of
+# 150 ms per answer (20 periods) and of 1.5 s (4 periods): every state answered, no
+# lockstep timeout, the fast run's states bit for bit
+foreach(lang IN LISTS readme_langs)
+  set(extra "")
+  if(lang STREQUAL "c")
+    set(extra "${readme_c_build}")
+  endif()
+  add_test(NAME clients_readme_${lang} COMMAND ${readme_run} ${extra} ${lang}-dipc)
+  add_test(NAME clients_readme_${lang}_slow_law
+    COMMAND ${readme_run} ${extra} --think 0.15 --periods 20 ${lang}-dipc)
+  add_test(NAME clients_readme_${lang}_slower_law
+    COMMAND ${readme_run} ${extra} --think 1.5 --periods 4 ${lang}-dipc)
+  list(APPEND lang_tests clients_readme_${lang} clients_readme_${lang}_slow_law
+    clients_readme_${lang}_slower_law)
+endforeach()
 
 # ---- README.md's shell recipes, run as written (tests/clients/readme_recipes.py): by hand
 # (controller, server for 10 s, lagsimctl status, an offline CSV) and record (lcm-logger,
