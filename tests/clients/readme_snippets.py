@@ -19,8 +19,9 @@ run's own (LCM_DEFAULT_URL): nothing of it may be heard on LCM's default URL.
 --think S runs each block twice for --periods N periods: once as written, then as written
 with a control law that takes S wall seconds per answer it builds (tests/clients/think/:
 every joint_command_t the block constructs, or every lag_client_send_command it calls,
-sleeps S first; the block's text is unchanged). The slow run must answer every state,
-with no lockstep timeout, and hear the states of the fast run bit for bit. In lockstep
+sleeps S first and is counted; the block's text is unchanged). The slow run must answer
+every state, with no lockstep timeout, run its law once per sim_time, and hear the
+states of the fast run bit for bit. In lockstep
 the daemon publishes a state again until an answer arrives: a block that ran its law for
 every copy would fall behind by a copy's worth of thinking per state and never catch up.
 A law slower than realtime.lockstep_timeout is late by definition, so that timeout is
@@ -64,9 +65,14 @@ def java_think_classes(build, tmp):
                             "joint_command_t.java")).read()
     plain = "public joint_command_t()\n    {\n    }"
     assert plain in src, "lcm-gen's Java constructor changed"
-    src = src.replace(plain, "public joint_command_t()\n    {\n        try { Thread.sleep((long)"
+    src = src.replace(plain, "public joint_command_t()\n    {\n        try {"
+                      " java.nio.file.Files.write(java.nio.file.Paths.get(System.getenv("
+                      "\"LAGSIM_THINK_LOG\")), \"law\\n\".getBytes(),"
+                      " java.nio.file.StandardOpenOption.CREATE,"
+                      " java.nio.file.StandardOpenOption.APPEND);"
+                      " Thread.sleep((long)"
                       "(1000 * Double.parseDouble(System.getenv(\"LAGSIM_THINK_S\")))); }"
-                      " catch (InterruptedException e) { }\n    }")
+                      " catch (Exception e) { }\n    }")
     d = os.path.join(tmp, "think_java")
     os.makedirs(os.path.join(d, "lagsim"))
     with open(os.path.join(d, "lagsim", "joint_command_t.java"), "w") as f:
@@ -165,6 +171,9 @@ def run_block(a, build, text, name, lang, think):
     env = dict(os.environ)
     env.update(env_extra(build))
     env["LAGSIM_THINK_S"] = repr(think)
+    think_log = os.path.join(tmp, "think.log")
+    if think > 0:
+        env["LAGSIM_THINK_LOG"] = think_log
     state_url, command_url = plant_urls()
     lc, lc_cmd = LCM(state_url), LCM(command_url)
     heard = {"states": 0, "max_th": 0.0, "t": -1.0, "status": None, "by_time": {}}
@@ -259,6 +268,12 @@ def run_block(a, build, text, name, lang, think):
          "on a port of its own: %d of its messages heard on LCM's default URL"
          % heard["stray"]),
     ]
+    if think > 0:
+        # the law runs once per state: the probe's, the N answered, perhaps the last one
+        laws = len(open(think_log).readlines()) if os.path.exists(think_log) else 0
+        checks.append((periods + 1 <= laws <= periods + 2,
+                       "its law ran %d times for the probe and %d states (once per sim_time: "
+                       "%d or %d)" % (laws, periods + 1, periods + 1, periods + 2)))
     print("---- %s (%s)%s" % (name, path, " with a law of %g s per answer" % think if think else ""))
     if out.strip():
         print(out.rstrip())

@@ -187,7 +187,7 @@ def case_live(a):
 def case_effects(a):
     prefix = f"TT{os.getpid()}S"
     d = Daemon(a, os.path.join(a.source, "config", "stick.yaml"), prefix, "--set",
-               "realtime.mode=fast", "--duration", "5")
+               "realtime.mode=fast", "--set", "realtime.start=running", "--duration", "5")
     d.read(10)
     rc = d.stop()
     t = d.text()
