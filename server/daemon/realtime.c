@@ -413,17 +413,48 @@ static void mode_lockstep(rt_server *s)
 /* ---------------------------------------------------------------- commands */
 static void lockstep_rewait(rt_server *s);
 
+/* The model's joints, the actuated ones marked: "theta0 (actuated), theta1, theta2" (or
+ * only the actuated ones), as the scene loader lists them; what a rejection offers. */
+static const char *joint_list(const rt_server *s, bool actuated_only, char *buf, size_t n)
+{
+    size_t k = 0;
+    buf[0] = '\0';
+    for (int i = 0; i < s->nq && k < n; i++) {
+        if (actuated_only && !s->info->actuated[i]) continue;
+        int w = snprintf(buf + k, n - k, "%s%s%s", k ? ", " : "", s->info->joint_names[i],
+                         !actuated_only && s->info->actuated[i] ? " (actuated)" : "");
+        if (w < 0) break;
+        k += (size_t)w;
+    }
+    if (!buf[0]) snprintf(buf, n, "none");
+    return buf;
+}
+
+/* A rejected command: counted by reason, and a command_rejected event (limited) whose
+ * detail says what was wrong and what would be accepted. */
 static void reject(rt_server *s, rt_reject why, const char *joint, double value,
-                   const char *what)
+                   const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+static void reject(rt_server *s, rt_reject why, const char *joint, double value,
+                   const char *fmt, ...)
 {
     static const char *const why_name[RT_REJ_COUNT] = {
-        "unknown joint", "unactuated joint", "non-finite effort", "bad length",
-        "undecodable payload", "stale (lockstep: answers another state)",
-        "effort beyond realtime.effort_limit"};
+        [RT_REJ_UNKNOWN_JOINT] = "unknown joint",
+        [RT_REJ_UNACTUATED] = "unactuated joint",
+        [RT_REJ_NONFINITE] = "non-finite effort",
+        [RT_REJ_BAD_LENGTH] = "bad length",
+        [RT_REJ_UNDECODABLE] = "undecodable payload",
+        [RT_REJ_STALE] = "stale (lockstep: answers another state)",
+        [RT_REJ_EFFORT_LIMIT] = "effort beyond realtime.effort_limit"};
+    _Static_assert(sizeof why_name / sizeof why_name[0] == RT_REJ_COUNT, "one name per reason");
+    char what[LAG_WIRE_TEXT_LEN];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
     s->rejected[why]++;
     /* a flood is counted in status, not echoed one for one */
-    limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s%s%s%s",
-                  why_name[why], what ? " (" : "", what ? what : "", what ? ")" : "");
+    limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s: %s",
+                  why_name[why], what);
 }
 
 /* A command is applied whole or not at all: every name known, actuated, distinct; every
@@ -434,15 +465,22 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
     lag_wire_joint_command c;
     int d = lag_wire_decode_joint_command(data, len, s->nq, &c);
     if (d == LAG_WIRE_ECOUNT) {
-        reject(s, RT_REJ_BAD_LENGTH, "", c.num_joints, "num_joints in value");
+        char all[160];
+        reject(s, RT_REJ_BAD_LENGTH, "", c.num_joints,
+               "num_joints %d (in value); accepted: 0 to %d, joints of %s: %s", c.num_joints,
+               s->nq, s->info->name, joint_list(s, false, all, sizeof all));
         return;
     }
     if (d == LAG_WIRE_ETOOLONG) { /* a well-formed name longer than any joint's */
-        reject(s, RT_REJ_UNKNOWN_JOINT, "", 0, "a name of 64 bytes or more");
+        char all[160];
+        reject(s, RT_REJ_UNKNOWN_JOINT, "", 0, "a name of 64 bytes or more; joints of %s: %s",
+               s->info->name, joint_list(s, false, all, sizeof all));
         return;
     }
     if (d != LAG_WIRE_OK) {
-        reject(s, RT_REJ_UNDECODABLE, "", (double)len, "payload bytes in value");
+        reject(s, RT_REJ_UNDECODABLE, "", (double)len,
+               "%zu bytes (in value) that are no lagsim.joint_command_t; accepted: a "
+               "joint_command_t as lcm-gen encodes it (lcmtypes/joint_command_t.lcm)", len);
         return;
     }
     /* lockstep: an answer to the state waited on, good or not, came: it needs no copies */
@@ -452,30 +490,38 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
         idx[i] = -1;
         for (int j = 0; j < s->nq; j++)
             if (strcmp(c.name[i], s->info->joint_names[j]) == 0) idx[i] = j;
+        char all[160];
         if (idx[i] < 0) {
-            reject(s, RT_REJ_UNKNOWN_JOINT, c.name[i], 0, NULL);
+            reject(s, RT_REJ_UNKNOWN_JOINT, c.name[i], 0, "'%s'; joints of %s: %s", c.name[i],
+                   s->info->name, joint_list(s, false, all, sizeof all));
             return;
         }
         for (int k = 0; k < i; k++)
             if (idx[k] == idx[i]) {
-                reject(s, RT_REJ_BAD_LENGTH, c.name[i], c.num_joints, "duplicate name");
+                reject(s, RT_REJ_BAD_LENGTH, c.name[i], c.num_joints,
+                       "'%s' named twice; accepted: each joint at most once (%s)", c.name[i],
+                       joint_list(s, false, all, sizeof all));
                 return;
             }
         if (!s->info->actuated[idx[i]]) {
-            reject(s, RT_REJ_UNACTUATED, c.name[i], 0, NULL);
+            reject(s, RT_REJ_UNACTUATED, c.name[i], 0,
+                   "'%s' takes no input; actuated joints of %s: %s", c.name[i], s->info->name,
+                   joint_list(s, true, all, sizeof all));
             return;
         }
         if (!isfinite(c.effort[i])) {
-            reject(s, RT_REJ_NONFINITE, c.name[i], 0, NULL);
+            reject(s, RT_REJ_NONFINITE, c.name[i], 0,
+                   "%g for '%s'; accepted: a finite effort within +-%g", c.effort[i], c.name[i],
+                   s->sc->realtime.effort_limit[idx[i]]);
             return;
         }
         /* a bound on what a command may ask, not the plant's saturation (that is the
          * actuator effect): an effort beyond it is a controller's bug, refused whole */
         double lim = s->sc->realtime.effort_limit[idx[i]];
         if (fabs(c.effort[i]) > lim) {
-            char what[64];
-            snprintf(what, sizeof what, "the effort in value, the limit %g", lim);
-            reject(s, RT_REJ_EFFORT_LIMIT, c.name[i], c.effort[i], what);
+            reject(s, RT_REJ_EFFORT_LIMIT, c.name[i], c.effort[i],
+                   "%g for '%s' (in value); accepted: |effort| <= %g", c.effort[i], c.name[i],
+                   lim);
             return;
         }
     }
@@ -489,7 +535,14 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
             return;
         }
         if (!waited_on && !(s->run != RT_RUNNING && c.sim_time == lag_sim_time(&s->sim))) {
-            reject(s, RT_REJ_STALE, "", c.sim_time, "its sim_time in value");
+            if (s->waiting)
+                reject(s, RT_REJ_STALE, "", c.sim_time,
+                       "sim_time %.9g (in value); accepted: %.9g, the state waited on",
+                       c.sim_time, s->waiting_time);
+            else
+                reject(s, RT_REJ_STALE, "", c.sim_time,
+                       "sim_time %.9g (in value); no state is waited on (the next one's "
+                       "sim_time will be)", c.sim_time);
             return;
         }
     }
@@ -609,14 +662,42 @@ static void lockstep_rewait(rt_server *s)
     else if (s->period_left == 0) s->want_state = true;
 }
 
+/* The requests of control_t, by value (lcmtypes/control_t.lcm): what a rejection of an
+ * unknown one offers. */
+static const char *control_requests(void)
+{
+    static const char *const names[] = {
+        [LAGSIM_CONTROL_T_PAUSE] = "PAUSE", [LAGSIM_CONTROL_T_RESUME] = "RESUME",
+        [LAGSIM_CONTROL_T_STEP] = "STEP", [LAGSIM_CONTROL_T_RESET] = "RESET",
+        [LAGSIM_CONTROL_T_RESET_TO] = "RESET_TO", [LAGSIM_CONTROL_T_STATUS] = "STATUS",
+        [LAGSIM_CONTROL_T_DESCRIBE] = "DESCRIBE", [LAGSIM_CONTROL_T_SET] = "SET"};
+    static char list[160];
+    if (!list[0]) {
+        size_t k = 0;
+        for (size_t i = 0; i < sizeof names / sizeof names[0] && k < sizeof list; i++) {
+            if (!names[i]) continue;
+            int w = snprintf(list + k, sizeof list - k, "%s%s = %zu", k ? ", " : "", names[i], i);
+            if (w < 0) break;
+            k += (size_t)w;
+        }
+    }
+    return list;
+}
+
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
 {
     rt_log_record(s, RT_LOG_IN, s->ch_control, data, len); /* --log: as received */
     lag_wire_control c;
     int d = lag_wire_decode_control(data, len, LAG_MAX_DOF, &c);
     if (d != LAG_WIRE_OK) {
-        control_rejected(s, d == LAG_WIRE_ECOUNT ? "control: num_joints out of range"
-                                                 : "control: undecodable payload");
+        char why[LAG_WIRE_TEXT_LEN];
+        if (d == LAG_WIRE_ECOUNT)
+            snprintf(why, sizeof why, "control: num_joints out of range; accepted: 0, or %d "
+                     "for reset_to (the joints of %s)", s->nq, s->info->name);
+        else
+            snprintf(why, sizeof why, "control: %zu bytes that are no lagsim.control_t; "
+                     "accepted: a control_t as lcm-gen encodes it (lcmtypes/control_t.lcm)", len);
+        control_rejected(s, why);
         return;
     }
     switch (c.request) {
@@ -644,11 +725,15 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
     case LAGSIM_CONTROL_T_STEP:
         if (s->run != RT_PAUSED && s->run != RT_WAITING) {
             control_rejected(s, s->run == RT_FAULT ? "step: in fault state (reset first)"
-                                                   : "step: only while paused");
+                                                   : "step: only while paused or waiting "
+                                                     "(pause first)");
             return;
         }
         if (c.count < 1) {
-            control_rejected(s, "step: count must be >= 1");
+            char why[96];
+            snprintf(why, sizeof why, "step: count %lld; accepted: a count >= 1",
+                     (long long)c.count);
+            control_rejected(s, why);
             return;
         }
         s->pending_steps = c.count;
@@ -663,7 +748,11 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
         return;
     case LAGSIM_CONTROL_T_RESET_TO: {
         if (c.num_joints != s->nq) {
-            control_rejected(s, "reset_to: num_joints must equal the model's joint count");
+            char why[LAG_WIRE_TEXT_LEN], all[160];
+            snprintf(why, sizeof why, "reset_to: num_joints %d; accepted: %d, the joints of %s "
+                     "in this order: %s", c.num_joints, s->nq, s->info->name,
+                     joint_list(s, false, all, sizeof all));
+            control_rejected(s, why);
             return;
         }
         double lim = s->sc->sim.explode_limit;
@@ -695,7 +784,10 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
         handle_set(s, &c);
         return;
     default:
-        control_rejected(s, "control: unknown request");
+        char why[LAG_WIRE_TEXT_LEN];
+        snprintf(why, sizeof why, "control: unknown request %d; accepted: %s", c.request,
+                 control_requests());
+        control_rejected(s, why);
         return;
     }
     s->want_status = true;

@@ -13,6 +13,7 @@
  *                           long_period chunks
  *                           step_paced control_flood command_flood duration signals
  *                           fault_effort lockstep_retry lockstep_loss other_plant
+ *                           reject_names
  */
 #include <math.h>
 #include <signal.h>
@@ -1119,6 +1120,57 @@ static void case_lockstep_retry(void)
     stop_server();
 }
 
+/* A rejection names what would be accepted: the DIPC's joints with the actuated one
+ * marked (theta0, the cart: its only input), the actuated joints alone, the effort limit,
+ * the sim_time waited on, the requests by value, a count >= 1, the joint count. */
+static void expect_detail(const char *kind, const char *want, int line)
+{
+    drain();
+    if (!strstr(last_detail(kind), want))
+        fail(line, "%s detail '%s' lacks '%s'", kind, last_detail(kind), want);
+    printf("%s: %s\n", kind, last_detail(kind));
+}
+
+static void case_reject_names(void)
+{
+    scene(LAG_RT_LOCKSTEP);
+    g_sc.realtime.start = LAG_RT_START_RUNNING;
+    g_sc.realtime.effort_limit[0] = 100;
+    start();
+    drain();
+    command(0.0, "cart", 1.0);
+    expect_detail("command_rejected", "unknown joint: 'cart'; joints of dipc: theta0 (actuated), "
+                  "theta1, theta2", __LINE__);
+    command(0.0, "theta1", 1.0);
+    expect_detail("command_rejected", "'theta1' takes no input; actuated joints of dipc: theta0",
+                  __LINE__);
+    command(0.0, "theta0", 250.0);
+    expect_detail("command_rejected", "250 for 'theta0' (in value); accepted: |effort| <= 100",
+                  __LINE__);
+    command(0.0, "theta0", NAN);
+    expect_detail("command_rejected", "accepted: a finite effort within +-100", __LINE__);
+    command(0.25, "theta0", 1.0);
+    expect_detail("command_rejected", "sim_time 0.25 (in value); accepted: 0, the state waited on",
+                  __LINE__);
+    control(99, 0);
+    expect_detail("control_rejected", "unknown request 99; accepted: PAUSE = 1, RESUME = 2, "
+                  "STEP = 3, RESET = 4, RESET_TO = 5, STATUS = 6, DESCRIBE = 7, SET = 8", __LINE__);
+    control(LAGSIM_CONTROL_T_PAUSE, 0);
+    control(LAGSIM_CONTROL_T_STEP, 0);
+    expect_detail("control_rejected", "step: count 0; accepted: a count >= 1", __LINE__);
+    {
+        uint8_t buf[256];
+        double q[2] = {0, 0}, qd[2] = {0, 0};
+        lagsim_control_t m = {0, LAGSIM_CONTROL_T_RESET_TO, 0, 2, q, qd, "", ""};
+        int n = lagsim_control_t_encode(buf, 0, sizeof buf, &m);
+        ENSURE(n > 0);
+        rt_handle_control(&g_srv, buf, (size_t)n);
+    }
+    expect_detail("control_rejected", "reset_to: num_joints 2; accepted: 3, the joints of dipc in "
+                  "this order: theta0 (actuated), theta1, theta2", __LINE__);
+    stop_server();
+}
+
 /* Runs a lockstep DIPC for `periods` periods with the test's controller losing `loss` of
  * the states and of the commands; returns the wall time (ns of the made-up clock). */
 static int64_t lockstep_run(double loss, int periods)
@@ -1232,6 +1284,7 @@ int main(int argc, char **argv)
         {"command_flood", case_command_flood}, {"duration", case_duration},
         {"signals", case_signals},         {"fault_effort", case_fault_effort},
         {"lockstep_retry", case_lockstep_retry}, {"lockstep_loss", case_lockstep_loss},
+        {"reject_names", case_reject_names},
         {"other_plant", case_other_plant},
     };
     if (argc != 2) {
