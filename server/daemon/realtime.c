@@ -430,6 +430,17 @@ static const char *joint_list(const rt_server *s, bool actuated_only, char *buf,
     return buf;
 }
 
+const char *const rt_reject_name[RT_REJ_COUNT] = {
+    [RT_REJ_UNKNOWN_JOINT] = "unknown joint",
+    [RT_REJ_UNACTUATED] = "unactuated joint",
+    [RT_REJ_NONFINITE] = "non-finite effort",
+    [RT_REJ_BAD_LENGTH] = "bad length",
+    [RT_REJ_UNDECODABLE] = "undecodable payload",
+    [RT_REJ_STALE] = "stale (lockstep: answers another state)",
+    [RT_REJ_EFFORT_LIMIT] = "effort beyond realtime.effort_limit"};
+_Static_assert(sizeof rt_reject_name / sizeof rt_reject_name[0] == RT_REJ_COUNT,
+               "one name per reason");
+
 /* A rejected command: counted by reason, and a command_rejected event (limited) whose
  * detail says what was wrong and what would be accepted. */
 static void reject(rt_server *s, rt_reject why, const char *joint, double value,
@@ -437,24 +448,16 @@ static void reject(rt_server *s, rt_reject why, const char *joint, double value,
 static void reject(rt_server *s, rt_reject why, const char *joint, double value,
                    const char *fmt, ...)
 {
-    static const char *const why_name[RT_REJ_COUNT] = {
-        [RT_REJ_UNKNOWN_JOINT] = "unknown joint",
-        [RT_REJ_UNACTUATED] = "unactuated joint",
-        [RT_REJ_NONFINITE] = "non-finite effort",
-        [RT_REJ_BAD_LENGTH] = "bad length",
-        [RT_REJ_UNDECODABLE] = "undecodable payload",
-        [RT_REJ_STALE] = "stale (lockstep: answers another state)",
-        [RT_REJ_EFFORT_LIMIT] = "effort beyond realtime.effort_limit"};
-    _Static_assert(sizeof why_name / sizeof why_name[0] == RT_REJ_COUNT, "one name per reason");
-    char what[LAG_WIRE_TEXT_LEN];
+    char what[192]; /* and the reason's name: within an event's detail */
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(what, sizeof what, fmt, ap);
     va_end(ap);
     s->rejected[why]++;
+    snprintf(s->last_reject, sizeof s->last_reject, "%s: %s", rt_reject_name[why], what);
     /* a flood is counted in status, not echoed one for one */
-    limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s: %s",
-                  why_name[why], what);
+    limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s",
+                  s->last_reject);
 }
 
 /* A command is applied whole or not at all: every name known, actuated, distinct; every
@@ -836,6 +839,16 @@ static void on_command(const lcm_recv_buf_t *rb, const char *ch, void *user)
     if (!s->discard) rt_handle_command(s, rb->data, rb->data_size);
 }
 
+/* A command on the state URL: the controller publishes on the wrong port. Counted (the
+ * waits say so, rt_wait.c), never applied. */
+static void on_wrong_port(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)rb;
+    (void)ch;
+    rt_server *s = user;
+    if (!s->discard) s->commands_wrong_port++;
+}
+
 static void on_control(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     (void)ch;
@@ -981,6 +994,10 @@ int rt_attach(rt_server *s, lcm_t *out, lcm_t *in, char *err, size_t errlen)
         return LAGSIMD_EXIT_RUNTIME;
     }
     lcm_subscription_set_queue_capacity(s->sub_scene, 16);
+    if (out != in) { /* udpm: commands sent to the state URL's port are heard (rt_bus.c) */
+        s->sub_wrong_port = lcm_subscribe(out, s->ch_command, on_wrong_port, s);
+        if (s->sub_wrong_port) lcm_subscription_set_queue_capacity(s->sub_wrong_port, 16);
+    }
     return LAGSIMD_EXIT_OK;
 }
 
@@ -990,6 +1007,8 @@ void rt_close(rt_server *s)
     if (s->sub_command) lcm_unsubscribe(s->lcm_in, s->sub_command);
     if (s->sub_control) lcm_unsubscribe(s->lcm_in, s->sub_control);
     if (s->sub_scene) lcm_unsubscribe(s->lcm, s->sub_scene);
+    if (s->sub_wrong_port) lcm_unsubscribe(s->lcm, s->sub_wrong_port);
+    s->sub_wrong_port = NULL;
     s->sub_command = s->sub_control = NULL;
     s->sub_scene = NULL;
 }
@@ -1051,6 +1070,7 @@ int64_t rt_next_wake(const rt_server *s)
     if (s->want_scene) wake = min64(wake, rt_limit_ready(&s->lim_scene, now));
     if (s->want_status) wake = min64(wake, rt_limit_ready(&s->lim_status, now));
     if (s->live_line) wake = min64(wake, s->next_line_ns);
+    wake = min64(wake, rt_wait_next(s));
     return wake;
 }
 
@@ -1090,6 +1110,7 @@ void rt_process(rt_server *s)
             }
         }
     }
+    rt_wait_update(s); /* what the plant waits for: a line every few seconds (rt_wait.c) */
     flush_answers(s);
     if (s->now >= s->next_status_ns) {
         publish_status(s);

@@ -31,6 +31,7 @@ import argparse
 import math
 import os
 import re
+import signal
 import subprocess
 import sys
 import tempfile
@@ -216,7 +217,7 @@ def run_block(a, build, text, name, lang, think):
             while stray.handle_timeout(0):
                 pass
 
-    th = threading.Thread(target=listen)
+    th = threading.Thread(target=listen, daemon=True)
     th.start()
     snip = subprocess.Popen(cmd(build, path, slow), cwd=tmp, env=env, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, universal_newlines=True)
@@ -233,13 +234,20 @@ def run_block(a, build, text, name, lang, think):
         time.sleep(0.2 + 1.5 * think)
     heard["states"] = 0
     periods = a.periods
-    daemon = subprocess.run(
+    daemon = subprocess.Popen(
         [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
          "--set", "realtime.mode=lockstep",
          "--set", "realtime.lockstep_timeout=%r" % max(1.0, 3 * think),
          "--duration", repr(periods * 0.01), "-q"],
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
-        timeout=60 + 3 * think * periods)
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    budget = 30 + 3 * think * periods  # three think times a state, and 30 s to start
+    try:
+        daemon.communicate(timeout=budget)
+        in_time = True
+    except subprocess.TimeoutExpired:  # too slow: stopped (its stop event ends the block)
+        daemon.send_signal(signal.SIGINT)
+        daemon.communicate()
+        in_time = False
     try:
         out, _ = snip.communicate(timeout=20 + 3 * think)
     except subprocess.TimeoutExpired:
@@ -256,7 +264,8 @@ def run_block(a, build, text, name, lang, think):
     acc = st.commands_accepted if st else -1
     lto = st.lockstep_timeouts if st else -1
     checks = [
-        (daemon.returncode == 0, "lagsimd ran %d periods and exited 0" % periods),
+        (in_time and daemon.returncode == 0,
+         "lagsimd ran %d periods within %g s and exited 0" % (periods, budget)),
         (snip.returncode == 0, "the snippet exited 0 after the daemon's stop"),
         (acc == periods and lto == 0,
          "answered %d of the %d states before t = %g s, %d lockstep timeout(s)"
