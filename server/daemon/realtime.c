@@ -454,10 +454,11 @@ static void reject(rt_server *s, rt_reject why, const char *joint, double value,
     vsnprintf(what, sizeof what, fmt, ap);
     va_end(ap);
     s->rejected[why]++;
-    snprintf(s->last_reject, sizeof s->last_reject, "%s: %s", rt_reject_name[why], what);
+    char detail[LAG_WIRE_TEXT_LEN];
+    snprintf(detail, sizeof detail, "%s: %s", rt_reject_name[why], what);
+    if (why != RT_REJ_STALE) memcpy(s->last_reject, detail, sizeof detail); /* waits say it */
     /* a flood is counted in status, not echoed one for one */
-    limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s",
-                  s->last_reject);
+    limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s", detail);
 }
 
 /* A command is applied whole or not at all: every name known, actuated, distinct; every
@@ -1032,6 +1033,7 @@ void rt_begin(rt_server *s)
            : s->run == RT_WAITING ? "waiting at t = 0 for the first command"
                                   : "running");
     publish_state(s); /* the initial state, t = 0 */
+    rt_wait_update(s); /* a wait for the first command begins now */
     publish_status(s);
     rt_pace_start(&s->pace, s->period_ns, s->now);
 }

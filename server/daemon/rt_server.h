@@ -232,7 +232,7 @@ typedef struct rt_server {
         int64_t wrong_port0;
     } wt;
     int64_t commands_wrong_port;          /* joint_command_t heard on the state URL */
-    char last_reject[LAG_WIRE_TEXT_LEN];  /* why the last command was rejected */
+    char last_reject[LAG_WIRE_TEXT_LEN];  /* why the last command was rejected (not stale) */
 
     uint8_t buf[RT_BUF_SIZE];
     uint8_t state_buf[RT_BUF_SIZE]; /* the last state published, as sent (lockstep retries) */

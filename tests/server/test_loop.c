@@ -13,7 +13,7 @@
  *                           long_period chunks
  *                           step_paced control_flood command_flood duration signals
  *                           fault_effort lockstep_retry lockstep_loss other_plant
- *                           reject_names
+ *                           reject_names waits
  */
 #include <math.h>
 #include <signal.h>
@@ -71,6 +71,8 @@ typedef struct outputs {
     double last_q[LAG_MAX_DOF];
     int64_t status_controls_rejected, status_states, status_overrun_bursts;
     char status_run[16];
+    char status_waiting_for[256], status_waiting_got[256]; /* the last status's */
+    double status_waiting_s;
     uint8_t scene_bytes[4096]; /* the last scene, as published */
     size_t scene_len;
 } outputs;
@@ -229,6 +231,9 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         g_out.status_states = m.states_published;
         g_out.status_overrun_bursts = m.overrun_bursts;
         snprintf(g_out.status_run, sizeof g_out.status_run, "%.15s", m.run_state);
+        snprintf(g_out.status_waiting_for, sizeof g_out.status_waiting_for, "%s", m.waiting_for);
+        snprintf(g_out.status_waiting_got, sizeof g_out.status_waiting_got, "%s", m.waiting_got);
+        g_out.status_waiting_s = m.waiting_s;
     } else if (!strcmp(sfx, "EVENT")) {
         lag_wire_event m;
         if (lag_wire_decode_event(rb->data, rb->data_size, &m) != LAG_WIRE_OK) fail(__LINE__, "bad event");
@@ -1171,6 +1176,83 @@ static void case_reject_names(void)
     stop_server();
 }
 
+/* No silent waits: the status says what the plant waits for, on which channel and URL,
+ * how long it has waited and what came instead, for each wait: the first command, a
+ * lockstep answer (after 1 s), paused, the fault state; nothing while it advances. */
+static void status_now(void)
+{
+    control(LAGSIM_CONTROL_T_STATUS, 0);
+    run_until(g_srv.now + 60 * MS, 1000);
+}
+
+#define EXPECT_HAS(str, want)                                                           \
+    do {                                                                                \
+        if (!strstr((str), (want))) fail(__LINE__, "'%s' lacks '%s'", (str), (want));   \
+        else printf("ok: ... %s\n", (want));                                            \
+    } while (0)
+
+static void case_waits(void)
+{
+    scene(LAG_RT_LOCKSTEP);
+    g_sc.realtime.start = LAG_RT_START_FIRST_COMMAND;
+    g_sc.realtime.lockstep_timeout = 10.0;
+    start();
+    /* the command URL: the state URL's group on the next port (lagsim_bus.h, tested there) */
+    char on_cmd[400], on_ctl[400];
+    snprintf(on_cmd, sizeof on_cmd, "on TL_COMMAND at %s", g_srv.bus.command_url);
+    snprintf(on_ctl, sizeof on_ctl, "on TL_CONTROL at %s (paused)", g_srv.bus.command_url);
+    ENSURE(strstr(g_srv.bus.command_url, ":7668"));
+    run_until(g_srv.now + 2 * SEC, 1000);
+    status_now();
+    EXPECT_HAS(g_out.status_waiting_for, "the first command (sim_time 0) ");
+    EXPECT_HAS(g_out.status_waiting_for, on_cmd);
+    ENSUREF(g_out.status_waiting_s >= 2.0 && g_out.status_waiting_s < 2.5, "waited %g s",
+            g_out.status_waiting_s);
+    ENSURE(!strcmp(g_out.status_waiting_got, ""));
+    /* what came instead: two rejections, an answer to another sim_time */
+    command(0.0, "cart", 1.0);
+    command(0.0, "theta1", 1.0);
+    command(0.5, "theta0", 1.0);
+    status_now();
+    EXPECT_HAS(g_out.status_waiting_got, "2 commands rejected (unknown joint 1, unactuated joint 1; "
+               "the last: unactuated joint: 'theta1' takes no input; actuated joints of dipc: theta0)");
+    EXPECT_HAS(g_out.status_waiting_got, "; 1 answer to another sim_time");
+    /* the answer: the run goes; a lockstep round trip of less than 1 s is not a wait */
+    command(0.0, "theta0", 1.0);
+    run_until(g_srv.now + 500 * MS, 1000);
+    status_now();
+    ENSUREF(!strcmp(g_out.status_waiting_for, "") && g_out.status_waiting_s == 0,
+            "'%s' %g s", g_out.status_waiting_for, g_out.status_waiting_s);
+    /* unanswered for more than a second: a wait, of its own age, with nothing else come */
+    run_until(g_srv.now + 1500 * MS, 1000);
+    status_now();
+    EXPECT_HAS(g_out.status_waiting_for, "a command answering sim_time 0.01 ");
+    EXPECT_HAS(g_out.status_waiting_for, on_cmd);
+    ENSURE(g_out.status_waiting_s >= 1.5 && g_out.status_waiting_s < 2.2);
+    ENSURE(!strcmp(g_out.status_waiting_got, ""));
+    /* paused */
+    control(LAGSIM_CONTROL_T_PAUSE, 0);
+    run_until(g_srv.now + 1 * SEC, 1000);
+    status_now();
+    EXPECT_HAS(g_out.status_waiting_for, "RESUME or STEP ");
+    EXPECT_HAS(g_out.status_waiting_for, on_ctl);
+    ENSURE(g_out.status_waiting_s >= 1.0 && g_out.status_waiting_s < 1.2);
+    stop_server();
+
+    /* realtime: waiting for the first command, then running: nothing to wait for */
+    scene(LAG_RT_REALTIME);
+    g_sc.realtime.start = LAG_RT_START_FIRST_COMMAND;
+    start();
+    run_until(g_srv.now + 1 * SEC, 1000);
+    status_now();
+    EXPECT_HAS(g_out.status_waiting_for, "the first command on TL_COMMAND at udpm://");
+    command(0.0, "theta0", 0.0);
+    run_until(g_srv.now + 1 * SEC, 1000);
+    status_now();
+    ENSURE(!strcmp(g_out.status_waiting_for, "") && !strcmp(g_out.status_run, "running"));
+    stop_server();
+}
+
 /* Runs a lockstep DIPC for `periods` periods with the test's controller losing `loss` of
  * the states and of the commands; returns the wall time (ns of the made-up clock). */
 static int64_t lockstep_run(double loss, int periods)
@@ -1284,7 +1366,7 @@ int main(int argc, char **argv)
         {"command_flood", case_command_flood}, {"duration", case_duration},
         {"signals", case_signals},         {"fault_effort", case_fault_effort},
         {"lockstep_retry", case_lockstep_retry}, {"lockstep_loss", case_lockstep_loss},
-        {"reject_names", case_reject_names},
+        {"reject_names", case_reject_names}, {"waits", case_waits},
         {"other_plant", case_other_plant},
     };
     if (argc != 2) {
