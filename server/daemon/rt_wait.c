@@ -58,9 +58,9 @@ void rt_wait_update(rt_server *s)
     }
     if (k == RT_WAIT_NONE || s->now < s->wt.next_line_ns) return;
     s->wt.next_line_ns = rt_sat_add(s->now, RT_WAIT_LINE_NS);
-    char what[LAG_WIRE_TEXT_LEN], got[LAG_WIRE_TEXT_LEN];
+    char what[2 * LAG_WIRE_TEXT_LEN], got[2 * LAG_WIRE_TEXT_LEN]; /* the status cuts them */
     double waited = rt_wait_describe(s, what, sizeof what, got, sizeof got);
-    char line[3 * LAG_WIRE_TEXT_LEN];
+    char line[5 * LAG_WIRE_TEXT_LEN];
     snprintf(line, sizeof line, "lagsimd: %s waits %.0f s for %s; %s%s", s->sc->lcm.prefix,
              waited, what, got[0] ? "got instead: " : "nothing else came", got);
     rt_term_say(s, line);
@@ -137,9 +137,9 @@ double rt_wait_describe(const rt_server *s, char *what, size_t whatlen, char *go
     }
     int64_t wrong = s->commands_wrong_port - s->wt.wrong_port0;
     if (wrong > 0)
-        n = add(got, gotlen, n, "%s%lld command%s on %s at the state URL %s (commands go to %s)",
-                n ? "; " : "", (long long)wrong, wrong > 1 ? "s" : "", s->ch_command,
-                s->bus.state_url, curl);
+        n = add(got, gotlen, n, "%s%lld command%s on %s at the state port %d (commands go to "
+                "port %d)", n ? "; " : "", (long long)wrong, wrong > 1 ? "s" : "", s->ch_command,
+                s->bus.state_port, s->bus.command_port);
     if (stale > 0)
         n = add(got, gotlen, n, "%s%lld answer%s to another sim_time", n ? "; " : "",
                 (long long)stale, stale > 1 ? "s" : "");
