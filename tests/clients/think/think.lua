@@ -2,7 +2,10 @@
 -- Runs SCRIPT (its arguments after it) with every joint_command_t it constructs taking
 -- LAGSIM_THINK_S wall seconds first (think.py says why the constructor), and a line
 -- appended to the file LAGSIM_THINK_LOG (if set). Nothing else of the script changes.
+-- LAGSIM_THINK_TYPES: a directory of the generated types (else LUA_PATH finds them).
 local think = tonumber(os.getenv('LAGSIM_THINK_S') or '0')
+local types = os.getenv('LAGSIM_THINK_TYPES')
+if types then package.path = types .. '/?.lua;' .. types .. '/?/init.lua;' .. package.path end
 local log = os.getenv('LAGSIM_THINK_LOG')
 local T = require('lagsim.joint_command_t')
 local new = T.new
