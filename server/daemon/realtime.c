@@ -787,12 +787,13 @@ void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
     case LAGSIM_CONTROL_T_SET:
         handle_set(s, &c);
         return;
-    default:
+    default: {
         char why[LAG_WIRE_TEXT_LEN];
         snprintf(why, sizeof why, "control: unknown request %d; accepted: %s", c.request,
                  control_requests());
         control_rejected(s, why);
         return;
+    }
     }
     s->want_status = true;
 }
