@@ -140,6 +140,7 @@ static int dispatch(lag_client *c, const char *channel, const void *data, size_t
         const lag_wire_joint_state *m = &c->tmp.state;
         if (c->have_state && m->utime == c->state.utime && m->step == c->state.step &&
             m->sim_time == c->state.sim_time) {
+            c->counters.states++; /* received and valid: kept, as the state it copies */
             c->counters.copies++;
             if (c->answer_len > 0 &&
                 lcm_publish(c->lcm_cmd, c->ch_command, c->answer, c->answer_len) == 0)

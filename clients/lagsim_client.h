@@ -72,7 +72,8 @@ typedef struct lag_client_counters {
     int64_t states, scenes, statuses, events;  /* messages received and kept */
     int64_t dropped;                           /* undecodable or out-of-range messages */
     int64_t commands_sent, controls_sent;
-    int64_t copies;   /* copies of the latest state (lockstep re-sends): not returned */
+    int64_t copies;   /* of states, copies of the latest state (lockstep re-sends): not
+                       * returned again, not passed to on_state */
     int64_t repeats;  /* of them, answered again with the command sent for that state */
 } lag_client_counters;
 
