@@ -208,11 +208,11 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_ja
   list(APPEND lang_tests clients_cross_language_dipc)
 endif()
 
-# ---- The shipped Python and Lua controllers with a slow law (tests/clients/think/: every
+# ---- The shipped Python, Lua and Java controllers with a slow law (tests/clients/think/: every
 # command they build takes 0.15 s, or 1.5 s, first): the same states as the C controller's
 # fast run, bit for bit, every state answered (the law runs once per state, a re-sent copy
 # gets the same answer); a law slower than lockstep_timeout is late by definition
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
   set(think_dir ${CMAKE_CURRENT_SOURCE_DIR}/clients/think)
   foreach(pair "slow_law:0.15:21:0.2" "slower_law:1.5:5:0.04")
     string(REPLACE ":" ";" p "${pair}")
@@ -224,7 +224,8 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
       COMMAND ${lang_xl} ${lang_dipc_cfg} --set realtime.lockstep_timeout=5 --states ${states}
         --run c 0 "$<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration ${dur} -q --k ${lang_K} --trace {trace}"
         --run python 0 "env LAGSIM_THINK_S=${think} PYTHONPATH=${CMAKE_BINARY_DIR}/python ${LAGSIM_PYTHON3} ${think_dir}/think.py ${py_dir}/dipc_balance.py --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --duration ${dur} -q --k ${lang_K} --trace {trace}"
-        --run lua 0 "env LAGSIM_THINK_S=${think} LAGSIM_THINK_TYPES=${CMAKE_BINARY_DIR}/lua ${LAGSIM_LUA52} ${think_dir}/think.lua ${lua_dir}/dipc_balance.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} --duration ${dur} -q --k ${lang_K} --trace {trace}")
+        --run lua 0 "env LAGSIM_THINK_S=${think} LAGSIM_THINK_TYPES=${CMAKE_BINARY_DIR}/lua ${LAGSIM_LUA52} ${think_dir}/think.lua ${lua_dir}/dipc_balance.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} --duration ${dur} -q --k ${lang_K} --trace {trace}"
+        --run java 0 "env LAGSIM_THINK_S=${think} ${LAGSIM_PYTHON3} ${think_dir}/think_java.py ${CMAKE_BINARY_DIR} java -cp {think}:/usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${CMAKE_BINARY_DIR}/lagsim_examples.jar lagsim.examples.DipcBalance --prefix {prefix} --duration ${dur} -q --k ${lang_K} --trace {trace}")
     list(APPEND lang_tests clients_cross_language_${name})
   endforeach()
 endif()

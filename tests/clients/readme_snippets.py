@@ -59,28 +59,12 @@ RUNNERS = {
 
 
 def java_think_classes(build, tmp):
-    """A joint_command_t whose constructor takes LAGSIM_THINK_S wall seconds (lcm-gen's
-    own source with a sleep in its constructor), compiled into tmp: first on the class
-    path, it stands in for the types jar's."""
-    src = open(os.path.join(build, "lcmtypes", "java", "src", "lagsim",
-                            "joint_command_t.java")).read()
-    plain = "public joint_command_t()\n    {\n    }"
-    assert plain in src, "lcm-gen's Java constructor changed"
-    src = src.replace(plain, "public joint_command_t()\n    {\n        try {"
-                      " java.nio.file.Files.write(java.nio.file.Paths.get(System.getenv("
-                      "\"LAGSIM_THINK_LOG\")), \"law\\n\".getBytes(),"
-                      " java.nio.file.StandardOpenOption.CREATE,"
-                      " java.nio.file.StandardOpenOption.APPEND);"
-                      " Thread.sleep((long)"
-                      "(1000 * Double.parseDouble(System.getenv(\"LAGSIM_THINK_S\")))); }"
-                      " catch (Exception e) { }\n    }")
-    d = os.path.join(tmp, "think_java")
-    os.makedirs(os.path.join(d, "lagsim"))
-    with open(os.path.join(d, "lagsim", "joint_command_t.java"), "w") as f:
-        f.write(src)
-    subprocess.run(["javac", "-nowarn", "-cp", "/usr/share/java/lcm.jar", "-d", d,
-                    os.path.join(d, "lagsim", "joint_command_t.java")], check=True)
-    return d
+    """A joint_command_t whose constructor takes LAGSIM_THINK_S wall seconds, compiled
+    into tmp (think/think_java.py): first on the class path, it stands in for the types
+    jar's."""
+    sys.path.insert(0, THINK_DIR)
+    from think_java import think_classes
+    return think_classes(build, os.path.join(tmp, "think_java"))
 
 
 def snippets(readme):
