@@ -170,11 +170,11 @@ static void publish_state(rt_server *s)
  * at gaps that double up to retry_cap_ns (a sixteenth of lockstep_timeout: as many more
  * chances before it), so that a state or a command lost on the way costs a retry instead
  * of a timeout, and a controller that thinks long per state gets a copy every 62.5 ms at
- * most (default scene), not one per lockstep_retry. Once any command for that sim_time arrived
- * (applied or rejected) the controller has the state: no more copies. A controller answers
- * each state once and a copy of it with the same answer; a second answer to a state
- * already answered is ignored (commands_ignored), so the run does not depend on how many
- * copies arrived. */
+ * most (default scene), not one per lockstep_retry. Once any command for that sim_time
+ * arrived (applied or rejected) the controller has the state: no more copies. A
+ * controller answers each state once and a copy of it with the same answer; a second
+ * answer to a state already answered is ignored (commands_ignored), so the run does not
+ * depend on how many copies arrived. */
 static void lockstep_retry(rt_server *s)
 {
     if (s->now < s->next_retry_ns || s->state_len == 0 || s->answer_heard) return;
