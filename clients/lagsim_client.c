@@ -45,6 +45,10 @@ struct lag_client {
     lag_client_status status;
     bool have_status;
     lag_client_counters counters;
+    /* the last command sent for the latest state, as encoded (a copy of that state gets
+     * it again) */
+    uint8_t answer[LAG_WIRE_BUF_SIZE];
+    unsigned answer_len;         /* 0: none for the latest state */
 
     /* decoding scratch: a message is copied to the fields above only when valid */
     union {
@@ -133,6 +137,22 @@ static int dispatch(lag_client *c, const char *channel, const void *data, size_t
 {
     if (!strcmp(channel, c->ch_state)) {
         if (!decode(c, LAG_WIRE_JOINT_STATE, data, len)) return LAG_CLIENT_OK;
+        /* Each state once: a copy of the latest state (the same utime, step and sim_time:
+         * in lockstep the daemon publishes a state again until an answer to it arrives)
+         * is neither returned nor passed to on_state, so the control law runs once per
+         * state and a law slower than the copies never falls behind on them; a command
+         * already sent for it goes out again at once (the first may have been lost). */
+        const lag_wire_joint_state *m = &c->tmp.state;
+        if (c->have_state && m->utime == c->state.utime && m->step == c->state.step &&
+            m->sim_time == c->state.sim_time) {
+            c->counters.states++; /* received and valid: kept, as the state it copies */
+            c->counters.copies++;
+            if (c->answer_len > 0 &&
+                lcm_publish(c->lcm_cmd, c->ch_command, c->answer, c->answer_len) == 0)
+                c->counters.repeats++;
+            return LAG_CLIENT_OK;
+        }
+        c->answer_len = 0;
         c->state = c->tmp.state;
         c->have_state = c->new_state = true;
         c->counters.states++;
@@ -394,7 +414,12 @@ int lag_client_send_command(lag_client *c, double sim_time, int n, const char *c
         return LAG_CLIENT_ERR_ARG;
     }
     int rc = publish(c, c->ch_command, LAG_WIRE_JOINT_COMMAND, &m);
-    if (rc == LAG_CLIENT_OK) c->counters.commands_sent++;
+    if (rc != LAG_CLIENT_OK) return rc;
+    c->counters.commands_sent++;
+    if (c->have_state && sim_time == c->state.sim_time) { /* answers the latest state */
+        int n_enc = lag_wire_encode(LAG_WIRE_JOINT_COMMAND, &m, c->answer, sizeof c->answer);
+        c->answer_len = n_enc > 0 ? (unsigned)n_enc : 0;
+    }
     return rc;
 }
 

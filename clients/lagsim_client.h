@@ -29,7 +29,10 @@
  *
  * Lockstep contract (realtime.mode: lockstep): the daemon advances one control period
  * only when a command whose sim_time equals the last published state's sim_time arrives,
- * so answer every state with lag_client_send_command(c, state.sim_time, ...).
+ * so answer every state with lag_client_send_command(c, state.sim_time, ...). The
+ * daemon sends the state again until an answer arrives; the client returns each state
+ * once and answers a copy with the command already sent for it (counters: copies,
+ * repeats), so a slow control law never falls behind on copies.
  */
 #ifndef LAGSIM_CLIENT_H
 #define LAGSIM_CLIENT_H
@@ -70,6 +73,9 @@ typedef struct lag_client_counters {
     int64_t states, scenes, statuses, events;  /* messages received and kept */
     int64_t dropped;                           /* undecodable or out-of-range messages */
     int64_t commands_sent, controls_sent;
+    int64_t copies;   /* of states, copies of the latest state (lockstep re-sends): not
+                       * returned again, not passed to on_state */
+    int64_t repeats;  /* of them, answered again with the command sent for that state */
 } lag_client_counters;
 
 typedef struct lag_client lag_client;

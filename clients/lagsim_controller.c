@@ -353,18 +353,8 @@ int lag_ctl_next_state(lag_ctl *ctl, lag_client_state *st)
             return LAG_CLIENT_TIMEOUT;
         }
         int rc = lag_client_wait_state(ctl->client, 0.05, st);
-        if (rc == LAG_CLIENT_OK && ctl->have_last && st->step == ctl->last_step &&
-            st->sim_time == ctl->last_time) {
-            /* the state answered last, again: the same answer (it may have been lost) */
-            const char *names[LAG_CLIENT_MAX_JOINTS];
-            for (int i = 0; i < ctl->last_n; i++) names[i] = ctl->last_names[i];
-            rc = lag_client_send_command(ctl->client, st->sim_time, ctl->last_n, names,
-                                         ctl->last_effort);
-            if (rc == LAG_CLIENT_OK) {
-                ctl->repeats++;
-                continue;
-            }
-        }
+        /* a copy of a state already returned never comes back: the client answers it
+         * with the same command (lagsim_client.c), so the law runs once per state */
         if (rc == LAG_CLIENT_OK) {
             if (ctl->states++ == 0) ctl->t_first = st->sim_time;
             ctl->current = *st;
@@ -399,14 +389,6 @@ int lag_ctl_command(lag_ctl *ctl, const lag_client_state *st, int n, const char 
         ctl->failed = true;
         return rc;
     }
-    ctl->last_n = n;
-    for (int i = 0; i < n; i++) {
-        snprintf(ctl->last_names[i], sizeof ctl->last_names[i], "%s", names[i]);
-        ctl->last_effort[i] = e[i];
-    }
-    ctl->last_step = st->step;
-    ctl->last_time = st->sim_time;
-    ctl->have_last = true;
     if (ctl->trace) {
         /* %.17g reads back to the same double */
         fprintf(ctl->trace, "%.17g", st->sim_time);
@@ -427,7 +409,7 @@ int lag_ctl_finish(lag_ctl *ctl, const char *fmt, ...)
     va_start(ap, fmt);
     vprintf(fmt, ap);
     va_end(ap);
-    printf(" dropped=%lld repeats=%lld\n", (long long)cnt.dropped, (long long)ctl->repeats);
+    printf(" dropped=%lld repeats=%lld\n", (long long)cnt.dropped, (long long)cnt.repeats);
     fflush(stdout);
     if (ctl->trace) fclose(ctl->trace);
     ctl->trace = NULL;

@@ -102,16 +102,6 @@ typedef struct lag_ctl {
     double heard;              /* monotonic s of the last message from the daemon */
     bool stopped;              /* the daemon's stop event arrived */
     lag_client_state current;  /* the state last returned */
-    /* the last command sent and the state it answered: a copy of that state (a lockstep
-     * retry, when the state or the answer was lost) is answered again with it, not
-     * returned */
-    int last_n;
-    char last_names[LAG_CLIENT_MAX_JOINTS][LAG_CLIENT_NAME_LEN];
-    double last_effort[LAG_CLIENT_MAX_JOINTS];
-    int64_t last_step;
-    double last_time;
-    bool have_last;
-    int64_t repeats;           /* copies answered again so */
 
     /* optional, set before lag_ctl_start: called with every event from the daemon (from
      * inside lag_ctl_next_state), after the setup has looked at it */
@@ -149,7 +139,7 @@ int lag_ctl_command(lag_ctl *ctl, const lag_client_state *st, int n, const char 
                     const double *effort);
 
 /* Prints "<name>: summary end=<end> <fmt...> dropped=<n> repeats=<n>" on stdout (repeats:
- * copies of a state answered again), closes the trace and
+ * copies of a state answered again by the client, lagsim_client.h), closes the trace and
  * the client. Returns the exit status: 0, or 1 when a client error ended the run. */
 int lag_ctl_finish(lag_ctl *ctl, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 

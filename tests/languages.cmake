@@ -309,6 +309,28 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_ja
   list(APPEND lang_tests clients_cross_language_dipc)
 endif()
 
+# ---- The shipped Python, Lua and Java controllers with a slow law (tests/clients/think/: every
+# command they build takes 0.15 s, or 1.5 s, first): the same states as the C controller's
+# fast run, bit for bit, every state answered (the law runs once per state, a re-sent copy
+# gets the same answer); a law slower than lockstep_timeout is late by definition
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
+  set(think_dir ${CMAKE_CURRENT_SOURCE_DIR}/clients/think)
+  foreach(pair "slow_law:0.15:21:0.2" "slower_law:1.5:5:0.04")
+    string(REPLACE ":" ";" p "${pair}")
+    list(GET p 0 name)
+    list(GET p 1 think)
+    list(GET p 2 states)
+    list(GET p 3 dur)
+    add_test(NAME clients_cross_language_${name}
+      COMMAND ${lang_xl} ${lang_dipc_cfg} --set realtime.lockstep_timeout=5 --states ${states}
+        --run c 0 "$<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration ${dur} -q --k ${lang_K} --trace {trace}"
+        --run python 0 "env LAGSIM_THINK_S=${think} PYTHONPATH=${CMAKE_BINARY_DIR}/python ${LAGSIM_PYTHON3} ${think_dir}/think.py ${py_dir}/dipc_balance.py --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --duration ${dur} -q --k ${lang_K} --trace {trace}"
+        --run lua 0 "env LAGSIM_THINK_S=${think} LAGSIM_THINK_TYPES=${CMAKE_BINARY_DIR}/lua ${LAGSIM_LUA52} ${think_dir}/think.lua ${lua_dir}/dipc_balance.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} --duration ${dur} -q --k ${lang_K} --trace {trace}"
+        --run java 0 "env LAGSIM_THINK_S=${think} ${LAGSIM_PYTHON3} ${think_dir}/think_java.py ${CMAKE_BINARY_DIR} java -cp {think}:/usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${CMAKE_BINARY_DIR}/lagsim_examples.jar lagsim.examples.DipcBalance --prefix {prefix} --duration ${dur} -q --k ${lang_K} --trace {trace}")
+    list(APPEND lang_tests clients_cross_language_${name})
+  endforeach()
+endif()
+
 # ---- README.md's controller blocks, run as written (tests/clients/readme_snippets.py)
 set(readme_run ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_snippets.py
     --lagsimd ${lang_lagsimd} --build ${CMAKE_BINARY_DIR} --readme ${PROJECT_SOURCE_DIR}/README.md
@@ -323,19 +345,31 @@ if(LAGSIM_FUZZ)
   string(APPEND readme_c_flags " -fsanitize=fuzzer-no-link")
 endif()
 string(REPLACE ";" " " readme_lcm_libs "${LCM_LINK_LIBRARIES}")
-add_test(NAME clients_readme_c COMMAND ${readme_run}
-  "--c-build=${CMAKE_C_COMPILER} -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror ${readme_c_flags} {src} -o {out} -I${PROJECT_SOURCE_DIR}/clients -I${PROJECT_SOURCE_DIR}/server/wire -I${CMAKE_BINARY_DIR}/lcmtypes/c $<TARGET_FILE:lagsim_client> $<TARGET_FILE:lagsim_wire> $<TARGET_FILE:lagsim_lcmtypes> ${readme_lcm_libs} -lm"
-  c-dipc)
-add_test(NAME clients_readme_python COMMAND ${readme_run} python-dipc)
-list(APPEND lang_tests clients_readme_c clients_readme_python)
+set(readme_c_build
+  "--c-build=${CMAKE_C_COMPILER} -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror ${readme_c_flags} {src} -o {out} -I${PROJECT_SOURCE_DIR}/clients -I${PROJECT_SOURCE_DIR}/server/wire -I${CMAKE_BINARY_DIR}/lcmtypes/c $<TARGET_FILE:lagsim_client> $<TARGET_FILE:lagsim_wire> $<TARGET_FILE:lagsim_lcmtypes> ${readme_lcm_libs} -lm")
+set(readme_langs c python)
 if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
-  add_test(NAME clients_readme_lua COMMAND ${readme_run} lua-dipc)
-  list(APPEND lang_tests clients_readme_lua)
+  list(APPEND readme_langs lua)
 endif()
 if(TARGET lagsim_lcmtypes_java)
-  add_test(NAME clients_readme_java COMMAND ${readme_run} java-dipc)
-  list(APPEND lang_tests clients_readme_java)
+  list(APPEND readme_langs java)
 endif()
+# each block as written; then beside a run of it as written, the same block with a law of
+# 150 ms per answer (20 periods) and of 1.5 s (4 periods): every state answered, no
+# lockstep timeout, the fast run's states bit for bit
+foreach(lang IN LISTS readme_langs)
+  set(extra "")
+  if(lang STREQUAL "c")
+    set(extra "${readme_c_build}")
+  endif()
+  add_test(NAME clients_readme_${lang} COMMAND ${readme_run} ${extra} ${lang}-dipc)
+  add_test(NAME clients_readme_${lang}_slow_law
+    COMMAND ${readme_run} ${extra} --think 0.15 --periods 20 ${lang}-dipc)
+  add_test(NAME clients_readme_${lang}_slower_law
+    COMMAND ${readme_run} ${extra} --think 1.5 --periods 4 ${lang}-dipc)
+  list(APPEND lang_tests clients_readme_${lang} clients_readme_${lang}_slow_law
+    clients_readme_${lang}_slower_law)
+endforeach()
 # the MATLAB/Octave block by a plain octave --eval (the .m files of <build>/octave on the path)
 if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
   add_test(NAME clients_readme_octave COMMAND ${readme_run} octave-dipc)

@@ -28,9 +28,11 @@ add_test(NAME scene_cli
          COMMAND ${LAGSIM_BASH} ${scene_dir}/cli.sh $<TARGET_FILE:lagsimd> ${scene_cfg}/dipc.yaml)
 add_test(NAME scene_accuracy
          COMMAND ${LAGSIM_BASH} ${scene_dir}/accuracy.sh $<TARGET_FILE:lagsimd> ${scene_cfg})
+# every scene in config/ (listed when the test runs) waits at t = 0 for the first command
+add_test(NAME scene_shipped_wait
+         COMMAND ${LAGSIM_BASH} ${scene_dir}/shipped_wait.sh $<TARGET_FILE:lagsimd> ${scene_cfg})
 set_tests_properties(scene_set_overrides scene_offline_csv scene_determinism scene_cli scene_limits
-                     scene_accuracy
-                     PROPERTIES TIMEOUT 60 LABELS scene)
+                     scene_accuracy scene_shipped_wait PROPERTIES TIMEOUT 60 LABELS scene)
 
 # The loader under libFuzzer (tests/fuzz/fuzz_scene.c): file bytes plus --set overrides,
 # then the core on what was accepted. Inputs: tests/fuzz/scene/{corpus,crash}, written by

@@ -204,7 +204,8 @@ end
 -- Iterator over states: each newest state once, until the run ends. A copy of the state
 -- answered last (same step and sim time: the daemon published it again because no answer
 -- reached it) is answered at once with the same command and not returned: every state
--- received is answered, the control law runs once per state.
+-- received is answered, the control law runs once per state (a law run for every copy
+-- would cost a think time per copy and fall behind for good: docs/clients.md, the rule).
 function Controller:states()
   local o = self.o
   local t_first

@@ -233,7 +233,9 @@ class Controller(object):
         """Yields each newest state once until the run ends (self.end says why). A copy of
         the state answered last (same step and sim time: the daemon published it again
         because no answer reached it) is answered at once with the same command and not
-        yielded: every state received is answered, the control law runs once per state."""
+        yielded: every state received is answered, the control law runs once per state (a
+        law run for every copy would cost a think time per copy and fall behind for good:
+        docs/clients.md, the rule)."""
         a = self.args
         t_first = None
         while True:

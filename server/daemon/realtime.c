@@ -113,29 +113,6 @@ static bool state_wanted(const rt_server *s)
     return s->want_state && s->run != RT_FAULT && s->period_left == 0;
 }
 
-/* The scene's model, as its scene names it. */
-static const char *model_name(const rt_server *s)
-{
-    const lag_model_info *mi = lag_model_info_get(s->sc->sim.model.kind);
-    return mi ? mi->name : "?";
-}
-
-/* The joints the daemon publishes, "theta0, theta1, theta2": what a count is checked
- * against, named in the message that refuses it. */
-typedef struct joint_text { char text[LAG_MAX_DOF * (LAG_WIRE_NAME_LEN + 2)]; } joint_text;
-static joint_text joint_list(const rt_server *s)
-{
-    joint_text j = {""};
-    size_t n = 0;
-    for (int i = 0; i < s->nq && n < sizeof j.text; i++) {
-        int k = snprintf(j.text + n, sizeof j.text - n, "%s%s", i ? ", " : "",
-                         s->info->joint_names[i]);
-        if (k < 0) break;
-        n += (size_t)k;
-    }
-    return j;
-}
-
 /* An unlimited event (start, stop). */
 static void eventf(rt_server *s, const char *kind, double value, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
@@ -185,23 +162,32 @@ static void publish_state(rt_server *s)
         s->answered = false;
         s->waiting_time = lag_sim_time(&s->sim);
         s->wait_start_ns = s->now;
-        s->next_retry_ns = rt_sat_add(s->now, s->lockstep_retry_ns);
+        s->answer_heard = false;
+        s->retry_gap_ns = s->lockstep_retry_ns;
+        s->next_retry_ns = rt_sat_add(s->now, s->retry_gap_ns);
     }
 }
 
-/* Lockstep, while a state is waited on and no answer has come: every lockstep_retry the
- * same state goes out again, byte for byte (utime included), so that a state or a
- * command lost on the way costs one retry instead of a timeout. A controller answers
- * every state it receives; a second answer to a state already answered is ignored
- * (commands_ignored), so the run does not depend on how many copies arrived. */
+/* Lockstep, while a state is waited on and no answer to it has come: the same state goes
+ * out again, byte for byte (utime included), lockstep_retry after it was published, then
+ * at gaps that double up to retry_cap_ns (a sixteenth of lockstep_timeout: as many more
+ * chances before it), so that a state or a command lost on the way costs a retry instead
+ * of a timeout, and a controller that thinks long per state gets a copy every 62.5 ms at
+ * most (default scene), not one per lockstep_retry. Once any command for that sim_time
+ * arrived (applied or rejected) the controller has the state: no more copies. A
+ * controller answers each state once and a copy of it with the same answer; a second
+ * answer to a state already answered is ignored (commands_ignored), so the run does not
+ * depend on how many copies arrived. */
 static void lockstep_retry(rt_server *s)
 {
-    if (s->now < s->next_retry_ns || s->state_len == 0) return;
+    if (s->now < s->next_retry_ns || s->state_len == 0 || s->answer_heard) return;
     /* straight to LCM, not through rt_wire's publish: a copy for the network, which --log
      * (the run's record, one state per period) does not keep */
     lcm_publish(s->lcm, s->ch_state, s->state_buf, s->state_len);
     s->lockstep_retries++;
-    s->next_retry_ns = rt_sat_add(s->now, s->lockstep_retry_ns);
+    int64_t cap = s->retry_cap_ns;
+    s->retry_gap_ns = s->retry_gap_ns > cap / 2 ? cap : 2 * s->retry_gap_ns;
+    s->next_retry_ns = rt_sat_add(s->now, s->retry_gap_ns);
 }
 
 static void publish_status(rt_server *s)
@@ -430,18 +416,53 @@ static void mode_lockstep(rt_server *s)
 /* ---------------------------------------------------------------- commands */
 static void lockstep_rewait(rt_server *s);
 
-static void reject(rt_server *s, rt_reject why, const char *joint, double value,
-                   const char *what)
+/* The model's joints, the actuated ones marked: "theta0 (actuated), theta1, theta2" (or
+ * only the actuated ones), as the scene loader lists them; what a rejection offers. */
+static const char *joint_list(const rt_server *s, bool actuated_only, char *buf, size_t n)
 {
-    static const char *const why_name[RT_REJ_COUNT] = {
-        "unknown joint", "unactuated joint", "non-finite effort", "bad length",
-        "undecodable payload", "stale (lockstep: answers another state)",
-        "effort beyond realtime.effort_limit"};
+    size_t k = 0;
+    buf[0] = '\0';
+    for (int i = 0; i < s->nq && k < n; i++) {
+        if (actuated_only && !s->info->actuated[i]) continue;
+        int w = snprintf(buf + k, n - k, "%s%s%s", k ? ", " : "", s->info->joint_names[i],
+                         !actuated_only && s->info->actuated[i] ? " (actuated)" : "");
+        if (w < 0) break;
+        k += (size_t)w;
+    }
+    if (!buf[0]) snprintf(buf, n, "none");
+    return buf;
+}
+
+const char *const rt_reject_name[RT_REJ_COUNT] = {
+    [RT_REJ_UNKNOWN_JOINT] = "unknown joint",
+    [RT_REJ_UNACTUATED] = "unactuated joint",
+    [RT_REJ_NONFINITE] = "non-finite effort",
+    [RT_REJ_BAD_LENGTH] = "bad length",
+    [RT_REJ_UNDECODABLE] = "undecodable payload",
+    [RT_REJ_STALE] = "stale (lockstep: answers another state)",
+    [RT_REJ_EFFORT_LIMIT] = "effort beyond realtime.effort_limit"};
+_Static_assert(sizeof rt_reject_name / sizeof rt_reject_name[0] == RT_REJ_COUNT,
+               "one name per reason");
+
+/* A rejected command: counted by reason, and a command_rejected event (limited) whose
+ * detail says what was wrong and what would be accepted. */
+static void reject(rt_server *s, rt_reject why, const char *joint, double value,
+                   const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+static void reject(rt_server *s, rt_reject why, const char *joint, double value,
+                   const char *fmt, ...)
+{
+    char what[192]; /* and the reason's name: within an event's detail */
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
     s->rejected[why]++;
     rt_log_rx_fate(s, why == RT_REJ_UNDECODABLE ? RT_RX_UNDECODABLE : RT_RX_REFUSED); /* --log */
+    char detail[LAG_WIRE_TEXT_LEN];
+    snprintf(detail, sizeof detail, "%s: %s", rt_reject_name[why], what);
+    if (why != RT_REJ_STALE) memcpy(s->last_reject, detail, sizeof detail); /* waits say it */
     /* a flood is counted in status, not echoed one for one */
-    limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s%s%s%s",
-                  why_name[why], what ? " (" : "", what ? what : "", what ? ")" : "");
+    limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s", detail);
 }
 
 static void handle_command(rt_server *s, const uint8_t *data, size_t len);
@@ -461,49 +482,63 @@ static void handle_command(rt_server *s, const uint8_t *data, size_t len)
     lag_wire_joint_command c;
     int d = lag_wire_decode_joint_command(data, len, s->nq, &c);
     if (d == LAG_WIRE_ECOUNT) {
-        char what[320];
-        snprintf(what, sizeof what, "num_joints %d in value: expected 0 to %d, the joints of "
-                 "model %s (%.160s)", c.num_joints, s->nq, model_name(s), joint_list(s).text);
-        reject(s, RT_REJ_BAD_LENGTH, "", c.num_joints, what);
+        char all[160];
+        reject(s, RT_REJ_BAD_LENGTH, "", c.num_joints,
+               "num_joints %d (in value); accepted: 0 to %d, joints of %s: %s", c.num_joints,
+               s->nq, s->info->name, joint_list(s, false, all, sizeof all));
         return;
     }
     if (d == LAG_WIRE_ETOOLONG) { /* a well-formed name longer than any joint's */
-        reject(s, RT_REJ_UNKNOWN_JOINT, "", 0, "a name of 64 bytes or more");
+        char all[160];
+        reject(s, RT_REJ_UNKNOWN_JOINT, "", 0, "a name of 64 bytes or more; joints of %s: %s",
+               s->info->name, joint_list(s, false, all, sizeof all));
         return;
     }
     if (d != LAG_WIRE_OK) {
-        reject(s, RT_REJ_UNDECODABLE, "", (double)len, "payload bytes in value");
+        reject(s, RT_REJ_UNDECODABLE, "", (double)len,
+               "%zu bytes (in value) that are no lagsim.joint_command_t; accepted: a "
+               "joint_command_t as lcm-gen encodes it (lcmtypes/joint_command_t.lcm)", len);
         return;
     }
+    /* lockstep: an answer to the state waited on, good or not, came: it needs no copies */
+    if (s->waiting && c.sim_time == s->waiting_time) s->answer_heard = true;
     int idx[LAG_MAX_DOF];
     for (int i = 0; i < c.num_joints; i++) {
         idx[i] = -1;
         for (int j = 0; j < s->nq; j++)
             if (strcmp(c.name[i], s->info->joint_names[j]) == 0) idx[i] = j;
+        char all[160];
         if (idx[i] < 0) {
-            reject(s, RT_REJ_UNKNOWN_JOINT, c.name[i], 0, NULL);
+            reject(s, RT_REJ_UNKNOWN_JOINT, c.name[i], 0, "'%s'; joints of %s: %s", c.name[i],
+                   s->info->name, joint_list(s, false, all, sizeof all));
             return;
         }
         for (int k = 0; k < i; k++)
             if (idx[k] == idx[i]) {
-                reject(s, RT_REJ_BAD_LENGTH, c.name[i], c.num_joints, "duplicate name");
+                reject(s, RT_REJ_BAD_LENGTH, c.name[i], c.num_joints,
+                       "'%s' named twice; accepted: each joint at most once (%s)", c.name[i],
+                       joint_list(s, false, all, sizeof all));
                 return;
             }
         if (!s->info->actuated[idx[i]]) {
-            reject(s, RT_REJ_UNACTUATED, c.name[i], 0, NULL);
+            reject(s, RT_REJ_UNACTUATED, c.name[i], 0,
+                   "'%s' takes no input; actuated joints of %s: %s", c.name[i], s->info->name,
+                   joint_list(s, true, all, sizeof all));
             return;
         }
         if (!isfinite(c.effort[i])) {
-            reject(s, RT_REJ_NONFINITE, c.name[i], 0, NULL);
+            reject(s, RT_REJ_NONFINITE, c.name[i], 0,
+                   "%g for '%s'; accepted: a finite effort within +-%g", c.effort[i], c.name[i],
+                   s->sc->realtime.effort_limit[idx[i]]);
             return;
         }
         /* a bound on what a command may ask, not the plant's saturation (that is the
          * actuator effect): an effort beyond it is a controller's bug, refused whole */
         double lim = s->sc->realtime.effort_limit[idx[i]];
         if (fabs(c.effort[i]) > lim) {
-            char what[64];
-            snprintf(what, sizeof what, "the effort in value, the limit %g", lim);
-            reject(s, RT_REJ_EFFORT_LIMIT, c.name[i], c.effort[i], what);
+            reject(s, RT_REJ_EFFORT_LIMIT, c.name[i], c.effort[i],
+                   "%g for '%s' (in value); accepted: |effort| <= %g", c.effort[i], c.name[i],
+                   lim);
             return;
         }
     }
@@ -518,7 +553,14 @@ static void handle_command(rt_server *s, const uint8_t *data, size_t len)
             return;
         }
         if (!waited_on && !(s->run != RT_RUNNING && c.sim_time == lag_sim_time(&s->sim))) {
-            reject(s, RT_REJ_STALE, "", c.sim_time, "its sim_time in value");
+            if (s->waiting)
+                reject(s, RT_REJ_STALE, "", c.sim_time,
+                       "sim_time %.9g (in value); accepted: %.9g, the state waited on",
+                       c.sim_time, s->waiting_time);
+            else
+                reject(s, RT_REJ_STALE, "", c.sim_time,
+                       "sim_time %.9g (in value); no state is waited on (the next one's "
+                       "sim_time will be)", c.sim_time);
             return;
         }
     }
@@ -686,6 +728,29 @@ static void lockstep_rewait(rt_server *s)
 static void handle_control(rt_server *s, const uint8_t *data, size_t len);
 
 /* --log: as received, once its fate is known (rt_log_rx_*) */
+
+/* The requests of control_t, by value (lcmtypes/control_t.lcm): what a rejection of an
+ * unknown one offers. */
+static const char *control_requests(void)
+{
+    static const char *const names[] = {
+        [LAGSIM_CONTROL_T_PAUSE] = "PAUSE", [LAGSIM_CONTROL_T_RESUME] = "RESUME",
+        [LAGSIM_CONTROL_T_STEP] = "STEP", [LAGSIM_CONTROL_T_RESET] = "RESET",
+        [LAGSIM_CONTROL_T_RESET_TO] = "RESET_TO", [LAGSIM_CONTROL_T_STATUS] = "STATUS",
+        [LAGSIM_CONTROL_T_DESCRIBE] = "DESCRIBE", [LAGSIM_CONTROL_T_SET] = "SET"};
+    static char list[160];
+    if (!list[0]) {
+        size_t k = 0;
+        for (size_t i = 0; i < sizeof names / sizeof names[0] && k < sizeof list; i++) {
+            if (!names[i]) continue;
+            int w = snprintf(list + k, sizeof list - k, "%s%s = %zu", k ? ", " : "", names[i], i);
+            if (w < 0) break;
+            k += (size_t)w;
+        }
+    }
+    return list;
+}
+
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
 {
     rt_log_rx_begin(s, s->ch_control, data, len);
@@ -700,13 +765,13 @@ static void handle_control(rt_server *s, const uint8_t *data, size_t len)
     int d = lag_wire_decode_control(data, len, LAG_WIRE_MAX_JOINTS, &c);
     if (d != LAG_WIRE_OK) {
         if (d != LAG_WIRE_ECOUNT) rt_log_rx_fate(s, RT_RX_UNDECODABLE);
-        char why[160];
+        char why[LAG_WIRE_TEXT_LEN];
         if (d == LAG_WIRE_ECOUNT)
-            snprintf(why, sizeof why, "control: num_joints %d: expected 0 to %d (reset_to on "
-                     "model %s: %d)", c.num_joints, LAG_WIRE_MAX_JOINTS, model_name(s), s->nq);
+            snprintf(why, sizeof why, "control: num_joints out of range; accepted: 0, or %d "
+                     "for reset_to (the joints of %s)", s->nq, s->info->name);
         else
-            snprintf(why, sizeof why, "control: undecodable payload (%s)",
-                     lag_wire_result_string(d));
+            snprintf(why, sizeof why, "control: %zu bytes that are no lagsim.control_t; "
+                     "accepted: a control_t as lcm-gen encodes it (lcmtypes/control_t.lcm)", len);
         control_rejected(s, why);
         return;
     }
@@ -735,12 +800,13 @@ static void handle_control(rt_server *s, const uint8_t *data, size_t len)
     case LAGSIM_CONTROL_T_STEP:
         if (s->run != RT_PAUSED && s->run != RT_WAITING) {
             control_rejected(s, s->run == RT_FAULT ? "step: in fault state (reset first)"
-                                                   : "step: only while paused");
+                                                   : "step: only while paused or waiting "
+                                                     "(pause first)");
             return;
         }
         if (c.count < 1) {
             char why[96];
-            snprintf(why, sizeof why, "step: count %lld: expected 1 or more control periods",
+            snprintf(why, sizeof why, "step: count %lld; accepted: a count >= 1",
                      (long long)c.count);
             control_rejected(s, why);
             return;
@@ -774,10 +840,10 @@ static void handle_control(rt_server *s, const uint8_t *data, size_t len)
         return;
     case LAGSIM_CONTROL_T_RESET_TO: {
         if (c.num_joints != s->nq) {
-            char why[320];
-            snprintf(why, sizeof why, "reset_to: %d joints given; model %s has %d (%.160s): q and "
-                     "qd need %d values each", c.num_joints, model_name(s), s->nq,
-                     joint_list(s).text, s->nq);
+            char why[LAG_WIRE_TEXT_LEN], all[160];
+            snprintf(why, sizeof why, "reset_to: num_joints %d; accepted: %d, the joints of %s "
+                     "in this order: %s", c.num_joints, s->nq, s->info->name,
+                     joint_list(s, false, all, sizeof all));
             control_rejected(s, why);
             return;
         }
@@ -811,9 +877,13 @@ static void handle_control(rt_server *s, const uint8_t *data, size_t len)
     case LAGSIM_CONTROL_T_SET:
         handle_set(s, &c);
         return;
-    default:
-        control_rejected(s, "control: unknown request");
+    default: {
+        char why[LAG_WIRE_TEXT_LEN];
+        snprintf(why, sizeof why, "control: unknown request %d; accepted: %s", c.request,
+                 control_requests());
+        control_rejected(s, why);
         return;
+    }
     }
     s->want_status = true;
 }
@@ -871,6 +941,16 @@ static void on_command(const lcm_recv_buf_t *rb, const char *ch, void *user)
     (void)ch;
     rt_server *s = user;
     if (!s->discard) rt_handle_command(s, rb->data, rb->data_size);
+}
+
+/* A command on the state URL: the controller publishes on the wrong port. Counted (the
+ * waits say so, rt_wait.c), never applied. */
+static void on_wrong_port(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)rb;
+    (void)ch;
+    rt_server *s = user;
+    if (!s->discard) s->commands_wrong_port++;
 }
 
 static void on_control(const lcm_recv_buf_t *rb, const char *ch, void *user)
@@ -958,6 +1038,8 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
                                ? rt_clamp_ns(sc->realtime.lockstep_retry * 1e9, RT_RETRY_NS_MIN,
                                              INT64_MAX)
                                : INT64_MAX;
+    s->retry_cap_ns = s->lockstep_wait_ns / 16 > s->lockstep_retry_ns ? s->lockstep_wait_ns / 16
+                                                                     : s->lockstep_retry_ns;
 
     s->nq = s->sim.nq;
     s->info = lag_sim_info(&s->sim); /* the joints published: a stick that may fly has h */
@@ -1019,6 +1101,10 @@ int rt_attach(rt_server *s, lcm_t *out, lcm_t *in, char *err, size_t errlen)
         return LAGSIMD_EXIT_RUNTIME;
     }
     lcm_subscription_set_queue_capacity(s->sub_scene, 16);
+    if (out != in) { /* udpm: commands sent to the state URL's port are heard (rt_bus.c) */
+        s->sub_wrong_port = lcm_subscribe(out, s->ch_command, on_wrong_port, s);
+        if (s->sub_wrong_port) lcm_subscription_set_queue_capacity(s->sub_wrong_port, 16);
+    }
     return LAGSIMD_EXIT_OK;
 }
 
@@ -1028,6 +1114,8 @@ void rt_close(rt_server *s)
     if (s->sub_command) lcm_unsubscribe(s->lcm_in, s->sub_command);
     if (s->sub_control) lcm_unsubscribe(s->lcm_in, s->sub_control);
     if (s->sub_scene) lcm_unsubscribe(s->lcm, s->sub_scene);
+    if (s->sub_wrong_port) lcm_unsubscribe(s->lcm, s->sub_wrong_port);
+    s->sub_wrong_port = NULL;
     s->sub_command = s->sub_control = NULL;
     s->sub_scene = NULL;
 }
@@ -1051,6 +1139,7 @@ void rt_begin(rt_server *s)
            : s->run == RT_WAITING ? "waiting at t = 0 for the first command"
                                   : "running");
     publish_state(s); /* the initial state, t = 0 */
+    rt_wait_update(s); /* a wait for the first command begins now */
     publish_status(s);
     rt_pace_start(&s->pace, s->period_ns, s->now);
 }
@@ -1079,7 +1168,8 @@ int64_t rt_next_wake(const rt_server *s)
                 wake = min64(wake, rt_sat_add(now, RT_LOG_HOLD_NS));
             } else {
                 wake = min64(wake, rt_sat_add(s->wait_start_ns, s->lockstep_wait_ns));
-                if (s->run == RT_RUNNING || s->pending_steps > 0) wake = min64(wake, s->next_retry_ns);
+                if ((s->run == RT_RUNNING || s->pending_steps > 0) && !s->answer_heard)
+                    wake = min64(wake, s->next_retry_ns);
             }
         }
         break;
@@ -1088,6 +1178,7 @@ int64_t rt_next_wake(const rt_server *s)
     if (s->want_scene) wake = min64(wake, rt_limit_ready(&s->lim_scene, now));
     if (s->want_status) wake = min64(wake, rt_limit_ready(&s->lim_status, now));
     if (s->live_line) wake = min64(wake, s->next_line_ns);
+    wake = min64(wake, rt_wait_next(s));
     return wake;
 }
 
@@ -1127,6 +1218,7 @@ void rt_process(rt_server *s)
             }
         }
     }
+    rt_wait_update(s); /* what the plant waits for: a line every few seconds (rt_wait.c) */
     flush_answers(s);
     if (s->now >= s->next_status_ns) {
         publish_status(s);

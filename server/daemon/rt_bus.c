@@ -9,8 +9,8 @@
  * For memq:// (tests, one process) one lcm_t is both.
  *
  * One plant per prefix: the state URL's lcm_t subscribes to _SCENE (its receive socket
- * filtered to that channel, so the kernel drops the daemon's own states instead of
- * handing them back). Before it publishes anything, the daemon asks its prefix for a
+ * filtered to that channel and _COMMAND, so the kernel drops the daemon's own states
+ * instead of handing them back; a command sent there, to the wrong port, is counted). Before it publishes anything, the daemon asks its prefix for a
  * scene (DESCRIBE) and listens RT_LOOK_MS (look_for_other_plant); another plant's scene
  * (rt_handle_scene: one that decodes, names this prefix and is not one of the daemon's
  * own) makes it refuse to start, and later makes it stop. Whom it hears follows the
@@ -63,9 +63,10 @@ static int look_for_other_plant(rt_server *s, char *err, size_t errlen)
 {
     const lag_bus *b = &s->bus;
     bool host_only = !s->sc->lcm.allow_lan;
-    const char *out[] = {s->ch_scene};
+    /* and _COMMAND: a command sent to the state port is counted (rt_wait.c says so) */
+    const char *out[] = {s->ch_scene, s->ch_command};
     char ferr[256];
-    int n = lag_net_filter(b->state_port, host_only, out, 1, ferr, sizeof ferr);
+    int n = lag_net_filter(b->state_port, host_only, out, 2, ferr, sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s: cannot filter the state URL %s for the plant watch",
                  n < 0 ? ferr : "LCM's receive socket for the state port was not found",

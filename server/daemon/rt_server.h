@@ -77,6 +77,15 @@ typedef enum rt_stop {
     RT_STOP_ERROR,
 } rt_stop;
 
+/* What a plant that does not advance waits for (rt_wait.c). */
+typedef enum rt_wait_kind {
+    RT_WAIT_NONE = 0,
+    RT_WAIT_FIRST,   /* the first command (start: first_command, or after a reset) */
+    RT_WAIT_ANSWER,  /* lockstep: a command answering the state published */
+    RT_WAIT_RESUME,  /* paused: RESUME or STEP */
+    RT_WAIT_RESET,   /* the fault state: RESET or RESET_TO */
+} rt_wait_kind;
+
 #define RT_SCENES_KEPT 8 /* the last scenes published, to tell them from another plant's */
 
 typedef struct rt_server {
@@ -88,6 +97,7 @@ typedef struct rt_server {
                                 * same lcm_t as `lcm` for memq://) */
     lcm_subscription_t *sub_command, *sub_control;
     lcm_subscription_t *sub_scene; /* _SCENE on the state URL: another plant's (plant watch) */
+    lcm_subscription_t *sub_wrong_port; /* _COMMAND on the state URL: counted, not applied */
     lag_bus bus;               /* the URLs and channels (lagsim_bus.h) */
     bool discard;              /* drop what arrives: before the start, LCM's queues may
                                 * hold datagrams that came in before the filter */
@@ -128,6 +138,10 @@ typedef struct rt_server {
     int64_t lockstep_wait_ns;  /* realtime.lockstep_timeout, saturated */
     int64_t lockstep_retry_ns; /* realtime.lockstep_retry, saturated */
     int64_t next_retry_ns;     /* when the state waited on goes out again */
+    int64_t retry_gap_ns;      /* the gap before that copy: doubles after each, up to */
+    int64_t retry_cap_ns;      /* lockstep_timeout / 16, at least lockstep_retry */
+    bool answer_heard;         /* a command for the state waited on came (applied or not):
+                                * no more copies of it */
     double answered_time;      /* sim_time of the last state a command answered */
     bool have_answered;        /* answered_time holds one (since start or reset) */
 
@@ -225,6 +239,18 @@ typedef struct rt_server {
     int scene_next;
     char other_plant[160];     /* what gave it away, the last one heard ("" = nothing) */
 
+    /* the waits (rt_wait.c): what the plant waits for, since when, what came instead */
+    struct {
+        rt_wait_kind kind;
+        double t;              /* the sim_time an answer must carry */
+        int64_t since_ns;      /* when the wait began */
+        int64_t next_line_ns;  /* its next line on stderr */
+        int64_t rejected0[RT_REJ_COUNT]; /* the counters when it began */
+        int64_t wrong_port0;
+    } wt;
+    int64_t commands_wrong_port;          /* joint_command_t heard on the state URL */
+    char last_reject[LAG_WIRE_TEXT_LEN];  /* why the last command was rejected (not stale) */
+
     uint8_t buf[RT_BUF_SIZE];
     uint8_t state_buf[RT_BUF_SIZE]; /* the last state published, as sent (lockstep retries) */
     unsigned state_len;
@@ -286,6 +312,19 @@ int rt_log_end(rt_server *s);
 void rt_term_event(rt_server *s, double sim_time, const char *kind, const char *joint,
                    double value, const char *detail, bool effect);
 void rt_term_line(rt_server *s, bool final);
+/* One line of the daemon's own (not an event) on stderr, the live line kept below it;
+ * nothing with -q. */
+void rt_term_say(rt_server *s, const char *line);
+
+/* rt_wait.c: the waits. rt_wait_update (each wake-up) notes when a wait begins and
+ * prints its line every few seconds; rt_wait_next is when that line is due (INT64_MAX:
+ * no wait). rt_wait_describe writes what the plant waits for and where ("" while it
+ * advances) and what came instead ("" = nothing) and returns the wall s waited. */
+void rt_wait_update(rt_server *s);
+int64_t rt_wait_next(const rt_server *s);
+double rt_wait_describe(const rt_server *s, char *what, size_t whatlen, char *got, size_t gotlen);
+/* The reasons of rt_reject, by index (realtime.c). */
+extern const char *const rt_reject_name[RT_REJ_COUNT];
 
 /* realtime.c: the server in pieces (lagsimd_realtime strings them together; tests and
  * the fuzz target drive them with their own clock and LCM, e.g. memq://). */

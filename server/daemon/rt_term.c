@@ -54,6 +54,15 @@ void rt_term_event(rt_server *s, double sim_time, const char *kind, const char *
     else fflush(stderr);
 }
 
+void rt_term_say(rt_server *s, const char *line)
+{
+    if (quiet(s)) return;
+    clear_line(s);
+    fprintf(stderr, "%s\n", line);
+    if (s->live_line) rt_term_line(s, false);
+    else fflush(stderr);
+}
+
 void rt_term_line(rt_server *s, bool final)
 {
     if (!s->live_line) return;

@@ -136,6 +136,9 @@ void rt_publish_status(rt_server *s)
     m.commands_ignored = s->commands_ignored;
     PUT(m.contact, lag_sim_contact(&s->sim));
     m.plant_conflicts = s->plant_conflicts;
+    m.waiting_s = fin(rt_wait_describe(s, m.waiting_for, sizeof m.waiting_for, m.waiting_got,
+                                       sizeof m.waiting_got));
+    m.commands_wrong_port = s->commands_wrong_port;
     publish(s, s->ch_status, LAG_WIRE_STATUS, &m);
     s->rtf = m.rtf;
     if (wall < 0.05 && s->run == RT_RUNNING) return; /* the window goes on */

@@ -109,6 +109,10 @@ static const lag_wire_field status_fields[] = {
     SCALAR(ST, LAG_WIRE_INT64, commands_ignored),
     STRING(ST, contact),
     SCALAR(ST, LAG_WIRE_INT64, plant_conflicts),
+    STRING(ST, waiting_for),
+    SCALAR(ST, LAG_WIRE_DOUBLE, waiting_s),
+    STRING(ST, waiting_got),
+    SCALAR(ST, LAG_WIRE_INT64, commands_wrong_port),
 };
 
 typedef lag_wire_scene SC;

@@ -155,6 +155,10 @@ typedef struct lag_wire_status {
     int64_t commands_ignored;
     char contact[LAG_WIRE_NAME_LEN]; /* the stick's floor: flight, contact, flat or "" */
     int64_t plant_conflicts;
+    char waiting_for[LAG_WIRE_TEXT_LEN]; /* what the plant waits for, where; "" */
+    double waiting_s;
+    char waiting_got[LAG_WIRE_TEXT_LEN]; /* what came instead; "" */
+    int64_t commands_wrong_port;
 } lag_wire_status;
 
 /* <PREFIX>_SCENE: the scene description. */

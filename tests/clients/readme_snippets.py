@@ -16,33 +16,62 @@ daemon's final status must show every state before t = 2 s answered (200
 commands_accepted, no lockstep timeout), and every state heard must keep both rods within 0.1 rad of
 upright (the shipped scene starts at 0.05 rad). Everything runs on a multicast port of this
 run's own (LCM_DEFAULT_URL): nothing of it may be heard on LCM's default URL.
+
+--think S runs each block twice for --periods N periods: once as written, then as written
+with a control law that takes S wall seconds per answer it builds (tests/clients/think/:
+every joint_command_t the block constructs, or every lag_client_send_command it calls,
+sleeps S first and is counted; the block's text is unchanged). The slow run must answer
+every state, with no lockstep timeout, run its law once per sim_time, and hear the
+states of the fast run bit for bit. In lockstep
+the daemon publishes a state again until an answer arrives: a block that ran its law for
+every copy would fall behind by a copy's worth of thinking per state and never catch up.
+A law slower than realtime.lockstep_timeout is late by definition, so that timeout is
+set to at least three think times.
 """
 import argparse
 import math
 import os
 import re
+import signal
 import subprocess
 import sys
 import tempfile
 import threading
 import time
 
+THINK_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "think")
+# name: (file, command line (build, file, slow: the think wrapper, or ""), environment)
 RUNNERS = {
-    "c": ("balance.c", lambda b, f: [f[:-2]], lambda b: {}),
-    "python": ("balance.py", lambda b, f: ["python3", f],
+    "c": ("balance.c", lambda b, f, slow: [f[:-2]], lambda b: {}),
+    "python": ("balance.py",
+               lambda b, f, slow: ["python3"] + ([os.path.join(THINK_DIR, "think.py")]
+                                                 if slow else []) + [f],
                lambda b: {"PYTHONPATH": os.path.join(b, "python")}),
-    "lua": ("balance.lua", lambda b, f: ["lua5.2", f],
+    "lua": ("balance.lua",
+            lambda b, f, slow: ["lua5.2"] + ([os.path.join(THINK_DIR, "think.lua")]
+                                             if slow else []) + [f],
             lambda b: {"LUA_PATH": "%s/lua/?.lua;%s/lua/?/init.lua;;" % (b, b)}),
     "java": ("Balance.java",
-             lambda b, f: ["java", "-cp", "/usr/share/java/lcm.jar:%s/lagsim_types.jar:"
-                                          "%s/lagsim_examples.jar" % (b, b), f],
+             lambda b, f, slow: ["java", "-cp", (slow + ":" if slow else "") +
+                                 "/usr/share/java/lcm.jar:%s/lagsim_types.jar:"
+                                 "%s/lagsim_examples.jar" % (b, b), f],
              lambda b: {}),
-    # a plain octave --eval of the script, from its folder, the .m files on the path
+    # a plain octave --eval of the script, from its folder, the .m files on the path (no
+    # think wrapper: the slow-law runs are the other languages')
     "octave": ("balance.m",
-               lambda b, f: ["octave", "--no-gui", "--quiet", "--no-init-file", "--path",
+               lambda b, f, slow: ["octave", "--no-gui", "--quiet", "--no-init-file", "--path",
                              os.path.join(b, "octave"), "--eval", "balance"],
                lambda b: {}),
 }
+
+
+def java_think_classes(build, tmp):
+    """A joint_command_t whose constructor takes LAGSIM_THINK_S wall seconds, compiled
+    into tmp (think/think_java.py): first on the class path, it stands in for the types
+    jar's."""
+    sys.path.insert(0, THINK_DIR)
+    from think_java import think_classes
+    return think_classes(build, os.path.join(tmp, "think_java"))
 
 
 def snippets(readme):
@@ -61,6 +90,9 @@ def main():
     ap.add_argument("--config", required=True)
     ap.add_argument("--c-build", default="",
                     help="how to build the C block: a command line with {src} and {out}")
+    ap.add_argument("--think", type=float, default=0.0,
+                    help="also run each block with a law of this many wall s per answer")
+    ap.add_argument("--periods", type=int, default=200, help="control periods of a run")
     ap.add_argument("names", nargs="+")
     a = ap.parse_args()
     build = os.path.abspath(a.build)
@@ -75,8 +107,6 @@ def main():
                                      % (20000 + 2 * (os.getpid() % 6000)))  # and the next port
     print("LCM_DEFAULT_URL=%s" % os.environ["LCM_DEFAULT_URL"])
     sys.path.insert(0, os.path.join(build, "python"))
-    from lagsim_lcm import LCM, plant_urls
-    from lagsim import joint_command_t, joint_state_t, status_t
 
     found = snippets(a.readme)
     fails = 0
@@ -86,119 +116,173 @@ def main():
             print("FAIL: no block marked <!-- snippet: %s --> in %s" % (name, a.readme))
             fails += 1
             continue
-        fname, cmd, env_extra = RUNNERS[lang]
-        prefix = "RDME%s_%d" % (lang.upper(), os.getpid())
-        tmp = tempfile.mkdtemp(prefix="lagsim_readme_")
-        path = os.path.join(tmp, fname)
-        with open(path, "w") as f:
-            f.write(found[name].replace('"DIPC_', '"%s_' % prefix).replace("'DIPC_", "'%s_" % prefix)
-                    .replace('"DIPC"', '"%s"' % prefix))
-        if lang == "c":
-            cc = subprocess.run([w.replace("{src}", path).replace("{out}", path[:-2])
-                                 for w in a.c_build.split()], stdout=subprocess.PIPE,
-                                stderr=subprocess.STDOUT, universal_newlines=True)
-            if cc.returncode != 0:
-                print("FAIL: the C block does not build:\n" + cc.stdout)
-                fails += 1
-                continue
-        env = dict(os.environ)
-        env.update(env_extra(build))
-        state_url, command_url = plant_urls()
-        lc, lc_cmd = LCM(state_url), LCM(command_url)
-        heard = {"states": 0, "max_th": 0.0, "t": -1.0, "status": None}
-
-        def on_state(ch, data):
-            st = joint_state_t.decode(data)
-            if st.sim_time < 0:
-                return
-            heard["states"] += 1
-            heard["t"] = max(heard["t"], st.sim_time)
-            heard["max_th"] = max([heard["max_th"]] + [abs(x) for x in st.position[1:3]])
-
-        def on_status(ch, data):
-            heard["status"] = status_t.decode(data)
-
-        def on_command(ch, data):
-            if joint_command_t.decode(data).sim_time == -1.0:
-                heard["ready"] = True
-
-        # LCM's own default URL must hear nothing of this run: it is on its own port
-        stray = LCM("udpm://239.255.76.67:7667?ttl=0")
-        heard["stray"] = 0
-
-        def on_stray(ch, data):
-            heard["stray"] += 1
-
-        stray.subscribe(prefix + "_.*", on_stray)
-        lc.subscribe(prefix + "_STATE", on_state)
-        lc.subscribe(prefix + "_STATUS", on_status)
-        lc_cmd.subscribe(prefix + "_COMMAND", on_command)
-        heard["ready"] = False
-        listening = [True]
-
-        def listen():  # its own thread: the daemon in lockstep outruns a late reader
-            while listening[0]:
-                lc.handle_timeout(20)
-                while lc_cmd.handle_timeout(0):
-                    pass
-                while stray.handle_timeout(0):
-                    pass
-
-        th = threading.Thread(target=listen)
-        th.start()
-        snip = subprocess.Popen(cmd(build, path), cwd=tmp, env=env, stdout=subprocess.PIPE,
-                                stderr=subprocess.STDOUT, universal_newlines=True)
-        # Ready when it answers: a probe state at sim time -1, every 0.2 s, until a command
-        # for it comes back (java compiles the file first). Then the daemon starts.
-        probe = joint_state_t()
-        probe.sim_time, probe.num_joints = -1.0, 3
-        probe.name = ["theta0", "theta1", "theta2"]
-        probe.position = probe.velocity = probe.effort = [0.0, 0.0, 0.0]
-        deadline = time.monotonic() + 30
-        while not heard["ready"] and time.monotonic() < deadline and snip.poll() is None:
-            lc.publish(prefix + "_STATE", probe.encode())
-            time.sleep(0.2)
-        heard["states"] = 0
-        daemon = subprocess.run(
-            [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
-             "--set", "realtime.mode=lockstep", "--duration", "2", "-q"],
-            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
-            timeout=60)
-        try:
-            out, _ = snip.communicate(timeout=20)
-        except subprocess.TimeoutExpired:
-            snip.kill()
-            out, _ = snip.communicate()
-            out += "\n(killed: did not exit after the daemon's stop)"
-        time.sleep(0.5)
-        listening[0] = False
-        th.join()
-        lc.close()
-        lc_cmd.close()
-        stray.close()
-        st = heard["status"]
-        acc = st.commands_accepted if st else -1
-        lto = st.lockstep_timeouts if st else -1
-        checks = [
-            (daemon.returncode == 0, "lagsimd ran 2 s and exited 0"),
-            (snip.returncode == 0, "the snippet exited 0 after the daemon's stop"),
-            (acc == 200 and lto == 0,
-             "answered %d of the 200 states before t = 2 s, %d lockstep timeout(s)"
-             % (acc, lto)),
-            (heard["states"] > 0 and heard["max_th"] < 0.1 and math.isfinite(heard["max_th"]),
-             "balanced: %d states heard, largest |theta1|, |theta2| %.4f rad"
-             % (heard["states"], heard["max_th"])),
-            (heard["stray"] == 0,
-             "on a port of its own: %d of its messages heard on LCM's default URL"
-             % heard["stray"]),
-        ]
-        print("---- %s (%s)" % (name, path))
-        if out.strip():
-            print(out.rstrip())
-        for good, what in checks:
-            print("%s: %s" % ("ok  " if good else "FAIL", what))
+        thinks = [0.0] + ([a.think] if a.think > 0 else [])
+        runs = []
+        for think in thinks:
+            bad, states = run_block(a, build, found[name], name, lang, think)
+            fails += bad
+            runs.append(states)
+        if len(runs) == 2:
+            fast, slow = runs
+            same = sorted(fast) == sorted(slow) and all(fast[t] == slow[t] for t in fast)
+            diff = [t for t in sorted(fast) if slow.get(t) != fast[t]][:3]
+            good = same and len(fast) == a.periods + 1
+            print("%s: with a law of %g s per answer: the same %d states as the fast run, bit for "
+                  "bit (%d heard; first differing sim times %s)"
+                  % ("ok  " if good else "FAIL", a.think, len(fast), len(slow), diff))
             fails += 0 if good else 1
     return 1 if fails else 0
+
+
+def run_block(a, build, text, name, lang, think):
+    """Runs one block against lagsimd for a.periods periods in lockstep, its law taking
+    `think` wall s per answer; prints its checks. Returns (failures, {sim_time: the
+    state's positions and velocities})."""
+    from lagsim_lcm import LCM, plant_urls
+    from lagsim import joint_command_t, joint_state_t, status_t
+    fname, cmd, env_extra = RUNNERS[lang]
+    prefix = "RDME%s_%d" % (lang.upper(), os.getpid())
+    tmp = tempfile.mkdtemp(prefix="lagsim_readme_")
+    path = os.path.join(tmp, fname)
+    with open(path, "w") as f:
+        f.write(text.replace('"DIPC_', '"%s_' % prefix).replace("'DIPC_", "'%s_" % prefix)
+                .replace('"DIPC"', '"%s"' % prefix))
+    slow = ""
+    if lang == "c":
+        build_cmd = a.c_build.split()
+        if think > 0:  # the same block, built with a slow law in front of its sends
+            build_cmd[1:1] = ["-include", os.path.join(THINK_DIR, "think.h")]
+        cc = subprocess.run([w.replace("{src}", path).replace("{out}", path[:-2])
+                             for w in build_cmd], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, universal_newlines=True)
+        if cc.returncode != 0:
+            print("FAIL: the C block does not build:\n" + cc.stdout)
+            return 1, {}
+    elif think > 0:
+        slow = java_think_classes(build, tmp) if lang == "java" else "yes"
+    env = dict(os.environ)
+    env.update(env_extra(build))
+    env["LAGSIM_THINK_S"] = repr(think)
+    think_log = os.path.join(tmp, "think.log")
+    if think > 0:
+        env["LAGSIM_THINK_LOG"] = think_log
+    state_url, command_url = plant_urls()
+    lc, lc_cmd = LCM(state_url), LCM(command_url)
+    heard = {"states": 0, "max_th": 0.0, "t": -1.0, "status": None, "by_time": {}}
+
+    def on_state(ch, data):
+        st = joint_state_t.decode(data)
+        if st.sim_time < 0:
+            return
+        heard["states"] += 1
+        heard["t"] = max(heard["t"], st.sim_time)
+        heard["max_th"] = max([heard["max_th"]] + [abs(x) for x in st.position[1:3]])
+        heard["by_time"][st.sim_time] = tuple(st.position) + tuple(st.velocity)
+
+    def on_status(ch, data):
+        heard["status"] = status_t.decode(data)
+
+    def on_command(ch, data):
+        if joint_command_t.decode(data).sim_time == -1.0:
+            heard["ready"] = True
+
+    # LCM's own default URL must hear nothing of this run: it is on its own port
+    stray = LCM("udpm://239.255.76.67:7667?ttl=0")
+    heard["stray"] = 0
+
+    def on_stray(ch, data):
+        heard["stray"] += 1
+
+    stray.subscribe(prefix + "_.*", on_stray)
+    lc.subscribe(prefix + "_STATE", on_state)
+    lc.subscribe(prefix + "_STATUS", on_status)
+    lc_cmd.subscribe(prefix + "_COMMAND", on_command)
+    heard["ready"] = False
+    listening = [True]
+
+    def listen():  # its own thread: the daemon in lockstep outruns a late reader
+        while listening[0]:
+            lc.handle_timeout(20)
+            while lc_cmd.handle_timeout(0):
+                pass
+            while stray.handle_timeout(0):
+                pass
+
+    th = threading.Thread(target=listen, daemon=True)
+    th.start()
+    snip = subprocess.Popen(cmd(build, path, slow), cwd=tmp, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, universal_newlines=True)
+    # Ready when it answers: a probe state at sim time -1, every 0.2 s (and more slowly
+    # than its law), until a command for it comes back (java compiles the file first).
+    # Then the daemon starts.
+    probe = joint_state_t()
+    probe.sim_time, probe.num_joints = -1.0, 3
+    probe.name = ["theta0", "theta1", "theta2"]
+    probe.position = probe.velocity = probe.effort = [0.0, 0.0, 0.0]
+    deadline = time.monotonic() + 30 + 2 * think
+    while not heard["ready"] and time.monotonic() < deadline and snip.poll() is None:
+        lc.publish(prefix + "_STATE", probe.encode())
+        time.sleep(0.2 + 1.5 * think)
+    heard["states"] = 0
+    periods = a.periods
+    daemon = subprocess.Popen(
+        [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
+         "--set", "realtime.mode=lockstep",
+         "--set", "realtime.lockstep_timeout=%r" % max(1.0, 3 * think),
+         "--duration", repr(periods * 0.01), "-q"],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    budget = 30 + 3 * think * periods  # three think times a state, and 30 s to start
+    try:
+        daemon.communicate(timeout=budget)
+        in_time = True
+    except subprocess.TimeoutExpired:  # too slow: stopped (its stop event ends the block)
+        daemon.send_signal(signal.SIGINT)
+        daemon.communicate()
+        in_time = False
+    try:
+        out, _ = snip.communicate(timeout=20 + 3 * think)
+    except subprocess.TimeoutExpired:
+        snip.kill()
+        out, _ = snip.communicate()
+        out += "\n(killed: did not exit after the daemon's stop)"
+    time.sleep(0.5)
+    listening[0] = False
+    th.join()
+    lc.close()
+    lc_cmd.close()
+    stray.close()
+    st = heard["status"]
+    acc = st.commands_accepted if st else -1
+    lto = st.lockstep_timeouts if st else -1
+    checks = [
+        (in_time and daemon.returncode == 0,
+         "lagsimd ran %d periods within %g s and exited 0" % (periods, budget)),
+        (snip.returncode == 0, "the snippet exited 0 after the daemon's stop"),
+        (acc == periods and lto == 0,
+         "answered %d of the %d states before t = %g s, %d lockstep timeout(s)"
+         % (acc, periods, periods * 0.01, lto)),
+        (heard["states"] > 0 and heard["max_th"] < 0.1 and math.isfinite(heard["max_th"]),
+         "balanced: %d states heard, largest |theta1|, |theta2| %.4f rad"
+         % (heard["states"], heard["max_th"])),
+        (heard["stray"] == 0,
+         "on a port of its own: %d of its messages heard on LCM's default URL"
+         % heard["stray"]),
+    ]
+    if think > 0:
+        # the law runs once per state: the probe's, the N answered, perhaps the last one
+        laws = len(open(think_log).readlines()) if os.path.exists(think_log) else 0
+        checks.append((periods + 1 <= laws <= periods + 2,
+                       "its law ran %d times for the probe and %d states (once per sim_time: "
+                       "%d or %d)" % (laws, periods + 1, periods + 1, periods + 2)))
+    print("---- %s (%s)%s" % (name, path, " with a law of %g s per answer" % think if think else ""))
+    if out.strip():
+        print(out.rstrip())
+    fails = 0
+    for good, what in checks:
+        print("%s: %s" % ("ok  " if good else "FAIL", what))
+        fails += 0 if good else 1
+    sys.stdout.flush()
+    return fails, heard["by_time"]
 
 
 if __name__ == "__main__":

@@ -154,7 +154,7 @@ int main(void)
     snprintf(ch, sizeof ch, "%s_STATUS", prefix);
     lagsim_status_t gs = {1, 2.5, 3, 4.5, 5.5, 6, 7.5, 8.5, 9.5, "dopri5", "lockstep", "paused",
                           13, 14, 15, 16, 17, 18, 19, 1, 21, 22, 23, 24, 25, 26, 27, 28, 29,
-                          "flat", 30};
+                          "flat", 30, "the first command", 30.5, "", 31};
     lagsim_status_t_publish(peer, ch, &gs);
     pump(peer, c, 100);
     lag_client_status ss;
@@ -172,6 +172,8 @@ int main(void)
     ENSURE(ss.states_published == 26 && ss.rejected_effort_limit == 27);
     ENSURE(ss.lockstep_retries == 28 && ss.commands_ignored == 29 && !strcmp(ss.contact, "flat"));
     ENSURE(ss.plant_conflicts == 30);
+    ENSURE(!strcmp(ss.waiting_for, "the first command") && ss.waiting_s == 30.5);
+    ENSURE(!strcmp(ss.waiting_got, "") && ss.commands_wrong_port == 31);
 
     /* commands */
     const char *names[2] = {"q1", "q2"};
@@ -208,6 +210,30 @@ int main(void)
     pump(peer, c, 100);
     ENSURE(last_ctl.request == LAGSIM_CONTROL_T_STEP && last_ctl.count == 7);
     ENSURE(lag_client_pause(c) == LAG_CLIENT_OK && lag_client_resume(c) == LAG_CLIENT_OK);
+
+    /* Each state once (the law runs once per state): a copy of the latest state (the same
+     * utime, step and sim_time: the daemon re-sends a state in lockstep until an answer
+     * arrives) is not returned; once a command answered the state, a copy gets that very
+     * command again, at once. */
+    snprintf(ch, sizeof ch, "%s_STATE", prefix);
+    publish_state(peer, ch, 3, NULL, 4.0, 0.1);
+    ENSURE(lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK && st.sim_time == 4.0);
+    publish_state(peer, ch, 3, NULL, 4.0, 0.1); /* a copy before the answer */
+    ENSURE(lag_client_wait_state(c, 0.3, &st) == LAG_CLIENT_TIMEOUT);
+    int before = commands;
+    ENSURE(lag_client_send_command(c, 4.0, 2, names, eff) == LAG_CLIENT_OK);
+    pump(peer, c, 100);
+    ENSURE(commands == before + 1 && last_cmd.sim_time == 4.0);
+    int64_t utime_answer = last_cmd.utime;
+    publish_state(peer, ch, 3, NULL, 4.0, 0.1); /* a copy after it: answered again */
+    pump(peer, c, 100);
+    ENSURE(lag_client_wait_state(c, 0.1, &st) == LAG_CLIENT_TIMEOUT);
+    ENSURE(commands == before + 2 && last_cmd.sim_time == 4.0 && last_cmd.utime == utime_answer &&
+           last_cmd.effort[1] == -2.25);
+    lag_client_get_counters(c, &cnt);
+    ENSURE(cnt.copies == 2 && cnt.repeats == 1 && cnt.commands_sent == 2);
+    publish_state(peer, ch, 3, NULL, 4.01, 0.1); /* the next state: returned */
+    ENSURE(lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK && st.sim_time == 4.01);
 
     /* lag_client_feed: the same path as the bus; another channel is refused */
     ENSURE(lag_client_feed(c, "OTHER_STATE", junk, sizeof junk) == LAG_CLIENT_ERR_ARG);

@@ -171,7 +171,7 @@ def main():
               % ({k: first[k] for k in ("t", "theta1", "theta2")} if first else None))
 
         r = ctl("reset-to", "0", "0")
-        check(r.returncode == 1 and "1 joints given; model" in r.stderr and "has 3" in r.stderr
+        check(r.returncode == 1 and "num_joints 1; accepted: 3" in r.stderr
               and "refused" in r.stderr,
               "reset-to with 1 joint of 3: exit 1, the daemon's reason on stderr")
 

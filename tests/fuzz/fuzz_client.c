@@ -69,6 +69,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         check_terminated(ss.integrator, sizeof ss.integrator);
         check_terminated(ss.mode, sizeof ss.mode);
         check_terminated(ss.run_state, sizeof ss.run_state);
+        check_terminated(ss.waiting_for, sizeof ss.waiting_for);
+        check_terminated(ss.waiting_got, sizeof ss.waiting_got);
         if (!lag_wire_all_finite(LAG_WIRE_STATUS, &ss)) fail("non-finite status");
     }
     return 0;

@@ -14,6 +14,10 @@ Cases:
             sim time the core locates
   quiet     -q: no live line and no event line (only the line saying where it listens)
   pipe      stderr not a terminal: event lines only, no live line, no control codes
+  waits     no controller: every 3 s a line says what the plant waits for (the first
+            command, on <PREFIX>_COMMAND at the command URL) and, once a command for an
+            unknown joint came and one on the state URL's port, what came instead; each
+            on its own line above the live line
 """
 import argparse
 import fcntl
@@ -118,10 +122,10 @@ class Sender:
         self.lc = LCM(plant_urls()[1])  # the daemon's command URL (the next port)
         self.cmd_t, self.prefix = joint_command_t, prefix
 
-    def command(self, name="theta0", effort=0.0):
+    def command(self, name="theta0", effort=0.0, lc=None):
         c = self.cmd_t()
         c.sim_time, c.num_joints, c.name, c.effort = 0.0, 1, [name], [effort]
-        self.lc.publish(self.prefix + "_COMMAND", c.encode())
+        (lc or self.lc).publish(self.prefix + "_COMMAND", c.encode())
 
     def send_for(self, d, seconds, hz=100):
         end = time.monotonic() + seconds
@@ -187,7 +191,7 @@ def case_live(a):
 def case_effects(a):
     prefix = f"TT{os.getpid()}S"
     d = Daemon(a, os.path.join(a.source, "config", "stick.yaml"), prefix, "--set",
-               "realtime.mode=fast", "--duration", "5")
+               "realtime.mode=fast", "--set", "realtime.start=running", "--duration", "5")
     d.read(10)
     rc = d.stop()
     t = d.text()
@@ -231,7 +235,58 @@ def case_pipe(a):
     check(ok and [e.split()[2] for e in evs] == ["start", "stop"], "the start and stop events, one line each")
 
 
-CASES = {"live": case_live, "effects": case_effects, "quiet": case_quiet, "pipe": case_pipe}
+def wait_lines(text, prefix):
+    """The lines saying what the plant waits for: (each starts a line and ends at its \\n
+    without a \\r, the lines)."""
+    ok, lines = True, []
+    for m in re.finditer(r"lagsimd: " + re.escape(prefix) + r" waits ", text):
+        i = m.start()
+        before = text[max(0, i - 4):i]
+        end = text.find("\n", i)
+        line = text[i:end if end >= 0 else len(text)]
+        ok &= (i == 0 or before.endswith("\n") or before.endswith("\r\x1b[K")) and end >= 0 \
+            and "\r" not in line
+        lines.append(line)
+    return ok, lines
+
+
+def case_waits(a):
+    prefix = f"TT{os.getpid()}W"
+    sys.path.insert(0, a.python)
+    from lagsim_lcm import LCM, plant_urls
+    state_url, command_url = plant_urls()
+    d = Daemon(a, os.path.join(a.source, "config", "dipc.yaml"), prefix)
+    s = Sender(a, prefix)
+    d.read(4.0)
+    ok, lines = wait_lines(d.text(), prefix)
+    for l in lines:
+        print("  wait line:", l)
+    check(ok and len(lines) == 1, f"one line after 3 s of waiting, on its own line ({len(lines)})")
+    check(lines and lines[0].startswith(f"lagsimd: {prefix} waits 3 s for the first command on "
+                                        f"{prefix}_COMMAND at {command_url}; nothing else came"),
+          "it says what it waits for, on which channel and URL, and that nothing else came")
+    s.command(name="cart")
+    wrong = LCM(state_url)
+    s.command(lc=wrong)  # a controller publishing on the state URL's port
+    d.read(3.5)
+    rc = d.stop()
+    wrong.close()
+    ok, lines = wait_lines(d.text(), prefix)
+    for l in lines[1:]:
+        print("  wait line:", l)
+    check(ok and len(lines) == 2, f"a line every 3 s, each on its own line ({len(lines)})")
+    last = lines[-1] if lines else ""
+    check("waits 6 s for the first command" in last and "got instead: 1 command rejected "
+          "(unknown joint 1; the last: unknown joint: 'cart'; joints of dipc: theta0 (actuated), "
+          "theta1, theta2)" in last, "what came instead: the rejected command and why")
+    sport, cport = (int(re.search(r":(\d+)", u).group(1)) for u in (state_url, command_url))
+    check(f"; 1 command on {prefix}_COMMAND at the state port {sport} (commands go to port "
+          f"{cport})" in last, "and the command on the state URL's port")
+    check(len(live_lines(d.text(), prefix)) > 0, "the live line below them")
+    check(rc == 0, f"exit {rc}")
+
+
+CASES = {"waits": case_waits, "live": case_live, "effects": case_effects, "quiet": case_quiet, "pipe": case_pipe}
 
 
 def main():

@@ -13,6 +13,7 @@
  *                           long_period chunks
  *                           step_paced control_flood command_flood duration signals
  *                           fault_effort lockstep_retry lockstep_loss other_plant
+ *                           reject_names waits
  */
 #include <math.h>
 #include <signal.h>
@@ -70,6 +71,8 @@ typedef struct outputs {
     double last_q[LAG_MAX_DOF];
     int64_t status_controls_rejected, status_states, status_overrun_bursts, status_conflicts;
     char status_run[16];
+    char status_waiting_for[256], status_waiting_got[256]; /* the last status's */
+    double status_waiting_s;
     uint8_t scene_bytes[4096]; /* the last scene, as published */
     size_t scene_len;
 } outputs;
@@ -91,6 +94,7 @@ typedef struct controller {
     bool have[CTL_MAX_STEPS];
     double x[CTL_MAX_STEPS][2 * LAG_MAX_DOF];
     int64_t last_step;
+    int64_t end_step;             /* states from this step on are not answered (0: all) */
 } controller;
 static controller g_ctl;
 static void command(double sim_time, const char *joint, double effort);
@@ -122,6 +126,7 @@ static void ctl_state(const lag_wire_joint_state *m)
         memcpy(g_ctl.x[k], x, sizeof x);
     }
     g_ctl.last_step = m->step;
+    if (g_ctl.end_step > 0 && m->step >= g_ctl.end_step) return; /* the run is over */
     /* a balancing law of the DIPC, from the state alone */
     double u = 1.67 * m->position[0] - 396.4 * m->position[1] + 448.4 * m->position[2] +
                6.17 * m->velocity[0] - 16.3 * m->velocity[1] + 68.4 * m->velocity[2];
@@ -227,6 +232,9 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         g_out.status_overrun_bursts = m.overrun_bursts;
         g_out.status_conflicts = m.plant_conflicts;
         snprintf(g_out.status_run, sizeof g_out.status_run, "%.15s", m.run_state);
+        snprintf(g_out.status_waiting_for, sizeof g_out.status_waiting_for, "%s", m.waiting_for);
+        snprintf(g_out.status_waiting_got, sizeof g_out.status_waiting_got, "%s", m.waiting_got);
+        g_out.status_waiting_s = m.waiting_s;
     } else if (!strcmp(sfx, "EVENT")) {
         lag_wire_event m;
         if (lag_wire_decode_event(rb->data, rb->data_size, &m) != LAG_WIRE_OK) fail(__LINE__, "bad event");
@@ -1035,11 +1043,27 @@ static void case_fault_effort(void)
     stop_server();
 }
 
+/* Copies of the state waited on due within `span_ns` of its publication with a first
+ * gap of `first` ns that doubles up to `cap` ns: the back-off rule, counted here by its
+ * definition (docs/server.md), not by the daemon's code. */
+static int64_t copies_within(int64_t span_ns, int64_t first, int64_t cap)
+{
+    int64_t n = 0, at = 0, gap = first;
+    for (;;) {
+        at += gap;
+        if (at >= span_ns) return n;
+        n++;
+        gap = 2 * gap < cap ? 2 * gap : cap;
+    }
+}
+
 /* Lockstep retries: a state not answered within lockstep_retry (20 ms) goes out again,
- * byte for byte, every 20 ms, until an answer comes; the wait (and lockstep_timeout)
- * still counts from the first publication. A second answer to the state is ignored and
- * counted (commands_ignored), with no event, whether it comes before the period ran or
- * after; an answer to an older state is still a stale rejection. */
+ * byte for byte, after gaps that double (20, 40, 80 ms, ...) up to a sixteenth of
+ * lockstep_timeout; the wait (and lockstep_timeout) still counts from the first
+ * publication. A second answer to the state is ignored and counted (commands_ignored),
+ * with no event, whether it comes before the period ran or after; an answer to an older
+ * state is still a stale rejection. Any answer to the state waited on, even one rejected,
+ * ends its copies: the controller has it. */
 static void case_lockstep_retry(void)
 {
     scene(LAG_RT_LOCKSTEP);
@@ -1053,7 +1077,8 @@ static void case_lockstep_retry(void)
     unsigned first_len = g_srv.state_len;
     memcpy(first, g_srv.state_buf, first_len);
     run_until(t0 + 110 * MS, 1000);
-    ENSUREF(g_srv.lockstep_retries == 5 && g_out.state == 6, "%lld retries, %lld states in 110 ms",
+    /* copies at 20 and 60 ms (the next, at 140 ms, is not due) */
+    ENSUREF(g_srv.lockstep_retries == 2 && g_out.state == 3, "%lld retries, %lld states in 110 ms",
             (long long)g_srv.lockstep_retries, (long long)g_out.state);
     ENSURE(g_srv.state_len == first_len && memcmp(first, g_srv.state_buf, first_len) == 0);
     ENSURE(g_srv.sim.tick == 0 && g_srv.lockstep_timeouts == 0 && g_out.last_step == 0);
@@ -1062,7 +1087,7 @@ static void case_lockstep_retry(void)
     command(0.0, "theta0", 9.0);
     ENSURE(g_srv.accepted == 1 && g_srv.commands_ignored == 1 && g_srv.held[0] == 0.5);
     run_until(g_srv.now + 1 * MS, 1000);
-    ENSURE(g_srv.sim.tick == 10 && g_out.state == 7 && g_out.last_step == 10);
+    ENSURE(g_srv.sim.tick == 10 && g_out.state == 4 && g_out.last_step == 10);
     /* a late copy of the answer to t = 0: ignored, counted, no event */
     command(0.0, "theta0", 9.0);
     ENSURE(g_srv.commands_ignored == 2 && g_srv.held[0] == 0.5);
@@ -1070,16 +1095,162 @@ static void case_lockstep_retry(void)
     /* an answer to a state that was never published: stale */
     command(0.5, "theta0", 9.0);
     ENSURE(g_srv.rejected[RT_REJ_STALE] == 1 && g_srv.held[0] == 0.5);
-    /* no answer for a second: 49 retries, then the timeout (no more 20 ms retries) */
-    int64_t r0 = g_srv.lockstep_retries;
+    /* no answer for a second: the backed-off copies (20, 60 ms, then every 62.5 ms),
+     * then the timeout */
+    int64_t r0 = g_srv.lockstep_retries, want = copies_within(1000 * MS, 20 * MS, 62500000);
     run_until(g_srv.now + 1100 * MS, 1000);
     ENSUREF(g_srv.lockstep_timeouts == 1 && g_srv.run == RT_WAITING, "%lld timeouts",
             (long long)g_srv.lockstep_timeouts);
-    ENSUREF(g_srv.lockstep_retries - r0 == 49, "%lld retries before the timeout",
-            (long long)(g_srv.lockstep_retries - r0));
+    ENSUREF(g_srv.lockstep_retries - r0 == want && want == 17,
+            "%lld retries before the timeout, %lld by the rule",
+            (long long)(g_srv.lockstep_retries - r0), (long long)want);
     /* the status says it */
     control(LAGSIM_CONTROL_T_STATUS, 0);
     run_until(g_srv.now + 1 * MS, 1000);
+    stop_server();
+
+    /* an answer that is rejected (a joint the model does not have) still tells the
+     * daemon the controller has the state: no copy of it after that */
+    scene(LAG_RT_LOCKSTEP);
+    g_sc.realtime.start = LAG_RT_START_RUNNING;
+    g_sc.realtime.lockstep_timeout = 1.0;
+    g_sc.realtime.lockstep_retry = 0.02;
+    start();
+    run_until(g_srv.now + 30 * MS, 1000);
+    ENSURE(g_srv.lockstep_retries == 1);
+    command(0.0, "cart", 1.0);
+    ENSURE(g_srv.rejected[RT_REJ_UNKNOWN_JOINT] == 1 && !g_srv.answered);
+    run_until(g_srv.now + 900 * MS, 1000);
+    ENSUREF(g_srv.lockstep_retries == 1, "%lld copies after a rejected answer",
+            (long long)g_srv.lockstep_retries);
+    stop_server();
+}
+
+/* A rejection names what would be accepted: the DIPC's joints with the actuated one
+ * marked (theta0, the cart: its only input), the actuated joints alone, the effort limit,
+ * the sim_time waited on, the requests by value, a count >= 1, the joint count. */
+static void expect_detail(const char *kind, const char *want, int line)
+{
+    drain();
+    if (!strstr(last_detail(kind), want))
+        fail(line, "%s detail '%s' lacks '%s'", kind, last_detail(kind), want);
+    printf("%s: %s\n", kind, last_detail(kind));
+}
+
+static void case_reject_names(void)
+{
+    scene(LAG_RT_LOCKSTEP);
+    g_sc.realtime.start = LAG_RT_START_RUNNING;
+    g_sc.realtime.effort_limit[0] = 100;
+    start();
+    drain();
+    command(0.0, "cart", 1.0);
+    expect_detail("command_rejected", "unknown joint: 'cart'; joints of dipc: theta0 (actuated), "
+                  "theta1, theta2", __LINE__);
+    command(0.0, "theta1", 1.0);
+    expect_detail("command_rejected", "'theta1' takes no input; actuated joints of dipc: theta0",
+                  __LINE__);
+    command(0.0, "theta0", 250.0);
+    expect_detail("command_rejected", "250 for 'theta0' (in value); accepted: |effort| <= 100",
+                  __LINE__);
+    command(0.0, "theta0", NAN);
+    expect_detail("command_rejected", "accepted: a finite effort within +-100", __LINE__);
+    command(0.25, "theta0", 1.0);
+    expect_detail("command_rejected", "sim_time 0.25 (in value); accepted: 0, the state waited on",
+                  __LINE__);
+    control(99, 0);
+    expect_detail("control_rejected", "unknown request 99; accepted: PAUSE = 1, RESUME = 2, "
+                  "STEP = 3, RESET = 4, RESET_TO = 5, STATUS = 6, DESCRIBE = 7, SET = 8", __LINE__);
+    control(LAGSIM_CONTROL_T_PAUSE, 0);
+    control(LAGSIM_CONTROL_T_STEP, 0);
+    expect_detail("control_rejected", "step: count 0; accepted: a count >= 1", __LINE__);
+    {
+        uint8_t buf[256];
+        double q[2] = {0, 0}, qd[2] = {0, 0};
+        lagsim_control_t m = {0, LAGSIM_CONTROL_T_RESET_TO, 0, 2, q, qd, "", ""};
+        int n = lagsim_control_t_encode(buf, 0, sizeof buf, &m);
+        ENSURE(n > 0);
+        rt_handle_control(&g_srv, buf, (size_t)n);
+    }
+    expect_detail("control_rejected", "reset_to: num_joints 2; accepted: 3, the joints of dipc in "
+                  "this order: theta0 (actuated), theta1, theta2", __LINE__);
+    stop_server();
+}
+
+/* No silent waits: the status says what the plant waits for, on which channel and URL,
+ * how long it has waited and what came instead, for each wait: the first command, a
+ * lockstep answer (after 1 s), paused, the fault state; nothing while it advances. */
+static void status_now(void)
+{
+    control(LAGSIM_CONTROL_T_STATUS, 0);
+    run_until(g_srv.now + 60 * MS, 1000);
+}
+
+#define EXPECT_HAS(str, want)                                                           \
+    do {                                                                                \
+        if (!strstr((str), (want))) fail(__LINE__, "'%s' lacks '%s'", (str), (want));   \
+        else printf("ok: ... %s\n", (want));                                            \
+    } while (0)
+
+static void case_waits(void)
+{
+    scene(LAG_RT_LOCKSTEP);
+    g_sc.realtime.start = LAG_RT_START_FIRST_COMMAND;
+    g_sc.realtime.lockstep_timeout = 10.0;
+    start();
+    /* the command URL: the state URL's group on the next port (lagsim_bus.h, tested there) */
+    char on_cmd[400], on_ctl[400];
+    snprintf(on_cmd, sizeof on_cmd, "on TL_COMMAND at %s", g_srv.bus.command_url);
+    snprintf(on_ctl, sizeof on_ctl, "on TL_CONTROL at %s (paused)", g_srv.bus.command_url);
+    ENSURE(strstr(g_srv.bus.command_url, ":7668"));
+    run_until(g_srv.now + 2 * SEC, 1000);
+    status_now();
+    EXPECT_HAS(g_out.status_waiting_for, "the first command (sim_time 0) ");
+    EXPECT_HAS(g_out.status_waiting_for, on_cmd);
+    ENSUREF(g_out.status_waiting_s >= 2.0 && g_out.status_waiting_s < 2.5, "waited %g s",
+            g_out.status_waiting_s);
+    ENSURE(!strcmp(g_out.status_waiting_got, ""));
+    /* what came instead: two rejections, an answer to another sim_time */
+    command(0.0, "cart", 1.0);
+    command(0.0, "theta1", 1.0);
+    command(0.5, "theta0", 1.0);
+    status_now();
+    EXPECT_HAS(g_out.status_waiting_got, "2 commands rejected (unknown joint 1, unactuated joint 1; "
+               "the last: unactuated joint: 'theta1' takes no input; actuated joints of dipc: theta0)");
+    EXPECT_HAS(g_out.status_waiting_got, "; 1 answer to another sim_time");
+    /* the answer: the run goes; a lockstep round trip of less than 1 s is not a wait */
+    command(0.0, "theta0", 1.0);
+    run_until(g_srv.now + 500 * MS, 1000);
+    status_now();
+    ENSUREF(!strcmp(g_out.status_waiting_for, "") && g_out.status_waiting_s == 0,
+            "'%s' %g s", g_out.status_waiting_for, g_out.status_waiting_s);
+    /* unanswered for more than a second: a wait, of its own age, with nothing else come */
+    run_until(g_srv.now + 1500 * MS, 1000);
+    status_now();
+    EXPECT_HAS(g_out.status_waiting_for, "a command answering sim_time 0.01 ");
+    EXPECT_HAS(g_out.status_waiting_for, on_cmd);
+    ENSURE(g_out.status_waiting_s >= 1.5 && g_out.status_waiting_s < 2.2);
+    ENSURE(!strcmp(g_out.status_waiting_got, ""));
+    /* paused */
+    control(LAGSIM_CONTROL_T_PAUSE, 0);
+    run_until(g_srv.now + 1 * SEC, 1000);
+    status_now();
+    EXPECT_HAS(g_out.status_waiting_for, "RESUME or STEP ");
+    EXPECT_HAS(g_out.status_waiting_for, on_ctl);
+    ENSURE(g_out.status_waiting_s >= 1.0 && g_out.status_waiting_s < 1.2);
+    stop_server();
+
+    /* realtime: waiting for the first command, then running: nothing to wait for */
+    scene(LAG_RT_REALTIME);
+    g_sc.realtime.start = LAG_RT_START_FIRST_COMMAND;
+    start();
+    run_until(g_srv.now + 1 * SEC, 1000);
+    status_now();
+    EXPECT_HAS(g_out.status_waiting_for, "the first command on TL_COMMAND at udpm://");
+    command(0.0, "theta0", 0.0);
+    run_until(g_srv.now + 1 * SEC, 1000);
+    status_now();
+    ENSURE(!strcmp(g_out.status_waiting_for, "") && !strcmp(g_out.status_run, "running"));
     stop_server();
 }
 
@@ -1094,6 +1265,7 @@ static int64_t lockstep_run(double loss, int periods)
     g_ctl.on = true;
     g_ctl.loss = loss;
     g_ctl.rng = 12345;
+    g_ctl.end_step = 10 * (int64_t)periods;
     start();
     const int64_t t0 = g_srv.now;
     while (g_srv.sim.tick < 10 * (int64_t)periods && g_srv.now - t0 < 600 * SEC)
@@ -1262,8 +1434,8 @@ static void case_messages(void)
     rt_handle_control(&g_srv, buf, (size_t)n);
     run_until(g_srv.now + 10 * MS, 1000);
     ENSUREF(n_events("control_rejected") == 1 &&
-                strstr(last_detail("control_rejected"), "4 joints given; model dipc has 3 "
-                       "(theta0, theta1, theta2)"),
+                strstr(last_detail("control_rejected"), "reset_to: num_joints 4; accepted: 3, "
+                       "the joints of dipc in this order: theta0 (actuated), theta1, theta2"),
             "reset_to with 4 joints: '%s'", last_detail("control_rejected"));
     /* a command of 4 joints */
     lag_wire_joint_command jc;
@@ -1275,13 +1447,13 @@ static void case_messages(void)
     rt_handle_command(&g_srv, buf, (size_t)n);
     run_until(g_srv.now + 10 * MS, 1000);
     ENSUREF(n_events("command_rejected") == 1 &&
-                strstr(last_detail("command_rejected"), "num_joints 4 in value: expected 0 to 3, "
-                       "the joints of model dipc (theta0, theta1, theta2)"),
+                strstr(last_detail("command_rejected"), "num_joints 4 (in value); accepted: 0 to 3, "
+                       "joints of dipc: theta0 (actuated), theta1, theta2"),
             "command with 4 joints: '%s'", last_detail("command_rejected"));
     control(LAGSIM_CONTROL_T_STEP, 0);
     run_until(g_srv.now + 10 * MS, 1000);
     ENSUREF(n_events("control_rejected") == 2 &&
-                strstr(last_detail("control_rejected"), "step: count 0: expected 1 or more"),
+                strstr(last_detail("control_rejected"), "step: count 0; accepted: a count >= 1"),
             "step 0: '%s'", last_detail("control_rejected"));
     stop_server();
 }
@@ -1302,6 +1474,7 @@ int main(int argc, char **argv)
         {"signals", case_signals},         {"fault_effort", case_fault_effort},
         {"lockstep_retry", case_lockstep_retry}, {"lockstep_loss", case_lockstep_loss},
         {"other_plant", case_other_plant}, {"messages", case_messages},
+        {"reject_names", case_reject_names}, {"waits", case_waits},
     };
     if (argc != 2) {
         fprintf(stderr, "usage: test_loop CASE\n");

@@ -270,6 +270,12 @@ static void check_agreement(void)
         g.contact = "flight";
         strcpy(w.contact, "flight");
         g.plant_conflicts = w.plant_conflicts = 30;
+        g.waiting_for = "the first command on X_COMMAND at udpm://239.255.76.67:7668?ttl=0";
+        strcpy(w.waiting_for, g.waiting_for);
+        g.waiting_s = w.waiting_s = 30.5;
+        g.waiting_got = "2 commands rejected (unknown joint 2; the last: unknown joint: 'cart')";
+        strcpy(w.waiting_got, g.waiting_got);
+        g.commands_wrong_port = w.commands_wrong_port = 31;
         int nt = lagsim_status_t_encode(theirs, 0, sizeof theirs, &g);
         agree(LAG_WIRE_STATUS, &w, nt);
     }

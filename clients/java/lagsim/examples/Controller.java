@@ -214,7 +214,9 @@ public final class Controller {
     /** The newest state not yet returned, or null when the run has ended (see endReason).
      *  A copy of the state answered last (same step and sim time: the daemon published it
      *  again because no answer reached it) is answered at once with the same command and
-     *  not returned: every state received is answered, the law runs once per state. */
+     *  not returned: every state received is answered, the law runs once per state (a law
+     *  run for every copy would cost a think time per copy and fall behind for good:
+     *  docs/clients.md, the rule). */
     public joint_state_t nextState() throws InterruptedException {
         synchronized (lock) {
             if (endReason != null) return null;

@@ -1,0 +1,147 @@
+/*
+ * A plant never waits in silence. Whenever the run does not advance, the daemon knows
+ * what it waits for and says so: in every status (waiting_for, waiting_s, waiting_got)
+ * and, every RT_WAIT_LINE_NS of the wait, in one line on stderr (unless -q):
+ *
+ *   lagsimd: DIPC waits 6 s for the first command on DIPC_COMMAND at
+ *   udpm://239.255.76.67:7668?ttl=0; got instead: 3 commands rejected (unknown joint 3;
+ *   the last: unknown joint: 'cart'; joints of dipc: theta0 (actuated), theta1, theta2)
+ *
+ * The waits: the first command (realtime.start: first_command, or after a reset), in
+ * lockstep a command answering the state published (shown once it lasted RT_WAIT_SHOW_NS:
+ * a lockstep round trip is a wait too, a short one), RESUME or STEP while paused, RESET
+ * while in the fault state. What came instead, since the wait began: commands rejected
+ * (by reason, and the last one's reason), commands heard on the state URL (the port
+ * before the command port: a controller that publishes on the wrong port), answers to
+ * another sim_time (stale).
+ */
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "rt_server.h"
+
+#define RT_WAIT_SHOW_NS RT_NS_PER_S         /* a lockstep wait is said after 1 s */
+#define RT_WAIT_LINE_NS (3 * RT_NS_PER_S)   /* a line every 3 s of a wait */
+
+/* What the plant waits for now (RT_WAIT_NONE: the run advances); *t: the sim_time a
+ * lockstep answer must carry. */
+static rt_wait_kind wait_kind(const rt_server *s, double *t)
+{
+    *t = 0;
+    if (s->run == RT_FAULT) return RT_WAIT_RESET;
+    if (s->run == RT_PAUSED && s->pending_steps == 0) return RT_WAIT_RESUME;
+    bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
+    if (s->run == RT_WAITING && s->pending_steps == 0 && !s->have_command) {
+        *t = lag_sim_time(&s->sim);
+        return RT_WAIT_FIRST;
+    }
+    if (lockstep && s->waiting && !s->answered &&
+        (s->run == RT_RUNNING || s->run == RT_WAITING || s->pending_steps > 0)) {
+        *t = s->waiting_time;
+        return RT_WAIT_ANSWER;
+    }
+    return RT_WAIT_NONE;
+}
+
+void rt_wait_update(rt_server *s)
+{
+    double t;
+    rt_wait_kind k = wait_kind(s, &t);
+    if (k != s->wt.kind || (k != RT_WAIT_NONE && t != s->wt.t)) {
+        s->wt.kind = k;
+        s->wt.t = t;
+        s->wt.since_ns = s->now;
+        s->wt.next_line_ns = rt_sat_add(s->now, RT_WAIT_LINE_NS);
+        memcpy(s->wt.rejected0, s->rejected, sizeof s->rejected);
+        s->wt.wrong_port0 = s->commands_wrong_port;
+    }
+    if (k == RT_WAIT_NONE || s->now < s->wt.next_line_ns) return;
+    s->wt.next_line_ns = rt_sat_add(s->now, RT_WAIT_LINE_NS);
+    char what[2 * LAG_WIRE_TEXT_LEN], got[2 * LAG_WIRE_TEXT_LEN]; /* the status cuts them */
+    double waited = rt_wait_describe(s, what, sizeof what, got, sizeof got);
+    char line[5 * LAG_WIRE_TEXT_LEN];
+    snprintf(line, sizeof line, "lagsimd: %s waits %.0f s for %s; %s%s", s->sc->lcm.prefix,
+             waited, what, got[0] ? "got instead: " : "nothing else came", got);
+    rt_term_say(s, line);
+}
+
+int64_t rt_wait_next(const rt_server *s)
+{
+    return s->wt.kind == RT_WAIT_NONE ? INT64_MAX : s->wt.next_line_ns;
+}
+
+/* Appends printf-style text to buf (of cap bytes, holding n), cut at its end. */
+static size_t add(char *buf, size_t cap, size_t n, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static size_t add(char *buf, size_t cap, size_t n, const char *fmt, ...)
+{
+    if (n + 1 >= cap) return n;
+    va_list ap;
+    va_start(ap, fmt);
+    int w = vsnprintf(buf + n, cap - n, fmt, ap);
+    va_end(ap);
+    if (w < 0) return n;
+    return n + (size_t)w < cap ? n + (size_t)w : cap - 1;
+}
+
+double rt_wait_describe(const rt_server *s, char *what, size_t whatlen, char *got, size_t gotlen)
+{
+    what[0] = got[0] = '\0';
+    double t;
+    rt_wait_kind k = wait_kind(s, &t);
+    /* a wait that began since the last update (a handler changed the run) is 0 s old */
+    bool same = k == s->wt.kind && (k == RT_WAIT_NONE || t == s->wt.t);
+    double waited = same ? (double)(s->now - s->wt.since_ns) * 1e-9 : 0.0;
+    if (k == RT_WAIT_NONE || (k == RT_WAIT_ANSWER && waited * 1e9 < (double)RT_WAIT_SHOW_NS))
+        return 0.0;
+    const char *curl = s->bus.command_url;
+    switch (k) {
+    case RT_WAIT_FIRST:
+        if (s->sc->realtime.mode == LAG_RT_LOCKSTEP)
+            snprintf(what, whatlen, "the first command (sim_time %.9g) on %s at %s", t,
+                     s->ch_command, curl);
+        else
+            snprintf(what, whatlen, "the first command on %s at %s", s->ch_command, curl);
+        break;
+    case RT_WAIT_ANSWER:
+        snprintf(what, whatlen, "a command answering sim_time %.9g on %s at %s", t,
+                 s->ch_command, curl);
+        break;
+    case RT_WAIT_RESUME:
+        snprintf(what, whatlen, "RESUME or STEP on %s at %s (paused)", s->ch_control, curl);
+        break;
+    case RT_WAIT_RESET:
+        snprintf(what, whatlen, "RESET or RESET_TO on %s at %s (numeric fault)", s->ch_control,
+                 curl);
+        break;
+    case RT_WAIT_NONE: break;
+    }
+    if (!same) return 0.0;
+    /* what came instead, since the wait began */
+    size_t n = 0;
+    int64_t bad = 0, stale = s->rejected[RT_REJ_STALE] - s->wt.rejected0[RT_REJ_STALE];
+    for (int r = 0; r < RT_REJ_COUNT; r++)
+        if (r != RT_REJ_STALE) bad += s->rejected[r] - s->wt.rejected0[r];
+    if (bad > 0) {
+        n = add(got, gotlen, n, "%lld command%s rejected (", (long long)bad, bad > 1 ? "s" : "");
+        bool first = true;
+        for (int r = 0; r < RT_REJ_COUNT; r++) {
+            int64_t d = s->rejected[r] - s->wt.rejected0[r];
+            if (r == RT_REJ_STALE || d == 0) continue;
+            n = add(got, gotlen, n, "%s%s %lld", first ? "" : ", ", rt_reject_name[r],
+                    (long long)d);
+            first = false;
+        }
+        n = add(got, gotlen, n, "; the last: %s)", s->last_reject);
+    }
+    int64_t wrong = s->commands_wrong_port - s->wt.wrong_port0;
+    if (wrong > 0)
+        n = add(got, gotlen, n, "%s%lld command%s on %s at the state port %d (commands go to "
+                "port %d)", n ? "; " : "", (long long)wrong, wrong > 1 ? "s" : "", s->ch_command,
+                s->bus.state_port, s->bus.command_port);
+    if (stale > 0)
+        n = add(got, gotlen, n, "%s%lld answer%s to another sim_time", n ? "; " : "",
+                (long long)stale, stale > 1 ? "s" : "");
+    return waited;
+}
