@@ -334,6 +334,7 @@ endif()
 # ---- README.md's controller blocks, run as written (tests/clients/readme_snippets.py)
 set(readme_run ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_snippets.py
     --lagsimd ${lang_lagsimd} --build ${CMAKE_BINARY_DIR} --readme ${PROJECT_SOURCE_DIR}/README.md
+    --readme ${PROJECT_SOURCE_DIR}/docs/clients.md
     --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml)
 # the C block, built as a user would against the client library (and, in a sanitizer
 # build, its runtime)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Runs the controllers that README.md shows, exactly as written there.
+"""Runs the controllers that README.md (and docs/clients.md) show, exactly as written there.
 
     readme_snippets.py --lagsimd BIN --build DIR --readme README.md NAME...
 
@@ -86,7 +86,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lagsimd", required=True)
     ap.add_argument("--build", required=True)
-    ap.add_argument("--readme", required=True)
+    ap.add_argument("--readme", action="append", required=True,
+                    help="a file with marked blocks (repeatable: README.md, docs/clients.md)")
     ap.add_argument("--config", required=True)
     ap.add_argument("--c-build", default="",
                     help="how to build the C block: a command line with {src} and {out}")
@@ -108,12 +109,14 @@ def main():
     print("LCM_DEFAULT_URL=%s" % os.environ["LCM_DEFAULT_URL"])
     sys.path.insert(0, os.path.join(build, "python"))
 
-    found = snippets(a.readme)
+    found = {}
+    for f in a.readme:
+        found.update(snippets(f))
     fails = 0
     for name in a.names:
         lang = name.split("-")[0]
         if name not in found or lang not in RUNNERS:
-            print("FAIL: no block marked <!-- snippet: %s --> in %s" % (name, a.readme))
+            print("FAIL: no block marked <!-- snippet: %s --> in %s" % (name, ", ".join(a.readme)))
             fails += 1
             continue
         thinks = [0.0] + ([a.think] if a.think > 0 else [])
