@@ -159,11 +159,13 @@ lag_result lag_cost_measure(const lag_sim_def *def, const lag_cost_opts *o,
     }
     c.t_start = c.clock(o->clock_ctx);
 
-    /* the reference: dopri5 far below the target, at the finest tick a setting may have
-     * (a bounce shorter than a tick ends in resting contact: the Zeno guard of the floor
-     * and the stops depends on the tick, and the reference's must be the finest) */
+    /* the reference: dopri5 far below the target; with a floor or stops at the finest
+     * tick a setting may have (a bounce shorter than a tick ends in resting contact: their
+     * Zeno guard depends on the tick, and the reference's must be the finest), else a
+     * tick a period (dopri5 steps across ticks as it likes) */
     out->ref_tol = fmax(1e-14, fmin(1e-10, o->target * 1e-4));
-    const int64_t ref_tpp = (int64_t)1 << MAX_REFINE;
+    const uint32_t zeno = LAG_EFF_FLOOR | LAG_EFF_LIMITS; /* effects whose rest depends on the tick */
+    const int64_t ref_tpp = (def->effects.enabled & zeno) ? (int64_t)1 << MAX_REFINE : 1;
     {
         lag_integrator_def in = def->integrator;
         in.method = LAG_DOPRI5;

@@ -5,8 +5,8 @@
  * "Error" means: over `horizon` seconds of sim time from the scene's initial state, with
  * no input (or the scene's held input), the largest difference between a setting's q and
  * a reference's q at the scene's publish times, in each joint's own unit (m or rad). The
- * reference is dopri5 at a tolerance far below the error asked for, with a tick of
- * period / 1024, the finest dt tried. Effects stay as the scene has them (a floor, stops
+ * reference is dopri5 at a tolerance far below the error asked for (with a floor or stops,
+ * at a tick of period / 1024, the finest dt tried). Effects stay as the scene has them (a floor, stops
  * or friction are located and applied as in a run); a bounce shorter than one tick ends
  * in resting contact (the Zeno guard), so a coarse tick can end bouncing earlier than the
  * reference does, and shows as error.

@@ -13,6 +13,7 @@
 
 #include "cost.h"
 #include "daemon.h"
+#include "lagsim_out.h"
 
 /* The real-time margin a chosen setting must keep at least: the daemon also serves LCM,
  * logs and publishes, and a loaded machine has less than one core for it. */
@@ -122,14 +123,47 @@ int lagsimd_choose_integrator(const lag_scene *sc, bool offline, bool quiet, lag
     return LAGSIMD_EXIT_OK;
 }
 
-/* The work-precision diagram of the table, drawn by gnuplot into png. */
-static int plot(const lag_scene *sc, const lag_cost_table *t, double target, const char *png)
+/* Copies the file at path into the descriptor out (closed). Returns 0 or -1. */
+static int copy_into(const char *path, int out)
 {
+    FILE *in = fopen(path, "rb");
+    char buf[65536];
+    size_t n;
+    int rc = in ? 0 : -1;
+    while (in && (n = fread(buf, 1, sizeof buf, in)) > 0)
+        if (write(out, buf, n) != (ssize_t)n) rc = -1;
+    if (in) fclose(in);
+    if (close(out) != 0) rc = -1;
+    return rc;
+}
+
+/* The work-precision diagram of the table, drawn by gnuplot into a temporary file and
+ * copied to png, opened first by the rules of every output (lagsim_out.h). */
+static int plot(const lag_scene *sc, const lag_cost_table *t, double target, const char *png,
+                bool force)
+{
+    char oerr[512];
+    const char *inputs[1] = {sc->path};
+    int out = lag_out_open("--plot", png, force, inputs, 1, 0, oerr, sizeof oerr);
+    if (out < 0) {
+        fprintf(stderr, "lagsimd: %s\n", oerr);
+        return out == LAG_OUT_REFUSED ? LAGSIMD_EXIT_USAGE : LAGSIMD_EXIT_RUNTIME;
+    }
+    char tmp_png[] = "/tmp/lagsimd-cost-XXXXXX.png";
+    int tfd = mkstemps(tmp_png, 4);
+    if (tfd < 0) {
+        close(out);
+        fprintf(stderr, "lagsimd: --plot: cannot make a temporary file: %s\n", strerror(errno));
+        return LAGSIMD_EXIT_RUNTIME;
+    }
+    close(tfd);
     char data[] = "/tmp/lagsimd-cost-XXXXXX";
     int fd = mkstemp(data);
     if (fd < 0) {
+        close(out);
+        unlink(tmp_png);
         fprintf(stderr, "lagsimd: --plot: cannot make a temporary file: %s\n", strerror(errno));
-        return -1;
+        return LAGSIMD_EXIT_RUNTIME;
     }
     FILE *f = fdopen(fd, "w");
     for (int m = 0; f && m < LAG_METHOD_COUNT; m++) { /* one block per method */
@@ -140,15 +174,19 @@ static int plot(const lag_scene *sc, const lag_cost_table *t, double target, con
         fputs("\n\n", f);
     }
     if (!f || fclose(f) != 0) {
+        close(out);
         unlink(data);
+        unlink(tmp_png);
         fprintf(stderr, "lagsimd: --plot: cannot write %s\n", data);
-        return -1;
+        return LAGSIMD_EXIT_RUNTIME;
     }
     FILE *g = popen("gnuplot", "w");
     if (!g) {
+        close(out);
         unlink(data);
+        unlink(tmp_png);
         fprintf(stderr, "lagsimd: --plot: cannot run gnuplot\n");
-        return -1;
+        return LAGSIMD_EXIT_RUNTIME;
     }
     fprintf(g, "set terminal pngcairo size 900,600 enhanced font 'DejaVu Sans,11'\n"
                "set output '%s'\nset logscale xy\nset format x '10^{%%L}'\nset format y '10^{%%L}'\n"
@@ -160,7 +198,7 @@ static int plot(const lag_scene *sc, const lag_cost_table *t, double target, con
                "set label 'error asked for' at graph 0.02, first %g offset 0,0.6 tc rgb 'red'\n"
                "set arrow from graph 0, first %g to graph 1, first %g nohead dt 3 lc rgb 'gray40'\n"
                "set label 'what a setting must reach (/ %g)' at graph 0.02, first %g offset 0,-0.7 tc rgb 'gray40'\n",
-            png, opts_for(sc, target).horizon, sc->path, target, target, target,
+            tmp_png, opts_for(sc, target).horizon, sc->path, target, target, target,
             target / opts_for(sc, target).safety, target / opts_for(sc, target).safety,
             opts_for(sc, target).safety, target / opts_for(sc, target).safety);
     fputs("plot ", g);
@@ -171,13 +209,21 @@ static int plot(const lag_scene *sc, const lag_cost_table *t, double target, con
     int rc = pclose(g);
     unlink(data);
     if (rc != 0) {
+        close(out);
+        unlink(tmp_png);
         fprintf(stderr, "lagsimd: --plot: gnuplot failed (exit %d)\n", rc);
-        return -1;
+        return LAGSIMD_EXIT_RUNTIME;
     }
-    return 0;
+    rc = copy_into(tmp_png, out);
+    unlink(tmp_png);
+    if (rc != 0) {
+        fprintf(stderr, "lagsimd: --plot: cannot write %s\n", png);
+        return LAGSIMD_EXIT_RUNTIME;
+    }
+    return LAGSIMD_EXIT_OK;
 }
 
-int lagsimd_cost(const lag_scene *sc, const char *png)
+int lagsimd_cost(const lag_scene *sc, const char *png, bool force)
 {
     static lag_cost_table t;
     const double target = sc->accuracy.error > 0 ? sc->accuracy.error : DEFAULT_TARGET;
@@ -185,7 +231,8 @@ int lagsimd_cost(const lag_scene *sc, const char *png)
     const lag_cost_opts o = opts_for(sc, target);
     const lag_model_info *info = lag_model_info_get(sc->sim.model.kind);
     printf("# %s: %s, error asked for %g over %g s (a setting meets it with %g times to spare),\n"
-           "# publish period %g s; reference dopri5 tolerance %.0e at a tick of period/1024;\n"
+           "# publish period %g s; reference dopri5 tolerance %.0e (with a floor or stops at a\n"
+           "# tick of period/1024);\n"
            "# CPU measured on this machine: %.2f s for %d settings%s\n",
            sc->path, info ? info->name : "?", target, o.horizon, o.safety, o.period, t.ref_tol,
            t.spent, t.n, t.budget_hit ? " (budget ran out: finer settings unmeasured)" : "");
@@ -204,6 +251,5 @@ int lagsimd_cost(const lag_scene *sc, const char *png)
                i == t.chosen ? "meets, chosen" : r->meets ? "meets" : "");
     }
     if (t.chosen < 0) printf("# no setting measured meets %g\n", target);
-    if (png && plot(sc, &t, target, png) != 0) return LAGSIMD_EXIT_RUNTIME;
-    return LAGSIMD_EXIT_OK;
+    return png ? plot(sc, &t, target, png, force) : LAGSIMD_EXIT_OK;
 }

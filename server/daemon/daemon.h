@@ -52,7 +52,8 @@ typedef struct lagsimd_choice {
  * integrator.error. OUT: ch */
 int lagsimd_choose_integrator(const lag_scene *sc, bool offline, bool quiet, lagsimd_choice *ch);
 /* --cost: the table of what each setting costs on this scene and machine, on stdout;
- * with png, gnuplot's work-precision diagram too. Returns an exit code. */
-int lagsimd_cost(const lag_scene *sc, const char *png);
+ * with png, gnuplot's work-precision diagram too, written by lag_out_open's rules (force:
+ * replace an existing file). Returns an exit code. */
+int lagsimd_cost(const lag_scene *sc, const char *png, bool force);
 
 #endif

@@ -53,7 +53,7 @@ static void usage(FILE *f)
         "                         never makes the loop wait in realtime mode (what a slow\n"
         "                         disk loses is counted and said; exit 1 if anything was\n"
         "                         lost)\n"
-        "      --force            --log, --csv: replace FILE if it exists (else refused,\n"
+        "      --force            --log, --csv, --plot: replace FILE if it exists (else refused,\n"
         "                         exit 2); never a symbolic link (not followed) nor the\n"
         "                         scene file itself, --force or not\n"
         "  -i, --increment        --log: if FILE exists, write FILE.00, FILE.01, ... (the\n"
@@ -347,8 +347,8 @@ int main(int argc, char **argv)
         rc = usage_error("%s", "--increment picks a free name for --log FILE: give --log, and not --force");
     } else if (increment && next_free_name(&opts.log) != 0) {
         rc = LAGSIMD_EXIT_USAGE;
-    } else if (opts.force && !opts.log && !opts.csv) {
-        rc = usage_error("%s", "--force replaces the file of --log or --csv: give one");
+    } else if (opts.force && !opts.log && !opts.csv && !plot) {
+        rc = usage_error("%s", "--force replaces the file of --log, --csv or --plot: give one");
     } else {
         static lag_scene sc;
         char err[1024];
@@ -362,7 +362,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "%s\n", err);
             rc = LAGSIMD_EXIT_USAGE;
         } else if (cost) {
-            rc = lagsimd_cost(&sc, plot);
+            rc = lagsimd_cost(&sc, plot, opts.force);
         } else if (replay && sc.accuracy.error > 0 && !integrator_given(sets, nsets)) {
             fprintf(stderr, "lagsimd: %s: integrator.error: the recorded run chose its integrator "
                     "when it started; give the same with --set integrator.method=... --set "

@@ -51,6 +51,27 @@ done
 head -c 8 "$work/cost.png" | od -An -c | grep -q "P   N   G" && ok "--plot wrote a PNG" \
     || bad "--plot wrote no PNG"
 
+# --plot writes by the rules of every output (lagsim_out.h): an existing file only with
+# --force, never through a symbolic link, never the scene file
+"$lagsimd" --config "$cfg/manipulator.yaml" --cost --plot "$work/cost.png" > /dev/null 2> "$work/p.err"
+rc=$?
+[ $rc -eq 2 ] && grep -q "exists" "$work/p.err" && ok "--plot refuses an existing file" \
+    || bad "--plot over an existing file: exit $rc"
+"$lagsimd" --config "$cfg/manipulator.yaml" --cost --plot "$work/cost.png" --force > /dev/null
+rc=$?
+[ $rc -eq 0 ] && ok "--plot --force replaces it" || bad "--plot --force: exit $rc"
+echo "results of a week" > "$work/precious"
+ln -s "$work/precious" "$work/link.png"
+"$lagsimd" --config "$cfg/manipulator.yaml" --cost --plot "$work/link.png" --force > /dev/null 2>&1
+rc=$?
+[ $rc -eq 2 ] && [ "$(cat "$work/precious")" = "results of a week" ] \
+    && ok "--plot refuses a symbolic link, its target unchanged" || bad "--plot through a link: exit $rc"
+cp "$cfg/manipulator.yaml" "$work/scene.yaml"
+"$lagsimd" --config "$work/scene.yaml" --cost --plot "$work/scene.yaml" --force > /dev/null 2>&1
+rc=$?
+[ $rc -eq 2 ] && cmp -s "$cfg/manipulator.yaml" "$work/scene.yaml" \
+    && ok "--plot refuses the scene file itself" || bad "--plot over the scene: exit $rc"
+
 # 4. paced real time that cannot keep the margin (1000 times real time: the cheapest
 #    setting for 1e-12 costs about 5e-3 s per sim-second here): refused before it runs
 timeout 60 "$lagsimd" --config "$cfg/dipc.yaml" --set integrator.error=1e-12 \
