@@ -650,7 +650,13 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     }
     if (nargs != want_args) {
-        fprintf(stderr, "lagsimctl: %s takes %d argument(s), got %d\n", cmd, want_args, nargs);
+        fprintf(stderr, "lagsimctl: %s takes %d argument(s), got %d", cmd, want_args, nargs);
+        for (int i = 0; i < nargs; i++)
+            if (args[i][0] == '-') { /* an option after the command: say where it goes */
+                fprintf(stderr, " (options go before the command: lagsimctl %s %s)", args[i], cmd);
+                break;
+            }
+        fputc('\n', stderr);
         return EXIT_USAGE;
     }
 

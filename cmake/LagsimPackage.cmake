@@ -42,7 +42,7 @@ set(_lagsim_deb_needs
   "Recommends # lua5.2, liblcm-lua # the Lua 5.2 modules in /usr/share/lua/5.2"
   "Recommends # liblcm-java, default-jre-headless | java-runtime-headless # lagsim_types.jar and lagsim_examples.jar (Java, MATLAB, Octave)"
   "Suggests # liblcm-dev, libglib2.0-dev # C controllers: lagsim-client.pc requires lcm.pc, which needs glib's"
-  "Suggests # octave # the Octave/MATLAB controllers")
+  "Suggests # octave, octave-control # the Octave/MATLAB controllers (dlqr, lqr from octave-control)")
 foreach(_rel Depends Recommends Suggests)
   set(_l "")
   foreach(_n ${_lagsim_deb_needs})

@@ -210,6 +210,13 @@ add_test(NAME clients_octave_matlab_syntax
           ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_octave_lqr.m ${CMAKE_CURRENT_SOURCE_DIR}/net/plant_urls_octave.m
           --readme ${PROJECT_SOURCE_DIR}/README.md)
 list(APPEND lang_tests clients_octave_matlab_syntax)
+# the jars load in MATLAB's bundled Java 8: every class of LAGSIM_JAVA_RELEASE
+if(TARGET lagsim_examples_java)
+  add_test(NAME clients_java_release
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/java_release.py ${LAGSIM_JAVA_RELEASE}
+            ${CMAKE_BINARY_DIR}/lagsim_types.jar ${CMAKE_BINARY_DIR}/lagsim_examples.jar)
+  list(APPEND lang_tests clients_java_release)
+endif()
 if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
   set(octave_run ${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh ${CMAKE_BINARY_DIR}/octave)
   # Bad options (those checked before connecting: the design's own are checked once the

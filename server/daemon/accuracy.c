@@ -109,9 +109,11 @@ int lagsimd_choose_integrator(const lag_scene *sc, bool offline, bool quiet, lag
     lag_cost_row_describe(&t.row[best], d, sizeof d);
     if (paced) {
         fprintf(stderr, "lagsimd: %s: integrator.error %g cannot be met at real time on this "
-                "machine: the best setting that keeps a %gx margin is %s, error %.2g over %g s "
+                "machine (a setting must be %g times below it and keep a %gx margin to real "
+                "time): the best that keeps the margin is %s, error %.2g over %g s "
                 "(lagsimd --cost shows every setting; a larger error, a lower publish_hz or "
-                "realtime.rate, or lockstep mode would do)\n", sc->path, e, RT_MARGIN_MIN, d,
+                "realtime.rate, or lockstep mode would do)\n", sc->path, e,
+                lag_cost_opts_default().safety, RT_MARGIN_MIN, d,
                 t.row[best].error, horizon);
         return LAGSIMD_EXIT_USAGE;
     }

@@ -24,6 +24,7 @@
 #include <unistd.h>
 
 #include "lagsim_out.h"
+#include "lagsim/lagsim_control_t.h" /* the requests' constants */
 
 #define L2C_MAX_CHANNELS 256
 #define L2C_MAX_KINDS 48
@@ -446,18 +447,23 @@ static bool write_command(l2c *c, chan *h, const lag_log_record *r,
     return true;
 }
 
+/* control_t's requests by their constants (lcmtypes/control_t.lcm) */
 static const char *request_name(int r)
 {
-    static const char *const names[] = {"", "pause", "resume", "step", "reset", "reset_to",
-                                        "status", "describe"};
-    return r >= 1 && r <= 7 ? names[r] : "unknown";
+    static const char *const names[] = {
+        [LAGSIM_CONTROL_T_PAUSE] = "pause", [LAGSIM_CONTROL_T_RESUME] = "resume",
+        [LAGSIM_CONTROL_T_STEP] = "step", [LAGSIM_CONTROL_T_RESET] = "reset",
+        [LAGSIM_CONTROL_T_RESET_TO] = "reset_to", [LAGSIM_CONTROL_T_STATUS] = "status",
+        [LAGSIM_CONTROL_T_DESCRIBE] = "describe", [LAGSIM_CONTROL_T_SET] = "set"};
+    const int n = (int)(sizeof names / sizeof names[0]);
+    return r >= 0 && r < n && names[r] ? names[r] : "unknown";
 }
 
 static bool write_control(l2c *c, chan *h, const lag_log_record *r, const lag_wire_control *m)
 {
     if (!h->csv) {
         if (!(h->csv = open_csv(c, h))) return false;
-        fputs("wall_time,log_time,request,name,count,q,qd\n", h->csv);
+        fputs("wall_time,log_time,request,name,count,q,qd,key,value\n", h->csv);
     }
     FILE *f = h->csv;
     char q[L2C_JOINTS * 26] = "", qd[L2C_JOINTS * 26] = "";
@@ -473,6 +479,8 @@ static bool write_control(l2c *c, chan *h, const lag_log_record *r, const lag_wi
     put_i(f, m->count);
     put_numbers(f, q);
     put_numbers(f, qd);
+    put_s(f, m->key);   /* SET: what it changes */
+    put_s(f, m->value);
     fputc('\n', f);
     return true;
 }

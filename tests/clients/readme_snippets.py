@@ -58,9 +58,9 @@ RUNNERS = {
              lambda b: {}),
     # a plain octave --eval of the script, from its folder, the .m files on the path (no
     # think wrapper: the slow-law runs are the other languages')
-    "octave": ("balance.m",
+    "octave": ("lqr_dipc.m",
                lambda b, f, slow: ["octave", "--no-gui", "--quiet", "--no-init-file", "--path",
-                             os.path.join(b, "octave"), "--eval", "balance"],
+                             os.path.join(b, "octave"), "--eval", "lqr_dipc"],
                lambda b: {}),
 }
 

@@ -86,10 +86,11 @@ class Types:
         c.num_joints, c.name, c.effort = len(names), list(names), list(efforts)
         return c.encode()
 
-    def control(self, request, count=0, q=(), qd=()):
+    def control(self, request, count=0, q=(), qd=(), key="", value=""):
         c = self.m.control_t()
         c.utime, c.request, c.count = 1_700_000_000_000_000, request, count
         c.num_joints, c.q, c.qd = len(q), list(q), list(qd)
+        c.key, c.value = key, value
         return c.encode()
 
     def state_fp(self):

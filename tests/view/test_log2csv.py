@@ -71,6 +71,15 @@ def case_exact(a, t, tmp):
     ct = rows(os.path.join(out, "T_CONTROL.csv"))
     check(len(ct) == 1 and ct[0]["name"] == "reset_to" and ct[0]["q"] == "0 0.10000000000000001 0.20000000000000001",
           "control: request by name, q")
+    # a SET request: named, with the key and value it asked for
+    setlog = os.path.join(tmp, "set.lcm")
+    with open(setlog, "wb") as f:
+        f.write(lcmlog.log([("T_CONTROL", t.control(8, key="parameters.m2", value="1.25"))]))
+    ps = run(a.log2csv, setlog, "-q", "-o", os.path.join(tmp, "set"))
+    cs = rows(os.path.join(tmp, "set", "T_CONTROL.csv"))
+    check(ps.returncode == 0 and len(cs) == 1 and cs[0]["name"] == "set" and
+          cs[0]["key"] == "parameters.m2" and cs[0]["value"] == "1.25",
+          "control: a SET named, its key and value kept (%s)" % (cs[0] if cs else None))
     ev = rows(os.path.join(out, "T_EVENT.csv"))
     check(len(ev) == 3 and ev[0]["detail"] == 'say "hi", newline' and ev[1]["kind"] == "limit" and
           float(ev[1]["value"]) == -0.5, "events: quoted detail, control characters replaced")

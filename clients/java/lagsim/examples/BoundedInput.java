@@ -57,7 +57,7 @@ public final class BoundedInput implements DataInput {
         }
         LCMDataOutputStream out = new LCMDataOutputStream(len);
         msg.encode(out);
-        if (out.size() != len || !Arrays.equals(out.getBuffer(), 0, len, buf, off, off + len))
+        if (out.size() != len || !sameBytes(out.getBuffer(), buf, off, len))
             throw new IOException("does not encode back to the bytes received");
         try {
             for (Field f : msg.getClass().getFields()) {
@@ -138,4 +138,11 @@ public final class BoundedInput implements DataInput {
     @Override public double readDouble() throws IOException { return in.readDouble(); }
     @Override public String readLine() throws IOException { return in.readLine(); }
     @Override public String readUTF() throws IOException { return in.readUTF(); }
+
+    /** a[0..len) equals b[off..off+len) (Java 8 has no ranged Arrays.equals). */
+    private static boolean sameBytes(byte[] a, byte[] b, int off, int len) {
+        for (int i = 0; i < len; i++)
+            if (a[i] != b[off + i]) return false;
+        return true;
+    }
 }
