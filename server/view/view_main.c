@@ -123,6 +123,12 @@ int main(int argc, char **argv)
             for (size_t i = 0; ok && i < n; i++) /* a DNS name or an address literal */
                 ok = (optarg[i] >= 'a' && optarg[i] <= 'z') || (optarg[i] >= 'A' && optarg[i] <= 'Z') ||
                      (optarg[i] >= '0' && optarg[i] <= '9') || strchr("-._[]:", optarg[i]);
+            /* NAME:PORT (one colon: no IPv6 address has one) or [ADDR]:PORT: a port, which
+             * the check compares separately with the port bound */
+            const char *colon = strchr(optarg, ':'), *bracket = strchr(optarg, ']');
+            if (ok && ((colon && !strchr(colon + 1, ':') && optarg[0] != '[') ||
+                       (bracket && bracket[1] == ':')))
+                ok = false;
             if (!ok) {
                 fprintf(stderr, "lagsim-view: --allow-host: expected a host name or address "
                         "without a port (letters, digits, '-', '.', '_', an IPv6 address; at "
