@@ -96,6 +96,12 @@ void rt_publish_state(rt_server *s)
     }
 }
 
+double rt_error_budget(const lag_scene *sc)
+{
+    const double e = sc->accuracy.error, h = sc->accuracy.horizon;
+    return e > 0 && h > 0 ? e / (sc->publish_hz * h) : 0.0;
+}
+
 void rt_publish_status(rt_server *s)
 {
     int64_t now = rt_mono_ns();
@@ -136,6 +142,10 @@ void rt_publish_status(rt_server *s)
     m.commands_ignored = s->commands_ignored;
     PUT(m.contact, lag_sim_contact(&s->sim));
     m.plant_conflicts = s->plant_conflicts;
+    m.error_estimate = fin(s->err_estimate);
+    PUT(m.error_joint, s->err_joint >= 0 && s->err_joint < s->nq ? s->info->joint_names[s->err_joint] : "");
+    m.error_budget = fin(rt_error_budget(s->sc));
+    m.error_warnings = s->err_warnings;
     publish(s, s->ch_status, LAG_WIRE_STATUS, &m);
     s->rtf = m.rtf;
     if (wall < 0.05 && s->run == RT_RUNNING) return; /* the window goes on */

@@ -155,6 +155,10 @@ typedef struct lag_wire_status {
     int64_t commands_ignored;
     char contact[LAG_WIRE_NAME_LEN]; /* the stick's floor: flight, contact, flat or "" */
     int64_t plant_conflicts;
+    double error_estimate;           /* m or rad, the live error estimate (docs/accuracy.md) */
+    char error_joint[LAG_WIRE_NAME_LEN];
+    double error_budget;             /* m or rad per period; 0 without integrator.error */
+    int64_t error_warnings;
 } lag_wire_status;
 
 /* <PREFIX>_SCENE: the scene description. */
