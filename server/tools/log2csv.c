@@ -299,7 +299,8 @@ static bool write_status(l2c *c, chan *h, const lag_log_record *r, const lag_wir
               "rejected_unknown_joint,rejected_unactuated,rejected_nonfinite,"
               "rejected_bad_length,rejected_undecodable,controls_rejected,watchdog_tripped,"
               "watchdog_trips,lockstep_timeouts,numeric_faults,rejected_stale,overrun_bursts,"
-              "states_published\n", h->csv);
+              "states_published,error_estimate,error_joint,error_budget,error_warnings\n",
+              h->csv);
     }
     FILE *f = h->csv;
     fprintf(f, "%.17g", m->sim_time);
@@ -329,6 +330,10 @@ static bool write_status(l2c *c, chan *h, const lag_log_record *r, const lag_wir
     put_i(f, m->rejected_stale);
     put_i(f, m->overrun_bursts);
     put_i(f, m->states_published);
+    put_d(f, m->error_estimate);
+    put_s(f, m->error_joint);
+    put_d(f, m->error_budget);
+    put_i(f, m->error_warnings);
     fputc('\n', f);
     h->last_status = *m;
     h->have_status = true;

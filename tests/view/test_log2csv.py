@@ -80,6 +80,9 @@ def case_exact(a, t, tmp):
     ss = rows(os.path.join(out, "T_STATUS.csv"))
     check(len(ss) == 1 and float(ss[0]["energy"]) == 7.25 and ss[0]["run_state"] == "running",
           "status: every field")
+    check(float(ss[0]["error_estimate"]) == 2.5e-7 and ss[0]["error_joint"] == "theta1" and
+          float(ss[0]["error_budget"]) == 1e-8 and ss[0]["error_warnings"] == "3",
+          "status: the live error estimate")
 
     s = p.stdout
     check("T_STATE: joint_state_t, 6 messages" in s, "summary: state count")
