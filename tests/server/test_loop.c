@@ -1332,6 +1332,7 @@ static void case_live_error(void)
             ENSUREF(ev >= 3 && ev <= 3 + (int64_t)wall_s + 1, "%lld error_estimate events in "
                     "%.2f s", (long long)ev, wall_s);
             const char *d = last_detail("error_estimate");
+            printf("%lld error_estimate events in %.2f s, the last: %s\n", (long long)ev, wall_s, d);
             ENSUREF(strstr(d, "to theta") && strstr(d, "integrator.error 1e-09 over 1 s") &&
                         strstr(d, "suppressed"), "detail: %s", d);
             ENSURE(g_out.kind_value[kind_index("error_estimate")] > budget);
