@@ -29,9 +29,9 @@ typedef enum lag_rt_start {
 
 /* Every this many periods the daemon estimates the error the integration adds (a shadow
  * run of the period, lag_sim_shadow_error), when a scene asks for integrator.error and
- * does not say integrator.estimate_every: its CPU cost is then about 2/20 of the run's
+ * does not say integrator.estimate_every: its CPU cost is then about 2/50 of the run's
  * with a fixed-step method (docs/accuracy.md measures it). */
-#define LAG_SCENE_ESTIMATE_EVERY 20
+#define LAG_SCENE_ESTIMATE_EVERY 50
 
 typedef struct lag_scene {
     char path[512];          /* file it was read from ("" if built in code) */
