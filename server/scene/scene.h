@@ -29,8 +29,8 @@ typedef enum lag_rt_start {
 
 /* Every this many periods the daemon estimates the error the integration adds (a shadow
  * run of the period, lag_sim_shadow_error), when a scene asks for integrator.error and
- * does not say integrator.estimate_every: its CPU cost is then about 2/50 of the run's
- * with a fixed-step method (docs/accuracy.md measures it). */
+ * does not say integrator.estimate_every: it then adds 3 to 5 % to a period's work
+ * (docs/accuracy.md, bench/live_error_cost.sh). */
 #define LAG_SCENE_ESTIMATE_EVERY 50
 
 typedef struct lag_scene {
