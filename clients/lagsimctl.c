@@ -198,6 +198,7 @@ static const char *status_unit(const char *name)
         {"sim_time", "s"}, {"wall_time", "s"}, {"step", "ticks"}, {"rtf", "x real time"},
         {"step_time_max_us", "us"}, {"step_time_mean_us", "us"}, {"energy", "J"},
         {"overruns", "periods"}, {"states_published", "states"}, {"waiting_s", "wall s"},
+        {"error_estimate", "m or rad per period"}, {"error_budget", "m or rad per period"},
     };
     for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
         if (!strcmp(units[i].name, name)) return units[i].unit;

@@ -29,7 +29,7 @@ add_executable(test_loop ${CMAKE_CURRENT_LIST_DIR}/server/test_loop.c)
 target_link_libraries(test_loop PRIVATE lagsimd_internal)
 foreach(case pacing rate_huge status_hz lockstep_wait start set long_period chunks step_paced
         control_flood command_flood duration signals fault_effort lockstep_retry lockstep_loss
-        other_plant set_replay messages reject_names waits)
+        other_plant set_replay messages reject_names waits live_error)
   add_test(NAME server_loop_${case} COMMAND test_loop ${case})
   set_tests_properties(server_loop_${case} PROPERTIES TIMEOUT 60 LABELS server)
 endforeach()

@@ -137,6 +137,7 @@ static lag_result dp_run(lag_sim *s, double *t, double t_end, double t_stop, dou
     for (int64_t attempts = 0; *t < t_end; attempts++) {
         if (attempts >= max_steps) return LAG_ERR_MAX_STEPS;
         double h = s->dp.h;
+        if (s->dp.h_max > 0.0 && h > s->dp.h_max) h = s->dp.h_max; /* a shadow's cap */
         bool lands = false;
         if (*t + h >= t_stop) {
             h = t_stop - *t;

@@ -79,6 +79,7 @@ static const struct {
     [RT_EV_EVENTS_DROPPED] = {"events_dropped", 1, 3},
     /* one in RT_CONFLICT_EVERY_S however many scenes a forger or a log player sends */
     [RT_EV_PLANT_CONFLICT] = {"plant_conflict", 1.0 / RT_CONFLICT_EVERY_S, 1},
+    [RT_EV_ERROR_ESTIMATE] = {"error_estimate", 1, 3},
 };
 _Static_assert(sizeof ev_limits / sizeof ev_limits[0] == RT_EV_COUNT, "one bucket per rt_ev");
 
@@ -253,7 +254,7 @@ typedef enum rt_progress { RT_P_DONE, RT_P_MORE, RT_P_FAULT } rt_progress;
 
 /* Starts a control period: watchdog, then the held efforts become the sim's input for
  * the whole period (zero-order hold). */
-static void period_begin(rt_server *s)
+static void period_begin(rt_server *s, int64_t budget)
 {
     const lag_scene *sc = s->sc;
     double dt = sc->sim.integrator.dt;
@@ -271,6 +272,36 @@ static void period_begin(rt_server *s)
     rt_log_input(s); /* --log with an actuator lag: the input this period runs with */
     s->period_left = sc->ticks_per_period;
     s->period_us = 0;
+    /* the live error estimate: a period run in one piece (nothing changes the sim between
+     * its chunks then) is run again after it is published, from a copy of its start */
+    const int every = lag_scene_estimate_every(sc);
+    s->shadow_armed = every > 0 && s->periods_done % every == 0 && s->period_left <= budget;
+    if (s->shadow_armed) s->shadow_start = s->sim;
+}
+
+/* The live error estimate of the period just published (docs/accuracy.md): its error,
+ * largest over the joints, for status; over the scene's budget, an error_estimate event
+ * naming the joint. A shadow that faults says nothing (the run itself did not). */
+static void estimate_error(rt_server *s)
+{
+    s->shadow_armed = false;
+    double err[LAG_MAX_DOF];
+    if (lag_sim_shadow_error(&s->shadow_start, &s->sim, err) != LAG_OK) return;
+    int j = 0;
+    for (int i = 1; i < s->nq; i++)
+        if (err[i] > err[j]) j = i;
+    if (!isfinite(err[j])) return;
+    s->err_estimate = err[j];
+    s->err_joint = j;
+    const double budget = rt_error_budget(s->sc);
+    if (budget > 0 && err[j] > budget) {
+        s->err_warnings++;
+        limited_event(s, RT_EV_ERROR_ESTIMATE, s->info->joint_names[j], err[j],
+                      "the integration added an estimated %.3g to %s over the period ending at "
+                      "t = %.9g s, %.3g times its budget %.3g (integrator.error %g over %g s)",
+                      err[j], s->info->joint_names[j], lag_sim_time(&s->sim), err[j] / budget,
+                      budget, s->sc->accuracy.error, s->sc->accuracy.horizon);
+    }
 }
 
 /* The period is complete: its state goes out; STEP and --duration are booked. */
@@ -294,7 +325,7 @@ static void period_end(rt_server *s)
  * *budget ticks (taken from it). No allocation. */
 static rt_progress period_run(rt_server *s, int64_t *budget)
 {
-    if (s->period_left == 0) period_begin(s);
+    if (s->period_left == 0) period_begin(s, *budget);
     int64_t n = s->period_left < *budget ? s->period_left : *budget;
     if (n < 1) return RT_P_MORE;
     *budget -= n;
@@ -309,11 +340,14 @@ static rt_progress period_run(rt_server *s, int64_t *budget)
     s->ticks_since_status += n;
     publish_effect_events(s);
     if (r != LAG_OK || !state_finite(&s->sim)) {
+        s->shadow_armed = false;
         enter_fault(s, r);
         return RT_P_FAULT;
     }
     if (s->period_left > 0) return RT_P_MORE;
     period_end(s);
+    s->periods_done++;
+    if (s->shadow_armed) estimate_error(s); /* after the state went out */
     return RT_P_DONE;
 }
 
@@ -1043,6 +1077,7 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
 
     s->nq = s->sim.nq;
     s->info = lag_sim_info(&s->sim); /* the joints published: a stick that may fly has h */
+    s->err_joint = -1;      /* no live error estimate yet */
     /* the URLs and channels, by the rule every client follows (lagsim_bus.h) */
     char berr[256];
     if (lag_bus_init(&s->bus, sc->lcm.url, sc->lcm.prefix, berr, sizeof berr) != 0)

@@ -51,6 +51,11 @@ typedef enum rt_reject {
  * and said by the next event of that kind that gets through. `start`, `stop` and the
  * effects' events (at most a fixed number per period, located by the core) are not
  * limited. */
+/* The error a period may add (m or rad): integrator.error * period / integrator.horizon
+ * (the horizon's periods each adding this much sum to the error asked for); 0 when the
+ * scene asks for none. */
+double rt_error_budget(const lag_scene *sc);
+
 typedef enum rt_ev {
     RT_EV_COMMAND_REJECTED = 0,
     RT_EV_CONTROL_REJECTED,
@@ -66,6 +71,7 @@ typedef enum rt_ev {
     RT_EV_NUMERIC_FAULT,
     RT_EV_EVENTS_DROPPED,
     RT_EV_PLANT_CONFLICT,     /* a scene of another plant heard on this prefix while running */
+    RT_EV_ERROR_ESTIMATE,     /* the live error estimate over the scene's budget per period */
     RT_EV_COUNT
 } rt_ev;
 
@@ -174,6 +180,15 @@ typedef struct rt_server {
     int64_t states_published;
     int64_t effect_events_dropped; /* sim.events_dropped already reported */
     int64_t plant_conflicts;   /* scenes of another plant heard on this prefix while running */
+
+    /* the live error estimate (docs/accuracy.md): every estimate_every-th period is run
+     * again from a copy of its start, after its state is published */
+    lag_sim shadow_start;      /* the sim at the start of the period to estimate */
+    bool shadow_armed;         /* the period in progress is to be estimated */
+    int64_t periods_done;      /* control periods completed since start */
+    double err_estimate;       /* the last estimate, largest over the joints (m or rad) */
+    int err_joint;             /* its joint, -1 before the first */
+    int64_t err_warnings;      /* estimates over the budget (rt_error_budget) */
 
     /* timing */
     int64_t start_ns;

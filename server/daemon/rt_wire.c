@@ -96,6 +96,12 @@ void rt_publish_state(rt_server *s)
     }
 }
 
+double rt_error_budget(const lag_scene *sc)
+{
+    const double e = sc->accuracy.error, h = sc->accuracy.horizon;
+    return e > 0 && h > 0 ? e / (sc->publish_hz * h) : 0.0;
+}
+
 void rt_publish_status(rt_server *s)
 {
     int64_t now = rt_mono_ns();
@@ -139,6 +145,10 @@ void rt_publish_status(rt_server *s)
     m.waiting_s = fin(rt_wait_describe(s, m.waiting_for, sizeof m.waiting_for, m.waiting_got,
                                        sizeof m.waiting_got));
     m.commands_wrong_port = s->commands_wrong_port;
+    m.error_estimate = fin(s->err_estimate);
+    PUT(m.error_joint, s->err_joint >= 0 && s->err_joint < s->nq ? s->info->joint_names[s->err_joint] : "");
+    m.error_budget = fin(rt_error_budget(s->sc));
+    m.error_warnings = s->err_warnings;
     publish(s, s->ch_status, LAG_WIRE_STATUS, &m);
     s->rtf = m.rtf;
     if (wall < 0.05 && s->run == RT_RUNNING) return; /* the window goes on */

@@ -18,6 +18,7 @@ void lag_scene_default(lag_scene *sc, lag_model_kind kind)
     sc->sim = lag_default_sim_def(kind);
     sc->publish_hz = 100.0;
     sc->accuracy.horizon = 1.0;
+    sc->accuracy.estimate_every = -1; /* not given: lag_scene_estimate_every */
     /* 1/100 s at dt = 1 ms; the loader recomputes it from the scene's values. */
     sc->ticks_per_period = 10;
     if (sc->sim.integrator.dt > 0.0) {
@@ -227,4 +228,10 @@ int lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, si
         }
     }
     return 0;
+}
+
+int lag_scene_estimate_every(const lag_scene *sc)
+{
+    if (sc->accuracy.estimate_every >= 0) return sc->accuracy.estimate_every;
+    return sc->accuracy.error > 0 ? LAG_SCENE_ESTIMATE_EVERY : 0;
 }

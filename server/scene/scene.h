@@ -27,6 +27,12 @@ typedef enum lag_rt_start {
  * suffix of a plant's channels (_COMMAND, _CONTROL) has 8. */
 #define LAG_SCENE_PREFIX_MAX 55
 
+/* Every this many periods the daemon estimates the error the integration adds (a shadow
+ * run of the period, lag_sim_shadow_error), when a scene asks for integrator.error and
+ * does not say integrator.estimate_every: it then adds 3 to 5 % to a period's work
+ * (docs/accuracy.md, bench/live_error_cost.sh). */
+#define LAG_SCENE_ESTIMATE_EVERY 50
+
 typedef struct lag_scene {
     char path[512];          /* file it was read from ("" if built in code) */
     lag_sim_def sim;         /* model, parameters, integrator, initial state */
@@ -36,6 +42,9 @@ typedef struct lag_scene {
                                 lagsimd then chooses sim.integrator's method and dt (and
                                 ticks_per_period) itself, measuring on this scene */
         double horizon;      /* integrator.horizon, s of sim time; default 1 */
+        int estimate_every;  /* integrator.estimate_every: the live error estimate runs
+                                every this many periods, 0: never; -1: not given (see
+                                lag_scene_estimate_every) */
     } accuracy;
     double publish_hz;       /* state output rate = control rate, Hz; default 100 */
     int64_t ticks_per_period;/* (1/publish_hz) / dt, an integer (validated) */
@@ -107,6 +116,9 @@ int lag_scene_load_buffer(const char *name, const char *text, size_t len,
                           const char *const *sets, int nsets, lag_scene *sc, char *err,
                           size_t errlen);
 
+/* The periods between two live error estimates of SC: integrator.estimate_every when
+ * given, else LAG_SCENE_ESTIMATE_EVERY with integrator.error and 0 (none) without. */
+int lag_scene_estimate_every(const lag_scene *sc);
 const char *lag_rt_mode_name(lag_rt_mode m);
 const char *lag_rt_start_name(lag_rt_start s);  /* "running", "paused", "first_command" */
 

@@ -554,6 +554,16 @@ static int key_horizon(conv *cv, const ynode *nd, const char *path)
     return get_range(cv, nd, path, &R_HORIZON, &cv->sc->accuracy.horizon);
 }
 
+/* integrator.estimate_every: the live error estimate's shadow run every N periods (0: off) */
+static int key_estimate_every(conv *cv, const ynode *nd, const char *path)
+{
+    long long v = 0;
+    if (get_int(cv, nd, path, 0, 1000000, &v) < 0)
+        return -1;
+    cv->sc->accuracy.estimate_every = (int)v;
+    return 0;
+}
+
 static const keyrow k_integrator_keys[] = {
     {"method", key_method, K_OTHER},         /* euler | semi-implicit-euler | rk4 | dopri5 | ... */
     {"dt", key_dt, K_NUMBER},                 /* s */
@@ -565,6 +575,7 @@ static const keyrow k_integrator_keys[] = {
     {"newton_tol", key_newton_tol, K_NUMBER}, /* implicit methods */
     {"error", key_error, K_NUMBER},           /* m or rad over horizon: chooses method, dt */
     {"horizon", key_horizon, K_NUMBER},       /* s, the error's horizon (1) */
+    {"estimate_every", key_estimate_every, K_INTEGER}, /* periods between live error estimates */
     {NULL, NULL, K_OTHER, NULL, NULL},
 };
 

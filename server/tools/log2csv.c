@@ -291,45 +291,43 @@ static bool write_state(l2c *c, chan *h, const lag_log_record *r, const lag_wire
     return true;
 }
 
+/* The status CSV's columns: t (sim time), wall_time (the daemon's utime), log_time, then
+ * every other field of status_t in its order, from the codec's table (a field added to
+ * the type is a column without anyone listing it); the daemon's own wall_time field is
+ * daemon_wall_time, a boolean is 0 or 1. */
+static bool status_column(const lag_wire_field *fd)
+{
+    return fd->count_field < 0 && strcmp(fd->name, "utime") && strcmp(fd->name, "sim_time");
+}
+
 static bool write_status(l2c *c, chan *h, const lag_log_record *r, const lag_wire_status *m)
 {
+    int n = 0;
+    const lag_wire_field *fd = lag_wire_fields(LAG_WIRE_STATUS, &n);
     if (!h->csv) {
         if (!(h->csv = open_csv(c, h))) return false;
-        fputs("t,wall_time,log_time,step,daemon_wall_time,rtf,overruns,step_time_max_us,"
-              "step_time_mean_us,energy,integrator,mode,run_state,commands_accepted,"
-              "rejected_unknown_joint,rejected_unactuated,rejected_nonfinite,"
-              "rejected_bad_length,rejected_undecodable,controls_rejected,watchdog_tripped,"
-              "watchdog_trips,lockstep_timeouts,numeric_faults,rejected_stale,overrun_bursts,"
-              "states_published\n", h->csv);
+        fputs("t,wall_time,log_time", h->csv);
+        for (int i = 0; i < n; i++)
+            if (status_column(&fd[i]))
+                fprintf(h->csv, ",%s", strcmp(fd[i].name, "wall_time") ? fd[i].name : "daemon_wall_time");
+        fputc('\n', h->csv);
     }
     FILE *f = h->csv;
     fprintf(f, "%.17g", m->sim_time);
     put_us(f, m->utime, false);
     put_us(f, r->timestamp, false);
-    put_i(f, m->step);
-    put_d(f, m->wall_time);
-    put_d(f, m->rtf);
-    put_i(f, m->overruns);
-    put_d(f, m->step_time_max_us);
-    put_d(f, m->step_time_mean_us);
-    put_d(f, m->energy);
-    put_s(f, m->integrator);
-    put_s(f, m->mode);
-    put_s(f, m->run_state);
-    put_i(f, m->commands_accepted);
-    put_i(f, m->rejected_unknown_joint);
-    put_i(f, m->rejected_unactuated);
-    put_i(f, m->rejected_nonfinite);
-    put_i(f, m->rejected_bad_length);
-    put_i(f, m->rejected_undecodable);
-    put_i(f, m->controls_rejected);
-    put_i(f, m->watchdog_tripped ? 1 : 0);
-    put_i(f, m->watchdog_trips);
-    put_i(f, m->lockstep_timeouts);
-    put_i(f, m->numeric_faults);
-    put_i(f, m->rejected_stale);
-    put_i(f, m->overrun_bursts);
-    put_i(f, m->states_published);
+    for (int i = 0; i < n; i++) {
+        if (!status_column(&fd[i])) continue;
+        const char *p = (const char *)m + fd[i].offset;
+        switch (fd[i].kind) {
+        case LAG_WIRE_INT8: put_i(f, *(const int8_t *)p); break;
+        case LAG_WIRE_INT16: put_i(f, *(const int16_t *)p); break;
+        case LAG_WIRE_INT64: put_i(f, *(const int64_t *)p); break;
+        case LAG_WIRE_DOUBLE: put_d(f, *(const double *)p); break;
+        case LAG_WIRE_BOOLEAN: put_i(f, *(const bool *)p ? 1 : 0); break;
+        case LAG_WIRE_STRING: put_s(f, p); break;
+        }
+    }
     fputc('\n', f);
     h->last_status = *m;
     h->have_status = true;

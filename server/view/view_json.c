@@ -216,6 +216,10 @@ void view_json_status(jbuf *b, const lag_wire_status *m)
     jb_int(b, "overrun_bursts", m->overrun_bursts);
     jb_int(b, "states_published", m->states_published);
     jb_int(b, "plant_conflicts", m->plant_conflicts);
+    jb_dbl(b, "error_estimate", m->error_estimate);
+    jb_s(b, "error_joint", m->error_joint);
+    jb_dbl(b, "error_budget", m->error_budget);
+    jb_int(b, "error_warnings", m->error_warnings);
     jb_raw(b, "}");
 }
 

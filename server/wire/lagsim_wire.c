@@ -113,6 +113,10 @@ static const lag_wire_field status_fields[] = {
     SCALAR(ST, LAG_WIRE_DOUBLE, waiting_s),
     STRING(ST, waiting_got),
     SCALAR(ST, LAG_WIRE_INT64, commands_wrong_port),
+    SCALAR(ST, LAG_WIRE_DOUBLE, error_estimate),
+    STRING(ST, error_joint),
+    SCALAR(ST, LAG_WIRE_DOUBLE, error_budget),
+    SCALAR(ST, LAG_WIRE_INT64, error_warnings),
 };
 
 typedef lag_wire_scene SC;

@@ -159,6 +159,10 @@ typedef struct lag_wire_status {
     double waiting_s;
     char waiting_got[LAG_WIRE_TEXT_LEN]; /* what came instead; "" */
     int64_t commands_wrong_port;
+    double error_estimate;           /* m or rad, the live error estimate (docs/accuracy.md) */
+    char error_joint[LAG_WIRE_NAME_LEN];
+    double error_budget;             /* m or rad per period; 0 without integrator.error */
+    int64_t error_warnings;
 } lag_wire_status;
 
 /* <PREFIX>_SCENE: the scene description. */

@@ -154,7 +154,7 @@ int main(void)
     snprintf(ch, sizeof ch, "%s_STATUS", prefix);
     lagsim_status_t gs = {1, 2.5, 3, 4.5, 5.5, 6, 7.5, 8.5, 9.5, "dopri5", "lockstep", "paused",
                           13, 14, 15, 16, 17, 18, 19, 1, 21, 22, 23, 24, 25, 26, 27, 28, 29,
-                          "flat", 30, "the first command", 30.5, "", 31};
+                          "flat", 30, "the first command", 30.5, "", 31, 31.5, "q2", 33.5, 34};
     lagsim_status_t_publish(peer, ch, &gs);
     pump(peer, c, 100);
     lag_client_status ss;
@@ -174,6 +174,8 @@ int main(void)
     ENSURE(ss.plant_conflicts == 30);
     ENSURE(!strcmp(ss.waiting_for, "the first command") && ss.waiting_s == 30.5);
     ENSURE(!strcmp(ss.waiting_got, "") && ss.commands_wrong_port == 31);
+    ENSURE(ss.error_estimate == 31.5 && !strcmp(ss.error_joint, "q2"));
+    ENSURE(ss.error_budget == 33.5 && ss.error_warnings == 34);
 
     /* commands */
     const char *names[2] = {"q1", "q2"};

@@ -79,7 +79,7 @@ static counts g_c;
 static const char *const k_limited[RT_EV_COUNT] = {
     "command_rejected", "control_rejected", "pause", "resume", "step", "step_done", "reset",
     "watchdog_trip", "watchdog_clear", "lockstep_timeout", "overrun_burst", "numeric_fault",
-    "events_dropped", "plant_conflict"};
+    "events_dropped", "plant_conflict", "error_estimate"};
 
 static void bad(const char *what)
 {
@@ -114,8 +114,9 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
     } else if (!strcmp(sfx, "STATUS")) {
         lag_wire_status m;
         if (lag_wire_decode_status(rb->data, rb->data_size, &m) != LAG_WIRE_OK) bad("undecodable status");
-        double d[] = {m.sim_time, m.wall_time, m.rtf, m.step_time_max_us, m.step_time_mean_us, m.energy};
-        need_finite(d, 6, "status number");
+        double d[] = {m.sim_time, m.wall_time, m.rtf, m.step_time_max_us, m.step_time_mean_us,
+                      m.energy, m.error_estimate, m.error_budget};
+        need_finite(d, 8, "status number");
         g_c.status++;
     } else if (!strcmp(sfx, "EVENT")) {
         lag_wire_event m;

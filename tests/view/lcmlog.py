@@ -72,6 +72,10 @@ class Types:
                   "rejected_stale", "overrun_bursts", "states_published"):
             setattr(s, k, counters.get(k, 0))
         s.watchdog_tripped = bool(counters.get("watchdog_tripped", False))
+        s.error_estimate = counters.get("error_estimate", 0.0)
+        s.error_joint = counters.get("error_joint", "")
+        s.error_budget = counters.get("error_budget", 0.0)
+        s.error_warnings = counters.get("error_warnings", 0)
         return s.encode()
 
     def event(self, sim_time, step, kind, joint="", value=0.0, detail=""):
@@ -123,7 +127,9 @@ def sample_run(t, prefix="T"):
     recs.append((prefix + "_EVENT", t.event(0.015, 15, "limit", "theta0", -0.5, "limit at t")))
     recs.append((prefix + "_EVENT", t.event(0.02, 20, "limit", "theta0", 0.5, "again")))
     recs.append((prefix + "_STATUS", t.status(0.04, 40, commands_accepted=5,
-                                              rejected_unknown_joint=2, rejected_stale=1)))
+                                              rejected_unknown_joint=2, rejected_stale=1,
+                                              error_estimate=2.5e-7, error_joint="theta1",
+                                              error_budget=1e-8, error_warnings=3)))
     recs.append(("OTHER_CHANNEL", b"not lagsim"))
     return recs
 

@@ -87,8 +87,17 @@ def case_exact(a, t, tmp):
     check(len(sc) == 1 and sc[0]["effects"] == "limits" and "theta0:actuated:q0=0:qd0=0:limits=-1..1" in sc[0]["joints"]
           and "m0=1.5" in sc[0]["parameters"], "scene: effects, limits, parameters")
     ss = rows(os.path.join(out, "T_STATUS.csv"))
+    # a column for every field of status_t (lcm-gen's Python type: not the tool's own list)
+    want = {"daemon_wall_time" if f == "wall_time" else f
+            for f in t.m.status_t.__slots__ if f not in ("utime", "sim_time")}
+    have = set(ss[0].keys()) if ss else set()
+    check(want <= have, "status: a column for every status_t field (missing: %s)"
+          % sorted(want - have))
     check(len(ss) == 1 and float(ss[0]["energy"]) == 7.25 and ss[0]["run_state"] == "running",
           "status: every field")
+    check(float(ss[0]["error_estimate"]) == 2.5e-7 and ss[0]["error_joint"] == "theta1" and
+          float(ss[0]["error_budget"]) == 1e-8 and ss[0]["error_warnings"] == "3",
+          "status: the live error estimate")
 
     s = p.stdout
     check("T_STATE: joint_state_t, 6 messages" in s, "summary: state count")

@@ -276,6 +276,11 @@ static void check_agreement(void)
         g.waiting_got = "2 commands rejected (unknown joint 2; the last: unknown joint: 'cart')";
         strcpy(w.waiting_got, g.waiting_got);
         g.commands_wrong_port = w.commands_wrong_port = 31;
+        g.error_estimate = w.error_estimate = 31.5;
+        g.error_joint = "theta1";
+        strcpy(w.error_joint, "theta1");
+        g.error_budget = w.error_budget = 33.5;
+        g.error_warnings = w.error_warnings = 34;
         int nt = lagsim_status_t_encode(theirs, 0, sizeof theirs, &g);
         agree(LAG_WIRE_STATUS, &w, nt);
     }

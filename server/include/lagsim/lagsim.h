@@ -430,6 +430,7 @@ typedef struct lag_sim {
         double t_prev;             /* start of the last accepted step */
         double rcont[5][LAG_MAX_STATE]; /* dense-output coefficients of the last step */
         bool valid;                /* internal state valid and continuous with public */
+        double h_max;              /* 0, or the largest step (lag_sim_shadow_error's copy) */
     } dp;
 } lag_sim;
 
@@ -492,6 +493,20 @@ void lag_sim_fault_describe(const lag_sim *s, char *buf, size_t len);
 /* Right-hand side of the first-order system y = (q, qd): ydot = (qd, qdd) with the
  * sim's held input. Exposed for tests and benchmarks. OUT: ydot (2n) */
 lag_result lag_sim_rhs(lag_sim *s, const double *y, double *ydot);
+
+/* The live error estimate: what the steps over some ticks added to the error of q (m or
+ * rad, per coordinate of lag_sim_info's joints). START is a copy of a sim taken before
+ * the ticks and END the same sim after them (same input, START->tick < END->tick). A
+ * scratch copy of START runs the same span again, more accurately, and
+ *   err_i = |q_i(END) - q_i(shadow)| K / (K - 1):
+ * a fixed-step method of order p with half the tick (step doubling, Richardson: K = 2^p);
+ * dopri5 with rtol and atol divided by LAG_SHADOW_TOL_DIV and steps at most half as long
+ * as END's were on average over the span (so that a step far within its tolerance, e.g.
+ * one cut short to land on the span's end, is refined too; K = 2^5). Neither sim changes; no allocation (the scratch
+ * copy is on the stack). LAG_ERR_ARG for a span that is not one or settings that differ;
+ * else what the shadow ran into (err then zero). OUT: err (START->nq) */
+#define LAG_SHADOW_TOL_DIV 1024.0
+lag_result lag_sim_shadow_error(const lag_sim *start, const lag_sim *end, double *err);
 
 /* Pops the oldest recorded event into ev; returns false when there is none. */
 bool lag_sim_poll_event(lag_sim *s, lag_event *ev);

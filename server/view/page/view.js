@@ -400,6 +400,10 @@ function drawStatus() {
     rows.push(["numeric faults", String(s.numeric_faults), s.numeric_faults > 0]);
     rows.push(["energy", fmt(s.energy, 6) + " J"]);
     rows.push(["states published", String(s.states_published)]);
+    if (s.error_joint)
+      rows.push(["error estimate", `${Number(s.error_estimate).toPrecision(3)} per period (${s.error_joint})` +
+                 (s.error_budget > 0 ? `, budget ${Number(s.error_budget).toPrecision(3)}, ${s.error_warnings} over` : ""),
+                 s.error_budget > 0 && s.error_estimate > s.error_budget]);
     if (s.plant_conflicts > 0)
       rows.push(["prefix conflict", `${s.plant_conflicts} scenes of another plant on this prefix (running on; one plant per prefix)`, true]);
   } else rows.push(["status", "none yet"]);
