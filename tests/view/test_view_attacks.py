@@ -544,7 +544,7 @@ def case_host(a):
     r = subprocess.run([a.view, "--allow-host", "evil.example/x"], capture_output=True, text=True)
     check(r.returncode == 2 and "--allow-host" in r.stderr, "--allow-host with a '/': usage error, exit 2")
     for hp in ("view.lab.example:8918", "[fd00::99]:80"):  # a port would never match: refused
-        r = subprocess.run([a.view, "--allow-host", hp], capture_output=True, text=True)
+        r = subprocess.run([a.view, "--allow-host", hp], capture_output=True, text=True, timeout=30)
         check(r.returncode == 2 and "without a port" in r.stderr,
               "--allow-host %s (a port): usage error, exit 2" % hp)
     v = View(a, prefix, ["--listen", "0.0.0.0", "--allow-host", "view.lab.example",
