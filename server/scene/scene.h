@@ -25,8 +25,8 @@ typedef enum lag_rt_start {
 } lag_rt_start;
 
 /* The longest lcm.prefix: LCM channel names have at most 63 bytes, and the longest
- * suffix of a plant's channels (_COMMAND, _CONTROL) has 8. */
-#define LAG_SCENE_PREFIX_MAX 55
+ * suffix of a plant's channels (_REFERENCE) has 10. */
+#define LAG_SCENE_PREFIX_MAX 53
 
 /* The scene's `reference:`: what each joint should follow (server/eval/reference.h),
  * published on <PREFIX>_REFERENCE beside every state. Not the core's business: the plant

@@ -718,7 +718,7 @@ static int key_prefix(conv *cv, const ynode *nd, const char *path)
     if (n == 0 || n > LAG_SCENE_PREFIX_MAX)
         return yfail(cv->err, nd, path, "expected a channel prefix of 1 to %d characters, got "
                      "%zu (LCM channel names have at most 63 bytes, and the longest suffix, "
-                     "_COMMAND, has 8)", LAG_SCENE_PREFIX_MAX, n);
+                     "_REFERENCE, has 10)", LAG_SCENE_PREFIX_MAX, n);
     for (size_t i = 0; i < n; i++) {
         char c = s[i];
         bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') ||
