@@ -14,7 +14,8 @@ Cases:
              without one publishes none
   realtime   the same paced in real time
   lockstep   the same in lockstep with dipc_lqr answering; --replay: difference 0 with the
-             references compared, and a log whose reference was changed by one ulp fails
+             references compared, and a log whose reference was changed by one ulp fails;
+             lagsim-log2csv writes <PREFIX>_REFERENCE.csv with every reference as sent
   set        SET reference.theta0.amplitude while running (lagsimctl, a paced run with
              dipc_lqr): references logged
              before the `set` event have the old amplitude, those after it the new one,
@@ -203,6 +204,18 @@ def case_lockstep(t):
     rc, compared, diff = t.replay(log, prefix)
     check(rc == 0 and compared == n and diff == 0.0,
           f"--replay: {compared} references compared ({n} logged), difference {diff}, exit {rc}")
+    # lagsim-log2csv: <PREFIX>_REFERENCE.csv, a row per reference, the numbers as sent
+    out = os.path.join(t.tmp, "csv")
+    p = t.run("lagsim-log2csv", log, "-o", out, "-q")
+    rows = open(os.path.join(out, prefix + "_REFERENCE.csv")).read().splitlines()
+    sent = [t.t.reference_t.decode(d) for ch, d, _ in recs if ch == prefix + "_REFERENCE"]
+    same = len(rows) == len(sent) + 1 and all(
+        [float(x) for x in row.split(",")[4:]] == list(m.r) + list(m.rdot) and
+        float(row.split(",")[0]) == m.sim_time for row, m in zip(rows[1:], sent))
+    check(p.returncode == 0 and rows[0] == 't,wall_time,log_time,step,"theta0","theta1",'
+          '"theta0_dot","theta1_dot"' and same,
+          f"lagsim-log2csv: {prefix}_REFERENCE.csv, {len(rows) - 1} rows equal to the "
+          f"{len(sent)} references logged: {rows[0]}")
     # one ulp more in the 100th reference's r of theta0: the replay fails
     refs = [k for k, (ch, _, _) in enumerate(recs) if ch == prefix + "_REFERENCE"]
     b = bytearray(open(log, "rb").read())
