@@ -21,7 +21,8 @@ Cases:
              before the `set` event have the old amplitude, those after it the new one,
              from the tick it took effect at; --replay re-applies it, difference 0
   offline    --offline --csv: <joint>_ref and <joint>_ref_dot columns after energy, equal to
-             the closed form; without a reference the header is unchanged
+             the closed form; without a reference the header is unchanged; lagsim-plot
+             draws them dashed over q and q dot (also from <PREFIX>_REFERENCE.csv, lockstep)
 """
 import argparse
 import math
@@ -188,6 +189,23 @@ class T:
         return p.returncode, int(m.group(1)) if m else -1, float(d.group(1)) if d else None
 
 
+def plot_has_reference(t, csv, rcsv, want):
+    """lagsim-plot draws each reference column of rcsv dashed (dt 2), in its joint's colour
+    (the lt of the joint's own line), with the title in want (title: column)."""
+    gp = os.path.join(t.tmp, "plot.gp")
+    p = t.run("lagsim-plot", csv, "-o", os.path.join(t.tmp, "plot.png"), "--force", "--gnuplot", gp)
+    script = open(gp).read() if os.path.exists(gp) else ""
+    found = {}
+    for m in re.finditer(r'"([^"]*)" using 1:(\d+) axes \S+ with lines lt (\d+) (dt 2 )?lw 1.5 title "([^"]*)"', script):
+        found[m.group(5)] = (os.path.basename(m.group(1)), int(m.group(2)), int(m.group(3)), bool(m.group(4)))
+    ok = p.returncode == 0
+    for title, col in want.items():
+        joint = found.get(title.replace(" ref", ""))
+        ok &= title in found and found[title][:2] == (rcsv, col) and found[title][3] and \
+            joint is not None and joint[2] == found[title][2] and not joint[3]
+    check(ok, f"lagsim-plot draws {sorted(want)} dashed from {rcsv} in their joints' colours")
+
+
 def case_fast(t):
     t.memq("fast", 2.0)
 
@@ -216,6 +234,9 @@ def case_lockstep(t):
           '"theta0_dot","theta1_dot"' and same,
           f"lagsim-log2csv: {prefix}_REFERENCE.csv, {len(rows) - 1} rows equal to the "
           f"{len(sent)} references logged: {rows[0]}")
+    plot_has_reference(t, os.path.join(out, prefix + "_STATE.csv"), prefix + "_REFERENCE.csv",
+                       {"theta0 ref": 5, "theta1 ref (right)": 6, "theta0_dot ref": 7,
+                        "theta1_dot ref (right)": 8})
     # one ulp more in the 100th reference's r of theta0: the replay fails
     refs = [k for k, (ch, _, _) in enumerate(recs) if ch == prefix + "_REFERENCE"]
     b = bytearray(open(log, "rb").read())
@@ -265,6 +286,10 @@ def case_offline(t):
         worst = max(worst, max(abs(a - b) for a, b in zip(v[-4:], want)))
     check(len(lines) == 152 and worst <= 1e-12,
           f"{len(lines) - 1} rows, r and r-dot equal to the closed form (largest difference {worst:.3g})")
+    csv = os.path.join(t.tmp, "run.csv")
+    open(csv, "w").write(p.stdout)
+    plot_has_reference(t, csv, "run.csv", {"theta0 ref": 9, "theta1 ref": 11,  # one axis: no
+                                           "theta0_dot ref": 10, "theta1_dot ref": 12})  # scene
     p = t.run("lagsimd", "--config", t.dipc, "--offline", "--duration", "0.1", "--csv", "-")
     check(p.stdout.splitlines()[0] == "t,theta0,theta1,theta2,theta0_dot,theta1_dot,theta2_dot,energy",
           "without a reference the header is what it was")
