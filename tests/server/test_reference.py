@@ -20,6 +20,8 @@ Cases:
              dipc_lqr): references logged
              before the `set` event have the old amplitude, those after it the new one,
              from the tick it took effect at; --replay re-applies it, difference 0
+  manipulator  manipulator_pd (C) tracks a reference set on the command line, not its own:
+             the logged q within bounds of the reference's closed form after 2 s
   offline    --offline --csv: <joint>_ref and <joint>_ref_dot columns after energy, equal to
              the closed form; without a reference the header is unchanged; lagsim-plot
              draws them dashed over q and q dot (also from <PREFIX>_REFERENCE.csv, lockstep)
@@ -295,7 +297,66 @@ def case_offline(t):
           "without a reference the header is what it was")
 
 
-CASES = {"fast": case_fast, "realtime": case_realtime, "lockstep": case_lockstep,
+MAN_SINE = dict(start=0.0, amplitude=0.2, offset=0.1, frequency=0.2)
+MAN_POINTS = [(0.0, 0.0), (4.003, 0.1), (8.007, 0.0)]
+MAN_REFERENCE = ("reference={q1: {type: sine, amplitude: 0.2, offset: 0.1, frequency: 0.2}, "
+                 "q2: {type: waypoints, offset: 0.5, points: [%s]}}"
+                 % ", ".join("[%g, %g]" % p for p in MAN_POINTS))
+
+
+def man_reference(t):
+    """q1's and q2's r at t, closed form."""
+    w = 2 * math.pi * MAN_SINE["frequency"]
+    r1 = MAN_SINE["offset"] + MAN_SINE["amplitude"] * math.sin(w * t)
+    r2 = 0.5 + MAN_POINTS[-1][1]
+    for (t0, w0), (t1, w1) in zip(MAN_POINTS, MAN_POINTS[1:]):
+        if t0 <= t < t1:
+            r2 = 0.5 + w0 + (w1 - w0) / (t1 - t0) * (t - t0)
+    return r1, r2
+
+
+def case_manipulator(t):
+    """manipulator_pd tracks the scene's reference, not a trajectory of its own: a
+    reference other than config/manipulator.yaml's (a sine and waypoints), the error of the
+    logged q from its closed form after 2 s: computed torque with wn = 10 leaves the
+    initial error (0.1 rad, 0.25 rad/s) below 1e-7 after 2 s (e ~ (1 + wn t) e^(-wn t));
+    what remains is the effort held over a period (5e-5, see tests/clients.cmake) and, at
+    a waypoint corner, r' jumping by 0.05 m/s one period before the backward difference
+    feeds it forward: about 0.05 m/s x 10 ms = 5e-4 m. Bounds 1e-3 rad, 2e-3 m."""
+    prefix = "REFM" + str(os.getpid())
+    log = os.path.join(t.tmp, "man.lcm")
+    man = os.path.join(t.a.source, "config", "manipulator.yaml")
+    pd = subprocess.Popen([os.path.join(t.a.bin, "manipulator_pd"), "--prefix", prefix],
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        time.sleep(0.3)
+        d = t.run("lagsimd", "--config", man, "--set", f"lcm.prefix={prefix}", "--set",
+                  "realtime.mode=lockstep", "--set", MAN_REFERENCE, "--duration", "10", "-q",
+                  "--log", log)
+        out, _ = pd.communicate(timeout=30)
+    finally:
+        if pd.poll() is None:
+            pd.kill()
+    print("  manipulator_pd: " + "\n  ".join(out.strip().splitlines()[-3:]))
+    check(d.returncode == 0 and pd.returncode == 0 and "tracking q1 its reference, q2 its reference" in out,
+          "manipulator_pd ran against a lockstep lagsimd and says it tracks both references")
+    worst, n = [0.0, 0.0], 0
+    for ch, data, _ in read_log(log):
+        if ch != prefix + "_STATE":
+            continue
+        st = t.t.joint_state_t.decode(data)
+        if st.sim_time < 2.0:
+            continue
+        n += 1
+        r = man_reference(st.sim_time)
+        for k in range(2):
+            worst[k] = max(worst[k], abs(st.position[k] - r[k]))
+    check(n == 801 and worst[0] <= 1e-3 and worst[1] <= 2e-3,
+          f"{n} states after 2 s: |q1 - r1| <= {worst[0]:.3g} rad (bound 1e-3), "
+          f"|q2 - r2| <= {worst[1]:.3g} m (bound 2e-3), r from the closed form")
+
+
+CASES = {"fast": case_fast, "manipulator": case_manipulator, "realtime": case_realtime, "lockstep": case_lockstep,
          "set": case_set, "offline": case_offline}
 
 
