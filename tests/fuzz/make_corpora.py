@@ -159,9 +159,10 @@ for name, data in [("joint-state.bin", state()), ("joint-command.bin", command()
 write("wire", "corpus", "joint-state-bound-2.bin", b"\x03" + state())
 write("wire", "corpus", "joint-state-negative-count.bin", B8 + state()[:34 - 2] + b"\xff\xff")
 
-# ---- client: first byte = channel (0 STATE, 1 STATUS, 2 EVENT, 3 SCENE)
+# ---- client: first byte = channel (0 STATE, 1 STATUS, 2 EVENT, 3 SCENE, 4 REFERENCE)
 for name, data in [("state.bin", b"\x00" + state()), ("status.bin", b"\x01" + status()),
-                   ("event.bin", b"\x02" + event()), ("scene.bin", b"\x03" + scene())]:
+                   ("event.bin", b"\x02" + event()), ("scene.bin", b"\x03" + scene()),
+                   ("reference.bin", b"\x04" + reference())]:
     write("client", "corpus", name, data)
 # what crashed, overread or leaked in the client's lcm-gen decoders
 write("client", "crash", "state-negative-name-length.bin",
