@@ -165,14 +165,14 @@ class T:
         self.check_log(log, prefix)
         self.none_without(prefix, *sets)
 
-    def lockstep(self, prefix, log, extra=(), during=None, mode="lockstep"):
+    def lockstep(self, prefix, log, extra=(), during=None, mode="lockstep", duration=3):
         lqr = subprocess.Popen([os.path.join(self.a.bin, "dipc_lqr"), "--prefix", prefix, "-q"],
                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         try:
             time.sleep(0.3)
             d = subprocess.Popen([os.path.join(self.a.bin, "lagsimd"), "--config", self.dipc,
                                   "--set", f"lcm.prefix={prefix}", "--set", f"realtime.mode={mode}",
-                                  "--set", REFERENCE, *extra, "--duration", "3", "-q", "--log", log])
+                                  "--set", REFERENCE, *extra, "--duration", str(duration), "-q", "--log", log])
             if during:
                 during()
             d.wait(timeout=120)
@@ -267,7 +267,8 @@ def case_set(t):
         check(p.returncode == 1 and "a sine reference takes no frequency_end" in p.stderr,
               "a key the kind does not take is refused with the loader's message")
 
-    t.lockstep(prefix, log, during=during, mode="realtime")  # paced: 3 s to change it in
+    # paced: 5 wall s, the change 1 s after the start, its answer waited for 2 s at most
+    t.lockstep(prefix, log, during=during, mode="realtime", duration=5)
     t.check_log(log, prefix, amplitude_after=0.3)
     rc, compared, diff = t.replay(log, prefix)
     check(rc == 0 and compared > 100 and diff == 0.0,
