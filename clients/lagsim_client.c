@@ -35,7 +35,8 @@ struct lag_client {
     char prefix[64];
     char ch_state[LAG_BUS_CHANNEL_LEN], ch_status[LAG_BUS_CHANNEL_LEN],
         ch_event[LAG_BUS_CHANNEL_LEN], ch_scene[LAG_BUS_CHANNEL_LEN],
-        ch_command[LAG_BUS_CHANNEL_LEN], ch_control[LAG_BUS_CHANNEL_LEN];
+        ch_command[LAG_BUS_CHANNEL_LEN], ch_control[LAG_BUS_CHANNEL_LEN],
+        ch_reference[LAG_BUS_CHANNEL_LEN];
     char errmsg[256];
 
     lag_client_state state;      /* latest state */
@@ -44,6 +45,8 @@ struct lag_client {
     bool have_scene;
     lag_client_status status;
     bool have_status;
+    lag_client_reference reference; /* latest reference */
+    bool have_reference;
     lag_client_counters counters;
     /* the last command sent for the latest state, as encoded (a copy of that state gets
      * it again) */
@@ -56,6 +59,7 @@ struct lag_client {
         lag_wire_scene scene;
         lag_wire_status status;
         lag_wire_event event;
+        lag_wire_reference reference;
     } tmp;
     uint8_t buf[LAG_WIRE_BUF_SIZE]; /* encoding of outgoing messages */
 
@@ -169,6 +173,11 @@ static int dispatch(lag_client *c, const char *channel, const void *data, size_t
         c->have_status = true;
         c->counters.statuses++;
         if (c->on_status) c->on_status(&c->status, c->on_status_user);
+    } else if (!strcmp(channel, c->ch_reference)) {
+        if (!decode(c, LAG_WIRE_REFERENCE, data, len)) return LAG_CLIENT_OK;
+        c->reference = c->tmp.reference;
+        c->have_reference = true;
+        c->counters.references++;
     } else if (!strcmp(channel, c->ch_event)) {
         if (!decode(c, LAG_WIRE_EVENT, data, len)) return LAG_CLIENT_OK;
         c->counters.events++;
@@ -232,16 +241,19 @@ lag_client *lag_client_create(const char *url, const char *prefix, char *err, si
     snprintf(c->ch_scene, sizeof c->ch_scene, "%s", c->bus.channel[LAG_BUS_SCENE]);
     snprintf(c->ch_command, sizeof c->ch_command, "%s", c->bus.channel[LAG_BUS_COMMAND]);
     snprintf(c->ch_control, sizeof c->ch_control, "%s", c->bus.channel[LAG_BUS_CONTROL]);
+    snprintf(c->ch_reference, sizeof c->ch_reference, "%s", c->bus.channel[LAG_BUS_REFERENCE]);
     /* lcm_subscribe takes a POSIX regular expression: escape the channel names so that
      * a prefix with regex characters still matches only itself. */
-    char re[4][200];
-    const char *chans[4] = {c->ch_state, c->ch_status, c->ch_event, c->ch_scene};
-    for (int k = 0; k < 4; k++) regex_escape(re[k], sizeof re[k], chans[k]);
+    char re[5][200];
+    const char *chans[5] = {c->ch_state, c->ch_status, c->ch_event, c->ch_scene,
+                            c->ch_reference};
+    for (int k = 0; k < 5; k++) regex_escape(re[k], sizeof re[k], chans[k]);
     lcm_subscription_t *s1 = lcm_subscribe(c->lcm, re[0], on_message, c);
     lcm_subscription_t *s2 = lcm_subscribe(c->lcm, re[1], on_message, c);
     lcm_subscription_t *s3 = lcm_subscribe(c->lcm, re[2], on_message, c);
     lcm_subscription_t *s4 = lcm_subscribe(c->lcm, re[3], on_message, c);
-    if (!s1 || !s2 || !s3 || !s4) {
+    lcm_subscription_t *s5 = lcm_subscribe(c->lcm, re[4], on_message, c);
+    if (!s1 || !s2 || !s3 || !s4 || !s5) {
         if (err) snprintf(err, errlen, "cannot subscribe to %s_*", prefix);
         lag_client_destroy(c);
         return NULL;
@@ -249,6 +261,7 @@ lag_client *lag_client_create(const char *url, const char *prefix, char *err, si
     /* The state subscription keeps a deeper queue: a slow controller still sees states
      * in order rather than losing them inside LCM. */
     lcm_subscription_set_queue_capacity(s1, 64);
+    lcm_subscription_set_queue_capacity(s5, 64); /* each state's reference with it */
     return c;
 }
 
@@ -369,6 +382,12 @@ bool lag_client_latest_status(const lag_client *c, lag_client_status *st)
 {
     if (c->have_status && st) *st = c->status;
     return c->have_status;
+}
+
+bool lag_client_latest_reference(const lag_client *c, lag_client_reference *ref)
+{
+    if (c->have_reference && ref) *ref = c->reference;
+    return c->have_reference;
 }
 
 /* ---------------------------------------------------------------- sending */
@@ -533,6 +552,13 @@ int lag_client_state_joint(const lag_client_state *st, const char *name)
 {
     for (int i = 0; i < st->num_joints; i++)
         if (strcmp(st->name[i], name) == 0) return i;
+    return -1;
+}
+
+int lag_client_reference_joint(const lag_client_reference *ref, const char *name)
+{
+    for (int i = 0; i < ref->num_joints; i++)
+        if (strcmp(ref->name[i], name) == 0) return i;
     return -1;
 }
 

@@ -68,6 +68,7 @@ typedef lag_wire_scene lag_client_scene;        /* scene_t */
 typedef lag_wire_joint_state lag_client_state;  /* joint_state_t */
 typedef lag_wire_status lag_client_status;      /* status_t */
 typedef lag_wire_event lag_client_event;        /* event_t */
+typedef lag_wire_reference lag_client_reference; /* reference_t */
 
 typedef struct lag_client_counters {
     int64_t states, scenes, statuses, events;  /* messages received and kept */
@@ -76,6 +77,7 @@ typedef struct lag_client_counters {
     int64_t copies;   /* of states, copies of the latest state (lockstep re-sends): not
                        * returned again, not passed to on_state */
     int64_t repeats;  /* of them, answered again with the command sent for that state */
+    int64_t references;                        /* references received and kept */
 } lag_client_counters;
 
 typedef struct lag_client lag_client;
@@ -87,7 +89,7 @@ typedef void (*lag_client_scene_fn)(const lag_client_scene *sc, void *user);
 
 /* Connects to the plant whose LCM URL is url (the daemon's lcm.url; NULL or "": LCM's
  * default, which honours LCM_DEFAULT_URL) and prefix: subscribes to <prefix>_STATE,
- * _STATUS, _EVENT, _SCENE on that (state) URL, and sends commands and control requests
+ * _STATUS, _EVENT, _SCENE, _REFERENCE on that (state) URL, and sends commands and control requests
  * to the plant's command URL, the same group on the next port (lagsim_bus.h). Returns
  * NULL on failure with a message in err (may be NULL). */
 lag_client *lag_client_create(const char *url, const char *prefix, char *err, size_t errlen);
@@ -105,7 +107,7 @@ int lag_client_fileno(const lag_client *c);
 int lag_client_handle(lag_client *c, int timeout_ms);
 
 /* Handles one message as if it had arrived on `channel` (one of this handle's
- * <prefix>_STATE, _STATUS, _EVENT, _SCENE): decoding, counters, callbacks, as for the
+ * <prefix>_STATE, _STATUS, _EVENT, _SCENE, _REFERENCE): decoding, counters, callbacks, as for the
  * bus. For messages read elsewhere (a log file) and for tests. Returns LAG_CLIENT_OK
  * (kept or dropped: the counters say which) or LAG_CLIENT_ERR_ARG for another channel. */
 int lag_client_feed(lag_client *c, const char *channel, const void *data, size_t len);
@@ -130,6 +132,12 @@ int lag_client_wait_state(lag_client *c, double timeout_s, lag_client_state *st)
  * Return false if none has arrived yet. OUT: st */
 bool lag_client_latest_state(const lag_client *c, lag_client_state *st);
 bool lag_client_latest_status(const lag_client *c, lag_client_status *st);
+/* The latest reference (<prefix>_REFERENCE: the scene's `reference:`, r and r' of the
+ * joints that have one, which the daemon publishes just before each state with the same
+ * sim_time; so when a state arrives its reference has arrived already, unless UDP lost
+ * it: compare the sim_times). False if none has arrived: a scene without a reference
+ * publishes none. OUT: ref */
+bool lag_client_latest_reference(const lag_client *c, lag_client_reference *ref);
 
 /* Publishes a command on <prefix>_COMMAND: efforts for n joints named in names (N or
  * N m), answering the state at sim_time (lockstep advances on it; pass the sim_time of
@@ -168,6 +176,8 @@ int lag_client_scene_joint(const lag_client_scene *sc, const char *name);
 double lag_client_scene_param(const lag_client_scene *sc, const char *name);
 /* Index of joint `name` in a state (or -1). */
 int lag_client_state_joint(const lag_client_state *st, const char *name);
+/* Index of joint `name` in a reference (or -1: the scene gives it no reference). */
+int lag_client_reference_joint(const lag_client_reference *ref, const char *name);
 
 /* ---------------------------------------------------------------- finding plants */
 

@@ -1,9 +1,14 @@
 /*
- * manipulator_pd: makes the rotary/prismatic manipulator track a smooth joint trajectory
- *   q1_d(t) = A1 sin(w1 t),  q2_d(t) = c2 + A2 sin(w2 t)   (t = sim time, s)
- * (defaults 0.3 rad, 0.5 rad/s; 0.5 m, 0.1 m, 1 rad/s) with PD plus model feedforward
- * (computed torque) built from the scene's parameters by the core:
+ * manipulator_pd: makes the rotary/prismatic manipulator track the scene's reference
+ * (its `reference:` key, which lagsimd publishes on <PREFIX>_REFERENCE just before each
+ * state: q_d = r, qd_d = r' at the state's sim time; config/manipulator.yaml gives
+ * q1 = 0.3 sin(0.5 t), q2 = 0.5 + 0.1 sin(t)) with PD plus model feedforward (computed
+ * torque) built from the scene's parameters by the core:
  *   tau = M(q) (qdd_d + Kp (q_d - q) + Kd (qd_d - qd)) + C(q, qd) qd + g(q).
+ * qdd_d is the backward difference of r' over the last control period (0 at the first
+ * state and after a gap): an error of about h/2 |d3r/dt3| in the acceleration. A joint
+ * the scene gives no reference holds its position at the first state (qd_d = 0). A state
+ * whose reference was lost (another sim_time) keeps the last one, and is counted.
  * With the exact model the error obeys e'' + Kd e' + Kp e = 0 (Kp = wn^2, Kd = 2 wn,
  * critically damped), up to the zero-order hold of the effort over a control period.
  * Answers every state (lockstep-safe) and prints the tracking error.
@@ -15,19 +20,39 @@
 #include "lagsim/lagsim.h"
 #include "lagsim_controller.h"
 
-typedef struct traj {
-    double a1, w1, c2, a2, w2;
-} traj;
+/* What the joints should do at a state: from the scene's reference. */
+typedef struct desired {
+    bool have[2];           /* the joint has a reference (else: hold) */
+    double hold[2];         /* a joint without one: its position at the first state */
+    double q[2], qd[2], qdd[2];
+    double prev_t, prev_qd[2];
+    bool have_prev;
+    int64_t stale;          /* states whose reference did not arrive (the last one kept) */
+} desired;
 
-/* Desired position, velocity, acceleration at sim time t. OUT: q, qd, qdd (2 each) */
-static void traj_eval(const traj *tr, double t, double *q, double *qd, double *qdd)
+/* Desired position, velocity, acceleration at state st (q1 at i[0], q2 at i[1]), from
+ * the latest reference. */
+static void desired_at(desired *d, lag_ctl *ctl, const lag_client_state *st, const int i[2],
+                       double period, const char *const jn[2], bool first)
 {
-    q[0] = tr->a1 * sin(tr->w1 * t);
-    qd[0] = tr->a1 * tr->w1 * cos(tr->w1 * t);
-    qdd[0] = -tr->a1 * tr->w1 * tr->w1 * sin(tr->w1 * t);
-    q[1] = tr->c2 + tr->a2 * sin(tr->w2 * t);
-    qd[1] = tr->a2 * tr->w2 * cos(tr->w2 * t);
-    qdd[1] = -tr->a2 * tr->w2 * tr->w2 * sin(tr->w2 * t);
+    lag_client_reference ref;
+    bool have = lag_client_latest_reference(ctl->client, &ref);
+    if (have && ref.sim_time != st->sim_time) d->stale++;
+    for (int k = 0; k < 2; k++) {
+        int j = have ? lag_client_reference_joint(&ref, jn[k]) : -1;
+        d->have[k] = j >= 0;
+        if (first) d->hold[k] = st->position[i[k]];
+        d->q[k] = j >= 0 ? ref.r[j] : d->hold[k];
+        d->qd[k] = j >= 0 ? ref.rdot[j] : 0.0;
+    }
+    /* the acceleration: r' one control period ago and now */
+    bool next = d->have_prev && fabs(st->sim_time - d->prev_t - period) <= 1e-9 * period;
+    for (int k = 0; k < 2; k++) {
+        d->qdd[k] = next ? (d->qd[k] - d->prev_qd[k]) / period : 0.0;
+        d->prev_qd[k] = d->qd[k];
+    }
+    d->prev_t = st->sim_time;
+    d->have_prev = true;
 }
 
 int main(int argc, char **argv)
@@ -41,13 +66,13 @@ int main(int argc, char **argv)
     lag_ctl ctl;
     lag_ctl_init(&ctl, "manipulator_pd", "MANIPULATOR");
     int rc = lag_ctl_parse(&ctl, argc, argv,
-                           "Tracks q1 = 0.3 sin(0.5 t), q2 = 0.5 + 0.1 sin(t) on a running "
+                           "Tracks the scene's reference (<PREFIX>_REFERENCE) on a running "
                            "lagsimd manipulator\nwith PD + computed-torque feedforward from "
-                           "its scene description.",
+                           "its scene description; a joint\nwithout a reference holds its "
+                           "first position.",
                            mine, (int)(sizeof mine / sizeof mine[0]));
     if (rc >= 0) return rc;
     const double kp = wn * wn, kd = 2.0 * wn;
-    const traj tr = {0.3, 0.5, 0.5, 0.1, 1.0};
 
     if (lag_ctl_start(&ctl, "manipulator")) return lag_ctl_fail(&ctl);
     const lag_model model = ctl.model;
@@ -64,6 +89,8 @@ int main(int argc, char **argv)
     fflush(stdout);
 
     lag_client_state st;
+    desired des;
+    memset(&des, 0, sizeof des);
     int64_t states = 0, n_settled = 0;
     double t_first = NAN, t_last = NAN, t_report = -INFINITY;
     double emax[2] = {0, 0}, esq[2] = {0, 0}, emax_all[2] = {0, 0};
@@ -73,7 +100,19 @@ int main(int argc, char **argv)
         double q[2] = {st.position[i1], st.position[i2]};
         double qd[2] = {st.velocity[i1], st.velocity[i2]};
         double q_d[2], qd_d[2], qdd_d[2], M[4], hb[2], v[2], tau[2];
-        traj_eval(&tr, st.sim_time, q_d, qd_d, qdd_d);
+        const int idx[2] = {i1, i2};
+        desired_at(&des, &ctl, &st, idx, ctl.scene.control_period, jn, states == 0);
+        if (states == 0) {
+            printf("manipulator_pd: tracking %s %s, %s %s\n", jn[0],
+                   des.have[0] ? "its reference" : "its first position", jn[1],
+                   des.have[1] ? "its reference" : "its first position");
+            fflush(stdout);
+        }
+        for (int k = 0; k < 2; k++) {
+            q_d[k] = des.q[k];
+            qd_d[k] = des.qd[k];
+            qdd_d[k] = des.qdd[k];
+        }
         for (int k = 0; k < 2; k++)
             v[k] = qdd_d[k] + kp * (q_d[k] - q[k]) + kd * (qd_d[k] - qd[k]);
         lag_model_mass(&model, q, M);
@@ -105,7 +144,7 @@ int main(int argc, char **argv)
     return lag_ctl_finish(&ctl,
                           "states=%lld t_first=%.6f t_last=%.6f settle=%g max_abs_e1=%.6g "
                           "max_abs_e2=%.6g rms_e1=%.6g rms_e2=%.6g max_abs_e1_all=%.6g "
-                          "max_abs_e2_all=%.6g",
+                          "max_abs_e2_all=%.6g references_stale=%lld",
                           (long long)states, t_first, t_last, settle, emax[0], emax[1], rms[0],
-                          rms[1], emax_all[0], emax_all[1]);
+                          rms[1], emax_all[0], emax_all[1], (long long)des.stale);
 }

@@ -37,3 +37,17 @@ endforeach()
 # Fuzz target: the command and control handlers and the loop in every mode and run state,
 # on memq:// with a made-up clock (tests/fuzz/fuzz_rt.c; kept inputs in tests/fuzz/rt/).
 lagsim_fuzz_target(rt LIBS lagsimd_internal)
+
+# The scene's reference on <PREFIX>_REFERENCE in every mode, against its closed form; --log,
+# --replay (difference 0, a changed reference fails), SET while running, offline CSV columns
+# (tests/server/test_reference.py).
+find_program(LAGSIM_REF_PYTHON3 python3)
+if(LAGSIM_REF_PYTHON3)
+  foreach(case fast realtime lockstep set offline manipulator)
+    add_test(NAME server_reference_${case}
+             COMMAND ${LAGSIM_REF_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/server/test_reference.py
+                     --bin ${CMAKE_BINARY_DIR}/bin --types ${CMAKE_BINARY_DIR}/python
+                     --source ${PROJECT_SOURCE_DIR} ${case})
+    set_tests_properties(server_reference_${case} PROPERTIES TIMEOUT 120 LABELS server)
+  endforeach()
+endif()

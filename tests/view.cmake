@@ -29,9 +29,13 @@ if(LAGSIM_VIEW_PYTHON3)
   add_test(NAME view_hostile COMMAND ${view_test} hostile)
   add_test(NAME view_stick_flight COMMAND ${view_test} stick_flight)
   add_test(NAME view_cartpole COMMAND ${view_test} cartpole)
-  set_tests_properties(view_browser view_hostile view_stick_flight view_cartpole PROPERTIES TIMEOUT 180 LABELS view)
+  add_test(NAME view_reference COMMAND ${view_test} reference
+           --screenshot ${CMAKE_BINARY_DIR}/view_reference.png)
+  set_tests_properties(view_browser view_hostile view_stick_flight view_cartpole view_reference
+                       PROPERTIES TIMEOUT 180 LABELS view)
   if(NOT LAGSIM_CHROMIUM)
-    set_tests_properties(view_browser view_stick_flight view_cartpole PROPERTIES ENVIRONMENT "PATH=/nonexistent")
+    set_tests_properties(view_browser view_stick_flight view_cartpole view_reference
+                         PROPERTIES ENVIRONMENT "PATH=/nonexistent")
   endif()
 endif()
 

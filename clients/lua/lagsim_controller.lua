@@ -169,6 +169,11 @@ function Controller:start(argv)
     self.state = self:decode(t.joint_state_t, data) or self.state
   end)
   self.lc:subscribe(ch .. 'STATUS', function() self.silent_ms = 0 end)
+  -- the scene's reference, published just before each state with its sim_time
+  self.lc:subscribe(ch .. 'REFERENCE', function(_, data)
+    self.silent_ms = 0
+    self.reference = self:decode(t.reference_t, data) or self.reference
+  end)
   self.lc:subscribe(ch .. 'EVENT', function(_, data)
     self.silent_ms = 0
     local ev = self:decode(t.event_t, data)

@@ -1,7 +1,9 @@
 --[[
-manipulator_pd.lua: the manipulator tracks a smooth joint trajectory, in Lua 5.2.
-    q1_d(t) = 0.3 sin(0.5 t) rad,   q2_d(t) = 0.5 + 0.1 sin(t) m   (t = sim time)
-with PD plus computed-torque feedforward from the scene's parameters:
+manipulator_pd.lua: the manipulator tracks the scene's reference, in Lua 5.2: the
+reference_t on <PREFIX>_REFERENCE, published just before each state (q_d = r, qd_d = r';
+qdd_d the backward difference of r' over the last control period, 0 at the first state
+and after a gap; a joint without a reference holds its first position), as manipulator_pd
+in C does, with PD plus computed-torque feedforward from the scene's parameters:
     tau = M(q) (qdd_d + Kp e + Kd e_dot) + C(q, qd) qd + g(q),  Kp = wn^2, Kd = 2 wn,
 M, C and g in closed form from the model's T and U (docs/models.md), written exactly as
 in clients/python/manipulator_pd.py (same operations in the same order, the same libm),
@@ -15,10 +17,24 @@ local here = (arg and arg[0] or ''):match('^(.*)/[^/]*$') or '.'
 package.path = here .. '/?.lua;' .. package.path
 local Controller = require('lagsim_controller')
 
-local function desired(t)
-  return { 0.3 * math.sin(0.5 * t), 0.5 + 0.1 * math.sin(t) },
-         { 0.15 * math.cos(0.5 * t), 0.1 * math.cos(t) },
-         { -0.075 * math.sin(0.5 * t), -0.1 * math.sin(t) }
+-- q_d, qd_d, qdd_d at a state from the latest reference (manipulator_pd.c's rule)
+local des = { stale = 0, have = { false, false } }
+local function desired(ref, st, q, period)
+  if not des.hold then des.hold = { q[1], q[2] } end
+  if ref and ref.sim_time ~= st.sim_time then des.stale = des.stale + 1 end
+  local qdes, qddes = { des.hold[1], des.hold[2] }, { 0.0, 0.0 }
+  for k, name in ipairs({ 'q1', 'q2' }) do
+    local j = ref and Controller.joint(ref, name)
+    des.have[k] = j ~= nil
+    if j then qdes[k], qddes[k] = ref.r[j], ref.rdot[j] end
+  end
+  local nxt = des.prev_t and math.abs(st.sim_time - des.prev_t - period) <= 1e-9 * period
+  local qdd = { 0.0, 0.0 }
+  for k = 1, 2 do
+    if nxt then qdd[k] = (qddes[k] - des.prev_qd[k]) / period end
+  end
+  des.prev_t, des.prev_qd = st.sim_time, qddes
+  return qdes, qddes, qdd
 end
 
 -- tau = M(q) v + C(q, qd) qd + g(q) (closed form, see above)
@@ -31,7 +47,7 @@ local function computed_torque(p, q, qd, v)
 end
 
 local ctl = Controller.new('manipulator_pd.lua', 'MANIPULATOR', 'manipulator',
-                           'Tracks q1 = 0.3 sin(0.5 t), q2 = 0.5 + 0.1 sin(t) with PD + computed torque.')
+                           'Tracks the scene\'s reference (<PREFIX>_REFERENCE) with PD + computed torque.')
 ctl:option('wn', 10, 'PD bandwidth, rad/s: Kp = wn^2, Kd = 2 wn')
 ctl:option('settle', 2, 'error statistics skip the first S s')
 local o = ctl:start(arg)
@@ -61,7 +77,12 @@ for st in ctl:states() do
   if i1 and i2 then
     local q = { st.position[i1], st.position[i2] }
     local qd = { st.velocity[i1], st.velocity[i2] }
-    local qdes, qddes, qdddes = desired(st.sim_time)
+    local qdes, qddes, qdddes = desired(ctl.reference, st, q, ctl.scene.control_period)
+    if states == 0 and not o.quiet then
+      print(string.format('manipulator_pd.lua: tracking q1 %s, q2 %s',
+                          des.have[1] and 'its reference' or 'its first position',
+                          des.have[2] and 'its reference' or 'its first position'))
+    end
     local v = {}
     for k = 1, 2 do
       v[k] = qdddes[k] + kp * (qdes[k] - q[k]) + kd * (qddes[k] - qd[k])
@@ -95,5 +116,6 @@ for k = 1, 2 do
 end
 os.exit(ctl:finish(string.format(
   'states=%d t_first=%.6f t_last=%.6f settle=%g max_abs_e1=%.6g max_abs_e2=%.6g rms_e1=%.6g '
-    .. 'rms_e2=%.6g max_abs_e1_all=%.6g max_abs_e2_all=%.6g',
-  states, t_first, t_last, o.settle, emax[1], emax[2], rms[1], rms[2], emax_all[1], emax_all[2])))
+    .. 'rms_e2=%.6g max_abs_e1_all=%.6g max_abs_e2_all=%.6g references_stale=%d',
+  states, t_first, t_last, o.settle, emax[1], emax[2], rms[1], rms[2], emax_all[1], emax_all[2],
+  des.stale)))

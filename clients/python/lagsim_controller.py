@@ -74,6 +74,7 @@ class Controller(object):
         self.end = None
         self.dropped = 0
         self.scene = None
+        self.reference = None  # the latest reference_t (the scene's reference), or None
 
     def start(self):
         a = self.parser.parse_args()
@@ -108,6 +109,7 @@ class Controller(object):
         self.lc.subscribe(ch + "STATE", self._on_state)
         self.lc.subscribe(ch + "EVENT", self._on_event)
         self.lc.subscribe(ch + "STATUS", self._on_status)
+        self.lc.subscribe(ch + "REFERENCE", self._on_reference)
         # subscribed: from here on no state is missed (test harnesses wait for this line)
         print("%s: waiting for the scene description on %sSCENE" % (self.name, ch), flush=True)
         deadline = time.monotonic() + a.timeout
@@ -219,6 +221,13 @@ class Controller(object):
         st = self._decode(self.t.joint_state_t, data)
         if st is not None:
             self._state = st
+
+    def _on_reference(self, channel, data):
+        """The scene's reference, published just before each state with its sim_time."""
+        self._heard = time.monotonic()
+        r = self._decode(self.t.reference_t, data)
+        if r is not None:
+            self.reference = r
 
     def _on_status(self, channel, data):
         self._heard = time.monotonic()

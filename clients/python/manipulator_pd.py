@@ -2,9 +2,11 @@
 """Manipulator trajectory tracking in Python, standard library only.
 
 Talks to lagsimd through lagsim_lcm (ctypes over liblcm.so.1) and the lcm-gen Python
-types (PYTHONPATH=<build>/python, or --types DIR). Tracks
-    q1_d(t) = 0.3 sin(0.5 t)  rad,   q2_d(t) = 0.5 + 0.1 sin(t)  m   (t = sim time)
-with PD plus computed-torque feedforward, from the parameters of the scene description:
+types (PYTHONPATH=<build>/python, or --types DIR). Tracks the scene's reference (the
+reference_t on <PREFIX>_REFERENCE, published just before each state: q_d = r, qd_d = r';
+qdd_d the backward difference of r' over the last control period, 0 at the first state and
+after a gap; a joint without a reference holds its first position), as manipulator_pd in
+C does, with PD plus computed-torque feedforward, from the parameters of the scene description:
     tau = M(q) (qdd_d + Kp e + Kd e_dot) + C(q, qd) qd + g(q),  Kp = wn^2, Kd = 2 wn.
 The dynamics are written here in closed form from the model's T and U (docs/models.md),
 independently of the C core:
@@ -24,12 +26,29 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from lagsim_controller import Controller  # noqa: E402
 
 
-def desired(t):
-    """(q, qd, qdd) of the reference trajectory at sim time t."""
-    q = (0.3 * math.sin(0.5 * t), 0.5 + 0.1 * math.sin(t))
-    qd = (0.15 * math.cos(0.5 * t), 0.1 * math.cos(t))
-    qdd = (-0.075 * math.sin(0.5 * t), -0.1 * math.sin(t))
-    return q, qd, qdd
+class Desired(object):
+    """q_d, qd_d, qdd_d at each state, from the latest reference (manipulator_pd.c's rule)."""
+
+    def __init__(self, period):
+        self.period, self.hold, self.prev = period, None, None  # prev: (t, qd_d)
+        self.stale = 0
+        self.have = [False, False]
+
+    def at(self, ref, st, q):
+        if self.hold is None:
+            self.hold = q
+        if ref is not None and ref.sim_time != st.sim_time:
+            self.stale += 1
+        qdes, qddes = list(self.hold), [0.0, 0.0]
+        for k, name in enumerate(("q1", "q2")):
+            self.have[k] = ref is not None and name in ref.name
+            if self.have[k]:
+                j = ref.name.index(name)
+                qdes[k], qddes[k] = ref.r[j], ref.rdot[j]
+        nxt = self.prev is not None and abs(st.sim_time - self.prev[0] - self.period) <= 1e-9 * self.period
+        qdd = [(qddes[k] - self.prev[1][k]) / self.period if nxt else 0.0 for k in range(2)]
+        self.prev = (st.sim_time, qddes)
+        return qdes, qddes, qdd
 
 
 def computed_torque(p, q, qd, v):
@@ -62,6 +81,7 @@ def main():
               % (a.prefix, ctl.scene.mode, ctl.scene.control_period, kp, kd), flush=True)
 
     names = ["q1", "q2"]
+    des = Desired(ctl.scene.control_period)
     states = 0
     n_settled = 0
     t_first = t_last = float("nan")
@@ -76,7 +96,10 @@ def main():
             continue
         q = (st.position[i1], st.position[i2])
         qd = (st.velocity[i1], st.velocity[i2])
-        qdes, qddes, qdddes = desired(st.sim_time)
+        qdes, qddes, qdddes = des.at(ctl.reference, st, q)
+        if states == 0 and not a.q:
+            print("manipulator_pd.py: tracking q1 %s, q2 %s" % tuple(
+                "its reference" if h else "its first position" for h in des.have), flush=True)
         v = [qdddes[k] + kp * (qdes[k] - q[k]) + kd * (qddes[k] - qd[k]) for k in range(2)]
         tau = computed_torque(p, q, qd, v)
         ctl.command(st.sim_time, names, tau)
@@ -100,9 +123,9 @@ def main():
     rms = [math.sqrt(esq[k] / n_settled) if n_settled else float("nan") for k in range(2)]
     return ctl.finish("states=%d t_first=%.6f t_last=%.6f settle=%g max_abs_e1=%.6g "
                       "max_abs_e2=%.6g rms_e1=%.6g rms_e2=%.6g max_abs_e1_all=%.6g "
-                      "max_abs_e2_all=%.6g"
+                      "max_abs_e2_all=%.6g references_stale=%d"
                       % (states, t_first, t_last, a.settle, emax[0], emax[1], rms[0], rms[1],
-                         emax_all[0], emax_all[1]))
+                         emax_all[0], emax_all[1], des.stale))
 
 
 if __name__ == "__main__":

@@ -6,6 +6,7 @@
 #define LAGSIMD_DAEMON_H
 
 #include <stdbool.h>
+#include "lagsim_wire.h"
 #include "scene.h"
 
 typedef struct lagsimd_opts {
@@ -27,6 +28,13 @@ typedef struct lagsimd_opts {
 
 /* Exit codes of lagsimd. */
 enum { LAGSIMD_EXIT_OK = 0, LAGSIMD_EXIT_RUNTIME = 1, LAGSIMD_EXIT_USAGE = 2 };
+
+/* The reference of a scene's joints (ref, its `reference:` with the changes made while
+ * running) at sim time t and tick step, as published on <PREFIX>_REFERENCE: the joints
+ * with a reference in the model's order, r and r' from lag_reference_eval (utime 0: the
+ * publisher sets it). num_joints 0 when the scene has none. OUT: m */
+void lagsimd_reference_at(const lag_scene_reference *ref, lag_model_kind kind, double t,
+                          int64_t step, lag_wire_reference *m);
 
 /* Offline: simulate as fast as possible, write CSV. Returns an exit code. */
 int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o);

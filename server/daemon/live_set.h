@@ -38,7 +38,7 @@ typedef struct live_sets {
     int nk;
 } live_sets;
 
-/* The cheap checks, before any parse: key is under parameters or effects (a dotted path
+/* The cheap checks, before any parse: key is under parameters, effects or reference (a dotted path
  * as --set takes it) and has no '=', value is not empty, "key=value" fits. On success
  * 0 with "key=value" in kv (LIVE_SET_LEN bytes); else -1 with the reason in why. */
 int live_set_parse(const char *key, const char *value, char *kv, char *why, size_t whylen);

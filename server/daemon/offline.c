@@ -25,8 +25,9 @@ static volatile sig_atomic_t g_stop_signal;
 static void on_stop_signal(int signo) { g_stop_signal = signo; }
 
 /* One CSV row: t, q, qd as published (with the noise effect, if on), and the energy of
- * the true state. Returns <0 on write error. */
-static int write_row(FILE *f, const lag_sim *sim)
+ * the true state; then, when the scene has a reference, r and r' of each joint that has
+ * one (as lagsimd publishes them on <PREFIX>_REFERENCE). Returns <0 on write error. */
+static int write_row(FILE *f, const lag_sim *sim, const lag_scene_reference *ref)
 {
     char line[1024];
     double q[LAG_MAX_DOF], qd[LAG_MAX_DOF];
@@ -36,18 +37,30 @@ static int write_row(FILE *f, const lag_sim *sim)
         n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g", q[i]);
     for (int i = 0; i < sim->nq; i++)
         n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g", qd[i]);
-    n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g\n", lag_sim_energy(sim));
+    n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g", lag_sim_energy(sim));
+    if (ref->n > 0) {
+        lag_wire_reference m;
+        lagsimd_reference_at(ref, sim->def.model.kind, lag_sim_time(sim), sim->tick, &m);
+        for (int k = 0; k < m.num_joints; k++)
+            n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g,%.17g", m.r[k], m.rdot[k]);
+    }
+    n += snprintf(line + n, sizeof line - (size_t)n, "\n");
     return fwrite(line, 1, (size_t)n, f) == (size_t)n ? 0 : -1;
 }
 
-static void write_header(FILE *f, const lag_model_info *info)
+/* t, q, q_dot, energy; then <joint>_ref, <joint>_ref_dot for the joints with a
+ * reference (none without one: the columns before stay where they were) */
+static void write_header(FILE *f, const lag_model_info *info, const lag_scene_reference *ref)
 {
     fputs("t", f);
     for (int i = 0; i < info->nq; i++)
         fprintf(f, ",%s", info->joint_names[i]);
     for (int i = 0; i < info->nq; i++)
         fprintf(f, ",%s_dot", info->joint_names[i]);
-    fputs(",energy\n", f);
+    fputs(",energy", f);
+    for (int i = 0; i < info->nq && i < LAG_MAX_DOF; i++)
+        if (ref->on[i]) fprintf(f, ",%s_ref,%s_ref_dot", info->joint_names[i], info->joint_names[i]);
+    fputs("\n", f);
 }
 
 static double cpu_seconds(void)
@@ -103,8 +116,8 @@ int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)
             f = stdout;
         }
         setvbuf(f, csvbuf, _IOFBF, sizeof csvbuf);
-        write_header(f, info);
-        write_row(f, &sim);
+        write_header(f, info, &sc->reference);
+        write_row(f, &sim, &sc->reference);
     }
 
     /* a signal stops the run cleanly: the rows so far are flushed */
@@ -146,7 +159,7 @@ int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)
             break;
         }
         if (g_stop_signal) break; /* mid-period: no row */
-        if (f && write_row(f, &sim) < 0)
+        if (f && write_row(f, &sim, &sc->reference) < 0)
             break; /* reported below by ferror */
     }
     const double cpu = cpu_seconds() - c0;

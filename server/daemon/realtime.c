@@ -744,6 +744,7 @@ static void handle_set(rt_server *s, const lag_wire_control *c)
         control_rejected(s, why);
         return;
     }
+    s->ref = ns.reference; /* SET reference.*: from the next state on */
     live_set_keep(&s->live, kv);
     rt_publish_event(s, "set", "", 0, kv);
     s->want_scene = true;
@@ -868,6 +869,7 @@ static void handle_control(rt_server *s, const uint8_t *data, size_t len)
                      "kick(s)", undone, undone[0] ? ", " : "", s->live.nk);
             rt_publish_event(s, "restore", "", (double)s->live.n, detail);
             memset(&s->live, 0, sizeof s->live);
+            s->ref = s->sc->reference;
         }
         do_reset(s, NULL, NULL, c.count == 1 ? "reset to the scene file's initial state and "
                                                "values" : "reset to the scene's initial state");
@@ -1040,13 +1042,14 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
         return open_error(err, errlen, "bad scene: realtime.command_timeout must be >= 0 (got %g)",
                           sc->realtime.command_timeout);
     /* the loader bounds lcm.prefix (file:line:column); a scene built in code is checked here */
-    _Static_assert(LAG_SCENE_PREFIX_MAX + 8 == LCM_MAX_CHANNEL_NAME_LENGTH,
-                   "the loader's prefix bound leaves room for _COMMAND in an LCM channel name");
+    _Static_assert(LAG_SCENE_PREFIX_MAX + 10 == LCM_MAX_CHANNEL_NAME_LENGTH,
+                   "the loader's prefix bound leaves room for _REFERENCE in an LCM channel name");
     size_t plen = strnlen(sc->lcm.prefix, sizeof sc->lcm.prefix);
-    if (plen == 0 || plen + 8 > LCM_MAX_CHANNEL_NAME_LENGTH)
+    if (plen == 0 || plen + 10 > LCM_MAX_CHANNEL_NAME_LENGTH)
         return open_error(err, errlen, "bad scene: lcm.prefix must have 1 to %d characters "
-                          "(LCM channel names are at most %d, and the longest suffix is _COMMAND)",
-                          LCM_MAX_CHANNEL_NAME_LENGTH - 8, LCM_MAX_CHANNEL_NAME_LENGTH);
+                          "(LCM channel names are at most %d, and the longest suffix is "
+                          "_REFERENCE)", LCM_MAX_CHANNEL_NAME_LENGTH - 10,
+                          LCM_MAX_CHANNEL_NAME_LENGTH);
     if (o && o->duration > 0 && !rt_ticks_for(o->duration, dt, &s->stop_tick))
         return open_error(err, errlen, "--duration %g s is more than 2^53 ticks of dt %g s "
                           "(the longest run whose sim time is exact)", o->duration, dt);
@@ -1088,6 +1091,8 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     snprintf(s->ch_event, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_EVENT]);
     snprintf(s->ch_control, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_CONTROL]);
     snprintf(s->ch_scene, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_SCENE]);
+    snprintf(s->ch_reference, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_REFERENCE]);
+    s->ref = sc->reference;
     s->tick_budget = RT_TICK_BUDGET;
     for (int k = 0; k < RT_EV_COUNT; k++)
         rt_limit_init(&s->lim_event[k], ev_limits[k].per_s, ev_limits[k].burst, now);

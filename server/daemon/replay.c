@@ -41,6 +41,11 @@
  * (lag_sim_redefine), then to its end, as the daemon's chunks were; a restart applies
  * every change read before it first.
  *
+ * References. A scene with a `reference:` has <PREFIX>_REFERENCE records, one just before
+ * each state; each is compared with the reference computed again (lagsimd_reference_at)
+ * at its sim time, from the scene and the `reference.*` changes read before it in the log
+ * (log order: a change published before a reference was in force when it was computed).
+ *
  * For a run of the same scene and build recorded from its start (lagsimd --log, or a
  * logger started before the daemon), every difference is exactly 0: the daemon and the
  * replay make the same floating-point operations in the same order.
@@ -151,6 +156,10 @@ typedef struct replay_sets {
     int head, n;
     int64_t applied;
     bool failed;                            /* one could not be applied: said, exit 1 */
+    /* references: the scene's with the reference.* changes read so far (in log order) */
+    const lag_scene_reference *base_ref;
+    live_sets ref_live;
+    lag_scene_reference ref;
 } replay_sets;
 
 /* The replay's definition of a scene: with an actuator lag and the inputs in the log
@@ -167,13 +176,43 @@ static void replay_def(lag_sim_def *def, bool use_input)
         }
 }
 
+/* The reference in force from here on in the log: a `set` of a reference.* key read (kv)
+ * or a `restore` (kv NULL). False (said once) when the change cannot be applied. */
+static bool ref_read(replay_sets *rs, const char *kv, const lagsimd_opts *o)
+{
+    if (!kv) {
+        memset(&rs->ref_live, 0, sizeof rs->ref_live);
+        rs->ref = *rs->base_ref;
+        return true;
+    }
+    static lag_scene ns; /* large: not on the stack */
+    char key[LIVE_SET_LEN], checked[LIVE_SET_LEN], why[1024];
+    size_t klen = strcspn(kv, "=");
+    snprintf(key, sizeof key, "%.*s", (int)klen, kv);
+    if (kv[klen] != '=' || live_set_parse(key, kv + klen + 1, checked, why, sizeof why) != 0 ||
+        live_set_load(o, &rs->ref_live, checked, &ns, why, sizeof why) != 0) {
+        if (!rs->failed)
+            fprintf(stderr, "lagsimd: --replay: the log's change '%s' cannot be applied to "
+                            "this scene: %s (wrong --config or --set?)\n", kv, why);
+        rs->failed = true;
+        return false;
+    }
+    live_set_keep(&rs->ref_live, checked);
+    rs->ref = ns.reference;
+    return true;
+}
+
 /* A `set` event of the log: queued until the replay reaches its step. */
-static void set_read(replay_sets *rs, const lag_log_record *rec)
+static void set_read(replay_sets *rs, const lag_log_record *rec, const lagsimd_opts *o)
 {
     lag_wire_event ev;
     if (!rec->data || lag_wire_decode_event(rec->data, rec->size, &ev) != LAG_WIRE_OK ||
         (strcmp(ev.kind, "set") && strcmp(ev.kind, "kick") && strcmp(ev.kind, "restore") &&
          strcmp(ev.kind, "kicks_cleared")))
+        return;
+    if (!strcmp(ev.kind, "restore")) ref_read(rs, NULL, o);
+    if (!strcmp(ev.kind, "set") && !strncmp(ev.detail, "reference", 9) &&
+        (ev.detail[9] == '.' || ev.detail[9] == '=') && !ref_read(rs, ev.detail, o))
         return;
     if (rs->n == REPLAY_SETS_PENDING) {
         if (!rs->failed)
@@ -282,8 +321,9 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
     char err[512];
     const double tolerance = o ? o->tolerance : 0.0;
     const lag_model_info *info; /* the sim's joints (a stick that may fly: h too), below */
-    char channel[96], ch_input[96], ch_event[96];
+    char channel[96], ch_input[96], ch_event[96], ch_ref[96];
     snprintf(channel, sizeof channel, "%s_STATE", sc->lcm.prefix);
+    snprintf(ch_ref, sizeof ch_ref, "%s_REFERENCE", sc->lcm.prefix);
     snprintf(ch_input, sizeof ch_input, "%s_INPUT", sc->lcm.prefix);
     snprintf(ch_event, sizeof ch_event, "%s_EVENT", sc->lcm.prefix);
     static replay_sets sets;
@@ -301,6 +341,10 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
     const bool anchor = lagged && !use_input;
     replay_def(&def, use_input);
     sets.base = &def;
+    sets.base_ref = &sc->reference;
+    sets.ref = sc->reference;
+    int64_t refs_seen = 0, refs_compared = 0, refs_bad = 0;
+    double max_dr = 0.0;
     lag_sim sim;
     if (lag_sim_init(&sim, &def, err, sizeof err) != LAG_OK) {
         fprintf(stderr, "lagsimd: bad scene: %s\n", err);
@@ -338,7 +382,31 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
     int rc;
     while ((rc = lag_log_next(log, &rec)) == LAG_LOG_OK && !sets.failed) {
         if (strcmp(rec.channel, ch_event) == 0) {
-            set_read(&sets, &rec);
+            set_read(&sets, &rec, o);
+            continue;
+        }
+        if (strcmp(rec.channel, ch_ref) == 0) {
+            /* the reference as published, against the one computed again at its time */
+            refs_seen++;
+            lag_wire_reference lr, cr;
+            if (!rec.data || lag_wire_decode_reference(rec.data, rec.size, LAG_WIRE_MAX_JOINTS,
+                                                       &lr) != LAG_WIRE_OK) {
+                refs_bad++;
+                continue;
+            }
+            lagsimd_reference_at(&sets.ref, sc->sim.model.kind, lr.sim_time, lr.step, &cr);
+            bool same = cr.num_joints == lr.num_joints && lr.sim_time == (double)lr.step * dt;
+            for (int k = 0; same && k < lr.num_joints; k++) same = !strcmp(cr.name[k], lr.name[k]);
+            if (!same) {
+                refs_bad++;
+                continue;
+            }
+            for (int k = 0; k < lr.num_joints; k++) {
+                double a = fabs(cr.r[k] - lr.r[k]), b = fabs(cr.rdot[k] - lr.rdot[k]);
+                if (!(a <= max_dr)) max_dr = a;
+                if (!(b <= max_dr)) max_dr = b;
+            }
+            refs_compared++;
             continue;
         }
         if (use_input && strcmp(rec.channel, ch_input) == 0) {
@@ -507,6 +575,18 @@ int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts
     }
     printf("max |q - q_log| = %.17g\nmax |qd - qd_log| = %.17g\n", max_dq, max_dqd);
     if (use_input) printf("max |effort - effort_log| = %.17g\n", max_deff);
+    if (refs_seen > 0 || sc->reference.n > 0) {
+        printf("%lld references compared on %s (%lld of other joints, another time or "
+               "undecodable)\nmax |r - r_log|, |rdot - rdot_log| = %.17g\n",
+               (long long)refs_compared, ch_ref, (long long)refs_bad, max_dr);
+        if (max_dr > max_diff || isnan(max_dr)) max_diff = max_dr;
+        if (refs_bad > 0) {
+            fprintf(stderr, "lagsimd: --replay: FAILED: %lld reference(s) on %s are not "
+                            "this scene's (wrong --config or --set?)\n", (long long)refs_bad,
+                    ch_ref);
+            return LAGSIMD_EXIT_RUNTIME;
+        }
+    }
     printf("max difference = %.17g\n", max_diff);
     if (!(max_diff <= tolerance)) {
         fprintf(stderr, "lagsimd: --replay: FAILED: the largest difference %.17g is above "

@@ -110,7 +110,11 @@ typedef struct rt_server {
     lag_sim sim;
     int nq;
     char ch_state[RT_CHANNEL_MAX], ch_command[RT_CHANNEL_MAX], ch_status[RT_CHANNEL_MAX],
-        ch_event[RT_CHANNEL_MAX], ch_control[RT_CHANNEL_MAX], ch_scene[RT_CHANNEL_MAX];
+        ch_event[RT_CHANNEL_MAX], ch_control[RT_CHANNEL_MAX], ch_scene[RT_CHANNEL_MAX],
+        ch_reference[RT_CHANNEL_MAX];
+    /* the scene's reference with the changes made while running (SET reference.*):
+     * published on ch_reference before each state when ref.n > 0 */
+    lag_scene_reference ref;
 
     /* the loop's clock: CLOCK_MONOTONIC ns, read once per wake-up (tests set it by hand);
      * every decision of the loop and the handlers uses it */

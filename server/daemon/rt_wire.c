@@ -66,8 +66,22 @@ static int publish(rt_server *s, const char *channel, lag_wire_type t, const voi
 }
 
 /* ---------------------------------------------------------------- publishing */
+/* <PREFIX>_REFERENCE at the state's sim time, just before the state: a controller that
+ * reads both has the reference of a state when the state arrives. Nothing (no cost)
+ * when the scene has no reference. */
+static void publish_reference(rt_server *s)
+{
+    if (s->ref.n == 0) return;
+    lag_wire_reference m;
+    lagsimd_reference_at(&s->ref, s->sim.def.model.kind, lag_sim_time(&s->sim), s->sim.tick,
+                         &m);
+    m.utime = rt_wall_us();
+    publish(s, s->ch_reference, LAG_WIRE_REFERENCE, &m);
+}
+
 void rt_publish_state(rt_server *s)
 {
+    publish_reference(s);
     lag_wire_joint_state m;
     memset(&m, 0, sizeof m);
     double pos[LAG_MAX_DOF], vel[LAG_MAX_DOF];

@@ -8,6 +8,7 @@
 #define LAGSIM_SCENE_H
 
 #include "lagsim/lagsim.h"
+#include "reference.h"
 
 typedef enum lag_rt_mode {
     LAG_RT_REALTIME = 0, /* paced against CLOCK_MONOTONIC at realtime.rate */
@@ -24,8 +25,17 @@ typedef enum lag_rt_start {
 } lag_rt_start;
 
 /* The longest lcm.prefix: LCM channel names have at most 63 bytes, and the longest
- * suffix of a plant's channels (_COMMAND, _CONTROL) has 8. */
-#define LAG_SCENE_PREFIX_MAX 55
+ * suffix of a plant's channels (_REFERENCE) has 10. */
+#define LAG_SCENE_PREFIX_MAX 53
+
+/* The scene's `reference:`: what each joint should follow (server/eval/reference.h),
+ * published on <PREFIX>_REFERENCE beside every state. Not the core's business: the plant
+ * does not see it. n = 0: no reference, nothing published. */
+typedef struct lag_scene_reference {
+    int n;                   /* joints with a reference */
+    bool on[LAG_MAX_DOF];    /* joint i has one: joint[i] holds it (checked) */
+    lag_reference joint[LAG_MAX_DOF];
+} lag_scene_reference;
 
 /* Every this many periods the daemon estimates the error the integration adds (a shadow
  * run of the period, lag_sim_shadow_error), when a scene asks for integrator.error and
@@ -73,6 +83,7 @@ typedef struct lag_scene {
         int ttl;                 /* the multicast ttl the URL asks for (0 for "", memq://
                                     or a URL without ttl=), checked by the loader */
     } lcm;
+    lag_scene_reference reference; /* reference: per joint (none by default) */
 } lag_scene;
 
 /* What a scene may be, at most. A scene file is a few hundred bytes and about a hundred

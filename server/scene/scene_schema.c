@@ -95,6 +95,9 @@ typedef struct conv {
     int limit_seen;       /* bits: lower, upper given for the joint being read */
     int cur_joint;        /* the joint whose sub-mapping is being read */
     lag_disturbance *cur_dist; /* the disturbance being read */
+    lag_reference *cur_ref;    /* the reference being read */
+    int cur_ref_kind;          /* its kind, -1 before its type is known */
+    unsigned cur_ref_seen;     /* LAG_REF_KEY_* given */
     int cur_dist_kind;    /* bits: impulse, force given */
 } conv;
 
@@ -726,7 +729,7 @@ static int key_prefix(conv *cv, const ynode *nd, const char *path)
     if (n == 0 || n > LAG_SCENE_PREFIX_MAX)
         return yfail(cv->err, nd, path, "expected a channel prefix of 1 to %d characters, got "
                      "%zu (LCM channel names have at most 63 bytes, and the longest suffix, "
-                     "_COMMAND, has 8)", LAG_SCENE_PREFIX_MAX, n);
+                     "_REFERENCE, has 10)", LAG_SCENE_PREFIX_MAX, n);
     for (size_t i = 0; i < n; i++) {
         char c = s[i];
         bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') ||
@@ -1127,6 +1130,207 @@ static int key_effects(conv *cv, const ynode *nd, const char *path)
     return convert_map(cv, nd, path, k_effects, "effect");
 }
 
+/* ================================================================ reference */
+
+/* A reference's times and frequencies, as lag_reference_check takes them. */
+static const range R_REF_START = {0.0, T_MAX, false, "s"};
+static const range R_REF_FREQUENCY = {0.0, 1e6, true, "Hz"};
+static const range R_REF_DURATION = {0.0, T_MAX, true, "s"};
+
+/* The keys some kinds take, with their bit of lag_ref_kind_info.keys: which kind takes
+ * which key is the reference library's table (lag_ref_kind_table), not written here. */
+static const struct {
+    const char *name;
+    unsigned bit;
+} k_ref_key_bits[] = {
+    {"frequency", LAG_REF_KEY_FREQUENCY},
+    {"frequency_end", LAG_REF_KEY_FREQUENCY_END},
+    {"duration", LAG_REF_KEY_DURATION},
+    {"points", LAG_REF_KEY_POINTS},
+};
+#define N_REF_KEY_BITS (sizeof k_ref_key_bits / sizeof k_ref_key_bits[0])
+
+/* "step, ramp, sine, chirp, square, waypoints" */
+static void ref_kind_list(char *buf, size_t len)
+{
+    buf[0] = '\0';
+    for (int k = 0; k < LAG_REF_KIND_COUNT; k++) {
+        size_t used = strlen(buf);
+        snprintf(buf + used, len - used, "%s%s", k ? ", " : "", lag_ref_kind_table[k].name);
+    }
+}
+
+/* "type, start, amplitude, offset, frequency" : the keys a kind takes */
+static void ref_key_list(int kind, char *buf, size_t len)
+{
+    snprintf(buf, len, "type, start, amplitude, offset");
+    for (size_t b = 0; b < N_REF_KEY_BITS; b++)
+        if (lag_ref_kind_table[kind].keys & k_ref_key_bits[b].bit) {
+            size_t used = strlen(buf);
+            snprintf(buf + used, len - used, ", %s", k_ref_key_bits[b].name);
+        }
+}
+
+/* A key some kinds take: refused for a kind that does not. */
+static int ref_key_allowed(conv *cv, const ynode *nd, const char *path, const char *key)
+{
+    unsigned bit = 0;
+    for (size_t b = 0; b < N_REF_KEY_BITS; b++)
+        if (strcmp(k_ref_key_bits[b].name, key) == 0) bit = k_ref_key_bits[b].bit;
+    cv->cur_ref_seen |= bit;
+    int kind = cv->cur_ref_kind;
+    if (kind < 0 || (lag_ref_kind_table[kind].keys & bit))
+        return 0;
+    char keys[256];
+    ref_key_list(kind, keys, sizeof keys);
+    return yfail(cv->err, nd, path, "a %s reference takes no %s; its keys: %s",
+                 lag_ref_kind_table[kind].name, key, keys);
+}
+
+static int ref_type(conv *cv, const ynode *nd, const char *path)
+{
+    (void)cv; (void)nd; (void)path; /* read first: see ref_joint */
+    return 0;
+}
+
+static int ref_start(conv *cv, const ynode *nd, const char *path)
+{
+    return get_range(cv, nd, path, &R_REF_START, &cv->cur_ref->start);
+}
+
+/* amplitude and offset: a position, within explode_limit */
+static int ref_amplitude(conv *cv, const ynode *nd, const char *path)
+{
+    return get_within_explode(cv, nd, path, false, &cv->cur_ref->amplitude);
+}
+
+static int ref_offset(conv *cv, const ynode *nd, const char *path)
+{
+    return get_within_explode(cv, nd, path, false, &cv->cur_ref->offset);
+}
+
+static int ref_frequency(conv *cv, const ynode *nd, const char *path)
+{
+    if (ref_key_allowed(cv, nd, path, "frequency") < 0) return -1;
+    return get_range(cv, nd, path, &R_REF_FREQUENCY, &cv->cur_ref->frequency);
+}
+
+static int ref_frequency_end(conv *cv, const ynode *nd, const char *path)
+{
+    if (ref_key_allowed(cv, nd, path, "frequency_end") < 0) return -1;
+    return get_range(cv, nd, path, &R_REF_FREQUENCY, &cv->cur_ref->frequency_end);
+}
+
+static int ref_duration(conv *cv, const ynode *nd, const char *path)
+{
+    if (ref_key_allowed(cv, nd, path, "duration") < 0) return -1;
+    return get_range(cv, nd, path, &R_REF_DURATION, &cv->cur_ref->duration);
+}
+
+/* points: [[t, w], ...], t in s from start (strictly increasing), w a position within
+ * explode_limit (r = offset + amplitude w) */
+static int ref_points(conv *cv, const ynode *nd, const char *path)
+{
+    if (ref_key_allowed(cv, nd, path, "points") < 0) return -1;
+    lag_reference *ref = cv->cur_ref;
+    if (nd->kind != YN_SEQ || nd->n < 1 || nd->n > LAG_REF_MAX_POINTS)
+        return yfail(cv->err, nd, path, "expected a sequence of 1 to %d points [t, w] (s from "
+                     "start, and the value), got %s", LAG_REF_MAX_POINTS,
+                     nd->kind == YN_SEQ ? "more or none" : ynode_kind_name(nd));
+    for (int k = 0; k < nd->n; k++) {
+        const ynode *it = nd->items[k];
+        char sub[256], el[280];
+        snprintf(sub, sizeof sub, "%s[%d]", path, k);
+        if (it->kind != YN_SEQ || it->n != 2)
+            return yfail(cv->err, it, sub, "expected a point [t, w] (two numbers)");
+        snprintf(el, sizeof el, "%s[0]", sub);
+        if (get_range(cv, it->items[0], el, &R_REF_START, &ref->point_t[k]) < 0) return -1;
+        if (k > 0 && !(ref->point_t[k] > ref->point_t[k - 1]))
+            return yfail(cv->err, it->items[0], el, "the points' times must increase strictly "
+                         "(%.17g after %.17g)", ref->point_t[k], ref->point_t[k - 1]);
+        snprintf(el, sizeof el, "%s[1]", sub);
+        if (get_within_explode(cv, it->items[1], el, false, &ref->point_w[k]) < 0) return -1;
+    }
+    ref->n_points = nd->n;
+    return 0;
+}
+
+static const keyrow k_ref_keys[] = {
+    {"type", ref_type, K_OTHER},                   /* a kind of lag_ref_kind_table */
+    {"start", ref_start, K_NUMBER},                /* s */
+    {"amplitude", ref_amplitude, K_NUMBER},        /* m or rad, within explode_limit */
+    {"offset", ref_offset, K_NUMBER},              /* m or rad, within explode_limit */
+    {"frequency", ref_frequency, K_NUMBER},        /* Hz: sine, square, chirp */
+    {"frequency_end", ref_frequency_end, K_NUMBER},/* Hz: chirp */
+    {"duration", ref_duration, K_NUMBER},          /* s: ramp, chirp */
+    {"points", ref_points, K_OTHER},               /* waypoints: [[t, w], ...] (numbers
+                                                      range-checked in ref_points) */
+    {NULL, NULL, K_OTHER, NULL, NULL},
+};
+
+static int ref_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    lag_scene_reference *sr = &cv->sc->reference;
+    char kinds[128], what[256];
+    ref_kind_list(kinds, sizeof kinds);
+    snprintf(what, sizeof what, "a reference mapping (type: %s; start, amplitude, offset...)",
+             kinds);
+    if (need_map(cv, nd, path, what) < 0)
+        return -1;
+    /* the type first: it decides the other keys and their defaults */
+    const yentry *te = ymap_find(nd, "type");
+    int kind = -1;
+    if (te) {
+        char tpath[300];
+        const char *name;
+        join(tpath, sizeof tpath, path, "type");
+        snprintf(what, sizeof what, "a reference type (%s)", kinds);
+        if (get_string(cv, te->val, tpath, what, &name) < 0)
+            return -1;
+        kind = lag_ref_kind_from_name(name);
+        if (kind < 0)
+            return yfail(cv->err, te->val, tpath, "unknown reference type '%s'; allowed: %s",
+                         name, kinds);
+    }
+    lag_reference *ref = &sr->joint[j];
+    *ref = lag_reference_default(kind < 0 ? LAG_REF_STEP : (lag_ref_kind)kind);
+    cv->cur_ref = ref;
+    cv->cur_ref_kind = kind;
+    cv->cur_ref_seen = 0;
+    if (convert_map(cv, nd, path, k_ref_keys, "reference key") < 0)
+        return -1;
+    if (kind < 0)
+        return yfail(cv->err, nd, path, "a reference needs a type (%s)", kinds);
+    unsigned missing = lag_ref_kind_table[kind].needs & ~cv->cur_ref_seen;
+    for (size_t b = 0; b < N_REF_KEY_BITS; b++)
+        if (missing & k_ref_key_bits[b].bit)
+            return yfail(cv->err, nd, path, "a %s reference needs %s", lag_ref_kind_table[kind].name,
+                         k_ref_key_bits[b].name);
+    /* the library's own check, last (the relations between keys it knows of) */
+    char key[64], msg[256];
+    if (lag_reference_check(ref, key, sizeof key, msg, sizeof msg) != 0) {
+        char kpath[340];
+        size_t base = strcspn(key, "[");
+        char head[64];
+        snprintf(head, sizeof head, "%.*s", (int)base, key);
+        const yentry *ke = ymap_find(nd, head);
+        join(kpath, sizeof kpath, path, key);
+        return yfail(cv->err, ke ? ke->val : nd, kpath, "%s", msg);
+    }
+    if (!sr->on[j]) sr->n++;
+    sr->on[j] = true;
+    return 0;
+}
+
+static int key_reference(conv *cv, const ynode *nd, const char *path)
+{
+    /* `reference:` with nothing = no reference; a --set replaces what it names */
+    memset(&cv->sc->reference, 0, sizeof cv->sc->reference);
+    if (ynode_is_null(nd))
+        return 0;
+    return per_joint(cv, nd, path, ref_joint);
+}
+
 /* ================================================================ the scene */
 
 static const keyrow k_top_keys[] = {
@@ -1139,6 +1343,7 @@ static const keyrow k_top_keys[] = {
     {"realtime", key_realtime, K_MAP, k_realtime_keys},           /* pacing of the real-time server */
     {"lcm", key_lcm, K_MAP, k_lcm_keys},                     /* transport */
     {"effects", key_effects, K_MAP, k_effects},             /* per-scene effects */
+    {"reference", key_reference, K_JOINTS, k_ref_keys},     /* per joint: what to follow */
     {NULL, NULL, K_OTHER, NULL, NULL},
 };
 

@@ -291,6 +291,40 @@ static bool write_state(l2c *c, chan *h, const lag_log_record *r, const lag_wire
     return true;
 }
 
+/* A reference: t, times, step, then r and r' under the state CSV's names (<joint>,
+ * <joint>_dot), so that a row of the two files with the same t pairs q with r. */
+static bool write_reference(l2c *c, chan *h, const lag_log_record *r,
+                            const lag_wire_reference *m)
+{
+    if (!h->csv) {
+        h->nj = m->num_joints;
+        for (int i = 0; i < m->num_joints; i++) snprintf(h->joint[i], L2C_NAME, "%s", m->name[i]);
+        if (!(h->csv = open_csv(c, h))) return false;
+        fputs("t,wall_time,log_time,step", h->csv);
+        for (int k = 0; k < 2; k++)
+            for (int i = 0; i < m->num_joints; i++) {
+                fputc(',', h->csv);
+                put_text(h->csv, m->name[i], k ? "_dot" : "");
+            }
+        fputc('\n', h->csv);
+    }
+    bool same = m->num_joints == h->nj;
+    for (int i = 0; same && i < h->nj; i++) same = strcmp(m->name[i], h->joint[i]) == 0;
+    if (!same) {
+        h->mismatched++;
+        return true;
+    }
+    FILE *f = h->csv;
+    fprintf(f, "%.17g", m->sim_time);
+    put_us(f, m->utime, false);
+    put_us(f, r->timestamp, false);
+    put_i(f, m->step);
+    for (int i = 0; i < m->num_joints; i++) put_d(f, m->r[i]);
+    for (int i = 0; i < m->num_joints; i++) put_d(f, m->rdot[i]);
+    fputc('\n', f);
+    return true;
+}
+
 /* The status CSV's columns: t (sim time), wall_time (the daemon's utime), log_time, then
  * every other field of status_t in its order, from the codec's table (a field added to
  * the type is a column without anyone listing it); the daemon's own wall_time field is
@@ -522,6 +556,7 @@ static bool record(l2c *c, const lag_log_record *r)
         lag_wire_scene sc;
         lag_wire_joint_command cm;
         lag_wire_control ct;
+        lag_wire_reference rf;
     } m;
     int d = lag_wire_decode((lag_wire_type)t, r->data, r->size, LAG_WIRE_MAX_JOINTS, &m);
     /* an event's over-long detail is kept, cut (the rest of the event decoded) */
@@ -541,6 +576,7 @@ static bool record(l2c *c, const lag_log_record *r)
         break;
     case LAG_WIRE_JOINT_COMMAND: ok = write_command(c, h, r, &m.cm); break;
     case LAG_WIRE_CONTROL: ok = write_control(c, h, r, &m.ct); break;
+    case LAG_WIRE_REFERENCE: ok = write_reference(c, h, r, &m.rf); break;
     default: break;
     }
     if (h->selected) h->rows++;

@@ -54,7 +54,9 @@ void jb_str(jbuf *b, const char *s);
 void jb_num(jbuf *b, double x);
 void jb_key(jbuf *b, const char *key, bool first); /* ,"key": */
 
-void view_json_state(jbuf *b, const lag_wire_joint_state *m);
+/* A state, with "ref": {name, r, rdot} when ref holds its reference (ref may be NULL;
+ * num_joints 0: none). */
+void view_json_state(jbuf *b, const lag_wire_joint_state *m, const lag_wire_reference *ref);
 void view_json_status(jbuf *b, const lag_wire_status *m);
 void view_json_event(jbuf *b, const lag_wire_event *m, int64_t seq);
 void view_json_scene(jbuf *b, const lag_wire_scene *m);
@@ -71,11 +73,13 @@ typedef struct view_bridge {
     char prefix[64];
     char url[256];
     char ch_state[VIEW_CHANNEL_MAX], ch_status[VIEW_CHANNEL_MAX], ch_event[VIEW_CHANNEL_MAX],
-        ch_scene[VIEW_CHANNEL_MAX], ch_control[VIEW_CHANNEL_MAX];
+        ch_scene[VIEW_CHANNEL_MAX], ch_control[VIEW_CHANNEL_MAX], ch_reference[VIEW_CHANNEL_MAX];
 
     /* the latest of each, with a sequence number that grows on every update */
     lag_wire_joint_state state;
     int64_t state_seq;
+    lag_wire_reference reference;   /* the latest <PREFIX>_REFERENCE */
+    lag_wire_reference state_ref;   /* the state's own (same sim_time and step), or none */
     lag_wire_status status;
     int64_t status_seq;
     lag_wire_scene scene;
@@ -87,7 +91,7 @@ typedef struct view_bridge {
     bool discard;                   /* while the socket filter is put in place */
 
     /* counters for /api/state */
-    int64_t n_state, n_status, n_event, n_scene, n_undecodable;
+    int64_t n_state, n_status, n_event, n_scene, n_undecodable, n_reference;
     int64_t controls_sent, controls_refused;
     int64_t ctl_window_ns;
     int ctl_in_window;

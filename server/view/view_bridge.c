@@ -1,5 +1,6 @@
 /*
- * The bridge's LCM side: the daemon's STATE, STATUS, EVENT and SCENE channels decoded by
+ * The bridge's LCM side: the daemon's STATE, STATUS, EVENT, SCENE and REFERENCE channels
+ * (a state's reference goes out with it, in its JSON) decoded by
  * the shared bounded wire module into the latest snapshot, and control requests sent on
  * CONTROL. Nothing is queued: LCM's own queue per subscription is capped, each poll
  * handles a bounded number of messages, a newer state replaces the older one, events go
@@ -45,8 +46,29 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *user)
         return;
     }
     vb->state = m;
+    /* its reference, published just before it: the one with its sim_time and step */
+    if (vb->reference.num_joints > 0 && vb->reference.sim_time == m.sim_time &&
+        vb->reference.step == m.step)
+        vb->state_ref = vb->reference;
+    else
+        vb->state_ref.num_joints = 0;
     vb->state_seq++;
     vb->n_state++;
+    vb->last_msg_ns = view_mono_ns();
+}
+
+static void on_reference(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)ch;
+    view_bridge *vb = user;
+    if (vb->discard) return; /* came in before the socket filter */
+    lag_wire_reference m;
+    if (lag_wire_decode_reference(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) {
+        vb->n_undecodable++;
+        return;
+    }
+    vb->reference = m;
+    vb->n_reference++;
     vb->last_msg_ns = view_mono_ns();
 }
 
@@ -101,16 +123,16 @@ static void on_scene(const lcm_recv_buf_t *rb, const char *ch, void *user)
     vb->last_msg_ns = view_mono_ns();
 }
 
-/* Keeps only this plant's four channels on the state URL's receive socket and, unless
+/* Keeps only this plant's five channels on the state URL's receive socket and, unless
  * allow_lan, only datagrams from this host (lagsim_net.h, the daemon's filter); then reads
  * until a marker sent after the filter comes back, discarding what came before it. */
 static bool filter_input(view_bridge *vb, const lag_bus *bus, bool allow_lan, char *err,
                          size_t errlen)
 {
     const char *chans[] = {vb->ch_state, vb->ch_status, vb->ch_event, vb->ch_scene,
-                           LAG_NET_MARKER_CHANNEL};
+                           vb->ch_reference, LAG_NET_MARKER_CHANNEL};
     char ferr[256];
-    int n = lag_net_filter(bus->state_port, !allow_lan, chans, 5, ferr, sizeof ferr);
+    int n = lag_net_filter(bus->state_port, !allow_lan, chans, 6, ferr, sizeof ferr);
     if (n > 0) {
         vb->discard = true;
         int synced = lag_net_sync(vb->lcm, 3000);
@@ -120,7 +142,7 @@ static bool filter_input(view_bridge *vb, const lag_bus *bus, bool allow_lan, ch
                      "multicast route? docs/network.md)", bus->state_url);
             return false;
         }
-        n = lag_net_filter(bus->state_port, !allow_lan, chans, 4, ferr, sizeof ferr);
+        n = lag_net_filter(bus->state_port, !allow_lan, chans, 5, ferr, sizeof ferr);
     }
     if (n <= 0) {
         snprintf(err, errlen, "%s: cannot restrict the state URL %s to %s", n < 0 ? ferr :
@@ -161,6 +183,7 @@ bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, bool
     snprintf(vb->ch_event, VIEW_CHANNEL_MAX, "%s", bus.channel[LAG_BUS_EVENT]);
     snprintf(vb->ch_scene, VIEW_CHANNEL_MAX, "%s", bus.channel[LAG_BUS_SCENE]);
     snprintf(vb->ch_control, VIEW_CHANNEL_MAX, "%s", bus.channel[LAG_BUS_CONTROL]);
+    snprintf(vb->ch_reference, VIEW_CHANNEL_MAX, "%s", bus.channel[LAG_BUS_REFERENCE]);
     lag_net_note_inherited(); /* a parent's sockets are not filtered */
     vb->lcm = lcm_create(bus.state_url);
     vb->lcm_cmd = !vb->lcm ? NULL : bus.udpm ? lcm_create(bus.command_url) : vb->lcm;
@@ -170,13 +193,14 @@ bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, bool
         view_bridge_close(vb);
         return false;
     }
-    lcm_subscription_t *subs[4] = {
+    lcm_subscription_t *subs[5] = {
         lcm_subscribe(vb->lcm, vb->ch_state, on_state, vb),
         lcm_subscribe(vb->lcm, vb->ch_status, on_status, vb),
         lcm_subscribe(vb->lcm, vb->ch_event, on_event, vb),
         lcm_subscribe(vb->lcm, vb->ch_scene, on_scene, vb),
+        lcm_subscribe(vb->lcm, vb->ch_reference, on_reference, vb),
     };
-    for (int i = 0; i < 4; i++) {
+    for (int i = 0; i < 5; i++) {
         if (!subs[i]) {
             snprintf(err, errlen, "cannot subscribe to the %s channels", prefix);
             view_bridge_close(vb);

@@ -179,7 +179,7 @@ size_t view_frame(const view_bridge *vb, unsigned hz, view_cursor *s, char *buf,
     if (s->state_seq != vb->state_seq) {
         keep = b.len;
         jb_raw(&b, "event: state\ndata: ");
-        view_json_state(&b, &vb->state);
+        view_json_state(&b, &vb->state, &vb->state_ref);
         jb_raw(&b, "\n\n");
         if (b.overflow) part_too_big(cut, &b, keep, "state", &s->state_seq, vb->state_seq);
         else s->state_seq = vb->state_seq;

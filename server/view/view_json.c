@@ -169,7 +169,7 @@ static void jb_str_array(jbuf *b, const char *key, const char (*v)[LAG_WIRE_NAME
 
 static int joints(int n) { return n < 0 ? 0 : n > LAG_WIRE_MAX_JOINTS ? LAG_WIRE_MAX_JOINTS : n; }
 
-void view_json_state(jbuf *b, const lag_wire_joint_state *m)
+void view_json_state(jbuf *b, const lag_wire_joint_state *m, const lag_wire_reference *ref)
 {
     int n = joints(m->num_joints);
     jb_raw(b, "{");
@@ -181,6 +181,17 @@ void view_json_state(jbuf *b, const lag_wire_joint_state *m)
     jb_num_array(b, "q", m->position, n);
     jb_num_array(b, "qd", m->velocity, n);
     jb_num_array(b, "effort", m->effort, n);
+    int nr = ref ? joints(ref->num_joints) : 0;
+    if (nr > 0) { /* the scene's reference at this state's time */
+        jb_key(b, "ref", false);
+        jb_raw(b, "{");
+        jb_key(b, "sim_time", true);
+        jb_num(b, ref->sim_time);
+        jb_str_array(b, "name", ref->name, nr);
+        jb_num_array(b, "r", ref->r, nr);
+        jb_num_array(b, "rdot", ref->rdot, nr);
+        jb_raw(b, "}");
+    }
     jb_raw(b, "}");
 }
 
@@ -304,7 +315,10 @@ static void part(jbuf *b, const char *key, part_fn fn, const void *m, bool prese
     }
 }
 static void scene_part(jbuf *b, const void *m) { view_json_scene(b, m); }
-static void state_part(jbuf *b, const void *m) { view_json_state(b, m); }
+static void state_part(jbuf *b, const void *vb)
+{
+    view_json_state(b, &((const view_bridge *)vb)->state, &((const view_bridge *)vb)->state_ref);
+}
 static void status_part(jbuf *b, const void *m) { view_json_status(b, m); }
 
 size_t view_json_events(jbuf *b, const view_bridge *vb, int64_t first, int64_t last,
@@ -354,7 +368,7 @@ size_t view_json_snapshot(const view_bridge *vb, const view_http *h, char *out, 
     jb_dbl(&b, "last_message_age_s", vb->last_msg_ns ? (double)(now - vb->last_msg_ns) * 1e-9 : NAN);
     jb_raw(&b, "}");
     part(&b, "scene", scene_part, &vb->scene, vb->scene_seq != 0, &cut);
-    part(&b, "state", state_part, &vb->state, vb->state_seq != 0, &cut);
+    part(&b, "state", state_part, vb, vb->state_seq != 0, &cut);
     part(&b, "status", status_part, &vb->status, vb->status_seq != 0, &cut);
     /* the newest events that fit: from the newest back, what the rest of the buffer holds */
     int64_t first = vb->event_seq - VIEW_EVENTS_IN_STATE + 1;

@@ -11,6 +11,7 @@ static const char *const suffix[LAG_BUS_CHANNEL_COUNT] = {
     [LAG_BUS_STATE] = "_STATE",     [LAG_BUS_STATUS] = "_STATUS",
     [LAG_BUS_EVENT] = "_EVENT",     [LAG_BUS_SCENE] = "_SCENE",
     [LAG_BUS_COMMAND] = "_COMMAND", [LAG_BUS_CONTROL] = "_CONTROL",
+    [LAG_BUS_REFERENCE] = "_REFERENCE",
 };
 _Static_assert(sizeof suffix / sizeof suffix[0] == LAG_BUS_CHANNEL_COUNT, "one suffix per channel");
 
@@ -48,15 +49,15 @@ static int fail(char *err, size_t errlen, const char *fmt, const char *url)
     return -1;
 }
 
-_Static_assert(LAG_BUS_PREFIX_MAX == 55, "the message below says 55");
+_Static_assert(LAG_BUS_PREFIX_MAX == 53, "the message below says 53");
 
 int lag_bus_init(lag_bus *b, const char *url, const char *prefix, char *err, size_t errlen)
 {
     memset(b, 0, sizeof *b);
     if (err && errlen) err[0] = '\0';
     if (!prefix || prefix[0] == '\0' || strlen(prefix) > LAG_BUS_PREFIX_MAX)
-        return fail(err, errlen, "a channel prefix has 1 to 55 characters (LCM channel names "
-                    "have at most 63 bytes, and _COMMAND 8)%s", "");
+        return fail(err, errlen, "a channel prefix has 1 to 53 characters (LCM channel names "
+                    "have at most 63 bytes, and _REFERENCE 10)%s", "");
     for (int k = 0; k < LAG_BUS_CHANNEL_COUNT; k++)
         snprintf(b->channel[k], LAG_BUS_CHANNEL_LEN, "%s%s", prefix, suffix[k]);
 

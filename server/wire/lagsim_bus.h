@@ -30,13 +30,13 @@ extern "C" {
 #endif
 
 #define LAG_BUS_URL_LEN 320       /* a derived URL: the scene's (< 256) and a longer port */
-#define LAG_BUS_CHANNEL_LEN 72    /* prefix (< 64) + "_COMMAND" */
-#define LAG_BUS_PREFIX_MAX 55     /* a channel name has at most 63 bytes; _COMMAND has 8 */
+#define LAG_BUS_CHANNEL_LEN 76    /* prefix (< 64) + "_REFERENCE" */
+#define LAG_BUS_PREFIX_MAX 53     /* a channel name has at most 63 bytes; _REFERENCE has 10 */
 #define LAG_BUS_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0" /* LCM's own default */
 #define LAG_BUS_DEFAULT_GROUP "239.255.76.67"
 #define LAG_BUS_DEFAULT_PORT 7667
 
-/* The channels of one plant; the first four are the daemon's output. */
+/* The channels of one plant; all but COMMAND and CONTROL are the daemon's output. */
 typedef enum lag_bus_channel {
     LAG_BUS_STATE = 0,
     LAG_BUS_STATUS,
@@ -44,6 +44,7 @@ typedef enum lag_bus_channel {
     LAG_BUS_SCENE,
     LAG_BUS_COMMAND,  /* input: on the command URL */
     LAG_BUS_CONTROL,  /* input: on the command URL */
+    LAG_BUS_REFERENCE,/* output, on the state URL: only when the scene has a reference */
     LAG_BUS_CHANNEL_COUNT
 } lag_bus_channel;
 

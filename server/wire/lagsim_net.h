@@ -25,7 +25,7 @@
 #include <stddef.h>
 #include <lcm/lcm.h>
 
-#define LAG_NET_MAX_FILTER_CHANNELS 5 /* the view: its four and the marker */
+#define LAG_NET_MAX_FILTER_CHANNELS 6 /* the view: its five and the marker */
 #define LAG_NET_MARKER_CHANNEL "LCM_SELF_TEST" /* the channel LCM's own self-test uses */
 
 /* Attaches the filter to every UDP socket of this process bound to `port`, but those

@@ -15,6 +15,7 @@
 #include "lagsim/lagsim_event_t.h"
 #include "lagsim/lagsim_joint_command_t.h"
 #include "lagsim/lagsim_joint_state_t.h"
+#include "lagsim/lagsim_reference_t.h"
 #include "lagsim/lagsim_scene_t.h"
 #include "lagsim/lagsim_status_t.h"
 
@@ -42,6 +43,17 @@ static const lag_wire_field joint_state_fields[] = {
     ARRAY(JS, LAG_WIRE_DOUBLE, position, 3),
     ARRAY(JS, LAG_WIRE_DOUBLE, velocity, 3),
     ARRAY(JS, LAG_WIRE_DOUBLE, effort, 3),
+};
+
+typedef lag_wire_reference RF;
+static const lag_wire_field reference_fields[] = {
+    SCALAR(RF, LAG_WIRE_INT64, utime),
+    SCALAR(RF, LAG_WIRE_DOUBLE, sim_time),
+    SCALAR(RF, LAG_WIRE_INT64, step),
+    COUNT(RF, num_joints, LAG_WIRE_MAX_JOINTS, true),           /* 3 */
+    ARRAY(RF, LAG_WIRE_STRING, name, 3),
+    ARRAY(RF, LAG_WIRE_DOUBLE, r, 3),
+    ARRAY(RF, LAG_WIRE_DOUBLE, rdot, 3),
 };
 
 typedef lag_wire_joint_command JC;
@@ -167,6 +179,8 @@ static const type_info types[LAG_WIRE_TYPE_COUNT] = {
     [LAG_WIRE_EVENT] = TYPE("event_t", event_fields, EV, __lagsim_event_t_get_hash),
     [LAG_WIRE_STATUS] = TYPE("status_t", status_fields, ST, __lagsim_status_t_get_hash),
     [LAG_WIRE_SCENE] = TYPE("scene_t", scene_fields, SC, __lagsim_scene_t_get_hash),
+    [LAG_WIRE_REFERENCE] = TYPE("reference_t", reference_fields, RF,
+                                __lagsim_reference_t_get_hash),
 };
 _Static_assert(sizeof types / sizeof types[0] == LAG_WIRE_TYPE_COUNT,
                "one table per message type");
@@ -413,6 +427,11 @@ int lag_wire_decode_scene(const void *data, size_t len, int max_joints, lag_wire
 {
     return lag_wire_decode(LAG_WIRE_SCENE, data, len, max_joints, out);
 }
+int lag_wire_decode_reference(const void *data, size_t len, int max_joints,
+                              lag_wire_reference *out)
+{
+    return lag_wire_decode(LAG_WIRE_REFERENCE, data, len, max_joints, out);
+}
 
 int lag_wire_encode_joint_state(const lag_wire_joint_state *m, void *buf, size_t cap)
 {
@@ -437,6 +456,10 @@ int lag_wire_encode_status(const lag_wire_status *m, void *buf, size_t cap)
 int lag_wire_encode_scene(const lag_wire_scene *m, void *buf, size_t cap)
 {
     return lag_wire_encode(LAG_WIRE_SCENE, m, buf, cap);
+}
+int lag_wire_encode_reference(const lag_wire_reference *m, void *buf, size_t cap)
+{
+    return lag_wire_encode(LAG_WIRE_REFERENCE, m, buf, cap);
 }
 
 /* ---------------------------------------------------------------- introspection */

@@ -1,6 +1,7 @@
 /*
  * lagsim's wire format: bounded encoding and decoding of every lagsim LCM message
- * (joint_state_t, joint_command_t, control_t, event_t, status_t, scene_t), shared by the
+ * (joint_state_t, joint_command_t, control_t, event_t, status_t, scene_t, reference_t),
+ * shared by the
  * daemon, the C client library, --replay and the log tools.
  *
  * Why not lcm-gen's C decoders: they trust the payload. A string or array length read
@@ -58,6 +59,7 @@ typedef enum lag_wire_type {
     LAG_WIRE_EVENT,
     LAG_WIRE_STATUS,
     LAG_WIRE_SCENE,
+    LAG_WIRE_REFERENCE,
     LAG_WIRE_TYPE_COUNT
 } lag_wire_type;
 
@@ -190,6 +192,17 @@ typedef struct lag_wire_scene {
     double limit_upper[LAG_WIRE_MAX_JOINTS];
 } lag_wire_scene;
 
+/* <PREFIX>_REFERENCE: what the joints with a reference should follow, at a state's time. */
+typedef struct lag_wire_reference {
+    int64_t utime;
+    double sim_time;                                 /* the state's sim_time */
+    int64_t step;                                    /* the state's step */
+    int16_t num_joints;                              /* joints with a reference */
+    char name[LAG_WIRE_MAX_JOINTS][LAG_WIRE_NAME_LEN];
+    double r[LAG_WIRE_MAX_JOINTS];                   /* m or rad */
+    double rdot[LAG_WIRE_MAX_JOINTS];                /* m/s or rad/s */
+} lag_wire_reference;
+
 /* ---------------------------------------------------------------- per type */
 /* Decoders. max_joints bounds num_joints (clamped to [0, LAG_WIRE_MAX_JOINTS]). OUT: out */
 int lag_wire_decode_joint_state(const void *data, size_t len, int max_joints,
@@ -201,6 +214,8 @@ int lag_wire_decode_control(const void *data, size_t len, int max_joints,
 int lag_wire_decode_event(const void *data, size_t len, lag_wire_event *out);
 int lag_wire_decode_status(const void *data, size_t len, lag_wire_status *out);
 int lag_wire_decode_scene(const void *data, size_t len, int max_joints, lag_wire_scene *out);
+int lag_wire_decode_reference(const void *data, size_t len, int max_joints,
+                              lag_wire_reference *out);
 
 /* Encoders: return the number of bytes written to buf (> 0) or a negative result. */
 int lag_wire_encode_joint_state(const lag_wire_joint_state *m, void *buf, size_t cap);
@@ -209,6 +224,7 @@ int lag_wire_encode_control(const lag_wire_control *m, void *buf, size_t cap);
 int lag_wire_encode_event(const lag_wire_event *m, void *buf, size_t cap);
 int lag_wire_encode_status(const lag_wire_status *m, void *buf, size_t cap);
 int lag_wire_encode_scene(const lag_wire_scene *m, void *buf, size_t cap);
+int lag_wire_encode_reference(const lag_wire_reference *m, void *buf, size_t cap);
 
 /* ---------------------------------------------------------------- any type */
 /* The same, for a type chosen at run time; out / m point to that type's struct. */

@@ -196,7 +196,7 @@ def main():
         check(r.returncode == 1 and "expected a number > 0" in r.stderr,
               "set parameters.m0=-1: exit 1, the loader's reason on stderr")
         r = ctl("set", "integrator.dt=0.002")
-        check(r.returncode == 1 and "only keys under parameters and effects" in r.stderr,
+        check(r.returncode == 1 and "only keys under parameters, effects and reference" in r.stderr,
               "set integrator.dt: exit 1, only parameters and effects change")
 
         for bad in (["step", "0"], ["step", "abc"], ["reset-to", "1", "2", "3"], ["spin"],

@@ -1,8 +1,10 @@
 /*
  * Fuzz target: the C client library's handling of whatever arrives on a controller's
- * channels (the decoders of states, status, events and scenes behind the LCM handlers).
+ * channels (the decoders of states, status, events, scenes and references behind the LCM
+ * handlers).
  *
- * The first byte chooses the channel (<prefix>_STATE, _STATUS, _EVENT, _SCENE); the rest
+ * The first byte chooses the channel (<prefix>_STATE, _STATUS, _EVENT, _SCENE, _REFERENCE,
+ * modulo 5); the rest
  * is the payload, fed to one client handle through lag_client_feed, the path of the bus.
  * Nothing may crash or leak; a message is kept or dropped (counted), never both; what
  * the handle returns afterwards is whole: counts within the structs, strings terminated,
@@ -44,14 +46,16 @@ static void check_terminated(const char *s, size_t cap)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (size < 1) return 0;
-    static const char *const channels[] = {"FZ_STATE", "FZ_STATUS", "FZ_EVENT", "FZ_SCENE"};
+    static const char *const channels[] = {"FZ_STATE", "FZ_STATUS", "FZ_EVENT", "FZ_SCENE",
+                                           "FZ_REFERENCE"};
     lag_client_counters before, after;
     lag_client_get_counters(g_client, &before);
-    if (lag_client_feed(g_client, channels[data[0] % 4], data + 1, size - 1) != LAG_CLIENT_OK)
+    if (lag_client_feed(g_client, channels[data[0] % 5], data + 1, size - 1) != LAG_CLIENT_OK)
         fail("feed refused one of the handle's channels");
     lag_client_get_counters(g_client, &after);
     int64_t kept = (after.states - before.states) + (after.statuses - before.statuses) +
-                   (after.events - before.events) + (after.scenes - before.scenes);
+                   (after.events - before.events) + (after.scenes - before.scenes) +
+                   (after.references - before.references);
     if (kept + (after.dropped - before.dropped) != 1) fail("a message neither kept nor dropped");
 
     lag_client_state st;
@@ -63,6 +67,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 fail("non-finite state");
         }
         if (!isfinite(st.sim_time)) fail("non-finite sim_time");
+    }
+    lag_client_reference rf;
+    if (lag_client_latest_reference(g_client, &rf)) {
+        if (rf.num_joints < 0 || rf.num_joints > LAG_CLIENT_MAX_JOINTS) fail("reference joints");
+        for (int i = 0; i < rf.num_joints; i++) {
+            check_terminated(rf.name[i], sizeof rf.name[i]);
+            if (!isfinite(rf.r[i]) || !isfinite(rf.rdot[i])) fail("non-finite reference");
+        }
+        if (!isfinite(rf.sim_time)) fail("non-finite reference sim_time");
     }
     lag_client_status ss;
     if (lag_client_latest_status(g_client, &ss)) {

@@ -69,6 +69,22 @@ static void check_scene(const lag_scene *sc)
         check_in("disturbance t", e->disturbances[k].t, 0, LAG_SCENE_MAX_TIME);
         check_in("disturbance value", e->disturbances[k].value, -1e12, 1e12);
     }
+    /* the reference: as the library checks it, finite everywhere, its joints counted */
+    int nref = 0;
+    for (int i = 0; i < d->model.nq; i++) {
+        if (!sc->reference.on[i]) continue;
+        nref++;
+        const lag_reference *rf = &sc->reference.joint[i];
+        char key[64], msg[128];
+        if (lag_reference_check(rf, key, sizeof key, msg, sizeof msg) != 0)
+            die("accepted reference fails the library's check", key);
+        check_in("reference amplitude", rf->amplitude, -d->explode_limit, d->explode_limit);
+        check_in("reference offset", rf->offset, -d->explode_limit, d->explode_limit);
+        double r, rdot;
+        lag_reference_eval(rf, rf->start + 0.5, &r, &rdot);
+        if (!isfinite(r) || !isfinite(rdot)) die("accepted reference not finite", NULL);
+    }
+    if (nref != sc->reference.n) die("reference joints miscounted", NULL);
     int ttl = -1;
     char err[256];
     if (lag_scene_check_url(sc->lcm.url, sc->lcm.allow_lan, &ttl, err, sizeof err) != 0 ||

@@ -2,7 +2,7 @@
  * Fuzz target: lagsim-view's formatting of text off the bus and its HTTP side.
  *
  * The first byte chooses what the rest is:
- *   0  the bytes of a scene, a state, a status and 1 to 300 events (every string any
+ *   0  the bytes of a scene, a state and its reference, a status and 1 to 300 events (every string any
  *      bytes but NUL, up to its field's length; numbers any 64 bits): /api/state must
  *      be valid JSON that fits its buffer with every part and the newest 32 events; the
  *      stream frames a new browser is sent, one after the other, must each be valid
@@ -236,6 +236,14 @@ static void fill(src *s)
     }
     st->sim_time = num(s);
     vb.state_seq = byte(s) & 1;
+    lag_wire_reference *rf = &vb.state_ref; /* the state's reference, sent with it */
+    rf->num_joints = byte(s) % (LAG_WIRE_MAX_JOINTS + 1);
+    for (int i = 0; i < LAG_WIRE_MAX_JOINTS; i++) {
+        text(s, rf->name[i], sizeof rf->name[i]);
+        rf->r[i] = num(s);
+        rf->rdot[i] = num(s);
+    }
+    rf->sim_time = num(s);
     lag_wire_status *su = &vb.status;
     text(s, su->integrator, sizeof su->integrator);
     text(s, su->mode, sizeof su->mode);

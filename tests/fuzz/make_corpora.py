@@ -25,7 +25,7 @@ n_written = [0]
 here = os.path.dirname(os.path.abspath(__file__))
 root = os.path.dirname(os.path.dirname(here))
 sys.path.insert(0, os.path.join(build, "python"))
-from lagsim import control_t, event_t, joint_command_t, joint_state_t, scene_t, status_t  # noqa
+from lagsim import control_t, event_t, joint_command_t, joint_state_t, reference_t, scene_t, status_t  # noqa
 
 SYNC = 0xEDA1DA01
 
@@ -121,6 +121,15 @@ def scene(nparams=7, njoints=3):
     return m.encode()
 
 
+def reference(n=2, names=("theta0", "theta1"), t=0.01, step=10):
+    m = reference_t()
+    m.sim_time, m.step, m.num_joints = t, step, n
+    m.name = list(names[:n])
+    m.r = [0.2 * (i + 1) for i in range(n)]
+    m.rdot = [-0.5 * i for i in range(n)]
+    return m.encode()
+
+
 def forged_state(name_len, name_bytes, n=3, rest=True, pad_to=None):
     """A joint_state_t whose first name is written as name_len then name_bytes."""
     b = joint_state_t._get_packed_fingerprint() + struct.pack(">qdqh", 0, 0.0, 0, n)
@@ -144,14 +153,16 @@ B8 = b"\x09"
 for name, data in [("joint-state.bin", state()), ("joint-command.bin", command()),
                    ("control-reset-to.bin", control()), ("control-step.bin", control(control_t.STEP)),
                    ("event.bin", event()), ("status.bin", status()), ("scene.bin", scene()),
-                   ("scene-full.bin", scene(16, 8)), ("joint-state-no-joints.bin", state(0))]:
+                   ("scene-full.bin", scene(16, 8)), ("joint-state-no-joints.bin", state(0)),
+                   ("reference.bin", reference()), ("reference-no-joints.bin", reference(0))]:
     write("wire", "corpus", name, B8 + data)
 write("wire", "corpus", "joint-state-bound-2.bin", b"\x03" + state())
 write("wire", "corpus", "joint-state-negative-count.bin", B8 + state()[:34 - 2] + b"\xff\xff")
 
-# ---- client: first byte = channel (0 STATE, 1 STATUS, 2 EVENT, 3 SCENE)
+# ---- client: first byte = channel (0 STATE, 1 STATUS, 2 EVENT, 3 SCENE, 4 REFERENCE)
 for name, data in [("state.bin", b"\x00" + state()), ("status.bin", b"\x01" + status()),
-                   ("event.bin", b"\x02" + event()), ("scene.bin", b"\x03" + scene())]:
+                   ("event.bin", b"\x02" + event()), ("scene.bin", b"\x03" + scene()),
+                   ("reference.bin", b"\x04" + reference())]:
     write("client", "corpus", name, data)
 # what crashed, overread or leaked in the client's lcm-gen decoders
 write("client", "crash", "state-negative-name-length.bin",

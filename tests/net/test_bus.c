@@ -87,21 +87,26 @@ int main(int argc, char **argv)
     /* channels: the prefix and the suffix; inputs are the two the daemon receives */
     CHECK(lag_bus_init(&b, NULL, "RUN_7", err, sizeof err) == 0, "%s", err);
     const char *want[LAG_BUS_CHANNEL_COUNT] = {"RUN_7_STATE", "RUN_7_STATUS", "RUN_7_EVENT",
-                                               "RUN_7_SCENE", "RUN_7_COMMAND", "RUN_7_CONTROL"};
+                                               "RUN_7_SCENE", "RUN_7_COMMAND", "RUN_7_CONTROL",
+                                               "RUN_7_REFERENCE"};
     for (int k = 0; k < LAG_BUS_CHANNEL_COUNT; k++) {
         CHECK(strcmp(b.channel[k], want[k]) == 0, "channel %d: %s", k, b.channel[k]);
-        CHECK(lag_bus_is_input((lag_bus_channel)k) == (k >= LAG_BUS_COMMAND), "input %d", k);
+        CHECK(lag_bus_is_input((lag_bus_channel)k) == (k == LAG_BUS_COMMAND || k == LAG_BUS_CONTROL), "input %d", k);
     }
     /* the longest prefix whose longest channel LCM takes (63 bytes), and one more */
-    char p55[56];
-    memset(p55, 'P', 55);
-    p55[55] = '\0';
-    CHECK(lag_bus_init(&b, NULL, p55, err, sizeof err) == 0 &&
-              strlen(b.channel[LAG_BUS_COMMAND]) == 63, "55-character prefix");
-    char p56[57];
-    memset(p56, 'P', 56);
-    p56[56] = '\0';
-    CHECK(lag_bus_init(&b, NULL, p56, err, sizeof err) == -1, "56-character prefix accepted");
+    char p53[54];
+    memset(p53, 'P', 53);
+    p53[53] = '\0';
+    CHECK(lag_bus_init(&b, NULL, p53, err, sizeof err) == 0 &&
+              strlen(b.channel[LAG_BUS_REFERENCE]) == 63, "53-character prefix");
+    size_t longest = 0;
+    for (int k = 0; k < LAG_BUS_CHANNEL_COUNT; k++)
+        if (strlen(b.channel[k]) > longest) longest = strlen(b.channel[k]);
+    CHECK(longest == 63, "the longest channel of a 53-character prefix: %zu bytes", longest);
+    char p54[55];
+    memset(p54, 'P', 54);
+    p54[54] = '\0';
+    CHECK(lag_bus_init(&b, NULL, p54, err, sizeof err) == -1, "54-character prefix accepted");
     CHECK(lag_bus_init(&b, NULL, "", err, sizeof err) == -1, "empty prefix accepted");
 
     printf("test_bus: %d cases, %d checks, %d failures\n", cases, checks, failures);

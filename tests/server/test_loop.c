@@ -634,7 +634,7 @@ static void case_set(void)
         set_request(keys[i], "1");
         run_until(g_srv.now + 10 * MS, 1000);
         ENSUREF(n_events("control_rejected") == rejected + 1 &&
-                    strstr(last_detail("control_rejected"), "only keys under parameters and effects"),
+                    strstr(last_detail("control_rejected"), "only keys under parameters, effects and reference"),
                 "%s: '%s'", keys[i], last_detail("control_rejected"));
     }
     /* a stop around the initial q2 = 0.5 that leaves out where q2 is now */

@@ -269,8 +269,8 @@ def case_injection(a, t, tmp):
     script = open(gp).read() if os.path.exists(gp) else ""
     for i, n in enumerate(j):
         title = as_text(n).replace("\\", "\\\\").replace('"', '\\"')
-        check(re.search(r'using 1:%d (axes x1y1 )?with lines lw 1.5 title "%s"' % (5 + i, re.escape(title)), script) and
-              re.search(r'using 1:%d (axes x1y1 )?with lines lw 1.5 title "%s_dot"' % (13 + i, re.escape(title)), script),
+        check(re.search(r'using 1:%d (axes x1y1 )?with lines (lt \d+ )?lw 1.5 title "%s"' % (5 + i, re.escape(title)), script) and
+              re.search(r'using 1:%d (axes x1y1 )?with lines (lt \d+ )?lw 1.5 title "%s_dot"' % (13 + i, re.escape(title)), script),
               f"lagsim-plot: joint {i} ({n!r}) drawn from columns {5 + i} and {13 + i}")
 
 

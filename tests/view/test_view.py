@@ -409,16 +409,73 @@ def case_cartpole(a):
         rig.close()
 
 
+def case_reference(a):
+    """The scene's reference reaches the page with each state and is drawn dashed over q
+    and qd: /api/state's state carries "ref" with the state's sim_time and r, r' equal to
+    the sine's closed form (written here); the page draws one dashed series over q and one
+    over qd (theta1 only has a reference), and its pixels under the dashed curve are of
+    theta1's colour. Without a reference: no "ref", nothing dashed."""
+    amp, f, off = 0.2, 0.5, 0.05
+    rig = Rig(a, "VIEWR", sets=("initial.q=[0,0.3,-0.2]", "initial.qd=[0,0,0]",
+                                "reference={theta1: {type: sine, amplitude: %g, frequency: %g, "
+                                "offset: %g}}" % (amp, f, off)))
+    chrome = None
+    try:
+        s = rig.wait_api(lambda s: s["state"] and s["state"].get("ref"), what="a state with its reference")
+        st = s["state"] if s else None
+        if check(st is not None and st.get("ref") is not None, "/api/state: the state carries its reference"):
+            ref, t = st["ref"], st["sim_time"]
+            w = 2 * math.pi * f
+            want = (off + amp * math.sin(w * t), amp * w * math.cos(w * t))
+            check(ref["sim_time"] == t and ref["name"] == ["theta1"] and
+                  abs(ref["r"][0] - want[0]) <= 1e-12 and abs(ref["rdot"][0] - want[1]) <= 1e-12,
+                  "the reference at the state's sim time %.3f s: r %r, rdot %r (closed form %r)"
+                  % (t, ref["r"], ref["rdot"], want))
+        chrome = cdp.Chrome()
+        _, sid = chrome.open(rig.base + "/")
+        chrome.wait_for(sid, "window.lagsimView.drawn && window.lagsimView.drawn.ref && "
+                        "window.lagsimView.charts.qref.length > 20", 15, "a drawn reference")
+        d = drawn(chrome, sid)
+        check(d["ref_dashed"] == [1, 1], "one dashed series over q and one over qd: %r" % d["ref_dashed"])
+        check(d["ref"]["sim_time"] == d["sim_time"] and d["ref"]["name"] == ["theta1"],
+              "the drawn state's reference is at its sim time (%r)" % d["ref"]["sim_time"])
+        # the dashed curve is in theta1's colour (the second joint: COLORS[1]): the q chart's
+        # pixels of that colour outnumber those drawn without the reference
+        count = ("(() => { const c = document.getElementById('chart_q'); const g = c.getContext('2d');"
+                 " const d = g.getImageData(0, 0, c.width, c.height).data; let n = 0;"
+                 " for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - 0xd6) < 40 &&"
+                 " Math.abs(d[i + 1] - 0x27) < 40 && Math.abs(d[i + 2] - 0x28) < 40) n++; return n; })()")
+        if a.screenshot:
+            chrome.screenshot(sid, a.screenshot)
+        with_ref = chrome.eval(sid, count)
+        # the same chart without the reference: the stream goes on, so its samples are
+        # dropped again at each look, and the pixels counted on a frame drawn without them
+        without = chrome.eval(sid, "window.lagsimView.charts.qref.length = 0; drawCharts(); " + count)
+        check(with_ref > without + 50, "theta1's colour under the dashed curve: %d pixels with the "
+              "reference, %d without" % (with_ref, without))
+    finally:
+        if chrome:
+            chrome.quit()
+        rig.close()
+    rig = Rig(a, "VIEWN")
+    try:
+        s = rig.wait_api(lambda s: s["state"], what="a state")
+        check(s is not None and s["state"] and "ref" not in s["state"],
+              "a scene without a reference: no \"ref\" in the state")
+    finally:
+        rig.close()
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lagsimd", required=True)
     ap.add_argument("--view", required=True)
     ap.add_argument("--config", required=True)
     ap.add_argument("--screenshot")
-    ap.add_argument("case", choices=["browser", "hostile", "stick_flight", "cartpole"])
+    ap.add_argument("case", choices=["browser", "hostile", "stick_flight", "cartpole", "reference"])
     a = ap.parse_args()
     {"browser": case_browser, "hostile": case_hostile, "stick_flight": case_stick_flight,
-     "cartpole": case_cartpole}[a.case](a)
+     "cartpole": case_cartpole, "reference": case_reference}[a.case](a)
     print("%s: %d failure(s)" % ("FAILED" if failures else "passed", failures))
     return 1 if failures else 0
 

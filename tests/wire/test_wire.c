@@ -29,6 +29,7 @@
 #include "lagsim/lagsim_event_t.h"
 #include "lagsim/lagsim_joint_command_t.h"
 #include "lagsim/lagsim_joint_state_t.h"
+#include "lagsim/lagsim_reference_t.h"
 #include "lagsim/lagsim_scene_t.h"
 #include "lagsim/lagsim_status_t.h"
 #include "lagsim_wire.h"
@@ -169,6 +170,29 @@ static void check_agreement(void)
         w.num_joints = 0;
         nt = lagsim_joint_state_t_encode(theirs, 0, sizeof theirs, &g);
         agree(LAG_WIRE_JOINT_STATE, &w, nt);
+    }
+    {
+        /* a reference of two of three joints, and of none */
+        char *names[2] = {"theta0", "theta2"};
+        double r[2] = {0.2, -1e-300}, rd[2] = {-0.0, 6.283185307179586};
+        lagsim_reference_t g = {12, 1.5, 1500, 2, names, r, rd};
+        int nt = lagsim_reference_t_encode(theirs, 0, sizeof theirs, &g);
+        lag_wire_reference w;
+        memset(&w, 0, sizeof w);
+        w.utime = 12;
+        w.sim_time = 1.5;
+        w.step = 1500;
+        w.num_joints = 2;
+        for (int i = 0; i < 2; i++) {
+            strcpy(w.name[i], names[i]);
+            w.r[i] = r[i];
+            w.rdot[i] = rd[i];
+        }
+        agree(LAG_WIRE_REFERENCE, &w, nt);
+        g.num_joints = 0;
+        w.num_joints = 0;
+        nt = lagsim_reference_t_encode(theirs, 0, sizeof theirs, &g);
+        agree(LAG_WIRE_REFERENCE, &w, nt);
     }
     {
         char *names[2] = {"q1", ""};

@@ -1,7 +1,9 @@
 // lagsim view: draws the model from the scene description and animates it from the
 // newest state at the display's frame rate (a state that arrives between two frames
 // replaces the previous one: nothing queues). Strip charts of q, qd, effort (from the
-// states) and energy (from the status), the status, the events, control buttons.
+// states) and energy (from the status), the status, the events, control buttons. A state
+// that carries the scene's reference ("ref": r and r' of the joints that have one) has it
+// drawn dashed over q and qd, in the joint's colour.
 // Served by lagsim-view; uses no library.
 "use strict";
 
@@ -12,7 +14,8 @@ const EVENTS_MAX = 300;          // lines kept in the event list
 const view = {
   scene: null, state: null, status: null, connected: false,
   dirty: true, frames: 0, statesReceived: 0, camX: null,
-  charts: { q: [], qd: [], effort: [], energy: [] },   // [t, values[]] per sample
+  charts: { q: [], qd: [], effort: [], energy: [],     // [t, values[]] per sample
+            qref: [], qdref: [] },                     // the reference, in q's joint order
   drawn: null,                                         // what the last frame drew
 };
 window.lagsimView = view;   // read by tests (DevTools) and handy in the console
@@ -51,6 +54,11 @@ function onState(s) {
     push(view.charts.q, s.sim_time, s.q);
     push(view.charts.qd, s.sim_time, s.qd);
     push(view.charts.effort, s.sim_time, s.effort);
+    if (s.ref) {   // r and r' in the state's joint order (null: no reference for it)
+      const at = s.name.map((n) => s.ref.name.indexOf(n));
+      push(view.charts.qref, s.sim_time, at.map((i) => (i >= 0 ? s.ref.r[i] : null)));
+      push(view.charts.qdref, s.sim_time, at.map((i) => (i >= 0 ? s.ref.rdot[i] : null)));
+    }
   }
   view.dirty = true;
 }
@@ -329,20 +337,26 @@ function drawModel() {
 }
 
 // ---------------------------------------------------------------- charts
-function drawChart(canvas, samples, names) {
+// The samples drawn as lines, and those of ref (the reference, may be empty) dashed over
+// them in the same colours. Returns the number of dashed series drawn.
+function drawChart(canvas, samples, names, ref) {
   const { g, w, h } = fit(canvas);
   g.clearRect(0, 0, w, h);
   const win = Number($("window").value) || 10;
   const tEnd = samples.length ? samples[samples.length - 1][0] : 0;
   const t0 = samples.length ? Math.max(tEnd - win, samples[0][0]) : 0, span = Math.max(tEnd - t0, 1e-9);
-  let lo = Infinity, hi = -Infinity, first = samples.length;
+  let lo = Infinity, hi = -Infinity, first = samples.length, rfirst = ref ? ref.length : 0;
   for (let i = samples.length - 1; i >= 0 && samples[i][0] >= t0; i--) {
     first = i;
     for (const v of samples[i][1]) if (v !== null) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
   }
+  for (let i = rfirst - 1; i >= 0 && ref[i][0] >= t0; i--) {
+    rfirst = i;
+    for (const v of ref[i][1]) if (v !== null) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+  }
   g.fillStyle = "#555"; g.font = "11px DejaVu Sans, sans-serif";
   g.fillText(canvas.dataset.title, 6, 12);
-  if (!(hi >= lo)) return;
+  if (!(hi >= lo)) return 0;
   if (hi - lo < 1e-12 * Math.max(1, Math.abs(hi))) { const d = Math.max(0.5, 1e-6 * Math.abs(hi)); hi += d; lo -= d; }
   const pad = 0.08 * (hi - lo); lo -= pad; hi += pad;
   // enough digits to tell the bounds apart (energy drifts in its 7th digit)
@@ -368,12 +382,29 @@ function drawChart(canvas, samples, names) {
     g.fillStyle = COLORS[k % COLORS.length];
     g.fillText(names[k] || "", w - R + 6, T + 10 + 13 * k);
   }
+  let dashed = 0;
+  const nr = ref && ref.length ? ref[ref.length - 1][1].length : 0;
+  g.setLineDash([6, 4]);
+  for (let k = 0; k < nr; k++) {
+    g.strokeStyle = COLORS[k % COLORS.length]; g.lineWidth = 1.5; g.beginPath();
+    let pen = false, any = false;
+    for (let i = rfirst; i < ref.length; i++) {
+      const v = ref[i][1][k];
+      if (v === null || v === undefined) { pen = false; continue; }
+      if (pen) g.lineTo(X(ref[i][0]), Y(v)); else g.moveTo(X(ref[i][0]), Y(v));
+      pen = any = true;
+    }
+    g.stroke();
+    if (any) dashed++;
+  }
+  g.setLineDash([]);
+  return dashed;
 }
 
 function drawCharts() {
   const names = view.state ? view.state.name : [];
-  drawChart($("chart_q"), view.charts.q, names);
-  drawChart($("chart_qd"), view.charts.qd, names.map((n) => n + "_dot"));
+  view.refDashed = [drawChart($("chart_q"), view.charts.q, names, view.charts.qref),
+                    drawChart($("chart_qd"), view.charts.qd, names.map((n) => n + "_dot"), view.charts.qdref)];
   drawChart($("chart_effort"), view.charts.effort, names);
   drawChart($("chart_energy"), view.charts.energy, ["E"]);
 }
@@ -435,6 +466,8 @@ function frame() {
       stops: r && r.stops ? r.stops : null,      // [joint, value] of each stop drawn
       note: r && r.note ? r.note : null,         // said instead of a drawing
       run_state: view.status ? view.status.run_state : null,
+      ref: st && st.ref ? st.ref : null,         // the state's reference, as it came
+      ref_dashed: view.refDashed,                // dashed series drawn over q and over qd
     };
     document.body.dataset.drawnSimTime = st && st.sim_time !== null ? String(st.sim_time) : "";
   }

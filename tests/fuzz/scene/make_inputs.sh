@@ -24,6 +24,7 @@ with_sets set-stick-floor.bin "$root/config/stick.yaml" initial.qd=[0,-3] effect
 with_sets set-url.bin "$root/config/dipc.yaml" lcm.allow_lan=true "lcm.url=udpm://239.255.76.67:7667?ttl=1&recv_buf_size=65536"
 with_sets set-model-change.bin "$root/config/dipc.yaml" model=stick "parameters={m: 2}" initial.q=[0,1]
 with_sets set-empty-file.bin /dev/null model=dipc
+with_sets set-reference.bin "$root/config/dipc.yaml" "reference={theta0: {type: chirp, start: 0.5, amplitude: 0.1, frequency: 0.2, frequency_end: 3, duration: 4}, theta1: {type: square, frequency: 2, amplitude: 0.05}, theta2: {type: waypoints, points: [[0, 0], [1, 0.1], [2.5, -0.1]]}}" reference.theta0.amplitude=0.2 "reference.theta1={type: ramp, duration: 2}"
 
 # A mapping of 5 000 keys: the quadratic duplicate-key check took 47 s at 100 000.
 awk 'BEGIN { print "model: dipc"; for (i = 0; i < 5000; i++) printf "k%d: 1\n", i }' > "$here/crash/quadratic-duplicate-keys.yaml"
