@@ -28,6 +28,14 @@ add_test(NAME scene_cli
          COMMAND ${LAGSIM_BASH} ${scene_dir}/cli.sh $<TARGET_FILE:lagsimd> ${scene_cfg}/dipc.yaml)
 add_test(NAME scene_accuracy
          COMMAND ${LAGSIM_BASH} ${scene_dir}/accuracy.sh $<TARGET_FILE:lagsimd> ${scene_cfg})
+# every shipped scene at three errors, lagsimd --offline with integrator.error alone against
+# an independent reference (its calibration is timed: not in the sanitizer build, whose
+# CPU budget it would spend before reaching the finest settings)
+if(NOT LAGSIM_SANITIZE)
+  add_test(NAME scene_accuracy_all
+           COMMAND ${LAGSIM_BASH} ${scene_dir}/accuracy_all.sh $<TARGET_FILE:lagsimd> ${scene_cfg})
+  set_tests_properties(scene_accuracy_all PROPERTIES TIMEOUT 300 LABELS "scene;accuracy")
+endif()
 # every scene in config/ (listed when the test runs) waits at t = 0 for the first command
 add_test(NAME scene_shipped_wait
          COMMAND ${LAGSIM_BASH} ${scene_dir}/shipped_wait.sh $<TARGET_FILE:lagsimd> ${scene_cfg})
