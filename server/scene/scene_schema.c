@@ -1116,6 +1116,14 @@ static int key_effects(conv *cv, const ynode *nd, const char *path)
     return convert_map(cv, nd, path, k_effects, "effect");
 }
 
+/* `cases:` are lagsim-eval's (server/tools/eval_case.c reads and checks them); a scene
+ * that carries its evaluation cases runs as it would without them. */
+static int key_cases(conv *cv, const ynode *nd, const char *path)
+{
+    (void)cv, (void)nd, (void)path;
+    return 0;
+}
+
 /* ================================================================ the scene */
 
 static const keyrow k_top_keys[] = {
@@ -1128,6 +1136,7 @@ static const keyrow k_top_keys[] = {
     {"realtime", key_realtime, K_MAP, k_realtime_keys},           /* pacing of the real-time server */
     {"lcm", key_lcm, K_MAP, k_lcm_keys},                     /* transport */
     {"effects", key_effects, K_MAP, k_effects},             /* per-scene effects */
+    {"cases", key_cases, K_OTHER},                  /* lagsim-eval's, not the daemon's */
     {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
