@@ -113,12 +113,12 @@ static int report(const char *dir, bool force, const char *config, const eval_ca
     fclose(f);
     f = open_out("--report", gp, force, config);
     if (!f) return -1;
-    fprintf(f, "set terminal pngcairo size 1100,%d font ',10'\n", 420 + 90 * sc->nj);
+    fprintf(f, "set terminal pngcairo noenhanced size 1200,640 font ',10'\n");
     fprintf(f, "set output '%s'\n", png);
     fprintf(f, "set multiplot layout 2,1 title \"%s: case %s%s%s\"\n", sc->model, c->name,
             res->failed ? " FAILED: " : " (passed)", res->failed ? res->reason : "");
-    fprintf(f, "set grid\nset key outside right\nset xlabel 'sim time (s)'\n");
-    fprintf(f, "set lmargin 10\nset rmargin 40\n");
+    fprintf(f, "set grid\nset key top right\nset xlabel 'sim time (s)'\n");
+    fprintf(f, "set lmargin 10\nset rmargin at screen 0.64\n");
     /* metrics as labels, right of the first panel */
     int line = 0;
     for (int j = 0; j < sc->nj; j++) {
@@ -132,8 +132,8 @@ static int report(const char *dir, bool force, const char *config, const eval_ca
             u += (size_t)snprintf(row + u, sizeof row - u, "\\n  %s %s", lag_metric_table[m].name,
                                   v);
         }
-        fprintf(f, "set label %d \"%s\" at screen 0.70, screen %.3f left font ',9'\n", j + 1,
-                row, 0.92 - 0.45 * line / (sc->nj > 1 ? sc->nj : 1));
+        fprintf(f, "set label %d \"%s\" at screen %.3f, screen 0.9 left font ',9'\n", j + 1,
+                row, 0.66 + 0.33 * line / (sc->nj > 1 ? sc->nj : 1));
         line++;
     }
     fprintf(f, "set ylabel 'q (m or rad)'\nplot ");
