@@ -335,9 +335,9 @@ int main(int argc, char **argv)
                 fprintf(fcsv, "%s,%s,%d,%d,\"%s\"", c->name, csc[k].joint[j], res.failed,
                         met, res.failed ? res.reason : why);
                 for (int m = 0; m < LAG_METRIC_COUNT; m++) {
-                    char v[32];
-                    eval_fmt(res.m[j].v[m], v, sizeof v);
-                    fprintf(fcsv, ",%s", v);
+                    /* the CSV is read by programs: every digit of the double */
+                    if (isnan(res.m[j].v[m])) fprintf(fcsv, ",nan");
+                    else fprintf(fcsv, ",%.17g", res.m[j].v[m]);
                 }
                 fprintf(fcsv, ",%.17g,%zu,%.17g\n", res.max_abs_q[j], res.states, res.t_end);
             }
