@@ -185,6 +185,8 @@ int eval_scene_load(const char *config, const char *const *sets, int nsets, eval
             snprintf(out->joint[j], EVAL_NAME_LEN, "%s", info->joint_names[j]);
             out->angular[j] = info->angular[j];
             out->actuated[j] = info->actuated[j];
+            out->q0[j] = sc->sim.q0[j];
+            out->qd0[j] = sc->sim.qd0[j];
         }
         out->period = 1.0 / sc->publish_hz;
     }
@@ -379,9 +381,9 @@ int eval_read_log(const char *path, const char *prefix, const eval_scene *sc, do
             if (lag_wire_decode_event(rec.data, rec.size, &ev) != 0) continue;
             if (!strcmp(ev.kind, "numeric_fault"))
                 fail(res, "fault at t = %.6g s: %s", ev.sim_time, ev.detail);
-            else if (!strcmp(ev.kind, "lockstep_timeout"))
-                fail(res, "the controller did not answer the state at t = %.6g s",
-                     ev.sim_time);
+            /* a lockstep_timeout only delays a lockstep run: its states stay those of a
+             * run without it, bit for bit (docs/server.md); a controller that never
+             * answers ends in the wall timeout */
             else if (!strcmp(ev.kind, "stop")) {
                 if (strstr(ev.detail, "duration reached")) stopped_at_duration = true;
                 else fail(res, "stopped at t = %.6g s: %s", ev.sim_time, ev.detail);
@@ -453,9 +455,12 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
     argv[na++] = (char *)env->config;
     argv[na++] = "--set";
     argv[na++] = "realtime.mode=lockstep";
-    /* a controller that starts slowly on a loaded machine must not cost a period */
+    /* lockstep waits at t = 0 for the controller's first command and publishes that
+     * state again every lockstep_timeout: a controller that finds the plant after the
+     * first one (by discovery) then waits at most this long; the results do not depend
+     * on it (docs/server.md, lockstep) */
     argv[na++] = "--set";
-    argv[na++] = "realtime.lockstep_timeout=30";
+    argv[na++] = "realtime.lockstep_timeout=0.1";
     snprintf(owned[no], sizeof owned[no], "lcm.prefix=%s", env->prefix);
     argv[na++] = "--set";
     argv[na++] = owned[no++];

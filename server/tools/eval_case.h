@@ -56,6 +56,7 @@ typedef struct eval_scene {
     bool angular[EVAL_JOINTS_MAX];
     bool actuated[EVAL_JOINTS_MAX];
     double period;                          /* s, 1 / publish_hz */
+    double q0[EVAL_JOINTS_MAX], qd0[EVAL_JOINTS_MAX]; /* initial state */
 } eval_scene;
 
 /* Loads CONFIG with the overrides (nsets of them); -1 and the loader's message in err. */

@@ -30,7 +30,7 @@ static void usage(FILE *f)
 "Runs each case of a scene (its `cases:` key, or those of a suite file) in lockstep\n"
 "against a controller and reports per joint: rise, settle, overshoot, sse, iae, ise,\n"
 "peak_error, effort_peak, effort_rms (docs/evaluation.md), and whether the case failed\n"
-"(a fault, an early stop, an unanswered state, a joint past its bound).\n"
+"(a fault, an early stop, a joint past its bound).\n"
 "\n"
 "options:\n"
 "  -c, --config SCENE     the scene file (lagsimd's)\n"
