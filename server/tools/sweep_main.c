@@ -474,12 +474,13 @@ static int plot(const char *png, bool force, const char *config, const char *hea
     if (!f) return -1;
     fprintf(f, "set terminal pngcairo noenhanced size %d,420 font ',10'\n", 420 * nv + 80);
     fprintf(f, "set output '%s'\nset grid\nset datafile missing 'nan'\n", png);
+    fprintf(f, "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n");
     fprintf(f, "set multiplot layout 1,%d title '%d runs: %s (red: did not pass)'\n", nv, r->n,
             metric);
     for (int k = 0; k < nv; k++)
         fprintf(f, "set xlabel '%s'\nset ylabel '%s'\nplot '%s' u %d:($%d == 1 ? $%d : 1/0) "
                    "pt 7 ps 0.6 lc rgb '#1f77b4' t 'passed', '' u %d:($%d == 0 ? $%d : 1/0) "
-                   "pt 7 ps 0.6 lc rgb '#d62728' t 'failed'\n",
+                   "pt 7 ps 0.6 lc rgb '#d62728' t 'did not pass'\n",
                 vs[k].key, metric, dat, k + 1, nv + 2, nv + 1, k + 1, nv + 2, nv + 1);
     fprintf(f, "unset multiplot\n");
     fclose(f);
