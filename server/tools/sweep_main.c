@@ -481,7 +481,7 @@ static int plot(const char *png, bool force, const char *config, const char *hea
         fprintf(f, "set xlabel '%s'\nset ylabel '%s'\nplot '%s' u %d:($%d == 1 ? $%d : 1/0) "
                    "pt 7 ps 0.6 lc rgb '#1f77b4' t 'passed', '' u %d:($%d == 0 ? $%d : 1/0) "
                    "pt 7 ps 0.6 lc rgb '#d62728' t 'did not pass'\n",
-                vs[k].key, metric, dat, k + 1, nv + 2, nv + 1, k + 1, nv + 2, nv + 1);
+                hf[1 + k], metric, dat, k + 1, nv + 2, nv + 1, k + 1, nv + 2, nv + 1);
     fprintf(f, "unset multiplot\n");
     fclose(f);
     f = open_out("--plot", png, force, in, 1);
