@@ -433,7 +433,7 @@ static int merge(int argc, char **argv)
 
 /* ---------------------------------------------------------------- plot */
 static int plot(const char *png, bool force, const char *config, const char *header, rows *r,
-                const vary *vs, int nv, const char *metric)
+                int nv, const char *metric)
 {
     char hb[ROW_MAX];
     snprintf(hb, sizeof hb, "%s", header);
@@ -770,7 +770,7 @@ int main(int argc, char **argv)
         int n = split(lb, f, 512);
         passed += n > nv + 2 && !strcmp(f[nv + 1], "0") && !strcmp(f[nv + 2], "1");
     }
-    if (png && plot(png, force, config, header, &r, vs, nv, metric)) status = 2;
+    if (png && plot(png, force, config, header, &r, nv, metric)) status = 2;
     int all = passed == r.n;
     rows_free(&r);
     if (status) return status;
