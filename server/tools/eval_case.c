@@ -5,6 +5,9 @@
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
+#include <stdalign.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -323,16 +326,59 @@ static void fail(eval_result *res, const char *fmt, ...)
     va_end(ap);
 }
 
+/* The wire module's type for <PREFIX>_REFERENCE ("reference_t"), or -1 while it has none:
+ * found by name in the wire's table, its fields read through the wire's field table, so
+ * that this file follows the message's definition instead of copying it. */
+static int reference_type(void)
+{
+    for (int t = 0; t < LAG_WIRE_TYPE_COUNT; t++) {
+        const char *name = lag_wire_type_name((lag_wire_type)t);
+        if (name && !strcmp(name, "reference_t")) return t;
+    }
+    return -1;
+}
+
+static const lag_wire_field *field(const lag_wire_field *f, int n, const char *name,
+                                   lag_wire_kind kind)
+{
+    for (int i = 0; i < n; i++)
+        if (!strcmp(f[i].name, name) && f[i].kind == kind) return &f[i];
+    return NULL;
+}
+
 /* The reference of a logged <PREFIX>_REFERENCE record (published just before the state
  * of the same sim_time): its time and r of each joint it lists (the others keep 0).
  * Returns 1 when the record was read. */
 static int read_reference(const lag_log_record *rec, const eval_scene *sc, double *t,
                           double r[EVAL_JOINTS_MAX])
 {
-    /* The reference channel's type is read by the wire module once it has one; until
-     * then a log carries no reference and every case is a regulation case (r = 0). */
-    (void)rec, (void)sc, (void)t, (void)r;
-    return 0;
+    int type = reference_type();
+    if (type < 0) return 0; /* no reference type: every case regulates to r = 0 */
+    int nf = 0;
+    const lag_wire_field *fs = lag_wire_fields((lag_wire_type)type, &nf);
+    const lag_wire_field *f_t = field(fs, nf, "sim_time", LAG_WIRE_DOUBLE);
+    const lag_wire_field *f_n = field(fs, nf, "num_joints", LAG_WIRE_INT16);
+    const lag_wire_field *f_name = field(fs, nf, "name", LAG_WIRE_STRING);
+    const lag_wire_field *f_r = field(fs, nf, "r", LAG_WIRE_DOUBLE);
+    size_t size = lag_wire_struct_size((lag_wire_type)type);
+    if (!f_t || !f_n || !f_name || !f_r || f_r->count_field < 0 || f_name->count_field < 0)
+        return 0;
+    static _Alignas(max_align_t) unsigned char buf[1 << 16];
+    if (size > sizeof buf ||
+        lag_wire_decode((lag_wire_type)type, rec->data, rec->size, EVAL_JOINTS_MAX, buf) != 0)
+        return 0;
+    memcpy(t, buf + f_t->offset, sizeof *t);
+    int16_t n;
+    memcpy(&n, buf + f_n->offset, sizeof n);
+    for (int j = 0; j < EVAL_JOINTS_MAX; j++) r[j] = 0;
+    for (int i = 0; i < n && i < f_r->capacity && i < f_name->capacity; i++) {
+        const char *name = (const char *)(buf + f_name->offset + (size_t)i * f_name->size);
+        double v;
+        memcpy(&v, buf + f_r->offset + (size_t)i * sizeof v, sizeof v);
+        for (int j = 0; j < sc->nj; j++)
+            if (!strncmp(name, sc->joint[j], f_name->size) && isfinite(v)) r[j] = v;
+    }
+    return isfinite(*t);
 }
 
 int eval_read_log(const char *path, const char *prefix, const eval_scene *sc, double duration,

@@ -10,6 +10,7 @@ usage: test_eval.py BIN_DIR SOURCE_DIR CASE
   require    --require holding (exit 0), not holding (exit 1), naming an unknown joint
              or metric (exit 2)
   errors     a case file with a mistake: exit 2 and file:line:column
+  scene      cases in the scene file: lagsimd ignores them, lagsim-eval runs them
 """
 import csv
 import glob
@@ -163,6 +164,33 @@ def case_errors():
               "a scene without cases: exit 2")
 
 
-{"metrics": case_metrics, "require": case_require, "errors": case_errors}[CASE]()
+def case_scene():
+    """Cases in the scene file itself: lagsimd runs the scene as if they were not there,
+    lagsim-eval runs them without --suite."""
+    with tempfile.TemporaryDirectory() as d:
+        scene = os.path.join(d, "cartpole_cases.yaml")
+        with open(SCENE) as f, open(SUITE) as g:
+            text = f.read() + "\n" + g.read()
+        with open(scene, "w") as f:
+            f.write(text)
+        plain = subprocess.run([os.path.join(BIN, "lagsimd"), "--config", SCENE, "--offline",
+                                "--duration", "1", "--csv", "-"], stdout=subprocess.PIPE,
+                               universal_newlines=True)
+        with_cases = subprocess.run([os.path.join(BIN, "lagsimd"), "--config", scene,
+                                     "--offline", "--duration", "1", "--csv", "-"],
+                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                    universal_newlines=True)
+        print(with_cases.stderr)
+        check(with_cases.returncode == 0 and with_cases.stdout == plain.stdout,
+              "lagsimd runs a scene with cases: as the same scene without them")
+        p = subprocess.run([EVAL, "--config", scene, "--controller", CTRL, "--case", "tilt"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        print(p.stdout, p.stderr)
+        check(p.returncode == 0 and "tilt" in p.stdout, "lagsim-eval runs the scene's own cases")
+
+
+{"metrics": case_metrics, "require": case_require, "errors": case_errors,
+ "scene": case_scene}[CASE]()
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)
