@@ -8,7 +8,8 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             for the same overrides; --seed changes the drawn values
   slurm     the job-array script: shell syntax, two array tasks run outside Slurm with
             Slurm's variables set, merged, equal to the whole sweep
-  merge     merge refuses a run twice and shards of another sweep (exit 2)
+  merge     merge refuses a run twice and shards of another sweep (exit 2); a varied
+            coordinate of initial.q lands in the scene; an index on another key is refused
 """
 import csv
 import filecmp
@@ -131,6 +132,16 @@ def case_merge(d):
         g.write(f.read().replace("parameters.m0", "parameters.m2"))
     p = run([SWEEP, "merge", a, os.path.join(d, "d.csv"), "-o", os.path.join(d, "m2.csv")])
     check(p.returncode == 2 and "another sweep" in p.stderr, "another sweep's shard: exit 2")
+    # one coordinate of initial.q varied: joined into the scene's list (x stays 0); the
+    # pole released at rest from theta0 under LQR peaks at theta0 itself
+    g = os.path.join(d, "g.csv")
+    run([SWEEP, "--config", SCENE, "--controller", CTRL, "--duration", "3",
+         "--vary", "initial.q[1]=grid(0.02,0.08,2)", "--csv", g])
+    r = rows(g)
+    check([x["initial.q[1]"] for x in r] == ["0.02", "0.080000000000000002"] and
+          all(float(x["theta.peak_error"]) == float(x["initial.q[1]"]) for x in r) and
+          all(float(x["x.peak_error"]) > 0 for x in r),
+          "initial.q[1] varied: theta starts there (peak error = the value)")
     p = run([SWEEP] + ARGS + ["--vary", "initial.x[0]=normal(0,1)"])
     check(p.returncode == 2 and "initial.q[i]" in p.stderr, "an index on another key: exit 2")
 
