@@ -12,7 +12,8 @@ pkgs=(build-essential cmake pkg-config clang libclang-rt-14-dev   # gcc pass; cl
       octave octave-control                              # the MATLAB/Octave clients (dlqr, lqr) and their tests
       libmicrohttpd-dev chromium fonts-dejavu-core       # lagsim-view; its browser test and screenshot
       iproute2 nftables                                  # two hosts on one machine: namespaces, veth, packet loss
-      lintian systemd)                                   # the Debian package: lintian, systemd-analyze, its unit run by systemd
+      lintian systemd                                    # the Debian package: lintian, systemd-analyze, its unit run by systemd
+      parallel slurm-client)                             # lagsim-sweep shards: GNU parallel, sbatch (--test-only, no cluster)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

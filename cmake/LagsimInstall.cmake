@@ -1,7 +1,8 @@
 # `cmake --install <build> [--prefix /usr/local]`: everything a user of lagsim needs, laid
 # out as a Debian tool's files (GNUInstallDirs):
-#   bin/                     lagsimd, lagsimctl, lagsim-view, lagsim-log2csv, lagsim-plot
-#                            and the C example controllers (each when the build has it)
+#   bin/                     lagsimd, lagsimctl, lagsim-view, lagsim-log2csv, lagsim-plot,
+#                            lagsim-eval, lagsim-sweep and the C example controllers
+#                            (each when the build has it)
 #   include/lagsim/          lagsim.h (the core), lagsim_client.h, lagsim_controller.h,
 #                            lagsim_wire.h, lagsim_log.h, lagsim_bus.h, the generated C types
 #   lib/                     liblagsim_client.a, liblagsim_controller.a and what they
@@ -12,7 +13,8 @@
 #   share/lua/5.2/           lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
 #                            (on lua5.2's default path for prefix /usr/local)
 #   share/java/              lagsim_types.jar, lagsim_examples.jar
-#   share/lagsim/            config/*.yaml, lcmtypes/*.lcm, examples/{python,lua}/
+#   share/lagsim/            config/*.yaml, lcmtypes/*.lcm, examples/{python,lua}/,
+#                            slurm/lagsim-sweep-array.sh
 #   share/lagsim/octave/     the MATLAB/Octave controllers (clients/octave/CMakeLists.txt:
 #                            LAGSIM_OCTAVE_INSTALL_DIR)
 #   share/man/man1/          a page for each program of bin/
@@ -21,7 +23,7 @@
 # Included last from the top-level CMakeLists.txt, so every target exists already.
 include(GNUInstallDirs)
 
-set(_programs lagsimd lagsimctl lagsim-view lagsim-log2csv
+set(_programs lagsimd lagsimctl lagsim-view lagsim-log2csv lagsim-eval lagsim-sweep
               dipc_lqr lqr_balance manipulator_pd stick_push)
 foreach(t ${_programs})
   if(TARGET ${t})
@@ -62,6 +64,9 @@ file(GLOB _lcm ${PROJECT_SOURCE_DIR}/lcmtypes/*.lcm)
 install(FILES ${_lcm} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/lcmtypes)
 file(GLOB _cfg ${PROJECT_SOURCE_DIR}/config/*.yaml)
 install(FILES ${_cfg} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/config)
+# lagsim-sweep's Slurm job array (docs/evaluation.md)
+install(PROGRAMS ${PROJECT_SOURCE_DIR}/server/tools/slurm/lagsim-sweep-array.sh
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/slurm)
 # one page per program in bin/ (tests/install/check_man.py holds each to its --help)
 file(GLOB _man CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/docs/man/*.1)
 install(FILES ${_man} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)

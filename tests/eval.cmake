@@ -9,3 +9,29 @@ foreach(t metrics reference)
   target_link_libraries(test_eval_${t} PRIVATE lagsim_eval m)
   lagsim_add_test_cases(test_eval_${t} eval.${t} eval 60)
 endforeach()
+
+# lagsim-eval end to end: the cart-pole held by lqr_balance through a small case set
+# (tests/eval/cartpole_cases.yaml); metrics against the logged states, --require's exit
+# codes, case files with mistakes.
+find_program(LAGSIM_PYTHON3 python3)
+if(LAGSIM_PYTHON3)
+  foreach(c metrics require errors scene)
+    add_test(NAME eval_lagsim_eval_${c}
+      COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_eval.py
+              $<TARGET_FILE_DIR:lagsim-eval> ${PROJECT_SOURCE_DIR} ${c})
+    set_tests_properties(eval_lagsim_eval_${c} PROPERTIES LABELS eval TIMEOUT 300)
+  endforeach()
+endif()
+
+# lagsim-sweep end to end: 8 runs of the cart-pole over its masses; the CSV the same for
+# -j1, -j2, two shards run by GNU parallel and merged, and a Slurm job array's two tasks
+# run here with Slurm's variables (no cluster needed); merge's refusals.
+find_program(LAGSIM_GNU_PARALLEL parallel)
+if(LAGSIM_PYTHON3 AND LAGSIM_GNU_PARALLEL)
+  foreach(c same slurm merge)
+    add_test(NAME eval_lagsim_sweep_${c}
+      COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_sweep.py
+              $<TARGET_FILE_DIR:lagsim-sweep> ${PROJECT_SOURCE_DIR} ${c})
+    set_tests_properties(eval_lagsim_sweep_${c} PROPERTIES LABELS eval TIMEOUT 600)
+  endforeach()
+endif()

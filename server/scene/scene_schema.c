@@ -1331,6 +1331,14 @@ static int key_reference(conv *cv, const ynode *nd, const char *path)
     return per_joint(cv, nd, path, ref_joint);
 }
 
+/* `cases:` are lagsim-eval's (server/tools/eval_case.c reads and checks them); a scene
+ * that carries its evaluation cases runs as it would without them. */
+static int key_cases(conv *cv, const ynode *nd, const char *path)
+{
+    (void)cv, (void)nd, (void)path;
+    return 0;
+}
+
 /* ================================================================ the scene */
 
 static const keyrow k_top_keys[] = {
@@ -1344,6 +1352,7 @@ static const keyrow k_top_keys[] = {
     {"lcm", key_lcm, K_MAP, k_lcm_keys},                     /* transport */
     {"effects", key_effects, K_MAP, k_effects},             /* per-scene effects */
     {"reference", key_reference, K_JOINTS, k_ref_keys},     /* per joint: what to follow */
+    {"cases", key_cases, K_OTHER},                  /* lagsim-eval's, not the daemon's */
     {NULL, NULL, K_OTHER, NULL, NULL},
 };
 

@@ -62,9 +62,12 @@ def main():
             "share/java/lagsim_types.jar", "share/java/lagsim_examples.jar",
             "share/lagsim/octave/lagsim_setup.m", "share/lagsim/octave/dipc_balance.m"]
     # the other programs, each where the build made it
-    for prog in ("lagsimctl", "lagsim-view", "lagsim-log2csv", "lagsim-plot", "stick_push"):
+    for prog in ("lagsimctl", "lagsim-view", "lagsim-log2csv", "lagsim-plot", "stick_push",
+                 "lagsim-eval", "lagsim-sweep"):
         if os.path.exists(os.path.join(build, "bin", prog)):
             want.append("bin/" + prog)
+    if os.path.exists(os.path.join(build, "bin", "lagsim-sweep")):
+        want.append("share/lagsim/slurm/lagsim-sweep-array.sh")
     for w in want:
         check(os.path.exists(os.path.join(prefix, w)), "installed %s" % w)
     unit = os.path.join(prefix, "lib/systemd/system/lagsimd@.service")

@@ -1,0 +1,627 @@
+/* lagsim-eval's and lagsim-sweep's cases and runs (eval_case.h). */
+
+#include "eval_case.h"
+
+#include <errno.h>
+#include <math.h>
+#include <signal.h>
+#include <stdalign.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "lagsim_log.h"
+#include "lagsim_wire.h"
+#include "scene.h"
+#include "scene_yaml.h"
+
+/* ---------------------------------------------------------------- cases */
+static const char *const k_case_keys = "name, duration, set, bounds";
+
+static int read_number(errbuf *e, const ynode *nd, const char *what, double lo, double hi,
+                       double *v)
+{
+    if (nd->kind != YN_SCALAR || nd->quoted || lag_scene_read_decimal(nd->text, v) != 0 ||
+        !(*v >= lo && *v <= hi))
+        return yfail(e, nd, NULL, "%s: expected a number from %g to %g, got %s%s%s", what, lo,
+                     hi, nd->kind == YN_SCALAR ? "'" : "",
+                     nd->kind == YN_SCALAR ? nd->text : ynode_kind_name(nd),
+                     nd->kind == YN_SCALAR ? "'" : "");
+    return 0;
+}
+
+static int read_text(errbuf *e, const ynode *nd, const char *what, char *out, size_t len)
+{
+    if (nd->kind != YN_SCALAR || ynode_is_null(nd))
+        return yfail(e, nd, NULL, "%s: expected text, got %s", what, ynode_kind_name(nd));
+    if (strlen(nd->text) >= len)
+        return yfail(e, nd, NULL, "%s: longer than %zu characters", what, len - 1);
+    snprintf(out, len, "%s", nd->text);
+    return 0;
+}
+
+static int read_case(errbuf *e, const ynode *nd, int index, eval_case *c)
+{
+    memset(c, 0, sizeof *c);
+    if (nd->kind != YN_MAP)
+        return yfail(e, nd, NULL, "cases[%d]: expected a mapping (%s), got %s", index,
+                     k_case_keys, ynode_kind_name(nd));
+    bool has_duration = false;
+    for (int k = 0; k < nd->n; k++) {
+        const yentry *en = &nd->entries[k];
+        const ynode *v = en->val;
+        if (!strcmp(en->key, "name")) {
+            if (read_text(e, v, "name", c->name, sizeof c->name)) return -1;
+            for (const char *p = c->name; *p; p++)
+                if (!(*p == '_' || *p == '-' || *p == '.' || (*p >= '0' && *p <= '9') ||
+                      (*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z')))
+                    return yfail(e, v, NULL,
+                                 "name: letters, digits, '_', '-' and '.' only (it names "
+                                 "files), got '%s'", c->name);
+        } else if (!strcmp(en->key, "duration")) {
+            if (read_number(e, v, "duration", 1e-3, 1e6, &c->duration)) return -1;
+            has_duration = true;
+        } else if (!strcmp(en->key, "set")) {
+            if (v->kind != YN_SEQ)
+                return yfail(e, v, NULL,
+                             "set: expected a list of \"key=value\" overrides (as lagsimd "
+                             "--set), got %s", ynode_kind_name(v));
+            if (v->n > EVAL_SETS_MAX)
+                return yfail(e, v, NULL, "set: at most %d overrides", EVAL_SETS_MAX);
+            for (int i = 0; i < v->n; i++) {
+                if (read_text(e, v->items[i], "set", c->set[i], sizeof c->set[i])) return -1;
+                if (!strchr(c->set[i], '=') || c->set[i][0] == '=')
+                    return yfail(e, v->items[i], NULL,
+                                 "set: expected \"key=value\" (as lagsimd --set), got '%s'",
+                                 c->set[i]);
+            }
+            c->nsets = v->n;
+        } else if (!strcmp(en->key, "bounds")) {
+            if (v->kind != YN_MAP)
+                return yfail(e, v, NULL,
+                             "bounds: expected a mapping joint: largest |q| (e.g. "
+                             "{theta: 0.5}), got %s", ynode_kind_name(v));
+            if (v->n > EVAL_JOINTS_MAX)
+                return yfail(e, v, NULL, "bounds: at most %d joints", EVAL_JOINTS_MAX);
+            for (int i = 0; i < v->n; i++) {
+                if (strlen(v->entries[i].key) >= EVAL_NAME_LEN)
+                    return yfail_key(e, &v->entries[i], "bounds: joint name too long");
+                snprintf(c->bound_joint[i], EVAL_NAME_LEN, "%s", v->entries[i].key);
+                if (read_number(e, v->entries[i].val, "bounds", 0, 1e9, &c->bound[i]))
+                    return -1;
+            }
+            c->nbounds = v->n;
+        } else {
+            return yfail_key(e, en, "cases[%d]: unknown key '%s' (expected %s)", index,
+                             en->key, k_case_keys);
+        }
+    }
+    if (!c->name[0]) return yfail(e, nd, NULL, "cases[%d]: missing 'name'", index);
+    if (!has_duration) return yfail(e, nd, NULL, "cases[%d]: missing 'duration' (s)", index);
+    return 0;
+}
+
+int eval_cases_load(const char *path, eval_case **cases, int *n, char *err, size_t errlen)
+{
+    *cases = NULL;
+    *n = 0;
+    char *text = NULL;
+    size_t len = 0;
+    if (lag_scene_read(path, &text, &len, err, errlen) != 0) return -1;
+    ysrc src = {.name = path, .is_set = false};
+    errbuf e = {err, errlen};
+    ynode *root = NULL;
+    int rc = ytree_parse(text, len, &src, &e, &root);
+    free(text);
+    if (rc != 0) return -1;
+    rc = -1;
+    const yentry *ce = root->kind == YN_MAP ? ymap_find(root, "cases") : NULL;
+    if (root->kind != YN_MAP) {
+        yfail(&e, root, NULL, "expected a mapping with a 'cases:' list, got %s",
+              ynode_kind_name(root));
+        goto out;
+    }
+    if (!ce) {
+        rc = 0;
+        goto out;
+    }
+    const ynode *list = ce->val;
+    if (list->kind != YN_SEQ || list->n == 0) {
+        yfail(&e, list, NULL, "cases: expected a list of cases (each with %s), got %s",
+              k_case_keys, list->kind == YN_SEQ ? "an empty list" : ynode_kind_name(list));
+        goto out;
+    }
+    if (list->n > EVAL_CASES_MAX) {
+        yfail(&e, list, NULL, "cases: at most %d", EVAL_CASES_MAX);
+        goto out;
+    }
+    eval_case *cs = calloc((size_t)list->n, sizeof *cs);
+    if (!cs) {
+        snprintf(err, errlen, "%s: out of memory", path);
+        goto out;
+    }
+    for (int i = 0; i < list->n; i++) {
+        if (read_case(&e, list->items[i], i, &cs[i])) {
+            free(cs);
+            goto out;
+        }
+        for (int j = 0; j < i; j++)
+            if (!strcmp(cs[j].name, cs[i].name)) {
+                yfail(&e, list->items[i], NULL, "cases[%d]: a second case named '%s'", i,
+                      cs[i].name);
+                free(cs);
+                goto out;
+            }
+    }
+    *cases = cs;
+    *n = list->n;
+    rc = 0;
+out:
+    ynode_free(root);
+    return rc;
+}
+
+/* ---------------------------------------------------------------- scene */
+int eval_scene_load(const char *config, const char *const *sets, int nsets, eval_scene *out,
+                    char *err, size_t errlen)
+{
+    lag_scene *sc = calloc(1, sizeof *sc);
+    if (!sc) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    int rc = lag_scene_load(config, sets, nsets, sc, err, errlen);
+    if (rc == 0) {
+        memset(out, 0, sizeof *out);
+        const lag_model_info *info = lag_model_info_get(sc->sim.model.kind);
+        snprintf(out->model, sizeof out->model, "%s", info->name);
+        out->nj = sc->sim.model.nq < EVAL_JOINTS_MAX ? sc->sim.model.nq : EVAL_JOINTS_MAX;
+        for (int j = 0; j < out->nj; j++) {
+            snprintf(out->joint[j], EVAL_NAME_LEN, "%s", info->joint_names[j]);
+            out->angular[j] = info->angular[j];
+            out->actuated[j] = info->actuated[j];
+            out->q0[j] = sc->sim.q0[j];
+            out->qd0[j] = sc->sim.qd0[j];
+        }
+        out->period = 1.0 / sc->publish_hz;
+    }
+    free(sc);
+    return rc ? -1 : 0;
+}
+
+/* ---------------------------------------------------------------- processes */
+void eval_url(int slot, char *url, size_t len)
+{
+    /* a port pair per (process, slot): 20000..59998, apart from the tests' 20000 + 2 (pid
+     * % 6000) only by chance, hence the prefix of the run's own as well */
+    int port = 20000 + 2 * (int)(((long)getpid() * 61 + slot) % 20000);
+    snprintf(url, len, "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304", port);
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void sleep_s(double s)
+{
+    struct timespec ts = {(time_t)s, (long)((s - floor(s)) * 1e9)};
+    nanosleep(&ts, NULL);
+}
+
+/* Starts argv (or "sh -c cmd" when argv is NULL) in its own process group. */
+static pid_t spawn(char *const *argv, const char *cmd, const eval_env *env)
+{
+    fflush(NULL); /* nothing buffered is written twice */
+    pid_t pid = fork();
+    if (pid != 0) return pid;
+    setpgid(0, 0);
+    setenv("LCM_DEFAULT_URL", env->url, 1);
+    setenv("LAGSIM_PREFIX", env->prefix, 1);
+    if (!env->verbose) {
+        FILE *f = freopen("/dev/null", "w", stdout);
+        (void)f;
+        if (argv) {
+            f = freopen("/dev/null", "w", stderr);
+            (void)f;
+        }
+    }
+    if (argv)
+        execv(argv[0], argv);
+    else
+        execl("/bin/sh", "sh", "-c", cmd, (char *)NULL);
+    _exit(127);
+}
+
+/* Waits for pid until `deadline` (monotonic s); 1 and *status when it ended, 0 if not. */
+static int wait_until(pid_t pid, double deadline, int *status)
+{
+    for (;;) {
+        pid_t r = waitpid(pid, status, WNOHANG);
+        if (r == pid) return 1;
+        if (r < 0 && errno != EINTR) return 1;
+        if (now_s() >= deadline) return 0;
+        sleep_s(0.005);
+    }
+}
+
+static void stop_group(pid_t pid, int *status)
+{
+    kill(-pid, SIGTERM);
+    if (!wait_until(pid, now_s() + 2.0, status)) {
+        kill(-pid, SIGKILL);
+        waitpid(pid, status, 0);
+    }
+}
+
+/* "{prefix}" and "{url}" in cmd replaced. */
+static void expand(const char *cmd, const eval_env *env, char *out, size_t len)
+{
+    size_t o = 0;
+    for (const char *p = cmd; *p && o + 1 < len;) {
+        const char *rep = NULL;
+        size_t skip = 0;
+        if (!strncmp(p, "{prefix}", 8)) rep = env->prefix, skip = 8;
+        else if (!strncmp(p, "{url}", 5)) rep = env->url, skip = 5;
+        if (rep) {
+            int w = snprintf(out + o, len - o, "'%s'", rep);
+            o += w > 0 ? (size_t)w : 0;
+            if (o >= len) o = len - 1;
+            p += skip;
+        } else {
+            out[o++] = *p++;
+        }
+    }
+    out[o] = '\0';
+}
+
+void eval_series_free(eval_series *s)
+{
+    free(s->t);
+    for (int j = 0; j < EVAL_JOINTS_MAX; j++) {
+        free(s->q[j]);
+        free(s->r[j]);
+        free(s->u[j]);
+    }
+    memset(s, 0, sizeof *s);
+}
+
+static int series_grow(eval_series *s, int nj)
+{
+    if (s->n < s->cap) return 0;
+    size_t cap = s->cap ? 2 * s->cap : 1024;
+    double *t = realloc(s->t, cap * sizeof *t);
+    if (!t) return -1;
+    s->t = t;
+    for (int j = 0; j < nj; j++) {
+        double **arr[3] = {&s->q[j], &s->r[j], &s->u[j]};
+        for (int a = 0; a < 3; a++) {
+            double *p = realloc(*arr[a], cap * sizeof *p);
+            if (!p) return -1;
+            *arr[a] = p;
+        }
+    }
+    s->cap = cap;
+    return 0;
+}
+
+static void fail(eval_result *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void fail(eval_result *res, const char *fmt, ...)
+{
+    if (res->failed) return; /* the first reason stays */
+    res->failed = true;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(res->reason, sizeof res->reason, fmt, ap);
+    va_end(ap);
+}
+
+/* The wire module's type for <PREFIX>_REFERENCE ("reference_t"), or -1 while it has none:
+ * found by name in the wire's table, its fields read through the wire's field table, so
+ * that this file follows the message's definition instead of copying it. */
+static int reference_type(void)
+{
+    for (int t = 0; t < LAG_WIRE_TYPE_COUNT; t++) {
+        const char *name = lag_wire_type_name((lag_wire_type)t);
+        if (name && !strcmp(name, "reference_t")) return t;
+    }
+    return -1;
+}
+
+static const lag_wire_field *field(const lag_wire_field *f, int n, const char *name,
+                                   lag_wire_kind kind)
+{
+    for (int i = 0; i < n; i++)
+        if (!strcmp(f[i].name, name) && f[i].kind == kind) return &f[i];
+    return NULL;
+}
+
+/* The reference of a logged <PREFIX>_REFERENCE record (published just before the state
+ * of the same sim_time): its time and r of each joint it lists (the others keep 0).
+ * Returns 1 when the record was read. */
+static int read_reference(const lag_log_record *rec, const eval_scene *sc, double *t,
+                          double r[EVAL_JOINTS_MAX])
+{
+    int type = reference_type();
+    if (type < 0) return 0; /* no reference type: every case regulates to r = 0 */
+    int nf = 0;
+    const lag_wire_field *fs = lag_wire_fields((lag_wire_type)type, &nf);
+    const lag_wire_field *f_t = field(fs, nf, "sim_time", LAG_WIRE_DOUBLE);
+    const lag_wire_field *f_n = field(fs, nf, "num_joints", LAG_WIRE_INT16);
+    const lag_wire_field *f_name = field(fs, nf, "name", LAG_WIRE_STRING);
+    const lag_wire_field *f_r = field(fs, nf, "r", LAG_WIRE_DOUBLE);
+    size_t size = lag_wire_struct_size((lag_wire_type)type);
+    if (!f_t || !f_n || !f_name || !f_r || f_r->count_field < 0 || f_name->count_field < 0)
+        return 0;
+    static _Alignas(max_align_t) unsigned char buf[1 << 16];
+    if (size > sizeof buf ||
+        lag_wire_decode((lag_wire_type)type, rec->data, rec->size, EVAL_JOINTS_MAX, buf) != 0)
+        return 0;
+    memcpy(t, buf + f_t->offset, sizeof *t);
+    int16_t n;
+    memcpy(&n, buf + f_n->offset, sizeof n);
+    for (int j = 0; j < EVAL_JOINTS_MAX; j++) r[j] = 0;
+    for (int i = 0; i < n && i < f_r->capacity && i < f_name->capacity; i++) {
+        const char *name = (const char *)(buf + f_name->offset + (size_t)i * f_name->size);
+        double v;
+        memcpy(&v, buf + f_r->offset + (size_t)i * sizeof v, sizeof v);
+        for (int j = 0; j < sc->nj; j++)
+            if (!strncmp(name, sc->joint[j], f_name->size) && isfinite(v)) r[j] = v;
+    }
+    return isfinite(*t);
+}
+
+int eval_read_log(const char *path, const char *prefix, const eval_scene *sc, double duration,
+                  eval_series *s, eval_result *res, char *err, size_t errlen)
+{
+    char ch_state[96], ch_event[96], ch_ref[96];
+    snprintf(ch_state, sizeof ch_state, "%s_STATE", prefix);
+    snprintf(ch_event, sizeof ch_event, "%s_EVENT", prefix);
+    snprintf(ch_ref, sizeof ch_ref, "%s_REFERENCE", prefix);
+    lag_log *lg = lag_log_open(path, 1 << 20, err, errlen);
+    if (!lg) return -1;
+    lag_wire_joint_state st;
+    lag_wire_event ev;
+    bool stopped_at_duration = false;
+    double ref_time = NAN, ref_r[EVAL_JOINTS_MAX] = {0};
+    int rc = 0;
+    lag_log_record rec;
+    while ((rc = lag_log_next(lg, &rec)) == LAG_LOG_OK) {
+        if (!rec.data) continue;
+        if (!strcmp(rec.channel, ch_state)) {
+            if (lag_wire_decode_joint_state(rec.data, rec.size, sc->nj, &st) != 0 ||
+                st.num_joints != sc->nj)
+                continue;
+            /* a state published again (a lockstep retry, a status request) is one sample */
+            if (s->n && st.sim_time <= s->t[s->n - 1]) continue;
+            if (series_grow(s, sc->nj)) {
+                snprintf(err, errlen, "%s: out of memory", path);
+                lag_log_close(lg);
+                return -1;
+            }
+            size_t k = s->n++;
+            s->t[k] = st.sim_time;
+            bool ref = ref_time == st.sim_time;
+            if (ref) s->has_reference = true;
+            for (int j = 0; j < sc->nj; j++) {
+                s->q[j][k] = st.position[j];
+                s->r[j][k] = ref ? ref_r[j] : 0;
+                /* the state's effort was held over the period that ended at it; the last
+                 * state's is repeated as the held effort after it */
+                if (k) s->u[j][k - 1] = st.effort[j];
+                s->u[j][k] = st.effort[j];
+            }
+        } else if (!strcmp(rec.channel, ch_ref)) {
+            if (!read_reference(&rec, sc, &ref_time, ref_r)) ref_time = NAN;
+        } else if (!strcmp(rec.channel, ch_event)) {
+            if (lag_wire_decode_event(rec.data, rec.size, &ev) != 0) continue;
+            if (!strcmp(ev.kind, "numeric_fault"))
+                fail(res, "fault at t = %.6g s: %s", ev.sim_time, ev.detail);
+            /* a lockstep_timeout only delays a lockstep run: its states stay those of a
+             * run without it, bit for bit (docs/server.md); a controller that never
+             * answers ends in the wall timeout */
+            else if (!strcmp(ev.kind, "stop")) {
+                if (strstr(ev.detail, "duration reached")) stopped_at_duration = true;
+                else fail(res, "stopped at t = %.6g s: %s", ev.sim_time, ev.detail);
+            }
+        }
+    }
+    if (rc == LAG_LOG_ERROR) {
+        snprintf(err, errlen, "%s: %s", path, lag_log_errmsg(lg));
+        lag_log_close(lg);
+        return -1;
+    }
+    lag_log_close(lg);
+    res->states = s->n;
+    res->t_end = s->n ? s->t[s->n - 1] : 0;
+    if (!s->n) fail(res, "no state logged");
+    else if (res->t_end < duration - 0.5 * sc->period)
+        fail(res, "stopped at t = %.6g s before the duration %.6g s", res->t_end, duration);
+    else if (!stopped_at_duration)
+        fail(res, "the daemon did not stop on its duration");
+    return 0;
+}
+
+int eval_score(const eval_series *s, const eval_case *c, const eval_scene *sc,
+               eval_result *res, char *err, size_t errlen)
+{
+    res->nj = sc->nj;
+    lag_metric_opts o = lag_metric_opts_default();
+    for (int j = 0; j < sc->nj; j++) {
+        for (int m = 0; m < LAG_METRIC_COUNT; m++) res->m[j].v[m] = NAN;
+        res->m[j].step = NAN;
+        double mx = 0;
+        for (size_t k = 0; k < s->n; k++)
+            if (fabs(s->q[j][k]) > mx || !isfinite(s->q[j][k])) mx = fabs(s->q[j][k]);
+        res->max_abs_q[j] = s->n ? mx : NAN;
+        if (s->n < 2) continue;
+        char merr[256];
+        if (lag_metrics_compute(s->t, s->q[j], s->r[j], s->u[j], s->n, &o, &res->m[j], merr,
+                                sizeof merr) != 0) {
+            snprintf(err, errlen, "%s: %s", sc->joint[j], merr);
+            return -1;
+        }
+    }
+    for (int b = 0; b < c->nbounds; b++)
+        for (int j = 0; j < sc->nj; j++)
+            if (!strcmp(c->bound_joint[b], sc->joint[j]) && !(res->max_abs_q[j] <= c->bound[b]))
+                fail(res, "%s reached %.6g, past its bound %.6g", sc->joint[j],
+                     res->max_abs_q[j], c->bound[b]);
+    return 0;
+}
+
+/* ---------------------------------------------------------------- one run */
+int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, int nextra,
+             const eval_scene *sc, eval_result *res, eval_series *out, char *err,
+             size_t errlen)
+{
+    memset(res, 0, sizeof *res);
+    res->nj = sc->nj;
+    char log[1024];
+    snprintf(log, sizeof log, "%s/%s.lcm", env->workdir, env->prefix);
+    unlink(log);
+
+    /* lagsimd --config S --set ... (argv strings built in one arena) */
+    enum { ARGS_MAX = 2 * (EVAL_SETS_MAX * 2 + 16) };
+    char *argv[ARGS_MAX];
+    char owned[8][600];
+    int na = 0, no = 0;
+    argv[na++] = (char *)env->lagsimd;
+    argv[na++] = "--config";
+    argv[na++] = (char *)env->config;
+    argv[na++] = "--set";
+    argv[na++] = "realtime.mode=lockstep";
+    /* lockstep waits at t = 0 for the controller's first command and publishes that
+     * state again every lockstep_timeout: a controller that finds the plant after the
+     * first one (by discovery) then waits at most this long; the results do not depend
+     * on it (docs/server.md, lockstep) */
+    argv[na++] = "--set";
+    argv[na++] = "realtime.lockstep_timeout=0.1";
+    snprintf(owned[no], sizeof owned[no], "lcm.prefix=%s", env->prefix);
+    argv[na++] = "--set";
+    argv[na++] = owned[no++];
+    snprintf(owned[no], sizeof owned[no], "lcm.url=%s", env->url);
+    argv[na++] = "--set";
+    argv[na++] = owned[no++];
+    for (int i = 0; i < c->nsets && na + 2 < ARGS_MAX - 8; i++) {
+        argv[na++] = "--set";
+        argv[na++] = (char *)c->set[i];
+    }
+    for (int i = 0; i < nextra && na + 2 < ARGS_MAX - 8; i++) {
+        argv[na++] = "--set";
+        argv[na++] = (char *)extra[i];
+    }
+    snprintf(owned[no], sizeof owned[no], "%.17g", c->duration);
+    argv[na++] = "--duration";
+    argv[na++] = owned[no++];
+    argv[na++] = "--log";
+    argv[na++] = log;
+    argv[na++] = "-q";
+    argv[na] = NULL;
+
+    char cmd[4096];
+    expand(env->controller, env, cmd, sizeof cmd);
+    /* the controller first: in lockstep it then answers the first state (clients.md) */
+    pid_t cpid = spawn(NULL, cmd, env);
+    if (cpid < 0) {
+        snprintf(err, errlen, "cannot start the controller: %s", strerror(errno));
+        return -1;
+    }
+    pid_t dpid = spawn(argv, NULL, env);
+    if (dpid < 0) {
+        snprintf(err, errlen, "cannot start %s: %s", env->lagsimd, strerror(errno));
+        int st;
+        stop_group(cpid, &st);
+        return -1;
+    }
+    int dst = 0, cst = 0;
+    double t0 = now_s();
+    if (!wait_until(dpid, t0 + env->wall_timeout, &dst)) {
+        stop_group(dpid, &dst);
+        fail(res, "no end after %.3g wall s (--timeout)", env->wall_timeout);
+    }
+    /* a controller ends on the daemon's stop event; one that does not is stopped */
+    if (!wait_until(cpid, now_s() + 3.0, &cst)) stop_group(cpid, &cst);
+
+    if (WIFEXITED(dst) && WEXITSTATUS(dst) == 2) {
+        snprintf(err, errlen, "lagsimd refused the case '%s' (exit 2; rerun with -v)",
+                 c->name);
+        unlink(log);
+        return -1;
+    }
+    if (WIFEXITED(dst) && WEXITSTATUS(dst) == 127) {
+        snprintf(err, errlen, "cannot run %s", env->lagsimd);
+        return -1;
+    }
+    eval_series local = {0};
+    eval_series *s = out ? out : &local;
+    memset(s, 0, sizeof *s);
+    int rc = eval_read_log(log, env->prefix, sc, c->duration, s, res, err, errlen);
+    if (rc == 0) {
+        if (!(WIFEXITED(dst) && WEXITSTATUS(dst) == 0))
+            fail(res, "lagsimd ended with %s %d",
+                 WIFEXITED(dst) ? "exit status" : "signal",
+                 WIFEXITED(dst) ? WEXITSTATUS(dst) : WTERMSIG(dst));
+        rc = eval_score(s, c, sc, res, err, errlen);
+    }
+    if (!out) eval_series_free(&local);
+    if (!env->verbose) unlink(log);
+    return rc;
+}
+
+/* ---------------------------------------------------------------- requirements */
+static int joint_index(const eval_scene *sc, const char *name)
+{
+    for (int j = 0; j < sc->nj; j++)
+        if (!strcmp(sc->joint[j], name)) return j;
+    return -1;
+}
+
+int eval_require_check(const lag_require *req, const eval_scene *sc, char *err, size_t len)
+{
+    for (int i = 0; i < req->n; i++)
+        if (joint_index(sc, req->term[i].joint) < 0) {
+            char names[256] = "";
+            for (int j = 0; j < sc->nj; j++) {
+                size_t u = strlen(names);
+                snprintf(names + u, sizeof names - u, "%s%s", j ? ", " : "", sc->joint[j]);
+            }
+            snprintf(err, len, "--require: the %s has no joint '%s' (it has %s)", sc->model,
+                     req->term[i].joint, names);
+            return -1;
+        }
+    return 0;
+}
+
+bool eval_require_holds(const lag_require *req, const eval_scene *sc, const eval_result *res,
+                        char *why, size_t len)
+{
+    for (int i = 0; i < req->n; i++) {
+        int j = joint_index(sc, req->term[i].joint);
+        if (j < 0 || !lag_require_term_holds(&req->term[i], &res->m[j])) {
+            char t[160];
+            lag_require_term_format(&req->term[i], t, sizeof t);
+            char v[32];
+            eval_fmt(j < 0 ? NAN : res->m[j].v[req->term[i].metric], v, sizeof v);
+            snprintf(why, len, "%s fails (%s)", t, v);
+            return false;
+        }
+    }
+    return true;
+}
+
+void eval_fmt(double v, char *buf, size_t len)
+{
+    if (isnan(v)) snprintf(buf, len, "nan");
+    else snprintf(buf, len, "%.6g", v);
+}

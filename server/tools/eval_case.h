@@ -1,0 +1,130 @@
+/*
+ * lagsim-eval's and lagsim-sweep's common part: the cases of an evaluation, one run of a
+ * case against a controller, and what a run is reported as.
+ *
+ * A case is a list of scene overrides (the --set strings lagsimd takes), a duration and
+ * optional bounds, read from the `cases:` key of a scene file or of a suite file:
+ *
+ *   cases:
+ *     - name: tilt
+ *       duration: 5
+ *       set: ["initial.q=[0, 0.1]", "parameters.m1=0.2"]
+ *       bounds: {theta: 0.5}          # the case fails once |theta| > 0.5
+ *
+ * A run: lagsimd on the scene and the case's overrides in lockstep, with --log to a file
+ * of the run's own, on an LCM URL and a channel prefix of the run's own (no crosstalk),
+ * against the controller command (a shell command; {prefix} and {url} in it are replaced,
+ * and LCM_DEFAULT_URL and LAGSIM_PREFIX are set in its environment). The log is then read
+ * with the bounded log reader and each joint's series handed to the metrics library
+ * (metrics.h): nothing here computes a metric.
+ */
+#ifndef LAGSIM_EVAL_CASE_H
+#define LAGSIM_EVAL_CASE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "metrics.h"
+
+#define EVAL_NAME_LEN 64
+#define EVAL_SETS_MAX 32
+#define EVAL_SET_LEN 512
+#define EVAL_JOINTS_MAX 8
+#define EVAL_CASES_MAX 256
+
+typedef struct eval_case {
+    char name[EVAL_NAME_LEN];
+    double duration;                       /* sim s */
+    int nsets;
+    char set[EVAL_SETS_MAX][EVAL_SET_LEN]; /* "key=value", applied after the scene's file */
+    int nbounds;
+    char bound_joint[EVAL_JOINTS_MAX][EVAL_NAME_LEN];
+    double bound[EVAL_JOINTS_MAX];         /* |q| above it fails the case */
+} eval_case;
+
+/* Reads the `cases:` of a YAML file (a scene or a suite) into a new array of *n cases.
+ * Returns 0 (with *n = 0 when the file has no `cases:`), or -1 with "file:line:column:
+ * what was expected" in err. OUT: cases, n */
+int eval_cases_load(const char *path, eval_case **cases, int *n, char *err, size_t errlen);
+
+/* The scene's facts a run needs, from the scene file and the case's overrides, validated
+ * as lagsimd validates them (so a bad override is reported before anything runs). */
+typedef struct eval_scene {
+    char model[EVAL_NAME_LEN];
+    int nj;
+    char joint[EVAL_JOINTS_MAX][EVAL_NAME_LEN];
+    bool angular[EVAL_JOINTS_MAX];
+    bool actuated[EVAL_JOINTS_MAX];
+    double period;                          /* s, 1 / publish_hz */
+    double q0[EVAL_JOINTS_MAX], qd0[EVAL_JOINTS_MAX]; /* initial state */
+} eval_scene;
+
+/* Loads CONFIG with the overrides (nsets of them); -1 and the loader's message in err. */
+int eval_scene_load(const char *config, const char *const *sets, int nsets,
+                    eval_scene *sc /* OUT */, char *err, size_t errlen);
+
+typedef struct eval_env {
+    const char *lagsimd;     /* the daemon's path */
+    const char *config;      /* the scene file */
+    const char *controller;  /* shell command */
+    const char *workdir;     /* where the run's log goes */
+    char url[160];           /* the run's LCM URL */
+    char prefix[64];         /* the run's channel prefix */
+    double wall_timeout;     /* s a run may take before it is stopped (and failed) */
+    bool verbose;            /* pass the daemon's and the controller's output through */
+} eval_env;
+
+/* The URL of worker number `slot` of this process: a multicast port of its own. */
+void eval_url(int slot, char *url, size_t len);
+
+/* A joint's samples as logged: t, q, r (0 without a reference channel) and u (the
+ * effort held from t[k] to t[k+1]: the next state's effort). */
+typedef struct eval_series {
+    size_t n, cap;
+    double *t;
+    double *q[EVAL_JOINTS_MAX];
+    double *r[EVAL_JOINTS_MAX];
+    double *u[EVAL_JOINTS_MAX];
+    bool has_reference;      /* the log had <PREFIX>_REFERENCE states */
+} eval_series;
+
+void eval_series_free(eval_series *s);
+
+typedef struct eval_result {
+    bool failed;
+    char reason[256];        /* why it failed ("" if it did not) */
+    int nj;
+    lag_metrics m[EVAL_JOINTS_MAX];
+    double max_abs_q[EVAL_JOINTS_MAX];
+    double t_end;            /* last state's sim time */
+    size_t states;
+} eval_result;
+
+/* Runs a case (its overrides and `extra` ones after them) and fills res and, when s is
+ * not NULL, the series. Returns 0 when the run could be evaluated (failed or not), -1
+ * with a message in err when it could not be run at all. */
+int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, int nextra,
+             const eval_scene *sc, eval_result *res /* OUT */, eval_series *s /* OUT */,
+             char *err, size_t errlen);
+
+/* Reads a run's log (path) for a scene: each joint's series, and whether a fault or an
+ * early stop happened (res->failed, res->reason). OUT: s, res */
+int eval_read_log(const char *path, const char *prefix, const eval_scene *sc, double duration,
+                  eval_series *s, eval_result *res, char *err, size_t errlen);
+
+/* Metrics of each joint and the bounds of the case: fills res->m, res->max_abs_q, and
+ * fails res on a bound passed. Returns -1 with a message when a series is no run. */
+int eval_score(const eval_series *s, const eval_case *c, const eval_scene *sc,
+               eval_result *res, char *err, size_t errlen);
+
+/* Whether a requirement holds for a result; the first term that fails written to why. */
+bool eval_require_holds(const lag_require *req, const eval_scene *sc, const eval_result *res,
+                        char *why, size_t len);
+
+/* -1 and a message when a requirement names a joint the scene does not have. */
+int eval_require_check(const lag_require *req, const eval_scene *sc, char *err, size_t len);
+
+/* A number for tables and CSVs: %.6g, "nan" for none. */
+void eval_fmt(double v, char *buf, size_t len);
+
+#endif

@@ -1,0 +1,778 @@
+/*
+ * lagsim-sweep: Monte Carlo and grid sweeps of an evaluation case over scene keys, each run
+ * evaluated as lagsim-eval evaluates a case (eval_case.h); the CSV of the runs, a summary
+ * (pass rate, percentiles of each metric), a PNG of a metric against each varied key;
+ * shards (--shard K/N) and `lagsim-sweep merge` for sweeps spread over machines.
+ *
+ * Reproducible: run i's values come from (seed, i, the key's index) alone, never from
+ * the worker or the shard that runs it, and rows are written in run order, so the same
+ * seed gives the same CSV bit for bit whatever -j and however it is sharded and merged.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <libgen.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "eval_case.h"
+#include "lagsim_out.h"
+
+static const char *prog = "lagsim-sweep";
+
+#define VARY_MAX 16
+#define ROW_MAX 8192
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+"usage: lagsim-sweep --config SCENE --controller 'COMMAND' (--case NAME | --duration S)\n"
+"                    --vary KEY=DIST ... [--runs N] [--seed S] [-j N] [--shard K/N]\n"
+"                    [--suite FILE] [--require EXPR] [--csv OUT.csv] [--plot OUT.png]\n"
+"                    [--metric JOINT.METRIC] [--force] [--lagsimd PATH] [--timeout S] [-v]\n"
+"       lagsim-sweep merge A.csv B.csv ... -o OUT.csv [--force]\n"
+"\n"
+"Runs an evaluation case (lagsim-eval's) over scene keys drawn at random or on a grid,\n"
+"each run in lockstep against the controller, and writes one CSV row per run: the\n"
+"values, the verdict and every joint's metrics; prints the pass rate and percentiles.\n"
+"\n"
+"options:\n"
+"  -c, --config SCENE     the scene file (lagsimd's)\n"
+"  -C, --controller CMD   the controller's shell command ({prefix}, {url} replaced)\n"
+"      --case NAME        the case to vary (from the scene's or the suite's cases:)\n"
+"      --suite FILE       take the cases from FILE\n"
+"  -d, --duration S       without --case: a case of S sim seconds and no overrides\n"
+"      --vary KEY=DIST    a scene key (as lagsimd --set; initial.q[i], initial.qd[i]\n"
+"                         for one coordinate) and its values: uniform(A,B),\n"
+"                         normal(MEAN,SD) or grid(A,B,N) (N values from A to B);\n"
+"                         repeatable: grids multiply, random keys are drawn per run\n"
+"  -n, --runs N           runs (per grid point when there are grids; default 1)\n"
+"      --seed S           the seed of every random value (default 1)\n"
+"  -j, --jobs N           runs at once on this machine (default 1)\n"
+"      --shard K/N        only runs i with i mod N = K - 1 (K = 1..N): one machine's\n"
+"                         part; lagsim-sweep merge joins the parts\n"
+"      --require EXPR     a run that misses EXPR does not pass (as lagsim-eval)\n"
+"      --csv OUT.csv      the runs' CSV\n"
+"      --plot OUT.png     --metric against each varied key (gnuplot)\n"
+"      --metric J.M       the metric drawn (default: --require's first, else the first\n"
+"                         joint's iae)\n"
+"  -f, --force            replace existing output files\n"
+"      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
+"      --timeout S        wall seconds a run may take (default 600)\n"
+"  -v, --verbose          pass the daemon's and the controller's output through\n"
+"  -o, --output OUT.csv   merge: the joined CSV\n"
+"  -h, --help             this help\n"
+"\n"
+"exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
+"case error, or shard CSVs that do not belong together\n");
+}
+
+static int die(const char *fmt, const char *a)
+{
+    fprintf(stderr, "%s: ", prog);
+    fprintf(stderr, fmt, a);
+    fputc('\n', stderr);
+    return 2;
+}
+
+/* ---------------------------------------------------------------- varied keys */
+typedef enum { V_UNIFORM, V_NORMAL, V_GRID } vary_kind;
+
+typedef struct vary {
+    char text[EVAL_SET_LEN];  /* as given, the CSV column's name is its key */
+    char key[EVAL_SET_LEN];   /* "parameters.m1", "initial.q" */
+    int index;                /* initial.q[i]: i; else -1 */
+    vary_kind kind;
+    double a, b;
+    long n;                   /* grid points */
+} vary;
+
+static int parse_vary(const char *text, vary *v)
+{
+    memset(v, 0, sizeof *v);
+    snprintf(v->text, sizeof v->text, "%s", text);
+    const char *eq = strchr(text, '=');
+    if (!eq || eq == text || (size_t)(eq - text) >= sizeof v->key) return -1;
+    memcpy(v->key, text, (size_t)(eq - text));
+    v->index = -1;
+    char *br = strchr(v->key, '[');
+    if (br) {
+        char *end;
+        long i = strtol(br + 1, &end, 10);
+        if (end == br + 1 || strcmp(end, "]") || i < 0 || i >= EVAL_JOINTS_MAX) return -1;
+        if (strncmp(v->key, "initial.q[", 10) && strncmp(v->key, "initial.qd[", 11)) return -1;
+        *br = '\0';
+        v->index = (int)i;
+    }
+    const char *d = eq + 1;
+    double a, b, n;
+    char tail;
+    /* the distribution ends at its ')': nothing may follow it */
+    const char *close = strchr(d, ')');
+    if (!close || close[1] != '\0') return -1;
+    if (sscanf(d, "uniform(%lf ,%lf%c", &a, &b, &tail) == 3 && tail == ')' && a < b &&
+        isfinite(a) && isfinite(b)) {
+        v->kind = V_UNIFORM, v->a = a, v->b = b;
+    } else if (sscanf(d, "normal(%lf ,%lf%c", &a, &b, &tail) == 3 && tail == ')' && b >= 0 &&
+               isfinite(a) && isfinite(b)) {
+        v->kind = V_NORMAL, v->a = a, v->b = b;
+    } else if (sscanf(d, "grid(%lf ,%lf ,%lf%c", &a, &b, &n, &tail) == 4 && tail == ')' &&
+               isfinite(a) && isfinite(b) && n >= 1 && n <= 1e6 && n == floor(n) &&
+               (n == 1 || a != b)) {
+        v->kind = V_GRID, v->a = a, v->b = b, v->n = (long)n;
+    } else {
+        return -1;
+    }
+    return 0;
+}
+
+/* splitmix64: one 64-bit mix of (seed, run, key, draw), the only source of randomness */
+static uint64_t mix(uint64_t z)
+{
+    z += 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+static double unit(uint64_t seed, long run, int key, int draw)
+{
+    uint64_t z = mix(mix(mix(seed) ^ (uint64_t)run) ^ ((uint64_t)key << 8 | (uint64_t)draw));
+    return ((double)(z >> 11) + 0.5) * 0x1.0p-53; /* in (0, 1) */
+}
+
+/* The value of key k in run i: grids by the run's grid point, the others drawn. */
+static double vary_value(const vary *vs, int nv, int k, long run, long runs_per_point,
+                         uint64_t seed)
+{
+    const vary *v = &vs[k];
+    if (v->kind == V_GRID) {
+        long point = run / runs_per_point;
+        for (int g = nv - 1; g > k; g--)
+            if (vs[g].kind == V_GRID) point /= vs[g].n;
+        long at = point % v->n;
+        return v->n == 1 ? v->a : v->a + (v->b - v->a) * (double)at / (double)(v->n - 1);
+    }
+    double u1 = unit(seed, run, k, 0);
+    if (v->kind == V_UNIFORM) return v->a + (v->b - v->a) * u1;
+    double u2 = unit(seed, run, k, 1); /* Box-Muller */
+    return v->a + v->b * sqrt(-2.0 * log(u1)) * cos(2.0 * M_PI * u2);
+}
+
+/* The --set strings of a run: keys as they are, coordinates joined into their list. */
+static int run_sets(const vary *vs, int nv, const double *val, const eval_scene *sc,
+                    char sets[][EVAL_SET_LEN])
+{
+    int n = 0;
+    double q[EVAL_JOINTS_MAX], qd[EVAL_JOINTS_MAX];
+    bool has_q = false, has_qd = false;
+    memcpy(q, sc->q0, sizeof q);
+    memcpy(qd, sc->qd0, sizeof qd);
+    for (int k = 0; k < nv; k++) {
+        if (vs[k].index < 0) {
+            snprintf(sets[n++], EVAL_SET_LEN, "%s=%.17g", vs[k].key, val[k]);
+        } else if (!strcmp(vs[k].key, "initial.q")) {
+            q[vs[k].index] = val[k], has_q = true;
+        } else {
+            qd[vs[k].index] = val[k], has_qd = true;
+        }
+    }
+    for (int w = 0; w < 2; w++) {
+        if (!(w ? has_qd : has_q)) continue;
+        const double *x = w ? qd : q;
+        size_t u = (size_t)snprintf(sets[n], EVAL_SET_LEN, "initial.%s=[", w ? "qd" : "q");
+        for (int j = 0; j < sc->nj && u < EVAL_SET_LEN; j++)
+            u += (size_t)snprintf(sets[n] + u, EVAL_SET_LEN - u, "%s%.17g", j ? ", " : "", x[j]);
+        if (u < EVAL_SET_LEN) snprintf(sets[n] + u, EVAL_SET_LEN - u, "]");
+        n++;
+    }
+    return n;
+}
+
+/* ---------------------------------------------------------------- CSV rows */
+typedef struct rows {
+    int n, cap;
+    long *run;
+    char **line;
+} rows;
+
+static int rows_add(rows *r, long run, const char *line)
+{
+    if (r->n == r->cap) {
+        int cap = r->cap ? 2 * r->cap : 256;
+        long *ru = realloc(r->run, (size_t)cap * sizeof *ru);
+        if (!ru) return -1;
+        r->run = ru;
+        char **li = realloc(r->line, (size_t)cap * sizeof *li);
+        if (!li) return -1;
+        r->line = li;
+        r->cap = cap;
+    }
+    r->run[r->n] = run;
+    r->line[r->n] = strdup(line);
+    return r->line[r->n++] ? 0 : -1;
+}
+
+static void rows_free(rows *r)
+{
+    for (int i = 0; i < r->n; i++) free(r->line[i]);
+    free(r->run);
+    free(r->line);
+    memset(r, 0, sizeof *r);
+}
+
+static rows *sort_rows;
+static int by_run(const void *a, const void *b)
+{
+    long x = sort_rows->run[*(const int *)a], y = sort_rows->run[*(const int *)b];
+    return (x > y) - (x < y);
+}
+
+/* Writes the rows in run order; -1 on two rows of one run. */
+static int rows_write(rows *r, FILE *f, const char *header, char *err, size_t errlen)
+{
+    int *ord = malloc((size_t)(r->n ? r->n : 1) * sizeof *ord);
+    if (!ord) return -1;
+    for (int i = 0; i < r->n; i++) ord[i] = i;
+    sort_rows = r;
+    qsort(ord, (size_t)r->n, sizeof *ord, by_run);
+    for (int i = 1; i < r->n; i++)
+        if (r->run[ord[i]] == r->run[ord[i - 1]]) {
+            snprintf(err, errlen, "run %ld appears twice", r->run[ord[i]]);
+            free(ord);
+            return -1;
+        }
+    fprintf(f, "%s\n", header);
+    for (int i = 0; i < r->n; i++) fprintf(f, "%s\n", r->line[ord[i]]);
+    free(ord);
+    return 0;
+}
+
+/* The CSV fields of a line (reason quoted, the others plain): pointers into buf. */
+static int split(char *buf, char **field, int max)
+{
+    int n = 0;
+    char *p = buf;
+    while (n < max) {
+        if (*p == '"') {
+            field[n++] = ++p;
+            while (*p && !(*p == '"' && p[1] != '"')) p += *p == '"' ? 2 : 1;
+            if (*p) *p++ = '\0';
+        } else {
+            field[n++] = p;
+            p += strcspn(p, ",");
+        }
+        if (*p != ',') {
+            *p = '\0';
+            break;
+        }
+        *p++ = '\0';
+    }
+    return n;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double pct(const double *v, int n, double p)
+{
+    double at = p * (n - 1);
+    int lo = (int)floor(at);
+    if (lo >= n - 1) return v[n - 1];
+    return v[lo] + (v[lo + 1] - v[lo]) * (at - lo);
+}
+
+/* Pass rate and percentiles of every metric column, from the CSV's rows. */
+static void summary(const char *header, rows *r)
+{
+    char hb[ROW_MAX];
+    snprintf(hb, sizeof hb, "%s", header);
+    char *hf[512];
+    int nh = split(hb, hf, 512);
+    int c_failed = -1, c_req = -1, c_first = -1;
+    for (int i = 0; i < nh; i++) {
+        if (!strcmp(hf[i], "failed")) c_failed = i;
+        if (!strcmp(hf[i], "required")) c_req = i;
+        if (!strcmp(hf[i], "reason")) c_first = i + 1;
+    }
+    if (c_failed < 0 || c_req < 0 || c_first < 0) return;
+    int pass = 0, failed = 0;
+    double *vals = malloc((size_t)(r->n ? r->n : 1) * (size_t)nh * sizeof *vals);
+    int *nv = calloc((size_t)nh, sizeof *nv);
+    if (!vals || !nv) {
+        free(vals), free(nv);
+        return;
+    }
+    for (int i = 0; i < r->n; i++) {
+        char lb[ROW_MAX];
+        snprintf(lb, sizeof lb, "%s", r->line[i]);
+        char *f[512];
+        int n = split(lb, f, 512);
+        if (n != nh) continue;
+        bool fl = !strcmp(f[c_failed], "1"), ok = !fl && !strcmp(f[c_req], "1");
+        pass += ok, failed += fl;
+        for (int c = c_first; c < nh; c++) {
+            double x = strtod(f[c], NULL);
+            if (isfinite(x)) vals[(size_t)c * (size_t)r->n + (size_t)nv[c]++] = x;
+        }
+    }
+    printf("%d runs: %d passed (%.1f %%), %d failed, %d missed --require\n", r->n, pass,
+           r->n ? 100.0 * pass / r->n : 0.0, failed, r->n - pass - failed);
+    printf("%-22s %6s %12s %12s %12s %12s %12s\n", "metric", "n", "min", "p5", "p50", "p95",
+           "max");
+    for (int c = c_first; c < nh; c++) {
+        double *v = vals + (size_t)c * (size_t)r->n;
+        if (!nv[c]) {
+            printf("%-22s %6d %12s\n", hf[c], 0, "none");
+            continue;
+        }
+        qsort(v, (size_t)nv[c], sizeof *v, cmp_double);
+        printf("%-22s %6d %12.6g %12.6g %12.6g %12.6g %12.6g\n", hf[c], nv[c], v[0],
+               pct(v, nv[c], 0.05), pct(v, nv[c], 0.5), pct(v, nv[c], 0.95), v[nv[c] - 1]);
+    }
+    free(vals);
+    free(nv);
+}
+
+static FILE *open_out(const char *what, const char *path, bool force, const char *const *in,
+                      int nin)
+{
+    char err[512];
+    int fd = lag_out_open(what, path, force, in, nin, 0, err, sizeof err);
+    if (fd < 0) {
+        fprintf(stderr, "%s: %s\n", prog, err);
+        return NULL;
+    }
+    return fdopen(fd, "w");
+}
+
+/* ---------------------------------------------------------------- merge */
+static int merge(int argc, char **argv)
+{
+    const char *out = NULL;
+    bool force = false;
+    const char *in[256];
+    int nin = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output")) {
+            if (++i == argc) return die("%s needs a value", argv[i - 1]);
+            out = argv[i];
+        } else if (!strcmp(argv[i], "-f") || !strcmp(argv[i], "--force")) {
+            force = true;
+        } else if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
+            usage(stdout);
+            return 0;
+        } else if (argv[i][0] == '-') {
+            return die("merge: unknown option '%s' (try --help)", argv[i]);
+        } else if (nin < 256) {
+            in[nin++] = argv[i];
+        }
+    }
+    if (!nin) return die("%s", "merge: expected the shards' CSV files (try --help)");
+    if (!out) return die("%s", "merge: -o OUT.csv is required");
+    rows r = {0};
+    char header[ROW_MAX] = "", line[ROW_MAX];
+    for (int k = 0; k < nin; k++) {
+        FILE *f = fopen(in[k], "r");
+        if (!f) {
+            fprintf(stderr, "%s: %s: %s\n", prog, in[k], strerror(errno));
+            rows_free(&r);
+            return 2;
+        }
+        int ln = 0, bad = 0;
+        while (fgets(line, sizeof line, f)) {
+            ln++;
+            size_t len = strlen(line);
+            if (len && line[len - 1] == '\n') line[--len] = '\0';
+            if (ln == 1) {
+                if (strncmp(line, "run,", 4)) bad = 1;
+                else if (k && strcmp(header, line)) bad = 2;
+                else snprintf(header, sizeof header, "%s", line);
+            } else {
+                char *end;
+                long run = strtol(line, &end, 10);
+                if (end == line || *end != ',' || rows_add(&r, run, line)) bad = 3;
+            }
+            if (bad) {
+                fprintf(stderr, "%s: %s:%d: %s\n", prog, in[k], ln,
+                        bad == 1 ? "not a lagsim-sweep CSV (its header starts with 'run,')"
+                        : bad == 2 ? "another sweep's header than the first file's"
+                                   : "expected a row starting with its run number");
+                fclose(f);
+                rows_free(&r);
+                return 2;
+            }
+        }
+        fclose(f);
+    }
+    FILE *fo = open_out("-o", out, force, in, nin);
+    if (!fo) {
+        rows_free(&r);
+        return 2;
+    }
+    char err[256];
+    int rc = rows_write(&r, fo, header, err, sizeof err);
+    if (fclose(fo) != 0 || rc) {
+        fprintf(stderr, "%s: merge: %s\n", prog, rc ? err : strerror(errno));
+        unlink(out);
+        rows_free(&r);
+        return 2;
+    }
+    summary(header, &r);
+    rows_free(&r);
+    return 0;
+}
+
+/* ---------------------------------------------------------------- plot */
+static int plot(const char *png, bool force, const char *config, const char *header, rows *r,
+                int nv, const char *metric)
+{
+    char hb[ROW_MAX];
+    snprintf(hb, sizeof hb, "%s", header);
+    char *hf[512];
+    int nh = split(hb, hf, 512), cm = -1, cf = -1, finite = 0;
+    for (int i = 0; i < nh; i++) {
+        if (!strcmp(hf[i], metric)) cm = i;
+        if (!strcmp(hf[i], "failed")) cf = i;
+    }
+    if (cm < 0) {
+        fprintf(stderr, "%s: --metric %s: no such column\n", prog, metric);
+        return -1;
+    }
+    char dat[4200], gp[4200];
+    snprintf(dat, sizeof dat, "%s.dat", png);
+    snprintf(gp, sizeof gp, "%s.gp", png);
+    const char *in[1] = {config};
+    FILE *f = open_out("--plot", dat, force, in, 1);
+    if (!f) return -1;
+    for (int i = 0; i < r->n; i++) {
+        char lb[ROW_MAX];
+        snprintf(lb, sizeof lb, "%s", r->line[i]);
+        char *fl[512];
+        if (split(lb, fl, 512) != nh) continue;
+        for (int k = 0; k < nv; k++) fprintf(f, "%s ", fl[1 + k]);
+        /* passed: not failed and --require met */
+        fprintf(f, "%s %d\n", fl[cm], !strcmp(fl[cf], "0") && !strcmp(fl[cf + 1], "1"));
+        finite += isfinite(strtod(fl[cm], NULL));
+    }
+    fclose(f);
+    if (!finite) {
+        fprintf(stderr, "%s: --plot: %s is none in every run: nothing to draw\n", prog,
+                metric);
+        unlink(dat);
+        return 0;
+    }
+    f = open_out("--plot", gp, force, in, 1);
+    if (!f) return -1;
+    fprintf(f, "set terminal pngcairo noenhanced size %d,420 font ',10'\n", 420 * nv + 80);
+    fprintf(f, "set output '%s'\nset grid\nset datafile missing 'nan'\n", png);
+    fprintf(f, "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n");
+    fprintf(f, "set multiplot layout 1,%d title '%d runs: %s (red: did not pass)'\n", nv, r->n,
+            metric);
+    for (int k = 0; k < nv; k++)
+        fprintf(f, "set xlabel '%s'\nset ylabel '%s'\nplot '%s' u %d:($%d == 1 ? $%d : 1/0) "
+                   "pt 7 ps 0.6 lc rgb '#1f77b4' t 'passed', '' u %d:($%d == 0 ? $%d : 1/0) "
+                   "pt 7 ps 0.6 lc rgb '#d62728' t 'did not pass'\n",
+                hf[1 + k], metric, dat, k + 1, nv + 2, nv + 1, k + 1, nv + 2, nv + 1);
+    fprintf(f, "unset multiplot\n");
+    fclose(f);
+    f = open_out("--plot", png, force, in, 1);
+    if (!f) return -1;
+    fclose(f);
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        execlp("gnuplot", "gnuplot", gp, (char *)NULL);
+        _exit(127);
+    }
+    int st = 0;
+    if (pid < 0 || waitpid(pid, &st, 0) < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        fprintf(stderr, "%s: gnuplot failed on %s\n", prog, gp);
+        return -1;
+    }
+    return 0;
+}
+
+/* ---------------------------------------------------------------- the sweep */
+static void default_lagsimd(char *buf, size_t len)
+{
+    char self[4096];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n > 0) {
+        self[n] = '\0';
+        snprintf(buf, len, "%s/lagsimd", dirname(self));
+        if (access(buf, X_OK) == 0) return;
+    }
+    snprintf(buf, len, "lagsimd");
+}
+
+static double parse_pos(const char *opt, const char *s, double lo, double hi, int *bad)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end || !(v >= lo && v <= hi)) {
+        fprintf(stderr, "%s: %s: expected a number from %g to %g, got '%s'\n", prog, opt, lo,
+                hi, s);
+        *bad = 1;
+    }
+    return v;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1 && !strcmp(argv[1], "merge")) return merge(argc - 1, argv + 1);
+    const char *config = NULL, *controller = NULL, *suite = NULL, *case_name = NULL;
+    const char *require = NULL, *csv = NULL, *png = NULL, *metric = NULL;
+    double duration = 0, timeout = 600;
+    long runs = 1, jobs = 1, shard_k = 1, shard_n = 1;
+    uint64_t seed = 1;
+    bool force = false, verbose = false;
+    vary vs[VARY_MAX];
+    int nv = 0, bad = 0;
+    char lagsimd[4096];
+    default_lagsimd(lagsimd, sizeof lagsimd);
+    enum { O_CASE = 256, O_SUITE, O_VARY, O_SEED, O_SHARD, O_REQUIRE, O_CSV, O_PLOT, O_METRIC,
+           O_LAGSIMD, O_TIMEOUT };
+    static const struct option opts[] = {
+        {"config", required_argument, 0, 'c'},      {"controller", required_argument, 0, 'C'},
+        {"case", required_argument, 0, O_CASE},     {"suite", required_argument, 0, O_SUITE},
+        {"duration", required_argument, 0, 'd'},    {"vary", required_argument, 0, O_VARY},
+        {"runs", required_argument, 0, 'n'},        {"seed", required_argument, 0, O_SEED},
+        {"jobs", required_argument, 0, 'j'},        {"shard", required_argument, 0, O_SHARD},
+        {"require", required_argument, 0, O_REQUIRE}, {"csv", required_argument, 0, O_CSV},
+        {"plot", required_argument, 0, O_PLOT},     {"metric", required_argument, 0, O_METRIC},
+        {"force", no_argument, 0, 'f'},             {"lagsimd", required_argument, 0, O_LAGSIMD},
+        {"timeout", required_argument, 0, O_TIMEOUT}, {"verbose", no_argument, 0, 'v'},
+        {"help", no_argument, 0, 'h'},              {0, 0, 0, 0}};
+    int o;
+    opterr = 0;
+    while ((o = getopt_long(argc, argv, ":c:C:d:n:j:fvh", opts, NULL)) != -1) {
+        switch (o) {
+        case 'c': config = optarg; break;
+        case 'C': controller = optarg; break;
+        case O_CASE: case_name = optarg; break;
+        case O_SUITE: suite = optarg; break;
+        case 'd': duration = parse_pos("--duration", optarg, 1e-3, 1e6, &bad); break;
+        case O_VARY:
+            if (nv == VARY_MAX) return die("at most %s --vary", "16");
+            if (parse_vary(optarg, &vs[nv++]))
+                return die("--vary %s: expected KEY=uniform(A,B) (A < B), KEY=normal(MEAN,SD) "
+                           "or KEY=grid(A,B,N); an index only on initial.q[i] or "
+                           "initial.qd[i]", optarg);
+            break;
+        case 'n': runs = (long)parse_pos("--runs", optarg, 1, 1e7, &bad); break;
+        case O_SEED: seed = (uint64_t)parse_pos("--seed", optarg, 0, 9e15, &bad); break;
+        case 'j': jobs = (long)parse_pos("--jobs", optarg, 1, 256, &bad); break;
+        case O_SHARD:
+            if (sscanf(optarg, "%ld/%ld", &shard_k, &shard_n) != 2 || shard_n < 1 ||
+                shard_k < 1 || shard_k > shard_n)
+                return die("--shard: expected K/N with 1 <= K <= N, got '%s'", optarg);
+            break;
+        case O_REQUIRE: require = optarg; break;
+        case O_CSV: csv = optarg; break;
+        case O_PLOT: png = optarg; break;
+        case O_METRIC: metric = optarg; break;
+        case 'f': force = true; break;
+        case O_LAGSIMD: snprintf(lagsimd, sizeof lagsimd, "%s", optarg); break;
+        case O_TIMEOUT: timeout = parse_pos("--timeout", optarg, 1, 1e6, &bad); break;
+        case 'v': verbose = true; break;
+        case 'h': usage(stdout); return 0;
+        case ':': return die("%s needs a value (try --help)", argv[optind - 1]);
+        default: return die("unknown option '%s' (try --help)", argv[optind - 1]);
+        }
+        if (bad) return 2;
+    }
+    if (optind < argc) return die("unexpected argument '%s' (try --help)", argv[optind]);
+    if (!config) return die("%s", "--config SCENE is required (try --help)");
+    if (!controller) return die("%s", "--controller 'COMMAND' is required (try --help)");
+    if (!nv) return die("%s", "at least one --vary KEY=DIST is required (try --help)");
+    if (!case_name == !duration) return die("%s", "give either --case NAME or --duration S");
+
+    char err[2048];
+    eval_case c;
+    memset(&c, 0, sizeof c);
+    if (case_name) {
+        eval_case *cases = NULL;
+        int ncases = 0;
+        if (eval_cases_load(suite ? suite : config, &cases, &ncases, err, sizeof err))
+            return die("%s", err);
+        int found = -1;
+        for (int k = 0; k < ncases; k++)
+            if (!strcmp(cases[k].name, case_name)) found = k;
+        if (found < 0) {
+            free(cases);
+            fprintf(stderr, "%s: --case %s: no such case in %s\n", prog, case_name,
+                    suite ? suite : config);
+            return 2;
+        }
+        c = cases[found];
+        free(cases);
+    } else {
+        snprintf(c.name, sizeof c.name, "sweep");
+        c.duration = duration;
+    }
+    const char *sets[EVAL_SETS_MAX];
+    for (int i = 0; i < c.nsets; i++) sets[i] = c.set[i];
+    eval_scene sc;
+    if (eval_scene_load(config, sets, c.nsets, &sc, err, sizeof err))
+        return die("%s", err);
+    for (int k = 0; k < nv; k++)
+        if (vs[k].index >= sc.nj)
+            return die("--vary %s: the scene's model has fewer coordinates", vs[k].text);
+    lag_require req = {0};
+    if (require && (lag_require_parse(require, &req, err, sizeof err) ||
+                    eval_require_check(&req, &sc, err, sizeof err)))
+        return die("--require: %s", err);
+
+    long per_point = runs, total = runs;
+    for (int k = 0; k < nv; k++)
+        if (vs[k].kind == V_GRID) total *= vs[k].n;
+    if (total > 10000000) return die("%s", "more than 1e7 runs");
+
+    /* the CSV's header: run, the keys, the verdict, each joint's metrics */
+    char header[ROW_MAX];
+    size_t hu = (size_t)snprintf(header, sizeof header, "run");
+    for (int k = 0; k < nv; k++) {
+        if (vs[k].index < 0)
+            hu += (size_t)snprintf(header + hu, sizeof header - hu, ",%s", vs[k].key);
+        else
+            hu += (size_t)snprintf(header + hu, sizeof header - hu, ",%s[%d]", vs[k].key,
+                                   vs[k].index);
+    }
+    hu += (size_t)snprintf(header + hu, sizeof header - hu, ",failed,required,reason");
+    for (int j = 0; j < sc.nj; j++)
+        for (int m = 0; m < LAG_METRIC_COUNT; m++)
+            hu += (size_t)snprintf(header + hu, sizeof header - hu, ",%s.%s", sc.joint[j],
+                                   lag_metric_table[m].name);
+    char default_metric[160];
+    snprintf(default_metric, sizeof default_metric, "%s.%s",
+             req.n ? req.term[0].joint : sc.joint[0],
+             lag_metric_table[req.n ? req.term[0].metric : LAG_METRIC_IAE].name);
+    if (!metric) metric = default_metric;
+
+    FILE *fcsv = NULL;
+    const char *in[2] = {config, suite};
+    if (csv && !(fcsv = open_out("--csv", csv, force, in, 2))) return 2;
+
+    char tmpdir[] = "/tmp/lagsim-sweep.XXXXXX";
+    if (!mkdtemp(tmpdir)) {
+        fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
+        return 2;
+    }
+    /* workers: worker w runs this shard's runs i with (i / shard_n) mod jobs = w */
+    pid_t pids[256];
+    for (long w = 0; w < jobs; w++) {
+        fflush(NULL);
+        pids[w] = fork();
+        if (pids[w] < 0) {
+            fprintf(stderr, "%s: fork: %s\n", prog, strerror(errno));
+            return 2;
+        }
+        if (pids[w]) continue;
+        char path[256];
+        snprintf(path, sizeof path, "%s/%ld.rows", tmpdir, w);
+        FILE *f = fopen(path, "w");
+        if (!f) _exit(3);
+        int rc = 0;
+        for (long i = shard_k - 1; i < total; i += shard_n) {
+            if ((i / shard_n) % jobs != w) continue;
+            double val[VARY_MAX];
+            for (int k = 0; k < nv; k++) val[k] = vary_value(vs, nv, k, i, per_point, seed);
+            char extra[VARY_MAX][EVAL_SET_LEN];
+            int nx = run_sets(vs, nv, val, &sc, extra);
+            const char *xp[VARY_MAX + EVAL_SETS_MAX];
+            for (int k = 0; k < c.nsets; k++) xp[k] = c.set[k];
+            for (int k = 0; k < nx; k++) xp[c.nsets + k] = extra[k];
+            eval_result res;
+            memset(&res, 0, sizeof res);
+            char why[512] = "";
+            eval_scene rsc;
+            /* a value the scene refuses (a negative mass) is a failed run, not an abort */
+            if (eval_scene_load(config, xp, c.nsets + nx, &rsc, err, sizeof err)) {
+                res.failed = true;
+                snprintf(res.reason, sizeof res.reason, "refused: %.240s", err);
+                res.nj = sc.nj;
+                for (int j = 0; j < sc.nj; j++)
+                    for (int m = 0; m < LAG_METRIC_COUNT; m++) res.m[j].v[m] = NAN;
+            } else {
+                eval_env env = {.lagsimd = lagsimd, .config = config,
+                                .controller = controller, .workdir = tmpdir,
+                                .wall_timeout = timeout, .verbose = verbose};
+                eval_url((int)w, env.url, sizeof env.url);
+                snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_%ld", (int)getpid(), i);
+                if (eval_run(&env, &c, xp + c.nsets, nx, &rsc, &res, NULL, err, sizeof err)) {
+                    fprintf(stderr, "%s: run %ld: %s\n", prog, i, err);
+                    rc = 4;
+                    break;
+                }
+            }
+            bool met = !require || eval_require_holds(&req, &sc, &res, why, sizeof why);
+            /* one line per run: the run number first (the parent sorts by it) */
+            fprintf(f, "%ld", i);
+            for (int k = 0; k < nv; k++) fprintf(f, ",%.17g", val[k]);
+            const char *reason = res.failed ? res.reason : met ? "" : why;
+            fprintf(f, ",%d,%d,\"", res.failed, met);
+            for (const char *p = reason; *p; p++) {
+                if (*p == '"') fputc('"', f);
+                fputc(*p == '\n' ? ' ' : *p, f);
+            }
+            fputc('"', f);
+            for (int j = 0; j < sc.nj; j++)
+                for (int m = 0; m < LAG_METRIC_COUNT; m++) {
+                    if (isnan(res.m[j].v[m])) fprintf(f, ",nan");
+                    else fprintf(f, ",%.17g", res.m[j].v[m]);
+                }
+            fputc('\n', f);
+            fflush(f);
+        }
+        fclose(f);
+        _exit(rc);
+    }
+    int status = 0;
+    for (long w = 0; w < jobs; w++) {
+        int st = 0;
+        waitpid(pids[w], &st, 0);
+        if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) status = 2;
+    }
+    rows r = {0};
+    char line[ROW_MAX];
+    for (long w = 0; w < jobs; w++) {
+        char path[256];
+        snprintf(path, sizeof path, "%s/%ld.rows", tmpdir, w);
+        FILE *f = fopen(path, "r");
+        if (!f) continue;
+        while (fgets(line, sizeof line, f)) {
+            line[strcspn(line, "\n")] = '\0';
+            rows_add(&r, strtol(line, NULL, 10), line);
+        }
+        fclose(f);
+        unlink(path);
+    }
+    rmdir(tmpdir);
+    if (fcsv) {
+        if (rows_write(&r, fcsv, header, err, sizeof err) || fclose(fcsv) != 0) status = 2;
+    }
+    summary(header, &r);
+    int passed = 0;
+    for (int i = 0; i < r.n; i++) {
+        char lb[ROW_MAX];
+        snprintf(lb, sizeof lb, "%s", r.line[i]);
+        char *f[512];
+        int n = split(lb, f, 512);
+        passed += n > nv + 2 && !strcmp(f[nv + 1], "0") && !strcmp(f[nv + 2], "1");
+    }
+    if (png && plot(png, force, config, header, &r, nv, metric)) status = 2;
+    int all = passed == r.n;
+    rows_free(&r);
+    if (status) return status;
+    return all ? 0 : 1;
+}

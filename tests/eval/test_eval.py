@@ -1,0 +1,209 @@
+#!/usr/bin/env python3
+"""lagsim-eval end to end: the cart-pole held by lqr_balance through the cases of
+tests/eval/cartpole_cases.yaml.
+
+usage: test_eval.py BIN_DIR SOURCE_DIR CASE
+  metrics    each joint's metrics against an independent look at the logged states
+             (lagsim-log2csv's CSV of the run's kept log): settling time where |q| last
+             leaves the 2 % band, peak error, IAE by trapezoids, the effort's peak, and
+             the case that passes a bound fails
+  require    --require holding (exit 0), not holding (exit 1), naming an unknown joint
+             or metric (exit 2)
+  errors     a case file with a mistake: exit 2 and file:line:column
+  scene      cases in the scene file: lagsimd ignores them, lagsim-eval runs them
+"""
+import csv
+import glob
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+BIN, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
+SCENE = os.path.join(SRC, "config", "cartpole.yaml")
+SUITE = os.path.join(SRC, "tests", "eval", "cartpole_cases.yaml")
+CTRL = os.path.join(BIN, "lqr_balance") + " -q --prefix {prefix}"
+EVAL = os.path.join(BIN, "lagsim-eval")
+failures = []
+
+
+def check(ok, what):
+    print(("ok   " if ok else "FAIL ") + what)
+    if not ok:
+        failures.append(what)
+
+
+def run(*args, timeout=300):
+    p = subprocess.run([EVAL, "--config", SCENE, "--controller", CTRL] + list(args),
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                       universal_newlines=True, timeout=timeout)
+    print("$ lagsim-eval", " ".join(args), "->", p.returncode)
+    print(p.stdout[-3000:], p.stderr[-3000:])
+    return p
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def settle(t, q, band):
+    """The last time |q| leaves the band, interpolated linearly (0 if it never does)."""
+    last = None
+    for k in range(len(t) - 1):
+        a, b = abs(q[k]), abs(q[k + 1])
+        if a > band >= b:
+            # |q| is monotone across the sample pair here (one sign); linear crossing
+            qa, qb = q[k], q[k + 1]
+            s = band if qa > 0 else -band
+            last = t[k] + (t[k + 1] - t[k]) * (qa - s) / (qa - qb) if qa != qb else t[k + 1]
+        elif b > band:
+            last = math.inf  # still outside
+    return 0.0 if last is None else last
+
+
+def case_metrics():
+    with tempfile.TemporaryDirectory() as d:
+        rep = os.path.join(d, "report")
+        out = os.path.join(d, "eval.csv")
+        p = run("--suite", SUITE, "--case", "tilt", "--case", "push", "--case", "push_end",
+                "--csv", out, "--report", rep, "-v")
+        check(p.returncode == 0, "tilt, push and push_end pass (exit 0)")
+        rows = {(r["case"], r["joint"]): r for r in read_csv(out)}
+        cases = ("tilt", "push", "push_end")
+        check(set(rows) == {(c, j) for c in cases for j in ("x", "theta")},
+              "one CSV row per case and joint")
+        check(all(os.path.getsize(os.path.join(rep, c + ".png")) > 10000 for c in cases),
+              "a PNG report per case")
+        # the logs in case order (the prefix ends in the case's index in the suite)
+        logs = sorted(glob.glob(os.path.join(rep, "EVAL*_*.lcm")),
+                      key=lambda p: int(p.rsplit("_", 1)[1].split(".")[0]))
+        check(len(logs) == 3, "-v keeps each run's log (%d)" % len(logs))
+        for log, case in zip(logs, cases):
+            cdir = os.path.join(d, case)
+            subprocess.run([os.path.join(BIN, "lagsim-log2csv"), log, "-o", cdir, "-q"],
+                           check=True)
+            st = read_csv(glob.glob(os.path.join(cdir, "*_STATE.csv"))[0])
+            t = [float(r["t"]) for r in st]
+            # a state published twice (a lockstep retry) is one sample
+            keep = [k for k in range(len(t)) if k == 0 or t[k] > t[k - 1]]
+            t = [t[k] for k in keep]
+            T = 1.1 if case == "push_end" else 8.0
+            check(abs(t[-1] - T) < 1e-9 and len(t) == round(T * 100) + 1,
+                  "%s: a state every 10 ms up to t = %g s (%d, %g)" % (case, T, len(t), t[-1]))
+            for j in ("x", "theta"):
+                q = [float(st[k][j]) for k in keep]
+                u = [float(st[k][j + "_effort"]) for k in keep]
+                m = rows[(case, j)]
+                A = 0.0 - q[0]
+                peak = max(abs(v) for v in q)
+                band = 0.02 * (abs(A) if A != 0 else peak)
+                ts = settle(t, q, band)
+                # a run that ends outside the band has no settling time (nan)
+                check(m["settle"] == "nan" if ts == math.inf else
+                      abs(float(m["settle"]) - ts) < 1e-6,
+                      "%s %s: settle %s = last exit of the %.3g band %.9g"
+                      % (case, j, m["settle"], band, ts))
+                check(abs(float(m["peak_error"]) - peak) < 1e-5 * max(peak, 1e-9),
+                      "%s %s: peak_error %s = max|q| %.9g" % (case, j, m["peak_error"], peak))
+                iae = 0.0
+                for k in range(len(t) - 1):  # |e| by trapezoids, split at sign changes
+                    a, b = q[k], q[k + 1]
+                    h = t[k + 1] - t[k]
+                    if a * b >= 0:
+                        iae += 0.5 * h * (abs(a) + abs(b))
+                    else:
+                        iae += 0.5 * h * (a * a + b * b) / (abs(a) + abs(b))
+                check(abs(float(m["iae"]) - iae) < 1e-5 * iae,
+                      "%s %s: iae %s = trapezoids %.9g" % (case, j, m["iae"], iae))
+                # a state carries the effort held over the period that ended at it: the
+                # effort held from t[k] to t[k+1] is state k+1's
+                rms = math.sqrt(sum(u[k + 1] ** 2 * (t[k + 1] - t[k])
+                                    for k in range(len(t) - 1)) / (t[-1] - t[0]))
+                check(abs(float(m["effort_rms"]) - rms) < 1e-9 + 1e-6 * rms,
+                      "%s %s: effort_rms %s = held efforts' %.9g" % (case, j,
+                                                                     m["effort_rms"], rms))
+                ep = max(abs(v) for v in u)
+                check(abs(float(m["effort_peak"]) - ep) < 1e-5 * max(ep, 1e-9),
+                      "%s %s: effort_peak %s = max|effort| %.9g" % (case, j,
+                                                                    m["effort_peak"], ep))
+        # the push moves nothing before t = 1 s: no step, the band is 2 % of the peak
+        check(rows[("push", "theta")]["rise"] == "nan", "push: no step, no rise time")
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "falls.csv")
+        p = run("--suite", SUITE, "--case", "falls", "--csv", out)
+        check(p.returncode == 1, "a bound passed fails the case (exit 1)")
+        r = read_csv(out)
+        check(all(x["failed"] == "1" and "past its bound 0.05" in x["reason"] for x in r),
+              "the CSV says why: " + r[0]["reason"])
+
+
+def case_require():
+    p = run("--suite", SUITE, "--case", "tilt", "--require",
+            "theta.settle < 7 and theta.peak_error <= 0.1 and x.effort_peak < 10")
+    check(p.returncode == 0, "--require that holds: exit 0")
+    p = run("--suite", SUITE, "--case", "tilt", "--require", "theta.settle<2")
+    check(p.returncode == 1 and "theta.settle < 2 fails" in p.stdout,
+          "--require that does not hold: exit 1, the term named")
+    p = run("--suite", SUITE, "--case", "tilt", "--require", "phi.settle<2")
+    check(p.returncode == 2 and "no joint 'phi'" in p.stderr, "unknown joint: exit 2")
+    p = run("--suite", SUITE, "--case", "tilt", "--require", "theta.settling<2")
+    check(p.returncode == 2 and "settle" in p.stderr, "unknown metric: exit 2")
+
+
+BAD = [
+    ("cases:\n  - name: a\n    duration: -1\n", ":3:15:", "duration"),
+    ("cases:\n  - name: a\n    duration: 1\n    set: [\"initial.q\"]\n", ":4:11:",
+     "key=value"),
+    ("cases:\n  - name: a\n    duration: 1\n    colour: red\n", ":4:5:", "unknown key"),
+    ("cases:\n  - name: a\n    duration: 1\n    set: [\"parameters.m1=-3\"]\n", "case a",
+     "parameters.m1"),
+    ("cases:\n  - name: a\n    duration: 1\n    bounds: {phi: 1}\n", "case a", "no joint"),
+]
+
+
+def case_errors():
+    with tempfile.TemporaryDirectory() as d:
+        for k, (text, where, what) in enumerate(BAD):
+            f = os.path.join(d, "suite%d.yaml" % k)
+            with open(f, "w") as fh:
+                fh.write(text)
+            p = run("--suite", f)
+            check(p.returncode == 2 and where in p.stderr and what in p.stderr,
+                  "bad suite %d: exit 2 with %r and %r" % (k, where, what))
+        p = run()
+        check(p.returncode == 2 and "has no `cases:`" in p.stderr,
+              "a scene without cases: exit 2")
+
+
+def case_scene():
+    """Cases in the scene file itself: lagsimd runs the scene as if they were not there,
+    lagsim-eval runs them without --suite."""
+    with tempfile.TemporaryDirectory() as d:
+        scene = os.path.join(d, "cartpole_cases.yaml")
+        with open(SCENE) as f, open(SUITE) as g:
+            text = f.read() + "\n" + g.read()
+        with open(scene, "w") as f:
+            f.write(text)
+        plain = subprocess.run([os.path.join(BIN, "lagsimd"), "--config", SCENE, "--offline",
+                                "--duration", "1", "--csv", "-"], stdout=subprocess.PIPE,
+                               universal_newlines=True)
+        with_cases = subprocess.run([os.path.join(BIN, "lagsimd"), "--config", scene,
+                                     "--offline", "--duration", "1", "--csv", "-"],
+                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                    universal_newlines=True)
+        print(with_cases.stderr)
+        check(with_cases.returncode == 0 and with_cases.stdout == plain.stdout,
+              "lagsimd runs a scene with cases: as the same scene without them")
+        p = subprocess.run([EVAL, "--config", scene, "--controller", CTRL, "--case", "tilt"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        print(p.stdout, p.stderr)
+        check(p.returncode == 0 and "tilt" in p.stdout, "lagsim-eval runs the scene's own cases")
+
+
+{"metrics": case_metrics, "require": case_require, "errors": case_errors,
+ "scene": case_scene}[CASE]()
+print("FAILED: %d" % len(failures) if failures else "PASSED")
+sys.exit(1 if failures else 0)

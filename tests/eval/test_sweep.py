@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""lagsim-sweep end to end: the cart-pole held by lqr_balance over its masses, 8 runs.
+
+usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
+  same      the CSV of -j1, of -j2, and of two shards (run by GNU parallel on this host)
+            merged, byte for byte equal; the grid's values are the grid's, the uniform
+            ones inside their range and not all equal; a run's metrics equal lagsim-eval's
+            for the same overrides; --seed changes the drawn values
+  slurm     the job-array script: shell syntax, two array tasks run outside Slurm with
+            Slurm's variables set, merged, equal to the whole sweep
+  merge     merge refuses a run twice and shards of another sweep (exit 2); a varied
+            coordinate of initial.q lands in the scene; an index on another key is refused
+"""
+import csv
+import filecmp
+import glob
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+BIN, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
+SCENE = os.path.join(SRC, "config", "cartpole.yaml")
+SWEEP = os.path.join(BIN, "lagsim-sweep")
+CTRL = os.path.join(BIN, "lqr_balance") + " -q --prefix {prefix}"
+ARGS = ["--config", SCENE, "--controller", CTRL, "--duration", "8",
+        "--vary", "parameters.m0=uniform(0.5,2)", "--vary", "parameters.m1=grid(0.05,0.3,4)",
+        "--runs", "2", "--seed", "7", "--require", "theta.settle<6.5"]
+failures = []
+
+
+def check(ok, what):
+    print(("ok   " if ok else "FAIL ") + what)
+    if not ok:
+        failures.append(what)
+
+
+def run(cmd, **kw):
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                       universal_newlines=True, timeout=600, **kw)
+    print("$", " ".join(cmd[:1] + cmd[-6:]), "->", p.returncode)
+    print(p.stdout[-1500:], p.stderr[-1500:])
+    return p
+
+
+def rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def case_same(d):
+    a1, a2, m = (os.path.join(d, n) for n in ("j1.csv", "j2.csv", "merged.csv"))
+    p = run([SWEEP] + ARGS + ["-j1", "--csv", a1, "--plot", os.path.join(d, "s.png")])
+    check(p.returncode in (0, 1), "the sweep ran (exit %d)" % p.returncode)
+    check("8 runs:" in p.stdout and "theta.settle" in p.stdout, "a summary of 8 runs")
+    check(os.path.getsize(os.path.join(d, "s.png")) > 5000, "a PNG of the metric")
+    run([SWEEP] + ARGS + ["-j2", "--csv", a2])
+    check(filecmp.cmp(a1, a2, shallow=False), "-j1 and -j2 give the same CSV, byte for byte")
+    # two shards with GNU parallel on this host, then merged
+    sh = os.path.join(d, "shard-{}.csv")
+    cmd = ["parallel", "--will-cite", "-j2", SWEEP] + ["'%s'" % a for a in ARGS] + \
+          ["--shard", "{}/2", "--csv", sh, ":::", "1", "2"]
+    p = run(cmd)
+    check(p.returncode in (0, 1), "GNU parallel ran both shards")
+    p = run([SWEEP, "merge", os.path.join(d, "shard-2.csv"), os.path.join(d, "shard-1.csv"),
+             "-o", m])
+    check(p.returncode == 0, "merge: exit 0")
+    check(filecmp.cmp(a1, m, shallow=False), "2 shards merged = the whole sweep, byte for byte")
+    r = rows(a1)
+    check([int(x["run"]) for x in r] == list(range(8)), "8 rows in run order")
+    m1 = [float(x["parameters.m1"]) for x in r]
+    grid = [0.05 + (0.3 - 0.05) * k / 3 for k in range(4)]
+    check(all(abs(m1[i] - grid[i // 2]) < 1e-15 for i in range(8)),
+          "grid(0.05,0.3,4) with 2 runs a point: %s" % m1)
+    m0 = [float(x["parameters.m0"]) for x in r]
+    check(all(0.5 < v < 2 for v in m0) and len(set(m0)) == 8,
+          "uniform(0.5,2): 8 different values inside: %s" % m0)
+    # run 5 again through lagsim-eval: the same overrides give the same metrics
+    suite = os.path.join(d, "one.yaml")
+    with open(suite, "w") as f:
+        f.write('cases:\n  - name: r5\n    duration: 8\n    set: ["parameters.m0=%s", '
+                '"parameters.m1=%s"]\n' % (r[5]["parameters.m0"], r[5]["parameters.m1"]))
+    e = os.path.join(d, "eval.csv")
+    run([os.path.join(BIN, "lagsim-eval"), "--config", SCENE, "--controller", CTRL,
+         "--suite", suite, "--csv", e])
+    ev = {x["joint"]: x for x in rows(e)}
+    same = all(ev[j][mm] == r[5][j + "." + mm] for j in ("x", "theta")
+               for mm in ("rise", "settle", "overshoot", "sse", "iae", "ise", "peak_error",
+                          "effort_peak", "effort_rms"))
+    check(same, "run 5's metrics = lagsim-eval's for its overrides")
+    req = [float(x["theta.settle"]) < 6.5 for x in r]
+    check([x["required"] == "1" for x in r] == req, "required column = theta.settle < 6.5")
+    s8 = os.path.join(d, "seed8.csv")
+    run([SWEEP] + [a if a != "7" else "8" for a in ARGS] + ["-j2", "--csv", s8])
+    check([x["parameters.m0"] for x in rows(s8)] != [x["parameters.m0"] for x in r],
+          "another seed draws other values")
+
+
+def case_slurm(d):
+    script = os.path.join(SRC, "server", "tools", "slurm", "lagsim-sweep-array.sh")
+    check(subprocess.run(["bash", "-n", script]).returncode == 0, "shell syntax")
+    text = open(script).read()
+    check("#SBATCH --array=" in text, "an #SBATCH --array line")
+    whole = os.path.join(d, "whole.csv")
+    run([SWEEP] + ARGS + ["-j2", "--csv", whole])
+    out = os.path.join(d, "out")
+    for task in (3, 4):  # an array 3-4: Slurm sets these in each task
+        env = dict(os.environ, SLURM_ARRAY_TASK_ID=str(task), SLURM_ARRAY_TASK_MIN="3",
+                   SLURM_ARRAY_TASK_COUNT="2", SLURM_CPUS_PER_TASK="1", LAGSIM_SWEEP=SWEEP)
+        p = run(["bash", script, out, "--"] + ARGS, env=env)
+        check(p.returncode in (0, 1), "array task %d ran" % task)
+    shards = sorted(glob.glob(os.path.join(out, "shard-*-of-2.csv")))
+    check(len(shards) == 2, "two shard CSVs: %s" % shards)
+    m = os.path.join(d, "merged.csv")
+    run([SWEEP, "merge"] + shards + ["-o", m])
+    check(filecmp.cmp(whole, m, shallow=False), "the array's shards merged = the whole sweep")
+    p = run(["bash", script, out, "--"] + ARGS, env={"PATH": os.environ["PATH"]})
+    check(p.returncode != 0 and "array task" in p.stderr, "outside an array task: refused")
+
+
+def case_merge(d):
+    a = os.path.join(d, "a.csv")
+    run([SWEEP] + ARGS + ["--runs", "1", "--shard", "1/4", "--csv", a])
+    b = os.path.join(d, "b.csv")
+    shutil.copy(a, b)
+    p = run([SWEEP, "merge", a, b, "-o", os.path.join(d, "m.csv")])
+    check(p.returncode == 2 and "appears twice" in p.stderr, "a run twice: exit 2")
+    c = os.path.join(d, "c.csv")
+    run([SWEEP] + ARGS[:-2] + ["--runs", "1", "--shard", "2/4", "--csv", c])  # no --require
+    with open(c) as f, open(os.path.join(d, "d.csv"), "w") as g:
+        g.write(f.read().replace("parameters.m0", "parameters.m2"))
+    p = run([SWEEP, "merge", a, os.path.join(d, "d.csv"), "-o", os.path.join(d, "m2.csv")])
+    check(p.returncode == 2 and "another sweep" in p.stderr, "another sweep's shard: exit 2")
+    # one coordinate of initial.q varied: joined into the scene's list (x stays 0); the
+    # pole released at rest from theta0 under LQR peaks at theta0 itself
+    g = os.path.join(d, "g.csv")
+    run([SWEEP, "--config", SCENE, "--controller", CTRL, "--duration", "3",
+         "--vary", "initial.q[1]=grid(0.02,0.08,2)", "--csv", g])
+    r = rows(g)
+    check([x["initial.q[1]"] for x in r] == ["0.02", "0.080000000000000002"] and
+          all(float(x["theta.peak_error"]) == float(x["initial.q[1]"]) for x in r) and
+          all(float(x["x.peak_error"]) > 0 for x in r),
+          "initial.q[1] varied: theta starts there (peak error = the value)")
+    p = run([SWEEP] + ARGS + ["--vary", "initial.x[0]=normal(0,1)"])
+    check(p.returncode == 2 and "initial.q[i]" in p.stderr, "an index on another key: exit 2")
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    {"same": case_same, "slurm": case_slurm, "merge": case_merge}[CASE](tmp)
+print("FAILED: %d" % len(failures) if failures else "PASSED")
+sys.exit(1 if failures else 0)
