@@ -83,6 +83,7 @@ static void usage(FILE *f)
             "  -d, --digits N       significant digits of numbers (default 17: exact; the\n"
             "                       status for people: 6)\n"
             "  -h, --help           this text\n"
+            "  -V, --version        print the version\n"
             "exit status: 0 done, 1 the daemon refused (its reason on stderr), 2 bad usage\n"
             "(several plants and no --prefix too), 3 no answer within the timeout (list: no\n"
             "plant heard)\n");
@@ -542,10 +543,10 @@ int main(int argc, char **argv)
         {"prefix", required_argument, NULL, 'p'}, {"url", required_argument, NULL, 'u'},
         {"timeout", required_argument, NULL, 't'}, {"digits", required_argument, NULL, 'd'},
         {"json", no_argument, NULL, 'j'}, {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0}};
+        {"version", no_argument, NULL, 'V'}, {NULL, 0, NULL, 0}};
     int opt;
     /* "+": options end at the command, so reset-to's negative numbers stay arguments */
-    while ((opt = getopt_long(argc, argv, "+p:u:t:d:jh", longopts, NULL)) != -1) {
+    while ((opt = getopt_long(argc, argv, "+p:u:t:d:jhV", longopts, NULL)) != -1) {
         char *end;
         switch (opt) {
         case 'p': prefix = optarg; break;
@@ -571,6 +572,7 @@ int main(int argc, char **argv)
             break;
         }
         case 'h': usage(stdout); return EXIT_OK;
+        case 'V': printf("lagsimctl %s\n", LAGSIM_VERSION); return EXIT_OK;
         default: usage(stderr); return EXIT_USAGE;
         }
     }
