@@ -12,7 +12,6 @@
 
 #include "daemon.h"
 
-#define LAGSIMD_VERSION "0.1.0" /* keep in step with project(VERSION) in CMakeLists.txt */
 
 static void usage(FILE *f)
 {
@@ -312,7 +311,7 @@ int main(int argc, char **argv)
             free(sets);
             return LAGSIMD_EXIT_OK;
         case 'V':
-            printf("lagsimd %s\n", LAGSIMD_VERSION);
+            printf("lagsimd %s\n", LAGSIM_VERSION);
             free(sets);
             return LAGSIMD_EXIT_OK;
         default: /* '?' or ':' */
