@@ -391,5 +391,11 @@ add_test(NAME clients_readme_recipes
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_recipes.py
           --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} by-hand record)
 set_tests_properties(clients_readme_recipes PROPERTIES TIMEOUT 200 LABELS clients)
+# evaluate (lagsim-eval with --require, a 200-run lagsim-sweep and its figure): minutes of
+# lockstep runs, so not in the sanitizer pass (label slow)
+add_test(NAME clients_readme_evaluate
+  COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_recipes.py
+          --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} --timeout 500 evaluate)
+set_tests_properties(clients_readme_evaluate PROPERTIES TIMEOUT 560 LABELS "clients;slow")
 
 set_tests_properties(${lang_tests} PROPERTIES TIMEOUT 90 LABELS clients)

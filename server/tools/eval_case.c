@@ -546,12 +546,30 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
     }
     int dst = 0, cst = 0;
     double t0 = now_s();
-    if (!wait_until(dpid, t0 + env->wall_timeout, &dst)) {
+    bool daemon_done = false, controller_done = false;
+    /* the daemon's end, or the controller's: a controller that ends first (it could not
+     * start, it crashed) leaves a lockstep plant waiting for ever, so the daemon gets a
+     * few seconds to end on its own (a controller ends on the daemon's stop event, a
+     * moment before the daemon exits) and is then stopped */
+    while (!daemon_done && now_s() < t0 + env->wall_timeout) {
+        daemon_done = wait_until(dpid, now_s() + 0.05, &dst);
+        if (!daemon_done && !controller_done && waitpid(cpid, &cst, WNOHANG) == cpid) {
+            controller_done = true;
+            if (!wait_until(dpid, now_s() + 5.0, &dst)) {
+                stop_group(dpid, &dst);
+                fail(res, "the controller ended (%s %d) before the run did",
+                     WIFEXITED(cst) ? "exit status" : "signal",
+                     WIFEXITED(cst) ? WEXITSTATUS(cst) : WTERMSIG(cst));
+            }
+            daemon_done = true;
+        }
+    }
+    if (!daemon_done) {
         stop_group(dpid, &dst);
         fail(res, "no end after %.3g wall s (--timeout)", env->wall_timeout);
     }
     /* a controller ends on the daemon's stop event; one that does not is stopped */
-    if (!wait_until(cpid, now_s() + 3.0, &cst)) stop_group(cpid, &cst);
+    if (!controller_done && !wait_until(cpid, now_s() + 3.0, &cst)) stop_group(cpid, &cst);
 
     if (WIFEXITED(dst) && WEXITSTATUS(dst) == 2) {
         snprintf(err, errlen, "lagsimd refused the case '%s' (exit 2; rerun with -v)",

@@ -74,13 +74,30 @@ def check_record(out, tmp):
     return checks
 
 
-CHECKS = {"by-hand": check_by_hand, "record": check_record}
+def check_evaluate(out, tmp):
+    """lagsim-eval measured both cases and they met the requirement; lagsim-sweep ran 200
+    runs, all passed, and drew its figure"""
+    checks = []
+    for case in ("tilt", "heavy_pole"):
+        checks.append((re.search(r"^%s\s+x\s+ok\b" % case, out, re.M) is not None,
+                       "lagsim-eval: case %s measured, ok" % case))
+    checks.append(("UNMET" not in out and "FAIL" not in out, "lagsim-eval: no case failed or unmet"))
+    m = re.search(r"^200 runs: (\d+) passed", out, re.M)
+    checks.append((m is not None and m.group(1) == "200", "lagsim-sweep: 200 runs, all passed (%s)"
+                   % (m.group(0) if m else "no summary")))
+    png = os.path.join(tmp, "sweep.png")
+    checks.append((os.path.exists(png) and os.path.getsize(png) > 1000, "sweep.png drawn"))
+    return checks
+
+
+CHECKS = {"by-hand": check_by_hand, "record": check_record, "evaluate": check_evaluate}
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", required=True)
     ap.add_argument("--source", required=True)
+    ap.add_argument("--timeout", type=float, default=150, help="wall s a recipe may take")
     ap.add_argument("names", nargs="+")
     a = ap.parse_args()
     build, src = os.path.abspath(a.build), os.path.abspath(a.source)
@@ -96,8 +113,9 @@ def main():
             if line.startswith("cmake "):
                 print("(left out, the tree is built: %s)" % line)
                 continue
-            line = re.sub(r"(^|[\s;&(])build/bin/", r"\g<1>%s/bin/" % build, line)
+            line = re.sub(r"(^|[\s;&('])build/bin/", r"\g<1>%s/bin/" % build, line)
             line = re.sub(r"(^|[\s;&(=])config/", r"\g<1>%s/config/" % src, line)
+            line = re.sub(r"(^|[\s;&(=])tests/", r"\g<1>%s/tests/" % src, line)
             lines.append(line)
         script = "\n".join(lines) + "\n"
         tmp = tempfile.mkdtemp(prefix="lagsim_recipe_")
@@ -106,7 +124,7 @@ def main():
         print("---- recipe %s in %s, LCM_DEFAULT_URL=%s\n%s" % (name, tmp, env["LCM_DEFAULT_URL"], script))
         try:
             r = subprocess.run(["bash", "-c", script], cwd=tmp, env=env, stdout=subprocess.PIPE,
-                               stderr=subprocess.STDOUT, universal_newlines=True, timeout=150)
+                               stderr=subprocess.STDOUT, universal_newlines=True, timeout=a.timeout)
             out, code = r.stdout, r.returncode
         except subprocess.TimeoutExpired as e:
             out, code = (e.stdout or b"").decode() if isinstance(e.stdout, bytes) else (e.stdout or ""), -1

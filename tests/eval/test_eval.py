@@ -19,6 +19,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 
 BIN, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
 SCENE = os.path.join(SRC, "config", "cartpole.yaml")
@@ -175,6 +176,17 @@ def case_errors():
         p = run()
         check(p.returncode == 2 and "has no `cases:`" in p.stderr,
               "a scene without cases: exit 2")
+    # a controller that cannot start: the case fails at once, the lockstep plant is not
+    # left waiting for ever
+    t0 = time.monotonic()
+    p = subprocess.run([EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt",
+                        "--controller", "/nonexistent/controller --prefix {prefix}"],
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                       universal_newlines=True, timeout=120)
+    check(p.returncode == 1 and "the controller ended (exit status 127) before the run did"
+          in p.stdout and time.monotonic() - t0 < 60,
+          "a controller that does not start: the case fails within a minute (%.1f s, exit %d)"
+          % (time.monotonic() - t0, p.returncode))
 
 
 def case_scene():
