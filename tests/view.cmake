@@ -29,9 +29,12 @@ if(LAGSIM_VIEW_PYTHON3)
   add_test(NAME view_hostile COMMAND ${view_test} hostile)
   add_test(NAME view_stick_flight COMMAND ${view_test} stick_flight)
   add_test(NAME view_cartpole COMMAND ${view_test} cartpole)
-  set_tests_properties(view_browser view_hostile view_stick_flight view_cartpole PROPERTIES TIMEOUT 180 LABELS view)
+  add_test(NAME view_charts COMMAND ${view_test} charts)
+  set_tests_properties(view_browser view_hostile view_stick_flight view_cartpole view_charts
+                       PROPERTIES TIMEOUT 180 LABELS view)
   if(NOT LAGSIM_CHROMIUM)
-    set_tests_properties(view_browser view_stick_flight view_cartpole PROPERTIES ENVIRONMENT "PATH=/nonexistent")
+    set_tests_properties(view_browser view_stick_flight view_cartpole view_charts
+                         PROPERTIES ENVIRONMENT "PATH=/nonexistent")
   endif()
 endif()
 

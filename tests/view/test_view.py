@@ -14,6 +14,11 @@ CASE cartpole: config/cartpole.yaml (beside --config) released from 0.3 rad betw
               stops on x and theta: the page draws the cart at the published x and the pole l1
               long at the published theta, both stops, and it animates; a model the page
               cannot draw still shows a note, its coordinates and its charts.
+CASE charts: config/cartpole.yaml (beside --config) swinging freely for N s, then a page
+              opened: its charts show the N s at once (the bridge's history), the energy,
+              varying by round-off only, is drawn on an axis at least 1e-6 x max(1, |E|)
+              wide, x (m) and theta (rad) on separate axes, a legend click hides and shows
+              a trace, and the unactuated theta has no effort trace.
 CASE hostile: garbage, oversized headers, a connection flood, a slow reader, vanished
               clients, foreign Host headers, control floods; afterwards the bridge
               answers at once, holds no stream, and its memory stayed bounded.
@@ -409,16 +414,91 @@ def case_cartpole(a):
         rig.close()
 
 
+def case_charts(a):
+    cfg = os.path.join(os.path.dirname(a.config), "cartpole.yaml")
+    rig = Rig(a, "VIEWH", cfg, ("initial.q=[0,0.3]", "initial.qd=[0,0]"))
+    chrome = None
+    N = 6.0
+    try:
+        s = rig.wait_api(lambda s: s["state"] and s["state"]["sim_time"] >= N, 30,
+                         "%g s of sim time" % N)
+        sc = s["scene"]
+        check(sc["joints"] == ["x", "theta"] and sc["actuated"] == [True, False],
+              "the cart-pole: x actuated, theta not (%s, %s)" % (sc["joints"], sc["actuated"]))
+        chrome = cdp.Chrome()
+        opened = time.monotonic()
+        _, sid = chrome.open(rig.base + "/")
+        chrome.wait_for(sid, "window.lagsimView.drawn && window.lagsimView.drawn.sim_time !== null && "
+                             "window.lagsimView.charts.energy.length", 15, "a drawn state and energy")
+        time.sleep(0.2)   # a frame with both
+        age = time.monotonic() - opened
+        d = drawn(chrome, sid)
+        ch = d.get("charts") or {}
+        q = chrome.eval(sid, "JSON.stringify([window.lagsimView.charts.q[0][0], "
+                             "window.lagsimView.charts.q[window.lagsimView.charts.q.length - 1][0], "
+                             "window.lagsimView.charts.q.length])")
+        t_first, t_last, n = json.loads(q)
+        # at once: more history than the page can have gathered since it was opened
+        check(t_first <= 0.0 + 1e-9 and t_last - t_first >= N and t_last - t_first > age + 3,
+              "a page opened after %.1f s shows %.2f s of history at once (t %.2f .. %.2f s, %d "
+              "states, page %.2f s old)" % (N, t_last - t_first, t_first, t_last, n, age))
+        # the energy varies by round-off only: drawn flat, on an axis of the minimum span
+        es = json.loads(chrome.eval(sid, "JSON.stringify(window.lagsimView.charts.energy.map(s => s[1][0]))"))
+        var = max(es) - min(es) if es else float("nan")
+        big = max(1.0, max(abs(e) for e in es)) if es else float("nan")
+        ax = (ch.get("energy") or {}).get("axes", {}).get("left")
+        check(0 < var < 1e-8 and len(es) > 10,
+              "the energy over %d statuses varies by %.3g J (round-off)" % (len(es), var))
+        check(ax is not None and ax["hi"] - ax["lo"] >= 1e-6 * big and
+              min(es) >= ax["lo"] and max(es) <= ax["hi"],
+              "the energy axis spans %s J (at least 1e-6 x %.6g): drawn flat" %
+              (ax and "%.3g" % (ax["hi"] - ax["lo"]), big))
+        # separate axes by unit, from the scene
+        for chart, left, right in (("q", "m", "rad"), ("qd", "m/s", "rad/s")):
+            axes = (ch.get(chart) or {}).get("axes", {})
+            ser = {x["label"]: x["axis"] for x in (ch.get(chart) or {}).get("series", [])}
+            check(axes.get("left", {}).get("units") == [left] and
+                  axes.get("right", {}).get("units") == [right] and
+                  list(ser.values()) == ["left", "right"],
+                  "%s: %s on the left axis, %s on the right (%s, %s)" % (chart, left, right, axes, ser))
+        # the unactuated theta: no effort trace, nor a legend entry
+        eff = [x["key"] for x in (ch.get("effort") or {}).get("series", [])]
+        legend = chrome.eval(sid, "JSON.stringify([...document.querySelectorAll('#chart_effort + .legend button')]"
+                                  ".map(b => b.dataset.key))")
+        check(eff == ["effort:x"] and json.loads(legend or "[]") == ["effort:x"],
+              "effort: only the actuated x is drawn (%s; legend %s)" % (eff, legend))
+        # a legend click hides a trace (and its axis), a second one shows it again
+        btn = "document.querySelector('#chart_q + .legend button[data-key=\"q:theta\"]')"
+        if check(chrome.eval(sid, "!!" + btn), "a legend entry for theta under the q chart"):
+            chrome.eval(sid, btn + ".click(); 0")
+            chrome.wait_for(sid, "!window.lagsimView.drawn.charts.q.series.some(s => s.key === 'q:theta')",
+                            5, "theta hidden")
+            d = drawn(chrome, sid)
+            check([x["key"] for x in d["charts"]["q"]["series"]] == ["q:x"] and
+                  "right" not in d["charts"]["q"]["axes"],
+                  "a click on theta's legend entry hides its trace and the rad axis")
+            chrome.eval(sid, btn + ".click(); 0")
+            chrome.wait_for(sid, "window.lagsimView.drawn.charts.q.series.some(s => s.key === 'q:theta')",
+                            5, "theta shown")
+            check(True, "a second click shows it again")
+        if a.screenshot:
+            chrome.screenshot(sid, a.screenshot)
+    finally:
+        if chrome:
+            chrome.quit()
+        rig.close()
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lagsimd", required=True)
     ap.add_argument("--view", required=True)
     ap.add_argument("--config", required=True)
     ap.add_argument("--screenshot")
-    ap.add_argument("case", choices=["browser", "hostile", "stick_flight", "cartpole"])
+    ap.add_argument("case", choices=["browser", "hostile", "stick_flight", "cartpole", "charts"])
     a = ap.parse_args()
     {"browser": case_browser, "hostile": case_hostile, "stick_flight": case_stick_flight,
-     "cartpole": case_cartpole}[a.case](a)
+     "cartpole": case_cartpole, "charts": case_charts}[a.case](a)
     print("%s: %d failure(s)" % ("FAILED" if failures else "passed", failures))
     return 1 if failures else 0
 
