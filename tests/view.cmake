@@ -30,7 +30,8 @@ if(LAGSIM_VIEW_PYTHON3)
   add_test(NAME view_stick_flight COMMAND ${view_test} stick_flight)
   add_test(NAME view_cartpole COMMAND ${view_test} cartpole)
   add_test(NAME view_charts COMMAND ${view_test} charts)
-  set_tests_properties(view_browser view_hostile view_stick_flight view_cartpole view_charts
+  add_test(NAME view_history COMMAND ${view_test} history)
+  set_tests_properties(view_browser view_hostile view_stick_flight view_cartpole view_charts view_history
                        PROPERTIES TIMEOUT 180 LABELS view)
   if(NOT LAGSIM_CHROMIUM)
     set_tests_properties(view_browser view_stick_flight view_cartpole view_charts

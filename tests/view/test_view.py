@@ -19,6 +19,10 @@ CASE charts: config/cartpole.yaml (beside --config) swinging freely for N s, the
               varying by round-off only, is drawn on an axis at least 1e-6 x max(1, |E|)
               wide, x (m) and theta (rad) on separate axes, a legend click hides and shows
               a trace, and the unactuated theta has no effort trace.
+CASE history: GET /api/history over a cart-pole in fast mode: the ring holds the newest
+              6000 states, in pieces of at most 64 kB that together give each once, in order
+              (fast mode: states the bus dropped are missing);
+              paused, the repeated state is kept once; a reset starts it over.
 CASE hostile: garbage, oversized headers, a connection flood, a slow reader, vanished
               clients, foreign Host headers, control floods; afterwards the bridge
               answers at once, holds no stream, and its memory stayed bounded.
@@ -33,6 +37,7 @@ import socket
 import subprocess
 import sys
 import time
+import urllib.error
 import urllib.request
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -414,6 +419,73 @@ def case_cartpole(a):
         rig.close()
 
 
+def history(rig, of):
+    """Every piece of /api/history?of=OF, as the page asks for them."""
+    pieces, frm = [], 0
+    for _ in range(100):
+        with urllib.request.urlopen(rig.base + "/api/history?of=%s&from=%d" % (of, frm), timeout=5) as r:
+            body = r.read()
+        j = json.loads(body)
+        pieces.append((len(body), j))
+        if not j["samples"] or j["next"] > j["last"]:
+            break
+        frm = j["next"]
+    return pieces
+
+
+def control(rig, request):
+    req = urllib.request.Request(rig.base + "/api/control?request=" + request, method="POST",
+                                 headers={"X-Lagsim": "1"})
+    with urllib.request.urlopen(req, timeout=5) as r:
+        return r.status
+
+
+def case_history(a):
+    cfg = os.path.join(os.path.dirname(a.config), "cartpole.yaml")
+    rig = Rig(a, "VIEWR", cfg, ("initial.q=[0,0.3]", "initial.qd=[0,0]", "realtime.mode=fast"))
+    try:
+        rig.wait_api(lambda s: s["bridge"]["states"] > 8000, 60, "8000 states")
+        control(rig, "pause")
+        rig.wait_api(lambda s: s["status"] and s["status"]["run_state"] == "paused", 10, "paused")
+        time.sleep(0.5)
+        pieces = history(rig, "state")
+        j0 = pieces[0][1]
+        ts = [x[0] for _, j in pieces for x in j["samples"]]
+        period = rig.api()["scene"]["control_period"]
+        check(j0["last"] - j0["first"] + 1 == 6000 and len(ts) == 6000,
+              "the ring holds the newest 6000 states (seqs %d..%d, %d sent)" % (j0["first"], j0["last"], len(ts)))
+        check(len(pieces) > 1 and all(n <= 64 * 1024 for n, _ in pieces),
+              "sent in %d pieces of at most 64 kB (%s bytes)" % (len(pieces), [n for n, _ in pieces]))
+        # fast mode: the bus may drop states the bridge never saw, never repeat or reorder them
+        steps = [round((b - c) / period, 6) for c, b in zip(ts, ts[1:])]
+        check(all(x >= 1 and x == int(x) for x in steps),
+              "each state once, in order, whole control periods apart (%d of %d steps one period)"
+              % (steps.count(1), len(steps)))
+        st = rig.api()["state"]
+        check(ts and ts[-1] == st["sim_time"], "the newest is the paused state (%.2f s), held once" % st["sim_time"])
+        es = [x[0] for _, j in history(rig, "energy") for x in j["samples"]]
+        check(len(es) >= 2 and all(b > c for c, b in zip(es, es[1:])) and es[-1] <= ts[-1],
+              "energies: %d, in order of sim time" % len(es))
+        control(rig, "reset")
+        rig.wait_api(lambda s: s["state"]["sim_time"] < 1, 10, "a reset")
+        control(rig, "pause")
+        time.sleep(0.5)
+        p2 = history(rig, "state")
+        ts2 = [x[0] for _, j in p2 for x in j["samples"]]
+        check(p2[0][1]["first"] > j0["last"] and ts2 and ts2[0] == 0 and ts2[-1] < ts[0],
+              "a reset starts the ring over (seqs from %d, t %.2f .. %.2f s)" %
+              (p2[0][1]["first"], ts2[0] if ts2 else -1, ts2[-1] if ts2 else -1))
+        for bad in ("of=nothing", "of=state&from=-1", "of=state&from=x"):
+            try:
+                urllib.request.urlopen(rig.base + "/api/history?" + bad, timeout=5)
+                code = 200
+            except urllib.error.HTTPError as e:
+                code = e.code
+            check(code == 400, "/api/history?%s: 400 (%s)" % (bad, code))
+    finally:
+        rig.close()
+
+
 def case_charts(a):
     cfg = os.path.join(os.path.dirname(a.config), "cartpole.yaml")
     rig = Rig(a, "VIEWH", cfg, ("initial.q=[0,0.3]", "initial.qd=[0,0]"))
@@ -495,10 +567,11 @@ def main():
     ap.add_argument("--view", required=True)
     ap.add_argument("--config", required=True)
     ap.add_argument("--screenshot")
-    ap.add_argument("case", choices=["browser", "hostile", "stick_flight", "cartpole", "charts"])
+    ap.add_argument("case", choices=["browser", "hostile", "stick_flight", "cartpole", "charts", "history"])
     a = ap.parse_args()
     {"browser": case_browser, "hostile": case_hostile, "stick_flight": case_stick_flight,
-     "cartpole": case_cartpole, "charts": case_charts}[a.case](a)
+     "cartpole": case_cartpole, "charts": case_charts,
+     "history": case_history}[a.case](a)
     print("%s: %d failure(s)" % ("FAILED" if failures else "passed", failures))
     return 1 if failures else 0
 
