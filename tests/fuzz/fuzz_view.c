@@ -292,7 +292,7 @@ static void check_history(const char *of, int64_t first, int64_t last)
         size_t n = view_json_history(&vb, of, f, out, sizeof out);
         if (n == 0) fail("/api/history did not answer", of, strlen(of));
         if (!json_ok(out, n - 1) || out[n - 1] != '\n') fail("/api/history is not valid JSON", out, n);
-        long long a, b, next;
+        long long a = 0, b = 0, next = 0;
         const char *t = strstr(out, "],\"next\":");
         if (sscanf(out, "{\"of\":\"%*[a-z]\",\"first\":%lld,\"last\":%lld", &a, &b) != 2 || !t ||
             sscanf(t, "],\"next\":%lld}", &next) != 1 || a != first || b != last)
