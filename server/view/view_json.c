@@ -237,19 +237,13 @@ void view_json_event(jbuf *b, const lag_wire_event *m, int64_t seq)
     jb_raw(b, "}");
 }
 
-/* The core's model whose joints are the scene's, in order (a stick that may fly publishes
- * the flying stick's x, phi, h), or NULL: where a joint's unit (m or rad) comes from, as
- * lagsim-log2csv finds it. */
+/* The core's model whose joints are the scene's (lag_model_info_by_joints), or NULL: where
+ * a joint's unit (m or rad) comes from. */
 static const lag_model_info *scene_model(const lag_wire_scene *m, int n)
 {
-    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
-        const lag_model_info *info = lag_model_info_get((lag_model_kind)k);
-        bool same = info && info->nq == n;
-        for (int i = 0; same && i < n; i++)
-            same = strcmp(info->joint_names[i], m->joint_name[i]) == 0;
-        if (same) return info;
-    }
-    return NULL;
+    const char *names[LAG_WIRE_MAX_JOINTS];
+    for (int i = 0; i < n; i++) names[i] = m->joint_name[i];
+    return lag_model_info_by_joints(names, n);
 }
 
 void view_json_scene(jbuf *b, const lag_wire_scene *m)
