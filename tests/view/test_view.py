@@ -510,8 +510,9 @@ def case_charts(a):
                              "window.lagsimView.charts.q[window.lagsimView.charts.q.length - 1][0], "
                              "window.lagsimView.charts.q.length])")
         t_first, t_last, n = json.loads(q)
-        # at once: more history than the page can have gathered since it was opened
-        check(t_first <= 0.0 + 1e-9 and t_last - t_first >= N and t_last - t_first > age + 3,
+        # at once: more history than the page can have gathered since it was opened (the
+        # bridge, started beside the daemon, may have missed its first states on a busy host)
+        check(t_first < 1 and t_last - t_first >= N - 1 and t_last - t_first > age + 3,
               "a page opened after %.1f s shows %.2f s of history at once (t %.2f .. %.2f s, %d "
               "states, page %.2f s old)" % (N, t_last - t_first, t_first, t_last, n, age))
         # the energy varies by round-off only: drawn flat, on an axis of the minimum span
