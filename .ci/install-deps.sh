@@ -11,6 +11,7 @@ pkgs=(build-essential cmake pkg-config clang libclang-rt-14-dev   # gcc pass; cl
       liblcm-java libjchart2d-java default-jdk-headless  # the Java clients; lcm-spy with lagsim's types
       octave octave-control                              # the MATLAB/Octave clients (dlqr, lqr) and their tests
       libmicrohttpd-dev chromium fonts-dejavu-core       # lagsim-view; its browser test and screenshot
+      curl                                               # the walkthrough (docs/clients.md) asks lagsim-view for its history
       iproute2 nftables                                  # two hosts on one machine: namespaces, veth, packet loss
       lintian systemd                                    # the Debian package: lintian, systemd-analyze, its unit run by systemd
       parallel slurm-client)                             # lagsim-sweep shards: GNU parallel, sbatch (--test-only, no cluster)

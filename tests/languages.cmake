@@ -397,5 +397,12 @@ add_test(NAME clients_readme_evaluate
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_recipes.py
           --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} --timeout 500 evaluate)
 set_tests_properties(clients_readme_evaluate PROPERTIES TIMEOUT 560 LABELS "clients;slow")
+# docs/clients.md's newcomer walkthrough, its balance.py and commands as written: the
+# cart-pole balanced by Python for 10 s, logged, replayed, converted, plotted, and played
+# back to lagsim-view (which binds the walkthrough's port 8765)
+add_test(NAME clients_walkthrough
+  COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_recipes.py
+          --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} walkthrough)
+set_tests_properties(clients_walkthrough PROPERTIES TIMEOUT 200 LABELS clients)
 
 set_tests_properties(${lang_tests} PROPERTIES TIMEOUT 90 LABELS clients)

@@ -31,10 +31,12 @@ if(LAGSIM_VIEW_PYTHON3)
   add_test(NAME view_cartpole COMMAND ${view_test} cartpole)
   add_test(NAME view_reference COMMAND ${view_test} reference
            --screenshot ${CMAKE_BINARY_DIR}/view_reference.png)
+  add_test(NAME view_charts COMMAND ${view_test} charts)
+  add_test(NAME view_history COMMAND ${view_test} history)
   set_tests_properties(view_browser view_hostile view_stick_flight view_cartpole view_reference
-                       PROPERTIES TIMEOUT 180 LABELS view)
+                       view_charts view_history PROPERTIES TIMEOUT 180 LABELS view)
   if(NOT LAGSIM_CHROMIUM)
-    set_tests_properties(view_browser view_stick_flight view_cartpole view_reference
+    set_tests_properties(view_browser view_stick_flight view_cartpole view_reference view_charts
                          PROPERTIES ENVIRONMENT "PATH=/nonexistent")
   endif()
 endif()

@@ -44,6 +44,17 @@ const lag_model_info *lag_model_info_get(lag_model_kind kind)
     return lag_models[kind]->info;
 }
 
+const lag_model_info *lag_model_info_by_joints(const char *const *names, int n)
+{
+    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
+        const lag_model_info *info = lag_models[k]->info;
+        bool same = info->nq == n;
+        for (int i = 0; same && i < n; i++) same = names[i] && strcmp(info->joint_names[i], names[i]) == 0;
+        if (same) return info;
+    }
+    return NULL;
+}
+
 int lag_model_kind_from_name(const char *name)
 {
     for (int k = 0; k < LAG_MODEL_COUNT; k++)

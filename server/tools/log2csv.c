@@ -396,18 +396,15 @@ static bool write_event(l2c *c, chan *h, const lag_log_record *r, const lag_wire
     return true;
 }
 
-/* The core's model whose joints are the scene's, in order (a stick that may fly publishes
- * the flying stick's x, phi, h), or NULL: where a joint's unit (m or rad) comes from. */
+/* The core's model whose joints are the scene's (lag_model_info_by_joints), or NULL: where
+ * a joint's unit (m or rad) comes from. */
 static const lag_model_info *scene_model(const lag_wire_scene *m)
 {
-    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
-        const lag_model_info *info = lag_model_info_get((lag_model_kind)k);
-        bool same = info && info->nq == m->num_joints;
-        for (int i = 0; same && i < m->num_joints; i++)
-            same = strcmp(info->joint_names[i], m->joint_name[i]) == 0;
-        if (same) return info;
-    }
-    return NULL;
+    const char *names[LAG_WIRE_MAX_JOINTS];
+    int n = m->num_joints < 0 ? 0 : m->num_joints > LAG_WIRE_MAX_JOINTS ? LAG_WIRE_MAX_JOINTS
+                                                                        : m->num_joints;
+    for (int i = 0; i < n; i++) names[i] = m->joint_name[i];
+    return n == m->num_joints ? lag_model_info_by_joints(names, n) : NULL;
 }
 
 static bool write_scene(l2c *c, chan *h, const lag_log_record *r, const lag_wire_scene *m)

@@ -26,6 +26,9 @@
 #define VIEW_STREAM_BUF 32768      /* one stream's frame buffer */
 #define VIEW_CONTROLS_PER_S 10     /* control requests forwarded per second at most */
 #define VIEW_CHANNEL_MAX 96
+/* History for a page opened mid-run (GET /api/history): the newest states and energies,
+ * 60 s at the shipped 100 Hz publish rate (less at a higher rate: the ring is capped). */
+#define VIEW_HISTORY 6000
 /* Budgets for text off the bus, in bytes of JSON (escapes included): a name (63 bytes on
  * the wire) or a detail (255) that needs more is cut and ends in "…[truncated N bytes]"
  * (N: the bytes of the original left out). Twice the wire's length: text as the daemon
@@ -62,6 +65,24 @@ void view_json_event(jbuf *b, const lag_wire_event *m, int64_t seq);
 void view_json_scene(jbuf *b, const lag_wire_scene *m);
 
 /* ---------------------------------------------------------------- bridge (view_bridge.c) */
+/* One state of the history: sim time (s), q, qd, effort of n joints. */
+typedef struct view_sample {
+    double t;
+    int n;
+    double q[LAG_WIRE_MAX_JOINTS], qd[LAG_WIRE_MAX_JOINTS], effort[LAG_WIRE_MAX_JOINTS];
+} view_sample;
+
+/* A ring of the newest VIEW_HISTORY samples, numbered seq = 1, 2, ... (slot seq %
+ * VIEW_HISTORY): it holds first..last (none while last < first). A sim time before the
+ * newest one (a reset) starts it over; the newest one's time again (paused: the daemon
+ * republishes) replaces that sample. */
+typedef struct view_history {
+    view_sample state[VIEW_HISTORY];
+    int64_t state_first, state_last;
+    double energy_t[VIEW_HISTORY], energy[VIEW_HISTORY]; /* from the status: s, J */
+    int64_t energy_first, energy_last;
+} view_history;
+
 typedef struct view_event {
     int64_t seq;                   /* 1, 2, ... */
     lag_wire_event ev;
@@ -86,6 +107,7 @@ typedef struct view_bridge {
     int64_t scene_seq;
     view_event events[VIEW_EVENTS]; /* ring: events[seq % VIEW_EVENTS] */
     int64_t event_seq;              /* of the newest */
+    view_history hist;              /* for a page opened mid-run */
     int64_t last_msg_ns;            /* CLOCK_MONOTONIC of the last decoded message */
     int64_t last_describe_ns;       /* when a DESCRIBE was last sent */
     bool discard;                   /* while the socket filter is put in place */
@@ -164,6 +186,12 @@ typedef struct view_cursor {
 size_t view_frame(const view_bridge *vb, unsigned hz, view_cursor *c, char *buf, size_t cap,
                   int64_t *cut);
 
+/* GET /api/history?of=state|energy&from=SEQ: the ring's samples from seq `from` (or its
+ * oldest) on, oldest first, as many as fit in cap: {"of":..,"first":F,"last":L,"next":N,
+ * "samples":[[t,[q..],[qd..],[effort..]],..]} (energy: [t,E]); N is the seq to ask for
+ * next (N > L: all sent). Returns the length, 0 for an unknown `of` or a bad `from`. */
+size_t view_json_history(const view_bridge *vb, const char *of, const char *from, char *out,
+                         size_t cap);
 /* The snapshot as JSON (GET /api/state). A part that does not fit is null (counted in
  * parts_omitted); the newest events that fit are kept (the others counted in
  * events_omitted). Returns the length, 0 only if cap cannot hold the bridge's counters. */

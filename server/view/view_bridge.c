@@ -35,6 +35,43 @@ int64_t view_wall_us(void)
     return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
+/* The seq a sample at sim time t takes in a ring of VIEW_HISTORY holding first..last whose
+ * newest sample is at newest_t (view_history); -1: not kept (t not finite). */
+static int64_t ring_slot(int64_t *first, int64_t *last, double newest_t, double t)
+{
+    if (!isfinite(t)) return -1;
+    bool any = *last >= *first;
+    if (any && t == newest_t) return *last; /* paused: the same state again */
+    if (any && t < newest_t) *first = *last + 1; /* a reset: start over */
+    ++*last;
+    if (*last - *first + 1 > VIEW_HISTORY) *first = *last - VIEW_HISTORY + 1;
+    return *last;
+}
+
+static void history_state(view_history *h, const lag_wire_joint_state *m)
+{
+    double newest = h->state[h->state_last % VIEW_HISTORY].t;
+    int64_t seq = ring_slot(&h->state_first, &h->state_last, newest, m->sim_time);
+    if (seq < 0) return;
+    view_sample *s = &h->state[seq % VIEW_HISTORY];
+    int n = m->num_joints < 0 ? 0 : m->num_joints > LAG_WIRE_MAX_JOINTS ? LAG_WIRE_MAX_JOINTS
+                                                                        : m->num_joints;
+    s->t = m->sim_time;
+    s->n = n;
+    memcpy(s->q, m->position, sizeof s->q);
+    memcpy(s->qd, m->velocity, sizeof s->qd);
+    memcpy(s->effort, m->effort, sizeof s->effort);
+}
+
+static void history_energy(view_history *h, const lag_wire_status *m)
+{
+    double newest = h->energy_t[h->energy_last % VIEW_HISTORY];
+    int64_t seq = ring_slot(&h->energy_first, &h->energy_last, newest, m->sim_time);
+    if (seq < 0) return;
+    h->energy_t[seq % VIEW_HISTORY] = m->sim_time;
+    h->energy[seq % VIEW_HISTORY] = m->energy;
+}
+
 static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     (void)ch;
@@ -53,6 +90,7 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *user)
     else
         vb->state_ref.num_joints = 0;
     vb->state_seq++;
+    history_state(&vb->hist, &m);
     vb->n_state++;
     vb->last_msg_ns = view_mono_ns();
 }
@@ -84,6 +122,7 @@ static void on_status(const lcm_recv_buf_t *rb, const char *ch, void *user)
     }
     vb->status = m;
     vb->status_seq++;
+    history_energy(&vb->hist, &m);
     vb->n_status++;
     vb->last_msg_ns = view_mono_ns();
 }
@@ -157,6 +196,7 @@ bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, bool
                       char *err, size_t errlen)
 {
     memset(vb, 0, sizeof *vb);
+    vb->hist.state_first = vb->hist.energy_first = 1; /* empty: last < first */
     size_t n = strlen(prefix);
     if (n == 0 || n >= sizeof vb->prefix) {
         snprintf(err, errlen, "--prefix: 1 to %zu characters", sizeof vb->prefix - 1);

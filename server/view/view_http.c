@@ -5,6 +5,8 @@
  *   GET  /, /view.js, /view.css   the page (embedded in the binary; nothing fetched
  *                                 from elsewhere: the Content-Security-Policy says so)
  *   GET  /api/state               the snapshot as JSON
+ *   GET  /api/history?of=state|energy[&from=SEQ]   the newest states or energies, in
+ *                                 pieces of at most 64 kB (a page opened mid-run)
  *   GET  /events                  server-sent events: "scene", "state", "status",
  *                                 "events" (an array), "bridge" frames
  *   POST /api/control?request=pause|resume|step|reset[&count=N]   (header X-Lagsim: 1)
@@ -415,6 +417,13 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     }
     if (!get) return reply_text(c, 405, "GET only\n");
     if (strcmp(url, "/events") == 0) return open_stream(h, c, rec);
+    if (strcmp(url, "/api/history") == 0) {
+        size_t n = view_json_history(h->vb, MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "of"),
+                                     MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "from"),
+                                     h->json, sizeof h->json);
+        if (n == 0) return reply_text(c, 400, "history: of=state|energy[&from=SEQ >= 0]\n");
+        return reply(c, 200, "application/json", h->json, n, MHD_RESPMEM_MUST_COPY);
+    }
     if (strcmp(url, "/api/state") == 0) {
         size_t n = view_json_snapshot(h->vb, h, h->json, sizeof h->json);
         if (n == 0) return reply_text(c, 500, "state too large\n"); /* the budgets rule it out */

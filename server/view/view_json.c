@@ -7,8 +7,10 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "lagsim/lagsim.h"
 #include "view.h"
 
 void jb_init(jbuf *b, char *mem, size_t cap)
@@ -250,6 +252,15 @@ void view_json_event(jbuf *b, const lag_wire_event *m, int64_t seq)
     jb_raw(b, "}");
 }
 
+/* The core's model whose joints are the scene's (lag_model_info_by_joints), or NULL: where
+ * a joint's unit (m or rad) comes from. */
+static const lag_model_info *scene_model(const lag_wire_scene *m, int n)
+{
+    const char *names[LAG_WIRE_MAX_JOINTS];
+    for (int i = 0; i < n; i++) names[i] = m->joint_name[i];
+    return lag_model_info_by_joints(names, n);
+}
+
 void view_json_scene(jbuf *b, const lag_wire_scene *m)
 {
     int n = joints(m->num_joints);
@@ -271,6 +282,15 @@ void view_json_scene(jbuf *b, const lag_wire_scene *m)
     jb_key(b, "actuated", false);
     jb_raw(b, "[");
     for (int i = 0; i < n; i++) jb_raw(b, i ? (m->actuated[i] ? ",true" : ",false") : (m->actuated[i] ? "true" : "false"));
+    jb_raw(b, "]");
+    /* "m" or "rad" per joint from the core's table (null: a model it does not know) */
+    const lag_model_info *info = scene_model(m, n);
+    jb_key(b, "units", false);
+    jb_raw(b, "[");
+    for (int i = 0; i < n; i++) {
+        if (i) jb_raw(b, ",");
+        jb_raw(b, !info ? "null" : info->angular[i] ? "\"rad\"" : "\"m\"");
+    }
     jb_raw(b, "]");
     jb_num_array(b, "initial_q", m->initial_q, n);
     jb_num_array(b, "initial_qd", m->initial_qd, n);
@@ -343,6 +363,69 @@ size_t view_json_events(jbuf *b, const view_bridge *vb, int64_t first, int64_t l
     }
     b->cap = cap;
     return n;
+}
+
+static void jb_nums(jbuf *b, const double *v, int n)
+{
+    jb_raw(b, "[");
+    for (int i = 0; i < n; i++) {
+        if (i) jb_raw(b, ",");
+        jb_num(b, v[i]);
+    }
+    jb_raw(b, "]");
+}
+
+size_t view_json_history(const view_bridge *vb, const char *of, const char *from, char *out,
+                         size_t cap)
+{
+    const view_history *h = &vb->hist;
+    bool states = of && strcmp(of, "state") == 0;
+    if (!states && !(of && strcmp(of, "energy") == 0)) return 0;
+    int64_t first = states ? h->state_first : h->energy_first;
+    int64_t last = states ? h->state_last : h->energy_last;
+    long long f = first;
+    if (from) {
+        char *end = NULL;
+        f = strtoll(from, &end, 10);
+        if (end == from || *end || f < 0) return 0;
+    }
+    if (f < first) f = first;
+    jbuf b;
+    jb_init(&b, out, cap);
+    jb_fmt(&b, "{\"of\":\"%s\",\"first\":%lld,\"last\":%lld,\"samples\":[",
+           states ? "state" : "energy", (long long)first, (long long)last);
+    if (b.overflow) return 0;
+    size_t room = b.cap;
+    b.cap -= 48; /* the tail: ],"next":N} */
+    int64_t q = f;
+    for (; q <= last; q++) {
+        size_t keep = b.len;
+        if (q > f) jb_raw(&b, ",");
+        jb_raw(&b, "[");
+        if (states) {
+            const view_sample *s = &h->state[q % VIEW_HISTORY];
+            jb_num(&b, s->t);
+            jb_raw(&b, ",");
+            jb_nums(&b, s->q, s->n);
+            jb_raw(&b, ",");
+            jb_nums(&b, s->qd, s->n);
+            jb_raw(&b, ",");
+            jb_nums(&b, s->effort, s->n);
+        } else {
+            jb_num(&b, h->energy_t[q % VIEW_HISTORY]);
+            jb_raw(&b, ",");
+            jb_num(&b, h->energy[q % VIEW_HISTORY]);
+        }
+        jb_raw(&b, "]");
+        if (b.overflow) {
+            b.len = keep;
+            b.overflow = false;
+            break;
+        }
+    }
+    b.cap = room;
+    jb_fmt(&b, "],\"next\":%lld}\n", (long long)q);
+    return b.overflow ? 0 : b.len;
 }
 
 size_t view_json_snapshot(const view_bridge *vb, const view_http *h, char *out, size_t cap)

@@ -27,8 +27,10 @@ static void usage(FILE *f)
           "                   [--hz N] [--max-views N] [--allow-host NAME]... [--allow-lan]\n"
           "\n"
           "Serves a live view of a lagsimd daemon to browsers: the model drawn to scale from\n"
-          "its scene description and animated from its states, strip charts, status, events,\n"
-          "and pause / resume / step / reset buttons.\n"
+          "its scene description and animated from its states, strip charts (the last seconds\n"
+          "at once: it keeps the newest 6000 states and energies; m and rad on separate axes;\n"
+          "a legend click hides a trace), status, events, and pause / resume / step / reset\n"
+          "and kick controls.\n"
           "\n"
           "  -p, --prefix P     the daemon's channel prefix (default: the only plant on the\n"
           "                     bus; several: they are named, exit 2; none: DIPC)\n"
@@ -49,8 +51,10 @@ static void usage(FILE *f)
           "  -h, --help         this help\n"
           "\n"
           "HTTP: GET / (the page), GET /api/state (latest scene, state, status, events as\n"
-          "JSON), GET /events (server-sent events), POST /api/control?request=pause|resume|\n"
-          "step|reset[&count=N] with the header X-Lagsim: 1.\n",
+          "JSON), GET /api/history?of=state|energy[&from=SEQ] (the kept states or energies,\n"
+          "in pieces of at most 64 kB), GET /events (server-sent events),\n"
+          "POST /api/control?request=pause|resume|step|reset[&count=N] and\n"
+          "POST /api/kick?joint=J&impulse=I[&duration=S] with the header X-Lagsim: 1.\n",
           f);
 }
 

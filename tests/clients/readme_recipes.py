@@ -1,15 +1,17 @@
 #!/usr/bin/env python3
-"""Runs README.md's shell recipes as written, so that they cannot drift from the programs.
+"""Runs the shell recipes of README.md and docs/clients.md as written, so that they cannot
+drift from the programs.
 
     readme_recipes.py --build DIR --source DIR NAME...
 
-README.md marks each recipe with <!-- recipe: NAME --> on the line before its ```sh fence.
-The block runs in bash in a fresh temporary directory, with `build/bin/` and `config/`
-pointing into this tree's build and sources; a line that builds (`cmake ...`) is left out,
-the tree being built already. LCM_DEFAULT_URL gets a multicast port of this run's own
-(ttl=0), which every program of the recipe honours, so that the recipe's default prefix
-(DIPC) cannot meet another test's. Each recipe has its own checks below: what a person who
-ran it would look at.
+A recipe is marked with <!-- recipe: NAME --> on the line before its ```sh fence; a file
+it needs with <!-- recipe-file: NAME FILE --> before any fence (its text is written to
+FILE first). The block runs in bash in a fresh temporary directory, with `build/` and
+`config/` pointing into this tree's build and sources; a line that builds (`cmake ...`)
+or installs the Debian packages (`.ci/install-deps.sh`) is left out, the tree being built
+already. LCM_DEFAULT_URL gets a multicast port of this run's own (ttl=0), which every
+program of the recipe honours, so that the recipe's default prefix cannot meet another
+test's. Each recipe has its own checks below: what a person who ran it would look at.
 """
 import argparse
 import csv
@@ -20,10 +22,19 @@ import sys
 import tempfile
 
 
-def recipes(readme):
-    text = open(readme).read()
-    return {m.group(1): m.group(2) for m in
-            re.finditer(r"<!-- recipe: (\S+) -->\s*\n```sh\n(.*?)\n```", text, re.S)}
+DOCS = ("README.md", os.path.join("docs", "clients.md"))
+
+
+def recipes(src):
+    """{name: shell text} and {name: [(file, text)]} of every marked block of DOCS"""
+    found, files = {}, {}
+    for doc in DOCS:
+        text = open(os.path.join(src, doc)).read()
+        for m in re.finditer(r"<!-- recipe: (\S+) -->\s*\n```sh\n(.*?)\n```", text, re.S):
+            found[m.group(1)] = m.group(2)
+        for m in re.finditer(r"<!-- recipe-file: (\S+) (\S+) -->\s*\n```\w*\n(.*?\n)```", text, re.S):
+            files.setdefault(m.group(1), []).append((m.group(2), m.group(3)))
+    return found, files
 
 
 def rows(path):
@@ -90,7 +101,43 @@ def check_evaluate(out, tmp):
     return checks
 
 
-CHECKS = {"by-hand": check_by_hand, "record": check_record, "evaluate": check_evaluate}
+def check_walkthrough(out, tmp):
+    """docs/clients.md's newcomer walkthrough: balance.py balanced the cart-pole for the 10 s
+    of the run and ended on its stop; the replay found every state exact; the summary, the
+    CSV and the plot are there; the view, fed the log by lcm-logplayer, kept every state"""
+    checks = []
+    checks.append(("balance.py: the plant stopped at t = 10.00 s" in out,
+                   "balance.py ended on the plant's stop at t = 10 s"))
+    m = re.search(r"replay run.lcm: (\d+) states compared on CARTPOLE_STATE \(\d+ restarts at "
+                  r"resets, (\d+) gaps", out)
+    checks.append((m is not None and int(m.group(1)) >= 1000 and m.group(2) == "0"
+                   and "\nmax difference = 0\n" in out,
+                   "--replay: every state compared, 0 gaps, max difference 0 (%s)"
+                   % (m.group(0) if m else "no replay line")))
+    checks.append(("sim time 0 .. 10 s, step 0 .. 10000; gaps 0 (0 states missing" in out,
+                   "lagsim-log2csv's summary: states from 0 to 10 s, 0 gaps"))
+    path = os.path.join(tmp, "run", "CARTPOLE_STATE.csv")
+    r = list(csv.DictReader(open(path))) if os.path.exists(path) else []
+    t = [float(x["t"]) for x in r]
+    th = [float(x["theta"]) for x in r]
+    x = [float(v["x"]) for v in r]
+    late = [abs(b) for a, b in zip(t, th) if a >= 3]
+    checks.append((len(set(t)) == 1001 and max(map(abs, th)) == 0.05 and late and max(late) < 0.003
+                   and 0.1 < max(x) < 0.2 and abs(x[-1]) < 0.01,
+                   "balanced, as the text says: %d sim times, |theta| <= %s, < 0.003 rad after 3 s "
+                   "(%s), x peaks at %s m, ends at %s m" % (len(set(t)), max(map(abs, th)) if th else "?",
+                                                           max(late) if late else "?",
+                                                           max(x) if x else "?", x[-1] if x else "?")))
+    png = os.path.join(tmp, "run", "CARTPOLE_STATE.png")
+    checks.append((os.path.exists(png) and os.path.getsize(png) > 1000, "run/CARTPOLE_STATE.png drawn"))
+    m = re.search(r'\{"of":"state","first":(\d+),"last":(\d+)', out)
+    checks.append((m is not None and int(m.group(2)) - int(m.group(1)) + 1 >= 990,
+                   "the view kept the replayed run: %s" % (m.group(0) if m else "no history answer")))
+    return checks
+
+
+CHECKS = {"by-hand": check_by_hand, "record": check_record, "evaluate": check_evaluate,
+          "walkthrough": check_walkthrough}
 
 
 def main():
@@ -101,24 +148,28 @@ def main():
     ap.add_argument("names", nargs="+")
     a = ap.parse_args()
     build, src = os.path.abspath(a.build), os.path.abspath(a.source)
-    found = recipes(os.path.join(src, "README.md"))
+    found, files = recipes(src)
     fails = 0
     for name in a.names:
         if name not in found or name not in CHECKS:
-            print("FAIL: no recipe %s in README.md (or no checks for it)" % name)
+            print("FAIL: no recipe %s in %s (or no checks for it)" % (name, " or ".join(DOCS)))
             fails += 1
             continue
         lines = []
         for line in found[name].splitlines():
-            if line.startswith("cmake "):
+            if line.startswith("cmake ") or line.startswith(".ci/install-deps.sh"):
                 print("(left out, the tree is built: %s)" % line)
                 continue
-            line = re.sub(r"(^|[\s;&('])build/bin/", r"\g<1>%s/bin/" % build, line)
+            line = re.sub(r"(^|[\s;&(='])build/", r"\g<1>%s/" % build, line)
             line = re.sub(r"(^|[\s;&(=])config/", r"\g<1>%s/config/" % src, line)
             line = re.sub(r"(^|[\s;&(=])tests/", r"\g<1>%s/tests/" % src, line)
             lines.append(line)
         script = "\n".join(lines) + "\n"
         tmp = tempfile.mkdtemp(prefix="lagsim_recipe_")
+        for fname, text in files.get(name, []):
+            with open(os.path.join(tmp, fname), "w") as f:
+                f.write(text)
+            print("---- %s written as given" % fname)
         env = dict(os.environ)
         env["LCM_DEFAULT_URL"] = "udpm://239.255.76.67:%d?ttl=0" % (30000 + 2 * (os.getpid() % 10000))
         print("---- recipe %s in %s, LCM_DEFAULT_URL=%s\n%s" % (name, tmp, env["LCM_DEFAULT_URL"], script))

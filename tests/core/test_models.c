@@ -223,6 +223,12 @@ static void check_table(void)
         const lag_model_info *inf = c->info;
         ENSURE(lag_model_info_get((lag_model_kind)k) == inf);
         ENSURE(inf->name && inf->name[0] && lag_model_kind_from_name(inf->name) == k);
+        /* found again by its joints: the first model with those names, whose units and
+         * actuation are this one's (what lagsim-log2csv and lagsim-view read) */
+        const lag_model_info *by = lag_model_info_by_joints(inf->joint_names, inf->nq);
+        ENSURE(by != NULL);
+        for (int j = 0; by && j < inf->nq; ++j)
+            ENSURE(by->angular[j] == inf->angular[j] && by->actuated[j] == inf->actuated[j]);
         ENSURE(strstr(names, inf->name) != NULL);
         ENSURE(inf->nq >= 1 && inf->nq <= LAG_MAX_DOF && inf->np >= 1 && inf->np <= LAG_MAX_PARAMS);
         bool any_actuated = false;
@@ -307,6 +313,12 @@ static void check_info(void)
         }
     }
     ENSURE(lag_model_kind_from_name("pendulum") == -1);
+    {   /* joints no model has, in another order, or too few: none */
+        const char *odd[2] = {"phi", "x"}, *one[1] = {"x"}, *cp[2] = {"x", "theta"};
+        ENSURE(lag_model_info_by_joints(odd, 2) == NULL && lag_model_info_by_joints(one, 1) == NULL);
+        ENSURE(lag_model_info_by_joints(cp, 2) && !lag_model_info_by_joints(cp, 2)->angular[0] &&
+               lag_model_info_by_joints(cp, 2)->angular[1]);
+    }
     /* Parameters named as in the course assignment. */
     ENSURE(lag_model_param_index(LAG_MODEL_STICK, "m") == LAG_STICK_M);
     ENSURE(lag_model_param_index(LAG_MODEL_STICK, "I") == LAG_STICK_I);

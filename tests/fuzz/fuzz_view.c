@@ -7,7 +7,9 @@
  *      be valid JSON that fits its buffer with every part and the newest 32 events; the
  *      stream frames a new browser is sent, one after the other, must each be valid
  *      server-sent events of valid JSON, never cut a part ({"truncated":true}), and
- *      carry every event of the ring (the others counted missed);
+ *      carry every event of the ring (the others counted missed); /api/history, for
+ *      up to VIEW_HISTORY states and energies of any numbers, answers valid JSON in
+ *      pieces that fit its buffer and together carry every sample once, in order;
  *   1  a raw HTTP request (any bytes; "@P" is replaced by the port bound) sent to a
  *      running bridge (memq://, on 127.0.0.1) over TCP, answered until it closes;
  *   2  a Host header's value for the allow-list check: never accepted with a port that is
@@ -266,6 +268,50 @@ static void fill(src *s)
         }
     }
     vb.event_seq = n;
+    /* the history: a ring holding any span of seqs, of any numbers */
+    view_history *h = &vb.hist;
+    int64_t base = byte(s) << 16 | byte(s) << 8;
+    int ns = (int)((byte(s) << 8 | byte(s)) % (VIEW_HISTORY + 1));
+    int ne = (int)((byte(s) << 8 | byte(s)) % (VIEW_HISTORY + 1));
+    h->state_first = base + 1, h->state_last = base + ns;
+    h->energy_first = base + 1, h->energy_last = base + ne;
+    for (int64_t q = h->state_first; q <= h->state_last; q++) {
+        view_sample *x = &h->state[q % VIEW_HISTORY];
+        x->n = byte(s) % (LAG_WIRE_MAX_JOINTS + 1);
+        x->t = num(s);
+        for (int i = 0; i < LAG_WIRE_MAX_JOINTS; i++)
+            x->q[i] = num(s), x->qd[i] = num(s), x->effort[i] = num(s);
+    }
+    for (int64_t q = h->energy_first; q <= h->energy_last; q++) {
+        h->energy_t[q % VIEW_HISTORY] = num(s);
+        h->energy[q % VIEW_HISTORY] = num(s);
+    }
+}
+
+/* /api/history of one kind asked for piece after piece, as the page does: each piece
+ * valid JSON, the seqs first..last all sent once, in order. */
+static void check_history(const char *of, int64_t first, int64_t last)
+{
+    static char out[64 * 1024]; /* view_http.c's VIEW_STATE_JSON */
+    int64_t from = 0, got = 0;
+    for (int k = 0; k <= VIEW_HISTORY + 1; k++) {
+        char f[32];
+        snprintf(f, sizeof f, "%lld", (long long)from);
+        size_t n = view_json_history(&vb, of, f, out, sizeof out);
+        if (n == 0) fail("/api/history did not answer", of, strlen(of));
+        if (!json_ok(out, n - 1) || out[n - 1] != '\n') fail("/api/history is not valid JSON", out, n);
+        long long a = 0, b = 0, next = 0;
+        const char *t = strstr(out, "],\"next\":");
+        if (sscanf(out, "{\"of\":\"%*[a-z]\",\"first\":%lld,\"last\":%lld", &a, &b) != 2 || !t ||
+            sscanf(t, "],\"next\":%lld}", &next) != 1 || a != first || b != last)
+            fail("/api/history without first, last, next", out, n);
+        int64_t start = from < first ? first : from;
+        got += next - start;
+        if (next > last) break;
+        if (next == start) fail("/api/history sent nothing and is not done", out, n);
+        from = next;
+    }
+    if (got != (last >= first ? last - first + 1 : 0)) fail("/api/history lost samples", of, strlen(of));
 }
 
 static void check_json_side(void)
@@ -303,6 +349,8 @@ static void check_json_side(void)
         }
     }
     if (cut) fail("a stream frame cut a part", buf, 0);
+    check_history("state", vb.hist.state_first, vb.hist.state_last);
+    check_history("energy", vb.hist.energy_first, vb.hist.energy_last);
     if (c.event_seq != vb.event_seq || events + missed != vb.event_seq)
         fail("a new stream was not sent every event", buf, 0);
 }

@@ -14,6 +14,15 @@ CASE cartpole: config/cartpole.yaml (beside --config) released from 0.3 rad betw
               stops on x and theta: the page draws the cart at the published x and the pole l1
               long at the published theta, both stops, and it animates; a model the page
               cannot draw still shows a note, its coordinates and its charts.
+CASE charts: config/cartpole.yaml (beside --config) swinging freely for N s, then a page
+              opened: its charts show the N s at once (the bridge's history), the energy,
+              varying by round-off only, is drawn on an axis at least 1e-6 x max(1, |E|)
+              wide, x (m) and theta (rad) on separate axes, a legend click hides and shows
+              a trace, and the unactuated theta has no effort trace.
+CASE history: GET /api/history over a cart-pole in fast mode: the ring holds the newest
+              6000 states, in pieces of at most 64 kB that together give each once, in order
+              (fast mode: states the bus dropped are missing);
+              paused, the repeated state is kept once; a reset starts it over.
 CASE hostile: garbage, oversized headers, a connection flood, a slow reader, vanished
               clients, foreign Host headers, control floods; afterwards the bridge
               answers at once, holds no stream, and its memory stayed bounded.
@@ -28,6 +37,7 @@ import socket
 import subprocess
 import sys
 import time
+import urllib.error
 import urllib.request
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -466,16 +476,161 @@ def case_reference(a):
         rig.close()
 
 
+def history(rig, of):
+    """Every piece of /api/history?of=OF, as the page asks for them."""
+    pieces, frm = [], 0
+    for _ in range(100):
+        with urllib.request.urlopen(rig.base + "/api/history?of=%s&from=%d" % (of, frm), timeout=5) as r:
+            body = r.read()
+        j = json.loads(body)
+        pieces.append((len(body), j))
+        if not j["samples"] or j["next"] > j["last"]:
+            break
+        frm = j["next"]
+    return pieces
+
+
+def control(rig, request):
+    req = urllib.request.Request(rig.base + "/api/control?request=" + request, method="POST",
+                                 headers={"X-Lagsim": "1"})
+    with urllib.request.urlopen(req, timeout=5) as r:
+        return r.status
+
+
+def case_history(a):
+    cfg = os.path.join(os.path.dirname(a.config), "cartpole.yaml")
+    rig = Rig(a, "VIEWR", cfg, ("initial.q=[0,0.3]", "initial.qd=[0,0]", "realtime.mode=fast"))
+    try:
+        rig.wait_api(lambda s: s["bridge"]["states"] > 8000, 60, "8000 states")
+        control(rig, "pause")
+        rig.wait_api(lambda s: s["status"] and s["status"]["run_state"] == "paused", 10, "paused")
+        time.sleep(0.5)
+        pieces = history(rig, "state")
+        j0 = pieces[0][1]
+        ts = [x[0] for _, j in pieces for x in j["samples"]]
+        period = rig.api()["scene"]["control_period"]
+        check(j0["last"] - j0["first"] + 1 == 6000 and len(ts) == 6000,
+              "the ring holds the newest 6000 states (seqs %d..%d, %d sent)" % (j0["first"], j0["last"], len(ts)))
+        check(len(pieces) > 1 and all(n <= 64 * 1024 for n, _ in pieces),
+              "sent in %d pieces of at most 64 kB (%s bytes)" % (len(pieces), [n for n, _ in pieces]))
+        # fast mode: the bus may drop states the bridge never saw, never repeat or reorder them
+        steps = [round((b - c) / period, 6) for c, b in zip(ts, ts[1:])]
+        check(all(x >= 1 and x == int(x) for x in steps),
+              "each state once, in order, whole control periods apart (%d of %d steps one period)"
+              % (steps.count(1), len(steps)))
+        st = rig.api()["state"]
+        check(ts and ts[-1] == st["sim_time"], "the newest is the paused state (%.2f s), held once" % st["sim_time"])
+        es = [x[0] for _, j in history(rig, "energy") for x in j["samples"]]
+        check(len(es) >= 2 and all(b > c for c, b in zip(es, es[1:])) and es[-1] <= ts[-1],
+              "energies: %d, in order of sim time" % len(es))
+        control(rig, "reset")
+        rig.wait_api(lambda s: s["state"]["sim_time"] < 1, 10, "a reset")
+        control(rig, "pause")
+        time.sleep(0.5)
+        p2 = history(rig, "state")
+        ts2 = [x[0] for _, j in p2 for x in j["samples"]]
+        check(p2[0][1]["first"] > j0["last"] and ts2 and ts2[0] == 0 and ts2[-1] < ts[0],
+              "a reset starts the ring over (seqs from %d, t %.2f .. %.2f s)" %
+              (p2[0][1]["first"], ts2[0] if ts2 else -1, ts2[-1] if ts2 else -1))
+        for bad in ("of=nothing", "of=state&from=-1", "of=state&from=x"):
+            try:
+                urllib.request.urlopen(rig.base + "/api/history?" + bad, timeout=5)
+                code = 200
+            except urllib.error.HTTPError as e:
+                code = e.code
+            check(code == 400, "/api/history?%s: 400 (%s)" % (bad, code))
+    finally:
+        rig.close()
+
+
+def case_charts(a):
+    cfg = os.path.join(os.path.dirname(a.config), "cartpole.yaml")
+    rig = Rig(a, "VIEWH", cfg, ("initial.q=[0,0.3]", "initial.qd=[0,0]"))
+    chrome = None
+    N = 6.0
+    try:
+        s = rig.wait_api(lambda s: s["state"] and s["state"]["sim_time"] >= N, 30,
+                         "%g s of sim time" % N)
+        sc = s["scene"]
+        check(sc["joints"] == ["x", "theta"] and sc["actuated"] == [True, False],
+              "the cart-pole: x actuated, theta not (%s, %s)" % (sc["joints"], sc["actuated"]))
+        chrome = cdp.Chrome()
+        opened = time.monotonic()
+        _, sid = chrome.open(rig.base + "/")
+        chrome.wait_for(sid, "window.lagsimView.drawn && window.lagsimView.drawn.sim_time !== null && "
+                             "window.lagsimView.charts.energy.length", 15, "a drawn state and energy")
+        time.sleep(0.2)   # a frame with both
+        age = time.monotonic() - opened
+        d = drawn(chrome, sid)
+        ch = d.get("charts") or {}
+        q = chrome.eval(sid, "JSON.stringify([window.lagsimView.charts.q[0][0], "
+                             "window.lagsimView.charts.q[window.lagsimView.charts.q.length - 1][0], "
+                             "window.lagsimView.charts.q.length])")
+        t_first, t_last, n = json.loads(q)
+        # at once: more history than the page can have gathered since it was opened (the
+        # bridge, started beside the daemon, may have missed its first states on a busy host)
+        check(t_first < 1 and t_last - t_first >= N - 1 and t_last - t_first > age + 3,
+              "a page opened after %.1f s shows %.2f s of history at once (t %.2f .. %.2f s, %d "
+              "states, page %.2f s old)" % (N, t_last - t_first, t_first, t_last, n, age))
+        # the energy varies by round-off only: drawn flat, on an axis of the minimum span
+        es = json.loads(chrome.eval(sid, "JSON.stringify(window.lagsimView.charts.energy.map(s => s[1][0]))"))
+        var = max(es) - min(es) if es else float("nan")
+        big = max(1.0, max(abs(e) for e in es)) if es else float("nan")
+        ax = (ch.get("energy") or {}).get("axes", {}).get("left")
+        check(0 < var < 1e-8 and len(es) > 10,
+              "the energy over %d statuses varies by %.3g J (round-off)" % (len(es), var))
+        check(ax is not None and ax["hi"] - ax["lo"] >= 1e-6 * big and
+              min(es) >= ax["lo"] and max(es) <= ax["hi"],
+              "the energy axis spans %s J (at least 1e-6 x %.6g): drawn flat" %
+              (ax and "%.3g" % (ax["hi"] - ax["lo"]), big))
+        # separate axes by unit, from the scene
+        for chart, left, right in (("q", "m", "rad"), ("qd", "m/s", "rad/s")):
+            axes = (ch.get(chart) or {}).get("axes", {})
+            ser = {x["label"]: x["axis"] for x in (ch.get(chart) or {}).get("series", [])}
+            check(axes.get("left", {}).get("units") == [left] and
+                  axes.get("right", {}).get("units") == [right] and
+                  list(ser.values()) == ["left", "right"],
+                  "%s: %s on the left axis, %s on the right (%s, %s)" % (chart, left, right, axes, ser))
+        # the unactuated theta: no effort trace, nor a legend entry
+        eff = [x["key"] for x in (ch.get("effort") or {}).get("series", [])]
+        legend = chrome.eval(sid, "JSON.stringify([...document.querySelectorAll('#chart_effort + .legend button')]"
+                                  ".map(b => b.dataset.key))")
+        check(eff == ["effort:x"] and json.loads(legend or "[]") == ["effort:x"],
+              "effort: only the actuated x is drawn (%s; legend %s)" % (eff, legend))
+        # a legend click hides a trace (and its axis), a second one shows it again
+        btn = "document.querySelector('#chart_q + .legend button[data-key=\"q:theta\"]')"
+        if check(chrome.eval(sid, "!!" + btn), "a legend entry for theta under the q chart"):
+            chrome.eval(sid, btn + ".click(); 0")
+            chrome.wait_for(sid, "!window.lagsimView.drawn.charts.q.series.some(s => s.key === 'q:theta')",
+                            5, "theta hidden")
+            d = drawn(chrome, sid)
+            check([x["key"] for x in d["charts"]["q"]["series"]] == ["q:x"] and
+                  "right" not in d["charts"]["q"]["axes"],
+                  "a click on theta's legend entry hides its trace and the rad axis")
+            chrome.eval(sid, btn + ".click(); 0")
+            chrome.wait_for(sid, "window.lagsimView.drawn.charts.q.series.some(s => s.key === 'q:theta')",
+                            5, "theta shown")
+            check(True, "a second click shows it again")
+        if a.screenshot:
+            chrome.screenshot(sid, a.screenshot)
+    finally:
+        if chrome:
+            chrome.quit()
+        rig.close()
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lagsimd", required=True)
     ap.add_argument("--view", required=True)
     ap.add_argument("--config", required=True)
     ap.add_argument("--screenshot")
-    ap.add_argument("case", choices=["browser", "hostile", "stick_flight", "cartpole", "reference"])
+    ap.add_argument("case", choices=["browser", "hostile", "stick_flight", "cartpole", "reference",
+                                     "charts", "history"])
     a = ap.parse_args()
     {"browser": case_browser, "hostile": case_hostile, "stick_flight": case_stick_flight,
-     "cartpole": case_cartpole, "reference": case_reference}[a.case](a)
+     "cartpole": case_cartpole, "reference": case_reference, "charts": case_charts,
+     "history": case_history}[a.case](a)
     print("%s: %d failure(s)" % ("FAILED" if failures else "passed", failures))
     return 1 if failures else 0
 

@@ -133,6 +133,10 @@ typedef struct lag_model_info {
  * tests iterate kinds 0..LAG_MODEL_COUNT-1: a model added to the core's table is then
  * known to them by name without another list. */
 const lag_model_info *lag_model_info_get(lag_model_kind kind);
+/* The first model whose joints are names[0..n-1], in order, or NULL: how a tool that has
+ * only a scene description (joint names) finds each joint's unit (angular) and actuation.
+ * (A stick that may fly publishes the flying stick's x, phi, h.) */
+const lag_model_info *lag_model_info_by_joints(const char *const *names, int n);
 /* Returns the kind for a name, or -1. */
 int lag_model_kind_from_name(const char *name);
 /* "stick, manipulator, dipc, ...": every model's name, in the table's order, for messages

@@ -16,6 +16,8 @@ const view = {
   dirty: true, frames: 0, statesReceived: 0, camX: null,
   charts: { q: [], qd: [], effort: [], energy: [],     // [t, values[]] per sample
             qref: [], qdref: [] },                     // the reference, in q's joint order
+  hidden: new Set(),                                   // keys of the series toggled off
+  history: null,                                       // what /api/history gave at load
   drawn: null,                                         // what the last frame drew
 };
 window.lagsimView = view;   // read by tests (DevTools) and handy in the console
@@ -32,6 +34,38 @@ function connect() {
   es.addEventListener("state", (e) => onState(JSON.parse(e.data)));
   es.addEventListener("status", (e) => onStatus(JSON.parse(e.data)));
   es.addEventListener("events", (e) => onEvents(JSON.parse(e.data)));
+}
+
+// A page opened mid-run: the bridge's ring of the newest states and energies (GET
+// /api/history, in pieces of at most 64 kB) is charted before the stream starts, so the
+// charts show the last seconds at once; the stream's first state is newer than all of them.
+async function loadHistory() {
+  const got = { state: 0, energy: 0, requests: 0 };
+  try {
+    for (const of of ["state", "energy"]) {
+      let from = 0;
+      for (let k = 0; k < 64; k++) {   // bounded: the ring's 6000 fit in far fewer pieces
+        const r = await fetch("/api/history?of=" + of + "&from=" + from);
+        got.requests++;
+        if (!r.ok) break;
+        const j = await r.json();
+        for (const smp of j.samples) {
+          if (of === "state") {
+            push(view.charts.q, smp[0], smp[1]);
+            push(view.charts.qd, smp[0], smp[2]);
+            push(view.charts.effort, smp[0], smp[3]);
+          } else if (smp[1] !== null) push(view.charts.energy, smp[0], [smp[1]]);
+        }
+        got[of] += j.samples.length;
+        if (!j.samples.length || j.next > j.last) break;
+        from = j.next;
+      }
+    }
+  } catch (err) {
+    got.error = String(err);   // the stream still starts: live charts only
+  }
+  view.history = got;
+  view.dirty = true;
 }
 
 function showConn() {
@@ -337,76 +371,173 @@ function drawModel() {
 }
 
 // ---------------------------------------------------------------- charts
-// The samples drawn as lines, and those of ref (the reference, may be empty) dashed over
-// them in the same colours. Returns the number of dashed series drawn.
-function drawChart(canvas, samples, names, ref) {
+// A chart draws a list of series. A series is a key (unique, for the toggles), a label,
+// a colour, a dash pattern, a unit, the samples it reads ([t, values[]] each) and get(values)
+// giving its number from one sample; a second series per joint (a reference, say) is one
+// more entry in what a chart's series() returns. Units of the "m" family go on the left
+// axis, those of the "rad" family on the right one, each axis with its own range.
+const UNIT_FAMILY = { m: "left", "m/s": "left", N: "left", rad: "right", "rad/s": "right", "N m": "right" };
+const DERIVED_UNIT = {   // a joint's unit (scene.units, from the core's table) per chart
+  q: (u) => u, qd: (u) => u + "/s", effort: (u) => (u === "m" ? "N" : "N m"),
+};
+const MIN_SPAN = 1e-6;   // an axis spans at least MIN_SPAN x max(1, |largest value|), as lagsim-plot
+
+// The scene's facts about a joint by name: its unit ("m", "rad", or null) and whether a
+// command can move it (unknown: treated as actuated).
+function jointInfo(name) {
+  const sc = view.scene, i = sc ? sc.joints.indexOf(name) : -1;
+  return {
+    unit: i >= 0 && sc.units ? sc.units[i] : null,
+    actuated: i >= 0 ? sc.actuated[i] : true,
+  };
+}
+
+// One series per joint of the newest state, from samples `list`; `keep(name)` picks joints.
+function jointSeries(chart, list, suffix, keep) {
+  const names = view.state ? view.state.name : [];
+  const out = [];
+  names.forEach((name, k) => {
+    const info = jointInfo(name);
+    if (keep && !keep(name, info)) return;
+    out.push({
+      key: chart + ":" + name, label: name + suffix, color: COLORS[k % COLORS.length], dash: [],
+      unit: info.unit ? DERIVED_UNIT[chart](info.unit) : null, samples: list, get: (v) => v[k],
+    });
+  });
+  return out;
+}
+
+// The reference (r over q, r' over q dot), dashed in its joint's colour: the scene's
+// `reference:` as the daemon publishes it beside each state (none: no series).
+function refSeries(chart, list, suffix) {
+  if (!list.length) return [];
+  return jointSeries(chart, list, suffix).map((s) => Object.assign(s, { key: s.key + ":ref", dash: [6, 4] }));
+}
+
+const CHARTS = [
+  { id: "chart_q", name: "q",
+    series: () => jointSeries("q", view.charts.q, "").concat(refSeries("q", view.charts.qref, "_ref")) },
+  { id: "chart_qd", name: "qd",
+    series: () => jointSeries("qd", view.charts.qd, "_dot").concat(refSeries("qd", view.charts.qdref, "_dot_ref")) },
+  // an unactuated joint's effort is zero by definition: not drawn
+  { id: "chart_effort", name: "effort",
+    series: () => jointSeries("effort", view.charts.effort, "_effort", (n, info) => info.actuated) },
+  { id: "chart_energy", name: "energy",
+    series: () => [{ key: "energy:E", label: "E = T + U", color: COLORS[0], dash: [], unit: "J",
+                     samples: view.charts.energy, get: (v) => v[0] }] },
+];
+
+// lo..hi widened to the minimum span about its middle, then padded 8 % each side.
+function axisRange(lo, hi) {
+  const min = MIN_SPAN * Math.max(1, Math.abs(lo), Math.abs(hi));
+  if (hi - lo < min) { const c = 0.5 * (lo + hi); lo = c - 0.5 * min; hi = c + 0.5 * min; }
+  const pad = 0.08 * (hi - lo);
+  return [lo - pad, hi + pad];
+}
+
+// The legend under a chart: one button per series, a click hides or shows it.
+function legend(canvas, series) {
+  let box = canvas.nextElementSibling;
+  if (!box || !box.classList.contains("legend")) {
+    box = document.createElement("div");
+    box.className = "legend";
+    canvas.after(box);
+  }
+  const keys = series.map((s) => s.key).join("\n");
+  if (box.dataset.keys !== keys) {
+    box.dataset.keys = keys;
+    box.textContent = "";
+    for (const s of series) {
+      const b = document.createElement("button");
+      b.type = "button";
+      b.dataset.key = s.key;
+      b.textContent = s.label + (s.unit ? " (" + s.unit + ")" : "");
+      b.style.color = s.color;
+      b.title = "click: hide or show this trace";
+      b.addEventListener("click", () => {
+        if (view.hidden.has(s.key)) view.hidden.delete(s.key); else view.hidden.add(s.key);
+        view.dirty = true;
+      });
+      box.appendChild(b);
+    }
+  }
+  for (const b of box.children) b.classList.toggle("off", view.hidden.has(b.dataset.key));
+}
+
+// Draws a chart's visible series over the chosen window of sim time; returns what it drew
+// (axes with their unit and range, the series on each) for view.drawn.
+function drawChart(canvas, series) {
   const { g, w, h } = fit(canvas);
   g.clearRect(0, 0, w, h);
-  const win = Number($("window").value) || 10;
-  const tEnd = samples.length ? samples[samples.length - 1][0] : 0;
-  const t0 = samples.length ? Math.max(tEnd - win, samples[0][0]) : 0, span = Math.max(tEnd - t0, 1e-9);
-  let lo = Infinity, hi = -Infinity, first = samples.length, rfirst = ref ? ref.length : 0;
-  for (let i = samples.length - 1; i >= 0 && samples[i][0] >= t0; i--) {
-    first = i;
-    for (const v of samples[i][1]) if (v !== null) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
-  }
-  for (let i = rfirst - 1; i >= 0 && ref[i][0] >= t0; i--) {
-    rfirst = i;
-    for (const v of ref[i][1]) if (v !== null) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
-  }
+  legend(canvas, series);
   g.fillStyle = "#555"; g.font = "11px DejaVu Sans, sans-serif";
   g.fillText(canvas.dataset.title, 6, 12);
-  if (!(hi >= lo)) return 0;
-  if (hi - lo < 1e-12 * Math.max(1, Math.abs(hi))) { const d = Math.max(0.5, 1e-6 * Math.abs(hi)); hi += d; lo -= d; }
-  const pad = 0.08 * (hi - lo); lo -= pad; hi += pad;
-  // enough digits to tell the bounds apart (energy drifts in its 7th digit)
-  const digits = Math.min(12, Math.max(4, 2 + Math.ceil(Math.log10(Math.max(Math.abs(hi), Math.abs(lo)) / (hi - lo)))));
+  const win = Number($("window").value) || 10;
+  const shown = series.filter((s) => !view.hidden.has(s.key));
+  let tEnd = -Infinity;
+  for (const s of shown) if (s.samples.length) tEnd = Math.max(tEnd, s.samples[s.samples.length - 1][0]);
+  const drawnInfo = { axes: {}, series: [] };
+  if (!Number.isFinite(tEnd)) return drawnInfo;
+  let t0 = tEnd - win;
+  let tFirst = Infinity;
+  for (const s of shown) if (s.samples.length) tFirst = Math.min(tFirst, s.samples[0][0]);
+  t0 = Math.max(t0, tFirst);
+  const span = Math.max(tEnd - t0, 1e-9);
+  // one axis per side: the units of a side (one family) and their range
+  const axes = {};
+  for (const s of shown) {
+    const side = UNIT_FAMILY[s.unit] || "left";
+    const ax = axes[side] || (axes[side] = { units: [], lo: Infinity, hi: -Infinity });
+    if (!ax.units.includes(s.unit || "m or rad")) ax.units.push(s.unit || "m or rad");
+    for (let i = s.samples.length - 1; i >= 0 && s.samples[i][0] >= t0; i--) {
+      const v = s.get(s.samples[i][1]);
+      if (v !== null && v !== undefined && Number.isFinite(v)) { ax.lo = Math.min(ax.lo, v); ax.hi = Math.max(ax.hi, v); }
+    }
+  }
   const L = 86, R = 86, T = 16, B = 14;
-  const X = (t) => L + (t - t0) / span * (w - L - R), Y = (v) => T + (hi - v) / (hi - lo) * (h - T - B);
-  g.strokeStyle = "#eee"; g.lineWidth = 1;
-  g.beginPath(); g.moveTo(L, Y(0)); g.lineTo(w - R, Y(0)); g.stroke();
+  const X = (t) => L + (t - t0) / span * (w - L - R);
+  for (const side of Object.keys(axes)) {
+    const ax = axes[side];
+    if (!(ax.hi >= ax.lo)) { delete axes[side]; continue; }
+    [ax.lo, ax.hi] = axisRange(ax.lo, ax.hi);
+    ax.Y = (v) => T + (ax.hi - v) / (ax.hi - ax.lo) * (h - T - B);
+    // enough digits to tell the bounds apart (energy drifts in its 7th digit)
+    const digits = Math.min(12, Math.max(4, 2 + Math.ceil(Math.log10(Math.max(Math.abs(ax.hi), Math.abs(ax.lo)) / (ax.hi - ax.lo)))));
+    const x = side === "left" ? 2 : w - R + 4;
+    g.fillStyle = "#777";
+    g.fillText(ax.units.join(", "), x, T + 20);
+    g.fillText(ax.hi.toPrecision(digits), x, T + 8); g.fillText(ax.lo.toPrecision(digits), x, h - B);
+    if (ax.lo < 0 && ax.hi > 0) {
+      g.strokeStyle = "#eee"; g.lineWidth = 1;
+      g.beginPath(); g.moveTo(L, ax.Y(0)); g.lineTo(w - R, ax.Y(0)); g.stroke();
+    }
+    drawnInfo.axes[side] = { units: ax.units, lo: ax.lo, hi: ax.hi };
+  }
   g.fillStyle = "#777";
-  g.fillText(hi.toPrecision(digits), 2, T + 8); g.fillText(lo.toPrecision(digits), 2, h - B);
   g.fillText(t0.toFixed(1) + " s", L, h - 2); g.fillText(tEnd.toFixed(1) + " s", w - R - 40, h - 2);
-  const n = samples.length ? samples[samples.length - 1][1].length : 0;
-  for (let k = 0; k < n; k++) {
-    g.strokeStyle = COLORS[k % COLORS.length]; g.lineWidth = 1.5; g.beginPath();
-    let pen = false;
-    for (let i = first; i < samples.length; i++) {
-      const v = samples[i][1][k];
+  for (const s of shown) {
+    const side = UNIT_FAMILY[s.unit] || "left", ax = axes[side];
+    if (!ax) continue;
+    g.strokeStyle = s.color; g.lineWidth = 1.5; g.setLineDash(s.dash); g.beginPath();
+    let pen = false, n = 0, first = s.samples.length;
+    while (first > 0 && s.samples[first - 1][0] >= t0) first--;
+    for (let i = first; i < s.samples.length; i++) {
+      const v = s.get(s.samples[i][1]);
       if (v === null || v === undefined) { pen = false; continue; }
-      if (pen) g.lineTo(X(samples[i][0]), Y(v)); else g.moveTo(X(samples[i][0]), Y(v));
-      pen = true;
+      if (pen) g.lineTo(X(s.samples[i][0]), ax.Y(v)); else g.moveTo(X(s.samples[i][0]), ax.Y(v));
+      pen = true; n++;
     }
-    g.stroke();
-    g.fillStyle = COLORS[k % COLORS.length];
-    g.fillText(names[k] || "", w - R + 6, T + 10 + 13 * k);
+    g.stroke(); g.setLineDash([]);
+    drawnInfo.series.push({ key: s.key, label: s.label, unit: s.unit, axis: side, points: n,
+                            t_first: first < s.samples.length ? s.samples[first][0] : null });
   }
-  let dashed = 0;
-  const nr = ref && ref.length ? ref[ref.length - 1][1].length : 0;
-  g.setLineDash([6, 4]);
-  for (let k = 0; k < nr; k++) {
-    g.strokeStyle = COLORS[k % COLORS.length]; g.lineWidth = 1.5; g.beginPath();
-    let pen = false, any = false;
-    for (let i = rfirst; i < ref.length; i++) {
-      const v = ref[i][1][k];
-      if (v === null || v === undefined) { pen = false; continue; }
-      if (pen) g.lineTo(X(ref[i][0]), Y(v)); else g.moveTo(X(ref[i][0]), Y(v));
-      pen = any = true;
-    }
-    g.stroke();
-    if (any) dashed++;
-  }
-  g.setLineDash([]);
-  return dashed;
+  return drawnInfo;
 }
 
 function drawCharts() {
-  const names = view.state ? view.state.name : [];
-  view.refDashed = [drawChart($("chart_q"), view.charts.q, names, view.charts.qref),
-                    drawChart($("chart_qd"), view.charts.qd, names.map((n) => n + "_dot"), view.charts.qdref)];
-  drawChart($("chart_effort"), view.charts.effort, names);
-  drawChart($("chart_energy"), view.charts.energy, ["E"]);
+  const out = {};
+  for (const c of CHARTS) out[c.name] = drawChart($(c.id), c.series());
+  return out;
 }
 
 // ---------------------------------------------------------------- status
@@ -452,7 +583,7 @@ function frame() {
   if (view.dirty) {
     view.dirty = false;
     const r = drawModel();
-    drawCharts();
+    const charts = drawCharts();
     drawStatus();
     const st = view.state;
     if (st && st.sim_time !== null) $("simtime").textContent = "t = " + st.sim_time.toFixed(3) + " s";
@@ -467,7 +598,9 @@ function frame() {
       note: r && r.note ? r.note : null,         // said instead of a drawing
       run_state: view.status ? view.status.run_state : null,
       ref: st && st.ref ? st.ref : null,         // the state's reference, as it came
-      ref_dashed: view.refDashed,                // dashed series drawn over q and over qd
+      // dashed series drawn over q and over qd (with at least one point)
+      ref_dashed: ["q", "qd"].map((c) => charts[c].series.filter((s) => s.key.endsWith(":ref") && s.points > 0).length),
+      charts,                                    // per chart: axes {left, right} and series drawn
     };
     document.body.dataset.drawnSimTime = st && st.sim_time !== null ? String(st.sim_time) : "";
   }
@@ -476,5 +609,5 @@ function frame() {
 
 $("window").addEventListener("change", () => { view.dirty = true; });
 window.addEventListener("resize", () => { view.dirty = true; });
-connect();
+loadHistory().finally(connect);
 requestAnimationFrame(frame);
