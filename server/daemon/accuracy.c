@@ -83,15 +83,15 @@ int lagsimd_choose_integrator(const lag_scene *sc, bool offline, bool quiet, lag
     char d[96];
     if (pick >= 0) {
         lag_cost_row_describe(&t.row[pick], d, sizeof d);
-        if (!quiet)
-            fprintf(stderr, "lagsimd: integrator.error %g over %g s: %s, the cheapest of %d "
+        (void)quiet; /* said even with -q: a log of this run replays only with the overrides */
+        fprintf(stderr, "lagsimd: integrator.error %g over %g s: %s, the cheapest of %d "
                     "settings measured on this scene that meets it %g times over (error %.2g; "
                     "%.2g s of CPU per sim-second, %.3g x real time); calibration took %.2f s "
                     "of CPU%s\n", e, horizon, d, t.n, lag_cost_opts_default().safety,
                     t.row[pick].error, t.row[pick].cpu_per_sim_s, margin(sc, &t.row[pick]),
                     t.spent, t.budget_hit ? " (its budget ran out: some settings unmeasured)" : "");
         apply(ch, &t.row[pick]);
-        if (!quiet) say_overrides(ch);
+        say_overrides(ch);
         return LAGSIMD_EXIT_OK;
     }
     /* none: the most accurate setting (that runs in real time, when paced) */
@@ -140,17 +140,10 @@ static int copy_into(const char *path, int out)
 }
 
 /* The work-precision diagram of the table, drawn by gnuplot into a temporary file and
- * copied to png, opened first by the rules of every output (lagsim_out.h). */
+ * copied to out (png, opened already by the rules of every output, lagsim_out.h). */
 static int plot(const lag_scene *sc, const lag_cost_table *t, double target, const char *png,
-                bool force)
+                int out)
 {
-    char oerr[512];
-    const char *inputs[1] = {sc->path};
-    int out = lag_out_open("--plot", png, force, inputs, 1, 0, oerr, sizeof oerr);
-    if (out < 0) {
-        fprintf(stderr, "lagsimd: %s\n", oerr);
-        return out == LAG_OUT_REFUSED ? LAGSIMD_EXIT_USAGE : LAGSIMD_EXIT_RUNTIME;
-    }
     char tmp_png[] = "/tmp/lagsimd-cost-XXXXXX.png";
     int tfd = mkstemps(tmp_png, 4);
     if (tfd < 0) {
@@ -228,15 +221,31 @@ static int plot(const lag_scene *sc, const lag_cost_table *t, double target, con
 int lagsimd_cost(const lag_scene *sc, const char *png, bool force)
 {
     static lag_cost_table t;
-    const double target = sc->accuracy.error > 0 ? sc->accuracy.error : DEFAULT_TARGET;
-    if (measure(sc, target, true, &t) != 0) return LAGSIMD_EXIT_USAGE;
+    const bool asked = sc->accuracy.error > 0;
+    const double target = asked ? sc->accuracy.error : DEFAULT_TARGET;
+    int out = -1;
+    if (png) { /* refused before anything is measured */
+        char oerr[512];
+        const char *inputs[1] = {sc->path};
+        out = lag_out_open("--plot", png, force, inputs, 1, 0, oerr, sizeof oerr);
+        if (out < 0) {
+            fprintf(stderr, "lagsimd: %s\n", oerr);
+            return out == LAG_OUT_REFUSED ? LAGSIMD_EXIT_USAGE : LAGSIMD_EXIT_RUNTIME;
+        }
+    }
+    if (measure(sc, target, true, &t) != 0) {
+        if (out >= 0) close(out);
+        return LAGSIMD_EXIT_USAGE;
+    }
     const lag_cost_opts o = opts_for(sc, target);
     const lag_model_info *info = lag_model_info_get(sc->sim.model.kind);
-    printf("# %s: %s, error asked for %g over %g s (a setting meets it with %g times to spare),\n"
+    printf("# %s: %s, error %s %g over %g s (a setting meets it with %g times to spare),\n"
            "# publish period %g s; reference dopri5 tolerance %.0e (with a floor or stops at a\n"
            "# tick of period/1024);\n"
            "# CPU measured on this machine: %.2f s for %d settings%s\n",
-           sc->path, info ? info->name : "?", target, o.horizon, o.safety, o.period, t.ref_tol,
+           sc->path, info ? info->name : "?",
+           asked ? "asked for (integrator.error)" : "not asked for by the scene: rows marked at",
+           target, o.horizon, o.safety, o.period, t.ref_tol,
            t.spent, t.n, t.budget_hit ? " (budget ran out: finer settings unmeasured)" : "");
     printf("%-34s %12s %14s %13s %13s  %s\n", "setting", "error", "energy error", "CPU s/sim-s",
            "x real time", "");
@@ -250,8 +259,9 @@ int lagsimd_cost(const lag_scene *sc, const char *png, bool force)
         }
         printf("%-34s %12.3g %14.3g %13.3g %13.3g  %s\n", d, r->error, r->energy_error,
                r->cpu_per_sim_s, margin(sc, r),
-               i == t.chosen ? "meets, chosen" : r->meets ? "meets" : "");
+               i == t.chosen ? (asked ? "meets, chosen" : "meets, would be chosen")
+                             : r->meets ? "meets" : "");
     }
     if (t.chosen < 0) printf("# no setting measured meets %g\n", target);
-    return png ? plot(sc, &t, target, png, force) : LAGSIMD_EXIT_OK;
+    return png ? plot(sc, &t, target, png, out) : LAGSIMD_EXIT_OK;
 }

@@ -182,6 +182,22 @@ static bool integrator_given(const char *const *sets, int nsets)
     return false;
 }
 
+/* integrator.error: the integrator the calibration chooses, or the one the command line
+ * names with --set integrator.method=... (a rerun of a choice, or the user's own): then
+ * said, and not measured. Returns an exit code. OUT: ch */
+static int choose(const lag_scene *sc, const char *const *sets, int nsets, bool offline,
+                  bool quiet, lagsimd_choice *ch)
+{
+    ch->n = 0;
+    if (sc->accuracy.error > 0 && integrator_given(sets, nsets)) {
+        fprintf(stderr, "lagsimd: integrator.error %g: the integrator given by --set (%s, dt %g "
+                "s) is used, not measured\n", sc->accuracy.error,
+                lag_method_name(sc->sim.integrator.method), sc->sim.integrator.dt);
+        return LAGSIMD_EXIT_OK;
+    }
+    return lagsimd_choose_integrator(sc, offline, quiet, ch);
+}
+
 /* Appends the calibration's choice to the overrides (main made room for its 4) and
  * loads the scene again with it. */
 static int reload_with(const char *config, const char *text, size_t len, const char **sets,
@@ -369,7 +385,7 @@ int main(int argc, char **argv)
                     "integrator.dt=... (and rtol, atol for dopri5), as the run printed them\n",
                     config);
             rc = LAGSIMD_EXIT_USAGE;
-        } else if (!replay && lagsimd_choose_integrator(&sc, offline, opts.quiet, &choice) != LAGSIMD_EXIT_OK) {
+        } else if (!replay && choose(&sc, sets, nsets, offline, opts.quiet, &choice) != LAGSIMD_EXIT_OK) {
             rc = LAGSIMD_EXIT_USAGE; /* said why */
         } else if (choice.n > 0 && reload_with(config, text, len, sets, &nsets, &choice, &sc) != 0) {
             rc = LAGSIMD_EXIT_USAGE;

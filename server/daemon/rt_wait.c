@@ -1,7 +1,8 @@
 /*
  * A plant never waits in silence. Whenever the run does not advance, the daemon knows
  * what it waits for and says so: in every status (waiting_for, waiting_s, waiting_got)
- * and, every RT_WAIT_LINE_NS of the wait, in one line on stderr (unless -q):
+ * and in one line on stderr (unless -q) after 3 s of the wait, 6 s, 12 s, ... doubling up
+ * to a line a minute:
  *
  *   lagsimd: DIPC waits 6 s for the first command on DIPC_COMMAND at
  *   udpm://239.255.76.67:7668?ttl=0; got instead: 3 commands rejected (unknown joint 3;
@@ -22,7 +23,8 @@
 #include "rt_server.h"
 
 #define RT_WAIT_SHOW_NS RT_NS_PER_S         /* a lockstep wait is said after 1 s */
-#define RT_WAIT_LINE_NS (3 * RT_NS_PER_S)   /* a line every 3 s of a wait */
+#define RT_WAIT_LINE_NS (3 * RT_NS_PER_S)   /* the first line after 3 s of a wait, */
+#define RT_WAIT_LINE_MAX_NS (60 * RT_NS_PER_S) /* then at gaps as long as the wait, <= 1 min */
 
 /* What the plant waits for now (RT_WAIT_NONE: the run advances); *t: the sim_time a
  * lockstep answer must carry. */
@@ -57,7 +59,11 @@ void rt_wait_update(rt_server *s)
         s->wt.wrong_port0 = s->commands_wrong_port;
     }
     if (k == RT_WAIT_NONE || s->now < s->wt.next_line_ns) return;
-    s->wt.next_line_ns = rt_sat_add(s->now, RT_WAIT_LINE_NS);
+    /* 3, 6, 12, 24, 48 s, then every minute: a wait nobody answers does not fill the
+     * terminal */
+    int64_t gap = s->now - s->wt.since_ns;
+    gap = gap < RT_WAIT_LINE_NS ? RT_WAIT_LINE_NS : gap > RT_WAIT_LINE_MAX_NS ? RT_WAIT_LINE_MAX_NS : gap;
+    s->wt.next_line_ns = rt_sat_add(s->now, gap);
     char what[2 * LAG_WIRE_TEXT_LEN], got[2 * LAG_WIRE_TEXT_LEN]; /* the status cuts them */
     double waited = rt_wait_describe(s, what, sizeof what, got, sizeof got);
     char line[5 * LAG_WIRE_TEXT_LEN];

@@ -38,6 +38,20 @@ sets=$(grep -o -- "--set integrator\.[a-z]*=[^ ]*" "$work/chosen.err" | tr '\n' 
 cmp -s "$work/chosen.csv" "$work/again.csv" && ok "rerun with '$sets' is bit-identical" \
     || bad "rerun with '$sets' differs"
 
+# 2b. the integrator named by --set is run as given, said, not measured; -q still says the
+#     choice and its overrides (a log of the run replays only with them)
+"$lagsimd" -q --config "$cfg/dipc.yaml" --set integrator.error=$E --set integrator.method=rk4 \
+    --set integrator.dt=0.005 --offline --duration 1 --csv "$work/given.csv" 2> "$work/given.err"
+"$lagsimd" -q --config "$cfg/dipc.yaml" --set integrator.method=rk4 --set integrator.dt=0.005 \
+    --offline --duration 1 --csv "$work/plain.csv"
+grep -q "the integrator given by --set (rk4, dt 0.005 s) is used, not measured" "$work/given.err" \
+    && ! grep -q "calibration took" "$work/given.err" && cmp -s "$work/given.csv" "$work/plain.csv" \
+    && ok "--set integrator.method with integrator.error: run as given, said, not measured" \
+    || bad "--set integrator.method with integrator.error: $(cat "$work/given.err")"
+"$lagsimd" -q --config "$cfg/dipc.yaml" --set integrator.error=$E --offline --duration 0 2> "$work/q.err"
+grep -q "to run this setting again" "$work/q.err" && ok "-q still prints the overrides" \
+    || bad "-q hid the overrides"
+
 # 3. --cost: a table with one chosen row, and a PNG
 "$lagsimd" --config "$cfg/manipulator.yaml" --set integrator.error=1e-4 --cost \
     --plot "$work/cost.png" > "$work/cost.txt"

@@ -1246,6 +1246,19 @@ static void case_waits(void)
     EXPECT_HAS(g_out.status_waiting_for, "RESUME or STEP ");
     EXPECT_HAS(g_out.status_waiting_for, on_ctl);
     ENSURE(g_out.status_waiting_s >= 1.0 && g_out.status_waiting_s < 1.2);
+    /* a wait nobody answers: its lines thin out, at 3, 6, 12, 24, 48, 96 s of the wait,
+     * then a minute apart */
+    run_until(g_srv.now + 20 * SEC, 1000000);
+    int64_t since = g_srv.wt.since_ns, next = rt_wait_next(&g_srv);
+    ENSUREF(next - since == 24 * SEC, "after %.1f s of a wait the next line at %.1f s of it (24)",
+            (double)(g_srv.now - since) / SEC, (double)(next - since) / SEC);
+    run_until(g_srv.now + 300 * SEC, 100000000);
+    next = rt_wait_next(&g_srv);
+    /* (each line comes at the loop's first wake-up after it is due: 100 ms steps here) */
+    ENSUREF(next > g_srv.now && next - g_srv.now <= 60 * SEC &&
+                (next - since - 96 * SEC) % (60 * SEC) < SEC,
+            "after %.1f s of a wait the next line at %.1f s of it (96 + 60 k, within 1 s)",
+            (double)(g_srv.now - since) / SEC, (double)(next - since) / SEC);
     stop_server();
 
     /* realtime: waiting for the first command, then running: nothing to wait for */
