@@ -3,6 +3,7 @@
 #include "eval_case.h"
 
 #include <errno.h>
+#include <libgen.h>
 #include <math.h>
 #include <signal.h>
 #include <stdalign.h>
@@ -19,6 +20,7 @@
 #include <unistd.h>
 
 #include "lagsim_log.h"
+#include "lagsim_out.h"
 #include "lagsim_wire.h"
 #include "scene.h"
 #include "scene_yaml.h"
@@ -642,4 +644,28 @@ void eval_fmt(double v, char *buf, size_t len)
 {
     if (isnan(v)) snprintf(buf, len, "nan");
     else snprintf(buf, len, "%.6g", v);
+}
+
+void eval_default_lagsimd(char *buf, size_t len)
+{
+    char self[4096];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n > 0) {
+        self[n] = '\0';
+        snprintf(buf, len, "%s/lagsimd", dirname(self));
+        if (access(buf, X_OK) == 0) return;
+    }
+    snprintf(buf, len, "lagsimd");
+}
+
+FILE *eval_open_out(const char *prog, const char *what, const char *path, bool force,
+                    const char *const *in, int nin)
+{
+    char err[512];
+    int fd = lag_out_open(what, path, force, in, nin, 0, err, sizeof err);
+    if (fd < 0) {
+        fprintf(stderr, "%s: %s\n", prog, err);
+        return NULL;
+    }
+    return fdopen(fd, "w");
 }

@@ -21,6 +21,7 @@
 #ifndef LAGSIM_EVAL_CASE_H
 #define LAGSIM_EVAL_CASE_H
 
+#include <stdio.h>
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -126,5 +127,14 @@ int eval_require_check(const lag_require *req, const eval_scene *sc, char *err, 
 
 /* A number for tables and CSVs: %.6g, "nan" for none. */
 void eval_fmt(double v, char *buf, size_t len);
+
+/* The lagsimd beside the running program (/proc/self/exe), else "lagsimd" on PATH. */
+void eval_default_lagsimd(char *buf, size_t len);
+
+/* An output file opened by the rules of every lagsim output (lagsim_out.h: no symbolic
+ * link, never one of the nin inputs, an existing file only with force); NULL after saying
+ * why on stderr, prefixed with prog. */
+FILE *eval_open_out(const char *prog, const char *what, const char *path, bool force,
+                    const char *const *in, int nin);
 
 #endif

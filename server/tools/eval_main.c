@@ -6,7 +6,6 @@
 
 #include <errno.h>
 #include <getopt.h>
-#include <libgen.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,7 +15,6 @@
 #include <unistd.h>
 
 #include "eval_case.h"
-#include "lagsim_out.h"
 
 static const char *prog = "lagsim-eval";
 
@@ -64,29 +62,11 @@ static int die(const char *fmt, const char *a)
     return 2;
 }
 
-/* The lagsimd beside /proc/self/exe, else "lagsimd" on PATH. */
-static void default_lagsimd(char *buf, size_t len)
-{
-    char self[4096];
-    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-    if (n > 0) {
-        self[n] = '\0';
-        snprintf(buf, len, "%s/lagsimd", dirname(self));
-        if (access(buf, X_OK) == 0) return;
-    }
-    snprintf(buf, len, "lagsimd");
-}
-
+/* An output of this run: never the scene file it reads (eval_open_out). */
 static FILE *open_out(const char *what, const char *path, bool force, const char *config)
 {
-    char err[512];
     const char *inputs[1] = {config};
-    int fd = lag_out_open(what, path, force, inputs, 1, 0, err, sizeof err);
-    if (fd < 0) {
-        fprintf(stderr, "%s: %s\n", prog, err);
-        return NULL;
-    }
-    return fdopen(fd, "w");
+    return eval_open_out(prog, what, path, force, inputs, 1);
 }
 
 /* The PNG of one case: q (solid) and r (dashed) of each joint, the efforts, and the
@@ -179,7 +159,7 @@ int main(int argc, char **argv)
     bool force = false, verbose = false;
     double timeout = 600;
     char lagsimd[4096];
-    default_lagsimd(lagsimd, sizeof lagsimd);
+    eval_default_lagsimd(lagsimd, sizeof lagsimd);
     enum { O_CASE = 256, O_SUITE, O_REQUIRE, O_CSV, O_REPORT, O_LAGSIMD, O_TIMEOUT };
     static const struct option opts[] = {
         {"config", required_argument, 0, 'c'},   {"controller", required_argument, 0, 'C'},

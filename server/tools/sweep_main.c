@@ -10,7 +10,6 @@
  */
 #include <errno.h>
 #include <getopt.h>
-#include <libgen.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -21,7 +20,6 @@
 #include <unistd.h>
 
 #include "eval_case.h"
-#include "lagsim_out.h"
 
 static const char *prog = "lagsim-sweep";
 
@@ -342,18 +340,6 @@ static void summary(const char *header, rows *r)
     free(nv);
 }
 
-static FILE *open_out(const char *what, const char *path, bool force, const char *const *in,
-                      int nin)
-{
-    char err[512];
-    int fd = lag_out_open(what, path, force, in, nin, 0, err, sizeof err);
-    if (fd < 0) {
-        fprintf(stderr, "%s: %s\n", prog, err);
-        return NULL;
-    }
-    return fdopen(fd, "w");
-}
-
 /* ---------------------------------------------------------------- merge */
 static int merge(int argc, char **argv)
 {
@@ -413,7 +399,7 @@ static int merge(int argc, char **argv)
         }
         fclose(f);
     }
-    FILE *fo = open_out("-o", out, force, in, nin);
+    FILE *fo = eval_open_out(prog, "-o", out, force, in, nin);
     if (!fo) {
         rows_free(&r);
         return 2;
@@ -451,7 +437,7 @@ static int plot(const char *png, bool force, const char *config, const char *hea
     snprintf(dat, sizeof dat, "%s.dat", png);
     snprintf(gp, sizeof gp, "%s.gp", png);
     const char *in[1] = {config};
-    FILE *f = open_out("--plot", dat, force, in, 1);
+    FILE *f = eval_open_out(prog, "--plot", dat, force, in, 1);
     if (!f) return -1;
     for (int i = 0; i < r->n; i++) {
         char lb[ROW_MAX];
@@ -470,7 +456,7 @@ static int plot(const char *png, bool force, const char *config, const char *hea
         unlink(dat);
         return 0;
     }
-    f = open_out("--plot", gp, force, in, 1);
+    f = eval_open_out(prog, "--plot", gp, force, in, 1);
     if (!f) return -1;
     fprintf(f, "set terminal pngcairo noenhanced size %d,420 font ',10'\n", 420 * nv + 80);
     fprintf(f, "set output '%s'\nset grid\nset datafile missing 'nan'\n", png);
@@ -484,7 +470,7 @@ static int plot(const char *png, bool force, const char *config, const char *hea
                 hf[1 + k], metric, dat, k + 1, nv + 2, nv + 1, k + 1, nv + 2, nv + 1);
     fprintf(f, "unset multiplot\n");
     fclose(f);
-    f = open_out("--plot", png, force, in, 1);
+    f = eval_open_out(prog, "--plot", png, force, in, 1);
     if (!f) return -1;
     fclose(f);
     fflush(NULL);
@@ -502,18 +488,6 @@ static int plot(const char *png, bool force, const char *config, const char *hea
 }
 
 /* ---------------------------------------------------------------- the sweep */
-static void default_lagsimd(char *buf, size_t len)
-{
-    char self[4096];
-    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-    if (n > 0) {
-        self[n] = '\0';
-        snprintf(buf, len, "%s/lagsimd", dirname(self));
-        if (access(buf, X_OK) == 0) return;
-    }
-    snprintf(buf, len, "lagsimd");
-}
-
 static double parse_pos(const char *opt, const char *s, double lo, double hi, int *bad)
 {
     char *end;
@@ -539,7 +513,7 @@ int main(int argc, char **argv)
     vary vs[VARY_MAX];
     int nv = 0, bad = 0;
     char lagsimd[4096];
-    default_lagsimd(lagsimd, sizeof lagsimd);
+    eval_default_lagsimd(lagsimd, sizeof lagsimd);
     enum { O_CASE = 256, O_SUITE, O_VARY, O_SEED, O_SHARD, O_REQUIRE, O_CSV, O_PLOT, O_METRIC,
            O_LAGSIMD, O_TIMEOUT };
     static const struct option opts[] = {
@@ -661,7 +635,7 @@ int main(int argc, char **argv)
 
     FILE *fcsv = NULL;
     const char *in[2] = {config, suite};
-    if (csv && !(fcsv = open_out("--csv", csv, force, in, 2))) return 2;
+    if (csv && !(fcsv = eval_open_out(prog, "--csv", csv, force, in, 2))) return 2;
 
     char tmpdir[] = "/tmp/lagsim-sweep.XXXXXX";
     if (!mkdtemp(tmpdir)) {
