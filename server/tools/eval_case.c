@@ -669,3 +669,19 @@ FILE *eval_open_out(const char *prog, const char *what, const char *path, bool f
     }
     return fdopen(fd, "w");
 }
+
+int eval_gnuplot(const char *prog, const char *gp)
+{
+    fflush(NULL); /* nothing buffered is written twice */
+    pid_t pid = fork();
+    if (pid == 0) {
+        execlp("gnuplot", "gnuplot", gp, (char *)NULL);
+        _exit(127);
+    }
+    int st = 0;
+    if (pid < 0 || waitpid(pid, &st, 0) < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        fprintf(stderr, "%s: gnuplot failed on %s\n", prog, gp);
+        return -1;
+    }
+    return 0;
+}

@@ -128,6 +128,9 @@ int eval_require_check(const lag_require *req, const eval_scene *sc, char *err, 
 /* A number for tables and CSVs: %.6g, "nan" for none. */
 void eval_fmt(double v, char *buf, size_t len);
 
+/* Runs gnuplot on the script gp; 0, or -1 after saying it failed (prefixed with prog). */
+int eval_gnuplot(const char *prog, const char *gp);
+
 /* The lagsimd beside the running program (/proc/self/exe), else "lagsimd" on PATH. */
 void eval_default_lagsimd(char *buf, size_t len);
 

@@ -11,7 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "eval_case.h"
@@ -136,18 +135,7 @@ static int report(const char *dir, bool force, const char *config, const eval_ca
     f = open_out("--report", png, force, config);
     if (!f) return -1;
     fclose(f);
-    fflush(NULL);
-    pid_t pid = fork();
-    if (pid == 0) {
-        execlp("gnuplot", "gnuplot", gp, (char *)NULL);
-        _exit(127);
-    }
-    int st = 0;
-    if (pid < 0 || waitpid(pid, &st, 0) < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-        fprintf(stderr, "%s: gnuplot failed on %s\n", prog, gp);
-        return -1;
-    }
-    return 0;
+    return eval_gnuplot(prog, gp);
 }
 
 int main(int argc, char **argv)

@@ -473,18 +473,7 @@ static int plot(const char *png, bool force, const char *config, const char *hea
     f = eval_open_out(prog, "--plot", png, force, in, 1);
     if (!f) return -1;
     fclose(f);
-    fflush(NULL);
-    pid_t pid = fork();
-    if (pid == 0) {
-        execlp("gnuplot", "gnuplot", gp, (char *)NULL);
-        _exit(127);
-    }
-    int st = 0;
-    if (pid < 0 || waitpid(pid, &st, 0) < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-        fprintf(stderr, "%s: gnuplot failed on %s\n", prog, gp);
-        return -1;
-    }
-    return 0;
+    return eval_gnuplot(prog, gp);
 }
 
 /* ---------------------------------------------------------------- the sweep */
