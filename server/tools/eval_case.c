@@ -202,9 +202,10 @@ int eval_scene_load(const char *config, const char *const *sets, int nsets, eval
 /* ---------------------------------------------------------------- processes */
 void eval_url(int slot, char *url, size_t len)
 {
-    /* a port pair per (process, slot): 20000..59998, apart from the tests' 20000 + 2 (pid
-     * % 6000) only by chance, hence the prefix of the run's own as well */
-    int port = 20000 + 2 * (int)(((long)getpid() * 61 + slot) % 20000);
+    /* a port pair per (process, slot) in 64000..65518, above the ports the tests draw
+     * theirs from (20000..63998): a run never shares a bus with a test whose programs look
+     * for the only plant on it; a prefix of the run's own as well */
+    int port = 64000 + 2 * (int)(((long)getpid() * 61 + slot) % 760);
     snprintf(url, len, "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304", port);
 }
 
