@@ -258,6 +258,9 @@ typedef struct lag_effect_row {
                   double *rate, double *accel);
     lag_result (*on_event)(lag_sim *s, const lag_watcher *w, double *y, double t);
     void (*observe)(const lag_sim *s, double *q, double *qd);
+    /* does it keep state of its own from tick to tick under these settings (modes, a lag
+     * state: not in q, qd, tick and the definition)? NULL: never */
+    bool (*keeps_state)(const lag_effects_def *e);
 } lag_effect_row;
 
 /* Without its size, as lag_models: effects.c's _Static_assert counts the rows. */

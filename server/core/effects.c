@@ -15,6 +15,10 @@
  *              their maps and `value` the event function of custom ones: makes it a
  *              per-tick event effect
  *   observe    a change of the published state only (noise)
+ *   keeps_state  whether, under its settings, it keeps state of its own from tick to tick
+ *              that q, qd, tick and the definition do not hold (contact and stick/slip
+ *              modes, a lag's state): a restart from a logged (q, qd, tick) is then not
+ *              exact (lag_effect_info.keeps_state, lag_effects_keeping_state)
  * The rows' order is the order of their forces, per-tick work and watchers (ties between
  * events at one instant go to the earlier row): forces are added damping, friction,
  * disturbance, spring; per-tick work is the actuator's, then the disturbances'.
@@ -63,6 +67,13 @@ static const char *jfield(char *buf, const char *effect, const char *joint, cons
 static const char *jname(const lag_sim_def *def, int i)
 {
     return lag_model_info_get(def->model.kind)->joint_names[i];
+}
+
+/* keeps_state of the effects whose modes are state of their own whatever their settings */
+static bool always(const lag_effects_def *e)
+{
+    (void)e;
+    return true;
 }
 
 /* ================================================================== damping */
@@ -423,6 +434,14 @@ static lag_result actuator_validate(const lag_sim_def *def, lag_diag *d)
     return LAG_OK;
 }
 
+/* The lag's state (mode.act_state) is the actuator's own, while some input has a lag. */
+static bool actuator_lagged(const lag_effects_def *e)
+{
+    for (int i = 0; i < LAG_MAX_DOF; i++)
+        if (e->actuator_tau[i] > 0) return true;
+    return false;
+}
+
 static void actuator_pre_tick(lag_sim *s)
 {
     const lag_effects_def *e = &s->def.effects;
@@ -611,14 +630,15 @@ static double spring_potential(const lag_sim *s, const double *q)
 const lag_effect_row lag_effect_rows[] = {
     {.bit = LAG_EFF_DAMPING, .name = "damping", .validate = damping_validate, .force = damping_force},
     {.bit = LAG_EFF_LIMITS, .name = "limits", .validate = limits_validate, .watch = limits_watch,
-     .on_event = limits_event, .max_watch_joint = 2},
+     .on_event = limits_event, .max_watch_joint = 2, .keeps_state = always},
     {.bit = LAG_EFF_FLOOR, .name = "floor", .validate = floor_validate, .watch = floor_watch,
      .value = floor_normal, .gap = floor_gap, .on_event = floor_event, .max_watch_joint = 2,
-     .max_watch_global = 1},
+     .max_watch_global = 1, .keeps_state = always},
     {.bit = LAG_EFF_FRICTION, .name = "friction", .validate = friction_validate, .force = friction_force,
-     .watch = friction_watch, .on_event = friction_event, .max_watch_joint = 1},
+     .watch = friction_watch, .on_event = friction_event, .max_watch_joint = 1,
+     .keeps_state = always},
     {.bit = LAG_EFF_ACTUATOR, .name = "actuator", .validate = actuator_validate,
-     .pre_tick = actuator_pre_tick},
+     .pre_tick = actuator_pre_tick, .keeps_state = actuator_lagged},
     {.bit = LAG_EFF_DISTURBANCE, .name = "disturbance", .validate = disturbance_validate,
      .pre_tick = disturbance_pre_tick, .force = disturbance_force},
     {.bit = LAG_EFF_NOISE, .name = "noise", .validate = noise_validate, .observe = noise_observe},
@@ -641,7 +661,18 @@ lag_effect_info lag_effect_info_get(int index)
     inf.per_tick = r->pre_tick != NULL || r->watch != NULL;
     inf.events = r->watch != NULL;
     inf.observe = r->observe != NULL;
+    inf.keeps_state = r->keeps_state != NULL;
     return inf;
+}
+
+uint32_t lag_effects_keeping_state(const lag_effects_def *e)
+{
+    uint32_t m = 0;
+    for (int k = 0; k < LAG_EFF_COUNT; k++) {
+        const lag_effect_row *r = &lag_effect_rows[k];
+        if ((e->enabled & r->bit) && r->keeps_state && r->keeps_state(e)) m |= r->bit;
+    }
+    return m;
 }
 
 int lag_effect_from_name(const char *name)

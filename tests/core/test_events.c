@@ -284,6 +284,7 @@ static void check_table(int arg)
         ENSURE(inf.per_tick == (r->pre_tick != NULL || r->watch != NULL));
         ENSURE(inf.events == (r->watch != NULL) && inf.force == (r->force != NULL) &&
                inf.potential == (r->potential != NULL) && inf.observe == (r->observe != NULL));
+        ENSURE(inf.keeps_state == (r->keeps_state != NULL));
         ENSURE((r->watch != NULL) == (r->on_event != NULL));
         ENSURE((r->watch != NULL) == (r->max_watch_joint + r->max_watch_global > 0));
         all |= r->bit;

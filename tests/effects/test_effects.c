@@ -772,6 +772,71 @@ static void off(void)
     ENSURE(identical == compared);
 }
 
+
+/* ------------------------------------------------------------------ keeps_state */
+/* The table's keeps_state against what a restart does: a run of each effect that, under
+ * its settings, keeps no state of its own (lag_effects_keeping_state) is restarted from
+ * its (q, qd, tick) halfway and must go on bit for bit as the run itself; the effects that
+ * keep state say so exactly for the settings that make them (the actuator with a lag). */
+static void restart_settings(lag_sim_def *d, uint32_t bit)
+{
+    lag_effects_def *e = &d->effects;
+    e->enabled = bit;
+    for (int i = 0; i < LAG_MAX_DOF; i++) {
+        e->damping[i] = 0.7; e->spring_k[i] = 3.0; e->spring_rest[i] = 0.1;
+        e->actuator_max[i] = 0.4; e->noise_q[i] = 0.05; e->noise_qd[i] = 0.05;
+        e->friction_static[i] = 0.3; e->friction_kinetic[i] = 0.2;
+        e->limit_on[i] = true; e->limit_lower[i] = -1.0; e->limit_upper[i] = 1.0;
+        e->restitution[i] = 0.5;
+    }
+    e->n_disturbances = 2;
+    e->disturbances[0] = (lag_disturbance){0.05, 0, false, 2.0, 0.2};
+    e->disturbances[1] = (lag_disturbance){0.21, 1, true, 0.3, 0.0};
+    if (bit == LAG_EFF_FLOOR) {
+        *d = lag_default_sim_def(LAG_MODEL_STICK);
+        d->effects.enabled = bit;
+        d->q0[1] = 1.2;
+    }
+}
+
+static void restart(void)
+{
+    int checked = 0;
+    for (int k = 0; k < LAG_EFF_COUNT; k++) {
+        const lag_effect_info inf = lag_effect_info_get(k);
+        lag_sim_def d = lag_default_sim_def(LAG_MODEL_CARTPOLE);
+        d.q0[1] = 0.4; d.qd0[0] = 0.3;
+        restart_settings(&d, inf.bit);
+        const uint32_t keeps = lag_effects_keeping_state(&d.effects);
+        /* its own bit at most, and only if the table says it may keep state */
+        ENSURE((keeps & ~inf.bit) == 0 && (inf.keeps_state || keeps == 0));
+        if (inf.bit == LAG_EFF_ACTUATOR) { /* the lag is the actuator's state */
+            d.effects.actuator_tau[0] = 0.1;
+            ENSURE(lag_effects_keeping_state(&d.effects) == LAG_EFF_ACTUATOR);
+            d.effects.actuator_tau[0] = 0.0;
+            ENSURE(lag_effects_keeping_state(&d.effects) == 0);
+        }
+        if (lag_effects_keeping_state(&d.effects)) continue;
+        lag_sim a, b;
+        te_init(&a, &d);
+        te_init(&b, &d);
+        const double u[3] = {0.5, -0.3, 0.0};
+        lag_sim_set_input(&a, u);
+        ENSURE(lag_sim_advance(&a, 150, false) == LAG_OK);
+        lag_sim_reset(&b, a.q, a.qd);
+        b.tick = a.tick;
+        lag_sim_set_input(&b, u);
+        ENSURE(lag_sim_advance(&a, 150, false) == LAG_OK);
+        ENSURE(lag_sim_advance(&b, 150, false) == LAG_OK);
+        size_t nb = (size_t)a.nq * sizeof(double);
+        bool same = memcmp(a.q, b.q, nb) == 0 && memcmp(a.qd, b.qd, nb) == 0;
+        if (!same) LT_FAIL("%s keeps no state by the table, but a restart at tick 150 differs", inf.name);
+        else ENSURE(same);
+        checked++;
+    }
+    ENSURE(checked >= 1);
+}
+
 static void case_damping(int a) { (void)a; damping_power_converges(); damping_stick_x(); damping_pendulum(); }
 static void case_friction(int a) { (void)a; friction_block(); friction_dipc(); }
 static void case_limits(int a) { (void)a; limits_free(); limits_spin(1.0); limits_spin(0.6); }
@@ -781,6 +846,7 @@ static void case_disturbance(int a) { (void)a; disturbance(); disturbance_far();
 static void case_noise(int a) { (void)a; noise(); }
 static void case_off(int a) { (void)a; off(); }
 static void case_spring(int a) { (void)a; spring_stick_x(); spring_energy(); }
+static void case_keeps_state(int a) { (void)a; restart(); }
 
 static void case_coverage(int a);
 static const lt_case cases[] = {
@@ -789,6 +855,7 @@ static const lt_case cases[] = {
     {"actuator", case_actuator, 0, 0},       {"disturbance", case_disturbance, 0, 0},
     {"noise", case_noise, 0, 0},             {"off", case_off, 0, 0},
     {"spring", case_spring, 0, 0},           {"coverage", case_coverage, 0, 0},
+    {"keeps_state", case_keeps_state, 0, 0},
 };
 #define NCASES ((int)(sizeof cases / sizeof cases[0]))
 

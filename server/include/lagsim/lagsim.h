@@ -263,6 +263,12 @@ typedef struct lag_effect_info {
     bool per_tick;   /* works at every tick boundary (the step stops at each) */
     bool events;     /* has events located in time within a tick */
     bool observe;    /* changes the published state only */
+    bool keeps_state; /* may keep state of its own from tick to tick that q, qd, tick and
+                         the definition do not hold (contact and stick/slip modes: limits,
+                         floor, friction; the actuator's lag state, only while a lag is
+                         set): a run restarted from a logged (q, qd, tick) is then not the
+                         same run. Whether it does under given settings:
+                         lag_effects_keeping_state */
 } lag_effect_info;
 
 /* The table's row `index` of 0..LAG_EFF_COUNT-1 (a zeroed struct outside). */
@@ -305,6 +311,11 @@ typedef struct lag_effects_def {
     double spring_k[LAG_MAX_DOF];           /* k_i >= 0 (N/m or N m/rad) */
     double spring_rest[LAG_MAX_DOF];        /* rest position (m or rad) */
 } lag_effects_def;
+
+/* The bits of the effects enabled in e that keep state of their own under e's settings
+ * (lag_effect_info.keeps_state: a mode, or an actuator with a lag time > 0): 0 when a run
+ * restarted from its (q, qd, tick) goes on as the run itself did. */
+uint32_t lag_effects_keeping_state(const lag_effects_def *e);
 
 /* All effects off, neutral parameters (no saturation, no lag, rest_velocity 1e-3, a
  * floor the stick may leave). */
