@@ -91,7 +91,11 @@ lag_result lag_lu_solve_inplace(int n, double *A, double *b);
 /* First-order right-hand side in (q, qd) and in canonical (q, p) coordinates. */
 lag_result lag_sim_rhs_qp(lag_sim *s, const double *y, double *ydot);
 
+/* The generalized forces besides gravity and inertia: the applied effort plus each
+ * enabled effect's force (damping, sliding friction, disturbance forces, springs). OUT: Q */
 void lag_effects_force(const lag_sim *s, const double *q, const double *qd, double *Q);
+/* Forward dynamics with the effects' locked joints held (qdd_i = qd_i = 0) and the
+ * constraint forces lambda_i (M qdd = Q - h + lambda) they need. lambda may be NULL. */
 lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *qd,
                               const double *Q, double *qdd, double *lambda);
 
@@ -131,11 +135,6 @@ lag_result lag_adaptive_advance(lag_sim *s, int64_t n, int64_t stop);
 bool lag_method_table_ok(void);
 /* dopri5 without events: advances the public state to tick + n (see lag_sim_advance). */
 lag_result lag_dopri5_advance(lag_sim *s, int64_t n, int64_t stop);
-
-/* Forward dynamics with the effects' locked joints held (qdd_i = qd_i = 0) and the
- * constraint forces lambda_i (M qdd = Q - h + lambda) they need. lambda may be NULL. */
-lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *qd,
-                              const double *Q, double *qdd, double *lambda);
 
 /* qd from canonical momenta p at q: qd_f = M_ff^-1 p_f on free joints, 0 on locked. */
 lag_result lag_qd_from_p(const lag_sim *s, const double *q, const double *p, double *qd);
@@ -269,9 +268,6 @@ extern const lag_effect_row lag_effect_rows[];
 lag_result lag_effects_check(const lag_sim_def *def, lag_diag *d);
 /* Fills s->fx (the rows the enabled effects use, per hook) from s->def. */
 void lag_effects_prepare(lag_sim *s);
-/* The generalized forces besides gravity and inertia: the applied effort plus each
- * enabled effect's force (damping, sliding friction, disturbance forces, springs). OUT: Q */
-void lag_effects_force(const lag_sim *s, const double *q, const double *qd, double *Q);
 /* Energy stored by the enabled effects at q. */
 double lag_effects_potential(const lag_sim *s, const double *q);
 void lag_effects_pre_tick(lag_sim *s);

@@ -213,8 +213,14 @@ static void check_model(lag_model_kind kind, uint64_t seed)
  * NaN, and defaults that pass the model's own check. */
 static void check_table(void)
 {
-    char names[256];
+    /* lag_model_names: exactly the table's names, in its order, joined by ", " */
+    char names[256], expect[256] = "";
     lag_model_names(names, sizeof names);
+    for (int k = 0; k < LAG_MODEL_COUNT; ++k) {
+        if (k) strcat(expect, ", ");
+        strcat(expect, lag_model_info_get((lag_model_kind)k)->name);
+    }
+    ENSURE(strcmp(names, expect) == 0);
     for (int k = 0; k < LAG_MODEL_COUNT; ++k) {
         const lag_model_class *c = lag_models[k];
         ENSURE(c && c->info && c->mass && c->mass_deriv && c->coriolis && c->gravity &&
@@ -229,7 +235,9 @@ static void check_table(void)
         ENSURE(by != NULL);
         for (int j = 0; by && j < inf->nq; ++j)
             ENSURE(by->angular[j] == inf->angular[j] && by->actuated[j] == inf->actuated[j]);
-        ENSURE(strstr(names, inf->name) != NULL);
+        /* a name: [a-z][a-z0-9-]*, what a scene's `model:` key holds */
+        ENSURE(inf->name && inf->name[0] >= 'a' && inf->name[0] <= 'z' &&
+               strspn(inf->name, "abcdefghijklmnopqrstuvwxyz0123456789-") == strlen(inf->name));
         ENSURE(inf->nq >= 1 && inf->nq <= LAG_MAX_DOF && inf->np >= 1 && inf->np <= LAG_MAX_PARAMS);
         bool any_actuated = false;
         for (int j = 0; j < LAG_MAX_DOF; ++j) {
@@ -312,7 +320,9 @@ static void check_info(void)
             ENSURE(inf->actuated[j] == act[k][j]);
         }
     }
-    ENSURE(lag_model_kind_from_name("pendulum") == -1);
+    /* not a model's name by the rule check_table enforces ([a-z][a-z0-9-]*): never a model */
+    ENSURE(lag_model_kind_from_name("no such model!") == -1 && lag_model_kind_from_name("") == -1 &&
+           lag_model_kind_from_name(NULL) == -1);
     {   /* joints no model has, in another order, or too few: none */
         const char *odd[2] = {"phi", "x"}, *one[1] = {"x"}, *cp[2] = {"x", "theta"};
         ENSURE(lag_model_info_by_joints(odd, 2) == NULL && lag_model_info_by_joints(one, 1) == NULL);

@@ -1,5 +1,7 @@
 /*
- * lagsim core: three Lagrangian models, six integrators, a simulation state.
+ * lagsim core: Lagrangian models and integrators, each kept in a table of the core's
+ * (lag_model_info_get, lag_method_info_get: kinds 0..LAG_MODEL_COUNT-1, methods
+ * 0..LAG_METHOD_COUNT-1), effects (lag_effect_info_get), and a simulation state.
  *
  * The core knows nothing of LCM or YAML. A model is read-only (`const lag_model*`), a
  * simulation (`lag_sim`) is the mutable state; no function here allocates memory, prints,
@@ -139,8 +141,9 @@ const lag_model_info *lag_model_info_get(lag_model_kind kind);
 const lag_model_info *lag_model_info_by_joints(const char *const *names, int n);
 /* Returns the kind for a name, or -1. */
 int lag_model_kind_from_name(const char *name);
-/* "stick, manipulator, dipc, ...": every model's name, in the table's order, for messages
- * and --help. Returns buf. */
+/* Every model's name, in the table's order, joined by ", " (the first of the table's
+ * kinds: "stick, manipulator, ..."), for messages and --help. Returns buf; truncated to
+ * len - 1 characters when that is too small. */
 const char *lag_model_names(char *buf, size_t len);
 
 typedef struct lag_model {
