@@ -32,6 +32,9 @@ typedef struct lag_model_class {
 /* Declared without its size, so that the definition's own count of rows is what the
  * _Static_assert there compares with LAG_MODEL_COUNT. */
 extern const lag_model_class *const lag_models[];
+/* The flying stick measured from end A [0] and from end B [1], whatever its
+ * p[LAG_FSTICK_END]: what the floor has the sim integrate (lag_sim.dyn). */
+extern const lag_model_class lag_flying_stick_ends[2];
 /* The stick's parameters, one rod, as both its models (sliding, flying) describe them in
  * their lag_model_info. */
 #define LAG_STICK_PARAMS_INFO                                                      \
@@ -112,7 +115,7 @@ static inline lag_result lag_rhs(lag_sim *s, const double *y, double *ydot)
         return lag_forward_locked(s, y, y + n, Q, ydot + n, NULL);
     }
     /* The bare model, the hot path: the model's closed-form forward dynamics. */
-    return lag_models[s->model.kind]->forward(s->model.p, y, y + n, s->tau_applied, ydot + n);
+    return s->dyn->forward(s->model.p, y, y + n, s->tau_applied, ydot + n);
 }
 /* A right-hand side failed with r at stage state y: a "singular" mass matrix of a
  * non-finite q (a stage that overflowed: cos(inf)) is a non-finite state, not a singular
@@ -222,15 +225,6 @@ static inline bool lag_has_friction(const lag_sim *s, int i)
 lag_event_kind lag_friction_settle(lag_sim *s, double *y, int i);
 void lag_refresh_slip(lag_sim *s, double *y);
 void lag_effects_init_modes(lag_sim *s);
-/* The floor with flight (the flying stick, h held on the floor): is joint i its h? */
-static inline bool lag_floor_h(const lag_sim *s, int i)
-{
-    return i == 2 && s->model.kind == LAG_MODEL_FLYING_STICK &&
-           (s->def.effects.enabled & LAG_EFF_FLOOR);
-}
-/* Published (x, phi, h_lower) to the sim's: the end below the centre is h's end.
- * IN/OUT: q, qd; sets s->model's end */
-void lag_floor_from_lower_end(lag_sim *s, double *q, double *qd);
 /* One tick with event location, from y (in place). */
 lag_result lag_events_tick(lag_sim *s, double *y);
 void lag_sim_record_event(lag_sim *s, lag_event_kind kind, int joint, double t, double value);
@@ -260,10 +254,51 @@ typedef struct lag_effect_row {
     /* does it keep state of its own from tick to tick under these settings (modes, a lag
      * state: not in q, qd, tick and the definition)? NULL: never */
     bool (*keeps_state)(const lag_effects_def *e);
+    /* The hooks of an effect that changes what the sim integrates (the floor's flight,
+     * effect_floor.c); each is called for the enabled rows that have it, in table order. */
+    /* the model def has the sim integrate (IN: def's model; OUT: the one integrated) */
+    void (*sim_model)(const lag_sim_def *def, lag_model *m);
+    const char *sim_model_key; /* the setting that decides it ("flight"), for messages */
+    /* at a reset, the state set and the modes cleared: its run state from the state */
+    void (*reset)(lag_sim *s);
+    /* the holds it starts with at the current state (after friction's modes), at a reset
+     * and when a redefinition derives the modes again */
+    void (*init_holds)(lag_sim *s);
+    /* the joints whose holds a generalized impulse does not break (bits) */
+    uint32_t (*firm_holds)(const lag_sim *s);
+    /* joint i's hold on a stop let go (the force would pull; lambda: the holds' forces at
+     * y): true if the hold is this effect's and what follows is done (events recorded) */
+    bool (*release)(lag_sim *s, int i, double *y, double t, const double *lambda);
+    /* the landing hook: refines the step from y0 to its watcher w's located event (length
+     * hs of at most H, state ys there) before the event's map. IN/OUT: hs, ys */
+    lag_result (*land)(lag_sim *s, const lag_watcher *w, const double *y0, double H,
+                       double *hs, double *ys);
+    /* the published state in its own coordinates, before observe's changes */
+    void (*publish)(const lag_sim *s, double *q, double *qd);
+    /* the run's state as the initial state of a definition (lag_sim_redefine's check) */
+    void (*as_initial)(const lag_sim *s, lag_sim_def *at);
 } lag_effect_row;
 
 /* Without its size, as lag_models: effects.c's _Static_assert counts the rows. */
-extern const lag_effect_row lag_effect_rows[];
+extern const lag_effect_row *const lag_effect_rows[];
+/* The rows defined in units of their own (the others are effects.c's). */
+extern const lag_effect_row lag_effect_floor; /* effect_floor.c */
+
+/* A stop of joint w->joint reached (limits, the floor): an impact with restitution w->e,
+ * or resting contact (rest_kind; a LAG_EV_LANDING that the floor would have to hold by
+ * pulling is an impact, `bounce`) when slower than rest_velocity or when the bounce would
+ * come back within one tick. IN/OUT: y */
+lag_result lag_stop_event(lag_sim *s, const lag_watcher *w, double *y, double t,
+                          lag_event_kind bounce, lag_event_kind rest_kind);
+/* rest_velocity: finite, >= 0 (field: the effect's key for it). */
+lag_result lag_rest_velocity_validate(const lag_sim_def *def, lag_diag *d, const char *field);
+/* The dispatch of the hooks above (lag_effect_row), over the enabled rows. */
+int lag_effects_sim_model(const lag_sim_def *def, lag_model *m); /* row that changed m, -1 */
+void lag_effects_reset(lag_sim *s);
+void lag_effects_init_holds(lag_sim *s);
+uint32_t lag_effects_firm_holds(const lag_sim *s);
+bool lag_effects_release(lag_sim *s, int i, double *y, double t, const double *lambda);
+void lag_effects_as_initial(const lag_sim *s, lag_sim_def *at);
 
 lag_result lag_effects_check(const lag_sim_def *def, lag_diag *d);
 /* Fills s->fx (the rows the enabled effects use, per hook) from s->def. */

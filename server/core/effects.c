@@ -96,12 +96,12 @@ static void damping_force(const lag_sim *s, const double *q, const double *qd, d
     for (int i = 0; i < s->nq; i++) Q[i] -= s->def.effects.damping[i] * qd[i];
 }
 
-/* ================================================================== stops: limits, floor */
+/* ================================================================== stops: limits (and the floor's) */
 /* A stop at position `bound` on one side of a joint: a POSITION watcher; its map is an
  * impact with restitution e, or resting contact (a hold) when the impact is slower than
  * rest_velocity or the bounce would come back within one tick (the Zeno guard). */
 
-static lag_result stop_event(lag_sim *s, const lag_watcher *w, double *y, double t,
+lag_result lag_stop_event(lag_sim *s, const lag_watcher *w, double *y, double t,
                              lag_event_kind bounce, lag_event_kind rest_kind)
 {
     const int n = s->nq, i = w->joint;
@@ -141,7 +141,7 @@ static lag_result stop_event(lag_sim *s, const lag_watcher *w, double *y, double
     return LAG_OK;
 }
 
-static lag_result rest_velocity_validate(const lag_sim_def *def, lag_diag *d, const char *field)
+lag_result lag_rest_velocity_validate(const lag_sim_def *def, lag_diag *d, const char *field)
 {
     double v = def->effects.rest_velocity;
     if (!(isfinite(v) && v >= 0)) return lag_diag_fail(d, field, "expected a finite number >= 0, got %g", v);
@@ -154,7 +154,7 @@ static lag_result limits_validate(const lag_sim_def *def, lag_diag *d)
 {
     const lag_effects_def *e = &def->effects;
     char f[LAG_FIELD_MAX];
-    lag_result r = rest_velocity_validate(def, d, "effects.limits.rest_velocity");
+    lag_result r = lag_rest_velocity_validate(def, d, "effects.limits.rest_velocity");
     if (r != LAG_OK) return r;
     for (int i = 0; i < def->model.nq; i++) {
         if (!e->limit_on[i]) continue;
@@ -193,180 +193,7 @@ static bool limits_watch(const lag_sim *s, int joint, int self, lag_watch_set *w
 
 static lag_result limits_event(lag_sim *s, const lag_watcher *w, double *y, double t)
 {
-    return stop_event(s, w, y, t, LAG_EV_LIMIT, LAG_EV_REST);
-}
-
-/* ---------------------------------------------------------------- floor: the stick's */
-/* Stick only. Without flight (floor_flight false): its end on the floor, impacts of the
- * free end at phi = 0 and pi (reported as impacts), resting contact, and lift-off (the
- * normal force reaching zero, a CUSTOM watcher) is a fault.
- * With flight, the sim integrates the flying stick (x, phi, h), h the height of one end
- * (model_flying_stick.c), and the floor is a stop of h at 0 on the lower side:
- *   - in contact h is held (a resting stop): the stop's hold force is the normal force,
- *     and when it would pull the hold lets go (events.c: a `liftoff`, the stick flies);
- *     the free end's impacts are those of the stick without flight, at phi = k pi and
- *     (k + 1) pi around the contact's interval of phi;
- *   - in flight h's stop is watched (that end landing: a frictionless impact, the
- *     vertical impulse at the end being a generalized impulse on h alone, J = e_h), and
- *     the other end's height h + sigma l sin phi (a GAP watcher): when it reaches the
- *     floor, h is made that end's height (a change of coordinates: x, phi, the velocities
- *     and the energy unchanged) and it lands as h's end does;
- *   - a landing ends in sliding contact (`landing`, h held) when it is slower than
- *     rest_velocity or its bounce would come back within one tick (the Zeno guard), and
- *     the floor then pushes (else the end touches and the stick flies on: `impact`);
- *     otherwise the end bounces (`impact`), J qd+ = -e J qd-. */
-
-static lag_result floor_validate(const lag_sim_def *def, lag_diag *d)
-{
-    const lag_effects_def *e = &def->effects;
-    if (def->model.kind != LAG_MODEL_STICK)
-        return lag_diag_fail(d, "effects.floor", "the floor effect is for the stick model only");
-    lag_result r = rest_velocity_validate(def, d, "effects.floor.rest_velocity");
-    if (r != LAG_OK) return r;
-    if (!(e->floor_restitution >= 0 && e->floor_restitution <= 1))
-        return lag_diag_fail(d, "effects.floor.restitution", "expected a number in [0, 1], got %g",
-                             e->floor_restitution);
-    if (def->q0[1] < 0 || def->q0[1] > M_PI)
-        return lag_diag_fail(d, "initial.q[1]", "initial phi = %g must be in [0, pi] with a floor",
-                             def->q0[1]);
-    if (e->floor_flight) {
-        double h = def->q0[2], hd = def->qd0[2];
-        if (!(isfinite(h) && h >= 0 && h <= def->explode_limit))
-            return lag_diag_fail(d, "initial.q[2]",
-                                 "the stick's lower end is at height h = %g: expected a number "
-                                 "in [0, explode_limit]", h);
-        if (!(isfinite(hd) && fabs(hd) <= def->explode_limit))
-            return lag_diag_fail(d, "initial.qd[2]", "expected a finite number within "
-                                 "explode_limit, got %g", hd);
-    } else if (def->q0[2] != 0 || def->qd0[2] != 0) {
-        return lag_diag_fail(d, "initial.q[2]", "a height needs a floor the stick may leave "
-                             "(flight: true)");
-    }
-    return LAG_OK;
-}
-
-/* sigma of the flying stick: +1 when h is end A's height, -1 for end B's */
-static double floor_sigma(const lag_sim *s)
-{
-    return s->model.p[LAG_FSTICK_END] != 0.0 ? -1.0 : 1.0;
-}
-
-/* In contact on h's end, the interval [k pi, (k + 1) pi] of phi in which the stick is
- * above the floor: k even for end A (sin phi >= 0), odd for end B; the one whose middle
- * is nearest phi (phi may lie a rounding outside it after a landing). */
-static double floor_k(const lag_sim *s, double phi)
-{
-    double off = s->model.p[LAG_FSTICK_END] != 0.0 ? 1.0 : 0.0;
-    return 2.0 * round((phi / M_PI - off - 0.5) / 2.0) + off;
-}
-
-static bool floor_watch(const lag_sim *s, int joint, int self, lag_watch_set *ws)
-{
-    const double e = s->def.effects.floor_restitution;
-    if (s->model.kind == LAG_MODEL_FLYING_STICK) {
-        const bool contact = s->mode.locked & (1u << 2);
-        lag_watcher w = {.kind = LAG_WATCH_POSITION, .owner = (uint8_t)self, .strict = true,
-                         .e = e, .side = -1};
-        if (joint == 2) { /* h's end landing (h is free: a held joint has its hold only) */
-            w.joint = 2;
-            w.bound = 0.0;
-            return lag_watch_add(ws, w);
-        }
-        if (joint == 1 && contact) { /* the free end reaching the floor */
-            double k = floor_k(s, s->q[1]);
-            w.joint = 1;
-            w.bound = k * M_PI;
-            if (!lag_watch_add(ws, w)) return false;
-            w.side = +1;
-            w.bound = (k + 1.0) * M_PI;
-            return lag_watch_add(ws, w);
-        }
-        if (joint < 0 && !contact) /* the other end landing */
-            return lag_watch_add(ws, (lag_watcher){.kind = LAG_WATCH_GAP, .owner = (uint8_t)self,
-                                                   .joint = 2, .strict = true, .e = e});
-        return true;
-    }
-    if (joint < 0) /* lift-off: the normal force, with the dynamics (value below) */
-        return lag_watch_add(ws, (lag_watcher){.kind = LAG_WATCH_CUSTOM, .owner = (uint8_t)self,
-                                               .joint = 1, .strict = false});
-    if (joint != 1) return true;
-    lag_watcher w = {.kind = LAG_WATCH_POSITION, .owner = (uint8_t)self, .joint = 1,
-                     .strict = true, .e = e};
-    w.side = -1;
-    w.bound = 0.0;
-    if (!lag_watch_add(ws, w)) return false;
-    w.side = +1;
-    w.bound = M_PI;
-    return lag_watch_add(ws, w);
-}
-
-/* N = m (g + d2/dt2 ((l/2) sin phi)), divided by m */
-static double floor_normal(lag_sim *s, const lag_watcher *w, const double *y, const double *qdd)
-{
-    (void)w;
-    const double *p = s->def.model.p;
-    const int n = s->nq;
-    double ph = y[1], phd = y[n + 1];
-    return p[LAG_STICK_G] + 0.5 * p[LAG_STICK_L] * (cos(ph) * qdd[1] - sin(ph) * phd * phd);
-}
-
-/* The other end's height h + sigma l sin phi, its rate and its second derivative. */
-static double floor_gap(const lag_sim *s, const lag_watcher *w, const double *y,
-                        const double *qdd, double *rate, double *accel)
-{
-    (void)w;
-    const int n = s->nq;
-    const double sl = floor_sigma(s) * s->model.p[LAG_STICK_L];
-    double sn = sin(y[1]), c = cos(y[1]), phd = y[n + 1];
-    if (rate) *rate = y[n + 2] + sl * c * phd;
-    if (accel && qdd) *accel = qdd[2] + sl * (c * qdd[1] - sn * phd * phd);
-    return y[2] + sl * sn;
-}
-
-static lag_result floor_event(lag_sim *s, const lag_watcher *w, double *y, double t)
-{
-    if (w->kind == LAG_WATCH_CUSTOM) {
-        lag_sim_record_event(s, LAG_EV_LIFTOFF, 1, t, 0.0);
-        return LAG_ERR_LIFTOFF;
-    }
-    if (w->kind == LAG_WATCH_GAP) {
-        /* h becomes the landing end's height: y = h + sigma a s = h' - sigma a s */
-        const int n = s->nq;
-        double rate, gap = floor_gap(s, w, y, NULL, &rate, NULL);
-        y[2] = gap;
-        y[n + 2] = rate;
-        s->model.p[LAG_FSTICK_END] = s->model.p[LAG_FSTICK_END] != 0.0 ? 0.0 : 1.0;
-        s->dp.valid = false;
-        lag_watcher h = {.kind = LAG_WATCH_POSITION, .owner = w->owner, .joint = 2, .side = -1,
-                         .strict = true, .bound = 0.0, .e = w->e};
-        return stop_event(s, &h, y, t, LAG_EV_IMPACT, LAG_EV_LANDING);
-    }
-    if (w->joint == 2) return stop_event(s, w, y, t, LAG_EV_IMPACT, LAG_EV_LANDING);
-    return stop_event(s, w, y, t, LAG_EV_IMPACT, LAG_EV_REST);
-}
-
-void lag_floor_from_lower_end(lag_sim *s, double *q, double *qd)
-{
-    (void)q; (void)qd;
-    /* h is the lower end's height: end B's when it is below the centre */
-    s->model.p[LAG_FSTICK_END] = sin(q[1]) < 0 ? 1.0 : 0.0;
-}
-
-/* The published h: the lower end's height and vertical velocity (0 in contact). */
-static void floor_publish(const lag_sim *s, double *q, double *qd)
-{
-    if (s->mode.locked & (1u << 2)) {
-        q[2] = 0.0;
-        qd[2] = 0.0;
-        return;
-    }
-    double rate, other = floor_gap(s, NULL, (const double[]){s->q[0], s->q[1], s->q[2],
-                                                             s->qd[0], s->qd[1], s->qd[2]},
-                                   NULL, &rate, NULL);
-    if (other < s->q[2]) {
-        q[2] = other;
-        qd[2] = rate;
-    }
+    return lag_stop_event(s, w, y, t, LAG_EV_LIMIT, LAG_EV_REST);
 }
 
 /* ================================================================== friction */
@@ -511,9 +338,9 @@ static void disturbance_pre_tick(lag_sim *s)
         if (d->impulse) {
             if (s->tick != kd) continue;
             double x[LAG_MAX_DOF];
-            /* an impulse breaks any hold but the floor's of h (which then pushes, or lets go
+            /* an impulse breaks any hold but a firm one (the floor's of h, which then pushes, or lets go
              * at the tick's start); modes are re-settled */
-            s->mode.locked &= lag_floor_h(s, 2) ? (1u << 2) : 0u;
+            s->mode.locked &= lag_effects_firm_holds(s);
             if (lag_minv_column(s, y, d->joint, x) != LAG_OK) continue;
             for (int i = 0; i < n; i++) y[n + i] += x[i] * d->value;
             impulse = true;
@@ -627,23 +454,31 @@ static double spring_potential(const lag_sim *s, const double *q)
 
 /* ================================================================== the table */
 
-const lag_effect_row lag_effect_rows[] = {
-    {.bit = LAG_EFF_DAMPING, .name = "damping", .validate = damping_validate, .force = damping_force},
-    {.bit = LAG_EFF_LIMITS, .name = "limits", .validate = limits_validate, .watch = limits_watch,
-     .on_event = limits_event, .max_watch_joint = 2, .keeps_state = always},
-    {.bit = LAG_EFF_FLOOR, .name = "floor", .validate = floor_validate, .watch = floor_watch,
-     .value = floor_normal, .gap = floor_gap, .on_event = floor_event, .max_watch_joint = 2,
-     .max_watch_global = 1, .keeps_state = always},
-    {.bit = LAG_EFF_FRICTION, .name = "friction", .validate = friction_validate, .force = friction_force,
-     .watch = friction_watch, .on_event = friction_event, .max_watch_joint = 1,
-     .keeps_state = always},
-    {.bit = LAG_EFF_ACTUATOR, .name = "actuator", .validate = actuator_validate,
-     .pre_tick = actuator_pre_tick, .keeps_state = actuator_lagged},
-    {.bit = LAG_EFF_DISTURBANCE, .name = "disturbance", .validate = disturbance_validate,
-     .pre_tick = disturbance_pre_tick, .force = disturbance_force},
-    {.bit = LAG_EFF_NOISE, .name = "noise", .validate = noise_validate, .observe = noise_observe},
-    {.bit = LAG_EFF_SPRING, .name = "spring", .validate = spring_validate, .force = spring_force,
-     .potential = spring_potential},
+static const lag_effect_row damping_row = {
+    .bit = LAG_EFF_DAMPING, .name = "damping", .validate = damping_validate, .force = damping_force};
+static const lag_effect_row limits_row = {
+    .bit = LAG_EFF_LIMITS, .name = "limits", .validate = limits_validate, .watch = limits_watch,
+    .on_event = limits_event, .max_watch_joint = 2, .keeps_state = always};
+static const lag_effect_row friction_row = {
+    .bit = LAG_EFF_FRICTION, .name = "friction", .validate = friction_validate,
+    .force = friction_force, .watch = friction_watch, .on_event = friction_event,
+    .max_watch_joint = 1, .keeps_state = always};
+static const lag_effect_row actuator_row = {
+    .bit = LAG_EFF_ACTUATOR, .name = "actuator", .validate = actuator_validate,
+    .pre_tick = actuator_pre_tick, .keeps_state = actuator_lagged};
+static const lag_effect_row disturbance_row = {
+    .bit = LAG_EFF_DISTURBANCE, .name = "disturbance", .validate = disturbance_validate,
+    .pre_tick = disturbance_pre_tick, .force = disturbance_force};
+static const lag_effect_row noise_row = {
+    .bit = LAG_EFF_NOISE, .name = "noise", .validate = noise_validate, .observe = noise_observe};
+static const lag_effect_row spring_row = {
+    .bit = LAG_EFF_SPRING, .name = "spring", .validate = spring_validate, .force = spring_force,
+    .potential = spring_potential};
+
+/* The table, in dispatch order; a row may live in a unit of its own (the floor's). */
+const lag_effect_row *const lag_effect_rows[] = {
+    &damping_row, &limits_row, &lag_effect_floor, &friction_row,
+    &actuator_row, &disturbance_row, &noise_row, &spring_row,
 };
 _Static_assert(sizeof lag_effect_rows / sizeof lag_effect_rows[0] == LAG_EFF_COUNT,
                "the effect table needs one row per LAG_EFF_* bit");
@@ -653,7 +488,7 @@ lag_effect_info lag_effect_info_get(int index)
 {
     lag_effect_info inf = {0};
     if (index < 0 || index >= LAG_EFF_COUNT) return inf;
-    const lag_effect_row *r = &lag_effect_rows[index];
+    const lag_effect_row *r = lag_effect_rows[index];
     inf.bit = r->bit;
     inf.name = r->name;
     inf.force = r->force != NULL;
@@ -669,7 +504,7 @@ uint32_t lag_effects_keeping_state(const lag_effects_def *e)
 {
     uint32_t m = 0;
     for (int k = 0; k < LAG_EFF_COUNT; k++) {
-        const lag_effect_row *r = &lag_effect_rows[k];
+        const lag_effect_row *r = lag_effect_rows[k];
         if ((e->enabled & r->bit) && r->keeps_state && r->keeps_state(e)) m |= r->bit;
     }
     return m;
@@ -678,14 +513,14 @@ uint32_t lag_effects_keeping_state(const lag_effects_def *e)
 int lag_effect_from_name(const char *name)
 {
     for (int k = 0; k < LAG_EFF_COUNT; k++)
-        if (name && strcmp(name, lag_effect_rows[k].name) == 0) return k;
+        if (name && strcmp(name, lag_effect_rows[k]->name) == 0) return k;
     return -1;
 }
 
 uint32_t lag_effects_known(void)
 {
     uint32_t m = 0;
-    for (int k = 0; k < LAG_EFF_COUNT; k++) m |= lag_effect_rows[k].bit;
+    for (int k = 0; k < LAG_EFF_COUNT; k++) m |= lag_effect_rows[k]->bit;
     return m;
 }
 
@@ -693,7 +528,7 @@ uint32_t lag_effects_per_tick(uint32_t enabled)
 {
     uint32_t m = 0;
     for (int k = 0; k < LAG_EFF_COUNT; k++)
-        if (lag_effect_rows[k].pre_tick || lag_effect_rows[k].watch) m |= lag_effect_rows[k].bit;
+        if (lag_effect_rows[k]->pre_tick || lag_effect_rows[k]->watch) m |= lag_effect_rows[k]->bit;
     return enabled & m;
 }
 
@@ -701,7 +536,7 @@ uint32_t lag_effects_with_events(uint32_t enabled)
 {
     uint32_t m = 0;
     for (int k = 0; k < LAG_EFF_COUNT; k++)
-        if (lag_effect_rows[k].watch) m |= lag_effect_rows[k].bit;
+        if (lag_effect_rows[k]->watch) m |= lag_effect_rows[k]->bit;
     return enabled & m;
 }
 
@@ -712,7 +547,7 @@ lag_result lag_effects_check(const lag_sim_def *def, lag_diag *d)
     const uint32_t en = def->effects.enabled, known = lag_effects_known();
     if (en & ~known) return lag_diag_fail(d, "effects", "unknown effect bits 0x%x", (unsigned)(en & ~known));
     for (int k = 0; k < LAG_EFF_COUNT; k++) {
-        const lag_effect_row *r = &lag_effect_rows[k];
+        const lag_effect_row *r = lag_effect_rows[k];
         lag_result res;
         if ((en & r->bit) && (res = r->validate(def, d)) != LAG_OK) return res;
     }
@@ -725,7 +560,7 @@ void lag_effects_prepare(lag_sim *s)
     const uint32_t en = s->def.effects.enabled;
     s->fx.enabled = en;
     for (int k = 0; k < LAG_EFF_COUNT; k++) {
-        const lag_effect_row *r = &lag_effect_rows[k];
+        const lag_effect_row *r = lag_effect_rows[k];
         if (!(en & r->bit)) continue;
         if (r->force) s->fx.force[s->fx.n_force++] = (uint8_t)k;
         if (r->pre_tick) s->fx.pre_tick[s->fx.n_pre_tick++] = (uint8_t)k;
@@ -740,26 +575,26 @@ void lag_effects_force(const lag_sim *s, const double *q, const double *qd, doub
 {
     LAG_ASSERT(s->fx.enabled == s->def.effects.enabled); /* prepared for this definition */
     for (int i = 0; i < s->nq; i++) Q[i] = s->tau_applied[i];
-    for (int k = 0; k < s->fx.n_force; k++) lag_effect_rows[s->fx.force[k]].force(s, q, qd, Q);
+    for (int k = 0; k < s->fx.n_force; k++) lag_effect_rows[s->fx.force[k]]->force(s, q, qd, Q);
 }
 
 double lag_effects_potential(const lag_sim *s, const double *q)
 {
     double U = 0.0;
-    for (int k = 0; k < s->fx.n_potential; k++) U += lag_effect_rows[s->fx.potential[k]].potential(s, q);
+    for (int k = 0; k < s->fx.n_potential; k++) U += lag_effect_rows[s->fx.potential[k]]->potential(s, q);
     return U;
 }
 
 void lag_effects_pre_tick(lag_sim *s)
 {
-    for (int k = 0; k < s->fx.n_pre_tick; k++) lag_effect_rows[s->fx.pre_tick[k]].pre_tick(s);
+    for (int k = 0; k < s->fx.n_pre_tick; k++) lag_effect_rows[s->fx.pre_tick[k]]->pre_tick(s);
 }
 
 bool lag_effects_watch(const lag_sim *s, int joint, lag_watch_set *ws)
 {
     for (int k = 0; k < s->fx.n_watch; k++) {
         int row = s->fx.watch[k];
-        if (!lag_effect_rows[row].watch(s, joint, row, ws)) return false;
+        if (!lag_effect_rows[row]->watch(s, joint, row, ws)) return false;
     }
     return true;
 }
@@ -767,6 +602,56 @@ bool lag_effects_watch(const lag_sim *s, int joint, lag_watch_set *ws)
 void lag_sim_observe(const lag_sim *s, double *q, double *qd)
 {
     for (int i = 0; i < s->nq; i++) { q[i] = s->q[i]; qd[i] = s->qd[i]; }
-    if (lag_floor_h(s, 2)) floor_publish(s, q, qd);
-    for (int k = 0; k < s->fx.n_observe; k++) lag_effect_rows[s->fx.observe[k]].observe(s, q, qd);
+    for (int k = 0; k < LAG_EFF_COUNT; k++) {
+        const lag_effect_row *r = lag_effect_rows[k];
+        if ((s->def.effects.enabled & r->bit) && r->publish) r->publish(s, q, qd);
+    }
+    for (int k = 0; k < s->fx.n_observe; k++) lag_effect_rows[s->fx.observe[k]]->observe(s, q, qd);
+}
+
+/* ------------------------------------------------------------------ the run-state hooks */
+/* Rare (a reset, a redefinition, an impulse, a release): over the enabled rows. */
+#define FOR_ENABLED_WITH(en, hook) \
+    for (int k_ = 0; k_ < LAG_EFF_COUNT; k_++) \
+        if (((en) & lag_effect_rows[k_]->bit) && lag_effect_rows[k_]->hook)
+
+int lag_effects_sim_model(const lag_sim_def *def, lag_model *m)
+{
+    int row = -1;
+    *m = def->model;
+    FOR_ENABLED_WITH(def->effects.enabled, sim_model) {
+        lag_model before = *m;
+        lag_effect_rows[k_]->sim_model(def, m);
+        if (memcmp(&before, m, sizeof *m) != 0) row = k_;
+    }
+    return row;
+}
+
+void lag_effects_reset(lag_sim *s)
+{
+    FOR_ENABLED_WITH(s->def.effects.enabled, reset) lag_effect_rows[k_]->reset(s);
+}
+
+void lag_effects_init_holds(lag_sim *s)
+{
+    FOR_ENABLED_WITH(s->def.effects.enabled, init_holds) lag_effect_rows[k_]->init_holds(s);
+}
+
+uint32_t lag_effects_firm_holds(const lag_sim *s)
+{
+    uint32_t m = 0;
+    FOR_ENABLED_WITH(s->def.effects.enabled, firm_holds) m |= lag_effect_rows[k_]->firm_holds(s);
+    return m;
+}
+
+bool lag_effects_release(lag_sim *s, int i, double *y, double t, const double *lambda)
+{
+    FOR_ENABLED_WITH(s->def.effects.enabled, release)
+        if (lag_effect_rows[k_]->release(s, i, y, t, lambda)) return true;
+    return false;
+}
+
+void lag_effects_as_initial(const lag_sim *s, lag_sim_def *at)
+{
+    FOR_ENABLED_WITH(s->def.effects.enabled, as_initial) lag_effect_rows[k_]->as_initial(s, at);
 }

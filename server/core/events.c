@@ -207,12 +207,7 @@ void lag_effects_init_modes(lag_sim *s)
     for (int i = 0; i < n; i++) { s->mode.lock_side[i] = 0; s->mode.slip_dir[i] = 0; }
     lag_refresh_slip(s, y);
     for (int i = 0; i < n; i++) s->qd[i] = y[n + i];
-    /* a stick that can fly starts on the floor when h and h_dot are 0 (it lifts off at
-     * once if the floor would have to pull) */
-    if (lag_floor_h(s, 2) && s->q[2] == 0.0 && s->qd[2] == 0.0) {
-        s->mode.locked |= 1u << 2;
-        s->mode.lock_side[2] = -1;
-    }
+    lag_effects_init_holds(s); /* the holds an effect starts with (the floor's of h) */
 }
 
 /* A hold lets go (its watcher fired): a stop releases the joint (which friction may hold
@@ -227,16 +222,8 @@ static lag_result release_hold(lag_sim *s, int i, double *y, double t)
     s->mode.locked &= ~(1u << i);
     s->mode.lock_side[i] = 0;
     y[n + i] = 0.0;
-    if (stop && lag_floor_h(s, i)) {
-        /* the floor's normal force reached zero: the stick flies (its free end, if held
-         * on the floor too, is released with it: no end is held in flight) */
-        lag_sim_record_event(s, LAG_EV_LIFTOFF, i, t, lambda[i]);
-        s->mode.released |= 1u << i;
-        if (s->mode.locked & (1u << 1)) {
-            s->mode.locked &= ~(1u << 1);
-            s->mode.lock_side[1] = 0;
-            y[n + 1] = 0.0;
-        }
+    if (stop && lag_effects_release(s, i, y, t, lambda)) {
+        /* an effect's own release (the floor's lift-off) */
     } else if (stop) {
         lag_sim_record_event(s, LAG_EV_RELEASE, i, t, lambda[i]);
         if (lag_has_friction(s, i)) {
@@ -316,12 +303,12 @@ static lag_result eval_watchers(void *vctx, const double *y, double *val)
                          : -s->mode.lock_side[i] * lambda[i];
             break;
         case LAG_WATCH_CUSTOM:
-            LAG_ASSERT(c->dyn && w->owner < LAG_EFF_COUNT && lag_effect_rows[w->owner].value);
-            val[k] = lag_effect_rows[w->owner].value(s, w, y, c->qdd);
+            LAG_ASSERT(c->dyn && w->owner < LAG_EFF_COUNT && lag_effect_rows[w->owner]->value);
+            val[k] = lag_effect_rows[w->owner]->value(s, w, y, c->qdd);
             break;
         case LAG_WATCH_GAP:
-            LAG_ASSERT(w->owner < LAG_EFF_COUNT && lag_effect_rows[w->owner].gap);
-            val[k] = lag_effect_rows[w->owner].gap(s, w, y, NULL, NULL, NULL);
+            LAG_ASSERT(w->owner < LAG_EFF_COUNT && lag_effect_rows[w->owner]->gap);
+            val[k] = lag_effect_rows[w->owner]->gap(s, w, y, NULL, NULL, NULL);
             break;
         }
     }
@@ -333,8 +320,8 @@ static lag_result handle(lag_sim *s, const lag_watcher *w, double *y, double t)
 {
     LAG_ASSERT(w->joint >= 0 && w->joint < s->nq);
     if (w->kind == LAG_WATCH_HOLD) return release_hold(s, w->joint, y, t);
-    LAG_ASSERT(w->owner < LAG_EFF_COUNT && lag_effect_rows[w->owner].on_event);
-    return lag_effect_rows[w->owner].on_event(s, w, y, t);
+    LAG_ASSERT(w->owner < LAG_EFF_COUNT && lag_effect_rows[w->owner]->on_event);
+    return lag_effect_rows[w->owner]->on_event(s, w, y, t);
 }
 
 /* At the start of an interval: an event already due (at or past a stop and moving into
@@ -352,7 +339,7 @@ static int due_now(lag_sim *s, const lag_watch_set *ws, const double *y, const d
         int i = w->joint;
         if ((w->kind == LAG_WATCH_POSITION || w->kind == LAG_WATCH_GAP) && val[k] <= 0) {
             /* moving into the stop (qd toward it, or at rest and accelerating toward it) */
-            const lag_effect_row *row = &lag_effect_rows[w->owner];
+            const lag_effect_row *row = lag_effect_rows[w->owner];
             double v, a = 0.0; /* v > 0: moving into the stop */
             if (w->kind == LAG_WATCH_GAP) row->gap(s, w, y, NULL, &v, NULL), v = -v;
             else v = y[n + i] * w->side;
@@ -384,51 +371,6 @@ static int due_now(lag_sim *s, const lag_watch_set *ws, const double *y, const d
 static lag_result checked(int N, const double *y, double limit)
 {
     if (!lag_state_ok(N, y, limit)) return lag_state_ok(N, y, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
-    return LAG_OK;
-}
-
-/* The floor's watchers with flight: the step redone up to the located instant ends where
- * the method's own step puts it, which for a low-order method is off the interpolant the
- * instant was found on (an end below the floor by O(h^2) with euler). Newton on the
- * length of the redone step, with the watcher's rate, puts the end on the floor: at most
- * 8 more steps, only at such events, keeping the best. IN/OUT: hs, ys */
-static double watch_rate(lag_sim *s, const lag_watcher *w, const double *y, double *val)
-{
-    const int n = s->nq;
-    if (w->kind == LAG_WATCH_GAP) {
-        double rate;
-        *val = lag_effect_rows[w->owner].gap(s, w, y, NULL, &rate, NULL);
-        return rate;
-    }
-    *val = w->side < 0 ? y[w->joint] - w->bound : w->bound - y[w->joint];
-    return -w->side * y[n + w->joint];
-}
-
-static lag_result land_on_floor(lag_sim *s, const lag_watcher *w, const double *y0, double H,
-                                double *hs, double *ys)
-{
-    if (w->kind != LAG_WATCH_POSITION && w->kind != LAG_WATCH_GAP) return LAG_OK;
-    const int N = 2 * s->nq;
-    const double tol = 1e-15 * (1.0 + s->def.model.p[LAG_STICK_L]);
-    double val, rate = watch_rate(s, w, ys, &val);
-    double h = *hs, best = fabs(val), hp = NAN, vp = NAN;
-    for (int it = 0; it < 12 && best > tol; it++) {
-        /* Newton with the end's rate first, then secant on the method's own steps */
-        double hn = (it == 0 || !(val != vp)) ? h - val / rate : h - val * (h - hp) / (val - vp);
-        if (!(hn > 0 && hn <= H) || hn == h) break;
-        double yt[LAG_MAX_STATE], vn;
-        lag_result r = lag_step(s, hn, y0, yt);
-        if (r != LAG_OK) return r;
-        if ((r = checked(N, yt, s->def.explode_limit)) != LAG_OK) return r;
-        rate = watch_rate(s, w, yt, &vn);
-        hp = h; vp = val;
-        h = hn; val = vn;
-        if (fabs(vn) < best) {
-            best = fabs(vn);
-            *hs = hn;
-            memcpy(ys, yt, sizeof(double) * (size_t)N);
-        }
-    }
     return LAG_OK;
 }
 
@@ -496,11 +438,11 @@ lag_result lag_events_tick(lag_sim *s, double *y)
         } else {
             memcpy(ys, y, sizeof(double) * (size_t)N);
         }
-        bool landed = false;
-        if (hs > 0 && lag_floor_h(s, 2) && ws.w[k_best].kind != LAG_WATCH_HOLD &&
-            lag_effect_rows[ws.w[k_best].owner].bit == LAG_EFF_FLOOR) {
+        bool landed = false; /* the owner's landing hook moved the event's instant */
+        const lag_watcher *wb = &ws.w[k_best];
+        if (hs > 0 && wb->kind != LAG_WATCH_HOLD && lag_effect_rows[wb->owner]->land) {
             double hs0 = hs;
-            if ((r = land_on_floor(s, &ws.w[k_best], y, H, &hs, ys)) != LAG_OK) return r;
+            if ((r = lag_effect_rows[wb->owner]->land(s, wb, y, H, &hs, ys)) != LAG_OK) return r;
             landed = hs != hs0;
         }
         tloc = (th_best >= 1.0 && !landed) ? dt : tloc + hs;

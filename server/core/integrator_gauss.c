@@ -41,7 +41,7 @@ lag_result lag_step_gauss(lag_sim *s, int stages, double h, const double *yin, d
 
     /* y0 = (q0, M(q0) qd0) */
     double y0[LAG_MAX_STATE], M[LAG_MAX_DOF * LAG_MAX_DOF];
-    lag_model_mass(&s->model, yin, M);
+    s->dyn->mass(s->model.p, yin, M);
     for (int i = 0; i < n; i++) {
         y0[i] = yin[i];
         double p = 0.0;

@@ -11,7 +11,9 @@
  * are q = (x, phi, h), h the height of one end above the floor: end A at
  * r_c - a (cos phi, sin phi) (a = l/2; the end the sliding stick stands on, sigma = +1) or
  * end B at r_c + a (cos phi, sin phi) (sigma = -1), chosen by p[LAG_FSTICK_END] (0: A,
- * 1: B). So y = h + sigma a sin phi: the contact of that end with the floor is h = 0, a
+ * 1: B) for the model of the table; the floor, which switches ends while it runs, keeps
+ * its end in the sim's state and integrates the two classes below (lag_flying_stick_ends),
+ * the model's parameters untouched. So y = h + sigma a sin phi: the contact of that end with the floor is h = 0, a
  * coordinate at a stop, which the event engine holds, releases and hits; x and phi mean
  * what they mean for the sliding stick. The other end is at height h + sigma l sin phi.
  *   r_c = (x, h + sigma a s),  v_c = (x_dot, h_dot + sigma a c phi_dot),  omega = phi_dot
@@ -47,10 +49,11 @@
 #define P_L p[LAG_STICK_L]
 #define P_I p[LAG_STICK_I]
 #define P_G p[LAG_STICK_G]
-/* sigma: +1 when h is end A's height, -1 for end B's */
-#define SIG (p[LAG_FSTICK_END] != 0.0 ? -1.0 : 1.0)
+/* sigma: +1 when h is end A's height, -1 for end B's (each function below takes it as
+ * `sig`; the classes at the end fix it) */
+#define SIG sig
 
-static void fs_mass(const double *p, const double *q, double *M)
+static inline void fs_mass(double sig, const double *p, const double *q, double *M)
 {
     double a = 0.5 * P_L, c = cos(q[1]);
     M[0] = P_M; M[1] = 0.0;                    M[2] = 0.0;
@@ -58,7 +61,7 @@ static void fs_mass(const double *p, const double *q, double *M)
     M[6] = 0.0; M[7] = M[5];                   M[8] = P_M;
 }
 
-static void fs_mass_deriv(const double *p, const double *q, double *dM)
+static inline void fs_mass_deriv(double sig, const double *p, const double *q, double *dM)
 {
     double a = 0.5 * P_L, s = sin(q[1]), c = cos(q[1]);
     for (int i = 0; i < 27; i++) dM[i] = 0.0;
@@ -67,7 +70,7 @@ static void fs_mass_deriv(const double *p, const double *q, double *dM)
     dM[9 + 5] = dM[9 + 7] = -SIG * P_M * a * s;
 }
 
-static void fs_coriolis(const double *p, const double *q, const double *qd, double *C)
+static inline void fs_coriolis(double sig, const double *p, const double *q, const double *qd, double *C)
 {
     double a = 0.5 * P_L, s = sin(q[1]), c = cos(q[1]);
     for (int i = 0; i < 9; i++) C[i] = 0.0;
@@ -75,14 +78,14 @@ static void fs_coriolis(const double *p, const double *q, const double *qd, doub
     C[7] = -SIG * P_M * a * s * qd[1];
 }
 
-static void fs_gravity(const double *p, const double *q, double *g)
+static inline void fs_gravity(double sig, const double *p, const double *q, double *g)
 {
     g[0] = 0.0;
     g[1] = SIG * P_M * P_G * 0.5 * P_L * cos(q[1]);
     g[2] = P_M * P_G;
 }
 
-static void fs_mass_bias(const double *p, const double *q, const double *qd, double *M,
+static inline void fs_mass_bias(double sig, const double *p, const double *q, const double *qd, double *M,
                          double *h)
 {
     double a = 0.5 * P_L, s, c;
@@ -99,7 +102,7 @@ static void fs_mass_bias(const double *p, const double *q, const double *qd, dou
 /* The closed form of the header; M is positive definite exactly when m a^2 c^2 + I > 0
  * (its leading minors are m, m (m a^2 c^2 + I) and m^2 I), the pivot tested (a NaN angle
  * fails it, as for the other models). */
-static lag_result fs_forward(const double *p, const double *q, const double *qd,
+static inline lag_result fs_forward(double sig, const double *p, const double *q, const double *qd,
                              const double *tau, double *qdd)
 {
     double a = 0.5 * P_L, s, c;
@@ -112,16 +115,48 @@ static lag_result fs_forward(const double *p, const double *q, const double *qd,
     return LAG_OK;
 }
 
-static double fs_kinetic(const double *p, const double *q, const double *qd)
+static inline double fs_kinetic(double sig, const double *p, const double *q, const double *qd)
 {
     double vy = qd[2] + SIG * 0.5 * P_L * cos(q[1]) * qd[1];
     return 0.5 * P_M * (qd[0] * qd[0] + vy * vy) + 0.5 * P_I * qd[1] * qd[1];
 }
 
-static double fs_potential(const double *p, const double *q)
+static inline double fs_potential(double sig, const double *p, const double *q)
 {
     return P_M * P_G * (q[2] + SIG * 0.5 * P_L * sin(q[1]));
 }
+
+/* The class's functions for one sigma expression S (of p): SUFFIX names them. */
+#define FS_CLASS_FUNCS(SUFFIX, S)                                                          \
+    static void mass##SUFFIX(const double *p, const double *q, double *M)                 \
+    { fs_mass(S, p, q, M); }                                                               \
+    static void mass_deriv##SUFFIX(const double *p, const double *q, double *dM)          \
+    { fs_mass_deriv(S, p, q, dM); }                                                        \
+    static void coriolis##SUFFIX(const double *p, const double *q, const double *qd,      \
+                                 double *C)                                                \
+    { fs_coriolis(S, p, q, qd, C); }                                                       \
+    static void gravity##SUFFIX(const double *p, const double *q, double *g)              \
+    { fs_gravity(S, p, q, g); }                                                            \
+    static void mass_bias##SUFFIX(const double *p, const double *q, const double *qd,     \
+                                  double *M, double *h)                                    \
+    { fs_mass_bias(S, p, q, qd, M, h); }                                                   \
+    static lag_result forward##SUFFIX(const double *p, const double *q, const double *qd, \
+                                      const double *tau, double *qdd)                      \
+    { return fs_forward(S, p, q, qd, tau, qdd); }                                          \
+    static double kinetic##SUFFIX(const double *p, const double *q, const double *qd)     \
+    { return fs_kinetic(S, p, q, qd); }                                                    \
+    static double potential##SUFFIX(const double *p, const double *q)                     \
+    { return fs_potential(S, p, q); }
+#define FS_CLASS(SUFFIX)                                                                   \
+    {.info = &info, .mass = mass##SUFFIX, .mass_deriv = mass_deriv##SUFFIX,                \
+     .coriolis = coriolis##SUFFIX, .gravity = gravity##SUFFIX,                             \
+     .mass_bias = mass_bias##SUFFIX, .forward = forward##SUFFIX,                           \
+     .kinetic = kinetic##SUFFIX, .potential = potential##SUFFIX}
+
+/* the table's model: the end p[LAG_FSTICK_END] names; the floor's: end A, end B */
+FS_CLASS_FUNCS(_p, (p[LAG_FSTICK_END] != 0.0 ? -1.0 : 1.0))
+FS_CLASS_FUNCS(_a, 1.0)
+FS_CLASS_FUNCS(_b, -1.0)
 
 static const lag_model_info info = {
     .name = "flying-stick",
@@ -133,14 +168,8 @@ static const lag_model_info info = {
 };
 
 /* The model table's row (model.c). */
-const lag_model_class lag_flying_stick_model = {
-    .info = &info,
-    .mass = fs_mass,
-    .mass_deriv = fs_mass_deriv,
-    .coriolis = fs_coriolis,
-    .gravity = fs_gravity,
-    .mass_bias = fs_mass_bias,
-    .forward = fs_forward,
-    .kinetic = fs_kinetic,
-    .potential = fs_potential,
-};
+const lag_model_class lag_flying_stick_model = FS_CLASS(_p);
+
+/* The flying stick measured from end A and from end B, whatever p[LAG_FSTICK_END] says:
+ * the floor's (effect_floor.c), indexed by the end h measures. */
+const lag_model_class lag_flying_stick_ends[2] = {FS_CLASS(_a), FS_CLASS(_b)};

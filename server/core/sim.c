@@ -71,25 +71,14 @@ lag_result lag_sim_def_validate(const lag_sim_def *def, char *err, size_t errlen
     return r;
 }
 
-/* Does the sim fly the stick off its floor (the flying stick, h held in contact)? */
-static bool flies(const lag_sim_def *def)
-{
-    return def->model.kind == LAG_MODEL_STICK && (def->effects.enabled & LAG_EFF_FLOOR) &&
-           def->effects.floor_flight;
-}
-
 lag_result lag_sim_init(lag_sim *s, const lag_sim_def *def, char *err, size_t errlen)
 {
     lag_result r = lag_sim_def_validate(def, err, errlen);
     if (r != LAG_OK) return r;
     memset(s, 0, sizeof *s);
     s->def = *def;
-    s->model = def->model;
-    if (flies(def)) {
-        s->model.kind = LAG_MODEL_FLYING_STICK;
-        s->model.nq = 3;
-        s->model.p[LAG_FSTICK_END] = 0.0;
-    }
+    lag_effects_sim_model(def, &s->model); /* def's model, or one an effect integrates */
+    s->dyn = lag_model_vt(&s->model);
     s->nq = s->model.nq;
     lag_effects_prepare(s);
     lag_sim_reset(s, NULL, NULL);
@@ -109,11 +98,12 @@ void lag_sim_reset(lag_sim *s, const double *q, const double *qd)
         s->qd[i] = qd ? qd[i] : s->def.qd0[i];
         s->tau[i] = 0.0;
     }
-    if (flies(&s->def)) lag_floor_from_lower_end(s, s->q, s->qd);
     s->tick = 0;
     s->dp.valid = false;
     s->dp.h = 0.0;
     memset(&s->mode, 0, sizeof s->mode);
+    s->dyn = lag_model_vt(&s->model);
+    if (s->def.effects.enabled) lag_effects_reset(s); /* the effects' run state (the floor's end) */
     memset(&s->fault, 0, sizeof s->fault);
     for (int i = 0; i < n; i++) s->tau_applied[i] = 0.0;
     s->n_events = 0;
@@ -139,10 +129,16 @@ lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_
                                   "running (not the model, the integrator or explode_limit)");
         return LAG_ERR_ARG;
     }
-    if (flies(def) != flies(&s->def)) {
+    lag_model integrated;
+    int row = lag_effects_sim_model(def, &integrated);
+    if (integrated.kind != s->model.kind) {
+        if (row < 0) row = lag_effects_sim_model(&s->def, &(lag_model){0});
+        const lag_effect_row *e = row >= 0 ? lag_effect_rows[row] : NULL;
         if (err && errlen)
-            snprintf(err, errlen, "the floor's flight (a stick that may leave its floor) does "
-                                  "not change while running");
+            snprintf(err, errlen, "effects.%s.%s does not change while running (it decides "
+                     "the model integrated: %s now)", e ? e->name : "?",
+                     e && e->sim_model_key ? e->sim_model_key : "?",
+                     lag_model_info_get(s->model.kind)->name);
         return LAG_ERR_ARG;
     }
     /* checked as a definition that starts where the run is now */
@@ -151,12 +147,7 @@ lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_
         at.q0[i] = s->q[i];
         at.qd0[i] = s->qd[i];
     }
-    if (flies(def)) {
-        /* a stick in the air or on either end is above its floor by construction: checked
-         * as standing on it at the same |sin phi| */
-        at.q0[1] = acos(cos(s->q[1]));
-        at.q0[2] = at.qd0[2] = 0.0;
-    }
+    lag_effects_as_initial(s, &at); /* the floor's: a stick standing on it */
     lag_diag d;
     if (lag_sim_def_check(&at, &d) != LAG_OK) {
         /* the "initial" state checked is where the run is now: said so */
@@ -170,13 +161,12 @@ lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_
     }
     const uint32_t was = s->def.effects.enabled;
     s->def.model = def->model;
-    for (int i = 0; i < LAG_STICK_NP && flies(def); i++) s->model.p[i] = def->model.p[i];
-    if (!flies(def)) s->model = def->model;
+    s->model = integrated; /* the run's state (the floor's end, lag_sim.dyn) is kept */
     s->def.effects = def->effects;
     lag_effects_prepare(s);
     s->dp.valid = false; /* dopri5's internal state was integrated with the old definition */
     const uint32_t now = s->def.effects.enabled;
-    if ((was | now) & (LAG_EFF_FRICTION | LAG_EFF_LIMITS | LAG_EFF_FLOOR))
+    if (lag_effects_with_events(was | now)) /* the effects with modes: derived again */
         lag_effects_init_modes(s);
     for (int i = 0; i < s->nq; i++) {
         if ((now & LAG_EFF_ACTUATOR) && !(was & LAG_EFF_ACTUATOR))
@@ -187,13 +177,6 @@ lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_
         }
     }
     return LAG_OK;
-}
-
-const char *lag_sim_contact(const lag_sim *s)
-{
-    if (!flies(&s->def)) return "";
-    if (!(s->mode.locked & (1u << 2))) return "flight";
-    return (s->mode.locked & (1u << 1)) ? "flat" : "contact";
 }
 
 void lag_sim_set_input(lag_sim *s, const double *tau)
@@ -225,7 +208,7 @@ int64_t lag_ticks_ceil(double t, double dt)
 
 double lag_sim_energy(const lag_sim *s)
 {
-    double E = lag_model_kinetic(&s->model, s->q, s->qd) + lag_model_potential(&s->model, s->q);
+    double E = s->dyn->kinetic(s->model.p, s->q, s->qd) + s->dyn->potential(s->model.p, s->q);
     return s->fx.n_potential ? E + lag_effects_potential(s, s->q) : E;
 }
 
@@ -260,10 +243,10 @@ lag_result lag_forward_locked(const lag_sim *s, const double *q, const double *q
     if (!locked) {
         if (lambda)
             for (int i = 0; i < n; i++) lambda[i] = 0.0;
-        return lag_model_vt(&s->model)->forward(s->model.p, q, qd, Q, qdd);
+        return s->dyn->forward(s->model.p, q, qd, Q, qdd);
     }
     double M[LAG_MAX_DOF * LAG_MAX_DOF], h[LAG_MAX_DOF], r[LAG_MAX_DOF];
-    lag_model_vt(&s->model)->mass_bias(s->model.p, q, qd, M, h);
+    s->dyn->mass_bias(s->model.p, q, qd, M, h);
     for (int i = 0; i < n; i++) r[i] = Q[i] - h[i];
     /* M_ff qdd_f = r_f on the free joints; qdd_L = 0 */
     lag_result res = solve_free(n, locked, M, r, qdd);
@@ -291,7 +274,7 @@ lag_result lag_sim_rhs(lag_sim *s, const double *y, double *ydot)
 lag_result lag_qd_from_p(const lag_sim *s, const double *q, const double *p, double *qd)
 {
     double M[LAG_MAX_DOF * LAG_MAX_DOF];
-    lag_model_vt(&s->model)->mass(s->model.p, q, M);
+    s->dyn->mass(s->model.p, q, M);
     return solve_free(s->nq, s->mode.locked, M, p, qd);
 }
 
@@ -303,7 +286,7 @@ lag_result lag_sim_rhs_qp(lag_sim *s, const double *y, double *ydot)
 {
     int n = s->nq;
     const lag_model *m = &s->model;
-    const lag_model_class *vt = lag_model_vt(m);
+    const lag_model_class *vt = s->dyn;
     double dM[LAG_MAX_DOF * LAG_MAX_DOF * LAG_MAX_DOF];
     double g[LAG_MAX_DOF], Q[LAG_MAX_DOF], qd[LAG_MAX_DOF];
     s->stats.rhs_evals++;

@@ -78,8 +78,8 @@ static void check_capacity(int arg)
      * (one hold watcher, fewer), plus the global ones */
     int per_joint = 0, global = 0;
     for (int k = 0; k < LAG_EFF_COUNT; ++k) {
-        per_joint += lag_effect_rows[k].max_watch_joint;
-        global += lag_effect_rows[k].max_watch_global;
+        per_joint += lag_effect_rows[k]->max_watch_joint;
+        global += lag_effect_rows[k]->max_watch_global;
     }
     int need = LAG_MAX_DOF * (per_joint > 1 ? per_joint : 1) + global;
     printf("capacity: rows declare at most %d watchers per joint and %d global: %d for %d "
@@ -104,7 +104,7 @@ static void check_capacity(int arg)
     if (tc_sim_init(&s, &d)) return;
     for (int j = -1; j < 2; ++j)
         for (int k = 0; k < LAG_EFF_COUNT; ++k) {
-            const lag_effect_row *r = &lag_effect_rows[k];
+            const lag_effect_row *r = lag_effect_rows[k];
             if (!r->watch || !(d.effects.enabled & r->bit)) continue;
             ws.n = 0;
             ENSURE(r->watch(&s, j, k, &ws));
@@ -125,7 +125,7 @@ static void check_capacity(int arg)
     if (tc_sim_init(&s, &d)) return;
     for (int j = -1; j < 3; ++j)
         for (int k = 0; k < LAG_EFF_COUNT; ++k) {
-            const lag_effect_row *r = &lag_effect_rows[k];
+            const lag_effect_row *r = lag_effect_rows[k];
             if (!r->watch || !(d.effects.enabled & r->bit)) continue;
             ws.n = 0;
             ENSURE(r->watch(&s, j, k, &ws));
@@ -275,7 +275,7 @@ static void check_table(int arg)
     (void)arg;
     uint32_t all = 0;
     for (int k = 0; k < LAG_EFF_COUNT; ++k) {
-        const lag_effect_row *r = &lag_effect_rows[k];
+        const lag_effect_row *r = lag_effect_rows[k];
         lag_effect_info inf = lag_effect_info_get(k);
         /* one bit each, distinct (the rows' order is the dispatch order, not the bits') */
         ENSURE(r->bit != 0 && (r->bit & (r->bit - 1)) == 0 && !(all & r->bit) && inf.bit == r->bit);

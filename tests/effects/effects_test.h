@@ -61,7 +61,9 @@ static inline void te_mass(const lag_model *m, const double *q, double *M)
 
 static inline double te_sim_energy(const lag_sim *s)
 {
-    return te_energy(&s->model, s->q, s->qd); /* the model integrated (a flying stick: its own) */
+    lag_model m; /* the model integrated now (a flying stick: measured from its end) */
+    lag_sim_dynamics(s, &m);
+    return te_energy(&m, s->q, s->qd);
 }
 
 static inline bool te_finite_state(const lag_sim *s)

@@ -90,9 +90,11 @@ typedef enum lag_model_kind {
 
 /* Parameter indices into lag_model.p, named as in docs/models.md. */
 enum { LAG_STICK_M, LAG_STICK_L, LAG_STICK_I, LAG_STICK_G, LAG_STICK_NP };
-/* The flying stick has the stick's parameters; p[LAG_FSTICK_END] is not a parameter but
- * which end h measures: 0 end A (at r_c - l/2 (cos phi, sin phi), the end the stick model
- * stands on), 1 end B (the other). The sim switches it when end B lands. */
+/* The flying stick has the stick's parameters; p[LAG_FSTICK_END] is not a parameter a
+ * scene gives but which end h measures: 0 end A (at r_c - l/2 (cos phi, sin phi), the end
+ * the stick model stands on), 1 end B (the other). A run never writes it: a sim whose
+ * floor switches ends keeps the end in its state (lag_sim.mode.floor_end; the model with
+ * that end: lag_sim_dynamics). */
 enum { LAG_FSTICK_END = LAG_STICK_NP };
 enum { LAG_MANIP_M1, LAG_MANIP_M2, LAG_MANIP_L1, LAG_MANIP_I1, LAG_MANIP_I2, LAG_MANIP_G,
        LAG_MANIP_NP };
@@ -395,13 +397,20 @@ typedef struct lag_sim_stats {
     int64_t faults;           /* steps refused for a numeric fault */
 } lag_sim_stats;
 
+struct lag_model_class; /* the core's own (core_internal.h) */
+
 /* The mutable simulation. Sim time is tick * dt, computed, never accumulated. */
 typedef struct lag_sim {
     lag_sim_def def;
     /* The model integrated and its coordinates q[0..nq-1]: def.model, except for a stick
      * whose floor lets it fly: the flying stick (x, phi, h), h the height of the end of
-     * p[LAG_FSTICK_END], held at h = 0 (a resting stop) while that end is on the floor. */
+     * mode.floor_end, held at h = 0 (a resting stop) while that end is on the floor.
+     * Read-only data after lag_sim_init (a redefinition replaces it): what changes while
+     * running is the sim's state below. */
     lag_model model;
+    /* The closed forms integrated (the core's own): model's row of the core's model table,
+     * or the flying stick measured from mode.floor_end. */
+    const struct lag_model_class *dyn;
     int nq;
     int64_t tick;                 /* number of dt ticks taken */
     double q[LAG_MAX_DOF];
@@ -423,6 +432,8 @@ typedef struct lag_sim {
         double dist_force[LAG_MAX_DOF]; /* disturbance forces held over this tick */
         uint32_t released;         /* bit i: the floor's hold of joint i let go at this
                                       instant (not a landing again before a step) */
+        int8_t floor_end;          /* the floor with flight: the end h measures (0: end A,
+                                      1: end B; see LAG_FSTICK_END) */
     } mode;
     /* The effect table's rows that the enabled effects use, per hook, in table order: made
      * once by lag_sim_init from def.effects.enabled, so that the step calls those rows
@@ -473,6 +484,10 @@ void lag_sim_reset(lag_sim *s, const double *q, const double *qd);
  * held by static friction) are derived again from the state, as at a reset; a newly
  * switched-on actuator starts from the effort applied now; dopri5 restarts its step. */
 lag_result lag_sim_redefine(lag_sim *s, const lag_sim_def *def, char *err, size_t errlen);
+/* The model whose closed forms the sim integrates now: s->model, with p[LAG_FSTICK_END]
+ * the end h measures for a flying stick (mode.floor_end). A copy, for tools and tests
+ * that evaluate the model at the sim's state (its energy, ...). OUT: m */
+void lag_sim_dynamics(const lag_sim *s, lag_model *m);
 /* The stick's contact with its floor, for status: "flight" (no end on it), "contact" (an
  * end on it, sliding), "flat" (lying on it: both ends held); "" without a floor that lets
  * it fly. */
