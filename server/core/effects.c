@@ -346,8 +346,8 @@ static void disturbance_pre_tick(lag_sim *s)
             impulse = true;
             lag_sim_record_event(s, LAG_EV_DISTURBANCE, d->joint, t0, d->value);
         } else {
-            double tend = d->t + d->duration;
-            if (s->tick >= kd && t0 < tend - 1e-9 * dt) {
+            /* held over the ticks that start before t + duration */
+            if (s->tick >= kd && s->tick < lag_ticks_ceil(d->t + d->duration, dt)) {
                 s->mode.dist_force[d->joint] += d->value;
                 if (s->tick == kd) lag_sim_record_event(s, LAG_EV_DISTURBANCE, d->joint, t0, d->value);
             }

@@ -122,6 +122,74 @@ static void noise_qd(lag_sim_def *d)
     d->effects.noise_qd[1] = -1;
 }
 
+static void inf_damping(lag_sim_def *d)
+{
+    d->effects.enabled = LAG_EFF_DAMPING;
+    d->effects.damping[0] = INFINITY;
+}
+static void friction_kinetic(lag_sim_def *d)
+{
+    d->effects.enabled = LAG_EFF_FRICTION;
+    d->effects.friction_kinetic[1] = -0.5;
+    d->effects.friction_static[1] = 1;
+}
+static void limits_rest_velocity(lag_sim_def *d)
+{
+    limits_e(d);
+    d->effects.restitution[0] = 0.5;
+    d->effects.rest_velocity = NAN;
+}
+static void floor_phi(lag_sim_def *d)
+{
+    d->effects.enabled = LAG_EFF_FLOOR;
+    d->q0[1] = -0.2;
+}
+static void floor_h(lag_sim_def *d)
+{
+    d->effects.enabled = LAG_EFF_FLOOR;
+    d->q0[1] = 1;
+    d->q0[2] = -0.1;
+}
+static void floor_hd(lag_sim_def *d)
+{
+    d->effects.enabled = LAG_EFF_FLOOR;
+    d->q0[1] = 1;
+    d->qd0[2] = NAN;
+}
+static void floor_no_flight_h(lag_sim_def *d)
+{
+    d->effects.enabled = LAG_EFF_FLOOR;
+    d->effects.floor_flight = false;
+    d->q0[1] = 1;
+    d->q0[2] = 0.5;
+}
+static void dist_count(lag_sim_def *d)
+{
+    d->effects.enabled = LAG_EFF_DISTURBANCE;
+    d->effects.n_disturbances = LAG_MAX_DISTURBANCES + 1;
+}
+static void dist_impulse(lag_sim_def *d)
+{
+    d->effects.enabled = LAG_EFF_DISTURBANCE;
+    d->effects.n_disturbances = 1;
+    d->effects.disturbances[0] = (lag_disturbance){0.5, 0, true, INFINITY, 0};
+}
+static void noise_q(lag_sim_def *d)
+{
+    d->effects.enabled = LAG_EFF_NOISE;
+    d->effects.noise_q[0] = -0.01;
+}
+static void spring_k(lag_sim_def *d)
+{
+    d->effects.enabled = LAG_EFF_SPRING;
+    d->effects.spring_k[1] = -2;
+}
+static void spring_rest(lag_sim_def *d)
+{
+    d->effects.enabled = LAG_EFF_SPRING;
+    d->effects.spring_rest[0] = NAN;
+}
+
 static const bad_case bad_cases[] = {
     {LAG_MODEL_DIPC, "parameters.m1", "> 0 (kg)", neg_m1},
     {LAG_MODEL_STICK, "parameters.l", "finite", nan_l},
@@ -154,6 +222,20 @@ static const bad_case bad_cases[] = {
     {LAG_MODEL_STICK, "effects.disturbance[0].duration", "> 0", dist_duration},
     {LAG_MODEL_STICK, "effects.disturbance[0].joint", "no joint", dist_joint},
     {LAG_MODEL_MANIPULATOR, "effects.noise.qd.q2", ">= 0", noise_qd},
+    /* every other rule of the effects' settings (the core's check is the truth: a loader's
+     * ranges only bound what its syntax can say) */
+    {LAG_MODEL_CARTPOLE, "effects.damping.x", "finite", inf_damping},
+    {LAG_MODEL_CARTPOLE, "effects.friction.theta.kinetic", ">= 0", friction_kinetic},
+    {LAG_MODEL_MANIPULATOR, "effects.limits.rest_velocity", ">= 0", limits_rest_velocity},
+    {LAG_MODEL_STICK, "initial.q[1]", "[0, pi]", floor_phi},
+    {LAG_MODEL_STICK, "initial.q[2]", "explode_limit", floor_h},
+    {LAG_MODEL_STICK, "initial.qd[2]", "finite", floor_hd},
+    {LAG_MODEL_STICK, "initial.q[2]", "flight", floor_no_flight_h},
+    {LAG_MODEL_STICK, "effects.disturbance", "at most", dist_count},
+    {LAG_MODEL_STICK, "effects.disturbance[0].impulse", "finite", dist_impulse},
+    {LAG_MODEL_CARTPOLE, "effects.noise.q.x", ">= 0", noise_q},
+    {LAG_MODEL_CARTPOLE, "effects.spring.theta.k", ">= 0", spring_k},
+    {LAG_MODEL_DIPC, "effects.spring.theta0.rest", "finite", spring_rest},
 };
 
 static void check_fields(int arg)
@@ -191,6 +273,17 @@ static void check_fields(int arg)
     }
     printf("validate: %d of %zu broken definitions blamed on the expected field\n", named,
            sizeof bad_cases / sizeof bad_cases[0]);
+    /* every effect of the core's table has a refusal above, blamed on one of its keys */
+    for (int k = 0; k < LAG_EFF_COUNT; ++k) {
+        const char *name = lag_effect_info_get(k).name;
+        char key[LAG_FIELD_MAX];
+        snprintf(key, sizeof key, "effects.%s", name);
+        bool found = false;
+        for (size_t c = 0; c < sizeof bad_cases / sizeof bad_cases[0]; ++c)
+            found |= strncmp(bad_cases[c].field, key, strlen(key)) == 0;
+        if (!found) LT_FAIL("effect '%s' has no refused setting in test_validate's cases", name);
+        else ENSURE(found);
+    }
 }
 
 /* lag_model_check blames parameters.<name> with the parameter's unit. */
@@ -242,6 +335,61 @@ static void check_ticks_ceil(int arg)
                     (long long)c[i].want);
         else
             ENSURE(got == c[i].want);
+    }
+}
+
+/* The last boundary at or before t, with the same tolerance (1e-9 dt) and saturation. */
+static void check_ticks_floor(int arg)
+{
+    (void)arg;
+    struct { double t, dt; int64_t want; } c[] = {
+        {0.0, 1e-3, 0},
+        {-5.0, 1e-3, 0},
+        {1.0, 1e-3, 1000},
+        {1.0 - 1e-13, 1e-3, 1000},     /* 1e-10 dt below: counted as on the boundary */
+        {1.0 - 1e-11, 1e-3, 999},      /* 1e-8 dt below: the one before */
+        {0.0015, 1e-3, 1},
+        {0.3, 0.1, 3},                 /* 0.3 / 0.1 = 2.9999999999999996 */
+        {9.3e15, 1e-3, INT64_MAX},
+        {INFINITY, 1e-3, INT64_MAX},
+        {NAN, 1e-3, INT64_MAX},
+    };
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; ++i) {
+        int64_t got = lag_ticks_floor(c[i].t, c[i].dt);
+        if (got != c[i].want)
+            LT_FAIL("lag_ticks_floor(%g, %g) = %lld, expected %lld", c[i].t, c[i].dt, (long long)got,
+                    (long long)c[i].want);
+        else
+            ENSURE(got == c[i].want);
+    }
+}
+
+/* A whole number of ticks, within 1e-9 of one; not for a negative, non-finite or
+ * unrepresentable count. */
+static void check_ticks_exact(int arg)
+{
+    (void)arg;
+    struct { double t, dt; bool ok; int64_t want; } c[] = {
+        {0.02, 1e-3, true, 20},
+        {0.3, 0.1, true, 3},           /* 2.9999999999999996 ticks */
+        {1.0 / 60.0, 1.0 / 600.0, true, 10},
+        {0.0, 1e-3, true, 0},
+        {0.0025, 1e-3, false, 0},      /* 2.5 ticks */
+        {1.0 + 1e-11, 1e-3, false, 0}, /* 1e-8 of a tick off */
+        {1.0 + 1e-13, 1e-3, true, 1000},
+        {-0.002, 1e-3, false, 0},
+        {1e300, 1e-3, false, 0},
+        {INFINITY, 1e-3, false, 0},
+        {NAN, 1e-3, false, 0},
+    };
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; ++i) {
+        int64_t n = -1;
+        bool ok = lag_ticks_exact(c[i].t, c[i].dt, &n);
+        if (ok != c[i].ok || (ok && n != c[i].want))
+            LT_FAIL("lag_ticks_exact(%g, %g) = %d (%lld), expected %d (%lld)", c[i].t, c[i].dt, ok,
+                    (long long)n, c[i].ok, (long long)c[i].want);
+        else
+            ENSURE(ok == c[i].ok);
     }
 }
 
@@ -302,6 +450,8 @@ int main(int argc, char **argv)
         {"fields", check_fields, 0, 0},
         {"model_fields", check_model_fields, 0, 0},
         {"ticks_ceil", check_ticks_ceil, 0, 0},
+        {"ticks_floor", check_ticks_floor, 0, 0},
+        {"ticks_exact", check_ticks_exact, 0, 0},
         {"redefine", check_redefine, 0, 0},
     };
     return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));

@@ -508,11 +508,21 @@ lag_result lag_sim_advance(lag_sim *s, int64_t n, bool continuous);
  * other methods step tick by tick and do not need it. */
 lag_result lag_sim_advance_within(lag_sim *s, int64_t n, int64_t stop);
 double lag_sim_time(const lag_sim *s);
-/* The first tick boundary at or after time t for a tick of dt > 0: ceil(t / dt), with t
- * within 1e-9 dt above a boundary counted as on it (rounding of t = k dt). Saturated: a t
- * whose tick is past INT64_MAX (t = 1e300, or NaN) gives INT64_MAX, a tick never reached;
- * t <= 0 gives 0. The core converts times to tick counts only through this. */
+/* Time to tick counts, for a tick of dt > 0: the core converts times to ticks only
+ * through these three, and so should any other part (one rule, one tolerance). A time
+ * within LAG_TICK_TOL ticks (LAG_TICK_TOL dt) of a boundary counts as on it: the rounding
+ * of t = k dt, computed or read back from text. Saturated: a count past INT64_MAX (t =
+ * 1e300, or NaN) gives INT64_MAX, a tick never reached; t <= 0 gives 0. */
+#define LAG_TICK_TOL 1e-9
+/* The first tick boundary at or after t: ceil(t / dt), t just above a boundary on it
+ * (when a disturbance starts; the ticks a run of t seconds takes). */
 int64_t lag_ticks_ceil(double t, double dt);
+/* The last tick boundary at or before t: floor(t / dt), t just below a boundary on it. */
+int64_t lag_ticks_floor(double t, double dt);
+/* Is t a whole number of ticks (within LAG_TICK_TOL of one, t >= 0 and finite, the count
+ * below INT64_MAX)? Then *n (if not NULL) is that number: how many ticks a control period
+ * takes. */
+bool lag_ticks_exact(double t, double dt, int64_t *n);
 /* T + U at the public state, plus the energy the scene's effects store (springs). */
 double lag_sim_energy(const lag_sim *s);
 
