@@ -31,105 +31,158 @@ static void tableau(int stages, double A[MAX_STAGES][MAX_STAGES], double *b)
     }
 }
 
-lag_result lag_step_gauss(lag_sim *s, int stages, double h, const double *yin, double *yout)
-{
-    LAG_ASSERT(stages >= 1 && stages <= MAX_STAGES);
-    const int n = s->nq, N = 2 * n, S = stages * N;
-    const lag_integrator_def *in = &s->def.integrator;
+/* One step's state: the tableau, the start in (q, p), the Newton matrix, the stages. */
+typedef struct gauss_step {
+    lag_sim *s;
+    int stages, n, N, S; /* stages, coordinates, state size 2n, system size stages * N */
+    double h;
     double A[MAX_STAGES][MAX_STAGES], b[MAX_STAGES];
-    tableau(stages, A, b);
+    double y0[LAG_MAX_STATE], f0[LAG_MAX_STATE];
+    double W[MAX_SYS * MAX_SYS]; /* I - h (A kron J) */
+    double Z[MAX_SYS], F[MAX_SYS];
+} gauss_step;
 
-    /* y0 = (q0, M(q0) qd0) */
-    double y0[LAG_MAX_STATE], M[LAG_MAX_DOF * LAG_MAX_DOF];
-    s->dyn->mass(s->model.p, yin, M);
+/* y0 = (q0, M(q0) qd0) and f0 = f(y0). */
+static lag_result gauss_start(gauss_step *g, const double *yin)
+{
+    const int n = g->n;
+    double M[LAG_MAX_DOF * LAG_MAX_DOF];
+    g->s->dyn->mass(g->s->model.p, yin, M);
     for (int i = 0; i < n; i++) {
-        y0[i] = yin[i];
+        g->y0[i] = yin[i];
         double p = 0.0;
         for (int j = 0; j < n; j++) p += M[i * n + j] * yin[n + j];
-        y0[n + i] = p;
+        g->y0[n + i] = p;
     }
+    return lag_sim_rhs_qp(g->s, g->y0, g->f0);
+}
 
-    /* f0 and the Jacobian J = df/dy at y0 by forward differences. */
-    double f0[LAG_MAX_STATE], J[LAG_MAX_STATE * LAG_MAX_STATE];
-    lag_result r = lag_sim_rhs_qp(s, y0, f0);
-    if (r != LAG_OK) return r;
+/* The Jacobian J = df/dy at y0 by forward differences, and the Newton matrix
+ * I - h (A kron J), factored once per step (LU, in place each solve: at most 12 x 12,
+ * cheaper to refactor than to keep pivots). */
+static lag_result gauss_newton_matrix(gauss_step *g)
+{
+    const int N = g->N, S = g->S;
+    double J[LAG_MAX_STATE * LAG_MAX_STATE];
+    lag_result r;
     for (int j = 0; j < N; j++) {
         double yp[LAG_MAX_STATE], fp[LAG_MAX_STATE];
-        memcpy(yp, y0, sizeof(double) * N);
-        double d = 1.4901161193847656e-08 * fmax(1.0, fabs(y0[j])); /* sqrt(eps) */
+        memcpy(yp, g->y0, sizeof(double) * N);
+        double d = 1.4901161193847656e-08 * fmax(1.0, fabs(g->y0[j])); /* sqrt(eps) */
         yp[j] += d;
-        d = yp[j] - y0[j]; /* the step actually represented */
-        if ((r = lag_sim_rhs_qp(s, yp, fp)) != LAG_OK) return r;
-        for (int i = 0; i < N; i++) J[i * N + j] = (fp[i] - f0[i]) / d;
+        d = yp[j] - g->y0[j]; /* the step actually represented */
+        if ((r = lag_sim_rhs_qp(g->s, yp, fp)) != LAG_OK) return r;
+        for (int i = 0; i < N; i++) J[i * N + j] = (fp[i] - g->f0[i]) / d;
     }
-
-    /* Newton matrix I - h (A kron J), factored once per step (LU, in place each solve:
-     * at most 12 x 12, cheaper to refactor than to keep pivots). */
-    double W[MAX_SYS * MAX_SYS];
-    for (int bi = 0; bi < stages; bi++)
-        for (int bj = 0; bj < stages; bj++)
+    for (int bi = 0; bi < g->stages; bi++)
+        for (int bj = 0; bj < g->stages; bj++)
             for (int i = 0; i < N; i++)
                 for (int j = 0; j < N; j++)
-                    W[(bi * N + i) * S + bj * N + j] =
-                        (bi == bj && i == j ? 1.0 : 0.0) - h * A[bi][bj] * J[i * N + j];
+                    g->W[(bi * N + i) * S + bj * N + j] =
+                        (bi == bj && i == j ? 1.0 : 0.0) - g->h * g->A[bi][bj] * J[i * N + j];
+    return LAG_OK;
+}
 
-    /* Initial guess Z_i = h sum_j a_ij f0 */
-    double Z[MAX_SYS], F[MAX_SYS];
-    for (int bi = 0; bi < stages; bi++) {
+/* Initial guess Z_i = h sum_j a_ij f0. */
+static void gauss_guess(gauss_step *g)
+{
+    for (int bi = 0; bi < g->stages; bi++) {
         double ci = 0.0;
-        for (int bj = 0; bj < stages; bj++) ci += A[bi][bj];
-        for (int i = 0; i < N; i++) Z[bi * N + i] = h * ci * f0[i];
+        for (int bj = 0; bj < g->stages; bj++) ci += g->A[bi][bj];
+        for (int i = 0; i < g->N; i++) g->Z[bi * g->N + i] = g->h * ci * g->f0[i];
     }
+}
 
+/* F_i = f(y0 + Z_i), each stage. */
+static lag_result gauss_stage_rhs(gauss_step *g)
+{
+    lag_result r;
+    for (int bi = 0; bi < g->stages; bi++) {
+        double y[LAG_MAX_STATE];
+        for (int i = 0; i < g->N; i++) y[i] = g->y0[i] + g->Z[bi * g->N + i];
+        if ((r = lag_sim_rhs_qp(g->s, y, g->F + bi * g->N)) != LAG_OK) return r;
+    }
+    return LAG_OK;
+}
+
+/* One simplified-Newton update of Z; *dn = its scaled size (NaN propagates). */
+static lag_result gauss_newton_update(gauss_step *g, const double *scale, double *dn)
+{
+    const int N = g->N, S = g->S;
+    lag_result r = gauss_stage_rhs(g);
+    if (r != LAG_OK) return r;
+    /* residual G_i = Z_i - h sum_j a_ij F_j, solved with the Newton matrix */
+    double G[MAX_SYS], Wc[MAX_SYS * MAX_SYS];
+    for (int bi = 0; bi < g->stages; bi++)
+        for (int i = 0; i < N; i++) {
+            double acc = g->Z[bi * N + i];
+            for (int bj = 0; bj < g->stages; bj++) acc -= g->h * g->A[bi][bj] * g->F[bj * N + i];
+            G[bi * N + i] = -acc;
+        }
+    memcpy(Wc, g->W, sizeof(double) * S * S);
+    if (lag_lu_solve_inplace(S, Wc, G) != LAG_OK) return LAG_ERR_NEWTON;
+    *dn = 0.0;
+    for (int k = 0; k < S; k++) {
+        g->Z[k] += G[k];
+        double e = fabs(G[k]) * scale[k % N];
+        if (!(e <= *dn)) *dn = e; /* NaN propagates into dn */
+    }
+    g->s->stats.newton_iters++;
+    return LAG_OK;
+}
+
+/* Newton on the stage equations until Hairer & Wanner's test holds (LAG_ERR_NEWTON when
+ * it diverges, fails or runs out of iterations). */
+static lag_result gauss_solve(gauss_step *g)
+{
+    const lag_integrator_def *in = &g->s->def.integrator;
     double scale[LAG_MAX_STATE];
-    for (int i = 0; i < N; i++) scale[i] = 1.0 / (1.0 + fabs(y0[i]));
+    for (int i = 0; i < g->N; i++) scale[i] = 1.0 / (1.0 + fabs(g->y0[i]));
     double dn_prev = 0.0;
-    bool converged = false;
-    for (int it = 0; it < in->max_iter && !converged; it++) {
-        /* F_i = f(y0 + Z_i); residual G_i = Z_i - h sum_j a_ij F_j */
-        for (int bi = 0; bi < stages; bi++) {
-            double y[LAG_MAX_STATE];
-            for (int i = 0; i < N; i++) y[i] = y0[i] + Z[bi * N + i];
-            if ((r = lag_sim_rhs_qp(s, y, F + bi * N)) != LAG_OK) return r;
-        }
-        double G[MAX_SYS], Wc[MAX_SYS * MAX_SYS];
-        for (int bi = 0; bi < stages; bi++)
-            for (int i = 0; i < N; i++) {
-                double acc = Z[bi * N + i];
-                for (int bj = 0; bj < stages; bj++) acc -= h * A[bi][bj] * F[bj * N + i];
-                G[bi * N + i] = -acc;
-            }
-        memcpy(Wc, W, sizeof(double) * S * S);
-        if (lag_lu_solve_inplace(S, Wc, G) != LAG_OK) return LAG_ERR_NEWTON;
-        double dn = 0.0;
-        for (int k = 0; k < S; k++) {
-            Z[k] += G[k];
-            double e = fabs(G[k]) * scale[k % N];
-            if (!(e <= dn)) dn = e; /* NaN propagates into dn */
-        }
-        s->stats.newton_iters++;
+    for (int it = 0; it < in->max_iter; it++) {
+        double dn;
+        lag_result r = gauss_newton_update(g, scale, &dn);
+        if (r != LAG_OK) return r;
         if (!isfinite(dn)) return LAG_ERR_NEWTON;
-        if (dn <= in->newton_tol) {
-            converged = true;
-        } else if (it > 0) {
+        if (dn <= in->newton_tol) return LAG_OK;
+        if (it > 0) {
             double theta = dn / dn_prev;
-            if (theta < 1.0 && theta / (1.0 - theta) * dn <= in->newton_tol) converged = true;
-            else if (theta >= 1.0 && it > 2) return LAG_ERR_NEWTON; /* diverging */
+            if (theta < 1.0 && theta / (1.0 - theta) * dn <= in->newton_tol) return LAG_OK;
+            if (theta >= 1.0 && it > 2) return LAG_ERR_NEWTON; /* diverging */
         }
         dn_prev = dn;
     }
-    if (!converged) return LAG_ERR_NEWTON;
+    return LAG_ERR_NEWTON;
+}
 
-    /* y1 = y0 + h sum_i b_i f(y0 + Z_i) at the converged stages */
+/* y1 = y0 + h sum_i b_i f(y0 + Z_i) at the converged stages, back in (q, qd): qd1 =
+ * M(q1)^-1 p1 (on the free joints when some are locked). */
+static lag_result gauss_finish(gauss_step *g, double *yout)
+{
+    const int N = g->N;
     double y1[LAG_MAX_STATE];
-    memcpy(y1, y0, sizeof(double) * N);
-    for (int bi = 0; bi < stages; bi++) {
+    memcpy(y1, g->y0, sizeof(double) * N);
+    for (int bi = 0; bi < g->stages; bi++) {
         double y[LAG_MAX_STATE];
-        for (int i = 0; i < N; i++) y[i] = y0[i] + Z[bi * N + i];
-        if ((r = lag_sim_rhs_qp(s, y, F + bi * N)) != LAG_OK) return r;
-        for (int i = 0; i < N; i++) y1[i] += h * b[bi] * F[bi * N + i];
+        for (int i = 0; i < N; i++) y[i] = g->y0[i] + g->Z[bi * N + i];
+        lag_result r = lag_sim_rhs_qp(g->s, y, g->F + bi * N);
+        if (r != LAG_OK) return r;
+        for (int i = 0; i < N; i++) y1[i] += g->h * g->b[bi] * g->F[bi * N + i];
     }
-    /* back to (q, qd): qd1 = M(q1)^-1 p1 (on the free joints when some are locked) */
-    memcpy(yout, y1, sizeof(double) * n);
-    return lag_qd_from_p(s, yout, y1 + n, yout + n);
+    memcpy(yout, y1, sizeof(double) * g->n);
+    return lag_qd_from_p(g->s, yout, y1 + g->n, yout + g->n);
+}
+
+lag_result lag_step_gauss(lag_sim *s, int stages, double h, const double *yin, double *yout)
+{
+    LAG_ASSERT(stages >= 1 && stages <= MAX_STAGES);
+    gauss_step g = {.s = s, .stages = stages, .n = s->nq, .N = 2 * s->nq,
+                    .S = stages * 2 * s->nq, .h = h};
+    tableau(stages, g.A, g.b);
+    lag_result r;
+    if ((r = gauss_start(&g, yin)) != LAG_OK) return r;
+    if ((r = gauss_newton_matrix(&g)) != LAG_OK) return r;
+    gauss_guess(&g);
+    if ((r = gauss_solve(&g)) != LAG_OK) return r;
+    return gauss_finish(&g, yout);
 }
