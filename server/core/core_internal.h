@@ -151,7 +151,8 @@ void lag_diag_format(const lag_diag *d, char *err, size_t errlen);
 /* True if every entry is finite and |x_i| <= limit. */
 bool lag_state_ok(int n, const double *x, double limit);
 
-/* ================================================================ events.c: the engine */
+/* ================================================================ events.c: the engine;
+ * contact.c: impulses, holds, stops; event_queue.c: the sim's events */
 #define LAG_MAX_WATCHERS 16        /* watchers of one tick (checked: core.events.capacity) */
 #define LAG_MAX_EVENTS_PER_TICK 16 /* then LAG_EV_EVENT_LIMIT and no more location */
 

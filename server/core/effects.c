@@ -96,59 +96,8 @@ static void damping_force(const lag_sim *s, const double *q, const double *qd, d
     for (int i = 0; i < s->nq; i++) Q[i] -= s->def.effects.damping[i] * qd[i];
 }
 
-/* ================================================================== stops: limits (and the floor's) */
-/* A stop at position `bound` on one side of a joint: a POSITION watcher; its map is an
- * impact with restitution e, or resting contact (a hold) when the impact is slower than
- * rest_velocity or the bounce would come back within one tick (the Zeno guard). */
-
-lag_result lag_stop_event(lag_sim *s, const lag_watcher *w, double *y, double t,
-                             lag_event_kind bounce, lag_event_kind rest_kind)
-{
-    const int n = s->nq, i = w->joint;
-    lag_result r;
-    double v = y[n + i];
-    /* Zeno guard: rest if slower than rest_velocity, or if the bounce would come back
-     * within one tick (e |v| < a dt, a the acceleration into the stop). */
-    double Q[LAG_MAX_DOF], qdd[LAG_MAX_DOF];
-    lag_effects_force(s, y, y + n, Q);
-    if ((r = lag_forward_locked(s, y, y + n, Q, qdd, NULL)) != LAG_OK) return r;
-    double a_in = qdd[i] * w->side;
-    bool rest = fabs(v) < s->def.effects.rest_velocity ||
-                (a_in > 0 && w->e * fabs(v) < a_in * s->def.integrator.dt);
-    if (rest) {
-        if ((r = lag_impulse_map(s, y, i, 0.0)) != LAG_OK) return r;
-        y[n + i] = 0.0;
-        s->mode.locked |= 1u << i;
-        s->mode.lock_side[i] = (int8_t)w->side;
-        s->mode.slip_dir[i] = 0;
-        double lambda[LAG_MAX_DOF];
-        if (rest_kind == LAG_EV_LANDING &&
-            (r = lag_forward_locked(s, y, y + n, Q, qdd, lambda)) == LAG_OK &&
-            -w->side * lambda[i] < 0) {
-            /* the floor would have to pull: the end touches it and flies on */
-            s->mode.locked &= ~(1u << i);
-            s->mode.lock_side[i] = 0;
-            lag_sim_record_event(s, bounce, i, t, v);
-        } else {
-            if (r != LAG_OK) return r;
-            lag_sim_record_event(s, rest_kind, i, t, v);
-        }
-    } else {
-        if ((r = lag_impulse_map(s, y, i, w->e)) != LAG_OK) return r;
-        lag_sim_record_event(s, bounce, i, t, v);
-    }
-    lag_refresh_slip(s, y);
-    return LAG_OK;
-}
-
-lag_result lag_rest_velocity_validate(const lag_sim_def *def, lag_diag *d, const char *field)
-{
-    double v = def->effects.rest_velocity;
-    if (!(isfinite(v) && v >= 0)) return lag_diag_fail(d, field, "expected a finite number >= 0, got %g", v);
-    return LAG_OK;
-}
-
-/* ---------------------------------------------------------------- limits: per-joint stops */
+/* ================================================================== limits: per-joint stops */
+/* A stop of each side of a joint (lag_stop_event, contact.c). */
 
 static lag_result limits_validate(const lag_sim_def *def, lag_diag *d)
 {
@@ -654,4 +603,18 @@ bool lag_effects_release(lag_sim *s, int i, double *y, double t, const double *l
 void lag_effects_as_initial(const lag_sim *s, lag_sim_def *at)
 {
     FOR_ENABLED_WITH(s->def.effects.enabled, as_initial) lag_effect_rows[k_]->as_initial(s, at);
+}
+
+/* The modes of the effects with events derived from the state (a reset, a
+ * redefinition): friction's slip or stick, then the holds an effect starts with. */
+void lag_effects_init_modes(lag_sim *s)
+{
+    const int n = s->nq;
+    double y[LAG_MAX_STATE];
+    for (int i = 0; i < n; i++) { y[i] = s->q[i]; y[n + i] = s->qd[i]; }
+    s->mode.locked = 0;
+    for (int i = 0; i < n; i++) { s->mode.lock_side[i] = 0; s->mode.slip_dir[i] = 0; }
+    lag_refresh_slip(s, y);
+    for (int i = 0; i < n; i++) s->qd[i] = y[n + i];
+    lag_effects_init_holds(s); /* the holds an effect starts with (the floor's of h) */
 }

@@ -11,7 +11,7 @@
  * LAG_MAX_EVENTS_PER_TICK events per tick (then LAG_EV_EVENT_LIMIT and the rest of the
  * tick without location); sim time stays tick * dt.
  *
- * Impulse map at joint i (frictionless impact, J = e_i^T):
+ * Impulse map at joint i (frictionless impact, J = e_i^T; contact.c):
  *   P = -(1 + e) (J qd-) / (J M^-1 J^T),  qd+ = qd- + M^-1 J^T P
  * so J qd+ = -e J qd- and the kinetic energy never increases for e in [0, 1].
  *
@@ -19,42 +19,17 @@
  * = 0; the constraint force lambda_i it needs is watched: a stop releases when lambda_i
  * would have to pull, static friction lets go when |lambda_i| > mu_s.
  *
- * What effects.c's rows give the engine: watchers (lag_effect_row.watch) and the maps of
- * their events (on_event). The pieces are separate functions so that they can be tested
- * on their own (tests/core/test_events.c): lag_hermite, lag_watch_add, lag_event_locate,
- * lag_impulse_map.
+ * What the effect table's rows give the engine: watchers (lag_effect_row.watch) and the
+ * maps of their events (on_event), built on contact.c (impulses, holds, the stop's map).
+ * The pieces are separate functions so that they can be tested on their own
+ * (tests/core/test_events.c): lag_hermite, lag_watch_add, lag_event_locate, and
+ * contact.c's lag_impulse_map.
  */
 #include <math.h>
 #include <string.h>
 #include "core_internal.h"
 
 #define NSEG 4 /* samples of the interpolant per step for sign changes */
-
-/* ------------------------------------------------------------------ the event queue */
-
-void lag_sim_record_event(lag_sim *s, lag_event_kind kind, int joint, double t, double value)
-{
-    int cap = (int)(sizeof s->events / sizeof s->events[0]);
-    LAG_ASSERT(s->n_events >= 0 && s->n_events <= cap);
-    if (s->n_events >= cap) {
-        s->events_dropped++;
-        return;
-    }
-    lag_event *ev = &s->events[s->n_events++];
-    ev->kind = kind;
-    ev->joint = joint;
-    ev->t = t;
-    ev->value = isfinite(value) ? value : 0.0;
-}
-
-bool lag_sim_poll_event(lag_sim *s, lag_event *ev)
-{
-    if (s->n_events == 0) return false;
-    *ev = s->events[0];
-    memmove(&s->events[0], &s->events[1], sizeof(lag_event) * (size_t)(s->n_events - 1));
-    s->n_events--;
-    return true;
-}
 
 /* ------------------------------------------------------------------ watchers */
 
@@ -137,29 +112,6 @@ lag_result lag_event_locate(int N, double H, const double *y0, const double *f0,
     return locate(N, H, y0, f0, y1, f1, ws, v0, eval, ctx, which, theta);
 }
 
-/* ------------------------------------------------------------------ impulses, holds */
-
-/* x = M^-1 e_i on the free joints (locked ones get no velocity). OUT: x */
-lag_result lag_minv_column(const lag_sim *s, const double *q, int i, double *x)
-{
-    double p[LAG_MAX_DOF] = {0};
-    p[i] = 1.0;
-    return lag_qd_from_p(s, q, p, x);
-}
-
-lag_result lag_impulse_map(lag_sim *s, double *y, int i, double e)
-{
-    const int n = s->nq;
-    double x[LAG_MAX_DOF];
-    lag_result r = lag_minv_column(s, y, i, x);
-    if (r != LAG_OK) return r;
-    if (!(x[i] > 0)) return LAG_ERR_SINGULAR;
-    double P = -(1.0 + e) * y[n + i] / x[i];
-    for (int k = 0; k < n; k++) y[n + k] += x[k] * P;
-    y[n + i] = -e * (y[n + i] - x[i] * P) ; /* exact: avoid rounding leaving a residue */
-    return LAG_OK;
-}
-
 static int sgn(double v) { return (v > 0) - (v < 0); }
 
 /* Constraint forces with the current locks at state y. OUT: lambda */
@@ -169,45 +121,6 @@ static lag_result lock_forces(lag_sim *s, const double *y, double *lambda)
     double Q[LAG_MAX_DOF], qdd[LAG_MAX_DOF];
     lag_effects_force(s, y, y + n, Q);
     return lag_forward_locked(s, y, y + n, Q, qdd, lambda);
-}
-
-lag_event_kind lag_friction_settle(lag_sim *s, double *y, int i)
-{
-    const int n = s->nq;
-    y[n + i] = 0.0;
-    s->mode.slip_dir[i] = 0;
-    s->mode.locked |= 1u << i;
-    s->mode.lock_side[i] = 0;
-    double lambda[LAG_MAX_DOF];
-    if (lock_forces(s, y, lambda) == LAG_OK &&
-        fabs(lambda[i]) <= s->def.effects.friction_static[i])
-        return LAG_EV_STICK;
-    s->mode.locked &= ~(1u << i);
-    s->mode.slip_dir[i] = (int8_t)(-sgn(lambda[i]));
-    return LAG_EV_SLIP;
-}
-
-void lag_refresh_slip(lag_sim *s, double *y)
-{
-    const int n = s->nq;
-    for (int i = 0; i < n; i++) {
-        if (!lag_has_friction(s, i) || (s->mode.locked & (1u << i))) continue;
-        double v = y[n + i];
-        if (v != 0.0) s->mode.slip_dir[i] = (int8_t)sgn(v);
-        else lag_friction_settle(s, y, i);
-    }
-}
-
-void lag_effects_init_modes(lag_sim *s)
-{
-    const int n = s->nq;
-    double y[LAG_MAX_STATE];
-    for (int i = 0; i < n; i++) { y[i] = s->q[i]; y[n + i] = s->qd[i]; }
-    s->mode.locked = 0;
-    for (int i = 0; i < n; i++) { s->mode.lock_side[i] = 0; s->mode.slip_dir[i] = 0; }
-    lag_refresh_slip(s, y);
-    for (int i = 0; i < n; i++) s->qd[i] = y[n + i];
-    lag_effects_init_holds(s); /* the holds an effect starts with (the floor's of h) */
 }
 
 /* A hold lets go (its watcher fired): a stop releases the joint (which friction may hold
