@@ -313,7 +313,8 @@ const char *lag_sim_contact(const lag_sim *s)
 void lag_sim_dynamics(const lag_sim *s, lag_model *m)
 {
     *m = s->model;
-    if (flying(s)) m->p[LAG_FSTICK_END] = s->mode.floor_end;
+    if (flying(s) && (s->def.effects.enabled & LAG_EFF_FLOOR))
+        m->p[LAG_FSTICK_END] = s->mode.floor_end;
 }
 
 /* The table's row (effects.c lists it in its place). */

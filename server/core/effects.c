@@ -287,8 +287,8 @@ static void disturbance_pre_tick(lag_sim *s)
         if (d->impulse) {
             if (s->tick != kd) continue;
             double x[LAG_MAX_DOF];
-            /* an impulse breaks any hold but a firm one (the floor's of h, which then pushes, or lets go
-             * at the tick's start); modes are re-settled */
+            /* an impulse breaks any hold but a firm one (the floor's of h, which then
+             * pushes, or lets go at the tick's start); modes are re-settled */
             s->mode.locked &= lag_effects_firm_holds(s);
             if (lag_minv_column(s, y, d->joint, x) != LAG_OK) continue;
             for (int i = 0; i < n; i++) y[n + i] += x[i] * d->value;
