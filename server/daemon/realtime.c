@@ -564,42 +564,24 @@ static void mode_lockstep(rt_server *s)
 /* ---------------------------------------------------------------- commands */
 static void lockstep_rewait(rt_server *s);
 
-/* The model's joints, the actuated ones marked: "theta0 (actuated), theta1, theta2" (or
- * only the actuated ones), as the scene loader lists them; what a rejection offers. */
 static const char *joint_list(const rt_server *s, bool actuated_only, char *buf, size_t n)
 {
-    size_t k = 0;
-    buf[0] = '\0';
-    for (int i = 0; i < s->nq && k < n; i++) {
-        if (actuated_only && !s->info->actuated[i]) continue;
-        int w = snprintf(buf + k, n - k, "%s%s%s", k ? ", " : "", s->info->joint_names[i],
-                         !actuated_only && s->info->actuated[i] ? " (actuated)" : "");
-        if (w < 0) break;
-        k += (size_t)w;
-    }
-    if (!buf[0]) snprintf(buf, n, "none");
-    return buf;
+    return rt_joint_list(s->info, s->nq, actuated_only, buf, n);
 }
 
-/* A rejected command: counted by reason, and a command_rejected event (limited) whose
- * detail says what was wrong and what would be accepted. */
-static void reject(rt_server *s, rt_reject why, const char *joint, double value,
-                   const char *fmt, ...) __attribute__((format(printf, 5, 6)));
-static void reject(rt_server *s, rt_reject why, const char *joint, double value,
-                   const char *fmt, ...)
+/* A rejected command (rt_command.h's verdict): counted by reason, and a command_rejected
+ * event (limited) whose detail says what was wrong and what would be accepted. */
+static void reject(rt_server *s, const rt_verdict *v)
 {
-    char what[192]; /* and the reason's name: within an event's detail */
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(what, sizeof what, fmt, ap);
-    va_end(ap);
+    const rt_reject why = v->why;
+    const char *what = v->what; /* and the reason's name: within an event's detail */
     s->rejected[why]++;
     rt_log_rx_fate(&s->rec, s->now, why == RT_REJ_UNDECODABLE ? RT_RX_UNDECODABLE : RT_RX_REFUSED); /* --log */
     char detail[LAG_WIRE_TEXT_LEN];
     snprintf(detail, sizeof detail, "%s: %s", rt_reject_name[why], what);
     if (why != RT_REJ_STALE) memcpy(s->last_reject, detail, sizeof detail); /* waits say it */
     /* a flood is counted in status, not echoed one for one */
-    limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s", detail);
+    limited_event(s, RT_EV_COMMAND_REJECTED, v->joint, v->value, "command rejected: %s", detail);
 }
 
 static void handle_command(rt_server *s, const uint8_t *data, size_t len);
@@ -612,76 +594,9 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
     rt_log_rx_end(&s->rec, s->now);
 }
 
-/* A command is applied whole or not at all: every name known, actuated, distinct; every
- * effort finite and within the scene's realtime.effort_limit. Its steps: */
-
-/* Decodes it into c; one that does not decode is rejected (false). */
-static bool command_decode(rt_server *s, const uint8_t *data, size_t len,
-                           lag_wire_joint_command *c)
-{
-    int d = lag_wire_decode_joint_command(data, len, s->nq, c);
-    char all[160];
-    if (d == LAG_WIRE_ECOUNT) {
-        reject(s, RT_REJ_BAD_LENGTH, "", c->num_joints,
-               "num_joints %d (in value); accepted: 0 to %d, joints of %s: %s", c->num_joints,
-               s->nq, s->info->name, joint_list(s, false, all, sizeof all));
-        return false;
-    }
-    if (d == LAG_WIRE_ETOOLONG) { /* a well-formed name longer than any joint's */
-        reject(s, RT_REJ_UNKNOWN_JOINT, "", 0, "a name of 64 bytes or more; joints of %s: %s",
-               s->info->name, joint_list(s, false, all, sizeof all));
-        return false;
-    }
-    if (d != LAG_WIRE_OK) {
-        reject(s, RT_REJ_UNDECODABLE, "", (double)len,
-               "%zu bytes (in value) that are no lagsim.joint_command_t; accepted: a "
-               "joint_command_t as lcm-gen encodes it (lcmtypes/joint_command_t.lcm)", len);
-        return false;
-    }
-    return true;
-}
-
-/* Its entry i: a joint of the model (its index in idx[i]), named once, actuated, with a
- * finite effort within the limit; else rejected (false). */
-static bool command_entry(rt_server *s, const lag_wire_joint_command *c, int i, int *idx)
-{
-    const char *name = c->name[i];
-    idx[i] = -1;
-    for (int j = 0; j < s->nq; j++)
-        if (strcmp(name, s->info->joint_names[j]) == 0) idx[i] = j;
-    char all[160];
-    if (idx[i] < 0) {
-        reject(s, RT_REJ_UNKNOWN_JOINT, name, 0, "'%s'; joints of %s: %s", name, s->info->name,
-               joint_list(s, false, all, sizeof all));
-        return false;
-    }
-    for (int k = 0; k < i; k++)
-        if (idx[k] == idx[i]) {
-            reject(s, RT_REJ_BAD_LENGTH, name, c->num_joints,
-                   "'%s' named twice; accepted: each joint at most once (%s)", name,
-                   joint_list(s, false, all, sizeof all));
-            return false;
-        }
-    if (!s->info->actuated[idx[i]]) {
-        reject(s, RT_REJ_UNACTUATED, name, 0, "'%s' takes no input; actuated joints of %s: %s",
-               name, s->info->name, joint_list(s, true, all, sizeof all));
-        return false;
-    }
-    /* a bound on what a command may ask, not the plant's saturation (that is the actuator
-     * effect): an effort beyond it is a controller's bug, refused whole */
-    double lim = s->sc->realtime.effort_limit[idx[i]];
-    if (!isfinite(c->effort[i])) {
-        reject(s, RT_REJ_NONFINITE, name, 0, "%g for '%s'; accepted: a finite effort within +-%g",
-               c->effort[i], name, lim);
-        return false;
-    }
-    if (fabs(c->effort[i]) > lim) {
-        reject(s, RT_REJ_EFFORT_LIMIT, name, c->effort[i],
-               "%g for '%s' (in value); accepted: |effort| <= %g", c->effort[i], name, lim);
-        return false;
-    }
-    return true;
-}
+/* A command is applied whole or not at all: it decodes, every name is known, actuated,
+ * distinct, every effort finite and within the scene's realtime.effort_limit
+ * (rt_command.h), and in lockstep it answers the state waited on. Its steps: */
 
 /* Lockstep: the command answers the state waited on (or, not running, the state the sim
  * holds). A second answer to a state already answered (the controller got it twice, a
@@ -696,13 +611,14 @@ static bool command_in_step(rt_server *s, const lag_wire_joint_command *c)
     }
     bool waited_on = s->ls.waiting && c->sim_time == s->ls.waiting_time;
     if (waited_on || (s->run != RT_RUNNING && c->sim_time == lag_sim_time(&s->sim))) return true;
+    rt_verdict v = {RT_REJ_STALE, "", c->sim_time, ""};
     if (s->ls.waiting)
-        reject(s, RT_REJ_STALE, "", c->sim_time,
-               "sim_time %.9g (in value); accepted: %.9g, the state waited on", c->sim_time,
-               s->ls.waiting_time);
+        snprintf(v.what, sizeof v.what, "sim_time %.9g (in value); accepted: %.9g, the state "
+                 "waited on", c->sim_time, s->ls.waiting_time);
     else
-        reject(s, RT_REJ_STALE, "", c->sim_time, "sim_time %.9g (in value); no state is waited "
-               "on (the next one's sim_time will be)", c->sim_time);
+        snprintf(v.what, sizeof v.what, "sim_time %.9g (in value); no state is waited on (the "
+                 "next one's sim_time will be)", c->sim_time);
+    reject(s, &v);
     return false;
 }
 
@@ -733,12 +649,18 @@ static void command_apply(rt_server *s, const lag_wire_joint_command *c, const i
 static void handle_command(rt_server *s, const uint8_t *data, size_t len)
 {
     lag_wire_joint_command c;
-    if (!command_decode(s, data, len, &c)) return;
+    rt_verdict v;
+    if (!rt_command_decode(s->info, s->nq, data, len, &c, &v)) {
+        reject(s, &v);
+        return;
+    }
     /* lockstep: an answer to the state waited on, good or not, came: it needs no copies */
     rt_lockstep_heard(&s->ls, c.sim_time);
     int idx[LAG_MAX_DOF];
-    for (int i = 0; i < c.num_joints; i++)
-        if (!command_entry(s, &c, i, idx)) return;
+    if (!rt_command_entries(s->info, s->nq, s->sc->realtime.effort_limit, &c, idx, &v)) {
+        reject(s, &v);
+        return;
+    }
     if (!command_in_step(s, &c)) return;
     command_apply(s, &c, idx);
 }

@@ -28,6 +28,7 @@
 #include "lagsim_bus.h"
 #include "lagsim_wire.h"
 #include "rt_bus.h"
+#include "rt_command.h"
 #include "rt_lockstep.h"
 #include "rt_pace.h"
 #include "rt_record.h"

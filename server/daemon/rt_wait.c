@@ -27,17 +27,6 @@
 #define RT_WAIT_LINE_NS (3 * RT_NS_PER_S)   /* the first line after 3 s of a wait, */
 #define RT_WAIT_LINE_MAX_NS (60 * RT_NS_PER_S) /* then at gaps as long as the wait, <= 1 min */
 
-const char *const rt_reject_name[RT_REJ_COUNT] = {
-    [RT_REJ_UNKNOWN_JOINT] = "unknown joint",
-    [RT_REJ_UNACTUATED] = "unactuated joint",
-    [RT_REJ_NONFINITE] = "non-finite effort",
-    [RT_REJ_BAD_LENGTH] = "bad length",
-    [RT_REJ_UNDECODABLE] = "undecodable payload",
-    [RT_REJ_STALE] = "stale (lockstep: answers another state)",
-    [RT_REJ_EFFORT_LIMIT] = "effort beyond realtime.effort_limit"};
-_Static_assert(sizeof rt_reject_name / sizeof rt_reject_name[0] == RT_REJ_COUNT,
-               "one name per reason");
-
 void rt_wait_init(rt_wait *w, const lag_bus *bus, const char *prefix, bool lockstep)
 {
     w->bus = bus;

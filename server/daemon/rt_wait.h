@@ -14,21 +14,8 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "lagsim_bus.h"
+#include "rt_command.h"
 #include "rt_term.h"
-
-/* Why a command was rejected; indexes the loop's counters (rt_server.rejected). */
-typedef enum rt_reject {
-    RT_REJ_UNKNOWN_JOINT = 0,
-    RT_REJ_UNACTUATED,
-    RT_REJ_NONFINITE,
-    RT_REJ_BAD_LENGTH,
-    RT_REJ_UNDECODABLE,
-    RT_REJ_STALE,             /* lockstep: answers a state other than the one waited on */
-    RT_REJ_EFFORT_LIMIT,      /* an |effort| beyond the scene's realtime.effort_limit */
-    RT_REJ_COUNT
-} rt_reject;
-/* The reasons of rt_reject, by index. */
-extern const char *const rt_reject_name[RT_REJ_COUNT];
 
 /* What a plant that does not advance waits for. */
 typedef enum rt_wait_kind {
