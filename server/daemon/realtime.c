@@ -531,12 +531,12 @@ static void mode_fast(rt_server *s)
 static void mode_lockstep(rt_server *s)
 {
     if (s->run == RT_WAITING && s->pending_steps == 0) {
-        if (s->ls.waiting && s->now - s->ls.wait_start_ns >= s->ls.wait_ns)
+        if (s->ls.waiting && rt_lockstep_timed_out(&s->ls, s->now))
             s->want_state = true; /* the same state again, through the state bucket */
         return;
     }
     if (!active(s) || !s->ls.waiting) return;
-    if (!s->ls.answered && s->now - s->ls.wait_start_ns >= s->ls.wait_ns) {
+    if (!s->ls.answered && rt_lockstep_timed_out(&s->ls, s->now)) {
         if (s->pending_steps > 0) { /* STEP N: a period without a command, as asked */
             s->ls.answered = true;
         } else {
@@ -576,7 +576,8 @@ static void reject(rt_server *s, const rt_verdict *v)
     const rt_reject why = v->why;
     const char *what = v->what; /* and the reason's name: within an event's detail */
     s->rejected[why]++;
-    rt_log_rx_fate(&s->rec, s->now, why == RT_REJ_UNDECODABLE ? RT_RX_UNDECODABLE : RT_RX_REFUSED); /* --log */
+    /* --log */
+    rt_log_rx_fate(&s->rec, s->now, why == RT_REJ_UNDECODABLE ? RT_RX_UNDECODABLE : RT_RX_REFUSED);
     char detail[LAG_WIRE_TEXT_LEN];
     snprintf(detail, sizeof detail, "%s: %s", rt_reject_name[why], what);
     if (why != RT_REJ_STALE) memcpy(s->last_reject, detail, sizeof detail); /* waits say it */

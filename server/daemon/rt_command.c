@@ -60,7 +60,8 @@ bool rt_command_decode(const lag_model_info *info, int nq, const uint8_t *data, 
     if (d == LAG_WIRE_ECOUNT)
         return refuse(v, RT_REJ_BAD_LENGTH, "", c->num_joints,
                       "num_joints %d (in value); accepted: 0 to %d, joints of %s: %s",
-                      c->num_joints, nq, info->name, rt_joint_list(info, nq, false, all, sizeof all));
+                      c->num_joints, nq, info->name,
+                      rt_joint_list(info, nq, false, all, sizeof all));
     if (d == LAG_WIRE_ETOOLONG) /* a well-formed name longer than any joint's */
         return refuse(v, RT_REJ_UNKNOWN_JOINT, "", 0, "a name of 64 bytes or more; joints of "
                       "%s: %s", info->name, rt_joint_list(info, nq, false, all, sizeof all));

@@ -148,8 +148,9 @@ int rt_log_check(rt_record *r, int64_t now, bool running, rt_record_note *notes)
         r->error_said = true;
         notes[nn] = (rt_record_note){"log_error", (double)st.error, ""};
         detail = notes[nn++].detail;
-        snprintf(detail, sizeof notes->detail, "--log %s: writing failed after %lld bytes: %s; the rest "
-                 "of the run is not logged", path, (long long)st.written, strerror(st.error));
+        snprintf(detail, sizeof notes->detail, "--log %s: writing failed after %lld bytes: "
+                 "%s; the rest of the run is not logged", path, (long long)st.written,
+                 strerror(st.error));
         if (r->quiet) fprintf(stderr, "lagsimd: %s\n", detail); /* else: the event's line */
     }
     /* a flood of refused messages: said in the log (and on the bus) at most once a
@@ -157,9 +158,10 @@ int rt_log_check(rt_record *r, int64_t now, bool running, rt_record_note *notes)
     if (unsampled(r) > r->unsampled_said && rt_limit_take(&r->lim_sample_said, now)) {
         notes[nn] = (rt_record_note){"log_sampled", (double)unsampled(r), ""};
         detail = notes[nn++].detail;
-        snprintf(detail, sizeof notes->detail, "--log %s: received so far %lld refused commands and "
-                 "control requests (%lld undecodable) and %lld status or describe requests: "
-                 "%lld written as a sample (%lld bytes, at most %d a second), %lld counted only",
+        snprintf(detail, sizeof notes->detail, "--log %s: received so far %lld refused "
+                 "commands and control requests (%lld undecodable) and %lld status or describe "
+                 "requests: %lld written as a sample (%lld bytes, at most %d a second), %lld "
+                 "counted only",
                  path, (long long)r->rx_refused, (long long)r->rx_undecodable,
                  (long long)r->rx_queries, (long long)r->rx_sampled,
                  (long long)r->rx_sampled_bytes, RT_LOG_SAMPLE_BPS, (long long)unsampled(r));
