@@ -287,10 +287,11 @@ static void status_message(const rt_server *s, int64_t now, lag_wire_status *m)
     m->waiting_s = rt_wait_describe(&s->wait, s->now, &w, m->waiting_for, sizeof m->waiting_for,
                                     m->waiting_got, sizeof m->waiting_got);
     m->commands_wrong_port = s->bus.commands_wrong_port;
-    m->error_estimate = s->err_estimate;
+    const rt_estimate *e = &s->est;
+    m->error_estimate = e->err;
     snprintf(m->error_joint, sizeof m->error_joint, "%s",
-             s->err_joint >= 0 && s->err_joint < s->nq ? s->info->joint_names[s->err_joint] : "");
-    m->error_warnings = s->err_warnings;
+             e->joint >= 0 && e->joint < s->nq ? s->info->joint_names[e->joint] : "");
+    m->error_warnings = e->warnings;
 }
 
 /* Every status goes out through here; the RTF's window starts again (unless it was too
@@ -383,39 +384,28 @@ static void period_begin(rt_server *s, int64_t budget)
                       age, sc->realtime.command_timeout);
     }
     lag_sim_set_input(&s->sim, s->held);
-    rt_log_input(&s->rec, s->now, &s->sim, s->info); /* --log with an actuator lag: the input this period runs with */
+    /* --log with an actuator lag: the input this period runs with */
+    rt_log_input(&s->rec, s->now, &s->sim, s->info);
     s->period_left = sc->ticks_per_period;
     s->period_us = 0;
     /* the live error estimate: a period run in one piece (nothing changes the sim between
      * its chunks then) is run again after it is published, from a copy of its start */
-    const int every = lag_scene_estimate_every(sc);
-    s->shadow_armed = every > 0 && s->periods_done % every == 0 && s->period_left <= budget;
-    if (s->shadow_armed) s->shadow_start = s->sim;
+    rt_estimate_arm(&s->est, &s->sim, s->period_left <= budget);
 }
 
-/* The live error estimate of the period just published (docs/accuracy.md): its error,
- * largest over the joints, for status; over the scene's budget, an error_estimate event
- * naming the joint. A shadow that faults says nothing (the run itself did not). */
+/* The live error estimate of the period just published (rt_estimate.h): its error,
+ * largest over the joints, goes in status; over the scene's budget, an error_estimate
+ * event naming the joint. */
 static void estimate_error(rt_server *s)
 {
-    s->shadow_armed = false;
-    double err[LAG_MAX_DOF];
-    if (lag_sim_shadow_error(&s->shadow_start, &s->sim, err) != LAG_OK) return;
-    int j = 0;
-    for (int i = 1; i < s->nq; i++)
-        if (err[i] > err[j]) j = i;
-    if (!isfinite(err[j])) return;
-    s->err_estimate = err[j];
-    s->err_joint = j;
-    const double budget = rt_error_budget(s->sc);
-    if (budget > 0 && err[j] > budget) {
-        s->err_warnings++;
-        limited_event(s, RT_EV_ERROR_ESTIMATE, s->info->joint_names[j], err[j],
-                      "the integration added an estimated %.3g to %s over the period ending at "
-                      "t = %.9g s, %.3g times its budget %.3g (integrator.error %g over %g s)",
-                      err[j], s->info->joint_names[j], lag_sim_time(&s->sim), err[j] / budget,
-                      budget, s->sc->accuracy.error, s->sc->accuracy.horizon);
-    }
+    if (!rt_estimate_period(&s->est, &s->sim)) return;
+    const int j = s->est.joint;
+    const double err = s->est.err, budget = s->est.budget;
+    limited_event(s, RT_EV_ERROR_ESTIMATE, s->info->joint_names[j], err,
+                  "the integration added an estimated %.3g to %s over the period ending at "
+                  "t = %.9g s, %.3g times its budget %.3g (integrator.error %g over %g s)",
+                  err, s->info->joint_names[j], lag_sim_time(&s->sim), err / budget, budget,
+                  s->sc->accuracy.error, s->sc->accuracy.horizon);
 }
 
 /* The period is complete: its state goes out; STEP and --duration are booked. */
@@ -454,14 +444,13 @@ static rt_progress period_run(rt_server *s, int64_t *budget)
     s->ticks_since_status += n;
     publish_effect_events(s);
     if (r != LAG_OK || !state_finite(&s->sim)) {
-        s->shadow_armed = false;
+        rt_estimate_disarm(&s->est);
         enter_fault(s, r);
         return RT_P_FAULT;
     }
     if (s->period_left > 0) return RT_P_MORE;
     period_end(s);
-    s->periods_done++;
-    if (s->shadow_armed) estimate_error(s); /* after the state went out */
+    estimate_error(s); /* after the state went out */
     return RT_P_DONE;
 }
 
@@ -1163,7 +1152,7 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     open_clocks(s, quiet);
     s->nq = s->sim.nq;
     s->info = lag_sim_info(&s->sim); /* the joints published: a stick that may fly has h */
-    s->err_joint = -1;      /* no live error estimate yet */
+    rt_estimate_init(&s->est, lag_scene_estimate_every(sc), rt_error_budget(sc));
     s->ref = sc->reference;
     s->tick_budget = RT_TICK_BUDGET;
     open_limits(s, now);

@@ -10,6 +10,8 @@
  *   rt_term.h      the terminal: event lines and the live line
  *   rt_wait.h      what the plant waits for, and its lines
  *   rt_lockstep.h  the state waited on, its timeout and its copies
+ *   rt_command.h   what a command must be to be applied (no state)
+ *   rt_estimate.h  the live error estimate
  *   rt_pace.h      deadlines and token buckets (pure arithmetic)
  *   live_set.h     the changes made while running (SET, kicks)
  *
@@ -29,6 +31,7 @@
 #include "lagsim_wire.h"
 #include "rt_bus.h"
 #include "rt_command.h"
+#include "rt_estimate.h"
 #include "rt_lockstep.h"
 #include "rt_pace.h"
 #include "rt_record.h"
@@ -100,6 +103,7 @@ typedef struct rt_server {
     rt_term term;              /* stderr (rt_term.h) */
     rt_wait wait;              /* what the plant waits for (rt_wait.h) */
     rt_lockstep ls;            /* lockstep's wait for an answer (rt_lockstep.h) */
+    rt_estimate est;           /* the live error estimate (rt_estimate.h) */
     rt_pace pace;              /* pacing of periods (realtime) and of the paused
                                 * republication (realtime, fast) */
     live_sets live;            /* changes made while running (control_t SET), in the
@@ -149,15 +153,6 @@ typedef struct rt_server {
     int64_t states_published;
     int64_t effect_events_dropped; /* sim.events_dropped already reported */
     int64_t plant_conflicts;   /* scenes of another plant heard on this prefix while running */
-
-    /* the live error estimate (docs/accuracy.md): every estimate_every-th period is run
-     * again from a copy of its start, after its state is published */
-    lag_sim shadow_start;      /* the sim at the start of the period to estimate */
-    bool shadow_armed;         /* the period in progress is to be estimated */
-    int64_t periods_done;      /* control periods completed since start */
-    double err_estimate;       /* the last estimate, largest over the joints (m or rad) */
-    int err_joint;             /* its joint, -1 before the first */
-    int64_t err_warnings;      /* estimates over the budget (rt_error_budget) */
 
     /* timing */
     int64_t start_ns;

@@ -1511,8 +1511,8 @@ static void case_live_error(void)
         if (on) {
             memcpy(q_on, g_srv.sim.q, sizeof q_on);
             memcpy(qd_on, g_srv.sim.qd, sizeof qd_on);
-            ENSUREF(g_srv.err_warnings >= 290, "%lld periods over the budget",
-                    (long long)g_srv.err_warnings);
+            ENSUREF(g_srv.est.warnings >= 290, "%lld periods over the budget",
+                    (long long)g_srv.est.warnings);
             const int64_t ev = n_events("error_estimate");
             ENSUREF(ev >= 3 && ev <= 3 + (int64_t)wall_s + 1, "%lld error_estimate events in "
                     "%.2f s", (long long)ev, wall_s);
@@ -1524,7 +1524,7 @@ static void case_live_error(void)
         }
         stop_server(); /* every number published finite */
         if (on) {
-            ENSURE(g_out.status_err_warnings == g_srv.err_warnings);
+            ENSURE(g_out.status_err_warnings == g_srv.est.warnings);
             ENSURE(g_out.status_err_budget == budget);
             ENSUREF(g_out.status_err_estimate > budget && g_out.status_err_estimate < 1e-3,
                     "estimate %g", g_out.status_err_estimate);
