@@ -5,7 +5,7 @@
  *     while not stopped:
  *         wake = rt_next_wake(s)    the earliest thing due (a deadline, a status, an
  *                                   answer the rate limit holds back); now if busy
- *         wait(s, io, wake)         ppoll on the LCM socket, a signalfd and a timerfd
+ *         rt_io_wait(io, wake)      ppoll on the LCM socket, a signalfd and a timerfd
  *                                   armed at `wake` (never a busy spin); then the
  *                                   signals and LCM messages that arrived (bounded)
  *         rt_process(s)             what is due at s->now: the mode's periods, answers,
@@ -34,27 +34,22 @@
  *
  * The stepping path allocates nothing: the server struct holds every buffer.
  */
-#include <errno.h>
 #include <math.h>
-#include <poll.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/signalfd.h>
-#include <sys/timerfd.h>
 #include <unistd.h>
 
 #include "live_set.h"
+#include "rt_io.h"
 #include "rt_server.h"
 #include "lagsim/lagsim_control_t.h"
 
-#define RT_DRAIN_MAX 256          /* LCM messages handled per wake-up at most */
 #define RT_TICK_BUDGET 4096       /* ticks advanced per wake-up at most */
 #define RT_LINE_NS 250000000LL    /* live status line refresh */
 #define RT_STATUS_NS_MIN 10000000LL /* periodic status at most every 10 ms (100 Hz) */
-#define RT_SIGNALS_PER_WAKE 16    /* signals read per wake-up at most */
 #define RT_CONFLICT_EVERY_S 5     /* another plant's scenes: said at most once in 5 s */
 
 /* The buckets of the limited events (rt_ev): name, answers per second, burst. */
@@ -1347,74 +1342,7 @@ void rt_finish(rt_server *s)
 }
 
 /* ---------------------------------------------------------------- the loop */
-typedef struct rt_io {
-    int in_fd, timer_fd, sig_fd;
-    int watch_fd; /* the state URL's receive socket (the plant watch); -1 for memq:// */
-    int64_t armed_ns; /* what the timer is armed at (INT64_MAX: disarmed) */
-} rt_io;
-
-/* Waits until `wake` (absolute), a signal or an LCM message, then handles the signals
- * and the messages that arrived (at most RT_DRAIN_MAX). */
-static void wait_and_handle(rt_server *s, rt_io *io, int64_t wake)
-{
-    struct timespec zero = {0, 0}, *tmo = NULL;
-    if (wake <= rt_mono_ns()) {
-        tmo = &zero;
-    } else if (wake != io->armed_ns) {
-        struct itimerspec its = {{0, 0}, {0, 0}};
-        if (wake != INT64_MAX) {
-            its.it_value.tv_sec = (time_t)(wake / RT_NS_PER_S);
-            its.it_value.tv_nsec = (long)(wake % RT_NS_PER_S);
-        }
-        if (timerfd_settime(io->timer_fd, TFD_TIMER_ABSTIME, &its, NULL) == 0) io->armed_ns = wake;
-        else tmo = &zero; /* cannot arm: do not sleep past the deadline */
-    }
-    struct pollfd pf[4] = {{io->in_fd, POLLIN, 0}, {io->timer_fd, POLLIN, 0},
-                           {io->sig_fd, POLLIN, 0}, {io->watch_fd, POLLIN, 0}};
-    int np = ppoll(pf, io->watch_fd >= 0 ? 4 : 3, tmo, NULL);
-    s->now = rt_mono_ns();
-    if (np < 0) {
-        if (errno == EINTR) return;
-        perror("lagsimd: poll");
-        s->stop = true;
-        s->stop_reason = RT_STOP_ERROR;
-        return;
-    }
-    if (pf[2].revents & POLLIN) {
-        struct signalfd_siginfo si;
-        for (int k = 0; k < RT_SIGNALS_PER_WAKE; k++) {
-            if (read(io->sig_fd, &si, sizeof si) != (ssize_t)sizeof si) break;
-            rt_signal(s, (int)si.ssi_signo);
-        }
-    }
-    if (pf[1].revents & POLLIN) {
-        uint64_t expirations;
-        if (read(io->timer_fd, &expirations, sizeof expirations) < 0) expirations = 0;
-        io->armed_ns = INT64_MAX;
-    }
-    if (pf[0].revents & POLLIN) {
-        for (int k = 0; k < RT_DRAIN_MAX && !s->stop; k++)
-            if (lcm_handle_timeout(s->bus.lcm_in, 0) <= 0) break;
-    }
-    if (io->watch_fd >= 0 && (pf[3].revents & POLLIN)) {
-        for (int k = 0; k < 16 && !s->stop; k++)
-            if (lcm_handle_timeout(s->bus.lcm, 0) <= 0) break;
-    }
-    s->now = rt_mono_ns();
-}
-
-/* Signals the daemon handles: these stop it cleanly (a stop event and a final status);
- * SIGUSR1/SIGUSR2 ask for a status and a line on stderr. SIGPIPE is ignored. */
-static void handled_signals(sigset_t *set)
-{
-    sigemptyset(set);
-    sigaddset(set, SIGINT);
-    sigaddset(set, SIGTERM);
-    sigaddset(set, SIGHUP);
-    sigaddset(set, SIGQUIT);
-    sigaddset(set, SIGUSR1);
-    sigaddset(set, SIGUSR2);
-}
+static void on_signal(void *ctx, int signo) { rt_signal(ctx, signo); }
 
 int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
 {
@@ -1422,22 +1350,11 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
     rt_server *s = &srv;
     bool quiet = o && o->quiet;
     char err[512];
-
-    /* signals through a signalfd: blocked before LCM starts any thread */
-    sigset_t sigs, old_mask;
-    handled_signals(&sigs);
-    sigprocmask(SIG_BLOCK, &sigs, &old_mask);
-    struct sigaction ign = {.sa_handler = SIG_IGN}, old_pipe;
-    sigemptyset(&ign.sa_mask);
-    sigaction(SIGPIPE, &ign, &old_pipe);
-    rt_io io = {-1, -1, -1, -1, INT64_MAX};
+    rt_io io;
     int rc = LAGSIMD_EXIT_OK;
     bool opened = false;
 
-    io.sig_fd = signalfd(-1, &sigs, SFD_CLOEXEC | SFD_NONBLOCK);
-    io.timer_fd = timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC | TFD_NONBLOCK);
-    if (io.sig_fd < 0 || io.timer_fd < 0) {
-        perror("lagsimd: signalfd/timerfd");
+    if (rt_io_open(&io, &s->now, &s->stop, on_signal, s) != 0) {
         rc = LAGSIMD_EXIT_RUNTIME;
         goto out;
     }
@@ -1456,24 +1373,24 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
         goto out;
     }
     s->term.live_line = isatty(STDERR_FILENO) && !quiet;
-    io.in_fd = lcm_get_fileno(s->bus.lcm_in);
-    if (s->bus.lcm != s->bus.lcm_in) io.watch_fd = lcm_get_fileno(s->bus.lcm);
+    rt_io_watch(&io, s->bus.lcm_in, s->bus.lcm != s->bus.lcm_in ? s->bus.lcm : NULL);
 
     s->now = rt_mono_ns();
     s->bus.discard = false;
     rt_begin(s);
     while (!s->stop) {
-        wait_and_handle(s, &io, rt_next_wake(s));
+        if (rt_io_wait(&io, rt_next_wake(s)) != 0) {
+            s->stop = true;
+            s->stop_reason = RT_STOP_ERROR;
+        }
         rt_process(s);
     }
     rt_finish(s);
-    if (rt_log_end(&s->rec) != 0 && rc == LAGSIMD_EXIT_OK) rc = LAGSIMD_EXIT_RUNTIME; /* --log lost records */
+    /* --log lost records */
+    if (rt_log_end(&s->rec) != 0 && rc == LAGSIMD_EXIT_OK) rc = LAGSIMD_EXIT_RUNTIME;
 out:
     rt_log_end(&s->rec); /* --log opened, then the start failed */
     if (opened) rt_bus_close(&s->bus);
-    if (io.timer_fd >= 0) close(io.timer_fd);
-    if (io.sig_fd >= 0) close(io.sig_fd);
-    sigaction(SIGPIPE, &old_pipe, NULL);
-    sigprocmask(SIG_SETMASK, &old_mask, NULL);
+    rt_io_close(&io);
     return rc;
 }
