@@ -18,7 +18,7 @@
 
 typedef struct rt_io {
     int in_fd, timer_fd, sig_fd;
-    int watch_fd;              /* the state URL's receive socket (the plant watch); -1 for memq:// */
+    int watch_fd;              /* the state URL's receive socket (the plant watch); -1: none */
     int64_t armed_ns;          /* what the timer is armed at (INT64_MAX: disarmed) */
     lcm_t *in, *watch;         /* the command URL's lcm_t; the state URL's, or NULL */
     int64_t *now;              /* the loop's clock */
