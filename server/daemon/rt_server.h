@@ -12,6 +12,7 @@
  *   rt_lockstep.h  the state waited on, its timeout and its copies
  *   rt_command.h   what a command must be to be applied (no state)
  *   rt_estimate.h  the live error estimate
+ *   rt_io.h        the wait: signalfd, timerfd, one ppoll per wake-up
  *   rt_pace.h      deadlines and token buckets (pure arithmetic)
  *   live_set.h     the changes made while running (SET, kicks)
  *
