@@ -51,3 +51,13 @@ if(LAGSIM_REF_PYTHON3)
     set_tests_properties(server_reference_${case} PROPERTIES TIMEOUT 120 LABELS server)
   endforeach()
 endif()
+
+# The daemon's files stand on floors: no circle of calls or includes between
+# server/daemon/*.c, and only the loop (realtime.c) includes its header rt_server.h.
+find_program(LAGSIM_PYTHON3 python3)
+if(LAGSIM_PYTHON3)
+  add_test(NAME server_daemon_floors
+           COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/server/daemon_floors.py
+                   ${PROJECT_SOURCE_DIR}/server/daemon)
+  set_tests_properties(server_daemon_floors PROPERTIES TIMEOUT 30 LABELS server)
+endif()

@@ -5,7 +5,7 @@
  *     while not stopped:
  *         wake = rt_next_wake(s)    the earliest thing due (a deadline, a status, an
  *                                   answer the rate limit holds back); now if busy
- *         wait(s, io, wake)         ppoll on the LCM socket, a signalfd and a timerfd
+ *         rt_io_wait(io, wake)      ppoll on the LCM socket, a signalfd and a timerfd
  *                                   armed at `wake` (never a busy spin); then the
  *                                   signals and LCM messages that arrived (bounded)
  *         rt_process(s)             what is due at s->now: the mode's periods, answers,
@@ -34,28 +34,22 @@
  *
  * The stepping path allocates nothing: the server struct holds every buffer.
  */
-#include <errno.h>
 #include <math.h>
-#include <poll.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/signalfd.h>
-#include <sys/timerfd.h>
 #include <unistd.h>
 
 #include "live_set.h"
+#include "rt_io.h"
 #include "rt_server.h"
 #include "lagsim/lagsim_control_t.h"
 
-#define RT_DRAIN_MAX 256          /* LCM messages handled per wake-up at most */
 #define RT_TICK_BUDGET 4096       /* ticks advanced per wake-up at most */
 #define RT_LINE_NS 250000000LL    /* live status line refresh */
 #define RT_STATUS_NS_MIN 10000000LL /* periodic status at most every 10 ms (100 Hz) */
-#define RT_SIGNALS_PER_WAKE 16    /* signals read per wake-up at most */
-#define RT_RETRY_NS_MIN 1000000LL /* lockstep retries at most every millisecond */
 #define RT_CONFLICT_EVERY_S 5     /* another plant's scenes: said at most once in 5 s */
 
 /* The buckets of the limited events (rt_ev): name, answers per second, burst. */
@@ -114,6 +108,78 @@ static bool state_wanted(const rt_server *s)
     return s->want_state && s->run != RT_FAULT && s->period_left == 0;
 }
 
+const char *rt_run_name(rt_run r)
+{
+    switch (r) {
+    case RT_RUNNING: return "running";
+    case RT_PAUSED: return "paused";
+    case RT_WAITING: return "waiting";
+    case RT_FAULT: return "fault";
+    }
+    return "?";
+}
+
+/* Where what the loop publishes goes now: the bus and the log (rt_wire.h). */
+static rt_out out(rt_server *s) { return (rt_out){&s->bus, &s->rec, s->now}; }
+
+/* Every event goes out through here: on the bus (and --log), and on the terminal;
+ * `effect`: one of the effects' events, located in a tick at sim_time. */
+static void event_at(rt_server *s, double sim_time, const char *kind, const char *joint,
+                     double value, const char *detail, bool effect)
+{
+    lag_wire_event m;
+    rt_out o = out(s);
+    rt_publish_event(&o, sim_time, s->sim.tick, kind, joint, value, detail, &m);
+    rt_term_event(&s->term, s->now, m.sim_time, m.kind, m.joint, m.value, m.detail, effect);
+}
+
+static void event(rt_server *s, const char *kind, const char *joint, double value,
+                  const char *detail)
+{
+    event_at(s, lag_sim_time(&s->sim), kind, joint, value, detail, false);
+}
+
+static void publish_scene(rt_server *s)
+{
+    rt_out o = out(s);
+    rt_publish_scene(&o, s->sc, &s->sim, s->info);
+}
+
+/* What the plant waits for now (RT_WAIT_NONE: the run advances), with what came so far:
+ * what the waits say (rt_wait.h). */
+static rt_wait_seen wait_seen(const rt_server *s)
+{
+    rt_wait_seen w = {RT_WAIT_NONE, 0, s->rejected, s->bus.commands_wrong_port, s->last_reject};
+    bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
+    if (s->run == RT_FAULT) w.kind = RT_WAIT_RESET;
+    else if (s->run == RT_PAUSED && s->pending_steps == 0) w.kind = RT_WAIT_RESUME;
+    else if (s->run == RT_WAITING && s->pending_steps == 0 && !s->have_command) {
+        w.kind = RT_WAIT_FIRST;
+        w.t = lag_sim_time(&s->sim);
+    } else if (lockstep && s->ls.waiting && !s->ls.answered &&
+               (s->run == RT_RUNNING || s->run == RT_WAITING || s->pending_steps > 0)) {
+        w.kind = RT_WAIT_ANSWER;
+        w.t = s->ls.waiting_time;
+    }
+    return w;
+}
+
+static void wait_update(rt_server *s)
+{
+    rt_wait_seen w = wait_seen(s);
+    rt_wait_update(&s->wait, s->now, &w, &s->term);
+}
+
+/* The live line's content (rt_term.h), asked when it is drawn. */
+static void term_view(void *ctx, rt_term_view *v)
+{
+    const rt_server *s = ctx;
+    *v = (rt_term_view){s->sc->lcm.prefix, lag_sim_time(&s->sim), s->rtf,
+                        lag_sim_energy(&s->sim), s->sim.q, s->nq,
+                        s->have_command && !s->watchdog_tripped, s->accepted, s->overruns,
+                        rt_run_name(s->run)};
+}
+
 /* An unlimited event (start, stop). */
 static void eventf(rt_server *s, const char *kind, double value, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
@@ -124,7 +190,7 @@ static void eventf(rt_server *s, const char *kind, double value, const char *fmt
     va_start(ap, fmt);
     vsnprintf(detail, sizeof detail, fmt, ap);
     va_end(ap);
-    rt_publish_event(s, kind, "", value, detail);
+    event(s, kind, "", value, detail);
 }
 
 /* A limited event: published if its kind's bucket has a token, else counted as
@@ -150,51 +216,95 @@ static void limited_event(rt_server *s, rt_ev ev, const char *joint, double valu
     va_end(ap);
     if (n < 0) detail[0] = '\0';
     strcat(detail, note);
-    rt_publish_event(s, ev_limits[ev].kind, joint, value, detail);
+    event(s, ev_limits[ev].kind, joint, value, detail);
 }
 
 /* Every state goes out through here: in lockstep a published state is waited on. */
 static void publish_state(rt_server *s)
 {
-    rt_publish_state(s);
-    s->want_state = false;
-    if (s->sc->realtime.mode == LAG_RT_LOCKSTEP) {
-        s->waiting = true;
-        s->answered = false;
-        s->waiting_time = lag_sim_time(&s->sim);
-        s->wait_start_ns = s->now;
-        s->answer_heard = false;
-        s->retry_gap_ns = s->lockstep_retry_ns;
-        s->next_retry_ns = rt_sat_add(s->now, s->retry_gap_ns);
+    rt_out o = out(s);
+    int n = rt_publish_state(&o, &s->sim, s->info, &s->ref);
+    if (n > 0) {
+        s->states_published++;
+        memcpy(s->state_buf, s->bus.buf, (size_t)n); /* as sent: a lockstep retry sends it again */
+        s->state_len = (unsigned)n;
     }
+    s->want_state = false;
+    if (s->sc->realtime.mode == LAG_RT_LOCKSTEP)
+        rt_lockstep_published(&s->ls, lag_sim_time(&s->sim), s->now);
 }
 
 /* Lockstep, while a state is waited on and no answer to it has come: the same state goes
- * out again, byte for byte (utime included), lockstep_retry after it was published, then
- * at gaps that double up to retry_cap_ns (a sixteenth of lockstep_timeout: as many more
- * chances before it), so that a state or a command lost on the way costs a retry instead
- * of a timeout, and a controller that thinks long per state gets a copy every 62.5 ms at
- * most (default scene), not one per lockstep_retry. Once any command for that sim_time
- * arrived (applied or rejected) the controller has the state: no more copies. A
- * controller answers each state once and a copy of it with the same answer; a second
- * answer to a state already answered is ignored (commands_ignored), so the run does not
- * depend on how many copies arrived. */
+ * out again, byte for byte, at the gaps rt_lockstep.c explains. */
 static void lockstep_retry(rt_server *s)
 {
-    if (s->now < s->next_retry_ns || s->state_len == 0 || s->answer_heard) return;
+    if (s->state_len == 0 || !rt_lockstep_retry(&s->ls, s->now)) return;
     /* straight to LCM, not through rt_wire's publish: a copy for the network, which --log
      * (the run's record, one state per period) does not keep */
-    lcm_publish(s->lcm, s->ch_state, s->state_buf, s->state_len);
+    lcm_publish(s->bus.lcm, s->bus.ch_state, s->state_buf, s->state_len);
     s->lockstep_retries++;
-    int64_t cap = s->retry_cap_ns;
-    s->retry_gap_ns = s->retry_gap_ns > cap / 2 ? cap : 2 * s->retry_gap_ns;
-    s->next_retry_ns = rt_sat_add(s->now, s->retry_gap_ns);
 }
 
+/* The status: the sim's figures (rt_status_base), the loop's counters, what the plant
+ * waits for; the RTF over the window since the last one. */
+static void status_message(const rt_server *s, int64_t now, lag_wire_status *m)
+{
+    double wall = (double)(now - s->last_status_ns) * 1e-9;
+    double sim_adv = (double)s->ticks_since_status * s->sc->sim.integrator.dt;
+    rt_status_base(m, &s->sim, s->sc);
+    m->wall_time = (double)(now - s->start_ns) * 1e-9;
+    /* a window shorter than 50 ms (a status on request, the final one) is too short to
+     * measure: it repeats the last figure */
+    m->rtf = s->run != RT_RUNNING ? 0.0 : wall < 0.05 ? s->rtf : sim_adv / wall;
+    m->overruns = s->overruns;
+    m->step_time_max_us = s->step_us_max;
+    m->step_time_mean_us = s->step_us_n > 0 ? s->step_us_sum / (double)s->step_us_n : 0.0;
+    snprintf(m->run_state, sizeof m->run_state, "%s", rt_run_name(s->run));
+    m->commands_accepted = s->accepted;
+    m->rejected_unknown_joint = s->rejected[RT_REJ_UNKNOWN_JOINT];
+    m->rejected_unactuated = s->rejected[RT_REJ_UNACTUATED];
+    m->rejected_nonfinite = s->rejected[RT_REJ_NONFINITE];
+    m->rejected_bad_length = s->rejected[RT_REJ_BAD_LENGTH];
+    m->rejected_undecodable = s->rejected[RT_REJ_UNDECODABLE];
+    m->rejected_stale = s->rejected[RT_REJ_STALE];
+    m->rejected_effort_limit = s->rejected[RT_REJ_EFFORT_LIMIT];
+    m->controls_rejected = s->controls_rejected;
+    m->watchdog_tripped = s->watchdog_tripped;
+    m->watchdog_trips = s->watchdog_trips;
+    m->lockstep_timeouts = s->lockstep_timeouts;
+    m->numeric_faults = s->numeric_faults;
+    m->overrun_bursts = s->overrun_bursts;
+    m->states_published = s->states_published;
+    m->lockstep_retries = s->lockstep_retries;
+    m->commands_ignored = s->commands_ignored;
+    m->plant_conflicts = s->plant_conflicts;
+    rt_wait_seen w = wait_seen(s);
+    m->waiting_s = rt_wait_describe(&s->wait, s->now, &w, m->waiting_for, sizeof m->waiting_for,
+                                    m->waiting_got, sizeof m->waiting_got);
+    m->commands_wrong_port = s->bus.commands_wrong_port;
+    const rt_estimate *e = &s->est;
+    m->error_estimate = e->err;
+    snprintf(m->error_joint, sizeof m->error_joint, "%s",
+             e->joint >= 0 && e->joint < s->nq ? s->info->joint_names[e->joint] : "");
+    m->error_warnings = e->warnings;
+}
+
+/* Every status goes out through here; the RTF's window starts again (unless it was too
+ * short to measure while running). */
 static void publish_status(rt_server *s)
 {
-    rt_publish_status(s);
+    int64_t now = rt_mono_ns();
+    lag_wire_status m;
+    status_message(s, now, &m);
+    rt_out o = out(s);
+    rt_publish_status(&o, &m);
+    s->rtf = m.rtf;
     s->want_status = false;
+    if ((double)(now - s->last_status_ns) * 1e-9 < 0.05 && s->run == RT_RUNNING) return;
+    s->last_status_ns = now;
+    s->ticks_since_status = 0;
+    s->step_us_sum = 0;
+    s->step_us_n = 0;
 }
 
 /* Numeric fault: pause in the fault state. The sim holds the last good tick (not a
@@ -206,7 +316,7 @@ static void enter_fault(rt_server *s, lag_result r)
     s->run = RT_FAULT;
     s->pending_steps = 0;
     s->period_left = 0;
-    s->waiting = false;
+    s->ls.waiting = false;
     s->want_state = false;
     s->numeric_faults++;
     char why[LAG_WIRE_TEXT_LEN] = "";
@@ -238,7 +348,7 @@ static void publish_effect_events(rt_server *s)
         const char *joint = ev.joint >= 0 && ev.joint < s->nq ? s->info->joint_names[ev.joint] : "";
         char detail[96];
         snprintf(detail, sizeof detail, "%s at t = %.9g s", lag_event_kind_name(ev.kind), ev.t);
-        rt_publish_event_at(s, ev.t, lag_event_kind_name(ev.kind), joint, ev.value, detail);
+        event_at(s, ev.t, lag_event_kind_name(ev.kind), joint, ev.value, detail, true);
     }
     if (s->sim.events_dropped > s->effect_events_dropped) {
         int64_t lost = s->sim.events_dropped - s->effect_events_dropped;
@@ -269,39 +379,28 @@ static void period_begin(rt_server *s, int64_t budget)
                       age, sc->realtime.command_timeout);
     }
     lag_sim_set_input(&s->sim, s->held);
-    rt_log_input(s); /* --log with an actuator lag: the input this period runs with */
+    /* --log with an actuator lag: the input this period runs with */
+    rt_log_input(&s->rec, s->now, &s->sim, s->info);
     s->period_left = sc->ticks_per_period;
     s->period_us = 0;
     /* the live error estimate: a period run in one piece (nothing changes the sim between
      * its chunks then) is run again after it is published, from a copy of its start */
-    const int every = lag_scene_estimate_every(sc);
-    s->shadow_armed = every > 0 && s->periods_done % every == 0 && s->period_left <= budget;
-    if (s->shadow_armed) s->shadow_start = s->sim;
+    rt_estimate_arm(&s->est, &s->sim, s->period_left <= budget);
 }
 
-/* The live error estimate of the period just published (docs/accuracy.md): its error,
- * largest over the joints, for status; over the scene's budget, an error_estimate event
- * naming the joint. A shadow that faults says nothing (the run itself did not). */
+/* The live error estimate of the period just published (rt_estimate.h): its error,
+ * largest over the joints, goes in status; over the scene's budget, an error_estimate
+ * event naming the joint. */
 static void estimate_error(rt_server *s)
 {
-    s->shadow_armed = false;
-    double err[LAG_MAX_DOF];
-    if (lag_sim_shadow_error(&s->shadow_start, &s->sim, err) != LAG_OK) return;
-    int j = 0;
-    for (int i = 1; i < s->nq; i++)
-        if (err[i] > err[j]) j = i;
-    if (!isfinite(err[j])) return;
-    s->err_estimate = err[j];
-    s->err_joint = j;
-    const double budget = rt_error_budget(s->sc);
-    if (budget > 0 && err[j] > budget) {
-        s->err_warnings++;
-        limited_event(s, RT_EV_ERROR_ESTIMATE, s->info->joint_names[j], err[j],
-                      "the integration added an estimated %.3g to %s over the period ending at "
-                      "t = %.9g s, %.3g times its budget %.3g (integrator.error %g over %g s)",
-                      err[j], s->info->joint_names[j], lag_sim_time(&s->sim), err[j] / budget,
-                      budget, s->sc->accuracy.error, s->sc->accuracy.horizon);
-    }
+    if (!rt_estimate_period(&s->est, &s->sim)) return;
+    const int j = s->est.joint;
+    const double err = s->est.err, budget = s->est.budget;
+    limited_event(s, RT_EV_ERROR_ESTIMATE, s->info->joint_names[j], err,
+                  "the integration added an estimated %.3g to %s over the period ending at "
+                  "t = %.9g s, %.3g times its budget %.3g (integrator.error %g over %g s)",
+                  err, s->info->joint_names[j], lag_sim_time(&s->sim), err / budget, budget,
+                  s->sc->accuracy.error, s->sc->accuracy.horizon);
 }
 
 /* The period is complete: its state goes out; STEP and --duration are booked. */
@@ -335,19 +434,18 @@ static rt_progress period_run(rt_server *s, int64_t *budget)
     int64_t t0 = rt_mono_ns(), tick0 = s->sim.tick;
     lag_result r = lag_sim_advance_within(&s->sim, n, s->sim.tick + s->period_left);
     s->period_us += (double)(rt_mono_ns() - t0) * 1e-3;
-    s->lg.ticks += s->sim.tick - tick0; /* the log's clock */
+    s->rec.ticks += s->sim.tick - tick0; /* the log's clock */
     s->period_left -= n;
     s->ticks_since_status += n;
     publish_effect_events(s);
     if (r != LAG_OK || !state_finite(&s->sim)) {
-        s->shadow_armed = false;
+        rt_estimate_disarm(&s->est);
         enter_fault(s, r);
         return RT_P_FAULT;
     }
     if (s->period_left > 0) return RT_P_MORE;
     period_end(s);
-    s->periods_done++;
-    if (s->shadow_armed) estimate_error(s); /* after the state went out */
+    estimate_error(s); /* after the state went out */
     return RT_P_DONE;
 }
 
@@ -393,7 +491,7 @@ static void mode_realtime(rt_server *s)
  * instead of losing records (realtime never waits: rt_log.h). */
 static bool log_holds(const rt_server *s)
 {
-    return s->lg.log && s->sc->realtime.mode != LAG_RT_REALTIME && !rt_log_room(s->lg.log);
+    return s->rec.log && s->sc->realtime.mode != LAG_RT_REALTIME && !rt_log_room(s->rec.log);
 }
 #define RT_LOG_HOLD_NS 1000000LL /* a held period looks at the ring again 1 ms later */
 
@@ -417,32 +515,32 @@ static void mode_fast(rt_server *s)
 static void mode_lockstep(rt_server *s)
 {
     if (s->run == RT_WAITING && s->pending_steps == 0) {
-        if (s->waiting && s->now - s->wait_start_ns >= s->lockstep_wait_ns)
+        if (s->ls.waiting && rt_lockstep_timed_out(&s->ls, s->now))
             s->want_state = true; /* the same state again, through the state bucket */
         return;
     }
-    if (!active(s) || !s->waiting) return;
-    if (!s->answered && s->now - s->wait_start_ns >= s->lockstep_wait_ns) {
+    if (!active(s) || !s->ls.waiting) return;
+    if (!s->ls.answered && rt_lockstep_timed_out(&s->ls, s->now)) {
         if (s->pending_steps > 0) { /* STEP N: a period without a command, as asked */
-            s->answered = true;
+            s->ls.answered = true;
         } else {
             s->lockstep_timeouts++;
             s->run = RT_WAITING;
-            limited_event(s, RT_EV_LOCKSTEP_TIMEOUT, "", s->waiting_time,
+            limited_event(s, RT_EV_LOCKSTEP_TIMEOUT, "", s->ls.waiting_time,
                           "no command answered sim time %.9g s within %.6g s: waiting for one "
-                          "(the state is published again every %.6g s)", s->waiting_time,
+                          "(the state is published again every %.6g s)", s->ls.waiting_time,
                           s->sc->realtime.lockstep_timeout, s->sc->realtime.lockstep_timeout);
             s->want_state = true;
             s->want_status = true;
             return;
         }
     }
-    if (!s->answered) {
+    if (!s->ls.answered) {
         lockstep_retry(s);
         return;
     }
     if (log_holds(s)) return;
-    s->waiting = false;
+    s->ls.waiting = false;
     int64_t budget = s->tick_budget;
     period_run(s, &budget);
 }
@@ -450,53 +548,25 @@ static void mode_lockstep(rt_server *s)
 /* ---------------------------------------------------------------- commands */
 static void lockstep_rewait(rt_server *s);
 
-/* The model's joints, the actuated ones marked: "theta0 (actuated), theta1, theta2" (or
- * only the actuated ones), as the scene loader lists them; what a rejection offers. */
 static const char *joint_list(const rt_server *s, bool actuated_only, char *buf, size_t n)
 {
-    size_t k = 0;
-    buf[0] = '\0';
-    for (int i = 0; i < s->nq && k < n; i++) {
-        if (actuated_only && !s->info->actuated[i]) continue;
-        int w = snprintf(buf + k, n - k, "%s%s%s", k ? ", " : "", s->info->joint_names[i],
-                         !actuated_only && s->info->actuated[i] ? " (actuated)" : "");
-        if (w < 0) break;
-        k += (size_t)w;
-    }
-    if (!buf[0]) snprintf(buf, n, "none");
-    return buf;
+    return rt_joint_list(s->info, s->nq, actuated_only, buf, n);
 }
 
-const char *const rt_reject_name[RT_REJ_COUNT] = {
-    [RT_REJ_UNKNOWN_JOINT] = "unknown joint",
-    [RT_REJ_UNACTUATED] = "unactuated joint",
-    [RT_REJ_NONFINITE] = "non-finite effort",
-    [RT_REJ_BAD_LENGTH] = "bad length",
-    [RT_REJ_UNDECODABLE] = "undecodable payload",
-    [RT_REJ_STALE] = "stale (lockstep: answers another state)",
-    [RT_REJ_EFFORT_LIMIT] = "effort beyond realtime.effort_limit"};
-_Static_assert(sizeof rt_reject_name / sizeof rt_reject_name[0] == RT_REJ_COUNT,
-               "one name per reason");
-
-/* A rejected command: counted by reason, and a command_rejected event (limited) whose
- * detail says what was wrong and what would be accepted. */
-static void reject(rt_server *s, rt_reject why, const char *joint, double value,
-                   const char *fmt, ...) __attribute__((format(printf, 5, 6)));
-static void reject(rt_server *s, rt_reject why, const char *joint, double value,
-                   const char *fmt, ...)
+/* A rejected command (rt_command.h's verdict): counted by reason, and a command_rejected
+ * event (limited) whose detail says what was wrong and what would be accepted. */
+static void reject(rt_server *s, const rt_verdict *v)
 {
-    char what[192]; /* and the reason's name: within an event's detail */
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(what, sizeof what, fmt, ap);
-    va_end(ap);
+    const rt_reject why = v->why;
+    const char *what = v->what; /* and the reason's name: within an event's detail */
     s->rejected[why]++;
-    rt_log_rx_fate(s, why == RT_REJ_UNDECODABLE ? RT_RX_UNDECODABLE : RT_RX_REFUSED); /* --log */
+    /* --log */
+    rt_log_rx_fate(&s->rec, s->now, why == RT_REJ_UNDECODABLE ? RT_RX_UNDECODABLE : RT_RX_REFUSED);
     char detail[LAG_WIRE_TEXT_LEN];
     snprintf(detail, sizeof detail, "%s: %s", rt_reject_name[why], what);
     if (why != RT_REJ_STALE) memcpy(s->last_reject, detail, sizeof detail); /* waits say it */
     /* a flood is counted in status, not echoed one for one */
-    limited_event(s, RT_EV_COMMAND_REJECTED, joint, value, "command rejected: %s", detail);
+    limited_event(s, RT_EV_COMMAND_REJECTED, v->joint, v->value, "command rejected: %s", detail);
 }
 
 static void handle_command(rt_server *s, const uint8_t *data, size_t len);
@@ -504,114 +574,53 @@ static void handle_command(rt_server *s, const uint8_t *data, size_t len);
 /* --log: as received, once its fate is known (rt_log_rx_*) */
 void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
 {
-    rt_log_rx_begin(s, s->ch_command, data, len);
+    rt_log_rx_begin(&s->rec, s->bus.ch_command, data, len);
     handle_command(s, data, len);
-    rt_log_rx_end(s);
+    rt_log_rx_end(&s->rec, s->now);
 }
 
-/* A command is applied whole or not at all: every name known, actuated, distinct; every
- * effort finite and within the scene's realtime.effort_limit. */
-static void handle_command(rt_server *s, const uint8_t *data, size_t len)
+/* A command is applied whole or not at all: it decodes, every name is known, actuated,
+ * distinct, every effort finite and within the scene's realtime.effort_limit
+ * (rt_command.h), and in lockstep it answers the state waited on. Its steps: */
+
+/* Lockstep: the command answers the state waited on (or, not running, the state the sim
+ * holds). A second answer to a state already answered (the controller got it twice, a
+ * retry crossing its first answer) is not applied: counted, no event. Else stale. */
+static bool command_in_step(rt_server *s, const lag_wire_joint_command *c)
 {
-    lag_wire_joint_command c;
-    int d = lag_wire_decode_joint_command(data, len, s->nq, &c);
-    if (d == LAG_WIRE_ECOUNT) {
-        char all[160];
-        reject(s, RT_REJ_BAD_LENGTH, "", c.num_joints,
-               "num_joints %d (in value); accepted: 0 to %d, joints of %s: %s", c.num_joints,
-               s->nq, s->info->name, joint_list(s, false, all, sizeof all));
-        return;
+    if (s->sc->realtime.mode != LAG_RT_LOCKSTEP) return true;
+    if (rt_lockstep_repeated(&s->ls, c->sim_time)) {
+        s->commands_ignored++;
+        rt_log_rx_fate(&s->rec, s->now, RT_RX_REFUSED); /* --log: a sample of them */
+        return false;
     }
-    if (d == LAG_WIRE_ETOOLONG) { /* a well-formed name longer than any joint's */
-        char all[160];
-        reject(s, RT_REJ_UNKNOWN_JOINT, "", 0, "a name of 64 bytes or more; joints of %s: %s",
-               s->info->name, joint_list(s, false, all, sizeof all));
-        return;
-    }
-    if (d != LAG_WIRE_OK) {
-        reject(s, RT_REJ_UNDECODABLE, "", (double)len,
-               "%zu bytes (in value) that are no lagsim.joint_command_t; accepted: a "
-               "joint_command_t as lcm-gen encodes it (lcmtypes/joint_command_t.lcm)", len);
-        return;
-    }
-    /* lockstep: an answer to the state waited on, good or not, came: it needs no copies */
-    if (s->waiting && c.sim_time == s->waiting_time) s->answer_heard = true;
-    int idx[LAG_MAX_DOF];
-    for (int i = 0; i < c.num_joints; i++) {
-        idx[i] = -1;
-        for (int j = 0; j < s->nq; j++)
-            if (strcmp(c.name[i], s->info->joint_names[j]) == 0) idx[i] = j;
-        char all[160];
-        if (idx[i] < 0) {
-            reject(s, RT_REJ_UNKNOWN_JOINT, c.name[i], 0, "'%s'; joints of %s: %s", c.name[i],
-                   s->info->name, joint_list(s, false, all, sizeof all));
-            return;
-        }
-        for (int k = 0; k < i; k++)
-            if (idx[k] == idx[i]) {
-                reject(s, RT_REJ_BAD_LENGTH, c.name[i], c.num_joints,
-                       "'%s' named twice; accepted: each joint at most once (%s)", c.name[i],
-                       joint_list(s, false, all, sizeof all));
-                return;
-            }
-        if (!s->info->actuated[idx[i]]) {
-            reject(s, RT_REJ_UNACTUATED, c.name[i], 0,
-                   "'%s' takes no input; actuated joints of %s: %s", c.name[i], s->info->name,
-                   joint_list(s, true, all, sizeof all));
-            return;
-        }
-        if (!isfinite(c.effort[i])) {
-            reject(s, RT_REJ_NONFINITE, c.name[i], 0,
-                   "%g for '%s'; accepted: a finite effort within +-%g", c.effort[i], c.name[i],
-                   s->sc->realtime.effort_limit[idx[i]]);
-            return;
-        }
-        /* a bound on what a command may ask, not the plant's saturation (that is the
-         * actuator effect): an effort beyond it is a controller's bug, refused whole */
-        double lim = s->sc->realtime.effort_limit[idx[i]];
-        if (fabs(c.effort[i]) > lim) {
-            reject(s, RT_REJ_EFFORT_LIMIT, c.name[i], c.effort[i],
-                   "%g for '%s' (in value); accepted: |effort| <= %g", c.effort[i], c.name[i],
-                   lim);
-            return;
-        }
-    }
-    if (s->sc->realtime.mode == LAG_RT_LOCKSTEP) {
-        bool waited_on = s->waiting && c.sim_time == s->waiting_time;
-        /* a second answer to a state already answered (the controller got it twice, a
-         * retry crossing its first answer): not applied, counted, no event */
-        if ((waited_on && s->answered) ||
-            (!waited_on && s->have_answered && c.sim_time == s->answered_time)) {
-            s->commands_ignored++;
-            rt_log_rx_fate(s, RT_RX_REFUSED); /* --log: a sample of them */
-            return;
-        }
-        if (!waited_on && !(s->run != RT_RUNNING && c.sim_time == lag_sim_time(&s->sim))) {
-            if (s->waiting)
-                reject(s, RT_REJ_STALE, "", c.sim_time,
-                       "sim_time %.9g (in value); accepted: %.9g, the state waited on",
-                       c.sim_time, s->waiting_time);
-            else
-                reject(s, RT_REJ_STALE, "", c.sim_time,
-                       "sim_time %.9g (in value); no state is waited on (the next one's "
-                       "sim_time will be)", c.sim_time);
-            return;
-        }
-    }
-    for (int i = 0; i < c.num_joints; i++) s->held[idx[i]] = c.effort[i];
+    bool waited_on = s->ls.waiting && c->sim_time == s->ls.waiting_time;
+    if (waited_on || (s->run != RT_RUNNING && c->sim_time == lag_sim_time(&s->sim))) return true;
+    rt_verdict v = {RT_REJ_STALE, "", c->sim_time, ""};
+    if (s->ls.waiting)
+        snprintf(v.what, sizeof v.what, "sim_time %.9g (in value); accepted: %.9g, the state "
+                 "waited on", c->sim_time, s->ls.waiting_time);
+    else
+        snprintf(v.what, sizeof v.what, "sim_time %.9g (in value); no state is waited on (the "
+                 "next one's sim_time will be)", c->sim_time);
+    reject(s, &v);
+    return false;
+}
+
+/* The efforts are held from now on; a run waiting for a command goes on, a tripped
+ * watchdog clears. */
+static void command_apply(rt_server *s, const lag_wire_joint_command *c, const int *idx)
+{
+    for (int i = 0; i < c->num_joints; i++) s->held[idx[i]] = c->effort[i];
     s->accepted++;
     s->have_command = true;
     s->command_tick = s->sim.tick;
-    if (s->waiting && c.sim_time == s->waiting_time) {
-        s->answered = true;
-        s->answered_time = c.sim_time;
-        s->have_answered = true;
-    }
+    rt_lockstep_answer(&s->ls, c->sim_time);
     if (s->run == RT_WAITING) {
         /* the command the run was waiting for: it goes on from here */
         s->run = RT_RUNNING;
         s->restart_pace = true; /* realtime: deadlines start now, not at the daemon's start */
-        if (s->sc->realtime.mode == LAG_RT_LOCKSTEP && !s->answered) lockstep_rewait(s);
+        if (s->sc->realtime.mode == LAG_RT_LOCKSTEP && !s->ls.answered) lockstep_rewait(s);
         limited_event(s, RT_EV_RESUME, "", lag_sim_time(&s->sim),
                       "a command arrived at sim time %.9g s: running", lag_sim_time(&s->sim));
         s->want_status = true;
@@ -622,6 +631,25 @@ static void handle_command(rt_server *s, const uint8_t *data, size_t len)
     }
 }
 
+static void handle_command(rt_server *s, const uint8_t *data, size_t len)
+{
+    lag_wire_joint_command c;
+    rt_verdict v;
+    if (!rt_command_decode(s->info, s->nq, data, len, &c, &v)) {
+        reject(s, &v);
+        return;
+    }
+    /* lockstep: an answer to the state waited on, good or not, came: it needs no copies */
+    rt_lockstep_heard(&s->ls, c.sim_time);
+    int idx[LAG_MAX_DOF];
+    if (!rt_command_entries(s->info, s->nq, s->sc->realtime.effort_limit, &c, idx, &v)) {
+        reject(s, &v);
+        return;
+    }
+    if (!command_in_step(s, &c)) return;
+    command_apply(s, &c, idx);
+}
+
 /* ---------------------------------------------------------------- control requests */
 static void do_reset(rt_server *s, const double *q, const double *qd, const char *what)
 {
@@ -630,7 +658,7 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
         snprintf(detail, sizeof detail, "a reset ends the %d kick(s) of the run before it",
                  s->live.nk);
         live_kicks_clear(&s->live, &s->sim);
-        rt_publish_event(s, "kicks_cleared", "", 0, detail); /* --replay applies it here */
+        event(s, "kicks_cleared", "", 0, detail); /* --replay applies it here */
     }
     lag_sim_reset(&s->sim, q, qd);
     s->effect_events_dropped = s->sim.events_dropped;
@@ -639,8 +667,8 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
     s->watchdog_tripped = false;
     s->pending_steps = 0;
     s->period_left = 0;
-    s->waiting = false; /* lockstep: the new state is waited on once it is published */
-    s->have_answered = false;
+    s->ls.waiting = false; /* lockstep: the new state is waited on once it is published */
+    s->ls.have_answered = false;
     if (s->run == RT_FAULT) s->run = RT_PAUSED;
     char kept[200];
     live_set_describe(&s->live, kept, sizeof kept);
@@ -660,7 +688,7 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
 static void control_rejected(rt_server *s, const char *why)
 {
     s->controls_rejected++;
-    rt_log_rx_fate(s, RT_RX_REFUSED); /* --log: a sample of them */
+    rt_log_rx_fate(&s->rec, s->now, RT_RX_REFUSED); /* --log: a sample of them */
     limited_event(s, RT_EV_CONTROL_REJECTED, "", 0, "%s", why);
     s->want_status = true;
 }
@@ -695,7 +723,7 @@ static void handle_kick(rt_server *s, const lag_wire_control *c)
         control_rejected(s, why);
         return;
     }
-    rt_publish_event(s, "kick", lag_model_info_get(s->sim.def.model.kind)->joint_names[k.joint],
+    event(s, "kick", lag_model_info_get(s->sim.def.model.kind)->joint_names[k.joint],
                      k.impulse, kv);
     s->want_status = true;
 }
@@ -746,7 +774,7 @@ static void handle_set(rt_server *s, const lag_wire_control *c)
     }
     s->ref = ns.reference; /* SET reference.*: from the next state on */
     live_set_keep(&s->live, kv);
-    rt_publish_event(s, "set", "", 0, kv);
+    event(s, "set", "", 0, kv);
     s->want_scene = true;
     s->want_status = true;
 }
@@ -756,7 +784,7 @@ static void handle_set(rt_server *s, const lag_wire_control *c)
 static void lockstep_rewait(rt_server *s)
 {
     if (s->sc->realtime.mode != LAG_RT_LOCKSTEP) return;
-    if (s->waiting) s->wait_start_ns = s->now;
+    if (s->ls.waiting) s->ls.wait_start_ns = s->now;
     else if (s->period_left == 0) s->want_state = true;
 }
 
@@ -788,131 +816,158 @@ static const char *control_requests(void)
 
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
 {
-    rt_log_rx_begin(s, s->ch_control, data, len);
+    rt_log_rx_begin(&s->rec, s->bus.ch_control, data, len);
     handle_control(s, data, len);
-    rt_log_rx_end(s);
+    rt_log_rx_end(&s->rec, s->now);
+}
+
+/* A control request, decoded into c; one that does not decode is rejected (false). Any
+ * count a message may carry decodes; reset_to checks it against the model's. */
+static bool control_decode(rt_server *s, const uint8_t *data, size_t len, lag_wire_control *c)
+{
+    int d = lag_wire_decode_control(data, len, LAG_WIRE_MAX_JOINTS, c);
+    if (d == LAG_WIRE_OK) return true;
+    if (d != LAG_WIRE_ECOUNT) rt_log_rx_fate(&s->rec, s->now, RT_RX_UNDECODABLE);
+    char why[LAG_WIRE_TEXT_LEN];
+    if (d == LAG_WIRE_ECOUNT)
+        snprintf(why, sizeof why, "control: num_joints out of range; accepted: 0, or %d "
+                 "for reset_to (the joints of %s)", s->nq, s->info->name);
+    else
+        snprintf(why, sizeof why, "control: %zu bytes that are no lagsim.control_t; "
+                 "accepted: a control_t as lcm-gen encodes it (lcmtypes/control_t.lcm)", len);
+    control_rejected(s, why);
+    return false;
+}
+
+/* The requests, one step each; a status follows the handler's own answer where it says
+ * (want_status). */
+static void control_pause(rt_server *s)
+{
+    if (s->run == RT_FAULT) {
+        control_rejected(s, "pause: in fault state (reset first)");
+        return;
+    }
+    s->run = RT_PAUSED;
+    s->pending_steps = 0;
+    s->restart_pace = true; /* the held state is republished from now on */
+    limited_event(s, RT_EV_PAUSE, "", 0, "paused");
+    s->want_status = true;
+}
+
+static void control_resume(rt_server *s)
+{
+    if (s->run == RT_FAULT) {
+        control_rejected(s, "resume: in fault state (reset first)");
+        return;
+    }
+    s->run = RT_RUNNING;
+    s->pending_steps = 0;
+    s->restart_pace = true; /* deadlines restart from now */
+    lockstep_rewait(s);
+    limited_event(s, RT_EV_RESUME, "", 0, "running");
+    s->want_status = true;
+}
+
+/* STEP N: step_done (and its status) follow when the steps are done. */
+static void control_step(rt_server *s, int64_t count)
+{
+    if (s->run != RT_PAUSED && s->run != RT_WAITING) {
+        control_rejected(s, s->run == RT_FAULT ? "step: in fault state (reset first)"
+                                               : "step: only while paused or waiting "
+                                                 "(pause first)");
+        return;
+    }
+    if (count < 1) {
+        char why[96];
+        snprintf(why, sizeof why, "step: count %lld; accepted: a count >= 1", (long long)count);
+        control_rejected(s, why);
+        return;
+    }
+    s->pending_steps = count;
+    s->restart_pace = true; /* realtime: the first period ends one period from now */
+    lockstep_rewait(s);
+    limited_event(s, RT_EV_STEP, "", (double)count,
+                  "stepping %lld control periods at the %s mode's pace", (long long)count,
+                  lag_rt_mode_name(s->sc->realtime.mode));
+}
+
+/* RESET; count 1: the scene file's values too, after a `restore` event (never
+ * suppressed: --replay undoes the changes where it says) before the reset's. */
+static void control_reset(rt_server *s, int64_t count)
+{
+    if (count == 1 && (s->live.n > 0 || s->live.nk > 0)) {
+        char err[512], why[700];
+        if (lag_sim_redefine(&s->sim, &s->sc->sim, err, sizeof err) != LAG_OK) {
+            snprintf(why, sizeof why, "reset to the scene file's values: %s", err);
+            control_rejected(s, why);
+            return;
+        }
+        char undone[180], detail[LAG_WIRE_TEXT_LEN];
+        live_set_describe(&s->live, undone, sizeof undone);
+        snprintf(detail, sizeof detail, "the scene file's values again: undone %s%s%d "
+                 "kick(s)", undone, undone[0] ? ", " : "", s->live.nk);
+        event(s, "restore", "", (double)s->live.n, detail);
+        memset(&s->live, 0, sizeof s->live);
+        s->ref = s->sc->reference;
+    }
+    do_reset(s, NULL, NULL, count == 1 ? "reset to the scene file's initial state and "
+                                         "values" : "reset to the scene's initial state");
+}
+
+/* RESET_TO: a state of the model's joints, finite, within explode_limit, where the mass
+ * matrix is positive definite and the stick is not below the floor. */
+static void control_reset_to(rt_server *s, const lag_wire_control *c)
+{
+    if (c->num_joints != s->nq) {
+        char why[LAG_WIRE_TEXT_LEN], all[160];
+        snprintf(why, sizeof why, "reset_to: num_joints %d; accepted: %d, the joints of %s "
+                 "in this order: %s", c->num_joints, s->nq, s->info->name,
+                 joint_list(s, false, all, sizeof all));
+        control_rejected(s, why);
+        return;
+    }
+    double lim = s->sc->sim.explode_limit;
+    for (int i = 0; i < s->nq; i++)
+        if (!isfinite(c->q[i]) || !isfinite(c->qd[i]) || fabs(c->q[i]) > lim ||
+            fabs(c->qd[i]) > lim) {
+            control_rejected(s, "reset_to: q and qd must be finite and within explode_limit");
+            return;
+        }
+    double qdd[LAG_MAX_DOF];
+    if (lag_model_forward(&s->sim.model, c->q, c->qd, NULL, qdd) != LAG_OK) {
+        control_rejected(s, "reset_to: mass matrix not positive definite at q");
+        return;
+    }
+    if (lag_sim_contact(&s->sim)[0] && c->q[2] < 0) {
+        control_rejected(s, "reset_to: h, the stick's lower end, must not be below the "
+                            "floor (h >= 0)");
+        return;
+    }
+    do_reset(s, c->q, c->qd, "reset to a given state");
+}
+
+/* STATUS and DESCRIBE change nothing (--log: a sample of them); their answer is a status
+ * or the scene, through its bucket. */
+static void control_query(rt_server *s, bool scene)
+{
+    rt_log_rx_fate(&s->rec, s->now, RT_RX_QUERY);
+    if (scene) s->want_scene = true;
+    else s->want_status = true;
 }
 
 static void handle_control(rt_server *s, const uint8_t *data, size_t len)
 {
     lag_wire_control c;
-    /* any count a message may carry decodes; reset_to checks it against the model's */
-    int d = lag_wire_decode_control(data, len, LAG_WIRE_MAX_JOINTS, &c);
-    if (d != LAG_WIRE_OK) {
-        if (d != LAG_WIRE_ECOUNT) rt_log_rx_fate(s, RT_RX_UNDECODABLE);
-        char why[LAG_WIRE_TEXT_LEN];
-        if (d == LAG_WIRE_ECOUNT)
-            snprintf(why, sizeof why, "control: num_joints out of range; accepted: 0, or %d "
-                     "for reset_to (the joints of %s)", s->nq, s->info->name);
-        else
-            snprintf(why, sizeof why, "control: %zu bytes that are no lagsim.control_t; "
-                     "accepted: a control_t as lcm-gen encodes it (lcmtypes/control_t.lcm)", len);
-        control_rejected(s, why);
-        return;
-    }
+    if (!control_decode(s, data, len, &c)) return;
     switch (c.request) {
-    case LAGSIM_CONTROL_T_PAUSE:
-        if (s->run == RT_FAULT) {
-            control_rejected(s, "pause: in fault state (reset first)");
-            return;
-        }
-        s->run = RT_PAUSED;
-        s->pending_steps = 0;
-        s->restart_pace = true; /* the held state is republished from now on */
-        limited_event(s, RT_EV_PAUSE, "", 0, "paused");
-        break;
-    case LAGSIM_CONTROL_T_RESUME:
-        if (s->run == RT_FAULT) {
-            control_rejected(s, "resume: in fault state (reset first)");
-            return;
-        }
-        s->run = RT_RUNNING;
-        s->pending_steps = 0;
-        s->restart_pace = true; /* deadlines restart from now */
-        lockstep_rewait(s);
-        limited_event(s, RT_EV_RESUME, "", 0, "running");
-        break;
-    case LAGSIM_CONTROL_T_STEP:
-        if (s->run != RT_PAUSED && s->run != RT_WAITING) {
-            control_rejected(s, s->run == RT_FAULT ? "step: in fault state (reset first)"
-                                                   : "step: only while paused or waiting "
-                                                     "(pause first)");
-            return;
-        }
-        if (c.count < 1) {
-            char why[96];
-            snprintf(why, sizeof why, "step: count %lld; accepted: a count >= 1",
-                     (long long)c.count);
-            control_rejected(s, why);
-            return;
-        }
-        s->pending_steps = c.count;
-        s->restart_pace = true; /* realtime: the first period ends one period from now */
-        lockstep_rewait(s);
-        limited_event(s, RT_EV_STEP, "", (double)c.count,
-                      "stepping %lld control periods at the %s mode's pace", (long long)c.count,
-                      lag_rt_mode_name(s->sc->realtime.mode));
-        return; /* step_done (and its status) follow when the steps are done */
-    case LAGSIM_CONTROL_T_RESET:
-        if (c.count == 1 && (s->live.n > 0 || s->live.nk > 0)) {
-            /* count 1: the scene file's values too. A `restore` event (never suppressed:
-             * --replay undoes the changes where it says) before the reset's. */
-            char err[512], why[700];
-            if (lag_sim_redefine(&s->sim, &s->sc->sim, err, sizeof err) != LAG_OK) {
-                snprintf(why, sizeof why, "reset to the scene file's values: %s", err);
-                control_rejected(s, why);
-                return;
-            }
-            char undone[180], detail[LAG_WIRE_TEXT_LEN];
-            live_set_describe(&s->live, undone, sizeof undone);
-            snprintf(detail, sizeof detail, "the scene file's values again: undone %s%s%d "
-                     "kick(s)", undone, undone[0] ? ", " : "", s->live.nk);
-            rt_publish_event(s, "restore", "", (double)s->live.n, detail);
-            memset(&s->live, 0, sizeof s->live);
-            s->ref = s->sc->reference;
-        }
-        do_reset(s, NULL, NULL, c.count == 1 ? "reset to the scene file's initial state and "
-                                               "values" : "reset to the scene's initial state");
-        return;
-    case LAGSIM_CONTROL_T_RESET_TO: {
-        if (c.num_joints != s->nq) {
-            char why[LAG_WIRE_TEXT_LEN], all[160];
-            snprintf(why, sizeof why, "reset_to: num_joints %d; accepted: %d, the joints of %s "
-                     "in this order: %s", c.num_joints, s->nq, s->info->name,
-                     joint_list(s, false, all, sizeof all));
-            control_rejected(s, why);
-            return;
-        }
-        double lim = s->sc->sim.explode_limit;
-        for (int i = 0; i < s->nq; i++)
-            if (!isfinite(c.q[i]) || !isfinite(c.qd[i]) || fabs(c.q[i]) > lim ||
-                fabs(c.qd[i]) > lim) {
-                control_rejected(s, "reset_to: q and qd must be finite and within explode_limit");
-                return;
-            }
-        double qdd[LAG_MAX_DOF];
-        if (lag_model_forward(&s->sim.model, c.q, c.qd, NULL, qdd) != LAG_OK) {
-            control_rejected(s, "reset_to: mass matrix not positive definite at q");
-            return;
-        }
-        if (lag_sim_contact(&s->sim)[0] && c.q[2] < 0) {
-            control_rejected(s, "reset_to: h, the stick's lower end, must not be below the "
-                                "floor (h >= 0)");
-            return;
-        }
-        do_reset(s, c.q, c.qd, "reset to a given state");
-        return;
-    }
-    case LAGSIM_CONTROL_T_STATUS:
-        rt_log_rx_fate(s, RT_RX_QUERY); /* --log: changes nothing; a sample of them */
-        break; /* the status below is the answer */
-    case LAGSIM_CONTROL_T_DESCRIBE:
-        rt_log_rx_fate(s, RT_RX_QUERY);
-        s->want_scene = true;
-        return;
-    case LAGSIM_CONTROL_T_SET:
-        handle_set(s, &c);
-        return;
+    case LAGSIM_CONTROL_T_PAUSE: control_pause(s); return;
+    case LAGSIM_CONTROL_T_RESUME: control_resume(s); return;
+    case LAGSIM_CONTROL_T_STEP: control_step(s, c.count); return;
+    case LAGSIM_CONTROL_T_RESET: control_reset(s, c.count); return;
+    case LAGSIM_CONTROL_T_RESET_TO: control_reset_to(s, &c); return;
+    case LAGSIM_CONTROL_T_STATUS: control_query(s, false); return;
+    case LAGSIM_CONTROL_T_DESCRIBE: control_query(s, true); return;
+    case LAGSIM_CONTROL_T_SET: handle_set(s, &c); return;
     default: {
         char why[LAG_WIRE_TEXT_LEN];
         snprintf(why, sizeof why, "control: unknown request %d; accepted: %s", c.request,
@@ -921,32 +976,12 @@ static void handle_control(rt_server *s, const uint8_t *data, size_t len)
         return;
     }
     }
-    s->want_status = true;
 }
 
 /* ---------------------------------------------------------------- one plant per prefix */
-uint64_t rt_hash(const uint8_t *data, size_t len)
-{
-    uint64_t h = 14695981039346656037ULL;
-    for (size_t i = 0; i < len; i++) h = (h ^ data[i]) * 1099511628211ULL;
-    return h;
-}
-
 void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len)
 {
-    uint64_t h = rt_hash(data, len);
-    for (int k = 0; k < RT_SCENES_KEPT; k++)
-        if (s->scene_sent[k] == h) return; /* this daemon's own */
-    if (s->discard && s->other_plant[0]) return; /* at start: said already */
-    /* a plant's scene decodes and names its prefix; anything else on the channel is not a
-     * plant (junk, a forgery of no consequence) and is ignored */
-    static lag_wire_scene m; /* large: not on the stack of a handler */
-    if (lag_wire_decode_scene(data, len, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK ||
-        strcmp(m.prefix, s->sc->lcm.prefix) != 0)
-        return;
-    snprintf(s->other_plant, sizeof s->other_plant, "a scene this daemon did not send "
-             "(model %.20s, mode %.10s, dt %g s)", m.model, m.mode, m.dt);
-    if (s->discard) return; /* at start (rt_bus_open's look before publishing): refused there */
+    if (!rt_bus_foreign_scene(&s->bus, data, len)) return;
     /* running: one datagram from any process must not stop a plant that may be driving an
      * experiment; the conflict is counted and said, rate-limited, and the run goes on */
     s->plant_conflicts++;
@@ -954,46 +989,37 @@ void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len)
     limited_event(s, RT_EV_PLANT_CONFLICT, "", (double)s->plant_conflicts,
                   "another plant publishes on prefix %s (%s): %lld such scenes so far (in "
                   "value); running on; one plant per prefix: stop the other, or give one "
-                  "another lcm.prefix", s->sc->lcm.prefix, s->other_plant,
+                  "another lcm.prefix", s->sc->lcm.prefix, s->bus.other_plant,
                   (long long)s->plant_conflicts);
     if (l->suppressed == 0) { /* the event went out: the terminal hears it too, even with -q */
         if (s->opts && s->opts->quiet)
             fprintf(stderr, "lagsimd: another plant publishes on prefix %s (%s): %lld such "
-                    "scenes so far; running on\n", s->sc->lcm.prefix, s->other_plant,
+                    "scenes so far; running on\n", s->sc->lcm.prefix, s->bus.other_plant,
                     (long long)s->plant_conflicts);
         s->want_status = true;
     }
 }
 
 /* ---------------------------------------------------------------- the server in pieces */
-static void on_scene(const lcm_recv_buf_t *rb, const char *ch, void *user)
+/* What arrives on the bus comes back here (rt_bus_handlers). */
+static void on_command(void *ctx, const uint8_t *data, size_t len)
 {
-    (void)ch;
-    rt_handle_scene(user, rb->data, rb->data_size);
+    rt_handle_command(ctx, data, len);
 }
 
-static void on_command(const lcm_recv_buf_t *rb, const char *ch, void *user)
+static void on_control(void *ctx, const uint8_t *data, size_t len)
 {
-    (void)ch;
-    rt_server *s = user;
-    if (!s->discard) rt_handle_command(s, rb->data, rb->data_size);
+    rt_handle_control(ctx, data, len);
 }
 
-/* A command on the state URL: the controller publishes on the wrong port. Counted (the
- * waits say so, rt_wait.c), never applied. */
-static void on_wrong_port(const lcm_recv_buf_t *rb, const char *ch, void *user)
+static void on_scene(void *ctx, const uint8_t *data, size_t len)
 {
-    (void)rb;
-    (void)ch;
-    rt_server *s = user;
-    if (!s->discard) s->commands_wrong_port++;
+    rt_handle_scene(ctx, data, len);
 }
 
-static void on_control(const lcm_recv_buf_t *rb, const char *ch, void *user)
+static rt_bus_handlers handlers(rt_server *s)
 {
-    (void)ch;
-    rt_server *s = user;
-    if (!s->discard) rt_handle_control(s, rb->data, rb->data_size);
+    return (rt_bus_handlers){on_command, on_control, on_scene, s};
 }
 
 static int open_error(char *err, size_t errlen, const char *fmt, ...)
@@ -1007,21 +1033,10 @@ static int open_error(char *err, size_t errlen, const char *fmt, ...)
     return LAGSIMD_EXIT_USAGE;
 }
 
-int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t now, bool quiet,
-            char *err, size_t errlen)
+/* rt_open's steps. Everything that can fail on a bad scene fails before anything is
+ * published: the scene's real-time settings, checked (2, with a message in err). */
+static int open_check(const lag_scene *sc, char *err, size_t errlen)
 {
-    memset(s, 0, sizeof *s);
-    s->sc = sc;
-    s->opts = o;
-    s->now = now;
-    s->info = lag_model_info_get(sc->sim.model.kind);
-
-    /* everything that can fail on a bad scene fails before anything is published */
-    char serr[256];
-    if (!s->info) return open_error(err, errlen, "bad scene: unknown model");
-    if (lag_sim_init(&s->sim, &sc->sim, serr, sizeof serr) != LAG_OK)
-        return open_error(err, errlen, "bad scene: %s", serr);
-    const double dt = sc->sim.integrator.dt;
     const double rate = sc->realtime.rate;
     if (!(sc->publish_hz > 0) || !isfinite(sc->publish_hz) || sc->ticks_per_period < 1 ||
         sc->ticks_per_period > RT_MAX_RUN_TICKS)
@@ -1050,12 +1065,15 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
                           "(LCM channel names are at most %d, and the longest suffix is "
                           "_REFERENCE)", LCM_MAX_CHANNEL_NAME_LENGTH - 10,
                           LCM_MAX_CHANNEL_NAME_LENGTH);
-    if (o && o->duration > 0 && !rt_ticks_for(o->duration, dt, &s->stop_tick))
-        return open_error(err, errlen, "--duration %g s is more than 2^53 ticks of dt %g s "
-                          "(the longest run whose sim time is exact)", o->duration, dt);
+    return LAGSIMD_EXIT_OK;
+}
 
-    /* settings the loop cannot honour as given are clamped, and said so */
-    const double period_s = (double)sc->ticks_per_period * dt;
+/* The clocks of the loop: settings it cannot honour as given are clamped, and said so. */
+static void open_clocks(rt_server *s, bool quiet)
+{
+    const lag_scene *sc = s->sc;
+    const double rate = sc->realtime.rate;
+    const double period_s = (double)sc->ticks_per_period * sc->sim.integrator.dt;
     bool clamped = false;
     s->period_ns = rt_pace_period_ns(period_s, rate, &clamped);
     if (clamped && !quiet)
@@ -1069,95 +1087,83 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     if ((double)s->status_period_ns > status_ns + 0.5 && !quiet)
         fprintf(stderr, "lagsimd: warning: realtime.status_hz %g: statuses go out at most "
                 "every %g s\n", sc->realtime.status_hz, (double)RT_STATUS_NS_MIN * 1e-9);
-    s->lockstep_wait_ns = rt_ns_from_s(sc->realtime.lockstep_timeout);
-    /* a retry at most every millisecond (a scene built in code may say 0) */
-    s->lockstep_retry_ns = sc->realtime.lockstep_retry > 0
-                               ? rt_clamp_ns(sc->realtime.lockstep_retry * 1e9, RT_RETRY_NS_MIN,
-                                             INT64_MAX)
-                               : INT64_MAX;
-    s->retry_cap_ns = s->lockstep_wait_ns / 16 > s->lockstep_retry_ns ? s->lockstep_wait_ns / 16
-                                                                     : s->lockstep_retry_ns;
+    rt_lockstep_init(&s->ls, sc->realtime.lockstep_timeout, sc->realtime.lockstep_retry);
+}
 
-    s->nq = s->sim.nq;
-    s->info = lag_sim_info(&s->sim); /* the joints published: a stick that may fly has h */
-    s->err_joint = -1;      /* no live error estimate yet */
-    /* the URLs and channels, by the rule every client follows (lagsim_bus.h) */
-    char berr[256];
-    if (lag_bus_init(&s->bus, sc->lcm.url, sc->lcm.prefix, berr, sizeof berr) != 0)
-        return open_error(err, errlen, "bad scene: lcm.url: %s", berr);
-    snprintf(s->ch_state, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_STATE]);
-    snprintf(s->ch_command, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_COMMAND]);
-    snprintf(s->ch_status, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_STATUS]);
-    snprintf(s->ch_event, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_EVENT]);
-    snprintf(s->ch_control, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_CONTROL]);
-    snprintf(s->ch_scene, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_SCENE]);
-    snprintf(s->ch_reference, RT_CHANNEL_MAX, "%s", s->bus.channel[LAG_BUS_REFERENCE]);
-    s->ref = sc->reference;
-    s->tick_budget = RT_TICK_BUDGET;
+/* The answers' and events' buckets, full at `now`. */
+static void open_limits(rt_server *s, int64_t now)
+{
     for (int k = 0; k < RT_EV_COUNT; k++)
         rt_limit_init(&s->lim_event[k], ev_limits[k].per_s, ev_limits[k].burst, now);
     rt_limit_init(&s->lim_status, RT_STATUS_PER_S, RT_STATUS_BURST, now);
     rt_limit_init(&s->lim_scene, RT_SCENE_PER_S, RT_SCENE_BURST, now);
     rt_limit_init(&s->lim_state, RT_STATE_PER_S, RT_STATE_BURST, now);
     rt_limit_init(&s->lim_set, RT_SET_PER_S, RT_SET_BURST, now);
-    rt_limit_init(&s->term.lim_print, 20, 20, now);
-    rt_limit_init(&s->lg.lim_said, 1, 1, now);
-    rt_limit_init(&s->lg.lim_sample_said, 1, 1, now);
-    s->lg.sample_credit = RT_LOG_SAMPLE_BPS; /* a full bucket at start */
-    s->lg.sample_ns = now;
+}
 
-    /* --log, last: nothing after it can fail */
+/* The parts: the bus's URLs and channels (by the rule every client follows,
+ * lagsim_bus.h), the terminal, the waits, the log's bookkeeping; then --log itself, last:
+ * nothing after it can fail. */
+static int open_parts(rt_server *s, const lagsimd_opts *o, char *err, size_t errlen)
+{
+    const lag_scene *sc = s->sc;
+    char berr[256];
+    if (rt_bus_init(&s->bus, sc, berr, sizeof berr) != 0)
+        return open_error(err, errlen, "bad scene: lcm.url: %s", berr);
+    bool quiet = o && o->quiet; /* the terminal's and the log's -q */
+    rt_term_init(&s->term, quiet, s->bus.ch_event, s->now);
+    s->term.view = term_view;
+    s->term.ctx = s;
+    rt_wait_init(&s->wait, &s->bus.urls, sc->lcm.prefix, sc->realtime.mode == LAG_RT_LOCKSTEP);
+    rt_record_init(&s->rec, sc->sim.integrator.dt, quiet, s->now);
     if (o && o->log) {
-        s->lg.input = actuator_lagged(&sc->sim.effects, s->nq);
-        snprintf(s->lg.ch_input, RT_CHANNEL_MAX, "%s_INPUT", sc->lcm.prefix);
-        s->lg.log = rt_log_open(o->log, o->log_ring ? o->log_ring : RT_LOG_RING_DEFAULT,
-                                o->force, o->scene_name, err, errlen);
-        if (!s->lg.log) return LAGSIMD_EXIT_USAGE;
+        s->rec.input = actuator_lagged(&sc->sim.effects, s->nq);
+        snprintf(s->rec.ch_input, sizeof s->rec.ch_input, "%s_INPUT", sc->lcm.prefix);
+        s->rec.log = rt_log_open(o->log, o->log_ring ? o->log_ring : RT_LOG_RING_DEFAULT,
+                                 o->force, o->scene_name, err, errlen);
+        if (!s->rec.log) return LAGSIMD_EXIT_USAGE;
     }
     return LAGSIMD_EXIT_OK;
+}
+
+int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t now, bool quiet,
+            char *err, size_t errlen)
+{
+    memset(s, 0, sizeof *s);
+    s->sc = sc;
+    s->opts = o;
+    s->now = now;
+    s->info = lag_model_info_get(sc->sim.model.kind);
+    char serr[256];
+    if (!s->info) return open_error(err, errlen, "bad scene: unknown model");
+    if (lag_sim_init(&s->sim, &sc->sim, serr, sizeof serr) != LAG_OK)
+        return open_error(err, errlen, "bad scene: %s", serr);
+    int rc = open_check(sc, err, errlen);
+    if (rc != LAGSIMD_EXIT_OK) return rc;
+    const double dt = sc->sim.integrator.dt;
+    if (o && o->duration > 0 && !rt_ticks_for(o->duration, dt, &s->stop_tick))
+        return open_error(err, errlen, "--duration %g s is more than 2^53 ticks of dt %g s "
+                          "(the longest run whose sim time is exact)", o->duration, dt);
+    open_clocks(s, quiet);
+    s->nq = s->sim.nq;
+    s->info = lag_sim_info(&s->sim); /* the joints published: a stick that may fly has h */
+    rt_estimate_init(&s->est, lag_scene_estimate_every(sc), rt_error_budget(sc));
+    s->ref = sc->reference;
+    s->tick_budget = RT_TICK_BUDGET;
+    open_limits(s, now);
+    return open_parts(s, o, err, errlen);
 }
 
 int rt_attach(rt_server *s, lcm_t *out, lcm_t *in, char *err, size_t errlen)
 {
-    s->lcm = out;
-    s->lcm_in = in;
-    s->sub_command = lcm_subscribe(in, s->ch_command, on_command, s);
-    s->sub_control = lcm_subscribe(in, s->ch_control, on_control, s);
-    if (!s->sub_command || !s->sub_control) {
-        rt_close(s);
-        snprintf(err, errlen, "cannot subscribe to %s and %s", s->ch_command, s->ch_control);
-        return LAGSIMD_EXIT_RUNTIME;
-    }
-    /* a flood must not queue up without bound: LCM drops beyond this */
-    lcm_subscription_set_queue_capacity(s->sub_command, 1000);
-    lcm_subscription_set_queue_capacity(s->sub_control, 1000);
-    /* the plant watch: another daemon's scene on this prefix. For udpm this gives the
-     * state URL's lcm_t a receive socket, which rt_bus_open filters to _SCENE (the
-     * daemon's own states are dropped by the kernel, never read back) */
-    s->sub_scene = lcm_subscribe(out, s->ch_scene, on_scene, s);
-    if (!s->sub_scene) {
-        rt_close(s);
-        snprintf(err, errlen, "cannot subscribe to %s", s->ch_scene);
-        return LAGSIMD_EXIT_RUNTIME;
-    }
-    lcm_subscription_set_queue_capacity(s->sub_scene, 16);
-    if (out != in) { /* udpm: commands sent to the state URL's port are heard (rt_bus.c) */
-        s->sub_wrong_port = lcm_subscribe(out, s->ch_command, on_wrong_port, s);
-        if (s->sub_wrong_port) lcm_subscription_set_queue_capacity(s->sub_wrong_port, 16);
-    }
-    return LAGSIMD_EXIT_OK;
+    rt_bus_handlers h = handlers(s);
+    return rt_bus_attach(&s->bus, out, in, &h, err, errlen);
 }
 
 void rt_close(rt_server *s)
 {
-    rt_log_end(s); /* a no-op when lagsimd_realtime has closed it already */
-    if (s->sub_command) lcm_unsubscribe(s->lcm_in, s->sub_command);
-    if (s->sub_control) lcm_unsubscribe(s->lcm_in, s->sub_control);
-    if (s->sub_scene) lcm_unsubscribe(s->lcm, s->sub_scene);
-    if (s->sub_wrong_port) lcm_unsubscribe(s->lcm, s->sub_wrong_port);
-    s->sub_wrong_port = NULL;
-    s->sub_command = s->sub_control = NULL;
-    s->sub_scene = NULL;
+    rt_log_end(&s->rec); /* a no-op when lagsimd_realtime has closed it already */
+    rt_bus_detach(&s->bus);
 }
 
 void rt_begin(rt_server *s)
@@ -1170,7 +1176,7 @@ void rt_begin(rt_server *s)
     s->run = sc->realtime.start == LAG_RT_START_PAUSED          ? RT_PAUSED
              : sc->realtime.start == LAG_RT_START_FIRST_COMMAND ? RT_WAITING
                                                                 : RT_RUNNING;
-    rt_publish_scene(s);
+    publish_scene(s);
     eventf(s, "start", 0, "%s, %s, dt %.6g s, control period %.6g s, mode %s, rate %.6g: %s",
            lag_model_info_get(sc->sim.model.kind)->name, lag_method_name(sc->sim.integrator.method), sc->sim.integrator.dt,
            (double)sc->ticks_per_period * sc->sim.integrator.dt,
@@ -1179,7 +1185,7 @@ void rt_begin(rt_server *s)
            : s->run == RT_WAITING ? "waiting at t = 0 for the first command"
                                   : "running");
     publish_state(s); /* the initial state, t = 0 */
-    rt_wait_update(s); /* a wait for the first command begins now */
+    wait_update(s); /* a wait for the first command begins now */
     publish_status(s);
     rt_pace_start(&s->pace, s->period_ns, s->now);
 }
@@ -1202,14 +1208,14 @@ int64_t rt_next_wake(const rt_server *s)
             wake = min64(wake, rt_pace_next(&s->pace));
         break;
     case LAG_RT_LOCKSTEP:
-        if ((act || s->run == RT_WAITING) && s->waiting && !s->want_state) {
-            if (act && s->answered && !log_holds(s)) return now;
-            if (act && s->answered) {
+        if ((act || s->run == RT_WAITING) && s->ls.waiting && !s->want_state) {
+            if (act && s->ls.answered && !log_holds(s)) return now;
+            if (act && s->ls.answered) {
                 wake = min64(wake, rt_sat_add(now, RT_LOG_HOLD_NS));
             } else {
-                wake = min64(wake, rt_sat_add(s->wait_start_ns, s->lockstep_wait_ns));
-                if ((s->run == RT_RUNNING || s->pending_steps > 0) && !s->answer_heard)
-                    wake = min64(wake, s->next_retry_ns);
+                wake = min64(wake, rt_sat_add(s->ls.wait_start_ns, s->ls.wait_ns));
+                if ((s->run == RT_RUNNING || s->pending_steps > 0) && !s->ls.answer_heard)
+                    wake = min64(wake, s->ls.next_retry_ns);
             }
         }
         break;
@@ -1217,9 +1223,17 @@ int64_t rt_next_wake(const rt_server *s)
     if (state_wanted(s)) wake = min64(wake, rt_limit_ready(&s->lim_state, now));
     if (s->want_scene) wake = min64(wake, rt_limit_ready(&s->lim_scene, now));
     if (s->want_status) wake = min64(wake, rt_limit_ready(&s->lim_status, now));
-    if (s->live_line) wake = min64(wake, s->next_line_ns);
-    wake = min64(wake, rt_wait_next(s));
+    if (s->term.live_line) wake = min64(wake, s->next_line_ns);
+    wake = min64(wake, rt_wait_next(&s->wait));
     return wake;
+}
+
+/* What --log has to say (rt_log_check's notes) goes out as events. */
+static void log_check(rt_server *s, bool running)
+{
+    rt_record_note notes[RT_RECORD_NOTES];
+    int n = rt_log_check(&s->rec, s->now, running, notes);
+    for (int k = 0; k < n; k++) event(s, notes[k].kind, "", notes[k].value, notes[k].detail);
 }
 
 /* Answers held back by their bucket go out when it allows, one for many requests. */
@@ -1231,7 +1245,7 @@ static void flush_answers(rt_server *s)
     }
     if (s->want_scene && rt_limit_ready(&s->lim_scene, s->now) <= s->now) {
         rt_limit_take(&s->lim_scene, s->now);
-        rt_publish_scene(s);
+        publish_scene(s);
         s->want_scene = false;
     }
     if (s->want_status && rt_limit_ready(&s->lim_status, s->now) <= s->now) {
@@ -1258,20 +1272,20 @@ void rt_process(rt_server *s)
             }
         }
     }
-    rt_wait_update(s); /* what the plant waits for: a line every few seconds (rt_wait.c) */
+    wait_update(s); /* what the plant waits for: a line every few seconds (rt_wait.c) */
     flush_answers(s);
     if (s->now >= s->next_status_ns) {
         publish_status(s);
         s->next_status_ns = rt_sat_add(s->next_status_ns, s->status_period_ns);
         if (s->next_status_ns <= s->now) s->next_status_ns = rt_sat_add(s->now, s->status_period_ns);
     }
-    if (s->live_line && s->now >= s->next_line_ns) {
-        rt_term_line(s, false);
+    if (s->term.live_line && s->now >= s->next_line_ns) {
+        rt_term_line(&s->term, s->now, false);
         s->next_line_ns = rt_sat_add(s->now, RT_LINE_NS);
     }
     /* the log's clock stops while paused or in the fault state, not while waiting for a
      * command (docs/server.md): a wake-up during the wait must not change the stamps */
-    rt_log_check(s, active(s) || s->run == RT_WAITING);
+    log_check(s, active(s) || s->run == RT_WAITING);
     if (s->report_line) {
         s->report_line = false;
         if (s->opts && s->opts->quiet) return;
@@ -1324,78 +1338,11 @@ void rt_finish(rt_server *s)
         break;
     }
     publish_status(s);
-    if (s->live_line) rt_term_line(s, true);
+    if (s->term.live_line) rt_term_line(&s->term, s->now, true);
 }
 
 /* ---------------------------------------------------------------- the loop */
-typedef struct rt_io {
-    int in_fd, timer_fd, sig_fd;
-    int watch_fd; /* the state URL's receive socket (the plant watch); -1 for memq:// */
-    int64_t armed_ns; /* what the timer is armed at (INT64_MAX: disarmed) */
-} rt_io;
-
-/* Waits until `wake` (absolute), a signal or an LCM message, then handles the signals
- * and the messages that arrived (at most RT_DRAIN_MAX). */
-static void wait_and_handle(rt_server *s, rt_io *io, int64_t wake)
-{
-    struct timespec zero = {0, 0}, *tmo = NULL;
-    if (wake <= rt_mono_ns()) {
-        tmo = &zero;
-    } else if (wake != io->armed_ns) {
-        struct itimerspec its = {{0, 0}, {0, 0}};
-        if (wake != INT64_MAX) {
-            its.it_value.tv_sec = (time_t)(wake / RT_NS_PER_S);
-            its.it_value.tv_nsec = (long)(wake % RT_NS_PER_S);
-        }
-        if (timerfd_settime(io->timer_fd, TFD_TIMER_ABSTIME, &its, NULL) == 0) io->armed_ns = wake;
-        else tmo = &zero; /* cannot arm: do not sleep past the deadline */
-    }
-    struct pollfd pf[4] = {{io->in_fd, POLLIN, 0}, {io->timer_fd, POLLIN, 0},
-                           {io->sig_fd, POLLIN, 0}, {io->watch_fd, POLLIN, 0}};
-    int np = ppoll(pf, io->watch_fd >= 0 ? 4 : 3, tmo, NULL);
-    s->now = rt_mono_ns();
-    if (np < 0) {
-        if (errno == EINTR) return;
-        perror("lagsimd: poll");
-        s->stop = true;
-        s->stop_reason = RT_STOP_ERROR;
-        return;
-    }
-    if (pf[2].revents & POLLIN) {
-        struct signalfd_siginfo si;
-        for (int k = 0; k < RT_SIGNALS_PER_WAKE; k++) {
-            if (read(io->sig_fd, &si, sizeof si) != (ssize_t)sizeof si) break;
-            rt_signal(s, (int)si.ssi_signo);
-        }
-    }
-    if (pf[1].revents & POLLIN) {
-        uint64_t expirations;
-        if (read(io->timer_fd, &expirations, sizeof expirations) < 0) expirations = 0;
-        io->armed_ns = INT64_MAX;
-    }
-    if (pf[0].revents & POLLIN) {
-        for (int k = 0; k < RT_DRAIN_MAX && !s->stop; k++)
-            if (lcm_handle_timeout(s->lcm_in, 0) <= 0) break;
-    }
-    if (io->watch_fd >= 0 && (pf[3].revents & POLLIN)) {
-        for (int k = 0; k < 16 && !s->stop; k++)
-            if (lcm_handle_timeout(s->lcm, 0) <= 0) break;
-    }
-    s->now = rt_mono_ns();
-}
-
-/* Signals the daemon handles: these stop it cleanly (a stop event and a final status);
- * SIGUSR1/SIGUSR2 ask for a status and a line on stderr. SIGPIPE is ignored. */
-static void handled_signals(sigset_t *set)
-{
-    sigemptyset(set);
-    sigaddset(set, SIGINT);
-    sigaddset(set, SIGTERM);
-    sigaddset(set, SIGHUP);
-    sigaddset(set, SIGQUIT);
-    sigaddset(set, SIGUSR1);
-    sigaddset(set, SIGUSR2);
-}
+static void on_signal(void *ctx, int signo) { rt_signal(ctx, signo); }
 
 int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
 {
@@ -1403,22 +1350,11 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
     rt_server *s = &srv;
     bool quiet = o && o->quiet;
     char err[512];
-
-    /* signals through a signalfd: blocked before LCM starts any thread */
-    sigset_t sigs, old_mask;
-    handled_signals(&sigs);
-    sigprocmask(SIG_BLOCK, &sigs, &old_mask);
-    struct sigaction ign = {.sa_handler = SIG_IGN}, old_pipe;
-    sigemptyset(&ign.sa_mask);
-    sigaction(SIGPIPE, &ign, &old_pipe);
-    rt_io io = {-1, -1, -1, -1, INT64_MAX};
+    rt_io io;
     int rc = LAGSIMD_EXIT_OK;
     bool opened = false;
 
-    io.sig_fd = signalfd(-1, &sigs, SFD_CLOEXEC | SFD_NONBLOCK);
-    io.timer_fd = timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC | TFD_NONBLOCK);
-    if (io.sig_fd < 0 || io.timer_fd < 0) {
-        perror("lagsimd: signalfd/timerfd");
+    if (rt_io_open(&io, &s->now, &s->stop, on_signal, s) != 0) {
         rc = LAGSIMD_EXIT_RUNTIME;
         goto out;
     }
@@ -1430,30 +1366,31 @@ int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
     }
     /* LCM: publishing on the state URL, receiving on the command URL */
     opened = true;
-    rc = rt_bus_open(s, err, sizeof err);
+    rt_bus_handlers h = handlers(s);
+    rc = rt_bus_open(&s->bus, &h, err, sizeof err);
     if (rc != LAGSIMD_EXIT_OK) {
         fprintf(stderr, "lagsimd: %s\n", err);
         goto out;
     }
-    s->live_line = isatty(STDERR_FILENO) && !quiet;
-    io.in_fd = lcm_get_fileno(s->lcm_in);
-    if (s->lcm != s->lcm_in) io.watch_fd = lcm_get_fileno(s->lcm);
+    s->term.live_line = isatty(STDERR_FILENO) && !quiet;
+    rt_io_watch(&io, s->bus.lcm_in, s->bus.lcm != s->bus.lcm_in ? s->bus.lcm : NULL);
 
     s->now = rt_mono_ns();
-    s->discard = false;
+    s->bus.discard = false;
     rt_begin(s);
     while (!s->stop) {
-        wait_and_handle(s, &io, rt_next_wake(s));
+        if (rt_io_wait(&io, rt_next_wake(s)) != 0) {
+            s->stop = true;
+            s->stop_reason = RT_STOP_ERROR;
+        }
         rt_process(s);
     }
     rt_finish(s);
-    if (rt_log_end(s) != 0 && rc == LAGSIMD_EXIT_OK) rc = LAGSIMD_EXIT_RUNTIME; /* --log lost records */
+    /* --log lost records */
+    if (rt_log_end(&s->rec) != 0 && rc == LAGSIMD_EXIT_OK) rc = LAGSIMD_EXIT_RUNTIME;
 out:
-    rt_log_end(s); /* --log opened, then the start failed */
-    if (opened) rt_bus_close(s);
-    if (io.timer_fd >= 0) close(io.timer_fd);
-    if (io.sig_fd >= 0) close(io.sig_fd);
-    sigaction(SIGPIPE, &old_pipe, NULL);
-    sigprocmask(SIG_SETMASK, &old_mask, NULL);
+    rt_log_end(&s->rec); /* --log opened, then the start failed */
+    if (opened) rt_bus_close(&s->bus);
+    rt_io_close(&io);
     return rc;
 }

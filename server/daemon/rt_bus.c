@@ -1,9 +1,9 @@
 /*
  * The daemon's LCM instances (lagsim_bus.h gives the URLs):
- *   s->lcm        the state URL, publishing only: it never subscribes, so LCM never
+ *   b->lcm        the state URL, publishing only: it never subscribes, so LCM never
  *                 opens a receive socket for it and the daemon never reads back its own
  *                 states (in fast mode, tens of thousands a second);
- *   s->lcm_in     the command URL: _COMMAND and _CONTROL. Its receive socket gets a
+ *   b->lcm_in     the command URL: _COMMAND and _CONTROL. Its receive socket gets a
  *                 filter (lagsim_net.h): only this plant's two channels, and unless
  *                 lcm.allow_lan only datagrams sent from this host;
  * For memq:// (tests, one process) one lcm_t is both.
@@ -12,40 +12,164 @@
  * filtered to that channel and _COMMAND, so the kernel drops the daemon's own states
  * instead of handing them back; a command sent there, to the wrong port, is counted). Before it publishes anything, the daemon asks its prefix for a
  * scene (DESCRIBE) and listens RT_LOOK_MS (look_for_other_plant); another plant's scene
- * (rt_handle_scene: one that decodes, names this prefix and is not one of the daemon's
- * own) makes it refuse to start, and later makes it stop. Whom it hears follows the
+ * (rt_bus_foreign_scene: one that decodes, names this prefix and is not one of the
+ * daemon's own) makes it refuse to start, and later makes it stop. Whom it hears follows the
  * command URL's rule: this host only unless lcm.allow_lan.
  */
 #include <stdio.h>
 #include <string.h>
 
 #include "lagsim_net.h"
-#include "rt_server.h"
+#include "daemon.h"
+#include "rt_bus.h"
+#include "rt_pace.h"
 #include "lagsim/lagsim_control_t.h"
 
+int rt_bus_init(rt_bus *b, const lag_scene *sc, char *err, size_t errlen)
+{
+    b->sc = sc;
+    if (lag_bus_init(&b->urls, sc->lcm.url, sc->lcm.prefix, err, errlen) != 0) return -1;
+    snprintf(b->ch_state, RT_CHANNEL_MAX, "%s", b->urls.channel[LAG_BUS_STATE]);
+    snprintf(b->ch_command, RT_CHANNEL_MAX, "%s", b->urls.channel[LAG_BUS_COMMAND]);
+    snprintf(b->ch_status, RT_CHANNEL_MAX, "%s", b->urls.channel[LAG_BUS_STATUS]);
+    snprintf(b->ch_event, RT_CHANNEL_MAX, "%s", b->urls.channel[LAG_BUS_EVENT]);
+    snprintf(b->ch_control, RT_CHANNEL_MAX, "%s", b->urls.channel[LAG_BUS_CONTROL]);
+    snprintf(b->ch_scene, RT_CHANNEL_MAX, "%s", b->urls.channel[LAG_BUS_SCENE]);
+    snprintf(b->ch_reference, RT_CHANNEL_MAX, "%s", b->urls.channel[LAG_BUS_REFERENCE]);
+    return 0;
+}
+
+/* ---------------------------------------------------------------- subscriptions */
+static void on_scene(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)ch;
+    rt_bus *b = user;
+    b->on.scene(b->on.ctx, rb->data, rb->data_size);
+}
+
+static void on_command(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)ch;
+    rt_bus *b = user;
+    if (!b->discard) b->on.command(b->on.ctx, rb->data, rb->data_size);
+}
+
+/* A command on the state URL: the controller publishes on the wrong port. Counted (the
+ * waits say so, rt_wait.c), never applied. */
+static void on_wrong_port(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)rb;
+    (void)ch;
+    rt_bus *b = user;
+    if (!b->discard) b->commands_wrong_port++;
+}
+
+static void on_control(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)ch;
+    rt_bus *b = user;
+    if (!b->discard) b->on.control(b->on.ctx, rb->data, rb->data_size);
+}
+
+int rt_bus_attach(rt_bus *b, lcm_t *out, lcm_t *in, const rt_bus_handlers *h, char *err,
+                  size_t errlen)
+{
+    b->on = *h;
+    b->lcm = out;
+    b->lcm_in = in;
+    b->sub_command = lcm_subscribe(in, b->ch_command, on_command, b);
+    b->sub_control = lcm_subscribe(in, b->ch_control, on_control, b);
+    if (!b->sub_command || !b->sub_control) {
+        rt_bus_detach(b);
+        snprintf(err, errlen, "cannot subscribe to %s and %s", b->ch_command, b->ch_control);
+        return LAGSIMD_EXIT_RUNTIME;
+    }
+    /* a flood must not queue up without bound: LCM drops beyond this */
+    lcm_subscription_set_queue_capacity(b->sub_command, 1000);
+    lcm_subscription_set_queue_capacity(b->sub_control, 1000);
+    /* the plant watch: another daemon's scene on this prefix. For udpm this gives the
+     * state URL's lcm_t a receive socket, which rt_bus_open filters to _SCENE (the
+     * daemon's own states are dropped by the kernel, never read back) */
+    b->sub_scene = lcm_subscribe(out, b->ch_scene, on_scene, b);
+    if (!b->sub_scene) {
+        rt_bus_detach(b);
+        snprintf(err, errlen, "cannot subscribe to %s", b->ch_scene);
+        return LAGSIMD_EXIT_RUNTIME;
+    }
+    lcm_subscription_set_queue_capacity(b->sub_scene, 16);
+    if (out != in) { /* udpm: commands sent to the state URL's port are heard */
+        b->sub_wrong_port = lcm_subscribe(out, b->ch_command, on_wrong_port, b);
+        if (b->sub_wrong_port) lcm_subscription_set_queue_capacity(b->sub_wrong_port, 16);
+    }
+    return LAGSIMD_EXIT_OK;
+}
+
+void rt_bus_detach(rt_bus *b)
+{
+    if (b->sub_command) lcm_unsubscribe(b->lcm_in, b->sub_command);
+    if (b->sub_control) lcm_unsubscribe(b->lcm_in, b->sub_control);
+    if (b->sub_scene) lcm_unsubscribe(b->lcm, b->sub_scene);
+    if (b->sub_wrong_port) lcm_unsubscribe(b->lcm, b->sub_wrong_port);
+    b->sub_wrong_port = NULL;
+    b->sub_command = b->sub_control = NULL;
+    b->sub_scene = NULL;
+}
+
+/* ---------------------------------------------------------------- one plant per prefix */
+uint64_t rt_bus_hash(const uint8_t *data, size_t len)
+{
+    uint64_t h = 14695981039346656037ULL;
+    for (size_t i = 0; i < len; i++) h = (h ^ data[i]) * 1099511628211ULL;
+    return h;
+}
+
+void rt_bus_sent_scene(rt_bus *b, const uint8_t *data, size_t len)
+{
+    b->scene_sent[b->scene_next] = rt_bus_hash(data, len);
+    b->scene_next = (b->scene_next + 1) % RT_SCENES_KEPT;
+}
+
+bool rt_bus_foreign_scene(rt_bus *b, const uint8_t *data, size_t len)
+{
+    uint64_t h = rt_bus_hash(data, len);
+    for (int k = 0; k < RT_SCENES_KEPT; k++)
+        if (b->scene_sent[k] == h) return false; /* this daemon's own */
+    if (b->discard && b->other_plant[0]) return false; /* at start: said already */
+    /* a plant's scene decodes and names its prefix; anything else on the channel is not a
+     * plant (junk, a forgery of no consequence) and is ignored */
+    static lag_wire_scene m; /* large: not on the stack of a handler */
+    if (lag_wire_decode_scene(data, len, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK ||
+        strcmp(m.prefix, b->sc->lcm.prefix) != 0)
+        return false;
+    snprintf(b->other_plant, sizeof b->other_plant, "a scene this daemon did not send "
+             "(model %.20s, mode %.10s, dt %g s)", m.model, m.mode, m.dt);
+    return !b->discard; /* at start (rt_bus_open's look before publishing): refused there */
+}
+
+/* ---------------------------------------------------------------- opening the bus */
 /* Filters the receive socket of the command URL's lcm_t, then reads until a marker sent
  * after the filter comes back, discarding whatever came before it (it may have come in
  * before the filter did). Returns 0, or an exit code with a message in err. */
-static int filter_input(rt_server *s, char *err, size_t errlen)
+static int filter_input(rt_bus *b, char *err, size_t errlen)
 {
-    const lag_bus *b = &s->bus;
-    bool host_only = !s->sc->lcm.allow_lan;
-    const char *with_marker[] = {s->ch_command, s->ch_control, LAG_NET_MARKER_CHANNEL};
+    const lag_bus *u = &b->urls;
+    bool host_only = !b->sc->lcm.allow_lan;
+    const char *with_marker[] = {b->ch_command, b->ch_control, LAG_NET_MARKER_CHANNEL};
     char ferr[256];
-    int n = lag_net_filter(b->command_port, host_only, with_marker, 3, ferr, sizeof ferr);
+    int n = lag_net_filter(u->command_port, host_only, with_marker, 3, ferr, sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s%s: cannot restrict the command URL %s to %s", n < 0 ? ferr :
                  "LCM's receive socket for the command port was not found",
-                 host_only ? "" : " (lcm.allow_lan: true)", b->command_url,
+                 host_only ? "" : " (lcm.allow_lan: true)", u->command_url,
                  host_only ? "this host (lcm.allow_lan: false)" : "this plant's channels");
         return LAGSIMD_EXIT_RUNTIME;
     }
-    if (lag_net_sync(s->lcm_in, 3000) != 0) {
+    if (lag_net_sync(b->lcm_in, 3000) != 0) {
         snprintf(err, errlen, "LCM on %s does not hear its own messages (is there a multicast "
-                 "route? docs/network.md)", b->command_url);
+                 "route? docs/network.md)", u->command_url);
         return LAGSIMD_EXIT_RUNTIME;
     }
-    n = lag_net_filter(b->command_port, host_only, with_marker, 2, ferr, sizeof ferr);
+    n = lag_net_filter(u->command_port, host_only, with_marker, 2, ferr, sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s", n < 0 ? ferr : "LCM's receive socket went away");
         return LAGSIMD_EXIT_RUNTIME;
@@ -59,94 +183,94 @@ static int filter_input(rt_server *s, char *err, size_t errlen)
  * (the plant watch), asks the prefix for its scene (DESCRIBE on the command URL; a daemon
  * there answers on the state URL) and listens RT_LOOK_MS for another plant's. Returns 0,
  * or an exit code with a message. */
-static int look_for_other_plant(rt_server *s, char *err, size_t errlen)
+static int look_for_other_plant(rt_bus *b, char *err, size_t errlen)
 {
-    const lag_bus *b = &s->bus;
-    bool host_only = !s->sc->lcm.allow_lan;
+    const lag_bus *u = &b->urls;
+    bool host_only = !b->sc->lcm.allow_lan;
     /* and _COMMAND: a command sent to the state port is counted (rt_wait.c says so) */
-    const char *out[] = {s->ch_scene, s->ch_command};
+    const char *out[] = {b->ch_scene, b->ch_command};
     char ferr[256];
-    int n = lag_net_filter(b->state_port, host_only, out, 2, ferr, sizeof ferr);
+    int n = lag_net_filter(u->state_port, host_only, out, 2, ferr, sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s: cannot filter the state URL %s for the plant watch",
                  n < 0 ? ferr : "LCM's receive socket for the state port was not found",
-                 b->state_url);
+                 u->state_url);
         return LAGSIMD_EXIT_RUNTIME;
     }
     lag_wire_control c;
     memset(&c, 0, sizeof c);
     c.utime = rt_wall_us();
     c.request = LAGSIM_CONTROL_T_DESCRIBE;
-    int len = lag_wire_encode(LAG_WIRE_CONTROL, &c, s->buf, RT_BUF_SIZE);
-    if (len > 0) lcm_publish(s->lcm_in, s->ch_control, s->buf, (unsigned)len);
+    int len = lag_wire_encode(LAG_WIRE_CONTROL, &c, b->buf, RT_BUF_SIZE);
+    if (len > 0) lcm_publish(b->lcm_in, b->ch_control, b->buf, (unsigned)len);
     int64_t end = rt_mono_ns() + RT_LOOK_MS * 1000000LL;
-    for (int64_t left; !s->other_plant[0] && (left = end - rt_mono_ns()) > 0;)
-        lcm_handle_timeout(s->lcm, (int)(left / 1000000) + 1);
-    if (s->other_plant[0]) {
+    for (int64_t left; !b->other_plant[0] && (left = end - rt_mono_ns()) > 0;)
+        lcm_handle_timeout(b->lcm, (int)(left / 1000000) + 1);
+    if (b->other_plant[0]) {
         snprintf(err, errlen, "another plant publishes on prefix %s (%s): refusing to start; "
                  "one plant per prefix (give this one another lcm.prefix, or stop the other)",
-                 s->sc->lcm.prefix, s->other_plant);
+                 b->sc->lcm.prefix, b->other_plant);
         return LAGSIMD_EXIT_RUNTIME;
     }
     return LAGSIMD_EXIT_OK;
 }
 
-int rt_bus_open(rt_server *s, char *err, size_t errlen)
+int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
 {
-    const lag_bus *b = &s->bus;
+    const lag_bus *u = &b->urls;
     lag_net_note_inherited(); /* a parent's sockets are not filtered */
-    lcm_t *out = lcm_create(b->state_url);
-    lcm_t *in = !b->udpm ? out : out ? lcm_create(b->command_url) : NULL;
+    lcm_t *out = lcm_create(u->state_url);
+    lcm_t *in = !u->udpm ? out : out ? lcm_create(u->command_url) : NULL;
     if (!out || !in) {
-        snprintf(err, errlen, "cannot create LCM on %s", out ? b->command_url : b->state_url);
+        snprintf(err, errlen, "cannot create LCM on %s", out ? u->command_url : u->state_url);
         if (out) lcm_destroy(out);
         return LAGSIMD_EXIT_RUNTIME;
     }
-    s->discard = true; /* until rt_begin: nothing that arrives before the start counts */
-    int rc = rt_attach(s, out, in, err, errlen);
+    b->discard = true; /* until rt_begin: nothing that arrives before the start counts */
+    int rc = rt_bus_attach(b, out, in, h, err, errlen);
     if (rc != LAGSIMD_EXIT_OK) {
         if (in != out) lcm_destroy(in);
         lcm_destroy(out);
-        s->lcm = s->lcm_in = NULL;
+        b->lcm = b->lcm_in = NULL;
         return rc;
     }
-    if (!b->udpm) {
-        fprintf(stderr, "lagsimd: %s: on %s (this process only)\n", s->sc->lcm.prefix,
-                b->state_url);
+    if (!u->udpm) {
+        fprintf(stderr, "lagsimd: %s: on %s (this process only)\n", b->sc->lcm.prefix,
+                u->state_url);
         return LAGSIMD_EXIT_OK;
     }
-    rc = look_for_other_plant(s, err, errlen);
-    if (rc == LAGSIMD_EXIT_OK) rc = filter_input(s, err, errlen);
+    rc = look_for_other_plant(b, err, errlen);
+    if (rc == LAGSIMD_EXIT_OK) rc = filter_input(b, err, errlen);
     if (rc != LAGSIMD_EXIT_OK) {
-        rt_bus_close(s);
+        rt_bus_close(b);
         return rc;
     }
     /* where the daemon listens, and who can reach it */
     char ifname[64];
-    if (lag_net_group_iface(b->group, ifname, sizeof ifname) != 0)
-        snprintf(ifname, sizeof ifname, "no interface (no route to %s)", b->group);
-    int ttl = s->sc->lcm.ttl; /* the loader's reading of the URL (LCM_DEFAULT_URL included) */
+    if (lag_net_group_iface(u->group, ifname, sizeof ifname) != 0)
+        snprintf(ifname, sizeof ifname, "no interface (no route to %s)", u->group);
+    int ttl = b->sc->lcm.ttl; /* the loader's reading of the URL (LCM_DEFAULT_URL included) */
     if (ttl > 0)
         fprintf(stderr, "lagsimd: warning: LCM url '%s' has ttl=%d: states, status and events "
-                "leave this host (multicast to the local network%s)\n", b->state_url, ttl,
+                "leave this host (multicast to the local network%s)\n", u->state_url, ttl,
                 ttl > 1 ? " and beyond routers" : "");
-    if (s->sc->lcm.allow_lan)
+    if (b->sc->lcm.allow_lan)
         fprintf(stderr, "lagsimd: %s: listening on %s for commands and control from the "
                 "network (lcm.allow_lan: true: any host that reaches %s can command this "
-                "plant) on %s; states on %s\n", s->sc->lcm.prefix, ifname, ifname,
-                b->command_url, b->state_url);
+                "plant) on %s; states on %s\n", b->sc->lcm.prefix, ifname, ifname,
+                u->command_url, u->state_url);
     else
         fprintf(stderr, "lagsimd: %s: listening on %s for commands and control from this "
-                "host only (lcm.allow_lan: false) on %s; states on %s%s\n", s->sc->lcm.prefix,
-                ifname, b->command_url, b->state_url,
+                "host only (lcm.allow_lan: false) on %s; states on %s%s\n", b->sc->lcm.prefix,
+                ifname, u->command_url, u->state_url,
                 ttl == 0 ? ", which stay on this host (ttl=0)" : "");
     return LAGSIMD_EXIT_OK;
 }
 
-void rt_bus_close(rt_server *s)
+void rt_bus_close(rt_bus *b)
 {
-    rt_close(s);
-    if (s->lcm_in && s->lcm_in != s->lcm) lcm_destroy(s->lcm_in);
-    if (s->lcm) lcm_destroy(s->lcm);
-    s->lcm = s->lcm_in = NULL;
+    rt_bus_detach(b);
+    if (b->lcm_in && b->lcm_in != b->lcm) lcm_destroy(b->lcm_in);
+    if (b->lcm) lcm_destroy(b->lcm);
+    b->lcm = b->lcm_in = NULL;
 }

@@ -12,7 +12,7 @@
  * commanded input the period runs with (<PREFIX>_INPUT, a joint_command_t whose sim_time
  * is the period's start), from which --replay re-simulates the lag exactly.
  *
- * Timestamps (us) follow the log's own clock (rt_server.h, s->lg): a lockstep or fast run
+ * Timestamps (us) follow the log's own clock (rt_record.h): a lockstep or fast run
  * is stamped at the pace of its sim time, so lcm-logplayer plays it back at 1x instead of
  * as one burst; each message's own utime still says when it was sent.
  */
@@ -21,97 +21,105 @@
 #include <string.h>
 
 #include "lagsim_log.h"
-#include "rt_server.h"
+#include "lagsim_wire.h"
+#include "rt_record.h"
 
 #define RT_LOG_STALL_MS 5000 /* at exit: a writer without progress this long is given up */
 
-/* The log's clock at s->now, in us since the epoch; never earlier than the last one. */
-static int64_t log_clock(rt_server *s)
+/* The log's clock at `now`, in us since the epoch; never earlier than the last one. */
+static int64_t log_clock(rt_record *r, int64_t now)
 {
-    if (s->lg.base_us == 0) {
-        s->lg.base_us = rt_wall_us();
-        s->lg.prev_ns = s->now;
+    if (r->base_us == 0) {
+        r->base_us = rt_wall_us();
+        r->prev_ns = now;
     }
-    double sim_us = (double)s->lg.ticks * s->sc->sim.integrator.dt * 1e6;
-    int64_t idle = s->lg.idle_ns + (s->lg.was_idle ? s->now - s->lg.prev_ns : 0);
-    int64_t ts = rt_sat_add(rt_sat_add(s->lg.base_us, rt_sat_i64(sim_us + 0.5)), idle / 1000);
-    if (ts < s->lg.last_us) ts = s->lg.last_us;
-    s->lg.last_us = ts;
+    double sim_us = (double)r->ticks * r->dt * 1e6;
+    int64_t idle = r->idle_ns + (r->was_idle ? now - r->prev_ns : 0);
+    int64_t ts = rt_sat_add(rt_sat_add(r->base_us, rt_sat_i64(sim_us + 0.5)), idle / 1000);
+    if (ts < r->last_us) ts = r->last_us;
+    r->last_us = ts;
     return ts;
 }
 
-void rt_log_record(rt_server *s, rt_log_dir dir, const char *channel, const void *data,
-                   size_t len)
+void rt_record_init(rt_record *r, double dt, bool quiet, int64_t now)
 {
-    if (!s->lg.log) return;
+    r->dt = dt;
+    r->quiet = quiet;
+    rt_limit_init(&r->lim_said, 1, 1, now);
+    rt_limit_init(&r->lim_sample_said, 1, 1, now);
+    r->sample_credit = RT_LOG_SAMPLE_BPS; /* a full bucket at start */
+    r->sample_ns = now;
+}
+
+void rt_log_record(rt_record *r, int64_t now, rt_log_dir dir, const char *channel,
+                   const void *data, size_t len)
+{
+    if (!r->log) return;
     /* published while a received message is pending: in answer to it, which was accepted */
-    if (s->lg.rx_pending) rt_log_rx_fate(s, RT_RX_ACCEPTED);
-    rt_log_put(s->lg.log, dir, log_clock(s), channel, data, len);
+    if (r->rx_pending) rt_log_rx_fate(r, now, RT_RX_ACCEPTED);
+    rt_log_put(r->log, dir, log_clock(r, now), channel, data, len);
 }
 
-void rt_log_rx_begin(rt_server *s, const char *channel, const void *data, size_t len)
+void rt_log_rx_begin(rt_record *r, const char *channel, const void *data, size_t len)
 {
-    if (!s->lg.log) return;
-    s->lg.rx_channel = channel;
-    s->lg.rx_data = data;
-    s->lg.rx_len = len;
-    s->lg.rx_pending = true;
+    if (!r->log) return;
+    r->rx_channel = channel;
+    r->rx_data = data;
+    r->rx_len = len;
+    r->rx_pending = true;
 }
 
-/* The sample's byte bucket at s->now: RT_LOG_SAMPLE_BPS bytes a second, as much in a
+/* The sample's byte bucket at `now`: RT_LOG_SAMPLE_BPS bytes a second, as much in a
  * burst. Takes `bytes` and returns true when it holds them. */
-static bool sample_take(rt_server *s, size_t bytes)
+static bool sample_take(rt_record *r, int64_t now, size_t bytes)
 {
-    if (s->now < s->lg.sample_ns) s->lg.sample_ns = s->now;
-    s->lg.sample_credit += (double)(s->now - s->lg.sample_ns) * 1e-9 * RT_LOG_SAMPLE_BPS;
-    if (s->lg.sample_credit > RT_LOG_SAMPLE_BPS) s->lg.sample_credit = RT_LOG_SAMPLE_BPS;
-    s->lg.sample_ns = s->now;
-    if (s->lg.sample_credit < (double)bytes) return false;
-    s->lg.sample_credit -= (double)bytes;
+    if (now < r->sample_ns) r->sample_ns = now;
+    r->sample_credit += (double)(now - r->sample_ns) * 1e-9 * RT_LOG_SAMPLE_BPS;
+    if (r->sample_credit > RT_LOG_SAMPLE_BPS) r->sample_credit = RT_LOG_SAMPLE_BPS;
+    r->sample_ns = now;
+    if (r->sample_credit < (double)bytes) return false;
+    r->sample_credit -= (double)bytes;
     return true;
 }
 
-void rt_log_rx_fate(rt_server *s, rt_rx_fate fate)
+void rt_log_rx_fate(rt_record *r, int64_t now, rt_rx_fate fate)
 {
-    if (!s->lg.log || !s->lg.rx_pending) return;
-    s->lg.rx_pending = false;
+    if (!r->log || !r->rx_pending) return;
+    r->rx_pending = false;
     if (fate != RT_RX_ACCEPTED) {
-        if (fate == RT_RX_QUERY) s->lg.rx_queries++;
-        else s->lg.rx_refused++;
-        if (fate == RT_RX_UNDECODABLE) s->lg.rx_undecodable++;
-        size_t bytes = LAG_LOG_HEADER_SIZE + strlen(s->lg.rx_channel) + s->lg.rx_len;
-        if (!sample_take(s, bytes)) return; /* counted only */
-        s->lg.rx_sampled++;
-        s->lg.rx_sampled_bytes += (int64_t)bytes;
+        if (fate == RT_RX_QUERY) r->rx_queries++;
+        else r->rx_refused++;
+        if (fate == RT_RX_UNDECODABLE) r->rx_undecodable++;
+        size_t bytes = LAG_LOG_HEADER_SIZE + strlen(r->rx_channel) + r->rx_len;
+        if (!sample_take(r, now, bytes)) return; /* counted only */
+        r->rx_sampled++;
+        r->rx_sampled_bytes += (int64_t)bytes;
     }
-    rt_log_put(s->lg.log, RT_LOG_IN, log_clock(s), s->lg.rx_channel, s->lg.rx_data,
-               s->lg.rx_len);
+    rt_log_put(r->log, RT_LOG_IN, log_clock(r, now), r->rx_channel, r->rx_data,
+               r->rx_len);
 }
 
-void rt_log_rx_end(rt_server *s) { rt_log_rx_fate(s, RT_RX_ACCEPTED); }
+void rt_log_rx_end(rt_record *r, int64_t now) { rt_log_rx_fate(r, now, RT_RX_ACCEPTED); }
 
-void rt_log_input(rt_server *s)
+void rt_log_input(rt_record *r, int64_t now, const lag_sim *sim, const lag_model_info *info)
 {
-    if (!s->lg.log || !s->lg.input) return;
+    if (!r->log || !r->input) return;
     lag_wire_joint_command m;
     memset(&m, 0, sizeof m);
     m.utime = rt_wall_us();
-    m.sim_time = lag_sim_time(&s->sim);
+    m.sim_time = lag_sim_time(sim);
     int k = 0;
-    for (int i = 0; i < s->nq && k < LAG_WIRE_MAX_JOINTS; i++) {
-        if (!s->info->actuated[i]) continue;
-        snprintf(m.name[k], sizeof m.name[k], "%s", s->info->joint_names[i]);
-        m.effort[k] = s->sim.tau[i];
+    for (int i = 0; i < sim->nq && k < LAG_WIRE_MAX_JOINTS; i++) {
+        if (!info->actuated[i]) continue;
+        snprintf(m.name[k], sizeof m.name[k], "%s", info->joint_names[i]);
+        m.effort[k] = sim->tau[i];
         k++;
     }
     m.num_joints = (int16_t)k;
     uint8_t buf[LAG_WIRE_BUF_SIZE];
     int n = lag_wire_encode(LAG_WIRE_JOINT_COMMAND, &m, buf, sizeof buf);
-    if (n > 0) rt_log_record(s, RT_LOG_OUT, s->lg.ch_input, buf, (size_t)n);
+    if (n > 0) rt_log_record(r, now, RT_LOG_OUT, r->ch_input, buf, (size_t)n);
 }
-
-/* -q: the terminal shows no event lines, but what the log lost is still said. */
-static bool quiet(const rt_server *s) { return s->opts && s->opts->quiet; }
 
 /* Records lost so far, but those refused after a failed write (said once, with it). */
 static int64_t lost(const rt_log_stats *st)
@@ -120,69 +128,76 @@ static int64_t lost(const rt_log_stats *st)
 }
 
 /* Refused messages and queries received and not written (the sample's bucket was empty). */
-static int64_t unsampled(const rt_server *s)
+static int64_t unsampled(const rt_record *r)
 {
-    return s->lg.rx_refused + s->lg.rx_queries - s->lg.rx_sampled;
+    return r->rx_refused + r->rx_queries - r->rx_sampled;
 }
 
-void rt_log_check(rt_server *s, bool running)
+int rt_log_check(rt_record *r, int64_t now, bool running, rt_record_note *notes)
 {
-    if (s->lg.was_idle) s->lg.idle_ns += s->now - s->lg.prev_ns;
-    s->lg.prev_ns = s->now;
-    s->lg.was_idle = !running;
-    if (!s->lg.log) return;
+    int nn = 0;
+    if (r->was_idle) r->idle_ns += now - r->prev_ns;
+    r->prev_ns = now;
+    r->was_idle = !running;
+    if (!r->log) return 0;
     rt_log_stats st;
-    rt_log_get_stats(s->lg.log, &st);
-    const char *path = rt_log_path(s->lg.log);
-    char detail[320];
-    if (st.error != 0 && !s->lg.error_said) {
-        s->lg.error_said = true;
-        snprintf(detail, sizeof detail, "--log %s: writing failed after %lld bytes: %s; the rest "
-                 "of the run is not logged", path, (long long)st.written, strerror(st.error));
-        if (quiet(s)) fprintf(stderr, "lagsimd: %s\n", detail); /* else: the event's line */
-        rt_publish_event(s, "log_error", "", (double)st.error, detail);
+    rt_log_get_stats(r->log, &st);
+    const char *path = rt_log_path(r->log);
+    char *detail;
+    if (st.error != 0 && !r->error_said) {
+        r->error_said = true;
+        notes[nn] = (rt_record_note){"log_error", (double)st.error, ""};
+        detail = notes[nn++].detail;
+        snprintf(detail, sizeof notes->detail, "--log %s: writing failed after %lld bytes: "
+                 "%s; the rest of the run is not logged", path, (long long)st.written,
+                 strerror(st.error));
+        if (r->quiet) fprintf(stderr, "lagsimd: %s\n", detail); /* else: the event's line */
     }
     /* a flood of refused messages: said in the log (and on the bus) at most once a
      * second, how many were counted without being written */
-    if (unsampled(s) > s->lg.unsampled_said && rt_limit_take(&s->lg.lim_sample_said, s->now)) {
-        snprintf(detail, sizeof detail, "--log %s: received so far %lld refused commands and "
-                 "control requests (%lld undecodable) and %lld status or describe requests: "
-                 "%lld written as a sample (%lld bytes, at most %d a second), %lld counted only",
-                 path, (long long)s->lg.rx_refused, (long long)s->lg.rx_undecodable,
-                 (long long)s->lg.rx_queries, (long long)s->lg.rx_sampled,
-                 (long long)s->lg.rx_sampled_bytes, RT_LOG_SAMPLE_BPS, (long long)unsampled(s));
-        s->lg.unsampled_said = unsampled(s);
-        rt_publish_event(s, "log_sampled", "", (double)unsampled(s), detail);
+    if (unsampled(r) > r->unsampled_said && rt_limit_take(&r->lim_sample_said, now)) {
+        notes[nn] = (rt_record_note){"log_sampled", (double)unsampled(r), ""};
+        detail = notes[nn++].detail;
+        snprintf(detail, sizeof notes->detail, "--log %s: received so far %lld refused "
+                 "commands and control requests (%lld undecodable) and %lld status or describe "
+                 "requests: %lld written as a sample (%lld bytes, at most %d a second), %lld "
+                 "counted only",
+                 path, (long long)r->rx_refused, (long long)r->rx_undecodable,
+                 (long long)r->rx_queries, (long long)r->rx_sampled,
+                 (long long)r->rx_sampled_bytes, RT_LOG_SAMPLE_BPS, (long long)unsampled(r));
+        r->unsampled_said = unsampled(r);
     }
-    if (lost(&st) > lost(&s->lg.seen) && rt_limit_take(&s->lg.lim_said, s->now)) {
-        snprintf(detail, sizeof detail, "--log %s: %lld records not written so far (%lld "
+    if (lost(&st) > lost(&r->seen) && rt_limit_take(&r->lim_said, now)) {
+        notes[nn] = (rt_record_note){"log_dropped", (double)lost(&st), ""};
+        detail = notes[nn++].detail;
+        snprintf(detail, sizeof notes->detail, "--log %s: %lld records not written so far (%lld "
                  "published and %lld received while the ring of %zu bytes was full, %lld too "
                  "large): the disk is slower than the run", path, (long long)lost(&st),
                  (long long)st.dropped_full, (long long)st.dropped_in, st.ring,
                  (long long)st.too_large);
-        s->lg.seen = st;
-        if (quiet(s)) fprintf(stderr, "lagsimd: %s\n", detail); /* else: the event's line */
-        rt_publish_event(s, "log_dropped", "", (double)lost(&st), detail);
+        r->seen = st;
+        if (r->quiet) fprintf(stderr, "lagsimd: %s\n", detail); /* else: the event's line */
     }
+    return nn;
 }
 
-int rt_log_end(rt_server *s)
+int rt_log_end(rt_record *r)
 {
-    if (!s->lg.log) return 0;
+    if (!r->log) return 0;
     char path[256];
-    snprintf(path, sizeof path, "%s", rt_log_path(s->lg.log));
+    snprintf(path, sizeof path, "%s", rt_log_path(r->log));
     rt_log_stats st;
-    int rc = rt_log_close(s->lg.log, RT_LOG_STALL_MS, &st);
-    s->lg.log = NULL;
+    int rc = rt_log_close(r->log, RT_LOG_STALL_MS, &st);
+    r->log = NULL;
     char refused[256] = "";
-    if (unsampled(s) > 0)
+    if (unsampled(r) > 0)
         snprintf(refused, sizeof refused, "; received %lld refused commands and control "
                  "requests (%lld undecodable) and %lld status or describe requests: %lld "
-                 "written as a sample, %lld counted only", (long long)s->lg.rx_refused,
-                 (long long)s->lg.rx_undecodable, (long long)s->lg.rx_queries,
-                 (long long)s->lg.rx_sampled, (long long)unsampled(s));
+                 "written as a sample, %lld counted only", (long long)r->rx_refused,
+                 (long long)r->rx_undecodable, (long long)r->rx_queries,
+                 (long long)r->rx_sampled, (long long)unsampled(r));
     if (rc == 0) {
-        if (!quiet(s))
+        if (!r->quiet)
             fprintf(stderr, "lagsimd: --log %s: %lld records, %lld bytes, complete%s\n", path,
                     (long long)st.records, (long long)st.bytes, refused);
         return 0;

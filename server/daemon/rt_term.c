@@ -20,87 +20,100 @@
 #include <sys/ioctl.h>
 #include <unistd.h>
 
-#include "rt_server.h"
+#include "rt_term.h"
 
 #define RT_TERM_WINDOW_NS RT_NS_PER_S /* commands per second: over the last second */
 
-static bool quiet(const rt_server *s) { return s->opts && s->opts->quiet; }
-
 /* Clears the live line, if it is on screen, so that what follows starts a fresh line. */
-static void clear_line(rt_server *s)
+static void clear_line(rt_term *t)
 {
-    if (s->term.line_shown) fputs("\r\033[K", stderr);
-    s->term.line_shown = false;
+    if (t->line_shown) fputs("\r\033[K", stderr);
+    t->line_shown = false;
 }
 
-void rt_term_event(rt_server *s, double sim_time, const char *kind, const char *joint,
-                   double value, const char *detail, bool effect)
+void rt_term_init(rt_term *t, bool quiet, const char *ch_event, int64_t now)
 {
-    if (quiet(s)) return;
-    int64_t suppressed = s->term.lim_print.suppressed;
-    if (!rt_limit_take(&s->term.lim_print, s->now)) return;
-    s->term.lim_print.suppressed = 0;
-    clear_line(s);
+    t->quiet = quiet;
+    t->ch_event = ch_event;
+    rt_limit_init(&t->lim_print, 20, 20, now);
+}
+
+void rt_term_event(rt_term *t, int64_t now, double sim_time, const char *kind,
+                   const char *joint, double value, const char *detail, bool effect)
+{
+    if (t->quiet) return;
+    int64_t suppressed = t->lim_print.suppressed;
+    if (!rt_limit_take(&t->lim_print, now)) return;
+    t->lim_print.suppressed = 0;
+    clear_line(t);
     if (suppressed > 0)
         fprintf(stderr, "lagsimd: (%lld more events not shown: at most 20 lines a second; "
-                "every event is on %s)\n", (long long)suppressed, s->ch_event);
+                "every event is on %s)\n", (long long)suppressed, t->ch_event);
     if (effect)
         fprintf(stderr, "lagsimd: event %s at t = %.9f s, joint %s, value %g\n", kind, sim_time,
                 joint && joint[0] ? joint : "-", value);
     else
         fprintf(stderr, "lagsimd: event %s at t = %.9f s%s%s: %s\n", kind, sim_time,
                 joint && joint[0] ? ", joint " : "", joint ? joint : "", detail ? detail : "");
-    if (s->live_line) rt_term_line(s, false);
+    if (t->live_line) rt_term_line(t, now, false);
     else fflush(stderr);
 }
 
-void rt_term_say(rt_server *s, const char *line)
+void rt_term_say(rt_term *t, int64_t now, const char *line)
 {
-    if (quiet(s)) return;
-    clear_line(s);
+    if (t->quiet) return;
+    clear_line(t);
     fprintf(stderr, "%s\n", line);
-    if (s->live_line) rt_term_line(s, false);
+    if (t->live_line) rt_term_line(t, now, false);
     else fflush(stderr);
 }
 
-void rt_term_line(rt_server *s, bool final)
+/* Commands accepted per second: since the newest redraw at least a second ago (or the
+ * oldest one kept, when the line is younger than that); the redraw is remembered. */
+static double command_rate(rt_term *t, int64_t now, int64_t accepted)
 {
-    if (!s->live_line) return;
-    /* commands accepted per second: since the newest redraw at least a second ago (or
-     * the oldest one kept, when the line is younger than that) */
     double rate = 0.0;
-    for (int k = 0; k < s->term.nsnap; k++) {
-        int i = (s->term.next_snap - 1 - k + 8) % 8;
-        int64_t span = s->now - s->term.snap_ns[i];
-        if (span > 0 && (span >= RT_TERM_WINDOW_NS || k == s->term.nsnap - 1))
-            rate = (double)(s->accepted - s->term.snap_n[i]) / ((double)span * 1e-9);
+    for (int k = 0; k < t->nsnap; k++) {
+        int i = (t->next_snap - 1 - k + 8) % 8;
+        int64_t span = now - t->snap_ns[i];
+        if (span > 0 && (span >= RT_TERM_WINDOW_NS || k == t->nsnap - 1))
+            rate = (double)(accepted - t->snap_n[i]) / ((double)span * 1e-9);
         if (span >= RT_TERM_WINDOW_NS) break;
     }
-    if (s->term.nsnap == 0 || s->now >= s->term.snap_ns[(s->term.next_snap + 7) % 8] + RT_NS_PER_S / 8) {
-        s->term.snap_ns[s->term.next_snap] = s->now;
-        s->term.snap_n[s->term.next_snap] = s->accepted;
-        s->term.next_snap = (s->term.next_snap + 1) % 8;
-        if (s->term.nsnap < 8) s->term.nsnap++;
+    if (t->nsnap == 0 || now >= t->snap_ns[(t->next_snap + 7) % 8] + RT_NS_PER_S / 8) {
+        t->snap_ns[t->next_snap] = now;
+        t->snap_n[t->next_snap] = accepted;
+        t->next_snap = (t->next_snap + 1) % 8;
+        if (t->nsnap < 8) t->nsnap++;
     }
+    return rate;
+}
+
+void rt_term_line(rt_term *t, int64_t now, bool final)
+{
+    if (!t->live_line || !t->view) return;
+    rt_term_view v;
+    memset(&v, 0, sizeof v);
+    t->view(t->ctx, &v);
+    double rate = command_rate(t, now, v.accepted);
     char q[160] = "";
     size_t n = 0;
-    for (int i = 0; i < s->nq && n < sizeof q; i++) {
-        int k = snprintf(q + n, sizeof q - n, "%s%+.3f", i ? " " : "", s->sim.q[i]);
+    for (int i = 0; i < v.nq && n < sizeof q; i++) {
+        int k = snprintf(q + n, sizeof q - n, "%s%+.3f", i ? " " : "", v.q[i]);
         if (k < 0) break;
         n += (size_t)k;
     }
     char ctl[32];
-    if (!s->have_command || s->watchdog_tripped) snprintf(ctl, sizeof ctl, "no controller");
+    if (!v.controller) snprintf(ctl, sizeof ctl, "no controller");
     else snprintf(ctl, sizeof ctl, "%.0f cmd/s", rate);
     char line[512];
     snprintf(line, sizeof line, "%s t=%.3f s RTF %.3f q=(%s) %s E=%+.4g J ovr %lld %s",
-             s->sc->lcm.prefix, lag_sim_time(&s->sim), s->rtf, q, ctl, lag_sim_energy(&s->sim),
-             (long long)s->overruns, rt_run_name(s->run));
+             v.prefix, v.t, v.rtf, q, ctl, v.energy, (long long)v.overruns, v.run);
     /* never wider than the terminal: a wrapped line cannot be redrawn in place */
     struct winsize ws;
     if (ioctl(STDERR_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 1 && ws.ws_col < sizeof line)
         line[ws.ws_col - 1] = '\0';
     fprintf(stderr, "\r\033[K%s%s", line, final ? "\n" : "");
     fflush(stderr);
-    s->term.line_shown = !final;
+    t->line_shown = !final;
 }

@@ -20,61 +20,49 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "rt_server.h"
+#include "lagsim_wire.h"
+#include "rt_wait.h"
 
 #define RT_WAIT_SHOW_NS RT_NS_PER_S         /* a lockstep wait is said after 1 s */
 #define RT_WAIT_LINE_NS (3 * RT_NS_PER_S)   /* the first line after 3 s of a wait, */
 #define RT_WAIT_LINE_MAX_NS (60 * RT_NS_PER_S) /* then at gaps as long as the wait, <= 1 min */
 
-/* What the plant waits for now (RT_WAIT_NONE: the run advances); *t: the sim_time a
- * lockstep answer must carry. */
-static rt_wait_kind wait_kind(const rt_server *s, double *t)
+void rt_wait_init(rt_wait *w, const lag_bus *bus, const char *prefix, bool lockstep)
 {
-    *t = 0;
-    if (s->run == RT_FAULT) return RT_WAIT_RESET;
-    if (s->run == RT_PAUSED && s->pending_steps == 0) return RT_WAIT_RESUME;
-    bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
-    if (s->run == RT_WAITING && s->pending_steps == 0 && !s->have_command) {
-        *t = lag_sim_time(&s->sim);
-        return RT_WAIT_FIRST;
-    }
-    if (lockstep && s->waiting && !s->answered &&
-        (s->run == RT_RUNNING || s->run == RT_WAITING || s->pending_steps > 0)) {
-        *t = s->waiting_time;
-        return RT_WAIT_ANSWER;
-    }
-    return RT_WAIT_NONE;
+    w->bus = bus;
+    w->prefix = prefix;
+    w->lockstep = lockstep;
 }
 
-void rt_wait_update(rt_server *s)
+void rt_wait_update(rt_wait *w, int64_t now, const rt_wait_seen *seen, rt_term *term)
 {
-    double t;
-    rt_wait_kind k = wait_kind(s, &t);
-    if (k != s->wt.kind || (k != RT_WAIT_NONE && t != s->wt.t)) {
-        s->wt.kind = k;
-        s->wt.t = t;
-        s->wt.since_ns = s->now;
-        s->wt.next_line_ns = rt_sat_add(s->now, RT_WAIT_LINE_NS);
-        memcpy(s->wt.rejected0, s->rejected, sizeof s->rejected);
-        s->wt.wrong_port0 = s->commands_wrong_port;
+    rt_wait_kind k = seen->kind;
+    double t = seen->t;
+    if (k != w->kind || (k != RT_WAIT_NONE && t != w->t)) {
+        w->kind = k;
+        w->t = t;
+        w->since_ns = now;
+        w->next_line_ns = rt_sat_add(now, RT_WAIT_LINE_NS);
+        memcpy(w->rejected0, seen->rejected, sizeof w->rejected0);
+        w->wrong_port0 = seen->wrong_port;
     }
-    if (k == RT_WAIT_NONE || s->now < s->wt.next_line_ns) return;
+    if (k == RT_WAIT_NONE || now < w->next_line_ns) return;
     /* 3, 6, 12, 24, 48 s, then every minute: a wait nobody answers does not fill the
      * terminal */
-    int64_t gap = s->now - s->wt.since_ns;
+    int64_t gap = now - w->since_ns;
     gap = gap < RT_WAIT_LINE_NS ? RT_WAIT_LINE_NS : gap > RT_WAIT_LINE_MAX_NS ? RT_WAIT_LINE_MAX_NS : gap;
-    s->wt.next_line_ns = rt_sat_add(s->now, gap);
+    w->next_line_ns = rt_sat_add(now, gap);
     char what[2 * LAG_WIRE_TEXT_LEN], got[2 * LAG_WIRE_TEXT_LEN]; /* the status cuts them */
-    double waited = rt_wait_describe(s, what, sizeof what, got, sizeof got);
+    double waited = rt_wait_describe(w, now, seen, what, sizeof what, got, sizeof got);
     char line[5 * LAG_WIRE_TEXT_LEN];
-    snprintf(line, sizeof line, "lagsimd: %s waits %.0f s for %s; %s%s", s->sc->lcm.prefix,
+    snprintf(line, sizeof line, "lagsimd: %s waits %.0f s for %s; %s%s", w->prefix,
              waited, what, got[0] ? "got instead: " : "nothing else came", got);
-    rt_term_say(s, line);
+    rt_term_say(term, now, line);
 }
 
-int64_t rt_wait_next(const rt_server *s)
+int64_t rt_wait_next(const rt_wait *w)
 {
-    return s->wt.kind == RT_WAIT_NONE ? INT64_MAX : s->wt.next_line_ns;
+    return w->kind == RT_WAIT_NONE ? INT64_MAX : w->next_line_ns;
 }
 
 /* Appends printf-style text to buf (of cap bytes, holding n), cut at its end. */
@@ -91,34 +79,37 @@ static size_t add(char *buf, size_t cap, size_t n, const char *fmt, ...)
     return n + (size_t)w < cap ? n + (size_t)w : cap - 1;
 }
 
-double rt_wait_describe(const rt_server *s, char *what, size_t whatlen, char *got, size_t gotlen)
+double rt_wait_describe(const rt_wait *w, int64_t now, const rt_wait_seen *seen, char *what,
+                        size_t whatlen, char *got, size_t gotlen)
 {
     what[0] = got[0] = '\0';
-    double t;
-    rt_wait_kind k = wait_kind(s, &t);
+    rt_wait_kind k = seen->kind;
+    double t = seen->t;
     /* a wait that began since the last update (a handler changed the run) is 0 s old */
-    bool same = k == s->wt.kind && (k == RT_WAIT_NONE || t == s->wt.t);
-    double waited = same ? (double)(s->now - s->wt.since_ns) * 1e-9 : 0.0;
+    bool same = k == w->kind && (k == RT_WAIT_NONE || t == w->t);
+    double waited = same ? (double)(now - w->since_ns) * 1e-9 : 0.0;
     if (k == RT_WAIT_NONE || (k == RT_WAIT_ANSWER && waited * 1e9 < (double)RT_WAIT_SHOW_NS))
         return 0.0;
-    const char *curl = s->bus.command_url;
+    const char *curl = w->bus->command_url;
+    const char *ch_command = w->bus->channel[LAG_BUS_COMMAND];
+    const char *ch_control = w->bus->channel[LAG_BUS_CONTROL];
     switch (k) {
     case RT_WAIT_FIRST:
-        if (s->sc->realtime.mode == LAG_RT_LOCKSTEP)
+        if (w->lockstep)
             snprintf(what, whatlen, "the first command (sim_time %.9g) on %s at %s", t,
-                     s->ch_command, curl);
+                     ch_command, curl);
         else
-            snprintf(what, whatlen, "the first command on %s at %s", s->ch_command, curl);
+            snprintf(what, whatlen, "the first command on %s at %s", ch_command, curl);
         break;
     case RT_WAIT_ANSWER:
         snprintf(what, whatlen, "a command answering sim_time %.9g on %s at %s", t,
-                 s->ch_command, curl);
+                 ch_command, curl);
         break;
     case RT_WAIT_RESUME:
-        snprintf(what, whatlen, "RESUME or STEP on %s at %s (paused)", s->ch_control, curl);
+        snprintf(what, whatlen, "RESUME or STEP on %s at %s (paused)", ch_control, curl);
         break;
     case RT_WAIT_RESET:
-        snprintf(what, whatlen, "RESET or RESET_TO on %s at %s (numeric fault)", s->ch_control,
+        snprintf(what, whatlen, "RESET or RESET_TO on %s at %s (numeric fault)", ch_control,
                  curl);
         break;
     case RT_WAIT_NONE: break;
@@ -126,26 +117,26 @@ double rt_wait_describe(const rt_server *s, char *what, size_t whatlen, char *go
     if (!same) return 0.0;
     /* what came instead, since the wait began */
     size_t n = 0;
-    int64_t bad = 0, stale = s->rejected[RT_REJ_STALE] - s->wt.rejected0[RT_REJ_STALE];
+    int64_t bad = 0, stale = seen->rejected[RT_REJ_STALE] - w->rejected0[RT_REJ_STALE];
     for (int r = 0; r < RT_REJ_COUNT; r++)
-        if (r != RT_REJ_STALE) bad += s->rejected[r] - s->wt.rejected0[r];
+        if (r != RT_REJ_STALE) bad += seen->rejected[r] - w->rejected0[r];
     if (bad > 0) {
         n = add(got, gotlen, n, "%lld command%s rejected (", (long long)bad, bad > 1 ? "s" : "");
         bool first = true;
         for (int r = 0; r < RT_REJ_COUNT; r++) {
-            int64_t d = s->rejected[r] - s->wt.rejected0[r];
+            int64_t d = seen->rejected[r] - w->rejected0[r];
             if (r == RT_REJ_STALE || d == 0) continue;
             n = add(got, gotlen, n, "%s%s %lld", first ? "" : ", ", rt_reject_name[r],
                     (long long)d);
             first = false;
         }
-        n = add(got, gotlen, n, "; the last: %s)", s->last_reject);
+        n = add(got, gotlen, n, "; the last: %s)", seen->last_reject);
     }
-    int64_t wrong = s->commands_wrong_port - s->wt.wrong_port0;
+    int64_t wrong = seen->wrong_port - w->wrong_port0;
     if (wrong > 0)
         n = add(got, gotlen, n, "%s%lld command%s on %s at the state port %d (commands go to "
-                "port %d)", n ? "; " : "", (long long)wrong, wrong > 1 ? "s" : "", s->ch_command,
-                s->bus.state_port, s->bus.command_port);
+                "port %d)", n ? "; " : "", (long long)wrong, wrong > 1 ? "s" : "", ch_command,
+                w->bus->state_port, w->bus->command_port);
     if (stale > 0)
         n = add(got, gotlen, n, "%s%lld answer%s to another sim_time", n ? "; " : "",
                 (long long)stale, stale > 1 ? "s" : "");

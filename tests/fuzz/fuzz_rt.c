@@ -301,7 +301,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             }
             double t;
             switch (u8(&b) % 3) {
-            case 0: t = g_s.waiting_time; break;
+            case 0: t = g_s.ls.waiting_time; break;
             case 1: t = lag_sim_time(&g_s.sim); break;
             default: t = dbl(&b); break;
             }

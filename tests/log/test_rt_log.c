@@ -134,7 +134,7 @@ static void start(const char *log, size_t ring)
     g_opts.log = log;
     g_opts.log_ring = ring;
     ENSUREF(rt_open(&g_srv, &g_sc, &g_opts, 1 * SEC, true, err, sizeof err) == 0, "%s", err);
-    ENSURE(g_srv.lg.log != NULL);
+    ENSURE(g_srv.rec.log != NULL);
     ENSUREF(rt_attach(&g_srv, g_lcm, g_lcm, err, sizeof err) == 0, "%s", err);
     rt_begin(&g_srv);
     drain();
@@ -145,7 +145,7 @@ static int finish(void)
 {
     rt_finish(&g_srv);
     drain();
-    int rc = rt_log_end(&g_srv);
+    int rc = rt_log_end(&g_srv.rec);
     rt_close(&g_srv);
     drain();
     return rc;
@@ -154,7 +154,7 @@ static int finish(void)
 static rt_log_stats stats(void)
 {
     rt_log_stats st;
-    rt_log_get_stats(g_srv.lg.log, &st);
+    rt_log_get_stats(g_srv.rec.log, &st);
     return st;
 }
 
@@ -287,7 +287,7 @@ static void case_file(void)
     ENSURE(stats().ring == RT_LOG_RING_DEFAULT);
     for (int k = 0; k < 300; k++) {
         run_until(g_srv.now + 10 * MS, 1000);
-        command(g_srv.waiting_time, 0.2 * sin(0.05 * k));
+        command(g_srv.ls.waiting_time, 0.2 * sin(0.05 * k));
     }
     control(LAGSIM_CONTROL_T_STATUS);
     run_until(g_srv.now + 5 * MS, 1000);
@@ -399,17 +399,17 @@ static void stalled_no_deadline(lag_rt_mode mode)
     if (g_answer) command(0.0, 0.0);
     /* fill the ring: the writer has stalled once the FIFO's buffer is full */
     double guard = wall_s() + 30;
-    while (rt_log_room(g_srv.lg.log)) {
+    while (rt_log_room(g_srv.rec.log)) {
         run_until(g_srv.now + 1 * MS, 1000);
         ENSUREF(wall_s() < guard && !g_srv.stop, "the ring never fills (%lld states)",
                 (long long)g_states);
     }
     run_until(g_srv.now + 2 * SEC, 1000);
     int64_t held = g_states;
-    ENSURE(!rt_log_room(g_srv.lg.log));
+    ENSURE(!rt_log_room(g_srv.rec.log));
     ENSUREF(rt_next_wake(&g_srv) > g_srv.now, "wake in %lld ns: waiting %d answered %d "
             "period_left %lld want %d%d%d", (long long)(rt_next_wake(&g_srv) - g_srv.now),
-            g_srv.waiting, g_srv.answered, (long long)g_srv.period_left, g_srv.want_state,
+            g_srv.ls.waiting, g_srv.ls.answered, (long long)g_srv.period_left, g_srv.want_state,
             g_srv.want_scene, g_srv.want_status); /* it sleeps while held */
     run_until(g_srv.now + 2 * SEC, 1000);
     ENSUREF(g_states == held, "%lld states while held, then %lld", (long long)held,
@@ -428,7 +428,7 @@ static void stalled_no_deadline(lag_rt_mode mode)
     guard = wall_s() + 60;
     while (!g_srv.stop) {
         run_until(g_srv.now + 1 * MS, 1000);
-        if (!rt_log_room(g_srv.lg.log)) usleep(200); /* let the writer write */
+        if (!rt_log_room(g_srv.rec.log)) usleep(200); /* let the writer write */
         ENSUREF(wall_s() < guard, "the run does not end (%lld states)", (long long)g_states);
     }
     ENSURE(g_states == 2001);
@@ -519,14 +519,14 @@ static void case_flood_refused(void)
         for (int k = 0; k < 2; k++) rt_handle_command(&g_srv, junk, sizeof junk);
         control(LAGSIM_CONTROL_T_STATUS);
         if (ms % 10 == 5) {
-            command(g_srv.waiting_time, 0.1 * sin(0.01 * ms));
+            command(g_srv.ls.waiting_time, 0.1 * sin(0.01 * ms));
             good++;
         }
     }
     run_until(t0 + 3500 * MS, 1000);
-    ENSURE(g_srv.lg.rx_refused == 36000 && g_srv.lg.rx_undecodable == 6000 &&
-           g_srv.lg.rx_queries == 3000);
-    int64_t sampled = g_srv.lg.rx_sampled, sampled_bytes = g_srv.lg.rx_sampled_bytes;
+    ENSURE(g_srv.rec.rx_refused == 36000 && g_srv.rec.rx_undecodable == 6000 &&
+           g_srv.rec.rx_queries == 3000);
+    int64_t sampled = g_srv.rec.rx_sampled, sampled_bytes = g_srv.rec.rx_sampled_bytes;
     ENSURE(finish() == 0); /* complete: nothing lost, the rest was counted by design */
     logfacts f;
     read_log(g_file, &f);

@@ -1080,7 +1080,7 @@ static void case_lockstep_retry(void)
     g_sc.realtime.lockstep_retry = 0.02;
     start();
     const int64_t t0 = g_srv.now;
-    ENSURE(g_out.state == 1 && g_srv.waiting && !g_srv.answered);
+    ENSURE(g_out.state == 1 && g_srv.ls.waiting && !g_srv.ls.answered);
     uint8_t first[RT_BUF_SIZE];
     unsigned first_len = g_srv.state_len;
     memcpy(first, g_srv.state_buf, first_len);
@@ -1127,7 +1127,7 @@ static void case_lockstep_retry(void)
     run_until(g_srv.now + 30 * MS, 1000);
     ENSURE(g_srv.lockstep_retries == 1);
     command(0.0, "cart", 1.0);
-    ENSURE(g_srv.rejected[RT_REJ_UNKNOWN_JOINT] == 1 && !g_srv.answered);
+    ENSURE(g_srv.rejected[RT_REJ_UNKNOWN_JOINT] == 1 && !g_srv.ls.answered);
     run_until(g_srv.now + 900 * MS, 1000);
     ENSUREF(g_srv.lockstep_retries == 1, "%lld copies after a rejected answer",
             (long long)g_srv.lockstep_retries);
@@ -1208,9 +1208,9 @@ static void case_waits(void)
     start();
     /* the command URL: the state URL's group on the next port (lagsim_bus.h, tested there) */
     char on_cmd[400], on_ctl[400];
-    snprintf(on_cmd, sizeof on_cmd, "on TL_COMMAND at %s", g_srv.bus.command_url);
-    snprintf(on_ctl, sizeof on_ctl, "on TL_CONTROL at %s (paused)", g_srv.bus.command_url);
-    ENSURE(strstr(g_srv.bus.command_url, ":7668"));
+    snprintf(on_cmd, sizeof on_cmd, "on TL_COMMAND at %s", g_srv.bus.urls.command_url);
+    snprintf(on_ctl, sizeof on_ctl, "on TL_CONTROL at %s (paused)", g_srv.bus.urls.command_url);
+    ENSURE(strstr(g_srv.bus.urls.command_url, ":7668"));
     run_until(g_srv.now + 2 * SEC, 1000);
     status_now();
     EXPECT_HAS(g_out.status_waiting_for, "the first command (sim_time 0) ");
@@ -1249,11 +1249,11 @@ static void case_waits(void)
     /* a wait nobody answers: its lines thin out, at 3, 6, 12, 24, 48, 96 s of the wait,
      * then a minute apart */
     run_until(g_srv.now + 20 * SEC, 1000000);
-    int64_t since = g_srv.wt.since_ns, next = rt_wait_next(&g_srv);
+    int64_t since = g_srv.wait.since_ns, next = rt_wait_next(&g_srv.wait);
     ENSUREF(next - since == 24 * SEC, "after %.1f s of a wait the next line at %.1f s of it (24)",
             (double)(g_srv.now - since) / SEC, (double)(next - since) / SEC);
     run_until(g_srv.now + 300 * SEC, 100000000);
-    next = rt_wait_next(&g_srv);
+    next = rt_wait_next(&g_srv.wait);
     /* (each line comes at the loop's first wake-up after it is due: 100 ms steps here) */
     ENSUREF(next > g_srv.now && next - g_srv.now <= 60 * SEC &&
                 (next - since - 96 * SEC) % (60 * SEC) < SEC,
@@ -1350,7 +1350,7 @@ static void case_other_plant(void)
     memcpy(other, g_out.scene_bytes, len);
     lcm_publish(g_lcm, "TL_SCENE", other, (unsigned)len); /* a copy of its own */
     run_until(g_srv.now + 100 * MS, 0);
-    ENSURE(!g_srv.stop && g_srv.other_plant[0] == '\0' && g_srv.sim.tick > 0);
+    ENSURE(!g_srv.stop && g_srv.bus.other_plant[0] == '\0' && g_srv.sim.tick > 0);
     other[8 + 7] ^= 1; /* utime, after the fingerprint */
     /* not a plant's: junk, a scene cut short, another prefix's scene */
     g_junk_scenes = true;
@@ -1361,7 +1361,7 @@ static void case_other_plant(void)
     pfx[0] = 'X';
     lcm_publish(g_lcm, "TL_SCENE", other, (unsigned)len);
     run_until(g_srv.now + 100 * MS, 0);
-    ENSURE(!g_srv.stop && g_srv.other_plant[0] == '\0');
+    ENSURE(!g_srv.stop && g_srv.bus.other_plant[0] == '\0');
     pfx[0] = 'T';
     /* another plant's scene (a forgery, an old log played back) while running: the plant
      * runs on, its states continue, the conflict is counted, published in status and said
@@ -1405,11 +1405,11 @@ static void case_other_plant(void)
     /* at start (before the daemon publishes: rt_bus_open's look) the same scene is noted,
      * not counted, for rt_bus_open to refuse the start */
     start();
-    g_srv.discard = true;
+    g_srv.bus.discard = true;
     lcm_publish(g_lcm, "TL_SCENE", other, (unsigned)len);
     drain();
-    ENSURE(g_srv.other_plant[0] != '\0' && g_srv.plant_conflicts == 0 && n_events("plant_conflict") == 0);
-    g_srv.discard = false;
+    ENSURE(g_srv.bus.other_plant[0] != '\0' && g_srv.plant_conflicts == 0 && n_events("plant_conflict") == 0);
+    g_srv.bus.discard = false;
     stop_server();
 }
 
@@ -1511,8 +1511,8 @@ static void case_live_error(void)
         if (on) {
             memcpy(q_on, g_srv.sim.q, sizeof q_on);
             memcpy(qd_on, g_srv.sim.qd, sizeof qd_on);
-            ENSUREF(g_srv.err_warnings >= 290, "%lld periods over the budget",
-                    (long long)g_srv.err_warnings);
+            ENSUREF(g_srv.est.warnings >= 290, "%lld periods over the budget",
+                    (long long)g_srv.est.warnings);
             const int64_t ev = n_events("error_estimate");
             ENSUREF(ev >= 3 && ev <= 3 + (int64_t)wall_s + 1, "%lld error_estimate events in "
                     "%.2f s", (long long)ev, wall_s);
@@ -1524,7 +1524,7 @@ static void case_live_error(void)
         }
         stop_server(); /* every number published finite */
         if (on) {
-            ENSURE(g_out.status_err_warnings == g_srv.err_warnings);
+            ENSURE(g_out.status_err_warnings == g_srv.est.warnings);
             ENSURE(g_out.status_err_budget == budget);
             ENSUREF(g_out.status_err_estimate > budget && g_out.status_err_estimate < 1e-3,
                     "estimate %g", g_out.status_err_estimate);

@@ -1,0 +1,87 @@
+/*
+ * The real-time server's bus (rt_bus.c): its LCM instances, the subscriptions, the
+ * channels, the encode buffer, and the plant watch (one plant per prefix).
+ *
+ * A part of the loop's (realtime.c holds one). What arrives is handed to the loop through
+ * the handlers it gives at attach (rt_bus_handlers), never decoded here; a scene heard on
+ * the prefix is judged here (rt_bus_foreign_scene) and what follows is the loop's.
+ */
+#ifndef LAGSIMD_RT_BUS_H
+#define LAGSIMD_RT_BUS_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <lcm/lcm.h>
+#include "lagsim_bus.h"
+#include "lagsim_wire.h"
+#include "scene.h"
+
+#define RT_CHANNEL_MAX LAG_BUS_CHANNEL_LEN /* prefix (< 64) + "_COMMAND" */
+#define RT_BUF_SIZE LAG_WIRE_BUF_SIZE      /* encode buffer: holds any message */
+#define RT_SCENES_KEPT 8 /* the last scenes published, to tell them from another plant's */
+
+/* What the loop does with a message: a command, a control request, a scene heard on the
+ * state URL (see rt_bus_foreign_scene). */
+typedef struct rt_bus_handlers {
+    void (*command)(void *ctx, const uint8_t *data, size_t len);
+    void (*control)(void *ctx, const uint8_t *data, size_t len);
+    void (*scene)(void *ctx, const uint8_t *data, size_t len);
+    void *ctx;
+} rt_bus_handlers;
+
+typedef struct rt_bus {
+    const lag_scene *sc;
+    lag_bus urls;              /* the URLs and channels (lagsim_bus.h) */
+    char ch_state[RT_CHANNEL_MAX], ch_command[RT_CHANNEL_MAX], ch_status[RT_CHANNEL_MAX],
+        ch_event[RT_CHANNEL_MAX], ch_control[RT_CHANNEL_MAX], ch_scene[RT_CHANNEL_MAX],
+        ch_reference[RT_CHANNEL_MAX];
+    lcm_t *lcm;                /* publishes on the state URL (never receives but _SCENE) */
+    lcm_t *lcm_in;             /* receives _COMMAND and _CONTROL on the command URL (the
+                                * same lcm_t as `lcm` for memq://) */
+    lcm_subscription_t *sub_command, *sub_control;
+    lcm_subscription_t *sub_scene; /* _SCENE on the state URL: another plant's (plant watch) */
+    lcm_subscription_t *sub_wrong_port; /* _COMMAND on the state URL: counted, not applied */
+    rt_bus_handlers on;
+    bool discard;              /* drop commands and control requests: before the start,
+                                * LCM's queues may hold datagrams that came in before the
+                                * filter */
+    int64_t commands_wrong_port; /* joint_command_t heard on the state URL */
+    /* one plant per prefix: the scenes this daemon published (FNV-1a of their bytes, which
+     * include utime), and what was heard from another plant */
+    uint64_t scene_sent[RT_SCENES_KEPT];
+    int scene_next;
+    char other_plant[160];     /* what gave it away, the last one heard ("" = nothing) */
+    uint8_t buf[RT_BUF_SIZE];  /* the one encode buffer */
+} rt_bus;
+
+/* The URLs and channels of the scene's lcm section, by the rule every client follows
+ * (lagsim_bus.h); no LCM yet. Returns 0, or -1 with a message in err. */
+int rt_bus_init(rt_bus *b, const lag_scene *sc, char *err, size_t errlen);
+/* Publishes on `out` and subscribes to _COMMAND and _CONTROL on `in` (the same lcm_t for
+ * memq://; the caller owns both and destroys them after rt_bus_detach), and to _SCENE on
+ * `out`; what arrives goes to `h`. Returns 0, or an exit code with a message in err. */
+int rt_bus_attach(rt_bus *b, lcm_t *out, lcm_t *in, const rt_bus_handlers *h, char *err,
+                  size_t errlen);
+/* Unsubscribes (the caller destroys its lcm). */
+void rt_bus_detach(rt_bus *b);
+/* The daemon's LCM instances: one publishing on the state URL, one receiving on the
+ * command URL (one lcm_t for memq://), attached with `h`; before anything is published,
+ * the look for another plant on the prefix; and what the daemon says about them at start.
+ * Leaves b->discard set (the loop clears it at the start). Returns 0, or an exit code with
+ * a message in err; rt_bus_close detaches and destroys what rt_bus_open made. */
+int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen);
+void rt_bus_close(rt_bus *b);
+
+/* FNV-1a, 64 bits: how a published scene is remembered. */
+uint64_t rt_bus_hash(const uint8_t *data, size_t len);
+/* A scene this daemon published (encoded in data): remembered. */
+void rt_bus_sent_scene(rt_bus *b, const uint8_t *data, size_t len);
+/* A scene heard on this prefix: one that decodes, names this prefix and is not one this
+ * daemon published is another plant's (or a forgery, or an old log played back), and is
+ * noted in b->other_plant. At start (b->discard) that is all (rt_bus_open refuses to
+ * start); returns true when one is heard while running (the loop says so). Anything else
+ * on the channel is ignored. */
+bool rt_bus_foreign_scene(rt_bus *b, const uint8_t *data, size_t len);
+
+#endif
