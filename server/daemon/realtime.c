@@ -1397,7 +1397,7 @@ static void handled_signals(sigset_t *set)
     sigaddset(set, SIGUSR2);
 }
 
-int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
+lag_result lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
 {
     static rt_server srv; /* large (encode buffer): static, one server per process */
     rt_server *s = &srv;
