@@ -465,9 +465,9 @@ static lag_result send_control(lag_client *c, int8_t request, int64_t count, int
 }
 
 lag_result lag_client_pause(lag_client *c) { return send_control(c, LAGSIM_CONTROL_T_PAUSE, 0, 0, NULL, NULL); }
-                            lag_result lag_client_resume(lag_client *c) { return send_control(c, LAGSIM_CONTROL_T_RESUME, 0, 0, NULL, NULL); }
-                            lag_result lag_client_reset(lag_client *c) { return send_control(c, LAGSIM_CONTROL_T_RESET, 0, 0, NULL, NULL); }
-                            lag_result lag_client_request_status(lag_client *c)
+lag_result lag_client_resume(lag_client *c) { return send_control(c, LAGSIM_CONTROL_T_RESUME, 0, 0, NULL, NULL); }
+lag_result lag_client_reset(lag_client *c) { return send_control(c, LAGSIM_CONTROL_T_RESET, 0, 0, NULL, NULL); }
+lag_result lag_client_request_status(lag_client *c)
 {
     return send_control(c, LAGSIM_CONTROL_T_STATUS, 0, 0, NULL, NULL);
 }

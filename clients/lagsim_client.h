@@ -152,9 +152,9 @@ lag_result lag_client_send_command(lag_client *c, double sim_time, int n, const 
 lag_result lag_client_pause(lag_client *c);
 lag_result lag_client_resume(lag_client *c);
 lag_result lag_client_step(lag_client *c, int64_t count);           /* control periods, >= 1 */
-                           lag_result lag_client_reset(lag_client *c);                         /* scene's initial state */
-                           lag_result lag_client_reset_to(lag_client *c, int n, const double *q, const double *qd); /* finite */
-                           lag_result lag_client_request_status(lag_client *c);
+lag_result lag_client_reset(lag_client *c);                         /* scene's initial state */
+lag_result lag_client_reset_to(lag_client *c, int n, const double *q, const double *qd); /* finite */
+lag_result lag_client_request_status(lag_client *c);
 lag_result lag_client_request_describe(lag_client *c);
 /* SET: changes a scene key under parameters or effects while running, e.g. ("parameters.m2",
  * "1.25"), value in YAML; the daemon validates it as the scene file and answers with a
