@@ -137,7 +137,7 @@ static bool decode(lag_client *c, lag_wire_type t, const void *data, size_t len)
 }
 
 /* One message from `channel`: decoded, kept, passed to the callback. */
-static int dispatch(lag_client *c, const char *channel, const void *data, size_t len)
+static lag_result dispatch(lag_client *c, const char *channel, const void *data, size_t len)
 {
     if (!strcmp(channel, c->ch_state)) {
         if (!decode(c, LAG_WIRE_JOINT_STATE, data, len)) return LAG_CLIENT_OK;
@@ -194,7 +194,7 @@ static void on_message(const lcm_recv_buf_t *rbuf, const char *channel, void *us
     dispatch(user, channel, rbuf->data, rbuf->data_size);
 }
 
-int lag_client_feed(lag_client *c, const char *channel, const void *data, size_t len)
+lag_result lag_client_feed(lag_client *c, const char *channel, const void *data, size_t len)
 {
     if (!channel || (!data && len > 0)) {
         set_err(c, "feed: NULL channel or data");
@@ -306,7 +306,7 @@ void lag_client_get_counters(const lag_client *c, lag_client_counters *out)
 
 /* ---------------------------------------------------------------- waiting */
 
-int lag_client_handle(lag_client *c, int timeout_ms)
+lag_result lag_client_handle(lag_client *c, int timeout_ms)
 {
     if (timeout_ms < 0) timeout_ms = 0;
     errno = 0;
@@ -321,7 +321,7 @@ int lag_client_handle(lag_client *c, int timeout_ms)
 
 /* Handles messages until `flag` becomes true or the deadline (monotonic s) passes.
  * Returns LAG_CLIENT_OK if flag, LAG_CLIENT_TIMEOUT, or an error. */
-static int handle_until(lag_client *c, const bool *flag, double deadline)
+static lag_result handle_until(lag_client *c, const bool *flag, double deadline)
 {
     while (!*flag) {
         double left = deadline - lag_client_now();
@@ -333,7 +333,7 @@ static int handle_until(lag_client *c, const bool *flag, double deadline)
     return LAG_CLIENT_OK;
 }
 
-int lag_client_wait_scene(lag_client *c, double timeout_s, lag_client_scene *sc)
+lag_result lag_client_wait_scene(lag_client *c, double timeout_s, lag_client_scene *sc)
 {
     double t0 = lag_client_now(), deadline = t0 + timeout_s;
     while (!c->have_scene) {
@@ -353,7 +353,7 @@ int lag_client_wait_scene(lag_client *c, double timeout_s, lag_client_scene *sc)
     return LAG_CLIENT_OK;
 }
 
-int lag_client_wait_state(lag_client *c, double timeout_s, lag_client_state *st)
+lag_result lag_client_wait_state(lag_client *c, double timeout_s, lag_client_state *st)
 {
     int rc = handle_until(c, &c->new_state, lag_client_now() + timeout_s);
     if (rc != LAG_CLIENT_OK) {
@@ -393,7 +393,7 @@ bool lag_client_latest_reference(const lag_client *c, lag_client_reference *ref)
 /* ---------------------------------------------------------------- sending */
 
 /* Encodes message m of type t and publishes it on channel. */
-static int publish(lag_client *c, const char *channel, lag_wire_type t, const void *m)
+static lag_result publish(lag_client *c, const char *channel, lag_wire_type t, const void *m)
 {
     int n = lag_wire_encode(t, m, c->buf, sizeof c->buf);
     if (n < 0) {
@@ -407,8 +407,8 @@ static int publish(lag_client *c, const char *channel, lag_wire_type t, const vo
     return LAG_CLIENT_OK;
 }
 
-int lag_client_send_command(lag_client *c, double sim_time, int n, const char *const *names,
-                            const double *effort)
+lag_result lag_client_send_command(lag_client *c, double sim_time, int n, const char *const *names,
+                                   const double *effort)
 {
     if (n < 0 || n > LAG_CLIENT_MAX_JOINTS || (n > 0 && (!names || !effort))) {
         set_err(c, "send_command: %d joints (0 to %d, with names and efforts)", n,
@@ -442,8 +442,8 @@ int lag_client_send_command(lag_client *c, double sim_time, int n, const char *c
     return rc;
 }
 
-static int send_control(lag_client *c, int8_t request, int64_t count, int n, const double *q,
-                        const double *qd)
+static lag_result send_control(lag_client *c, int8_t request, int64_t count, int n, const double *q,
+                               const double *qd)
 {
     lag_wire_control m;
     memset(&m, 0, sizeof m);
@@ -464,19 +464,19 @@ static int send_control(lag_client *c, int8_t request, int64_t count, int n, con
     return rc;
 }
 
-int lag_client_pause(lag_client *c) { return send_control(c, LAGSIM_CONTROL_T_PAUSE, 0, 0, NULL, NULL); }
-int lag_client_resume(lag_client *c) { return send_control(c, LAGSIM_CONTROL_T_RESUME, 0, 0, NULL, NULL); }
-int lag_client_reset(lag_client *c) { return send_control(c, LAGSIM_CONTROL_T_RESET, 0, 0, NULL, NULL); }
-int lag_client_request_status(lag_client *c)
+lag_result lag_client_pause(lag_client *c) { return send_control(c, LAGSIM_CONTROL_T_PAUSE, 0, 0, NULL, NULL); }
+lag_result lag_client_resume(lag_client *c) { return send_control(c, LAGSIM_CONTROL_T_RESUME, 0, 0, NULL, NULL); }
+lag_result lag_client_reset(lag_client *c) { return send_control(c, LAGSIM_CONTROL_T_RESET, 0, 0, NULL, NULL); }
+lag_result lag_client_request_status(lag_client *c)
 {
     return send_control(c, LAGSIM_CONTROL_T_STATUS, 0, 0, NULL, NULL);
 }
-int lag_client_request_describe(lag_client *c)
+lag_result lag_client_request_describe(lag_client *c)
 {
     return send_control(c, LAGSIM_CONTROL_T_DESCRIBE, 0, 0, NULL, NULL);
 }
 
-int lag_client_set(lag_client *c, const char *key, const char *value)
+lag_result lag_client_set(lag_client *c, const char *key, const char *value)
 {
     lag_wire_control m;
     memset(&m, 0, sizeof m);
@@ -495,7 +495,7 @@ int lag_client_set(lag_client *c, const char *key, const char *value)
     return rc;
 }
 
-int lag_client_kick(lag_client *c, const char *joint, double impulse, double duration)
+lag_result lag_client_kick(lag_client *c, const char *joint, double impulse, double duration)
 {
     char key[LAG_WIRE_NAME_LEN], value[64];
     if (!joint || !joint[0] || snprintf(key, sizeof key, "kick.%s", joint) >= (int)sizeof key ||
@@ -509,12 +509,12 @@ int lag_client_kick(lag_client *c, const char *joint, double impulse, double dur
     return lag_client_set(c, key, value);
 }
 
-int lag_client_reset_scene(lag_client *c)
+lag_result lag_client_reset_scene(lag_client *c)
 {
     return send_control(c, LAGSIM_CONTROL_T_RESET, 1, 0, NULL, NULL);
 }
 
-int lag_client_step(lag_client *c, int64_t count)
+lag_result lag_client_step(lag_client *c, int64_t count)
 {
     if (count < 1) {
         set_err(c, "step: count must be >= 1, got %lld", (long long)count);
@@ -523,7 +523,7 @@ int lag_client_step(lag_client *c, int64_t count)
     return send_control(c, LAGSIM_CONTROL_T_STEP, count, 0, NULL, NULL);
 }
 
-int lag_client_reset_to(lag_client *c, int n, const double *q, const double *qd)
+lag_result lag_client_reset_to(lag_client *c, int n, const double *q, const double *qd)
 {
     if (n < 1 || n > LAG_CLIENT_MAX_JOINTS || !q || !qd) {
         set_err(c, "reset_to: %d joints (1 to %d, with q and qd)", n, LAG_CLIENT_MAX_JOINTS);
@@ -728,8 +728,8 @@ static void disc_ask(disc *d, lcm_t *cmd, int i, uint8_t *buf, size_t cap)
     d->asked[i] = lag_client_now();
 }
 
-int lag_client_discover(const char *url, double wait_s, double settle_s,
-                        lag_client_plant *plants, int max, int *n, char *err, size_t errlen)
+lag_result lag_client_discover(const char *url, double wait_s, double settle_s,
+                               lag_client_plant *plants, int max, int *n, char *err, size_t errlen)
 {
     if (n) *n = 0;
     if (err && errlen) err[0] = '\0';
@@ -817,8 +817,8 @@ static void plant_names(const lag_client_plant *p, int n, char *out, size_t cap)
     }
 }
 
-int lag_client_pick_plant(const char *url, const char *model, double wait_s,
-                          lag_client_plant *out, char *err, size_t errlen)
+lag_result lag_client_pick_plant(const char *url, const char *model, double wait_s,
+                                 lag_client_plant *out, char *err, size_t errlen)
 {
     if (err && errlen) err[0] = '\0';
     if (!out) {

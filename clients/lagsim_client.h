@@ -13,10 +13,10 @@
  *   }
  *   lag_client_destroy(c);
  *
- * One return convention (SQLite's): every function returning int returns LAG_CLIENT_OK
- * (0) on success, LAG_CLIENT_TIMEOUT (> 0) when nothing arrived in time (not an error),
- * or a negative error code, with a message kept on the handle (lag_client_errmsg). The
- * library never prints and never exits. Not thread-safe: use one handle per thread.
+ * One return convention (SQLite's): every function returning lag_result (lagsim/result.h)
+ * returns LAG_CLIENT_OK (0) on success, LAG_CLIENT_TIMEOUT (> 0) when nothing arrived in
+ * time (not an error), or a negative error code, with a message kept on the handle
+ * (lag_client_errmsg). The library never prints and never exits. Not thread-safe: use one handle per thread.
  *
  * Messages are decoded by lagsim's bounded wire module (lagsim_wire.h) into its
  * fixed-size structs, which are this library's message types: every field of every
@@ -41,6 +41,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "lagsim/result.h"
 #include "lagsim_wire.h"
 
 #ifdef __cplusplus
@@ -51,16 +52,17 @@ extern "C" {
 #define LAG_CLIENT_MAX_PARAMS LAG_WIRE_MAX_PARAMS   /* 16 */
 #define LAG_CLIENT_NAME_LEN LAG_WIRE_NAME_LEN       /* 64: 63 bytes + NUL */
 
-/* Result codes. */
-enum {
-    LAG_CLIENT_OK = 0,
-    LAG_CLIENT_TIMEOUT = 2,      /* nothing arrived in time (not an error); a positive
-                                  * value other than 1, so that it never reads as "true" */
-    LAG_CLIENT_ERR_ARG = -1,     /* bad argument (message says which) */
-    LAG_CLIENT_ERR_LCM = -2,     /* LCM could not be created, publish or handle failed */
-    LAG_CLIENT_ERR_NOMEM = -3,
-    LAG_CLIENT_ERR_AMBIGUOUS = -4 /* several plants could be meant (message names them) */
-};
+/* Result codes: the one space of lagsim/result.h (lag_result). The client's names stay,
+ * as aliases of its codes, with the values they always had. */
+#define LAG_CLIENT_OK LAG_OK
+#define LAG_CLIENT_TIMEOUT LAG_TIMEOUT             /* nothing arrived in time (not an error);
+                                                    * positive, 2: never reads as "true" */
+#define LAG_CLIENT_ERR_ARG LAG_ERR_ARG             /* bad argument (message says which) */
+#define LAG_CLIENT_ERR_LCM LAG_ERR_LCM             /* LCM could not be created, publish or
+                                                      handle failed */
+#define LAG_CLIENT_ERR_NOMEM LAG_ERR_NOMEM
+#define LAG_CLIENT_ERR_AMBIGUOUS LAG_ERR_AMBIGUOUS /* several plants could be meant (message
+                                                      names them) */
 
 /* The messages, as the wire module decodes them (every field of the .lcm types; the
  * field meanings are in lcmtypes/<type>.lcm and docs/messages.md). */
@@ -104,13 +106,13 @@ int lag_client_fileno(const lag_client *c);
  * Returns LAG_CLIENT_OK if a message was handled (kept or dropped), LAG_CLIENT_TIMEOUT if
  * none arrived (or a signal interrupted the wait), < 0 on error. Callbacks run from
  * inside this call. */
-int lag_client_handle(lag_client *c, int timeout_ms);
+lag_result lag_client_handle(lag_client *c, int timeout_ms);
 
 /* Handles one message as if it had arrived on `channel` (one of this handle's
  * <prefix>_STATE, _STATUS, _EVENT, _SCENE, _REFERENCE): decoding, counters, callbacks, as for the
  * bus. For messages read elsewhere (a log file) and for tests. Returns LAG_CLIENT_OK
  * (kept or dropped: the counters say which) or LAG_CLIENT_ERR_ARG for another channel. */
-int lag_client_feed(lag_client *c, const char *channel, const void *data, size_t len);
+lag_result lag_client_feed(lag_client *c, const char *channel, const void *data, size_t len);
 
 /* Callbacks (NULL to remove), called for every kept message from lag_client_handle. */
 void lag_client_on_state(lag_client *c, lag_client_state_fn fn, void *user);
@@ -121,12 +123,12 @@ void lag_client_on_scene(lag_client *c, lag_client_scene_fn fn, void *user);
 /* Waits up to timeout_s (wall seconds) for the scene description, sending a DESCRIBE
  * request at once and every 0.25 s until it arrives (a scene already received counts).
  * Returns LAG_CLIENT_OK, LAG_CLIENT_TIMEOUT or an error. OUT: sc */
-int lag_client_wait_scene(lag_client *c, double timeout_s, lag_client_scene *sc);
+lag_result lag_client_wait_scene(lag_client *c, double timeout_s, lag_client_scene *sc);
 
 /* Waits up to timeout_s for a state not yet returned by this function (the newest one
  * if several arrived: a controller wants the latest). Returns LAG_CLIENT_OK with *st
  * filled, LAG_CLIENT_TIMEOUT, or an error. OUT: st */
-int lag_client_wait_state(lag_client *c, double timeout_s, lag_client_state *st);
+lag_result lag_client_wait_state(lag_client *c, double timeout_s, lag_client_state *st);
 
 /* Polling: the latest state / status received, whether or not already returned.
  * Return false if none has arrived yet. OUT: st */
@@ -143,31 +145,31 @@ bool lag_client_latest_reference(const lag_client *c, lag_client_reference *ref)
  * N m), answering the state at sim_time (lockstep advances on it; pass the sim_time of
  * the state the effort was computed from). Joints not named keep their effort. A
  * non-finite effort or sim_time, or a name of 64 bytes or more, is refused. */
-int lag_client_send_command(lag_client *c, double sim_time, int n, const char *const *names,
-                            const double *effort);
+lag_result lag_client_send_command(lag_client *c, double sim_time, int n, const char *const *names,
+                                   const double *effort);
 
 /* Control requests on <prefix>_CONTROL (lagsim_control_t). */
-int lag_client_pause(lag_client *c);
-int lag_client_resume(lag_client *c);
-int lag_client_step(lag_client *c, int64_t count);           /* control periods, >= 1 */
-int lag_client_reset(lag_client *c);                         /* scene's initial state */
-int lag_client_reset_to(lag_client *c, int n, const double *q, const double *qd); /* finite */
-int lag_client_request_status(lag_client *c);
-int lag_client_request_describe(lag_client *c);
+lag_result lag_client_pause(lag_client *c);
+lag_result lag_client_resume(lag_client *c);
+lag_result lag_client_step(lag_client *c, int64_t count);           /* control periods, >= 1 */
+lag_result lag_client_reset(lag_client *c);                         /* scene's initial state */
+lag_result lag_client_reset_to(lag_client *c, int n, const double *q, const double *qd); /* finite */
+lag_result lag_client_request_status(lag_client *c);
+lag_result lag_client_request_describe(lag_client *c);
 /* SET: changes a scene key under parameters or effects while running, e.g. ("parameters.m2",
  * "1.25"), value in YAML; the daemon validates it as the scene file and answers with a
  * `set` event (and the new scene) or `control_rejected` with the reason. */
-int lag_client_set(lag_client *c, const char *key, const char *value);
+lag_result lag_client_set(lag_client *c, const char *key, const char *value);
 
 /* A kick: a disturbance on joint `joint` from the current sim time on, adding to the
  * scene's disturbances and to earlier kicks: impulse N s (N m s on an angle) at once
  * (duration 0), or spread as a force impulse/duration over duration s. Sent as SET
  * "kick.<joint>" = "<impulse>[,<duration>]"; answered by a `kick` event (replayed exactly
  * from a log) or control_rejected with the reason. */
-int lag_client_kick(lag_client *c, const char *joint, double impulse, double duration);
+lag_result lag_client_kick(lag_client *c, const char *joint, double impulse, double duration);
 /* RESET to the scene file's initial state and values: the changes made by SET and the
  * kicks are undone (a `restore` event says which), then the `reset` event. */
-int lag_client_reset_scene(lag_client *c);
+lag_result lag_client_reset_scene(lag_client *c);
 
 void lag_client_get_counters(const lag_client *c, lag_client_counters *out);
 
@@ -203,16 +205,16 @@ typedef struct lag_client_plant {
  * wait_s). Plants are sorted by prefix; at most max (<= LAG_CLIENT_MAX_PLANTS) are kept,
  * the number in *n (a note in err if more were heard). Returns LAG_CLIENT_OK (also when
  * none was heard: *n = 0) or an error with a message in err. OUT: plants, n */
-int lag_client_discover(const char *url, double wait_s, double settle_s,
-                        lag_client_plant *plants, int max, int *n, char *err, size_t errlen);
+lag_result lag_client_discover(const char *url, double wait_s, double settle_s,
+                               lag_client_plant *plants, int max, int *n, char *err, size_t errlen);
 
 /* The plant a program talks to when the user named none: the only plant on the bus (of
  * `model`, unless NULL). Returns LAG_CLIENT_OK with *out; LAG_CLIENT_TIMEOUT when there is
  * none within wait_s (err says so, naming the plants of other models heard);
  * LAG_CLIENT_ERR_AMBIGUOUS when several run (err names them: prefix, model, run state);
  * another error. OUT: out */
-int lag_client_pick_plant(const char *url, const char *model, double wait_s,
-                          lag_client_plant *out, char *err, size_t errlen);
+lag_result lag_client_pick_plant(const char *url, const char *model, double wait_s,
+                                 lag_client_plant *out, char *err, size_t errlen);
 
 /* Wall clock (CLOCK_MONOTONIC) in seconds, for controllers' own timing. */
 double lag_client_now(void);

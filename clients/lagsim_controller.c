@@ -196,22 +196,22 @@ int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
             else
                 fprintf(stderr, "%s: unknown option '%s'\n", ctl->name, argv[optind - 1]);
             fprintf(stderr, "%s: --help lists the options\n", ctl->name);
-            return 2;
+            return lag_result_exit(LAG_ERR_USAGE);
         }
         char err[256];
         if (o->set(optarg, o->target, err, sizeof err) != 0) {
             fprintf(stderr, "%s: --%s: %s\n", ctl->name, o->name, err);
-            return 2;
+            return lag_result_exit(LAG_ERR_USAGE);
         }
     }
     if (optind < argc) {
         fprintf(stderr, "%s: unexpected argument '%s' (--help lists the options)\n", ctl->name,
                 argv[optind]);
-        return 2;
+        return lag_result_exit(LAG_ERR_USAGE);
     }
     if (help) {
         usage(ctl, stdout, what, all, n);
-        return 0;
+        return lag_result_exit(LAG_OK);
     }
     return -1;
 }
@@ -272,7 +272,8 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
             printf("%s: %s; waiting for prefix %s\n", ctl->name, perr, ctl->prefix);
         } else {
             fprintf(stderr, "%s: %s\n", ctl->name, perr);
-            ctl->fail_code = rc == LAG_CLIENT_ERR_AMBIGUOUS ? 2 : 1; /* several: --prefix */
+            ctl->fail_code = lag_result_exit(rc == LAG_CLIENT_ERR_AMBIGUOUS ? LAG_ERR_AMBIGUOUS
+                                                                        : LAG_ERR_RUNTIME);
             return ctl->fail_code;
         }
     }
@@ -415,7 +416,7 @@ int lag_ctl_finish(lag_ctl *ctl, const char *fmt, ...)
     ctl->trace = NULL;
     lag_client_destroy(ctl->client);
     ctl->client = NULL;
-    return ctl->failed ? 1 : 0;
+    return lag_result_exit(ctl->failed ? LAG_ERR_RUNTIME : LAG_OK);
 }
 
 int lag_ctl_fail(lag_ctl *ctl)
@@ -424,5 +425,5 @@ int lag_ctl_fail(lag_ctl *ctl)
     ctl->trace = NULL;
     lag_client_destroy(ctl->client);
     ctl->client = NULL;
-    return ctl->fail_code ? ctl->fail_code : 1;
+    return ctl->fail_code ? ctl->fail_code : lag_result_exit(LAG_ERR_RUNTIME);
 }

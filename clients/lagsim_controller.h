@@ -140,11 +140,12 @@ int lag_ctl_command(lag_ctl *ctl, const lag_client_state *st, int n, const char 
 
 /* Prints "<name>: summary end=<end> <fmt...> dropped=<n> repeats=<n>" on stdout (repeats:
  * copies of a state answered again by the client, lagsim_client.h), closes the trace and
- * the client. Returns the exit status: 0, or 1 when a client error ended the run. */
+ * the client. Returns the exit status (lag_result_exit): 0, or 1 when a client error ended
+ * the run. */
 int lag_ctl_finish(lag_ctl *ctl, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /* Closes the trace and the client without a summary (a run that could not start).
- * Returns 1, the exit status. */
+ * Returns the exit status (lag_result_exit): 1, or 2 when several plants could be meant. */
 int lag_ctl_fail(lag_ctl *ctl);
 
 #ifdef __cplusplus

@@ -38,7 +38,12 @@
 #include "lagsim_bus.h"
 #include "lagsim_wire.h"
 
-enum { EXIT_OK = 0, EXIT_REFUSED = 1, EXIT_USAGE = 2, EXIT_NOANSWER = 3 };
+/* What lagsimctl ends with: codes of the one space (lagsim/result.h); main() turns them
+ * into exit statuses with lag_result_exit (0, 1, 2, 3 for these four). */
+#define EXIT_OK LAG_OK
+#define EXIT_REFUSED LAG_ERR_REFUSED
+#define EXIT_USAGE LAG_ERR_USAGE
+#define EXIT_NOANSWER LAG_ERR_NOANSWER
 
 static volatile sig_atomic_t g_signal = 0;
 static void on_signal(int sig) { g_signal = sig; }
@@ -437,8 +442,8 @@ static void on_scene(const lag_client_scene *sc, void *user)
 
 /* Handles messages until done(), or until `timeout` wall s have passed (since the
  * start, or with `silence`, since the last message from the daemon). */
-static int wait_for(lag_client *c, answer *a, double timeout, bool silence,
-                    bool (*done)(const answer *))
+static lag_result wait_for(lag_client *c, answer *a, double timeout, bool silence,
+                           bool (*done)(const answer *))
 {
     double t0 = lag_client_now();
     while (!done(a) && !g_signal) {
@@ -461,7 +466,7 @@ static bool step_done(const answer *a) { return a->refused || (a->got_event2 && 
 
 /* ---------------------------------------------------------------- list */
 /* Every plant on the bus, a table for people (or a JSON array): exit 0, or 3 if none. */
-static int list_plants(const char *url, double wait_s)
+static lag_result list_plants(const char *url, double wait_s)
 {
     static lag_client_plant p[LAG_CLIENT_MAX_PLANTS];
     int n = 0;
@@ -534,7 +539,7 @@ static int parse_doubles(char **argv, int n, double *out)
     return 0;
 }
 
-int main(int argc, char **argv)
+static lag_result lagsimctl_main(int argc, char **argv)
 {
     const char *prefix = NULL, *url = NULL;
     double timeout = 2.0;
@@ -785,4 +790,9 @@ int main(int argc, char **argv)
     }
     lag_client_destroy(c);
     return code;
+}
+
+int main(int argc, char **argv)
+{
+    return lag_result_exit(lagsimctl_main(argc, argv));
 }

@@ -91,7 +91,7 @@ int main(int argc, char **argv)
     for (int i = 0; i < qw.n; i++)
         if (qw.v[i] < 0) {
             fprintf(stderr, "lqr_balance: --q: weights must be >= 0, got %g\n", qw.v[i]);
-            return 2;
+            return lag_result_exit(LAG_ERR_USAGE);
         }
     if (lag_ctl_start(&ctl, NULL)) return lag_ctl_fail(&ctl);
     const lag_client_scene sc = ctl.scene;

@@ -46,6 +46,7 @@ foreach(t lagsim_controller lagsim_client lagsim_wire lagsim_lcmtypes lagsim_cor
   endif()
 endforeach()
 install(FILES ${PROJECT_SOURCE_DIR}/server/include/lagsim/lagsim.h
+              ${PROJECT_SOURCE_DIR}/server/include/lagsim/result.h
               ${PROJECT_SOURCE_DIR}/clients/lagsim_client.h
               ${PROJECT_SOURCE_DIR}/clients/lagsim_controller.h
               ${PROJECT_SOURCE_DIR}/server/wire/lagsim_wire.h

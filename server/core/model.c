@@ -21,23 +21,6 @@ const lag_model_class *const lag_models[] = {
 _Static_assert(sizeof lag_models / sizeof lag_models[0] == LAG_MODEL_COUNT,
                "the model table needs one row per lag_model_kind");
 
-const char *lag_result_string(lag_result r)
-{
-    switch (r) {
-    case LAG_OK: return "ok";
-    case LAG_ERR_ARG: return "invalid argument";
-    case LAG_ERR_SINGULAR: return "mass matrix not positive definite";
-    case LAG_ERR_NONFINITE: return "non-finite state";
-    case LAG_ERR_EXPLODE: return "state exceeded explode_limit";
-    case LAG_ERR_NEWTON: return "implicit solver (Newton) did not converge";
-    case LAG_ERR_STEPSIZE: return "adaptive step size fell below dt_min";
-    case LAG_ERR_MAX_STEPS: return "adaptive method needed more than max_steps steps for one tick";
-    case LAG_ERR_LIFTOFF: return "stick lifted off the floor (normal force < 0)";
-    case LAG_ERR_FORCE: return "applied force or impulse too large for one tick";
-    }
-    return "unknown result";
-}
-
 const lag_model_info *lag_model_info_get(lag_model_kind kind)
 {
     if ((int)kind < 0 || kind >= LAG_MODEL_COUNT) return NULL;

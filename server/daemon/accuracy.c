@@ -69,7 +69,8 @@ static void say_overrides(const lagsimd_choice *ch)
     fputs("\n", stderr);
 }
 
-int lagsimd_choose_integrator(const lag_scene *sc, bool offline, bool quiet, lagsimd_choice *ch)
+lag_result lagsimd_choose_integrator(const lag_scene *sc, bool offline, bool quiet,
+                                      lagsimd_choice *ch)
 {
     ch->n = 0;
     if (!(sc->accuracy.error > 0)) return LAGSIMD_EXIT_OK;
@@ -218,7 +219,7 @@ static int plot(const lag_scene *sc, const lag_cost_table *t, double target, con
     return LAGSIMD_EXIT_OK;
 }
 
-int lagsimd_cost(const lag_scene *sc, const char *png, bool force)
+lag_result lagsimd_cost(const lag_scene *sc, const char *png, bool force)
 {
     static lag_cost_table t;
     const bool asked = sc->accuracy.error > 0;

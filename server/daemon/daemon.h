@@ -26,8 +26,11 @@ typedef struct lagsimd_opts {
     bool force;          /* --force: --log and --csv may replace an existing file */
 } lagsimd_opts;
 
-/* Exit codes of lagsimd. */
-enum { LAGSIMD_EXIT_OK = 0, LAGSIMD_EXIT_RUNTIME = 1, LAGSIMD_EXIT_USAGE = 2 };
+/* What lagsimd's parts return: codes of the one space (lagsim/result.h), which main turns
+ * into the exit status with lag_result_exit (0, 1 and 2 for these three). */
+#define LAGSIMD_EXIT_OK LAG_OK
+#define LAGSIMD_EXIT_RUNTIME LAG_ERR_RUNTIME /* exit 1 */
+#define LAGSIMD_EXIT_USAGE LAG_ERR_USAGE     /* exit 2: nothing ran */
 
 /* The reference of a scene's joints (ref, its `reference:` with the changes made while
  * running) at sim time t and tick step, as published on <PREFIX>_REFERENCE: the joints
@@ -36,15 +39,15 @@ enum { LAGSIMD_EXIT_OK = 0, LAGSIMD_EXIT_RUNTIME = 1, LAGSIMD_EXIT_USAGE = 2 };
 void lagsimd_reference_at(const lag_scene_reference *ref, lag_model_kind kind, double t,
                           int64_t step, lag_wire_reference *m);
 
-/* Offline: simulate as fast as possible, write CSV. Returns an exit code. */
-int lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o);
-/* The real-time LCM server until SIGINT/SIGTERM (or opts->duration). Returns an exit code. */
-int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o);
+/* Offline: simulate as fast as possible, write CSV. Returns a lag_result. */
+lag_result lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o);
+/* The real-time LCM server until SIGINT/SIGTERM (or opts->duration). Returns a lag_result. */
+lag_result lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o);
 /* Re-simulates a run recorded by lagsimd --log or lcm-logger from the efforts in its
  * logged states (and the commanded inputs, when the log has them) and prints the largest
- * difference from the logged states. Returns an exit code: 0 when it is at most
- * o->tolerance, 1 when it is larger or nothing could be checked. */
-int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts *o);
+ * difference from the logged states. Returns LAG_OK when it is at most o->tolerance,
+ * LAG_ERR_MISMATCH when it is larger, LAG_ERR_RUNTIME when nothing could be checked. */
+lag_result lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts *o);
 /* The integrator a calibration chose, as scene overrides ("integrator.method=rk4",
  * "integrator.dt=0.0025", dopri5's rtol and atol): applied after the scene's own --set,
  * so that every reload of the scene (a change made while running) gives the same. */
@@ -56,12 +59,13 @@ typedef struct lagsimd_choice {
  * cheapest that meets the error (in a paced real-time run, one that also keeps a margin
  * to real time), printing the choice in one line unless quiet. Offline, a scene no
  * setting meets runs with the most accurate one and a warning; paced, it is refused.
- * Returns an exit code (LAGSIMD_EXIT_OK when the scene may run); ch->n = 0 without
+ * Returns LAGSIMD_EXIT_OK when the scene may run; ch->n = 0 without
  * integrator.error. OUT: ch */
-int lagsimd_choose_integrator(const lag_scene *sc, bool offline, bool quiet, lagsimd_choice *ch);
+lag_result lagsimd_choose_integrator(const lag_scene *sc, bool offline, bool quiet,
+                                      lagsimd_choice *ch);
 /* --cost: the table of what each setting costs on this scene and machine, on stdout;
  * with png, gnuplot's work-precision diagram too, written by lag_out_open's rules (force:
- * replace an existing file). Returns an exit code. */
-int lagsimd_cost(const lag_scene *sc, const char *png, bool force);
+ * replace an existing file). Returns a lag_result. */
+lag_result lagsimd_cost(const lag_scene *sc, const char *png, bool force);
 
 #endif

@@ -1,7 +1,8 @@
 /*
  * lagsimd's command line: reads the scene (file + --set overrides), then runs the
  * real-time LCM server, an offline run to CSV, or a replay of a recorded log.
- * Exit codes: 0 ok, 1 runtime failure, 2 usage or scene error (nothing ran).
+ * Exit codes: 0 ok, 1 runtime failure, 2 usage or scene error (nothing ran): each part
+ * returns a lag_result and main() ends with lag_result_exit, the one mapping.
  */
 #include <getopt.h>
 #include <sys/stat.h>
@@ -81,7 +82,7 @@ static void usage(FILE *f)
         f);
 }
 
-static int usage_error(const char *fmt, const char *arg)
+static lag_result usage_error(const char *fmt, const char *arg)
 {
     fputs("lagsimd: ", stderr);
     fprintf(stderr, fmt, arg);
@@ -92,7 +93,7 @@ static int usage_error(const char *fmt, const char *arg)
 /* Names what getopt_long refused. argv[at] is the element it was reading when it answered
  * c ('?' unknown, ':' value missing): options are not permuted ('+'), so that is the
  * option's own element, even inside a cluster like -zq (where argv[optind - 1] is not). */
-static int option_error(const struct option *longopts, char **argv, int at, int c)
+static lag_result option_error(const struct option *longopts, char **argv, int at, int c)
 {
     char msg[256];
     const char *arg = argv[at];
@@ -133,44 +134,45 @@ static int option_error(const struct option *longopts, char **argv, int at, int 
 /* A scene without lcm.url leaves the choice to LCM, which reads LCM_DEFAULT_URL: that
  * URL gets the scene's checks too (no file:// logs, no ttl above 0 without
  * lcm.allow_lan) and becomes the scene's, so what runs is what was checked.
- * Returns 0, or -1 after printing why (exit 2: nothing has run). */
-static int resolve_default_url(lag_scene *sc)
+ * Returns LAG_OK, or LAG_ERR_SCENE after printing why (exit 2: nothing has run). */
+static lag_result resolve_default_url(lag_scene *sc)
 {
     const char *env = getenv("LCM_DEFAULT_URL");
     if (sc->lcm.url[0] != '\0' || !env || env[0] == '\0')
-        return 0;
+        return LAG_OK;
     char err[512];
     if (strlen(env) >= sizeof sc->lcm.url) {
         fprintf(stderr, "lagsimd: LCM_DEFAULT_URL: longer than %zu characters\n",
                 sizeof sc->lcm.url - 1);
-        return -1;
+        return LAG_ERR_SCENE;
     }
     if (lag_scene_check_url(env, sc->lcm.allow_lan, &sc->lcm.ttl, err, sizeof err) != 0) {
         fprintf(stderr, "lagsimd: LCM_DEFAULT_URL: %s\n", err);
-        return -1;
+        return LAG_ERR_SCENE;
     }
     snprintf(sc->lcm.url, sizeof sc->lcm.url, "%s", env);
-    return 0;
+    return LAG_OK;
 }
 
 /* --increment: *path, or when it exists the first of path.00 ... path.99 that does not
- * (lstat: a dangling symbolic link is a name taken too). Returns 0, or -1 after saying why. */
-static int next_free_name(const char **path)
+ * (lstat: a dangling symbolic link is a name taken too). Returns LAG_OK, or LAG_ERR_FILE
+ * after saying why. */
+static lag_result next_free_name(const char **path)
 {
     static char name[4096];
     struct stat st;
-    if (lstat(*path, &st) != 0) return 0;
+    if (lstat(*path, &st) != 0) return LAG_OK;
     for (int k = 0; k < 100; k++) {
         if (snprintf(name, sizeof name, "%s.%02d", *path, k) >= (int)sizeof name) break;
         if (lstat(name, &st) != 0) {
             fprintf(stderr, "lagsimd: --log %s exists: writing %s\n", *path, name);
             *path = name;
-            return 0;
+            return LAG_OK;
         }
     }
     fprintf(stderr, "lagsimd: --log %s and %s.00 to .99 exist: move them away or give --force\n",
             *path, *path);
-    return -1;
+    return LAG_ERR_FILE;
 }
 
 /* Whether the --set overrides give integrator.method (a scene's integrator.error then
@@ -184,9 +186,9 @@ static bool integrator_given(const char *const *sets, int nsets)
 
 /* integrator.error: the integrator the calibration chooses, or the one the command line
  * names with --set integrator.method=... (a rerun of a choice, or the user's own): then
- * said, and not measured. Returns an exit code. OUT: ch */
-static int choose(const lag_scene *sc, const char *const *sets, int nsets, bool offline,
-                  bool quiet, lagsimd_choice *ch)
+ * said, and not measured. OUT: ch */
+static lag_result choose(const lag_scene *sc, const char *const *sets, int nsets, bool offline,
+                         bool quiet, lagsimd_choice *ch)
 {
     ch->n = 0;
     if (sc->accuracy.error > 0 && integrator_given(sets, nsets)) {
@@ -200,210 +202,227 @@ static int choose(const lag_scene *sc, const char *const *sets, int nsets, bool 
 
 /* Appends the calibration's choice to the overrides (main made room for its 4) and
  * loads the scene again with it. */
-static int reload_with(const char *config, const char *text, size_t len, const char **sets,
-                       int *nsets, const lagsimd_choice *ch, lag_scene *sc)
+static lag_result reload_with(const char *config, const char *text, size_t len,
+                              const char **sets, int *nsets, const lagsimd_choice *ch,
+                              lag_scene *sc)
 {
     char err[1024];
     for (int i = 0; i < ch->n; i++) sets[(*nsets)++] = ch->kv[i];
     if (lag_scene_load_buffer(config, text, len, sets, *nsets, sc, err, sizeof err) != 0) {
         fprintf(stderr, "lagsimd: the integrator chosen for integrator.error: %s\n", err);
-        return -1;
+        return LAG_ERR_SCENE;
     }
-    return 0;
+    return LAG_OK;
 }
 
-int main(int argc, char **argv)
+/* What the command line says. */
+typedef struct cmdline {
+    const char *config, *replay, *plot;
+    bool cost, increment, offline;
+    bool have_duration, have_tolerance, have_ring; /* given, for the checks of combinations */
+    lagsimd_opts opts;
+    const char **sets; /* the --set overrides, and room for a calibration's choice */
+    int nsets;
+} cmdline;
+
+enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE,
+       OPT_COST, OPT_PLOT, OPT_FORCE };
+static const struct option longopts[] = {
+    {"config", required_argument, NULL, 'c'},
+    {"set", required_argument, NULL, 's'},
+    {"duration", required_argument, NULL, 'd'},
+    {"offline", no_argument, NULL, OPT_OFFLINE},
+    {"csv", required_argument, NULL, OPT_CSV},
+    {"replay", required_argument, NULL, OPT_REPLAY},
+    {"log", required_argument, NULL, OPT_LOG},
+    {"log-buffer", required_argument, NULL, OPT_LOG_BUFFER},
+    {"tolerance", required_argument, NULL, OPT_TOLERANCE},
+    {"cost", no_argument, NULL, OPT_COST},
+    {"plot", required_argument, NULL, OPT_PLOT},
+    {"force", no_argument, NULL, OPT_FORCE},
+    {"increment", no_argument, NULL, 'i'},
+    {"quiet", no_argument, NULL, 'q'},
+    {"help", no_argument, NULL, 'h'},
+    {"version", no_argument, NULL, 'V'},
+    {NULL, 0, NULL, 0},
+};
+
+/* The options with a number: a plain decimal in range, else a usage error. */
+static lag_result take_number(cmdline *cl, int c, const char *arg)
 {
-    enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE,
-           OPT_COST, OPT_PLOT, OPT_FORCE };
-    static const struct option longopts[] = {
-        {"config", required_argument, NULL, 'c'},
-        {"set", required_argument, NULL, 's'},
-        {"duration", required_argument, NULL, 'd'},
-        {"offline", no_argument, NULL, OPT_OFFLINE},
-        {"csv", required_argument, NULL, OPT_CSV},
-        {"replay", required_argument, NULL, OPT_REPLAY},
-        {"log", required_argument, NULL, OPT_LOG},
-        {"log-buffer", required_argument, NULL, OPT_LOG_BUFFER},
-        {"tolerance", required_argument, NULL, OPT_TOLERANCE},
-        {"cost", no_argument, NULL, OPT_COST},
-        {"plot", required_argument, NULL, OPT_PLOT},
-        {"force", no_argument, NULL, OPT_FORCE},
-        {"increment", no_argument, NULL, 'i'},
-        {"quiet", no_argument, NULL, 'q'},
-        {"help", no_argument, NULL, 'h'},
-        {"version", no_argument, NULL, 'V'},
-        {NULL, 0, NULL, 0},
-    };
-
-    const char *config = NULL, *replay = NULL, *plot = NULL;
-    bool cost = false, increment = false;
-    bool offline = false, have_duration = false, have_tolerance = false, have_ring = false;
-    lagsimd_opts opts = {.quiet = false, .duration = 0.0, .csv = NULL};
-    /* the --set overrides, and room for a calibration's choice (lagsimd_choice) */
-    const char **sets = calloc((size_t)argc + 1 + 4, sizeof *sets);
-    int nsets = 0;
-    if (!sets) {
-        fputs("lagsimd: out of memory\n", stderr);
-        return LAGSIMD_EXIT_RUNTIME;
+    double v = 0.0;
+    const bool plain = lag_scene_read_decimal(arg, &v) == LAG_OK;
+    if (c == 'd') {
+        /* at most LAG_SCENE_MAX_TIME, so that the run's tick count is exact and cannot
+         * overflow */
+        if (!plain || !(v >= 0.0) || !(v <= LAG_SCENE_MAX_TIME))
+            return usage_error("--duration: expected a number of seconds from 0 to 1e9, "
+                               "got '%s'", arg);
+        cl->opts.duration = v;
+        cl->have_duration = true;
+    } else if (c == OPT_LOG_BUFFER) {
+        if (!plain || !(v >= 0.25) || !(v <= 1024))
+            return usage_error("--log-buffer: expected a number of MiB from 0.25 to 1024, "
+                               "got '%s'", arg);
+        cl->opts.log_ring = (size_t)(v * 1048576.0);
+        cl->have_ring = true;
+    } else { /* OPT_TOLERANCE */
+        if (!plain || !(v >= 0.0) || !isfinite(v))
+            return usage_error("--tolerance: expected a number >= 0, got '%s'", arg);
+        cl->opts.tolerance = v;
+        cl->have_tolerance = true;
     }
+    return LAG_OK;
+}
 
+/* One option that getopt_long returned (not -h, -V nor an error). */
+static lag_result take_option(cmdline *cl, int c, const char *arg)
+{
+    switch (c) {
+    case 'c': cl->config = arg; break;
+    case 's': cl->sets[cl->nsets++] = arg; break;
+    case 'd': case OPT_LOG_BUFFER: case OPT_TOLERANCE: return take_number(cl, c, arg);
+    case OPT_OFFLINE: cl->offline = true; break;
+    case OPT_CSV: cl->opts.csv = arg; break;
+    case OPT_REPLAY: cl->replay = arg; break;
+    case OPT_LOG: cl->opts.log = arg; break;
+    case OPT_COST: cl->cost = true; break;
+    case OPT_PLOT: cl->plot = arg; break;
+    case OPT_FORCE: cl->opts.force = true; break;
+    case 'i': cl->increment = true; break;
+    case 'q': cl->opts.quiet = true; break;
+    }
+    return LAG_OK;
+}
+
+/* Reads the options into cl. *done: --help or --version answered (LAG_OK). */
+static lag_result read_options(cmdline *cl, int argc, char **argv, bool *done)
+{
     opterr = 0; /* our own messages */
     int c, at = optind;
     /* '+': stop at the first argument that is not an option (reported below), so that
      * argv[at] is always the element an error concerns */
     while ((c = getopt_long(argc, argv, "+:c:s:d:iqhV", longopts, NULL)) != -1) {
-        switch (c) {
-        case 'c':
-            config = optarg;
-            break;
-        case 's':
-            sets[nsets++] = optarg;
-            break;
-        case 'd': {
-            /* a plain decimal; at most LAG_SCENE_MAX_TIME, so that the run's tick count
-             * is exact and cannot overflow */
-            double d = 0.0;
-            if (lag_scene_read_decimal(optarg, &d) != 0 || !(d >= 0.0) ||
-                !(d <= LAG_SCENE_MAX_TIME)) {
-                free(sets);
-                return usage_error("--duration: expected a number of seconds from 0 to "
-                                   "1e9, got '%s'", optarg);
-            }
-            opts.duration = d;
-            have_duration = true;
-            break;
+        if (c == 'h' || c == 'V') {
+            if (c == 'h') usage(stdout);
+            else printf("lagsimd %s\n", LAGSIM_VERSION);
+            *done = true;
+            return LAG_OK;
         }
-        case OPT_OFFLINE:
-            offline = true;
-            break;
-        case OPT_CSV:
-            opts.csv = optarg;
-            break;
-        case OPT_REPLAY:
-            replay = optarg;
-            break;
-        case OPT_LOG:
-            opts.log = optarg;
-            break;
-        case OPT_LOG_BUFFER: {
-            double mib = 0.0;
-            if (lag_scene_read_decimal(optarg, &mib) != 0 || !(mib >= 0.25) || !(mib <= 1024)) {
-                free(sets);
-                return usage_error("--log-buffer: expected a number of MiB from 0.25 to 1024, "
-                                   "got '%s'", optarg);
-            }
-            opts.log_ring = (size_t)(mib * 1048576.0);
-            have_ring = true;
-            break;
-        }
-        case OPT_TOLERANCE: {
-            double tol = 0.0;
-            if (lag_scene_read_decimal(optarg, &tol) != 0 || !(tol >= 0.0) || !isfinite(tol)) {
-                free(sets);
-                return usage_error("--tolerance: expected a number >= 0, got '%s'", optarg);
-            }
-            opts.tolerance = tol;
-            have_tolerance = true;
-            break;
-        }
-        case OPT_COST:
-            cost = true;
-            break;
-        case OPT_PLOT:
-            plot = optarg;
-            break;
-        case OPT_FORCE:
-            opts.force = true;
-            break;
-        case 'i':
-            increment = true;
-            break;
-        case 'q':
-            opts.quiet = true;
-            break;
-        case 'h':
-            usage(stdout);
-            free(sets);
-            return LAGSIMD_EXIT_OK;
-        case 'V':
-            printf("lagsimd %s\n", LAGSIM_VERSION);
-            free(sets);
-            return LAGSIMD_EXIT_OK;
-        default: /* '?' or ':' */
-            free(sets);
-            return option_error(longopts, argv, at, c);
-        }
+        if (c == '?' || c == ':') return option_error(longopts, argv, at, c);
+        lag_result r = take_option(cl, c, optarg);
+        if (r != LAG_OK) return r;
         at = optind;
     }
-    if (optind < argc) {
-        free(sets);
-        return usage_error("unexpected argument '%s'", argv[optind]);
+    if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
+    return LAG_OK;
+}
+
+/* The options that need or exclude each other (said as a usage error), and --increment's
+ * free name. */
+static lag_result check_options(cmdline *cl)
+{
+    const lagsimd_opts *o = &cl->opts;
+    const char *why = NULL;
+    if (!cl->config) why = "--config FILE is required";
+    else if (cl->offline && cl->replay) why = "--offline and --replay exclude each other";
+    else if (o->csv && !cl->offline) why = "--csv needs --offline";
+    else if (cl->offline && !cl->have_duration) why = "--offline needs --duration SECONDS";
+    else if (o->log && (cl->offline || cl->replay))
+        why = "--log records the real-time server: not with --offline or --replay";
+    else if (cl->have_ring && !o->log) why = "--log-buffer needs --log FILE";
+    else if (cl->have_tolerance && !cl->replay) why = "--tolerance needs --replay LOG";
+    else if (cl->cost && (cl->offline || cl->replay || o->log))
+        why = "--cost measures the scene and exits: not with --offline, --replay or --log";
+    else if (cl->plot && !cl->cost) why = "--plot needs --cost";
+    else if (cl->increment && (!o->log || o->force))
+        why = "--increment picks a free name for --log FILE: give --log, and not --force";
+    else if (cl->increment && next_free_name(&cl->opts.log) != LAG_OK) return LAG_ERR_FILE;
+    else if (o->force && !o->log && !o->csv && !cl->plot)
+        why = "--force replaces the file of --log, --csv or --plot: give one";
+    return why ? usage_error("%s", why) : LAG_OK;
+}
+
+/* The scene as it runs: loaded from its file's bytes and the overrides, with the
+ * integrator integrator.error chooses (replay: the one the command line gives). */
+static lag_result prepare_scene(cmdline *cl, const char *text, size_t len, lag_scene *sc)
+{
+    static lagsimd_choice choice;
+    char err[1024];
+    if (lag_scene_load_buffer(cl->config, text, len, cl->sets, cl->nsets, sc, err,
+                              sizeof err) != LAG_OK) {
+        fprintf(stderr, "%s\n", err);
+        return LAG_ERR_SCENE;
     }
-    int rc = LAGSIMD_EXIT_USAGE;
-    if (!config) {
-        rc = usage_error("%s", "--config FILE is required");
-    } else if (offline && replay) {
-        rc = usage_error("%s", "--offline and --replay exclude each other");
-    } else if (opts.csv && !offline) {
-        rc = usage_error("%s", "--csv needs --offline");
-    } else if (offline && !have_duration) {
-        rc = usage_error("%s", "--offline needs --duration SECONDS");
-    } else if (opts.log && (offline || replay)) {
-        rc = usage_error("%s", "--log records the real-time server: not with --offline or --replay");
-    } else if (have_ring && !opts.log) {
-        rc = usage_error("%s", "--log-buffer needs --log FILE");
-    } else if (have_tolerance && !replay) {
-        rc = usage_error("%s", "--tolerance needs --replay LOG");
-    } else if (cost && (offline || replay || opts.log)) {
-        rc = usage_error("%s", "--cost measures the scene and exits: not with --offline, --replay or --log");
-    } else if (plot && !cost) {
-        rc = usage_error("%s", "--plot needs --cost");
-    } else if (increment && (!opts.log || opts.force)) {
-        rc = usage_error("%s", "--increment picks a free name for --log FILE: give --log, and not --force");
-    } else if (increment && next_free_name(&opts.log) != 0) {
-        rc = LAGSIMD_EXIT_USAGE;
-    } else if (opts.force && !opts.log && !opts.csv && !plot) {
-        rc = usage_error("%s", "--force replaces the file of --log, --csv or --plot: give one");
+    if (cl->cost) return LAG_OK;
+    if (cl->replay && sc->accuracy.error > 0 && !integrator_given(cl->sets, cl->nsets)) {
+        fprintf(stderr, "lagsimd: %s: integrator.error: the recorded run chose its integrator "
+                "when it started; give the same with --set integrator.method=... --set "
+                "integrator.dt=... (and rtol, atol for dopri5), as the run printed them\n",
+                cl->config);
+        return LAG_ERR_USAGE;
+    }
+    choice.n = 0;
+    if (!cl->replay && choose(sc, cl->sets, cl->nsets, cl->offline, cl->opts.quiet,
+                              &choice) != LAG_OK)
+        return LAG_ERR_USAGE; /* said why */
+    if (choice.n > 0)
+        return reload_with(cl->config, text, len, cl->sets, &cl->nsets, &choice, sc);
+    return LAG_OK;
+}
+
+/* Reads the scene file once (the scene and any change made while running come from the
+ * same bytes) and runs what the command line asks. */
+static lag_result run(cmdline *cl)
+{
+    static lag_scene sc;
+    char err[1024];
+    char *text = NULL;
+    size_t len = 0;
+    lag_result rc;
+    if (lag_scene_read(cl->config, &text, &len, err, sizeof err) != LAG_OK) {
+        fprintf(stderr, "%s\n", err);
+        rc = LAG_ERR_SCENE;
+    } else if ((rc = prepare_scene(cl, text, len, &sc)) != LAG_OK) {
+        /* said why */
+    } else if (cl->cost) {
+        rc = lagsimd_cost(&sc, cl->plot, cl->opts.force);
     } else {
-        static lag_scene sc;
-        char err[1024];
-        /* the file is read once: the scene and any change made while running come from
-         * the same bytes */
-        char *text = NULL;
-        size_t len = 0;
-        static lagsimd_choice choice;
-        if (lag_scene_read(config, &text, &len, err, sizeof err) != 0 ||
-            lag_scene_load_buffer(config, text, len, sets, nsets, &sc, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            rc = LAGSIMD_EXIT_USAGE;
-        } else if (cost) {
-            rc = lagsimd_cost(&sc, plot, opts.force);
-        } else if (replay && sc.accuracy.error > 0 && !integrator_given(sets, nsets)) {
-            fprintf(stderr, "lagsimd: %s: integrator.error: the recorded run chose its integrator "
-                    "when it started; give the same with --set integrator.method=... --set "
-                    "integrator.dt=... (and rtol, atol for dopri5), as the run printed them\n",
-                    config);
-            rc = LAGSIMD_EXIT_USAGE;
-        } else if (!replay && choose(&sc, sets, nsets, offline, opts.quiet, &choice) != LAGSIMD_EXIT_OK) {
-            rc = LAGSIMD_EXIT_USAGE; /* said why */
-        } else if (choice.n > 0 && reload_with(config, text, len, sets, &nsets, &choice, &sc) != 0) {
-            rc = LAGSIMD_EXIT_USAGE;
-        } else {
-            opts.scene_name = config;
-            opts.scene_text = text;
-            opts.scene_len = len;
-            opts.sets = sets;
-            opts.nsets = nsets;
-            if (offline)
-                rc = lagsimd_offline(&sc, &opts);
-            else if (replay)
-                rc = lagsimd_replay(&sc, replay, &opts);
-            else if (resolve_default_url(&sc) == 0)
-                rc = lagsimd_realtime(&sc, &opts);
-        }
-        free(text);
+        lagsimd_opts *o = &cl->opts;
+        o->scene_name = cl->config;
+        o->scene_text = text;
+        o->scene_len = len;
+        o->sets = cl->sets;
+        o->nsets = cl->nsets;
+        if (cl->offline)
+            rc = lagsimd_offline(&sc, o);
+        else if (cl->replay)
+            rc = lagsimd_replay(&sc, cl->replay, o);
+        else if ((rc = resolve_default_url(&sc)) == LAG_OK)
+            rc = lagsimd_realtime(&sc, o);
     }
-    free(sets);
+    free(text);
     return rc;
+}
+
+static lag_result lagsimd_main(int argc, char **argv)
+{
+    cmdline cl = {.opts = {.quiet = false, .duration = 0.0, .csv = NULL}};
+    /* the --set overrides, and room for a calibration's choice (lagsimd_choice) */
+    cl.sets = calloc((size_t)argc + 1 + 4, sizeof *cl.sets);
+    if (!cl.sets) {
+        fputs("lagsimd: out of memory\n", stderr);
+        return LAG_ERR_NOMEM;
+    }
+    bool done = false;
+    lag_result rc = read_options(&cl, argc, argv, &done);
+    if (rc == LAG_OK && !done) rc = check_options(&cl);
+    if (rc == LAG_OK && !done) rc = run(&cl);
+    free(cl.sets);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    return lag_result_exit(lagsimd_main(argc, argv));
 }

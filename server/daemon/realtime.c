@@ -1344,7 +1344,7 @@ void rt_finish(rt_server *s)
 /* ---------------------------------------------------------------- the loop */
 static void on_signal(void *ctx, int signo) { rt_signal(ctx, signo); }
 
-int lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
+lag_result lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
 {
     static rt_server srv; /* large (encode buffer): static, one server per process */
     rt_server *s = &srv;

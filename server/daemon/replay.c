@@ -316,285 +316,408 @@ static lag_result advance_with_sets(lag_sim *sim, int64_t n, replay_sets *rs,
     return sim->tick < end ? lag_sim_advance_within(sim, end - sim->tick, end) : LAG_OK;
 }
 
-int lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts *o)
-{
-    char err[512];
-    const double tolerance = o ? o->tolerance : 0.0;
-    const lag_model_info *info; /* the sim's joints (a stick that may fly: h too), below */
+/* A replay's state: what it reads, the re-simulation, where it stands, what it counted. */
+typedef struct replay_run {
+    const lag_scene *sc;
+    const lagsimd_opts *o;
+    const char *log_path;
     char channel[96], ch_input[96], ch_event[96], ch_ref[96];
-    snprintf(channel, sizeof channel, "%s_STATE", sc->lcm.prefix);
-    snprintf(ch_ref, sizeof ch_ref, "%s_REFERENCE", sc->lcm.prefix);
-    snprintf(ch_input, sizeof ch_input, "%s_INPUT", sc->lcm.prefix);
-    snprintf(ch_event, sizeof ch_event, "%s_EVENT", sc->lcm.prefix);
-    static replay_sets sets;
-    memset(&sets, 0, sizeof sets);
-
-    /* With an actuator lag and the inputs in the log, the replay runs the actuator from
-     * them. Otherwise the logged effort is the actuator's output, applied as it is: the
-     * actuator stays on with neither lag nor bound, so that the ticks are taken exactly as
-     * the daemon took them (an actuator makes every tick a separate step). */
-    lag_sim_def def = sc->sim;
-    bool lagged = false;
-    if (def.effects.enabled & LAG_EFF_ACTUATOR)
-        for (int i = 0; i < def.model.nq; i++) lagged |= def.effects.actuator_tau[i] > 0;
-    const bool use_input = lagged && log_has_channel(log_path, ch_input);
-    const bool anchor = lagged && !use_input;
-    replay_def(&def, use_input);
-    sets.base = &def;
-    sets.base_ref = &sc->reference;
-    sets.ref = sc->reference;
-    int64_t refs_seen = 0, refs_compared = 0, refs_bad = 0;
-    double max_dr = 0.0;
+    replay_sets sets;
+    lag_sim_def def;            /* the scene's definition, as replayed (replay_def) */
     lag_sim sim;
-    if (lag_sim_init(&sim, &def, err, sizeof err) != LAG_OK) {
+    const lag_model_info *info; /* the sim's joints (a stick that may fly: h too) */
+    bool lagged;                /* the scene has an actuator lag */
+    bool use_input;             /* ... and the log its inputs: the actuator is re-simulated */
+    bool anchor;                /* ... but not: each period from the logged state before it */
+    int nq;
+    int64_t tpp;                /* ticks per control period */
+    double dt;
+    const char *inexact;        /* why a restart here is not exact, or NULL */
+    /* where it stands */
+    bool have;                  /* the sim holds a logged state to go on from */
+    bool checking;              /* the sim's history is the daemon's: states are compared */
+    bool have_u;                /* use_input: the input of the period starting at u_t */
+    double u[LAG_MAX_DOF], u_t;
+    /* what it counted */
+    int64_t seen, compared, restarts, gaps, undecodable, invalid, errors, unchecked;
+    int64_t refs_seen, refs_compared, refs_bad;
+    int64_t error_step;         /* the first failed re-simulation: towards this step */
+    lag_result error_kind;      /* ... with this result */
+    const char *unchecked_why;
+    double max_dq, max_dqd, max_deff, max_dr;
+} replay_run;
+
+/* What the loop does after a record. */
+typedef enum { REPLAY_NEXT, REPLAY_STOP, REPLAY_FAIL } replay_step;
+
+/* The channels, the replay's definition (with an actuator lag and the inputs in the log,
+ * the replay runs the actuator from them; otherwise the logged effort is the actuator's
+ * output, applied as it is: replay_def) and the simulation. */
+static lag_result replay_setup(replay_run *run)
+{
+    const lag_scene *sc = run->sc;
+    char err[512];
+    snprintf(run->channel, sizeof run->channel, "%s_STATE", sc->lcm.prefix);
+    snprintf(run->ch_ref, sizeof run->ch_ref, "%s_REFERENCE", sc->lcm.prefix);
+    snprintf(run->ch_input, sizeof run->ch_input, "%s_INPUT", sc->lcm.prefix);
+    snprintf(run->ch_event, sizeof run->ch_event, "%s_EVENT", sc->lcm.prefix);
+    run->def = sc->sim;
+    lag_sim_def *def = &run->def;
+    if (def->effects.enabled & LAG_EFF_ACTUATOR)
+        for (int i = 0; i < def->model.nq; i++) run->lagged |= def->effects.actuator_tau[i] > 0;
+    run->use_input = run->lagged && log_has_channel(run->log_path, run->ch_input);
+    run->anchor = run->lagged && !run->use_input;
+    replay_def(def, run->use_input);
+    run->sets.base = def;
+    run->sets.base_ref = &sc->reference;
+    run->sets.ref = sc->reference;
+    if (lag_sim_init(&run->sim, def, err, sizeof err) != LAG_OK) {
         fprintf(stderr, "lagsimd: bad scene: %s\n", err);
-        return LAGSIMD_EXIT_USAGE;
+        return LAG_ERR_SCENE;
     }
-    info = lag_sim_info(&sim);
-    lag_log *log = lag_log_open(log_path, REPLAY_DATA_MAX, err, sizeof err);
-    if (!log) {
-        fprintf(stderr, "lagsimd: --replay: %s\n", err);
-        return LAGSIMD_EXIT_RUNTIME;
-    }
-    if (use_input)
-        printf("actuator lag: re-simulated from the commanded inputs logged on %s\n", ch_input);
-    else if (lagged)
+    run->info = lag_sim_info(&run->sim);
+    run->nq = run->sim.nq;
+    run->tpp = sc->ticks_per_period;
+    run->dt = sc->sim.integrator.dt;
+    run->error_step = -1;
+    return LAG_OK;
+}
+
+/* Says how the actuator is replayed, for a scene with an actuator lag. */
+static void replay_say_actuator(const replay_run *run)
+{
+    if (run->use_input)
+        printf("actuator lag: re-simulated from the commanded inputs logged on %s\n",
+               run->ch_input);
+    else if (run->lagged)
         printf("note: this scene has an actuator lag and the log has no %s records (lagsimd "
                "--log writes them; lcm-logger records only the bus): the applied effort "
                "changes within a control period and the log holds its last value, so each "
                "state is re-simulated from the logged one a period before it and the "
-               "difference is approximate (give --tolerance)\n", ch_input);
-    const int nq = sim.nq;
-    const int64_t tpp = sc->ticks_per_period;
-    const double dt = sc->sim.integrator.dt;
-    const char *inexact = restart_inexact(&sim.def, lagged);
+               "difference is approximate (give --tolerance)\n", run->ch_input);
+}
 
-    int64_t seen = 0, compared = 0, restarts = 0, gaps = 0, undecodable = 0, invalid = 0;
-    int64_t errors = 0, error_step = -1, unchecked = 0;
-    const char *unchecked_why = NULL;
-    lag_result error_kind = LAG_OK;
-    double max_dq = 0, max_dqd = 0, max_deff = 0;
-    bool have = false;       /* the sim holds a logged state to go on from */
-    bool checking = false;   /* the sim's history is the daemon's: states are compared */
-    bool have_u = false;     /* use_input: the input of the period starting at u_t */
-    double u[LAG_MAX_DOF], u_t = 0;
-    lag_log_record rec;
-    int rc;
-    while ((rc = lag_log_next(log, &rec)) == LAG_LOG_OK && !sets.failed) {
-        if (strcmp(rec.channel, ch_event) == 0) {
-            set_read(&sets, &rec, o);
-            continue;
-        }
-        if (strcmp(rec.channel, ch_ref) == 0) {
-            /* the reference as published, against the one computed again at its time */
-            refs_seen++;
-            lag_wire_reference lr, cr;
-            if (!rec.data || lag_wire_decode_reference(rec.data, rec.size, LAG_WIRE_MAX_JOINTS,
-                                                       &lr) != LAG_WIRE_OK) {
-                refs_bad++;
-                continue;
-            }
-            lagsimd_reference_at(&sets.ref, sc->sim.model.kind, lr.sim_time, lr.step, &cr);
-            bool same = cr.num_joints == lr.num_joints && lr.sim_time == (double)lr.step * dt;
-            for (int k = 0; same && k < lr.num_joints; k++) same = !strcmp(cr.name[k], lr.name[k]);
-            if (!same) {
-                refs_bad++;
-                continue;
-            }
-            for (int k = 0; k < lr.num_joints; k++) {
-                double a = fabs(cr.r[k] - lr.r[k]), b = fabs(cr.rdot[k] - lr.rdot[k]);
-                if (!(a <= max_dr)) max_dr = a;
-                if (!(b <= max_dr)) max_dr = b;
-            }
-            refs_compared++;
-            continue;
-        }
-        if (use_input && strcmp(rec.channel, ch_input) == 0) {
-            have_u = decode_input(&rec, info, nq, u, &u_t);
-            continue;
-        }
-        if (strcmp(rec.channel, channel) != 0) continue;
-        seen++;
-        lag_wire_joint_state m;
-        if (!rec.data ||
-            lag_wire_decode_joint_state(rec.data, rec.size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) {
-            undecodable++;
-            continue;
-        }
-        bool ok = m.num_joints == nq;
-        for (int i = 0; ok && i < nq; i++) ok = strcmp(m.name[i], info->joint_names[i]) == 0;
-        if (!ok) {
-            fprintf(stderr, "lagsimd: --replay: a state on %s does not match this scene's "
-                            "joints (%s); wrong --config?\n", channel,
-                    lag_model_info_get(sc->sim.model.kind)->name);
-            lag_log_close(log);
-            return LAGSIMD_EXIT_RUNTIME;
-        }
-        /* the daemon publishes finite numbers and steps from 0: anything else was not
-         * published by it and cannot be checked */
-        if (!lag_wire_all_finite(LAG_WIRE_JOINT_STATE, &m) || m.step < 0 ||
-            m.step > REPLAY_STEP_MAX) {
-            invalid++;
-            continue;
-        }
-        /* both steps lie in [0, 2^53]: the difference cannot overflow */
-        int64_t dticks = have ? m.step - sim.tick : -1;
-        bool same = dticks == 0;
-        double oq[LAG_MAX_DOF], oqd[LAG_MAX_DOF];
-        lag_sim_observe(&sim, oq, oqd);
-        for (int i = 0; same && i < nq; i++)
-            same = oq[i] == m.position[i] && oqd[i] == m.velocity[i];
-        /* a period with an actuator lag needs its logged input */
-        bool input_missing = use_input && dticks == tpp && !(have_u && u_t == lag_sim_time(&sim));
-        bool is_gap = have && dticks > 0 && (dticks != tpp || input_missing);
-        if (!have || dticks < 0 || (dticks == 0 && !same) || is_gap) {
-            /* changes read before this state happened before it */
-            while (sets.n > 0 && set_apply(&sets, &sim, o, use_input, true)) {
-            }
-            if (sets.failed) break;
-            inexact = restart_inexact(&sim.def, lagged);
-            /* the first state, a reset (the step went back, or the state changed in
-             * place), or a gap: start over from this state */
-            if (is_gap) {
-                gaps++;
-                if (gaps <= REPLAY_GAPS_SAID)
-                    printf("gap: %s between t = %.9g s and t = %.9g s (step %lld to %lld): "
-                           "restarted from t = %.9g s%s\n",
-                           input_missing ? "the period's logged input is missing"
-                                         : "states missing",
-                           lag_sim_time(&sim), (double)m.step * dt, (long long)sim.tick,
-                           (long long)m.step, (double)m.step * dt,
-                           checking && inexact ? ", not checked until the next reset" : "");
-                else if (gaps == REPLAY_GAPS_SAID + 1)
-                    printf("gap: more gaps follow, counted below\n");
-            } else if (have) {
-                restarts++;
-            }
-            bool initial = restart(&sim, &m);
-            checking = initial || (m.step == 0 && !(sim.def.effects.enabled & LAG_EFF_NOISE)) ||
-                       !inexact;
-            if (!checking && !unchecked_why)
-                unchecked_why = m.step == 0 ? "the logged state carries the noise effect, not "
-                                              "the true state" : inexact;
-            have = true;
-            have_u = false;
-            continue;
-        }
-        if (dticks > 0) {
-            lag_sim_set_input(&sim, use_input ? u : m.effort);
-            have_u = false;
-            const int64_t applied = sets.applied;
-            lag_result r = advance_with_sets(&sim, dticks, &sets, o, use_input);
-            if (sets.failed) break;
-            if (sets.applied != applied) inexact = restart_inexact(&sim.def, lagged);
-            if (r != LAG_OK || sim.tick != m.step) {
-                if (errors++ == 0) {
-                    error_step = m.step;
-                    error_kind = r;
-                }
-                restart(&sim, &m); /* go on from the logged state */
-                checking = false;
-                continue;
-            }
-        }
-        if (!checking) {
-            unchecked++;
-            continue;
-        }
-        lag_sim_observe(&sim, oq, oqd); /* as the daemon published it (noise effect) */
-        for (int i = 0; i < nq; i++) {
-            double a = fabs(oq[i] - m.position[i]), b = fabs(oqd[i] - m.velocity[i]);
-            if (!(a <= max_dq)) max_dq = a; /* NaN propagates as the max */
-            if (!(b <= max_dqd)) max_dqd = b;
-            if (use_input) {
-                double c = fabs(sim.tau_applied[i] - m.effort[i]);
-                if (!(c <= max_deff)) max_deff = c;
-            }
-        }
-        compared++;
-        /* a lag without its inputs: each period from the logged state before it, so that
-         * the difference is that of one period, not one grown by an unstable plant */
-        if (anchor) restart(&sim, &m);
+/* A <PREFIX>_REFERENCE record: the reference as published, against the one computed
+ * again at its time. */
+static void replay_reference(replay_run *run, const lag_log_record *rec)
+{
+    run->refs_seen++;
+    lag_wire_reference lr, cr;
+    if (!rec->data || lag_wire_decode_reference(rec->data, rec->size, LAG_WIRE_MAX_JOINTS,
+                                                &lr) != LAG_WIRE_OK) {
+        run->refs_bad++;
+        return;
     }
+    lagsimd_reference_at(&run->sets.ref, run->sc->sim.model.kind, lr.sim_time, lr.step, &cr);
+    bool same = cr.num_joints == lr.num_joints && lr.sim_time == (double)lr.step * run->dt;
+    for (int k = 0; same && k < lr.num_joints; k++) same = !strcmp(cr.name[k], lr.name[k]);
+    if (!same) {
+        run->refs_bad++;
+        return;
+    }
+    for (int k = 0; k < lr.num_joints; k++) {
+        double a = fabs(cr.r[k] - lr.r[k]), b = fabs(cr.rdot[k] - lr.rdot[k]);
+        if (!(a <= run->max_dr)) run->max_dr = a;
+        if (!(b <= run->max_dr)) run->max_dr = b;
+    }
+    run->refs_compared++;
+}
+
+/* Starts over from logged state m (the first state, a reset: the step went back or the
+ * state changed in place, or a gap), after the changes read before it (they happened
+ * before it). REPLAY_STOP when one of them cannot be applied. */
+static replay_step replay_restart(replay_run *run, const lag_wire_joint_state *m, bool is_gap,
+                                  bool input_missing)
+{
+    while (run->sets.n > 0 && set_apply(&run->sets, &run->sim, run->o, run->use_input, true)) {
+    }
+    if (run->sets.failed) return REPLAY_STOP;
+    run->inexact = restart_inexact(&run->sim.def, run->lagged);
+    if (is_gap) {
+        run->gaps++;
+        if (run->gaps <= REPLAY_GAPS_SAID)
+            printf("gap: %s between t = %.9g s and t = %.9g s (step %lld to %lld): "
+                   "restarted from t = %.9g s%s\n",
+                   input_missing ? "the period's logged input is missing" : "states missing",
+                   lag_sim_time(&run->sim), (double)m->step * run->dt,
+                   (long long)run->sim.tick, (long long)m->step, (double)m->step * run->dt,
+                   run->checking && run->inexact ? ", not checked until the next reset" : "");
+        else if (run->gaps == REPLAY_GAPS_SAID + 1)
+            printf("gap: more gaps follow, counted below\n");
+    } else if (run->have) {
+        run->restarts++;
+    }
+    bool initial = restart(&run->sim, m);
+    run->checking = initial ||
+                    (m->step == 0 && !(run->sim.def.effects.enabled & LAG_EFF_NOISE)) ||
+                    !run->inexact;
+    if (!run->checking && !run->unchecked_why)
+        run->unchecked_why = m->step == 0 ? "the logged state carries the noise effect, not "
+                                            "the true state"
+                                          : run->inexact;
+    run->have = true;
+    run->have_u = false;
+    return REPLAY_NEXT;
+}
+
+/* Re-simulates the dticks before logged state m with its effort (or the logged input),
+ * applying the changes on the way. A failure is counted and the replay goes on from the
+ * logged state, unchecked: then false. */
+static bool replay_advance(replay_run *run, const lag_wire_joint_state *m, int64_t dticks)
+{
+    lag_sim_set_input(&run->sim, run->use_input ? run->u : m->effort);
+    run->have_u = false;
+    const int64_t applied = run->sets.applied;
+    lag_result r = advance_with_sets(&run->sim, dticks, &run->sets, run->o, run->use_input);
+    if (run->sets.failed) return false;
+    if (run->sets.applied != applied) run->inexact = restart_inexact(&run->sim.def, run->lagged);
+    if (r != LAG_OK || run->sim.tick != m->step) {
+        if (run->errors++ == 0) {
+            run->error_step = m->step;
+            run->error_kind = r;
+        }
+        restart(&run->sim, m); /* go on from the logged state */
+        run->checking = false;
+        return false;
+    }
+    return true;
+}
+
+/* Compares the re-simulated state, as the daemon published it (noise effect), with m. */
+static void replay_compare(replay_run *run, const lag_wire_joint_state *m)
+{
+    double oq[LAG_MAX_DOF], oqd[LAG_MAX_DOF];
+    lag_sim_observe(&run->sim, oq, oqd);
+    for (int i = 0; i < run->nq; i++) {
+        double a = fabs(oq[i] - m->position[i]), b = fabs(oqd[i] - m->velocity[i]);
+        if (!(a <= run->max_dq)) run->max_dq = a; /* NaN propagates as the max */
+        if (!(b <= run->max_dqd)) run->max_dqd = b;
+        if (run->use_input) {
+            double c = fabs(run->sim.tau_applied[i] - m->effort[i]);
+            if (!(c <= run->max_deff)) run->max_deff = c;
+        }
+    }
+    run->compared++;
+    /* a lag without its inputs: each period from the logged state before it, so that the
+     * difference is that of one period, not one grown by an unstable plant */
+    if (run->anchor) restart(&run->sim, m);
+}
+
+/* Decodes a <PREFIX>_STATE record into m: false (counted) when it cannot be checked;
+ * REPLAY_FAIL in *step when its joints are not this scene's. */
+static bool replay_decode_state(replay_run *run, const lag_log_record *rec,
+                                lag_wire_joint_state *m, replay_step *step)
+{
+    run->seen++;
+    if (!rec->data ||
+        lag_wire_decode_joint_state(rec->data, rec->size, LAG_WIRE_MAX_JOINTS, m) != LAG_WIRE_OK) {
+        run->undecodable++;
+        return false;
+    }
+    bool ok = m->num_joints == run->nq;
+    for (int i = 0; ok && i < run->nq; i++) ok = strcmp(m->name[i], run->info->joint_names[i]) == 0;
+    if (!ok) {
+        fprintf(stderr, "lagsimd: --replay: a state on %s does not match this scene's "
+                        "joints (%s); wrong --config?\n", run->channel,
+                lag_model_info_get(run->sc->sim.model.kind)->name);
+        *step = REPLAY_FAIL;
+        return false;
+    }
+    /* the daemon publishes finite numbers and steps from 0: anything else was not
+     * published by it and cannot be checked */
+    if (!lag_wire_all_finite(LAG_WIRE_JOINT_STATE, m) || m->step < 0 ||
+        m->step > REPLAY_STEP_MAX) {
+        run->invalid++;
+        return false;
+    }
+    return true;
+}
+
+/* A <PREFIX>_STATE record: a restart, or the period before it re-simulated and compared. */
+static replay_step replay_state(replay_run *run, const lag_log_record *rec)
+{
+    lag_wire_joint_state m;
+    replay_step step = REPLAY_NEXT;
+    if (!replay_decode_state(run, rec, &m, &step)) return step;
+    /* both steps lie in [0, 2^53]: the difference cannot overflow */
+    int64_t dticks = run->have ? m.step - run->sim.tick : -1;
+    bool same = dticks == 0;
+    double oq[LAG_MAX_DOF], oqd[LAG_MAX_DOF];
+    lag_sim_observe(&run->sim, oq, oqd);
+    for (int i = 0; same && i < run->nq; i++)
+        same = oq[i] == m.position[i] && oqd[i] == m.velocity[i];
+    /* a period with an actuator lag needs its logged input */
+    bool input_missing = run->use_input && dticks == run->tpp &&
+                         !(run->have_u && run->u_t == lag_sim_time(&run->sim));
+    bool is_gap = run->have && dticks > 0 && (dticks != run->tpp || input_missing);
+    if (!run->have || dticks < 0 || (dticks == 0 && !same) || is_gap)
+        return replay_restart(run, &m, is_gap, input_missing);
+    if (dticks > 0 && !replay_advance(run, &m, dticks))
+        return run->sets.failed ? REPLAY_STOP : REPLAY_NEXT;
+    if (!run->checking) {
+        run->unchecked++;
+        return REPLAY_NEXT;
+    }
+    replay_compare(run, &m);
+    return REPLAY_NEXT;
+}
+
+/* One record of the log, by its channel. */
+static replay_step replay_record(replay_run *run, const lag_log_record *rec)
+{
+    if (strcmp(rec->channel, run->ch_event) == 0) {
+        set_read(&run->sets, rec, run->o);
+        return REPLAY_NEXT;
+    }
+    if (strcmp(rec->channel, run->ch_ref) == 0) {
+        replay_reference(run, rec);
+        return REPLAY_NEXT;
+    }
+    if (run->use_input && strcmp(rec->channel, run->ch_input) == 0) {
+        run->have_u = decode_input(rec, run->info, run->nq, run->u, &run->u_t);
+        return REPLAY_NEXT;
+    }
+    if (strcmp(rec->channel, run->channel) != 0) return REPLAY_NEXT;
+    return replay_state(run, rec);
+}
+
+/* How the log ended (rc: lag_log_next's last answer): a log error, a change that could not
+ * be applied, damage, no state at all. LAG_OK when the states can be judged. */
+static lag_result replay_log_end(replay_run *run, lag_log *log, int rc)
+{
     lag_log_stats ls;
     lag_log_get_stats(log, &ls);
     if (rc == LAG_LOG_ERROR) {
         fprintf(stderr, "lagsimd: --replay: %s\n", lag_log_errmsg(log));
-        lag_log_close(log);
-        return LAGSIMD_EXIT_RUNTIME;
+        return LAG_ERR_RUNTIME;
     }
-    lag_log_close(log);
-    if (sets.failed) return LAGSIMD_EXIT_RUNTIME;
+    if (run->sets.failed) return LAG_ERR_RUNTIME;
     if (ls.damaged > 0)
         fprintf(stderr, "lagsimd: --replay: warning: %s is damaged in %lld place(s): %lld "
                         "bytes passed over\n",
-                log_path, (long long)ls.damaged, (long long)ls.bytes_skipped);
+                run->log_path, (long long)ls.damaged, (long long)ls.bytes_skipped);
     if (ls.truncated_bytes > 0)
         fprintf(stderr, "lagsimd: --replay: warning: the last record of %s is cut short "
                         "(%lld bytes; was the logger stopped while writing?)\n",
-                log_path, (long long)ls.truncated_bytes);
-    if (seen == 0) {
+                run->log_path, (long long)ls.truncated_bytes);
+    if (run->seen == 0) {
         fprintf(stderr, "lagsimd: --replay: no %s messages in %s (%lld records read)\n",
-                channel, log_path, (long long)ls.records);
-        return LAGSIMD_EXIT_RUNTIME;
+                run->channel, run->log_path, (long long)ls.records);
+        return LAG_ERR_RUNTIME;
     }
+    return LAG_OK;
+}
+
+/* The counts: states compared, restarts, gaps, changes applied, states not compared. */
+static void replay_say_counts(const replay_run *run)
+{
     printf("replay %s: %lld states compared on %s (%lld restarts at resets, %lld gaps, "
            "%lld undecodable, %lld integrator errors)\n",
-           log_path, (long long)compared, channel, (long long)restarts, (long long)gaps,
-           (long long)undecodable, (long long)errors);
-    if (sets.applied > 0)
+           run->log_path, (long long)run->compared, run->channel, (long long)run->restarts,
+           (long long)run->gaps, (long long)run->undecodable, (long long)run->errors);
+    if (run->sets.applied > 0)
         printf("%lld change(s) made while running applied at their steps (set, kick, "
                "kicks_cleared and restore events on %s)\n",
-               (long long)sets.applied, ch_event);
-    if (unchecked > 0)
-        printf("%lld states after a restart were not compared: %s\n", (long long)unchecked,
-               unchecked_why ? unchecked_why : "the re-simulation failed before them");
-    if (invalid > 0)
+               (long long)run->sets.applied, run->ch_event);
+    if (run->unchecked > 0)
+        printf("%lld states after a restart were not compared: %s\n", (long long)run->unchecked,
+               run->unchecked_why ? run->unchecked_why : "the re-simulation failed before them");
+    if (run->invalid > 0)
         printf("%lld states with a non-finite number or a step outside [0, 2^53] were "
-               "not checked\n", (long long)invalid);
-    if (errors > 0) {
+               "not checked\n", (long long)run->invalid);
+}
+
+/* Whether anything could be checked: no failed re-simulation, a finite difference, at
+ * least one state compared. LAG_OK, or LAG_ERR_RUNTIME after saying why. OUT: max_diff */
+static lag_result replay_checked(const replay_run *run, double *max_diff)
+{
+    if (run->errors > 0) {
         fprintf(stderr, "lagsimd: --replay: the re-simulation failed %lld time(s), first "
                         "towards step %lld (%s): the log could not be checked\n",
-                (long long)errors, (long long)error_step,
-                error_kind == LAG_OK ? "stopped at another step" : lag_result_string(error_kind));
-        return LAGSIMD_EXIT_RUNTIME;
+                (long long)run->errors, (long long)run->error_step,
+                run->error_kind == LAG_OK ? "stopped at another step"
+                                          : lag_result_string(run->error_kind));
+        return LAG_ERR_RUNTIME;
     }
-    double max_diff = max_dq > max_dqd || isnan(max_dq) ? max_dq : max_dqd;
-    if (max_deff > max_diff || isnan(max_deff)) max_diff = max_deff;
-    if (isnan(max_diff)) {
+    double d = run->max_dq > run->max_dqd || isnan(run->max_dq) ? run->max_dq : run->max_dqd;
+    if (run->max_deff > d || isnan(run->max_deff)) d = run->max_deff;
+    *max_diff = d;
+    if (isnan(d)) {
         fprintf(stderr, "lagsimd: --replay: the re-simulation produced a non-finite state: "
                         "the log could not be checked\n");
-        return LAGSIMD_EXIT_RUNTIME;
+        return LAG_ERR_RUNTIME;
     }
-    if (compared == 0) {
+    if (run->compared == 0) {
         fprintf(stderr, "lagsimd: --replay: %s: no state of %s follows another by one "
                         "control period (%lld ticks) from a state the re-simulation can "
                         "start from exactly: nothing could be checked\n",
-                log_path, channel, (long long)tpp);
-        return LAGSIMD_EXIT_RUNTIME;
+                run->log_path, run->channel, (long long)run->tpp);
+        return LAG_ERR_RUNTIME;
     }
-    printf("max |q - q_log| = %.17g\nmax |qd - qd_log| = %.17g\n", max_dq, max_dqd);
-    if (use_input) printf("max |effort - effort_log| = %.17g\n", max_deff);
-    if (refs_seen > 0 || sc->reference.n > 0) {
+    return LAG_OK;
+}
+
+/* The differences and the verdict against the tolerance: LAG_OK, or LAG_ERR_MISMATCH
+ * (a reference not this scene's, a difference above the tolerance). */
+static lag_result replay_verdict(const replay_run *run, double max_diff)
+{
+    printf("max |q - q_log| = %.17g\nmax |qd - qd_log| = %.17g\n", run->max_dq, run->max_dqd);
+    if (run->use_input) printf("max |effort - effort_log| = %.17g\n", run->max_deff);
+    if (run->refs_seen > 0 || run->sc->reference.n > 0) {
         printf("%lld references compared on %s (%lld of other joints, another time or "
                "undecodable)\nmax |r - r_log|, |rdot - rdot_log| = %.17g\n",
-               (long long)refs_compared, ch_ref, (long long)refs_bad, max_dr);
-        if (max_dr > max_diff || isnan(max_dr)) max_diff = max_dr;
-        if (refs_bad > 0) {
+               (long long)run->refs_compared, run->ch_ref, (long long)run->refs_bad,
+               run->max_dr);
+        if (run->max_dr > max_diff || isnan(run->max_dr)) max_diff = run->max_dr;
+        if (run->refs_bad > 0) {
             fprintf(stderr, "lagsimd: --replay: FAILED: %lld reference(s) on %s are not "
-                            "this scene's (wrong --config or --set?)\n", (long long)refs_bad,
-                    ch_ref);
-            return LAGSIMD_EXIT_RUNTIME;
+                            "this scene's (wrong --config or --set?)\n",
+                    (long long)run->refs_bad, run->ch_ref);
+            return LAG_ERR_MISMATCH;
         }
     }
     printf("max difference = %.17g\n", max_diff);
+    const double tolerance = run->o ? run->o->tolerance : 0.0;
     if (!(max_diff <= tolerance)) {
         fprintf(stderr, "lagsimd: --replay: FAILED: the largest difference %.17g is above "
                         "the tolerance %.17g: %s\n", max_diff, tolerance,
-                anchor ? "the replay of this log is approximate (see the note above)"
-                       : "the log does not match this scene and build (wrong --config or "
-                         "--set, another build, or a changed log)");
-        return LAGSIMD_EXIT_RUNTIME;
+                run->anchor ? "the replay of this log is approximate (see the note above)"
+                            : "the log does not match this scene and build (wrong --config "
+                              "or --set, another build, or a changed log)");
+        return LAG_ERR_MISMATCH;
     }
-    return LAGSIMD_EXIT_OK;
+    return LAG_OK;
+}
+
+lag_result lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsimd_opts *o)
+{
+    static replay_run run; /* large: not on the stack */
+    memset(&run, 0, sizeof run);
+    run.sc = sc;
+    run.o = o;
+    run.log_path = log_path;
+    lag_result r = replay_setup(&run);
+    if (r != LAG_OK) return r;
+    char err[512];
+    lag_log *log = lag_log_open(log_path, REPLAY_DATA_MAX, err, sizeof err);
+    if (!log) {
+        fprintf(stderr, "lagsimd: --replay: %s\n", err);
+        return LAG_ERR_RUNTIME;
+    }
+    replay_say_actuator(&run);
+    run.inexact = restart_inexact(&run.sim.def, run.lagged);
+
+    lag_log_record rec;
+    int rc;
+    replay_step step = REPLAY_NEXT;
+    while (step == REPLAY_NEXT && (rc = lag_log_next(log, &rec)) == LAG_LOG_OK &&
+           !run.sets.failed)
+        step = replay_record(&run, &rec);
+    r = step == REPLAY_FAIL ? LAG_ERR_RUNTIME : replay_log_end(&run, log, rc);
+    lag_log_close(log);
+    if (r != LAG_OK) return r;
+    replay_say_counts(&run);
+    double max_diff = 0.0;
+    r = replay_checked(&run, &max_diff);
+    return r != LAG_OK ? r : replay_verdict(&run, max_diff);
 }

@@ -47,7 +47,7 @@ void lag_scene_default(lag_scene *sc, lag_model_kind kind)
     sc->lcm.prefix[i] = '\0';
 }
 
-int lag_scene_read_decimal(const char *t, double *v)
+lag_result lag_scene_read_decimal(const char *t, double *v)
 {
     const char *p = t;
     if (*p == '+' || *p == '-')
@@ -59,23 +59,23 @@ int lag_scene_read_decimal(const char *t, double *v)
         while (*p >= '0' && *p <= '9') { p++; digits++; }
     }
     if (digits == 0)
-        return -1;
+        return LAG_ERR_SYNTAX;
     if (*p == 'e' || *p == 'E') {
         p++;
         if (*p == '+' || *p == '-')
             p++;
         if (!(*p >= '0' && *p <= '9'))
-            return -1;
+            return LAG_ERR_SYNTAX;
         while (*p >= '0' && *p <= '9')
             p++;
     }
     if (*p != '\0')
-        return -1;
+        return LAG_ERR_SYNTAX;
     double x = strtod(t, NULL);
     if (!isfinite(x))
-        return -2;
+        return LAG_ERR_RANGE;
     *v = x;
-    return 0;
+    return LAG_OK;
 }
 
 const char *lag_rt_start_name(lag_rt_start s)
@@ -119,17 +119,17 @@ static bool read_uint(const char **p, int maxdigits, long *out)
 
 /* See scene.h. The grammar is LCM's (lcm_udpm.c), made strict: LCM 1.3 only warns about
  * unknown options and accepts any provider it was built with. */
-int lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, size_t errlen)
+lag_result lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, size_t errlen)
 {
     *ttl = 0;
     if (!url || url[0] == '\0')
-        return 0;
+        return LAG_OK;
     if (strncmp(url, "memq://", 7) == 0) {
         if (url[7] != '\0') {
             snprintf(err, errlen, "memq:// takes no address or options, got '%s'", url);
-            return -1;
+            return LAG_ERR_SCENE;
         }
-        return 0;
+        return LAG_OK;
     }
     if (strncmp(url, "udpm://", 7) != 0) {
         const char *sep = strstr(url, "://");
@@ -140,7 +140,7 @@ int lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, si
         else
             snprintf(err, errlen, "expected an LCM URL udpm://GROUP:PORT?ttl=0 "
                      "(or memq:// for tests), got '%s'", url);
-        return -1;
+        return LAG_ERR_SCENE;
     }
     const char *p = url + 7;
     if (*p != '\0' && *p != '?') {
@@ -150,14 +150,14 @@ int lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, si
             if ((i > 0 && *p++ != '.') || !read_uint(&p, 3, &oct[i]) || oct[i] > 255) {
                 snprintf(err, errlen, "expected udpm://GROUP:PORT with GROUP a dotted IPv4 "
                          "multicast address (e.g. 239.255.76.67), got '%s'", url);
-                return -1;
+                return LAG_ERR_SCENE;
             }
         }
         if (oct[0] < 224 || oct[0] > 239) {
             snprintf(err, errlen, "%ld.%ld.%ld.%ld is not a multicast address "
                      "(224.0.0.0 to 239.255.255.255): udpm needs a multicast group",
                      oct[0], oct[1], oct[2], oct[3]);
-            return -1;
+            return LAG_ERR_SCENE;
         }
         if (*p == ':') {
             p++;
@@ -167,13 +167,13 @@ int lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, si
                 snprintf(err, errlen, "expected a port from 1 to 65534 (commands go to the "
                          "next port) after the group in "
                          "'%s'", url);
-                return -1;
+                return LAG_ERR_SCENE;
             }
         }
         if (*p != '\0' && *p != '?') {
             snprintf(err, errlen, "unexpected '%c' after the address in '%s' "
                      "(expected udpm://GROUP:PORT?option=value&...)", *p, url);
-            return -1;
+            return LAG_ERR_SCENE;
         }
     }
     if (*p == '?') {
@@ -189,29 +189,29 @@ int lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, si
             if (!is_ttl && !is_buf) {
                 snprintf(err, errlen, "unknown udpm option '%.*s' in '%s'; allowed: ttl, "
                          "recv_buf_size", klen > 32 ? 32 : klen, p, url);
-                return -1;
+                return LAG_ERR_SCENE;
             }
             if ((is_ttl && seen_ttl) || (is_buf && seen_buf)) {
                 snprintf(err, errlen, "udpm option '%.*s' given twice in '%s'", klen, p, url);
-                return -1;
+                return LAG_ERR_SCENE;
             }
             const char *v = eq;
             long val;
             if (*v++ != '=' || !read_uint(&v, 10, &val) || (*v != '\0' && *v != '&')) {
                 snprintf(err, errlen, "expected %.*s=<integer> in '%s'", klen, p, url);
-                return -1;
+                return LAG_ERR_SCENE;
             }
             if (is_ttl) {
                 seen_ttl = true;
                 if (val > 255) {
                     snprintf(err, errlen, "ttl must be 0 to 255, got %ld", val);
-                    return -1;
+                    return LAG_ERR_SCENE;
                 }
                 if (val > 0 && !allow_lan) {
                     snprintf(err, errlen, "ttl=%ld sends every message beyond this host "
                              "(1: the local network, more: through routers); set "
                              "lcm.allow_lan: true if that is meant, or use ttl=0", val);
-                    return -1;
+                    return LAG_ERR_SCENE;
                 }
                 *ttl = (int)val;
             } else {
@@ -219,7 +219,7 @@ int lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, si
                 if (val < 4096 || val > 268435456) {
                     snprintf(err, errlen, "recv_buf_size must be 4096 to 268435456 bytes, "
                              "got %ld", val);
-                    return -1;
+                    return LAG_ERR_SCENE;
                 }
             }
             if (*v == '\0')
@@ -227,7 +227,7 @@ int lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, si
             p = v + 1; /* past '&' */
         }
     }
-    return 0;
+    return LAG_OK;
 }
 
 int lag_scene_estimate_every(const lag_scene *sc)

@@ -110,22 +110,25 @@ typedef struct lag_scene {
 void lag_scene_default(lag_scene *sc, lag_model_kind kind);
 
 /* Loads a YAML scene file, then applies `nsets` overrides "dotted.key.path=yaml value"
- * (same validation as the file). On failure returns non-zero and writes
- * "file:line:column: what was expected" (or "--set key: ...") into err. OUT: sc */
-int lag_scene_load(const char *path, const char *const *sets, int nsets, lag_scene *sc,
-                   char *err, size_t errlen);
+ * (same validation as the file). Returns LAG_OK, or LAG_ERR_SCENE (LAG_ERR_ARG for a
+ * NULL path or sc) and writes "file:line:column: what was expected" (or "--set key: ...")
+ * into err. OUT: sc */
+lag_result lag_scene_load(const char *path, const char *const *sets, int nsets, lag_scene *sc,
+                          char *err, size_t errlen);
 
 /* Reads a scene file as lag_scene_load does (at most LAG_SCENE_MAX_BYTES, the same
  * errors), so that a caller can keep the bytes a scene came from (lagsimd does, to
  * validate a change made while running against the same source). On success *text is a
- * new buffer of *len bytes (free it); else -1 with the message in err. OUT: text, len */
-int lag_scene_read(const char *path, char **text, size_t *len, char *err, size_t errlen);
+ * new buffer of *len bytes (free it); else LAG_ERR_SCENE (LAG_ERR_ARG for NULL arguments)
+ * with the message in err. OUT: text, len */
+lag_result lag_scene_read(const char *path, char **text, size_t *len, char *err, size_t errlen);
 
 /* The same for a scene already in memory: `name` stands for the file in messages, `text`
- * holds `len` bytes (not NUL-terminated; at most LAG_SCENE_MAX_BYTES). OUT: sc */
-int lag_scene_load_buffer(const char *name, const char *text, size_t len,
-                          const char *const *sets, int nsets, lag_scene *sc, char *err,
-                          size_t errlen);
+ * holds `len` bytes (not NUL-terminated; at most LAG_SCENE_MAX_BYTES). Returns what
+ * lag_scene_load does. OUT: sc */
+lag_result lag_scene_load_buffer(const char *name, const char *text, size_t len,
+                                 const char *const *sets, int nsets, lag_scene *sc, char *err,
+                                 size_t errlen);
 
 /* The periods between two live error estimates of SC: integrator.estimate_every when
  * given, else LAG_SCENE_ESTIMATE_EVERY with integrator.error and 0 (none) without. */
@@ -136,9 +139,9 @@ const char *lag_rt_start_name(lag_rt_start s);  /* "running", "paused", "first_c
 /* Reads a number written as a plain decimal, the only way a scene (or lagsimd's command
  * line) writes one: [-+]? (digits [. digits?] | . digits) ([eE] [-+]? digits)?, finite.
  * Not "0x1p-10", "inf", "nan", "1_000" or "1e999", whatever strtod makes of them.
- * Returns 0, -1 if s is not a plain decimal, -2 if it is one too large for a double
- * (1e999). OUT: v */
-int lag_scene_read_decimal(const char *s, double *v);
+ * Returns LAG_OK, LAG_ERR_SYNTAX if s is not a plain decimal, LAG_ERR_RANGE if it is one
+ * too large for a double (1e999). OUT: v */
+lag_result lag_scene_read_decimal(const char *s, double *v);
 
 /* Checks an LCM URL the way the loader does for lcm.url (and lagsimd for
  * LCM_DEFAULT_URL): "" (LCM's default), memq:// (in-process, for tests) or
@@ -146,8 +149,8 @@ int lag_scene_read_decimal(const char *s, double *v);
  * address (224.0.0.0/4), PORT 1..65534 (a plant's commands go to PORT + 1), each
  * option at most once, ttl 0..255 and above 0 only with allow_lan, recv_buf_size
  * 4096..268435456. Every other provider (file://
- * writes files, tcpq:// opens connections) is refused. Returns 0, or -1 with what was
- * expected in err. OUT: ttl (0 when the URL does not set it) */
-int lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, size_t errlen);
+ * writes files, tcpq:// opens connections) is refused. Returns LAG_OK, or LAG_ERR_SCENE
+ * with what was expected in err. OUT: ttl (0 when the URL does not set it) */
+lag_result lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, size_t errlen);
 
 #endif

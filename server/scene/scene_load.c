@@ -92,23 +92,23 @@ static void one_line(char *buf, size_t len)
     snprintf(buf, len, "%s", out);
 }
 
-static int load_buffer(const char *name, const char *text, size_t len,
-                       const char *const *sets, int nsets, lag_scene *sc, char *err,
-                       size_t errlen);
+static lag_result load_buffer(const char *name, const char *text, size_t len,
+                              const char *const *sets, int nsets, lag_scene *sc, char *err,
+                              size_t errlen);
 
-int lag_scene_load_buffer(const char *name, const char *text, size_t len,
-                          const char *const *sets, int nsets, lag_scene *sc, char *err,
-                          size_t errlen)
+lag_result lag_scene_load_buffer(const char *name, const char *text, size_t len,
+                                 const char *const *sets, int nsets, lag_scene *sc, char *err,
+                                 size_t errlen)
 {
-    int rc = load_buffer(name, text, len, sets, nsets, sc, err, errlen);
+    lag_result rc = load_buffer(name, text, len, sets, nsets, sc, err, errlen);
     if (rc != 0)
         one_line(err, errlen);
     return rc;
 }
 
-static int load_buffer(const char *name, const char *text, size_t len,
-                       const char *const *sets, int nsets, lag_scene *sc, char *err,
-                       size_t errlen)
+static lag_result load_buffer(const char *name, const char *text, size_t len,
+                              const char *const *sets, int nsets, lag_scene *sc, char *err,
+                              size_t errlen)
 {
     char dummy[8];
     errbuf e = {.buf = err ? err : dummy, .len = err ? errlen : sizeof dummy};
@@ -116,7 +116,7 @@ static int load_buffer(const char *name, const char *text, size_t len,
         e.buf[0] = '\0';
     if (!name || (!text && len) || !sc || nsets < 0 || (nsets > 0 && !sets)) {
         snprintf(e.buf, e.len, "lag_scene_load: invalid arguments");
-        return -1;
+        return LAG_ERR_ARG;
     }
     memset(sc, 0, sizeof *sc);
 
@@ -124,7 +124,7 @@ static int load_buffer(const char *name, const char *text, size_t len,
     ysrc *srcs = calloc((size_t)nsets + 1, sizeof *srcs);
     char **names = calloc((size_t)nsets + 1, sizeof *names);
     ynode *root = NULL;
-    int rc = -1;
+    lag_result rc = LAG_ERR_SCENE;
     if (!srcs || !names) {
         snprintf(e.buf, e.len, "%s: out of memory", name);
         goto done;
@@ -181,7 +181,7 @@ static int load_buffer(const char *name, const char *text, size_t len,
             goto done;
     }
 
-    rc = scene_schema_convert(root, name, sc, &e) < 0 ? -1 : 0;
+    rc = scene_schema_convert(root, name, sc, &e) < 0 ? LAG_ERR_SCENE : LAG_OK;
 done:
     ynode_free(root);
     if (names)
@@ -192,7 +192,7 @@ done:
     return rc;
 }
 
-int lag_scene_read(const char *path, char **text, size_t *len, char *err, size_t errlen)
+lag_result lag_scene_read(const char *path, char **text, size_t *len, char *err, size_t errlen)
 {
     char dummy[8];
     errbuf e = {.buf = err ? err : dummy, .len = err ? errlen : sizeof dummy};
@@ -200,17 +200,17 @@ int lag_scene_read(const char *path, char **text, size_t *len, char *err, size_t
         e.buf[0] = '\0';
     if (!path || !text || !len) {
         snprintf(e.buf, e.len, "lag_scene_read: invalid arguments");
-        return -1;
+        return LAG_ERR_ARG;
     }
     if (read_scene_file(path, text, len, &e) < 0) {
         one_line(err, errlen);
-        return -1;
+        return LAG_ERR_SCENE;
     }
-    return 0;
+    return LAG_OK;
 }
 
-int lag_scene_load(const char *path, const char *const *sets, int nsets, lag_scene *sc,
-                   char *err, size_t errlen)
+lag_result lag_scene_load(const char *path, const char *const *sets, int nsets, lag_scene *sc,
+                          char *err, size_t errlen)
 {
     char dummy[8];
     errbuf e = {.buf = err ? err : dummy, .len = err ? errlen : sizeof dummy};
@@ -218,16 +218,16 @@ int lag_scene_load(const char *path, const char *const *sets, int nsets, lag_sce
         e.buf[0] = '\0';
     if (!path || !sc) {
         snprintf(e.buf, e.len, "lag_scene_load: invalid arguments");
-        return -1;
+        return LAG_ERR_ARG;
     }
     memset(sc, 0, sizeof *sc);
     char *text;
     size_t len;
     if (read_scene_file(path, &text, &len, &e) < 0) {
         one_line(err, errlen);
-        return -1;
+        return LAG_ERR_SCENE;
     }
-    int rc = lag_scene_load_buffer(path, text, len, sets, nsets, sc, err, errlen);
+    lag_result rc = lag_scene_load_buffer(path, text, len, sets, nsets, sc, err, errlen);
     free(text);
     return rc;
 }

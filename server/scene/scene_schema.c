@@ -212,10 +212,10 @@ static int get_number(conv *cv, const ynode *nd, const char *path, double *out)
         strcmp(t, ".nan") == 0 || strcmp(t, ".NaN") == 0 || strcmp(t, ".NAN") == 0)
         return yfail(cv->err, nd, path, "expected a finite number, got %s", t);
     double v;
-    int r = lag_scene_read_decimal(t, &v);
-    if (r == -2)
+    lag_result r = lag_scene_read_decimal(t, &v);
+    if (r == LAG_ERR_RANGE)
         return yfail(cv->err, nd, path, "expected a finite number, got %s", t); /* 1e999 */
-    if (r < 0)
+    if (r != LAG_OK)
         return yfail(cv->err, nd, path, "expected a number, got '%s'", t);
     *out = v;
     return 0;

@@ -663,19 +663,19 @@ static void summarize(l2c *c, const lag_log_stats *ls, FILE *f)
                 c->untracked);
 }
 
-int l2c_convert(lag_log *lg, const l2c_opts *o, FILE *summary, char *err, size_t errlen)
+lag_result l2c_convert(lag_log *lg, const l2c_opts *o, FILE *summary, char *err, size_t errlen)
 {
     l2c c;
     memset(&c, 0, sizeof c);
     c.o = o;
     c.err = err;
     c.errlen = errlen;
-    int rc = 0;
+    lag_result rc = LAG_OK;
     lag_log_record r;
     int got;
     while ((got = lag_log_next(lg, &r)) == LAG_LOG_OK) {
         if (!record(&c, &r)) {
-            rc = 2;
+            rc = LAG_ERR_FILE;
             break;
         }
     }
@@ -683,19 +683,19 @@ int l2c_convert(lag_log *lg, const l2c_opts *o, FILE *summary, char *err, size_t
     lag_log_get_stats(lg, &ls);
     if (got == LAG_LOG_ERROR) {
         snprintf(err, errlen, "%s", lag_log_errmsg(lg));
-        rc = 1;
-    } else if (rc == 0 && ls.records == 0 && (ls.damaged > 0 || ls.truncated_bytes > 0)) {
+        rc = LAG_ERR_RUNTIME;
+    } else if (rc == LAG_OK && ls.records == 0 && (ls.damaged > 0 || ls.truncated_bytes > 0)) {
         /* bytes, and not one whole record among them */
         snprintf(err, errlen, "no complete LCM log record in its %lld bytes: not an LCM log",
                  (long long)(ls.bytes_skipped + ls.truncated_bytes));
-        rc = 1;
+        rc = LAG_ERR_RUNTIME;
     }
     for (int i = 0; i < c.n_ch; i++)
         if (c.ch[i].csv && c.ch[i].csv != c.discard) {
             if (ferror(c.ch[i].csv) || fclose(c.ch[i].csv) != 0) {
-                if (rc == 0) {
+                if (rc == LAG_OK) {
                     snprintf(err, errlen, "write error on the CSV of %s", c.ch[i].name);
-                    rc = 2;
+                    rc = LAG_ERR_FILE;
                 }
             }
             c.ch[i].csv = NULL;

@@ -8,6 +8,7 @@
 
 #include <stdbool.h>
 #include <stdio.h>
+#include "lagsim/result.h"
 #include "lagsim_log.h"
 #include "lagsim_wire.h"
 
@@ -24,8 +25,9 @@ typedef struct l2c_opts {
 } l2c_opts;
 
 /* Reads the whole log, writes the CSVs and the summary (to `summary`, may be NULL).
- * Returns 0, 1 when the log ended in an error (the CSVs hold every record before it; the
- * message is in err), 2 when nothing could be written (message in err). */
-int l2c_convert(lag_log *lg, const l2c_opts *o, FILE *summary, char *err, size_t errlen);
+ * Returns LAG_OK, LAG_ERR_RUNTIME when the log ended in an error (the CSVs hold every
+ * record before it; the message is in err), LAG_ERR_FILE when a CSV could not be written
+ * (message in err). */
+lag_result l2c_convert(lag_log *lg, const l2c_opts *o, FILE *summary, char *err, size_t errlen);
 
 #endif

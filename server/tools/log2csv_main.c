@@ -2,9 +2,9 @@
  * lagsim-log2csv LOG [--channel CH ...] [-o DIR] [--force] [-q]
  *
  * Turns an LCM log (written by lagsimd --log or by lcm-logger) into one CSV per channel
- * that carries lagsim's messages, and prints a summary. Exit codes: 0 ok, 1 the log ends
- * in an error (truncated, corrupt: the CSVs hold every record before it), 2 usage, or
- * the log cannot be opened, or a CSV cannot be written.
+ * that carries lagsim's messages, and prints a summary. Exit codes (lag_result_exit): 0 ok,
+ * 1 the log ends in an error (truncated, corrupt: the CSVs hold every record before it),
+ * 2 usage, or the log cannot be opened, or a CSV cannot be written.
  */
 #include <errno.h>
 #include <getopt.h>
@@ -42,7 +42,7 @@ static void usage(FILE *f)
           f);
 }
 
-int main(int argc, char **argv)
+static lag_result log2csv_main(int argc, char **argv)
 {
     static const struct option longopts[] = {
         {"channel", required_argument, NULL, 'c'}, {"output", required_argument, NULL, 'o'},
@@ -59,7 +59,7 @@ int main(int argc, char **argv)
         case 'c':
             if (o.n_select >= L2C_MAX_SELECT) {
                 fprintf(stderr, "lagsim-log2csv: at most %d --channel options\n", L2C_MAX_SELECT);
-                return 2;
+                return LAG_ERR_USAGE;
             }
             o.select[o.n_select++] = optarg;
             break;
@@ -74,33 +74,33 @@ int main(int argc, char **argv)
             break;
         case 'h':
             usage(stdout);
-            return 0;
+            return LAG_OK;
         case ':':
             fprintf(stderr, "lagsim-log2csv: option %s needs a value\n", argv[optind - 1]);
-            return 2;
+            return LAG_ERR_USAGE;
         default:
             fprintf(stderr, "lagsim-log2csv: unknown option '%s' (try --help)\n", argv[optind - 1]);
-            return 2;
+            return LAG_ERR_USAGE;
         }
     }
     if (optind != argc - 1) {
         fprintf(stderr, "lagsim-log2csv: expected one LOG file (try --help)\n");
-        return 2;
+        return LAG_ERR_USAGE;
     }
     const char *path = argv[optind];
     o.input = path;
     if (mkdir(o.outdir, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "lagsim-log2csv: cannot create %s: %s\n", o.outdir, strerror(errno));
-        return 2;
+        return LAG_ERR_FILE;
     }
     if (quiet) o.listing = NULL;
     char err[512] = "";
     lag_log *lg = lag_log_open(path, L2C_MAX_DATA, err, sizeof err);
     if (!lg) {
         fprintf(stderr, "lagsim-log2csv: %s\n", err);
-        return 2;
+        return LAG_ERR_FILE;
     }
-    int rc = l2c_convert(lg, &o, quiet ? NULL : stdout, err, sizeof err);
+    lag_result rc = l2c_convert(lg, &o, quiet ? NULL : stdout, err, sizeof err);
     lag_log_stats ls;
     lag_log_get_stats(lg, &ls);
     lag_log_close(lg);
@@ -113,10 +113,15 @@ int main(int argc, char **argv)
         fprintf(stderr, "lagsim-log2csv: warning: %s ends inside a record (%lld bytes cut "
                         "short: a logger stopped while writing?)\n",
                 path, (long long)ls.truncated_bytes);
-    if (rc == 1)
+    if (rc == LAG_ERR_RUNTIME)
         fprintf(stderr, "lagsim-log2csv: %s: %s (the CSVs hold every record before it)\n",
                 path, err);
-    else if (rc != 0)
+    else if (rc != LAG_OK)
         fprintf(stderr, "lagsim-log2csv: %s\n", err);
     return rc;
+}
+
+int main(int argc, char **argv)
+{
+    return lag_result_exit(log2csv_main(argc, argv));
 }

@@ -6,7 +6,7 @@
  * that draws the model from the scene description, animates it from the states, charts
  * coordinates, velocities, efforts and energy, shows status and events, and sends
  * pause / resume / step / reset. See view.h for the design, docs/view.md for use.
- * Exit codes: 0 stopped by a signal, 1 runtime failure, 2 usage.
+ * Exit codes (lag_result_exit): 0 stopped by a signal, 1 runtime failure, 2 usage.
  */
 #include <errno.h>
 #include <getopt.h>
@@ -54,7 +54,9 @@ static void usage(FILE *f)
           "JSON), GET /api/history?of=state|energy[&from=SEQ] (the kept states or energies,\n"
           "in pieces of at most 64 kB), GET /events (server-sent events),\n"
           "POST /api/control?request=pause|resume|step|reset[&count=N] and\n"
-          "POST /api/kick?joint=J&impulse=I[&duration=S] with the header X-Lagsim: 1.\n",
+          "POST /api/kick?joint=J&impulse=I[&duration=S] with the header X-Lagsim: 1.\n"
+          "\n"
+          "exit codes: 0 stopped by a signal, 1 runtime failure (LCM, the port), 2 usage\n",
           f);
 }
 
@@ -73,7 +75,7 @@ static bool is_loopback(const char *a)
     return strncmp(a, "127.", 4) == 0 || strcmp(a, "::1") == 0;
 }
 
-int main(int argc, char **argv)
+static lag_result view_main(int argc, char **argv)
 {
     enum { OPT_PORT = 256, OPT_URL, OPT_LISTEN, OPT_HZ, OPT_MAX_VIEWS, OPT_ALLOW_HOST,
            OPT_ALLOW_LAN };
@@ -106,19 +108,19 @@ int main(int argc, char **argv)
         case OPT_PORT:
             if (!parse_uint(optarg, 0, 65535, &ho.port)) {
                 fprintf(stderr, "lagsim-view: --port: expected 0 to 65535, got '%s'\n", optarg);
-                return 2;
+                return LAG_ERR_USAGE;
             }
             break;
         case OPT_HZ:
             if (!parse_uint(optarg, 1, 240, &ho.hz)) {
                 fprintf(stderr, "lagsim-view: --hz: expected 1 to 240, got '%s'\n", optarg);
-                return 2;
+                return LAG_ERR_USAGE;
             }
             break;
         case OPT_MAX_VIEWS:
             if (!parse_uint(optarg, 1, 256, &ho.max_streams)) {
                 fprintf(stderr, "lagsim-view: --max-views: expected 1 to 256, got '%s'\n", optarg);
-                return 2;
+                return LAG_ERR_USAGE;
             }
             break;
         case OPT_ALLOW_HOST: {
@@ -138,25 +140,25 @@ int main(int argc, char **argv)
                         "without a port (letters, digits, '-', '.', '_', an IPv6 address; at "
                         "most 16 of them), "
                         "got '%s'\n", optarg);
-                return 2;
+                return LAG_ERR_USAGE;
             }
             allow_hosts[n_allow_hosts++] = optarg;
             break;
         }
         case OPT_ALLOW_LAN: allow_lan = true; break;
         case 'q': quiet = true; break;
-        case 'h': usage(stdout); return 0;
+        case 'h': usage(stdout); return LAG_OK;
         case ':':
             fprintf(stderr, "lagsim-view: option %s needs a value\n", argv[optind - 1]);
-            return 2;
+            return LAG_ERR_USAGE;
         default:
             fprintf(stderr, "lagsim-view: unknown option '%s' (try --help)\n", argv[optind - 1]);
-            return 2;
+            return LAG_ERR_USAGE;
         }
     }
     if (optind < argc) {
         fprintf(stderr, "lagsim-view: unexpected argument '%s' (try --help)\n", argv[optind]);
-        return 2;
+        return LAG_ERR_USAGE;
     }
     ho.max_connections = ho.max_streams + 240;
     ho.allow_hosts = allow_hosts;
@@ -174,7 +176,7 @@ int main(int argc, char **argv)
     int sig_fd = signalfd(-1, &sigs, SFD_CLOEXEC | SFD_NONBLOCK);
     if (sig_fd < 0) {
         perror("lagsim-view: signalfd");
-        return 1;
+        return LAG_ERR_RUNTIME;
     }
 
     char err[1200];
@@ -184,7 +186,7 @@ int main(int argc, char **argv)
         int pr = lag_client_pick_plant(url, NULL, 2.0, &found, err, sizeof err);
         if (pr == LAG_CLIENT_ERR_AMBIGUOUS) {
             fprintf(stderr, "lagsim-view: %s\n", err);
-            return 2;
+            return LAG_ERR_AMBIGUOUS;
         }
         if (pr == LAG_CLIENT_OK) {
             prefix = found.prefix;
@@ -196,13 +198,13 @@ int main(int argc, char **argv)
     static view_bridge vb; /* large (rings): static, one bridge per process */
     if (!view_bridge_open(&vb, url, prefix, allow_lan, err, sizeof err)) {
         fprintf(stderr, "lagsim-view: %s\n", err);
-        return strstr(err, "--prefix") ? 2 : 1;
+        return strstr(err, "--prefix") ? LAG_ERR_USAGE : LAG_ERR_RUNTIME;
     }
     view_http *h = view_http_start(&vb, &ho, err, sizeof err);
     if (!h) {
         fprintf(stderr, "lagsim-view: %s\n", err);
         view_bridge_close(&vb);
-        return strstr(err, "--listen") ? 2 : 1;
+        return strstr(err, "--listen") ? LAG_ERR_USAGE : LAG_ERR_RUNTIME;
     }
     bool v6 = strchr(ho.listen, ':') != NULL;
     printf("lagsim-view: http://%s%s%s:%u/  (prefix %s)\n", v6 ? "[" : "", ho.listen,
@@ -219,7 +221,7 @@ int main(int argc, char **argv)
                         "Ctrl-C stops\n");
 
     int lcm_fd = lcm_get_fileno(vb.lcm), http_fd = view_http_fd(h);
-    int rc = 0;
+    lag_result rc = LAG_OK;
     for (;;) {
         int timeout = view_http_timeout_ms(h);
         /* streams waiting for a frame: wake at the frame rate; otherwise once a second
@@ -230,7 +232,7 @@ int main(int argc, char **argv)
         int n = poll(pf, 3, timeout);
         if (n < 0 && errno != EINTR) {
             perror("lagsim-view: poll");
-            rc = 1;
+            rc = LAG_ERR_RUNTIME;
             break;
         }
         if (n > 0 && (pf[2].revents & POLLIN)) break;
@@ -241,4 +243,9 @@ int main(int argc, char **argv)
     view_bridge_close(&vb);
     close(sig_fd);
     return rc;
+}
+
+int main(int argc, char **argv)
+{
+    return lag_result_exit(view_main(argc, argv));
 }

@@ -18,6 +18,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "lagsim/result.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -27,25 +29,9 @@ extern "C" {
 #define LAG_MAX_PARAMS 12
 
 /* ---------------------------------------------------------------- result codes */
-typedef enum lag_result {
-    LAG_OK = 0,
-    LAG_ERR_ARG,       /* invalid argument or definition (message says which) */
-    LAG_ERR_SINGULAR,  /* mass matrix not positive definite at this state */
-    LAG_ERR_NONFINITE, /* a step produced NaN or Inf: state left unchanged */
-    LAG_ERR_EXPLODE,   /* |q| or |qd| exceeded lag_sim_def.explode_limit: state unchanged */
-    LAG_ERR_NEWTON,    /* implicit method: Newton did not converge in max_iter */
-    LAG_ERR_STEPSIZE,  /* dopri5: step size fell below dt_min */
-    LAG_ERR_LIFTOFF,   /* stick with a floor: the normal force went negative */
-    LAG_ERR_FORCE,     /* the applied forces (or an impulse) are too large for one tick:
-                          at the tick's start they give an acceleration that takes the state
-                          past explode_limit within dt, or a non-finite one. Reported
-                          instead of what the step then ran into (a non-finite state, a
-                          mass matrix evaluated at an overflowed q, Newton or dopri5
-                          failing); see lag_sim_fault_describe. State unchanged */
-    LAG_ERR_MAX_STEPS  /* dopri5: more than max_steps steps for one tick (bounded work) */
-} lag_result;
-
-const char *lag_result_string(lag_result r);
+/* lag_result, its names, sentences and exit statuses: lagsim/result.h (one space for the
+ * core, the scene loader, the client library and the programs). The core returns LAG_OK,
+ * LAG_ERR_ARG and the numeric faults LAG_ERR_SINGULAR .. LAG_ERR_MAX_STEPS. */
 
 /* What is wrong with a definition, for a loader to point at (SQLite's habit of a message
  * on the caller's side, plus where): `field` is the path of the offending value in the
