@@ -18,7 +18,7 @@ typedef struct url_reader {
     size_t errlen;
 } url_reader;
 
-static bool fail(url_reader *r, const char *fmt, ...)
+__attribute__((format(printf, 2, 3))) static bool fail(url_reader *r, const char *fmt, ...)
 {
     if (r->err && r->errlen) {
         va_list ap;
