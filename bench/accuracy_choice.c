@@ -17,16 +17,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+#include "lagsim_clock.h"
 
 #include "cost.h"
 #include "scene.h"
 
 static double cpu_now(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return lag_clock_thread_cpu_s();
 }
 
 /* One run of DEF with integrator IN over the horizon, period by period; false on a fault. */

@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+#include "lagsim_clock.h"
 
 #include "bench.h"
 
@@ -186,9 +186,7 @@ int bench_run_lagsim(const bench_scene *sc, const bench_config *c, bench_samples
 /* ---------------------------------------------------------------- timing */
 double bench_cpu_now(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return lag_clock_process_cpu_s();
 }
 
 static bench_runner runner_for(bench_impl impl)

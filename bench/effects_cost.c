@@ -15,7 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+#include "lagsim_clock.h"
 
 #include "lagsim/lagsim.h"
 
@@ -27,9 +27,7 @@ static const char *const row_names[ROW_COUNT] = {
 
 static double now_s(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return lag_clock_mono_s();
 }
 
 /* The scene of one row: the model's moving initial state plus that one effect.

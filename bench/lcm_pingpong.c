@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
-#include <time.h>
+#include "lagsim_clock.h"
 #include <unistd.h>
 
 static int got;
@@ -23,9 +23,7 @@ static void on_msg(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 
 static double now_s(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return lag_clock_mono_s();
 }
 
 int main(int argc, char **argv)

@@ -12,17 +12,16 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+#include "lagsim_clock.h"
 
 #include <lcm/lcm.h>
 #include "lagsim/lagsim_joint_command_t.h"
+#include "lagsim_bus.h"
 #include "lagsim_wire.h"
 
 static double now_s(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return lag_clock_mono_s();
 }
 
 typedef struct counts {
@@ -72,7 +71,7 @@ int main(int argc, char **argv)
         printf("flood: %ld messages in %g s on %s of %s\n", sent, secs, argv[3], argv[2]);
     } else if (!strcmp(argv[1], "listen")) {
         char ch[96];
-        snprintf(ch, sizeof ch, "%s_STATE", argv[3]);
+        lag_bus_channel_name(ch, sizeof ch, argv[3], LAG_BUS_STATE);
         counts c = {0};
         lcm_subscription_t *sub = lcm_subscribe(lcm, ch, on_state, &c);
         lcm_subscription_set_queue_capacity(sub, 1000);

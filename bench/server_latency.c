@@ -36,23 +36,14 @@
 
 #include <lcm/lcm.h>
 #include "lagsim_bus.h"
+#include "lagsim_clock.h"
 #include "lagsim/lagsim_joint_command_t.h"
 #include "lagsim/lagsim_joint_state_t.h"
 #include "lagsim/lagsim_status_t.h"
 #include "lagsim_wire.h"
 
-static int64_t mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
-static int64_t wall_us(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
+static int64_t mono_ns(void) { return lag_clock_mono_ns(); }
+static int64_t wall_us(void) { return lag_clock_wall_us(); }
 
 /* ---------------------------------------------------------------- samples */
 typedef struct samples {
@@ -290,12 +281,12 @@ int main(int argc, char **argv)
     lcm_unsubscribe(b.lcm, pong);
 
     /* 3. lagsimd in real time with this process as the controller */
-    snprintf(ch, sizeof ch, "%s_STATE", prefix);
+    lag_bus_channel_name(ch, sizeof ch, prefix, LAG_BUS_STATE);
     lcm_subscription_t *ss = lcm_subscribe(b.lcm, ch, on_state, &b);
     lcm_subscription_set_queue_capacity(ss, 100000);
-    snprintf(ch, sizeof ch, "%s_STATUS", prefix);
+    lag_bus_channel_name(ch, sizeof ch, prefix, LAG_BUS_STATUS);
     lcm_subscribe(b.lcm, ch, on_status, &b);
-    snprintf(b.ch_command, sizeof b.ch_command, "%s_COMMAND", prefix);
+    lag_bus_channel_name(b.ch_command, sizeof b.ch_command, prefix, LAG_BUS_COMMAND);
     b.control = true;
     b.pending_mark = -1;
     pid_t d = run_daemon(lagsimd, scene, prefix, "realtime", hz, seconds);
@@ -314,10 +305,10 @@ int main(int argc, char **argv)
     int64_t n0 = b.n_states;
     char lprefix[80];
     snprintf(lprefix, sizeof lprefix, "%sL", prefix);
-    snprintf(ch, sizeof ch, "%s_STATE", lprefix);
+    lag_bus_channel_name(ch, sizeof ch, lprefix, LAG_BUS_STATE);
     lcm_unsubscribe(b.lcm, ss);
     ss = lcm_subscribe(b.lcm, ch, on_state, &b);
-    snprintf(b.ch_command, sizeof b.ch_command, "%s_COMMAND", lprefix);
+    lag_bus_channel_name(b.ch_command, sizeof b.ch_command, lprefix, LAG_BUS_COMMAND);
     /* run long enough in sim time; we stop it after ls_seconds of wall time */
     int64_t tl0 = mono_ns();
     pid_t dl = run_daemon(lagsimd, scene, lprefix, "lockstep", hz, 1e6);

@@ -19,12 +19,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include <lcm/lcm.h>
 
 #include "lagsim/lagsim_control_t.h"
 #include "lagsim_bus.h"
+#include "lagsim_clock.h"
 
 struct lag_client {
     lcm_t *lcm;                  /* the state URL: states, status, events, scene in */
@@ -83,19 +83,7 @@ static void set_err(lag_client *c, const char *fmt, ...)
     va_end(ap);
 }
 
-double lag_client_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int64_t wall_utime(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
+double lag_client_now(void) { return lag_clock_mono_s(); }
 
 /* Copies src into dst[cap]; returns false (dst = truncated copy) if it does not fit. */
 static bool copy_str(char *dst, size_t cap, const char *src)
@@ -417,7 +405,7 @@ lag_result lag_client_send_command(lag_client *c, double sim_time, int n, const 
     }
     lag_wire_joint_command m;
     memset(&m, 0, sizeof m);
-    m.utime = wall_utime();
+    m.utime = lag_clock_wall_us();
     m.sim_time = sim_time;
     m.num_joints = (int16_t)n;
     for (int i = 0; i < n; i++) {
@@ -447,7 +435,7 @@ static lag_result send_control(lag_client *c, int8_t request, int64_t count, int
 {
     lag_wire_control m;
     memset(&m, 0, sizeof m);
-    m.utime = wall_utime();
+    m.utime = lag_clock_wall_us();
     m.request = request;
     m.count = count;
     m.num_joints = (int16_t)n;
@@ -486,7 +474,7 @@ lag_result lag_client_set(lag_client *c, const char *key, const char *value)
                 sizeof m.value - 1);
         return LAG_CLIENT_ERR_ARG;
     }
-    m.utime = wall_utime();
+    m.utime = lag_clock_wall_us();
     m.request = LAGSIM_CONTROL_T_SET;
     memcpy(m.key, key, strlen(key) + 1);
     memcpy(m.value, value, strlen(value) + 1);
@@ -720,7 +708,7 @@ static void disc_ask(disc *d, lcm_t *cmd, int i, uint8_t *buf, size_t cap)
         if ((k == 0 && d->scene[i]) || (k == 1 && d->status[i])) continue;
         lag_wire_control m;
         memset(&m, 0, sizeof m);
-        m.utime = wall_utime();
+        m.utime = lag_clock_wall_us();
         m.request = req[k];
         int len = lag_wire_encode(LAG_WIRE_CONTROL, &m, buf, cap);
         if (len > 0) lcm_publish(cmd, ch, buf, (unsigned)len);

@@ -38,7 +38,7 @@ endforeach()
 
 # C: the client library, the libraries it and the examples link, their headers.
 set(_libs "")
-foreach(t lagsim_controller lagsim_client lagsim_wire lagsim_lcmtypes lagsim_core)
+foreach(t lagsim_controller lagsim_client lagsim_wire lagsim_wire_base lagsim_lcmtypes lagsim_core)
   if(TARGET ${t})
     install(TARGETS ${t} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
     string(REPLACE "lagsim_" "-llagsim_" _l ${t})

@@ -40,3 +40,25 @@ if(LAGSIM_PYTHON3)
            COMMAND ${LAGSIM_PYTHON3} ${LAGSIM_FUZZ_DIR}/make_corpora.py ${CMAKE_BINARY_DIR} --check)
   set_tests_properties(fuzz_corpora_current PROPERTIES TIMEOUT 120 LABELS fuzz)
 endif()
+
+# The one LCM URL reader (server/wire/lagsim_url.c) and its two users, the plant's URLs and
+# a scene's lcm.url, on one table of URLs (tests/wire/test_url.c).
+add_executable(test_url ${CMAKE_CURRENT_LIST_DIR}/wire/test_url.c)
+target_include_directories(test_url PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
+target_link_libraries(test_url PRIVATE lagsim_scene lagsim_wire_base)
+foreach(case bus scene one_rule fields)
+  add_test(NAME wire_url_${case} COMMAND test_url ${case})
+  set_tests_properties(wire_url_${case} PROPERTIES TIMEOUT 30 LABELS wire)
+endforeach()
+
+# One clock, one URL reader, one table of channel suffixes in the wire layer
+# (tests/wire/one_place.py): a second copy anywhere in server/, clients/ or bench/ fails.
+find_program(LAGSIM_WIRE_PYTHON3 python3)
+if(LAGSIM_WIRE_PYTHON3)
+  foreach(check clock url channels)
+    add_test(NAME wire_one_place_${check}
+             COMMAND ${LAGSIM_WIRE_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/wire/one_place.py
+                     ${PROJECT_SOURCE_DIR} ${check})
+    set_tests_properties(wire_one_place_${check} PROPERTIES TIMEOUT 30 LABELS wire)
+  endforeach()
+endif()

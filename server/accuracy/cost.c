@@ -1,5 +1,6 @@
 /* What accuracy costs on one scene (cost.h says what is measured and how). */
 #include "cost.h"
+#include "lagsim_clock.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -21,9 +22,7 @@ lag_cost_opts lag_cost_opts_default(void)
 static double thread_cpu(void *ctx)
 {
     (void)ctx;
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return lag_clock_thread_cpu_s();
 }
 
 lag_integrator_def lag_cost_row_integrator(const lag_sim_def *def, const lag_cost_row *row)

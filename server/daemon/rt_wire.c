@@ -14,21 +14,12 @@
 #include <time.h>
 
 #include "daemon.h"
+#include "lagsim_clock.h"
 #include "rt_wire.h"
 
-int64_t rt_mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
+int64_t rt_mono_ns(void) { return lag_clock_mono_ns(); }
 
-int64_t rt_wall_us(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
+int64_t rt_wall_us(void) { return lag_clock_wall_us(); }
 
 /* A finite double, or 0: what goes on the bus. */
 static double fin(double x) { return isfinite(x) ? x : 0.0; }

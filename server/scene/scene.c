@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "scene.h"
+#include "lagsim_url.h"
 
 /* Defaults for a model kind: the core's lag_default_sim_def (rk4 at 1 ms, at rest at
  * q = 0, the model's default parameters) plus the daemon's defaults documented in
@@ -98,135 +99,18 @@ const char *lag_rt_mode_name(lag_rt_mode m)
     return "?";
 }
 
-/* Reads a decimal integer of 1 to `maxdigits` digits without leading zeros (inet_aton
- * and strtol(.., 0) read those as octal) from *p, advanced past it. */
-static bool read_uint(const char **p, int maxdigits, long *out)
-{
-    const char *s = *p;
-    long v = 0;
-    int n = 0;
-    while (*s >= '0' && *s <= '9' && n < maxdigits) {
-        v = v * 10 + (*s - '0');
-        s++;
-        n++;
-    }
-    if (n == 0 || (*s >= '0' && *s <= '9') || (n > 1 && **p == '0'))
-        return false;
-    *p = s;
-    *out = v;
-    return true;
-}
-
-/* See scene.h. The grammar is LCM's (lcm_udpm.c), made strict: LCM 1.3 only warns about
- * unknown options and accepts any provider it was built with. */
-lag_result lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err, size_t errlen)
+/* See scene.h: the wire layer's one URL reader, under a scene's rules. */
+lag_result lag_scene_check_url(const char *url, bool allow_lan, int *ttl, char *err,
+                               size_t errlen)
 {
     *ttl = 0;
     if (!url || url[0] == '\0')
         return LAG_OK;
-    if (strncmp(url, "memq://", 7) == 0) {
-        if (url[7] != '\0') {
-            snprintf(err, errlen, "memq:// takes no address or options, got '%s'", url);
-            return LAG_ERR_SCENE;
-        }
-        return LAG_OK;
-    }
-    if (strncmp(url, "udpm://", 7) != 0) {
-        const char *sep = strstr(url, "://");
-        int n = sep ? (int)(sep - url) : 0;
-        if (sep && n < 16)
-            snprintf(err, errlen, "LCM provider '%.*s://' is not accepted in a scene: "
-                     "expected udpm://GROUP:PORT?ttl=0 (or memq:// for tests)", n, url);
-        else
-            snprintf(err, errlen, "expected an LCM URL udpm://GROUP:PORT?ttl=0 "
-                     "(or memq:// for tests), got '%s'", url);
+    lag_url u;
+    int flags = LAG_URL_SCENE_RULES | (allow_lan ? LAG_URL_ALLOW_LAN : 0);
+    if (lag_url_parse(url, flags, &u, err, errlen) != 0)
         return LAG_ERR_SCENE;
-    }
-    const char *p = url + 7;
-    if (*p != '\0' && *p != '?') {
-        /* GROUP: four decimal octets, a multicast address */
-        long oct[4];
-        for (int i = 0; i < 4; i++) {
-            if ((i > 0 && *p++ != '.') || !read_uint(&p, 3, &oct[i]) || oct[i] > 255) {
-                snprintf(err, errlen, "expected udpm://GROUP:PORT with GROUP a dotted IPv4 "
-                         "multicast address (e.g. 239.255.76.67), got '%s'", url);
-                return LAG_ERR_SCENE;
-            }
-        }
-        if (oct[0] < 224 || oct[0] > 239) {
-            snprintf(err, errlen, "%ld.%ld.%ld.%ld is not a multicast address "
-                     "(224.0.0.0 to 239.255.255.255): udpm needs a multicast group",
-                     oct[0], oct[1], oct[2], oct[3]);
-            return LAG_ERR_SCENE;
-        }
-        if (*p == ':') {
-            p++;
-            long port;
-            /* a plant's commands go to the next port (lagsim_bus.h) */
-            if (!read_uint(&p, 5, &port) || port < 1 || port > 65534) {
-                snprintf(err, errlen, "expected a port from 1 to 65534 (commands go to the "
-                         "next port) after the group in "
-                         "'%s'", url);
-                return LAG_ERR_SCENE;
-            }
-        }
-        if (*p != '\0' && *p != '?') {
-            snprintf(err, errlen, "unexpected '%c' after the address in '%s' "
-                     "(expected udpm://GROUP:PORT?option=value&...)", *p, url);
-            return LAG_ERR_SCENE;
-        }
-    }
-    if (*p == '?') {
-        p++;
-        bool seen_ttl = false, seen_buf = false;
-        for (;;) {
-            const char *eq = p;
-            while (*eq && *eq != '=' && *eq != '&')
-                eq++;
-            int klen = (int)(eq - p);
-            bool is_ttl = klen == 3 && strncmp(p, "ttl", 3) == 0;
-            bool is_buf = klen == 13 && strncmp(p, "recv_buf_size", 13) == 0;
-            if (!is_ttl && !is_buf) {
-                snprintf(err, errlen, "unknown udpm option '%.*s' in '%s'; allowed: ttl, "
-                         "recv_buf_size", klen > 32 ? 32 : klen, p, url);
-                return LAG_ERR_SCENE;
-            }
-            if ((is_ttl && seen_ttl) || (is_buf && seen_buf)) {
-                snprintf(err, errlen, "udpm option '%.*s' given twice in '%s'", klen, p, url);
-                return LAG_ERR_SCENE;
-            }
-            const char *v = eq;
-            long val;
-            if (*v++ != '=' || !read_uint(&v, 10, &val) || (*v != '\0' && *v != '&')) {
-                snprintf(err, errlen, "expected %.*s=<integer> in '%s'", klen, p, url);
-                return LAG_ERR_SCENE;
-            }
-            if (is_ttl) {
-                seen_ttl = true;
-                if (val > 255) {
-                    snprintf(err, errlen, "ttl must be 0 to 255, got %ld", val);
-                    return LAG_ERR_SCENE;
-                }
-                if (val > 0 && !allow_lan) {
-                    snprintf(err, errlen, "ttl=%ld sends every message beyond this host "
-                             "(1: the local network, more: through routers); set "
-                             "lcm.allow_lan: true if that is meant, or use ttl=0", val);
-                    return LAG_ERR_SCENE;
-                }
-                *ttl = (int)val;
-            } else {
-                seen_buf = true;
-                if (val < 4096 || val > 268435456) {
-                    snprintf(err, errlen, "recv_buf_size must be 4096 to 268435456 bytes, "
-                             "got %ld", val);
-                    return LAG_ERR_SCENE;
-                }
-            }
-            if (*v == '\0')
-                break;
-            p = v + 1; /* past '&' */
-        }
-    }
+    *ttl = u.ttl;
     return LAG_OK;
 }
 

@@ -23,6 +23,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "lagsim_bus.h"
 #include "lagsim_out.h"
 #include "lagsim/lagsim_control_t.h" /* the requests' constants */
 
@@ -205,10 +206,12 @@ static chan *find_chan(l2c *c, const char *name)
 /* The scene channel that goes with a state channel: "<PREFIX>_STATE" -> "<PREFIX>_SCENE". */
 static chan *scene_of(l2c *c, const chan *state)
 {
-    size_t n = strlen(state->name);
-    if (n < 6 || strcmp(state->name + n - 6, "_STATE") != 0) return NULL;
-    char name[LAG_LOG_CHANNEL_MAX + 1];
-    snprintf(name, sizeof name, "%.*s_SCENE", (int)(n - 6), state->name);
+    const char *st = lag_bus_suffix(LAG_BUS_STATE);
+    size_t n = strlen(state->name), k = strlen(st);
+    if (n < k || strcmp(state->name + n - k, st) != 0) return NULL;
+    char prefix[LAG_LOG_CHANNEL_MAX + 1], name[LAG_LOG_CHANNEL_MAX + 1];
+    snprintf(prefix, sizeof prefix, "%.*s", (int)(n - k), state->name);
+    lag_bus_channel_name(name, sizeof name, prefix, LAG_BUS_SCENE);
     for (int i = 0; i < c->n_ch; i++)
         if (strcmp(c->ch[i].name, name) == 0) return &c->ch[i];
     return NULL;

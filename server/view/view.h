@@ -18,6 +18,7 @@
 #include <stdint.h>
 #include <lcm/lcm.h>
 
+#include "lagsim_clock.h"
 #include "lagsim_wire.h"
 
 #define VIEW_EVENTS 256            /* events kept for streams and /api/state */
@@ -119,8 +120,6 @@ typedef struct view_bridge {
     int ctl_in_window;
 } view_bridge;
 
-int64_t view_mono_ns(void);
-int64_t view_wall_us(void);
 /* Connects and subscribes; on udpm keeps only the plant's channels and, unless allow_lan,
  * only datagrams sent from this host. Returns false with a message in err. */
 bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, bool allow_lan,

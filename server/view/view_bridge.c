@@ -10,7 +10,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "view.h"
 #include "lagsim/lagsim_control_t.h"
@@ -20,20 +19,6 @@
 #define VIEW_DRAIN_MAX 512        /* messages handled per poll at most */
 #define VIEW_LCM_QUEUE 200        /* LCM's queue per subscription */
 #define VIEW_DESCRIBE_NS 1000000000
-
-int64_t view_mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
-
-int64_t view_wall_us(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
 
 /* The seq a sample at sim time t takes in a ring of VIEW_HISTORY holding first..last whose
  * newest sample is at newest_t (view_history); -1: not kept (t not finite). */
@@ -92,7 +77,7 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *user)
     vb->state_seq++;
     history_state(&vb->hist, &m);
     vb->n_state++;
-    vb->last_msg_ns = view_mono_ns();
+    vb->last_msg_ns = lag_clock_mono_ns();
 }
 
 static void on_reference(const lcm_recv_buf_t *rb, const char *ch, void *user)
@@ -107,7 +92,7 @@ static void on_reference(const lcm_recv_buf_t *rb, const char *ch, void *user)
     }
     vb->reference = m;
     vb->n_reference++;
-    vb->last_msg_ns = view_mono_ns();
+    vb->last_msg_ns = lag_clock_mono_ns();
 }
 
 static void on_status(const lcm_recv_buf_t *rb, const char *ch, void *user)
@@ -124,7 +109,7 @@ static void on_status(const lcm_recv_buf_t *rb, const char *ch, void *user)
     vb->status_seq++;
     history_energy(&vb->hist, &m);
     vb->n_status++;
-    vb->last_msg_ns = view_mono_ns();
+    vb->last_msg_ns = lag_clock_mono_ns();
 }
 
 static void on_event(const lcm_recv_buf_t *rb, const char *ch, void *user)
@@ -143,7 +128,7 @@ static void on_event(const lcm_recv_buf_t *rb, const char *ch, void *user)
     vb->events[vb->event_seq % VIEW_EVENTS].seq = vb->event_seq;
     vb->events[vb->event_seq % VIEW_EVENTS].ev = m;
     vb->n_event++;
-    vb->last_msg_ns = view_mono_ns();
+    vb->last_msg_ns = lag_clock_mono_ns();
 }
 
 static void on_scene(const lcm_recv_buf_t *rb, const char *ch, void *user)
@@ -159,7 +144,7 @@ static void on_scene(const lcm_recv_buf_t *rb, const char *ch, void *user)
     vb->scene = m;
     vb->scene_seq++;
     vb->n_scene++;
-    vb->last_msg_ns = view_mono_ns();
+    vb->last_msg_ns = lag_clock_mono_ns();
 }
 
 /* Keeps only this plant's five channels on the state URL's receive socket and, unless
@@ -266,7 +251,7 @@ static bool send_control(view_bridge *vb, int request, int64_t count)
 {
     lag_wire_control m;
     memset(&m, 0, sizeof m);
-    m.utime = view_wall_us();
+    m.utime = lag_clock_wall_us();
     m.request = (int8_t)request;
     m.count = count;
     uint8_t buf[LAG_WIRE_BUF_SIZE];
@@ -277,7 +262,7 @@ static bool send_control(view_bridge *vb, int request, int64_t count)
 /* The window limit every control request of a page shares: false (counted) beyond it. */
 static bool control_allowed(view_bridge *vb)
 {
-    int64_t now = view_mono_ns();
+    int64_t now = lag_clock_mono_ns();
     if (now - vb->ctl_window_ns >= 1000000000) {
         vb->ctl_window_ns = now;
         vb->ctl_in_window = 0;
@@ -313,7 +298,7 @@ int view_bridge_kick(view_bridge *vb, const char *joint, const char *impulse,
     }
     if (d > 0) snprintf(m.value, sizeof m.value, "%.17g,%.17g", j, d);
     else snprintf(m.value, sizeof m.value, "%.17g", j);
-    m.utime = view_wall_us();
+    m.utime = lag_clock_wall_us();
     m.request = LAGSIM_CONTROL_T_SET;
     uint8_t buf[LAG_WIRE_BUF_SIZE];
     int n = lag_wire_encode_control(&m, buf, sizeof buf);
@@ -331,7 +316,7 @@ void view_bridge_poll(view_bridge *vb)
 {
     for (int k = 0; k < VIEW_DRAIN_MAX; k++)
         if (lcm_handle_timeout(vb->lcm, 0) <= 0) break;
-    int64_t now = view_mono_ns();
+    int64_t now = lag_clock_mono_ns();
     if (!vb->scene_seq && now - vb->last_describe_ns >= VIEW_DESCRIBE_NS) {
         vb->last_describe_ns = now;
         send_control(vb, LAGSIM_CONTROL_T_DESCRIBE, 0);

@@ -229,7 +229,7 @@ static ssize_t stream_read(void *cls, uint64_t pos, char *buf, size_t max)
     (void)pos;
     stream *s = cls;
     view_http *h = s->h;
-    int64_t now = view_mono_ns();
+    int64_t now = lag_clock_mono_ns();
     if (s->off >= s->len) {
         s->len = s->off = 0;
         if (now >= s->next_frame_ns) {
@@ -271,7 +271,7 @@ static enum MHD_Result open_stream(view_http *h, struct MHD_Connection *c, conn 
     if (!s) return reply_text(c, 503, "out of memory\n");
     s->h = h;
     s->conn = c;
-    s->last_write_ns = s->progress_ns = view_mono_ns();
+    s->last_write_ns = s->progress_ns = lag_clock_mono_ns();
     struct MHD_Response *r =
         MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 16384, stream_read, s, stream_free);
     if (!r) {
@@ -382,7 +382,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     }
     conn *rec = conn_of(c);
     /* the headers are in: a request that is not a stream has VIEW_REQUEST_DEADLINE_S */
-    if (rec) rec->deadline_ns = view_mono_ns() + VIEW_REQUEST_DEADLINE_S * 1000000000LL;
+    if (rec) rec->deadline_ns = lag_clock_mono_ns() + VIEW_REQUEST_DEADLINE_S * 1000000000LL;
     unsigned bad = host_check(h, c);
     if (bad) {
         h->n_bad_host++;
@@ -452,7 +452,7 @@ static void on_connection(void *cls, struct MHD_Connection *c, void **socket_con
             return;
         }
         r->fd = i->connect_fd;
-        r->deadline_ns = view_mono_ns() + VIEW_HEADER_DEADLINE_S * 1000000000LL;
+        r->deadline_ns = lag_clock_mono_ns() + VIEW_HEADER_DEADLINE_S * 1000000000LL;
         r->next = h->conns;
         if (h->conns) h->conns->prev = r;
         h->conns = r;
@@ -478,7 +478,7 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
     (void)con_cls;
     (void)toe;
     conn *r = conn_of(c);
-    if (r && !r->stream) r->deadline_ns = view_mono_ns() + VIEW_HEADER_DEADLINE_S * 1000000000LL;
+    if (r && !r->stream) r->deadline_ns = lag_clock_mono_ns() + VIEW_HEADER_DEADLINE_S * 1000000000LL;
 }
 
 /* Ends a connection from outside libmicrohttpd's callbacks: the socket is shut down, the
@@ -695,7 +695,7 @@ int view_http_timeout_ms(view_http *h)
 void view_http_run(view_http *h)
 {
     view_bridge *vb = h->vb;
-    int64_t now = view_mono_ns();
+    int64_t now = lag_clock_mono_ns();
     /* wake a suspended stream when it is behind the snapshot (something changed, or a
      * backlog of events remains) and its next frame is due, and every VIEW_KEEPALIVE_NS
      * for a keep-alive */

@@ -432,7 +432,7 @@ size_t view_json_snapshot(const view_bridge *vb, const view_http *h, char *out, 
 {
     jbuf b;
     jb_init(&b, out, cap);
-    int64_t now = view_mono_ns();
+    int64_t now = lag_clock_mono_ns();
     int cut = 0;
     jb_raw(&b, "{\"bridge\":{");
     jb_key(&b, "prefix", true);

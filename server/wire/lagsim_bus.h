@@ -33,8 +33,6 @@ extern "C" {
 #define LAG_BUS_CHANNEL_LEN 76    /* prefix (< 64) + "_REFERENCE" */
 #define LAG_BUS_PREFIX_MAX 53     /* a channel name has at most 63 bytes; _REFERENCE has 10 */
 #define LAG_BUS_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0" /* LCM's own default */
-#define LAG_BUS_DEFAULT_GROUP "239.255.76.67"
-#define LAG_BUS_DEFAULT_PORT 7667
 
 /* The channels of one plant; all but COMMAND and CONTROL are the daemon's output. */
 typedef enum lag_bus_channel {
@@ -45,7 +43,10 @@ typedef enum lag_bus_channel {
     LAG_BUS_COMMAND,  /* input: on the command URL */
     LAG_BUS_CONTROL,  /* input: on the command URL */
     LAG_BUS_REFERENCE,/* output, on the state URL: only when the scene has a reference */
-    LAG_BUS_CHANNEL_COUNT
+    LAG_BUS_CHANNEL_COUNT,
+    /* Not on the bus: in the daemon's --log only, the commanded input of a period. */
+    LAG_BUS_INPUT = LAG_BUS_CHANNEL_COUNT,
+    LAG_BUS_SUFFIX_COUNT
 } lag_bus_channel;
 
 typedef struct lag_bus {
@@ -59,13 +60,18 @@ typedef struct lag_bus {
 
 /* Derives the URLs and channels of the plant with LCM URL `url` (NULL or "": the
  * environment's LCM_DEFAULT_URL, else LCM's default) and channel prefix `prefix`.
- * Accepts memq:// and udpm://[GROUP[:PORT]][?OPTIONS] (GROUP dotted IPv4, PORT 1 to
- * 65534: the command port is PORT + 1); anything else, or a prefix of 0 or more than 55
- * characters, is refused with a message in err. Returns 0 or -1. OUT: b */
+ * Accepts memq:// and udpm://[GROUP[:PORT]][?OPTIONS] as lag_url_parse reads them
+ * (lagsim_url.h; the options kept as given; the command port is PORT + 1); anything else,
+ * a URL of 256 characters or more, or a prefix of 0 or more than 53 characters, is refused
+ * with a message in err. Returns 0 or -1. OUT: b */
 int lag_bus_init(lag_bus *b, const char *url, const char *prefix, char *err, size_t errlen);
 
-/* The suffix of a channel ("_STATE", ...). */
+/* The suffix of a channel ("_STATE", ...; "_INPUT"): the one table of them. */
 const char *lag_bus_suffix(lag_bus_channel ch);
+
+/* Writes the name of channel ch of the plant with prefix `prefix` ("<PREFIX>_STATE") to
+ * dst; returns what snprintf returns (>= cap: cut short). OUT: dst */
+int lag_bus_channel_name(char *dst, size_t cap, const char *prefix, lag_bus_channel ch);
 
 /* Whether the channel goes to the daemon (command URL) rather than from it. */
 bool lag_bus_is_input(lag_bus_channel ch);

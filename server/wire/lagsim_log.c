@@ -203,103 +203,142 @@ static int too_far(lag_log *lg, int64_t searched)
     return LAG_LOG_ERROR;
 }
 
+/* One search for the next record: lag_log_next's steps share it. */
+typedef struct log_search {
+    lag_log *lg;
+    lag_log_record *rec;
+    int64_t searched;  /* bytes passed over since the last good record */
+    int64_t suspect;   /* offset of a header that did not fit in the file, or -1 */
+    bool damaged;      /* the sequence of records was lost on the way */
+    int64_t off;       /* offset of the sync word found */
+    uint8_t h[HEADER + LAG_LOG_CHANNEL_MAX]; /* the header after it, and the channel */
+    int nread;         /* bytes of h read */
+    int64_t evnum, stamp, chan_len, data_len;
+} log_search;
+
+/* A step's result besides lag_log_next's own (LAG_LOG_OK, _END, _ERROR). */
+enum { STEP_ON = 2, STEP_NOT_A_RECORD = 3 };
+
+/* The end inside a record: the bytes passed over before it are skipped, and the last
+ * `cut` bytes are the record cut short. */
+static int end_in_record(log_search *s, int64_t cut)
+{
+    s->lg->st.bytes_skipped += s->searched;
+    if (s->damaged) s->lg->st.damaged++;
+    return at_end(s->lg, cut);
+}
+
+/* Reads up to and including the next sync word: STEP_ON, or the end, or an error. */
+static int find_sync(log_search *s)
+{
+    lag_log *lg = s->lg;
+    uint32_t w = 0;
+    int64_t have = 0;
+    for (;;) {
+        int c = src_getc(lg);
+        if (c < 0) {
+            /* the end inside the search: what was passed over is junk, unless it follows
+             * a header that did not fit (a last record cut short) */
+            int64_t junk = s->searched + have;
+            int64_t cut = s->suspect >= 0 ? lg->pos - s->suspect : 0;
+            if (junk > cut) {
+                lg->st.bytes_skipped += junk - cut;
+                lg->st.damaged++;
+            }
+            return at_end(lg, cut);
+        }
+        w = (w << 8) | (uint32_t)c;
+        have++;
+        if (have >= 4 && w == SYNC) break;
+        /* all but the last 3 bytes read cannot start a sync word any more */
+        if (s->searched + have - 3 > LAG_LOG_SCAN_MAX) return too_far(lg, s->searched + have);
+    }
+    s->searched += have - 4;
+    if (have > 4) s->damaged = true;
+    s->off = lg->pos - 4;
+    return STEP_ON;
+}
+
+/* Reads the header after the sync word and the channel: STEP_ON when they make a record
+ * that fits, STEP_NOT_A_RECORD when not, or the end. */
+static int read_header(log_search *s)
+{
+    lag_log *lg = s->lg;
+    size_t got = src_read(lg, s->h, HEADER);
+    if (got < HEADER) return end_in_record(s, 4 + (int64_t)got);
+    s->evnum = be(s->h, 8);
+    s->stamp = be(s->h + 8, 8);
+    s->chan_len = be(s->h + 16, 4);
+    s->data_len = be(s->h + 20, 4);
+    bool ok = s->chan_len >= 1 && s->chan_len <= LAG_LOG_CHANNEL_MAX && s->data_len >= 0;
+    if (ok && lg->regular && s->chan_len + s->data_len > src_left(lg)) {
+        ok = false;
+        if (s->suspect < 0) s->suspect = s->off;
+    }
+    s->nread = HEADER;
+    if (ok) {
+        got = src_read(lg, s->h + HEADER, (size_t)s->chan_len);
+        s->nread += (int)got;
+        if (got < (size_t)s->chan_len) return end_in_record(s, 4 + s->nread);
+        ok = memchr(s->h + HEADER, 0, (size_t)s->chan_len) == NULL;
+    }
+    return ok ? STEP_ON : STEP_NOT_A_RECORD;
+}
+
+/* Not a record: search again from the byte after this sync word (the sync word cannot
+ * overlap itself, so none starts inside it). STEP_ON, or an error. */
+static int search_again(log_search *s)
+{
+    src_unread(s->lg, s->h, s->nread);
+    s->searched += 4;
+    s->damaged = true;
+    if (s->searched > LAG_LOG_SCAN_MAX) return too_far(s->lg, s->searched);
+    return STEP_ON;
+}
+
+/* Reads the record's data (passed over when larger than max_data) and fills the record:
+ * LAG_LOG_OK, or the end. */
+static int read_data(log_search *s)
+{
+    lag_log *lg = s->lg;
+    lag_log_record *rec = s->rec;
+    size_t got;
+    if ((size_t)s->data_len <= lg->max_data) {
+        got = src_read(lg, lg->data, (size_t)s->data_len);
+        rec->data = lg->data;
+    } else {
+        got = src_read(lg, NULL, (size_t)s->data_len);
+        rec->data = NULL;
+        lg->st.too_large++;
+    }
+    if (got < (size_t)s->data_len) {
+        memset(rec, 0, sizeof *rec);
+        return end_in_record(s, 4 + s->nread + (int64_t)got);
+    }
+    rec->offset = s->off;
+    rec->event_number = s->evnum;
+    rec->timestamp = s->stamp;
+    memcpy(rec->channel, s->h + HEADER, (size_t)s->chan_len);
+    rec->channel[s->chan_len] = '\0';
+    rec->size = (size_t)s->data_len;
+    lg->st.records++;
+    lg->st.bytes_skipped += s->searched;
+    if (s->damaged) lg->st.damaged++;
+    return LAG_LOG_OK;
+}
+
 int lag_log_next(lag_log *lg, lag_log_record *rec)
 {
     memset(rec, 0, sizeof *rec);
     if (!lg) return LAG_LOG_ERROR;
     if (lg->state != LAG_LOG_OK) return lg->state;
-
-    int64_t searched = 0;       /* bytes passed over since the last good record */
-    int64_t suspect = -1;       /* offset of a header that did not fit in the file */
-    bool damaged = false;
+    log_search s = {.lg = lg, .rec = rec, .suspect = -1};
     for (;;) {
-        /* the sync word */
-        uint32_t w = 0;
-        int64_t have = 0;
-        for (;;) {
-            int c = src_getc(lg);
-            if (c < 0) {
-                /* the end inside the search: what was passed over is junk, unless it
-                 * follows a header that did not fit (a last record cut short) */
-                int64_t junk = searched + have;
-                int64_t cut = suspect >= 0 ? lg->pos - suspect : 0;
-                if (junk > cut) {
-                    lg->st.bytes_skipped += junk - cut;
-                    lg->st.damaged++;
-                }
-                return at_end(lg, cut);
-            }
-            w = (w << 8) | (uint32_t)c;
-            have++;
-            if (have >= 4 && w == SYNC) break;
-            /* all but the last 3 bytes read cannot start a sync word any more */
-            if (searched + have - 3 > LAG_LOG_SCAN_MAX) return too_far(lg, searched + have);
-        }
-        searched += have - 4;
-        if (have > 4) damaged = true;
-        int64_t off = lg->pos - 4;
-
-        /* the header */
-        uint8_t h[HEADER + LAG_LOG_CHANNEL_MAX];
-        size_t got = src_read(lg, h, HEADER);
-        if (got < HEADER) {
-            lg->st.bytes_skipped += searched;
-            if (damaged) lg->st.damaged++;
-            return at_end(lg, 4 + (int64_t)got);
-        }
-        int64_t evnum = be(h, 8), stamp = be(h + 8, 8);
-        int64_t chan_len = be(h + 16, 4), data_len = be(h + 20, 4);
-        bool ok = chan_len >= 1 && chan_len <= LAG_LOG_CHANNEL_MAX && data_len >= 0;
-        if (ok && lg->regular && chan_len + data_len > src_left(lg)) {
-            ok = false;
-            if (suspect < 0) suspect = off;
-        }
-        int nread = HEADER;
-        if (ok) {
-            got = src_read(lg, h + HEADER, (size_t)chan_len);
-            nread += (int)got;
-            if (got < (size_t)chan_len) {
-                lg->st.bytes_skipped += searched;
-                if (damaged) lg->st.damaged++;
-                return at_end(lg, 4 + nread);
-            }
-            ok = memchr(h + HEADER, 0, (size_t)chan_len) == NULL;
-        }
-        if (!ok) {
-            /* not a record: search again from the byte after this sync word (the sync
-             * word cannot overlap itself, so none starts inside it) */
-            src_unread(lg, h, nread);
-            searched += 4;
-            damaged = true;
-            if (searched > LAG_LOG_SCAN_MAX) return too_far(lg, searched);
-            continue;
-        }
-
-        /* the data */
-        if ((size_t)data_len <= lg->max_data) {
-            got = src_read(lg, lg->data, (size_t)data_len);
-            rec->data = lg->data;
-        } else {
-            got = src_read(lg, NULL, (size_t)data_len);
-            rec->data = NULL;
-            lg->st.too_large++;
-        }
-        if (got < (size_t)data_len) {
-            memset(rec, 0, sizeof *rec);
-            lg->st.bytes_skipped += searched;
-            if (damaged) lg->st.damaged++;
-            return at_end(lg, 4 + nread + (int64_t)got);
-        }
-        rec->offset = off;
-        rec->event_number = evnum;
-        rec->timestamp = stamp;
-        memcpy(rec->channel, h + HEADER, (size_t)chan_len);
-        rec->channel[chan_len] = '\0';
-        rec->size = (size_t)data_len;
-        lg->st.records++;
-        lg->st.bytes_skipped += searched;
-        if (damaged) lg->st.damaged++;
-        return LAG_LOG_OK;
+        int r = find_sync(&s);
+        if (r == STEP_ON) r = read_header(&s);
+        if (r == STEP_NOT_A_RECORD) r = search_again(&s);
+        else if (r == STEP_ON) return read_data(&s);
+        if (r != STEP_ON) return r;
     }
 }
 

@@ -3,6 +3,7 @@
  * carry, and the interface a group is joined on. See lagsim_net.h.
  */
 #include "lagsim_net.h"
+#include "lagsim_clock.h"
 
 #include <arpa/inet.h>
 #include <dirent.h>
@@ -16,7 +17,6 @@
 #include <string.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 /* Where an LCM datagram's fields are for a UDP socket filter: offset 0 is the UDP
@@ -214,21 +214,15 @@ static void on_marker(const lcm_recv_buf_t *rb, const char *ch, void *user)
     if (rb->data_size == n && memcmp(rb->data, m->text, n) == 0) m->seen = true;
 }
 
-static int64_t mono_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
-}
+static int64_t mono_ms(void) { return lag_clock_mono_ns() / 1000000; }
 
 int lag_net_sync(lcm_t *lcm, int timeout_ms)
 {
     static unsigned counter;
     marker m = {.seen = false};
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    snprintf(m.text, sizeof m.text, "lagsim %ld sync %u %lld.%09ld", (long)getpid(), ++counter,
-             (long long)ts.tv_sec, ts.tv_nsec);
+    int64_t t = lag_clock_mono_ns();
+    snprintf(m.text, sizeof m.text, "lagsim %ld sync %u %lld.%09lld", (long)getpid(), ++counter,
+             (long long)(t / 1000000000), (long long)(t % 1000000000));
     lcm_subscription_t *sub = lcm_subscribe(lcm, LAG_NET_MARKER_CHANNEL, on_marker, &m);
     if (!sub) return -1;
     lcm_subscription_set_queue_capacity(sub, 1000);
