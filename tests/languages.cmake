@@ -226,7 +226,8 @@ if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
               "--timeout" "--url;tcpq://127.0.0.1:7700")
     string(REGEX REPLACE "^-+" "" bad_name "${bad}")
     string(REPLACE ";" "_" bad_name "${bad_name}")
-    string(REGEX REPLACE "[^A-Za-z0-9_.-]" "" bad_name "${bad_name}")
+    string(REGEX REPLACE "[.:]" "_" bad_name "${bad_name}")
+    string(REGEX REPLACE "[^A-Za-z0-9_-]" "" bad_name "${bad_name}")
     add_test(NAME clients_octave_usage_${bad_name}
              COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/clients/expect_exit.sh 1
                      "error: dipc_balance: .*(--|'-z'|'stray')" ${octave_run} dipc_balance ${bad})
