@@ -128,7 +128,7 @@ list(APPEND lang_tests clients_c_dipc_late_controller clients_python_dipc_late_c
 # pushes vertically, so x_dot ends at F T / m (100 ticks of a constant acceleration: a few
 # ulp, bound 1e-12 relative) through every impact; phi's motion is that of the stick
 # released from rest, whose first landing a quadrature of dphi/dt puts at 0.426664058881 s
-# (tests/effects.cmake, effects.floor; bound 1e-8 s: the event locator's tolerance is far
+# (tests/effects.cmake, effects_floor; bound 1e-8 s: the event locator's tolerance is far
 # below); near phi = 0 each rebound comes back with the speed it left, so successive
 # impacts' phi_dot differ by the restitution 0.3 (bound 1e-8); it comes to rest, never
 # lifts off.

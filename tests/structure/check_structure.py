@@ -218,8 +218,12 @@ def check_function_length(src, limit):
     files = []
     for top in ('server', 'clients', 'bench'):
         files += [f for f in c_files(src, top)]
-    out = subprocess.run(['ctags', '-x', '--c-kinds=f', '--_xformat=%N %F %n %e'] + files,
-                         check=True, capture_output=True, text=True).stdout
+    try:
+        out = subprocess.run(['ctags', '-x', '--c-kinds=f', '--_xformat=%N %F %n %e'] + files,
+                             check=True, capture_output=True, text=True).stdout
+    except (OSError, subprocess.CalledProcessError) as e:
+        return [f'universal-ctags did not run ({e}): install universal-ctags '
+                '(.ci/install-deps.sh)']
     bad = []
     for line in out.splitlines():
         parts = line.split()
