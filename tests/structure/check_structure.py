@@ -36,8 +36,8 @@ MACRO = re.compile(r'^\s*#\s*define\s+((?:ENSURE|CHECK|EXPECT|ASSERT|REQUIRE|LT_
 COUNTER = re.compile(r'^static\s+(?:volatile\s+)?(?:unsigned\s+)?(?:int|long|size_t|int64_t)\s+'
                      r'[^;(]*\b(?:g_)?(?:n_?)?(?:checks|failures|fails|failed|errors)\b[^;(]*;', re.M)
 # a case chosen by comparing a name: `if (!strcmp(g_case, "file")) case_file();`
-CHAIN = re.compile(r'\bif\s*\(\s*!?\s*strcmp\s*\([^;{}]*\)\s*(?:==\s*0\s*)?\)\s*\{?\s*'
-                   r'(?:case|test|check|run)_\w+\s*\(')
+CHAIN = re.compile(r'\bstrcmp\s*\([^;{}()]*(?:\([^;{}()]*\)[^;{}()]*)*\)\s*(?:==\s*0\s*)?\)\s*'
+                   r'\{?\s*(?:case|test|check|run)_\w+\s*\(')
 
 
 def c_files(root, sub):
