@@ -1,16 +1,15 @@
 # Accuracy as a setting (server/accuracy): the integrator setting chosen for an error E on
 # every shipped scene stays within E of an independent reference (tests/accuracy/).
-include(${CMAKE_CURRENT_LIST_DIR}/common/cases.cmake)
 add_executable(test_accuracy_cost ${CMAKE_CURRENT_LIST_DIR}/accuracy/test_cost.c)
 target_include_directories(test_accuracy_cost PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_compile_definitions(test_accuracy_cost PRIVATE LAGSIM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
                            $<$<BOOL:${LAGSIM_SANITIZE}>:LAGSIM_SANITIZED>)
 target_link_libraries(test_accuracy_cost PRIVATE lagsim_accuracy lagsim_scene lagsim_core m)
-lagsim_add_test_cases(test_accuracy_cost accuracy.cost accuracy 300)
+lagsim_add_test_cases(test_accuracy_cost accuracy_cost accuracy 300)
 
 # The live error estimate against the true per-period error (tests/accuracy/test_live_error.c).
 add_executable(test_accuracy_live ${CMAKE_CURRENT_LIST_DIR}/accuracy/test_live_error.c)
 target_include_directories(test_accuracy_live PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_compile_definitions(test_accuracy_live PRIVATE LAGSIM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 target_link_libraries(test_accuracy_live PRIVATE lagsim_scene lagsim_core m)
-lagsim_add_test_cases(test_accuracy_live accuracy.live accuracy 300)
+lagsim_add_test_cases(test_accuracy_live accuracy_live accuracy 300)

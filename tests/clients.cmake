@@ -1,31 +1,32 @@
 # Clients: LQR design unit test, the C client library (messages, status fields, forged
 # messages), end-to-end runs of lagsimd with the C controllers (lockstep and real time,
 # how a run ends, options) and the Python manipulator controller.
+# Label clients; one ctest per case of each C program's table.
 add_executable(test_lqr ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_lqr.c)
+target_include_directories(test_lqr PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common)
 target_link_libraries(test_lqr PRIVATE lagsim_lqr lagsim_core m)
-add_test(NAME clients_lqr COMMAND test_lqr)
-set_tests_properties(clients_lqr PROPERTIES TIMEOUT 30)
+lagsim_add_test_cases(test_lqr clients clients 30)
 
 # Client library over real LCM (loopback, prefix unique per process): odd messages
 # dropped and counted, exact copies, commands/control as sent, DESCRIBE and timeouts.
 add_executable(test_client ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client.c)
+target_include_directories(test_client PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common)
 target_link_libraries(test_client PRIVATE lagsim_client m)
-add_test(NAME clients_library COMMAND test_client)
-set_tests_properties(clients_library PROPERTIES TIMEOUT 30)
+lagsim_add_test_cases(test_client clients clients 30)
 
 # Every field of status_t (read from lcmtypes/status_t.lcm) reaches lag_client_status.
 add_executable(test_client_status ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client_status.c)
-target_include_directories(test_client_status PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/wire)
+target_include_directories(test_client_status PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/wire
+                                                      ${CMAKE_CURRENT_SOURCE_DIR}/common)
 target_link_libraries(test_client_status PRIVATE lagsim_client)
-add_test(NAME clients_status_fields COMMAND test_client_status ${PROJECT_SOURCE_DIR}/lcmtypes)
-set_tests_properties(clients_status_fields PROPERTIES TIMEOUT 30)
+lagsim_add_test_cases(test_client_status clients clients 30 ${PROJECT_SOURCE_DIR}/lcmtypes)
 
 # Forged states, status, events and scenes (lengths of -1, 0x7fffffff, 32767 joints, a
 # name without its NUL) are dropped and counted, never a crash.
 add_executable(test_client_hostile ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client_hostile.c)
+target_include_directories(test_client_hostile PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common)
 target_link_libraries(test_client_hostile PRIVATE lagsim_client)
-add_test(NAME clients_hostile_messages COMMAND test_client_hostile)
-set_tests_properties(clients_hostile_messages PROPERTIES TIMEOUT 30)
+lagsim_add_test_cases(test_client_hostile clients clients 30)
 
 # The C controllers' options: a value that is not a number, out of range, an unknown
 # option, a stray argument: exit 2 with a message naming the option.
@@ -34,7 +35,8 @@ foreach(bad "--duration;abc" "--timeout;0" "--duration;-1" "--duration;inf" "--q
             "--r;0" "--gain;foo" "--k;1,2,3" "-z" "stray" "--timeout")
   string(REGEX REPLACE "^-+" "" bad_name "${bad}")
   string(REPLACE ";" "_" bad_name "${bad_name}")
-  string(REGEX REPLACE "[^A-Za-z0-9_.-]" "" bad_name "${bad_name}")
+  string(REGEX REPLACE "[.:]" "_" bad_name "${bad_name}")
+  string(REGEX REPLACE "[^A-Za-z0-9_-]" "" bad_name "${bad_name}")
   add_test(NAME clients_dipc_lqr_usage_${bad_name}
            COMMAND ${expect_exit} 2 "^dipc_lqr: .*(--|'-z'|'stray')" $<TARGET_FILE:dipc_lqr> ${bad})
   set_tests_properties(clients_dipc_lqr_usage_${bad_name} PROPERTIES TIMEOUT 10)
@@ -42,7 +44,8 @@ endforeach()
 foreach(bad "--wn;-1" "--settle;x" "--duration;1e999")
   string(REGEX REPLACE "^-+" "" bad_name "${bad}")
   string(REPLACE ";" "_" bad_name "${bad_name}")
-  string(REGEX REPLACE "[^A-Za-z0-9_.-]" "" bad_name "${bad_name}")
+  string(REGEX REPLACE "[.:]" "_" bad_name "${bad_name}")
+  string(REGEX REPLACE "[^A-Za-z0-9_-]" "" bad_name "${bad_name}")
   add_test(NAME clients_manipulator_pd_usage_${bad_name}
            COMMAND ${expect_exit} 2 "^manipulator_pd: --" $<TARGET_FILE:manipulator_pd> ${bad})
   set_tests_properties(clients_manipulator_pd_usage_${bad_name} PROPERTIES TIMEOUT 10)
@@ -58,7 +61,8 @@ foreach(bad "--prefix;P;--q;1,-2" "--prefix;P;--q;1,2,3,4,5,6,7" "--prefix;P;--r
   string(REPLACE "--prefix;P;" "" bad_name "${bad}")
   string(REGEX REPLACE "^-+" "" bad_name "${bad_name}")
   string(REPLACE ";" "_" bad_name "${bad_name}")
-  string(REGEX REPLACE "[^A-Za-z0-9_.-]" "" bad_name "${bad_name}")
+  string(REGEX REPLACE "[.:]" "_" bad_name "${bad_name}")
+  string(REGEX REPLACE "[^A-Za-z0-9_-]" "" bad_name "${bad_name}")
   add_test(NAME clients_lqr_balance_usage_${bad_name}
            COMMAND ${expect_exit} 2 "^lqr_balance: --" $<TARGET_FILE:lqr_balance> ${bad})
   set_tests_properties(clients_lqr_balance_usage_${bad_name} PROPERTIES TIMEOUT 10)
@@ -225,3 +229,14 @@ endif()
 # Fuzz target: what arrives on a controller's channels, through the client library
 # (tests/fuzz/fuzz_client.c; corpora and kept crash inputs under tests/fuzz/client/).
 lagsim_fuzz_target(client LIBS lagsim_client)
+
+# Every test above carries the label clients (ctest -L clients; structure_names fails on
+# a test without a label).
+get_property(clients_tests DIRECTORY PROPERTY TESTS)
+list(FILTER clients_tests INCLUDE REGEX "^clients_")
+foreach(t ${clients_tests})
+  get_test_property(${t} LABELS t_labels)
+  if(NOT t_labels)
+    set_tests_properties(${t} PROPERTIES LABELS clients)
+  endif()
+endforeach()

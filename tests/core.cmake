@@ -1,7 +1,6 @@
 # Physics tests of the core: models vs T and U, structure (SPD, skew, power), conservation,
 # convergence orders, determinism. Plain C programs, see tests/core/; one ctest per case of
-# each program (core.<program>.<case>), the cases listed by the programs themselves.
-include(${CMAKE_CURRENT_LIST_DIR}/common/cases.cmake)
+# each program (core_<program>_<case>), the cases listed by the programs themselves.
 foreach(t models structure conservation convergence determinism validate faults events)
   add_executable(test_core_${t} ${CMAKE_CURRENT_SOURCE_DIR}/core/test_${t}.c)
   # server/core: the unit tests of the core's internals (tables, event engine) read its
@@ -10,7 +9,7 @@ foreach(t models structure conservation convergence determinism validate faults 
                                                     ${CMAKE_CURRENT_SOURCE_DIR}/common
                                                     ${PROJECT_SOURCE_DIR}/server/core)
   target_link_libraries(test_core_${t} PRIVATE lagsim_core m)
-  lagsim_add_test_cases(test_core_${t} core.${t} core 300)
+  lagsim_add_test_cases(test_core_${t} core_${t} core 300)
 endforeach()
 
 # The core from definitions made of arbitrary bytes (tests/fuzz/fuzz_sim.c): its corpus

@@ -128,7 +128,7 @@ list(APPEND lang_tests clients_c_dipc_late_controller clients_python_dipc_late_c
 # pushes vertically, so x_dot ends at F T / m (100 ticks of a constant acceleration: a few
 # ulp, bound 1e-12 relative) through every impact; phi's motion is that of the stick
 # released from rest, whose first landing a quadrature of dphi/dt puts at 0.426664058881 s
-# (tests/effects.cmake, effects.floor; bound 1e-8 s: the event locator's tolerance is far
+# (tests/effects.cmake, effects_floor; bound 1e-8 s: the event locator's tolerance is far
 # below); near phi = 0 each rebound comes back with the speed it left, so successive
 # impacts' phi_dot differ by the restitution 0.3 (bound 1e-8); it comes to rest, never
 # lifts off.
@@ -226,7 +226,8 @@ if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
               "--timeout" "--url;tcpq://127.0.0.1:7700")
     string(REGEX REPLACE "^-+" "" bad_name "${bad}")
     string(REPLACE ";" "_" bad_name "${bad_name}")
-    string(REGEX REPLACE "[^A-Za-z0-9_.-]" "" bad_name "${bad_name}")
+    string(REGEX REPLACE "[.:]" "_" bad_name "${bad_name}")
+    string(REGEX REPLACE "[^A-Za-z0-9_-]" "" bad_name "${bad_name}")
     add_test(NAME clients_octave_usage_${bad_name}
              COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/clients/expect_exit.sh 1
                      "error: dipc_balance: .*(--|'-z'|'stray')" ${octave_run} dipc_balance ${bad})

@@ -1,12 +1,9 @@
 # lagsimd --log: the log writer beside the loop (made-up clock, memq://, a FIFO for a disk
 # that stalls, /dev/full for one that is full).
 add_executable(test_rt_log ${CMAKE_CURRENT_LIST_DIR}/log/test_rt_log.c)
+target_include_directories(test_rt_log PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_rt_log PRIVATE lagsimd_internal)
-foreach(case file clock realtime_stalled fast_stalled lockstep_stalled full flood_in
-        flood_refused)
-  add_test(NAME log_rt_${case} COMMAND test_rt_log ${case})
-  set_tests_properties(log_rt_${case} PROPERTIES TIMEOUT 120 LABELS log)
-endforeach()
+lagsim_add_test_cases(test_rt_log log_rt log 120)
 
 # End to end: dipc_lqr in lockstep with lagsimd --log, the log read back by this test's own
 # reader, liblcm's, lcm.jar's and lcm-logplayer; --replay on it, on a changed copy and on

@@ -1,9 +1,9 @@
 # A plant on a network (server/wire/lagsim_bus, the daemon's receive filter and plant
 # watch, tests/net): the URL rule in every language, and two hosts on one machine.
 add_executable(test_bus ${CMAKE_CURRENT_LIST_DIR}/net/test_bus.c)
+target_include_directories(test_bus PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_bus PRIVATE lagsim_wire)
-add_test(NAME net_plant_urls_c COMMAND test_bus ${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.txt)
-set_tests_properties(net_plant_urls_c PROPERTIES TIMEOUT 30 LABELS net)
+lagsim_add_test_cases(test_bus net net 30 ${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.txt)
 # The same rule in Python, Lua and Java, against the same table.
 find_program(LAGSIM_NET_PYTHON3 python3)
 find_program(LAGSIM_NET_LUA52 lua5.2)
@@ -41,11 +41,10 @@ endif()
 
 # The daemon's receive-socket filter, its sync marker and the route to the group, on this
 # host (tests/net/test_net.c); one ctest per case.
-include(${CMAKE_CURRENT_LIST_DIR}/common/cases.cmake)
 add_executable(test_net ${CMAKE_CURRENT_LIST_DIR}/net/test_net.c)
 target_include_directories(test_net PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_net PRIVATE lagsimd_internal)
-lagsim_add_test_cases(test_net net.filter net 60)
+lagsim_add_test_cases(test_net net_filter net 60)
 
 # Two hosts on one machine (tests/net/two_hosts.sh): network namespaces joined by a veth
 # pair, lagsimd in one, peers in the other, nftables for packet loss. Needs root; skipped

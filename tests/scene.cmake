@@ -50,6 +50,6 @@ lagsim_fuzz_target(scene LIBS lagsim_scene)
 # Every numeric key of the loader's tables, for every model, refuses +-1e300 at its
 # file:line:column (tests/scene/test_ranges.c).
 add_executable(test_scene_ranges ${scene_dir}/test_ranges.c)
+target_include_directories(test_scene_ranges PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_scene_ranges PRIVATE lagsim_scene)
-add_test(NAME scene_ranges COMMAND test_scene_ranges)
-set_tests_properties(scene_ranges PROPERTIES TIMEOUT 60 LABELS scene)
+lagsim_add_test_cases(test_scene_ranges scene scene 60)

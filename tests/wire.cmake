@@ -1,27 +1,23 @@
 # The wire module (server/wire): bounded encoding/decoding of every lagsim message type and
 # the bounded LCM log reader.
+# Label wire; one ctest per case of each program's table.
 add_executable(test_wire ${CMAKE_CURRENT_LIST_DIR}/wire/test_wire.c)
+target_include_directories(test_wire PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_wire PRIVATE lagsim_wire lagsim_lcmtypes)
-add_test(NAME wire_messages COMMAND test_wire ${PROJECT_SOURCE_DIR}/lcmtypes)
-set_tests_properties(wire_messages PROPERTIES TIMEOUT 60)
+lagsim_add_test_cases(test_wire wire wire 60 ${PROJECT_SOURCE_DIR}/lcmtypes)
 
 add_executable(test_log ${CMAKE_CURRENT_LIST_DIR}/wire/test_log.c)
+target_include_directories(test_log PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_log PRIVATE lagsim_wire PkgConfig::LCM)
-add_test(NAME wire_log_reader COMMAND test_log)
-set_tests_properties(wire_log_reader PROPERTIES TIMEOUT 120)
+lagsim_add_test_cases(test_log wire_log wire 120)
 
 # lagsimd --replay on good and hostile logs written by the test (no crash, no hang, no
 # leak, no success reported without a check).
 add_executable(test_replay ${CMAKE_CURRENT_LIST_DIR}/wire/test_replay.c)
+target_include_directories(test_replay PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_replay PRIVATE lagsim_scene lagsim_core lagsim_lcmtypes)
-set(LAGSIM_REPLAY_CASES valid nothing_to_check negative_name_length name_fills_buffer
-    huge_data_length step_jump step_int64_min dev_zero not_a_log undecodable_flood
-    resim_failure garbage_between)
-foreach(case ${LAGSIM_REPLAY_CASES})
-  add_test(NAME wire_replay_${case}
-           COMMAND test_replay $<TARGET_FILE:lagsimd> ${PROJECT_SOURCE_DIR}/config/dipc.yaml ${case})
-  set_tests_properties(wire_replay_${case} PROPERTIES TIMEOUT 120)
-endforeach()
+lagsim_add_test_cases(test_replay wire_replay wire 120 $<TARGET_FILE:lagsimd>
+                      ${PROJECT_SOURCE_DIR}/config/dipc.yaml)
 
 # Fuzz targets (tests/fuzz/fuzz_<name>.c; corpora and kept crash inputs under tests/fuzz/<name>/,
 # written by tests/fuzz/make_corpora.py): the wire module's decoders and encoders, the log

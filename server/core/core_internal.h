@@ -12,7 +12,7 @@
 
 /* One model kind: its facts and its closed forms, one row of the core's model table
  * (model.c). All arrays are n x n row-major (n = nq); p is lag_model.p. Every member is
- * required (core.models.info checks that no row has a hole). */
+ * required (core_models_info checks that no row has a hole). */
 typedef struct lag_model_class {
     const lag_model_info *info;
     void (*mass)(const double *p, const double *q, double *M);
@@ -134,7 +134,7 @@ lag_result lag_dopri5_span(lag_sim *s, double h, const double *y0, double *y1);
  * input may change (INT64_MAX: none; see lag_sim_advance_within). Its row's `advance`. */
 lag_result lag_adaptive_advance(lag_sim *s, int64_t n, int64_t stop);
 /* The method table has no hole: a name, a step, an order for every row, an advance
- * exactly for the adaptive ones, unique names (core.models.info checks it). */
+ * exactly for the adaptive ones, unique names (core_models_info checks it). */
 bool lag_method_table_ok(void);
 /* dopri5 without events: advances the public state to tick + n (see lag_sim_advance). */
 lag_result lag_dopri5_advance(lag_sim *s, int64_t n, int64_t stop);
@@ -153,7 +153,7 @@ bool lag_state_ok(int n, const double *x, double limit);
 
 /* ================================================================ events.c: the engine;
  * contact.c: impulses, holds, stops; event_queue.c: the sim's events */
-#define LAG_MAX_WATCHERS 16        /* watchers of one tick (checked: core.events.capacity) */
+#define LAG_MAX_WATCHERS 16        /* watchers of one tick (checked: core_events_capacity) */
 #define LAG_MAX_EVENTS_PER_TICK 16 /* then LAG_EV_EVENT_LIMIT and no more location */
 
 typedef enum lag_watch_kind {

@@ -155,7 +155,7 @@ static lag_result release_hold(lag_sim *s, int i, double *y, double t)
 /* Per joint: a held joint has its hold's watcher only; a free one every row's watchers
  * for it, in table order; then the rows' watchers of no joint. Fails (LAG_ERR_ARG) if the
  * rows ask for more than LAG_MAX_WATCHERS: their declared maxima are checked against it
- * (core.events.capacity), so this is the safe path of a check that never fails. */
+ * (core_events_capacity), so this is the safe path of a check that never fails. */
 static lag_result build_watchers(const lag_sim *s, lag_watch_set *ws)
 {
     const int n = s->nq;

@@ -23,16 +23,8 @@
 #include "lagsim/lagsim_status_t.h"
 #include "lagsim_bus.h"
 #include "lagsim_client.h"
+#include "lagsim_test.h"
 #include "lagsim_wire.h"
-
-static int failures = 0;
-#define ENSURE(cond)                                                                   \
-    do {                                                                               \
-        if (!(cond)) {                                                                 \
-            fprintf(stderr, "%s:%d: ENSURE(%s) failed\n", __FILE__, __LINE__, #cond);  \
-            failures++;                                                                \
-        }                                                                              \
-    } while (0)
 
 static int describes = 0, commands = 0, controls = 0, on_state_url = 0;
 static lag_wire_joint_command last_cmd;
@@ -96,8 +88,9 @@ static void publish_state(lcm_t *peer, const char *ch, int n, const char *long_n
     lagsim_joint_state_t_publish(peer, ch, &m);
 }
 
-int main(void)
+static void case_library(int arg)
 {
+    (void)arg;
     char prefix[64], ch[128], err[256];
     snprintf(prefix, sizeof prefix, "CLTCLIENT_%d", (int)getpid());
 
@@ -111,7 +104,7 @@ int main(void)
     lcm_t *peer = lcm_create(bus.state_url);
     peer_in = lcm_create(bus.command_url);
     ENSURE(c != NULL && peer != NULL && peer_in != NULL && bus.udpm);
-    if (!c || !peer || !peer_in) return 1;
+    if (!c || !peer || !peer_in) return;
     lcm_subscribe(peer_in, bus.channel[LAG_BUS_CONTROL], on_control, NULL);
     lcm_subscribe(peer_in, bus.channel[LAG_BUS_COMMAND], on_command, NULL);
     lcm_subscribe(peer, bus.channel[LAG_BUS_CONTROL], on_wrong_url, NULL);
@@ -274,10 +267,10 @@ int main(void)
     lag_client_destroy(c);
     lcm_destroy(peer);
     lcm_destroy(peer_in);
-    if (failures) {
-        fprintf(stderr, "test_client: %d failure(s)\n", failures);
-        return 1;
-    }
-    printf("test_client: all passed\n");
-    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {{"library", case_library, 0, 0}};
+    return lt_main(argc, argv, cases, 1);
 }

@@ -23,15 +23,7 @@
 #include "lagsim/lagsim_scene_t.h"
 #include "lagsim/lagsim_status_t.h"
 #include "lagsim_client.h"
-
-static int failures = 0;
-#define ENSURE(cond)                                                                   \
-    do {                                                                               \
-        if (!(cond)) {                                                                 \
-            fprintf(stderr, "%s:%d: ENSURE(%s) failed\n", __FILE__, __LINE__, #cond);  \
-            failures++;                                                                \
-        }                                                                              \
-    } while (0)
+#include "lagsim_test.h"
 
 static size_t put(uint8_t *b, size_t p, uint64_t v, int n)
 {
@@ -49,14 +41,15 @@ static size_t state_head(uint8_t *b, uint16_t n)
     return put(b, p, n, 2);
 }
 
-int main(void)
+static void case_hostile_messages(int arg)
 {
+    (void)arg;
     char prefix[64], ch[128], err[256];
     snprintf(prefix, sizeof prefix, "CLHOSTILE_%d", (int)getpid());
     lag_client *c = lag_client_create(NULL, prefix, err, sizeof err);
     lcm_t *peer = lcm_create(NULL);
     ENSURE(c != NULL && peer != NULL);
-    if (!c || !peer) return 1;
+    if (!c || !peer) return;
 
     uint8_t b[512];
     size_t p;
@@ -127,10 +120,10 @@ int main(void)
     ENSURE(cnt.states == 1 && cnt.statuses == 0 && cnt.events == 0 && cnt.scenes == 0);
     lag_client_destroy(c);
     lcm_destroy(peer);
-    if (failures) {
-        fprintf(stderr, "test_client_hostile: %d failure(s)\n", failures);
-        return 1;
-    }
-    printf("test_client_hostile: all passed\n");
-    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {{"hostile_messages", case_hostile_messages, 0, 0}};
+    return lt_main(argc, argv, cases, 1);
 }

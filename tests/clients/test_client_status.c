@@ -11,7 +11,7 @@
  * from offsetof on the member of that very name) and must hold the value; every other
  * field must still be zero or empty.
  *
- * usage: test_client_status LCMTYPES_DIR
+ * usage: test_client_status status_fields LCMTYPES_DIR   (tests/common/lagsim_test.h)
  */
 #include <math.h>
 #include <stdio.h>
@@ -19,20 +19,8 @@
 
 #include "lagsim/lagsim_status_t.h"
 #include "lagsim_client.h"
+#include "lagsim_test.h"
 #include "lcm_fields.h"
-
-static int failures = 0, checks = 0;
-#define ENSURE(cond) ENSUREF(cond, "%s", "")
-#define ENSUREF(cond, ...)                                                              \
-    do {                                                                                \
-        checks++;                                                                       \
-        if (!(cond)) {                                                                  \
-            fprintf(stderr, "%s:%d: ENSURE(%s) failed: ", __FILE__, __LINE__, #cond);   \
-            fprintf(stderr, __VA_ARGS__);                                               \
-            fputc('\n', stderr);                                                        \
-            failures++;                                                                 \
-        }                                                                               \
-    } while (0)
 
 static size_t put(uint8_t *b, size_t p, uint64_t v, int n)
 {
@@ -114,14 +102,11 @@ static bool holds(const lag_client_status *s, const lag_wire_field *w, int k, bo
     return false;
 }
 
-int main(int argc, char **argv)
+static void case_status_fields(int arg)
 {
-    if (argc != 2) {
-        fprintf(stderr, "usage: test_client_status LCMTYPES_DIR\n");
-        return 2;
-    }
+    (void)arg;
     char path[1024], err[256], ch[96];
-    snprintf(path, sizeof path, "%s/status_t.lcm", argv[1]);
+    snprintf(path, sizeof path, "%s/status_t.lcm", lt_arg(0));
     lcm_field f[64];
     int n = parse_lcm(path, f, 64);
     ENSUREF(n > 20, "cannot read the fields of %s", path);
@@ -143,7 +128,7 @@ int main(int argc, char **argv)
 
     lag_client *c = lag_client_create("memq://", "STATUSFIELDS", err, sizeof err);
     ENSUREF(c != NULL, "%s", err);
-    if (!c) return 1;
+    if (!c) return;
     snprintf(ch, sizeof ch, "STATUSFIELDS_STATUS");
     for (int k = 0; k < n; k++) {
         static uint8_t b[4096];
@@ -169,11 +154,12 @@ int main(int argc, char **argv)
         }
     }
     lag_client_destroy(c);
-    if (failures) {
-        fprintf(stderr, "test_client_status: %d of %d checks failed\n", failures, checks);
-        return 1;
-    }
-    printf("test_client_status: %d fields of status_t.lcm, each reaches lag_client_status "
-           "(%d checks)\n", n, checks);
-    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {{"status_fields", case_status_fields, 0, 0}};
+    const lt_program p = {.cases = cases, .n = 1, .args = "LCMTYPES_DIR", .min_args = 1,
+                          .max_args = 1};
+    return lt_run(argc, argv, &p);
 }

@@ -25,47 +25,30 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lagsim_test.h"
 #include "lqr.h"
-
-static int failures = 0;
-#define ENSURE(cond)                                                                   \
-    do {                                                                               \
-        if (!(cond)) {                                                                 \
-            fprintf(stderr, "%s:%d: ENSURE(%s) failed\n", __FILE__, __LINE__, #cond);  \
-            failures++;                                                                \
-        }                                                                              \
-    } while (0)
-#define ENSURE_NEAR(a, b, tol)                                                         \
-    do {                                                                               \
-        double a_ = (a), b_ = (b);                                                     \
-        if (!(fabs(a_ - b_) <= (tol))) {                                               \
-            fprintf(stderr, "%s:%d: %s = %.12g, expected %.12g +- %g\n", __FILE__,     \
-                    __LINE__, #a, a_, b_, (double)(tol));                              \
-            failures++;                                                                \
-        }                                                                              \
-    } while (0)
 
 static void test_double_integrator(void)
 {
     double A[4] = {0, 1, 0, 0}, B[2] = {0, 1}, Q[4] = {1, 0, 0, 1}, R[1] = {1};
     double X[4], K[2];
     ENSURE(lag_lqr_care(2, 1, A, B, Q, R, X, K) == LAG_LQR_OK);
-    ENSURE_NEAR(X[0], sqrt(3.0), 1e-12);
-    ENSURE_NEAR(X[1], 1.0, 1e-12);
-    ENSURE_NEAR(X[2], 1.0, 1e-12);
-    ENSURE_NEAR(X[3], sqrt(3.0), 1e-12);
-    ENSURE_NEAR(K[0], 1.0, 1e-12);
-    ENSURE_NEAR(K[1], sqrt(3.0), 1e-12);
+    ENSURE_NEAR(X[0], sqrt(3.0), 1e-12, "%s", __func__);
+    ENSURE_NEAR(X[1], 1.0, 1e-12, "%s", __func__);
+    ENSURE_NEAR(X[2], 1.0, 1e-12, "%s", __func__);
+    ENSURE_NEAR(X[3], sqrt(3.0), 1e-12, "%s", __func__);
+    ENSURE_NEAR(K[0], 1.0, 1e-12, "%s", __func__);
+    ENSURE_NEAR(K[1], sqrt(3.0), 1e-12, "%s", __func__);
     ENSURE(lag_lqr_care_residual(2, 1, A, B, Q, R, X) < 1e-13);
     /* ZOH of the double integrator: Ad = [[1, h], [0, 1]], Bd = [h^2/2, h] */
     double Ad[4], Bd[2], h = 0.1;
     ENSURE(lag_lqr_c2d(2, 1, A, B, h, Ad, Bd) == LAG_LQR_OK);
-    ENSURE_NEAR(Ad[0], 1.0, 1e-15);
-    ENSURE_NEAR(Ad[1], h, 1e-15);
-    ENSURE_NEAR(Ad[2], 0.0, 1e-15);
-    ENSURE_NEAR(Ad[3], 1.0, 1e-15);
-    ENSURE_NEAR(Bd[0], 0.5 * h * h, 1e-15);
-    ENSURE_NEAR(Bd[1], h, 1e-15);
+    ENSURE_NEAR(Ad[0], 1.0, 1e-15, "%s", __func__);
+    ENSURE_NEAR(Ad[1], h, 1e-15, "%s", __func__);
+    ENSURE_NEAR(Ad[2], 0.0, 1e-15, "%s", __func__);
+    ENSURE_NEAR(Ad[3], 1.0, 1e-15, "%s", __func__);
+    ENSURE_NEAR(Bd[0], 0.5 * h * h, 1e-15, "%s", __func__);
+    ENSURE_NEAR(Bd[1], h, 1e-15, "%s", __func__);
 }
 
 static void test_scalar_dare(void)
@@ -75,8 +58,8 @@ static void test_scalar_dare(void)
     ENSURE(lag_lqr_dare(1, 1, &a, &b, &q, &r, &X, &K) == LAG_LQR_OK);
     double qa = b * b, qb = r * (1 - a * a) - q * b * b, qc = -q * r;
     double Xref = (-qb + sqrt(qb * qb - 4 * qa * qc)) / (2 * qa);
-    ENSURE_NEAR(X, Xref, 1e-12 * Xref);
-    ENSURE_NEAR(K, b * Xref * a / (r + b * b * Xref), 1e-12);
+    ENSURE_NEAR(X, Xref, 1e-12 * Xref, "%s", __func__);
+    ENSURE_NEAR(K, b * Xref * a / (r + b * b * Xref), 1e-12, "%s", __func__);
     ENSURE(fabs(a - b * K) < 1.0);
 }
 
@@ -86,14 +69,14 @@ static void test_eig(void)
     double C[16] = {-5, -13, -19, -10, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     double re[4], im[4];
     ENSURE(lag_lqr_eig(4, C, re, im) == LAG_LQR_OK);
-    ENSURE_NEAR(re[0], -2.0, 1e-10);
-    ENSURE_NEAR(im[0], 0.0, 1e-10);
-    ENSURE_NEAR(re[1], -1.0, 1e-10);
-    ENSURE_NEAR(im[1], -2.0, 1e-10);
-    ENSURE_NEAR(re[2], -1.0, 1e-10);
-    ENSURE_NEAR(im[2], 0.0, 1e-10);
-    ENSURE_NEAR(re[3], -1.0, 1e-10);
-    ENSURE_NEAR(im[3], 2.0, 1e-10);
+    ENSURE_NEAR(re[0], -2.0, 1e-10, "%s", __func__);
+    ENSURE_NEAR(im[0], 0.0, 1e-10, "%s", __func__);
+    ENSURE_NEAR(re[1], -1.0, 1e-10, "%s", __func__);
+    ENSURE_NEAR(im[1], -2.0, 1e-10, "%s", __func__);
+    ENSURE_NEAR(re[2], -1.0, 1e-10, "%s", __func__);
+    ENSURE_NEAR(im[2], 0.0, 1e-10, "%s", __func__);
+    ENSURE_NEAR(re[3], -1.0, 1e-10, "%s", __func__);
+    ENSURE_NEAR(im[3], 2.0, 1e-10, "%s", __func__);
 }
 
 static void print_eig(const char *what, int n, const double *re, const double *im);
@@ -244,11 +227,11 @@ static void test_cartpole(void)
     double lam = sqrt(m1 * g * a * (m0 + m1) / ((m0 + m1) * (I1 + m1 * a * a) - m1 * a * m1 * a));
     print_eig("cart-pole open-loop poles", 4, re, im);
     printf("closed form: 0, 0, +-%.6f\n", lam);
-    ENSURE_NEAR(re[0], -lam, 1e-7 * lam);
-    ENSURE_NEAR(re[1], 0.0, 1e-7);
-    ENSURE_NEAR(re[2], 0.0, 1e-7);
-    ENSURE_NEAR(re[3], lam, 1e-7 * lam);
-    for (int i = 0; i < 4; i++) ENSURE_NEAR(im[i], 0.0, 1e-7);
+    ENSURE_NEAR(re[0], -lam, 1e-7 * lam, "%s", __func__);
+    ENSURE_NEAR(re[1], 0.0, 1e-7, "%s", __func__);
+    ENSURE_NEAR(re[2], 0.0, 1e-7, "%s", __func__);
+    ENSURE_NEAR(re[3], lam, 1e-7 * lam, "%s", __func__);
+    for (int i = 0; i < 4; i++) ENSURE_NEAR(im[i], 0.0, 1e-7, "%s", __func__);
     double Q[16] = {0}, R[1] = {1.0};
     for (int i = 0; i < 4; i++) Q[i * 4 + i] = 1.0;
     check_riccati("cart-pole, 1 input", 4, 1, A, B, Q, R, 0.01);
@@ -271,15 +254,15 @@ static void test_eig_hard(void)
         for (int j = 0; j < 4; j++) Mx[i * 4 + j] *= D[i] / D[j];
     ENSURE(lag_lqr_eig(4, Mx, re, im) == LAG_LQR_OK);
     for (int i = 0; i < 4; i++) {
-        ENSURE_NEAR(re[i], i + 1.0, 1e-9);
-        ENSURE_NEAR(im[i], 0.0, 1e-9);
+        ENSURE_NEAR(re[i], i + 1.0, 1e-9, "%s", __func__);
+        ENSURE_NEAR(im[i], 0.0, 1e-9, "%s", __func__);
     }
     double Rb[4] = {0.5, 2.0, -2.0, 0.5};
     ENSURE(lag_lqr_eig(2, Rb, re, im) == LAG_LQR_OK);
-    ENSURE_NEAR(re[0], 0.5, 1e-15);
-    ENSURE_NEAR(im[0], -2.0, 1e-15);
-    ENSURE_NEAR(re[1], 0.5, 1e-15);
-    ENSURE_NEAR(im[1], 2.0, 1e-15);
+    ENSURE_NEAR(re[0], 0.5, 1e-15, "%s", __func__);
+    ENSURE_NEAR(im[0], -2.0, 1e-15, "%s", __func__);
+    ENSURE_NEAR(re[1], 0.5, 1e-15, "%s", __func__);
+    ENSURE_NEAR(im[1], 2.0, 1e-15, "%s", __func__);
 }
 
 static void print_eig(const char *what, int n, const double *re, const double *im)
@@ -300,7 +283,7 @@ static void test_dipc(void)
     model.p[LAG_DIPC_L2] = 0.75;
     model.p[LAG_DIPC_G] = 9.81;
     lag_model_finish(&model); /* uniform rods: I = m l^2 / 12 */
-    ENSURE_NEAR(model.p[LAG_DIPC_I1], 0.5 * 0.25 / 12.0, 1e-15);
+    ENSURE_NEAR(model.p[LAG_DIPC_I1], 0.5 * 0.25 / 12.0, 1e-15, "%s", __func__);
 
     const int n = 6, m = 1, input = 0;
     double q0[3] = {0}, qd0[3] = {0}, A[36], B[6];
@@ -311,8 +294,8 @@ static void test_dipc(void)
     /* published to two decimals: 0, 0, +-4.10, +-10.39 */
     const double want[6] = {-10.39, -4.10, 0.0, 0.0, 4.10, 10.39};
     for (int i = 0; i < n; i++) {
-        ENSURE_NEAR(re[i], want[i], 0.006);
-        ENSURE_NEAR(im[i], 0.0, 1e-6);
+        ENSURE_NEAR(re[i], want[i], 0.006, "%s", __func__);
+        ENSURE_NEAR(im[i], 0.0, 1e-6, "%s", __func__);
     }
 
     double Q[36] = {0}, R[1] = {1.0}, X[36], K[6], Acl[36];
@@ -370,8 +353,9 @@ static void test_dipc(void)
     ENSURE(err_prev < 5e-3);
 }
 
-int main(void)
+static void case_lqr(int arg)
 {
+    (void)arg;
     test_double_integrator();
     test_scalar_dare();
     test_eig();
@@ -379,10 +363,10 @@ int main(void)
     test_riccati_properties();
     test_cartpole();
     test_eig_hard();
-    if (failures) {
-        fprintf(stderr, "test_lqr: %d failure(s)\n", failures);
-        return 1;
-    }
-    printf("test_lqr: all passed\n");
-    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {{"lqr", case_lqr, 0, 0}};
+    return lt_main(argc, argv, cases, 1);
 }

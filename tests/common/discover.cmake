@@ -1,28 +1,18 @@
-# cmake -D EXE=... -D OUT=... -D PREFIX=... -D LABEL=... -D TIMEOUT=... -P discover.cmake
-# Writes one add_test per line of `EXE --list` (see cases.cmake). Exit code 77 of a case
-# means skipped (lt_skip in lagsim_test.h).
+# cmake -D EXE=... -D OUT=... -P discover.cmake
+# Writes the cases `EXE --list` prints (see cases.cmake) as the list lt_cases, which the
+# program's include file (cases.cmake) turns into one add_test each.
 execute_process(COMMAND ${EXE} --list OUTPUT_VARIABLE listing RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "${EXE} --list failed (${rc})")
 endif()
 string(REPLACE "\n" ";" lines "${listing}")
-set(body "")
+set(cases "")
 foreach(line IN LISTS lines)
-  if(line STREQUAL "")
-    continue()
+  if(NOT line STREQUAL "")
+    list(APPEND cases "${line}")
   endif()
-  string(REPLACE " " ";" words "${line}")
-  list(GET words 0 name)
-  set(labels "${LABEL}")
-  list(LENGTH words nwords)
-  if(nwords GREATER 1)
-    list(GET words 1 extra)
-    set(labels "${LABEL}\\;${extra}")
-  endif()
-  string(APPEND body "add_test(${PREFIX}.${name} \"${EXE}\" ${name})\n")
-  string(APPEND body "set_tests_properties(${PREFIX}.${name} PROPERTIES TIMEOUT ${TIMEOUT} SKIP_RETURN_CODE 77 LABELS \"${labels}\")\n")
 endforeach()
-if(body STREQUAL "")
+if(cases STREQUAL "")
   message(FATAL_ERROR "${EXE} --list printed no case")
 endif()
-file(WRITE ${OUT} "${body}")
+file(WRITE ${OUT} "set(lt_cases \"${cases}\")\n")

@@ -1,18 +1,22 @@
 /*
- * The test harness of the core's C tests (tests/core, tests/effects): plain C, no
- * framework (Box2D's ENSURE), one copy for every program.
+ * The one test harness of the C tests: plain C, no framework (Box2D's ENSURE), one copy
+ * for every program. A test file defines no check macro or case dispatch of its own
+ * (the ctest structure_harness fails when one does).
  *
  *   ENSURE(cond)                        counts a check; prints the expression if false
+ *   ENSUREF(cond, fmt...)               the same, with a printf-style message if false
  *   ENSURE_NEAR(got, want, tol, fmt...) |got - want| <= tol, else prints both and context
  *   LT_FAIL(fmt...)                     counts a failed check with a message
  *
- * A program lists its cases in a table and hands it to lt_main, which
+ * A program lists its cases in a table and hands it to lt_main (or lt_run, for a program
+ * that takes arguments, sets up before its case or stops at the first failed check),
+ * which
  *   - with no argument runs every case but those marked LT_BY_NAME (slow ones);
  *   - with `--list` prints one case a line ("name" or "name slow"): tests/common/cases.cmake
- *     turns that list into one ctest per case, so a case added to a table is a ctest
- *     without anyone listing it again;
- *   - with a name runs that case; a name it does not know is an error (exit 2), never a
- *     pass;
+ *     turns that list into one ctest per case (PREFIX_name), so a case added to a table
+ *     is a ctest without anyone listing it again;
+ *   - with a name (and the program's arguments after it: lt_arg) runs that case; a name
+ *     it does not know is an error (exit 2), never a pass;
  *   - fails when the cases run made no check at all ("0 checks" is not a pass), unless a
  *     case said why it could not run here (lt_skip): then it exits 77, which ctest
  *     reports as skipped, not passed.
@@ -32,12 +36,42 @@ static int lt_failures = 0;
 static int lt_checks = 0;
 #define LT_QUIET_AFTER 30 /* failures printed in detail; the rest are only counted */
 
+static const char *lt_case_name = "all"; /* the case running */
+static bool lt_stop_on_failure;          /* lt_run's stop_on_failure */
+static void (*lt_teardown)(void);        /* lt_run's teardown */
+
+/* After a failed check: a program that stops at the first one (its later steps need what
+ * failed: a child to talk to, a file written) tears down and exits 1 here. */
+static inline void lt_failed(void)
+{
+    if (!lt_stop_on_failure) return;
+    fprintf(stderr, "%s: stopped at the first failed check (%d checks)\n", lt_case_name,
+            lt_checks);
+    if (lt_teardown) lt_teardown();
+    exit(1);
+}
+
 #define ENSURE(cond)                                                                       \
     do {                                                                                   \
         lt_checks++;                                                                       \
         if (!(cond)) {                                                                     \
             if (lt_failures++ < LT_QUIET_AFTER)                                            \
                 fprintf(stderr, "%s:%d: ENSURE failed: %s\n", __FILE__, __LINE__, #cond);  \
+            lt_failed();                                                                   \
+        }                                                                                  \
+    } while (0)
+
+/* ENSURE with a printf-style message (what was seen, what was expected) when it fails. */
+#define ENSUREF(cond, ...)                                                                 \
+    do {                                                                                   \
+        lt_checks++;                                                                       \
+        if (!(cond)) {                                                                     \
+            if (lt_failures++ < LT_QUIET_AFTER) {                                          \
+                fprintf(stderr, "%s:%d: ENSURE failed: %s: ", __FILE__, __LINE__, #cond);  \
+                fprintf(stderr, __VA_ARGS__);                                              \
+                fprintf(stderr, "\n");                                                     \
+            }                                                                              \
+            lt_failed();                                                                   \
         }                                                                                  \
     } while (0)
 
@@ -54,6 +88,7 @@ static int lt_checks = 0;
                 fprintf(stderr, __VA_ARGS__);                                              \
                 fprintf(stderr, "\n");                                                     \
             }                                                                              \
+            lt_failed();                                                                   \
         }                                                                                  \
     } while (0)
 
@@ -66,6 +101,7 @@ static int lt_checks = 0;
             fprintf(stderr, __VA_ARGS__);                                                  \
             fprintf(stderr, "\n");                                                         \
         }                                                                                  \
+        lt_failed();                                                                       \
     } while (0)
 
 static int lt_skipped = 0;
@@ -105,10 +141,28 @@ static inline void lt_add(lt_cases *cs, const char *name, void (*fn)(int), int a
     cs->c[cs->n++] = (lt_case){name, fn, arg, flags};
 }
 
+/* A program's cases and how to run them (lt_main fills only cases and n). */
+typedef struct lt_program {
+    const lt_case *cases;
+    int n;
+    const char *args;             /* the arguments after CASE, for the usage line ("LAGSIMD") */
+    int min_args, max_args;       /* how many of them it takes */
+    void (*setup)(void);          /* before the case(s), once lt_case_name and lt_arg are set */
+    void (*teardown)(void);       /* after them, and before exiting on a failed check */
+    bool stop_on_failure;         /* the first failed check ends the program */
+} lt_program;
+
+static int lt_nargs;
+static char **lt_args;
+/* The i-th argument after the case's name, NULL when absent. */
+static inline const char *lt_arg(int i) { return i >= 0 && i < lt_nargs ? lt_args[i] : NULL; }
+
 /* Runs the cases named by argv (see the header comment). */
-static inline int lt_main(int argc, char **argv, const lt_case *cases, int n)
+static inline int lt_run(int argc, char **argv, const lt_program *p)
 {
     const char *prog = argc > 0 ? argv[0] : "test";
+    const lt_case *cases = p->cases;
+    int n = p->n;
     for (int i = 0; i < n; i++)
         for (int j = 0; j < i; j++)
             if (strcmp(cases[i].name, cases[j].name) == 0) {
@@ -121,24 +175,32 @@ static inline int lt_main(int argc, char **argv, const lt_case *cases, int n)
         return 0;
     }
     const char *label = argc > 1 ? argv[1] : "all";
-    if (argc > 2) {
-        fprintf(stderr, "usage: %s [--list | CASE]\n", prog);
+    lt_nargs = argc > 2 ? argc - 2 : 0;
+    lt_args = argv + 2;
+    if (lt_nargs < p->min_args || lt_nargs > p->max_args) {
+        fprintf(stderr, "usage: %s [--list | CASE%s%s]\n", prog, p->args ? " " : "",
+                p->args ? p->args : "");
         return 2;
     }
-    bool ran = false;
-    for (int i = 0; i < n; i++) {
-        bool named = argc > 1 && strcmp(argv[1], cases[i].name) == 0;
-        if (named || (argc == 1 && !(cases[i].flags & LT_BY_NAME))) {
-            cases[i].fn(cases[i].arg);
-            ran = true;
+    int which = -1; /* the case named, or -1 for all */
+    if (argc > 1) {
+        for (int i = 0; i < n; i++)
+            if (strcmp(argv[1], cases[i].name) == 0) which = i;
+        if (which < 0) {
+            fprintf(stderr, "%s: unknown case '%s'; cases:", prog, label);
+            for (int i = 0; i < n; i++) fprintf(stderr, " %s", cases[i].name);
+            fprintf(stderr, "\n");
+            return 2;
         }
     }
-    if (!ran) {
-        fprintf(stderr, "%s: unknown case '%s'; cases:", prog, label);
-        for (int i = 0; i < n; i++) fprintf(stderr, " %s", cases[i].name);
-        fprintf(stderr, "\n");
-        return 2;
-    }
+    lt_case_name = label;
+    lt_stop_on_failure = p->stop_on_failure;
+    lt_teardown = p->teardown;
+    if (p->setup) p->setup();
+    for (int i = 0; i < n; i++)
+        if (i == which || (which < 0 && !(cases[i].flags & LT_BY_NAME)))
+            cases[i].fn(cases[i].arg);
+    if (p->teardown) p->teardown();
     printf("%s: %d checks, %d failed%s\n", label, lt_checks, lt_failures,
            lt_skipped ? ", some skipped" : "");
     if (lt_failures) return 1;
@@ -147,7 +209,14 @@ static inline int lt_main(int argc, char **argv, const lt_case *cases, int n)
         fprintf(stderr, "%s: case '%s' made no check: that is not a pass\n", prog, label);
         return 1;
     }
-    return lt_failures ? 1 : 0;
+    return 0;
+}
+
+/* A program of cases that takes no argument after the case's name. */
+static inline int lt_main(int argc, char **argv, const lt_case *cases, int n)
+{
+    const lt_program p = {.cases = cases, .n = n};
+    return lt_run(argc, argv, &p);
 }
 
 /* ------------------------------------------------------------------ seeded RNG */

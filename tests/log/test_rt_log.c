@@ -6,7 +6,7 @@
  * reached the file is read back with the wire module's bounded reader.
  *
  *   test_rt_log CASE    CASE: file clock realtime_stalled fast_stalled lockstep_stalled
- *                             full flood_in flood_refused
+ *                             full flood_in flood_refused (--list)
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -22,31 +22,16 @@
 #include <unistd.h>
 
 #include "lagsim_log.h"
+#include "lagsim_test.h"
 #include "rt_server.h"
 #include "lagsim/lagsim_control_t.h"
 #include "lagsim/lagsim_joint_command_t.h"
 
-static const char *g_case = "?";
-static int g_checks;
-#define ENSURE(c) do { g_checks++; if (!(c)) fail(__LINE__, "%s", #c); } while (0)
-#define ENSUREF(c, ...) do { g_checks++; if (!(c)) fail(__LINE__, __VA_ARGS__); } while (0)
-static void fail(int line, const char *fmt, ...) __attribute__((format(printf, 2, 3), noreturn));
 static char g_fifo[128], g_file[128];
 static void cleanup(void)
 {
     if (g_fifo[0]) unlink(g_fifo);
     if (g_file[0]) unlink(g_file);
-}
-static void fail(int line, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "test_rt_log %s: FAIL line %d: ", g_case, line);
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, "\n");
-    va_end(ap);
-    cleanup();
-    exit(1);
 }
 
 #define MS 1000000LL
@@ -279,8 +264,9 @@ static void read_log(const char *path, logfacts *f)
 /* A realtime run to a regular file: everything published and received is there, in the
  * order the loop saw it, numbered, stamped on the run's clock (states exactly one control
  * period apart while running). */
-static void case_file(void)
+static void case_file(int arg)
 {
+    (void)arg;
     scene(LAG_RT_REALTIME, 100);
     snprintf(g_file, sizeof g_file, "/tmp/lagsim_rt_log_%d.lcm", (int)getpid());
     start(g_file, 0);
@@ -322,8 +308,9 @@ static void case_file(void)
 /* Lockstep answered at once: the log's clock is sim time (a state every 10 ms of log time
  * however fast the run went), plus the wall time spent paused; an actuator lag adds the
  * commanded input of each period, stamped before the period's state. */
-static void case_clock(void)
+static void case_clock(int arg)
 {
+    (void)arg;
     scene(LAG_RT_LOCKSTEP, 100);
     g_sc.sim.effects.enabled |= LAG_EFF_ACTUATOR;
     g_sc.sim.effects.actuator_tau[0] = 0.005;
@@ -358,8 +345,9 @@ static void case_clock(void)
  * never waits (a state at every deadline), the records that do not fit are counted and
  * said (a log_dropped event at most once a second), the end says the log is incomplete;
  * what reached the file is whole records, numbered without holes. */
-static void case_realtime_stalled(void)
+static void case_realtime_stalled(int arg)
 {
+    (void)arg;
     scene(LAG_RT_REALTIME, 1000);
     start(fifo_open(), RT_LOG_RING_MIN);
     run_until(g_srv.now + 10 * SEC, 1000);
@@ -442,13 +430,14 @@ static void stalled_no_deadline(lag_rt_mode mode)
     ENSURE(f.commands == g_commands_sent);
 }
 
-static void case_fast_stalled(void) { stalled_no_deadline(LAG_RT_FAST); }
-static void case_lockstep_stalled(void) { stalled_no_deadline(LAG_RT_LOCKSTEP); }
+static void case_fast_stalled(int arg) { (void)arg; stalled_no_deadline(LAG_RT_FAST); }
+static void case_lockstep_stalled(int arg) { (void)arg; stalled_no_deadline(LAG_RT_LOCKSTEP); }
 
 /* A full disk (/dev/full: every write fails with ENOSPC): said once (a log_error event),
  * the run goes on at its pace, the end says the log is incomplete and why. */
-static void case_full(void)
+static void case_full(int arg)
 {
+    (void)arg;
     scene(LAG_RT_REALTIME, 100);
     start("/dev/full", 0);
     run_until(g_srv.now + 1 * SEC, 1000);
@@ -469,8 +458,9 @@ static void case_full(void)
 
 /* A flood on the input channels cannot push the states out: received messages go in
  * only while the ring is at most 3/4 full, what the daemon publishes up to the full ring. */
-static void case_flood_in(void)
+static void case_flood_in(int arg)
 {
+    (void)arg;
     scene(LAG_RT_REALTIME, 100);
     start(fifo_open(), RT_LOG_RING_MIN);
     for (int k = 0; k < 10000; k++) command(0.0, 0.0);
@@ -497,8 +487,9 @@ static void case_flood_in(void)
  * is logged; of the rest, counted exactly, a sample whose bytes are within the bucket:
  * 64 KiB at start and 64 KiB a second after (<= 4 x 64 KiB over 3 s, and all of it used);
  * the log's own log_sampled events say so; the replay of the log gives difference 0. */
-static void case_flood_refused(void)
+static void case_flood_refused(int arg)
 {
+    (void)arg;
     scene(LAG_RT_REALTIME, 100);
     g_sc.realtime.start = LAG_RT_START_RUNNING;
     snprintf(g_file, sizeof g_file, "/tmp/lagsim_rt_log_%d.lcm", (int)getpid());
@@ -571,31 +562,30 @@ static void case_flood_refused(void)
     ENSURE(lagsimd_replay(&g_sc, g_file, &ro) == 0);
 }
 
-int main(int argc, char **argv)
+static void setup(void)
 {
-    if (argc != 2) {
-        fprintf(stderr, "usage: test_rt_log CASE\n");
-        return 2;
-    }
-    g_case = argv[1];
     signal(SIGPIPE, SIG_IGN);
     g_lcm = lcm_create("memq://");
     ENSURE(g_lcm);
     lcm_subscribe(g_lcm, "TRL_.*", on_any, NULL);
-    if (!strcmp(g_case, "file")) case_file();
-    else if (!strcmp(g_case, "clock")) case_clock();
-    else if (!strcmp(g_case, "realtime_stalled")) case_realtime_stalled();
-    else if (!strcmp(g_case, "fast_stalled")) case_fast_stalled();
-    else if (!strcmp(g_case, "lockstep_stalled")) case_lockstep_stalled();
-    else if (!strcmp(g_case, "full")) case_full();
-    else if (!strcmp(g_case, "flood_in")) case_flood_in();
-    else if (!strcmp(g_case, "flood_refused")) case_flood_refused();
-    else {
-        fprintf(stderr, "unknown case %s\n", g_case);
-        return 2;
-    }
-    lcm_destroy(g_lcm);
-    cleanup();
-    printf("test_rt_log %s: %d checks passed\n", g_case, g_checks);
-    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {
+        {"file", case_file, 0, 0},
+        {"clock", case_clock, 0, 0},
+        {"realtime_stalled", case_realtime_stalled, 0, 0},
+        {"fast_stalled", case_fast_stalled, 0, 0},
+        {"lockstep_stalled", case_lockstep_stalled, 0, 0},
+        {"full", case_full, 0, 0},
+        {"flood_in", case_flood_in, 0, 0},
+        {"flood_refused", case_flood_refused, 0, 0},
+    };
+    /* a failed check ends the case (its files removed): what follows it needs what failed */
+    const lt_program p = {.cases = cases, .n = (int)(sizeof cases / sizeof cases[0]),
+                          .setup = setup, .teardown = cleanup, .stop_on_failure = true};
+    int rc = lt_run(argc, argv, &p);
+    if (g_lcm) lcm_destroy(g_lcm);
+    return rc;
 }

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lagsim_test.h"
 #include "scene.h"
 #include "scene_schema.h"
 
@@ -62,9 +63,10 @@ static void check_key(void *vc, const char *path, bool integer)
         yaml_for(body, sizeof body, path, values[v], c->nq);
         snprintf(text, sizeof text, "model: %s\n%s\n", c->model, body);
         static lag_scene sc;
-        if (lag_scene_load_buffer("t.yaml", text, strlen(text), NULL, 0, &sc, err,
-                                  sizeof err) == 0) {
-            printf("FAIL: %s: %s = %s accepted\n%s", c->model, path, values[v], text);
+        bool accepted = lag_scene_load_buffer("t.yaml", text, strlen(text), NULL, 0, &sc, err,
+                                              sizeof err) == 0;
+        ENSUREF(!accepted, "%s: %s = %s accepted\n%s", c->model, path, values[v], text);
+        if (accepted) {
             c->failures++;
             continue;
         }
@@ -75,16 +77,15 @@ static void check_key(void *vc, const char *path, bool integer)
         bool at_key = strncmp(err, "t.yaml:2:", 9) == 0 && nlen > 0 &&
                       strncmp(named, path, nlen) == 0 &&
                       (path[nlen] == '\0' || path[nlen] == '.' || path[nlen] == '[');
-        if (!at_key || strstr(err, "unknown")) {
-            printf("FAIL: %s: %s = %s: refused, but not at the key: %s\n", c->model, path,
-                   values[v], err);
-            c->failures++;
-        }
+        ENSUREF(at_key && !strstr(err, "unknown"), "%s: %s = %s: refused, but not at the key: %s",
+                c->model, path, values[v], err);
+        if (!at_key || strstr(err, "unknown")) c->failures++;
     }
 }
 
-int main(void)
+static void case_ranges(int arg)
 {
+    (void)arg;
     int failures = 0, total = 0;
     for (int k = 0; k < LAG_MODEL_COUNT; k++) {
         const lag_model_info *info = lag_model_info_get((lag_model_kind)k);
@@ -92,20 +93,23 @@ int main(void)
         char text[64], err[1024];
         static lag_scene sc;
         snprintf(text, sizeof text, "model: %s\n", info->name);
-        if (lag_scene_load_buffer("t.yaml", text, strlen(text), NULL, 0, &sc, err,
-                                  sizeof err) != 0) {
-            printf("FAIL: the defaults of %s are refused: %s\n", info->name, err);
-            failures++;
-        }
+        bool refused = lag_scene_load_buffer("t.yaml", text, strlen(text), NULL, 0, &sc, err,
+                                             sizeof err) != 0;
+        ENSUREF(!refused, "the defaults of %s are refused: %s", info->name, err);
+        failures += refused;
         scene_schema_each_number((lag_model_kind)k, check_key, &c);
         printf("%s: %d numeric keys, %d failures\n", info->name, c.keys, c.failures);
-        if (c.keys < 30) { /* the walk itself must not come back empty */
-            printf("FAIL: only %d numeric keys listed for %s\n", c.keys, info->name);
-            failures++;
-        }
+        /* the walk itself must not come back empty */
+        ENSUREF(c.keys >= 30, "only %d numeric keys listed for %s", c.keys, info->name);
+        failures += c.keys < 30;
         failures += c.failures;
         total += c.keys;
     }
     printf("%d numeric keys over %d models, %d failures\n", total, LAG_MODEL_COUNT, failures);
-    return failures ? 1 : 0;
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {{"ranges", case_ranges, 0, 0}};
+    return lt_main(argc, argv, cases, 1);
 }

@@ -5,7 +5,8 @@
  * prefix, talks to it with the raw LCM C API and the generated types, and always kills it
  * at the end (SIGKILL on our own death too: PR_SET_PDEATHSIG).
  *
- *   server_test LAGSIMD CASE [LCM_LOGGER]
+ *   server_test CASE LAGSIMD [LCM_LOGGER]   (the cases: server_test --list; those that
+ *                                            record a run are skipped without LCM_LOGGER)
  *     CASE: control hostile watchdog lockstep_timeout two_daemons fault replay
  *           replay_dopri5 replay_effects replay_flight sigterm bad_scene effects control_flood
  *           step_flood lockstep_huge status_rate rate_huge long_period duration_huge
@@ -15,7 +16,7 @@
  * Expected states are computed independently of the daemon's loop: a lag_sim of the same
  * scene (loaded with lag_scene_load, as the daemon does) advanced from the published state
  * with the efforts the test sent. Exits 0 on success, 1 with a message on the first
- * failed ENSURE.
+ * failed check (tests/common/lagsim_test.h).
  */
 #include <errno.h>
 #include <math.h>
@@ -38,6 +39,7 @@
 #include "lagsim/lagsim_joint_state_t.h"
 #include "lagsim/lagsim_scene_t.h"
 #include "lagsim/lagsim_status_t.h"
+#include "lagsim_test.h"
 #include "lagsim_wire.h"
 
 static const char *g_case = "?";
@@ -52,21 +54,6 @@ static void kill_children(void)
             kill(g_children[i], SIGKILL);
             waitpid(g_children[i], NULL, 0);
         }
-}
-
-#define ENSURE(c) do { if (!(c)) fail(__LINE__, "%s", #c); } while (0)
-#define ENSUREF(c, ...) do { if (!(c)) fail(__LINE__, __VA_ARGS__); } while (0)
-static void fail(int line, const char *fmt, ...) __attribute__((format(printf, 2, 3), noreturn));
-static void fail(int line, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "server_test %s: FAIL line %d: ", g_case, line);
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, "\n");
-    va_end(ap);
-    kill_children();
-    exit(1);
 }
 
 static double now_s(void)
@@ -446,8 +433,9 @@ static const char *DIPC_MOVING =
 
 /* ---------------------------------------------------------------- cases */
 /* pause / step / reset / reset_to / resume / describe do what they say. */
-static void case_control(void)
+static void case_control(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -555,8 +543,9 @@ static void publish_raw(client *c, const uint8_t *b, size_t n)
 
 /* Malformed and hostile commands are rejected and counted by reason; the state stays
  * finite and is unchanged by them. */
-static void case_hostile(void)
+static void case_hostile(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -663,8 +652,9 @@ static void case_hostile(void)
 
 /* The watchdog zeroes a stale command's effort, with an event and a status flag; the next
  * good command clears it. */
-static void case_watchdog(void)
+static void case_watchdog(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -704,8 +694,9 @@ static void case_watchdog(void)
  *    daemon waits (waiting, sim time still), republishing that same state, never stepping:
  *    no crawl of one period per timeout.
  * 4. A command answering it resumes the run (a resume event, running). */
-static void case_lockstep_timeout(void)
+static void case_lockstep_timeout(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -756,8 +747,9 @@ static void case_lockstep_timeout(void)
 }
 
 /* Two daemons with different prefixes do not hear each other. */
-static void case_two_daemons(void)
+static void case_two_daemons(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     char pa[80], pb[80];
     snprintf(pa, sizeof pa, "%sA", g_prefix);
@@ -795,8 +787,9 @@ static void case_two_daemons(void)
 /* A numeric fault pauses in the fault state with an event; no bad state is ever
  * published; reset recovers. The cart starts at 20 m/s with explode_limit 30 (the rods
  * upright at rest stay so): |theta0| passes 30 m after 1.5 s. */
-static void case_fault(void)
+static void case_fault(int arg)
 {
+    (void)arg;
     write_scene("model: dipc\n"
                 "initial:\n"
                 "  qd: [20, 0, 0]\n"
@@ -942,9 +935,15 @@ static bool replay_attempt(const char *logger, const char *method, int attempt)
 
 /* lcm-logger records a lockstep run; lagsimd --replay re-simulates it with difference
  * exactly 0; a second run gives a bit-identical state stream. */
-static void case_replay(const char *logger, const char *method)
+enum { REPLAY_RK4, REPLAY_DOPRI5, REPLAY_EFFECTS, REPLAY_FLIGHT };
+static void case_replay(int variant)
 {
-    if (!strcmp(g_case, "replay_effects"))
+    const char *logger = lt_arg(1), *method = variant == REPLAY_DOPRI5 ? "dopri5" : "rk4";
+    if (!logger) {
+        lt_skip("no LCM_LOGGER given");
+        return;
+    }
+    if (variant == REPLAY_EFFECTS)
         /* effects the replay must re-simulate exactly: damping, a stop on the cart,
          * scheduled disturbances, actuator saturation, noise on the published state */
         write_scene("model: dipc\n"
@@ -958,7 +957,7 @@ static void case_replay(const char *logger, const char *method)
                     "    - {t: 1.0, joint: theta0, force: 1.0, duration: 0.2}\n"
                     "  actuator: {theta0: {max: 0.8}}\n"
                     "  noise: {seed: 11, q: {theta1: 1e-3}, qd: {theta0: 1e-2}}\n");
-    else if (!strcmp(g_case, "replay_flight"))
+    else if (variant == REPLAY_FLIGHT)
         /* a stick that lifts off, flies, lands and slides, pushed along x: three joints
          * published (x, phi, h), the floor's events located inside the ticks */
         write_scene("model: stick\n"
@@ -969,12 +968,13 @@ static void case_replay(const char *logger, const char *method)
         write_scene(DIPC_MOVING);
     for (int attempt = 1; attempt <= 6; attempt++)
         if (replay_attempt(logger, method, attempt)) return;
-    fail(__LINE__, "UDP lost messages in every attempt");
+    LT_FAIL("UDP lost messages in every attempt");
 }
 
 /* SIGTERM: a final status, exit 0. */
-static void case_sigterm(void)
+static void case_sigterm(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1023,8 +1023,9 @@ static void ensure_event_times(const client *c, const char *kind, const double *
     ENSUREF(j == n, "%d '%s' events published, the core located %d", j, kind, n);
 }
 
-static void case_effects(void)
+static void case_effects(int arg)
 {
+    (void)arg;
     write_scene("model: stick\n"
                 "initial:\n  q: [0, 1.2]\n"
                 "realtime:\n  mode: fast\n"
@@ -1108,8 +1109,9 @@ static void case_effects(void)
            t_lift[0], t_land[0], c3.last.q[2]);
 }
 
-static void case_bad_scene(void)
+static void case_bad_scene(int arg)
 {
+    (void)arg;
     write_scene("model: dipc\nparameters:\n  m0: -1.5\n");
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1187,8 +1189,9 @@ static bool refused_at_start(pid_t d, client *c)
  * thousand in about a second) is answered by a bounded number of messages: each event kind
  * by its bucket (10, then 10 per second), statuses and scene descriptions coalesced and
  * limited. Everything is counted. */
-static void case_control_flood(void)
+static void case_control_flood(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1254,8 +1257,9 @@ static void on_any_state_url(const lcm_recv_buf_t *rb, const char *ch, void *u)
 /* A flood of commands (a child publishing valid heartbeats as fast as it can for 2 s)
  * reaches the daemon on the command URL and never the sockets of those who listen on the
  * state URL: a state subscriber receives none of it and misses no state meanwhile. */
-static void case_command_flood_ports(void)
+static void case_command_flood_ports(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1311,8 +1315,9 @@ static void case_command_flood_ports(void)
 
 /* STEP with count 2^62 while paused goes at the mode's pace (realtime: 100 periods a
  * second at 100 Hz), not as fast as the machine can publish; PAUSE ends it. */
-static void case_step_flood(void)
+static void case_step_flood(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1344,8 +1349,9 @@ static void case_step_flood(void)
 
 /* lockstep_timeout 1e10 s (or 1e300): the daemon waits for its controller, quietly and
  * without spinning: no lockstep_timeout event, no period, little CPU. */
-static void case_lockstep_huge(void)
+static void case_lockstep_huge(int arg)
 {
+    (void)arg;
     const char *values[] = {"realtime.lockstep_timeout=1e10", "realtime.lockstep_timeout=1e300"};
     for (int i = 0; i < 2; i++) {
         write_scene(DIPC_MOVING);
@@ -1375,8 +1381,9 @@ static void case_lockstep_huge(void)
 }
 
 /* status_hz 1e9: at most 100 statuses a second; 1e-300: none but the first. */
-static void case_status_rate(void)
+static void case_status_rate(int arg)
 {
+    (void)arg;
     const char *values[] = {"realtime.status_hz=1e9", "realtime.status_hz=1e-300"};
     const int64_t most[] = {100 + 5, 1};
     for (int i = 0; i < 2; i++) {
@@ -1406,8 +1413,9 @@ static void case_status_rate(void)
 
 /* realtime.rate 1e25 (a wall period of 1e-27 s) or 1e6: sim time advances as fast as the
  * loop goes; the overrun_burst events stay within their bucket (3, then 1 per second). */
-static void case_rate_huge(void)
+static void case_rate_huge(int arg)
 {
+    (void)arg;
     const char *values[] = {"realtime.rate=1e25", "realtime.rate=1e6"};
     for (int i = 0; i < 2; i++) {
         write_scene(DIPC_MOVING);
@@ -1438,8 +1446,9 @@ static void case_rate_huge(void)
 
 /* A control period of 1e12 ticks (fast mode, publish_hz 1e-9): the daemon still serves
  * signals: SIGTERM stops it at once, with its stop event and final status. */
-static void case_long_period(void)
+static void case_long_period(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1460,8 +1469,9 @@ static void case_long_period(void)
 
 /* --duration beyond what a run can count (1e300 s, 1e16 s) is refused (exit 2), in real
  * time and offline, instead of ending at once with exit 0. */
-static void case_duration_huge(void)
+static void case_duration_huge(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1482,8 +1492,9 @@ static void case_duration_huge(void)
 
 /* SIGHUP stops like SIGTERM (stop event naming it, final status, exit 0); SIGUSR1 asks
  * for a status and stops nothing; SIGQUIT stops. */
-static void case_signals(void)
+static void case_signals(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1517,8 +1528,9 @@ static void case_signals(void)
  * announced, the plant untouched. With the limit at 1e12, an effort of 1e12 drives the
  * state past explode_limit in one tick: the fault event names the efforts that were
  * held, so the cause is plain. */
-static void case_effort_absurd(void)
+static void case_effort_absurd(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1553,8 +1565,9 @@ static void case_effort_absurd(void)
 }
 
 /* An LCM URL with ttl > 0 is said at start: the daemon's messages leave this host. */
-static void case_ttl_warning(void)
+static void case_ttl_warning(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     char err_path[256];
     snprintf(err_path, sizeof err_path, "/tmp/lagsim_server_test_%d_%s.err", (int)getpid(), g_case);
@@ -1581,8 +1594,9 @@ static void case_ttl_warning(void)
  * publishes anything (its answer to a DESCRIBE, its states) and refuses to start, exit 1,
  * saying why; the first runs on untouched (no stop, its states go on, nothing from the
  * second on the prefix). */
-static void case_same_prefix(void)
+static void case_same_prefix(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1637,8 +1651,9 @@ static void slurp(const char *path, char *text, size_t cap)
  * event, a line on stderr even with -q); then a flood of 2000 forged scenes as fast as this
  * process publishes: still running, still one event (one in 5 s), the count grows (the
  * daemon's scene queue holds 16: what it drops is never seen); SIGTERM ends it, exit 0. */
-static void case_plant_conflict(void)
+static void case_plant_conflict(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     static client c;
     client_init(&c, g_prefix, 3);
@@ -1722,8 +1737,14 @@ static void case_plant_conflict(void)
  * lcm-logplayer plays that log onto the live bus (its old scene, states, statuses and
  * events, byte for byte): the live plant runs on, and counts and reports the conflict.
  * The live plant's messages are told from the played ones by their utime. */
-static void case_plant_conflict_logplayer(const char *logger)
+static void case_plant_conflict_logplayer(int arg)
 {
+    (void)arg;
+    const char *logger = lt_arg(1);
+    if (!logger) {
+        lt_skip("no LCM_LOGGER given");
+        return;
+    }
     write_scene(DIPC_MOVING);
     char log_path[256], chan[96];
     snprintf(log_path, sizeof log_path, "/tmp/lagsim_server_test_%d_%s.lcm", (int)getpid(), g_case);
@@ -1767,8 +1788,9 @@ static void case_plant_conflict_logplayer(const char *logger)
 
 /* An offline run stopped by SIGINT (or SIGTERM, SIGHUP) flushes the rows it computed,
  * whole, says where it stopped and exits 1. */
-static void case_offline_signal(void)
+static void case_offline_signal(int arg)
 {
+    (void)arg;
     write_scene(DIPC_MOVING);
     char csv[256];
     snprintf(csv, sizeof csv, "/tmp/lagsim_server_test_%d_%s.csv", (int)getpid(), g_case);
@@ -1800,14 +1822,10 @@ static void case_offline_signal(void)
     }
 }
 
-int main(int argc, char **argv)
+static void setup(void)
 {
-    if (argc < 3) {
-        fprintf(stderr, "usage: server_test LAGSIMD CASE [LCM_LOGGER]\n");
-        return 2;
-    }
-    snprintf(g_lagsimd, sizeof g_lagsimd, "%s", argv[1]);
-    g_case = argv[2];
+    snprintf(g_lagsimd, sizeof g_lagsimd, "%s", lt_arg(0));
+    g_case = lt_case_name;
     /* a prefix unique to this process and case: ctest -j never crosstalks */
     snprintf(g_prefix, sizeof g_prefix, "LT%d_%.20s", (int)getpid(), g_case);
     for (char *p = g_prefix; *p; p++)
@@ -1825,42 +1843,46 @@ int main(int argc, char **argv)
     snprintf(url, sizeof url, "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304",
              20000 + 2 * (int)(getpid() % 6000)); /* and the next port: the command URL */
     setenv("LCM_DEFAULT_URL", url, 1);
-    if (!strcmp(g_case, "control")) case_control();
-    else if (!strcmp(g_case, "hostile")) case_hostile();
-    else if (!strcmp(g_case, "watchdog")) case_watchdog();
-    else if (!strcmp(g_case, "lockstep_timeout")) case_lockstep_timeout();
-    else if (!strcmp(g_case, "two_daemons")) case_two_daemons();
-    else if (!strcmp(g_case, "fault")) case_fault();
-    else if (!strcmp(g_case, "replay")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "rk4");
-    else if (!strcmp(g_case, "replay_dopri5")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "dopri5");
-    else if (!strcmp(g_case, "replay_effects")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "rk4");
-    else if (!strcmp(g_case, "replay_flight")) case_replay(argc > 3 ? argv[3] : "lcm-logger", "rk4");
-    else if (!strcmp(g_case, "sigterm")) case_sigterm();
-    else if (!strcmp(g_case, "bad_scene")) case_bad_scene();
-    else if (!strcmp(g_case, "effects")) case_effects();
-    else if (!strcmp(g_case, "control_flood")) case_control_flood();
-    else if (!strcmp(g_case, "step_flood")) case_step_flood();
-    else if (!strcmp(g_case, "lockstep_huge")) case_lockstep_huge();
-    else if (!strcmp(g_case, "status_rate")) case_status_rate();
-    else if (!strcmp(g_case, "rate_huge")) case_rate_huge();
-    else if (!strcmp(g_case, "long_period")) case_long_period();
-    else if (!strcmp(g_case, "duration_huge")) case_duration_huge();
-    else if (!strcmp(g_case, "signals")) case_signals();
-    else if (!strcmp(g_case, "effort_absurd")) case_effort_absurd();
-    else if (!strcmp(g_case, "ttl_warning")) case_ttl_warning();
-    else if (!strcmp(g_case, "same_prefix")) case_same_prefix();
-    else if (!strcmp(g_case, "offline_signal")) case_offline_signal();
-    else if (!strcmp(g_case, "command_flood_ports")) case_command_flood_ports();
-    else if (!strcmp(g_case, "plant_conflict")) case_plant_conflict();
-    else if (!strcmp(g_case, "plant_conflict_logplayer"))
-        case_plant_conflict_logplayer(argc > 3 ? argv[3] : "lcm-logger");
-    else {
-        fprintf(stderr, "server_test: unknown case %s\n", g_case);
-        return 2;
-    }
-    kill_children();
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {
+        {"control", case_control, 0, 0},
+        {"hostile", case_hostile, 0, 0},
+        {"watchdog", case_watchdog, 0, 0},
+        {"lockstep_timeout", case_lockstep_timeout, 0, 0},
+        {"two_daemons", case_two_daemons, 0, 0},
+        {"fault", case_fault, 0, 0},
+        {"replay", case_replay, REPLAY_RK4, 0},
+        {"replay_dopri5", case_replay, REPLAY_DOPRI5, 0},
+        {"replay_effects", case_replay, REPLAY_EFFECTS, 0},
+        {"replay_flight", case_replay, REPLAY_FLIGHT, 0},
+        {"sigterm", case_sigterm, 0, 0},
+        {"bad_scene", case_bad_scene, 0, 0},
+        {"effects", case_effects, 0, 0},
+        {"control_flood", case_control_flood, 0, 0},
+        {"step_flood", case_step_flood, 0, 0},
+        {"lockstep_huge", case_lockstep_huge, 0, 0},
+        {"status_rate", case_status_rate, 0, 0},
+        {"rate_huge", case_rate_huge, 0, 0},
+        {"long_period", case_long_period, 0, 0},
+        {"duration_huge", case_duration_huge, 0, 0},
+        {"signals", case_signals, 0, 0},
+        {"effort_absurd", case_effort_absurd, 0, 0},
+        {"ttl_warning", case_ttl_warning, 0, 0},
+        {"same_prefix", case_same_prefix, 0, 0},
+        {"offline_signal", case_offline_signal, 0, 0},
+        {"command_flood_ports", case_command_flood_ports, 0, 0},
+        {"plant_conflict", case_plant_conflict, 0, 0},
+        {"plant_conflict_logplayer", case_plant_conflict_logplayer, 0, 0},
+    };
+    /* the first failed check kills the daemons and ends the case */
+    const lt_program p = {.cases = cases, .n = (int)(sizeof cases / sizeof cases[0]),
+                          .args = "LAGSIMD [LCM_LOGGER]", .min_args = 1, .max_args = 2,
+                          .setup = setup, .teardown = kill_children, .stop_on_failure = true};
+    int rc = lt_run(argc, argv, &p);
     client_free_all();
-    remove(g_scene_path);
-    printf("server_test %s: ok\n", g_case);
-    return 0;
+    if (g_scene_path[0]) remove(g_scene_path);
+    return rc;
 }

@@ -13,7 +13,7 @@
  *                           long_period chunks
  *                           step_paced control_flood command_flood duration signals
  *                           fault_effort lockstep_retry lockstep_loss other_plant
- *                           reject_names waits
+ *                           reject_names waits (--list)
  */
 #include <math.h>
 #include <signal.h>
@@ -25,6 +25,7 @@
 #include <unistd.h>
 #include <lcm/eventlog.h>
 
+#include "lagsim_test.h"
 #include "rt_server.h"
 #include "lagsim/lagsim_control_t.h"
 #include "lagsim/lagsim_event_t.h"
@@ -32,22 +33,6 @@
 #include "lagsim/lagsim_joint_state_t.h"
 #include "lagsim/lagsim_scene_t.h"
 #include "lagsim/lagsim_status_t.h"
-
-static const char *g_case = "?";
-static int g_checks;
-#define ENSURE(c) do { g_checks++; if (!(c)) fail(__LINE__, "%s", #c); } while (0)
-#define ENSUREF(c, ...) do { g_checks++; if (!(c)) fail(__LINE__, __VA_ARGS__); } while (0)
-static void fail(int line, const char *fmt, ...) __attribute__((format(printf, 2, 3), noreturn));
-static void fail(int line, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "test_loop %s: FAIL line %d: ", g_case, line);
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, "\n");
-    va_end(ap);
-    exit(1);
-}
 
 /* states a second of republication may publish: the state bucket's rate and burst
  * (realtime.c: RT_STATE_PER_S 20, RT_STATE_BURST 5) */
@@ -123,7 +108,7 @@ static void ctl_state(const lag_wire_joint_state *m)
             x[LAG_MAX_DOF + i] = m->velocity[i];
         }
         if (g_ctl.have[k] && memcmp(g_ctl.x[k], x, sizeof x) != 0)
-            fail(__LINE__, "step %lld received twice with different values", (long long)m->step);
+            LT_FAIL("step %lld received twice with different values", (long long)m->step);
         if (!g_ctl.have[k]) g_ctl.steps++;
         g_ctl.have[k] = true;
         memcpy(g_ctl.x[k], x, sizeof x);
@@ -152,7 +137,7 @@ static int kind_index(const char *kind)
 {
     for (int i = 0; i < g_out.nkinds; i++)
         if (!strcmp(g_out.kind[i], kind)) return i;
-    if (g_out.nkinds == MAX_KINDS) fail(__LINE__, "too many event kinds");
+    if (g_out.nkinds == MAX_KINDS) LT_FAIL("too many event kinds");
     snprintf(g_out.kind[g_out.nkinds], 32, "%s", kind);
     return g_out.nkinds++;
 }
@@ -197,7 +182,7 @@ static void record(const lcm_recv_buf_t *rb, const char *ch, bool is_set)
         lcm_eventlog_event_t ev = {.eventnum = 0, .timestamp = g_rec_n, .channellen = (int32_t)strlen(ch),
                                    .datalen = (int32_t)rb->data_size, .channel = (char *)ch,
                                    .data = rb->data};
-        if (lcm_eventlog_write_event(g_rec[k], &ev) != 0) fail(__LINE__, "cannot write the log");
+        if (lcm_eventlog_write_event(g_rec[k], &ev) != 0) LT_FAIL("cannot write the log");
     }
     g_rec_n++;
 }
@@ -215,7 +200,7 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
     record(rb, ch, is_set);
     if (!strcmp(sfx, "STATE")) {
         lag_wire_joint_state m;
-        if (lag_wire_decode_joint_state(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) fail(__LINE__, "bad state");
+        if (lag_wire_decode_joint_state(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) LT_FAIL("bad state");
         g_out.state++;
         if (!isfinite(m.sim_time) || !finite_all(m.position, m.num_joints) ||
             !finite_all(m.velocity, m.num_joints) || !finite_all(m.effort, m.num_joints))
@@ -226,7 +211,7 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         if (g_ctl.on) ctl_state(&m);
     } else if (!strcmp(sfx, "STATUS")) {
         lag_wire_status m;
-        if (lag_wire_decode_status(rb->data, rb->data_size, &m) != LAG_WIRE_OK) fail(__LINE__, "bad status");
+        if (lag_wire_decode_status(rb->data, rb->data_size, &m) != LAG_WIRE_OK) LT_FAIL("bad status");
         g_out.status++;
         double d[] = {m.sim_time, m.wall_time, m.rtf, m.step_time_max_us, m.step_time_mean_us, m.energy};
         if (!finite_all(d, 6)) g_out.nonfinite = true;
@@ -245,7 +230,7 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         g_out.status_waiting_s = m.waiting_s;
     } else if (!strcmp(sfx, "EVENT")) {
         lag_wire_event m;
-        if (lag_wire_decode_event(rb->data, rb->data_size, &m) != LAG_WIRE_OK) fail(__LINE__, "bad event");
+        if (lag_wire_decode_event(rb->data, rb->data_size, &m) != LAG_WIRE_OK) LT_FAIL("bad event");
         g_out.event++;
         if (!isfinite(m.sim_time) || !isfinite(m.value)) g_out.nonfinite = true;
         int k = kind_index(m.kind);
@@ -262,7 +247,7 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         lag_wire_scene m;
         if (lag_wire_decode_scene(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) {
             if (g_junk_scenes) return; /* other_plant sends some */
-            fail(__LINE__, "bad scene");
+            LT_FAIL("bad scene");
         }
         if (strcmp(m.prefix, "TL") != 0) return; /* another prefix's (other_plant) */
         g_out.scene++;
@@ -340,7 +325,7 @@ static void run_until(int64_t until, int64_t cost)
         rt_process(s);
         drain();
         g_wakeups++;
-        if (g_wakeups > 50000000) fail(__LINE__, "the loop does not get anywhere");
+        if (g_wakeups > 50000000) LT_FAIL("the loop does not get anywhere");
     }
 }
 
@@ -367,8 +352,9 @@ static void command(double sim_time, const char *joint, double effort)
 /* Realtime at 100 Hz: one state per 10 ms deadline exactly, no overrun, sim time = wall
  * time; a wake-up 25 ms late (deadline at T + 10 ms, woken at T + 35 ms) makes three
  * periods due, two of which started late. */
-static void case_pacing(void)
+static void case_pacing(int arg)
 {
+    (void)arg;
     scene(LAG_RT_REALTIME);
     start();
     const int64_t t0 = g_srv.now;
@@ -391,8 +377,9 @@ static void case_pacing(void)
 /* A rate so high that a period lasts nanoseconds (1e25: 1e-27 s; 1e6: 10 ns) runs as fast
  * as the loop goes (here: 0.4 ms per wake-up), and sim time advances; the clock re-bases
  * again and again, but overrun_burst events stay within their bucket (3, then 1/s). */
-static void case_rate_huge(void)
+static void case_rate_huge(int arg)
 {
+    (void)arg;
     const double rates[] = {1e25, 1e20, 1e6, 1e300};
     for (size_t i = 0; i < sizeof rates / sizeof rates[0]; i++) {
         scene(LAG_RT_REALTIME);
@@ -412,8 +399,9 @@ static void case_rate_huge(void)
 }
 
 /* status_hz 1e-300: no periodic status (the first one only); 1e9: at most 100 per second. */
-static void case_status_hz(void)
+static void case_status_hz(int arg)
 {
+    (void)arg;
     scene(LAG_RT_REALTIME);
     g_sc.realtime.status_hz = 1e-300;
     start();
@@ -434,8 +422,9 @@ static void case_status_hz(void)
  * no period, and the loop sleeps (a wake-up per status). lockstep_timeout 0: the first
  * wait times out at once, then the server waits without stepping (it never steps without
  * an answer), republishing the state within the state bucket, and does not spin. */
-static void case_lockstep_wait(void)
+static void case_lockstep_wait(int arg)
 {
+    (void)arg;
     const double waits[] = {1e10, 1e300, 9e9};
     for (size_t i = 0; i < sizeof waits / sizeof waits[0]; i++) {
         scene(LAG_RT_LOCKSTEP);
@@ -479,8 +468,9 @@ static void case_lockstep_wait(void)
  *  - first_command (lockstep): no lockstep_timeout however long the wait, the state
  *    republished every lockstep_timeout; the first answer starts the run;
  *  - running: the former behaviour (realtime: 100 periods in 1 s). */
-static void case_start(void)
+static void case_start(int arg)
 {
+    (void)arg;
     const lag_rt_mode modes[] = {LAG_RT_REALTIME, LAG_RT_FAST};
     for (int i = 0; i < 2; i++) {
         scene(modes[i]);
@@ -570,8 +560,9 @@ static void set_request(const char *key, const char *value)
  *    initial state;
  *  - an actuator lag the scene did not start with is refused, an actuator without one not;
  *  - a burst of 30 requests: 10 are validated, the rest refused (each is a scene parse). */
-static void case_set(void)
+static void case_set(int arg)
 {
+    (void)arg;
     static const char text[] =
         "model: manipulator\n"
         "parameters: {m1: 2.0, m2: 0.5, l1: 0.3, I1: 0.02, I2: 0.05, g: 9.81}\n"
@@ -725,8 +716,9 @@ static int replay(const lag_scene *sc, const char *path, double *diff)
  * bus recorded as lcm-logger records it replays with difference exactly 0 (the `set`
  * events say what changed and at which step); the same log without its `set` events does
  * not (so the changes mattered and the check can fail). With rk4 and dopri5. */
-static void case_set_replay(void)
+static void case_set_replay(int arg)
 {
+    (void)arg;
     static const char text[] =
         "model: manipulator\n"
         "parameters: {m1: 2.0, m2: 0.5, l1: 0.3, I1: 0.02, I2: 0.05, g: 9.81}\n"
@@ -810,8 +802,9 @@ static void case_set_replay(void)
     }
 }
 
-static void case_long_period(void)
+static void case_long_period(int arg)
 {
+    (void)arg;
     scene(LAG_RT_FAST);
     g_sc.publish_hz = 1e-9;
     g_sc.ticks_per_period = 1000000000000LL;
@@ -834,8 +827,9 @@ static void case_long_period(void)
  * to one call for the whole period, with every method: dopri5's chunks step across their
  * ends (dense output) and land on the period's end, as one call does (dopri5 twice: at the
  * scene's tolerances, and at rtol 1e-3, where it also rejects steps). */
-static void case_chunks(void)
+static void case_chunks(int arg)
 {
+    (void)arg;
     const lag_method methods[] = {LAG_RK4, LAG_DOPRI5, LAG_GAUSS4, LAG_DOPRI5};
     for (size_t i = 0; i < sizeof methods / sizeof methods[0]; i++) {
         scene(LAG_RT_FAST);
@@ -880,8 +874,9 @@ static void case_chunks(void)
 
 /* STEP 2^62 while paused runs at the mode's pace: realtime, one period per deadline (100
  * in a second, not tens of thousands); lockstep, one per answer or timeout. */
-static void case_step_paced(void)
+static void case_step_paced(int arg)
 {
+    (void)arg;
     scene(LAG_RT_REALTIME);
     start();
     run_until(g_srv.now + 100 * MS, 0);
@@ -913,8 +908,9 @@ static void case_step_paced(void)
  * STATUS, DESCRIBE, RESET, refused STEP), against at most a few hundred messages out. The
  * counters count everything; the next control_rejected event says how many were
  * suppressed. */
-static void case_control_flood(void)
+static void case_control_flood(int arg)
 {
+    (void)arg;
     scene(LAG_RT_REALTIME);
     start();
     run_until(g_srv.now + 100 * MS, 0);
@@ -961,8 +957,9 @@ static void case_control_flood(void)
 }
 
 /* A flood on _COMMAND: rejections counted, their events limited. */
-static void case_command_flood(void)
+static void case_command_flood(int arg)
 {
+    (void)arg;
     scene(LAG_RT_REALTIME);
     start();
     for (int k = 0; k < 10000; k++) {
@@ -977,8 +974,9 @@ static void case_command_flood(void)
 
 /* --duration: 1e300 s or 1e16 s is refused (more ticks than a run counts exactly);
  * 0.5 s stops after the period that reaches it. */
-static void case_duration(void)
+static void case_duration(int arg)
 {
+    (void)arg;
     scene(LAG_RT_FAST);
     g_opts.duration = 1e300;
     ENSURE(try_start(0) == LAGSIMD_EXIT_USAGE);
@@ -994,8 +992,9 @@ static void case_duration(void)
 
 /* Signals: SIGHUP, SIGQUIT, SIGINT and SIGTERM stop with a stop event naming the signal
  * and a final status; SIGUSR1 and SIGUSR2 ask for a status and stop nothing. */
-static void case_signals(void)
+static void case_signals(int arg)
 {
+    (void)arg;
     const int stops[] = {SIGHUP, SIGQUIT, SIGINT, SIGTERM};
     const char *names[] = {"SIGHUP", "SIGQUIT", "SIGINT", "SIGTERM"};
     for (int i = 0; i < 4; i++) {
@@ -1022,8 +1021,9 @@ static void case_signals(void)
  * counted, the state untouched. With the limit raised, it drives the state past
  * explode_limit: the fault event names the efforts that were held; nothing non-finite is
  * published. */
-static void case_fault_effort(void)
+static void case_fault_effort(int arg)
 {
+    (void)arg;
     scene(LAG_RT_REALTIME);
     start();
     run_until(g_srv.now + 50 * MS, 0);
@@ -1072,8 +1072,9 @@ static int64_t copies_within(int64_t span_ns, int64_t first, int64_t cap)
  * with no event, whether it comes before the period ran or after; an answer to an older
  * state is still a stale rejection. Any answer to the state waited on, even one rejected,
  * ends its copies: the controller has it. */
-static void case_lockstep_retry(void)
+static void case_lockstep_retry(int arg)
 {
+    (void)arg;
     scene(LAG_RT_LOCKSTEP);
     g_sc.realtime.start = LAG_RT_START_RUNNING;
     g_sc.realtime.lockstep_timeout = 1.0;
@@ -1140,13 +1141,14 @@ static void case_lockstep_retry(void)
 static void expect_detail(const char *kind, const char *want, int line)
 {
     drain();
-    if (!strstr(last_detail(kind), want))
-        fail(line, "%s detail '%s' lacks '%s'", kind, last_detail(kind), want);
+    ENSUREF(strstr(last_detail(kind), want), "(from line %d) %s detail '%s' lacks '%s'", line,
+            kind, last_detail(kind), want);
     printf("%s: %s\n", kind, last_detail(kind));
 }
 
-static void case_reject_names(void)
+static void case_reject_names(int arg)
 {
+    (void)arg;
     scene(LAG_RT_LOCKSTEP);
     g_sc.realtime.start = LAG_RT_START_RUNNING;
     g_sc.realtime.effort_limit[0] = 100;
@@ -1194,14 +1196,15 @@ static void status_now(void)
     run_until(g_srv.now + 60 * MS, 1000);
 }
 
-#define EXPECT_HAS(str, want)                                                           \
-    do {                                                                                \
-        if (!strstr((str), (want))) fail(__LINE__, "'%s' lacks '%s'", (str), (want));   \
-        else printf("ok: ... %s\n", (want));                                            \
-    } while (0)
-
-static void case_waits(void)
+static void expect_has(const char *str, const char *want, int line)
 {
+    ENSUREF(strstr(str, want), "(from line %d) '%s' lacks '%s'", line, str, want);
+    if (strstr(str, want)) printf("ok: ... %s\n", want);
+}
+
+static void case_waits(int arg)
+{
+    (void)arg;
     scene(LAG_RT_LOCKSTEP);
     g_sc.realtime.start = LAG_RT_START_FIRST_COMMAND;
     g_sc.realtime.lockstep_timeout = 10.0;
@@ -1213,8 +1216,8 @@ static void case_waits(void)
     ENSURE(strstr(g_srv.bus.urls.command_url, ":7668"));
     run_until(g_srv.now + 2 * SEC, 1000);
     status_now();
-    EXPECT_HAS(g_out.status_waiting_for, "the first command (sim_time 0) ");
-    EXPECT_HAS(g_out.status_waiting_for, on_cmd);
+    expect_has(g_out.status_waiting_for, "the first command (sim_time 0) ", __LINE__);
+    expect_has(g_out.status_waiting_for, on_cmd, __LINE__);
     ENSUREF(g_out.status_waiting_s >= 2.0 && g_out.status_waiting_s < 2.5, "waited %g s",
             g_out.status_waiting_s);
     ENSURE(!strcmp(g_out.status_waiting_got, ""));
@@ -1223,9 +1226,10 @@ static void case_waits(void)
     command(0.0, "theta1", 1.0);
     command(0.5, "theta0", 1.0);
     status_now();
-    EXPECT_HAS(g_out.status_waiting_got, "2 commands rejected (unknown joint 1, unactuated joint 1; "
-               "the last: unactuated joint: 'theta1' takes no input; actuated joints of dipc: theta0)");
-    EXPECT_HAS(g_out.status_waiting_got, "; 1 answer to another sim_time");
+    expect_has(g_out.status_waiting_got, "2 commands rejected (unknown joint 1, unactuated joint 1; "
+               "the last: unactuated joint: 'theta1' takes no input; actuated joints of dipc: theta0)",
+               __LINE__);
+    expect_has(g_out.status_waiting_got, "; 1 answer to another sim_time", __LINE__);
     /* the answer: the run goes; a lockstep round trip of less than 1 s is not a wait */
     command(0.0, "theta0", 1.0);
     run_until(g_srv.now + 500 * MS, 1000);
@@ -1235,16 +1239,16 @@ static void case_waits(void)
     /* unanswered for more than a second: a wait, of its own age, with nothing else come */
     run_until(g_srv.now + 1500 * MS, 1000);
     status_now();
-    EXPECT_HAS(g_out.status_waiting_for, "a command answering sim_time 0.01 ");
-    EXPECT_HAS(g_out.status_waiting_for, on_cmd);
+    expect_has(g_out.status_waiting_for, "a command answering sim_time 0.01 ", __LINE__);
+    expect_has(g_out.status_waiting_for, on_cmd, __LINE__);
     ENSURE(g_out.status_waiting_s >= 1.5 && g_out.status_waiting_s < 2.2);
     ENSURE(!strcmp(g_out.status_waiting_got, ""));
     /* paused */
     control(LAGSIM_CONTROL_T_PAUSE, 0);
     run_until(g_srv.now + 1 * SEC, 1000);
     status_now();
-    EXPECT_HAS(g_out.status_waiting_for, "RESUME or STEP ");
-    EXPECT_HAS(g_out.status_waiting_for, on_ctl);
+    expect_has(g_out.status_waiting_for, "RESUME or STEP ", __LINE__);
+    expect_has(g_out.status_waiting_for, on_ctl, __LINE__);
     ENSURE(g_out.status_waiting_s >= 1.0 && g_out.status_waiting_s < 1.2);
     /* a wait nobody answers: its lines thin out, at 3, 6, 12, 24, 48, 96 s of the wait,
      * then a minute apart */
@@ -1267,7 +1271,7 @@ static void case_waits(void)
     start();
     run_until(g_srv.now + 1 * SEC, 1000);
     status_now();
-    EXPECT_HAS(g_out.status_waiting_for, "the first command on TL_COMMAND at udpm://");
+    expect_has(g_out.status_waiting_for, "the first command on TL_COMMAND at udpm://", __LINE__);
     command(0.0, "theta0", 0.0);
     run_until(g_srv.now + 1 * SEC, 1000);
     status_now();
@@ -1299,8 +1303,9 @@ static int64_t lockstep_run(double loss, int periods)
 /* Lockstep under loss: with 10 % of the states and 10 % of the commands lost (and 30 %),
  * the controller receives every state of the run and the states are those of a lossless
  * run bit for bit; each loss costs a retry (20 ms), never a lockstep_timeout. */
-static void case_lockstep_loss(void)
+static void case_lockstep_loss(int arg)
 {
+    (void)arg;
     enum { N = 1000 };
     lockstep_run(0.0, N);
     ENSURE(g_srv.lockstep_retries == 0 && g_ctl.lost_states == 0 && g_ctl.steps == N + 1);
@@ -1322,7 +1327,7 @@ static void case_lockstep_loss(void)
         ENSURE(g_ctl.steps == N + 1);
         for (int k = 0; k <= N; k++)
             if (!g_ctl.have[k] || memcmp(g_ctl.x[k], ref.x[k], sizeof ref.x[k]) != 0)
-                fail(__LINE__, "loss %g: period %d differs from the lossless run", losses[i], k);
+                LT_FAIL("loss %g: period %d differs from the lossless run", losses[i], k);
         ENSURE(n_events("command_rejected") == 0 && n_events("lockstep_timeout") == 0);
         stop_server();
     }
@@ -1334,8 +1339,9 @@ static void case_lockstep_loss(void)
  * (the same with another utime: another daemon's, or a forgery) while running is a
  * conflict: counted, in status, said at most once in 5 s, and the plant runs on (a flood
  * of them too); at start it is what makes the daemon refuse to start. */
-static void case_other_plant(void)
+static void case_other_plant(int arg)
 {
+    (void)arg;
     scene(LAG_RT_REALTIME);
     g_sc.realtime.start = LAG_RT_START_RUNNING;
     start();
@@ -1417,8 +1423,9 @@ static void case_other_plant(void)
  * below it (effects=null, then effects.damping.* is applied, the damping on); every count
  * check names the expected count and the model (reset_to with 4 joints on the 3-joint
  * DIPC, a command of 4 joints, step 0). */
-static void case_messages(void)
+static void case_messages(int arg)
 {
+    (void)arg;
     static const char text[] =
         "model: dipc\n"
         "initial: {q: [0, 0.1, -0.05]}\n"
@@ -1486,8 +1493,9 @@ static void case_messages(void)
  * their bucket (3, then 1 a second) and name the joint and the size; status carries the
  * estimate, finite. The same run with the estimate off (estimate_every 0) has
  * bit-identical states and says nothing of it. */
-static void case_live_error(void)
+static void case_live_error(int arg)
 {
+    (void)arg;
     static const char text[] =
         "model: dipc\n"
         "initial: {q: [0, 0.8, -0.6]}\n"
@@ -1538,40 +1546,33 @@ static void case_live_error(void)
     }
 }
 
-int main(int argc, char **argv)
+static void setup(void)
 {
-    static const struct {
-        const char *name;
-        void (*fn)(void);
-    } cases[] = {
-        {"pacing", case_pacing},           {"rate_huge", case_rate_huge},
-        {"status_hz", case_status_hz},     {"lockstep_wait", case_lockstep_wait},
-        {"start", case_start},             {"set", case_set},
-        {"set_replay", case_set_replay},
-        {"long_period", case_long_period}, {"chunks", case_chunks},
-        {"step_paced", case_step_paced},   {"control_flood", case_control_flood},
-        {"command_flood", case_command_flood}, {"duration", case_duration},
-        {"signals", case_signals},         {"fault_effort", case_fault_effort},
-        {"lockstep_retry", case_lockstep_retry}, {"lockstep_loss", case_lockstep_loss},
-        {"other_plant", case_other_plant}, {"messages", case_messages},
-        {"reject_names", case_reject_names}, {"waits", case_waits},
-        {"live_error", case_live_error},
-    };
-    if (argc != 2) {
-        fprintf(stderr, "usage: test_loop CASE\n");
-        return 2;
-    }
-    g_case = argv[1];
     g_lcm = lcm_create("memq://");
     ENSURE(g_lcm);
     lcm_subscribe(g_lcm, "TL_.*", on_any, NULL);
-    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
-        if (!strcmp(cases[i].name, argv[1])) {
-            cases[i].fn();
-            lcm_destroy(g_lcm);
-            printf("test_loop %s: ok (%d checks)\n", g_case, g_checks);
-            return 0;
-        }
-    fprintf(stderr, "test_loop: unknown case %s\n", argv[1]);
-    return 2;
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {
+        {"pacing", case_pacing, 0, 0},           {"rate_huge", case_rate_huge, 0, 0},
+        {"status_hz", case_status_hz, 0, 0},     {"lockstep_wait", case_lockstep_wait, 0, 0},
+        {"start", case_start, 0, 0},             {"set", case_set, 0, 0},
+        {"set_replay", case_set_replay, 0, 0},
+        {"long_period", case_long_period, 0, 0}, {"chunks", case_chunks, 0, 0},
+        {"step_paced", case_step_paced, 0, 0},   {"control_flood", case_control_flood, 0, 0},
+        {"command_flood", case_command_flood, 0, 0}, {"duration", case_duration, 0, 0},
+        {"signals", case_signals, 0, 0},         {"fault_effort", case_fault_effort, 0, 0},
+        {"lockstep_retry", case_lockstep_retry, 0, 0}, {"lockstep_loss", case_lockstep_loss, 0, 0},
+        {"other_plant", case_other_plant, 0, 0}, {"messages", case_messages, 0, 0},
+        {"reject_names", case_reject_names, 0, 0}, {"waits", case_waits, 0, 0},
+        {"live_error", case_live_error, 0, 0},
+    };
+    /* a failed check ends the case: what follows it needs what failed */
+    const lt_program p = {.cases = cases, .n = (int)(sizeof cases / sizeof cases[0]),
+                          .setup = setup, .stop_on_failure = true};
+    int rc = lt_run(argc, argv, &p);
+    if (g_lcm) lcm_destroy(g_lcm);
+    return rc;
 }

@@ -4,29 +4,22 @@
  * (deadline k = base + k * period; every due period but the last started late; a token
  * bucket of `burst` tokens refilled at one per interval).
  *
- *   test_pace CASE     CASE: convert ticks pace burst rebase skip limit
+ *   test_pace CASE     CASE: convert ticks pace burst rebase skip limit (--list)
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "lagsim_test.h"
 #include "rt_pace.h"
-
-static const char *g_case = "?";
-static int g_checks;
-#define ENSURE(c) do { g_checks++; if (!(c)) fail(__LINE__, #c); } while (0)
-static void fail(int line, const char *what)
-{
-    fprintf(stderr, "test_pace %s: FAIL line %d: %s\n", g_case, line, what);
-    exit(1);
-}
 
 #define MS 1000000LL
 
 /* Doubles to int64 nanoseconds and ticks: saturating at both ends, NaN to 0. */
-static void case_convert(void)
+static void case_convert(int arg)
 {
+    (void)arg;
     ENSURE(rt_sat_i64(1e300) == INT64_MAX && rt_sat_i64(-1e300) == INT64_MIN);
     ENSURE(rt_sat_i64(INFINITY) == INT64_MAX && rt_sat_i64(-INFINITY) == INT64_MIN);
     ENSURE(rt_sat_i64(NAN) == 0);
@@ -62,8 +55,9 @@ static void case_convert(void)
 }
 
 /* --duration to ticks: the count must fit 2^53 (sim time = tick * dt exact). */
-static void case_ticks(void)
+static void case_ticks(int arg)
 {
+    (void)arg;
     int64_t t = -7;
     ENSURE(rt_ticks_for(2.0, 1e-3, &t) && t == 2000);
     ENSURE(rt_ticks_for(0.3, 1e-3, &t) && t == 300); /* 0.3/1e-3 = 299.99999999999994 */
@@ -81,8 +75,9 @@ static void case_ticks(void)
 }
 
 /* Deadlines on time: one period each, no overruns, no drift over a million periods. */
-static void case_pace(void)
+static void case_pace(int arg)
 {
+    (void)arg;
     rt_pace p;
     const int64_t t0 = 123456789, P = 10 * MS;
     rt_pace_start(&p, P, t0);
@@ -93,14 +88,15 @@ static void case_pace(void)
     ENSURE(d.due == 1 && d.run == 1 && d.overruns == 0 && !d.rebase);
     /* a clock before the base: nothing due */
     ENSURE(rt_pace_due(&p, t0 - 5 * P).due == 0);
-    for (int64_t k = 1; k <= 1000000; k++) {
+    bool on_time = true; /* one check for the million periods */
+    for (int64_t k = 1; k <= 1000000 && on_time; k++) {
         int64_t now = t0 + k * P + 37; /* woken 37 ns late each time */
         d = rt_pace_due(&p, now);
-        if (d.due != 1 || d.run != 1 || d.overruns != 0) fail(__LINE__, "one period due, on time");
+        on_time = d.due == 1 && d.run == 1 && d.overruns == 0;
         rt_pace_apply(&p, &d, now);
         rt_pace_ran(&p);
     }
-    g_checks++;
+    ENSUREF(on_time, "one period due, on time");
     ENSURE(rt_pace_next(&p) == t0 + 1000001 * P); /* exactly: no accumulated error */
 
     /* one wake-up 35 ms late with 10 ms periods: periods 2 and 3 due (2 started late) */
@@ -121,8 +117,9 @@ static void case_pace(void)
 
 /* A wake-up 155 ms late: 15 due, 14 of them late; bursts of 10 then 5; each overrun
  * counted once although the second look sees the same late periods. */
-static void case_burst(void)
+static void case_burst(int arg)
 {
+    (void)arg;
     rt_pace p;
     const int64_t t0 = 1000, P = 10 * MS, now = t0 + 155 * MS;
     rt_pace_start(&p, P, t0);
@@ -144,8 +141,9 @@ static void case_burst(void)
 
 /* Too far behind (more than 100 periods, or more than 0.2 s): give up catching up, run
  * one period now and the next one period later. */
-static void case_rebase(void)
+static void case_rebase(int arg)
 {
+    (void)arg;
     rt_pace p;
     const int64_t P = 1 * MS;
     rt_pace_start(&p, P, 0);
@@ -177,8 +175,9 @@ static void case_rebase(void)
 }
 
 /* Paused: every deadline slept through is skipped, the next one is in the future. */
-static void case_skip(void)
+static void case_skip(int arg)
 {
+    (void)arg;
     rt_pace p;
     const int64_t P = 10 * MS;
     rt_pace_start(&p, P, 0);
@@ -194,8 +193,9 @@ static void case_skip(void)
 
 /* Token buckets: a burst, then the rate; suppressed answers counted; a flood over 10 s
  * gets at most burst + 10 s * rate answers. */
-static void case_limit(void)
+static void case_limit(int arg)
 {
+    (void)arg;
     rt_limit l;
     const int64_t t0 = 5 * MS;
     rt_limit_init(&l, 10.0, 10, t0);
@@ -229,23 +229,13 @@ static void case_limit(void)
 
 int main(int argc, char **argv)
 {
-    static const struct {
-        const char *name;
-        void (*fn)(void);
-    } cases[] = {{"convert", case_convert}, {"ticks", case_ticks}, {"pace", case_pace},
-                 {"burst", case_burst},     {"rebase", case_rebase}, {"skip", case_skip},
-                 {"limit", case_limit}};
-    if (argc != 2) {
-        fprintf(stderr, "usage: test_pace CASE\n");
-        return 2;
-    }
-    g_case = argv[1];
-    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
-        if (!strcmp(cases[i].name, argv[1])) {
-            cases[i].fn();
-            printf("test_pace %s: ok (%d checks)\n", g_case, g_checks);
-            return 0;
-        }
-    fprintf(stderr, "test_pace: unknown case %s\n", argv[1]);
-    return 2;
+    static const lt_case cases[] = {
+        {"convert", case_convert, 0, 0}, {"ticks", case_ticks, 0, 0},
+        {"pace", case_pace, 0, 0},       {"burst", case_burst, 0, 0},
+        {"rebase", case_rebase, 0, 0},   {"skip", case_skip, 0, 0},
+        {"limit", case_limit, 0, 0},
+    };
+    const lt_program p = {.cases = cases, .n = (int)(sizeof cases / sizeof cases[0]),
+                          .stop_on_failure = true};
+    return lt_run(argc, argv, &p);
 }

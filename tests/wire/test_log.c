@@ -26,19 +26,7 @@
 #include <lcm/eventlog.h>
 
 #include "lagsim_log.h"
-
-static int failures = 0, checks = 0;
-#define ENSURE(cond) ENSUREF(cond, "%s", "")
-#define ENSUREF(cond, ...)                                                              \
-    do {                                                                                \
-        checks++;                                                                       \
-        if (!(cond)) {                                                                  \
-            fprintf(stderr, "%s:%d: ENSURE(%s) failed: ", __FILE__, __LINE__, #cond);   \
-            fprintf(stderr, __VA_ARGS__);                                               \
-            fputc('\n', stderr);                                                        \
-            failures++;                                                                 \
-        }                                                                               \
-    } while (0)
+#include "lagsim_test.h"
 
 #define NREC 40
 typedef struct ref {
@@ -313,8 +301,9 @@ static void check_open(void)
            strstr(err, "cannot open"));
 }
 
-int main(void)
+static void case_reader(int arg)
 {
+    (void)arg;
     snprintf(path, sizeof path, "/tmp/lagsim_test_log_%d.lcm", (int)getpid());
     for (int k = 0; k < NREC; k++) all[k] = k;
     write_reference();
@@ -324,10 +313,10 @@ int main(void)
     check_open();
     remove(path);
     free(image);
-    if (failures) {
-        fprintf(stderr, "test_log: %d of %d checks failed\n", failures, checks);
-        return 1;
-    }
-    printf("test_log: %d checks passed\n", checks);
-    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {{"reader", case_reader, 0, 0}};
+    return lt_main(argc, argv, cases, 1);
 }

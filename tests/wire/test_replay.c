@@ -8,7 +8,7 @@
  * exact answer of a replay is known: difference 0 on every state one period after
  * another.
  *
- * usage: test_replay LAGSIMD SCENE.yaml CASE
+ * usage: test_replay CASE LAGSIMD SCENE.yaml                (the cases: test_replay --list)
  *        test_replay LAGSIMD SCENE.yaml write_logs DIR   (each case's log into DIR/CASE.lcm,
  *                                                          nothing run: fuzzing corpora)
  * Cases:
@@ -47,6 +47,7 @@
 
 #include "lagsim/lagsim.h"
 #include "lagsim/lagsim_joint_state_t.h"
+#include "lagsim_test.h"
 #include "scene.h"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -59,18 +60,6 @@
 #ifndef SANITIZED
 #define SANITIZED 0
 #endif
-
-static int failures = 0;
-#define ENSURE(cond) ENSUREF(cond, "%s", "")
-#define ENSUREF(cond, ...)                                                              \
-    do {                                                                                \
-        if (!(cond)) {                                                                  \
-            fprintf(stderr, "%s:%d: ENSURE(%s) failed: ", __FILE__, __LINE__, #cond);   \
-            fprintf(stderr, __VA_ARGS__);                                               \
-            fputc('\n', stderr);                                                        \
-            failures++;                                                                 \
-        }                                                                               \
-    } while (0)
 
 static const char *g_lagsimd, *g_scene;
 static const char *g_write_dir; /* write_logs: keep the logs, run nothing */
@@ -233,8 +222,9 @@ static void ensure_checked(const result *r, long long n)
 }
 
 /* ---------------------------------------------------------------- cases */
-static void case_valid(void)
+static void case_valid(int arg)
 {
+    (void)arg;
     FILE *f = log_create();
     run(f, 100, NULL);
     fclose(f);
@@ -244,8 +234,9 @@ static void case_valid(void)
     ENSURE(strstr(r.out, "0 gaps, 0 undecodable, 0 integrator errors") != NULL);
 }
 
-static void case_nothing_to_check(void)
+static void case_nothing_to_check(int arg)
 {
+    (void)arg;
     FILE *f = log_create();
     run(f, 0, NULL);
     fclose(f);
@@ -288,8 +279,9 @@ static void hook_negative_name(FILE *f, int k)
     if (k == 50) forged_state(f, 0xffffffffu, "theta0", 6); /* length -1 */
 }
 
-static void case_negative_name_length(void)
+static void case_negative_name_length(int arg)
 {
+    (void)arg;
     FILE *f = log_create();
     run(f, 100, hook_negative_name);
     fclose(f);
@@ -306,8 +298,9 @@ static void hook_name_fills(FILE *f, int k)
     if (k == 50) forged_state(f, 6, lag_model_info_get(g_sc.sim.model.kind)->joint_names[0], 6);
 }
 
-static void case_name_fills_buffer(void)
+static void case_name_fills_buffer(int arg)
 {
+    (void)arg;
     FILE *f = log_create();
     run(f, 100, hook_name_fills);
     fclose(f);
@@ -334,8 +327,9 @@ static void hook_huge(FILE *f, int k)
     if (k == 50) huge_header(f);
 }
 
-static void case_huge_data_length(void)
+static void case_huge_data_length(int arg)
 {
+    (void)arg;
     FILE *f = log_create();
     run(f, 100, hook_huge);
     huge_header(f); /* and one at the end: a record cut short */
@@ -354,8 +348,9 @@ static void hook_jump(FILE *f, int k)
     if (k == 40) state(f, INT64_C(1) << 52, z, z, z);
 }
 
-static void case_step_jump(void)
+static void case_step_jump(int arg)
 {
+    (void)arg;
     FILE *f = log_create();
     run(f, 60, hook_jump);
     fclose(f);
@@ -377,8 +372,9 @@ static void hook_min(FILE *f, int k)
     if (k == 21) state(f, INT64_MAX, z, z, z);
 }
 
-static void case_step_int64_min(void)
+static void case_step_int64_min(int arg)
 {
+    (void)arg;
     FILE *f = log_create();
     run(f, 40, hook_min);
     fclose(f);
@@ -388,8 +384,9 @@ static void case_step_int64_min(void)
     ENSURE(strstr(r.out, "2 states with a non-finite number or a step outside") != NULL);
 }
 
-static void case_dev_zero(void)
+static void case_dev_zero(int arg)
 {
+    (void)arg;
     result r;
     if (!replay("/dev/zero", 30, 0, &r)) return;
     ENSUREF(r.status == 1, "status %d", r.status);
@@ -397,8 +394,9 @@ static void case_dev_zero(void)
     ENSURE(strstr(r.out, "max difference") == NULL);
 }
 
-static void case_not_a_log(void)
+static void case_not_a_log(int arg)
 {
+    (void)arg;
     result r;
     if (!replay(g_scene, 30, 0, &r)) return;
     ENSUREF(r.status == 1, "status %d", r.status);
@@ -422,8 +420,9 @@ static void hook_flood(FILE *f, int k)
     for (int i = 0; i < 2000; i++) record(f, g_channel, b, (uint32_t)p);
 }
 
-static void case_undecodable_flood(void)
+static void case_undecodable_flood(int arg)
 {
+    (void)arg;
     FILE *f = log_create();
     run(f, 20, hook_flood);
     fclose(f);
@@ -443,8 +442,9 @@ static void hook_explode(FILE *f, int k)
     state(f, 21 * g_sc.ticks_per_period, z, z, big);
 }
 
-static void case_resim_failure(void)
+static void case_resim_failure(int arg)
 {
+    (void)arg;
     FILE *f = log_create();
     run(f, 21, hook_explode);
     fclose(f);
@@ -467,8 +467,9 @@ static void hook_garbage(FILE *f, int k)
     }
 }
 
-static void case_garbage_between(void)
+static void case_garbage_between(int arg)
 {
+    (void)arg;
     FILE *f = log_create();
     run(f, 100, hook_garbage);
     fclose(f);
@@ -478,62 +479,56 @@ static void case_garbage_between(void)
     ENSURE(strstr(r.out, "damaged in 2 place") != NULL);
 }
 
-int main(int argc, char **argv)
+static const lt_case cases[] = {
+    {"valid", case_valid, 0, 0},
+    {"nothing_to_check", case_nothing_to_check, 0, 0},
+    {"negative_name_length", case_negative_name_length, 0, 0},
+    {"name_fills_buffer", case_name_fills_buffer, 0, 0},
+    {"huge_data_length", case_huge_data_length, 0, 0},
+    {"step_jump", case_step_jump, 0, 0},
+    {"step_int64_min", case_step_int64_min, 0, 0},
+    {"dev_zero", case_dev_zero, 0, 0},
+    {"not_a_log", case_not_a_log, 0, 0},
+    {"undecodable_flood", case_undecodable_flood, 0, 0},
+    {"resim_failure", case_resim_failure, 0, 0},
+    {"garbage_between", case_garbage_between, 0, 0},
+};
+#define NCASES ((int)(sizeof cases / sizeof cases[0]))
+
+/* The scene every case's log is made from; exits 1 when it cannot be loaded. */
+static void load_scene(const char *lagsimd, const char *scene)
 {
-    if (argc != 4 && !(argc == 5 && !strcmp(argv[3], "write_logs"))) {
-        fprintf(stderr, "usage: test_replay LAGSIMD SCENE.yaml CASE | write_logs DIR\n");
-        return 2;
-    }
-    g_lagsimd = argv[1];
-    g_scene = argv[2];
-    const char *c = argv[3];
-    if (argc == 5 && !strcmp(c, "write_logs")) g_write_dir = argv[4];
+    g_lagsimd = lagsimd;
+    g_scene = scene;
     char err[512];
     if (lag_scene_load(g_scene, NULL, 0, &g_sc, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
-        return 1;
+        exit(1);
     }
     snprintf(g_channel, sizeof g_channel, "%s_STATE", g_sc.lcm.prefix);
-    snprintf(g_log, sizeof g_log, "/tmp/lagsim_test_replay_%d_%s.lcm", (int)getpid(), c);
-    static const struct {
-        const char *name;
-        void (*fn)(void);
-    } cases[] = {
-        {"valid", case_valid},
-        {"nothing_to_check", case_nothing_to_check},
-        {"negative_name_length", case_negative_name_length},
-        {"name_fills_buffer", case_name_fills_buffer},
-        {"huge_data_length", case_huge_data_length},
-        {"step_jump", case_step_jump},
-        {"step_int64_min", case_step_int64_min},
-        {"dev_zero", case_dev_zero},
-        {"not_a_log", case_not_a_log},
-        {"undecodable_flood", case_undecodable_flood},
-        {"resim_failure", case_resim_failure},
-        {"garbage_between", case_garbage_between},
-    };
-    bool found = false;
-    if (g_write_dir) {
-        for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+}
+
+static void setup(void)
+{
+    load_scene(lt_arg(0), lt_arg(1));
+    snprintf(g_log, sizeof g_log, "/tmp/lagsim_test_replay_%d_%s.lcm", (int)getpid(),
+             lt_case_name);
+}
+
+static void teardown(void) { remove(g_log); }
+
+int main(int argc, char **argv)
+{
+    if (argc == 5 && strcmp(argv[3], "write_logs") == 0) { /* each case's log, nothing run */
+        load_scene(argv[1], argv[2]);
+        g_write_dir = argv[4];
+        for (int i = 0; i < NCASES; i++) {
             snprintf(g_log, sizeof g_log, "%s/%s.lcm", g_write_dir, cases[i].name);
-            cases[i].fn();
+            cases[i].fn(cases[i].arg);
         }
         return 0;
     }
-    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
-        if (!strcmp(c, cases[i].name)) {
-            cases[i].fn();
-            found = true;
-        }
-    remove(g_log);
-    if (!found) {
-        fprintf(stderr, "test_replay: unknown case '%s'\n", c);
-        return 2;
-    }
-    if (failures) {
-        fprintf(stderr, "test_replay %s: %d failure(s)\n", c, failures);
-        return 1;
-    }
-    printf("test_replay %s: passed\n", c);
-    return 0;
+    const lt_program p = {.cases = cases, .n = NCASES, .args = "LAGSIMD SCENE.yaml",
+                          .min_args = 2, .max_args = 2, .setup = setup, .teardown = teardown};
+    return lt_run(argc, argv, &p);
 }

@@ -17,7 +17,7 @@
  *              without a byte written past it, counts above the capacity and strings
  *              without their NUL refused.
  *
- * usage: test_wire LCMTYPES_DIR
+ * usage: test_wire messages LCMTYPES_DIR   (tests/common/lagsim_test.h)
  */
 #include <ctype.h>
 #include <math.h>
@@ -32,21 +32,9 @@
 #include "lagsim/lagsim_reference_t.h"
 #include "lagsim/lagsim_scene_t.h"
 #include "lagsim/lagsim_status_t.h"
+#include "lagsim_test.h"
 #include "lagsim_wire.h"
 #include "lcm_fields.h"
-
-static int failures = 0, checks = 0;
-#define ENSURE(cond) ENSUREF(cond, "%s", "")
-#define ENSUREF(cond, ...)                                                              \
-    do {                                                                                \
-        checks++;                                                                       \
-        if (!(cond)) {                                                                  \
-            fprintf(stderr, "%s:%d: ENSURE(%s) failed: ", __FILE__, __LINE__, #cond);   \
-            fprintf(stderr, __VA_ARGS__);                                               \
-            fputc('\n', stderr);                                                        \
-            failures++;                                                                 \
-        }                                                                               \
-    } while (0)
 
 static void check_tables(const char *lcmdir)
 {
@@ -536,20 +524,19 @@ static void check_encoder(void)
         ENSURE(strcmp(lag_wire_result_string(r), "unknown result") != 0);
 }
 
-int main(int argc, char **argv)
+static void case_messages(int arg)
 {
-    if (argc != 2) {
-        fprintf(stderr, "usage: test_wire LCMTYPES_DIR\n");
-        return 2;
-    }
-    check_tables(argv[1]);
+    (void)arg;
+    check_tables(lt_arg(0));
     check_agreement();
     check_hostile();
     check_encoder();
-    if (failures) {
-        fprintf(stderr, "test_wire: %d of %d checks failed\n", failures, checks);
-        return 1;
-    }
-    printf("test_wire: %d checks passed\n", checks);
-    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    static const lt_case cases[] = {{"messages", case_messages, 0, 0}};
+    const lt_program p = {.cases = cases, .n = 1, .args = "LCMTYPES_DIR", .min_args = 1,
+                          .max_args = 1};
+    return lt_run(argc, argv, &p);
 }

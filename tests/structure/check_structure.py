@@ -1,0 +1,266 @@
+#!/usr/bin/env python3
+"""The project's structure rules, each a ctest of its own (label structure):
+
+  check_structure.py harness SOURCE_DIR
+      Every C test program uses the one harness (tests/common/lagsim_test.h): no file under
+      tests/ but tests/common/ defines a check macro (ENSURE*, CHECK*, EXPECT*, ASSERT*,
+      REQUIRE*, LT_*) or a file-scope check/failure counter; every test program
+      (tests/**/test_*.c, tests/**/*_test.c) runs its cases through lt_main or lt_run, and
+      none dispatches them through a strcmp chain.
+  check_structure.py names BUILD_DIR [--ctest CTEST | --json FILE]
+      Every ctest's name is lowercase words joined by "_" (a word may hold a "-": a model's
+      name such as flying-stick, a number such as -1 or 1e-04; never a "." or a capital),
+      and every ctest has a label.
+  check_structure.py docs SOURCE_DIR BUILD_DIR [--ctest CTEST | --json FILE]
+      Every test name the docs (README.md, docs/**/*.md) give in backquotes is a ctest
+      (`a_{b,c}` is two names, `a_*` must match one, `_b` after `a_x` is a_b, `a` alone the
+      family of the ctests a_*; a dotted word is a key, not a name), and the label
+      table of docs/testing.md has exactly the labels the ctests carry.
+  check_structure.py function_length SOURCE_DIR [--max 80]
+      No C function in server/, clients/, bench/ is longer than 80 lines (universal-ctags:
+      from the line of its name to the line of its closing brace).
+
+Each prints what breaks the rule, one line each, and exits 1 then; 0 when nothing does.
+"""
+import argparse
+import fnmatch
+import json
+import os
+import re
+import subprocess
+import sys
+
+# ---------------------------------------------------------------- harness
+
+MACRO = re.compile(r'^\s*#\s*define\s+((?:ENSURE|CHECK|EXPECT|ASSERT|REQUIRE|LT_)\w*)', re.M)
+COUNTER = re.compile(r'^static\s+(?:volatile\s+)?(?:unsigned\s+)?(?:int|long|size_t|int64_t)\s+'
+                     r'[^;(]*\b(?:g_)?(?:n_?)?(?:checks|failures|fails|failed|errors)\b[^;(]*;', re.M)
+# a case chosen by comparing a name: `if (!strcmp(g_case, "file")) case_file();`
+CHAIN = re.compile(r'\bstrcmp\s*\([^;{}()]*(?:\([^;{}()]*\)[^;{}()]*)*\)\s*(?:==\s*0\s*)?\)\s*'
+                   r'\{?\s*(?:case|test|check|run)_\w+\s*\(')
+
+
+def c_files(root, sub):
+    for dirpath, _, names in os.walk(os.path.join(root, sub)):
+        for n in sorted(names):
+            if n.endswith(('.c', '.h')):
+                yield os.path.join(dirpath, n)
+
+
+def check_harness(src):
+    bad = []
+    common = os.path.join(src, 'tests', 'common') + os.sep
+    for path in c_files(src, 'tests'):
+        rel = os.path.relpath(path, src)
+        if path.startswith(common):
+            continue
+        text = open(path, encoding='utf-8', errors='replace').read()
+        for m in MACRO.finditer(text):
+            line = text.count('\n', 0, m.start()) + 1
+            bad.append(f'{rel}:{line}: defines {m.group(1)}: use tests/common/lagsim_test.h')
+        for m in COUNTER.finditer(text):
+            line = text.count('\n', 0, m.start()) + 1
+            bad.append(f'{rel}:{line}: a counter of its own ({m.group(0).strip()}): '
+                       'the harness counts checks')
+        base = os.path.basename(path)
+        if base.endswith('.c') and (base.startswith('test_') or base.endswith('_test.c')):
+            if not re.search(r'\blt_(main|run)\s*\(', text):
+                bad.append(f'{rel}: a test program that does not run its cases through '
+                           'lt_main or lt_run')
+            for m in CHAIN.finditer(text):
+                line = text.count('\n', 0, m.start()) + 1
+                bad.append(f'{rel}:{line}: dispatches through a strcmp chain: list the cases '
+                           'in an lt_case table')
+    return bad
+
+# ---------------------------------------------------------------- names
+
+
+NAME = re.compile(r'^[a-z][a-z0-9]*(_-?[a-z0-9]+(-[a-z0-9]+)*)+$')
+
+
+def load_tests(build, ctest, json_file):
+    if json_file:
+        text = open(json_file).read()
+    else:
+        text = subprocess.run([ctest, '--show-only=json-v1'], cwd=build, check=True,
+                              capture_output=True, text=True).stdout
+    tests = []
+    for t in json.loads(text)['tests']:
+        labels = []
+        for p in t.get('properties', []):
+            if p['name'] == 'LABELS':
+                labels = p['value']
+        tests.append((t['name'], labels))
+    return tests
+
+
+def check_names(tests):
+    bad = []
+    for name, labels in tests:
+        if not NAME.match(name):
+            bad.append(f'{name}: not lowercase words joined by "_" (no ".", no capital, '
+                       'no empty word)')
+        if not labels:
+            bad.append(f'{name}: no label')
+    if not tests:
+        bad.append('no ctest at all')
+    return bad
+
+# ---------------------------------------------------------------- docs
+
+
+def expand_braces(tok):
+    m = re.search(r'\{([^{}]*)\}', tok)
+    if not m:
+        return [tok]
+    out = []
+    for alt in m.group(1).split(','):
+        out += expand_braces(tok[:m.start()] + alt + tok[m.end():])
+    return out
+
+
+def source_words(src):
+    """Every word of the sources (not the docs): a program, a function, an event kind that
+    looks like a test name is one of these and not a test reference."""
+    words = set()
+    for top in ('server', 'clients', 'bench', 'tests', 'lcmtypes', 'config', 'cmake'):
+        for dirpath, dirs, names in os.walk(os.path.join(src, top)):
+            dirs[:] = [d for d in dirs if d not in ('corpus', 'crash')]
+            for n in names:
+                if not n.endswith(('.c', '.h', '.py', '.lua', '.java', '.m', '.sh', '.lcm',
+                                   '.cmake', '.txt', '.yaml', '.html', '.js')):
+                    continue
+                try:
+                    text = open(os.path.join(dirpath, n), encoding='utf-8',
+                                errors='replace').read()
+                except OSError:
+                    continue
+                words.update(re.findall(r'[A-Za-z0-9_]+', text))
+    words.update(re.findall(r'[A-Za-z0-9_]+', open(os.path.join(src, 'CMakeLists.txt')).read()))
+    return words
+
+
+def doc_files(src):
+    yield os.path.join(src, 'README.md')
+    for dirpath, _, names in os.walk(os.path.join(src, 'docs')):
+        for n in sorted(names):
+            if n.endswith('.md'):
+                yield os.path.join(dirpath, n)
+
+
+def check_docs(src, tests):
+    bad = []
+    names = {n for n, _ in tests}
+    areas = {re.split(r'[_.]', n)[0] for n in names}
+    words = source_words(src)
+    token_re = re.compile(r'^[a-z][a-z0-9_.*{},-]*$')
+
+    def exists(pattern):
+        if '*' in pattern:
+            return any(fnmatch.fnmatchcase(n, pattern) for n in names)
+        return pattern in names
+
+    for path in doc_files(src):
+        rel = os.path.relpath(path, src)
+        for lineno, line in enumerate(open(path, encoding='utf-8'), 1):
+            prev = None  # the last full test name of this line, for `_suffix` continuations
+            for span in re.findall(r'`([^`\n]+)`', line):
+                for tok in re.split(r'[\s,;()]+(?![^{]*\})', span):
+                    tok = tok.strip('.:')
+                    if tok.startswith('_') and prev and re.match(r'^_[a-z0-9_-]+$', tok):
+                        parts = prev.split('_')
+                        if not any('_'.join(parts[:k]) + tok in names
+                                   for k in range(1, len(parts))):
+                            bad.append(f'{rel}:{lineno}: `{tok}` (after {prev}) names no ctest')
+                        continue
+                    if not token_re.match(tok) or re.search(r'\.(c|h|py|md|yaml|lcm|sh|cmake|'
+                                                            r'txt|csv|json|png|svg|java|lua|m|'
+                                                            r'html|js)$', tok):
+                        continue
+                    area = tok.split('_')[0]
+                    # a dotted word is a scene key or a path (structure_names keeps "." out
+                    # of test names)
+                    if area not in areas or '.' in tok or '_' not in tok:
+                        continue
+                    if tok in words:  # a program, a function, an event kind
+                        continue
+                    for name in expand_braces(tok):
+                        if exists(name) or exists(name + '_*'):  # a test or a family
+                            if '*' not in name:
+                                prev = name
+                        elif name not in words:
+                            bad.append(f'{rel}:{lineno}: `{name}` names no ctest')
+    # docs/testing.md's label table against the labels the ctests carry
+    labels = {l for _, ls in tests for l in ls}
+    table = set()
+    in_table = False
+    for line in open(os.path.join(src, 'docs', 'testing.md'), encoding='utf-8'):
+        if re.match(r'^\| label \|', line):
+            in_table = True
+            continue
+        if in_table:
+            if not line.startswith('|'):
+                break
+            m = re.match(r'^\| `([a-z_]+)` \|', line)
+            if m:
+                table.add(m.group(1))
+    for l in sorted(labels - table):
+        bad.append(f'docs/testing.md: the label {l} has no row in the label table')
+    for l in sorted(table - labels):
+        bad.append(f'docs/testing.md: the label table names {l}, which no ctest carries')
+    return bad
+
+# ---------------------------------------------------------------- functions
+
+
+def check_function_length(src, limit):
+    files = []
+    for top in ('server', 'clients', 'bench'):
+        files += [f for f in c_files(src, top)]
+    try:
+        out = subprocess.run(['ctags', '-x', '--c-kinds=f', '--_xformat=%N %F %n %e'] + files,
+                             check=True, capture_output=True, text=True).stdout
+    except (OSError, subprocess.CalledProcessError) as e:
+        return [f'universal-ctags did not run ({e}): install universal-ctags '
+                '(.ci/install-deps.sh)']
+    bad = []
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) != 4 or not parts[3].isdigit():
+            continue
+        name, path, start, end = parts[0], parts[1], int(parts[2]), int(parts[3])
+        n = end - start + 1
+        if n > limit:
+            bad.append((n, f'{os.path.relpath(path, src)}:{start}: {name} has {n} lines '
+                           f'(at most {limit})'))
+    return [b for _, b in sorted(bad, reverse=True)]
+
+# ---------------------------------------------------------------- main
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('rule', choices=['harness', 'names', 'docs', 'function_length'])
+    ap.add_argument('dirs', nargs='+', help='SOURCE_DIR and/or BUILD_DIR (see above)')
+    ap.add_argument('--ctest', default='ctest')
+    ap.add_argument('--json', help="ctest --show-only=json-v1's output, instead of running it")
+    ap.add_argument('--max', type=int, default=80)
+    a = ap.parse_args()
+    if a.rule == 'harness':
+        bad = check_harness(a.dirs[0])
+    elif a.rule == 'names':
+        bad = check_names(load_tests(a.dirs[0], a.ctest, a.json))
+    elif a.rule == 'docs':
+        bad = check_docs(a.dirs[0], load_tests(a.dirs[1], a.ctest, a.json))
+    else:
+        bad = check_function_length(a.dirs[0], a.max)
+    for b in bad:
+        print(b)
+    print(f'{a.rule}: {len(bad)} breaking the rule')
+    return 1 if bad else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
