@@ -244,6 +244,7 @@ typedef struct lag_effect_row {
     const char *name;
     int max_watch_joint;  /* watchers it adds per free joint, at most */
     int max_watch_global; /* watchers of no joint it adds, at most */
+    bool keeps_state;     /* lag_effect_info.keeps_state: state of its own beyond (q, qd, tick) */
     lag_result (*validate)(const lag_sim_def *def, lag_diag *d);
     void (*force)(const lag_sim *s, const double *q, const double *qd, double *Q); /* adds */
     double (*potential)(const lag_sim *s, const double *q);

@@ -610,14 +610,14 @@ static double spring_potential(const lag_sim *s, const double *q)
 
 const lag_effect_row lag_effect_rows[] = {
     {.bit = LAG_EFF_DAMPING, .name = "damping", .validate = damping_validate, .force = damping_force},
-    {.bit = LAG_EFF_LIMITS, .name = "limits", .validate = limits_validate, .watch = limits_watch,
+    {.bit = LAG_EFF_LIMITS, .name = "limits", .keeps_state = true, .validate = limits_validate, .watch = limits_watch,
      .on_event = limits_event, .max_watch_joint = 2},
-    {.bit = LAG_EFF_FLOOR, .name = "floor", .validate = floor_validate, .watch = floor_watch,
+    {.bit = LAG_EFF_FLOOR, .name = "floor", .keeps_state = true, .validate = floor_validate, .watch = floor_watch,
      .value = floor_normal, .gap = floor_gap, .on_event = floor_event, .max_watch_joint = 2,
      .max_watch_global = 1},
-    {.bit = LAG_EFF_FRICTION, .name = "friction", .validate = friction_validate, .force = friction_force,
+    {.bit = LAG_EFF_FRICTION, .name = "friction", .keeps_state = true, .validate = friction_validate, .force = friction_force,
      .watch = friction_watch, .on_event = friction_event, .max_watch_joint = 1},
-    {.bit = LAG_EFF_ACTUATOR, .name = "actuator", .validate = actuator_validate,
+    {.bit = LAG_EFF_ACTUATOR, .name = "actuator", .keeps_state = true, .validate = actuator_validate,
      .pre_tick = actuator_pre_tick},
     {.bit = LAG_EFF_DISTURBANCE, .name = "disturbance", .validate = disturbance_validate,
      .pre_tick = disturbance_pre_tick, .force = disturbance_force},
@@ -641,6 +641,7 @@ lag_effect_info lag_effect_info_get(int index)
     inf.per_tick = r->pre_tick != NULL || r->watch != NULL;
     inf.events = r->watch != NULL;
     inf.observe = r->observe != NULL;
+    inf.keeps_state = r->keeps_state;
     return inf;
 }
 

@@ -263,6 +263,9 @@ typedef struct lag_effect_info {
     bool per_tick;   /* works at every tick boundary (the step stops at each) */
     bool events;     /* has events located in time within a tick */
     bool observe;    /* changes the published state only */
+    bool keeps_state; /* keeps state of its own from tick to tick that the published (q, qd)
+                         and the tick do not hold (contact modes; the actuator's lag): a
+                         restart from a logged state cannot rebuild it */
 } lag_effect_info;
 
 /* The table's row `index` of 0..LAG_EFF_COUNT-1 (a zeroed struct outside). */
