@@ -53,3 +53,14 @@ add_executable(test_scene_ranges ${scene_dir}/test_ranges.c)
 target_link_libraries(test_scene_ranges PRIVATE lagsim_scene)
 add_test(NAME scene_ranges COMMAND test_scene_ranges)
 set_tests_properties(scene_ranges PROPERTIES TIMEOUT 60 LABELS scene)
+
+# The core's effect table against its consumers: the loader's keys, the scene message,
+# what replay takes as stateless, the browser view, the docs' tables (tests/scene/test_tables.c).
+add_executable(test_scene_tables ${scene_dir}/test_tables.c)
+target_include_directories(test_scene_tables PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common)
+target_compile_definitions(test_scene_tables PRIVATE LAGSIM_SOURCE_DIR="${CMAKE_SOURCE_DIR}")
+target_link_libraries(test_scene_tables PRIVATE lagsimd_internal)
+foreach(case loader scene_message keeps_state view docs)
+  add_test(NAME scene_tables_${case} COMMAND test_scene_tables ${case})
+  set_tests_properties(scene_tables_${case} PROPERTIES TIMEOUT 60 LABELS scene)
+endforeach()

@@ -14,6 +14,7 @@
 
 static const range R_DAMPING = {0.0, F_MAX, false, "N s/m or N m s/rad"};
 static const range R_FRICTION = {0.0, F_MAX, false, "N or N m"};
+static const range R_STIFFNESS = {0.0, F_MAX, false, "N/m or N m/rad"};
 static const range R_TIME = {0.0, T_MAX, false, "s"};
 static const range R_GRAVITY = {0.0, 1e3, false, "m/s^2"}; /* 100 g; 0 switches gravity off */
 
@@ -365,6 +366,35 @@ static int key_effect_noise(conv *cv, const ynode *nd, const char *path)
     return sch_convert_map(cv, nd, path, k_noise_keys, "key");
 }
 
+/* spring: {joint: {k, rest}}: Q = -k (q - rest), N/m or N m/rad; rest in m or rad */
+static int spring_k(conv *cv, const ynode *nd, const char *path)
+{
+    return sch_get_range(cv, nd, path, &R_STIFFNESS, &fx(cv)->spring_k[cv->cur_joint]);
+}
+
+static int spring_rest(conv *cv, const ynode *nd, const char *path)
+{
+    return sch_get_within_explode(cv, nd, path, false, &fx(cv)->spring_rest[cv->cur_joint]);
+}
+
+static const keyrow k_spring_keys[] = {
+    {"k", spring_k, K_NUMBER},       /* stiffness, N/m or N m/rad */
+    {"rest", spring_rest, K_NUMBER}, /* m or rad, within explode_limit; default 0 */
+    {NULL, NULL, K_OTHER, NULL, NULL},
+};
+
+static int spring_joint(conv *cv, int j, const ynode *nd, const char *path)
+{
+    cv->cur_joint = j;
+    return sch_convert_map(cv, nd, path, k_spring_keys, "key");
+}
+
+static int key_effect_spring(conv *cv, const ynode *nd, const char *path)
+{
+    fx(cv)->enabled |= LAG_EFF_SPRING;
+    return sch_per_joint(cv, nd, path, spring_joint);
+}
+
 const keyrow k_effects[] = {
     {"gravity", key_effect_gravity, K_MAP, k_gravity_keys},
     {"damping", key_effect_damping, K_JOINTS},
@@ -374,6 +404,7 @@ const keyrow k_effects[] = {
     {"actuator", key_effect_actuator, K_JOINTS, k_actuator_keys},
     {"disturbance", key_effect_disturbance, K_LIST, k_dist_keys},
     {"noise", key_effect_noise, K_MAP, k_noise_keys},
+    {"spring", key_effect_spring, K_JOINTS, k_spring_keys},
     {NULL, NULL, K_OTHER, NULL, NULL},
 };
 
