@@ -64,3 +64,11 @@ foreach(case loader scene_message keeps_state view docs)
   add_test(NAME scene_tables_${case} COMMAND test_scene_tables ${case})
   set_tests_properties(scene_tables_${case} PROPERTIES TIMEOUT 60 LABELS scene)
 endforeach()
+
+# One rule, one place: a value the core refuses is refused with the core's message at the
+# key's file:line:column, for every numeric key and model (tests/scene/test_checks.c).
+add_executable(test_scene_checks ${scene_dir}/test_checks.c)
+target_include_directories(test_scene_checks PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common)
+target_link_libraries(test_scene_checks PRIVATE lagsim_scene)
+add_test(NAME scene_checks_core_messages COMMAND test_scene_checks core_messages)
+set_tests_properties(scene_checks_core_messages PROPERTIES TIMEOUT 60 LABELS scene)

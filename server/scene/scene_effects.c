@@ -58,7 +58,7 @@ static int key_effect_gravity(conv *cv, const ynode *nd, const char *path)
 /* damping: {joint: b}, N s/m or N m s/rad */
 static int damping_joint(conv *cv, int j, const ynode *nd, const char *path)
 {
-    return sch_get_range(cv, nd, path, &R_DAMPING, &fx(cv)->damping[j]);
+    return sch_get_magnitude(cv, nd, path, &R_DAMPING, &fx(cv)->damping[j]);
 }
 
 static int key_effect_damping(conv *cv, const ynode *nd, const char *path)
@@ -70,12 +70,12 @@ static int key_effect_damping(conv *cv, const ynode *nd, const char *path)
 /* friction: {joint: {static: mu_s, kinetic: mu_k}}, N or N m */
 static int fr_static(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_range(cv, nd, path, &R_FRICTION, &fx(cv)->friction_static[cv->cur_joint]);
+    return sch_get_magnitude(cv, nd, path, &R_FRICTION, &fx(cv)->friction_static[cv->cur_joint]);
 }
 
 static int fr_kinetic(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_range(cv, nd, path, &R_FRICTION, &fx(cv)->friction_kinetic[cv->cur_joint]);
+    return sch_get_magnitude(cv, nd, path, &R_FRICTION, &fx(cv)->friction_kinetic[cv->cur_joint]);
 }
 
 static const keyrow k_friction_keys[] = {
@@ -105,13 +105,13 @@ static int key_effect_friction(conv *cv, const ynode *nd, const char *path)
 static int lim_lower(conv *cv, const ynode *nd, const char *path)
 {
     cv->limit_seen |= 1;
-    return sch_get_within_explode(cv, nd, path, false, &fx(cv)->limit_lower[cv->cur_joint]);
+    return sch_get_within_explode(cv, nd, path, &fx(cv)->limit_lower[cv->cur_joint]);
 }
 
 static int lim_upper(conv *cv, const ynode *nd, const char *path)
 {
     cv->limit_seen |= 2;
-    return sch_get_within_explode(cv, nd, path, false, &fx(cv)->limit_upper[cv->cur_joint]);
+    return sch_get_within_explode(cv, nd, path, &fx(cv)->limit_upper[cv->cur_joint]);
 }
 
 /* in [0, 1]: the core's check */
@@ -130,7 +130,7 @@ static const keyrow k_limit_keys[] = {
 /* m/s or rad/s: an impact slower than this ends in resting contact */
 static int key_rest_velocity(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_within_explode(cv, nd, path, true, &fx(cv)->rest_velocity);
+    return sch_get_within_explode(cv, nd, path, &fx(cv)->rest_velocity);
 }
 
 /* the key of the limits section beside the joints */
@@ -200,13 +200,13 @@ static int key_effect_floor(conv *cv, const ynode *nd, const char *path)
 /* actuator: {joint: {max, lag}} on actuated joints */
 static int act_max(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_range(cv, nd, path, &R_EFFORT, &fx(cv)->actuator_max[cv->cur_joint]);
+    return sch_get_magnitude(cv, nd, path, &R_EFFORT, &fx(cv)->actuator_max[cv->cur_joint]);
 }
 
 /* The lag is advanced exactly (exp(-dt/lag)) and is stable for any value. */
 static int act_lag(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_range(cv, nd, path, &R_TIME, &fx(cv)->actuator_tau[cv->cur_joint]);
+    return sch_get_magnitude(cv, nd, path, &R_TIME, &fx(cv)->actuator_tau[cv->cur_joint]);
 }
 
 static const keyrow k_actuator_keys[] = {
@@ -232,7 +232,7 @@ static int key_effect_actuator(conv *cv, const ynode *nd, const char *path)
 /* disturbance: [{t, joint, impulse | force + duration}, ...] */
 static int dist_t(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_range(cv, nd, path, &R_TIME, &cv->cur_dist->t);
+    return sch_get_magnitude(cv, nd, path, &R_TIME, &cv->cur_dist->t);
 }
 
 static int dist_joint(conv *cv, const ynode *nd, const char *path)
@@ -271,9 +271,9 @@ static int dist_duration(conv *cv, const ynode *nd, const char *path)
     double dt = cv->sc->sim.integrator.dt;
     if (sch_get_number(cv, nd, path, &cv->cur_dist->duration) < 0)
         return -1;
-    double v = cv->cur_dist->duration;
-    if (!(v >= dt) || !(v <= T_MAX))
-        return yfail(cv->err, nd, path, "expected a number from %.6g (integrator.dt: a force "
+    double v = fabs(cv->cur_dist->duration); /* > 0: the core's check */
+    if (v != 0.0 && (!(v >= dt) || !(v <= T_MAX)))
+        return yfail(cv->err, nd, path, "expected a magnitude from %.6g (integrator.dt: a force "
                      "acts for whole ticks; a shorter push is an impulse) to %.6g (s), got %s",
                      dt, T_MAX, nd->text);
     return 0;
@@ -314,7 +314,7 @@ static int key_effect_disturbance(conv *cv, const ynode *nd, const char *path)
             return yfail(cv->err, it, sub, "expected both t and joint");
         if (cv->cur_dist_kind != 1 && cv->cur_dist_kind != 2)
             return yfail(cv->err, it, sub, "expected exactly one of impulse or force");
-        if (cv->cur_dist_kind == 2 && !(cv->cur_dist->duration > 0))
+        if (cv->cur_dist_kind == 2 && cv->cur_dist->duration == 0)
             return yfail(cv->err, it, sub, "a force needs a duration (s)");
         if (cv->cur_dist_kind == 1 && cv->cur_dist->duration != 0)
             return yfail(cv->err, it, sub, "an impulse takes no duration");
@@ -326,12 +326,12 @@ static int key_effect_disturbance(conv *cv, const ynode *nd, const char *path)
  * few explode_limits (the normal deviates are bounded by about 8.6). */
 static int noise_q_joint(conv *cv, int j, const ynode *nd, const char *path)
 {
-    return sch_get_within_explode(cv, nd, path, true, &fx(cv)->noise_q[j]);
+    return sch_get_within_explode(cv, nd, path, &fx(cv)->noise_q[j]);
 }
 
 static int noise_qd_joint(conv *cv, int j, const ynode *nd, const char *path)
 {
-    return sch_get_within_explode(cv, nd, path, true, &fx(cv)->noise_qd[j]);
+    return sch_get_within_explode(cv, nd, path, &fx(cv)->noise_qd[j]);
 }
 
 static int noise_q(conv *cv, const ynode *nd, const char *path)
@@ -369,12 +369,12 @@ static int key_effect_noise(conv *cv, const ynode *nd, const char *path)
 /* spring: {joint: {k, rest}}: Q = -k (q - rest), N/m or N m/rad; rest in m or rad */
 static int spring_k(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_range(cv, nd, path, &R_STIFFNESS, &fx(cv)->spring_k[cv->cur_joint]);
+    return sch_get_magnitude(cv, nd, path, &R_STIFFNESS, &fx(cv)->spring_k[cv->cur_joint]);
 }
 
 static int spring_rest(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_within_explode(cv, nd, path, false, &fx(cv)->spring_rest[cv->cur_joint]);
+    return sch_get_within_explode(cv, nd, path, &fx(cv)->spring_rest[cv->cur_joint]);
 }
 
 static const keyrow k_spring_keys[] = {

@@ -87,6 +87,8 @@ int sch_get_number(conv *cv, const ynode *nd, const char *path, double *out);
 int sch_get_in(conv *cv, const ynode *nd, const char *path, double lo, double hi,
                bool lo_open, const char *unit, double *out);
 int sch_get_range(conv *cv, const ynode *nd, const char *path, const range *r, double *out);
+int sch_get_magnitude(conv *cv, const ynode *nd, const char *path, const range *r,
+                      double *out);
 int sch_get_int(conv *cv, const ynode *nd, const char *path, long long lo, long long hi,
                 long long *out);
 int sch_get_string(conv *cv, const ynode *nd, const char *path, const char *what,
@@ -96,8 +98,7 @@ void sch_joint_list(const conv *cv, char *buf, size_t len);
 int sch_joint_index(const conv *cv, const char *name);
 int sch_per_joint(conv *cv, const ynode *nd, const char *path, joint_fn fn);
 int sch_need_actuated(conv *cv, int j, const ynode *nd, const char *path);
-int sch_get_within_explode(conv *cv, const ynode *nd, const char *path, bool nonneg,
-                           double *out);
+int sch_get_within_explode(conv *cv, const ynode *nd, const char *path, double *out);
 
 /* scene_effects.c: the `effects:` section, one row per effect (gravity, then the core's
  * effects by their scene keys). */

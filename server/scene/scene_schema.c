@@ -17,6 +17,7 @@
  * the core's lag_model_info; integrators from lag_method_name.
  */
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -198,6 +199,30 @@ int sch_get_range(conv *cv, const ynode *nd, const char *path, const range *r,
     return sch_get_in(cv, nd, path, r->lo, r->hi, r->lo_open, r->unit, out);
 }
 
+/* A number whose sign (and whether it may be 0) is the core's rule: 0, or a magnitude in
+ * r's window. The window keeps what the scene can say representable; lag_sim_def_check
+ * refuses a wrong sign with its own message, which the loader reports at the key. */
+int sch_get_magnitude(conv *cv, const ynode *nd, const char *path, const range *r,
+                      double *out)
+{
+    double v = 0.0;
+    if (sch_get_number(cv, nd, path, &v) < 0)
+        return -1;
+    double a = fabs(v);
+    if (v != 0.0 && (!(r->lo_open ? a > r->lo : a >= r->lo) || !(a <= r->hi))) {
+        char u[64] = "";
+        if (r->unit)
+            snprintf(u, sizeof u, " (%s)", r->unit);
+        if (r->lo == 0.0)
+            return yfail(cv->err, nd, path, "expected a magnitude of at most %.6g%s, got %s",
+                         r->hi, u, nd->text);
+        return yfail(cv->err, nd, path, "expected a magnitude from %.6g to %.6g%s, got %s",
+                     r->lo, r->hi, u, nd->text);
+    }
+    *out = v;
+    return 0;
+}
+
 /* An integer in [lo, hi], written as plain decimal digits. */
 int sch_get_int(conv *cv, const ynode *nd, const char *path, long long lo, long long hi,
                 long long *out)
@@ -304,19 +329,18 @@ int sch_need_actuated(conv *cv, int j, const ynode *nd, const char *path)
     return 0;
 }
 
-/* The scene's explode_limit (read in the first pass), as a bound on a position,
- * velocity or noise amplitude: a value beyond it can never be part of a valid state. */
-int sch_get_within_explode(conv *cv, const ynode *nd, const char *path, bool nonneg,
-                           double *out)
+/* The scene's explode_limit (read in the first pass), as a bound on the magnitude of a
+ * position, velocity or noise amplitude: a value beyond it can never be part of a valid
+ * state. A sign the value must have is the core's rule. */
+int sch_get_within_explode(conv *cv, const ynode *nd, const char *path, double *out)
 {
-    double lim = cv->sc->sim.explode_limit;
+    double lim = fabs(cv->sc->sim.explode_limit); /* its own sign: the core's check */
     double v = 0.0;
     if (sch_get_number(cv, nd, path, &v) < 0)
         return -1;
-    if (!(v <= lim) || !(nonneg ? v >= 0.0 : v >= -lim))
+    if (!(fabs(v) <= lim))
         return yfail(cv->err, nd, path, "expected a number from %.6g to %.6g (explode_limit%s), "
-                     "got %s", nonneg ? 0.0 : -lim, lim,
-                     cv->explode_limit ? "" : ", default", nd->text);
+                     "got %s", -lim, lim, cv->explode_limit ? "" : ", default", nd->text);
     *out = v;
     return 0;
 }
@@ -391,7 +415,7 @@ static int get_vector(conv *cv, const ynode *nd, const char *path, double *out)
     for (int i = 0; i < nq; i++) {
         char sub[256];
         snprintf(sub, sizeof sub, "%s[%d]", path, i);
-        if (sch_get_within_explode(cv, nd->items[i], sub, false, &out[i]) < 0)
+        if (sch_get_number(cv, nd->items[i], sub, &out[i]) < 0) /* within explode_limit: the core's check */
             return -1;
     }
     return 0;
@@ -443,28 +467,28 @@ static int key_method(conv *cv, const ynode *nd, const char *path)
 static int key_dt(conv *cv, const ynode *nd, const char *path)
 {
     cv->dt = nd;
-    return sch_get_range(cv, nd, path, &R_DT, &cv->sc->sim.integrator.dt);
+    return sch_get_magnitude(cv, nd, path, &R_DT, &cv->sc->sim.integrator.dt);
 }
 
 static int key_rtol(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_range(cv, nd, path, &R_RTOL, &cv->sc->sim.integrator.rtol);
+    return sch_get_magnitude(cv, nd, path, &R_RTOL, &cv->sc->sim.integrator.rtol);
 }
 
 static int key_atol(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_range(cv, nd, path, &R_ATOL, &cv->sc->sim.integrator.atol);
+    return sch_get_magnitude(cv, nd, path, &R_ATOL, &cv->sc->sim.integrator.atol);
 }
 
 static int key_dt_min(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_range(cv, nd, path, &R_DT_MIN, &cv->sc->sim.integrator.dt_min);
+    return sch_get_magnitude(cv, nd, path, &R_DT_MIN, &cv->sc->sim.integrator.dt_min);
 }
 
 static int key_max_iter(conv *cv, const ynode *nd, const char *path)
 {
     long long v = 0;
-    if (sch_get_int(cv, nd, path, 1, 1000, &v) < 0)
+    if (sch_get_int(cv, nd, path, INT_MIN, INT_MAX, &v) < 0) /* 1..1000: the core's check */
         return -1;
     cv->sc->sim.integrator.max_iter = (int)v;
     return 0;
@@ -474,15 +498,18 @@ static int key_max_iter(conv *cv, const ynode *nd, const char *path)
 static int key_max_steps(conv *cv, const ynode *nd, const char *path)
 {
     long long v = 0;
-    if (sch_get_int(cv, nd, path, 1, 1000000, &v) < 0)
+    if (sch_get_int(cv, nd, path, INT_MIN, INT_MAX, &v) < 0) /* >= 1: the core's check */
         return -1;
+    if (v > 1000000)
+        return yfail(cv->err, nd, path, "expected an integer of at most 1000000 (steps per "
+                     "tick), got %s", nd->text);
     cv->sc->sim.integrator.max_steps = (int)v;
     return 0;
 }
 
 static int key_newton_tol(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_range(cv, nd, path, &R_NEWTON_TOL, &cv->sc->sim.integrator.newton_tol);
+    return sch_get_magnitude(cv, nd, path, &R_NEWTON_TOL, &cv->sc->sim.integrator.newton_tol);
 }
 
 /* integrator.error: the largest difference from the exact q over integrator.horizon that
@@ -539,7 +566,7 @@ static int key_publish_hz(conv *cv, const ynode *nd, const char *path)
 static int key_explode_limit(conv *cv, const ynode *nd, const char *path)
 {
     cv->explode_limit = nd;
-    return sch_get_range(cv, nd, path, &R_EXPLODE, &cv->sc->sim.explode_limit);
+    return sch_get_magnitude(cv, nd, path, &R_EXPLODE, &cv->sc->sim.explode_limit);
 }
 
 /* ================================================================ realtime */
@@ -771,12 +798,12 @@ static int ref_start(conv *cv, const ynode *nd, const char *path)
 /* amplitude and offset: a position, within explode_limit */
 static int ref_amplitude(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_within_explode(cv, nd, path, false, &cv->cur_ref->amplitude);
+    return sch_get_within_explode(cv, nd, path, &cv->cur_ref->amplitude);
 }
 
 static int ref_offset(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_within_explode(cv, nd, path, false, &cv->cur_ref->offset);
+    return sch_get_within_explode(cv, nd, path, &cv->cur_ref->offset);
 }
 
 static int ref_frequency(conv *cv, const ynode *nd, const char *path)
@@ -819,7 +846,7 @@ static int ref_points(conv *cv, const ynode *nd, const char *path)
             return yfail(cv->err, it->items[0], el, "the points' times must increase strictly "
                          "(%.17g after %.17g)", ref->point_t[k], ref->point_t[k - 1]);
         snprintf(el, sizeof el, "%s[1]", sub);
-        if (sch_get_within_explode(cv, it->items[1], el, false, &ref->point_w[k]) < 0) return -1;
+        if (sch_get_within_explode(cv, it->items[1], el, &ref->point_w[k]) < 0) return -1;
     }
     ref->n_points = nd->n;
     return 0;
@@ -974,68 +1001,93 @@ static int check_period(conv *cv)
     return 0; /* dt_min <= dt: the core's check */
 }
 
-int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, errbuf *err)
+/* The core's own checks of def (parameters, the integrator's settings against each other,
+ * the effects' values against each other and the initial state, which models have a
+ * floor...), made by the core alone: its diagnosis names the field in the scene's own
+ * terms, and the field's node gives the position. */
+static int core_check(conv *cv, const lag_sim_def *def)
 {
-    conv cv = {.err = err, .sc = sc, .root = root, .gravity_enabled = -1};
+    lag_diag d;
+    if (lag_sim_def_check(def, &d) == LAG_OK)
+        return 0;
+    return yfail(cv->err, ytree_lookup(cv->root, d.field), d.field[0] ? d.field : NULL, "%s",
+                 d.message);
+}
+
+/* Step 1: the model comes first (parameters, the length of q and the defaults depend on
+ * it); sc gets the model's defaults. */
+static int convert_model(conv *cv, const char *path)
+{
+    const ynode *root = cv->root;
     if (root->kind != YN_MAP) {
         if (ynode_is_null(root))
-            return yfail(err, root, NULL,
+            return yfail(cv->err, root, NULL,
                          "expected a mapping with the scene's keys (at least 'model'), "
                          "got an empty document");
-        return yfail(err, root, NULL,
+        return yfail(cv->err, root, NULL,
                      "expected a mapping with the scene's keys (at least 'model'), got %s",
                      ynode_kind_name(root));
     }
-
-    /* The model comes first: parameters, the length of q and the defaults depend on it. */
     char models[256];
     model_list(models, sizeof models);
     const yentry *me = ymap_find(root, "model");
     if (!me)
-        return yfail(err, root, NULL, "missing required key 'model' (%s)", models);
+        return yfail(cv->err, root, NULL, "missing required key 'model' (%s)", models);
     const char *mname;
     char what[300];
     snprintf(what, sizeof what, "a model (%s)", models);
-    if (sch_get_string(&cv, me->val, "model", what, &mname) < 0)
+    if (sch_get_string(cv, me->val, "model", what, &mname) < 0)
         return -1;
     int kind = lag_model_kind_from_name(mname);
     if (kind < 0)
-        return yfail(err, me->val, "model", "unknown model '%s'; allowed: %s", mname, models);
+        return yfail(cv->err, me->val, "model", "unknown model '%s'; allowed: %s", mname, models);
+    lag_scene_default(cv->sc, (lag_model_kind)kind);
+    snprintf(cv->sc->path, sizeof cv->sc->path, "%s", path ? path : "");
+    lag_model_default_unfinished(&cv->sc->sim.model, (lag_model_kind)kind);
+    cv->info = lag_model_info_get((lag_model_kind)kind);
+    return 0;
+}
 
-    lag_scene_default(sc, (lag_model_kind)kind);
-    snprintf(sc->path, sizeof sc->path, "%s", path ? path : "");
-    lag_model_default_unfinished(&sc->sim.model, (lag_model_kind)kind);
-    cv.info = lag_model_info_get((lag_model_kind)kind);
-
-    /* Then what the other values are measured against, then the rest in file order. */
+/* Step 2: what the other values are measured against (integrator, publish_hz,
+ * explode_limit), checked by the core at once (a later key's range must not be measured
+ * against a value the core refuses), then the period they make. */
+static int convert_first_keys(conv *cv)
+{
+    lag_scene *sc = cv->sc;
     for (int k = 1; k_first_keys[k]; k++) {
-        const yentry *en = ymap_find(root, k_first_keys[k]);
+        const yentry *en = ymap_find(cv->root, k_first_keys[k]);
         if (!en)
             continue;
         const keyrow *r = k_top_keys;
         while (strcmp(r->name, en->key) != 0)
             r++;
-        if (r->fn(&cv, en->val, en->key) < 0)
+        if (r->fn(cv, en->val, en->key) < 0)
             return -1;
     }
-    if (check_period(&cv) < 0)
+    lag_sim_def first = sc->sim; /* the model's defaults, with their rods' inertias */
+    lag_model_finish(&first.model);
+    if (core_check(cv, &first) < 0 || check_period(cv) < 0)
         return -1;
     /* the watchdog default: 0.5 s, but never shorter than two control periods */
     double period = (double)sc->ticks_per_period * sc->sim.integrator.dt;
     if (sc->realtime.command_timeout < 2.0 * period)
         sc->realtime.command_timeout = 2.0 * period;
-    if (sch_convert_map_skip(&cv, root, "", k_top_keys, "key", k_first_keys) < 0)
-        return -1;
+    return 0;
+}
 
+/* Step 4: what follows from several keys once all are read, then the core's checks. */
+static int convert_finish(conv *cv)
+{
+    lag_scene *sc = cv->sc;
     /* effects.gravity overrides parameters.g (after both are read, whatever their order) */
     int gi = lag_model_param_index(sc->sim.model.kind, "g");
-    if (gi >= 0 && cv.gravity_g_node) sc->sim.model.p[gi] = cv.gravity_g;
-    if (gi >= 0 && cv.gravity_enabled == 0) sc->sim.model.p[gi] = 0.0;
+    if (gi >= 0 && cv->gravity_g_node) sc->sim.model.p[gi] = cv->gravity_g;
+    if (gi >= 0 && cv->gravity_enabled == 0) sc->sim.model.p[gi] = 0.0;
 
     /* realtime.start not given: a lockstep run waits for its controller's first command
      * (it cannot advance without one anyway, and then no start order can lose the first
      * state); realtime and fast run from the start, like a plant switched on */
-    if (!cv.start)
+    if (!cv->start)
         sc->realtime.start = sc->realtime.mode == LAG_RT_LOCKSTEP ? LAG_RT_START_FIRST_COMMAND
                                                                   : LAG_RT_START_RUNNING;
 
@@ -1045,8 +1097,8 @@ int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, err
     /* Real time: at most PERIODS_PER_S_MAX control periods per wall second. */
     if (sc->realtime.mode == LAG_RT_REALTIME &&
         sc->publish_hz * sc->realtime.rate > PERIODS_PER_S_MAX * (1.0 + 1e-12)) {
-        const ynode *at = cv.rate ? cv.rate : cv.publish_hz;
-        return yfail(err, at, cv.rate ? "realtime.rate" : "publish_hz",
+        const ynode *at = cv->rate ? cv->rate : cv->publish_hz;
+        return yfail(cv->err, at, cv->rate ? "realtime.rate" : "publish_hz",
                      "publish_hz * realtime.rate = %.6g control periods per wall second: at "
                      "most %.0f in realtime mode (mode: fast runs as fast as it can)",
                      sc->publish_hz * sc->realtime.rate, PERIODS_PER_S_MAX);
@@ -1055,17 +1107,19 @@ int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, err
     /* lcm.url, with lcm.allow_lan wherever it was given */
     char msg[256];
     if (lag_scene_check_url(sc->lcm.url, sc->lcm.allow_lan, &sc->lcm.ttl, msg, sizeof msg) < 0)
-        return yfail(err, cv.url, "lcm.url", "%s", msg);
+        return yfail(cv->err, cv->url, "lcm.url", "%s", msg);
+    return core_check(cv, &sc->sim);
+}
 
-    /* The core's own checks (parameters, the integrator's settings against each other,
-     * the effects' values against each other and the initial state, which models have a
-     * floor...), made once, by the core: its diagnosis names the field in the scene's own
-     * terms, and the field's node gives the position. */
-    lag_diag d;
-    if (lag_sim_def_check(&sc->sim, &d) != LAG_OK)
-        return yfail(err, ytree_lookup(root, d.field), d.field[0] ? d.field : NULL, "%s",
-                     d.message);
-    return 0;
+int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, errbuf *err)
+{
+    conv cv = {.err = err, .sc = sc, .root = root, .gravity_enabled = -1};
+    if (convert_model(&cv, path) < 0 || convert_first_keys(&cv) < 0)
+        return -1;
+    /* Step 3: every other key, in file order */
+    if (sch_convert_map_skip(&cv, root, "", k_top_keys, "key", k_first_keys) < 0)
+        return -1;
+    return convert_finish(&cv);
 }
 
 /* ================================================================ every numeric key */
