@@ -1,7 +1,7 @@
 /*
- * The core's effect table against everything that names effects: each consumer must
- * agree with it row for row, so that an effect added to the core (or renamed) shows up
- * everywhere or fails here by name.
+ * The core's effect table (and its model table, in the docs) against everything that
+ * names them: each consumer must agree with it row for row, so that an effect added to
+ * the core (or renamed) shows up everywhere or fails here by name.
  *
  *   loader         every row's key turns on exactly its bit (for some model), and every
  *                  effect key of the loader's tables but gravity is a row
@@ -13,6 +13,7 @@
  *   view           every effect the browser view asks about (view.js, hasEffect) is a row
  *   docs           docs/effects.md's table of effects and docs/scenes.md's table of
  *                  ranges list every row, and name no effect the core does not have
+ *   docs_models    docs/scenes.md names every model of the core's model table
  *
  * Files are read from the source tree (LAGSIM_SOURCE_DIR).
  */
@@ -322,10 +323,45 @@ static void case_docs(int arg)
     doc_lists("docs/scenes.md", "| key | range | unit |", "\n\n", "`effects.", ".[`", others);
 }
 
+/* docs/scenes.md names every model of the core's table where it lists them: the comment
+ * of `model:` in the scene reference, and a row of the parameters' table per model. */
+static void case_docs_models(int arg)
+{
+    (void)arg;
+    if (!read_source("docs/scenes.md", g_text, sizeof g_text)) return;
+    const char *line = strstr(g_text, "\nmodel: dipc ");
+    const char *table = strstr(g_text, "| model | key | default | unit | meaning |");
+    if (!line || !table) {
+        LT_FAIL("docs: docs/scenes.md has no `model:` line or parameters table any more");
+        return;
+    }
+    size_t llen = strcspn(line + 1, "\n") + 1;
+    const char *tend = strstr(table, "\n\n");
+    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
+        const char *name = lag_model_info_get((lag_model_kind)k)->name;
+        char cell[64];
+        bool in_line = false;
+        for (const char *p = line; (p = strstr(p, name)) && p < line + llen; p++) {
+            char after = p[strlen(name)];
+            in_line |= (p[-1] == ' ') && (after == ' ' || after == '\n');
+        }
+        snprintf(cell, sizeof cell, "\n| %s |", name);
+        const char *row = strstr(table, cell);
+        if (!in_line)
+            LT_FAIL("docs: docs/scenes.md's `model:` line does not name model '%s'", name);
+        else
+            ENSURE(in_line);
+        if (!row || (tend && row > tend))
+            LT_FAIL("docs: docs/scenes.md's parameters table has no row for model '%s'", name);
+        else
+            ENSURE(row);
+    }
+}
+
 static const lt_case cases[] = {
     {"loader", case_loader, 0, 0},           {"scene_message", case_scene_message, 0, 0},
     {"keeps_state", case_keeps_state, 0, 0}, {"view", case_view, 0, 0},
-    {"docs", case_docs, 0, 0},
+    {"docs", case_docs, 0, 0},              {"docs_models", case_docs_models, 0, 0},
 };
 
 int main(int argc, char **argv)
