@@ -53,3 +53,18 @@ add_executable(test_scene_ranges ${scene_dir}/test_ranges.c)
 target_include_directories(test_scene_ranges PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_scene_ranges PRIVATE lagsim_scene)
 lagsim_add_test_cases(test_scene_ranges scene scene 60)
+
+# The core's effect table against its consumers: the loader's keys, the scene message,
+# what replay takes as stateless, the browser view, the docs' tables (tests/scene/test_tables.c).
+add_executable(test_scene_tables ${scene_dir}/test_tables.c)
+target_include_directories(test_scene_tables PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common)
+target_compile_definitions(test_scene_tables PRIVATE LAGSIM_SOURCE_DIR="${CMAKE_SOURCE_DIR}")
+target_link_libraries(test_scene_tables PRIVATE lagsimd_internal)
+lagsim_add_test_cases(test_scene_tables scene_tables scene 60)
+
+# One rule, one place: a value the core refuses is refused with the core's message at the
+# key's file:line:column, for every numeric key and model (tests/scene/test_checks.c).
+add_executable(test_scene_checks ${scene_dir}/test_checks.c)
+target_include_directories(test_scene_checks PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common)
+target_link_libraries(test_scene_checks PRIVATE lagsim_scene)
+lagsim_add_test_cases(test_scene_checks scene_checks scene 60)

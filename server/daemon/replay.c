@@ -72,13 +72,10 @@
 #define REPLAY_GAPS_SAID 10                 /* gaps reported one by one, then counted */
 #define REPLAY_SETS_PENDING 1024            /* changes read and not yet reached, at most */
 
-/* Effects whose state is entirely in (q, qd, tick): a restart from a logged state of a
- * fixed-step method reproduces the daemon's numbers. Every other effect (and any new one)
- * is taken as keeping state of its own. */
-#define REPLAY_MEMORYLESS (LAG_EFF_DAMPING | LAG_EFF_DISTURBANCE | LAG_EFF_ACTUATOR)
-
 /* Why a restart away from the scene's initial state and from a reset cannot be exact for
- * this definition (the scene's, or as changed while running), or NULL when it can. */
+ * this definition (the scene's, or as changed while running), or NULL when it can. Which
+ * effects keep state of their own is the core's table (lag_effect_info.keeps_state): a
+ * new effect is taken into account without a change here. */
 static const char *restart_inexact(const lag_sim_def *def, bool lagged)
 {
     const lag_effects_def *fx = &def->effects;
@@ -88,8 +85,16 @@ static const char *restart_inexact(const lag_sim_def *def, bool lagged)
     if (mi && mi->adaptive)
         return "the adaptive method carries its step size from period to period";
     if (lagged) return "the actuator lag's state is not in the log";
-    if (fx->enabled & ~(uint32_t)REPLAY_MEMORYLESS)
-        return "friction, stops and the floor keep contact modes the log does not hold";
+    for (int k = 0; k < LAG_EFF_COUNT; k++) {
+        lag_effect_info e = lag_effect_info_get(k);
+        /* the actuator's state is its lag's, and it has none here (lagged is false) */
+        if (e.keeps_state && e.bit != LAG_EFF_ACTUATOR && (fx->enabled & e.bit)) {
+            static char why[96];
+            snprintf(why, sizeof why, "the %s effect keeps state of its own the log does not "
+                     "hold", e.name);
+            return why;
+        }
+    }
     return NULL;
 }
 

@@ -159,18 +159,16 @@ void rt_publish_scene(const rt_out *o, const lag_scene *sc, const lag_sim *sim,
         m.limit_lower[i] = m.limit_on[i] ? fin(d->effects.limit_lower[i]) : 0.0;
         m.limit_upper[i] = m.limit_on[i] ? fin(d->effects.limit_upper[i]) : 0.0;
     }
-    /* the effects that are on, by their scene-file names */
-    static const struct { uint32_t bit; const char *name; } fx[] = {
-        {LAG_EFF_DAMPING, "damping"},   {LAG_EFF_FRICTION, "friction"},
-        {LAG_EFF_LIMITS, "limits"},     {LAG_EFF_FLOOR, "floor"},
-        {LAG_EFF_ACTUATOR, "actuator"}, {LAG_EFF_DISTURBANCE, "disturbance"},
-        {LAG_EFF_NOISE, "noise"},
-    };
+    /* the effects that are on, by their scene-file names from the core's table, in the
+     * order of their bits */
     size_t ne = 0;
-    for (size_t k = 0; k < sizeof fx / sizeof fx[0]; k++)
-        if (d->effects.enabled & fx[k].bit)
-            ne += (size_t)snprintf(m.effects + ne, sizeof m.effects - ne, "%s%s", ne ? "," : "",
-                                   fx[k].name);
+    for (int b = 0; b < 32; b++)
+        for (int k = 0; k < LAG_EFF_COUNT; k++) {
+            lag_effect_info e = lag_effect_info_get(k);
+            if (e.bit == (1u << b) && (d->effects.enabled & e.bit) && ne < sizeof m.effects)
+                ne += (size_t)snprintf(m.effects + ne, sizeof m.effects - ne, "%s%s",
+                                       ne ? "," : "", e.name);
+        }
     m.dt = fin(d->integrator.dt);
     m.control_period = fin((double)sc->ticks_per_period * d->integrator.dt);
     PUT(m.integrator, lag_method_name(d->integrator.method));

@@ -106,89 +106,107 @@ lag_result lag_scene_load_buffer(const char *name, const char *text, size_t len,
     return rc;
 }
 
+/* A load in progress: the sources (the file, then one per --set) live until the tree
+ * is freed. */
+typedef struct load_state {
+    errbuf e;
+    ysrc *srcs;    /* [0] the file, [1 + i] --set i */
+    char **names;  /* the --set sources' names (their key paths), owned */
+    int nsets;
+    ynode *root;   /* the merged tree */
+} load_state;
+
+/* One --set "key.path=value": its value parsed as YAML and grafted onto the tree at its
+ * key path. */
+static int load_set(load_state *ls, int i, const char *s)
+{
+    errbuf *e = &ls->e;
+    const char *eq = s ? strchr(s, '=') : NULL;
+    if (!eq) {
+        snprintf(e->buf, e->len, "--set %.200s: expected key.path=value", s ? s : "(null)");
+        return -1;
+    }
+    size_t klen = (size_t)(eq - s);
+    if (klen == 0) {
+        snprintf(e->buf, e->len, "--set %.200s: expected key.path=value, the key is empty", s);
+        return -1;
+    }
+    if (klen > 255) {
+        snprintf(e->buf, e->len, "--set %.40s...: a key path of %zu characters: at most 255", s,
+                 klen);
+        return -1;
+    }
+    char *key = ls->names[i + 1] = malloc(klen + 1);
+    if (!key) {
+        snprintf(e->buf, e->len, "--set: out of memory");
+        return -1;
+    }
+    memcpy(key, s, klen);
+    key[klen] = '\0';
+    ysrc *src = &ls->srcs[i + 1];
+    src->name = key;
+    src->is_set = true;
+    ynode *val;
+    if (ytree_parse(eq + 1, strlen(eq + 1), src, e, &val) < 0)
+        return -1;
+    /* a root that is not a mapping (e.g. an empty file) is reported by the schema */
+    if (ls->root->kind != YN_MAP && ynode_is_null(ls->root)) {
+        ynode *m = calloc(1, sizeof *m);
+        if (!m) {
+            ynode_free(val);
+            snprintf(e->buf, e->len, "--set: out of memory");
+            return -1;
+        }
+        m->kind = YN_MAP;
+        m->line = m->col = 1;
+        m->src = &ls->srcs[0];
+        ynode_free(ls->root);
+        ls->root = m;
+    }
+    return ytree_graft(ls->root, src, val, e);
+}
+
+/* The file's tree, each --set grafted on in order, then the schema. */
+static int load_tree(load_state *ls, const char *name, const char *text, size_t len,
+                     const char *const *sets, lag_scene *sc)
+{
+    ls->srcs = calloc((size_t)ls->nsets + 1, sizeof *ls->srcs);
+    ls->names = calloc((size_t)ls->nsets + 1, sizeof *ls->names);
+    if (!ls->srcs || !ls->names) {
+        snprintf(ls->e.buf, ls->e.len, "%s: out of memory", name);
+        return -1;
+    }
+    ls->srcs[0].name = name;
+    ls->srcs[0].is_set = false;
+    if (ytree_parse(text ? text : "", len, &ls->srcs[0], &ls->e, &ls->root) < 0)
+        return -1;
+    for (int i = 0; i < ls->nsets; i++)
+        if (load_set(ls, i, sets[i]) < 0)
+            return -1;
+    return scene_schema_convert(ls->root, name, sc, &ls->e) < 0 ? -1 : 0;
+}
+
 static lag_result load_buffer(const char *name, const char *text, size_t len,
                               const char *const *sets, int nsets, lag_scene *sc, char *err,
                               size_t errlen)
 {
     char dummy[8];
-    errbuf e = {.buf = err ? err : dummy, .len = err ? errlen : sizeof dummy};
-    if (e.len)
-        e.buf[0] = '\0';
+    load_state ls = {.e = {.buf = err ? err : dummy, .len = err ? errlen : sizeof dummy},
+                     .nsets = nsets};
+    if (ls.e.len)
+        ls.e.buf[0] = '\0';
     if (!name || (!text && len) || !sc || nsets < 0 || (nsets > 0 && !sets)) {
-        snprintf(e.buf, e.len, "lag_scene_load: invalid arguments");
+        snprintf(ls.e.buf, ls.e.len, "lag_scene_load: invalid arguments");
         return LAG_ERR_ARG;
     }
     memset(sc, 0, sizeof *sc);
-
-    /* Sources live until the tree is freed: the file, then one per --set. */
-    ysrc *srcs = calloc((size_t)nsets + 1, sizeof *srcs);
-    char **names = calloc((size_t)nsets + 1, sizeof *names);
-    ynode *root = NULL;
-    lag_result rc = LAG_ERR_SCENE;
-    if (!srcs || !names) {
-        snprintf(e.buf, e.len, "%s: out of memory", name);
-        goto done;
-    }
-    srcs[0].name = name;
-    srcs[0].is_set = false;
-    if (ytree_parse(text ? text : "", len, &srcs[0], &e, &root) < 0)
-        goto done;
-
-    for (int i = 0; i < nsets; i++) {
-        const char *s = sets[i];
-        const char *eq = s ? strchr(s, '=') : NULL;
-        if (!eq) {
-            snprintf(e.buf, e.len, "--set %.200s: expected key.path=value", s ? s : "(null)");
-            goto done;
-        }
-        size_t klen = (size_t)(eq - s);
-        if (klen == 0) {
-            snprintf(e.buf, e.len, "--set %.200s: expected key.path=value, the key is empty", s);
-            goto done;
-        }
-        if (klen > 255) {
-            snprintf(e.buf, e.len, "--set %.40s...: a key path of %zu characters: at most 255",
-                     s, klen);
-            goto done;
-        }
-        names[i + 1] = malloc(klen + 1);
-        if (!names[i + 1]) {
-            snprintf(e.buf, e.len, "--set: out of memory");
-            goto done;
-        }
-        memcpy(names[i + 1], s, klen);
-        names[i + 1][klen] = '\0';
-        srcs[i + 1].name = names[i + 1];
-        srcs[i + 1].is_set = true;
-        ynode *val;
-        if (ytree_parse(eq + 1, strlen(eq + 1), &srcs[i + 1], &e, &val) < 0)
-            goto done;
-        /* a root that is not a mapping (e.g. an empty file) is reported by the schema */
-        if (root->kind != YN_MAP && ynode_is_null(root)) {
-            ynode *m = calloc(1, sizeof *m);
-            if (!m) {
-                ynode_free(val);
-                snprintf(e.buf, e.len, "--set: out of memory");
-                goto done;
-            }
-            m->kind = YN_MAP;
-            m->line = m->col = 1;
-            m->src = &srcs[0];
-            ynode_free(root);
-            root = m;
-        }
-        if (ytree_graft(root, &srcs[i + 1], val, &e) < 0)
-            goto done;
-    }
-
-    rc = scene_schema_convert(root, name, sc, &e) < 0 ? LAG_ERR_SCENE : LAG_OK;
-done:
-    ynode_free(root);
-    if (names)
+    lag_result rc = load_tree(&ls, name, text, len, sets, sc) < 0 ? LAG_ERR_SCENE : LAG_OK;
+    ynode_free(ls.root);
+    if (ls.names)
         for (int i = 0; i <= nsets; i++)
-            free(names[i]);
-    free(names);
-    free(srcs);
+            free(ls.names[i]);
+    free(ls.names);
+    free(ls.srcs);
     return rc;
 }
 

@@ -17,33 +17,23 @@
  * the core's lag_model_info; integrators from lag_method_name.
  */
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene_keys.h"
 #include "scene_schema.h"
 
 /* ================================================================ ranges */
 
-/* The longest sim time (scene.h explains the bound). */
-#define T_MAX LAG_SCENE_MAX_TIME
-/* The largest force-like value (N or N m, N s or N m s, N s/m): far beyond any load
- * these models are meant for (a 1e6 kg mass under 1e3 m/s^2 weighs 1e9 N) and small
- * enough that accelerations and energies computed from it stay finite. */
-#define F_MAX 1e12
 /* Fewest and most integrator ticks in one control period: one period is one call into
  * the core (fast mode runs periods back to back), so it must stay short. */
 #define TICKS_MAX 100000
 /* Control periods per wall second at most in real-time mode (publish_hz * rate). */
 #define PERIODS_PER_S_MAX 10000.0
-
-typedef struct range {
-    double lo, hi;
-    bool lo_open;      /* lo excluded ("> 0") */
-    const char *unit;  /* shown in messages; NULL for none */
-} range;
 
 static const range R_DT = {1e-6, 1.0, false, "s"};           /* above: resolves no motion of these models; below: see T_MAX */
 static const range R_RTOL = {1e-14, 0.1, false, NULL};      /* below ~50 eps no step can meet it */
@@ -58,11 +48,6 @@ static const range R_RATE = {1e-3, 1e3, false, "sim s per wall s"};
 static const range R_LOCKSTEP_TIMEOUT = {1e-3, 3600.0, false, "wall s"};
 static const range R_LOCKSTEP_RETRY = {1e-3, 3600.0, false, "wall s"}; /* as the timeout */
 static const range R_STATUS_HZ = {0.1, 100.0, false, "Hz"};
-static const range R_EFFORT = {0.0, F_MAX, true, "N or N m"};
-static const range R_DAMPING = {0.0, F_MAX, false, "N s/m or N m s/rad"};
-static const range R_FRICTION = {0.0, F_MAX, false, "N or N m"};
-static const range R_TIME = {0.0, T_MAX, false, "s"};
-static const range R_GRAVITY = {0.0, 1e3, false, "m/s^2"}; /* 100 g; 0 switches gravity off */
 
 /* The magnitude of a physical parameter, by its unit in lag_model_info (a new model with
  * these units needs no code here): masses from a milligram to a thousand tonnes, lengths
@@ -80,29 +65,8 @@ static const struct {
     {"m/s^2", 1e-6, 1e3},
 };
 
-/* ================================================================ conversion state */
-
-typedef struct conv {
-    errbuf *err;
-    lag_scene *sc;
-    const lag_model_info *info;
-    /* nodes remembered for the cross-checks (NULL if not given) */
-    const ynode *root, *publish_hz, *dt, *integrator, *explode_limit, *url, *rate, *start;
-    /* effects */
-    const ynode *gravity_g_node;
-    int gravity_enabled;  /* -1 not said, 0 off, 1 on */
-    double gravity_g;
-    int limit_seen;       /* bits: lower, upper given for the joint being read */
-    int cur_joint;        /* the joint whose sub-mapping is being read */
-    lag_disturbance *cur_dist; /* the disturbance being read */
-    lag_reference *cur_ref;    /* the reference being read */
-    int cur_ref_kind;          /* its kind, -1 before its type is known */
-    unsigned cur_ref_seen;     /* LAG_REF_KEY_* given */
-    int cur_dist_kind;    /* bits: impulse, force given */
-} conv;
-
 /* Joins "parent.key" into buf. */
-static const char *join(char *buf, size_t len, const char *parent, const char *key)
+const char *sch_join(char *buf, size_t len, const char *parent, const char *key)
 {
     if (parent && parent[0])
         snprintf(buf, len, "%s.%s", parent, key);
@@ -110,28 +74,6 @@ static const char *join(char *buf, size_t len, const char *parent, const char *k
         snprintf(buf, len, "%s", key);
     return buf;
 }
-
-/* Key tables: a NULL-terminated list of {name, handler, what the value is}. The handler
- * reads the value; the type (and the sub-table of a section) lets scene_schema_each_number
- * list every numeric key, so that a test can check each one has a range. */
-typedef struct keyrow keyrow;
-typedef int (*key_fn)(conv *cv, const ynode *val, const char *path);
-typedef enum keytype {
-    K_OTHER = 0, /* a string, a name, a boolean */
-    K_NUMBER,    /* a number */
-    K_INTEGER,   /* an integer */
-    K_MAP,       /* a section: the keys of `sub` */
-    K_JOINTS,    /* {joint: number}, or {joint: {keys of sub}}; plus the keys of `extra` */
-    K_VECTOR,    /* a sequence of one number per coordinate */
-    K_LIST,      /* a sequence of mappings with the keys of `sub` */
-    K_PARAMS     /* the model's parameters (lag_model_info) */
-} keytype;
-struct keyrow {
-    const char *name;
-    key_fn fn;
-    keytype type;
-    const keyrow *sub, *extra;
-};
 
 /* Lists the names of a key table: "a, b, c". */
 static void list_keys(char *buf, size_t len, const keyrow *rows)
@@ -144,7 +86,7 @@ static void list_keys(char *buf, size_t len, const keyrow *rows)
 }
 
 /* nd must be a mapping; `what` describes it ("a mapping (keys: a, b)"). */
-static int need_map(conv *cv, const ynode *nd, const char *path, const char *what)
+int sch_need_map(conv *cv, const ynode *nd, const char *path, const char *what)
 {
     if (nd->kind == YN_MAP)
         return 0;
@@ -155,14 +97,15 @@ static int need_map(conv *cv, const ynode *nd, const char *path, const char *wha
 
 /* Walks a mapping's entries in file order and dispatches each to its table row, skipping
  * the keys listed in `skip` (read before). */
-static int convert_map_skip(conv *cv, const ynode *nd, const char *path, const keyrow *rows,
-                            const char *what, const char *const *skip)
+static int sch_convert_map_skip(conv *cv, const ynode *nd, const char *path,
+                                const keyrow *rows, const char *what,
+                                const char *const *skip)
 {
     if (nd->kind != YN_MAP) {
         char allowed[512], expected[600];
         list_keys(allowed, sizeof allowed, rows);
         snprintf(expected, sizeof expected, "a mapping (keys: %s)", allowed);
-        return need_map(cv, nd, path, expected);
+        return sch_need_map(cv, nd, path, expected);
     }
     for (int i = 0; i < nd->n; i++) {
         const yentry *en = &nd->entries[i];
@@ -181,22 +124,22 @@ static int convert_map_skip(conv *cv, const ynode *nd, const char *path, const k
                              path[0] ? " in " : "", path, allowed);
         }
         char sub[256];
-        if (r->fn(cv, en->val, join(sub, sizeof sub, path, en->key)) < 0)
+        if (r->fn(cv, en->val, sch_join(sub, sizeof sub, path, en->key)) < 0)
             return -1;
     }
     return 0;
 }
 
-static int convert_map(conv *cv, const ynode *nd, const char *path, const keyrow *rows,
-                       const char *what)
+int sch_convert_map(conv *cv, const ynode *nd, const char *path, const keyrow *rows,
+                    const char *what)
 {
-    return convert_map_skip(cv, nd, path, rows, what, NULL);
+    return sch_convert_map_skip(cv, nd, path, rows, what, NULL);
 }
 
 /* ================================================================ scalars */
 
 /* A finite number written as a plain decimal scalar. */
-static int get_number(conv *cv, const ynode *nd, const char *path, double *out)
+int sch_get_number(conv *cv, const ynode *nd, const char *path, double *out)
 {
     if (ynode_is_null(nd))
         return yfail(cv->err, nd, path, "missing value: expected a number");
@@ -235,11 +178,11 @@ static void describe_range(char *buf, size_t len, double lo, double hi, bool lo_
 }
 
 /* A number in [lo, hi] (or (lo, hi]). */
-static int get_in(conv *cv, const ynode *nd, const char *path, double lo, double hi,
-                  bool lo_open, const char *unit, double *out)
+int sch_get_in(conv *cv, const ynode *nd, const char *path, double lo, double hi,
+               bool lo_open, const char *unit, double *out)
 {
     double v = 0.0;
-    if (get_number(cv, nd, path, &v) < 0)
+    if (sch_get_number(cv, nd, path, &v) < 0)
         return -1;
     if (!(lo_open ? v > lo : v >= lo) || !(v <= hi)) {
         char r[160];
@@ -250,15 +193,39 @@ static int get_in(conv *cv, const ynode *nd, const char *path, double lo, double
     return 0;
 }
 
-static int get_range(conv *cv, const ynode *nd, const char *path, const range *r,
-                     double *out)
+int sch_get_range(conv *cv, const ynode *nd, const char *path, const range *r,
+                  double *out)
 {
-    return get_in(cv, nd, path, r->lo, r->hi, r->lo_open, r->unit, out);
+    return sch_get_in(cv, nd, path, r->lo, r->hi, r->lo_open, r->unit, out);
+}
+
+/* A number whose sign (and whether it may be 0) is the core's rule: 0, or a magnitude in
+ * r's window. The window keeps what the scene can say representable; lag_sim_def_check
+ * refuses a wrong sign with its own message, which the loader reports at the key. */
+int sch_get_magnitude(conv *cv, const ynode *nd, const char *path, const range *r,
+                      double *out)
+{
+    double v = 0.0;
+    if (sch_get_number(cv, nd, path, &v) < 0)
+        return -1;
+    double a = fabs(v);
+    if (v != 0.0 && (!(r->lo_open ? a > r->lo : a >= r->lo) || !(a <= r->hi))) {
+        char u[64] = "";
+        if (r->unit)
+            snprintf(u, sizeof u, " (%s)", r->unit);
+        if (r->lo == 0.0)
+            return yfail(cv->err, nd, path, "expected a magnitude of at most %.6g%s, got %s",
+                         r->hi, u, nd->text);
+        return yfail(cv->err, nd, path, "expected a magnitude from %.6g to %.6g%s, got %s",
+                     r->lo, r->hi, u, nd->text);
+    }
+    *out = v;
+    return 0;
 }
 
 /* An integer in [lo, hi], written as plain decimal digits. */
-static int get_int(conv *cv, const ynode *nd, const char *path, long long lo, long long hi,
-                   long long *out)
+int sch_get_int(conv *cv, const ynode *nd, const char *path, long long lo, long long hi,
+                long long *out)
 {
     if (ynode_is_null(nd))
         return yfail(cv->err, nd, path, "missing value: expected an integer");
@@ -283,8 +250,8 @@ static int get_int(conv *cv, const ynode *nd, const char *path, long long lo, lo
 }
 
 /* A string scalar (quoted or plain). */
-static int get_string(conv *cv, const ynode *nd, const char *path, const char *what,
-                      const char **out)
+int sch_get_string(conv *cv, const ynode *nd, const char *path, const char *what,
+                   const char **out)
 {
     if (ynode_is_null(nd))
         return yfail(cv->err, nd, path, "missing value: expected %s", what);
@@ -295,7 +262,7 @@ static int get_string(conv *cv, const ynode *nd, const char *path, const char *w
 }
 
 /* A YAML boolean: true/false (also yes/no, on/off as YAML 1.1 spells them), plain. */
-static int get_bool(conv *cv, const ynode *nd, const char *path, bool *out)
+int sch_get_bool(conv *cv, const ynode *nd, const char *path, bool *out)
 {
     static const char *const yes[] = {"true", "True", "TRUE", "yes", "Yes", "on", "On", NULL};
     static const char *const no[] = {"false", "False", "FALSE", "no", "No", "off", "Off", NULL};
@@ -316,7 +283,7 @@ static int get_bool(conv *cv, const ynode *nd, const char *path, bool *out)
 /* ================================================================ joints */
 
 /* "x, phi" for messages */
-static void joint_list(const conv *cv, char *buf, size_t len)
+void sch_joint_list(const conv *cv, char *buf, size_t len)
 {
     buf[0] = '\0';
     for (int i = 0; i < cv->info->nq; i++) {
@@ -325,38 +292,36 @@ static void joint_list(const conv *cv, char *buf, size_t len)
     }
 }
 
-static int joint_index(const conv *cv, const char *name)
+int sch_joint_index(const conv *cv, const char *name)
 {
     for (int i = 0; i < cv->info->nq; i++)
         if (strcmp(name, cv->info->joint_names[i]) == 0) return i;
     return -1;
 }
 
-typedef int (*joint_fn)(conv *cv, int joint, const ynode *val, const char *path);
-
 /* Walks a mapping {joint name: value} and calls fn for each joint. */
-static int per_joint(conv *cv, const ynode *nd, const char *path, joint_fn fn)
+int sch_per_joint(conv *cv, const ynode *nd, const char *path, joint_fn fn)
 {
     char names[128], what[160];
-    joint_list(cv, names, sizeof names);
+    sch_joint_list(cv, names, sizeof names);
     snprintf(what, sizeof what, "a mapping of joints (%s)", names);
-    if (need_map(cv, nd, path, what) < 0)
+    if (sch_need_map(cv, nd, path, what) < 0)
         return -1;
     for (int i = 0; i < nd->n; i++) {
         const yentry *en = &nd->entries[i];
-        int j = joint_index(cv, en->key);
+        int j = sch_joint_index(cv, en->key);
         if (j < 0)
             return yfail_key(cv->err, en, "unknown joint '%s' in %s for model %s; allowed: %s",
                              en->key, path, cv->info->name, names);
         char sub[256];
-        if (fn(cv, j, en->val, join(sub, sizeof sub, path, en->key)) < 0)
+        if (fn(cv, j, en->val, sch_join(sub, sizeof sub, path, en->key)) < 0)
             return -1;
     }
     return 0;
 }
 
 /* Joint j takes an input (a command, an actuator). */
-static int need_actuated(conv *cv, int j, const ynode *nd, const char *path)
+int sch_need_actuated(conv *cv, int j, const ynode *nd, const char *path)
 {
     if (!cv->info->actuated[j])
         return yfail(cv->err, nd, path, "joint %s of model %s takes no input",
@@ -364,19 +329,18 @@ static int need_actuated(conv *cv, int j, const ynode *nd, const char *path)
     return 0;
 }
 
-/* The scene's explode_limit (read in the first pass), as a bound on a position,
- * velocity or noise amplitude: a value beyond it can never be part of a valid state. */
-static int get_within_explode(conv *cv, const ynode *nd, const char *path, bool nonneg,
-                              double *out)
+/* The scene's explode_limit (read in the first pass), as a bound on the magnitude of a
+ * position, velocity or noise amplitude: a value beyond it can never be part of a valid
+ * state. A sign the value must have is the core's rule. */
+int sch_get_within_explode(conv *cv, const ynode *nd, const char *path, double *out)
 {
-    double lim = cv->sc->sim.explode_limit;
+    double lim = fabs(cv->sc->sim.explode_limit); /* its own sign: the core's check */
     double v = 0.0;
-    if (get_number(cv, nd, path, &v) < 0)
+    if (sch_get_number(cv, nd, path, &v) < 0)
         return -1;
-    if (!(v <= lim) || !(nonneg ? v >= 0.0 : v >= -lim))
+    if (!(fabs(v) <= lim))
         return yfail(cv->err, nd, path, "expected a number from %.6g to %.6g (explode_limit%s), "
-                     "got %s", nonneg ? 0.0 : -lim, lim,
-                     cv->explode_limit ? "" : ", default", nd->text);
+                     "got %s", -lim, lim, cv->explode_limit ? "" : ", default", nd->text);
     *out = v;
     return 0;
 }
@@ -401,7 +365,7 @@ static int key_parameters(conv *cv, const ynode *nd, const char *path)
     }
     char what[300];
     snprintf(what, sizeof what, "a mapping (keys: %s)", allowed);
-    if (need_map(cv, nd, path, what) < 0)
+    if (sch_need_map(cv, nd, path, what) < 0)
         return -1;
     for (int i = 0; i < nd->n; i++) {
         const yentry *en = &nd->entries[i];
@@ -410,7 +374,7 @@ static int key_parameters(conv *cv, const ynode *nd, const char *path)
             return yfail_key(cv->err, en, "unknown parameter '%s' for model %s; allowed: %s",
                              en->key, info->name, allowed);
         char sub[256];
-        join(sub, sizeof sub, path, en->key);
+        sch_join(sub, sizeof sub, path, en->key);
         const char *unit = info->param_units[k] ? info->param_units[k] : "SI";
         double lo = 0.0, hi = F_MAX, v = 0.0;
         for (size_t w = 0; w < sizeof k_param_windows / sizeof k_param_windows[0]; w++) {
@@ -419,7 +383,7 @@ static int key_parameters(conv *cv, const ynode *nd, const char *path)
                 hi = k_param_windows[w].hi;
             }
         }
-        if (get_number(cv, en->val, sub, &v) < 0)
+        if (sch_get_number(cv, en->val, sub, &v) < 0)
             return -1;
         if (v != 0.0 && !(fabs(v) >= lo && fabs(v) <= hi))
             return yfail(cv->err, en->val, sub,
@@ -437,7 +401,7 @@ static int get_vector(conv *cv, const ynode *nd, const char *path, double *out)
     const lag_model_info *info = cv->info;
     int nq = info->nq;
     char names[128];
-    joint_list(cv, names, sizeof names);
+    sch_joint_list(cv, names, sizeof names);
     if (ynode_is_null(nd))
         return yfail(cv->err, nd, path, "missing value: expected a sequence of %d numbers (%s)",
                      nq, names);
@@ -451,7 +415,7 @@ static int get_vector(conv *cv, const ynode *nd, const char *path, double *out)
     for (int i = 0; i < nq; i++) {
         char sub[256];
         snprintf(sub, sizeof sub, "%s[%d]", path, i);
-        if (get_within_explode(cv, nd->items[i], sub, false, &out[i]) < 0)
+        if (sch_get_number(cv, nd->items[i], sub, &out[i]) < 0) /* within explode_limit: the core's check */
             return -1;
     }
     return 0;
@@ -475,7 +439,7 @@ static const keyrow k_initial_keys[] = {
 
 static int key_initial(conv *cv, const ynode *nd, const char *path)
 {
-    return convert_map(cv, nd, path, k_initial_keys, "key");
+    return sch_convert_map(cv, nd, path, k_initial_keys, "key");
 }
 
 /* ================================================================ integrator */
@@ -491,7 +455,7 @@ static int key_method(conv *cv, const ynode *nd, const char *path)
     char what[300];
     snprintf(what, sizeof what, "a method (%s)", allowed);
     const char *s;
-    if (get_string(cv, nd, path, what, &s) < 0)
+    if (sch_get_string(cv, nd, path, what, &s) < 0)
         return -1;
     int m = lag_method_from_name(s);
     if (m < 0)
@@ -503,28 +467,28 @@ static int key_method(conv *cv, const ynode *nd, const char *path)
 static int key_dt(conv *cv, const ynode *nd, const char *path)
 {
     cv->dt = nd;
-    return get_range(cv, nd, path, &R_DT, &cv->sc->sim.integrator.dt);
+    return sch_get_magnitude(cv, nd, path, &R_DT, &cv->sc->sim.integrator.dt);
 }
 
 static int key_rtol(conv *cv, const ynode *nd, const char *path)
 {
-    return get_range(cv, nd, path, &R_RTOL, &cv->sc->sim.integrator.rtol);
+    return sch_get_magnitude(cv, nd, path, &R_RTOL, &cv->sc->sim.integrator.rtol);
 }
 
 static int key_atol(conv *cv, const ynode *nd, const char *path)
 {
-    return get_range(cv, nd, path, &R_ATOL, &cv->sc->sim.integrator.atol);
+    return sch_get_magnitude(cv, nd, path, &R_ATOL, &cv->sc->sim.integrator.atol);
 }
 
 static int key_dt_min(conv *cv, const ynode *nd, const char *path)
 {
-    return get_range(cv, nd, path, &R_DT_MIN, &cv->sc->sim.integrator.dt_min);
+    return sch_get_magnitude(cv, nd, path, &R_DT_MIN, &cv->sc->sim.integrator.dt_min);
 }
 
 static int key_max_iter(conv *cv, const ynode *nd, const char *path)
 {
     long long v = 0;
-    if (get_int(cv, nd, path, 1, 1000, &v) < 0)
+    if (sch_get_int(cv, nd, path, INT_MIN, INT_MAX, &v) < 0) /* 1..1000: the core's check */
         return -1;
     cv->sc->sim.integrator.max_iter = (int)v;
     return 0;
@@ -534,34 +498,37 @@ static int key_max_iter(conv *cv, const ynode *nd, const char *path)
 static int key_max_steps(conv *cv, const ynode *nd, const char *path)
 {
     long long v = 0;
-    if (get_int(cv, nd, path, 1, 1000000, &v) < 0)
+    if (sch_get_int(cv, nd, path, INT_MIN, INT_MAX, &v) < 0) /* >= 1: the core's check */
         return -1;
+    if (v > 1000000)
+        return yfail(cv->err, nd, path, "expected an integer of at most 1000000 (steps per "
+                     "tick), got %s", nd->text);
     cv->sc->sim.integrator.max_steps = (int)v;
     return 0;
 }
 
 static int key_newton_tol(conv *cv, const ynode *nd, const char *path)
 {
-    return get_range(cv, nd, path, &R_NEWTON_TOL, &cv->sc->sim.integrator.newton_tol);
+    return sch_get_magnitude(cv, nd, path, &R_NEWTON_TOL, &cv->sc->sim.integrator.newton_tol);
 }
 
 /* integrator.error: the largest difference from the exact q over integrator.horizon that
  * the run may have; the daemon then chooses method and dt itself (lagsimd's calibration) */
 static int key_error(conv *cv, const ynode *nd, const char *path)
 {
-    return get_range(cv, nd, path, &R_ERROR, &cv->sc->accuracy.error);
+    return sch_get_range(cv, nd, path, &R_ERROR, &cv->sc->accuracy.error);
 }
 
 static int key_horizon(conv *cv, const ynode *nd, const char *path)
 {
-    return get_range(cv, nd, path, &R_HORIZON, &cv->sc->accuracy.horizon);
+    return sch_get_range(cv, nd, path, &R_HORIZON, &cv->sc->accuracy.horizon);
 }
 
 /* integrator.estimate_every: the live error estimate's shadow run every N periods (0: off) */
 static int key_estimate_every(conv *cv, const ynode *nd, const char *path)
 {
     long long v = 0;
-    if (get_int(cv, nd, path, 0, 1000000, &v) < 0)
+    if (sch_get_int(cv, nd, path, 0, 1000000, &v) < 0)
         return -1;
     cv->sc->accuracy.estimate_every = (int)v;
     return 0;
@@ -585,7 +552,7 @@ static const keyrow k_integrator_keys[] = {
 static int key_integrator(conv *cv, const ynode *nd, const char *path)
 {
     cv->integrator = nd;
-    return convert_map(cv, nd, path, k_integrator_keys, "key");
+    return sch_convert_map(cv, nd, path, k_integrator_keys, "key");
 }
 
 /* ================================================================ rates, limits */
@@ -593,13 +560,13 @@ static int key_integrator(conv *cv, const ynode *nd, const char *path)
 static int key_publish_hz(conv *cv, const ynode *nd, const char *path)
 {
     cv->publish_hz = nd;
-    return get_range(cv, nd, path, &R_PUBLISH_HZ, &cv->sc->publish_hz);
+    return sch_get_range(cv, nd, path, &R_PUBLISH_HZ, &cv->sc->publish_hz);
 }
 
 static int key_explode_limit(conv *cv, const ynode *nd, const char *path)
 {
     cv->explode_limit = nd;
-    return get_range(cv, nd, path, &R_EXPLODE, &cv->sc->sim.explode_limit);
+    return sch_get_magnitude(cv, nd, path, &R_EXPLODE, &cv->sc->sim.explode_limit);
 }
 
 /* ================================================================ realtime */
@@ -607,7 +574,7 @@ static int key_explode_limit(conv *cv, const ynode *nd, const char *path)
 static int key_mode(conv *cv, const ynode *nd, const char *path)
 {
     const char *s;
-    if (get_string(cv, nd, path, "a mode (realtime, fast, lockstep)", &s) < 0)
+    if (sch_get_string(cv, nd, path, "a mode (realtime, fast, lockstep)", &s) < 0)
         return -1;
     for (int m = LAG_RT_REALTIME; m <= LAG_RT_LOCKSTEP; m++) {
         if (strcmp(s, lag_rt_mode_name((lag_rt_mode)m)) == 0) {
@@ -621,7 +588,7 @@ static int key_mode(conv *cv, const ynode *nd, const char *path)
 static int key_rate(conv *cv, const ynode *nd, const char *path)
 {
     cv->rate = nd;
-    return get_range(cv, nd, path, &R_RATE, &cv->sc->realtime.rate);
+    return sch_get_range(cv, nd, path, &R_RATE, &cv->sc->realtime.rate);
 }
 
 /* At least one control period: a shorter timeout would zero the command of a controller
@@ -629,7 +596,7 @@ static int key_rate(conv *cv, const ynode *nd, const char *path)
 static int key_command_timeout(conv *cv, const ynode *nd, const char *path)
 {
     double period = (double)cv->sc->ticks_per_period * cv->sc->sim.integrator.dt;
-    if (get_number(cv, nd, path, &cv->sc->realtime.command_timeout) < 0)
+    if (sch_get_number(cv, nd, path, &cv->sc->realtime.command_timeout) < 0)
         return -1;
     double v = cv->sc->realtime.command_timeout;
     if (!(v >= period * (1.0 - 1e-9)) || !(v <= T_MAX))
@@ -640,30 +607,30 @@ static int key_command_timeout(conv *cv, const ynode *nd, const char *path)
 
 static int key_lockstep_timeout(conv *cv, const ynode *nd, const char *path)
 {
-    return get_range(cv, nd, path, &R_LOCKSTEP_TIMEOUT, &cv->sc->realtime.lockstep_timeout);
+    return sch_get_range(cv, nd, path, &R_LOCKSTEP_TIMEOUT, &cv->sc->realtime.lockstep_timeout);
 }
 
 static int key_lockstep_retry(conv *cv, const ynode *nd, const char *path)
 {
-    return get_range(cv, nd, path, &R_LOCKSTEP_RETRY, &cv->sc->realtime.lockstep_retry);
+    return sch_get_range(cv, nd, path, &R_LOCKSTEP_RETRY, &cv->sc->realtime.lockstep_retry);
 }
 
 static int key_status_hz(conv *cv, const ynode *nd, const char *path)
 {
-    return get_range(cv, nd, path, &R_STATUS_HZ, &cv->sc->realtime.status_hz);
+    return sch_get_range(cv, nd, path, &R_STATUS_HZ, &cv->sc->realtime.status_hz);
 }
 
 /* effort_limit: {actuated joint: bound} */
 static int effort_limit_joint(conv *cv, int j, const ynode *nd, const char *path)
 {
-    if (need_actuated(cv, j, nd, path) < 0)
+    if (sch_need_actuated(cv, j, nd, path) < 0)
         return -1;
-    return get_range(cv, nd, path, &R_EFFORT, &cv->sc->realtime.effort_limit[j]);
+    return sch_get_range(cv, nd, path, &R_EFFORT, &cv->sc->realtime.effort_limit[j]);
 }
 
 static int key_effort_limit(conv *cv, const ynode *nd, const char *path)
 {
-    return per_joint(cv, nd, path, effort_limit_joint);
+    return sch_per_joint(cv, nd, path, effort_limit_joint);
 }
 
 static int key_start(conv *cv, const ynode *nd, const char *path);
@@ -683,7 +650,7 @@ static const keyrow k_realtime_keys[] = {
 static int key_start(conv *cv, const ynode *nd, const char *path)
 {
     const char *s;
-    if (get_string(cv, nd, path, "a start (running, paused, first_command)", &s) < 0)
+    if (sch_get_string(cv, nd, path, "a start (running, paused, first_command)", &s) < 0)
         return -1;
     for (int k = LAG_RT_START_RUNNING; k <= LAG_RT_START_FIRST_COMMAND; k++) {
         if (strcmp(s, lag_rt_start_name((lag_rt_start)k)) == 0) {
@@ -697,7 +664,7 @@ static int key_start(conv *cv, const ynode *nd, const char *path)
 
 static int key_realtime(conv *cv, const ynode *nd, const char *path)
 {
-    return convert_map(cv, nd, path, k_realtime_keys, "key");
+    return sch_convert_map(cv, nd, path, k_realtime_keys, "key");
 }
 
 /* ================================================================ lcm */
@@ -711,7 +678,7 @@ static int key_url(conv *cv, const ynode *nd, const char *path)
         return 0;
     }
     const char *s;
-    if (get_string(cv, nd, path, "an LCM URL (e.g. udpm://239.255.76.67:7667?ttl=0)", &s) < 0)
+    if (sch_get_string(cv, nd, path, "an LCM URL (e.g. udpm://239.255.76.67:7667?ttl=0)", &s) < 0)
         return -1;
     if (strlen(s) >= sizeof cv->sc->lcm.url)
         return yfail(cv->err, nd, path, "URL longer than %zu characters",
@@ -723,7 +690,7 @@ static int key_url(conv *cv, const ynode *nd, const char *path)
 static int key_prefix(conv *cv, const ynode *nd, const char *path)
 {
     const char *s;
-    if (get_string(cv, nd, path, "a channel prefix of [A-Za-z0-9_]", &s) < 0)
+    if (sch_get_string(cv, nd, path, "a channel prefix of [A-Za-z0-9_]", &s) < 0)
         return -1;
     size_t n = strlen(s);
     if (n == 0 || n > LAG_SCENE_PREFIX_MAX)
@@ -745,7 +712,7 @@ static int key_prefix(conv *cv, const ynode *nd, const char *path)
 
 static int key_allow_lan(conv *cv, const ynode *nd, const char *path)
 {
-    return get_bool(cv, nd, path, &cv->sc->lcm.allow_lan);
+    return sch_get_bool(cv, nd, path, &cv->sc->lcm.allow_lan);
 }
 
 static const keyrow k_lcm_keys[] = {
@@ -757,377 +724,7 @@ static const keyrow k_lcm_keys[] = {
 
 static int key_lcm(conv *cv, const ynode *nd, const char *path)
 {
-    return convert_map(cv, nd, path, k_lcm_keys, "key");
-}
-
-/* ================================================================ effects */
-
-/* Each section present switches its effect on (lag_effects_def.enabled); per-joint
- * sections are mappings from joint names to values. Values are checked where they are
- * read, so errors point at the offending node. */
-
-static lag_effects_def *fx(conv *cv) { return &cv->sc->sim.effects; }
-
-/* gravity: {enabled: bool, g: m/s^2} -- applied after parameters (see the end) */
-static int key_gravity_enabled(conv *cv, const ynode *nd, const char *path)
-{
-    bool b = true;
-    if (get_bool(cv, nd, path, &b) < 0)
-        return -1;
-    cv->gravity_enabled = b ? 1 : 0;
-    return 0;
-}
-
-static int key_gravity_g(conv *cv, const ynode *nd, const char *path)
-{
-    if (get_range(cv, nd, path, &R_GRAVITY, &cv->gravity_g) < 0)
-        return -1;
-    cv->gravity_g_node = nd;
-    return 0;
-}
-
-static const keyrow k_gravity_keys[] = {
-    {"enabled", key_gravity_enabled, K_OTHER}, /* false: g = 0 */
-    {"g", key_gravity_g, K_NUMBER},             /* m/s^2, replaces parameters.g */
-    {NULL, NULL, K_OTHER, NULL, NULL},
-};
-
-static int key_effect_gravity(conv *cv, const ynode *nd, const char *path)
-{
-    if (nd->kind == YN_SCALAR && !ynode_is_null(nd))
-        return key_gravity_enabled(cv, nd, path); /* gravity: false */
-    return convert_map(cv, nd, path, k_gravity_keys, "key");
-}
-
-/* damping: {joint: b}, N s/m or N m s/rad */
-static int damping_joint(conv *cv, int j, const ynode *nd, const char *path)
-{
-    return get_range(cv, nd, path, &R_DAMPING, &fx(cv)->damping[j]);
-}
-
-static int key_effect_damping(conv *cv, const ynode *nd, const char *path)
-{
-    fx(cv)->enabled |= LAG_EFF_DAMPING;
-    return per_joint(cv, nd, path, damping_joint);
-}
-
-/* friction: {joint: {static: mu_s, kinetic: mu_k}}, N or N m */
-static int fr_static(conv *cv, const ynode *nd, const char *path)
-{
-    return get_range(cv, nd, path, &R_FRICTION, &fx(cv)->friction_static[cv->cur_joint]);
-}
-
-static int fr_kinetic(conv *cv, const ynode *nd, const char *path)
-{
-    return get_range(cv, nd, path, &R_FRICTION, &fx(cv)->friction_kinetic[cv->cur_joint]);
-}
-
-static const keyrow k_friction_keys[] = {
-    {"static", fr_static, K_NUMBER},   /* largest holding force, N or N m */
-    {"kinetic", fr_kinetic, K_NUMBER}, /* sliding force, N or N m */
-    {NULL, NULL, K_OTHER, NULL, NULL},
-};
-
-static int friction_joint(conv *cv, int j, const ynode *nd, const char *path)
-{
-    cv->cur_joint = j;
-    fx(cv)->friction_static[j] = NAN; /* "not given": defaults to kinetic below */
-    if (convert_map(cv, nd, path, k_friction_keys, "key") < 0)
-        return -1;
-    lag_effects_def *e = fx(cv);
-    if (isnan(e->friction_static[j])) e->friction_static[j] = e->friction_kinetic[j];
-    return 0; /* static >= kinetic: the core's check */
-}
-
-static int key_effect_friction(conv *cv, const ynode *nd, const char *path)
-{
-    fx(cv)->enabled |= LAG_EFF_FRICTION;
-    return per_joint(cv, nd, path, friction_joint);
-}
-
-/* limits: {joint: {lower, upper, restitution}}, plus rest_velocity for all */
-static int lim_lower(conv *cv, const ynode *nd, const char *path)
-{
-    cv->limit_seen |= 1;
-    return get_within_explode(cv, nd, path, false, &fx(cv)->limit_lower[cv->cur_joint]);
-}
-
-static int lim_upper(conv *cv, const ynode *nd, const char *path)
-{
-    cv->limit_seen |= 2;
-    return get_within_explode(cv, nd, path, false, &fx(cv)->limit_upper[cv->cur_joint]);
-}
-
-/* in [0, 1]: the core's check */
-static int lim_restitution(conv *cv, const ynode *nd, const char *path)
-{
-    return get_number(cv, nd, path, &fx(cv)->restitution[cv->cur_joint]);
-}
-
-static const keyrow k_limit_keys[] = {
-    {"lower", lim_lower, K_NUMBER},             /* m or rad, within explode_limit */
-    {"upper", lim_upper, K_NUMBER},             /* m or rad, within explode_limit */
-    {"restitution", lim_restitution, K_NUMBER}, /* [0, 1], default 0 */
-    {NULL, NULL, K_OTHER, NULL, NULL},
-};
-
-/* m/s or rad/s: an impact slower than this ends in resting contact */
-static int key_rest_velocity(conv *cv, const ynode *nd, const char *path)
-{
-    return get_within_explode(cv, nd, path, true, &fx(cv)->rest_velocity);
-}
-
-/* the key of the limits section beside the joints */
-static const keyrow k_limits_extra[] = {
-    {"rest_velocity", key_rest_velocity, K_NUMBER, NULL, NULL},
-    {NULL, NULL, K_OTHER, NULL, NULL},
-};
-
-static int key_effect_limits(conv *cv, const ynode *nd, const char *path)
-{
-    fx(cv)->enabled |= LAG_EFF_LIMITS;
-    if (need_map(cv, nd, path, "a mapping of joints and rest_velocity") < 0)
-        return -1;
-    for (int i = 0; i < nd->n; i++) {
-        const yentry *en = &nd->entries[i];
-        char sub[256];
-        join(sub, sizeof sub, path, en->key);
-        if (strcmp(en->key, k_limits_extra[0].name) == 0) {
-            if (k_limits_extra[0].fn(cv, en->val, sub) < 0) return -1;
-            continue;
-        }
-        int j = joint_index(cv, en->key);
-        if (j < 0) {
-            char names[128];
-            joint_list(cv, names, sizeof names);
-            return yfail_key(cv->err, en, "unknown joint '%s' in %s for model %s; allowed: %s, "
-                             "rest_velocity", en->key, path, cv->info->name, names);
-        }
-        cv->cur_joint = j;
-        cv->limit_seen = 0;
-        if (convert_map(cv, en->val, sub, k_limit_keys, "key") < 0)
-            return -1;
-        if (cv->limit_seen != 3)
-            return yfail(cv->err, en->val, sub, "expected both lower and upper");
-        fx(cv)->limit_on[j] = true; /* lower < upper: the core's check */
-    }
-    return 0;
-}
-
-/* floor (stick): {restitution, rest_velocity, flight} */
-static int floor_restitution(conv *cv, const ynode *nd, const char *path)
-{
-    return get_number(cv, nd, path, &fx(cv)->floor_restitution);
-}
-
-static int floor_flight(conv *cv, const ynode *nd, const char *path)
-{
-    return get_bool(cv, nd, path, &fx(cv)->floor_flight);
-}
-
-static const keyrow k_floor_keys[] = {
-    {"restitution", floor_restitution, K_NUMBER}, /* [0, 1], default 0 */
-    {"rest_velocity", key_rest_velocity, K_NUMBER}, /* rad/s, default 1e-3 */
-    {"flight", floor_flight, K_OTHER}, /* bool, default true: lift-off flies (else a fault) */
-    {NULL, NULL, K_OTHER, NULL, NULL},
-};
-
-/* which models have a floor, and where the initial state must then be: the core's check */
-static int key_effect_floor(conv *cv, const ynode *nd, const char *path)
-{
-    fx(cv)->enabled |= LAG_EFF_FLOOR;
-    if (ynode_is_null(nd))
-        return 0; /* floor: with defaults */
-    return convert_map(cv, nd, path, k_floor_keys, "key");
-}
-
-/* actuator: {joint: {max, lag}} on actuated joints */
-static int act_max(conv *cv, const ynode *nd, const char *path)
-{
-    return get_range(cv, nd, path, &R_EFFORT, &fx(cv)->actuator_max[cv->cur_joint]);
-}
-
-/* The lag is advanced exactly (exp(-dt/lag)) and is stable for any value. */
-static int act_lag(conv *cv, const ynode *nd, const char *path)
-{
-    return get_range(cv, nd, path, &R_TIME, &fx(cv)->actuator_tau[cv->cur_joint]);
-}
-
-static const keyrow k_actuator_keys[] = {
-    {"max", act_max, K_NUMBER}, /* |effort| bound, N or N m */
-    {"lag", act_lag, K_NUMBER}, /* first-order time constant, s */
-    {NULL, NULL, K_OTHER, NULL, NULL},
-};
-
-static int actuator_joint(conv *cv, int j, const ynode *nd, const char *path)
-{
-    if (need_actuated(cv, j, nd, path) < 0)
-        return -1;
-    cv->cur_joint = j;
-    return convert_map(cv, nd, path, k_actuator_keys, "key");
-}
-
-static int key_effect_actuator(conv *cv, const ynode *nd, const char *path)
-{
-    fx(cv)->enabled |= LAG_EFF_ACTUATOR;
-    return per_joint(cv, nd, path, actuator_joint);
-}
-
-/* disturbance: [{t, joint, impulse | force + duration}, ...] */
-static int dist_t(conv *cv, const ynode *nd, const char *path)
-{
-    return get_range(cv, nd, path, &R_TIME, &cv->cur_dist->t);
-}
-
-static int dist_joint(conv *cv, const ynode *nd, const char *path)
-{
-    const char *name;
-    char names[128];
-    joint_list(cv, names, sizeof names);
-    char what[160];
-    snprintf(what, sizeof what, "a joint name (%s)", names);
-    if (get_string(cv, nd, path, what, &name) < 0)
-        return -1;
-    int j = joint_index(cv, name);
-    if (j < 0)
-        return yfail(cv->err, nd, path, "unknown joint '%s'; allowed: %s", name, names);
-    cv->cur_dist->joint = j;
-    return 0;
-}
-
-static int dist_impulse(conv *cv, const ynode *nd, const char *path)
-{
-    cv->cur_dist_kind |= 1;
-    cv->cur_dist->impulse = true;
-    return get_in(cv, nd, path, -F_MAX, F_MAX, false, "N s or N m s", &cv->cur_dist->value);
-}
-
-static int dist_force(conv *cv, const ynode *nd, const char *path)
-{
-    cv->cur_dist_kind |= 2;
-    cv->cur_dist->impulse = false;
-    return get_in(cv, nd, path, -F_MAX, F_MAX, false, "N or N m", &cv->cur_dist->value);
-}
-
-/* A force acts over whole ticks: at least one dt (a shorter push is an impulse). */
-static int dist_duration(conv *cv, const ynode *nd, const char *path)
-{
-    double dt = cv->sc->sim.integrator.dt;
-    if (get_number(cv, nd, path, &cv->cur_dist->duration) < 0)
-        return -1;
-    double v = cv->cur_dist->duration;
-    if (!(v >= dt) || !(v <= T_MAX))
-        return yfail(cv->err, nd, path, "expected a number from %.6g (integrator.dt: a force "
-                     "acts for whole ticks; a shorter push is an impulse) to %.6g (s), got %s",
-                     dt, T_MAX, nd->text);
-    return 0;
-}
-
-static const keyrow k_dist_keys[] = {
-    {"t", dist_t, K_NUMBER},               /* s */
-    {"joint", dist_joint, K_OTHER},       /* joint name */
-    {"impulse", dist_impulse, K_NUMBER},   /* N s or N m s */
-    {"force", dist_force, K_NUMBER},       /* N or N m */
-    {"duration", dist_duration, K_NUMBER}, /* s, with force */
-    {NULL, NULL, K_OTHER, NULL, NULL},
-};
-
-static int key_effect_disturbance(conv *cv, const ynode *nd, const char *path)
-{
-    lag_effects_def *e = fx(cv);
-    e->enabled |= LAG_EFF_DISTURBANCE;
-    if (nd->kind != YN_SEQ)
-        return yfail(cv->err, nd, path,
-                     "expected a sequence of {t, joint, impulse} or {t, joint, force, duration}");
-    if (nd->n > LAG_MAX_DISTURBANCES)
-        return yfail(cv->err, nd, path, "at most %d disturbances, got %d",
-                     LAG_MAX_DISTURBANCES, nd->n);
-    e->n_disturbances = nd->n;
-    for (int k = 0; k < nd->n; k++) {
-        char sub[256];
-        snprintf(sub, sizeof sub, "%s[%d]", path, k);
-        cv->cur_dist = &e->disturbances[k];
-        memset(cv->cur_dist, 0, sizeof *cv->cur_dist);
-        cv->cur_dist->joint = -1;
-        cv->cur_dist->t = NAN;
-        cv->cur_dist_kind = 0;
-        if (convert_map(cv, nd->items[k], sub, k_dist_keys, "key") < 0)
-            return -1;
-        const ynode *it = nd->items[k];
-        if (isnan(cv->cur_dist->t) || cv->cur_dist->joint < 0)
-            return yfail(cv->err, it, sub, "expected both t and joint");
-        if (cv->cur_dist_kind != 1 && cv->cur_dist_kind != 2)
-            return yfail(cv->err, it, sub, "expected exactly one of impulse or force");
-        if (cv->cur_dist_kind == 2 && !(cv->cur_dist->duration > 0))
-            return yfail(cv->err, it, sub, "a force needs a duration (s)");
-        if (cv->cur_dist_kind == 1 && cv->cur_dist->duration != 0)
-            return yfail(cv->err, it, sub, "an impulse takes no duration");
-    }
-    return 0;
-}
-
-/* noise: {seed, q: {joint: std}, qd: {joint: std}}; the published state stays within a
- * few explode_limits (the normal deviates are bounded by about 8.6). */
-static int noise_q_joint(conv *cv, int j, const ynode *nd, const char *path)
-{
-    return get_within_explode(cv, nd, path, true, &fx(cv)->noise_q[j]);
-}
-
-static int noise_qd_joint(conv *cv, int j, const ynode *nd, const char *path)
-{
-    return get_within_explode(cv, nd, path, true, &fx(cv)->noise_qd[j]);
-}
-
-static int noise_q(conv *cv, const ynode *nd, const char *path)
-{
-    return per_joint(cv, nd, path, noise_q_joint);
-}
-
-static int noise_qd(conv *cv, const ynode *nd, const char *path)
-{
-    return per_joint(cv, nd, path, noise_qd_joint);
-}
-
-static int noise_seed(conv *cv, const ynode *nd, const char *path)
-{
-    long long v = 0;
-    if (get_int(cv, nd, path, 0, 9007199254740991LL, &v) < 0) /* 2^53 - 1: exact in JSON */
-        return -1;
-    fx(cv)->noise_seed = (uint64_t)v;
-    return 0;
-}
-
-static const keyrow k_noise_keys[] = {
-    {"seed", noise_seed, K_INTEGER}, /* integer, default 1 */
-    {"q", noise_q, K_JOINTS},       /* std dev per joint, m or rad */
-    {"qd", noise_qd, K_JOINTS},     /* std dev per joint, m/s or rad/s */
-    {NULL, NULL, K_OTHER, NULL, NULL},
-};
-
-static int key_effect_noise(conv *cv, const ynode *nd, const char *path)
-{
-    fx(cv)->enabled |= LAG_EFF_NOISE;
-    return convert_map(cv, nd, path, k_noise_keys, "key");
-}
-
-static const keyrow k_effects[] = {
-    {"gravity", key_effect_gravity, K_MAP, k_gravity_keys},
-    {"damping", key_effect_damping, K_JOINTS},
-    {"friction", key_effect_friction, K_JOINTS, k_friction_keys},
-    {"limits", key_effect_limits, K_JOINTS, k_limit_keys, k_limits_extra},
-    {"floor", key_effect_floor, K_MAP, k_floor_keys},
-    {"actuator", key_effect_actuator, K_JOINTS, k_actuator_keys},
-    {"disturbance", key_effect_disturbance, K_LIST, k_dist_keys},
-    {"noise", key_effect_noise, K_MAP, k_noise_keys},
-    {NULL, NULL, K_OTHER, NULL, NULL},
-};
-
-static int key_effects(conv *cv, const ynode *nd, const char *path)
-{
-    /* `effects:` with nothing = no effects */
-    if (ynode_is_null(nd))
-        return 0;
-    return convert_map(cv, nd, path, k_effects, "effect");
+    return sch_convert_map(cv, nd, path, k_lcm_keys, "key");
 }
 
 /* ================================================================ reference */
@@ -1195,36 +792,36 @@ static int ref_type(conv *cv, const ynode *nd, const char *path)
 
 static int ref_start(conv *cv, const ynode *nd, const char *path)
 {
-    return get_range(cv, nd, path, &R_REF_START, &cv->cur_ref->start);
+    return sch_get_range(cv, nd, path, &R_REF_START, &cv->cur_ref->start);
 }
 
 /* amplitude and offset: a position, within explode_limit */
 static int ref_amplitude(conv *cv, const ynode *nd, const char *path)
 {
-    return get_within_explode(cv, nd, path, false, &cv->cur_ref->amplitude);
+    return sch_get_within_explode(cv, nd, path, &cv->cur_ref->amplitude);
 }
 
 static int ref_offset(conv *cv, const ynode *nd, const char *path)
 {
-    return get_within_explode(cv, nd, path, false, &cv->cur_ref->offset);
+    return sch_get_within_explode(cv, nd, path, &cv->cur_ref->offset);
 }
 
 static int ref_frequency(conv *cv, const ynode *nd, const char *path)
 {
     if (ref_key_allowed(cv, nd, path, "frequency") < 0) return -1;
-    return get_range(cv, nd, path, &R_REF_FREQUENCY, &cv->cur_ref->frequency);
+    return sch_get_range(cv, nd, path, &R_REF_FREQUENCY, &cv->cur_ref->frequency);
 }
 
 static int ref_frequency_end(conv *cv, const ynode *nd, const char *path)
 {
     if (ref_key_allowed(cv, nd, path, "frequency_end") < 0) return -1;
-    return get_range(cv, nd, path, &R_REF_FREQUENCY, &cv->cur_ref->frequency_end);
+    return sch_get_range(cv, nd, path, &R_REF_FREQUENCY, &cv->cur_ref->frequency_end);
 }
 
 static int ref_duration(conv *cv, const ynode *nd, const char *path)
 {
     if (ref_key_allowed(cv, nd, path, "duration") < 0) return -1;
-    return get_range(cv, nd, path, &R_REF_DURATION, &cv->cur_ref->duration);
+    return sch_get_range(cv, nd, path, &R_REF_DURATION, &cv->cur_ref->duration);
 }
 
 /* points: [[t, w], ...], t in s from start (strictly increasing), w a position within
@@ -1244,12 +841,12 @@ static int ref_points(conv *cv, const ynode *nd, const char *path)
         if (it->kind != YN_SEQ || it->n != 2)
             return yfail(cv->err, it, sub, "expected a point [t, w] (two numbers)");
         snprintf(el, sizeof el, "%s[0]", sub);
-        if (get_range(cv, it->items[0], el, &R_REF_START, &ref->point_t[k]) < 0) return -1;
+        if (sch_get_range(cv, it->items[0], el, &R_REF_START, &ref->point_t[k]) < 0) return -1;
         if (k > 0 && !(ref->point_t[k] > ref->point_t[k - 1]))
             return yfail(cv->err, it->items[0], el, "the points' times must increase strictly "
                          "(%.17g after %.17g)", ref->point_t[k], ref->point_t[k - 1]);
         snprintf(el, sizeof el, "%s[1]", sub);
-        if (get_within_explode(cv, it->items[1], el, false, &ref->point_w[k]) < 0) return -1;
+        if (sch_get_within_explode(cv, it->items[1], el, &ref->point_w[k]) < 0) return -1;
     }
     ref->n_points = nd->n;
     return 0;
@@ -1275,7 +872,7 @@ static int ref_joint(conv *cv, int j, const ynode *nd, const char *path)
     ref_kind_list(kinds, sizeof kinds);
     snprintf(what, sizeof what, "a reference mapping (type: %s; start, amplitude, offset...)",
              kinds);
-    if (need_map(cv, nd, path, what) < 0)
+    if (sch_need_map(cv, nd, path, what) < 0)
         return -1;
     /* the type first: it decides the other keys and their defaults */
     const yentry *te = ymap_find(nd, "type");
@@ -1283,9 +880,9 @@ static int ref_joint(conv *cv, int j, const ynode *nd, const char *path)
     if (te) {
         char tpath[300];
         const char *name;
-        join(tpath, sizeof tpath, path, "type");
+        sch_join(tpath, sizeof tpath, path, "type");
         snprintf(what, sizeof what, "a reference type (%s)", kinds);
-        if (get_string(cv, te->val, tpath, what, &name) < 0)
+        if (sch_get_string(cv, te->val, tpath, what, &name) < 0)
             return -1;
         kind = lag_ref_kind_from_name(name);
         if (kind < 0)
@@ -1297,7 +894,7 @@ static int ref_joint(conv *cv, int j, const ynode *nd, const char *path)
     cv->cur_ref = ref;
     cv->cur_ref_kind = kind;
     cv->cur_ref_seen = 0;
-    if (convert_map(cv, nd, path, k_ref_keys, "reference key") < 0)
+    if (sch_convert_map(cv, nd, path, k_ref_keys, "reference key") < 0)
         return -1;
     if (kind < 0)
         return yfail(cv->err, nd, path, "a reference needs a type (%s)", kinds);
@@ -1314,7 +911,7 @@ static int ref_joint(conv *cv, int j, const ynode *nd, const char *path)
         char head[64];
         snprintf(head, sizeof head, "%.*s", (int)base, key);
         const yentry *ke = ymap_find(nd, head);
-        join(kpath, sizeof kpath, path, key);
+        sch_join(kpath, sizeof kpath, path, key);
         return yfail(cv->err, ke ? ke->val : nd, kpath, "%s", msg);
     }
     if (!sr->on[j]) sr->n++;
@@ -1328,7 +925,7 @@ static int key_reference(conv *cv, const ynode *nd, const char *path)
     memset(&cv->sc->reference, 0, sizeof cv->sc->reference);
     if (ynode_is_null(nd))
         return 0;
-    return per_joint(cv, nd, path, ref_joint);
+    return sch_per_joint(cv, nd, path, ref_joint);
 }
 
 /* `cases:` are lagsim-eval's (server/tools/eval_case.c reads and checks them); a scene
@@ -1404,68 +1001,93 @@ static int check_period(conv *cv)
     return 0; /* dt_min <= dt: the core's check */
 }
 
-int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, errbuf *err)
+/* The core's own checks of def (parameters, the integrator's settings against each other,
+ * the effects' values against each other and the initial state, which models have a
+ * floor...), made by the core alone: its diagnosis names the field in the scene's own
+ * terms, and the field's node gives the position. */
+static int core_check(conv *cv, const lag_sim_def *def)
 {
-    conv cv = {.err = err, .sc = sc, .root = root, .gravity_enabled = -1};
+    lag_diag d;
+    if (lag_sim_def_check(def, &d) == LAG_OK)
+        return 0;
+    return yfail(cv->err, ytree_lookup(cv->root, d.field), d.field[0] ? d.field : NULL, "%s",
+                 d.message);
+}
+
+/* Step 1: the model comes first (parameters, the length of q and the defaults depend on
+ * it); sc gets the model's defaults. */
+static int convert_model(conv *cv, const char *path)
+{
+    const ynode *root = cv->root;
     if (root->kind != YN_MAP) {
         if (ynode_is_null(root))
-            return yfail(err, root, NULL,
+            return yfail(cv->err, root, NULL,
                          "expected a mapping with the scene's keys (at least 'model'), "
                          "got an empty document");
-        return yfail(err, root, NULL,
+        return yfail(cv->err, root, NULL,
                      "expected a mapping with the scene's keys (at least 'model'), got %s",
                      ynode_kind_name(root));
     }
-
-    /* The model comes first: parameters, the length of q and the defaults depend on it. */
     char models[256];
     model_list(models, sizeof models);
     const yentry *me = ymap_find(root, "model");
     if (!me)
-        return yfail(err, root, NULL, "missing required key 'model' (%s)", models);
+        return yfail(cv->err, root, NULL, "missing required key 'model' (%s)", models);
     const char *mname;
     char what[300];
     snprintf(what, sizeof what, "a model (%s)", models);
-    if (get_string(&cv, me->val, "model", what, &mname) < 0)
+    if (sch_get_string(cv, me->val, "model", what, &mname) < 0)
         return -1;
     int kind = lag_model_kind_from_name(mname);
     if (kind < 0)
-        return yfail(err, me->val, "model", "unknown model '%s'; allowed: %s", mname, models);
+        return yfail(cv->err, me->val, "model", "unknown model '%s'; allowed: %s", mname, models);
+    lag_scene_default(cv->sc, (lag_model_kind)kind);
+    snprintf(cv->sc->path, sizeof cv->sc->path, "%s", path ? path : "");
+    lag_model_default_unfinished(&cv->sc->sim.model, (lag_model_kind)kind);
+    cv->info = lag_model_info_get((lag_model_kind)kind);
+    return 0;
+}
 
-    lag_scene_default(sc, (lag_model_kind)kind);
-    snprintf(sc->path, sizeof sc->path, "%s", path ? path : "");
-    lag_model_default_unfinished(&sc->sim.model, (lag_model_kind)kind);
-    cv.info = lag_model_info_get((lag_model_kind)kind);
-
-    /* Then what the other values are measured against, then the rest in file order. */
+/* Step 2: what the other values are measured against (integrator, publish_hz,
+ * explode_limit), checked by the core at once (a later key's range must not be measured
+ * against a value the core refuses), then the period they make. */
+static int convert_first_keys(conv *cv)
+{
+    lag_scene *sc = cv->sc;
     for (int k = 1; k_first_keys[k]; k++) {
-        const yentry *en = ymap_find(root, k_first_keys[k]);
+        const yentry *en = ymap_find(cv->root, k_first_keys[k]);
         if (!en)
             continue;
         const keyrow *r = k_top_keys;
         while (strcmp(r->name, en->key) != 0)
             r++;
-        if (r->fn(&cv, en->val, en->key) < 0)
+        if (r->fn(cv, en->val, en->key) < 0)
             return -1;
     }
-    if (check_period(&cv) < 0)
+    lag_sim_def first = sc->sim; /* the model's defaults, with their rods' inertias */
+    lag_model_finish(&first.model);
+    if (core_check(cv, &first) < 0 || check_period(cv) < 0)
         return -1;
     /* the watchdog default: 0.5 s, but never shorter than two control periods */
     double period = (double)sc->ticks_per_period * sc->sim.integrator.dt;
     if (sc->realtime.command_timeout < 2.0 * period)
         sc->realtime.command_timeout = 2.0 * period;
-    if (convert_map_skip(&cv, root, "", k_top_keys, "key", k_first_keys) < 0)
-        return -1;
+    return 0;
+}
 
+/* Step 4: what follows from several keys once all are read, then the core's checks. */
+static int convert_finish(conv *cv)
+{
+    lag_scene *sc = cv->sc;
     /* effects.gravity overrides parameters.g (after both are read, whatever their order) */
     int gi = lag_model_param_index(sc->sim.model.kind, "g");
-    if (gi >= 0 && cv.gravity_g_node) sc->sim.model.p[gi] = cv.gravity_g;
-    if (gi >= 0 && cv.gravity_enabled == 0) sc->sim.model.p[gi] = 0.0;
+    if (gi >= 0 && cv->gravity_g_node) sc->sim.model.p[gi] = cv->gravity_g;
+    if (gi >= 0 && cv->gravity_enabled == 0) sc->sim.model.p[gi] = 0.0;
 
     /* realtime.start not given: a lockstep run waits for its controller's first command
      * (it cannot advance without one anyway, and then no start order can lose the first
      * state); realtime and fast run from the start, like a plant switched on */
-    if (!cv.start)
+    if (!cv->start)
         sc->realtime.start = sc->realtime.mode == LAG_RT_LOCKSTEP ? LAG_RT_START_FIRST_COMMAND
                                                                   : LAG_RT_START_RUNNING;
 
@@ -1475,8 +1097,8 @@ int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, err
     /* Real time: at most PERIODS_PER_S_MAX control periods per wall second. */
     if (sc->realtime.mode == LAG_RT_REALTIME &&
         sc->publish_hz * sc->realtime.rate > PERIODS_PER_S_MAX * (1.0 + 1e-12)) {
-        const ynode *at = cv.rate ? cv.rate : cv.publish_hz;
-        return yfail(err, at, cv.rate ? "realtime.rate" : "publish_hz",
+        const ynode *at = cv->rate ? cv->rate : cv->publish_hz;
+        return yfail(cv->err, at, cv->rate ? "realtime.rate" : "publish_hz",
                      "publish_hz * realtime.rate = %.6g control periods per wall second: at "
                      "most %.0f in realtime mode (mode: fast runs as fast as it can)",
                      sc->publish_hz * sc->realtime.rate, PERIODS_PER_S_MAX);
@@ -1485,17 +1107,19 @@ int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, err
     /* lcm.url, with lcm.allow_lan wherever it was given */
     char msg[256];
     if (lag_scene_check_url(sc->lcm.url, sc->lcm.allow_lan, &sc->lcm.ttl, msg, sizeof msg) < 0)
-        return yfail(err, cv.url, "lcm.url", "%s", msg);
+        return yfail(cv->err, cv->url, "lcm.url", "%s", msg);
+    return core_check(cv, &sc->sim);
+}
 
-    /* The core's own checks (parameters, the integrator's settings against each other,
-     * the effects' values against each other and the initial state, which models have a
-     * floor...), made once, by the core: its diagnosis names the field in the scene's own
-     * terms, and the field's node gives the position. */
-    lag_diag d;
-    if (lag_sim_def_check(&sc->sim, &d) != LAG_OK)
-        return yfail(err, ytree_lookup(root, d.field), d.field[0] ? d.field : NULL, "%s",
-                     d.message);
-    return 0;
+int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, errbuf *err)
+{
+    conv cv = {.err = err, .sc = sc, .root = root, .gravity_enabled = -1};
+    if (convert_model(&cv, path) < 0 || convert_first_keys(&cv) < 0)
+        return -1;
+    /* Step 3: every other key, in file order */
+    if (sch_convert_map_skip(&cv, root, "", k_top_keys, "key", k_first_keys) < 0)
+        return -1;
+    return convert_finish(&cv);
 }
 
 /* ================================================================ every numeric key */

@@ -546,6 +546,57 @@ int ytree_parse(const char *text, size_t len, const ysrc *src, errbuf *e, ynode 
 
 /* ================================================================ graft --set */
 
+/* The mapping a --set walks into at `pathsofar`: nothing (`effects:`, `effects=null`) is
+ * an empty mapping, as the schema reads it: a key set inside it starts one, so that a null
+ * set earlier never makes later sets below it fail. Anything else but a mapping is an
+ * error at `at`. */
+static int graft_into(ynode *map, const ynode *at, const char *pathsofar, errbuf *err)
+{
+    if (map->kind == YN_SCALAR && ynode_is_null(map)) {
+        free(map->text);
+        map->text = NULL;
+        map->quoted = false;
+        map->kind = YN_MAP;
+    }
+    if (map->kind == YN_MAP)
+        return 0;
+    if (map->src->is_set)
+        return yfail(err, at, NULL,
+                     "cannot set a key inside '%s': it was set to %s by %s=..., not a "
+                     "mapping (set '%s' to a mapping, e.g. %s={}, first)",
+                     pathsofar, ynode_kind_name(map), map->src->name, pathsofar, pathsofar);
+    return yfail(err, at, NULL,
+                 "cannot set a key inside '%s', which is %s at %s:%d:%d, not a mapping",
+                 pathsofar, ynode_kind_name(map), map->src->name, map->line, map->col);
+}
+
+/* map's entry `key` (of len bytes), added (empty, from src) if the mapping has none;
+ * NULL with the error at `at`. */
+static yentry *graft_entry(ynode *map, const char *key, size_t len, const ysrc *src,
+                           const ynode *at, errbuf *err)
+{
+    yentry *en = (yentry *)ymap_find(map, key);
+    if (en)
+        return en;
+    if (map->n >= LAG_SCENE_MAX_ITEMS || !ynode_grow(map)) {
+        yfail(err, at, NULL, map->n >= LAG_SCENE_MAX_ITEMS
+              ? "the mapping has the most keys a mapping may have" : "out of memory");
+        return NULL;
+    }
+    en = &map->entries[map->n];
+    en->key = malloc(len + 1);
+    if (!en->key) {
+        yfail(err, at, NULL, "out of memory");
+        return NULL;
+    }
+    memcpy(en->key, key, len + 1);
+    en->line = en->col = 1;
+    en->src = src;
+    en->val = NULL;
+    map->n++;
+    return en;
+}
+
 int ytree_graft(ynode *root, const ysrc *src, ynode *val, errbuf *err)
 {
     ynode at = {.src = src};
@@ -567,46 +618,11 @@ int ytree_graft(ynode *root, const ysrc *src, ynode *val, errbuf *err)
         char key[256];
         memcpy(key, seg, len);
         key[len] = '\0';
-        if (map->kind == YN_SCALAR && ynode_is_null(map)) {
-            /* nothing (`effects:`, `effects=null`) is an empty mapping, as the schema
-             * reads it: a key set inside it starts one, so that a null set earlier never
-             * makes later sets below it fail */
-            free(map->text);
-            map->text = NULL;
-            map->quoted = false;
-            map->kind = YN_MAP;
-        }
-        if (map->kind != YN_MAP) {
+        yentry *en = NULL;
+        if (graft_into(map, &at, pathsofar, err) < 0 ||
+            !(en = graft_entry(map, key, len, src, &at, err))) {
             ynode_free(val);
-            if (map->src->is_set)
-                return yfail(err, &at, NULL,
-                             "cannot set a key inside '%s': it was set to %s by %s=..., not a "
-                             "mapping (set '%s' to a mapping, e.g. %s={}, first)",
-                             pathsofar, ynode_kind_name(map), map->src->name, pathsofar,
-                             pathsofar);
-            return yfail(err, &at, NULL,
-                         "cannot set a key inside '%s', which is %s at %s:%d:%d, not a mapping",
-                         pathsofar, ynode_kind_name(map), map->src->name, map->line, map->col);
-        }
-        yentry *en = (yentry *)ymap_find(map, key);
-        if (!en) {
-            if (map->n >= LAG_SCENE_MAX_ITEMS || !ynode_grow(map)) {
-                ynode_free(val);
-                return yfail(err, &at, NULL, map->n >= LAG_SCENE_MAX_ITEMS
-                             ? "the mapping has the most keys a mapping may have"
-                             : "out of memory");
-            }
-            en = &map->entries[map->n];
-            en->key = malloc(len + 1);
-            if (!en->key) {
-                ynode_free(val);
-                return yfail(err, &at, NULL, "out of memory");
-            }
-            memcpy(en->key, key, len + 1);
-            en->line = en->col = 1;
-            en->src = src;
-            en->val = NULL;
-            map->n++;
+            return -1;
         }
         if (!dot) {
             ynode_free(en->val);

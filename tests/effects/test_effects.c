@@ -720,46 +720,104 @@ static void spring_energy(void)
 
 /* ================================================================== off */
 
+/* Every effect's settings, given values that make each effect act on the run started at
+ * d's initial state (stops 0.01 around it, a disturbance at 10 ms, ...); enabled = 0. */
+static void off_fill(lag_effects_def *e, const lag_sim_def *d)
+{
+    for (int i = 0; i < LAG_MAX_DOF; i++) {
+        e->damping[i] = 3.0; e->friction_static[i] = 2.0; e->friction_kinetic[i] = 1.0;
+        e->limit_on[i] = true; e->limit_lower[i] = d->q0[i] - 0.01; e->limit_upper[i] = d->q0[i] + 0.01;
+        e->restitution[i] = 0.5; e->actuator_max[i] = 0.1; e->actuator_tau[i] = 0.3;
+        e->noise_q[i] = 0.1; e->noise_qd[i] = 0.1;
+        e->spring_k[i] = 4.0; e->spring_rest[i] = 0.1;
+    }
+    e->floor_restitution = 0.2;
+    e->n_disturbances = 1;
+    e->disturbances[0] = (lag_disturbance){0.01, 0, true, 5.0, 0.0};
+    e->enabled = 0;
+}
+
+/* d's model at a moving state, with method meth. */
+static lag_sim_def off_def(int kind, int meth)
+{
+    lag_sim_def d = lag_default_sim_def((lag_model_kind)kind);
+    d.integrator.method = (lag_method)meth;
+    d.q0[0] = 0.2; d.q0[1] = 0.7; d.qd0[0] = 0.3; d.qd0[1] = -0.4;
+    if (kind == LAG_MODEL_DIPC) { d.q0[2] = -0.5; d.qd0[2] = 0.2; }
+    return d;
+}
+
+/* Runs `ticks` ticks of def under a fixed input; false if the core refuses def. The
+ * observed state goes to o (2 x 3 entries), the run's own to s. */
+static bool off_run(lag_sim *s, const lag_sim_def *def, int64_t ticks, double o[6])
+{
+    char err[256];
+    if (lag_sim_init(s, def, err, sizeof err) != LAG_OK) return false;
+    double u[3] = {0.5, -0.3, 0.0};
+    lag_sim_set_input(s, u);
+    ENSURE(lag_sim_advance(s, ticks, true) == LAG_OK);
+    for (int i = 0; i < 6; i++) o[i] = 0.0;
+    lag_sim_observe(s, o, o + 3);
+    return true;
+}
+
+static bool off_same(const lag_sim *s0, const double o0[6], const lag_sim *s1, const double o1[6])
+{
+    size_t nb = (size_t)s0->nq * sizeof(double); /* only the model's nq entries are defined */
+    return s0->nq == s1->nq && memcmp(s0->q, s1->q, nb) == 0 && memcmp(s0->qd, s1->qd, nb) == 0 &&
+           memcmp(o0, o1, 6 * sizeof(double)) == 0 && s1->n_events == s0->n_events &&
+           s0->stats.rhs_evals == s1->stats.rhs_evals;
+}
+
+/* The fill above reaches every effect of the core's table: each one, switched on alone
+ * with it, changes the run of some model (state, observed state, events or work), so an
+ * effect whose settings the fill leaves out fails here by name, not by passing `off`
+ * with nothing configured. */
+static void off_fill_covers_table(void)
+{
+    int acting = 0;
+    for (int k = 0; k < LAG_EFF_COUNT; k++) {
+        lag_effect_info inf = lag_effect_info_get(k);
+        bool accepted = false, acts = false;
+        for (int kind = 0; kind < LAG_MODEL_COUNT && !acts; kind++) {
+            lag_sim_def d = off_def(kind, LAG_RK4), x = d;
+            off_fill(&x.effects, &d);
+            x.effects.enabled = inf.bit;
+            lag_sim s0, s1;
+            double o0[6], o1[6];
+            if (!off_run(&s1, &x, 200, o1)) continue;
+            accepted = true;
+            ENSURE(off_run(&s0, &d, 200, o0));
+            acts = !off_same(&s0, o0, &s1, o1);
+        }
+        if (!accepted || !acts)
+            LT_FAIL("off: effect '%s' of the core's table: the settings the test fills %s", inf.name,
+                    accepted ? "change no model's run when it is on alone (fill them in off_fill)"
+                             : "are refused by the core for every model");
+        else
+            ENSURE(acts);
+        acting += acts;
+    }
+    printf("off: the filled settings make %d of the %d effects of the core's table act\n",
+           acting, LAG_EFF_COUNT);
+}
+
 /* An effect that is off costs nothing: a definition carrying every effect's parameters but
  * enabled = 0 gives exactly the bare model's trajectory (memcmp), for every model and
  * method. */
 static void off(void)
 {
+    off_fill_covers_table();
     int compared = 0, identical = 0;
     for (int kind = 0; kind < LAG_MODEL_COUNT; kind++)
         for (int meth = 0; meth < LAG_METHOD_COUNT; meth++) {
-            lag_sim_def d = lag_default_sim_def((lag_model_kind)kind);
-            d.integrator.method = (lag_method)meth;
-            d.q0[0] = 0.2; d.q0[1] = 0.7; d.qd0[0] = 0.3; d.qd0[1] = -0.4;
-            if (kind == LAG_MODEL_DIPC) { d.q0[2] = -0.5; d.qd0[2] = 0.2; }
-            lag_sim_def x = d;
-            lag_effects_def *e = &x.effects;
-            for (int i = 0; i < LAG_MAX_DOF; i++) {
-                e->damping[i] = 3.0; e->friction_static[i] = 2.0; e->friction_kinetic[i] = 1.0;
-                e->limit_on[i] = true; e->limit_lower[i] = -0.01; e->limit_upper[i] = 0.01;
-                e->restitution[i] = 0.5; e->actuator_max[i] = 0.1; e->actuator_tau[i] = 0.3;
-                e->noise_q[i] = 0.1; e->noise_qd[i] = 0.1;
-            }
-            e->floor_restitution = 0.2;
-            e->n_disturbances = 1;
-            e->disturbances[0] = (lag_disturbance){0.01, 0, true, 5.0, 0.0};
-            e->enabled = 0;
+            lag_sim_def d = off_def(kind, meth), x = d;
+            off_fill(&x.effects, &d);
             lag_sim s0, s1;
-            te_init(&s0, &d);
-            te_init(&s1, &x);
-            double u[3] = {0.5, -0.3, 0.0};
-            lag_sim_set_input(&s0, u);
-            lag_sim_set_input(&s1, u);
-            ENSURE(lag_sim_advance(&s0, 2000, true) == LAG_OK);
-            ENSURE(lag_sim_advance(&s1, 2000, true) == LAG_OK);
-            /* only the model's nq entries are defined */
-            size_t nb = (size_t)s0.nq * sizeof(double);
-            double o0[6] = {0}, o1[6] = {0};
-            lag_sim_observe(&s1, o1, o1 + 3);
-            lag_sim_observe(&s0, o0, o0 + 3);
-            bool same = memcmp(s0.q, s1.q, nb) == 0 && memcmp(s0.qd, s1.qd, nb) == 0 &&
-                        memcmp(o0, o1, sizeof o0) == 0 && s1.n_events == 0 &&
-                        s0.stats.rhs_evals == s1.stats.rhs_evals;
+            double o0[6], o1[6];
+            ENSURE(off_run(&s0, &d, 2000, o0));
+            ENSURE(off_run(&s1, &x, 2000, o1));
+            bool same = off_same(&s0, o0, &s1, o1) && s1.n_events == 0;
             compared++;
             identical += same;
             if (!same)

@@ -80,9 +80,9 @@ else bad "realtime.effort_limit on the actuated joint refused"; fi
 
 # 7. errors name the --set; a file node keeps its file position after grafting
 e() { "$expect" "$lagsimd" "$cfg/dipc.yaml" "$@" || fail=1; }
-e --expect "--set integrator.dt: expected a number from 1e-06 to 1 (s), got -1" -- --set integrator.dt=-1
+e --expect "--set integrator.dt: expected a finite number > 0 (s), got -1" -- --set integrator.dt=-1
 e --expect "--set integrator.dt: missing value: expected a number" -- --set integrator.dt=
-e --expect "--set integrator: integrator.dt: expected a number from 1e-06 to 1 (s), got -1" -- --set "integrator={dt: -1}"
+e --expect "--set integrator: integrator.dt: expected a finite number > 0 (s), got -1" -- --set "integrator={dt: -1}"
 e --expect "--set integrator.method: unknown method 'rk5'" -- --set integrator.method=rk5
 e --expect "--set initial.q: expected a sequence of 3 numbers (theta0, theta1, theta2) for model dipc, got 2" -- --set "initial.q=[0,0.1]"
 e --expect "--set parameters.m9: unknown parameter 'm9' for model dipc" -- --set parameters.m9=1
