@@ -14,7 +14,8 @@ pkgs=(build-essential cmake pkg-config clang libclang-rt-14-dev   # gcc pass; cl
       curl                                               # the walkthrough (docs/clients.md) asks lagsim-view for its history
       iproute2 nftables                                  # two hosts on one machine: namespaces, veth, packet loss
       lintian systemd                                    # the Debian package: lintian, systemd-analyze, its unit run by systemd
-      parallel slurm-client)                             # lagsim-sweep shards: GNU parallel, sbatch (--test-only, no cluster)
+      parallel slurm-client                              # lagsim-sweep shards: GNU parallel, sbatch (--test-only, no cluster)
+      openssh-server openssh-client)                     # ... and parallel --sshlogin, tested against sshd in namespaces
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

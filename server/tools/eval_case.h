@@ -170,6 +170,7 @@ void eval_take_record(eval_take *tk, const lag_log_record *rec);
 
 /* ---------------------------------------------------------------- for eval_worker.c */
 double eval_now(void);
+double eval_now_wall(void); /* s since the epoch */
 void eval_sleep(double s);
 /* argv (or "sh -c cmd" when argv is NULL) in a process group of its own, with the run's
  * URL and prefix in its environment */

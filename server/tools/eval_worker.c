@@ -32,7 +32,7 @@
 
 #define W_ANSWER_S 0.5  /* a SET or RESET_TO unanswered this long is sent again */
 #define W_TRIES 8       /* ... this many times at most */
-#define W_STALL_S 5.0   /* a run with no new state for this long has stalled */
+#define W_QUIET_S 0.25  /* a run with no new state for this long: a status is asked for */
 #define W_LOG_WAIT_S 3.0 /* the log's writer writes within 0.1 s; this is its margin */
 
 struct eval_worker {
@@ -49,6 +49,8 @@ struct eval_worker {
     double q0[EVAL_JOINTS_MAX], qd0[EVAL_JOINTS_MAX];
     const char *set_wait; /* "key=value" whose set event is awaited */
     bool set_heard;
+    double t_heard;       /* the sim time of the last state heard */
+    bool moved;           /* a state after sim time 0 heard since the STEP */
 };
 
 /* ---------------------------------------------------------------- from the bus */
@@ -76,6 +78,8 @@ static bool reference_at(const eval_worker *w, double t, double *r)
 static void w_on_state(const lag_client_state *st, void *user)
 {
     eval_worker *w = user;
+    w->t_heard = st->sim_time;
+    if (st->sim_time > 0) w->moved = true;
     if (!w->armed || st->num_joints != w->sc.nj) return;
     if (!w->started && !(w->started = is_run_start(w, st))) return;
     eval_series *s = &w->s;
@@ -98,7 +102,7 @@ static void w_on_state(const lag_client_state *st, void *user)
 static void w_on_event(const lag_client_event *ev, void *user)
 {
     eval_worker *w = user;
-    if (!strcmp(ev->kind, "step_done")) w->step_done = true;
+    if (!strcmp(ev->kind, "step_done")) w->step_done = w->moved = true;
     else if (!strcmp(ev->kind, "numeric_fault") && w->armed) w->fault = true;
     else if (!strcmp(ev->kind, "set") && w->set_wait && !strcmp(ev->detail, w->set_wait))
         w->set_heard = true;
@@ -114,6 +118,48 @@ static int w_wait(eval_worker *w, const bool *flag, double seconds)
     return 0;
 }
 
+/* A status newer than now; false when none came within W_ANSWER_S or a state after sim
+ * time 0 came first (the daemon moved: the question is answered). OUT: st */
+static bool fresh_status(eval_worker *w, lag_client_status *st, bool stop_on_move)
+{
+    int64_t asked = (int64_t)(eval_now_wall() * 1e6);
+    if (lag_client_request_status(w->cl) != LAG_CLIENT_OK) return false;
+    double end = eval_now() + W_ANSWER_S;
+    while (eval_now() < end) {
+        lag_client_handle(w->cl, 5);
+        if (stop_on_move && w->moved) return false;
+        if (lag_client_latest_status(w->cl, st) && st->utime >= asked) return true;
+    }
+    return false;
+}
+
+/* Is the daemon paused at sim time 0 waiting for a STEP (the STEP was lost; while a STEP
+ * is under way it waits for answers instead)? */
+static bool still_at_start(eval_worker *w)
+{
+    lag_client_status st;
+    return fresh_status(w, &st, true) && st.sim_time == 0 &&
+           !strncmp(st.waiting_for, "RESUME or STEP", 14);
+}
+
+/* STEP n, sent again only when a fresh status says the daemon has not moved from sim
+ * time 0 (a second STEP that arrived would step twice); waits up to `seconds` for the
+ * first state after 0 (a controller may take seconds to answer its first state). */
+static int step_once(eval_worker *w, long n, double seconds)
+{
+    w->moved = false;
+    double end = eval_now() + seconds;
+    if (lag_client_step(w->cl, n) != LAG_CLIENT_OK) return -1;
+    while (!w->moved) {
+        if (eval_now() > end) return -1;
+        double next = eval_now() + W_ANSWER_S;
+        while (!w->moved && eval_now() < next) lag_client_handle(w->cl, 5);
+        if (!w->moved && still_at_start(w) && lag_client_step(w->cl, n) != LAG_CLIENT_OK)
+            return -1;
+    }
+    return 0;
+}
+
 /* ---------------------------------------------------------------- start, stop */
 static pid_t start_daemon(eval_worker *w, const eval_case *c)
 {
@@ -123,9 +169,11 @@ static pid_t start_daemon(eval_worker *w, const eval_case *c)
     argv[na++] = (char *)w->env.lagsimd;
     argv[na++] = "--config";
     argv[na++] = (char *)w->env.config;
-    /* lockstep_timeout as eval_run: a controller found late waits at most that long */
+    /* STEP takes a period without a command once lockstep_timeout passed (as asked): the
+     * longest one, so that a period never goes without its answer, as in a running
+     * lockstep plant (a lost answer costs a retry, docs/server.md) */
     static const char *const fixed[] = {"realtime.mode=lockstep", "realtime.start=paused",
-                                        "realtime.lockstep_timeout=0.1"};
+                                        "realtime.lockstep_timeout=3600"};
     for (int i = 0; i < 3; i++) {
         argv[na++] = "--set";
         argv[na++] = (char *)fixed[i];
@@ -176,8 +224,7 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
     lag_client_scene scene;
     if (lag_client_wait_scene(w->cl, 10.0, &scene) != LAG_CLIENT_OK)
         return start_failed(w, err, errlen, "no scene from the kept lagsimd");
-    w->step_done = false;
-    if (lag_client_step(w->cl, 1) != LAG_CLIENT_OK || w_wait(w, &w->step_done, 10))
+    if (step_once(w, 1, 30))
         return start_failed(w, err, errlen, "the kept lagsimd did not step");
     return w;
 }
@@ -241,15 +288,25 @@ static int reset_to(eval_worker *w, const double *q0, const double *qd0, char *e
     return 0;
 }
 
-/* The states until the last one, a fault or a stall. */
+/* The states until the last one, a fault, the daemon's end of the STEP (its last state
+ * lost on the way: a status says it is paused past the goal), or no progress within the
+ * wall timeout (a controller may think long: a status says whether the daemon still
+ * waits for an answer). */
 static void follow(eval_worker *w, double t_goal)
 {
-    double last = eval_now();
+    double start = eval_now(), last = start;
     size_t seen = w->s.n;
     while (!(w->s.n && w->s.t[w->s.n - 1] >= t_goal) && !w->fault) {
         if (lag_client_handle(w->cl, 20) < 0) break;
         if (w->s.n != seen) seen = w->s.n, last = eval_now();
-        if (eval_now() - last > W_STALL_S) break;
+        if (eval_now() - start > w->env.wall_timeout) break;
+        if (eval_now() - last < W_QUIET_S) continue;
+        lag_client_status st;
+        if (fresh_status(w, &st, false) &&
+            (!strcmp(st.run_state, "fault") ||
+             (st.sim_time >= t_goal && !strncmp(st.waiting_for, "RESUME or STEP", 14))))
+            break; /* what the bus lost, the log has */
+        last = eval_now();
     }
 }
 
@@ -310,8 +367,8 @@ int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets,
     off_t from = stat(w->log, &sb) == 0 ? sb.st_size : 0; /* before the run's RESET_TO */
     if (reset_to(w, q0, qd0, err, errlen)) return -1;
     long periods = lround(c->duration / w->sc.period);
-    if (lag_client_step(w->cl, periods) != LAG_CLIENT_OK) {
-        snprintf(err, errlen, "cannot send STEP");
+    if (step_once(w, periods, w->env.wall_timeout)) {
+        snprintf(err, errlen, "the kept lagsimd did not step");
         return -1;
     }
     double t_goal = c->duration - 0.5 * w->sc.period;

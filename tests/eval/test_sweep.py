@@ -18,6 +18,9 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
   loss      in a network namespace whose loopback drops 1 UDP datagram in 15 (nftables):
             the same CSV as without loss, byte for byte (SET and RESET_TO sent again, the
             runs the bus lost states of read from the kept daemon's log)
+  ssh       GNU parallel --sshlogin over two "hosts" (network namespaces, each running a
+            private sshd on its own address): one shard on each, merged, equal to the whole
+            sweep byte for byte (needs root, ip, sshd)
   stalled   the workers stopped and continued again and again (their sockets' queues
             overflow): runs read from the log, the same CSV, byte for byte
 """
@@ -71,10 +74,14 @@ def case_same(d):
     check(filecmp.cmp(a1, a2, shallow=False), "-j1 and -j2 give the same CSV, byte for byte")
     # two shards with GNU parallel on this host, then merged
     sh = os.path.join(d, "shard-{}.csv")
-    cmd = ["parallel", "--will-cite", "-j2", SWEEP] + ["'%s'" % a for a in ARGS] + \
-          ["--shard", "{}/2", "--csv", sh, ":::", "1", "2"]
-    p = run(cmd)
-    check(p.returncode in (0, 1), "GNU parallel ran both shards")
+    jl = os.path.join(d, "joblog")
+    cmd = ["parallel", "--will-cite", "--joblog", jl, "-j2", SWEEP] + \
+        ["'%s'" % a for a in ARGS] + ["--shard", "{}/2", "--csv", sh, ":::", "1", "2"]
+    run(cmd)
+    exits = [line.split("\t")[6] for line in open(jl).read().splitlines()[1:]]
+    # a sweep exits 1 when a run misses --require: it ran
+    check(len(exits) == 2 and all(e in ("0", "1") for e in exits),
+          "GNU parallel ran both shards (exit statuses %s)" % exits)
     p = run([SWEEP, "merge", os.path.join(d, "shard-2.csv"), os.path.join(d, "shard-1.csv"),
              "-o", m])
     check(p.returncode == 0, "merge: exit 0")
@@ -237,6 +244,77 @@ def case_loss(d):
         subprocess.run(["ip", "netns", "del", ns])
 
 
+def sshd_host(d, name, net):
+    """A network namespace `name` joined to this one by a veth pair on 10.<net>.0.0/24, its
+    loopback up with the multicast route (lagsim's bus stays on the host), and an sshd on
+    10.<net>.0.2 that takes the key d/id for root. Returns the address."""
+    host, peer = "10.%d.0.1" % net, "10.%d.0.2" % net
+    va, vb = "lgs%da%d" % (net, os.getpid() % 10000), "lgs%db%d" % (net, os.getpid() % 10000)
+    inns = ["ip", "netns", "exec", name]
+    for c in (["ip", "netns", "add", name],
+              ["ip", "link", "add", va, "type", "veth", "peer", "name", vb],
+              ["ip", "link", "set", vb, "netns", name],
+              ["ip", "addr", "add", host + "/24", "dev", va], ["ip", "link", "set", va, "up"],
+              inns + ["ip", "addr", "add", peer + "/24", "dev", vb],
+              inns + ["ip", "link", "set", vb, "up"], inns + ["ip", "link", "set", "lo", "up"],
+              inns + ["ip", "route", "add", "224.0.0.0/4", "dev", "lo"]):
+        subprocess.run(c, check=True)
+    cfg = os.path.join(d, "sshd-%s.conf" % name)
+    with open(cfg, "w") as f:
+        f.write("ListenAddress %s\nHostKey %s/hostkey\nAuthorizedKeysFile %s/authorized_keys\n"
+                "PermitRootLogin prohibit-password\nStrictModes no\nUsePAM no\n"
+                "PidFile %s/sshd-%s.pid\n" % (peer, d, d, d, name))
+    os.makedirs("/run/sshd", exist_ok=True)
+    subprocess.run(inns + ["/usr/sbin/sshd", "-f", cfg, "-E", os.path.join(d, name + ".log")],
+                   check=True)
+    return peer
+
+
+def case_ssh(d):
+    if os.geteuid() != 0 or not os.path.exists("/usr/sbin/sshd") or not shutil.which("ip"):
+        print("skipped: needs root, ip and sshd (openssh-server)")
+        sys.exit(77)
+    for key in ("hostkey", "id"):
+        subprocess.run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-f",
+                        os.path.join(d, key)], check=True)
+    shutil.copy(os.path.join(d, "id.pub"), os.path.join(d, "authorized_keys"))
+    names = ["lgsshb%d" % os.getpid(), "lgsshc%d" % os.getpid()]
+    try:
+        hosts = [sshd_host(d, n, 200 + k) for k, n in enumerate(names)]
+        whole = os.path.join(d, "whole.csv")
+        run([SWEEP] + ARGS + ["-j2", "--csv", whole])
+        ssh = ("ssh -i %s -o StrictHostKeyChecking=no -o UserKnownHostsFile=/dev/null "
+               "-o BatchMode=yes -o LogLevel=ERROR" % os.path.join(d, "id"))
+        sh = os.path.join(d, "shard-{}.csv")
+        # one shard a host (-j1 each): the shards run where ssh takes them
+        jl = os.path.join(d, "joblog")
+        run(["parallel", "--will-cite", "--joblog", jl, "--ssh", ssh, "--sshlogin",
+             ",".join(hosts), "-j1", SWEEP] + ["'%s'" % a for a in ARGS] +
+            ["-j1", "--shard", "{}/2", "--csv", sh, ":::", "1", "2"])
+        jobs = [line.split("\t") for line in open(jl).read().splitlines()[1:]]
+        # a sweep exits 1 when a run misses --require: it ran
+        check(sorted(j[1] for j in jobs) == sorted(hosts) and all(j[6] in ("0", "1") for j in jobs),
+              "GNU parallel --sshlogin ran one shard on each host: %s"
+              % [(j[1], j[6]) for j in jobs])
+        logins = [open(os.path.join(d, n + ".log")).read() for n in names]
+        check(all("Accepted publickey for root" in x for x in logins),
+              "each host's sshd took a login: %s" % [x.count("Accepted") for x in logins])
+        m = os.path.join(d, "merged.csv")
+        run([SWEEP, "merge", os.path.join(d, "shard-1.csv"), os.path.join(d, "shard-2.csv"),
+             "-o", m])
+        check(filecmp.cmp(whole, m, shallow=False),
+              "the shards run over ssh, merged = the whole sweep, byte for byte")
+    finally:
+        for n in names:
+            pid = os.path.join(d, "sshd-%s.pid" % n)
+            if os.path.exists(pid):
+                subprocess.run(["kill", open(pid).read().strip()])
+            subprocess.run(["ip", "netns", "del", n], stderr=subprocess.DEVNULL)
+        for k in range(2):
+            subprocess.run(["ip", "link", "del", "lgs%da%d" % (200 + k, os.getpid() % 10000)],
+                           stderr=subprocess.DEVNULL)
+
+
 def case_stalled(d):
     # the workers stopped (SIGSTOP) for 0.2 s again and again while their daemons and
     # controllers go on: their sockets' queues overflow and the bus loses states for them
@@ -268,6 +346,6 @@ def case_stalled(d):
 
 with tempfile.TemporaryDirectory() as tmp:
     {"same": case_same, "slurm": case_slurm, "merge": case_merge, "kept": case_kept,
-     "loss": case_loss, "stalled": case_stalled}[CASE](tmp)
+     "loss": case_loss, "stalled": case_stalled, "ssh": case_ssh}[CASE](tmp)
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)
