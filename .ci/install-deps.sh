@@ -15,6 +15,7 @@ pkgs=(build-essential cmake pkg-config clang libclang-rt-14-dev   # gcc pass; cl
       iproute2 nftables                                  # two hosts on one machine: namespaces, veth, packet loss
       lintian systemd                                    # the Debian package: lintian, systemd-analyze, its unit run by systemd
       parallel slurm-client                              # lagsim-sweep shards: GNU parallel, sbatch (--test-only, no cluster)
+      openssh-server openssh-client                      # ... and parallel --sshlogin, tested against sshd in namespaces
       universal-ctags)                                   # structure_function_length: each C function's first and last line
 missing=()
 for p in "${pkgs[@]}"; do

@@ -12,11 +12,7 @@
 
 int live_set_parse(const char *key, const char *value, char *kv, char *why, size_t whylen)
 {
-    size_t root = !strncmp(key, "parameters", 10) ? 10
-                  : !strncmp(key, "effects", 7)   ? 7
-                  : !strncmp(key, "reference", 9) ? 9
-                                                  : 0;
-    if (root == 0 || (key[root] != '\0' && key[root] != '.') || strchr(key, '=')) {
+    if (!lag_scene_key_live(key) || strchr(key, '=')) {
         snprintf(why, whylen, "set: only keys under parameters, effects and reference change "
                               "while running (e.g. parameters.m2, effects.friction.q2.kinetic, "
                               "reference.q1.amplitude)");

@@ -119,3 +119,13 @@ int lag_scene_estimate_every(const lag_scene *sc)
     if (sc->accuracy.estimate_every >= 0) return sc->accuracy.estimate_every;
     return sc->accuracy.error > 0 ? LAG_SCENE_ESTIMATE_EVERY : 0;
 }
+
+bool lag_scene_key_live(const char *key)
+{
+    static const char *const roots[] = {"parameters", "effects", "reference"};
+    for (size_t i = 0; i < sizeof roots / sizeof roots[0]; i++) {
+        size_t n = strlen(roots[i]);
+        if (!strncmp(key, roots[i], n) && (key[n] == '\0' || key[n] == '.')) return true;
+    }
+    return false;
+}

@@ -143,6 +143,10 @@ const char *lag_rt_start_name(lag_rt_start s);  /* "running", "paused", "first_c
  * too large for a double (1e999). OUT: v */
 lag_result lag_scene_read_decimal(const char *s, double *v);
 
+/* Does `key` (a dotted path as --set takes it) change while lagsimd runs, by control SET?
+ * The keys under parameters, effects and reference. */
+bool lag_scene_key_live(const char *key);
+
 /* Checks an LCM URL the way the loader does for lcm.url (and lagsimd for
  * LCM_DEFAULT_URL): "" (LCM's default), memq:// (in-process, for tests) or
  * udpm://GROUP[:PORT][?ttl=N&recv_buf_size=BYTES] with GROUP a dotted IPv4 multicast

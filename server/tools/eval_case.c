@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include "lagsim_log.h"
+#include "lagsim/lagsim_control_t.h" /* the requests' constants */
 #include "lagsim_out.h"
 #include "lagsim_wire.h"
 #include "scene.h"
@@ -193,6 +194,7 @@ int eval_scene_load(const char *config, const char *const *sets, int nsets, eval
             out->q0[j] = sc->sim.q0[j];
             out->qd0[j] = sc->sim.qd0[j];
         }
+        out->has_reference = sc->reference.n > 0;
         out->period = 1.0 / sc->publish_hz;
     }
     free(sc);
@@ -209,21 +211,28 @@ void eval_url(int slot, char *url, size_t len)
     snprintf(url, len, "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304", port);
 }
 
-static double now_s(void)
+double eval_now(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void sleep_s(double s)
+double eval_now_wall(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void eval_sleep(double s)
 {
     struct timespec ts = {(time_t)s, (long)((s - floor(s)) * 1e9)};
     nanosleep(&ts, NULL);
 }
 
 /* Starts argv (or "sh -c cmd" when argv is NULL) in its own process group. */
-static pid_t spawn(char *const *argv, const char *cmd, const eval_env *env)
+pid_t eval_spawn(char *const *argv, const char *cmd, const eval_env *env)
 {
     fflush(NULL); /* nothing buffered is written twice */
     pid_t pid = fork();
@@ -247,28 +256,28 @@ static pid_t spawn(char *const *argv, const char *cmd, const eval_env *env)
 }
 
 /* Waits for pid until `deadline` (monotonic s); 1 and *status when it ended, 0 if not. */
-static int wait_until(pid_t pid, double deadline, int *status)
+int eval_wait_until(pid_t pid, double deadline, int *status)
 {
     for (;;) {
         pid_t r = waitpid(pid, status, WNOHANG);
         if (r == pid) return 1;
         if (r < 0 && errno != EINTR) return 1;
-        if (now_s() >= deadline) return 0;
-        sleep_s(0.005);
+        if (eval_now() >= deadline) return 0;
+        eval_sleep(0.005);
     }
 }
 
-static void stop_group(pid_t pid, int *status)
+void eval_stop_group(pid_t pid, int *status)
 {
     kill(-pid, SIGTERM);
-    if (!wait_until(pid, now_s() + 2.0, status)) {
+    if (!eval_wait_until(pid, eval_now() + 2.0, status)) {
         kill(-pid, SIGKILL);
         waitpid(pid, status, 0);
     }
 }
 
 /* "{prefix}" and "{url}" in cmd replaced. */
-static void expand(const char *cmd, const eval_env *env, char *out, size_t len)
+void eval_expand(const char *cmd, const eval_env *env, char *out, size_t len)
 {
     size_t o = 0;
     for (const char *p = cmd; *p && o + 1 < len;) {
@@ -299,7 +308,7 @@ void eval_series_free(eval_series *s)
     memset(s, 0, sizeof *s);
 }
 
-static int series_grow(eval_series *s, int nj)
+int eval_series_grow(eval_series *s, int nj)
 {
     if (s->n < s->cap) return 0;
     size_t cap = s->cap ? 2 * s->cap : 1024;
@@ -318,8 +327,7 @@ static int series_grow(eval_series *s, int nj)
     return 0;
 }
 
-static void fail(eval_result *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void fail(eval_result *res, const char *fmt, ...)
+void eval_fail(eval_result *res, const char *fmt, ...)
 {
     if (res->failed) return; /* the first reason stays */
     res->failed = true;
@@ -384,74 +392,140 @@ static int read_reference(const lag_log_record *rec, const eval_scene *sc, doubl
     return isfinite(*t);
 }
 
+void eval_take_init(eval_take *tk, const char *prefix, const eval_scene *sc, eval_series *s,
+                    eval_result *res)
+{
+    memset(tk, 0, sizeof *tk);
+    snprintf(tk->ch_state, sizeof tk->ch_state, "%s_STATE", prefix);
+    snprintf(tk->ch_event, sizeof tk->ch_event, "%s_EVENT", prefix);
+    snprintf(tk->ch_ref, sizeof tk->ch_ref, "%s_REFERENCE", prefix);
+    snprintf(tk->ch_control, sizeof tk->ch_control, "%s_CONTROL", prefix);
+    tk->sc = sc;
+    tk->s = s;
+    tk->res = res;
+    tk->ref_time = NAN;
+    tk->t_stop = INFINITY;
+    tk->started = true;
+}
+
+/* A daemon kept for many runs: the run's records follow the last RESET_TO the records
+ * hold (everything before it, earlier runs' tails included, is dropped at each one). */
+void eval_take_from_last_reset(eval_take *tk)
+{
+    tk->per_reset = true;
+    tk->started = false;
+}
+
+static void take_state(eval_take *tk, const lag_log_record *rec)
+{
+    const eval_scene *sc = tk->sc;
+    eval_series *s = tk->s;
+    lag_wire_joint_state st;
+    if (lag_wire_decode_joint_state(rec->data, rec->size, sc->nj, &st) != 0 ||
+        st.num_joints != sc->nj)
+        return;
+    /* a state published again (a lockstep retry, a status request) is one sample; a
+     * kept daemon may step past the duration */
+    if ((s->n && st.sim_time <= s->t[s->n - 1]) || st.sim_time > tk->t_stop) return;
+    if (eval_series_grow(s, sc->nj)) {
+        tk->oom = true;
+        return;
+    }
+    size_t k = s->n++;
+    s->t[k] = st.sim_time;
+    bool ref = tk->ref_time == st.sim_time;
+    if (ref) s->has_reference = true;
+    for (int j = 0; j < sc->nj; j++) {
+        s->q[j][k] = st.position[j];
+        s->r[j][k] = ref ? tk->ref_r[j] : 0;
+        /* the state's effort was held over the period that ended at it; the last state's
+         * is repeated as the held effort after it */
+        if (k) s->u[j][k - 1] = st.effort[j];
+        s->u[j][k] = st.effort[j];
+    }
+}
+
+static void take_event(eval_take *tk, const lag_log_record *rec)
+{
+    lag_wire_event ev;
+    if (lag_wire_decode_event(rec->data, rec->size, &ev) != 0) return;
+    if (!strcmp(ev.kind, "numeric_fault")) {
+        eval_fail(tk->res, "fault at t = %.6g s: %s", ev.sim_time, ev.detail);
+        tk->fault = true;
+    }
+    /* a lockstep_timeout only delays a lockstep run: its states stay those of a run
+     * without it, bit for bit (docs/server.md); a controller that never answers ends in
+     * the wall timeout */
+    else if (!strcmp(ev.kind, "stop")) {
+        if (strstr(ev.detail, "duration reached")) tk->stopped_at_duration = true;
+        else eval_fail(tk->res, "stopped at t = %.6g s: %s", ev.sim_time, ev.detail);
+    }
+}
+
+/* A RESET_TO the daemon took (the log holds what it received with its fate: an input
+ * record is in the log only when accepted, docs/logging.md) */
+static bool is_reset_to(const eval_take *tk, const lag_log_record *rec)
+{
+    if (strcmp(rec->channel, tk->ch_control)) return false;
+    lag_wire_control m;
+    return lag_wire_decode_control(rec->data, rec->size, tk->sc->nj, &m) == 0 &&
+           m.request == LAGSIM_CONTROL_T_RESET_TO;
+}
+
+/* A kept daemon's RESET_TO: what came before belonged to earlier runs */
+static void take_restart(eval_take *tk)
+{
+    tk->s->n = 0;
+    tk->s->has_reference = false;
+    tk->res->failed = false;
+    tk->res->reason[0] = '\0';
+    tk->ref_time = NAN;
+    tk->fault = tk->stopped_at_duration = false;
+    tk->started = true;
+}
+
+void eval_take_record(eval_take *tk, const lag_log_record *rec)
+{
+    if (!rec->data) return;
+    if (tk->per_reset && is_reset_to(tk, rec)) take_restart(tk);
+    if (!tk->started) return;
+    if (!strcmp(rec->channel, tk->ch_state)) take_state(tk, rec);
+    else if (!strcmp(rec->channel, tk->ch_ref)) {
+        if (!read_reference(rec, tk->sc, &tk->ref_time, tk->ref_r)) tk->ref_time = NAN;
+    } else if (!strcmp(rec->channel, tk->ch_event)) take_event(tk, rec);
+}
+
+/* The run's end as the fresh daemon's log says it: an early stop or no state fail it */
+static void take_end(const eval_take *tk, double duration)
+{
+    const eval_series *s = tk->s;
+    eval_result *res = tk->res;
+    res->states = s->n;
+    res->t_end = s->n ? s->t[s->n - 1] : 0;
+    if (!s->n) eval_fail(res, "no state logged");
+    else if (res->t_end < duration - 0.5 * tk->sc->period)
+        eval_fail(res, "stopped at t = %.6g s before the duration %.6g s", res->t_end, duration);
+}
+
 int eval_read_log(const char *path, const char *prefix, const eval_scene *sc, double duration,
                   eval_series *s, eval_result *res, char *err, size_t errlen)
 {
-    char ch_state[96], ch_event[96], ch_ref[96];
-    snprintf(ch_state, sizeof ch_state, "%s_STATE", prefix);
-    snprintf(ch_event, sizeof ch_event, "%s_EVENT", prefix);
-    snprintf(ch_ref, sizeof ch_ref, "%s_REFERENCE", prefix);
     lag_log *lg = lag_log_open(path, 1 << 20, err, errlen);
     if (!lg) return -1;
-    lag_wire_joint_state st;
-    lag_wire_event ev;
-    bool stopped_at_duration = false;
-    double ref_time = NAN, ref_r[EVAL_JOINTS_MAX] = {0};
-    int rc = 0;
+    eval_take tk;
+    eval_take_init(&tk, prefix, sc, s, res);
+    int rc;
     lag_log_record rec;
-    while ((rc = lag_log_next(lg, &rec)) == LAG_LOG_OK) {
-        if (!rec.data) continue;
-        if (!strcmp(rec.channel, ch_state)) {
-            if (lag_wire_decode_joint_state(rec.data, rec.size, sc->nj, &st) != 0 ||
-                st.num_joints != sc->nj)
-                continue;
-            /* a state published again (a lockstep retry, a status request) is one sample */
-            if (s->n && st.sim_time <= s->t[s->n - 1]) continue;
-            if (series_grow(s, sc->nj)) {
-                snprintf(err, errlen, "%s: out of memory", path);
-                lag_log_close(lg);
-                return -1;
-            }
-            size_t k = s->n++;
-            s->t[k] = st.sim_time;
-            bool ref = ref_time == st.sim_time;
-            if (ref) s->has_reference = true;
-            for (int j = 0; j < sc->nj; j++) {
-                s->q[j][k] = st.position[j];
-                s->r[j][k] = ref ? ref_r[j] : 0;
-                /* the state's effort was held over the period that ended at it; the last
-                 * state's is repeated as the held effort after it */
-                if (k) s->u[j][k - 1] = st.effort[j];
-                s->u[j][k] = st.effort[j];
-            }
-        } else if (!strcmp(rec.channel, ch_ref)) {
-            if (!read_reference(&rec, sc, &ref_time, ref_r)) ref_time = NAN;
-        } else if (!strcmp(rec.channel, ch_event)) {
-            if (lag_wire_decode_event(rec.data, rec.size, &ev) != 0) continue;
-            if (!strcmp(ev.kind, "numeric_fault"))
-                fail(res, "fault at t = %.6g s: %s", ev.sim_time, ev.detail);
-            /* a lockstep_timeout only delays a lockstep run: its states stay those of a
-             * run without it, bit for bit (docs/server.md); a controller that never
-             * answers ends in the wall timeout */
-            else if (!strcmp(ev.kind, "stop")) {
-                if (strstr(ev.detail, "duration reached")) stopped_at_duration = true;
-                else fail(res, "stopped at t = %.6g s: %s", ev.sim_time, ev.detail);
-            }
-        }
-    }
-    if (rc == LAG_LOG_ERROR) {
-        snprintf(err, errlen, "%s: %s", path, lag_log_errmsg(lg));
+    while ((rc = lag_log_next(lg, &rec)) == LAG_LOG_OK && !tk.oom) eval_take_record(&tk, &rec);
+    if (rc == LAG_LOG_ERROR || tk.oom) {
+        snprintf(err, errlen, "%s: %s", path, tk.oom ? "out of memory" : lag_log_errmsg(lg));
         lag_log_close(lg);
         return -1;
     }
     lag_log_close(lg);
-    res->states = s->n;
-    res->t_end = s->n ? s->t[s->n - 1] : 0;
-    if (!s->n) fail(res, "no state logged");
-    else if (res->t_end < duration - 0.5 * sc->period)
-        fail(res, "stopped at t = %.6g s before the duration %.6g s", res->t_end, duration);
-    else if (!stopped_at_duration)
-        fail(res, "the daemon did not stop on its duration");
+    take_end(&tk, duration);
+    if (s->n && !res->failed && !tk.stopped_at_duration)
+        eval_fail(res, "the daemon did not stop on its duration");
     return 0;
 }
 
@@ -478,7 +552,7 @@ int eval_score(const eval_series *s, const eval_case *c, const eval_scene *sc,
     for (int b = 0; b < c->nbounds; b++)
         for (int j = 0; j < sc->nj; j++)
             if (!strcmp(c->bound_joint[b], sc->joint[j]) && !(res->max_abs_q[j] <= c->bound[b]))
-                fail(res, "%s reached %.6g, past its bound %.6g", sc->joint[j],
+                eval_fail(res, "%s reached %.6g, past its bound %.6g", sc->joint[j],
                      res->max_abs_q[j], c->bound[b]);
     return 0;
 }
@@ -533,34 +607,34 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
     argv[na] = NULL;
 
     char cmd[4096];
-    expand(env->controller, env, cmd, sizeof cmd);
+    eval_expand(env->controller, env, cmd, sizeof cmd);
     /* the controller first: in lockstep it then answers the first state (clients.md) */
-    pid_t cpid = spawn(NULL, cmd, env);
+    pid_t cpid = eval_spawn(NULL, cmd, env);
     if (cpid < 0) {
         snprintf(err, errlen, "cannot start the controller: %s", strerror(errno));
         return -1;
     }
-    pid_t dpid = spawn(argv, NULL, env);
+    pid_t dpid = eval_spawn(argv, NULL, env);
     if (dpid < 0) {
         snprintf(err, errlen, "cannot start %s: %s", env->lagsimd, strerror(errno));
         int st;
-        stop_group(cpid, &st);
+        eval_stop_group(cpid, &st);
         return -1;
     }
     int dst = 0, cst = 0;
-    double t0 = now_s();
+    double t0 = eval_now();
     bool daemon_done = false, controller_done = false;
     /* the daemon's end, or the controller's: a controller that ends first (it could not
      * start, it crashed) leaves a lockstep plant waiting for ever, so the daemon gets a
      * few seconds to end on its own (a controller ends on the daemon's stop event, a
      * moment before the daemon exits) and is then stopped */
-    while (!daemon_done && now_s() < t0 + env->wall_timeout) {
-        daemon_done = wait_until(dpid, now_s() + 0.05, &dst);
+    while (!daemon_done && eval_now() < t0 + env->wall_timeout) {
+        daemon_done = eval_wait_until(dpid, eval_now() + 0.05, &dst);
         if (!daemon_done && !controller_done && waitpid(cpid, &cst, WNOHANG) == cpid) {
             controller_done = true;
-            if (!wait_until(dpid, now_s() + 5.0, &dst)) {
-                stop_group(dpid, &dst);
-                fail(res, "the controller ended (%s %d) before the run did",
+            if (!eval_wait_until(dpid, eval_now() + 5.0, &dst)) {
+                eval_stop_group(dpid, &dst);
+                eval_fail(res, "the controller ended (%s %d) before the run did",
                      WIFEXITED(cst) ? "exit status" : "signal",
                      WIFEXITED(cst) ? WEXITSTATUS(cst) : WTERMSIG(cst));
             }
@@ -568,11 +642,11 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
         }
     }
     if (!daemon_done) {
-        stop_group(dpid, &dst);
-        fail(res, "no end after %.3g wall s (--timeout)", env->wall_timeout);
+        eval_stop_group(dpid, &dst);
+        eval_fail(res, "no end after %.3g wall s (--timeout)", env->wall_timeout);
     }
     /* a controller ends on the daemon's stop event; one that does not is stopped */
-    if (!controller_done && !wait_until(cpid, now_s() + 3.0, &cst)) stop_group(cpid, &cst);
+    if (!controller_done && !eval_wait_until(cpid, eval_now() + 3.0, &cst)) eval_stop_group(cpid, &cst);
 
     if (WIFEXITED(dst) && WEXITSTATUS(dst) == 2) {
         snprintf(err, errlen, "lagsimd refused the case '%s' (exit 2; rerun with -v)",
@@ -590,7 +664,7 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
     int rc = eval_read_log(log, env->prefix, sc, c->duration, s, res, err, errlen);
     if (rc == 0) {
         if (!(WIFEXITED(dst) && WEXITSTATUS(dst) == 0))
-            fail(res, "lagsimd ended with %s %d",
+            eval_fail(res, "lagsimd ended with %s %d",
                  WIFEXITED(dst) ? "exit status" : "signal",
                  WIFEXITED(dst) ? WEXITSTATUS(dst) : WTERMSIG(dst));
         rc = eval_score(s, c, sc, res, err, errlen);

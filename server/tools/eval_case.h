@@ -25,6 +25,9 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include <sys/types.h>
+
+#include "lagsim_log.h"
 #include "metrics.h"
 
 #define EVAL_NAME_LEN 64
@@ -58,6 +61,7 @@ typedef struct eval_scene {
     bool actuated[EVAL_JOINTS_MAX];
     double period;                          /* s, 1 / publish_hz */
     double q0[EVAL_JOINTS_MAX], qd0[EVAL_JOINTS_MAX]; /* initial state */
+    bool has_reference;                     /* publishes <PREFIX>_REFERENCE */
 } eval_scene;
 
 /* Loads CONFIG with the overrides (nsets of them); -1 and the loader's message in err. */
@@ -139,5 +143,64 @@ void eval_default_lagsimd(char *buf, size_t len);
  * why on stderr, prefixed with prog. */
 FILE *eval_open_out(const char *prog, const char *what, const char *path, bool force,
                     const char *const *in, int nin);
+
+/* ---------------------------------------------------------------- a run's records */
+/* What a run's log records make: each joint's series, and why the run failed. Fed the
+ * records of a run's own log (eval_read_log) or, from a daemon kept for many runs, those
+ * after its run's RESET_TO (eval_worker.c): one reading of the records for both. */
+typedef struct eval_take {
+    char ch_state[96], ch_event[96], ch_ref[96], ch_control[96];
+    const eval_scene *sc;
+    eval_series *s;
+    eval_result *res;
+    double ref_time, ref_r[EVAL_JOINTS_MAX]; /* the last reference and its sim time */
+    double t_stop;           /* states after this sim time are not the run's */
+    bool per_reset;          /* the run starts again at each RESET_TO */
+    bool started;            /* the records are the run's */
+    bool fault;              /* a numeric_fault event was taken */
+    bool stopped_at_duration;
+    bool oom;
+} eval_take;
+
+void eval_take_init(eval_take *tk, const char *prefix, const eval_scene *sc, eval_series *s,
+                    eval_result *res);
+/* A daemon kept for many runs: the run is what follows the last RESET_TO taken. */
+void eval_take_from_last_reset(eval_take *tk);
+void eval_take_record(eval_take *tk, const lag_log_record *rec);
+
+/* ---------------------------------------------------------------- for eval_worker.c */
+double eval_now(void);
+double eval_now_wall(void); /* s since the epoch */
+void eval_sleep(double s);
+/* argv (or "sh -c cmd" when argv is NULL) in a process group of its own, with the run's
+ * URL and prefix in its environment */
+pid_t eval_spawn(char *const *argv, const char *cmd, const eval_env *env);
+int eval_wait_until(pid_t pid, double deadline, int *status);
+void eval_stop_group(pid_t pid, int *status);
+void eval_expand(const char *cmd, const eval_env *env, char *out, size_t len);
+int eval_series_grow(eval_series *s, int nj);
+void eval_fail(eval_result *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* ---------------------------------------------------------------- reused processes */
+/* One daemon and one controller kept for many runs (lagsim-sweep without --restart): the
+ * daemon starts paused in lockstep with the scene and the case's overrides, logging to a
+ * file of the worker's own, and the controller designs itself against that scene once. A
+ * run is then SET of each varied key under parameters, effects or reference, RESET_TO its
+ * initial state and STEP of its periods; its states are taken from the bus, and read from
+ * the log instead whenever the bus lost any of them (or the run faulted or stalled), so a
+ * run's numbers are those of a daemon started for it with the same values set live. */
+typedef struct eval_worker eval_worker;
+
+eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const eval_scene *sc,
+                               char *err, size_t errlen);
+/* One run: sets are "key=value" (initial.* ones skipped: q0/qd0 carry them), q0 and qd0
+ * the run's initial state. Returns 0 when the run could be evaluated (failed or not), -1
+ * with a message when the worker is lost (stop it and start another). OUT: res */
+int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets, int nsets,
+                    const double *q0, const double *qd0, eval_result *res, char *err,
+                    size_t errlen);
+/* Runs since the worker started (its log grows with them). */
+long eval_worker_runs(const eval_worker *w);
+void eval_worker_stop(eval_worker *w);
 
 #endif

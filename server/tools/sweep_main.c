@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include "eval_case.h"
+#include "scene.h"
 
 static const char *prog = "lagsim-sweep";
 
@@ -31,6 +32,7 @@ static void usage(FILE *f)
     fprintf(f,
 "usage: lagsim-sweep --config SCENE --controller 'COMMAND' (--case NAME | --duration S)\n"
 "                    --vary KEY=DIST ... [--runs N] [--seed S] [-j N] [--shard K/N]\n"
+"                    [--restart]\n"
 "                    [--suite FILE] [--require EXPR] [--csv OUT.csv] [--plot OUT.png]\n"
 "                    [--metric JOINT.METRIC] [--force] [--lagsimd PATH] [--timeout S] [-v]\n"
 "       lagsim-sweep merge A.csv B.csv ... -o OUT.csv [--force]\n"
@@ -54,6 +56,10 @@ static void usage(FILE *f)
 "  -j, --jobs N           runs at once on this machine (default 1)\n"
 "      --shard K/N        only runs i with i mod N = K - 1 (K = 1..N): one machine's\n"
 "                         part; lagsim-sweep merge joins the parts\n"
+"      --restart          a daemon and a controller started for each run, with the\n"
+"                         run's values (default: one of each per worker, started\n"
+"                         with the scene's values; each run's values SET and its\n"
+"                         initial state RESET_TO between runs)\n"
 "      --require EXPR     a run that misses EXPR does not pass (as lagsim-eval)\n"
 "      --csv OUT.csv      the runs' CSV\n"
 "      --plot OUT.png     --metric against each varied key (gnuplot)\n"
@@ -490,21 +496,29 @@ static double parse_pos(const char *opt, const char *s, double lo, double hi, in
     return v;
 }
 
-int main(int argc, char **argv)
-{
-    if (argc > 1 && !strcmp(argv[1], "merge")) return merge(argc - 1, argv + 1);
-    const char *config = NULL, *controller = NULL, *suite = NULL, *case_name = NULL;
-    const char *require = NULL, *csv = NULL, *png = NULL, *metric = NULL;
-    double duration = 0, timeout = 600;
-    long runs = 1, jobs = 1, shard_k = 1, shard_n = 1;
-    uint64_t seed = 1;
-    bool force = false, verbose = false;
+/* ---------------------------------------------------------------- the sweep */
+/* What a sweep is, from the command line and the scene. */
+typedef struct sweep {
+    const char *config, *controller, *suite, *case_name, *require, *csv, *png, *metric;
+    double duration, timeout;
+    long runs, jobs, shard_k, shard_n, per_point, total;
+    uint64_t seed;
+    bool force, verbose, restart;
     vary vs[VARY_MAX];
-    int nv = 0, bad = 0;
+    int nv;
     char lagsimd[4096];
-    eval_default_lagsimd(lagsimd, sizeof lagsimd);
+    eval_case c;
+    eval_scene sc;
+    lag_require req;
+    char header[ROW_MAX];
+    char default_metric[160];
+    char tmpdir[64];
+} sweep;
+
+static int parse_options(sweep *x, int argc, char **argv)
+{
     enum { O_CASE = 256, O_SUITE, O_VARY, O_SEED, O_SHARD, O_REQUIRE, O_CSV, O_PLOT, O_METRIC,
-           O_LAGSIMD, O_TIMEOUT };
+           O_LAGSIMD, O_TIMEOUT, O_RESTART };
     static const struct option opts[] = {
         {"config", required_argument, 0, 'c'},      {"controller", required_argument, 0, 'C'},
         {"case", required_argument, 0, O_CASE},     {"suite", required_argument, 0, O_SUITE},
@@ -515,227 +529,348 @@ int main(int argc, char **argv)
         {"plot", required_argument, 0, O_PLOT},     {"metric", required_argument, 0, O_METRIC},
         {"force", no_argument, 0, 'f'},             {"lagsimd", required_argument, 0, O_LAGSIMD},
         {"timeout", required_argument, 0, O_TIMEOUT}, {"verbose", no_argument, 0, 'v'},
-        {"help", no_argument, 0, 'h'},              {0, 0, 0, 0}};
-    int o;
+        {"restart", no_argument, 0, O_RESTART},     {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0}};
+    int o, bad = 0;
     opterr = 0;
     while ((o = getopt_long(argc, argv, ":c:C:d:n:j:fvh", opts, NULL)) != -1) {
         switch (o) {
-        case 'c': config = optarg; break;
-        case 'C': controller = optarg; break;
-        case O_CASE: case_name = optarg; break;
-        case O_SUITE: suite = optarg; break;
-        case 'd': duration = parse_pos("--duration", optarg, 1e-3, 1e6, &bad); break;
+        case 'c': x->config = optarg; break;
+        case 'C': x->controller = optarg; break;
+        case O_CASE: x->case_name = optarg; break;
+        case O_SUITE: x->suite = optarg; break;
+        case 'd': x->duration = parse_pos("--duration", optarg, 1e-3, 1e6, &bad); break;
         case O_VARY:
-            if (nv == VARY_MAX) return die("at most %s --vary", "16");
-            if (parse_vary(optarg, &vs[nv++]))
+            if (x->nv == VARY_MAX) return die("at most %s --vary", "16");
+            if (parse_vary(optarg, &x->vs[x->nv++]))
                 return die("--vary %s: expected KEY=uniform(A,B) (A < B), KEY=normal(MEAN,SD) "
                            "or KEY=grid(A,B,N); an index only on initial.q[i] or "
                            "initial.qd[i]", optarg);
             break;
-        case 'n': runs = (long)parse_pos("--runs", optarg, 1, 1e7, &bad); break;
-        case O_SEED: seed = (uint64_t)parse_pos("--seed", optarg, 0, 9e15, &bad); break;
-        case 'j': jobs = (long)parse_pos("--jobs", optarg, 1, 256, &bad); break;
+        case 'n': x->runs = (long)parse_pos("--runs", optarg, 1, 1e7, &bad); break;
+        case O_SEED: x->seed = (uint64_t)parse_pos("--seed", optarg, 0, 9e15, &bad); break;
+        case 'j': x->jobs = (long)parse_pos("--jobs", optarg, 1, 256, &bad); break;
         case O_SHARD:
-            if (sscanf(optarg, "%ld/%ld", &shard_k, &shard_n) != 2 || shard_n < 1 ||
-                shard_k < 1 || shard_k > shard_n)
+            if (sscanf(optarg, "%ld/%ld", &x->shard_k, &x->shard_n) != 2 || x->shard_n < 1 ||
+                x->shard_k < 1 || x->shard_k > x->shard_n)
                 return die("--shard: expected K/N with 1 <= K <= N, got '%s'", optarg);
             break;
-        case O_REQUIRE: require = optarg; break;
-        case O_CSV: csv = optarg; break;
-        case O_PLOT: png = optarg; break;
-        case O_METRIC: metric = optarg; break;
-        case 'f': force = true; break;
-        case O_LAGSIMD: snprintf(lagsimd, sizeof lagsimd, "%s", optarg); break;
-        case O_TIMEOUT: timeout = parse_pos("--timeout", optarg, 1, 1e6, &bad); break;
-        case 'v': verbose = true; break;
+        case O_REQUIRE: x->require = optarg; break;
+        case O_CSV: x->csv = optarg; break;
+        case O_PLOT: x->png = optarg; break;
+        case O_METRIC: x->metric = optarg; break;
+        case 'f': x->force = true; break;
+        case O_LAGSIMD: snprintf(x->lagsimd, sizeof x->lagsimd, "%s", optarg); break;
+        case O_TIMEOUT: x->timeout = parse_pos("--timeout", optarg, 1, 1e6, &bad); break;
+        case 'v': x->verbose = true; break;
+        case O_RESTART: x->restart = true; break;
         case 'h': usage(stdout); return 0;
         case ':': return die("%s needs a value (try --help)", argv[optind - 1]);
         default: return die("unknown option '%s' (try --help)", argv[optind - 1]);
         }
         if (bad) return 2;
     }
+    return -1; /* go on */
+}
+
+static int check_options(const sweep *x, int argc, char **argv)
+{
     if (optind < argc) return die("unexpected argument '%s' (try --help)", argv[optind]);
-    if (!config) return die("%s", "--config SCENE is required (try --help)");
-    if (!controller) return die("%s", "--controller 'COMMAND' is required (try --help)");
-    if (!nv) return die("%s", "at least one --vary KEY=DIST is required (try --help)");
-    if (!case_name == !duration) return die("%s", "give either --case NAME or --duration S");
+    if (!x->config) return die("%s", "--config SCENE is required (try --help)");
+    if (!x->controller) return die("%s", "--controller 'COMMAND' is required (try --help)");
+    if (!x->nv) return die("%s", "at least one --vary KEY=DIST is required (try --help)");
+    if (!x->case_name == !x->duration) return die("%s", "give either --case NAME or --duration S");
+    return -1;
+}
 
+/* The case: --case NAME from the scene's or the suite's cases, or --duration alone. */
+static int load_case(sweep *x)
+{
     char err[2048];
-    eval_case c;
-    memset(&c, 0, sizeof c);
-    if (case_name) {
-        eval_case *cases = NULL;
-        int ncases = 0;
-        if (eval_cases_load(suite ? suite : config, &cases, &ncases, err, sizeof err))
-            return die("%s", err);
-        int found = -1;
-        for (int k = 0; k < ncases; k++)
-            if (!strcmp(cases[k].name, case_name)) found = k;
-        if (found < 0) {
-            free(cases);
-            fprintf(stderr, "%s: --case %s: no such case in %s\n", prog, case_name,
-                    suite ? suite : config);
-            return 2;
-        }
-        c = cases[found];
-        free(cases);
-    } else {
-        snprintf(c.name, sizeof c.name, "sweep");
-        c.duration = duration;
+    if (!x->case_name) {
+        snprintf(x->c.name, sizeof x->c.name, "sweep");
+        x->c.duration = x->duration;
+        return -1;
     }
+    const char *from = x->suite ? x->suite : x->config;
+    eval_case *cases = NULL;
+    int ncases = 0, found = -1;
+    if (eval_cases_load(from, &cases, &ncases, err, sizeof err)) return die("%s", err);
+    for (int k = 0; k < ncases; k++)
+        if (!strcmp(cases[k].name, x->case_name)) found = k;
+    if (found >= 0) x->c = cases[found];
+    free(cases);
+    if (found >= 0) return -1;
+    fprintf(stderr, "%s: --case %s: no such case in %s\n", prog, x->case_name, from);
+    return 2;
+}
+
+/* The scene with the case's overrides, the requirement, and whether the varied keys can
+ * change while one daemon runs (SET, RESET_TO) */
+static int load_scene(sweep *x)
+{
+    char err[2048];
     const char *sets[EVAL_SETS_MAX];
-    for (int i = 0; i < c.nsets; i++) sets[i] = c.set[i];
-    eval_scene sc;
-    if (eval_scene_load(config, sets, c.nsets, &sc, err, sizeof err))
+    for (int i = 0; i < x->c.nsets; i++) sets[i] = x->c.set[i];
+    if (eval_scene_load(x->config, sets, x->c.nsets, &x->sc, err, sizeof err))
         return die("%s", err);
-    for (int k = 0; k < nv; k++)
-        if (vs[k].index >= sc.nj)
-            return die("--vary %s: the scene's model has fewer coordinates", vs[k].text);
-    lag_require req = {0};
-    if (require && (lag_require_parse(require, &req, err, sizeof err) ||
-                    eval_require_check(&req, &sc, err, sizeof err)))
+    for (int k = 0; k < x->nv; k++)
+        if (x->vs[k].index >= x->sc.nj)
+            return die("--vary %s: the scene's model has fewer coordinates", x->vs[k].text);
+    if (x->require && (lag_require_parse(x->require, &x->req, err, sizeof err) ||
+                       eval_require_check(&x->req, &x->sc, err, sizeof err)))
         return die("--require: %s", err);
+    for (int k = 0; !x->restart && k < x->nv; k++) {
+        const char *key = x->vs[k].key;
+        if (lag_scene_key_live(key) || !strcmp(key, "initial.q") || !strcmp(key, "initial.qd"))
+            continue;
+        fprintf(stderr, "%s: %s cannot change while lagsimd runs (SET takes the keys under "
+                        "parameters, effects and reference, RESET_TO initial.q and "
+                        "initial.qd): a daemon and a controller are started for each run "
+                        "(--restart)\n", prog, key);
+        x->restart = true;
+    }
+    x->per_point = x->total = x->runs;
+    for (int k = 0; k < x->nv; k++)
+        if (x->vs[k].kind == V_GRID) x->total *= x->vs[k].n;
+    if (x->total > 10000000) return die("%s", "more than 1e7 runs");
+    return -1;
+}
 
-    long per_point = runs, total = runs;
-    for (int k = 0; k < nv; k++)
-        if (vs[k].kind == V_GRID) total *= vs[k].n;
-    if (total > 10000000) return die("%s", "more than 1e7 runs");
-
-    /* the CSV's header: run, the keys, the verdict, each joint's metrics */
-    char header[ROW_MAX];
-    size_t hu = (size_t)snprintf(header, sizeof header, "run");
-    for (int k = 0; k < nv; k++) {
-        if (vs[k].index < 0)
-            hu += (size_t)snprintf(header + hu, sizeof header - hu, ",%s", vs[k].key);
+/* The CSV's header: run, the keys, the verdict, each joint's metrics. */
+static void make_header(sweep *x)
+{
+    char *h = x->header;
+    size_t hu = (size_t)snprintf(h, ROW_MAX, "run");
+    for (int k = 0; k < x->nv; k++) {
+        if (x->vs[k].index < 0)
+            hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",%s", x->vs[k].key);
         else
-            hu += (size_t)snprintf(header + hu, sizeof header - hu, ",%s[%d]", vs[k].key,
-                                   vs[k].index);
+            hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",%s[%d]", x->vs[k].key,
+                                   x->vs[k].index);
     }
-    hu += (size_t)snprintf(header + hu, sizeof header - hu, ",failed,required,reason");
-    for (int j = 0; j < sc.nj; j++)
+    hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",failed,required,reason");
+    for (int j = 0; j < x->sc.nj; j++)
         for (int m = 0; m < LAG_METRIC_COUNT; m++)
-            hu += (size_t)snprintf(header + hu, sizeof header - hu, ",%s.%s", sc.joint[j],
+            hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",%s.%s", x->sc.joint[j],
                                    lag_metric_table[m].name);
-    char default_metric[160];
-    snprintf(default_metric, sizeof default_metric, "%s.%s",
-             req.n ? req.term[0].joint : sc.joint[0],
-             lag_metric_table[req.n ? req.term[0].metric : LAG_METRIC_IAE].name);
-    if (!metric) metric = default_metric;
+    snprintf(x->default_metric, sizeof x->default_metric, "%s.%s",
+             x->req.n ? x->req.term[0].joint : x->sc.joint[0],
+             lag_metric_table[x->req.n ? x->req.term[0].metric : LAG_METRIC_IAE].name);
+    if (!x->metric) x->metric = x->default_metric;
+}
 
-    FILE *fcsv = NULL;
-    const char *in[2] = {config, suite};
-    if (csv && !(fcsv = eval_open_out(prog, "--csv", csv, force, in, 2))) return 2;
+/* ---------------------------------------------------------------- a worker */
+#define KEEP_RUNS 200 /* a kept daemon is started again after this many runs (its log) */
 
-    char tmpdir[] = "/tmp/lagsim-sweep.XXXXXX";
-    if (!mkdtemp(tmpdir)) {
-        fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
-        return 2;
+typedef struct worker {
+    const sweep *x;
+    long w;          /* its number */
+    eval_worker *kept; /* the daemon and the controller kept for its runs */
+    FILE *rows;
+} worker;
+
+static eval_env worker_env(const worker *wk, long run)
+{
+    const sweep *x = wk->x;
+    eval_env env = {.lagsimd = x->lagsimd, .config = x->config, .controller = x->controller,
+                    .workdir = x->tmpdir, .wall_timeout = x->timeout, .verbose = x->verbose};
+    eval_url((int)wk->w, env.url, sizeof env.url);
+    if (run < 0) snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_W%ld", (int)getpid(), wk->w);
+    else snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_%ld", (int)getpid(), run);
+    return env;
+}
+
+/* A run on the kept processes: started when there are none, started again after
+ * KEEP_RUNS runs, after a run that stalled, and once for a run the kept ones lost. */
+static int run_kept(worker *wk, const char *const *sets, int nsets, const eval_scene *rsc,
+                    eval_result *res, char *err, size_t errlen)
+{
+    const sweep *x = wk->x;
+    for (int attempt = 0; attempt < 2; attempt++) {
+        if (wk->kept && eval_worker_runs(wk->kept) >= KEEP_RUNS) {
+            eval_worker_stop(wk->kept);
+            wk->kept = NULL;
+        }
+        eval_env env = worker_env(wk, -1);
+        if (!wk->kept && !(wk->kept = eval_worker_start(&env, &x->c, &x->sc, err, errlen)))
+            return -1;
+        int rc = eval_worker_run(wk->kept, &x->c, sets, nsets, rsc->q0, rsc->qd0, res, err,
+                                 errlen);
+        if (rc == 0 && !strstr(res->reason, "before the duration")) return 0;
+        eval_worker_stop(wk->kept);
+        wk->kept = NULL;
+        if (rc == 0) return 0;
     }
-    /* workers: worker w runs this shard's runs i with (i / shard_n) mod jobs = w */
+    return -1;
+}
+
+static void write_row(const worker *wk, long i, const double *val, const eval_result *res)
+{
+    const sweep *x = wk->x;
+    FILE *f = wk->rows;
+    char why[512] = "";
+    bool met = !x->require || eval_require_holds(&x->req, &x->sc, res, why, sizeof why);
+    /* one line per run: the run number first (the parent sorts by it) */
+    fprintf(f, "%ld", i);
+    for (int k = 0; k < x->nv; k++) fprintf(f, ",%.17g", val[k]);
+    const char *reason = res->failed ? res->reason : met ? "" : why;
+    fprintf(f, ",%d,%d,\"", res->failed, met);
+    for (const char *p = reason; *p; p++) {
+        if (*p == '"') fputc('"', f);
+        fputc(*p == '\n' ? ' ' : *p, f);
+    }
+    fputc('"', f);
+    for (int j = 0; j < x->sc.nj; j++)
+        for (int m = 0; m < LAG_METRIC_COUNT; m++) {
+            if (isnan(res->m[j].v[m])) fprintf(f, ",nan");
+            else fprintf(f, ",%.17g", res->m[j].v[m]);
+        }
+    fputc('\n', f);
+    fflush(f);
+}
+
+/* Run i: its values, then a failed row for values the scene refuses (a negative mass),
+ * else the run on the kept processes or on processes of its own. */
+static int run_one(worker *wk, long i)
+{
+    const sweep *x = wk->x;
+    char err[2048];
+    double val[VARY_MAX];
+    for (int k = 0; k < x->nv; k++)
+        val[k] = vary_value(x->vs, x->nv, k, i, x->per_point, x->seed);
+    char extra[VARY_MAX][EVAL_SET_LEN];
+    int nx = run_sets(x->vs, x->nv, val, &x->sc, extra);
+    const char *xp[VARY_MAX + EVAL_SETS_MAX];
+    for (int k = 0; k < x->c.nsets; k++) xp[k] = x->c.set[k];
+    for (int k = 0; k < nx; k++) xp[x->c.nsets + k] = extra[k];
+    eval_result res;
+    memset(&res, 0, sizeof res);
+    eval_scene rsc;
+    int rc = 0;
+    if (eval_scene_load(x->config, xp, x->c.nsets + nx, &rsc, err, sizeof err)) {
+        res.failed = true;
+        snprintf(res.reason, sizeof res.reason, "refused: %.240s", err);
+        res.nj = x->sc.nj;
+        for (int j = 0; j < x->sc.nj; j++)
+            for (int m = 0; m < LAG_METRIC_COUNT; m++) res.m[j].v[m] = NAN;
+    } else if (!x->restart) {
+        rc = run_kept(wk, xp + x->c.nsets, nx, &rsc, &res, err, sizeof err);
+    } else {
+        eval_env env = worker_env(wk, i);
+        rc = eval_run(&env, &x->c, xp + x->c.nsets, nx, &rsc, &res, NULL, err, sizeof err);
+    }
+    if (rc) {
+        fprintf(stderr, "%s: run %ld: %s\n", prog, i, err);
+        return 4;
+    }
+    write_row(wk, i, val, &res);
+    return 0;
+}
+
+/* Worker w runs this shard's runs i with (i / shard_n) mod jobs = w; its rows go to a
+ * file of its own. Never returns. */
+static void worker_main(const sweep *x, long w)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/%ld.rows", x->tmpdir, w);
+    worker wk = {.x = x, .w = w, .rows = fopen(path, "w")};
+    if (!wk.rows) _exit(3);
+    int rc = 0;
+    for (long i = x->shard_k - 1; i < x->total && !rc; i += x->shard_n)
+        if ((i / x->shard_n) % x->jobs == w) rc = run_one(&wk, i);
+    eval_worker_stop(wk.kept);
+    fclose(wk.rows);
+    _exit(rc);
+}
+
+/* ---------------------------------------------------------------- the results */
+static int run_workers(sweep *x)
+{
     pid_t pids[256];
-    for (long w = 0; w < jobs; w++) {
+    int status = 0;
+    for (long w = 0; w < x->jobs; w++) {
         fflush(NULL);
         pids[w] = fork();
         if (pids[w] < 0) {
             fprintf(stderr, "%s: fork: %s\n", prog, strerror(errno));
             return 2;
         }
-        if (pids[w]) continue;
-        char path[256];
-        snprintf(path, sizeof path, "%s/%ld.rows", tmpdir, w);
-        FILE *f = fopen(path, "w");
-        if (!f) _exit(3);
-        int rc = 0;
-        for (long i = shard_k - 1; i < total; i += shard_n) {
-            if ((i / shard_n) % jobs != w) continue;
-            double val[VARY_MAX];
-            for (int k = 0; k < nv; k++) val[k] = vary_value(vs, nv, k, i, per_point, seed);
-            char extra[VARY_MAX][EVAL_SET_LEN];
-            int nx = run_sets(vs, nv, val, &sc, extra);
-            const char *xp[VARY_MAX + EVAL_SETS_MAX];
-            for (int k = 0; k < c.nsets; k++) xp[k] = c.set[k];
-            for (int k = 0; k < nx; k++) xp[c.nsets + k] = extra[k];
-            eval_result res;
-            memset(&res, 0, sizeof res);
-            char why[512] = "";
-            eval_scene rsc;
-            /* a value the scene refuses (a negative mass) is a failed run, not an abort */
-            if (eval_scene_load(config, xp, c.nsets + nx, &rsc, err, sizeof err)) {
-                res.failed = true;
-                snprintf(res.reason, sizeof res.reason, "refused: %.240s", err);
-                res.nj = sc.nj;
-                for (int j = 0; j < sc.nj; j++)
-                    for (int m = 0; m < LAG_METRIC_COUNT; m++) res.m[j].v[m] = NAN;
-            } else {
-                eval_env env = {.lagsimd = lagsimd, .config = config,
-                                .controller = controller, .workdir = tmpdir,
-                                .wall_timeout = timeout, .verbose = verbose};
-                eval_url((int)w, env.url, sizeof env.url);
-                snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_%ld", (int)getpid(), i);
-                if (eval_run(&env, &c, xp + c.nsets, nx, &rsc, &res, NULL, err, sizeof err)) {
-                    fprintf(stderr, "%s: run %ld: %s\n", prog, i, err);
-                    rc = 4;
-                    break;
-                }
-            }
-            bool met = !require || eval_require_holds(&req, &sc, &res, why, sizeof why);
-            /* one line per run: the run number first (the parent sorts by it) */
-            fprintf(f, "%ld", i);
-            for (int k = 0; k < nv; k++) fprintf(f, ",%.17g", val[k]);
-            const char *reason = res.failed ? res.reason : met ? "" : why;
-            fprintf(f, ",%d,%d,\"", res.failed, met);
-            for (const char *p = reason; *p; p++) {
-                if (*p == '"') fputc('"', f);
-                fputc(*p == '\n' ? ' ' : *p, f);
-            }
-            fputc('"', f);
-            for (int j = 0; j < sc.nj; j++)
-                for (int m = 0; m < LAG_METRIC_COUNT; m++) {
-                    if (isnan(res.m[j].v[m])) fprintf(f, ",nan");
-                    else fprintf(f, ",%.17g", res.m[j].v[m]);
-                }
-            fputc('\n', f);
-            fflush(f);
-        }
-        fclose(f);
-        _exit(rc);
+        if (pids[w] == 0) worker_main(x, w);
     }
-    int status = 0;
-    for (long w = 0; w < jobs; w++) {
+    for (long w = 0; w < x->jobs; w++) {
         int st = 0;
         waitpid(pids[w], &st, 0);
         if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) status = 2;
     }
-    rows r = {0};
+    return status;
+}
+
+static void collect_rows(const sweep *x, rows *r)
+{
     char line[ROW_MAX];
-    for (long w = 0; w < jobs; w++) {
+    for (long w = 0; w < x->jobs; w++) {
         char path[256];
-        snprintf(path, sizeof path, "%s/%ld.rows", tmpdir, w);
+        snprintf(path, sizeof path, "%s/%ld.rows", x->tmpdir, w);
         FILE *f = fopen(path, "r");
         if (!f) continue;
         while (fgets(line, sizeof line, f)) {
             line[strcspn(line, "\n")] = '\0';
-            rows_add(&r, strtol(line, NULL, 10), line);
+            rows_add(r, strtol(line, NULL, 10), line);
         }
         fclose(f);
         unlink(path);
     }
-    rmdir(tmpdir);
-    if (fcsv) {
-        if (rows_write(&r, fcsv, header, err, sizeof err) || fclose(fcsv) != 0) status = 2;
-    }
-    summary(header, &r);
+    rmdir(x->tmpdir);
+}
+
+static int count_passed(const sweep *x, const rows *r)
+{
     int passed = 0;
-    for (int i = 0; i < r.n; i++) {
+    for (int i = 0; i < r->n; i++) {
         char lb[ROW_MAX];
-        snprintf(lb, sizeof lb, "%s", r.line[i]);
+        snprintf(lb, sizeof lb, "%s", r->line[i]);
         char *f[512];
         int n = split(lb, f, 512);
-        passed += n > nv + 2 && !strcmp(f[nv + 1], "0") && !strcmp(f[nv + 2], "1");
+        passed += n > x->nv + 2 && !strcmp(f[x->nv + 1], "0") && !strcmp(f[x->nv + 2], "1");
     }
-    if (png && plot(png, force, config, header, &r, nv, metric)) status = 2;
-    int all = passed == r.n;
+    return passed;
+}
+
+static int sweep_run(sweep *x)
+{
+    char err[2048];
+    FILE *fcsv = NULL;
+    const char *in[2] = {x->config, x->suite};
+    if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, 2))) return 2;
+    snprintf(x->tmpdir, sizeof x->tmpdir, "/tmp/lagsim-sweep.XXXXXX");
+    if (!mkdtemp(x->tmpdir)) {
+        fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
+        return 2;
+    }
+    int status = run_workers(x);
+    rows r = {0};
+    collect_rows(x, &r);
+    if (fcsv && (rows_write(&r, fcsv, x->header, err, sizeof err) || fclose(fcsv) != 0))
+        status = 2;
+    summary(x->header, &r);
+    bool all = count_passed(x, &r) == r.n;
+    if (x->png && plot(x->png, x->force, x->config, x->header, &r, x->nv, x->metric))
+        status = 2;
     rows_free(&r);
-    if (status) return status;
-    return all ? 0 : 1;
+    return status ? status : all ? 0 : 1;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1 && !strcmp(argv[1], "merge")) return merge(argc - 1, argv + 1);
+    static sweep x = {.timeout = 600, .runs = 1, .jobs = 1, .shard_k = 1, .shard_n = 1,
+                      .seed = 1};
+    eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
+    int rc;
+    if ((rc = parse_options(&x, argc, argv)) >= 0 || (rc = check_options(&x, argc, argv)) >= 0 ||
+        (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0)
+        return rc;
+    make_header(&x);
+    return sweep_run(&x);
 }

@@ -10,15 +10,30 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             Slurm's variables set, merged, equal to the whole sweep
   merge     merge refuses a run twice and shards of another sweep (exit 2); a varied
             coordinate of initial.q lands in the scene; an index on another key is refused
+  kept      one lagsimd and one controller per worker (counted through wrappers), a
+            process pair per run with --restart; the kept processes give the CSV of a
+            process pair per run, byte for byte, where the controller's design is the
+            same (the initial state varied; the masses at the scene's values after other
+            masses were SET); a mass SET differs from the controller's design
+  loss      in a network namespace whose loopback drops 1 UDP datagram in 15 (nftables):
+            the same CSV as without loss, byte for byte (SET and RESET_TO sent again, the
+            runs the bus lost states of read from the kept daemon's log)
+  ssh       GNU parallel --sshlogin over two "hosts" (network namespaces, each running a
+            private sshd on its own address): one shard on each, merged, equal to the whole
+            sweep byte for byte (needs root, ip, sshd)
+  stalled   the workers stopped and continued again and again (their sockets' queues
+            overflow): runs read from the log, the same CSV, byte for byte
 """
 import csv
 import filecmp
 import glob
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 
 BIN, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
 SCENE = os.path.join(SRC, "config", "cartpole.yaml")
@@ -59,10 +74,14 @@ def case_same(d):
     check(filecmp.cmp(a1, a2, shallow=False), "-j1 and -j2 give the same CSV, byte for byte")
     # two shards with GNU parallel on this host, then merged
     sh = os.path.join(d, "shard-{}.csv")
-    cmd = ["parallel", "--will-cite", "-j2", SWEEP] + ["'%s'" % a for a in ARGS] + \
-          ["--shard", "{}/2", "--csv", sh, ":::", "1", "2"]
-    p = run(cmd)
-    check(p.returncode in (0, 1), "GNU parallel ran both shards")
+    jl = os.path.join(d, "joblog")
+    cmd = ["parallel", "--will-cite", "--joblog", jl, "-j2", SWEEP] + \
+        ["'%s'" % a for a in ARGS] + ["--shard", "{}/2", "--csv", sh, ":::", "1", "2"]
+    run(cmd)
+    exits = [line.split("\t")[6] for line in open(jl).read().splitlines()[1:]]
+    # a sweep exits 1 when a run misses --require: it ran
+    check(len(exits) == 2 and all(e in ("0", "1") for e in exits),
+          "GNU parallel ran both shards (exit statuses %s)" % exits)
     p = run([SWEEP, "merge", os.path.join(d, "shard-2.csv"), os.path.join(d, "shard-1.csv"),
              "-o", m])
     check(p.returncode == 0, "merge: exit 0")
@@ -76,7 +95,10 @@ def case_same(d):
     m0 = [float(x["parameters.m0"]) for x in r]
     check(all(0.5 < v < 2 for v in m0) and len(set(m0)) == 8,
           "uniform(0.5,2): 8 different values inside: %s" % m0)
-    # run 5 again through lagsim-eval: the same overrides give the same metrics
+    # run 5 again through lagsim-eval: with --restart (a controller started with the run's
+    # values, as lagsim-eval starts it) the same overrides give the same metrics
+    rr = os.path.join(d, "restart.csv")
+    run([SWEEP] + ARGS + ["-j2", "--restart", "--csv", rr])
     suite = os.path.join(d, "one.yaml")
     with open(suite, "w") as f:
         f.write('cases:\n  - name: r5\n    duration: 8\n    set: ["parameters.m0=%s", '
@@ -85,10 +107,11 @@ def case_same(d):
     run([os.path.join(BIN, "lagsim-eval"), "--config", SCENE, "--controller", CTRL,
          "--suite", suite, "--csv", e])
     ev = {x["joint"]: x for x in rows(e)}
-    same = all(ev[j][mm] == r[5][j + "." + mm] for j in ("x", "theta")
+    r5 = rows(rr)[5]
+    same = all(ev[j][mm] == r5[j + "." + mm] for j in ("x", "theta")
                for mm in ("rise", "settle", "overshoot", "sse", "iae", "ise", "peak_error",
                           "effort_peak", "effort_rms"))
-    check(same, "run 5's metrics = lagsim-eval's for its overrides")
+    check(same, "--restart: run 5's metrics = lagsim-eval's for its overrides")
     req = [float(x["theta.settle"]) < 6.5 for x in r]
     check([x["required"] == "1" for x in r] == req, "required column = theta.settle < 6.5")
     s8 = os.path.join(d, "seed8.csv")
@@ -146,7 +169,183 @@ def case_merge(d):
     check(p.returncode == 2 and "initial.q[i]" in p.stderr, "an index on another key: exit 2")
 
 
+def starts(path):
+    return len(open(path).read().splitlines()) if os.path.exists(path) else 0
+
+
+def case_kept(d):
+    # wrappers that count the starts of the daemon and of the controller
+    dcount, ccount = os.path.join(d, "daemons"), os.path.join(d, "controllers")
+    wrap = os.path.join(d, "lagsimd")
+    with open(wrap, "w") as f:
+        f.write('#!/bin/sh\necho x >> %s\nexec %s "$@"\n' % (dcount, os.path.join(BIN, "lagsimd")))
+    os.chmod(wrap, 0o755)
+    ctrl = "echo x >> %s; exec %s" % (ccount, CTRL)
+    base = ["--config", SCENE, "--controller", ctrl, "--duration", "4", "--lagsimd", wrap]
+    q = base + ["--vary", "initial.q[1]=normal(0,0.05)", "--vary", "initial.qd[0]=uniform(-0.2,0.2)",
+                "--runs", "8", "--seed", "3"]
+    kept, fresh = os.path.join(d, "kept.csv"), os.path.join(d, "fresh.csv")
+    run([SWEEP] + q + ["-j2", "--csv", kept])
+    check((starts(dcount), starts(ccount)) == (2, 2),
+          "-j2, 8 runs: 2 daemons and 2 controllers started (got %d, %d)"
+          % (starts(dcount), starts(ccount)))
+    run([SWEEP] + q + ["-j2", "--restart", "--csv", fresh])
+    check((starts(dcount), starts(ccount)) == (10, 10),
+          "--restart: one daemon and one controller a run (got %d, %d in all)"
+          % (starts(dcount), starts(ccount)))
+    check(filecmp.cmp(kept, fresh, shallow=False),
+          "initial state varied: kept processes = a process pair per run, byte for byte")
+    # the pole's mass: two runs at 0.3, then two at the scene's 0.1 (-j1: in that order)
+    m = base + ["--vary", "parameters.m1=grid(0.05,0.1,2)", "--runs", "2"]
+    kept, fresh = os.path.join(d, "kept_m.csv"), os.path.join(d, "fresh_m.csv")
+    run([SWEEP] + m + ["-j1", "--csv", kept])
+    run([SWEEP] + m + ["-j1", "--restart", "--csv", fresh])
+    a, b = rows(kept), rows(fresh)
+    check([x["parameters.m1"] for x in a] == ["0.050000000000000003"] * 2 + ["0.10000000000000001"] * 2,
+          "grid(0.05,0.1,2): 0.05 twice, then the scene's 0.1 twice")
+    check(a[2:] == b[2:], "the scene's mass SET back after another: the rows of a process "
+          "pair started with it, byte for byte")
+    check(a[0]["theta.iae"] != b[0]["theta.iae"] and a[0]["theta.iae"] != a[2]["theta.iae"],
+          "mass 0.05 SET on the plant (rows differ from the scene's mass), the controller "
+          "designed for the scene's (rows differ from --restart's)")
+
+
+def case_loss(d):
+    if os.geteuid() != 0 or not shutil.which("nft") or not shutil.which("ip"):
+        print("skipped: needs root, ip and nft")
+        sys.exit(77)
+    ns = "lgsweep%d" % os.getpid()
+    if subprocess.run(["ip", "netns", "add", ns]).returncode != 0:
+        print("skipped: cannot make a network namespace here")
+        sys.exit(77)
+    try:
+        inns = ["ip", "netns", "exec", ns]
+        for c in (["ip", "link", "set", "lo", "up"],
+                  ["ip", "route", "add", "224.0.0.0/4", "dev", "lo"],
+                  ["nft", "add", "table", "inet", "loss"],
+                  ["nft", "add", "chain", "inet", "loss", "in",
+                   "{ type filter hook input priority 0; }"]):
+            subprocess.run(inns + c, check=True)
+        q = ARGS[:-2] + ["--vary", "initial.q[1]=normal(0,0.05)", "-j2", "-v"]
+        clean, lossy = os.path.join(d, "clean.csv"), os.path.join(d, "lossy.csv")
+        run(inns + [SWEEP] + q + ["--csv", clean])
+        subprocess.run(inns + ["nft", "add", "rule", "inet", "loss", "in", "udp", "dport",
+                               "64000-65535", "numgen", "random", "mod", "15", "==", "0",
+                               "counter", "drop"], check=True)
+        p = run(inns + [SWEEP] + q + ["--csv", lossy])
+        dropped = subprocess.run(inns + ["nft", "list", "chain", "inet", "loss", "in"],
+                                 stdout=subprocess.PIPE, universal_newlines=True).stdout
+        print(dropped)
+        check(" drop" in dropped and "packets 0 " not in dropped, "datagrams were dropped")
+        check(p.returncode in (0, 1), "the sweep ran under loss (exit %d)" % p.returncode)
+        check(filecmp.cmp(clean, lossy, shallow=False),
+              "1 datagram in 15 lost: the same CSV as without loss, byte for byte")
+    finally:
+        subprocess.run(["ip", "netns", "del", ns])
+
+
+def sshd_host(d, name, net):
+    """A network namespace `name` joined to this one by a veth pair on 10.<net>.0.0/24, its
+    loopback up with the multicast route (lagsim's bus stays on the host), and an sshd on
+    10.<net>.0.2 that takes the key d/id for root. Returns the address."""
+    host, peer = "10.%d.0.1" % net, "10.%d.0.2" % net
+    va, vb = "lgs%da%d" % (net, os.getpid() % 10000), "lgs%db%d" % (net, os.getpid() % 10000)
+    inns = ["ip", "netns", "exec", name]
+    for c in (["ip", "netns", "add", name],
+              ["ip", "link", "add", va, "type", "veth", "peer", "name", vb],
+              ["ip", "link", "set", vb, "netns", name],
+              ["ip", "addr", "add", host + "/24", "dev", va], ["ip", "link", "set", va, "up"],
+              inns + ["ip", "addr", "add", peer + "/24", "dev", vb],
+              inns + ["ip", "link", "set", vb, "up"], inns + ["ip", "link", "set", "lo", "up"],
+              inns + ["ip", "route", "add", "224.0.0.0/4", "dev", "lo"]):
+        subprocess.run(c, check=True)
+    cfg = os.path.join(d, "sshd-%s.conf" % name)
+    with open(cfg, "w") as f:
+        f.write("ListenAddress %s\nHostKey %s/hostkey\nAuthorizedKeysFile %s/authorized_keys\n"
+                "PermitRootLogin prohibit-password\nStrictModes no\nUsePAM no\n"
+                "PidFile %s/sshd-%s.pid\n" % (peer, d, d, d, name))
+    os.makedirs("/run/sshd", exist_ok=True)
+    subprocess.run(inns + ["/usr/sbin/sshd", "-f", cfg, "-E", os.path.join(d, name + ".log")],
+                   check=True)
+    return peer
+
+
+def case_ssh(d):
+    if os.geteuid() != 0 or not os.path.exists("/usr/sbin/sshd") or not shutil.which("ip"):
+        print("skipped: needs root, ip and sshd (openssh-server)")
+        sys.exit(77)
+    for key in ("hostkey", "id"):
+        subprocess.run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-f",
+                        os.path.join(d, key)], check=True)
+    shutil.copy(os.path.join(d, "id.pub"), os.path.join(d, "authorized_keys"))
+    names = ["lgsshb%d" % os.getpid(), "lgsshc%d" % os.getpid()]
+    try:
+        hosts = [sshd_host(d, n, 200 + k) for k, n in enumerate(names)]
+        whole = os.path.join(d, "whole.csv")
+        run([SWEEP] + ARGS + ["-j2", "--csv", whole])
+        ssh = ("ssh -i %s -o StrictHostKeyChecking=no -o UserKnownHostsFile=/dev/null "
+               "-o BatchMode=yes -o LogLevel=ERROR" % os.path.join(d, "id"))
+        sh = os.path.join(d, "shard-{}.csv")
+        # one shard a host (-j1 each): the shards run where ssh takes them
+        jl = os.path.join(d, "joblog")
+        run(["parallel", "--will-cite", "--joblog", jl, "--ssh", ssh, "--sshlogin",
+             ",".join(hosts), "-j1", SWEEP] + ["'%s'" % a for a in ARGS] +
+            ["-j1", "--shard", "{}/2", "--csv", sh, ":::", "1", "2"])
+        jobs = [line.split("\t") for line in open(jl).read().splitlines()[1:]]
+        # a sweep exits 1 when a run misses --require: it ran
+        check(sorted(j[1] for j in jobs) == sorted(hosts) and all(j[6] in ("0", "1") for j in jobs),
+              "GNU parallel --sshlogin ran one shard on each host: %s"
+              % [(j[1], j[6]) for j in jobs])
+        logins = [open(os.path.join(d, n + ".log")).read() for n in names]
+        check(all("Accepted publickey for root" in x for x in logins),
+              "each host's sshd took a login: %s" % [x.count("Accepted") for x in logins])
+        m = os.path.join(d, "merged.csv")
+        run([SWEEP, "merge", os.path.join(d, "shard-1.csv"), os.path.join(d, "shard-2.csv"),
+             "-o", m])
+        check(filecmp.cmp(whole, m, shallow=False),
+              "the shards run over ssh, merged = the whole sweep, byte for byte")
+    finally:
+        for n in names:
+            pid = os.path.join(d, "sshd-%s.pid" % n)
+            if os.path.exists(pid):
+                subprocess.run(["kill", open(pid).read().strip()])
+            subprocess.run(["ip", "netns", "del", n], stderr=subprocess.DEVNULL)
+        for k in range(2):
+            subprocess.run(["ip", "link", "del", "lgs%da%d" % (200 + k, os.getpid() % 10000)],
+                           stderr=subprocess.DEVNULL)
+
+
+def case_stalled(d):
+    # the workers stopped (SIGSTOP) for 0.2 s again and again while their daemons and
+    # controllers go on: their sockets' queues overflow and the bus loses states for them
+    q = [a if a != "2" else "6" for a in ARGS[:-2]] + ["--vary", "initial.q[1]=normal(0,0.05)",
+                                                      "-j2"]  # 24 runs
+    clean, stalled = os.path.join(d, "clean.csv"), os.path.join(d, "stalled.csv")
+    run([SWEEP] + q + ["--csv", clean])
+    p = subprocess.Popen([SWEEP] + q + ["-v", "--csv", stalled], stdout=subprocess.DEVNULL,
+                         stderr=subprocess.PIPE, universal_newlines=True)
+    stops = 0
+    while p.poll() is None:
+        time.sleep(0.1)
+        kids = subprocess.run(["pgrep", "-P", str(p.pid)], stdout=subprocess.PIPE,
+                              universal_newlines=True).stdout.split()
+        for k in kids:
+            os.kill(int(k), signal.SIGSTOP)
+        time.sleep(0.2)
+        for k in kids:
+            os.kill(int(k), signal.SIGCONT)
+        stops += bool(kids)
+    err = p.stderr.read()
+    print(err[-3000:])
+    check(p.returncode in (0, 1) and stops > 0, "the sweep ran, its workers stopped %d times"
+          % stops)
+    check("read from the log" in err, "runs whose states the bus lost were read from the log")
+    check(filecmp.cmp(clean, stalled, shallow=False),
+          "workers stopped again and again: the same CSV, byte for byte")
+
+
 with tempfile.TemporaryDirectory() as tmp:
-    {"same": case_same, "slurm": case_slurm, "merge": case_merge}[CASE](tmp)
+    {"same": case_same, "slurm": case_slurm, "merge": case_merge, "kept": case_kept,
+     "loss": case_loss, "stalled": case_stalled, "ssh": case_ssh}[CASE](tmp)
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)

@@ -1,0 +1,396 @@
+/*
+ * One lagsimd and one controller kept for many runs of a case (eval_case.h, "reused
+ * processes"). A run:
+ *
+ *   SET key=value      each varied key under parameters, effects or reference, resent until
+ *                      its `set` event is heard (SET is idempotent)
+ *   RESET_TO q0, qd0   resent until the state at sim time 0 with exactly q0, qd0 is heard
+ *   STEP n             the case's periods; the states are taken from the bus as they come
+ *
+ * The bus may lose a datagram; the daemon's --log does not. A run whose states from the
+ * bus are not all there (one missing, a reference missing), or that faulted or stalled, is
+ * read again from the log, from its last RESET_TO on (eval_take), once the log's writer
+ * has written it. So a run's series is always the one its daemon computed.
+ *
+ * The worker's daemon starts paused at the scene's initial state; one period is stepped
+ * first, so that no answer of the controller to that first state (sim time 0) can be taken
+ * for an answer to a run's first state.
+ */
+#include <errno.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "eval_case.h"
+#include "lagsim/lagsim.h"
+#include "lagsim_client.h"
+
+#define W_ANSWER_S 0.5  /* a SET or RESET_TO unanswered this long is sent again */
+#define W_TRIES 8       /* ... this many times at most */
+#define W_QUIET_S 0.25  /* a run with no new state for this long: a status is asked for */
+#define W_LOG_WAIT_S 3.0 /* the log's writer writes within 0.1 s; this is its margin */
+
+struct eval_worker {
+    eval_env env;
+    eval_scene sc;
+    char log[1024];
+    pid_t dpid, cpid;
+    lag_client *cl;
+    long runs;
+    /* the run in progress, from the bus */
+    eval_series s;
+    bool armed, started, fault, step_done;
+    long missing_refs;   /* states whose reference did not come before them */
+    double q0[EVAL_JOINTS_MAX], qd0[EVAL_JOINTS_MAX];
+    const char *set_wait; /* "key=value" whose set event is awaited */
+    bool set_heard;
+    double t_heard;       /* the sim time of the last state heard */
+    bool moved;           /* a state after sim time 0 heard since the STEP */
+};
+
+/* ---------------------------------------------------------------- from the bus */
+static bool is_run_start(const eval_worker *w, const lag_client_state *st)
+{
+    if (st->sim_time != 0) return false;
+    for (int j = 0; j < w->sc.nj; j++)
+        if (st->position[j] != w->q0[j] || st->velocity[j] != w->qd0[j]) return false;
+    return true;
+}
+
+/* The reference of the state at sim time t, joint by joint; false if it did not come. */
+static bool reference_at(const eval_worker *w, double t, double *r)
+{
+    lag_client_reference ref;
+    for (int j = 0; j < w->sc.nj; j++) r[j] = 0;
+    if (!lag_client_latest_reference(w->cl, &ref) || ref.sim_time != t) return false;
+    for (int j = 0; j < w->sc.nj; j++) {
+        int k = lag_client_reference_joint(&ref, w->sc.joint[j]);
+        if (k >= 0 && isfinite(ref.r[k])) r[j] = ref.r[k];
+    }
+    return true;
+}
+
+static void w_on_state(const lag_client_state *st, void *user)
+{
+    eval_worker *w = user;
+    w->t_heard = st->sim_time;
+    if (st->sim_time > 0) w->moved = true;
+    if (!w->armed || st->num_joints != w->sc.nj) return;
+    if (!w->started && !(w->started = is_run_start(w, st))) return;
+    eval_series *s = &w->s;
+    /* a state published again (a retry, a paused state) is one sample, as in a log */
+    if (s->n && st->sim_time <= s->t[s->n - 1]) return;
+    if (eval_series_grow(s, w->sc.nj)) return;
+    size_t k = s->n++;
+    double r[EVAL_JOINTS_MAX];
+    if (reference_at(w, st->sim_time, r)) s->has_reference = true;
+    else w->missing_refs++;
+    s->t[k] = st->sim_time;
+    for (int j = 0; j < w->sc.nj; j++) {
+        s->q[j][k] = st->position[j];
+        s->r[j][k] = r[j];
+        if (k) s->u[j][k - 1] = st->effort[j];
+        s->u[j][k] = st->effort[j];
+    }
+}
+
+static void w_on_event(const lag_client_event *ev, void *user)
+{
+    eval_worker *w = user;
+    if (!strcmp(ev->kind, "step_done")) w->step_done = w->moved = true;
+    else if (!strcmp(ev->kind, "numeric_fault") && w->armed) w->fault = true;
+    else if (!strcmp(ev->kind, "set") && w->set_wait && !strcmp(ev->detail, w->set_wait))
+        w->set_heard = true;
+}
+
+/* Handles messages until *flag or `seconds`; -1 on timeout or a client error. */
+static int w_wait(eval_worker *w, const bool *flag, double seconds)
+{
+    double end = eval_now() + seconds;
+    while (!*flag) {
+        if (eval_now() > end || lag_client_handle(w->cl, 5) < 0) return -1;
+    }
+    return 0;
+}
+
+/* A status newer than now; false when none came within W_ANSWER_S or a state after sim
+ * time 0 came first (the daemon moved: the question is answered). OUT: st */
+static bool fresh_status(eval_worker *w, lag_client_status *st, bool stop_on_move)
+{
+    int64_t asked = (int64_t)(eval_now_wall() * 1e6);
+    if (lag_client_request_status(w->cl) != LAG_CLIENT_OK) return false;
+    double end = eval_now() + W_ANSWER_S;
+    while (eval_now() < end) {
+        lag_client_handle(w->cl, 5);
+        if (stop_on_move && w->moved) return false;
+        if (lag_client_latest_status(w->cl, st) && st->utime >= asked) return true;
+    }
+    return false;
+}
+
+/* Is the daemon paused at sim time 0 waiting for a STEP (the STEP was lost; while a STEP
+ * is under way it waits for answers instead)? */
+static bool still_at_start(eval_worker *w)
+{
+    lag_client_status st;
+    return fresh_status(w, &st, true) && st.sim_time == 0 &&
+           !strncmp(st.waiting_for, "RESUME or STEP", 14);
+}
+
+/* STEP n, sent again only when a fresh status says the daemon has not moved from sim
+ * time 0 (a second STEP that arrived would step twice); waits up to `seconds` for the
+ * first state after 0 (a controller may take seconds to answer its first state). */
+static int step_once(eval_worker *w, long n, double seconds)
+{
+    w->moved = false;
+    double end = eval_now() + seconds;
+    if (lag_client_step(w->cl, n) != LAG_CLIENT_OK) return -1;
+    while (!w->moved) {
+        if (eval_now() > end) return -1;
+        double next = eval_now() + W_ANSWER_S;
+        while (!w->moved && eval_now() < next) lag_client_handle(w->cl, 5);
+        if (!w->moved && still_at_start(w) && lag_client_step(w->cl, n) != LAG_CLIENT_OK)
+            return -1;
+    }
+    return 0;
+}
+
+/* ---------------------------------------------------------------- start, stop */
+static pid_t start_daemon(eval_worker *w, const eval_case *c)
+{
+    char *argv[2 * EVAL_SETS_MAX + 24];
+    char owned[2][600];
+    int na = 0;
+    argv[na++] = (char *)w->env.lagsimd;
+    argv[na++] = "--config";
+    argv[na++] = (char *)w->env.config;
+    /* STEP takes a period without a command once lockstep_timeout passed (as asked): the
+     * longest one, so that a period never goes without its answer, as in a running
+     * lockstep plant (a lost answer costs a retry, docs/server.md) */
+    static const char *const fixed[] = {"realtime.mode=lockstep", "realtime.start=paused",
+                                        "realtime.lockstep_timeout=3600"};
+    for (int i = 0; i < 3; i++) {
+        argv[na++] = "--set";
+        argv[na++] = (char *)fixed[i];
+    }
+    snprintf(owned[0], sizeof owned[0], "lcm.prefix=%s", w->env.prefix);
+    snprintf(owned[1], sizeof owned[1], "lcm.url=%s", w->env.url);
+    for (int i = 0; i < 2; i++) {
+        argv[na++] = "--set";
+        argv[na++] = owned[i];
+    }
+    for (int i = 0; i < c->nsets; i++) {
+        argv[na++] = "--set";
+        argv[na++] = (char *)c->set[i];
+    }
+    argv[na++] = "--log";
+    argv[na++] = w->log;
+    argv[na++] = "-q";
+    argv[na] = NULL;
+    return eval_spawn(argv, NULL, &w->env);
+}
+
+static eval_worker *start_failed(eval_worker *w, char *err, size_t errlen, const char *why)
+{
+    snprintf(err, errlen, "%s", why);
+    eval_worker_stop(w);
+    return NULL;
+}
+
+eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const eval_scene *sc,
+                               char *err, size_t errlen)
+{
+    eval_worker *w = calloc(1, sizeof *w);
+    if (!w) return NULL;
+    w->env = *env;
+    w->sc = *sc;
+    snprintf(w->log, sizeof w->log, "%s/%s.lcm", env->workdir, env->prefix);
+    unlink(w->log);
+    char cmd[4096];
+    eval_expand(env->controller, env, cmd, sizeof cmd);
+    /* the controller first, as eval_run starts them */
+    w->cpid = eval_spawn(NULL, cmd, env);
+    w->dpid = start_daemon(w, c);
+    w->cl = lag_client_create(env->url, env->prefix, err, errlen);
+    if (w->cpid < 0 || w->dpid < 0 || !w->cl)
+        return start_failed(w, err, errlen, w->cl ? "cannot start the processes" : err);
+    lag_client_on_state(w->cl, w_on_state, w);
+    lag_client_on_event(w->cl, w_on_event, w);
+    lag_client_scene scene;
+    if (lag_client_wait_scene(w->cl, 10.0, &scene) != LAG_CLIENT_OK)
+        return start_failed(w, err, errlen, "no scene from the kept lagsimd");
+    if (step_once(w, 1, 30))
+        return start_failed(w, err, errlen, "the kept lagsimd did not step");
+    return w;
+}
+
+void eval_worker_stop(eval_worker *w)
+{
+    if (!w) return;
+    int st;
+    if (w->dpid > 0) {
+        kill(w->dpid, SIGTERM);
+        if (!eval_wait_until(w->dpid, eval_now() + 3.0, &st)) eval_stop_group(w->dpid, &st);
+    }
+    /* a controller ends on the daemon's stop; one that does not is stopped */
+    if (w->cpid > 0 && !eval_wait_until(w->cpid, eval_now() + 3.0, &st))
+        eval_stop_group(w->cpid, &st);
+    if (w->cl) lag_client_destroy(w->cl);
+    eval_series_free(&w->s);
+    if (!w->env.verbose) unlink(w->log);
+    free(w);
+}
+
+long eval_worker_runs(const eval_worker *w) { return w->runs; }
+
+/* ---------------------------------------------------------------- a run */
+static int set_keys(eval_worker *w, const char *const *sets, int nsets, char *err,
+                    size_t errlen)
+{
+    for (int i = 0; i < nsets; i++) {
+        if (!strncmp(sets[i], "initial.", 8)) continue;
+        char key[EVAL_SET_LEN];
+        snprintf(key, sizeof key, "%s", sets[i]);
+        char *eq = strchr(key, '=');
+        if (!eq) continue;
+        *eq = '\0';
+        w->set_wait = sets[i];
+        w->set_heard = false;
+        for (int t = 0; t < W_TRIES && !w->set_heard; t++)
+            if (lag_client_set(w->cl, key, eq + 1) != LAG_CLIENT_OK ||
+                (w_wait(w, &w->set_heard, W_ANSWER_S) && t == W_TRIES - 1)) {
+                snprintf(err, errlen, "the kept lagsimd did not take SET %s", sets[i]);
+                w->set_wait = NULL;
+                return -1;
+            }
+        w->set_wait = NULL;
+    }
+    return 0;
+}
+
+static int reset_to(eval_worker *w, const double *q0, const double *qd0, char *err,
+                    size_t errlen)
+{
+    memcpy(w->q0, q0, sizeof w->q0);
+    memcpy(w->qd0, qd0, sizeof w->qd0);
+    w->armed = true;
+    for (int t = 0; t < W_TRIES && !w->started; t++)
+        if (lag_client_reset_to(w->cl, w->sc.nj, q0, qd0) != LAG_CLIENT_OK ||
+            (w_wait(w, &w->started, W_ANSWER_S) && t == W_TRIES - 1)) {
+            snprintf(err, errlen, "no state at the run's initial state after RESET_TO");
+            return -1;
+        }
+    return 0;
+}
+
+/* The states until the last one, a fault, the daemon's end of the STEP (its last state
+ * lost on the way: a status says it is paused past the goal), or no progress within the
+ * wall timeout (a controller may think long: a status says whether the daemon still
+ * waits for an answer). */
+static void follow(eval_worker *w, double t_goal)
+{
+    double start = eval_now(), last = start;
+    size_t seen = w->s.n;
+    while (!(w->s.n && w->s.t[w->s.n - 1] >= t_goal) && !w->fault) {
+        if (lag_client_handle(w->cl, 20) < 0) break;
+        if (w->s.n != seen) seen = w->s.n, last = eval_now();
+        if (eval_now() - start > w->env.wall_timeout) break;
+        if (eval_now() - last < W_QUIET_S) continue;
+        lag_client_status st;
+        if (fresh_status(w, &st, false) &&
+            (!strcmp(st.run_state, "fault") ||
+             (st.sim_time >= t_goal && !strncmp(st.waiting_for, "RESUME or STEP", 14))))
+            break; /* what the bus lost, the log has */
+        last = eval_now();
+    }
+}
+
+static bool log_run(eval_worker *w, off_t from, double t_goal, eval_result *res, char *err,
+                    size_t errlen, bool *done)
+{
+    FILE *f = fopen(w->log, "rb");
+    if (!f || fseeko(f, from, SEEK_SET) != 0) {
+        snprintf(err, errlen, "%s: %s", w->log, strerror(errno));
+        if (f) fclose(f);
+        return false;
+    }
+    lag_log *lg = lag_log_open_stream(f, w->log, 1 << 20, err, errlen);
+    if (!lg) {
+        fclose(f);
+        return false;
+    }
+    eval_take tk;
+    eval_take_init(&tk, w->env.prefix, &w->sc, &w->s, res);
+    eval_take_from_last_reset(&tk);
+    tk.t_stop = t_goal + w->sc.period;
+    lag_log_record rec;
+    while (lag_log_next(lg, &rec) == LAG_LOG_OK && !tk.oom) eval_take_record(&tk, &rec);
+    lag_log_close(lg);
+    fclose(f);
+    *done = tk.started && (tk.fault || (w->s.n && w->s.t[w->s.n - 1] >= t_goal));
+    if (tk.oom) snprintf(err, errlen, "out of memory");
+    return !tk.oom;
+}
+
+/* The run as the log holds it, from its RESET_TO on: waits for the log's writer. */
+static int from_log(eval_worker *w, off_t from, double t_goal, eval_result *res, char *err,
+                    size_t errlen)
+{
+    double end = eval_now() + W_LOG_WAIT_S;
+    for (;;) {
+        bool done = false;
+        eval_series_free(&w->s);
+        memset(res, 0, sizeof *res);
+        if (!log_run(w, from, t_goal, res, err, errlen, &done)) return -1;
+        if (done || eval_now() > end) return 0;
+        eval_sleep(0.02);
+    }
+}
+
+int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets, int nsets,
+                    const double *q0, const double *qd0, eval_result *res, char *err,
+                    size_t errlen)
+{
+    memset(res, 0, sizeof *res);
+    eval_series_free(&w->s);
+    w->fault = w->armed = w->started = false;
+    w->missing_refs = 0;
+    w->runs++;
+    /* every varied key is SET in every run, so nothing of the run before stays */
+    if (set_keys(w, sets, nsets, err, errlen)) return -1;
+    struct stat sb;
+    off_t from = stat(w->log, &sb) == 0 ? sb.st_size : 0; /* before the run's RESET_TO */
+    if (reset_to(w, q0, qd0, err, errlen)) return -1;
+    long periods = lround(c->duration / w->sc.period);
+    if (step_once(w, periods, w->env.wall_timeout)) {
+        snprintf(err, errlen, "the kept lagsimd did not step");
+        return -1;
+    }
+    double t_goal = c->duration - 0.5 * w->sc.period;
+    follow(w, t_goal);
+    w->armed = false;
+    /* all there: as many states as periods + 1, each with its reference when the scene
+     * has one (the reference comes before its state: one missing means it was lost) */
+    bool want_ref = w->sc.has_reference;
+    for (int i = 0; i < nsets; i++) want_ref |= !strncmp(sets[i], "reference", 9);
+    bool whole = !w->fault && w->s.n == (size_t)periods + 1 &&
+                 w->s.t[w->s.n - 1] >= t_goal && (!want_ref || !w->missing_refs);
+    if (!whole && w->env.verbose)
+        fprintf(stderr, "%s: run %ld of this worker read from the log (%s)\n", w->env.prefix,
+                w->runs, w->fault ? "a fault" : w->s.n != (size_t)periods + 1
+                ? "the bus lost states, or the run stalled" : "the bus lost references");
+    if (!whole && from_log(w, from, t_goal, res, err, errlen)) return -1;
+    res->nj = w->sc.nj;
+    res->states = w->s.n;
+    res->t_end = w->s.n ? w->s.t[w->s.n - 1] : 0;
+    if (!w->s.n) eval_fail(res, "no state logged");
+    else if (res->t_end < t_goal)
+        eval_fail(res, "stopped at t = %.6g s before the duration %.6g s", res->t_end,
+                  c->duration);
+    return eval_score(&w->s, c, &w->sc, res, err, errlen);
+}
