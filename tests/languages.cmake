@@ -22,6 +22,38 @@ set(py_types --types ${CMAKE_BINARY_DIR}/python)
 set(lua_types --types ${CMAKE_BINARY_DIR}/lua)
 set(java_run java -cp /usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${CMAKE_BINARY_DIR}/lagsim_examples.jar)
 
+# ---- The reference a library hands the law (tests/clients/reference_law.py): a law that
+# answers each joint with its reference's r (tests/clients/reference/), the manipulator of
+# config/manipulator.yaml for 2 s in lockstep (201 states), every command checked against
+# the daemon's --log. As published: every state's own reference, none stale. Lost: only
+# q1 has a reference (q2 none: 0), and a relay loses the references of every 7th state
+# from the second on (29 of 201), so each of those states is answered with the reference
+# before it and counted stale. Hostile: forged references on the client's channel are
+# dropped and counted (12 kinds, each at least three times), and answered as if none came.
+set(ref_law ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/reference_law.py
+    --lagsimd ${lang_lagsimd} --types ${CMAKE_BINARY_DIR}/python
+    --config ${PROJECT_SOURCE_DIR}/config/manipulator.yaml --duration 2)
+function(lang_reference_tests lang) # ARGN: the client's command, with {prefix}
+  add_test(NAME clients_${lang}_reference_lockstep
+    COMMAND ${ref_law} --name CLREF${lang}
+      --check "end == 'stop'" --check "states == 201" --check "commands >= 200"
+      --check "references_stale == 0 and expected_stale == 0" --check "dropped == 0"
+      -- ${ARGN})
+  add_test(NAME clients_${lang}_reference_lost
+    COMMAND ${ref_law} --name CLREFLOST${lang} --lose-every 7
+      --set "reference={q1: {type: sine, amplitude: 0.3, frequency: 0.5}}"
+      --check "end == 'stop'" --check "states == 201" --check "lost == 29"
+      --check "references_stale == expected_stale and expected_stale == lost" --check "dropped == 0"
+      -- ${ARGN})
+  add_test(NAME clients_${lang}_reference_hostile
+    COMMAND ${ref_law} --name CLREFHOST${lang} --hostile
+      --check "end == 'stop'" --check "states == 201" --check "references_stale == 0"
+      --check "dropped >= 3 * 12"
+      -- ${ARGN})
+  set(lang_tests ${lang_tests} clients_${lang}_reference_lockstep clients_${lang}_reference_lost
+      clients_${lang}_reference_hostile PARENT_SCOPE)
+endfunction()
+
 set(lang_dipc_cfg --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml
                   --set "initial.q=[0,0.05,-0.03]" --set "initial.qd=[0,0,0]")
 set(lang_manip_cfg --config ${PROJECT_SOURCE_DIR}/config/manipulator.yaml
@@ -193,6 +225,20 @@ if(TARGET lagsim_examples_java)
       --daemon-first 2 ${late_checks} --check "states == 2001"
       -- ${java_run} lagsim.examples.DipcBalance --prefix {prefix} --duration 20 -q)
   list(APPEND lang_tests clients_java_dipc_late_controller)
+  # the reference's test law, compiled as the examples are (lint as errors)
+  set(ref_echo_java ${CMAKE_CURRENT_SOURCE_DIR}/clients/reference/ReferenceEcho.java)
+  set(ref_echo_classes ${CMAKE_CURRENT_BINARY_DIR}/reference_echo_java)
+  add_custom_command(
+    OUTPUT ${ref_echo_classes}/ReferenceEcho.class
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${ref_echo_classes}
+    COMMAND ${JAVAC} --release ${LAGSIM_JAVA_RELEASE} -Xlint:all -Werror
+            -cp /usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${LAGSIM_EXAMPLES_JAR}
+            -d ${ref_echo_classes} ${ref_echo_java}
+    DEPENDS ${ref_echo_java} ${LAGSIM_EXAMPLES_JAR}
+    COMMENT "javac: the reference's Java test law")
+  add_custom_target(reference_echo_java ALL DEPENDS ${ref_echo_classes}/ReferenceEcho.class)
+  add_dependencies(reference_echo_java lagsim_examples_java)
+  lang_reference_tests(java ${java_run}:${ref_echo_classes} ReferenceEcho --prefix {prefix} -q)
 else()
   message(WARNING "javac or liblcm-java missing: the Java clients' tests are not registered")
 endif()
@@ -208,6 +254,7 @@ file(GLOB octave_m CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/clients/octave/*.m)
 add_test(NAME clients_octave_matlab_syntax
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/matlab_syntax.py ${octave_m}
           ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_octave_lqr.m ${CMAKE_CURRENT_SOURCE_DIR}/net/plant_urls_octave.m
+          ${CMAKE_CURRENT_SOURCE_DIR}/clients/reference/reference_echo.m
           --readme ${PROJECT_SOURCE_DIR}/README.md)
 list(APPEND lang_tests clients_octave_matlab_syntax)
 # the jars load in MATLAB's bundled Java 8: every class of LAGSIM_JAVA_RELEASE
@@ -292,6 +339,9 @@ if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
     COMMAND ${lang_e2e} --config ${PROJECT_SOURCE_DIR}/config/cartpole.yaml --mode lockstep
       --name CLOCTCPC --timeout 60 ${octave_cartpole_checks} --check "abs(abs(k_x) - 1) <= 1e-9"
       -- ${octave_run} cartpole_balance --prefix {prefix} --duration 20 -q --gain continuous)
+  lang_reference_tests(octave ${LAGSIM_OCTAVE} --no-gui --quiet --no-window-system --no-init-file
+    --path ${CMAKE_BINARY_DIR}/octave --path ${CMAKE_CURRENT_SOURCE_DIR}/clients/reference
+    --eval "reference_echo('--prefix', '{prefix}', '-q')")
   list(APPEND lang_tests clients_octave_lqr clients_octave_dipc_lockstep clients_octave_dipc_hostile
        clients_octave_dipc_late_controller clients_octave_dipc_gain
        clients_octave_cartpole_lockstep clients_octave_cartpole_continuous)

@@ -14,6 +14,14 @@ classdef lagsim_controller < handle
 %   end
 %   ctl.finish(sprintf('states=%d', n));           % "dipc_balance: summary end=... states=..."
 %
+%   A scene with a reference: key has lagsimd publish a reference_t on <PREFIX>_REFERENCE
+%   just before each state, with that state's sim_time; after next_state, ctl.reference
+%   is the one that belongs to the state it returned (docs/clients.md, "Reading the
+%   reference"):
+%
+%   k = ctl.joint(ctl.reference, 'q1');            % 0: no reference for q1 (or none at all)
+%   if k > 0, r = ctl.reference.r(k); rdot = ctl.reference.rdot(k); end
+%
 %   Options: --prefix P, --url URL (the plant's lcm.url; commands go to the next port),
 %   --duration S (s of sim time from the first state; 0: until the daemon stops),
 %   --timeout S (wall s without a scene, or without any message once running),
@@ -40,6 +48,13 @@ classdef lagsim_controller < handle
         end_reason = '' % stop, silence or duration, once the run has ended
         dropped = 0     % messages on the plant's channels that did not decode whole
         repeats = 0     % copies of the state answered last, answered again (see next_state)
+        % the scene's reference for the state next_state returned last, as a struct
+        % (sim_time, step, name: a cell of joint names, r, rdot: columns): the one
+        % published with it (the same sim_time), or, when UDP lost that one, the last one
+        % received before it (an older sim_time, counted in references_stale); [] before
+        % the first (a scene without a reference publishes none)
+        reference = []
+        references_stale = 0   % states handed out whose own reference did not come
     end
 
     properties (Access = private)
@@ -54,6 +69,8 @@ classdef lagsim_controller < handle
         timeout = 5
         trace = -1
         latest = []     % the newest state received and not yet handled
+        ref_newest = [] % the newest reference received (a lagsim.reference_t)
+        ref_latest = [] % the one that was newest when latest came (its own, unless lost)
         current = []    % the state handed out last
         last_cmd = []   % the command that answered it
         stopped = false
@@ -167,7 +184,7 @@ classdef lagsim_controller < handle
             obj.agg.setMaxBufferSize(16 * 1024 * 1024);
             ch = [obj.prefix '_'];
             obj.lc.subscribe([javaMethod('quote', 'java.util.regex.Pattern', ch) ...
-                              '(STATE|SCENE|EVENT|STATUS)'], obj.agg);
+                              '(STATE|SCENE|EVENT|STATUS|REFERENCE)'], obj.agg);
             obj.heard = tic;
             % subscribed: from here on no state is missed (test harnesses wait for this line)
             obj.say('%s: waiting for the scene description on %sSCENE\n', obj.name, ch);
@@ -232,6 +249,7 @@ classdef lagsim_controller < handle
                 end
                 obj.pump(0);   % what came meanwhile: the newest state is answered
                 s = obj.latest;
+                r = obj.ref_latest;
                 obj.latest = [];
                 if isempty(obj.current) || double(s.step) ~= obj.current.step ...
                         || s.sim_time ~= obj.current.sim_time || isempty(obj.last_cmd)
@@ -253,6 +271,22 @@ classdef lagsim_controller < handle
             end
             obj.current = st;
             obj.last_cmd = [];
+            obj.reference = [];
+            if ~isempty(r)
+                names = r.name;
+                rv = r.r;
+                rdot = r.rdot;
+                ref = struct('sim_time', r.sim_time, 'step', double(r.step), ...
+                             'name', {cell(1, numel(names))}, 'r', double(rv(:)), ...
+                             'rdot', double(rdot(:)));
+                for k = 1:numel(names)
+                    ref.name{k} = char(names(k));
+                end
+                obj.reference = ref;
+                if ref.sim_time ~= st.sim_time
+                    obj.references_stale = obj.references_stale + 1;
+                end
+            end
             if isnan(obj.t_first)
                 obj.t_first = st.sim_time;
             end
@@ -288,21 +322,31 @@ classdef lagsim_controller < handle
         end
 
         function k = joint(obj, st, joint_name) %#ok<INUSL>
-            % The index of JOINT_NAME in a state's joints, or 0.
-            k = find(strcmp(st.name, joint_name), 1);
+            % The index of JOINT_NAME in a state's or a reference's joints (ST: a struct
+            % from next_state, or ctl.reference), or 0 (none; ST [] gives 0 too).
+            k = [];
+            if ~isempty(st)
+                k = find(strcmp(st.name, joint_name), 1);
+            end
             if isempty(k)
                 k = 0;
             end
         end
 
         function finish(obj, summary)
-            % Prints the summary line: "<name>: summary end=<why> <summary> dropped=N repeats=N".
+            % Prints the summary line: "<name>: summary end=<why> <summary> dropped=N
+            % repeats=N", then, when a reference came (a scene with a reference),
+            % " references_stale=N".
             if obj.trace >= 0
                 fclose(obj.trace);
                 obj.trace = -1;
             end
-            obj.say('%s: summary end=%s %s dropped=%d repeats=%d\n', obj.name, obj.end_reason, ...
-                    summary, obj.dropped, obj.repeats);
+            stale = '';
+            if ~isempty(obj.ref_newest)
+                stale = sprintf(' references_stale=%d', obj.references_stale);
+            end
+            obj.say('%s: summary end=%s %s dropped=%d repeats=%d%s\n', obj.name, obj.end_reason, ...
+                    summary, obj.dropped, obj.repeats, stale);
         end
 
         function say(obj, varargin) %#ok<INUSL>
@@ -350,6 +394,8 @@ classdef lagsim_controller < handle
             switch kind
                 case 'STATE'
                     msg = lagsim_decode(m.data, 'joint_state_t');
+                case 'REFERENCE'
+                    msg = lagsim_decode(m.data, 'reference_t');
                 case 'SCENE'
                     msg = lagsim_decode(m.data, 'scene_t');
                 otherwise
@@ -359,6 +405,9 @@ classdef lagsim_controller < handle
                 obj.dropped = obj.dropped + 1;
             elseif strcmp(kind, 'STATE')
                 obj.latest = msg;
+                obj.ref_latest = obj.ref_newest;
+            elseif strcmp(kind, 'REFERENCE')
+                obj.ref_newest = msg;
             elseif strcmp(kind, 'SCENE')
                 obj.scene = msg;
             elseif strcmp(kind, 'EVENT') && strcmp(char(msg.kind), 'stop')

@@ -1,6 +1,6 @@
 function msg = lagsim_decode(data, type)
-%LAGSIM_DECODE  The lagsim message of type TYPE ('joint_state_t', 'event_t', 'scene_t',
-%'status_t', ...) in DATA, the bytes of a received message (int8, as
+%LAGSIM_DECODE  The lagsim message of type TYPE ('joint_state_t', 'reference_t',
+%'event_t', 'scene_t', 'status_t', ...) in DATA, the bytes of a received message (int8, as
 %lcm.lcm.MessageAggregator's message.data gives them), or [] when they do not decode
 %whole.
 %

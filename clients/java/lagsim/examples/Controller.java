@@ -13,6 +13,7 @@ import lagsim.control_t;
 import lagsim.event_t;
 import lagsim.joint_command_t;
 import lagsim.joint_state_t;
+import lagsim.reference_t;
 import lagsim.scene_t;
 import lcm.lcm.LCM;
 import lcm.lcm.LCMDataInputStream;
@@ -32,9 +33,14 @@ import lcm.lcm.LCMSubscriber;
  *   ctl.finish("states=" + n);                        // "DipcBalance: summary end=... states=..."
  * </pre>
  *
+ * A scene with a {@code reference:} has lagsimd publish a reference_t on
+ * &lt;PREFIX&gt;_REFERENCE just before each state, with that state's sim_time;
+ * {@link #reference()} hands the law the one that belongs to the state nextState returned
+ * (docs/clients.md, "Reading the reference").
+ *
  * LCM's Java library delivers messages on its own receive thread; the handlers here only
- * keep the newest state and note the daemon's stop, and the caller's thread does the
- * work. A run ends when the daemon publishes its stop event, when nothing came from the
+ * keep the newest state and reference and note the daemon's stop, and the caller's thread
+ * does the work. A run ends when the daemon publishes its stop event, when nothing came from the
  * daemon (state, status or event) for --timeout wall seconds, or after --duration s of
  * sim time from the first state; endReason says which (stop, silence, duration). Exit
  * status: 0 for these; 1 when no scene came within --timeout or it is another model's;
@@ -56,6 +62,11 @@ public final class Controller {
     private PrintWriter trace;
     private final Object lock = new Object();
     private joint_state_t latest, current;
+    // the newest reference received; the one that was newest when `latest` came (its
+    // own, published just before it, unless UDP lost that); the one of `current`
+    private reference_t refNewest, refLatest, refCurrent;
+    /** States handed out whose own reference did not come (the last one was kept). */
+    public long referencesStale;
     // the last command sent and the state it answered (a copy of it is answered again)
     private joint_command_t lastCmd;
     private long lastStep;
@@ -168,6 +179,9 @@ public final class Controller {
                     try { // only messages that decode whole, string lengths checked first
                         if (channel.endsWith("_STATE")) {
                             latest = BoundedInput.decode(ins, joint_state_t::new);
+                            refLatest = refNewest;
+                        } else if (channel.endsWith("_REFERENCE")) {
+                            refNewest = BoundedInput.decode(ins, reference_t::new);
                         } else if (channel.endsWith("_SCENE")) {
                             scene = BoundedInput.decode(ins, scene_t::new);
                         } else if (channel.endsWith("_EVENT")) {
@@ -181,7 +195,7 @@ public final class Controller {
             }
         };
         String ch = prefix + "_";
-        lcm.subscribe(java.util.regex.Pattern.quote(ch) + "(STATE|SCENE|EVENT|STATUS)", sub);
+        lcm.subscribe(java.util.regex.Pattern.quote(ch) + "(STATE|SCENE|EVENT|STATUS|REFERENCE)", sub);
         // subscribed: from here on no state is missed (test harnesses wait for this line)
         System.out.println(name + ": waiting for the scene description on " + ch + "SCENE");
         System.out.flush();
@@ -237,6 +251,8 @@ public final class Controller {
                 repeats++;
             }
             current = st;
+            refCurrent = refLatest;
+            if (refCurrent != null && refCurrent.sim_time != st.sim_time) referencesStale++;
             if (Double.isNaN(tFirst)) tFirst = st.sim_time;
             if (duration > 0 && st.sim_time - tFirst >= duration - 0.5 * scene.control_period)
                 endReason = "duration"; // this state is still answered; the next call ends
@@ -281,10 +297,36 @@ public final class Controller {
         return -1;
     }
 
-    /** Prints the summary line; returns the exit status (0). The LCM stays open until the
-     *  process exits (closing it makes its receive thread print a socket exception). */
+    /** The scene's reference for the state nextState returned last: the reference_t
+     *  published with it (the same sim_time; r and rdot of the joints the scene gives a
+     *  reference), or, when UDP lost that one, the last one received before it (its
+     *  sim_time is older; counted in referencesStale). null before the first: a scene
+     *  without a reference publishes none. */
+    public reference_t reference() {
+        synchronized (lock) {
+            return refCurrent;
+        }
+    }
+
+    /** Index of joint `joint` in a reference, or -1 (no reference for it, or ref null). */
+    public static int joint(reference_t ref, String joint) {
+        if (ref == null) return -1;
+        for (int k = 0; k < ref.num_joints; k++)
+            if (ref.name[k].equals(joint)) return k;
+        return -1;
+    }
+
+    /** Prints the summary line, ending "dropped=N repeats=N", then, when a reference came
+     *  (a scene with a reference), "references_stale=N"; returns the exit status (0). The
+     *  LCM stays open until the process exits (closing it makes its receive thread print a
+     *  socket exception). */
     public int finish(String summary) {
-        System.out.println(name + ": summary end=" + endReason + " " + summary + " dropped=" + dropped + " repeats=" + repeats);
+        boolean ref;
+        synchronized (lock) {
+            ref = refNewest != null;
+        }
+        System.out.println(name + ": summary end=" + endReason + " " + summary + " dropped=" + dropped
+                           + " repeats=" + repeats + (ref ? " references_stale=" + referencesStale : ""));
         System.out.flush();
         if (trace != null) trace.close();
         return 0;
