@@ -19,6 +19,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "lagsim_bus.h"
+#include "lagsim_clock.h"
 #include "lagsim_log.h"
 #include "lagsim/lagsim_control_t.h" /* the requests' constants */
 #include "lagsim_out.h"
@@ -211,19 +213,9 @@ void eval_url(int slot, char *url, size_t len)
     snprintf(url, len, "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304", port);
 }
 
-double eval_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+double eval_now(void) { return lag_clock_mono_s(); }
 
-double eval_now_wall(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+double eval_now_wall(void) { return 1e-6 * (double)lag_clock_wall_us(); }
 
 void eval_sleep(double s)
 {
@@ -396,10 +388,10 @@ void eval_take_init(eval_take *tk, const char *prefix, const eval_scene *sc, eva
                     eval_result *res)
 {
     memset(tk, 0, sizeof *tk);
-    snprintf(tk->ch_state, sizeof tk->ch_state, "%s_STATE", prefix);
-    snprintf(tk->ch_event, sizeof tk->ch_event, "%s_EVENT", prefix);
-    snprintf(tk->ch_ref, sizeof tk->ch_ref, "%s_REFERENCE", prefix);
-    snprintf(tk->ch_control, sizeof tk->ch_control, "%s_CONTROL", prefix);
+    lag_bus_channel_name(tk->ch_state, sizeof tk->ch_state, prefix, LAG_BUS_STATE);
+    lag_bus_channel_name(tk->ch_event, sizeof tk->ch_event, prefix, LAG_BUS_EVENT);
+    lag_bus_channel_name(tk->ch_ref, sizeof tk->ch_ref, prefix, LAG_BUS_REFERENCE);
+    lag_bus_channel_name(tk->ch_control, sizeof tk->ch_control, prefix, LAG_BUS_CONTROL);
     tk->sc = sc;
     tk->s = s;
     tk->res = res;

@@ -29,10 +29,8 @@ DIRS = ("server", "clients", "bench")
 EXEMPT = {
     ("clock", "server/daemon/rt_log.c"),       # its writer's pacing and sem_timedwait deadline
     ("clock", "server/daemon/offline.c"),      # the CPU time of an offline run
-    ("clock", "server/tools/eval_case.c"),     # lagsim-eval's wait for a run
     ("channels", "server/daemon/realtime.c"),  # --log's <PREFIX>_INPUT
     ("channels", "server/daemon/replay.c"),    # the channels --replay reads
-    ("channels", "server/tools/eval_case.c"),  # the channels lagsim-eval records
     ("channels", "clients/lagsim_controller.c"),  # messages naming <PREFIX>_SCENE
 }
 
