@@ -329,11 +329,15 @@ def case_stalled(d):
         time.sleep(0.1)
         kids = subprocess.run(["pgrep", "-P", str(p.pid)], stdout=subprocess.PIPE,
                               universal_newlines=True).stdout.split()
-        for k in kids:
-            os.kill(int(k), signal.SIGSTOP)
-        time.sleep(0.2)
-        for k in kids:
-            os.kill(int(k), signal.SIGCONT)
+        for sig in (signal.SIGSTOP, None, signal.SIGCONT):
+            if sig is None:
+                time.sleep(0.2)
+                continue
+            for k in kids:
+                try:
+                    os.kill(int(k), sig)
+                except ProcessLookupError:  # a worker that ended since pgrep saw it
+                    pass
         stops += bool(kids)
     err = p.stderr.read()
     print(err[-3000:])
