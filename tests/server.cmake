@@ -32,7 +32,7 @@ lagsim_fuzz_target(rt LIBS lagsimd_internal)
 # (tests/server/test_reference.py).
 find_program(LAGSIM_REF_PYTHON3 python3)
 if(LAGSIM_REF_PYTHON3)
-  foreach(case fast realtime lockstep set offline manipulator)
+  foreach(case fast realtime lockstep set offline manipulator retry)
     add_test(NAME server_reference_${case}
              COMMAND ${LAGSIM_REF_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/server/test_reference.py
                      --bin ${CMAKE_BINARY_DIR}/bin --types ${CMAKE_BINARY_DIR}/python

@@ -223,7 +223,7 @@ static void limited_event(rt_server *s, rt_ev ev, const char *joint, double valu
 static void publish_state(rt_server *s)
 {
     rt_out o = out(s);
-    int n = rt_publish_state(&o, &s->sim, s->info, &s->ref);
+    int n = rt_publish_state(&o, &s->sim, s->info, &s->ref, &s->ref_sent);
     if (n > 0) {
         s->states_published++;
         memcpy(s->state_buf, s->bus.buf, (size_t)n); /* as sent: a lockstep retry sends it again */
@@ -240,7 +240,10 @@ static void lockstep_retry(rt_server *s)
 {
     if (s->state_len == 0 || !rt_lockstep_retry(&s->ls, s->now)) return;
     /* straight to LCM, not through rt_wire's publish: a copy for the network, which --log
-     * (the run's record, one state per period) does not keep */
+     * (the run's record, one state per period) does not keep; its reference just before
+     * it, as the first time (the reference may have been lost with it) */
+    if (s->ref_sent.len > 0)
+        lcm_publish(s->bus.lcm, s->bus.ch_reference, s->ref_sent.buf, s->ref_sent.len);
     lcm_publish(s->bus.lcm, s->bus.ch_state, s->state_buf, s->state_len);
     s->lockstep_retries++;
 }

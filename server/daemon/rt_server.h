@@ -169,6 +169,7 @@ typedef struct rt_server {
     bool report_line;          /* SIGUSR1/SIGUSR2: one status line on stderr */
 
     uint8_t state_buf[RT_BUF_SIZE]; /* the last state published, as sent (lockstep retries) */
+    rt_sent ref_sent;               /* its reference, as sent (lockstep retries) */
     unsigned state_len;
 } rt_server;
 

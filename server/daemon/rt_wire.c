@@ -52,19 +52,24 @@ static int publish(const rt_out *o, const char *channel, lag_wire_type t, const 
  * reads both has the reference of a state when the state arrives. Nothing (no cost)
  * when the scene has no reference. */
 static void publish_reference(const rt_out *o, const lag_sim *sim,
-                              const lag_scene_reference *ref)
+                              const lag_scene_reference *ref, rt_sent *sent)
 {
+    if (sent) sent->len = 0;
     if (ref->n == 0) return;
     lag_wire_reference m;
     lagsimd_reference_at(ref, sim->def.model.kind, lag_sim_time(sim), sim->tick, &m);
     m.utime = rt_wall_us();
-    publish(o, o->bus->ch_reference, LAG_WIRE_REFERENCE, &m);
+    int n = publish(o, o->bus->ch_reference, LAG_WIRE_REFERENCE, &m);
+    if (sent && n > 0) {
+        memcpy(sent->buf, o->bus->buf, (size_t)n);
+        sent->len = (unsigned)n;
+    }
 }
 
 int rt_publish_state(const rt_out *o, const lag_sim *sim, const lag_model_info *info,
-                     const lag_scene_reference *ref)
+                     const lag_scene_reference *ref, rt_sent *ref_sent)
 {
-    publish_reference(o, sim, ref);
+    publish_reference(o, sim, ref, ref_sent);
     lag_wire_joint_state m;
     memset(&m, 0, sizeof m);
     double pos[LAG_MAX_DOF], vel[LAG_MAX_DOF];

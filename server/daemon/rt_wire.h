@@ -28,11 +28,17 @@ typedef struct rt_out {
  * scene asks for none. */
 double rt_error_budget(const lag_scene *sc);
 
-/* The reference at the state's sim time (when the scene has one: ref->n > 0), then the
- * state as published (lag_sim_observe). Returns the state's bytes, as sent, in
- * o->bus->buf (0: not sent). */
+/* A message's bytes as sent, kept for sending again (a lockstep retry). */
+typedef struct rt_sent {
+    uint8_t buf[RT_BUF_SIZE];
+    unsigned len; /* 0: none */
+} rt_sent;
+
+/* The reference at the state's sim time (when the scene has one: ref->n > 0; its bytes
+ * to ref_sent when not NULL, len 0 without one), then the state as published
+ * (lag_sim_observe). Returns the state's bytes, as sent, in o->bus->buf (0: not sent). */
 int rt_publish_state(const rt_out *o, const lag_sim *sim, const lag_model_info *info,
-                     const lag_scene_reference *ref);
+                     const lag_scene_reference *ref, rt_sent *ref_sent);
 /* The parts of a status the sim and the scene give (time, step, energy, contact, the
  * integrator, the mode, the error budget); the loop fills its counters. */
 void rt_status_base(lag_wire_status *m, const lag_sim *sim, const lag_scene *sc);

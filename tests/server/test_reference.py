@@ -22,6 +22,9 @@ Cases:
              from the tick it took effect at; --replay re-applies it, difference 0
   manipulator  manipulator_pd (C) tracks a reference set on the command line, not its own:
              the logged q within bounds of the reference's closed form after 2 s
+  retry      lockstep, paused, STEP 1 with no controller: the daemon sends the waited-on
+             state again (lockstep_retry) until lockstep_timeout, and each copy goes out with
+             its reference just before it, as the first (lcm-logger records the bus: --log keeps one state per period)
   offline    --offline --csv: <joint>_ref and <joint>_ref_dot columns after energy, equal to
              the closed form; without a reference the header is unchanged; lagsim-plot
              draws them dashed over q and q dot (also from <PREFIX>_REFERENCE.csv, lockstep)
@@ -357,7 +360,40 @@ def case_manipulator(t):
           f"|q2 - r2| <= {worst[1]:.3g} m (bound 2e-3), r from the closed form")
 
 
-CASES = {"fast": case_fast, "manipulator": case_manipulator, "realtime": case_realtime, "lockstep": case_lockstep,
+def case_retry(t):
+    prefix = "REFR" + str(os.getpid())
+    bus = os.path.join(t.tmp, "bus.lcm")
+    logger = subprocess.Popen(["lcm-logger", "-q", "--channel", prefix + "_.*", bus],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    time.sleep(0.5)
+    # paused, then STEP 1: the state at 0 is waited on with retries until lockstep_timeout
+    # (nothing answers), then the period runs without a command, as a STEP does
+    d = subprocess.Popen([os.path.join(t.a.bin, "lagsimd"), "--config",
+                          os.path.join(t.a.source, "config", "manipulator.yaml"),
+                          "--set", "realtime.mode=lockstep", "--set", "lcm.prefix=" + prefix,
+                          "--set", "realtime.start=paused",
+                          "--set", "realtime.lockstep_timeout=1", "-q"])
+    time.sleep(0.5)
+    t.run("lagsimctl", "--prefix", prefix, "step", "1", timeout=30)
+    time.sleep(1.5)
+    d.terminate()
+    d.wait(timeout=10)
+    time.sleep(0.3)
+    logger.terminate()
+    logger.wait(timeout=10)
+    recs = [(ch, d) for ch, d, _ in read_log(bus)]
+    states = [k for k, (ch, _) in enumerate(recs) if ch == prefix + "_STATE"]
+    bad = 0
+    for k in states:
+        st = t.t.joint_state_t.decode(recs[k][1])
+        r = t.t.reference_t.decode(recs[k - 1][1]) if k and recs[k - 1][0] == prefix + "_REFERENCE" else None
+        bad += r is None or (r.sim_time, r.step) != (st.sim_time, st.step)
+    check(len(states) >= 5 and bad == 0,
+          f"{len(states)} copies of the waited-on state on the bus (no controller), "
+          f"{len(states) - bad} with their reference just before them")
+
+
+CASES = {"fast": case_fast, "retry": case_retry, "manipulator": case_manipulator, "realtime": case_realtime, "lockstep": case_lockstep,
          "set": case_set, "offline": case_offline}
 
 
