@@ -14,7 +14,13 @@
  *
  * The worker's daemon starts paused at the scene's initial state; one period is stepped
  * first, so that no answer of the controller to that first state (sim time 0) can be taken
- * for an answer to a run's first state.
+ * for an answer to a run's first state. Lockstep matches an answer to a state by its sim
+ * time alone, so an answer to an earlier run's state still on its way (a controller behind
+ * on copies of a state it got while it started) could be taken for the answer to this run's
+ * state at the same sim time: before each RESET_TO the worker hears the controller's answer
+ * to the paused state, the last it was sent. The controller answers in order and the
+ * daemon gets the answers and the worker's requests on one socket in the order they were
+ * sent, so every earlier answer reaches the daemon before the RESET_TO.
  */
 #include <errno.h>
 #include <math.h>
@@ -26,9 +32,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <lcm/lcm.h>
+
 #include "eval_case.h"
 #include "lagsim/lagsim.h"
+#include "lagsim_bus.h"
 #include "lagsim_client.h"
+#include "lagsim_wire.h"
 
 #define W_ANSWER_S 0.5  /* a SET or RESET_TO unanswered this long is sent again */
 #define W_TRIES 8       /* ... this many times at most */
@@ -51,9 +61,30 @@ struct eval_worker {
     bool set_heard;
     double t_heard;       /* the sim time of the last state heard */
     bool moved;           /* a state after sim time 0 heard since the STEP */
+    lcm_t *cmd;           /* the command URL: the controller's answers, as the daemon gets
+                           * them */
+    double t_answered;    /* the sim time of the last answer heard */
 };
 
 /* ---------------------------------------------------------------- from the bus */
+static void w_on_command(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    (void)channel;
+    eval_worker *w = user;
+    lag_wire_joint_command c;
+    if (lag_wire_decode_joint_command(rbuf->data, rbuf->data_size, EVAL_JOINTS_MAX, &c) == 0)
+        w->t_answered = c.sim_time;
+}
+
+/* What came on either URL, waiting up to ms on the state URL. */
+static int w_handle(eval_worker *w, int ms)
+{
+    int rc = lag_client_handle(w->cl, ms);
+    while (w->cmd && lcm_handle_timeout(w->cmd, 0) > 0) {
+    }
+    return rc;
+}
+
 static bool is_run_start(const eval_worker *w, const lag_client_state *st)
 {
     if (st->sim_time != 0) return false;
@@ -113,7 +144,7 @@ static int w_wait(eval_worker *w, const bool *flag, double seconds)
 {
     double end = eval_now() + seconds;
     while (!*flag) {
-        if (eval_now() > end || lag_client_handle(w->cl, 5) < 0) return -1;
+        if (eval_now() > end || w_handle(w, 5) < 0) return -1;
     }
     return 0;
 }
@@ -126,7 +157,7 @@ static bool fresh_status(eval_worker *w, lag_client_status *st, bool stop_on_mov
     if (lag_client_request_status(w->cl) != LAG_CLIENT_OK) return false;
     double end = eval_now() + W_ANSWER_S;
     while (eval_now() < end) {
-        lag_client_handle(w->cl, 5);
+        w_handle(w, 5);
         if (stop_on_move && w->moved) return false;
         if (lag_client_latest_status(w->cl, st) && st->utime >= asked) return true;
     }
@@ -153,7 +184,7 @@ static int step_once(eval_worker *w, long n, double seconds)
     while (!w->moved) {
         if (eval_now() > end) return -1;
         double next = eval_now() + W_ANSWER_S;
-        while (!w->moved && eval_now() < next) lag_client_handle(w->cl, 5);
+        while (!w->moved && eval_now() < next) w_handle(w, 5);
         if (!w->moved && still_at_start(w) && lag_client_step(w->cl, n) != LAG_CLIENT_OK)
             return -1;
     }
@@ -221,6 +252,11 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
         return start_failed(w, err, errlen, w->cl ? "cannot start the processes" : err);
     lag_client_on_state(w->cl, w_on_state, w);
     lag_client_on_event(w->cl, w_on_event, w);
+    lag_bus bus;
+    if (lag_bus_init(&bus, env->url, env->prefix, err, errlen) != 0 ||
+        !(w->cmd = lcm_create(bus.command_url)) ||
+        !lcm_subscribe(w->cmd, bus.channel[LAG_BUS_COMMAND], w_on_command, w))
+        return start_failed(w, err, errlen, "cannot listen to the controller's answers");
     lag_client_scene scene;
     if (lag_client_wait_scene(w->cl, 10.0, &scene) != LAG_CLIENT_OK)
         return start_failed(w, err, errlen, "no scene from the kept lagsimd");
@@ -241,6 +277,7 @@ void eval_worker_stop(eval_worker *w)
     if (w->cpid > 0 && !eval_wait_until(w->cpid, eval_now() + 3.0, &st))
         eval_stop_group(w->cpid, &st);
     if (w->cl) lag_client_destroy(w->cl);
+    if (w->cmd) lcm_destroy(w->cmd);
     eval_series_free(&w->s);
     if (!w->env.verbose) unlink(w->log);
     free(w);
@@ -279,6 +316,7 @@ static int reset_to(eval_worker *w, const double *q0, const double *qd0, char *e
     memcpy(w->q0, q0, sizeof w->q0);
     memcpy(w->qd0, qd0, sizeof w->qd0);
     w->armed = true;
+    w->t_answered = NAN;
     for (int t = 0; t < W_TRIES && !w->started; t++)
         if (lag_client_reset_to(w->cl, w->sc.nj, q0, qd0) != LAG_CLIENT_OK ||
             (w_wait(w, &w->started, W_ANSWER_S) && t == W_TRIES - 1)) {
@@ -297,7 +335,7 @@ static void follow(eval_worker *w, double t_goal)
     double start = eval_now(), last = start;
     size_t seen = w->s.n;
     while (!(w->s.n && w->s.t[w->s.n - 1] >= t_goal) && !w->fault) {
-        if (lag_client_handle(w->cl, 20) < 0) break;
+        if (w_handle(w, 20) < 0) break;
         if (w->s.n != seen) seen = w->s.n, last = eval_now();
         if (eval_now() - start > w->env.wall_timeout) break;
         if (eval_now() - last < W_QUIET_S) continue;
@@ -361,6 +399,10 @@ int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets,
     w->fault = w->armed = w->started = false;
     w->missing_refs = 0;
     w->runs++;
+    /* the answer to the paused state: every earlier answer has reached the daemon (at most
+     * W_ANSWER_S: a lost one is not sent again, nor anything before it) */
+    double end = eval_now() + W_ANSWER_S;
+    while (w->t_answered != w->t_heard && eval_now() < end) w_handle(w, 5);
     /* every varied key is SET in every run, so nothing of the run before stays */
     if (set_keys(w, sets, nsets, err, errlen)) return -1;
     struct stat sb;

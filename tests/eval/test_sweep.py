@@ -15,6 +15,8 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             process pair per run, byte for byte, where the controller's design is the
             same (the initial state varied; the masses at the scene's values after other
             masses were SET); a mass SET differs from the controller's design
+  kept_python  the same with a Python controller (slow to start: copies of the first
+            state pile up in its socket), three sweeps
   loss      in a network namespace whose loopback drops 1 UDP datagram in 15 (nftables):
             the same CSV as without loss, byte for byte (SET and RESET_TO sent again, the
             runs the bus lost states of read from the kept daemon's log)
@@ -210,6 +212,29 @@ def case_kept(d):
           "designed for the scene's (rows differ from --restart's)")
 
 
+def case_kept_python(d):
+    # a controller slow to start (Python): lockstep copies of the first state pile up in its
+    # socket while it imports, and it answers each; an answer to a state before a RESET_TO
+    # must not be taken for one of the run's (the same sim time). Three sweeps, the
+    # manipulator tracking its reference: kept processes = --restart, byte for byte
+    build_python = os.path.join(os.path.dirname(BIN), "python")
+    env = dict(os.environ, PYTHONPATH=build_python)
+    ctrl = "python3 %s -q --prefix {prefix}" % os.path.join(SRC, "clients", "python",
+                                                            "manipulator_pd.py")
+    q = ["--config", os.path.join(SRC, "config", "manipulator.yaml"), "--controller", ctrl,
+         "--duration", "2", "--vary", "initial.q[0]=normal(0,0.05)", "--runs", "4", "-j2"]
+    fresh = os.path.join(d, "fresh.csv")
+    run([SWEEP] + q + ["--seed", "2", "--restart", "--csv", fresh], env=env)
+    same = 0
+    for k in range(3):
+        kept = os.path.join(d, "kept%d.csv" % k)
+        run([SWEEP] + q + ["--seed", "2", "--csv", kept], env=env)
+        same += filecmp.cmp(kept, fresh, shallow=False)
+    check(len(rows(fresh)) == 4 and same == 3,
+          "Python controller, 3 sweeps with kept processes: %d of 3 equal to --restart's, "
+          "byte for byte" % same)
+
+
 def case_loss(d):
     if os.geteuid() != 0 or not shutil.which("nft") or not shutil.which("ip"):
         print("skipped: needs root, ip and nft")
@@ -350,6 +375,7 @@ def case_stalled(d):
 
 with tempfile.TemporaryDirectory() as tmp:
     {"same": case_same, "slurm": case_slurm, "merge": case_merge, "kept": case_kept,
-     "loss": case_loss, "stalled": case_stalled, "ssh": case_ssh}[CASE](tmp)
+     "loss": case_loss, "stalled": case_stalled, "ssh": case_ssh,
+     "kept_python": case_kept_python}[CASE](tmp)
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)
