@@ -237,45 +237,52 @@ static void heard_event(const lag_client_event *ev, void *user)
     if (ctl->on_event) ctl->on_event(ev, ctl->event_user);
 }
 
-int lag_ctl_start(lag_ctl *ctl, const char *model)
+/* --trace: replaced if it exists (a trace is rewritten run after run), but never written
+ * through a symbolic link (lagsim_out.h). */
+static int open_trace(lag_ctl *ctl)
+{
+    char oerr[512];
+    int fd = lag_out_open("--trace", ctl->trace_path, true, NULL, 0, 0, oerr, sizeof oerr);
+    ctl->trace = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (!ctl->trace) {
+        if (fd >= 0) {
+            snprintf(oerr, sizeof oerr, "--trace %s: %s", ctl->trace_path, strerror(errno));
+            close(fd);
+        }
+        fprintf(stderr, "%s: %s\n", ctl->name, oerr);
+        return 1;
+    }
+    return 0;
+}
+
+/* Without --prefix: the only plant (of this model) on the bus; with a default prefix a
+ * controller may start before its plant: a short look, then that prefix is waited on. */
+static int pick_prefix(lag_ctl *ctl, const char *model)
+{
+    char perr[1200];
+    lag_client_plant p;
+    double look = ctl->default_prefix ? 1.0 : ctl->timeout;
+    int rc = lag_client_pick_plant(ctl->url, model, look, &p, perr, sizeof perr);
+    if (rc == LAG_CLIENT_OK) {
+        snprintf(ctl->found_prefix, sizeof ctl->found_prefix, "%s", p.prefix);
+        ctl->prefix = ctl->found_prefix;
+        printf("%s: the only %s%splant on the bus: prefix %s (%s, %s)\n", ctl->name,
+               model ? model : "", model ? " " : "", p.prefix, p.mode, p.run_state);
+    } else if (rc == LAG_CLIENT_TIMEOUT && ctl->default_prefix) {
+        ctl->prefix = ctl->default_prefix;
+        printf("%s: %s; waiting for prefix %s\n", ctl->name, perr, ctl->prefix);
+    } else {
+        fprintf(stderr, "%s: %s\n", ctl->name, perr);
+        ctl->fail_code = rc == LAG_CLIENT_ERR_AMBIGUOUS ? 2 : 1; /* several: --prefix */
+        return ctl->fail_code;
+    }
+    return 0;
+}
+
+/* The client, its callbacks and the signal handlers. */
+static int connect_client(lag_ctl *ctl)
 {
     char err[256];
-    if (ctl->trace_path) {
-        /* replaced if it exists (a trace is rewritten run after run), but never written
-         * through a symbolic link (lagsim_out.h) */
-        char oerr[512];
-        int fd = lag_out_open("--trace", ctl->trace_path, true, NULL, 0, 0, oerr, sizeof oerr);
-        ctl->trace = fd >= 0 ? fdopen(fd, "w") : NULL;
-        if (!ctl->trace) {
-            if (fd >= 0) {
-                snprintf(oerr, sizeof oerr, "--trace %s: %s", ctl->trace_path, strerror(errno));
-                close(fd);
-            }
-            fprintf(stderr, "%s: %s\n", ctl->name, oerr);
-            return 1;
-        }
-    }
-    if (!ctl->prefix) {
-        /* the only plant (of this model) on the bus; with a default prefix a controller
-         * may start before its plant: a short look, then that prefix is waited on */
-        char perr[1200];
-        lag_client_plant p;
-        double look = ctl->default_prefix ? 1.0 : ctl->timeout;
-        int rc = lag_client_pick_plant(ctl->url, model, look, &p, perr, sizeof perr);
-        if (rc == LAG_CLIENT_OK) {
-            snprintf(ctl->found_prefix, sizeof ctl->found_prefix, "%s", p.prefix);
-            ctl->prefix = ctl->found_prefix;
-            printf("%s: the only %s%splant on the bus: prefix %s (%s, %s)\n", ctl->name,
-                   model ? model : "", model ? " " : "", p.prefix, p.mode, p.run_state);
-        } else if (rc == LAG_CLIENT_TIMEOUT && ctl->default_prefix) {
-            ctl->prefix = ctl->default_prefix;
-            printf("%s: %s; waiting for prefix %s\n", ctl->name, perr, ctl->prefix);
-        } else {
-            fprintf(stderr, "%s: %s\n", ctl->name, perr);
-            ctl->fail_code = rc == LAG_CLIENT_ERR_AMBIGUOUS ? 2 : 1; /* several: --prefix */
-            return ctl->fail_code;
-        }
-    }
     ctl->client = lag_client_create(ctl->url, ctl->prefix, err, sizeof err);
     if (!ctl->client) {
         fprintf(stderr, "%s: %s\n", ctl->name, err);
@@ -289,7 +296,11 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    return 0;
+}
 
+static int wait_scene(lag_ctl *ctl)
+{
     /* subscribed: from here on no state is missed (test harnesses wait for this line) */
     printf("%s: waiting for the scene description on %s_SCENE\n", ctl->name, ctl->prefix);
     fflush(stdout);
@@ -297,7 +308,7 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
     for (;;) {
         double left = deadline - lag_client_now();
         int rc = lag_client_wait_scene(ctl->client, left < 0.25 ? left : 0.25, &ctl->scene);
-        if (rc == LAG_CLIENT_OK) break;
+        if (rc == LAG_CLIENT_OK) return 0;
         if (rc < 0 || g_signal || !(left > 0.25)) {
             if (g_signal)
                 fprintf(stderr, "%s: interrupted while waiting for the scene\n", ctl->name);
@@ -310,6 +321,12 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
             return 1;
         }
     }
+}
+
+/* ctl->model from the scene's parameters, if the scene runs `model` (NULL: any). */
+static int model_from_scene(lag_ctl *ctl, const char *model)
+{
+    char err[256];
     if (!model) model = ctl->scene.model; /* any model this build knows */
     if (strcmp(ctl->scene.model, model) != 0) {
         fprintf(stderr, "%s: prefix %s runs model '%s', not %s\n", ctl->name, ctl->prefix,
@@ -335,6 +352,17 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
         fprintf(stderr, "%s: scene parameters: %s\n", ctl->name, err);
         return 1;
     }
+    return 0;
+}
+
+int lag_ctl_start(lag_ctl *ctl, const char *model)
+{
+    int rc;
+    if (ctl->trace_path && (rc = open_trace(ctl))) return rc;
+    if (!ctl->prefix && (rc = pick_prefix(ctl, model))) return rc;
+    if ((rc = connect_client(ctl)) || (rc = wait_scene(ctl)) ||
+        (rc = model_from_scene(ctl, model)))
+        return rc;
     ctl->heard = lag_client_now();
     return 0;
 }
