@@ -135,6 +135,21 @@ static void usage(const lag_ctl *ctl, FILE *f, const char *what, const lag_ctl_o
                "usage.\n");
 }
 
+/* getopt_long found no option (c is '?' or ':'): says which, returns 2 (bad usage). */
+static int bad_option(const lag_ctl *ctl, int c, char **argv)
+{
+    if (c == ':' && optopt && optopt < 256)
+        fprintf(stderr, "%s: option -%c needs a value\n", ctl->name, optopt);
+    else if (c == ':')
+        fprintf(stderr, "%s: option %s needs a value\n", ctl->name, argv[optind - 1]);
+    else if (optopt)
+        fprintf(stderr, "%s: unknown option '-%c'\n", ctl->name, optopt);
+    else
+        fprintf(stderr, "%s: unknown option '%s'\n", ctl->name, argv[optind - 1]);
+    fprintf(stderr, "%s: --help lists the options\n", ctl->name);
+    return 2;
+}
+
 int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
                   const lag_ctl_option *extra, int nextra)
 {
@@ -186,18 +201,7 @@ int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
         if (c >= 256) o = &all[c - 256];
         for (int i = 0; i < n && !o && c != '?' && c != ':'; i++)
             if (all[i].letter == c) o = &all[i];
-        if (!o) {
-            if (c == ':' && optopt && optopt < 256)
-                fprintf(stderr, "%s: option -%c needs a value\n", ctl->name, optopt);
-            else if (c == ':')
-                fprintf(stderr, "%s: option %s needs a value\n", ctl->name, argv[optind - 1]);
-            else if (optopt)
-                fprintf(stderr, "%s: unknown option '-%c'\n", ctl->name, optopt);
-            else
-                fprintf(stderr, "%s: unknown option '%s'\n", ctl->name, argv[optind - 1]);
-            fprintf(stderr, "%s: --help lists the options\n", ctl->name);
-            return 2;
-        }
+        if (!o) return bad_option(ctl, c, argv);
         char err[256];
         if (o->set(optarg, o->target, err, sizeof err) != 0) {
             fprintf(stderr, "%s: --%s: %s\n", ctl->name, o->name, err);
