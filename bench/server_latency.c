@@ -208,26 +208,178 @@ static pid_t run_daemon(const char *lagsimd, const char *scene, const char *pref
     return p;
 }
 
-int main(int argc, char **argv)
+/* ---------------------------------------------------------------- the four phases */
+/* What the run is asked to do, and what each phase measured. */
+typedef struct latency_run {
+    const char *lagsimd;
+    double seconds, ls_seconds, hz, floor_seconds;
+    char scene[128];            /* the DIPC scene file, removed at the end */
+    char prefix[64];
+    /* 1. */
+    samples floor_err;
+    int64_t floor_n;
+    /* 2. */
+    samples rtt;
+    /* 3. */
+    samples period_err, latency;
+    int64_t rt_states, overruns, on_time, late;
+    double step_max, rtf_mean;
+    /* 4. */
+    double cycles_per_s;
+} latency_run;
+
+static int parse_args(latency_run *r, int argc, char **argv)
 {
     if (argc < 2) {
         fprintf(stderr, "usage: server_latency LAGSIMD [--seconds S] [--lockstep-seconds S] [--hz HZ]\n");
         return 2;
     }
-    const char *lagsimd = argv[1];
-    double seconds = 60, ls_seconds = 10, hz = 1000;
+    r->lagsimd = argv[1];
+    r->seconds = 60, r->ls_seconds = 10, r->hz = 1000;
     for (int i = 2; i + 1 < argc; i += 2) {
-        if (!strcmp(argv[i], "--seconds")) seconds = atof(argv[i + 1]);
-        else if (!strcmp(argv[i], "--lockstep-seconds")) ls_seconds = atof(argv[i + 1]);
-        else if (!strcmp(argv[i], "--hz")) hz = atof(argv[i + 1]);
+        if (!strcmp(argv[i], "--seconds")) r->seconds = atof(argv[i + 1]);
+        else if (!strcmp(argv[i], "--lockstep-seconds")) r->ls_seconds = atof(argv[i + 1]);
+        else if (!strcmp(argv[i], "--hz")) r->hz = atof(argv[i + 1]);
     }
-    double floor_seconds = seconds < 10 ? seconds : 10;
-    char scene[128];
-    snprintf(scene, sizeof scene, "/tmp/lagsim_server_latency_%d.yaml", (int)getpid());
-    FILE *f = fopen(scene, "w");
+    r->floor_seconds = r->seconds < 10 ? r->seconds : 10;
+    return -1;
+}
+
+static int write_scene(latency_run *r)
+{
+    snprintf(r->scene, sizeof r->scene, "/tmp/lagsim_server_latency_%d.yaml", (int)getpid());
+    FILE *f = fopen(r->scene, "w");
     if (!f) return 1;
     fputs("model: dipc\nintegrator:\n  method: rk4\n  dt: 0.001\n", f);
     fclose(f);
+    return 0;
+}
+
+/* 1. paced publisher floor */
+static void floor_paced(latency_run *r, bench *b)
+{
+    char pubchan[96];
+    snprintf(pubchan, sizeof pubchan, "%s_PACED", r->prefix);
+    lcm_subscription_t *ps = lcm_subscribe(b->lcm, pubchan, on_state, b);
+    pid_t pp = child();
+    if (pp == 0) paced_publisher(pubchan, r->hz, r->floor_seconds);
+    pump_until_exit(b, pp);
+    lcm_unsubscribe(b->lcm, ps);
+    r->floor_err = b->period_err_us;
+    r->floor_n = b->n_states;
+    memset(&b->period_err_us, 0, sizeof b->period_err_us);
+    b->last_arrival_ns = 0;
+    b->n_states = 0;
+}
+
+/* 2. ping-pong floor */
+static void floor_pingpong(latency_run *r, bench *b)
+{
+    pid_t pe = child();
+    if (pe == 0) {
+        lcm_t *l = lcm_create(NULL);
+        lcm_subscribe(l, "LAGSIM_BENCH_PING", on_echo, l);
+        for (;;) lcm_handle(l);
+    }
+    lcm_subscription_t *pong = lcm_subscribe(b->lcm, "LAGSIM_BENCH_PONG", on_pong, b);
+    usleep(300000);
+    uint8_t payload[120] = {0};
+    int64_t t_end = mono_ns() + (int64_t)(r->floor_seconds * 1e9);
+    while (mono_ns() < t_end) {
+        b->pong_ns = 0;
+        int64_t t0 = mono_ns();
+        lcm_publish(b->lcm, "LAGSIM_BENCH_PING", payload, sizeof payload);
+        while (b->pong_ns == 0 && mono_ns() - t0 < 100000000) lcm_handle_timeout(b->lcm, 100);
+        if (b->pong_ns) add(&r->rtt, (double)(b->pong_ns - t0) * 1e-3);
+    }
+    kill(pe, SIGKILL);
+    waitpid(pe, NULL, 0);
+    lcm_unsubscribe(b->lcm, pong);
+}
+
+/* 3. lagsimd in real time with this process as the controller; returns the state
+ * subscription (phase 4 replaces it). */
+static lcm_subscription_t *realtime_run(latency_run *r, bench *b)
+{
+    char ch[96];
+    lag_bus_channel_name(ch, sizeof ch, r->prefix, LAG_BUS_STATE);
+    lcm_subscription_t *ss = lcm_subscribe(b->lcm, ch, on_state, b);
+    lcm_subscription_set_queue_capacity(ss, 100000);
+    lag_bus_channel_name(ch, sizeof ch, r->prefix, LAG_BUS_STATUS);
+    lcm_subscribe(b->lcm, ch, on_status, b);
+    lag_bus_channel_name(b->ch_command, sizeof b->ch_command, r->prefix, LAG_BUS_COMMAND);
+    b->control = true;
+    b->pending_mark = -1;
+    pid_t d = run_daemon(r->lagsimd, r->scene, r->prefix, "realtime", r->hz, r->seconds);
+    pump_until_exit(b, d);
+    r->rt_states = b->n_states;
+    r->overruns = b->status ? b->status->overruns : -1;
+    r->step_max = b->status ? b->status->step_time_max_us : NAN;
+    r->rtf_mean = b->status && b->status->wall_time > 0 ? b->status->sim_time / r->seconds : NAN;
+    r->latency = b->latency_us;
+    r->on_time = b->on_time, r->late = b->late;
+    memset(&b->latency_us, 0, sizeof b->latency_us);
+    r->period_err = b->period_err_us;
+    memset(&b->period_err_us, 0, sizeof b->period_err_us);
+    return ss;
+}
+
+/* 4. lockstep throughput */
+static void lockstep_run(latency_run *r, bench *b, lcm_subscription_t *ss)
+{
+    int64_t n0 = b->n_states;
+    char lprefix[80], ch[96];
+    snprintf(lprefix, sizeof lprefix, "%sL", r->prefix);
+    lag_bus_channel_name(ch, sizeof ch, lprefix, LAG_BUS_STATE);
+    lcm_unsubscribe(b->lcm, ss);
+    lcm_subscribe(b->lcm, ch, on_state, b);
+    lag_bus_channel_name(b->ch_command, sizeof b->ch_command, lprefix, LAG_BUS_COMMAND);
+    /* run long enough in sim time; we stop it after ls_seconds of wall time */
+    int64_t tl0 = mono_ns();
+    pid_t dl = run_daemon(r->lagsimd, r->scene, lprefix, "lockstep", r->hz, 1e6);
+    int64_t first_ns = 0, first_n = 0;
+    while (mono_ns() - tl0 < (int64_t)((r->ls_seconds + 1) * 1e9)) {
+        lcm_handle_timeout(b->lcm, 50);
+        if (!first_ns && b->n_states > n0 + 100) { first_ns = mono_ns(); first_n = b->n_states; }
+    }
+    int64_t last_ns = mono_ns(), last_n = b->n_states;
+    kill(dl, SIGTERM);
+    waitpid(dl, NULL, 0);
+    r->cycles_per_s = first_ns ? (double)(last_n - first_n) / ((double)(last_ns - first_ns) * 1e-9) : 0;
+}
+
+static void print_report(latency_run *r, double period_s)
+{
+    double f50 = pct(&r->floor_err, 0.5), f99 = pct(&r->floor_err, 0.99), fmx = pct(&r->floor_err, 1);
+    double d50 = pct(&r->period_err, 0.5), d99 = pct(&r->period_err, 0.99), dmx = pct(&r->period_err, 1);
+    double r50 = pct(&r->rtt, 0.5), r99 = pct(&r->rtt, 0.99), rmx = pct(&r->rtt, 1);
+    double l50 = pct(&r->latency, 0.5), l99 = pct(&r->latency, 0.99), lmx = pct(&r->latency, 1);
+    int64_t on_time = r->on_time, late = r->late;
+    printf("## lagsimd timing at %g Hz, %g s real time (DIPC, rk4, dt 1 ms), floors over %g s\n\n",
+           r->hz, r->seconds, r->floor_seconds);
+    printf("| figure (us) | p50 | p99 | max | samples |\n|---|---:|---:|---:|---:|\n");
+    printf("| floor: bare paced publisher, period error | %.1f | %.1f | %.1f | %lld |\n", f50, f99, fmx, (long long)r->floor_n);
+    printf("| lagsimd state period error | %.1f | %.1f | %.1f | %lld |\n", d50, d99, dmx, (long long)r->rt_states);
+    printf("| ratio lagsimd / floor | %.2f | %.2f | %.2f | |\n", d50 / f50, d99 / f99, dmx / fmx);
+    printf("| floor: bare LCM ping-pong round trip | %.1f | %.1f | %.1f | %zu |\n", r50, r99, rmx, r->rtt.n);
+    printf("| lagsimd command-to-applied (send -> state that applied it) | %.1f | %.1f | %.1f | %zu |\n", l50, l99, lmx, r->latency.n);
+    printf("| ratio command-to-applied / (period + ping-pong RTT) | %.2f | %.2f | %.2f | |\n",
+           l50 / (period_s * 1e6 + r50), l99 / (period_s * 1e6 + r99), lmx / (period_s * 1e6 + rmx));
+    printf("\n- commands applied to the period right after the state they answer: %lld of %lld (%.3f%%); later: %lld\n",
+           (long long)on_time, (long long)(on_time + late),
+           100.0 * (double)on_time / (double)(on_time + late > 0 ? on_time + late : 1), (long long)late);
+    printf("- overruns over %g s: %lld (daemon status; worst period compute %.1f us; sim time / requested duration %.4f)\n",
+           r->seconds, (long long)r->overruns, r->step_max, r->rtf_mean);
+    printf("- lockstep throughput with this controller: %.0f control cycles/s (ping-pong rate 1/RTT p50: %.0f /s)\n",
+           r->cycles_per_s, 1e6 / r50);
+}
+
+int main(int argc, char **argv)
+{
+    static latency_run r;
+    int code = parse_args(&r, argc, argv);
+    if (code >= 0) return code;
+    if (write_scene(&r)) return 1;
 
     static bench b;
     lag_bus bus;
@@ -239,111 +391,13 @@ int main(int argc, char **argv)
     b.lcm = lcm_create(bus.state_url);
     b.lcm_cmd = lcm_create(bus.command_url);
     if (!b.lcm || !b.lcm_cmd) return 1;
-    b.period_s = 1.0 / hz;
-    char prefix[64], ch[96];
-    snprintf(prefix, sizeof prefix, "LAGSIM_BENCH%d", (int)getpid());
+    b.period_s = 1.0 / r.hz;
+    snprintf(r.prefix, sizeof r.prefix, "LAGSIM_BENCH%d", (int)getpid());
 
-    /* 1. paced publisher floor */
-    char pubchan[96];
-    snprintf(pubchan, sizeof pubchan, "%s_PACED", prefix);
-    lcm_subscription_t *ps = lcm_subscribe(b.lcm, pubchan, on_state, &b);
-    pid_t pp = child();
-    if (pp == 0) paced_publisher(pubchan, hz, floor_seconds);
-    pump_until_exit(&b, pp);
-    lcm_unsubscribe(b.lcm, ps);
-    samples floor_err = b.period_err_us;
-    int64_t floor_n = b.n_states;
-    memset(&b.period_err_us, 0, sizeof b.period_err_us);
-    b.last_arrival_ns = 0;
-    b.n_states = 0;
-
-    /* 2. ping-pong floor */
-    samples rtt = {0};
-    pid_t pe = child();
-    if (pe == 0) {
-        lcm_t *l = lcm_create(NULL);
-        lcm_subscribe(l, "LAGSIM_BENCH_PING", on_echo, l);
-        for (;;) lcm_handle(l);
-    }
-    lcm_subscription_t *pong = lcm_subscribe(b.lcm, "LAGSIM_BENCH_PONG", on_pong, &b);
-    usleep(300000);
-    uint8_t payload[120] = {0};
-    int64_t t_end = mono_ns() + (int64_t)(floor_seconds * 1e9);
-    while (mono_ns() < t_end) {
-        b.pong_ns = 0;
-        int64_t t0 = mono_ns();
-        lcm_publish(b.lcm, "LAGSIM_BENCH_PING", payload, sizeof payload);
-        while (b.pong_ns == 0 && mono_ns() - t0 < 100000000) lcm_handle_timeout(b.lcm, 100);
-        if (b.pong_ns) add(&rtt, (double)(b.pong_ns - t0) * 1e-3);
-    }
-    kill(pe, SIGKILL);
-    waitpid(pe, NULL, 0);
-    lcm_unsubscribe(b.lcm, pong);
-
-    /* 3. lagsimd in real time with this process as the controller */
-    lag_bus_channel_name(ch, sizeof ch, prefix, LAG_BUS_STATE);
-    lcm_subscription_t *ss = lcm_subscribe(b.lcm, ch, on_state, &b);
-    lcm_subscription_set_queue_capacity(ss, 100000);
-    lag_bus_channel_name(ch, sizeof ch, prefix, LAG_BUS_STATUS);
-    lcm_subscribe(b.lcm, ch, on_status, &b);
-    lag_bus_channel_name(b.ch_command, sizeof b.ch_command, prefix, LAG_BUS_COMMAND);
-    b.control = true;
-    b.pending_mark = -1;
-    pid_t d = run_daemon(lagsimd, scene, prefix, "realtime", hz, seconds);
-    pump_until_exit(&b, d);
-    int64_t rt_states = b.n_states;
-    int64_t overruns = b.status ? b.status->overruns : -1;
-    double step_max = b.status ? b.status->step_time_max_us : NAN;
-    double rtf_mean = b.status && b.status->wall_time > 0 ? b.status->sim_time / seconds : NAN;
-    samples latency = b.latency_us;
-    int64_t on_time = b.on_time, late = b.late;
-    memset(&b.latency_us, 0, sizeof b.latency_us);
-
-    /* 4. lockstep throughput */
-    samples dummy = b.period_err_us;
-    memset(&b.period_err_us, 0, sizeof b.period_err_us);
-    int64_t n0 = b.n_states;
-    char lprefix[80];
-    snprintf(lprefix, sizeof lprefix, "%sL", prefix);
-    lag_bus_channel_name(ch, sizeof ch, lprefix, LAG_BUS_STATE);
-    lcm_unsubscribe(b.lcm, ss);
-    ss = lcm_subscribe(b.lcm, ch, on_state, &b);
-    lag_bus_channel_name(b.ch_command, sizeof b.ch_command, lprefix, LAG_BUS_COMMAND);
-    /* run long enough in sim time; we stop it after ls_seconds of wall time */
-    int64_t tl0 = mono_ns();
-    pid_t dl = run_daemon(lagsimd, scene, lprefix, "lockstep", hz, 1e6);
-    int64_t first_ns = 0, first_n = 0;
-    while (mono_ns() - tl0 < (int64_t)((ls_seconds + 1) * 1e9)) {
-        lcm_handle_timeout(b.lcm, 50);
-        if (!first_ns && b.n_states > n0 + 100) { first_ns = mono_ns(); first_n = b.n_states; }
-    }
-    int64_t last_ns = mono_ns(), last_n = b.n_states;
-    kill(dl, SIGTERM);
-    waitpid(dl, NULL, 0);
-    double cycles_per_s = first_ns ? (double)(last_n - first_n) / ((double)(last_ns - first_ns) * 1e-9) : 0;
-    samples period_err = dummy;
-
-    double f50 = pct(&floor_err, 0.5), f99 = pct(&floor_err, 0.99), fmx = pct(&floor_err, 1);
-    double d50 = pct(&period_err, 0.5), d99 = pct(&period_err, 0.99), dmx = pct(&period_err, 1);
-    double r50 = pct(&rtt, 0.5), r99 = pct(&rtt, 0.99), rmx = pct(&rtt, 1);
-    double l50 = pct(&latency, 0.5), l99 = pct(&latency, 0.99), lmx = pct(&latency, 1);
-    printf("## lagsimd timing at %g Hz, %g s real time (DIPC, rk4, dt 1 ms), floors over %g s\n\n",
-           hz, seconds, floor_seconds);
-    printf("| figure (us) | p50 | p99 | max | samples |\n|---|---:|---:|---:|---:|\n");
-    printf("| floor: bare paced publisher, period error | %.1f | %.1f | %.1f | %lld |\n", f50, f99, fmx, (long long)floor_n);
-    printf("| lagsimd state period error | %.1f | %.1f | %.1f | %lld |\n", d50, d99, dmx, (long long)rt_states);
-    printf("| ratio lagsimd / floor | %.2f | %.2f | %.2f | |\n", d50 / f50, d99 / f99, dmx / fmx);
-    printf("| floor: bare LCM ping-pong round trip | %.1f | %.1f | %.1f | %zu |\n", r50, r99, rmx, rtt.n);
-    printf("| lagsimd command-to-applied (send -> state that applied it) | %.1f | %.1f | %.1f | %zu |\n", l50, l99, lmx, latency.n);
-    printf("| ratio command-to-applied / (period + ping-pong RTT) | %.2f | %.2f | %.2f | |\n",
-           l50 / (b.period_s * 1e6 + r50), l99 / (b.period_s * 1e6 + r99), lmx / (b.period_s * 1e6 + rmx));
-    printf("\n- commands applied to the period right after the state they answer: %lld of %lld (%.3f%%); later: %lld\n",
-           (long long)on_time, (long long)(on_time + late),
-           100.0 * (double)on_time / (double)(on_time + late > 0 ? on_time + late : 1), (long long)late);
-    printf("- overruns over %g s: %lld (daemon status; worst period compute %.1f us; sim time / requested duration %.4f)\n",
-           seconds, (long long)overruns, step_max, rtf_mean);
-    printf("- lockstep throughput with this controller: %.0f control cycles/s (ping-pong rate 1/RTT p50: %.0f /s)\n",
-           cycles_per_s, 1e6 / r50);
-    remove(scene);
+    floor_paced(&r, &b);
+    floor_pingpong(&r, &b);
+    lockstep_run(&r, &b, realtime_run(&r, &b));
+    print_report(&r, b.period_s);
+    remove(r.scene);
     return 0;
 }

@@ -82,6 +82,181 @@ static int set_k(const char *v, void *target, char *err, size_t errlen)
     return 0;
 }
 
+/* The design: the plant linearized about upright, the continuous and discrete gains, and
+ * the gain applied (K points at one of them, or at --k's). */
+typedef struct design {
+    double h;                         /* control period, s */
+    double A[N * N], B[N], Q[N * N];  /* x' = A x + B u, cost weights */
+    double Kc[N];                     /* continuous LQR (CARE) */
+    double Ad[N * N], Bd[N], Kd[N];   /* zero-order-hold plant, discrete LQR (DARE) */
+    double cmax;                      /* largest real part of the continuous loop's poles */
+    const double *K;                  /* the gain applied */
+    const char *which;                /* "given", "continuous" or "discrete" */
+} design;
+
+/* Continuous LQR of the plant linearized about upright; prints its poles. */
+static int design_continuous(design *d, const lag_model *model, const double qw[N], double r)
+{
+    const int input = 0;
+    double q0[3] = {0, 0, 0}, qd0[3] = {0, 0, 0}, R[1] = {r}, X[N * N], Acl[N * N];
+    memset(d->Q, 0, sizeof d->Q);
+    for (int i = 0; i < N; i++) d->Q[i * N + i] = qw[i];
+    int rc = lag_lqr_linearize(model, q0, qd0, NULL, 1, &input, d->A, d->B);
+    if (rc == LAG_LQR_OK) rc = lag_lqr_care(N, 1, d->A, d->B, d->Q, R, X, d->Kc);
+    if (rc != LAG_LQR_OK) {
+        fprintf(stderr, "dipc_lqr: continuous LQR design failed (%d)\n", rc);
+        return -1;
+    }
+    print_eig("open-loop poles (1/s)", N, d->A);
+    printf("continuous LQR: K = [%.4f %.4f %.4f %.4f %.4f %.4f], CARE residual %.2e\n",
+           d->Kc[0], d->Kc[1], d->Kc[2], d->Kc[3], d->Kc[4], d->Kc[5],
+           lag_lqr_care_residual(N, 1, d->A, d->B, d->Q, R, X));
+    lag_lqr_closed_loop(N, 1, d->A, d->B, d->Kc, Acl);
+    print_eig("continuous closed-loop poles (1/s)", N, Acl);
+    d->cmax = max_real(N, Acl);
+    return 0;
+}
+
+/* Discrete LQR of the zero-order-hold plant at the control period, cost (Q h, R h); prints
+ * both gains' sampled loops. */
+static int design_discrete(design *d, double r)
+{
+    const double h = d->h;
+    double Qd[N * N], Rd[1] = {r * h}, Xd[N * N], Acl[N * N];
+    for (int i = 0; i < N * N; i++) Qd[i] = d->Q[i] * h;
+    int rc = lag_lqr_c2d(N, 1, d->A, d->B, h, d->Ad, d->Bd);
+    if (rc == LAG_LQR_OK) rc = lag_lqr_dare(N, 1, d->Ad, d->Bd, Qd, Rd, Xd, d->Kd);
+    if (rc != LAG_LQR_OK) {
+        fprintf(stderr, "dipc_lqr: discrete LQR design failed (%d)\n", rc);
+        return -1;
+    }
+    printf("discrete LQR (h = %g s): K = [%.4f %.4f %.4f %.4f %.4f %.4f], DARE residual %.2e\n",
+           h, d->Kd[0], d->Kd[1], d->Kd[2], d->Kd[3], d->Kd[4], d->Kd[5],
+           lag_lqr_dare_residual(N, 1, d->Ad, d->Bd, Qd, Rd, Xd));
+    lag_lqr_closed_loop(N, 1, d->Ad, d->Bd, d->Kd, Acl);
+    print_eig("discrete closed-loop eigenvalues (z)", N, Acl);
+    double rho_d = spectral_radius(N, Acl);
+    lag_lqr_closed_loop(N, 1, d->Ad, d->Bd, d->Kc, Acl);
+    double rho_c = spectral_radius(N, Acl);
+    printf("sampled loop spectral radius: discrete gain %.6f, continuous gain %.6f\n", rho_d,
+           rho_c);
+    return 0;
+}
+
+/* The gain to apply (--k's, or the design --gain names), refused unless it stabilizes the
+ * sampled loop. */
+static int choose_gain(design *d, const double kgiven[1 + N], int continuous)
+{
+    double Acl[N * N];
+    d->K = kgiven[0] ? kgiven + 1 : continuous ? d->Kc : d->Kd;
+    d->which = kgiven[0] ? "given" : continuous ? "continuous" : "discrete";
+    lag_lqr_closed_loop(N, 1, d->Ad, d->Bd, d->K, Acl);
+    double rho = spectral_radius(N, Acl);
+    if (!(d->cmax < 0.0) || !(rho < 1.0)) {
+        fprintf(stderr, "dipc_lqr: the %s gain does not stabilize the sampled loop "
+                        "(spectral radius %.6f)\n", d->which, rho);
+        return -1;
+    }
+    const double *K = d->K;
+    printf("applying the %s gain: u = -K x on theta0, K = [%.17g %.17g %.17g %.17g %.17g "
+           "%.17g]\n", d->which, K[0], K[1], K[2], K[3], K[4], K[5]);
+    fflush(stdout);
+    return 0;
+}
+
+/* What the run did: its states, peaks and end angles for the summary. */
+typedef struct balance {
+    int idx[3];                       /* theta0..2 in the state's joints (-1: look up) */
+    int64_t states;
+    double t_first, t_last, t_report;
+    double max_x, max_th1, max_th2, max_u, end_th1, end_th2;
+    double x_first[N];                /* the first state answered: the prediction's start */
+} balance;
+
+/* x = (theta0, theta1, theta2, their rates) from a state; -1 if it lacks a joint. */
+static int state_vector(balance *b, const lag_client_state *st, const char *const jn[3],
+                        double x[N])
+{
+    if (b->idx[0] < 0 || lag_client_state_joint(st, jn[0]) != b->idx[0]) {
+        for (int k = 0; k < 3; k++) b->idx[k] = lag_client_state_joint(st, jn[k]);
+        if (b->idx[0] < 0 || b->idx[1] < 0 || b->idx[2] < 0) {
+            fprintf(stderr, "dipc_lqr: state without theta0/theta1/theta2; ignored\n");
+            b->idx[0] = -1;
+            return -1;
+        }
+    }
+    for (int k = 0; k < 3; k++) {
+        x[k] = st->position[b->idx[k]];
+        x[3 + k] = st->velocity[b->idx[k]];
+    }
+    return 0;
+}
+
+static void record(balance *b, const lag_ctl *ctl, double t, const double x[N], double u)
+{
+    if (b->states == 0) {
+        b->t_first = t;
+        memcpy(b->x_first, x, sizeof b->x_first);
+    }
+    b->states++;
+    b->t_last = t;
+    b->max_x = fmax(b->max_x, fabs(x[0]));
+    b->max_th1 = fmax(b->max_th1, fabs(x[1]));
+    b->max_th2 = fmax(b->max_th2, fabs(x[2]));
+    b->max_u = fmax(b->max_u, fabs(u));
+    b->end_th1 = x[1];
+    b->end_th2 = x[2];
+    if (!ctl->quiet && t - b->t_report >= 1.0) {
+        b->t_report = t;
+        printf("t=%8.3f  x=%+.5f  th1=%+.6f  th2=%+.6f  u=%+.4f\n", t, x[0], x[1], x[2], u);
+        fflush(stdout);
+    }
+}
+
+/* Linear prediction from the first state answered: the same sampled loop
+ * x+ = (Ad - Bd K) x on the linearized plant, over the same number of periods.
+ * For small angles the daemon's nonlinear run should come close to it. */
+static void predict(const design *d, const balance *b, double pred[3])
+{
+    double Acl[N * N], xl[N], xn[N];
+    pred[0] = pred[1] = pred[2] = 0;
+    lag_lqr_closed_loop(N, 1, d->Ad, d->Bd, d->K, Acl);
+    memcpy(xl, b->x_first, sizeof xl);
+    for (int64_t k = 0; k < b->states; k++) {
+        for (int i = 0; i < 3; i++) pred[i] = fmax(pred[i], fabs(xl[i]));
+        for (int i = 0; i < N; i++) {
+            xn[i] = 0.0;
+            for (int j = 0; j < N; j++) xn[i] += Acl[i * N + j] * xl[j];
+        }
+        memcpy(xl, xn, sizeof xl);
+    }
+}
+
+static int finish(lag_ctl *ctl, const design *d, const balance *b)
+{
+    double pred[3];
+    predict(d, b, pred);
+    return lag_ctl_finish(ctl,
+                          "states=%lld t_first=%.6f t_last=%.6f max_abs_theta0=%.6g "
+                          "max_abs_theta1=%.6g max_abs_theta2=%.6g max_abs_effort=%.6g "
+                          "end_theta1=%.3g end_theta2=%.3g pred_max_abs_theta0=%.6g "
+                          "pred_max_abs_theta1=%.6g pred_max_abs_theta2=%.6g",
+                          (long long)b->states, b->t_first, b->t_last, b->max_x, b->max_th1,
+                          b->max_th2, b->max_u, b->end_th1, b->end_th2, pred[0], pred[1],
+                          pred[2]);
+}
+
+static void print_scene(const lag_ctl *ctl)
+{
+    const lag_client_scene *sc = &ctl->scene;
+    printf("dipc_lqr: scene %s on %s_*: mode %s, dt %g s, control period %g s, integrator %s\n",
+           sc->model, ctl->prefix, sc->mode, sc->dt, sc->control_period, sc->integrator);
+    printf("parameters:");
+    for (int k = 0; k < LAG_DIPC_NP; k++)
+        printf(" %s=%g", lag_model_info_get(LAG_MODEL_DIPC)->param_names[k], ctl->model.p[k]);
+    printf("\n");
+}
+
 int main(int argc, char **argv)
 {
     double r_weight = 1.0, qw[N] = {5, 50, 50, 20, 700, 700}, kgiven[1 + N] = {0};
@@ -104,139 +279,30 @@ int main(int argc, char **argv)
                            mine, (int)(sizeof mine / sizeof mine[0]));
     if (rc >= 0) return rc;
     if (lag_ctl_start(&ctl, "dipc")) return lag_ctl_fail(&ctl);
-    const lag_client_scene sc = ctl.scene;
-    const lag_model model = ctl.model;
     const char *jn[3] = {"theta0", "theta1", "theta2"};
-    int in_scene = lag_client_scene_joint(&sc, "theta0");
-    if (in_scene < 0 || !sc.actuated[in_scene]) {
+    int in_scene = lag_client_scene_joint(&ctl.scene, "theta0");
+    if (in_scene < 0 || !ctl.scene.actuated[in_scene]) {
         fprintf(stderr, "dipc_lqr: the scene has no actuated joint theta0\n");
         return lag_ctl_fail(&ctl);
     }
-    const double h = sc.control_period;
-    printf("dipc_lqr: scene %s on %s_*: mode %s, dt %g s, control period %g s, integrator %s\n",
-           sc.model, ctl.prefix, sc.mode, sc.dt, h, sc.integrator);
-    printf("parameters:");
-    for (int k = 0; k < LAG_DIPC_NP; k++)
-        printf(" %s=%g", lag_model_info_get(LAG_MODEL_DIPC)->param_names[k], model.p[k]);
-    printf("\n");
+    print_scene(&ctl);
 
     /* ---- design */
-    const int input = 0;
-    double q0[3] = {0, 0, 0}, qd0[3] = {0, 0, 0};
-    double A[N * N], B[N], Q[N * N] = {0}, R[1] = {r_weight};
-    double X[N * N], Kc[N], Acl[N * N];
-    for (int i = 0; i < N; i++) Q[i * N + i] = qw[i];
-    rc = lag_lqr_linearize(&model, q0, qd0, NULL, 1, &input, A, B);
-    if (rc == LAG_LQR_OK) rc = lag_lqr_care(N, 1, A, B, Q, R, X, Kc);
-    if (rc != LAG_LQR_OK) {
-        fprintf(stderr, "dipc_lqr: continuous LQR design failed (%d)\n", rc);
+    design d = {.h = ctl.scene.control_period};
+    if (design_continuous(&d, &ctl.model, qw, r_weight) || design_discrete(&d, r_weight) ||
+        choose_gain(&d, kgiven, continuous))
         return lag_ctl_fail(&ctl);
-    }
-    print_eig("open-loop poles (1/s)", N, A);
-    printf("continuous LQR: K = [%.4f %.4f %.4f %.4f %.4f %.4f], CARE residual %.2e\n",
-           Kc[0], Kc[1], Kc[2], Kc[3], Kc[4], Kc[5], lag_lqr_care_residual(N, 1, A, B, Q, R, X));
-    lag_lqr_closed_loop(N, 1, A, B, Kc, Acl);
-    print_eig("continuous closed-loop poles (1/s)", N, Acl);
-    double cmax = max_real(N, Acl);
-
-    double Ad[N * N], Bd[N], Qd[N * N], Rd[1] = {r_weight * h}, Xd[N * N], Kd[N];
-    for (int i = 0; i < N * N; i++) Qd[i] = Q[i] * h;
-    rc = lag_lqr_c2d(N, 1, A, B, h, Ad, Bd);
-    if (rc == LAG_LQR_OK) rc = lag_lqr_dare(N, 1, Ad, Bd, Qd, Rd, Xd, Kd);
-    if (rc != LAG_LQR_OK) {
-        fprintf(stderr, "dipc_lqr: discrete LQR design failed (%d)\n", rc);
-        return lag_ctl_fail(&ctl);
-    }
-    printf("discrete LQR (h = %g s): K = [%.4f %.4f %.4f %.4f %.4f %.4f], DARE residual %.2e\n",
-           h, Kd[0], Kd[1], Kd[2], Kd[3], Kd[4], Kd[5],
-           lag_lqr_dare_residual(N, 1, Ad, Bd, Qd, Rd, Xd));
-    double Adcl[N * N];
-    lag_lqr_closed_loop(N, 1, Ad, Bd, Kd, Adcl);
-    print_eig("discrete closed-loop eigenvalues (z)", N, Adcl);
-    double rho_d = spectral_radius(N, Adcl);
-    lag_lqr_closed_loop(N, 1, Ad, Bd, Kc, Acl);
-    double rho_c = spectral_radius(N, Acl);
-    printf("sampled loop spectral radius: discrete gain %.6f, continuous gain %.6f\n", rho_d,
-           rho_c);
-    const double *K = kgiven[0] ? kgiven + 1 : continuous ? Kc : Kd;
-    const char *which = kgiven[0] ? "given" : continuous ? "continuous" : "discrete";
-    lag_lqr_closed_loop(N, 1, Ad, Bd, K, Acl);
-    double rho = spectral_radius(N, Acl);
-    if (!(cmax < 0.0) || !(rho < 1.0)) {
-        fprintf(stderr, "dipc_lqr: the %s gain does not stabilize the sampled loop "
-                        "(spectral radius %.6f)\n", which, rho);
-        return lag_ctl_fail(&ctl);
-    }
-    printf("applying the %s gain: u = -K x on theta0, K = [%.17g %.17g %.17g %.17g %.17g "
-           "%.17g]\n", which, K[0], K[1], K[2], K[3], K[4], K[5]);
-    fflush(stdout);
 
     /* ---- control loop: answer every state until the run ends */
     lag_client_state st;
-    int64_t states = 0;
-    double t_first = NAN, t_last = NAN, t_report = -INFINITY;
-    double max_th1 = 0, max_th2 = 0, max_x = 0, max_u = 0, end_th1 = NAN, end_th2 = NAN;
-    double x_first[N] = {0};
-    int idx[3] = {-1, -1, -1};
+    balance b = {.idx = {-1, -1, -1}, .t_first = NAN, .t_last = NAN, .t_report = -INFINITY,
+                 .end_th1 = NAN, .end_th2 = NAN};
     while (lag_ctl_next_state(&ctl, &st) == LAG_CLIENT_OK) {
-        if (idx[0] < 0 || lag_client_state_joint(&st, jn[0]) != idx[0]) {
-            for (int k = 0; k < 3; k++) idx[k] = lag_client_state_joint(&st, jn[k]);
-            if (idx[0] < 0 || idx[1] < 0 || idx[2] < 0) {
-                fprintf(stderr, "dipc_lqr: state without theta0/theta1/theta2; ignored\n");
-                idx[0] = -1;
-                continue;
-            }
-        }
-        double x[N];
-        for (int k = 0; k < 3; k++) {
-            x[k] = st.position[idx[k]];
-            x[3 + k] = st.velocity[idx[k]];
-        }
-        double u = 0.0;
-        for (int k = 0; k < N; k++) u -= K[k] * x[k];
+        double x[N], u = 0.0;
+        if (state_vector(&b, &st, jn, x)) continue;
+        for (int k = 0; k < N; k++) u -= d.K[k] * x[k];
         lag_ctl_command(&ctl, &st, 1, jn, &u); /* a non-finite u is sent as 0 */
-
-        if (states == 0) {
-            t_first = st.sim_time;
-            memcpy(x_first, x, sizeof x_first);
-        }
-        states++;
-        t_last = st.sim_time;
-        max_x = fmax(max_x, fabs(x[0]));
-        max_th1 = fmax(max_th1, fabs(x[1]));
-        max_th2 = fmax(max_th2, fabs(x[2]));
-        max_u = fmax(max_u, fabs(u));
-        end_th1 = x[1];
-        end_th2 = x[2];
-        if (!ctl.quiet && st.sim_time - t_report >= 1.0) {
-            t_report = st.sim_time;
-            printf("t=%8.3f  x=%+.5f  th1=%+.6f  th2=%+.6f  u=%+.4f\n", st.sim_time, x[0],
-                   x[1], x[2], u);
-            fflush(stdout);
-        }
+        record(&b, &ctl, st.sim_time, x, u);
     }
-
-    /* Linear prediction from the first state answered: the same sampled loop
-     * x+ = (Ad - Bd K) x on the linearized plant, over the same number of periods.
-     * For small angles the daemon's nonlinear run should come close to it. */
-    double pred_th1 = 0, pred_th2 = 0, pred_x = 0, xl[N], xn[N];
-    lag_lqr_closed_loop(N, 1, Ad, Bd, K, Acl);
-    memcpy(xl, x_first, sizeof xl);
-    for (int64_t k = 0; k < states; k++) {
-        pred_x = fmax(pred_x, fabs(xl[0]));
-        pred_th1 = fmax(pred_th1, fabs(xl[1]));
-        pred_th2 = fmax(pred_th2, fabs(xl[2]));
-        for (int i = 0; i < N; i++) {
-            xn[i] = 0.0;
-            for (int j = 0; j < N; j++) xn[i] += Acl[i * N + j] * xl[j];
-        }
-        memcpy(xl, xn, sizeof xl);
-    }
-    return lag_ctl_finish(&ctl,
-                          "states=%lld t_first=%.6f t_last=%.6f max_abs_theta0=%.6g "
-                          "max_abs_theta1=%.6g max_abs_theta2=%.6g max_abs_effort=%.6g "
-                          "end_theta1=%.3g end_theta2=%.3g pred_max_abs_theta0=%.6g "
-                          "pred_max_abs_theta1=%.6g pred_max_abs_theta2=%.6g",
-                          (long long)states, t_first, t_last, max_x, max_th1, max_th2, max_u,
-                          end_th1, end_th2, pred_x, pred_th1, pred_th2);
+    return finish(&ctl, &d, &b);
 }

@@ -135,6 +135,21 @@ static void usage(const lag_ctl *ctl, FILE *f, const char *what, const lag_ctl_o
                "usage.\n");
 }
 
+/* getopt_long found no option (c is '?' or ':'): says which, returns 2 (bad usage). */
+static int bad_option(const lag_ctl *ctl, int c, char **argv)
+{
+    if (c == ':' && optopt && optopt < 256)
+        fprintf(stderr, "%s: option -%c needs a value\n", ctl->name, optopt);
+    else if (c == ':')
+        fprintf(stderr, "%s: option %s needs a value\n", ctl->name, argv[optind - 1]);
+    else if (optopt)
+        fprintf(stderr, "%s: unknown option '-%c'\n", ctl->name, optopt);
+    else
+        fprintf(stderr, "%s: unknown option '%s'\n", ctl->name, argv[optind - 1]);
+    fprintf(stderr, "%s: --help lists the options\n", ctl->name);
+    return lag_result_exit(LAG_ERR_USAGE);
+}
+
 int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
                   const lag_ctl_option *extra, int nextra)
 {
@@ -186,18 +201,7 @@ int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
         if (c >= 256) o = &all[c - 256];
         for (int i = 0; i < n && !o && c != '?' && c != ':'; i++)
             if (all[i].letter == c) o = &all[i];
-        if (!o) {
-            if (c == ':' && optopt && optopt < 256)
-                fprintf(stderr, "%s: option -%c needs a value\n", ctl->name, optopt);
-            else if (c == ':')
-                fprintf(stderr, "%s: option %s needs a value\n", ctl->name, argv[optind - 1]);
-            else if (optopt)
-                fprintf(stderr, "%s: unknown option '-%c'\n", ctl->name, optopt);
-            else
-                fprintf(stderr, "%s: unknown option '%s'\n", ctl->name, argv[optind - 1]);
-            fprintf(stderr, "%s: --help lists the options\n", ctl->name);
-            return lag_result_exit(LAG_ERR_USAGE);
-        }
+        if (!o) return bad_option(ctl, c, argv);
         char err[256];
         if (o->set(optarg, o->target, err, sizeof err) != 0) {
             fprintf(stderr, "%s: --%s: %s\n", ctl->name, o->name, err);
@@ -237,46 +241,54 @@ static void heard_event(const lag_client_event *ev, void *user)
     if (ctl->on_event) ctl->on_event(ev, ctl->event_user);
 }
 
-int lag_ctl_start(lag_ctl *ctl, const char *model)
+/* --trace: replaced if it exists (a trace is rewritten run after run), but never written
+ * through a symbolic link (lagsim_out.h). */
+static int open_trace(lag_ctl *ctl)
+{
+    char oerr[512];
+    int fd = lag_out_open("--trace", ctl->trace_path, true, NULL, 0, 0, oerr, sizeof oerr);
+    ctl->trace = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (!ctl->trace) {
+        if (fd >= 0) {
+            snprintf(oerr, sizeof oerr, "--trace %s: %s", ctl->trace_path, strerror(errno));
+            close(fd);
+        }
+        fprintf(stderr, "%s: %s\n", ctl->name, oerr);
+        return 1;
+    }
+    return 0;
+}
+
+/* Without --prefix: the only plant (of this model) on the bus; with a default prefix a
+ * controller may start before its plant: a short look, then that prefix is waited on. */
+static int pick_prefix(lag_ctl *ctl, const char *model)
+{
+    char perr[1200];
+    lag_client_plant p;
+    double look = ctl->default_prefix ? 1.0 : ctl->timeout;
+    int rc = lag_client_pick_plant(ctl->url, model, look, &p, perr, sizeof perr);
+    if (rc == LAG_CLIENT_OK) {
+        snprintf(ctl->found_prefix, sizeof ctl->found_prefix, "%s", p.prefix);
+        ctl->prefix = ctl->found_prefix;
+        printf("%s: the only %s%splant on the bus: prefix %s (%s, %s)\n", ctl->name,
+               model ? model : "", model ? " " : "", p.prefix, p.mode, p.run_state);
+    } else if (rc == LAG_CLIENT_TIMEOUT && ctl->default_prefix) {
+        ctl->prefix = ctl->default_prefix;
+        printf("%s: %s; waiting for prefix %s\n", ctl->name, perr, ctl->prefix);
+    } else {
+        fprintf(stderr, "%s: %s\n", ctl->name, perr);
+        /* several: --prefix */
+        ctl->fail_code = lag_result_exit(rc == LAG_CLIENT_ERR_AMBIGUOUS ? LAG_ERR_AMBIGUOUS
+                                                                    : LAG_ERR_RUNTIME);
+        return ctl->fail_code;
+    }
+    return 0;
+}
+
+/* The client, its callbacks and the signal handlers. */
+static int connect_client(lag_ctl *ctl)
 {
     char err[256];
-    if (ctl->trace_path) {
-        /* replaced if it exists (a trace is rewritten run after run), but never written
-         * through a symbolic link (lagsim_out.h) */
-        char oerr[512];
-        int fd = lag_out_open("--trace", ctl->trace_path, true, NULL, 0, 0, oerr, sizeof oerr);
-        ctl->trace = fd >= 0 ? fdopen(fd, "w") : NULL;
-        if (!ctl->trace) {
-            if (fd >= 0) {
-                snprintf(oerr, sizeof oerr, "--trace %s: %s", ctl->trace_path, strerror(errno));
-                close(fd);
-            }
-            fprintf(stderr, "%s: %s\n", ctl->name, oerr);
-            return 1;
-        }
-    }
-    if (!ctl->prefix) {
-        /* the only plant (of this model) on the bus; with a default prefix a controller
-         * may start before its plant: a short look, then that prefix is waited on */
-        char perr[1200];
-        lag_client_plant p;
-        double look = ctl->default_prefix ? 1.0 : ctl->timeout;
-        int rc = lag_client_pick_plant(ctl->url, model, look, &p, perr, sizeof perr);
-        if (rc == LAG_CLIENT_OK) {
-            snprintf(ctl->found_prefix, sizeof ctl->found_prefix, "%s", p.prefix);
-            ctl->prefix = ctl->found_prefix;
-            printf("%s: the only %s%splant on the bus: prefix %s (%s, %s)\n", ctl->name,
-                   model ? model : "", model ? " " : "", p.prefix, p.mode, p.run_state);
-        } else if (rc == LAG_CLIENT_TIMEOUT && ctl->default_prefix) {
-            ctl->prefix = ctl->default_prefix;
-            printf("%s: %s; waiting for prefix %s\n", ctl->name, perr, ctl->prefix);
-        } else {
-            fprintf(stderr, "%s: %s\n", ctl->name, perr);
-            ctl->fail_code = lag_result_exit(rc == LAG_CLIENT_ERR_AMBIGUOUS ? LAG_ERR_AMBIGUOUS
-                                                                        : LAG_ERR_RUNTIME);
-            return ctl->fail_code;
-        }
-    }
     ctl->client = lag_client_create(ctl->url, ctl->prefix, err, sizeof err);
     if (!ctl->client) {
         fprintf(stderr, "%s: %s\n", ctl->name, err);
@@ -290,7 +302,11 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    return 0;
+}
 
+static int wait_scene(lag_ctl *ctl)
+{
     /* subscribed: from here on no state is missed (test harnesses wait for this line) */
     printf("%s: waiting for the scene description on %s_SCENE\n", ctl->name, ctl->prefix);
     fflush(stdout);
@@ -298,7 +314,7 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
     for (;;) {
         double left = deadline - lag_client_now();
         int rc = lag_client_wait_scene(ctl->client, left < 0.25 ? left : 0.25, &ctl->scene);
-        if (rc == LAG_CLIENT_OK) break;
+        if (rc == LAG_CLIENT_OK) return 0;
         if (rc < 0 || g_signal || !(left > 0.25)) {
             if (g_signal)
                 fprintf(stderr, "%s: interrupted while waiting for the scene\n", ctl->name);
@@ -311,6 +327,12 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
             return 1;
         }
     }
+}
+
+/* ctl->model from the scene's parameters, if the scene runs `model` (NULL: any). */
+static int model_from_scene(lag_ctl *ctl, const char *model)
+{
+    char err[256];
     if (!model) model = ctl->scene.model; /* any model this build knows */
     if (strcmp(ctl->scene.model, model) != 0) {
         fprintf(stderr, "%s: prefix %s runs model '%s', not %s\n", ctl->name, ctl->prefix,
@@ -336,6 +358,17 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
         fprintf(stderr, "%s: scene parameters: %s\n", ctl->name, err);
         return 1;
     }
+    return 0;
+}
+
+int lag_ctl_start(lag_ctl *ctl, const char *model)
+{
+    int rc;
+    if (ctl->trace_path && (rc = open_trace(ctl))) return rc;
+    if (!ctl->prefix && (rc = pick_prefix(ctl, model))) return rc;
+    if ((rc = connect_client(ctl)) || (rc = wait_scene(ctl)) ||
+        (rc = model_from_scene(ctl, model)))
+        return rc;
     ctl->heard = lag_client_now();
     return 0;
 }

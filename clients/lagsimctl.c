@@ -539,11 +539,19 @@ static int parse_doubles(char **argv, int n, double *out)
     return 0;
 }
 
-static lag_result lagsimctl_main(int argc, char **argv)
+/* What a step of main returns to go on (not a result: lag_result_exit never sees it). */
+#define GO_ON 1000
+
+/* The options before the command. */
+typedef struct options {
+    const char *prefix, *url;   /* NULL: the only plant on the bus; LCM's default */
+    double timeout;             /* wall s */
+    bool timeout_set;
+} options;
+
+/* Parses the options (g_json and g_digits too): GO_ON, else the result to exit with. */
+static int parse_options(options *o, int argc, char **argv)
 {
-    const char *prefix = NULL, *url = NULL;
-    double timeout = 2.0;
-    bool timeout_set = false;
     static const struct option longopts[] = {
         {"prefix", required_argument, NULL, 'p'}, {"url", required_argument, NULL, 'u'},
         {"timeout", required_argument, NULL, 't'}, {"digits", required_argument, NULL, 'd'},
@@ -554,17 +562,17 @@ static lag_result lagsimctl_main(int argc, char **argv)
     while ((opt = getopt_long(argc, argv, "+p:u:t:d:jhV", longopts, NULL)) != -1) {
         char *end;
         switch (opt) {
-        case 'p': prefix = optarg; break;
+        case 'p': o->prefix = optarg; break;
         case 'j': g_json = true; break;
-        case 'u': url = optarg; break;
+        case 'u': o->url = optarg; break;
         case 't':
-            timeout = strtod(optarg, &end);
-            if (end == optarg || *end || !(timeout > 0) || !isfinite(timeout)) {
+            o->timeout = strtod(optarg, &end);
+            if (end == optarg || *end || !(o->timeout > 0) || !isfinite(o->timeout)) {
                 fprintf(stderr, "lagsimctl: --timeout wants a number of seconds > 0, not '%s'\n",
                         optarg);
                 return EXIT_USAGE;
             }
-            timeout_set = true;
+            o->timeout_set = true;
             break;
         case 'd': {
             long d = strtol(optarg, &end, 10);
@@ -581,111 +589,148 @@ static lag_result lagsimctl_main(int argc, char **argv)
         default: usage(stderr); return EXIT_USAGE;
         }
     }
-    if (optind >= argc) {
-        fprintf(stderr, "lagsimctl: which command? (list, status, describe, pause, resume, "
-                        "step N, reset [--scene], reset-to Q... QD..., set KEY=VALUE, kick "
-                        "JOINT IMPULSE [--duration S], watch)\n");
-        usage(stderr);
+    return GO_ON;
+}
+
+/* The command and its arguments, checked before the bus is touched. */
+typedef struct request {
+    const char *cmd;
+    char **args;
+    int nargs;
+    int want_args;              /* how many arguments the command takes */
+    long long count;            /* step */
+    double q[LAG_CLIENT_MAX_JOINTS], qd[LAG_CLIENT_MAX_JOINTS];
+    int nq;                     /* reset-to */
+    const char *kick_joint;
+    double kick_impulse, kick_duration;
+    bool reset_scene;           /* reset --scene */
+} request;
+
+static int check_step(request *r)
+{
+    r->want_args = 1;
+    if (r->nargs == 1 && parse_count(r->args[0], &r->count)) {
+        fprintf(stderr, "lagsimctl: step wants a whole number of periods >= 1, not '%s'\n",
+                r->args[0]);
         return EXIT_USAGE;
     }
-    const char *cmd = argv[optind];
-    char **args = argv + optind + 1;
-    int nargs = argc - optind - 1;
+    return GO_ON;
+}
 
-    /* check the command and its arguments before touching the bus */
-    long long count = 0;
-    double q[LAG_CLIENT_MAX_JOINTS], qd[LAG_CLIENT_MAX_JOINTS];
-    int nq = 0;
-    int want_args = 0;
-    const char *kick_joint = NULL;
-    double kick_impulse = 0, kick_duration = 0;
-    bool reset_scene = false;
-    if (!strcmp(cmd, "step")) {
-        want_args = 1;
-        if (nargs == 1 && parse_count(args[0], &count)) {
-            fprintf(stderr, "lagsimctl: step wants a whole number of periods >= 1, not '%s'\n",
-                    args[0]);
-            return EXIT_USAGE;
-        }
-    } else if (!strcmp(cmd, "reset-to")) {
-        if (nargs < 2 || nargs % 2 || nargs / 2 > LAG_CLIENT_MAX_JOINTS) {
-            fprintf(stderr, "lagsimctl: reset-to wants every position, then every velocity "
-                            "(2, 4 or 6 numbers for 1 to 3 joints), got %d\n", nargs);
-            return EXIT_USAGE;
-        }
-        nq = nargs / 2;
-        if (parse_doubles(args, nq, q) || parse_doubles(args + nq, nq, qd)) {
-            fprintf(stderr, "lagsimctl: reset-to wants finite numbers\n");
-            return EXIT_USAGE;
-        }
-        want_args = nargs;
-    } else if (!strcmp(cmd, "set")) {
-        want_args = 1;
-        const char *eq = nargs == 1 ? strchr(args[0], '=') : NULL;
-        if (nargs == 1 && (!eq || eq == args[0] || !eq[1])) {
-            fprintf(stderr, "lagsimctl: set wants KEY=VALUE, e.g. parameters.m2=1.5, not '%s'\n",
-                    args[0]);
-            return EXIT_USAGE;
-        }
-    } else if (!strcmp(cmd, "kick")) {
-        /* JOINT IMPULSE [--duration S] */
-        want_args = nargs == 4 ? 4 : 2;
-        if (nargs == 2 || nargs == 4) {
-            kick_joint = args[0];
-            if (parse_doubles(args + 1, 1, &kick_impulse)) {
-                fprintf(stderr, "lagsimctl: kick wants a finite impulse (N s, or N m s on an "
-                                "angle), not '%s'\n", args[1]);
-                return EXIT_USAGE;
-            }
-            if (nargs == 4 && (strcmp(args[2], "--duration") ||
-                               parse_doubles(args + 3, 1, &kick_duration) ||
-                               !(kick_duration > 0))) {
-                fprintf(stderr, "lagsimctl: kick JOINT IMPULSE [--duration S]: S is a time > 0 "
-                                "(s), not '%s %s'\n", args[2], args[3]);
-                return EXIT_USAGE;
-            }
-        }
-    } else if (!strcmp(cmd, "reset")) {
-        want_args = nargs == 1 ? 1 : 0;
-        if (nargs == 1 && strcmp(args[0], "--scene")) {
-            fprintf(stderr, "lagsimctl: reset takes --scene or nothing, not '%s'\n", args[0]);
-            return EXIT_USAGE;
-        }
-        reset_scene = nargs == 1;
-    } else if (strcmp(cmd, "status") && strcmp(cmd, "describe") && strcmp(cmd, "pause") &&
-               strcmp(cmd, "resume") && strcmp(cmd, "watch") && strcmp(cmd, "list")) {
+static int check_reset_to(request *r)
+{
+    if (r->nargs < 2 || r->nargs % 2 || r->nargs / 2 > LAG_CLIENT_MAX_JOINTS) {
+        fprintf(stderr, "lagsimctl: reset-to wants every position, then every velocity "
+                        "(2, 4 or 6 numbers for 1 to 3 joints), got %d\n", r->nargs);
+        return EXIT_USAGE;
+    }
+    r->nq = r->nargs / 2;
+    if (parse_doubles(r->args, r->nq, r->q) || parse_doubles(r->args + r->nq, r->nq, r->qd)) {
+        fprintf(stderr, "lagsimctl: reset-to wants finite numbers\n");
+        return EXIT_USAGE;
+    }
+    r->want_args = r->nargs;
+    return GO_ON;
+}
+
+static int check_set(request *r)
+{
+    r->want_args = 1;
+    const char *eq = r->nargs == 1 ? strchr(r->args[0], '=') : NULL;
+    if (r->nargs == 1 && (!eq || eq == r->args[0] || !eq[1])) {
+        fprintf(stderr, "lagsimctl: set wants KEY=VALUE, e.g. parameters.m2=1.5, not '%s'\n",
+                r->args[0]);
+        return EXIT_USAGE;
+    }
+    return GO_ON;
+}
+
+/* JOINT IMPULSE [--duration S] */
+static int check_kick(request *r)
+{
+    char **args = r->args;
+    r->want_args = r->nargs == 4 ? 4 : 2;
+    if (r->nargs != 2 && r->nargs != 4) return GO_ON;
+    r->kick_joint = args[0];
+    if (parse_doubles(args + 1, 1, &r->kick_impulse)) {
+        fprintf(stderr, "lagsimctl: kick wants a finite impulse (N s, or N m s on an "
+                        "angle), not '%s'\n", args[1]);
+        return EXIT_USAGE;
+    }
+    if (r->nargs == 4 && (strcmp(args[2], "--duration") ||
+                          parse_doubles(args + 3, 1, &r->kick_duration) ||
+                          !(r->kick_duration > 0))) {
+        fprintf(stderr, "lagsimctl: kick JOINT IMPULSE [--duration S]: S is a time > 0 "
+                        "(s), not '%s %s'\n", args[2], args[3]);
+        return EXIT_USAGE;
+    }
+    return GO_ON;
+}
+
+static int check_reset(request *r)
+{
+    r->want_args = r->nargs == 1 ? 1 : 0;
+    if (r->nargs == 1 && strcmp(r->args[0], "--scene")) {
+        fprintf(stderr, "lagsimctl: reset takes --scene or nothing, not '%s'\n", r->args[0]);
+        return EXIT_USAGE;
+    }
+    r->reset_scene = r->nargs == 1;
+    return GO_ON;
+}
+
+/* The command's arguments: GO_ON, else the result to exit with (a message said why). */
+static int check_request(request *r)
+{
+    int code = GO_ON;
+    const char *cmd = r->cmd;
+    if (!strcmp(cmd, "step")) code = check_step(r);
+    else if (!strcmp(cmd, "reset-to")) code = check_reset_to(r);
+    else if (!strcmp(cmd, "set")) code = check_set(r);
+    else if (!strcmp(cmd, "kick")) code = check_kick(r);
+    else if (!strcmp(cmd, "reset")) code = check_reset(r);
+    else if (strcmp(cmd, "status") && strcmp(cmd, "describe") && strcmp(cmd, "pause") &&
+             strcmp(cmd, "resume") && strcmp(cmd, "watch") && strcmp(cmd, "list")) {
         fprintf(stderr, "lagsimctl: unknown command '%s'\n", cmd);
         usage(stderr);
         return EXIT_USAGE;
     }
-    if (nargs != want_args) {
-        fprintf(stderr, "lagsimctl: %s takes %d argument(s), got %d", cmd, want_args, nargs);
-        for (int i = 0; i < nargs; i++)
-            if (args[i][0] == '-') { /* an option after the command: say where it goes */
-                fprintf(stderr, " (options go before the command: lagsimctl %s %s)", args[i], cmd);
+    if (code != GO_ON) return code;
+    if (r->nargs != r->want_args) {
+        fprintf(stderr, "lagsimctl: %s takes %d argument(s), got %d", cmd, r->want_args,
+                r->nargs);
+        for (int i = 0; i < r->nargs; i++)
+            if (r->args[i][0] == '-') { /* an option after the command: say where it goes */
+                fprintf(stderr, " (options go before the command: lagsimctl %s %s)",
+                        r->args[i], cmd);
                 break;
             }
         fputc('\n', stderr);
         return EXIT_USAGE;
     }
+    return GO_ON;
+}
 
+/* The client on the plant --prefix names, else on the only plant on the bus; NULL with
+ * the exit status in *code. */
+static lag_client *connect_plant(options *o, lag_client_plant *chosen, int *code)
+{
     char err[1200];
-    if (!strcmp(cmd, "list")) return list_plants(url, timeout_set ? timeout : 1.0);
-    lag_client_plant chosen;
-    if (!prefix) {
+    if (!o->prefix) {
         /* the only plant on the bus */
-        int rc = lag_client_pick_plant(url, NULL, timeout, &chosen, err, sizeof err);
+        int rc = lag_client_pick_plant(o->url, NULL, o->timeout, chosen, err, sizeof err);
         if (rc != LAG_CLIENT_OK) {
             fprintf(stderr, "lagsimctl: %s\n", err);
-            return rc == LAG_CLIENT_ERR_AMBIGUOUS ? EXIT_USAGE : EXIT_NOANSWER;
+            *code = rc == LAG_CLIENT_ERR_AMBIGUOUS ? EXIT_USAGE : EXIT_NOANSWER;
+            return NULL;
         }
-        prefix = chosen.prefix;
+        o->prefix = chosen->prefix;
     }
-    g_prefix = prefix;
-    lag_client *c = lag_client_create(url, prefix, err, sizeof err);
+    g_prefix = o->prefix;
+    lag_client *c = lag_client_create(o->url, o->prefix, err, sizeof err);
     if (!c) {
         fprintf(stderr, "lagsimctl: %s\n", err);
-        return EXIT_NOANSWER;
+        *code = EXIT_NOANSWER;
+        return NULL;
     }
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -693,7 +738,139 @@ static lag_result lagsimctl_main(int argc, char **argv)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
     sigaction(SIGPIPE, &sa, NULL);
+    return c;
+}
 
+/* A client result that is a usage error (set's key, kick's joint): exit 2, not 3. */
+#define RC_USAGE 100
+
+/* set KEY=VALUE: the "set" event, then the new scene. */
+static int send_set(lag_client *c, answer *a, const request *r, double timeout)
+{
+    char key[LAG_WIRE_NAME_LEN];
+    size_t klen = (size_t)(strchr(r->args[0], '=') - r->args[0]);
+    if (klen >= sizeof key) {
+        fprintf(stderr, "lagsimctl: set: the key is longer than %zu bytes\n", sizeof key - 1);
+        return RC_USAGE;
+    }
+    memcpy(key, r->args[0], klen);
+    key[klen] = '\0';
+    a->want = "set";
+    a->want_scene = true;
+    int rc = lag_client_set(c, key, r->args[0] + klen + 1);
+    if (rc == LAG_CLIENT_ERR_ARG) {
+        fprintf(stderr, "lagsimctl: %s\n", lag_client_errmsg(c));
+        return RC_USAGE;
+    }
+    if (rc == LAG_CLIENT_OK) rc = wait_for(c, a, timeout, false, event_and_scene);
+    return rc;
+}
+
+static int send_kick(lag_client *c, answer *a, const request *r, double timeout)
+{
+    a->want = "kick";
+    a->want_status = true;
+    int rc = lag_client_kick(c, r->kick_joint, r->kick_impulse, r->kick_duration);
+    if (rc == LAG_CLIENT_ERR_ARG) {
+        fprintf(stderr, "lagsimctl: %s\n", lag_client_errmsg(c));
+        return RC_USAGE;
+    }
+    if (rc == LAG_CLIENT_OK) rc = wait_for(c, a, timeout, false, event_and_status);
+    return rc;
+}
+
+/* Until the daemon's stop event or a signal; a daemon that is not there yet is waited for. */
+static int watch(lag_client *c, answer *a)
+{
+    int rc = LAG_CLIENT_OK;
+    a->watch = true;
+    g_watch_lines = true;
+    while (!a->stopped && !g_signal) {
+        rc = lag_client_handle(c, 100);
+        if (rc < 0) break;
+        rc = LAG_CLIENT_OK;
+    }
+    return rc;
+}
+
+/* pause, resume, reset, reset-to, step: the request's event and a status. */
+static int send_run_control(lag_client *c, answer *a, const request *r, double timeout)
+{
+    int rc;
+    const char *cmd = r->cmd;
+    a->want_status = true;
+    if (!strcmp(cmd, "pause")) {
+        a->want = "pause";
+        rc = lag_client_pause(c);
+    } else if (!strcmp(cmd, "resume")) {
+        a->want = "resume";
+        rc = lag_client_resume(c);
+    } else if (!strcmp(cmd, "reset")) {
+        a->want = "reset";
+        rc = r->reset_scene ? lag_client_reset_scene(c) : lag_client_reset(c);
+    } else if (!strcmp(cmd, "reset-to")) {
+        a->want = "reset";
+        rc = lag_client_reset_to(c, r->nq, r->q, r->qd);
+    } else { /* step */
+        a->want = "step";
+        a->want2 = "step_done";
+        rc = lag_client_step(c, r->count);
+    }
+    if (rc == LAG_CLIENT_OK && !a->want2) {
+        rc = wait_for(c, a, timeout, false, event_and_status);
+    } else if (rc == LAG_CLIENT_OK) {
+        /* step: the "step" event within the timeout, then step_done (or the end of the
+         * run) however long the steps take, as long as the daemon is heard from */
+        rc = wait_for(c, a, timeout, false, event_only);
+        if (rc == LAG_CLIENT_OK && !a->refused) rc = wait_for(c, a, timeout, true, step_done);
+    }
+    return rc;
+}
+
+/* Sends the request and waits for its answer: a client result, or RC_USAGE. */
+static int send_request(lag_client *c, answer *a, const request *r, double timeout)
+{
+    int rc = LAG_CLIENT_OK;
+    if (!strcmp(r->cmd, "describe")) {
+        lag_client_scene sc;
+        rc = lag_client_wait_scene(c, timeout, &sc);
+        if (rc == LAG_CLIENT_OK) print_scene(&sc);
+    } else if (!strcmp(r->cmd, "status")) {
+        a->want_status = true;
+        rc = lag_client_request_status(c);
+        if (rc == LAG_CLIENT_OK) rc = wait_for(c, a, timeout, false, status_only);
+    } else if (!strcmp(r->cmd, "set")) {
+        rc = send_set(c, a, r, timeout);
+    } else if (!strcmp(r->cmd, "kick")) {
+        rc = send_kick(c, a, r, timeout);
+    } else if (!strcmp(r->cmd, "watch")) {
+        rc = watch(c, a);
+    } else {
+        rc = send_run_control(c, a, r, timeout);
+    }
+    return rc;
+}
+
+static lag_result lagsimctl_main(int argc, char **argv)
+{
+    options o = {.timeout = 2.0};
+    int code = parse_options(&o, argc, argv);
+    if (code != GO_ON) return code;
+    if (optind >= argc) {
+        fprintf(stderr, "lagsimctl: which command? (list, status, describe, pause, resume, "
+                        "step N, reset [--scene], reset-to Q... QD..., set KEY=VALUE, kick "
+                        "JOINT IMPULSE [--duration S], watch)\n");
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    request r = {.cmd = argv[optind], .args = argv + optind + 1, .nargs = argc - optind - 1};
+    code = check_request(&r);
+    if (code != GO_ON) return code;
+
+    if (!strcmp(r.cmd, "list")) return list_plants(o.url, o.timeout_set ? o.timeout : 1.0);
+    lag_client_plant chosen;
+    lag_client *c = connect_plant(&o, &chosen, &code);
+    if (!c) return code;
     answer a = {0};
     a.heard = lag_client_now();
     lag_client_on_event(c, on_event, &a);
@@ -701,88 +878,16 @@ static lag_result lagsimctl_main(int argc, char **argv)
     lag_client_on_state(c, on_state, &a);
     lag_client_on_scene(c, on_scene, &a);
 
-    int rc = LAG_CLIENT_OK, code = EXIT_OK;
-    if (!strcmp(cmd, "describe")) {
-        lag_client_scene sc;
-        rc = lag_client_wait_scene(c, timeout, &sc);
-        if (rc == LAG_CLIENT_OK) print_scene(&sc);
-    } else if (!strcmp(cmd, "status")) {
-        a.want_status = true;
-        rc = lag_client_request_status(c);
-        if (rc == LAG_CLIENT_OK) rc = wait_for(c, &a, timeout, false, status_only);
-    } else if (!strcmp(cmd, "set")) {
-        char key[LAG_WIRE_NAME_LEN];
-        size_t klen = (size_t)(strchr(args[0], '=') - args[0]);
-        if (klen >= sizeof key) {
-            fprintf(stderr, "lagsimctl: set: the key is longer than %zu bytes\n", sizeof key - 1);
-            lag_client_destroy(c);
-            return EXIT_USAGE;
-        }
-        memcpy(key, args[0], klen);
-        key[klen] = '\0';
-        a.want = "set";
-        a.want_scene = true;
-        rc = lag_client_set(c, key, args[0] + klen + 1);
-        if (rc == LAG_CLIENT_ERR_ARG) {
-            fprintf(stderr, "lagsimctl: %s\n", lag_client_errmsg(c));
-            lag_client_destroy(c);
-            return EXIT_USAGE;
-        }
-        if (rc == LAG_CLIENT_OK) rc = wait_for(c, &a, timeout, false, event_and_scene);
-    } else if (!strcmp(cmd, "kick")) {
-        a.want = "kick";
-        a.want_status = true;
-        rc = lag_client_kick(c, kick_joint, kick_impulse, kick_duration);
-        if (rc == LAG_CLIENT_ERR_ARG) {
-            fprintf(stderr, "lagsimctl: %s\n", lag_client_errmsg(c));
-            lag_client_destroy(c);
-            return EXIT_USAGE;
-        }
-        if (rc == LAG_CLIENT_OK) rc = wait_for(c, &a, timeout, false, event_and_status);
-    } else if (!strcmp(cmd, "watch")) {
-        a.watch = true;
-        g_watch_lines = true;
-        /* until the daemon's stop event or a signal; a daemon that is not there yet is
-         * waited for */
-        while (!a.stopped && !g_signal) {
-            rc = lag_client_handle(c, 100);
-            if (rc < 0) break;
-            rc = LAG_CLIENT_OK;
-        }
-    } else {
-        a.want_status = true;
-        if (!strcmp(cmd, "pause")) {
-            a.want = "pause";
-            rc = lag_client_pause(c);
-        } else if (!strcmp(cmd, "resume")) {
-            a.want = "resume";
-            rc = lag_client_resume(c);
-        } else if (!strcmp(cmd, "reset")) {
-            a.want = "reset";
-            rc = reset_scene ? lag_client_reset_scene(c) : lag_client_reset(c);
-        } else if (!strcmp(cmd, "reset-to")) {
-            a.want = "reset";
-            rc = lag_client_reset_to(c, nq, q, qd);
-        } else { /* step */
-            a.want = "step";
-            a.want2 = "step_done";
-            rc = lag_client_step(c, count);
-        }
-        if (rc == LAG_CLIENT_OK && !a.want2) {
-            rc = wait_for(c, &a, timeout, false, event_and_status);
-        } else if (rc == LAG_CLIENT_OK) {
-            /* step: the "step" event within the timeout, then step_done (or the end of the
-             * run) however long the steps take, as long as the daemon is heard from */
-            rc = wait_for(c, &a, timeout, false, event_only);
-            if (rc == LAG_CLIENT_OK && !a.refused) rc = wait_for(c, &a, timeout, true, step_done);
-        }
-    }
-    if (rc < 0) {
+    int rc = send_request(c, &a, &r, o.timeout);
+    code = EXIT_OK;
+    if (rc == RC_USAGE) {
+        code = EXIT_USAGE;
+    } else if (rc < 0) {
         fprintf(stderr, "lagsimctl: %s\n", lag_client_errmsg(c));
         code = EXIT_NOANSWER;
     } else if (rc == LAG_CLIENT_TIMEOUT && !g_signal) {
         fprintf(stderr, "lagsimctl: no answer on %s_* within %g s (is lagsimd running with "
-                        "lcm.prefix %s?)\n", prefix, timeout, prefix);
+                        "lcm.prefix %s?)\n", o.prefix, o.timeout, o.prefix);
         code = EXIT_NOANSWER;
     } else if (a.refused) {
         fprintf(stderr, "lagsimctl: the daemon refused: %s\n", a.ev.detail);

@@ -66,6 +66,223 @@ static void print_eig(const char *what, int n, const double *M)
     printf("\n");
 }
 
+/* The plant as the scene describes it: its joints, which are inputs, the equilibrium. */
+typedef struct plant {
+    const lag_model_info *info;
+    int nq, n, m;                     /* coordinates, states (2 nq), inputs */
+    int inputs[NI];                   /* the actuated joints' indices */
+    const char *in_names[NI];
+    double q0[NI];                    /* the equilibrium's positions */
+} plant;
+
+/* The joints, the inputs and --q0 from the scene and the options; prints them. */
+static int plant_from_scene(plant *p, const lag_ctl *ctl, const weights *qw, const weights *q0w)
+{
+    const lag_model_info *info = lag_model_info_get(ctl->kind);
+    p->info = info;
+    p->nq = info->nq;
+    p->n = 2 * info->nq;
+    if ((qw->n && qw->n != p->n) || (q0w->n && q0w->n != p->nq)) {
+        fprintf(stderr, "lqr_balance: model %s has %d coordinates: --q takes %d weights, "
+                        "--q0 %d positions\n", info->name, p->nq, p->n, p->nq);
+        return -1;
+    }
+    p->m = 0;
+    for (int i = 0; i < p->nq; i++)
+        if (info->actuated[i]) {
+            p->inputs[p->m] = i;
+            p->in_names[p->m++] = info->joint_names[i];
+        }
+    const lag_client_scene *sc = &ctl->scene;
+    printf("lqr_balance: scene %s on %s_*: mode %s, dt %g s, control period %g s, integrator "
+           "%s\n", sc->model, ctl->prefix, sc->mode, sc->dt, sc->control_period, sc->integrator);
+    printf("parameters:");
+    for (int k = 0; k < info->np; k++) printf(" %s=%g", info->param_names[k], ctl->model.p[k]);
+    printf("\ninputs:");
+    for (int k = 0; k < p->m; k++) printf(" %s", p->in_names[k]);
+    printf("\n");
+    memset(p->q0, 0, sizeof p->q0);
+    for (int i = 0; i < q0w->n; i++) p->q0[i] = q0w->v[i];
+    return 0;
+}
+
+/* The equilibrium: qdd(q0, 0, 0) = 0. */
+static int check_equilibrium(const plant *p, const lag_model *model)
+{
+    double zero[NI] = {0}, qdd[NI];
+    if (lag_model_forward(model, p->q0, zero, zero, qdd) != LAG_OK) {
+        fprintf(stderr, "lqr_balance: the model's dynamics fail at q0\n");
+        return -1;
+    }
+    for (int i = 0; i < p->nq; i++)
+        if (!(fabs(qdd[i]) <= 1e-9)) { /* m/s^2 or rad/s^2 */
+            fprintf(stderr, "lqr_balance: q0 is not an equilibrium without input (%s'' = %g)\n",
+                    p->info->joint_names[i], qdd[i]);
+            return -1;
+        }
+    return 0;
+}
+
+/* The design: the continuous and discrete gains, the gain applied and its sampled loop. */
+typedef struct design {
+    double A[NS * NS], B[NS * NI], Q[NS * NS], R[NI * NI]; /* x' = A x + B u, weights */
+    double Kc[NI * NS];                                     /* continuous LQR (CARE) */
+    double Ad[NS * NS], Bd[NS * NI], Kd[NI * NS];           /* ZOH plant, discrete LQR */
+    const double *K;                                        /* the gain applied */
+    double Adcl[NS * NS];                                   /* its sampled loop Ad - Bd K */
+} design;
+
+/* Continuous LQR of the plant linearized about the equilibrium; prints its poles. */
+static int design_continuous(design *d, const plant *p, const lag_model *model,
+                             const weights *qw, double r)
+{
+    const int n = p->n, m = p->m;
+    double zero[NI] = {0}, X[NS * NS], Acl[NS * NS];
+    memset(d->Q, 0, sizeof d->Q);
+    memset(d->R, 0, sizeof d->R);
+    for (int i = 0; i < n; i++) d->Q[i * n + i] = qw->n ? qw->v[i] : 1.0;
+    for (int k = 0; k < m; k++) d->R[k * m + k] = r;
+    int rc = lag_lqr_linearize(model, p->q0, zero, NULL, m, p->inputs, d->A, d->B);
+    if (rc == LAG_LQR_OK) rc = lag_lqr_care(n, m, d->A, d->B, d->Q, d->R, X, d->Kc);
+    if (rc != LAG_LQR_OK) {
+        fprintf(stderr, "lqr_balance: continuous LQR design failed (%d)\n", rc);
+        return -1;
+    }
+    print_eig("open-loop poles (1/s)", n, d->A);
+    lag_lqr_closed_loop(n, m, d->A, d->B, d->Kc, Acl);
+    printf("continuous LQR: CARE residual %.2e\n",
+           lag_lqr_care_residual(n, m, d->A, d->B, d->Q, d->R, X));
+    print_eig("continuous closed-loop poles (1/s)", n, Acl);
+    return 0;
+}
+
+/* Discrete LQR of the zero-order-hold plant at the control period h, cost (Q h, R h). */
+static int design_discrete(design *d, const plant *p, double h)
+{
+    const int n = p->n, m = p->m;
+    double Qd[NS * NS], Rd[NI * NI], Xd[NS * NS];
+    for (int i = 0; i < n * n; i++) Qd[i] = d->Q[i] * h;
+    for (int i = 0; i < m * m; i++) Rd[i] = d->R[i] * h;
+    int rc = lag_lqr_c2d(n, m, d->A, d->B, h, d->Ad, d->Bd);
+    if (rc == LAG_LQR_OK) rc = lag_lqr_dare(n, m, d->Ad, d->Bd, Qd, Rd, Xd, d->Kd);
+    if (rc != LAG_LQR_OK) {
+        fprintf(stderr, "lqr_balance: discrete LQR design failed (%d)\n", rc);
+        return -1;
+    }
+    printf("discrete LQR (h = %g s): DARE residual %.2e\n", h,
+           lag_lqr_dare_residual(n, m, d->Ad, d->Bd, Qd, Rd, Xd));
+    return 0;
+}
+
+/* The gain --gain names, refused unless it stabilizes the sampled loop; prints it. */
+static int choose_gain(design *d, const plant *p, int continuous)
+{
+    const int n = p->n, m = p->m;
+    d->K = continuous ? d->Kc : d->Kd;
+    lag_lqr_closed_loop(n, m, d->Ad, d->Bd, d->K, d->Adcl);
+    print_eig("sampled closed-loop eigenvalues (z)", n, d->Adcl);
+    double rho = eig_bound(n, d->Adcl, 1);
+    if (!(rho < 1.0)) {
+        fprintf(stderr, "lqr_balance: the %s gain does not stabilize the sampled loop "
+                        "(spectral radius %.6f)\n", continuous ? "continuous" : "discrete", rho);
+        return -1;
+    }
+    for (int k = 0; k < m; k++) {
+        /* u, not the joint's name: a joint may be called x (the cart-pole's), the state's name */
+        printf("applying the %s gain on %s: u = -K x, K =", continuous ? "continuous" : "discrete",
+               p->in_names[k]);
+        for (int j = 0; j < n; j++) printf(" %.17g", d->K[k * n + j]);
+        printf("\n");
+    }
+    fflush(stdout);
+    return 0;
+}
+
+/* What the run did: its states, peaks and end positions for the summary. */
+typedef struct balance {
+    int idx[NI];                      /* the model's joints in the state's (-1: look up) */
+    int64_t states;
+    double t_first, t_last, t_report, max_u;
+    double x_first[NS];               /* the first state answered: the prediction's start */
+    double max_abs[NI], end[NI];
+} balance;
+
+/* x = (q - q0, qd) from a state; -1 if it lacks one of the model's joints. */
+static int state_vector(balance *b, const plant *p, const lag_client_state *st, double x[NS])
+{
+    bool have = true;
+    for (int i = 0; i < p->nq; i++) {
+        if (b->idx[i] < 0 || b->idx[i] >= st->num_joints ||
+            strcmp(st->name[b->idx[i]], p->info->joint_names[i]) != 0)
+            b->idx[i] = lag_client_state_joint(st, p->info->joint_names[i]);
+        have = have && b->idx[i] >= 0;
+    }
+    if (!have) {
+        fprintf(stderr, "lqr_balance: a state without the model's joints; ignored\n");
+        return -1;
+    }
+    for (int i = 0; i < p->nq; i++) {
+        x[i] = st->position[b->idx[i]] - p->q0[i];
+        x[p->nq + i] = st->velocity[b->idx[i]];
+    }
+    return 0;
+}
+
+static void record(balance *b, const plant *p, const lag_ctl *ctl, double t, const double x[NS])
+{
+    if (b->states == 0) {
+        b->t_first = t;
+        memcpy(b->x_first, x, sizeof b->x_first);
+    }
+    b->states++;
+    b->t_last = t;
+    for (int i = 0; i < p->nq; i++) {
+        b->max_abs[i] = fmax(b->max_abs[i], fabs(x[i]));
+        b->end[i] = x[i];
+    }
+    if (!ctl->quiet && t - b->t_report >= 1.0) {
+        b->t_report = t;
+        printf("t=%8.3f", t);
+        for (int i = 0; i < p->nq; i++) printf("  %s=%+.6f", p->info->joint_names[i], x[i]);
+        printf("\n");
+        fflush(stdout);
+    }
+}
+
+/* Linear prediction from the first state answered: the same sampled loop on the
+ * linearized plant over the same number of periods (near the equilibrium, the
+ * daemon's nonlinear run should come close to it). */
+static void predict(const design *d, const plant *p, const balance *b, double pred[NI])
+{
+    const int n = p->n;
+    double xl[NS], xn[NS];
+    memset(pred, 0, NI * sizeof *pred);
+    memcpy(xl, b->x_first, sizeof xl);
+    for (int64_t k = 0; k < b->states; k++) {
+        for (int i = 0; i < p->nq; i++) pred[i] = fmax(pred[i], fabs(xl[i]));
+        for (int i = 0; i < n; i++) {
+            xn[i] = 0.0;
+            for (int j = 0; j < n; j++) xn[i] += d->Adcl[i * n + j] * xl[j];
+        }
+        memcpy(xl, xn, sizeof xl);
+    }
+}
+
+static int finish(lag_ctl *ctl, const design *d, const plant *p, const balance *b)
+{
+    double pred[NI];
+    predict(d, p, b, pred);
+    const char *const *jn = p->info->joint_names;
+    char joints[1024] = "";
+    size_t len = 0;
+    for (int i = 0; i < p->nq && len < sizeof joints; i++)
+        len += (size_t)snprintf(joints + len, sizeof joints - len,
+                                " max_abs_%s=%.6g end_%s=%.3g pred_max_abs_%s=%.6g", jn[i],
+                                b->max_abs[i], jn[i], b->end[i], jn[i], pred[i]);
+    return lag_ctl_finish(ctl, "states=%lld t_first=%.6f t_last=%.6f max_abs_effort=%.6g%s",
+                          (long long)b->states, b->t_first, b->t_last, b->max_u, joints);
+}
+
 int main(int argc, char **argv)
 {
     double r_weight = 1.0;
@@ -94,159 +311,30 @@ int main(int argc, char **argv)
             return lag_result_exit(LAG_ERR_USAGE);
         }
     if (lag_ctl_start(&ctl, NULL)) return lag_ctl_fail(&ctl);
-    const lag_client_scene sc = ctl.scene;
-    const lag_model model = ctl.model;
-    const lag_model_info *info = lag_model_info_get(ctl.kind);
-    const int nq = info->nq, n = 2 * nq;
-    if ((qw.n && qw.n != n) || (q0w.n && q0w.n != nq)) {
-        fprintf(stderr, "lqr_balance: model %s has %d coordinates: --q takes %d weights, "
-                        "--q0 %d positions\n", info->name, nq, n, nq);
+    plant p;
+    if (plant_from_scene(&p, &ctl, &qw, &q0w) || check_equilibrium(&p, &ctl.model))
         return lag_ctl_fail(&ctl);
-    }
-    int inputs[NI], m = 0;
-    const char *in_names[NI];
-    for (int i = 0; i < nq; i++)
-        if (info->actuated[i]) {
-            inputs[m] = i;
-            in_names[m++] = info->joint_names[i];
-        }
-    const double h = sc.control_period;
-    printf("lqr_balance: scene %s on %s_*: mode %s, dt %g s, control period %g s, integrator "
-           "%s\n", sc.model, ctl.prefix, sc.mode, sc.dt, h, sc.integrator);
-    printf("parameters:");
-    for (int k = 0; k < info->np; k++) printf(" %s=%g", info->param_names[k], model.p[k]);
-    printf("\ninputs:");
-    for (int k = 0; k < m; k++) printf(" %s", in_names[k]);
-    printf("\n");
-
-    /* ---- the equilibrium: qdd(q0, 0, 0) = 0 */
-    double q0[NI] = {0}, zero[NI] = {0}, qdd[NI];
-    for (int i = 0; i < q0w.n; i++) q0[i] = q0w.v[i];
-    if (lag_model_forward(&model, q0, zero, zero, qdd) != LAG_OK) {
-        fprintf(stderr, "lqr_balance: the model's dynamics fail at q0\n");
-        return lag_ctl_fail(&ctl);
-    }
-    for (int i = 0; i < nq; i++)
-        if (!(fabs(qdd[i]) <= 1e-9)) { /* m/s^2 or rad/s^2 */
-            fprintf(stderr, "lqr_balance: q0 is not an equilibrium without input (%s'' = %g)\n",
-                    info->joint_names[i], qdd[i]);
-            return lag_ctl_fail(&ctl);
-        }
 
     /* ---- design */
-    double A[NS * NS], B[NS * NI], Q[NS * NS] = {0}, R[NI * NI] = {0};
-    double X[NS * NS], Kc[NI * NS], Acl[NS * NS];
-    for (int i = 0; i < n; i++) Q[i * n + i] = qw.n ? qw.v[i] : 1.0;
-    for (int k = 0; k < m; k++) R[k * m + k] = r_weight;
-    rc = lag_lqr_linearize(&model, q0, zero, NULL, m, inputs, A, B);
-    if (rc == LAG_LQR_OK) rc = lag_lqr_care(n, m, A, B, Q, R, X, Kc);
-    if (rc != LAG_LQR_OK) {
-        fprintf(stderr, "lqr_balance: continuous LQR design failed (%d)\n", rc);
+    design d;
+    if (design_continuous(&d, &p, &ctl.model, &qw, r_weight) ||
+        design_discrete(&d, &p, ctl.scene.control_period) || choose_gain(&d, &p, continuous))
         return lag_ctl_fail(&ctl);
-    }
-    print_eig("open-loop poles (1/s)", n, A);
-    lag_lqr_closed_loop(n, m, A, B, Kc, Acl);
-    printf("continuous LQR: CARE residual %.2e\n", lag_lqr_care_residual(n, m, A, B, Q, R, X));
-    print_eig("continuous closed-loop poles (1/s)", n, Acl);
-    double Ad[NS * NS], Bd[NS * NI], Qd[NS * NS], Rd[NI * NI], Xd[NS * NS], Kd[NI * NS];
-    for (int i = 0; i < n * n; i++) Qd[i] = Q[i] * h;
-    for (int i = 0; i < m * m; i++) Rd[i] = R[i] * h;
-    rc = lag_lqr_c2d(n, m, A, B, h, Ad, Bd);
-    if (rc == LAG_LQR_OK) rc = lag_lqr_dare(n, m, Ad, Bd, Qd, Rd, Xd, Kd);
-    if (rc != LAG_LQR_OK) {
-        fprintf(stderr, "lqr_balance: discrete LQR design failed (%d)\n", rc);
-        return lag_ctl_fail(&ctl);
-    }
-    printf("discrete LQR (h = %g s): DARE residual %.2e\n", h,
-           lag_lqr_dare_residual(n, m, Ad, Bd, Qd, Rd, Xd));
-    const double *K = continuous ? Kc : Kd;
-    double Adcl[NS * NS];
-    lag_lqr_closed_loop(n, m, Ad, Bd, K, Adcl);
-    print_eig("sampled closed-loop eigenvalues (z)", n, Adcl);
-    double rho = eig_bound(n, Adcl, 1);
-    if (!(rho < 1.0)) {
-        fprintf(stderr, "lqr_balance: the %s gain does not stabilize the sampled loop "
-                        "(spectral radius %.6f)\n", continuous ? "continuous" : "discrete", rho);
-        return lag_ctl_fail(&ctl);
-    }
-    for (int k = 0; k < m; k++) {
-        /* u, not the joint's name: a joint may be called x (the cart-pole's), the state's name */
-        printf("applying the %s gain on %s: u = -K x, K =", continuous ? "continuous" : "discrete",
-               in_names[k]);
-        for (int j = 0; j < n; j++) printf(" %.17g", K[k * n + j]);
-        printf("\n");
-    }
-    fflush(stdout);
 
     /* ---- control loop: answer every state until the run ends */
     lag_client_state st;
-    int64_t states = 0;
-    double t_first = NAN, t_last = NAN, t_report = -INFINITY, max_u = 0.0;
-    double x_first[NS] = {0}, max_abs[NI] = {0}, end[NI] = {0};
-    int idx[NI];
-    for (int i = 0; i < nq; i++) idx[i] = -1;
+    balance b = {.t_first = NAN, .t_last = NAN, .t_report = -INFINITY};
+    for (int i = 0; i < p.nq; i++) b.idx[i] = -1;
     while (lag_ctl_next_state(&ctl, &st) == LAG_CLIENT_OK) {
-        bool have = true;
-        for (int i = 0; i < nq; i++) {
-            if (idx[i] < 0 || idx[i] >= st.num_joints ||
-                strcmp(st.name[idx[i]], info->joint_names[i]) != 0)
-                idx[i] = lag_client_state_joint(&st, info->joint_names[i]);
-            have = have && idx[i] >= 0;
-        }
-        if (!have) {
-            fprintf(stderr, "lqr_balance: a state without the model's joints; ignored\n");
-            continue;
-        }
         double x[NS], u[NI];
-        for (int i = 0; i < nq; i++) {
-            x[i] = st.position[idx[i]] - q0[i];
-            x[nq + i] = st.velocity[idx[i]];
-        }
-        for (int k = 0; k < m; k++) {
+        if (state_vector(&b, &p, &st, x)) continue;
+        for (int k = 0; k < p.m; k++) {
             u[k] = 0.0;
-            for (int j = 0; j < n; j++) u[k] -= K[k * n + j] * x[j];
-            max_u = fmax(max_u, fabs(u[k]));
+            for (int j = 0; j < p.n; j++) u[k] -= d.K[k * p.n + j] * x[j];
+            b.max_u = fmax(b.max_u, fabs(u[k]));
         }
-        lag_ctl_command(&ctl, &st, m, in_names, u); /* a non-finite u is sent as 0 */
-        if (states == 0) {
-            t_first = st.sim_time;
-            memcpy(x_first, x, sizeof x_first);
-        }
-        states++;
-        t_last = st.sim_time;
-        for (int i = 0; i < nq; i++) {
-            max_abs[i] = fmax(max_abs[i], fabs(x[i]));
-            end[i] = x[i];
-        }
-        if (!ctl.quiet && st.sim_time - t_report >= 1.0) {
-            t_report = st.sim_time;
-            printf("t=%8.3f", st.sim_time);
-            for (int i = 0; i < nq; i++) printf("  %s=%+.6f", info->joint_names[i], x[i]);
-            printf("\n");
-            fflush(stdout);
-        }
+        lag_ctl_command(&ctl, &st, p.m, p.in_names, u); /* a non-finite u is sent as 0 */
+        record(&b, &p, &ctl, st.sim_time, x);
     }
-
-    /* Linear prediction from the first state answered: the same sampled loop on the
-     * linearized plant over the same number of periods (near the equilibrium, the
-     * daemon's nonlinear run should come close to it). */
-    double pred[NI] = {0}, xl[NS], xn[NS];
-    memcpy(xl, x_first, sizeof xl);
-    for (int64_t k = 0; k < states; k++) {
-        for (int i = 0; i < nq; i++) pred[i] = fmax(pred[i], fabs(xl[i]));
-        for (int i = 0; i < n; i++) {
-            xn[i] = 0.0;
-            for (int j = 0; j < n; j++) xn[i] += Adcl[i * n + j] * xl[j];
-        }
-        memcpy(xl, xn, sizeof xl);
-    }
-    char joints[1024] = "";
-    size_t len = 0;
-    for (int i = 0; i < nq && len < sizeof joints; i++)
-        len += (size_t)snprintf(joints + len, sizeof joints - len,
-                                " max_abs_%s=%.6g end_%s=%.3g pred_max_abs_%s=%.6g",
-                                info->joint_names[i], max_abs[i], info->joint_names[i], end[i],
-                                info->joint_names[i], pred[i]);
-    return lag_ctl_finish(&ctl, "states=%lld t_first=%.6f t_last=%.6f max_abs_effort=%.6g%s",
-                          (long long)states, t_first, t_last, max_u, joints);
+    return finish(&ctl, &d, &p, &b);
 }

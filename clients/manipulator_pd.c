@@ -55,6 +55,75 @@ static void desired_at(desired *d, lag_ctl *ctl, const lag_client_state *st, con
     d->have_prev = true;
 }
 
+/* The control law at one state: tau = M(q) (qdd_d + Kp e + Kd e_dot) + C(q, qd) qd + g(q). */
+static void computed_torque(const lag_model *model, double kp, double kd, const desired *d,
+                            const double q[2], const double qd[2], double tau[2])
+{
+    double v[2], M[4], hb[2];
+    for (int k = 0; k < 2; k++)
+        v[k] = d->qdd[k] + kp * (d->q[k] - q[k]) + kd * (d->qd[k] - qd[k]);
+    lag_model_mass(model, q, M);
+    lag_model_bias(model, q, qd, hb);
+    for (int k = 0; k < 2; k++) tau[k] = M[2 * k] * v[0] + M[2 * k + 1] * v[1] + hb[k];
+}
+
+/* The tracking error over the run: its peaks, and after --settle its RMS. */
+typedef struct tracking {
+    int64_t states, n_settled;
+    double t_first, t_last, t_report;
+    double emax[2], esq[2], emax_all[2];
+} tracking;
+
+static void track(tracking *tr, const lag_ctl *ctl, double settle, const lag_client_state *st,
+                  const double q[2], const desired *d, const double tau[2])
+{
+    if (tr->states == 0) tr->t_first = st->sim_time;
+    tr->states++;
+    tr->t_last = st->sim_time;
+    double e[2] = {d->q[0] - q[0], d->q[1] - q[1]};
+    for (int k = 0; k < 2; k++) tr->emax_all[k] = fmax(tr->emax_all[k], fabs(e[k]));
+    if (st->sim_time - tr->t_first >= settle) {
+        tr->n_settled++;
+        for (int k = 0; k < 2; k++) {
+            tr->emax[k] = fmax(tr->emax[k], fabs(e[k]));
+            tr->esq[k] += e[k] * e[k];
+        }
+    }
+    if (!ctl->quiet && st->sim_time - tr->t_report >= 1.0) {
+        tr->t_report = st->sim_time;
+        printf("t=%8.3f  q1=%+.5f (e %+.2e)  q2=%+.5f (e %+.2e)  tau=%+.3f %+.3f\n",
+               st->sim_time, q[0], e[0], q[1], e[1], tau[0], tau[1]);
+        fflush(stdout);
+    }
+}
+
+static int finish(lag_ctl *ctl, const tracking *tr, double settle, const desired *d)
+{
+    double rms[2] = {0, 0};
+    for (int k = 0; k < 2; k++)
+        rms[k] = tr->n_settled ? sqrt(tr->esq[k] / (double)tr->n_settled) : NAN;
+    return lag_ctl_finish(ctl,
+                          "states=%lld t_first=%.6f t_last=%.6f settle=%g max_abs_e1=%.6g "
+                          "max_abs_e2=%.6g rms_e1=%.6g rms_e2=%.6g max_abs_e1_all=%.6g "
+                          "max_abs_e2_all=%.6g references_stale=%lld",
+                          (long long)tr->states, tr->t_first, tr->t_last, settle, tr->emax[0],
+                          tr->emax[1], rms[0], rms[1], tr->emax_all[0], tr->emax_all[1],
+                          (long long)d->stale);
+}
+
+/* Both joints actuated, else a message and -1. */
+static int check_joints(const lag_ctl *ctl, const char *const jn[2])
+{
+    for (int k = 0; k < 2; k++) {
+        int j = lag_client_scene_joint(&ctl->scene, jn[k]);
+        if (j < 0 || !ctl->scene.actuated[j]) {
+            fprintf(stderr, "manipulator_pd: joint %s is not actuated in this scene\n", jn[k]);
+            return -1;
+        }
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     double wn = 10.0, settle = 2.0;
@@ -75,76 +144,32 @@ int main(int argc, char **argv)
     const double kp = wn * wn, kd = 2.0 * wn;
 
     if (lag_ctl_start(&ctl, "manipulator")) return lag_ctl_fail(&ctl);
-    const lag_model model = ctl.model;
     const char *jn[2] = {"q1", "q2"};
-    for (int k = 0; k < 2; k++) {
-        int j = lag_client_scene_joint(&ctl.scene, jn[k]);
-        if (j < 0 || !ctl.scene.actuated[j]) {
-            fprintf(stderr, "manipulator_pd: joint %s is not actuated in this scene\n", jn[k]);
-            return lag_ctl_fail(&ctl);
-        }
-    }
+    if (check_joints(&ctl, jn)) return lag_ctl_fail(&ctl);
     printf("manipulator_pd: scene on %s_*: mode %s, control period %g s; Kp %g, Kd %g\n",
            ctl.prefix, ctl.scene.mode, ctl.scene.control_period, kp, kd);
     fflush(stdout);
 
+    /* ---- control loop: answer every state until the run ends */
     lag_client_state st;
-    desired des;
-    memset(&des, 0, sizeof des);
-    int64_t states = 0, n_settled = 0;
-    double t_first = NAN, t_last = NAN, t_report = -INFINITY;
-    double emax[2] = {0, 0}, esq[2] = {0, 0}, emax_all[2] = {0, 0};
+    desired des = {0};
+    tracking tr = {.t_first = NAN, .t_last = NAN, .t_report = -INFINITY};
     while (lag_ctl_next_state(&ctl, &st) == LAG_CLIENT_OK) {
-        int i1 = lag_client_state_joint(&st, "q1"), i2 = lag_client_state_joint(&st, "q2");
-        if (i1 < 0 || i2 < 0) continue;
-        double q[2] = {st.position[i1], st.position[i2]};
-        double qd[2] = {st.velocity[i1], st.velocity[i2]};
-        double q_d[2], qd_d[2], qdd_d[2], M[4], hb[2], v[2], tau[2];
-        const int idx[2] = {i1, i2};
-        desired_at(&des, &ctl, &st, idx, ctl.scene.control_period, jn, states == 0);
-        if (states == 0) {
+        const int idx[2] = {lag_client_state_joint(&st, "q1"), lag_client_state_joint(&st, "q2")};
+        if (idx[0] < 0 || idx[1] < 0) continue;
+        double q[2] = {st.position[idx[0]], st.position[idx[1]]};
+        double qd[2] = {st.velocity[idx[0]], st.velocity[idx[1]]};
+        desired_at(&des, &ctl, &st, idx, ctl.scene.control_period, jn, tr.states == 0);
+        if (tr.states == 0) {
             printf("manipulator_pd: tracking %s %s, %s %s\n", jn[0],
                    des.have[0] ? "its reference" : "its first position", jn[1],
                    des.have[1] ? "its reference" : "its first position");
             fflush(stdout);
         }
-        for (int k = 0; k < 2; k++) {
-            q_d[k] = des.q[k];
-            qd_d[k] = des.qd[k];
-            qdd_d[k] = des.qdd[k];
-        }
-        for (int k = 0; k < 2; k++)
-            v[k] = qdd_d[k] + kp * (q_d[k] - q[k]) + kd * (qd_d[k] - qd[k]);
-        lag_model_mass(&model, q, M);
-        lag_model_bias(&model, q, qd, hb);
-        for (int k = 0; k < 2; k++) tau[k] = M[2 * k] * v[0] + M[2 * k + 1] * v[1] + hb[k];
+        double tau[2];
+        computed_torque(&ctl.model, kp, kd, &des, q, qd, tau);
         lag_ctl_command(&ctl, &st, 2, jn, tau); /* a non-finite tau is sent as 0 */
-
-        if (states == 0) t_first = st.sim_time;
-        states++;
-        t_last = st.sim_time;
-        double e[2] = {q_d[0] - q[0], q_d[1] - q[1]};
-        for (int k = 0; k < 2; k++) emax_all[k] = fmax(emax_all[k], fabs(e[k]));
-        if (st.sim_time - t_first >= settle) {
-            n_settled++;
-            for (int k = 0; k < 2; k++) {
-                emax[k] = fmax(emax[k], fabs(e[k]));
-                esq[k] += e[k] * e[k];
-            }
-        }
-        if (!ctl.quiet && st.sim_time - t_report >= 1.0) {
-            t_report = st.sim_time;
-            printf("t=%8.3f  q1=%+.5f (e %+.2e)  q2=%+.5f (e %+.2e)  tau=%+.3f %+.3f\n",
-                   st.sim_time, q[0], e[0], q[1], e[1], tau[0], tau[1]);
-            fflush(stdout);
-        }
+        track(&tr, &ctl, settle, &st, q, &des, tau);
     }
-    double rms[2] = {0, 0};
-    for (int k = 0; k < 2; k++) rms[k] = n_settled ? sqrt(esq[k] / (double)n_settled) : NAN;
-    return lag_ctl_finish(&ctl,
-                          "states=%lld t_first=%.6f t_last=%.6f settle=%g max_abs_e1=%.6g "
-                          "max_abs_e2=%.6g rms_e1=%.6g rms_e2=%.6g max_abs_e1_all=%.6g "
-                          "max_abs_e2_all=%.6g references_stale=%lld",
-                          (long long)states, t_first, t_last, settle, emax[0], emax[1], rms[0],
-                          rms[1], emax_all[0], emax_all[1], (long long)des.stale);
+    return finish(&ctl, &tr, settle, &des);
 }

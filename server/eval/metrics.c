@@ -81,13 +81,24 @@ static double abs_trapezoid(double h, double fa, double fb)
     return 0.5 * h * (c * fabs(fa) + (1 - c) * fabs(fb));
 }
 
-int lag_metrics_compute(const double *t, const double *y, const double *r, const double *u,
-                        size_t n, const lag_metric_opts *o, lag_metrics *out, char *err,
-                        size_t errlen)
+/* One joint's run as the metrics see it: the samples from k0 on (t >= t0). */
+typedef struct metric_run {
+    const double *t, *y, *r, *u; /* r, u may be NULL: zero reference, no effort */
+    size_t n, k0;
+    double tend, y0, rT, a;      /* the last time, y(t0), r(T), the step A = r(T) - y(t0) */
+    const lag_metric_opts *o;
+} metric_run;
+
+/* The error r - q at sample k. */
+static double error_at(const metric_run *m, size_t k)
 {
-    out->step = NAN;
-    for (int i = 0; i < LAG_METRIC_COUNT; i++) out->v[i] = NAN;
-    if (!t || !y || !o) return fail(err, errlen, "no samples");
+    return (m->r ? m->r[k] : 0.0) - m->y[k];
+}
+
+/* Every sample finite, t increasing. */
+static int check_samples(const double *t, const double *y, const double *r, const double *u,
+                         size_t n, char *err, size_t errlen)
+{
     for (size_t k = 0; k < n; k++) {
         if (!isfinite(t[k]) || !isfinite(y[k]) || (r && !isfinite(r[k])) || (u && !isfinite(u[k])))
             return fail(err, errlen, "sample %zu (t = %g) is not finite", k, t[k]);
@@ -95,21 +106,16 @@ int lag_metrics_compute(const double *t, const double *y, const double *r, const
             return fail(err, errlen, "sim time does not increase at sample %zu (%.17g after %.17g)",
                         k, t[k], t[k - 1]);
     }
-    size_t k0 = 0;
-    while (k0 < n && t[k0] < o->t0) k0++;
-    if (n - k0 < 2)
-        return fail(err, errlen, "fewer than 2 samples at or after t0 = %g s (%zu in all)", o->t0, n);
+    return 0;
+}
 
-    const double tend = t[n - 1], y0 = y[k0];
-    const double rT = r ? r[n - 1] : 0.0;
-    const double a = rT - y0;
-    out->step = a;
-#define E(k) ((r ? r[k] : 0.0) - y[k])
-
-    /* integrals of |e| and e^2, and the peak |e| */
-    double iae = 0, ise = 0, peak = fabs(E(k0));
-    for (size_t k = k0 + 1; k < n; k++) {
-        double h = t[k] - t[k - 1], ea = E(k - 1), eb = E(k);
+/* Integrals of |e| and e^2, and the peak |e|. */
+static void error_integrals(const metric_run *m, lag_metrics *out)
+{
+    const double *t = m->t;
+    double iae = 0, ise = 0, peak = fabs(error_at(m, m->k0));
+    for (size_t k = m->k0 + 1; k < m->n; k++) {
+        double h = t[k] - t[k - 1], ea = error_at(m, k - 1), eb = error_at(m, k);
         iae += abs_trapezoid(h, ea, eb);
         ise += 0.5 * h * (ea * ea + eb * eb);
         if (fabs(eb) > peak) peak = fabs(eb);
@@ -117,58 +123,98 @@ int lag_metrics_compute(const double *t, const double *y, const double *r, const
     out->v[LAG_METRIC_IAE] = iae;
     out->v[LAG_METRIC_ISE] = ise;
     out->v[LAG_METRIC_PEAK_ERROR] = peak;
+}
 
-    /* the steady state: the mean of e over the last ss_window of [t0, T] */
-    double tw = tend - o->ss_window * (tend - o->t0);
+/* The steady state: the mean of e over the last ss_window of [t0, T]. */
+static void steady_state(const metric_run *m, lag_metrics *out)
+{
+    const double *t = m->t;
+    double tw = m->tend - m->o->ss_window * (m->tend - m->o->t0);
     double area = 0;
-    for (size_t k = k0 + 1; k < n; k++) {
+    for (size_t k = m->k0 + 1; k < m->n; k++) {
         if (t[k] <= tw) continue;
-        double ta = t[k - 1], ea = E(k - 1), eb = E(k);
+        double ta = t[k - 1], ea = error_at(m, k - 1), eb = error_at(m, k);
         if (ta < tw) { /* the interval the window starts in: from tw on */
             ea = ea + (eb - ea) * (tw - ta) / (t[k] - ta);
             ta = tw;
         }
         area += 0.5 * (t[k] - ta) * (ea + eb);
     }
-    out->v[LAG_METRIC_SS_ERROR] = tend > tw ? area / (tend - tw) : E(n - 1);
+    out->v[LAG_METRIC_SS_ERROR] = m->tend > tw ? area / (m->tend - tw) : error_at(m, m->n - 1);
+}
 
-    /* settling: the last time |e| leaves the band, interpolated; NaN if it ends outside */
-    double band = o->settle_band * (a != 0 ? fabs(a) : peak);
+/* Settling: the last time |e| leaves the band, interpolated; NaN if it ends outside. */
+static void settling(const metric_run *m, lag_metrics *out)
+{
+    const double *t = m->t;
+    const size_t n = m->n;
+    double band = m->o->settle_band * (m->a != 0 ? fabs(m->a) : out->v[LAG_METRIC_PEAK_ERROR]);
     size_t last_out = n; /* none */
-    for (size_t k = k0; k < n; k++)
-        if (fabs(E(k)) > band) last_out = k;
+    for (size_t k = m->k0; k < n; k++)
+        if (fabs(error_at(m, k)) > band) last_out = k;
     if (last_out == n)
-        out->v[LAG_METRIC_SETTLE] = t[k0] - o->t0;
+        out->v[LAG_METRIC_SETTLE] = t[m->k0] - m->o->t0;
     else if (last_out + 1 < n) {
-        double fa = fabs(E(last_out)), fb = fabs(E(last_out + 1));
-        out->v[LAG_METRIC_SETTLE] = crossing(t[last_out], fa, t[last_out + 1], fb, band) - o->t0;
+        double fa = fabs(error_at(m, last_out)), fb = fabs(error_at(m, last_out + 1));
+        out->v[LAG_METRIC_SETTLE] =
+            crossing(t[last_out], fa, t[last_out + 1], fb, band) - m->o->t0;
     }
+}
 
-    if (a != 0) {
-        /* rise: first reach of rise_lo, then of rise_hi after it */
-        size_t at_lo, at_hi;
-        double t_lo = first_reach(t, y, y0, a, k0, n, o->rise_lo, &at_lo);
-        double t_hi = at_lo < n ? first_reach(t, y, y0, a, at_lo, n, o->rise_hi, &at_hi) : NAN;
-        out->v[LAG_METRIC_RISE] = t_hi - t_lo;
-        /* overshoot: how far y passes r(T), as a fraction of the step */
-        double os = 0;
-        for (size_t k = k0; k < n; k++) {
-            double s = (y[k] - rT) / a;
-            if (s > os) os = s;
-        }
-        out->v[LAG_METRIC_OVERSHOOT] = os;
+/* A step (A != 0): rise from rise_lo to rise_hi, and the overshoot past r(T). */
+static void step_shape(const metric_run *m, lag_metrics *out)
+{
+    const double *t = m->t, *y = m->y, a = m->a;
+    const size_t n = m->n;
+    /* rise: first reach of rise_lo, then of rise_hi after it */
+    size_t at_lo, at_hi;
+    double t_lo = first_reach(t, y, m->y0, a, m->k0, n, m->o->rise_lo, &at_lo);
+    double t_hi = at_lo < n ? first_reach(t, y, m->y0, a, at_lo, n, m->o->rise_hi, &at_hi) : NAN;
+    out->v[LAG_METRIC_RISE] = t_hi - t_lo;
+    /* overshoot: how far y passes r(T), as a fraction of the step */
+    double os = 0;
+    for (size_t k = m->k0; k < n; k++) {
+        double s = (y[k] - m->rT) / a;
+        if (s > os) os = s;
     }
-#undef E
+    out->v[LAG_METRIC_OVERSHOOT] = os;
+}
 
-    if (u) {
-        double upeak = 0, u2 = 0;
-        for (size_t k = k0; k < n; k++) {
-            if (fabs(u[k]) > upeak) upeak = fabs(u[k]);
-            if (k + 1 < n) u2 += u[k] * u[k] * (t[k + 1] - t[k]); /* held until t[k+1] */
-        }
-        out->v[LAG_METRIC_EFFORT_PEAK] = upeak;
-        out->v[LAG_METRIC_EFFORT_RMS] = sqrt(u2 / (tend - t[k0]));
+/* The effort's peak and RMS, each effort held until the next sample. */
+static void effort(const metric_run *m, lag_metrics *out)
+{
+    const double *t = m->t, *u = m->u;
+    double upeak = 0, u2 = 0;
+    for (size_t k = m->k0; k < m->n; k++) {
+        if (fabs(u[k]) > upeak) upeak = fabs(u[k]);
+        if (k + 1 < m->n) u2 += u[k] * u[k] * (t[k + 1] - t[k]); /* held until t[k+1] */
     }
+    out->v[LAG_METRIC_EFFORT_PEAK] = upeak;
+    out->v[LAG_METRIC_EFFORT_RMS] = sqrt(u2 / (m->tend - t[m->k0]));
+}
+
+int lag_metrics_compute(const double *t, const double *y, const double *r, const double *u,
+                        size_t n, const lag_metric_opts *o, lag_metrics *out, char *err,
+                        size_t errlen)
+{
+    out->step = NAN;
+    for (int i = 0; i < LAG_METRIC_COUNT; i++) out->v[i] = NAN;
+    if (!t || !y || !o) return fail(err, errlen, "no samples");
+    if (check_samples(t, y, r, u, n, err, errlen)) return -1;
+    size_t k0 = 0;
+    while (k0 < n && t[k0] < o->t0) k0++;
+    if (n - k0 < 2)
+        return fail(err, errlen, "fewer than 2 samples at or after t0 = %g s (%zu in all)", o->t0, n);
+
+    metric_run m = {.t = t, .y = y, .r = r, .u = u, .n = n, .k0 = k0, .o = o,
+                    .tend = t[n - 1], .y0 = y[k0], .rT = r ? r[n - 1] : 0.0};
+    m.a = m.rT - m.y0;
+    out->step = m.a;
+    error_integrals(&m, out);
+    steady_state(&m, out);
+    settling(&m, out);
+    if (m.a != 0) step_shape(&m, out);
+    if (u) effort(&m, out);
     return 0;
 }
 

@@ -75,10 +75,66 @@ static bool is_loopback(const char *a)
     return strncmp(a, "127.", 4) == 0 || strcmp(a, "::1") == 0;
 }
 
-static lag_result view_main(int argc, char **argv)
+enum { OPT_PORT = 256, OPT_URL, OPT_LISTEN, OPT_HZ, OPT_MAX_VIEWS, OPT_ALLOW_HOST,
+       OPT_ALLOW_LAN };
+
+/* The command line. */
+typedef struct view_opts {
+    const char *prefix, *url;   /* NULL: the only plant on the bus; LCM's default */
+    view_http_opts ho;
+    const char *allow_hosts[16];
+    bool quiet, allow_lan;
+} view_opts;
+
+/* --allow-host NAME: a DNS name or an address literal, without a port. */
+static bool add_allow_host(view_opts *o, const char *name)
 {
-    enum { OPT_PORT = 256, OPT_URL, OPT_LISTEN, OPT_HZ, OPT_MAX_VIEWS, OPT_ALLOW_HOST,
-           OPT_ALLOW_LAN };
+    size_t n = strlen(name);
+    bool ok = n > 0 && n < VIEW_HOST_LEN && o->ho.n_allow_hosts < 16;
+    for (size_t i = 0; ok && i < n; i++) /* a DNS name or an address literal */
+        ok = (name[i] >= 'a' && name[i] <= 'z') || (name[i] >= 'A' && name[i] <= 'Z') ||
+             (name[i] >= '0' && name[i] <= '9') || strchr("-._[]:", name[i]);
+    /* NAME:PORT (one colon: no IPv6 address has one) or [ADDR]:PORT: a port, which
+     * the check compares separately with the port bound */
+    const char *colon = strchr(name, ':'), *bracket = strchr(name, ']');
+    if (ok && ((colon && !strchr(colon + 1, ':') && name[0] != '[') ||
+               (bracket && bracket[1] == ':')))
+        ok = false;
+    if (!ok) {
+        fprintf(stderr, "lagsim-view: --allow-host: expected a host name or address "
+                "without a port (letters, digits, '-', '.', '_', an IPv6 address; at "
+                "most 16 of them), "
+                "got '%s'\n", name);
+        return false;
+    }
+    o->allow_hosts[o->ho.n_allow_hosts++] = name;
+    return true;
+}
+
+/* A number option's value, else a message; c is the option. */
+static bool parse_number_opt(view_http_opts *ho, int c, const char *v)
+{
+    if (c == OPT_PORT && !parse_uint(v, 0, 65535, &ho->port)) {
+        fprintf(stderr, "lagsim-view: --port: expected 0 to 65535, got '%s'\n", v);
+        return false;
+    }
+    if (c == OPT_HZ && !parse_uint(v, 1, 240, &ho->hz)) {
+        fprintf(stderr, "lagsim-view: --hz: expected 1 to 240, got '%s'\n", v);
+        return false;
+    }
+    if (c == OPT_MAX_VIEWS && !parse_uint(v, 1, 256, &ho->max_streams)) {
+        fprintf(stderr, "lagsim-view: --max-views: expected 1 to 256, got '%s'\n", v);
+        return false;
+    }
+    return true;
+}
+
+/* Parses argv: GO_ON, else the result to exit with. */
+/* What a step of main returns to go on (not a result: lag_result_exit never sees it). */
+#define GO_ON 1000
+
+static int parse_args(view_opts *o, int argc, char **argv)
+{
     static const struct option longopts[] = {
         {"prefix", required_argument, NULL, 'p'},
         {"port", required_argument, NULL, OPT_PORT},
@@ -92,61 +148,23 @@ static lag_result view_main(int argc, char **argv)
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
     };
-    const char *prefix = NULL, *url = NULL;
-    view_http_opts ho = {.listen = "127.0.0.1", .port = 8765, .hz = 60, .max_streams = 16,
-                         .max_connections = 64};
-    static const char *allow_hosts[16];
-    int n_allow_hosts = 0;
-    bool quiet = false, allow_lan = false;
     opterr = 0;
     int c;
     while ((c = getopt_long(argc, argv, ":p:qh", longopts, NULL)) != -1) {
         switch (c) {
-        case 'p': prefix = optarg; break;
-        case OPT_URL: url = optarg; break;
-        case OPT_LISTEN: ho.listen = optarg; break;
+        case 'p': o->prefix = optarg; break;
+        case OPT_URL: o->url = optarg; break;
+        case OPT_LISTEN: o->ho.listen = optarg; break;
         case OPT_PORT:
-            if (!parse_uint(optarg, 0, 65535, &ho.port)) {
-                fprintf(stderr, "lagsim-view: --port: expected 0 to 65535, got '%s'\n", optarg);
-                return LAG_ERR_USAGE;
-            }
-            break;
         case OPT_HZ:
-            if (!parse_uint(optarg, 1, 240, &ho.hz)) {
-                fprintf(stderr, "lagsim-view: --hz: expected 1 to 240, got '%s'\n", optarg);
-                return LAG_ERR_USAGE;
-            }
-            break;
         case OPT_MAX_VIEWS:
-            if (!parse_uint(optarg, 1, 256, &ho.max_streams)) {
-                fprintf(stderr, "lagsim-view: --max-views: expected 1 to 256, got '%s'\n", optarg);
-                return LAG_ERR_USAGE;
-            }
+            if (!parse_number_opt(&o->ho, c, optarg)) return LAG_ERR_USAGE;
             break;
-        case OPT_ALLOW_HOST: {
-            size_t n = strlen(optarg);
-            bool ok = n > 0 && n < VIEW_HOST_LEN && n_allow_hosts < 16;
-            for (size_t i = 0; ok && i < n; i++) /* a DNS name or an address literal */
-                ok = (optarg[i] >= 'a' && optarg[i] <= 'z') || (optarg[i] >= 'A' && optarg[i] <= 'Z') ||
-                     (optarg[i] >= '0' && optarg[i] <= '9') || strchr("-._[]:", optarg[i]);
-            /* NAME:PORT (one colon: no IPv6 address has one) or [ADDR]:PORT: a port, which
-             * the check compares separately with the port bound */
-            const char *colon = strchr(optarg, ':'), *bracket = strchr(optarg, ']');
-            if (ok && ((colon && !strchr(colon + 1, ':') && optarg[0] != '[') ||
-                       (bracket && bracket[1] == ':')))
-                ok = false;
-            if (!ok) {
-                fprintf(stderr, "lagsim-view: --allow-host: expected a host name or address "
-                        "without a port (letters, digits, '-', '.', '_', an IPv6 address; at "
-                        "most 16 of them), "
-                        "got '%s'\n", optarg);
-                return LAG_ERR_USAGE;
-            }
-            allow_hosts[n_allow_hosts++] = optarg;
+        case OPT_ALLOW_HOST:
+            if (!add_allow_host(o, optarg)) return LAG_ERR_USAGE;
             break;
-        }
-        case OPT_ALLOW_LAN: allow_lan = true; break;
-        case 'q': quiet = true; break;
+        case OPT_ALLOW_LAN: o->allow_lan = true; break;
+        case 'q': o->quiet = true; break;
         case 'h': usage(stdout); return LAG_OK;
         case ':':
             fprintf(stderr, "lagsim-view: option %s needs a value\n", argv[optind - 1]);
@@ -160,12 +178,14 @@ static lag_result view_main(int argc, char **argv)
         fprintf(stderr, "lagsim-view: unexpected argument '%s' (try --help)\n", argv[optind]);
         return LAG_ERR_USAGE;
     }
-    ho.max_connections = ho.max_streams + 240;
-    ho.allow_hosts = allow_hosts;
-    ho.n_allow_hosts = n_allow_hosts;
-    bool local = is_loopback(ho.listen);
+    o->ho.max_connections = o->ho.max_streams + 240;
+    o->ho.allow_hosts = o->allow_hosts;
+    return GO_ON;
+}
 
-    /* signals through a signalfd, blocked before LCM starts any thread */
+/* Signals through a signalfd, blocked before LCM starts any thread: its fd, or -1. */
+static int block_signals(void)
+{
     sigset_t sigs;
     sigemptyset(&sigs);
     sigaddset(&sigs, SIGINT);
@@ -174,71 +194,95 @@ static lag_result view_main(int argc, char **argv)
     sigprocmask(SIG_BLOCK, &sigs, NULL);
     signal(SIGPIPE, SIG_IGN);
     int sig_fd = signalfd(-1, &sigs, SFD_CLOEXEC | SFD_NONBLOCK);
-    if (sig_fd < 0) {
-        perror("lagsim-view: signalfd");
-        return LAG_ERR_RUNTIME;
-    }
+    if (sig_fd < 0) perror("lagsim-view: signalfd");
+    return sig_fd;
+}
 
-    char err[1200];
+/* Without --prefix: the only plant on the bus; none yet: DIPC, watched until it comes.
+ * GO_ON, else the result to exit with. */
+static int pick_prefix(view_opts *o)
+{
     static lag_client_plant found;
-    if (!prefix) {
-        /* the only plant on the bus; none yet: DIPC, watched until it comes */
-        int pr = lag_client_pick_plant(url, NULL, 2.0, &found, err, sizeof err);
-        if (pr == LAG_CLIENT_ERR_AMBIGUOUS) {
-            fprintf(stderr, "lagsim-view: %s\n", err);
-            return LAG_ERR_AMBIGUOUS;
-        }
-        if (pr == LAG_CLIENT_OK) {
-            prefix = found.prefix;
-        } else {
-            prefix = "DIPC";
-            fprintf(stderr, "lagsim-view: %s; watching prefix %s\n", err, prefix);
-        }
-    }
-    static view_bridge vb; /* large (rings): static, one bridge per process */
-    if (!view_bridge_open(&vb, url, prefix, allow_lan, err, sizeof err)) {
+    char err[1200];
+    int pr = lag_client_pick_plant(o->url, NULL, 2.0, &found, err, sizeof err);
+    if (pr == LAG_CLIENT_ERR_AMBIGUOUS) {
         fprintf(stderr, "lagsim-view: %s\n", err);
-        return strstr(err, "--prefix") ? LAG_ERR_USAGE : LAG_ERR_RUNTIME;
+        return LAG_ERR_AMBIGUOUS;
     }
-    view_http *h = view_http_start(&vb, &ho, err, sizeof err);
-    if (!h) {
-        fprintf(stderr, "lagsim-view: %s\n", err);
-        view_bridge_close(&vb);
-        return strstr(err, "--listen") ? LAG_ERR_USAGE : LAG_ERR_RUNTIME;
+    if (pr == LAG_CLIENT_OK) {
+        o->prefix = found.prefix;
+    } else {
+        o->prefix = "DIPC";
+        fprintf(stderr, "lagsim-view: %s; watching prefix %s\n", err, o->prefix);
     }
-    bool v6 = strchr(ho.listen, ':') != NULL;
-    printf("lagsim-view: http://%s%s%s:%u/  (prefix %s)\n", v6 ? "[" : "", ho.listen,
-           v6 ? "]" : "", view_http_port(h), prefix);
+    return GO_ON;
+}
+
+/* The address on stdout; on stderr, who can reach it. */
+static void print_address(const view_opts *o, view_http *h)
+{
+    const char *listen = o->ho.listen;
+    bool v6 = strchr(listen, ':') != NULL;
+    printf("lagsim-view: http://%s%s%s:%u/  (prefix %s)\n", v6 ? "[" : "", listen,
+           v6 ? "]" : "", view_http_port(h), o->prefix);
     fflush(stdout);
-    if (!local)
+    if (!is_loopback(listen))
         fprintf(stderr,
                 "lagsim-view: WARNING: listening on %s, not on this machine only: anyone who "
                 "reaches port %u sees the run and can pause, step and reset the simulation "
                 "(there is no authentication)\n",
-                ho.listen, view_http_port(h));
-    else if (!quiet)
+                listen, view_http_port(h));
+    else if (!o->quiet)
         fprintf(stderr, "lagsim-view: this machine only (--listen ADDR to open it wider); "
                         "Ctrl-C stops\n");
+}
 
-    int lcm_fd = lcm_get_fileno(vb.lcm), http_fd = view_http_fd(h);
-    lag_result rc = LAG_OK;
+/* Serves LCM and HTTP until a signal: LAG_OK, or LAG_ERR_RUNTIME when poll fails. */
+static lag_result serve(view_bridge *vb, view_http *h, unsigned hz, int sig_fd)
+{
+    int lcm_fd = lcm_get_fileno(vb->lcm), http_fd = view_http_fd(h);
     for (;;) {
         int timeout = view_http_timeout_ms(h);
         /* streams waiting for a frame: wake at the frame rate; otherwise once a second
          * (DESCRIBE while no scene is known, keep-alives) */
-        int tick = view_http_streams(h) ? (int)(1000 / ho.hz) : 1000;
+        int tick = view_http_streams(h) ? (int)(1000 / hz) : 1000;
         if (timeout < 0 || timeout > tick) timeout = tick;
         struct pollfd pf[3] = {{lcm_fd, POLLIN, 0}, {http_fd, POLLIN, 0}, {sig_fd, POLLIN, 0}};
         int n = poll(pf, 3, timeout);
         if (n < 0 && errno != EINTR) {
             perror("lagsim-view: poll");
-            rc = LAG_ERR_RUNTIME;
-            break;
+            return LAG_ERR_RUNTIME;
         }
-        if (n > 0 && (pf[2].revents & POLLIN)) break;
-        view_bridge_poll(&vb);
+        if (n > 0 && (pf[2].revents & POLLIN)) return LAG_OK;
+        view_bridge_poll(vb);
         view_http_run(h);
     }
+}
+
+static lag_result view_main(int argc, char **argv)
+{
+    view_opts o = {.ho = {.listen = "127.0.0.1", .port = 8765, .hz = 60, .max_streams = 16,
+                          .max_connections = 64}};
+    int code = parse_args(&o, argc, argv);
+    if (code != GO_ON) return code;
+    int sig_fd = block_signals();
+    if (sig_fd < 0) return LAG_ERR_RUNTIME;
+    if (!o.prefix && (code = pick_prefix(&o)) != GO_ON) return code;
+
+    char err[1200];
+    static view_bridge vb; /* large (rings): static, one bridge per process */
+    if (!view_bridge_open(&vb, o.url, o.prefix, o.allow_lan, err, sizeof err)) {
+        fprintf(stderr, "lagsim-view: %s\n", err);
+        return strstr(err, "--prefix") ? LAG_ERR_USAGE : LAG_ERR_RUNTIME;
+    }
+    view_http *h = view_http_start(&vb, &o.ho, err, sizeof err);
+    if (!h) {
+        fprintf(stderr, "lagsim-view: %s\n", err);
+        view_bridge_close(&vb);
+        return strstr(err, "--listen") ? LAG_ERR_USAGE : LAG_ERR_RUNTIME;
+    }
+    print_address(&o, h);
+    lag_result rc = serve(&vb, h, o.ho.hz, sig_fd);
     view_http_stop(h);
     view_bridge_close(&vb);
     close(sig_fd);
