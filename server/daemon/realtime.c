@@ -42,6 +42,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "lagsim_clock.h"
 #include "live_set.h"
 #include "rt_io.h"
 #include "rt_server.h"
@@ -293,7 +294,7 @@ static void status_message(const rt_server *s, int64_t now, lag_wire_status *m)
  * short to measure while running). */
 static void publish_status(rt_server *s)
 {
-    int64_t now = rt_mono_ns();
+    int64_t now = lag_clock_mono_ns();
     lag_wire_status m;
     status_message(s, now, &m);
     rt_out o = out(s);
@@ -431,9 +432,9 @@ static rt_progress period_run(rt_server *s, int64_t *budget)
     /* a chunk of the period, whose input holds to its end: dopri5 steps across the
      * chunk's end (dense output gives the state there) and lands on the period's, so the
      * period in chunks is bit-identical to one call for it */
-    int64_t t0 = rt_mono_ns(), tick0 = s->sim.tick;
+    int64_t t0 = lag_clock_mono_ns(), tick0 = s->sim.tick;
     lag_result r = lag_sim_advance_within(&s->sim, n, s->sim.tick + s->period_left);
-    s->period_us += (double)(rt_mono_ns() - t0) * 1e-3;
+    s->period_us += (double)(lag_clock_mono_ns() - t0) * 1e-3;
     s->rec.ticks += s->sim.tick - tick0; /* the log's clock */
     s->period_left -= n;
     s->ticks_since_status += n;
@@ -1118,7 +1119,8 @@ static int open_parts(rt_server *s, const lagsimd_opts *o, char *err, size_t err
     rt_record_init(&s->rec, sc->sim.integrator.dt, quiet, s->now);
     if (o && o->log) {
         s->rec.input = actuator_lagged(&sc->sim.effects, s->nq);
-        snprintf(s->rec.ch_input, sizeof s->rec.ch_input, "%s_INPUT", sc->lcm.prefix);
+        lag_bus_channel_name(s->rec.ch_input, sizeof s->rec.ch_input, sc->lcm.prefix,
+                             LAG_BUS_INPUT);
         s->rec.log = rt_log_open(o->log, o->log_ring ? o->log_ring : RT_LOG_RING_DEFAULT,
                                  o->force, o->scene_name, err, errlen);
         if (!s->rec.log) return LAGSIMD_EXIT_USAGE;
@@ -1359,7 +1361,7 @@ lag_result lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
         goto out;
     }
     /* everything that can fail on a bad scene fails before LCM is touched */
-    rc = rt_open(s, sc, o, rt_mono_ns(), quiet, err, sizeof err);
+    rc = rt_open(s, sc, o, lag_clock_mono_ns(), quiet, err, sizeof err);
     if (rc != LAGSIMD_EXIT_OK) {
         fprintf(stderr, "lagsimd: %s\n", err);
         goto out;
@@ -1375,7 +1377,7 @@ lag_result lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
     s->term.live_line = isatty(STDERR_FILENO) && !quiet;
     rt_io_watch(&io, s->bus.lcm_in, s->bus.lcm != s->bus.lcm_in ? s->bus.lcm : NULL);
 
-    s->now = rt_mono_ns();
+    s->now = lag_clock_mono_ns();
     s->bus.discard = false;
     rt_begin(s);
     while (!s->stop) {
