@@ -584,6 +584,31 @@ static bool record(l2c *c, const lag_log_record *r)
 }
 
 /* ---------------------------------------------------------------- summary */
+/* The last status of a status channel: its run state and counters. */
+static void summarize_status(const lag_wire_status *s, FILE *f)
+{
+    /* counters from the bus: summed in unsigned arithmetic (a hostile sum wraps,
+     * it does not overflow) */
+    int64_t rej = (int64_t)((uint64_t)s->rejected_unknown_joint +
+                            (uint64_t)s->rejected_unactuated +
+                            (uint64_t)s->rejected_nonfinite +
+                            (uint64_t)s->rejected_bad_length +
+                            (uint64_t)s->rejected_undecodable +
+                            (uint64_t)s->rejected_stale);
+    fprintf(f, "  last: run state %s, commands accepted %" PRId64
+               ", rejected %" PRId64 " (unknown joint %" PRId64
+               ", unactuated %" PRId64 ", non-finite %" PRId64
+               ", bad length %" PRId64 ", undecodable %" PRId64 ", stale %" PRId64
+               "), controls rejected %" PRId64 ", watchdog trips %" PRId64
+               ", lockstep timeouts %" PRId64 ", numeric faults %" PRId64
+               ", overruns %" PRId64 ", states published %" PRId64 "\n",
+            s->run_state, s->commands_accepted, rej, s->rejected_unknown_joint,
+            s->rejected_unactuated, s->rejected_nonfinite, s->rejected_bad_length,
+            s->rejected_undecodable, s->rejected_stale, s->controls_rejected,
+            s->watchdog_trips, s->lockstep_timeouts, s->numeric_faults,
+            s->overruns, s->states_published);
+}
+
 static void summarize(l2c *c, const lag_log_stats *ls, FILE *f)
 {
     fprintf(f, "records: %" PRId64 " (%" PRId64 " larger than %d bytes passed over; %" PRId64
@@ -619,29 +644,7 @@ static void summarize(l2c *c, const lag_log_stats *ls, FILE *f)
                         h->resets, h->repeats);
             break;
         case LAG_WIRE_STATUS:
-            if (h->have_status) {
-                const lag_wire_status *s = &h->last_status;
-                /* counters from the bus: summed in unsigned arithmetic (a hostile sum wraps,
-                 * it does not overflow) */
-                int64_t rej = (int64_t)((uint64_t)s->rejected_unknown_joint +
-                                        (uint64_t)s->rejected_unactuated +
-                                        (uint64_t)s->rejected_nonfinite +
-                                        (uint64_t)s->rejected_bad_length +
-                                        (uint64_t)s->rejected_undecodable +
-                                        (uint64_t)s->rejected_stale);
-                fprintf(f, "  last: run state %s, commands accepted %" PRId64
-                           ", rejected %" PRId64 " (unknown joint %" PRId64
-                           ", unactuated %" PRId64 ", non-finite %" PRId64
-                           ", bad length %" PRId64 ", undecodable %" PRId64 ", stale %" PRId64
-                           "), controls rejected %" PRId64 ", watchdog trips %" PRId64
-                           ", lockstep timeouts %" PRId64 ", numeric faults %" PRId64
-                           ", overruns %" PRId64 ", states published %" PRId64 "\n",
-                        s->run_state, s->commands_accepted, rej, s->rejected_unknown_joint,
-                        s->rejected_unactuated, s->rejected_nonfinite, s->rejected_bad_length,
-                        s->rejected_undecodable, s->rejected_stale, s->controls_rejected,
-                        s->watchdog_trips, s->lockstep_timeouts, s->numeric_faults,
-                        s->overruns, s->states_published);
-            }
+            if (h->have_status) summarize_status(&h->last_status, f);
             break;
         case LAG_WIRE_EVENT:
             fputs("  events:", f);
