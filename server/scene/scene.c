@@ -22,10 +22,9 @@ void lag_scene_default(lag_scene *sc, lag_model_kind kind)
     sc->accuracy.estimate_every = -1; /* not given: lag_scene_estimate_every */
     /* 1/100 s at dt = 1 ms; the loader recomputes it from the scene's values. */
     sc->ticks_per_period = 10;
-    if (sc->sim.integrator.dt > 0.0) {
-        double r = (1.0 / sc->publish_hz) / sc->sim.integrator.dt;
-        sc->ticks_per_period = r >= 1.0 ? (int64_t)(r + 0.5) : 1;
-    }
+    int64_t k;
+    if (lag_ticks_exact(1.0 / sc->publish_hz, sc->sim.integrator.dt, &k) && k >= 1)
+        sc->ticks_per_period = k;
     sc->realtime.mode = LAG_RT_REALTIME;
     sc->realtime.rate = 1.0;
     sc->realtime.command_timeout = 0.5;

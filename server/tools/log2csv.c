@@ -517,11 +517,15 @@ static bool write_control(l2c *c, chan *h, const lag_log_record *r, const lag_wi
     return true;
 }
 
-/* Ticks per control period of a scene (0 if it makes no sense). */
+/* Ticks per control period of a scene: a whole number of its ticks (lag_ticks_exact), as
+ * the daemon writes it; 0 if it makes no sense. */
 static int64_t period_ticks(const lag_wire_scene *m)
 {
-    double tpp = m->dt > 0 ? m->control_period / m->dt : 0;
-    return isfinite(tpp) && tpp >= 0.5 && tpp < 1e15 ? (int64_t)llround(tpp) : 0;
+    int64_t k;
+    return m->dt > 0 && lag_ticks_exact(m->control_period, m->dt, &k) && k >= 1 &&
+                   k < 1000000000000000LL
+               ? k
+               : 0;
 }
 
 /* One record: decode as the channel's type (the first that decodes fixes it). */
