@@ -1038,34 +1038,13 @@ static int open_error(char *err, size_t errlen, const char *fmt, ...)
  * published: the scene's real-time settings, checked (2, with a message in err). */
 static int open_check(const lag_scene *sc, char *err, size_t errlen)
 {
-    const double rate = sc->realtime.rate;
-    if (!(sc->publish_hz > 0) || !isfinite(sc->publish_hz) || sc->ticks_per_period < 1 ||
-        sc->ticks_per_period > RT_MAX_RUN_TICKS)
-        return open_error(err, errlen, "bad scene: publish_hz must be > 0 and finite, "
-                          "1/publish_hz a whole number of ticks (at most 2^53)");
-    if (!(rate > 0) || !isfinite(rate))
-        return open_error(err, errlen, "bad scene: realtime.rate must be > 0 and finite (got %g)", rate);
-    if (!(sc->realtime.status_hz > 0) || !isfinite(sc->realtime.status_hz))
-        return open_error(err, errlen, "bad scene: realtime.status_hz must be > 0 and finite (got %g)",
-                          sc->realtime.status_hz);
-    if (!(sc->realtime.lockstep_retry >= 0) || !isfinite(sc->realtime.lockstep_retry))
-        return open_error(err, errlen, "bad scene: realtime.lockstep_retry must be >= 0 and "
-                          "finite (got %g)", sc->realtime.lockstep_retry);
-    if (!(sc->realtime.lockstep_timeout >= 0) || !isfinite(sc->realtime.lockstep_timeout))
-        return open_error(err, errlen, "bad scene: realtime.lockstep_timeout must be >= 0 and "
-                          "finite (got %g)", sc->realtime.lockstep_timeout);
-    if (!(sc->realtime.command_timeout >= 0) || isnan(sc->realtime.command_timeout))
-        return open_error(err, errlen, "bad scene: realtime.command_timeout must be >= 0 (got %g)",
-                          sc->realtime.command_timeout);
-    /* the loader bounds lcm.prefix (file:line:column); a scene built in code is checked here */
     _Static_assert(LAG_SCENE_PREFIX_MAX + 10 == LCM_MAX_CHANNEL_NAME_LENGTH,
-                   "the loader's prefix bound leaves room for _REFERENCE in an LCM channel name");
-    size_t plen = strnlen(sc->lcm.prefix, sizeof sc->lcm.prefix);
-    if (plen == 0 || plen + 10 > LCM_MAX_CHANNEL_NAME_LENGTH)
-        return open_error(err, errlen, "bad scene: lcm.prefix must have 1 to %d characters "
-                          "(LCM channel names are at most %d, and the longest suffix is "
-                          "_REFERENCE)", LCM_MAX_CHANNEL_NAME_LENGTH - 10,
-                          LCM_MAX_CHANNEL_NAME_LENGTH);
+                   "the scene's prefix bound leaves room for _REFERENCE in an LCM channel name");
+    _Static_assert(LAG_SCENE_PERIOD_TICKS_MAX == RT_MAX_RUN_TICKS,
+                   "a period is at most as long as the longest run");
+    lag_diag d; /* the scene's rules, one place for the loader and a scene built in code */
+    if (lag_scene_check(sc, &d) != LAG_OK)
+        return open_error(err, errlen, "bad scene: %s: %s", d.field, d.message);
     return LAGSIMD_EXIT_OK;
 }
 
