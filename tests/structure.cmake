@@ -1,7 +1,8 @@
 # The project's structure rules (tests/structure/check_structure.py), label structure:
 # one test harness for the C tests, one naming rule for ctests (lowercase words joined by
 # "_", a label on each), docs that name only ctests that exist and docs/testing.md's label
-# table, and functions of at most 80 lines in server/, clients/, bench/.
+# table, functions of at most 80 lines in server/, clients/, bench/, and time to ticks
+# converted by the core's helpers alone.
 find_program(LAGSIM_STRUCTURE_PYTHON3 python3)
 if(LAGSIM_STRUCTURE_PYTHON3)
   set(structure_check ${LAGSIM_STRUCTURE_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/structure/check_structure.py)
@@ -14,8 +15,11 @@ if(LAGSIM_STRUCTURE_PYTHON3)
   # universal-ctags (.ci/install-deps.sh) finds each function's first and last line.
   add_test(NAME structure_function_length
            COMMAND ${structure_check} function_length ${PROJECT_SOURCE_DIR} --max 80)
+  # time to ticks only through the core's helpers (lag_ticks_*), outside server/core
+  add_test(NAME structure_ticks COMMAND ${structure_check} ticks ${PROJECT_SOURCE_DIR})
   set_tests_properties(structure_harness structure_names structure_docs
-                       structure_function_length PROPERTIES TIMEOUT 120 LABELS structure)
+                       structure_function_length structure_ticks
+                       PROPERTIES TIMEOUT 120 LABELS structure)
   # Off until the functions over 80 lines are split (it lists them: `ctest -R
   # structure_function_length -V` after removing this line, or run the script).
   set_tests_properties(structure_function_length PROPERTIES DISABLED TRUE)

@@ -173,8 +173,7 @@ int live_kicks_append(const live_sets *ls, lag_sim_def *def, char *why, size_t w
 static bool kick_over(const live_kick *k, int64_t tick, double dt)
 {
     if (!(k->duration > 0)) return tick > k->step;
-    double tend = (double)k->step * dt + k->duration;
-    return (double)tick * dt >= tend - 1e-9 * dt;
+    return tick >= lag_ticks_ceil((double)k->step * dt + k->duration, dt);
 }
 
 /* sim's definition with ls's kicks (after its own without those it carried before). */

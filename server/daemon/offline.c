@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "daemon.h"
+#include "lagsim_clock.h"
 #include "lagsim_out.h"
 #include "rt_pace.h"
 
@@ -61,13 +62,6 @@ static void write_header(FILE *f, const lag_model_info *info, const lag_scene_re
     for (int i = 0; i < info->nq && i < LAG_MAX_DOF; i++)
         if (ref->on[i]) fprintf(f, ",%s_ref,%s_ref_dot", info->joint_names[i], info->joint_names[i]);
     fputs("\n", f);
-}
-
-static double cpu_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* An offline run's state: the scene and options, the simulation, the CSV, where it is. */
@@ -241,9 +235,9 @@ lag_result lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)
 
     offline_catch_signals(&run, true);
     const double e0 = lag_sim_energy(&sim);
-    const double c0 = cpu_seconds();
+    const double c0 = lag_clock_process_cpu_s();
     offline_loop(&run);
-    const double cpu = cpu_seconds() - c0;
+    const double cpu = lag_clock_process_cpu_s() - c0;
     offline_catch_signals(&run, false);
     offline_close_csv(&run);
     if (!o->quiet) offline_summary(&run, e0, cpu);

@@ -42,6 +42,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "lagsim_clock.h"
 #include "live_set.h"
 #include "rt_io.h"
 #include "rt_server.h"
@@ -296,7 +297,7 @@ static void status_message(const rt_server *s, int64_t now, lag_wire_status *m)
  * short to measure while running). */
 static void publish_status(rt_server *s)
 {
-    int64_t now = rt_mono_ns();
+    int64_t now = lag_clock_mono_ns();
     lag_wire_status m;
     status_message(s, now, &m);
     rt_out o = out(s);
@@ -434,9 +435,9 @@ static rt_progress period_run(rt_server *s, int64_t *budget)
     /* a chunk of the period, whose input holds to its end: dopri5 steps across the
      * chunk's end (dense output gives the state there) and lands on the period's, so the
      * period in chunks is bit-identical to one call for it */
-    int64_t t0 = rt_mono_ns(), tick0 = s->sim.tick;
+    int64_t t0 = lag_clock_mono_ns(), tick0 = s->sim.tick;
     lag_result r = lag_sim_advance_within(&s->sim, n, s->sim.tick + s->period_left);
-    s->period_us += (double)(rt_mono_ns() - t0) * 1e-3;
+    s->period_us += (double)(lag_clock_mono_ns() - t0) * 1e-3;
     s->rec.ticks += s->sim.tick - tick0; /* the log's clock */
     s->period_left -= n;
     s->ticks_since_status += n;
@@ -1040,34 +1041,13 @@ static int open_error(char *err, size_t errlen, const char *fmt, ...)
  * published: the scene's real-time settings, checked (2, with a message in err). */
 static int open_check(const lag_scene *sc, char *err, size_t errlen)
 {
-    const double rate = sc->realtime.rate;
-    if (!(sc->publish_hz > 0) || !isfinite(sc->publish_hz) || sc->ticks_per_period < 1 ||
-        sc->ticks_per_period > RT_MAX_RUN_TICKS)
-        return open_error(err, errlen, "bad scene: publish_hz must be > 0 and finite, "
-                          "1/publish_hz a whole number of ticks (at most 2^53)");
-    if (!(rate > 0) || !isfinite(rate))
-        return open_error(err, errlen, "bad scene: realtime.rate must be > 0 and finite (got %g)", rate);
-    if (!(sc->realtime.status_hz > 0) || !isfinite(sc->realtime.status_hz))
-        return open_error(err, errlen, "bad scene: realtime.status_hz must be > 0 and finite (got %g)",
-                          sc->realtime.status_hz);
-    if (!(sc->realtime.lockstep_retry >= 0) || !isfinite(sc->realtime.lockstep_retry))
-        return open_error(err, errlen, "bad scene: realtime.lockstep_retry must be >= 0 and "
-                          "finite (got %g)", sc->realtime.lockstep_retry);
-    if (!(sc->realtime.lockstep_timeout >= 0) || !isfinite(sc->realtime.lockstep_timeout))
-        return open_error(err, errlen, "bad scene: realtime.lockstep_timeout must be >= 0 and "
-                          "finite (got %g)", sc->realtime.lockstep_timeout);
-    if (!(sc->realtime.command_timeout >= 0) || isnan(sc->realtime.command_timeout))
-        return open_error(err, errlen, "bad scene: realtime.command_timeout must be >= 0 (got %g)",
-                          sc->realtime.command_timeout);
-    /* the loader bounds lcm.prefix (file:line:column); a scene built in code is checked here */
     _Static_assert(LAG_SCENE_PREFIX_MAX + 10 == LCM_MAX_CHANNEL_NAME_LENGTH,
-                   "the loader's prefix bound leaves room for _REFERENCE in an LCM channel name");
-    size_t plen = strnlen(sc->lcm.prefix, sizeof sc->lcm.prefix);
-    if (plen == 0 || plen + 10 > LCM_MAX_CHANNEL_NAME_LENGTH)
-        return open_error(err, errlen, "bad scene: lcm.prefix must have 1 to %d characters "
-                          "(LCM channel names are at most %d, and the longest suffix is "
-                          "_REFERENCE)", LCM_MAX_CHANNEL_NAME_LENGTH - 10,
-                          LCM_MAX_CHANNEL_NAME_LENGTH);
+                   "the scene's prefix bound leaves room for _REFERENCE in an LCM channel name");
+    _Static_assert(LAG_SCENE_PERIOD_TICKS_MAX == RT_MAX_RUN_TICKS,
+                   "a period is at most as long as the longest run");
+    lag_diag d; /* the scene's rules, one place for the loader and a scene built in code */
+    if (lag_scene_check(sc, &d) != LAG_OK)
+        return open_error(err, errlen, "bad scene: %s: %s", d.field, d.message);
     return LAGSIMD_EXIT_OK;
 }
 
@@ -1121,7 +1101,8 @@ static int open_parts(rt_server *s, const lagsimd_opts *o, char *err, size_t err
     rt_record_init(&s->rec, sc->sim.integrator.dt, quiet, s->now);
     if (o && o->log) {
         s->rec.input = actuator_lagged(&sc->sim.effects, s->nq);
-        snprintf(s->rec.ch_input, sizeof s->rec.ch_input, "%s_INPUT", sc->lcm.prefix);
+        lag_bus_channel_name(s->rec.ch_input, sizeof s->rec.ch_input, sc->lcm.prefix,
+                             LAG_BUS_INPUT);
         s->rec.log = rt_log_open(o->log, o->log_ring ? o->log_ring : RT_LOG_RING_DEFAULT,
                                  o->force, o->scene_name, err, errlen);
         if (!s->rec.log) return LAGSIMD_EXIT_USAGE;
@@ -1362,7 +1343,7 @@ lag_result lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
         goto out;
     }
     /* everything that can fail on a bad scene fails before LCM is touched */
-    rc = rt_open(s, sc, o, rt_mono_ns(), quiet, err, sizeof err);
+    rc = rt_open(s, sc, o, lag_clock_mono_ns(), quiet, err, sizeof err);
     if (rc != LAGSIMD_EXIT_OK) {
         fprintf(stderr, "lagsimd: %s\n", err);
         goto out;
@@ -1378,7 +1359,7 @@ lag_result lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
     s->term.live_line = isatty(STDERR_FILENO) && !quiet;
     rt_io_watch(&io, s->bus.lcm_in, s->bus.lcm != s->bus.lcm_in ? s->bus.lcm : NULL);
 
-    s->now = rt_mono_ns();
+    s->now = lag_clock_mono_ns();
     s->bus.discard = false;
     rt_begin(s);
     while (!s->stop) {

@@ -63,6 +63,7 @@
 #include <string.h>
 
 #include "daemon.h"
+#include "lagsim_bus.h"
 #include "lagsim_log.h"
 #include "lagsim_wire.h"
 #include "live_set.h"
@@ -362,10 +363,10 @@ static lag_result replay_setup(replay_run *run)
 {
     const lag_scene *sc = run->sc;
     char err[512];
-    snprintf(run->channel, sizeof run->channel, "%s_STATE", sc->lcm.prefix);
-    snprintf(run->ch_ref, sizeof run->ch_ref, "%s_REFERENCE", sc->lcm.prefix);
-    snprintf(run->ch_input, sizeof run->ch_input, "%s_INPUT", sc->lcm.prefix);
-    snprintf(run->ch_event, sizeof run->ch_event, "%s_EVENT", sc->lcm.prefix);
+    lag_bus_channel_name(run->channel, sizeof run->channel, sc->lcm.prefix, LAG_BUS_STATE);
+    lag_bus_channel_name(run->ch_ref, sizeof run->ch_ref, sc->lcm.prefix, LAG_BUS_REFERENCE);
+    lag_bus_channel_name(run->ch_input, sizeof run->ch_input, sc->lcm.prefix, LAG_BUS_INPUT);
+    lag_bus_channel_name(run->ch_event, sizeof run->ch_event, sc->lcm.prefix, LAG_BUS_EVENT);
     run->def = sc->sim;
     lag_sim_def *def = &run->def;
     if (def->effects.enabled & LAG_EFF_ACTUATOR)

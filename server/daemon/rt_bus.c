@@ -19,6 +19,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "lagsim_clock.h"
 #include "lagsim_net.h"
 #include "daemon.h"
 #include "rt_bus.h"
@@ -199,12 +200,12 @@ static int look_for_other_plant(rt_bus *b, char *err, size_t errlen)
     }
     lag_wire_control c;
     memset(&c, 0, sizeof c);
-    c.utime = rt_wall_us();
+    c.utime = lag_clock_wall_us();
     c.request = LAGSIM_CONTROL_T_DESCRIBE;
     int len = lag_wire_encode(LAG_WIRE_CONTROL, &c, b->buf, RT_BUF_SIZE);
     if (len > 0) lcm_publish(b->lcm_in, b->ch_control, b->buf, (unsigned)len);
-    int64_t end = rt_mono_ns() + RT_LOOK_MS * 1000000LL;
-    for (int64_t left; !b->other_plant[0] && (left = end - rt_mono_ns()) > 0;)
+    int64_t end = lag_clock_mono_ns() + RT_LOOK_MS * 1000000LL;
+    for (int64_t left; !b->other_plant[0] && (left = end - lag_clock_mono_ns()) > 0;)
         lcm_handle_timeout(b->lcm, (int)(left / 1000000) + 1);
     if (b->other_plant[0]) {
         snprintf(err, errlen, "another plant publishes on prefix %s (%s): refusing to start; "

@@ -9,6 +9,7 @@
 #include <sys/timerfd.h>
 #include <unistd.h>
 
+#include "lagsim_clock.h"
 #include "rt_io.h"
 #include "rt_pace.h"
 
@@ -61,7 +62,7 @@ void rt_io_watch(rt_io *io, lcm_t *in, lcm_t *watch)
 static struct timespec *arm(rt_io *io, int64_t wake)
 {
     static struct timespec zero = {0, 0};
-    if (wake <= rt_mono_ns()) return &zero;
+    if (wake <= lag_clock_mono_ns()) return &zero;
     if (wake == io->armed_ns) return NULL;
     struct itimerspec its = {{0, 0}, {0, 0}};
     if (wake != INT64_MAX) {
@@ -79,7 +80,7 @@ int rt_io_wait(rt_io *io, int64_t wake)
     struct pollfd pf[4] = {{io->in_fd, POLLIN, 0}, {io->timer_fd, POLLIN, 0},
                            {io->sig_fd, POLLIN, 0}, {io->watch_fd, POLLIN, 0}};
     int np = ppoll(pf, io->watch_fd >= 0 ? 4 : 3, tmo, NULL);
-    *io->now = rt_mono_ns();
+    *io->now = lag_clock_mono_ns();
     if (np < 0) {
         if (errno == EINTR) return 0;
         perror("lagsimd: poll");
@@ -105,7 +106,7 @@ int rt_io_wait(rt_io *io, int64_t wake)
         for (int k = 0; k < 16 && !*io->stop; k++)
             if (lcm_handle_timeout(io->watch, 0) <= 0) break;
     }
-    *io->now = rt_mono_ns();
+    *io->now = lag_clock_mono_ns();
     return 0;
 }
 

@@ -30,6 +30,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "lagsim_clock.h"
 #include "lagsim_log.h"
 #include "lagsim_out.h"
 
@@ -55,7 +56,7 @@ struct rt_log {
 /* ---------------------------------------------------------------- the writer thread */
 static void deadline_in(struct timespec *ts, long ms)
 {
-    clock_gettime(CLOCK_REALTIME, ts); /* sem_timedwait's clock */
+    lag_clock_wall_timespec(ts); /* sem_timedwait's clock */
     ts->tv_sec += ms / 1000;
     ts->tv_nsec += (ms % 1000) * 1000000L;
     if (ts->tv_nsec >= 1000000000L) {
@@ -170,8 +171,7 @@ int rt_log_close(rt_log *l, int stall_ms, rt_log_stats *final)
     sem_post(&l->wake);
     bool joined = false;
     uint64_t seen = atomic_load(&l->tail);
-    struct timespec last;
-    clock_gettime(CLOCK_MONOTONIC, &last);
+    int64_t last = lag_clock_mono_ns();
     while (!joined) {
         struct timespec ts;
         deadline_in(&ts, 50);
@@ -179,16 +179,14 @@ int rt_log_close(rt_log *l, int stall_ms, rt_log_stats *final)
             joined = true;
             break;
         }
-        struct timespec now;
-        clock_gettime(CLOCK_MONOTONIC, &now);
+        int64_t now = lag_clock_mono_ns();
         uint64_t t = atomic_load(&l->tail);
         if (t != seen) { /* progress: the stall clock starts again */
             seen = t;
             last = now;
             continue;
         }
-        double idle_ms = (double)(now.tv_sec - last.tv_sec) * 1e3 +
-                         (double)(now.tv_nsec - last.tv_nsec) * 1e-6;
+        double idle_ms = (double)(now - last) * 1e-6;
         if (idle_ms < stall_ms) continue;
         /* stalled: cancel it (it waits in writev or sem_timedwait, both cancellation
          * points); what it still held is lost */

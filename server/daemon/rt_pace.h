@@ -18,10 +18,6 @@
 
 #define RT_NS_PER_S 1000000000LL
 
-/* The loop's clocks: CLOCK_MONOTONIC in ns, CLOCK_REALTIME in us (rt_wire.c). */
-int64_t rt_mono_ns(void);
-int64_t rt_wall_us(void);
-
 /* ---------------------------------------------------------------- conversions */
 /* x truncated toward zero, clamped to [INT64_MIN, INT64_MAX]; NaN gives 0. */
 int64_t rt_sat_i64(double x);

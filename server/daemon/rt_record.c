@@ -20,6 +20,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "lagsim_clock.h"
 #include "lagsim_log.h"
 #include "lagsim_wire.h"
 #include "rt_record.h"
@@ -30,7 +31,7 @@
 static int64_t log_clock(rt_record *r, int64_t now)
 {
     if (r->base_us == 0) {
-        r->base_us = rt_wall_us();
+        r->base_us = lag_clock_wall_us();
         r->prev_ns = now;
     }
     double sim_us = (double)r->ticks * r->dt * 1e6;
@@ -106,7 +107,7 @@ void rt_log_input(rt_record *r, int64_t now, const lag_sim *sim, const lag_model
     if (!r->log || !r->input) return;
     lag_wire_joint_command m;
     memset(&m, 0, sizeof m);
-    m.utime = rt_wall_us();
+    m.utime = lag_clock_wall_us();
     m.sim_time = lag_sim_time(sim);
     int k = 0;
     for (int i = 0; i < sim->nq && k < LAG_WIRE_MAX_JOINTS; i++) {

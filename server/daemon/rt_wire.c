@@ -17,10 +17,6 @@
 #include "lagsim_clock.h"
 #include "rt_wire.h"
 
-int64_t rt_mono_ns(void) { return lag_clock_mono_ns(); }
-
-int64_t rt_wall_us(void) { return lag_clock_wall_us(); }
-
 /* A finite double, or 0: what goes on the bus. */
 static double fin(double x) { return isfinite(x) ? x : 0.0; }
 
@@ -58,7 +54,7 @@ static void publish_reference(const rt_out *o, const lag_sim *sim,
     if (ref->n == 0) return;
     lag_wire_reference m;
     lagsimd_reference_at(ref, sim->def.model.kind, lag_sim_time(sim), sim->tick, &m);
-    m.utime = rt_wall_us();
+    m.utime = lag_clock_wall_us();
     int n = publish(o, o->bus->ch_reference, LAG_WIRE_REFERENCE, &m);
     if (sent && n > 0) {
         memcpy(sent->buf, o->bus->buf, (size_t)n);
@@ -75,7 +71,7 @@ int rt_publish_state(const rt_out *o, const lag_sim *sim, const lag_model_info *
     double pos[LAG_MAX_DOF], vel[LAG_MAX_DOF];
     /* the state as published: plus the noise effect when the scene turns it on */
     lag_sim_observe(sim, pos, vel);
-    m.utime = rt_wall_us();
+    m.utime = lag_clock_wall_us();
     m.sim_time = fin(lag_sim_time(sim));
     m.step = sim->tick;
     m.num_joints = (int16_t)sim->nq;
@@ -102,7 +98,7 @@ double rt_error_budget(const lag_scene *sc)
 void rt_status_base(lag_wire_status *m, const lag_sim *sim, const lag_scene *sc)
 {
     memset(m, 0, sizeof *m);
-    m->utime = rt_wall_us();
+    m->utime = lag_clock_wall_us();
     m->sim_time = lag_sim_time(sim);
     m->step = sim->tick;
     m->energy = lag_sim_energy(sim);
@@ -130,7 +126,7 @@ void rt_publish_event(const rt_out *o, double sim_time, int64_t step, const char
                       const char *joint, double value, const char *detail, lag_wire_event *m)
 {
     memset(m, 0, sizeof *m);
-    m->utime = rt_wall_us();
+    m->utime = lag_clock_wall_us();
     m->sim_time = fin(sim_time);
     m->step = step;
     PUT(m->kind, kind);
@@ -146,7 +142,7 @@ void rt_publish_scene(const rt_out *o, const lag_scene *sc, const lag_sim *sim,
     const lag_sim_def *d = &sim->def; /* the parameters and effects now (SET changes them) */
     lag_wire_scene m;
     memset(&m, 0, sizeof m);
-    m.utime = rt_wall_us();
+    m.utime = lag_clock_wall_us();
     PUT(m.model, lag_model_info_get(sc->sim.model.kind)->name); /* the scene's model; its joints are info's */
     PUT(m.prefix, sc->lcm.prefix);
     m.num_params = (int16_t)info->np;

@@ -2,6 +2,7 @@
  * Scene defaults and names: the part of the scene that needs no YAML.
  */
 #include <ctype.h>
+#include <stdarg.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,10 +23,9 @@ void lag_scene_default(lag_scene *sc, lag_model_kind kind)
     sc->accuracy.estimate_every = -1; /* not given: lag_scene_estimate_every */
     /* 1/100 s at dt = 1 ms; the loader recomputes it from the scene's values. */
     sc->ticks_per_period = 10;
-    if (sc->sim.integrator.dt > 0.0) {
-        double r = (1.0 / sc->publish_hz) / sc->sim.integrator.dt;
-        sc->ticks_per_period = r >= 1.0 ? (int64_t)(r + 0.5) : 1;
-    }
+    int64_t k;
+    if (lag_ticks_exact(1.0 / sc->publish_hz, sc->sim.integrator.dt, &k) && k >= 1)
+        sc->ticks_per_period = k;
     sc->realtime.mode = LAG_RT_REALTIME;
     sc->realtime.rate = 1.0;
     sc->realtime.command_timeout = 0.5;
@@ -46,6 +46,54 @@ void lag_scene_default(lag_scene *sc, lag_model_kind kind)
     for (; name[i] && i + 1 < sizeof sc->lcm.prefix; i++)
         sc->lcm.prefix[i] = (char)toupper((unsigned char)name[i]);
     sc->lcm.prefix[i] = '\0';
+}
+
+/* d's field and message (what is expected, what was found): a rule broken. */
+static lag_result fault(lag_diag *d, const char *field, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static lag_result fault(lag_diag *d, const char *field, const char *fmt, ...)
+{
+    snprintf(d->field, sizeof d->field, "%s", field);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(d->message, sizeof d->message, fmt, ap);
+    va_end(ap);
+    return LAG_ERR_ARG;
+}
+
+lag_result lag_scene_check_prefix_len(size_t n, lag_diag *d)
+{
+    if (n >= 1 && n <= LAG_SCENE_PREFIX_MAX) return LAG_OK;
+    return fault(d, "lcm.prefix", "expected a channel prefix of 1 to %d characters, got %zu "
+                 "(LCM channel names have at most 63 bytes, and the longest suffix, "
+                 "_REFERENCE, has 10)", LAG_SCENE_PREFIX_MAX, n);
+}
+
+lag_result lag_scene_check(const lag_scene *sc, lag_diag *d)
+{
+    const double hz = sc->publish_hz;
+    if (!(hz > 0) || !isfinite(hz) || sc->ticks_per_period < 1 ||
+        sc->ticks_per_period > LAG_SCENE_PERIOD_TICKS_MAX)
+        return fault(d, "publish_hz", "expected > 0 and finite, 1/publish_hz a whole number "
+                     "of ticks (1 to 2^53), got %g Hz (%lld ticks)", hz,
+                     (long long)sc->ticks_per_period);
+    const double rate = sc->realtime.rate, shz = sc->realtime.status_hz;
+    if (!(rate > 0) || !isfinite(rate))
+        return fault(d, "realtime.rate", "expected > 0 and finite (sim s per wall s), got %g",
+                     rate);
+    if (!(shz > 0) || !isfinite(shz))
+        return fault(d, "realtime.status_hz", "expected > 0 and finite (Hz), got %g", shz);
+    const double retry = sc->realtime.lockstep_retry, wait = sc->realtime.lockstep_timeout;
+    if (!(retry >= 0) || !isfinite(retry))
+        return fault(d, "realtime.lockstep_retry", "expected >= 0 and finite (wall s), got %g",
+                     retry);
+    if (!(wait >= 0) || !isfinite(wait))
+        return fault(d, "realtime.lockstep_timeout", "expected >= 0 and finite (wall s), got %g",
+                     wait);
+    if (!(sc->realtime.command_timeout >= 0))
+        return fault(d, "realtime.command_timeout", "expected >= 0 (sim s; inf: never), got %g",
+                     sc->realtime.command_timeout);
+    return lag_scene_check_prefix_len(strnlen(sc->lcm.prefix, sizeof sc->lcm.prefix), d);
 }
 
 lag_result lag_scene_read_decimal(const char *t, double *v)

@@ -109,6 +109,22 @@ typedef struct lag_scene {
 /* Defaults for a model kind: lag_default_sim_def plus the daemon defaults above. */
 void lag_scene_default(lag_scene *sc, lag_model_kind kind);
 
+/* The most ticks a control period may take in a scene built in code (a scene file allows
+ * far fewer): sim time tick * dt is exact up to 2^53. */
+#define LAG_SCENE_PERIOD_TICKS_MAX (1LL << 53)
+/* The scene-level rules, whoever built the scene (the loader, after it converted a file,
+ * or code): publish_hz > 0 and finite with ticks_per_period 1 to
+ * LAG_SCENE_PERIOD_TICKS_MAX; realtime.rate and realtime.status_hz > 0 and finite;
+ * realtime.lockstep_retry and realtime.lockstep_timeout >= 0 and finite;
+ * realtime.command_timeout >= 0 (inf: never); lcm.prefix of 1 to LAG_SCENE_PREFIX_MAX
+ * characters. A scene file's keys have narrower ranges, checked first (what a file may
+ * say); these are what lagsimd needs. Returns LAG_OK, or LAG_ERR_ARG with the first fault
+ * in d (field: the scene key, e.g. "realtime.rate"). OUT: d */
+lag_result lag_scene_check(const lag_scene *sc, lag_diag *d);
+/* The rule on the length n of a channel prefix (lcm.prefix), alone: the loader applies it
+ * to the prefix as the file gives it, before it is stored. OUT: d */
+lag_result lag_scene_check_prefix_len(size_t n, lag_diag *d);
+
 /* Loads a YAML scene file, then applies `nsets` overrides "dotted.key.path=yaml value"
  * (same validation as the file). Returns LAG_OK, or LAG_ERR_SCENE (LAG_ERR_ARG for a
  * NULL path or sc) and writes "file:line:column: what was expected" (or "--set key: ...")

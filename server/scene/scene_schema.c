@@ -693,10 +693,9 @@ static int key_prefix(conv *cv, const ynode *nd, const char *path)
     if (sch_get_string(cv, nd, path, "a channel prefix of [A-Za-z0-9_]", &s) < 0)
         return -1;
     size_t n = strlen(s);
-    if (n == 0 || n > LAG_SCENE_PREFIX_MAX)
-        return yfail(cv->err, nd, path, "expected a channel prefix of 1 to %d characters, got "
-                     "%zu (LCM channel names have at most 63 bytes, and the longest suffix, "
-                     "_REFERENCE, has 10)", LAG_SCENE_PREFIX_MAX, n);
+    lag_diag d; /* the rule is the scene's (lag_scene_check), on the length as given */
+    if (lag_scene_check_prefix_len(n, &d) != LAG_OK)
+        return yfail(cv->err, nd, path, "%s", d.message);
     for (size_t i = 0; i < n; i++) {
         char c = s[i];
         bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') ||
@@ -1108,7 +1107,12 @@ static int convert_finish(conv *cv)
     char msg[256];
     if (lag_scene_check_url(sc->lcm.url, sc->lcm.allow_lan, &sc->lcm.ttl, msg, sizeof msg) < 0)
         return yfail(cv->err, cv->url, "lcm.url", "%s", msg);
-    return core_check(cv, &sc->sim);
+    if (core_check(cv, &sc->sim) < 0) return -1;
+    /* the scene-level rules, as for a scene built in code (the keys' ranges above are
+     * narrower: a file's scene meets them) */
+    lag_diag d;
+    if (lag_scene_check(sc, &d) == LAG_OK) return 0;
+    return yfail(cv->err, ytree_lookup(cv->root, d.field), d.field, "%s", d.message);
 }
 
 int scene_schema_convert(const ynode *root, const char *path, lag_scene *sc, errbuf *err)

@@ -550,6 +550,91 @@ int eval_score(const eval_series *s, const eval_case *c, const eval_scene *sc,
 }
 
 /* ---------------------------------------------------------------- one run */
+/* lagsimd --config S --set ... : argv, its strings built in one arena */
+enum { ARGS_MAX = 2 * (EVAL_SETS_MAX * 2 + 16) };
+typedef struct daemon_args {
+    char *argv[ARGS_MAX];
+    char owned[8][600];
+    int na, no;
+} daemon_args;
+
+static void arg(daemon_args *d, const char *a) { d->argv[d->na++] = (char *)a; }
+
+/* A buffer of d's own for an argument (filled by the caller, then arg()). */
+static char *own(daemon_args *d) { return d->owned[d->no++]; }
+#define OWN_CAP sizeof ((daemon_args *)0)->owned[0]
+
+static void daemon_argv(daemon_args *d, const eval_env *env, const eval_case *c,
+                        const char *const *extra, int nextra, const char *log)
+{
+    d->na = d->no = 0;
+    arg(d, env->lagsimd);
+    arg(d, "--config");
+    arg(d, env->config);
+    arg(d, "--set");
+    arg(d, "realtime.mode=lockstep");
+    /* lockstep waits at t = 0 for the controller's first command and publishes that
+     * state again every lockstep_timeout: a controller that finds the plant after the
+     * first one (by discovery) then waits at most this long; the results do not depend
+     * on it (docs/server.md, lockstep) */
+    arg(d, "--set");
+    arg(d, "realtime.lockstep_timeout=0.1");
+    char *o = own(d);
+    snprintf(o, OWN_CAP, "lcm.prefix=%s", env->prefix);
+    arg(d, "--set");
+    arg(d, o);
+    o = own(d);
+    snprintf(o, OWN_CAP, "lcm.url=%s", env->url);
+    arg(d, "--set");
+    arg(d, o);
+    for (int i = 0; i < c->nsets && d->na + 2 < ARGS_MAX - 8; i++) {
+        arg(d, "--set");
+        arg(d, c->set[i]);
+    }
+    for (int i = 0; i < nextra && d->na + 2 < ARGS_MAX - 8; i++) {
+        arg(d, "--set");
+        arg(d, extra[i]);
+    }
+    o = own(d);
+    snprintf(o, OWN_CAP, "%.17g", c->duration);
+    arg(d, "--duration");
+    arg(d, o);
+    arg(d, "--log");
+    arg(d, log);
+    arg(d, "-q");
+    d->argv[d->na] = NULL;
+}
+
+/* Waits for the daemon's end, or the controller's: a controller that ends first (it could
+ * not start, it crashed) leaves a lockstep plant waiting for ever, so the daemon gets a
+ * few seconds to end on its own (a controller ends on the daemon's stop event, a moment
+ * before the daemon exits) and is then stopped. OUT: dst (the daemon's wait status) */
+static void wait_run(const eval_env *env, pid_t dpid, pid_t cpid, eval_result *res, int *dst)
+{
+    int cst = 0;
+    double t0 = eval_now();
+    bool daemon_done = false, controller_done = false;
+    while (!daemon_done && eval_now() < t0 + env->wall_timeout) {
+        daemon_done = eval_wait_until(dpid, eval_now() + 0.05, dst);
+        if (!daemon_done && !controller_done && waitpid(cpid, &cst, WNOHANG) == cpid) {
+            controller_done = true;
+            if (!eval_wait_until(dpid, eval_now() + 5.0, dst)) {
+                eval_stop_group(dpid, dst);
+                eval_fail(res, "the controller ended (%s %d) before the run did",
+                     WIFEXITED(cst) ? "exit status" : "signal",
+                     WIFEXITED(cst) ? WEXITSTATUS(cst) : WTERMSIG(cst));
+            }
+            daemon_done = true;
+        }
+    }
+    if (!daemon_done) {
+        eval_stop_group(dpid, dst);
+        eval_fail(res, "no end after %.3g wall s (--timeout)", env->wall_timeout);
+    }
+    /* a controller ends on the daemon's stop event; one that does not is stopped */
+    if (!controller_done && !eval_wait_until(cpid, eval_now() + 3.0, &cst)) eval_stop_group(cpid, &cst);
+}
+
 int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, int nextra,
              const eval_scene *sc, eval_result *res, eval_series *out, char *err,
              size_t errlen)
@@ -559,44 +644,8 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
     char log[1024];
     snprintf(log, sizeof log, "%s/%s.lcm", env->workdir, env->prefix);
     unlink(log);
-
-    /* lagsimd --config S --set ... (argv strings built in one arena) */
-    enum { ARGS_MAX = 2 * (EVAL_SETS_MAX * 2 + 16) };
-    char *argv[ARGS_MAX];
-    char owned[8][600];
-    int na = 0, no = 0;
-    argv[na++] = (char *)env->lagsimd;
-    argv[na++] = "--config";
-    argv[na++] = (char *)env->config;
-    argv[na++] = "--set";
-    argv[na++] = "realtime.mode=lockstep";
-    /* lockstep waits at t = 0 for the controller's first command and publishes that
-     * state again every lockstep_timeout: a controller that finds the plant after the
-     * first one (by discovery) then waits at most this long; the results do not depend
-     * on it (docs/server.md, lockstep) */
-    argv[na++] = "--set";
-    argv[na++] = "realtime.lockstep_timeout=0.1";
-    snprintf(owned[no], sizeof owned[no], "lcm.prefix=%s", env->prefix);
-    argv[na++] = "--set";
-    argv[na++] = owned[no++];
-    snprintf(owned[no], sizeof owned[no], "lcm.url=%s", env->url);
-    argv[na++] = "--set";
-    argv[na++] = owned[no++];
-    for (int i = 0; i < c->nsets && na + 2 < ARGS_MAX - 8; i++) {
-        argv[na++] = "--set";
-        argv[na++] = (char *)c->set[i];
-    }
-    for (int i = 0; i < nextra && na + 2 < ARGS_MAX - 8; i++) {
-        argv[na++] = "--set";
-        argv[na++] = (char *)extra[i];
-    }
-    snprintf(owned[no], sizeof owned[no], "%.17g", c->duration);
-    argv[na++] = "--duration";
-    argv[na++] = owned[no++];
-    argv[na++] = "--log";
-    argv[na++] = log;
-    argv[na++] = "-q";
-    argv[na] = NULL;
+    daemon_args d;
+    daemon_argv(&d, env, c, extra, nextra, log);
 
     char cmd[4096];
     eval_expand(env->controller, env, cmd, sizeof cmd);
@@ -606,39 +655,15 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
         snprintf(err, errlen, "cannot start the controller: %s", strerror(errno));
         return -1;
     }
-    pid_t dpid = eval_spawn(argv, NULL, env);
+    pid_t dpid = eval_spawn(d.argv, NULL, env);
     if (dpid < 0) {
         snprintf(err, errlen, "cannot start %s: %s", env->lagsimd, strerror(errno));
         int st;
         eval_stop_group(cpid, &st);
         return -1;
     }
-    int dst = 0, cst = 0;
-    double t0 = eval_now();
-    bool daemon_done = false, controller_done = false;
-    /* the daemon's end, or the controller's: a controller that ends first (it could not
-     * start, it crashed) leaves a lockstep plant waiting for ever, so the daemon gets a
-     * few seconds to end on its own (a controller ends on the daemon's stop event, a
-     * moment before the daemon exits) and is then stopped */
-    while (!daemon_done && eval_now() < t0 + env->wall_timeout) {
-        daemon_done = eval_wait_until(dpid, eval_now() + 0.05, &dst);
-        if (!daemon_done && !controller_done && waitpid(cpid, &cst, WNOHANG) == cpid) {
-            controller_done = true;
-            if (!eval_wait_until(dpid, eval_now() + 5.0, &dst)) {
-                eval_stop_group(dpid, &dst);
-                eval_fail(res, "the controller ended (%s %d) before the run did",
-                     WIFEXITED(cst) ? "exit status" : "signal",
-                     WIFEXITED(cst) ? WEXITSTATUS(cst) : WTERMSIG(cst));
-            }
-            daemon_done = true;
-        }
-    }
-    if (!daemon_done) {
-        eval_stop_group(dpid, &dst);
-        eval_fail(res, "no end after %.3g wall s (--timeout)", env->wall_timeout);
-    }
-    /* a controller ends on the daemon's stop event; one that does not is stopped */
-    if (!controller_done && !eval_wait_until(cpid, eval_now() + 3.0, &cst)) eval_stop_group(cpid, &cst);
+    int dst = 0;
+    wait_run(env, dpid, cpid, res, &dst);
 
     if (WIFEXITED(dst) && WEXITSTATUS(dst) == 2) {
         snprintf(err, errlen, "lagsimd refused the case '%s' (exit 2; rerun with -v)",

@@ -138,16 +138,29 @@ static int report(const char *dir, bool force, const char *config, const eval_ca
     return eval_gnuplot(prog, gp);
 }
 
-int main(int argc, char **argv)
-{
-    const char *config = NULL, *controller = NULL, *suite = NULL, *require = NULL;
-    const char *csv = NULL, *report_dir = NULL;
+/* A run of lagsim-eval: the options, the scene and its cases, the outputs. */
+typedef struct eval_cli {
+    const char *config, *controller, *suite, *require, *csv, *report_dir;
     const char *only[EVAL_CASES_MAX];
-    int nonly = 0;
-    bool force = false, verbose = false;
-    double timeout = 600;
+    int nonly;
+    bool force, verbose;
+    double timeout;
     char lagsimd[4096];
-    eval_default_lagsimd(lagsimd, sizeof lagsimd);
+    char err[2048];
+    eval_scene sc;
+    lag_require req;
+    eval_case *cases;
+    int ncases;
+    eval_scene csc[EVAL_CASES_MAX]; /* each case's scene, its overrides applied */
+    FILE *fcsv;
+    char tmpdir[32];
+    const char *workdir;
+    int failures, status;
+} eval_cli;
+
+/* The options. Returns -1 to go on, or the exit code. */
+static int parse_options(eval_cli *x, int argc, char **argv)
+{
     enum { O_CASE = 256, O_SUITE, O_REQUIRE, O_CSV, O_REPORT, O_LAGSIMD, O_TIMEOUT };
     static const struct option opts[] = {
         {"config", required_argument, 0, 'c'},   {"controller", required_argument, 0, 'C'},
@@ -161,167 +174,200 @@ int main(int argc, char **argv)
     opterr = 0;
     while ((o = getopt_long(argc, argv, ":c:C:fvh", opts, NULL)) != -1) {
         switch (o) {
-        case 'c': config = optarg; break;
-        case 'C': controller = optarg; break;
+        case 'c': x->config = optarg; break;
+        case 'C': x->controller = optarg; break;
         case O_CASE:
-            if (nonly == EVAL_CASES_MAX) return die("too many --case (at most %s)", "256");
-            only[nonly++] = optarg;
+            if (x->nonly == EVAL_CASES_MAX) return die("too many --case (at most %s)", "256");
+            x->only[x->nonly++] = optarg;
             break;
-        case O_SUITE: suite = optarg; break;
-        case O_REQUIRE: require = optarg; break;
-        case O_CSV: csv = optarg; break;
-        case O_REPORT: report_dir = optarg; break;
-        case 'f': force = true; break;
-        case O_LAGSIMD: snprintf(lagsimd, sizeof lagsimd, "%s", optarg); break;
+        case O_SUITE: x->suite = optarg; break;
+        case O_REQUIRE: x->require = optarg; break;
+        case O_CSV: x->csv = optarg; break;
+        case O_REPORT: x->report_dir = optarg; break;
+        case 'f': x->force = true; break;
+        case O_LAGSIMD: snprintf(x->lagsimd, sizeof x->lagsimd, "%s", optarg); break;
         case O_TIMEOUT: {
             char *end;
             errno = 0;
-            timeout = strtod(optarg, &end);
-            if (errno || *end || !(timeout >= 1 && timeout <= 1e6))
+            x->timeout = strtod(optarg, &end);
+            if (errno || *end || !(x->timeout >= 1 && x->timeout <= 1e6))
                 return die("--timeout: expected wall seconds from 1 to 1e6, got '%s'", optarg);
             break;
         }
-        case 'v': verbose = true; break;
+        case 'v': x->verbose = true; break;
         case 'h': usage(stdout); return 0;
         case ':': return die("%s needs a value (try --help)", argv[optind - 1]);
         default: return die("unknown option '%s' (try --help)", argv[optind - 1]);
         }
     }
     if (optind < argc) return die("unexpected argument '%s' (try --help)", argv[optind]);
-    if (!config) return die("%s", "--config SCENE is required (try --help)");
-    if (!controller) return die("%s", "--controller 'COMMAND' is required (try --help)");
+    if (!x->config) return die("%s", "--config SCENE is required (try --help)");
+    if (!x->controller) return die("%s", "--controller 'COMMAND' is required (try --help)");
+    return -1;
+}
 
-    char err[2048];
-    eval_scene sc;
-    if (eval_scene_load(config, NULL, 0, &sc, err, sizeof err)) return die("%s", err);
-    lag_require req = {0};
-    if (require && (lag_require_parse(require, &req, err, sizeof err) ||
-                    eval_require_check(&req, &sc, err, sizeof err)))
-        return die("--require: %s", err);
-
-    eval_case *cases = NULL;
-    int ncases = 0;
-    if (eval_cases_load(suite ? suite : config, &cases, &ncases, err, sizeof err))
-        return die("%s", err);
-    if (!ncases) {
-        fprintf(stderr, "%s: %s has no `cases:` (docs/evaluation.md)\n", prog,
-                suite ? suite : config);
+/* The scene, --require, the cases, and every --case among them. Returns -1 or the exit
+ * code. */
+static int load_cases(eval_cli *x)
+{
+    const char *from = x->suite ? x->suite : x->config;
+    if (eval_scene_load(x->config, NULL, 0, &x->sc, x->err, sizeof x->err))
+        return die("%s", x->err);
+    if (x->require && (lag_require_parse(x->require, &x->req, x->err, sizeof x->err) ||
+                       eval_require_check(&x->req, &x->sc, x->err, sizeof x->err)))
+        return die("--require: %s", x->err);
+    if (eval_cases_load(from, &x->cases, &x->ncases, x->err, sizeof x->err))
+        return die("%s", x->err);
+    if (!x->ncases) {
+        fprintf(stderr, "%s: %s has no `cases:` (docs/evaluation.md)\n", prog, from);
         return 2;
     }
-    for (int i = 0; i < nonly; i++) {
+    for (int i = 0; i < x->nonly; i++) {
         int found = 0;
-        for (int k = 0; k < ncases; k++) found |= !strcmp(cases[k].name, only[i]);
+        for (int k = 0; k < x->ncases; k++) found |= !strcmp(x->cases[k].name, x->only[i]);
         if (!found) {
-            fprintf(stderr, "%s: --case %s: no such case in %s (it has:", prog, only[i],
-                    suite ? suite : config);
-            for (int k = 0; k < ncases; k++) fprintf(stderr, " %s", cases[k].name);
+            fprintf(stderr, "%s: --case %s: no such case in %s (it has:", prog, x->only[i],
+                    from);
+            for (int k = 0; k < x->ncases; k++) fprintf(stderr, " %s", x->cases[k].name);
             fprintf(stderr, ")\n");
-            free(cases);
             return 2;
         }
     }
-    /* every case's overrides validated before anything runs; joint bounds named */
-    eval_scene csc[EVAL_CASES_MAX];
-    for (int k = 0; k < ncases; k++) {
+    return -1;
+}
+
+/* Every case's overrides validated before anything runs; joint bounds named. Returns -1
+ * or the exit code. */
+static int check_cases(eval_cli *x)
+{
+    for (int k = 0; k < x->ncases; k++) {
+        const eval_case *c = &x->cases[k];
+        eval_scene *csc = &x->csc[k];
         const char *sets[EVAL_SETS_MAX];
-        for (int i = 0; i < cases[k].nsets; i++) sets[i] = cases[k].set[i];
-        if (eval_scene_load(config, sets, cases[k].nsets, &csc[k], err, sizeof err)) {
-            fprintf(stderr, "%s: case %s: %s\n", prog, cases[k].name, err);
-            free(cases);
+        for (int i = 0; i < c->nsets; i++) sets[i] = c->set[i];
+        if (eval_scene_load(x->config, sets, c->nsets, csc, x->err, sizeof x->err)) {
+            fprintf(stderr, "%s: case %s: %s\n", prog, c->name, x->err);
             return 2;
         }
-        for (int b = 0; b < cases[k].nbounds; b++) {
+        for (int b = 0; b < c->nbounds; b++) {
             int found = 0;
-            for (int j = 0; j < csc[k].nj; j++)
-                found |= !strcmp(csc[k].joint[j], cases[k].bound_joint[b]);
+            for (int j = 0; j < csc->nj; j++) found |= !strcmp(csc->joint[j], c->bound_joint[b]);
             if (!found) {
                 fprintf(stderr, "%s: case %s: bounds: the %s has no joint '%s'\n", prog,
-                        cases[k].name, csc[k].model, cases[k].bound_joint[b]);
-                free(cases);
+                        c->name, csc->model, c->bound_joint[b]);
                 return 2;
             }
         }
     }
-    if (report_dir && mkdir(report_dir, 0777) != 0 && errno != EEXIST) {
-        fprintf(stderr, "%s: --report %s: %s\n", prog, report_dir, strerror(errno));
-        free(cases);
-        return 2;
-    }
-    FILE *fcsv = NULL;
-    if (csv && !(fcsv = open_out("--csv", csv, force, config))) {
-        free(cases);
-        return 2;
-    }
-    if (fcsv) {
-        fprintf(fcsv, "case,joint,failed,required,reason");
-        for (int m = 0; m < LAG_METRIC_COUNT; m++) fprintf(fcsv, ",%s", lag_metric_table[m].name);
-        fprintf(fcsv, ",max_abs_q,states,t_end\n");
-    }
-    char tmpdir[] = "/tmp/lagsim-eval.XXXXXX";
-    const char *workdir = report_dir && verbose ? report_dir : mkdtemp(tmpdir);
-    if (!workdir) {
-        fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
-        free(cases);
-        return 2;
-    }
+    return -1;
+}
 
-    /* the table's header */
+/* The report directory, the CSV (with its header) and the work directory. Returns -1 or
+ * the exit code. */
+static int open_outputs(eval_cli *x)
+{
+    if (x->report_dir && mkdir(x->report_dir, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "%s: --report %s: %s\n", prog, x->report_dir, strerror(errno));
+        return 2;
+    }
+    if (x->csv && !(x->fcsv = open_out("--csv", x->csv, x->force, x->config))) return 2;
+    if (x->fcsv) {
+        fprintf(x->fcsv, "case,joint,failed,required,reason");
+        for (int m = 0; m < LAG_METRIC_COUNT; m++)
+            fprintf(x->fcsv, ",%s", lag_metric_table[m].name);
+        fprintf(x->fcsv, ",max_abs_q,states,t_end\n");
+    }
+    snprintf(x->tmpdir, sizeof x->tmpdir, "%s", "/tmp/lagsim-eval.XXXXXX");
+    x->workdir = x->report_dir && x->verbose ? x->report_dir : mkdtemp(x->tmpdir);
+    if (!x->workdir) {
+        fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
+        return 2;
+    }
+    return -1;
+}
+
+/* The rows of one case and joint: the table on stdout and the CSV. */
+static void write_rows(eval_cli *x, const eval_case *c, const eval_scene *csc,
+                       const eval_result *res, bool met, const char *why)
+{
+    for (int j = 0; j < csc->nj; j++) {
+        printf("%-14s %-8s %-6s", j ? "" : c->name, csc->joint[j],
+               j ? "" : res->failed ? "FAIL" : met ? "ok" : "UNMET");
+        for (int m = 0; m < LAG_METRIC_COUNT; m++) {
+            char v[32];
+            eval_fmt(res->m[j].v[m], v, sizeof v);
+            printf(" %11s", v);
+        }
+        printf("\n");
+        if (!x->fcsv) continue;
+        fprintf(x->fcsv, "%s,%s,%d,%d,\"%s\"", c->name, csc->joint[j], res->failed, met,
+                res->failed ? res->reason : why);
+        for (int m = 0; m < LAG_METRIC_COUNT; m++) {
+            /* the CSV is read by programs: every digit of the double */
+            if (isnan(res->m[j].v[m])) fprintf(x->fcsv, ",nan");
+            else fprintf(x->fcsv, ",%.17g", res->m[j].v[m]);
+        }
+        fprintf(x->fcsv, ",%.17g,%zu,%.17g\n", res->max_abs_q[j], res->states, res->t_end);
+    }
+}
+
+/* Runs case k (if wanted) and reports it. Returns false when the run could not be made
+ * (status 2: no further case runs). */
+static bool run_case(eval_cli *x, int k)
+{
+    const eval_case *c = &x->cases[k];
+    int wanted = x->nonly == 0;
+    for (int i = 0; i < x->nonly; i++) wanted |= !strcmp(x->only[i], c->name);
+    if (!wanted) return true;
+    eval_env env = {.lagsimd = x->lagsimd, .config = x->config, .controller = x->controller,
+                    .workdir = x->workdir, .wall_timeout = x->timeout, .verbose = x->verbose};
+    eval_url(k, env.url, sizeof env.url);
+    snprintf(env.prefix, sizeof env.prefix, "EVAL%d_%d", (int)getpid(), k);
+    eval_result res;
+    eval_series s = {0};
+    if (eval_run(&env, c, NULL, 0, &x->csc[k], &res, &s, x->err, sizeof x->err)) {
+        fprintf(stderr, "%s: case %s: %s\n", prog, c->name, x->err);
+        eval_series_free(&s);
+        x->status = 2;
+        return false;
+    }
+    char why[256] = "";
+    bool met = !x->require || eval_require_holds(&x->req, &x->csc[k], &res, why, sizeof why);
+    if (res.failed || !met) x->failures++;
+    write_rows(x, c, &x->csc[k], &res, met, why);
+    if (res.failed) printf("  %s failed: %s\n", c->name, res.reason);
+    else if (!met) printf("  %s: --require: %s\n", c->name, why);
+    fflush(stdout);
+    if (x->report_dir && report(x->report_dir, x->force, x->config, c, &x->csc[k], &s, &res))
+        x->status = 2;
+    eval_series_free(&s);
+    return true;
+}
+
+/* The table's header, every case, then the outputs closed. Returns the exit code. */
+static int run_cases(eval_cli *x)
+{
     printf("%-14s %-8s %-6s", "case", "joint", "result");
     for (int m = 0; m < LAG_METRIC_COUNT; m++) printf(" %11s", lag_metric_table[m].name);
     printf("\n");
-    int failures = 0, status = 0;
-    for (int k = 0; k < ncases; k++) {
-        const eval_case *c = &cases[k];
-        int wanted = nonly == 0;
-        for (int i = 0; i < nonly; i++) wanted |= !strcmp(only[i], c->name);
-        if (!wanted) continue;
-        eval_env env = {.lagsimd = lagsimd, .config = config, .controller = controller,
-                        .workdir = workdir, .wall_timeout = timeout, .verbose = verbose};
-        eval_url(k, env.url, sizeof env.url);
-        snprintf(env.prefix, sizeof env.prefix, "EVAL%d_%d", (int)getpid(), k);
-        eval_result res;
-        eval_series s = {0};
-        if (eval_run(&env, c, NULL, 0, &csc[k], &res, &s, err, sizeof err)) {
-            fprintf(stderr, "%s: case %s: %s\n", prog, c->name, err);
-            eval_series_free(&s);
-            status = 2;
-            break;
-        }
-        char why[256] = "";
-        bool met = !require || eval_require_holds(&req, &csc[k], &res, why, sizeof why);
-        if (res.failed || !met) failures++;
-        for (int j = 0; j < csc[k].nj; j++) {
-            printf("%-14s %-8s %-6s", j ? "" : c->name, csc[k].joint[j],
-                   j ? "" : res.failed ? "FAIL" : met ? "ok" : "UNMET");
-            for (int m = 0; m < LAG_METRIC_COUNT; m++) {
-                char v[32];
-                eval_fmt(res.m[j].v[m], v, sizeof v);
-                printf(" %11s", v);
-            }
-            printf("\n");
-            if (fcsv) {
-                fprintf(fcsv, "%s,%s,%d,%d,\"%s\"", c->name, csc[k].joint[j], res.failed,
-                        met, res.failed ? res.reason : why);
-                for (int m = 0; m < LAG_METRIC_COUNT; m++) {
-                    /* the CSV is read by programs: every digit of the double */
-                    if (isnan(res.m[j].v[m])) fprintf(fcsv, ",nan");
-                    else fprintf(fcsv, ",%.17g", res.m[j].v[m]);
-                }
-                fprintf(fcsv, ",%.17g,%zu,%.17g\n", res.max_abs_q[j], res.states, res.t_end);
-            }
-        }
-        if (res.failed) printf("  %s failed: %s\n", c->name, res.reason);
-        else if (!met) printf("  %s: --require: %s\n", c->name, why);
-        fflush(stdout);
-        if (report_dir && report(report_dir, force, config, c, &csc[k], &s, &res)) status = 2;
-        eval_series_free(&s);
+    for (int k = 0; k < x->ncases && run_case(x, k); k++) {}
+    if (x->fcsv && fclose(x->fcsv) != 0) {
+        fprintf(stderr, "%s: --csv %s: %s\n", prog, x->csv, strerror(errno));
+        x->status = 2;
     }
-    if (fcsv && fclose(fcsv) != 0) {
-        fprintf(stderr, "%s: --csv %s: %s\n", prog, csv, strerror(errno));
-        status = 2;
-    }
-    if (workdir == tmpdir) rmdir(tmpdir);
-    free(cases);
-    if (status) return status;
-    return failures ? 1 : 0;
+    if (x->workdir == x->tmpdir) rmdir(x->tmpdir);
+    if (x->status) return x->status;
+    return x->failures ? 1 : 0;
+}
+
+int main(int argc, char **argv)
+{
+    static eval_cli x = {.timeout = 600};
+    eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
+    int rc;
+    if ((rc = parse_options(&x, argc, argv)) < 0 && (rc = load_cases(&x)) < 0 &&
+        (rc = check_cases(&x)) < 0 && (rc = open_outputs(&x)) < 0)
+        rc = run_cases(&x);
+    free(x.cases);
+    return rc;
 }

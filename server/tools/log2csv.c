@@ -517,11 +517,15 @@ static bool write_control(l2c *c, chan *h, const lag_log_record *r, const lag_wi
     return true;
 }
 
-/* Ticks per control period of a scene (0 if it makes no sense). */
+/* Ticks per control period of a scene: a whole number of its ticks (lag_ticks_exact), as
+ * the daemon writes it; 0 if it makes no sense. */
 static int64_t period_ticks(const lag_wire_scene *m)
 {
-    double tpp = m->dt > 0 ? m->control_period / m->dt : 0;
-    return isfinite(tpp) && tpp >= 0.5 && tpp < 1e15 ? (int64_t)llround(tpp) : 0;
+    int64_t k;
+    return m->dt > 0 && lag_ticks_exact(m->control_period, m->dt, &k) && k >= 1 &&
+                   k < 1000000000000000LL
+               ? k
+               : 0;
 }
 
 /* One record: decode as the channel's type (the first that decodes fixes it). */
@@ -584,6 +588,31 @@ static bool record(l2c *c, const lag_log_record *r)
 }
 
 /* ---------------------------------------------------------------- summary */
+/* The last status of a status channel: its run state and counters. */
+static void summarize_status(const lag_wire_status *s, FILE *f)
+{
+    /* counters from the bus: summed in unsigned arithmetic (a hostile sum wraps,
+     * it does not overflow) */
+    int64_t rej = (int64_t)((uint64_t)s->rejected_unknown_joint +
+                            (uint64_t)s->rejected_unactuated +
+                            (uint64_t)s->rejected_nonfinite +
+                            (uint64_t)s->rejected_bad_length +
+                            (uint64_t)s->rejected_undecodable +
+                            (uint64_t)s->rejected_stale);
+    fprintf(f, "  last: run state %s, commands accepted %" PRId64
+               ", rejected %" PRId64 " (unknown joint %" PRId64
+               ", unactuated %" PRId64 ", non-finite %" PRId64
+               ", bad length %" PRId64 ", undecodable %" PRId64 ", stale %" PRId64
+               "), controls rejected %" PRId64 ", watchdog trips %" PRId64
+               ", lockstep timeouts %" PRId64 ", numeric faults %" PRId64
+               ", overruns %" PRId64 ", states published %" PRId64 "\n",
+            s->run_state, s->commands_accepted, rej, s->rejected_unknown_joint,
+            s->rejected_unactuated, s->rejected_nonfinite, s->rejected_bad_length,
+            s->rejected_undecodable, s->rejected_stale, s->controls_rejected,
+            s->watchdog_trips, s->lockstep_timeouts, s->numeric_faults,
+            s->overruns, s->states_published);
+}
+
 static void summarize(l2c *c, const lag_log_stats *ls, FILE *f)
 {
     fprintf(f, "records: %" PRId64 " (%" PRId64 " larger than %d bytes passed over; %" PRId64
@@ -619,29 +648,7 @@ static void summarize(l2c *c, const lag_log_stats *ls, FILE *f)
                         h->resets, h->repeats);
             break;
         case LAG_WIRE_STATUS:
-            if (h->have_status) {
-                const lag_wire_status *s = &h->last_status;
-                /* counters from the bus: summed in unsigned arithmetic (a hostile sum wraps,
-                 * it does not overflow) */
-                int64_t rej = (int64_t)((uint64_t)s->rejected_unknown_joint +
-                                        (uint64_t)s->rejected_unactuated +
-                                        (uint64_t)s->rejected_nonfinite +
-                                        (uint64_t)s->rejected_bad_length +
-                                        (uint64_t)s->rejected_undecodable +
-                                        (uint64_t)s->rejected_stale);
-                fprintf(f, "  last: run state %s, commands accepted %" PRId64
-                           ", rejected %" PRId64 " (unknown joint %" PRId64
-                           ", unactuated %" PRId64 ", non-finite %" PRId64
-                           ", bad length %" PRId64 ", undecodable %" PRId64 ", stale %" PRId64
-                           "), controls rejected %" PRId64 ", watchdog trips %" PRId64
-                           ", lockstep timeouts %" PRId64 ", numeric faults %" PRId64
-                           ", overruns %" PRId64 ", states published %" PRId64 "\n",
-                        s->run_state, s->commands_accepted, rej, s->rejected_unknown_joint,
-                        s->rejected_unactuated, s->rejected_nonfinite, s->rejected_bad_length,
-                        s->rejected_undecodable, s->rejected_stale, s->controls_rejected,
-                        s->watchdog_trips, s->lockstep_timeouts, s->numeric_faults,
-                        s->overruns, s->states_published);
-            }
+            if (h->have_status) summarize_status(&h->last_status, f);
             break;
         case LAG_WIRE_EVENT:
             fputs("  events:", f);

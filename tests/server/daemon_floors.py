@@ -12,9 +12,6 @@ header (X.h belongs to X.c; a header's includes count as its owner's). Fails whe
 Prints the floors (0: calls no other daemon file) and, on failure, each circle with the
 calls and includes that make it.
 
-The loop's clocks (rt_mono_ns, rt_wall_us) are read by every floor and call nothing:
-calls to them draw no edge, wherever they are defined.
-
 Usage: daemon_floors.py DIR   (DIR: server/daemon)
 """
 import os
@@ -22,7 +19,6 @@ import re
 import sys
 
 LOOP_C, LOOP_H = "realtime.c", "rt_server.h"
-CLOCKS = {"rt_mono_ns", "rt_wall_us"}
 
 
 def strip(text):
@@ -59,7 +55,7 @@ def main(d):
 
     for f in sources:
         for name in sorted(set(CALL.findall(text[f]))):
-            if name in CLOCKS or name not in defined:
+            if name not in defined:
                 continue
             add(f, defined[name], "calls " + name)
 

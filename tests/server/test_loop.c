@@ -418,6 +418,75 @@ static void case_status_hz(int arg)
     stop_server();
 }
 
+/* A scene built in code meets the scene's rules as a loaded one does: rt_open refuses each
+ * bad real-time value with the rule's text, naming the key (lag_scene_check), and a prefix
+ * too long with the very text the loader gives for it in a file. */
+static void case_scene_rules(int arg)
+{
+    (void)arg;
+    static const struct {
+        const char *key, *rule;
+        double v;
+    } bad[] = {
+        {"publish_hz", "expected > 0 and finite, 1/publish_hz a whole number of ticks", -1},
+        {"publish_hz", "expected > 0 and finite, 1/publish_hz a whole number of ticks", NAN},
+        {"realtime.rate", "expected > 0 and finite (sim s per wall s), got 0", 0},
+        {"realtime.rate", "expected > 0 and finite (sim s per wall s), got inf", INFINITY},
+        {"realtime.status_hz", "expected > 0 and finite (Hz), got -5", -5},
+        {"realtime.lockstep_retry", "expected >= 0 and finite (wall s), got -0.5", -0.5},
+        {"realtime.lockstep_timeout", "expected >= 0 and finite (wall s), got inf", INFINITY},
+        {"realtime.command_timeout", "expected >= 0 (sim s; inf: never), got -1", -1},
+        {"realtime.command_timeout", "expected >= 0 (sim s; inf: never), got nan", NAN},
+    };
+    char err[512], want[256];
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        scene(LAG_RT_REALTIME);
+        const char *k = bad[i].key;
+        double *at = !strcmp(k, "publish_hz")            ? &g_sc.publish_hz
+                   : !strcmp(k, "realtime.rate")         ? &g_sc.realtime.rate
+                   : !strcmp(k, "realtime.status_hz")    ? &g_sc.realtime.status_hz
+                   : !strcmp(k, "realtime.lockstep_retry") ? &g_sc.realtime.lockstep_retry
+                   : !strcmp(k, "realtime.lockstep_timeout") ? &g_sc.realtime.lockstep_timeout
+                                                         : &g_sc.realtime.command_timeout;
+        *at = bad[i].v;
+        ENSURE(rt_open(&g_srv, &g_sc, &g_opts, 1 * SEC, true, err, sizeof err) ==
+               LAGSIMD_EXIT_USAGE);
+        snprintf(want, sizeof want, "bad scene: %s: %s", k, bad[i].rule);
+        ENSUREF(strstr(err, want), "%s = %g: \"%s\", expected \"%s\"", k, bad[i].v, err, want);
+    }
+    /* a period of no tick (ticks_per_period 0), and of more than 2^53 ticks */
+    static const int64_t ticks[] = {0, (1LL << 53) + 1};
+    for (int i = 0; i < 2; i++) {
+        scene(LAG_RT_REALTIME);
+        g_sc.ticks_per_period = ticks[i];
+        ENSURE(rt_open(&g_srv, &g_sc, &g_opts, 1 * SEC, true, err, sizeof err) ==
+               LAGSIMD_EXIT_USAGE);
+        ENSUREF(strstr(err, "bad scene: publish_hz: expected > 0 and finite, 1/publish_hz a "
+                            "whole number of ticks (1 to 2^53)"), "%s", err);
+    }
+    /* lcm.prefix: empty, and 54 characters, in code and in a file */
+    const char *rule = "lcm.prefix: expected a channel prefix of 1 to 53 characters, got ";
+    scene(LAG_RT_REALTIME);
+    g_sc.lcm.prefix[0] = '\0';
+    ENSURE(rt_open(&g_srv, &g_sc, &g_opts, 1 * SEC, true, err, sizeof err) == LAGSIMD_EXIT_USAGE);
+    snprintf(want, sizeof want, "bad scene: %s0 ", rule);
+    ENSUREF(strstr(err, want), "\"%s\", expected \"%s\"", err, want);
+    char p54[55];
+    memset(p54, 'P', 54);
+    p54[54] = '\0';
+    scene(LAG_RT_REALTIME);
+    snprintf(g_sc.lcm.prefix, sizeof g_sc.lcm.prefix, "%s", p54);
+    ENSURE(rt_open(&g_srv, &g_sc, &g_opts, 1 * SEC, true, err, sizeof err) == LAGSIMD_EXIT_USAGE);
+    const char *tail = strstr(err, rule);
+    ENSUREF(tail && !strncmp(err, "bad scene: ", 11), "%s", err);
+    char yaml[256], lerr[512];
+    snprintf(yaml, sizeof yaml, "model: dipc\nlcm:\n  prefix: %s\n", p54);
+    static lag_scene loaded;
+    ENSURE(lag_scene_load_buffer("rules.yaml", yaml, strlen(yaml), NULL, 0, &loaded, lerr,
+                                 sizeof lerr) != LAG_OK);
+    ENSUREF(strstr(lerr, tail), "the loader: \"%s\"; rt_open: \"%s\"", lerr, tail);
+}
+
 /* lockstep_timeout 1e10 or 1e300 s: the wait is (practically) for ever; no timeout event,
  * no period, and the loop sleeps (a wake-up per status). lockstep_timeout 0: the first
  * wait times out at once, then the server waits without stepping (it never steps without
@@ -1567,7 +1636,7 @@ int main(int argc, char **argv)
         {"lockstep_retry", case_lockstep_retry, 0, 0}, {"lockstep_loss", case_lockstep_loss, 0, 0},
         {"other_plant", case_other_plant, 0, 0}, {"messages", case_messages, 0, 0},
         {"reject_names", case_reject_names, 0, 0}, {"waits", case_waits, 0, 0},
-        {"live_error", case_live_error, 0, 0},
+        {"live_error", case_live_error, 0, 0},  {"scene_rules", case_scene_rules, 0, 0},
     };
     /* a failed check ends the case: what follows it needs what failed */
     const lt_program p = {.cases = cases, .n = (int)(sizeof cases / sizeof cases[0]),

@@ -19,6 +19,14 @@
   check_structure.py function_length SOURCE_DIR [--max 80]
       No C function in server/, clients/, bench/ is longer than 80 lines (universal-ctags:
       from the line of its name to the line of its closing brace).
+  check_structure.py ticks SOURCE_DIR
+      Time to ticks is converted by the core alone (lag_ticks_ceil / _floor / _exact,
+      lagsim.h, one tolerance LAG_TICK_TOL): no C file in server/ (but server/core/),
+      clients/, bench/ rounds a time divided by a dt (llround, lround, ceil, floor, round,
+      trunc, rint, or an integer cast of x + 0.5, on `t / dt`, `t / sc->sim.integrator.dt`,
+      or on a variable set from one a few lines before) or keeps a tolerance of its own in
+      ticks (`1e-9 * dt`). A few files wait or keep a rule of their own (TICKS_EXEMPT):
+      the check fails when one no longer needs its exemption, so the list only shrinks.
 
 Each prints what breaks the rule, one line each, and exits 1 then; 0 when nothing does.
 """
@@ -236,13 +244,91 @@ def check_function_length(src, limit):
                            f'(at most {limit})'))
     return [b for _, b in sorted(bad, reverse=True)]
 
+# ---------------------------------------------------------------- ticks
+
+# (file, why): files that still convert by hand.
+TICKS_EXEMPT = {
+    # a run's length (--duration) in ticks: a guard that grows with the count
+    # (x (1 - 1e-12) - 1e-9); the core's fixed LAG_TICK_TOL gives one tick more where the
+    # rounding of t / dt passes 1e-9 ticks (18.0405 s at dt 1 us: 18040501 ticks)
+    'server/daemon/rt_pace.c': 'rt_ticks_for: a tolerance that grows with the count',
+    # the loader's period check accepts |r - k| <= 1e-9 r, more than lag_ticks_exact's
+    # 1e-9 for r > 1: switching would refuse periods it accepts
+    'server/scene/scene_schema.c': 'check_period: a tolerance that grows with the count',
+    # files under another change at the time of writing
+    'server/accuracy/cost.c': 'the cost table\'s period in ticks',
+    'bench/bench_common.c': 'the benchmarks\' period in ticks',
+    'bench/accuracy_choice.c': 'the period in ticks',
+    'bench/peer_mujoco.c': 'the period in ticks',
+    'bench/peer_sundials.c': 'the period in ticks',
+}
+
+ROUND = r'\b(?:llround|lround|llrint|lrint|ceil|floor|round|trunc|rint|nearbyint)\s*\('
+CAST = r'\(\s*(?:int64_t|int|long|long\s+long|size_t|uint64_t)\s*\)\s*\('
+BY_DT = r'/\s*(?:\(\s*double\s*\)\s*)?(?:[A-Za-z_]\w*(?:->|\.))*dt\b'
+TICKS_DIRECT = re.compile(ROUND + r'[^;]*?' + BY_DT + r'|' + CAST + r'[^;]*?' + BY_DT +
+                          r'[^;]*?\+\s*0\.5\s*\)')
+TICKS_TOL = re.compile(r'\b(?:1e-9|1e-12|LAG_TICK_TOL)\s*\*\s*(?:[A-Za-z_]\w*(?:->|\.))*dt\b')
+TICKS_SET = re.compile(r'\b([A-Za-z_]\w*)\s*=(?!=)[^;]*?' + BY_DT + r'[^;]*;')
+TICKS_NEAR = 20  # lines after the assignment in which rounding the variable counts
+
+
+def c_code(text):
+    """The C text with comments blanked and string literals emptied (lines kept)."""
+    text = re.sub(r'/\*.*?\*/', lambda m: '\n' * m.group(0).count('\n') + ' ', text, flags=re.S)
+    text = re.sub(r'//[^\n]*', ' ', text)
+    return re.sub(r'"(?:\\.|[^"\\\n])*"', '""', text)
+
+
+def ticks_findings(src):
+    """{file: [line, ...]} of hand conversions of a time to ticks outside server/core."""
+    out = {}
+    core = os.path.join('server', 'core') + os.sep
+    for top in ('server', 'clients', 'bench'):
+        for path in c_files(src, top):
+            rel = os.path.relpath(path, src)
+            if rel.startswith(core):
+                continue
+            code = c_code(open(path, encoding='utf-8', errors='replace').read())
+            lines = set()
+            for rx in (TICKS_DIRECT, TICKS_TOL):
+                lines |= {code.count('\n', 0, m.start()) + 1 for m in rx.finditer(code)}
+            for m in TICKS_SET.finditer(code):
+                var = re.escape(m.group(1))
+                start = code.count('\n', 0, m.start()) + 1
+                after = code[m.end():]
+                near = '\n'.join(after.split('\n')[:TICKS_NEAR])
+                rounded = re.search(ROUND + r'[^;]*?\b' + var + r'\b|' + CAST + r'\s*' + var +
+                                    r'\s*\+\s*0\.5\s*\)', near)
+                if rounded:
+                    lines.add(start)
+            if lines:
+                out[rel] = sorted(lines)
+    return out
+
+
+def check_ticks(src):
+    bad = []
+    found = ticks_findings(src)
+    for rel, lines in sorted(found.items()):
+        if rel in TICKS_EXEMPT:
+            continue
+        for ln in lines:
+            bad.append(f'{rel}:{ln}: converts a time to ticks by hand: call lag_ticks_ceil, '
+                       'lag_ticks_floor or lag_ticks_exact (lagsim.h)')
+    for rel in sorted(TICKS_EXEMPT):
+        if rel not in found:
+            bad.append(f'{rel}: exempt from the ticks check but no longer needs it: drop it '
+                       'from TICKS_EXEMPT in tests/structure/check_structure.py')
+    return bad
+
 # ---------------------------------------------------------------- main
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument('rule', choices=['harness', 'names', 'docs', 'function_length'])
+    ap.add_argument('rule', choices=['harness', 'names', 'docs', 'function_length', 'ticks'])
     ap.add_argument('dirs', nargs='+', help='SOURCE_DIR and/or BUILD_DIR (see above)')
     ap.add_argument('--ctest', default='ctest')
     ap.add_argument('--json', help="ctest --show-only=json-v1's output, instead of running it")
@@ -254,6 +340,8 @@ def main():
         bad = check_names(load_tests(a.dirs[0], a.ctest, a.json))
     elif a.rule == 'docs':
         bad = check_docs(a.dirs[0], load_tests(a.dirs[1], a.ctest, a.json))
+    elif a.rule == 'ticks':
+        bad = check_ticks(a.dirs[0])
     else:
         bad = check_function_length(a.dirs[0], a.max)
     for b in bad:

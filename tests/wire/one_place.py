@@ -27,10 +27,6 @@ DIRS = ("server", "clients", "bench")
 
 # (check, file): files that still hold a copy and are to call the wire layer instead.
 EXEMPT = {
-    ("clock", "server/daemon/rt_log.c"),       # its writer's pacing and sem_timedwait deadline
-    ("clock", "server/daemon/offline.c"),      # the CPU time of an offline run
-    ("channels", "server/daemon/realtime.c"),  # --log's <PREFIX>_INPUT
-    ("channels", "server/daemon/replay.c"),    # the channels --replay reads
     ("channels", "clients/lagsim_controller.c"),  # messages naming <PREFIX>_SCENE
 }
 

@@ -498,7 +498,13 @@ double lag_sim_time(const lag_sim *s);
  * through these three, and so should any other part (one rule, one tolerance). A time
  * within LAG_TICK_TOL ticks (LAG_TICK_TOL dt) of a boundary counts as on it: the rounding
  * of t = k dt, computed or read back from text. Saturated: a count past INT64_MAX (t =
- * 1e300, or NaN) gives INT64_MAX, a tick never reached; t <= 0 gives 0. */
+ * 1e300, or NaN) gives INT64_MAX, a tick never reached; t <= 0 gives 0.
+ * The tolerance is LAG_TICK_TOL of a tick whatever the count: past a few million ticks
+ * the rounding of t / dt itself can pass it (lag_ticks_ceil(18.0405, 1e-6) is 18040501).
+ * Two rules grow with the count and so do not call these: the loader's period check
+ * (1/publish_hz = k dt within 1e-9 k) and a run's length in ticks (lagsimd's
+ * rt_ticks_for, within 1e-12 of the count plus 1e-9); tests/structure/check_structure.py
+ * (ticks) keeps every other conversion outside the core on these three. */
 #define LAG_TICK_TOL 1e-9
 /* The first tick boundary at or after t: ceil(t / dt), t just above a boundary on it
  * (when a disturbance starts; the ticks a run of t seconds takes). */
