@@ -20,7 +20,4 @@ if(LAGSIM_STRUCTURE_PYTHON3)
   set_tests_properties(structure_harness structure_names structure_docs
                        structure_function_length structure_ticks
                        PROPERTIES TIMEOUT 120 LABELS structure)
-  # Off until the functions over 80 lines are split (it lists them: `ctest -R
-  # structure_function_length -V` after removing this line, or run the script).
-  set_tests_properties(structure_function_length PROPERTIES DISABLED TRUE)
 endif()
