@@ -405,7 +405,7 @@ if(LAGSIM_FUZZ)
 endif()
 string(REPLACE ";" " " readme_lcm_libs "${LCM_LINK_LIBRARIES}")
 set(readme_c_build
-  "--c-build=${CMAKE_C_COMPILER} -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror ${readme_c_flags} {src} -o {out} -I${PROJECT_SOURCE_DIR}/clients -I${PROJECT_SOURCE_DIR}/server/wire -I${CMAKE_BINARY_DIR}/lcmtypes/c $<TARGET_FILE:lagsim_client> $<TARGET_FILE:lagsim_wire> $<TARGET_FILE:lagsim_lcmtypes> ${readme_lcm_libs} -lm")
+  "--c-build=${CMAKE_C_COMPILER} -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror ${readme_c_flags} {src} -o {out} -I${PROJECT_SOURCE_DIR}/clients -I${PROJECT_SOURCE_DIR}/server/include -I${PROJECT_SOURCE_DIR}/server/wire -I${CMAKE_BINARY_DIR}/lcmtypes/c $<TARGET_FILE:lagsim_client> $<TARGET_FILE:lagsim_wire> $<TARGET_FILE:lagsim_wire_base> $<TARGET_FILE:lagsim_core> $<TARGET_FILE:lagsim_lcmtypes> ${readme_lcm_libs} -lm")
 set(readme_langs c python)
 if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
   list(APPEND readme_langs lua)
