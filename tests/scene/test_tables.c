@@ -338,14 +338,16 @@ static void doc_keeps_state(void)
     for (p += strspn(p, seps); p < end; p += strspn(p, seps)) {
         size_t len = strcspn(p, seps);
         if (p + len > end) len = (size_t)(end - p);
+        if (len == 3 && strncmp(p, "and", 3) == 0) { /* "a, b and c" */
+            p += len;
+            continue;
+        }
         int row = -1;
         for (int k = 0; k < LAG_EFF_COUNT; k++) {
             const char *r = lag_effect_info_get(k).name;
             if (strlen(r) == len && strncmp(r, p, len) == 0) row = k;
         }
-        if (len == 3 && strncmp(p, "and", 3) == 0)
-            ;
-        else if (row < 0)
+        if (row < 0)
             LT_FAIL("docs: %s lists '%.*s' among the effects that keep state; the core's table "
                     "has no such effect", file, (int)len, p);
         else if (!lag_effect_info_get(row).keeps_state)
