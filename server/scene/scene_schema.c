@@ -14,7 +14,7 @@
  * Order: `model` first (parameters, joint names and the length of q depend on it), then
  * the keys other values are measured against (integrator, publish_hz, explode_limit),
  * then every other key in file order. Models, their parameters and their joints come from
- * the core's lag_model_info; integrators from lag_method_name.
+ * the core's lag_model_info; integrators from lag_method_from_name and lag_method_names.
  */
 #include <errno.h>
 #include <limits.h>
@@ -446,12 +446,8 @@ static int key_initial(conv *cv, const ynode *nd, const char *path)
 
 static int key_method(conv *cv, const ynode *nd, const char *path)
 {
-    char allowed[256] = "";
-    for (int i = 0; i < LAG_METHOD_COUNT; i++) {
-        size_t used = strlen(allowed);
-        snprintf(allowed + used, sizeof allowed - used, "%s%s", i ? ", " : "",
-                 lag_method_name((lag_method)i));
-    }
+    char allowed[256];
+    lag_method_names(allowed, sizeof allowed);
     char what[300];
     snprintf(what, sizeof what, "a method (%s)", allowed);
     const char *s;

@@ -386,7 +386,9 @@ static void check_info(void)
         ENSURE(mi && mi->order == facts[i].order && mi->adaptive == facts[i].adaptive &&
                mi->implicit == facts[i].implicit && mi->canonical == facts[i].canonical);
     }
-    ENSURE(lag_method_from_name("leapfrog") == -1);
+    /* not a method's name (a method is a word with hyphens), not a would-be method */
+    ENSURE(lag_method_from_name("no such method!") == -1 && lag_method_from_name("") == -1 &&
+           lag_method_from_name(NULL) == -1);
 }
 
 /* ---------------------------------------------------------------- the course assignment's DIPC */

@@ -834,8 +834,11 @@ static void off(void)
 /* ------------------------------------------------------------------ keeps_state */
 /* The table's keeps_state against what a restart does: a run of each effect that, under
  * its settings, keeps no state of its own (lag_effects_keeping_state) is restarted from
- * its (q, qd, tick) halfway and must go on bit for bit as the run itself; the effects that
- * keep state say so exactly for the settings that make them (the actuator with a lag). */
+ * its (q, qd, tick) halfway and must go on bit for bit as the run itself (state and
+ * observed state); the effects that keep state say so exactly for the settings that make
+ * them (the actuator with a lag). Every row of the core's table must act under the
+ * settings restart_settings gives it (restart_acts), so that a row left out there fails by
+ * name instead of restarting exactly because it acts on nothing. */
 static void restart_settings(lag_sim_def *d, uint32_t bit)
 {
     lag_effects_def *e = &d->effects;
@@ -857,6 +860,20 @@ static void restart_settings(lag_sim_def *d, uint32_t bit)
     }
 }
 
+/* Whether the definition's effects change its run of `ticks` ticks under the restart's
+ * input (state, observed state, events or work) against the same definition with every
+ * effect off; false too when the core refuses the definition. */
+static bool restart_acts(const lag_sim_def *d, int64_t ticks)
+{
+    lag_sim_def bare = *d;
+    bare.effects.enabled = 0;
+    lag_sim s0, s1;
+    double o0[6], o1[6];
+    if (!off_run(&s1, d, ticks, o1)) return false;
+    ENSURE(off_run(&s0, &bare, ticks, o0));
+    return !off_same(&s0, o0, &s1, o1);
+}
+
 static void restart(void)
 {
     int checked = 0;
@@ -865,6 +882,12 @@ static void restart(void)
         lag_sim_def d = lag_default_sim_def(LAG_MODEL_CARTPOLE);
         d.q0[1] = 0.4; d.qd0[0] = 0.3;
         restart_settings(&d, inf.bit);
+        if (!restart_acts(&d, 300)) {
+            LT_FAIL("keeps_state: effect '%s' of the core's table changes no run under the settings "
+                    "the test gives it (give it settings in restart_settings)", inf.name);
+            continue;
+        }
+        ENSURE(true);
         const uint32_t keeps = lag_effects_keeping_state(&d.effects);
         /* its own bit at most, and only if the table says it may keep state */
         ENSURE((keeps & ~inf.bit) == 0 && (inf.keeps_state || keeps == 0));
@@ -887,7 +910,11 @@ static void restart(void)
         ENSURE(lag_sim_advance(&a, 150, false) == LAG_OK);
         ENSURE(lag_sim_advance(&b, 150, false) == LAG_OK);
         size_t nb = (size_t)a.nq * sizeof(double);
-        bool same = memcmp(a.q, b.q, nb) == 0 && memcmp(a.qd, b.qd, nb) == 0;
+        double oa[6] = {0}, ob[6] = {0};
+        lag_sim_observe(&a, oa, oa + 3);
+        lag_sim_observe(&b, ob, ob + 3);
+        bool same = memcmp(a.q, b.q, nb) == 0 && memcmp(a.qd, b.qd, nb) == 0 &&
+                    memcmp(oa, ob, sizeof oa) == 0;
         if (!same) LT_FAIL("%s keeps no state by the table, but a restart at tick 150 differs", inf.name);
         else ENSURE(same);
         checked++;

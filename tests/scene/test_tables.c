@@ -9,11 +9,15 @@
  *                  (a scene with that effect alone, through rt_open on memq://), and the
  *                  message's effects field can hold every row's name at once
  *   keeps_state    a row that says it keeps no state of its own restarts exactly from
- *                  (q, qd, tick), which is what replay takes it at (replay.c)
+ *                  (q, qd, tick), state and published state, which is what replay takes
+ *                  it at (replay.c)
  *   view           every effect the browser view asks about (view.js, hasEffect) is a row
  *   docs           docs/effects.md's table of effects and docs/scenes.md's table of
- *                  ranges list every row, and name no effect the core does not have
- *   docs_models    docs/scenes.md names every model of the core's model table
+ *                  ranges list every row, and name no effect the core does not have;
+ *                  docs/server.md's list of the effects a replay restart cannot
+ *                  reproduce is the rows with keeps_state
+ *   docs_models    docs/scenes.md names every model of the core's model table, and
+ *                  README.md's first paragraph each model (by a phrase of its prose)
  *
  * Files are read from the source tree (LAGSIM_SOURCE_DIR).
  */
@@ -240,9 +244,13 @@ static void case_keeps_state(int arg)
         lag_sim_set_input(&c, u);
         ENSURE(lag_sim_advance(&c, 1500, true) == LAG_OK);
         size_t nb = (size_t)a.nq * sizeof(double);
-        if (memcmp(a.q, c.q, nb) != 0 || memcmp(a.qd, c.qd, nb) != 0)
+        double oa[6] = {0}, oc[6] = {0}; /* the published state too (noise) */
+        lag_sim_observe(&a, oa, oa + 3);
+        lag_sim_observe(&c, oc, oc + 3);
+        if (memcmp(a.q, c.q, nb) != 0 || memcmp(a.qd, c.qd, nb) != 0 || memcmp(oa, oc, sizeof oa) != 0)
             LT_FAIL("keeps_state: effect '%s' says it keeps no state, but a restart from (q, qd, "
-                    "tick) departs from the run (q[0] %.17g vs %.17g)", e.name, c.q[0], a.q[0]);
+                    "tick) departs from the run (q[0] %.17g vs %.17g, observed %.17g vs %.17g)",
+                    e.name, c.q[0], a.q[0], oc[0], oa[0]);
         else
             ENSURE(true);
         checked++;
@@ -311,6 +319,54 @@ static void doc_lists(const char *file, const char *start, const char *end, cons
     }
 }
 
+/* docs/server.md ("Gaps") lists the effects a restart from a logged state cannot
+ * reproduce as "(`lag_effect_info.keeps_state`: a, b, c)": exactly the rows that may keep
+ * state of their own, which is what replay.c takes. */
+static void doc_keeps_state(void)
+{
+    static const char file[] = "docs/server.md", start[] = "(`lag_effect_info.keeps_state`: ";
+    if (!read_source(file, g_text, sizeof g_text)) return;
+    const char *p = strstr(g_text, start);
+    if (!p) {
+        LT_FAIL("docs: %s has no \"%s\" any more (the test's landmark)", file, start);
+        return;
+    }
+    p += strlen(start);
+    const char *end = p + strcspn(p, ")");
+    bool listed[LAG_EFF_COUNT] = {false};
+    static const char seps[] = ", \n";
+    for (p += strspn(p, seps); p < end; p += strspn(p, seps)) {
+        size_t len = strcspn(p, seps);
+        if (p + len > end) len = (size_t)(end - p);
+        if (len == 3 && strncmp(p, "and", 3) == 0) { /* "a, b and c" */
+            p += len;
+            continue;
+        }
+        int row = -1;
+        for (int k = 0; k < LAG_EFF_COUNT; k++) {
+            const char *r = lag_effect_info_get(k).name;
+            if (strlen(r) == len && strncmp(r, p, len) == 0) row = k;
+        }
+        if (row < 0)
+            LT_FAIL("docs: %s lists '%.*s' among the effects that keep state; the core's table "
+                    "has no such effect", file, (int)len, p);
+        else if (!lag_effect_info_get(row).keeps_state)
+            LT_FAIL("docs: %s lists effect '%s' as keeping state; its row keeps none", file,
+                    lag_effect_info_get(row).name);
+        else
+            listed[row] = true;
+        p += len;
+    }
+    for (int k = 0; k < LAG_EFF_COUNT; k++) {
+        lag_effect_info e = lag_effect_info_get(k);
+        if (e.keeps_state && !listed[k])
+            LT_FAIL("docs: %s does not list effect '%s', whose row keeps state, among those a "
+                    "replay restart cannot reproduce", file, e.name);
+        else
+            ENSURE(listed[k] == e.keeps_state);
+    }
+}
+
 static void case_docs(int arg)
 {
     (void)arg;
@@ -321,6 +377,47 @@ static void case_docs(int arg)
     doc_lists("docs/effects.md", "```yaml\neffects:\n", "```", "\n  ", ":", others);
     /* scenes.md: the table of ranges */
     doc_lists("docs/scenes.md", "| key | range | unit |", "\n\n", "`effects.", ".[`", others);
+    /* server.md: the effects a replay restart cannot reproduce */
+    doc_keeps_state();
+}
+
+/* How README.md's first paragraph names each model in its prose (it names them as a reader
+ * knows them, not by the table's names); a model of the core's table without a phrase
+ * here fails: name it in the README and give its phrase. */
+static const char *const readme_phrase[LAG_MODEL_COUNT] = {
+    [LAG_MODEL_STICK] = "sliding stick",
+    [LAG_MODEL_MANIPULATOR] = "manipulator",
+    [LAG_MODEL_DIPC] = "double inverted pendulum on a cart (DIPC)",
+    [LAG_MODEL_CARTPOLE] = "cart-pole",
+    [LAG_MODEL_FLYING_STICK] = "can leave its floor", /* the sliding stick, flying */
+};
+
+static void readme_models(void)
+{
+    if (!read_source("README.md", g_text, sizeof g_text)) return;
+    /* the first paragraph after the title, its whitespace and emphasis folded */
+    char para[2048];
+    size_t n = 0;
+    const char *p = strstr(g_text, "\n\n");
+    p = p ? p + 2 : g_text;
+    for (; *p && !(p[0] == '\n' && p[1] == '\n') && n + 1 < sizeof para; p++) {
+        if (*p == '*') continue;
+        char c = (*p == '\n') ? ' ' : *p;
+        if (c == ' ' && n && para[n - 1] == ' ') continue;
+        para[n++] = c;
+    }
+    para[n] = '\0';
+    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
+        const char *name = lag_model_info_get((lag_model_kind)k)->name;
+        if (!readme_phrase[k])
+            LT_FAIL("docs: README.md: the test knows no phrase for model '%s' (name it in the "
+                    "README's first paragraph and give the phrase in readme_phrase)", name);
+        else if (!strstr(para, readme_phrase[k]))
+            LT_FAIL("docs: README.md's first paragraph does not name model '%s' (\"%s\")", name,
+                    readme_phrase[k]);
+        else
+            ENSURE(true);
+    }
 }
 
 /* docs/scenes.md names every model of the core's table where it lists them: the comment
@@ -356,6 +453,7 @@ static void case_docs_models(int arg)
         else
             ENSURE(row);
     }
+    readme_models();
 }
 
 static const lt_case cases[] = {
