@@ -42,6 +42,7 @@
 
 #define W_ANSWER_S 0.5  /* a SET or RESET_TO unanswered this long is sent again */
 #define W_TRIES 8       /* ... this many times at most */
+#define W_SET_REFUSALS 500 /* SETs refused for the daemon's rate, 20 ms apart: 10 s */
 #define W_QUIET_S 0.25  /* a run with no new state for this long: a status is asked for */
 #define W_LOG_WAIT_S 3.0 /* the log's writer writes within 0.1 s; this is its margin */
 
@@ -58,7 +59,7 @@ struct eval_worker {
     long missing_refs;   /* states whose reference did not come before them */
     double q0[EVAL_JOINTS_MAX], qd0[EVAL_JOINTS_MAX];
     const char *set_wait; /* "key=value" whose set event is awaited */
-    bool set_heard;
+    bool set_heard, set_refused;
     double t_heard;       /* the sim time of the last state heard */
     bool moved;           /* a state after sim time 0 heard since the STEP */
     lcm_t *cmd;           /* the command URL: the controller's answers, as the daemon gets
@@ -137,6 +138,10 @@ static void w_on_event(const lag_client_event *ev, void *user)
     else if (!strcmp(ev->kind, "numeric_fault") && w->armed) w->fault = true;
     else if (!strcmp(ev->kind, "set") && w->set_wait && !strcmp(ev->detail, w->set_wait))
         w->set_heard = true;
+    /* over the daemon's rate of SETs: sent again a moment later */
+    else if (!strcmp(ev->kind, "control_rejected") && w->set_wait &&
+             strstr(ev->detail, w->set_wait) && strstr(ev->detail, "changes a second"))
+        w->set_refused = true;
 }
 
 /* Handles messages until *flag or `seconds`; -1 on timeout or a client error. */
@@ -286,27 +291,38 @@ void eval_worker_stop(eval_worker *w)
 long eval_worker_runs(const eval_worker *w) { return w->runs; }
 
 /* ---------------------------------------------------------------- a run */
+/* One SET until its `set` event is heard: sent again after W_ANSWER_S without an answer
+ * (W_TRIES times), or a moment after the daemon refused it for its rate of SETs. */
+static int set_one(eval_worker *w, const char *kv, char *err, size_t errlen)
+{
+    char key[EVAL_SET_LEN];
+    snprintf(key, sizeof key, "%s", kv);
+    char *eq = strchr(key, '=');
+    if (!eq) return 0;
+    *eq = '\0';
+    w->set_wait = kv;
+    w->set_heard = false;
+    int lost = 0, refused = 0;
+    while (!w->set_heard && lost < W_TRIES && refused < W_SET_REFUSALS) {
+        w->set_refused = false;
+        if (lag_client_set(w->cl, key, eq + 1) != LAG_CLIENT_OK) break;
+        double end = eval_now() + W_ANSWER_S;
+        while (!w->set_heard && !w->set_refused && eval_now() < end && w_handle(w, 5) >= 0) {
+        }
+        if (w->set_refused) refused++, eval_sleep(0.02);
+        else if (!w->set_heard) lost++;
+    }
+    w->set_wait = NULL;
+    if (w->set_heard) return 0;
+    snprintf(err, errlen, "the kept lagsimd did not take SET %s", kv);
+    return -1;
+}
+
 static int set_keys(eval_worker *w, const char *const *sets, int nsets, char *err,
                     size_t errlen)
 {
-    for (int i = 0; i < nsets; i++) {
-        if (!strncmp(sets[i], "initial.", 8)) continue;
-        char key[EVAL_SET_LEN];
-        snprintf(key, sizeof key, "%s", sets[i]);
-        char *eq = strchr(key, '=');
-        if (!eq) continue;
-        *eq = '\0';
-        w->set_wait = sets[i];
-        w->set_heard = false;
-        for (int t = 0; t < W_TRIES && !w->set_heard; t++)
-            if (lag_client_set(w->cl, key, eq + 1) != LAG_CLIENT_OK ||
-                (w_wait(w, &w->set_heard, W_ANSWER_S) && t == W_TRIES - 1)) {
-                snprintf(err, errlen, "the kept lagsimd did not take SET %s", sets[i]);
-                w->set_wait = NULL;
-                return -1;
-            }
-        w->set_wait = NULL;
-    }
+    for (int i = 0; i < nsets; i++)
+        if (strncmp(sets[i], "initial.", 8) && set_one(w, sets[i], err, errlen)) return -1;
     return 0;
 }
 
@@ -423,9 +439,11 @@ int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets,
     bool whole = !w->fault && w->s.n == (size_t)periods + 1 &&
                  w->s.t[w->s.n - 1] >= t_goal && (!want_ref || !w->missing_refs);
     if (!whole && w->env.verbose)
-        fprintf(stderr, "%s: run %ld of this worker read from the log (%s)\n", w->env.prefix,
-                w->runs, w->fault ? "a fault" : w->s.n != (size_t)periods + 1
-                ? "the bus lost states, or the run stalled" : "the bus lost references");
+        fprintf(stderr, "%s: run %ld of this worker read from the log (%s: %zu of %ld states "
+                        "from the bus, the last at %.6g s)\n", w->env.prefix, w->runs,
+                w->fault ? "a fault" : w->s.n != (size_t)periods + 1
+                ? "the bus lost states, or the run stalled" : "the bus lost references",
+                w->s.n, periods + 1, w->s.n ? w->s.t[w->s.n - 1] : 0.0);
     if (!whole && from_log(w, from, t_goal, res, err, errlen)) return -1;
     res->nj = w->sc.nj;
     res->states = w->s.n;
