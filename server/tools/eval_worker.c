@@ -24,6 +24,7 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -77,10 +78,13 @@ static void w_on_command(const lcm_recv_buf_t *rbuf, const char *channel, void *
         w->t_answered = c.sim_time;
 }
 
-/* What came on either URL, waiting up to ms on the state URL. */
+/* What came on either URL, waiting up to ms for something on one of them. */
 static int w_handle(eval_worker *w, int ms)
 {
-    int rc = lag_client_handle(w->cl, ms);
+    struct pollfd pf[2] = {{lag_client_fileno(w->cl), POLLIN, 0},
+                           {w->cmd ? lcm_get_fileno(w->cmd) : -1, POLLIN, 0}};
+    if (poll(pf, 2, ms) < 0 && errno != EINTR) return -1;
+    int rc = lag_client_handle(w->cl, 0);
     while (w->cmd && lcm_handle_timeout(w->cmd, 0) > 0) {
     }
     return rc;
