@@ -19,41 +19,36 @@
 
 #include "lagsim/lagsim.h"
 
-enum { ROW_NONE, ROW_DAMPING, ROW_FRICTION, ROW_LIMITS, ROW_FLOOR, ROW_ACTUATOR,
-       ROW_DISTURBANCE, ROW_NOISE, ROW_COUNT };
-static const char *const row_names[ROW_COUNT] = {
-    "none (bare model)", "damping", "friction", "limits", "floor", "actuator", "disturbance", "noise",
-};
+/* Rows: the bare model, then each effect of the core's table in its order (row k + 1 is
+ * lag_effect_info_get(k)); an effect this file gives no settings makes the program fail
+ * by name (bench_effects_cost_rows), so a new effect is not left out of the table. */
+enum { ROW_NONE, ROW_COUNT = 1 + LAG_EFF_COUNT };
+
+static const char *row_name(int row)
+{
+    return row == ROW_NONE ? "none (bare model)" : lag_effect_info_get(row - 1).name;
+}
 
 static double now_s(void)
 {
     return lag_clock_mono_s();
 }
 
-/* The scene of one row: the model's moving initial state plus that one effect.
- * Returns false when the effect does not apply to the model (floor: stick only). */
-static bool scene(lag_model_kind kind, int row, lag_sim_def *d)
+/* The settings of effect `bit` on a model of n joints (d's initial state set). Returns
+ * 1, 0 when the effect does not apply to the model (floor: stick only), -1 when this file
+ * has no settings for it. */
+static int effect_settings(uint32_t bit, lag_model_kind kind, int n, lag_sim_def *d)
 {
-    *d = lag_default_sim_def(kind);
-    int n = d->model.nq;
-    switch (kind) {
-    case LAG_MODEL_STICK: d->q0[1] = 1.2; d->qd0[0] = 0.3; break;
-    case LAG_MODEL_MANIPULATOR: d->q0[0] = 0.3; d->q0[1] = 0.3; d->qd0[0] = 1.0; d->qd0[1] = 0.5; break;
-    default: d->q0[1] = 0.3; d->q0[2] = -0.2; break;
-    }
     lag_effects_def *e = &d->effects;
-    switch (row) {
-    case ROW_NONE: break;
-    case ROW_DAMPING:
-        e->enabled = LAG_EFF_DAMPING;
+    e->enabled = bit;
+    switch (bit) {
+    case LAG_EFF_DAMPING:
         for (int i = 0; i < n; i++) e->damping[i] = 0.05;
-        break;
-    case ROW_FRICTION:
-        e->enabled = LAG_EFF_FRICTION;
+        return 1;
+    case LAG_EFF_FRICTION:
         for (int i = 0; i < n; i++) { e->friction_static[i] = 0.2; e->friction_kinetic[i] = 0.1; }
-        break;
-    case ROW_LIMITS: /* stops on every joint; the manipulator's q2 hits its stops */
-        e->enabled = LAG_EFF_LIMITS;
+        return 1;
+    case LAG_EFF_LIMITS: /* stops on every joint; the manipulator's q2 hits its stops */
         for (int i = 0; i < n; i++) {
             e->limit_on[i] = true;
             e->limit_lower[i] = d->q0[i] - 20.0;
@@ -61,29 +56,41 @@ static bool scene(lag_model_kind kind, int row, lag_sim_def *d)
             e->restitution[i] = 0.5;
         }
         if (kind == LAG_MODEL_MANIPULATOR) { e->limit_lower[1] = 0.1; e->limit_upper[1] = 0.8; }
-        break;
-    case ROW_FLOOR:
-        if (kind != LAG_MODEL_STICK) return false;
-        e->enabled = LAG_EFF_FLOOR;
+        return 1;
+    case LAG_EFF_FLOOR:
         e->floor_restitution = 0.3;
-        break;
-    case ROW_ACTUATOR:
-        e->enabled = LAG_EFF_ACTUATOR;
+        return kind == LAG_MODEL_STICK;
+    case LAG_EFF_ACTUATOR:
         for (int i = 0; i < n; i++) { e->actuator_max[i] = 100.0; e->actuator_tau[i] = 0.02; }
-        break;
-    case ROW_DISTURBANCE:
-        e->enabled = LAG_EFF_DISTURBANCE;
+        return 1;
+    case LAG_EFF_DISTURBANCE:
         e->n_disturbances = 2;
         e->disturbances[0] = (lag_disturbance){0.5, 0, true, 0.1, 0.0};
         e->disturbances[1] = (lag_disturbance){1.0, 0, false, 0.2, 0.5};
-        break;
-    case ROW_NOISE:
-        e->enabled = LAG_EFF_NOISE;
+        return 1;
+    case LAG_EFF_NOISE:
         e->noise_seed = 7;
         for (int i = 0; i < n; i++) { e->noise_q[i] = 1e-3; e->noise_qd[i] = 1e-3; }
-        break;
+        return 1;
+    case LAG_EFF_SPRING: /* about each joint's initial position */
+        for (int i = 0; i < n; i++) { e->spring_k[i] = 1.0; e->spring_rest[i] = d->q0[i]; }
+        return 1;
     }
-    return true;
+    return -1;
+}
+
+/* The scene of one row: the model's moving initial state plus that one effect. Returns
+ * effect_settings' answer (1 for the bare model). */
+static int scene(lag_model_kind kind, int row, lag_sim_def *d)
+{
+    *d = lag_default_sim_def(kind);
+    switch (kind) {
+    case LAG_MODEL_STICK: d->q0[1] = 1.2; d->qd0[0] = 0.3; break;
+    case LAG_MODEL_MANIPULATOR: d->q0[0] = 0.3; d->q0[1] = 0.3; d->qd0[0] = 1.0; d->qd0[1] = 0.5; break;
+    default: d->q0[1] = 0.3; d->q0[2] = -0.2; break;
+    }
+    if (row == ROW_NONE) return 1;
+    return effect_settings(lag_effect_info_get(row - 1).bit, kind, d->model.nq, d);
 }
 
 /* ns per tick of one repetition; NAN if the scene faulted. */
@@ -130,7 +137,13 @@ int main(int argc, char **argv)
         for (int row = 0; row < ROW_COUNT; row++)
             for (int kind = 0; kind < LAG_MODEL_COUNT; kind++) {
                 lag_sim_def d;
-                if (!scene((lag_model_kind)kind, row, &d)) { ns[row][kind] = -1.0; continue; }
+                int has = scene((lag_model_kind)kind, row, &d);
+                if (has < 0) {
+                    fprintf(stderr, "effects_cost: effect '%s' of the core's table has no "
+                                    "settings here (effect_settings)\n", row_name(row));
+                    return 1;
+                }
+                if (!has) { ns[row][kind] = -1.0; continue; }
                 double v = measure(&d, 1, &sink);
                 if (isnan(v) || isnan(ns[row][kind])) ns[row][kind] = NAN;
                 else if (v < ns[row][kind]) ns[row][kind] = v;
@@ -145,7 +158,7 @@ int main(int argc, char **argv)
     for (int kind = 0; kind < LAG_MODEL_COUNT; kind++) printf("---:|");
     printf("\n");
     for (int row = 0; row < ROW_COUNT; row++) {
-        printf("| %s |", row_names[row]);
+        printf("| %s |", row_name(row));
         for (int kind = 0; kind < LAG_MODEL_COUNT; kind++) {
             double v = ns[row][kind];
             if (v < 0) printf(" n/a |");

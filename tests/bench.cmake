@@ -7,4 +7,9 @@
 if(LAGSIM_BENCH)
   add_test(NAME bench_quick COMMAND lagsim_bench --quick)
   set_tests_properties(bench_quick PROPERTIES TIMEOUT 120 LABELS bench)
+  # The cost-of-effects table has a row for every effect of the core's table: the
+  # program fails by name on an effect it has no settings for (one repetition here)
+  add_test(NAME bench_effects_cost_rows COMMAND effects_cost 1)
+  set_tests_properties(bench_effects_cost_rows PROPERTIES TIMEOUT 300 LABELS bench
+                       PASS_REGULAR_EXPRESSION "\\| spring \\|")
 endif()
