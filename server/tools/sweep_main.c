@@ -62,7 +62,8 @@ static void usage(FILE *f)
 "                         initial state RESET_TO between runs)\n"
 "      --require EXPR     a run that misses EXPR does not pass (as lagsim-eval)\n"
 "      --csv OUT.csv      the runs' CSV\n"
-"      --plot OUT.png     --metric against each varied key (gnuplot)\n"
+"      --plot OUT.png     --metric against each varied key (gnuplot); runs without\n"
+"                         a value (never settled) on a line at the top\n"
 "      --metric J.M       the metric drawn (default: --require's first, else the first\n"
 "                         joint's iae)\n"
 "  -f, --force            replace existing output files\n"
@@ -75,7 +76,8 @@ static void usage(FILE *f)
 "  -h, --help             this help\n"
 "\n"
 "exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
-"case error, or shard CSVs that do not belong together\n");
+"case error, an output that exists (checked before the first run), or shard CSVs that\n"
+"do not belong together or leave runs out\n");
 }
 
 static int die(const char *fmt, const char *a)
