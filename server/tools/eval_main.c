@@ -154,7 +154,9 @@ static int report(const char *dir, bool force, const char *config, const eval_ca
     for (int j = 0; j < sc->nj; j++) cols[nc++] = s->q[j], cols[nc++] = s->r[j];
     y_range(f, cols, nc, s->n);
     fprintf(f, "set ylabel 'q (m or rad)'\nplot ");
-    for (int j = 0; j < sc->nj; j++)
+    /* a run without a state (gnuplot would warn of a file with no valid points) */
+    if (!s->n) fprintf(f, "NaN t 'no state logged'");
+    for (int j = 0; s->n && j < sc->nj; j++)
         fprintf(f, "%s'%s' u 1:%d w l lw 2 lc %d t '%s', '%s' u 1:%d w l dt 2 lc %d t '%s ref'",
                 j ? ", " : "", dat, 2 + 3 * j, j + 1, sc->joint[j], dat, 3 + 3 * j, j + 1,
                 sc->joint[j]);
@@ -165,13 +167,13 @@ static int report(const char *dir, bool force, const char *config, const eval_ca
     y_range(f, cols, nc, s->n);
     fprintf(f, "set ylabel 'effort (N or N m)'\nplot ");
     int first = 1;
-    for (int j = 0; j < sc->nj; j++) {
+    for (int j = 0; s->n && j < sc->nj; j++) {
         if (!sc->actuated[j]) continue;
         fprintf(f, "%s'%s' u 1:%d w steps lw 1.5 lc %d t '%s effort'", first ? "" : ", ", dat,
                 4 + 3 * j, j + 1, sc->joint[j]);
         first = 0;
     }
-    if (first) fprintf(f, "0 t 'no actuated joint'");
+    if (first) fprintf(f, s->n ? "0 t 'no actuated joint'" : "NaN t 'no state logged'");
     fprintf(f, "\nunset multiplot\n");
     fclose(f);
     /* the PNG itself obeys the output rules too: opened (and refused) here first */
