@@ -56,6 +56,7 @@ static int read_text(errbuf *e, const ynode *nd, const char *what, char *out, si
 static int read_case(errbuf *e, const ynode *nd, int index, eval_case *c)
 {
     memset(c, 0, sizeof *c);
+    c->index = index;
     if (nd->kind != YN_MAP)
         return yfail(e, nd, NULL, "cases[%d]: expected a mapping (%s), got %s", index,
                      k_case_keys, ynode_kind_name(nd));
@@ -83,6 +84,8 @@ static int read_case(errbuf *e, const ynode *nd, int index, eval_case *c)
                 return yfail(e, v, NULL, "set: at most %d overrides", EVAL_SETS_MAX);
             for (int i = 0; i < v->n; i++) {
                 if (read_text(e, v->items[i], "set", c->set[i], sizeof c->set[i])) return -1;
+                c->set_line[i] = v->items[i]->line;
+                c->set_col[i] = v->items[i]->col;
                 if (!strchr(c->set[i], '=') || c->set[i][0] == '=')
                     return yfail(e, v->items[i], NULL,
                                  "set: expected \"key=value\" (as lagsimd --set), got '%s'",
@@ -201,6 +204,31 @@ int eval_scene_load(const char *config, const char *const *sets, int nsets, eval
     }
     free(sc);
     return rc ? -1 : 0;
+}
+
+int eval_case_scene_load(const char *config, const char *from, const eval_case *c,
+                         const char *const *extra, int nextra, eval_scene *sc, char *err,
+                         size_t errlen)
+{
+    const char *sets[EVAL_SETS_MAX * 2];
+    int n = 0;
+    for (int i = 0; i < c->nsets; i++) sets[n++] = c->set[i];
+    for (int i = 0; i < nextra && n < EVAL_SETS_MAX * 2; i++) sets[n++] = extra[i];
+    if (eval_scene_load(config, sets, n, sc, err, errlen) == 0) return 0;
+    /* the first of the case's own overrides with which the scene no longer loads (the
+     * loader applies them in order) is the one to point at */
+    char msg[2048];
+    eval_scene tmp;
+    for (int j = 0; j < c->nsets && from && c->set_line[j] > 0; j++)
+        if (eval_scene_load(config, sets, j + 1, &tmp, msg, sizeof msg) != 0) {
+            snprintf(err, errlen, "%s:%d:%d: cases[%d].set[%d]: %s", from, c->set_line[j],
+                     c->set_col[j], c->index, j, msg);
+            return -1;
+        }
+    char whole[2048];
+    snprintf(whole, sizeof whole, "%s", err);
+    snprintf(err, errlen, "case %s: %s", c->name, whole);
+    return -1;
 }
 
 /* ---------------------------------------------------------------- processes */
@@ -605,11 +633,11 @@ static void daemon_argv(daemon_args *d, const eval_env *env, const eval_case *c,
     d->argv[d->na] = NULL;
 }
 
-/* Waits for the daemon's end, or the controller's: a controller that ends first (it could
+/* Waits for the daemon's end, or the controller's (true when --timeout ended it): a controller that ends first (it could
  * not start, it crashed) leaves a lockstep plant waiting for ever, so the daemon gets a
  * few seconds to end on its own (a controller ends on the daemon's stop event, a moment
  * before the daemon exits) and is then stopped. OUT: dst (the daemon's wait status) */
-static void wait_run(const eval_env *env, pid_t dpid, pid_t cpid, eval_result *res, int *dst)
+static bool wait_run(const eval_env *env, pid_t dpid, pid_t cpid, eval_result *res, int *dst)
 {
     int cst = 0;
     double t0 = eval_now();
@@ -627,12 +655,14 @@ static void wait_run(const eval_env *env, pid_t dpid, pid_t cpid, eval_result *r
             daemon_done = true;
         }
     }
-    if (!daemon_done) {
+    bool timed_out = !daemon_done;
+    if (timed_out) {
         eval_stop_group(dpid, dst);
         eval_fail(res, "no end after %.3g wall s (--timeout)", env->wall_timeout);
     }
     /* a controller ends on the daemon's stop event; one that does not is stopped */
     if (!controller_done && !eval_wait_until(cpid, eval_now() + 3.0, &cst)) eval_stop_group(cpid, &cst);
+    return timed_out;
 }
 
 int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, int nextra,
@@ -663,7 +693,7 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
         return -1;
     }
     int dst = 0;
-    wait_run(env, dpid, cpid, res, &dst);
+    bool timed_out = wait_run(env, dpid, cpid, res, &dst);
 
     if (WIFEXITED(dst) && WEXITSTATUS(dst) == 2) {
         snprintf(err, errlen, "lagsimd refused the case '%s' (exit 2; rerun with -v)",
@@ -679,6 +709,13 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
     eval_series *s = out ? out : &local;
     memset(s, 0, sizeof *s);
     int rc = eval_read_log(log, env->prefix, sc, c->duration, s, res, err, errlen);
+    if (rc == 0 && timed_out && !(s->n && s->t[s->n - 1] > 0)) {
+        /* lockstep waits at t = 0 for the first command: nothing answered it */
+        res->failed = false;
+        eval_fail(res, "no end after %.3g wall s (--timeout): no command answered the first "
+                       "state (is the controller on the run's prefix: {prefix} or "
+                       "LAGSIM_PREFIX?)", env->wall_timeout);
+    }
     if (rc == 0) {
         if (!(WIFEXITED(dst) && WEXITSTATUS(dst) == 0))
             eval_fail(res, "lagsimd ended with %s %d",
@@ -708,7 +745,7 @@ int eval_require_check(const lag_require *req, const eval_scene *sc, char *err, 
                 size_t u = strlen(names);
                 snprintf(names + u, sizeof names - u, "%s%s", j ? ", " : "", sc->joint[j]);
             }
-            snprintf(err, len, "--require: the %s has no joint '%s' (it has %s)", sc->model,
+            snprintf(err, len, "the %s has no joint '%s' (it has %s)", sc->model,
                      req->term[i].joint, names);
             return -1;
         }

@@ -41,6 +41,8 @@ typedef struct eval_case {
     double duration;                       /* sim s */
     int nsets;
     char set[EVAL_SETS_MAX][EVAL_SET_LEN]; /* "key=value", applied after the scene's file */
+    int index;                             /* its place in the file's cases: */
+    int set_line[EVAL_SETS_MAX], set_col[EVAL_SETS_MAX]; /* where each set string is */
     int nbounds;
     char bound_joint[EVAL_JOINTS_MAX][EVAL_NAME_LEN];
     double bound[EVAL_JOINTS_MAX];         /* |q| above it fails the case */
@@ -67,6 +69,13 @@ typedef struct eval_scene {
 /* Loads CONFIG with the overrides (nsets of them); -1 and the loader's message in err. */
 int eval_scene_load(const char *config, const char *const *sets, int nsets,
                     eval_scene *sc /* OUT */, char *err, size_t errlen);
+
+/* eval_scene_load with a case's overrides (and `extra` ones after them), read from the
+ * case file `from`: an override the loader refuses is reported at its place in that file,
+ * "FILE:LINE:COL: cases[i].set[j]: the loader's message". */
+int eval_case_scene_load(const char *config, const char *from, const eval_case *c,
+                         const char *const *extra, int nextra, eval_scene *sc /* OUT */,
+                         char *err, size_t errlen);
 
 typedef struct eval_env {
     const char *lagsimd;     /* the daemon's path */
@@ -126,7 +135,8 @@ int eval_score(const eval_series *s, const eval_case *c, const eval_scene *sc,
 bool eval_require_holds(const lag_require *req, const eval_scene *sc, const eval_result *res,
                         char *why, size_t len);
 
-/* -1 and a message when a requirement names a joint the scene does not have. */
+/* -1 and a message when a requirement names a joint the scene does not have (the caller
+ * says it is --require's). */
 int eval_require_check(const lag_require *req, const eval_scene *sc, char *err, size_t len);
 
 /* A number for tables and CSVs: %.6g, "nan" for none. */

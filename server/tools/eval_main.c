@@ -41,10 +41,12 @@ static void usage(FILE *f)
 "                         'theta.settle<2 and theta.overshoot<0.1'\n"
 "      --csv OUT.csv      one row per case and joint: the metrics and the verdict\n"
 "      --report DIR       a PNG per case in DIR (gnuplot): response, reference,\n"
-"                         effort and the metrics\n"
+"                         effort and the metrics, titled with the case's result\n"
 "  -f, --force            replace existing output files\n"
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
-"      --timeout S        wall seconds a case may take (default 600)\n"
+"      --timeout S        wall seconds a case may take (default 600); a controller\n"
+"                         not on {prefix} or LAGSIM_PREFIX never answers: its case\n"
+"                         ends here\n"
 "  -v, --verbose          pass the daemon's and the controller's output through, keep\n"
 "                         each run's log in the report directory (or /tmp)\n"
 "  -h, --help             this help\n"
@@ -68,10 +70,35 @@ static FILE *open_out(const char *what, const char *path, bool force, const char
     return eval_open_out(prog, what, path, force, inputs, 1);
 }
 
+/* text in a double-quoted gnuplot string: '"' and '\\' escaped */
+static void gp_text(FILE *f, const char *t)
+{
+    for (; *t; t++) {
+        if (*t == '"' || *t == '\\') fputc('\\', f);
+        fputc(*t == '\n' ? ' ' : *t, f);
+    }
+}
+
+/* A y range that is never empty: [lo, hi] of the finite values of the nc columns (each
+ * n long), widened by 1 each way when they are all equal (a plant that never moved);
+ * gnuplot would otherwise warn of an empty range. */
+static void y_range(FILE *f, const double *const *col, int nc, size_t n)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    for (int c = 0; c < nc; c++)
+        for (size_t k = 0; k < n; k++)
+            if (isfinite(col[c][k])) lo = fmin(lo, col[c][k]), hi = fmax(hi, col[c][k]);
+    if (!(lo <= hi)) lo = hi = 0;
+    if (hi > lo) fprintf(f, "set yrange [*:*]\n");
+    else fprintf(f, "set yrange [%.9g:%.9g]\n", lo - 1, hi + 1);
+}
+
 /* The PNG of one case: q (solid) and r (dashed) of each joint, the efforts, and the
- * metrics as text; through gnuplot, from a data file beside it. */
+ * metrics as text; its title says the verdict as the table does (FAIL and why, UNMET and
+ * the term that fails, or ok); through gnuplot, from a data file beside it. */
 static int report(const char *dir, bool force, const char *config, const eval_case *c,
-                  const eval_scene *sc, const eval_series *s, const eval_result *res)
+                  const eval_scene *sc, const eval_series *s, const eval_result *res,
+                  bool met, const char *why)
 {
     char dat[1024], gp[1024], png[1024];
     snprintf(dat, sizeof dat, "%s/%s.dat", dir, c->name);
@@ -94,9 +121,16 @@ static int report(const char *dir, bool force, const char *config, const eval_ca
     if (!f) return -1;
     fprintf(f, "set terminal pngcairo noenhanced size 1200,640 font ',10'\n");
     fprintf(f, "set output '%s'\n", png);
-    fprintf(f, "set multiplot layout 2,1 title \"%s: case %s%s%s\"\n", sc->model, c->name,
-            res->failed ? " FAILED: " : " (passed)", res->failed ? res->reason : "");
+    fprintf(f, "set multiplot layout 2,1 title \"%s: case %s: ", sc->model, c->name);
+    if (res->failed) fprintf(f, "FAIL: ");
+    else if (!met) fprintf(f, "UNMET --require: ");
+    gp_text(f, res->failed ? res->reason : met ? "ok" : why);
+    fprintf(f, "\"\n");
     fprintf(f, "set grid\nset key top right\nset xlabel 'sim time (s)'\n");
+    /* the case's time, whatever the run reached: a run that never left t = 0 is no empty
+     * range */
+    double t_end = s->n ? s->t[s->n - 1] : 0;
+    fprintf(f, "set xrange [0:%.9g]\n", t_end > c->duration ? t_end : c->duration);
     fprintf(f, "set lmargin 10\nset rmargin at screen 0.64\n");
     /* metrics as labels, right of the first panel */
     int line = 0;
@@ -115,20 +149,31 @@ static int report(const char *dir, bool force, const char *config, const eval_ca
                 row, 0.66 + 0.33 * line / (sc->nj > 1 ? sc->nj : 1));
         line++;
     }
+    const double *cols[2 * EVAL_JOINTS_MAX];
+    int nc = 0;
+    for (int j = 0; j < sc->nj; j++) cols[nc++] = s->q[j], cols[nc++] = s->r[j];
+    y_range(f, cols, nc, s->n);
     fprintf(f, "set ylabel 'q (m or rad)'\nplot ");
-    for (int j = 0; j < sc->nj; j++)
+    /* a run without a state (gnuplot would warn of a file with no valid points) */
+    if (!s->n) fprintf(f, "NaN t 'no state logged'");
+    for (int j = 0; s->n && j < sc->nj; j++)
         fprintf(f, "%s'%s' u 1:%d w l lw 2 lc %d t '%s', '%s' u 1:%d w l dt 2 lc %d t '%s ref'",
                 j ? ", " : "", dat, 2 + 3 * j, j + 1, sc->joint[j], dat, 3 + 3 * j, j + 1,
                 sc->joint[j]);
-    fprintf(f, "\nunset label\nset ylabel 'effort (N or N m)'\nplot ");
+    nc = 0;
+    for (int j = 0; j < sc->nj; j++)
+        if (sc->actuated[j]) cols[nc++] = s->u[j];
+    fprintf(f, "\nunset label\n");
+    y_range(f, cols, nc, s->n);
+    fprintf(f, "set ylabel 'effort (N or N m)'\nplot ");
     int first = 1;
-    for (int j = 0; j < sc->nj; j++) {
+    for (int j = 0; s->n && j < sc->nj; j++) {
         if (!sc->actuated[j]) continue;
         fprintf(f, "%s'%s' u 1:%d w steps lw 1.5 lc %d t '%s effort'", first ? "" : ", ", dat,
                 4 + 3 * j, j + 1, sc->joint[j]);
         first = 0;
     }
-    if (first) fprintf(f, "0 t 'no actuated joint'");
+    if (first) fprintf(f, s->n ? "0 t 'no actuated joint'" : "NaN t 'no state logged'");
     fprintf(f, "\nunset multiplot\n");
     fclose(f);
     /* the PNG itself obeys the output rules too: opened (and refused) here first */
@@ -243,10 +288,9 @@ static int check_cases(eval_cli *x)
     for (int k = 0; k < x->ncases; k++) {
         const eval_case *c = &x->cases[k];
         eval_scene *csc = &x->csc[k];
-        const char *sets[EVAL_SETS_MAX];
-        for (int i = 0; i < c->nsets; i++) sets[i] = c->set[i];
-        if (eval_scene_load(x->config, sets, c->nsets, csc, x->err, sizeof x->err)) {
-            fprintf(stderr, "%s: case %s: %s\n", prog, c->name, x->err);
+        if (eval_case_scene_load(x->config, x->suite ? x->suite : x->config, c, NULL, 0, csc,
+                                 x->err, sizeof x->err)) {
+            fprintf(stderr, "%s: %s\n", prog, x->err);
             return 2;
         }
         for (int b = 0; b < c->nbounds; b++) {
@@ -338,7 +382,8 @@ static bool run_case(eval_cli *x, int k)
     if (res.failed) printf("  %s failed: %s\n", c->name, res.reason);
     else if (!met) printf("  %s: --require: %s\n", c->name, why);
     fflush(stdout);
-    if (x->report_dir && report(x->report_dir, x->force, x->config, c, &x->csc[k], &s, &res))
+    if (x->report_dir &&
+        report(x->report_dir, x->force, x->config, c, &x->csc[k], &s, &res, met, why))
         x->status = 2;
     eval_series_free(&s);
     return true;

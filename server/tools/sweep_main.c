@@ -35,7 +35,7 @@ static void usage(FILE *f)
 "                    [--restart]\n"
 "                    [--suite FILE] [--require EXPR] [--csv OUT.csv] [--plot OUT.png]\n"
 "                    [--metric JOINT.METRIC] [--force] [--lagsimd PATH] [--timeout S] [-v]\n"
-"       lagsim-sweep merge A.csv B.csv ... -o OUT.csv [--force]\n"
+"       lagsim-sweep merge A.csv B.csv ... -o OUT.csv [--partial] [--force]\n"
 "\n"
 "Runs an evaluation case (lagsim-eval's) over scene keys drawn at random or on a grid,\n"
 "each run in lockstep against the controller, and writes one CSV row per run: the\n"
@@ -62,7 +62,8 @@ static void usage(FILE *f)
 "                         initial state RESET_TO between runs)\n"
 "      --require EXPR     a run that misses EXPR does not pass (as lagsim-eval)\n"
 "      --csv OUT.csv      the runs' CSV\n"
-"      --plot OUT.png     --metric against each varied key (gnuplot)\n"
+"      --plot OUT.png     --metric against each varied key (gnuplot); runs without\n"
+"                         a value (never settled) on a line at the top\n"
 "      --metric J.M       the metric drawn (default: --require's first, else the first\n"
 "                         joint's iae)\n"
 "  -f, --force            replace existing output files\n"
@@ -70,10 +71,13 @@ static void usage(FILE *f)
 "      --timeout S        wall seconds a run may take (default 600)\n"
 "  -v, --verbose          pass the daemon's and the controller's output through\n"
 "  -o, --output OUT.csv   merge: the joined CSV\n"
+"      --partial          merge: join shards that leave runs out (default: refused\n"
+"                         unless the runs are exactly 0 to the last one found)\n"
 "  -h, --help             this help\n"
 "\n"
 "exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
-"case error, or shard CSVs that do not belong together\n");
+"case error, an output that exists (checked before the first run), or shard CSVs that\n"
+"do not belong together or leave runs out\n");
 }
 
 static int die(const char *fmt, const char *a)
@@ -230,6 +234,12 @@ static void rows_free(rows *r)
     memset(r, 0, sizeof *r);
 }
 
+static int cmp_long(const void *a, const void *b)
+{
+    long x = *(const long *)a, y = *(const long *)b;
+    return (x > y) - (x < y);
+}
+
 static rows *sort_rows;
 static int by_run(const void *a, const void *b)
 {
@@ -347,10 +357,45 @@ static void summary(const char *header, rows *r)
 }
 
 /* ---------------------------------------------------------------- merge */
+/* Whether the rows' run numbers are exactly 0..max (runs found twice are rows_write's to
+ * refuse); else the missing ones, as numbers and ranges, in buf. */
+static bool rows_whole(const rows *r, char *buf, size_t len)
+{
+    long *run = malloc((size_t)(r->n ? r->n : 1) * sizeof *run);
+    if (!run) {
+        snprintf(buf, len, "out of memory");
+        return false;
+    }
+    memcpy(run, r->run, (size_t)r->n * sizeof *run);
+    qsort(run, (size_t)r->n, sizeof *run, cmp_long);
+    size_t u = 0;
+    int gaps = 0;
+    long next = 0; /* the first run not yet seen */
+    buf[0] = '\0';
+    for (int i = 0; i <= r->n; i++) {
+        long at = i < r->n ? run[i] : next; /* past the end: no gap after the last */
+        if (at > next) {
+            if (gaps < 12 && u < len)
+                u += (size_t)(at - 1 > next
+                                  ? snprintf(buf + u, len - u, "%s%ld-%ld", gaps ? ", " : "",
+                                             next, at - 1)
+                                  : snprintf(buf + u, len - u, "%s%ld", gaps ? ", " : "", next));
+            else if (gaps == 12 && u < len)
+                u += (size_t)snprintf(buf + u, len - u, ", ...");
+            gaps++;
+        }
+        if (at + 1 > next) next = at + 1;
+    }
+    bool negative = r->n && run[0] < 0;
+    if (negative) snprintf(buf, len, "(a negative run number, %ld)", run[0]);
+    free(run);
+    return gaps == 0 && !negative;
+}
+
 static int merge(int argc, char **argv)
 {
     const char *out = NULL;
-    bool force = false;
+    bool force = false, partial = false;
     const char *in[256];
     int nin = 0;
     for (int i = 1; i < argc; i++) {
@@ -359,6 +404,8 @@ static int merge(int argc, char **argv)
             out = argv[i];
         } else if (!strcmp(argv[i], "-f") || !strcmp(argv[i], "--force")) {
             force = true;
+        } else if (!strcmp(argv[i], "--partial")) {
+            partial = true;
         } else if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
             usage(stdout);
             return 0;
@@ -405,6 +452,17 @@ static int merge(int argc, char **argv)
         }
         fclose(f);
     }
+    /* a run number is all a row says of its sweep: shards that leave a run out (one
+     * forgotten, one of another split) make no whole; the runs a sweep has are not in its
+     * CSV, so a missing last shard's runs past the others' cannot be told */
+    char missing[512];
+    if (!partial && !rows_whole(&r, missing, sizeof missing)) {
+        fprintf(stderr, "%s: merge: the shards do not make a whole sweep: missing runs %s "
+                        "(a whole sweep has every run from 0 to its last); give every shard, "
+                        "or --partial to merge only these\n", prog, missing);
+        rows_free(&r);
+        return 2;
+    }
     FILE *fo = eval_open_out(prog, "-o", out, force, in, nin);
     if (!fo) {
         rows_free(&r);
@@ -424,62 +482,92 @@ static int merge(int argc, char **argv)
 }
 
 /* ---------------------------------------------------------------- plot */
-static int plot(const char *png, bool force, const char *config, const char *header, rows *r,
-                int nv, const char *metric)
+/* The column of a metric in the CSV's header, or -1. */
+static int header_column(const char *header, const char *name)
 {
     char hb[ROW_MAX];
     snprintf(hb, sizeof hb, "%s", header);
     char *hf[512];
-    int nh = split(hb, hf, 512), cm = -1, cf = -1, finite = 0;
-    for (int i = 0; i < nh; i++) {
-        if (!strcmp(hf[i], metric)) cm = i;
-        if (!strcmp(hf[i], "failed")) cf = i;
-    }
-    if (cm < 0) {
-        fprintf(stderr, "%s: --metric %s: no such column\n", prog, metric);
+    int nh = split(hb, hf, 512);
+    for (int i = 0; i < nh; i++)
+        if (!strcmp(hf[i], name)) return i;
+    return -1;
+}
+
+/* The PNG: the metric against each varied key, one point a run. A run where the metric
+ * has no value (never settled: nan) is drawn too, as a red triangle on a line above the
+ * others, so that every run appears. The data and the script go to dir (the sweep's
+ * temporary directory); png was opened (and so checked) before the first run. */
+static int plot(const char *png, const char *dir, const char *header, rows *r, int nv,
+                const char *metric)
+{
+    char hb[ROW_MAX];
+    snprintf(hb, sizeof hb, "%s", header);
+    char *hf[512];
+    int nh = split(hb, hf, 512), cf = header_column(header, "failed");
+    int cm = header_column(header, metric);
+    if (cm < 0 || cf < 0) return -1; /* checked before the runs */
+    char dat[300], gp[300];
+    snprintf(dat, sizeof dat, "%s/plot.dat", dir);
+    snprintf(gp, sizeof gp, "%s/plot.gp", dir);
+    FILE *f = fopen(dat, "w");
+    if (!f) {
+        fprintf(stderr, "%s: --plot: %s: %s\n", prog, dat, strerror(errno));
         return -1;
     }
-    char dat[4200], gp[4200];
-    snprintf(dat, sizeof dat, "%s.dat", png);
-    snprintf(gp, sizeof gp, "%s.gp", png);
-    const char *in[1] = {config};
-    FILE *f = eval_open_out(prog, "--plot", dat, force, in, 1);
-    if (!f) return -1;
+    double lo = INFINITY, hi = -INFINITY;
+    int none = 0;
     for (int i = 0; i < r->n; i++) {
         char lb[ROW_MAX];
         snprintf(lb, sizeof lb, "%s", r->line[i]);
         char *fl[512];
         if (split(lb, fl, 512) != nh) continue;
         for (int k = 0; k < nv; k++) fprintf(f, "%s ", fl[1 + k]);
-        /* passed: not failed and --require met */
-        fprintf(f, "%s %d\n", fl[cm], !strcmp(fl[cf], "0") && !strcmp(fl[cf + 1], "1"));
-        finite += isfinite(strtod(fl[cm], NULL));
+        double v = strtod(fl[cm], NULL);
+        bool has = isfinite(v);
+        if (has) lo = fmin(lo, v), hi = fmax(hi, v);
+        none += !has;
+        /* the value (0 when none), passed (not failed and --require met), no value */
+        fprintf(f, "%s %d %d\n", has ? fl[cm] : "0",
+                !strcmp(fl[cf], "0") && !strcmp(fl[cf + 1], "1"), !has);
     }
     fclose(f);
-    if (!finite) {
-        fprintf(stderr, "%s: --plot: %s is none in every run: nothing to draw\n", prog,
-                metric);
+    if (!(lo <= hi)) lo = 0, hi = 1;
+    double span = hi > lo ? hi - lo : fmax(1, fabs(hi));
+    double top = hi + 0.12 * span; /* the line of the runs without a value */
+    f = fopen(gp, "w");
+    if (!f) {
+        fprintf(stderr, "%s: --plot: %s: %s\n", prog, gp, strerror(errno));
         unlink(dat);
-        return 0;
+        return -1;
     }
-    f = eval_open_out(prog, "--plot", gp, force, in, 1);
-    if (!f) return -1;
-    fprintf(f, "set terminal pngcairo noenhanced size %d,420 font ',10'\n", 420 * nv + 80);
-    fprintf(f, "set output '%s'\nset grid\nset datafile missing 'nan'\n", png);
-    fprintf(f, "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n");
-    fprintf(f, "set multiplot layout 1,%d title '%d runs: %s (red: did not pass)'\n", nv, r->n,
-            metric);
-    for (int k = 0; k < nv; k++)
-        fprintf(f, "set xlabel '%s'\nset ylabel '%s'\nplot '%s' u %d:($%d == 1 ? $%d : 1/0) "
-                   "pt 7 ps 0.6 lc rgb '#1f77b4' t 'passed', '' u %d:($%d == 0 ? $%d : 1/0) "
-                   "pt 7 ps 0.6 lc rgb '#d62728' t 'did not pass'\n",
-                hf[1 + k], metric, dat, k + 1, nv + 2, nv + 1, k + 1, nv + 2, nv + 1);
+    fprintf(f, "set terminal pngcairo noenhanced size %d,440 font ',10'\n", 420 * nv + 80);
+    fprintf(f, "set output '%s'\nset grid\n", png);
+    fprintf(f, "set offsets graph 0.05, graph 0.05, 0, 0\n");
+    fprintf(f, "set yrange [%.9g:%.9g]\n", lo - 0.06 * span, top + 0.06 * span);
+    fprintf(f, "set key outside bottom center horizontal\n");
+    fprintf(f, "set multiplot layout 1,%d title '%d runs: %s (red: did not pass; %d with no "
+               "value, drawn at the top)'\n", nv, r->n, metric, none);
+    int c_val = nv + 1, c_pass = nv + 2, c_none = nv + 3;
+    for (int k = 0; k < nv; k++) {
+        fprintf(f, "set xlabel '%s'\nset ylabel '%s'\n", hf[1 + k], metric);
+        fprintf(f, "set arrow 1 from graph 0, first %.9g to graph 1, first %.9g nohead dt 3 "
+                   "lc rgb '#d62728'\n", top, top);
+        fprintf(f, "plot '%s' u %d:($%d == 0 && $%d == 1 ? $%d : 1/0) pt 7 ps 0.6 "
+                   "lc rgb '#1f77b4' t 'passed', "
+                   "'' u %d:($%d == 0 && $%d == 0 ? $%d : 1/0) pt 7 ps 0.6 lc rgb '#d62728' "
+                   "t 'did not pass', "
+                   "'' u %d:($%d == 1 ? %.9g : 1/0) pt 9 ps 0.9 lc rgb '#d62728' "
+                   "t 'no value (e.g. never settled)'\n",
+                dat, k + 1, c_none, c_pass, c_val, k + 1, c_none, c_pass, c_val, k + 1, c_none,
+                top);
+    }
     fprintf(f, "unset multiplot\n");
     fclose(f);
-    f = eval_open_out(prog, "--plot", png, force, in, 1);
-    if (!f) return -1;
-    fclose(f);
-    return eval_gnuplot(prog, gp);
+    int rc = eval_gnuplot(prog, gp);
+    unlink(dat);
+    unlink(gp);
+    return rc;
 }
 
 /* ---------------------------------------------------------------- the sweep */
@@ -610,9 +698,8 @@ static int load_case(sweep *x)
 static int load_scene(sweep *x)
 {
     char err[2048];
-    const char *sets[EVAL_SETS_MAX];
-    for (int i = 0; i < x->c.nsets; i++) sets[i] = x->c.set[i];
-    if (eval_scene_load(x->config, sets, x->c.nsets, &x->sc, err, sizeof err))
+    if (eval_case_scene_load(x->config, x->suite ? x->suite : x->config, &x->c, NULL, 0, &x->sc,
+                             err, sizeof err))
         return die("%s", err);
     for (int k = 0; k < x->nv; k++)
         if (x->vs[k].index >= x->sc.nj)
@@ -637,8 +724,9 @@ static int load_scene(sweep *x)
     return -1;
 }
 
-/* The CSV's header: run, the keys, the verdict, each joint's metrics. */
-static void make_header(sweep *x)
+/* The CSV's header: run, the keys, the verdict, each joint's metrics; the metric to plot
+ * among its columns. Returns -1 or the exit code. */
+static int make_header(sweep *x)
 {
     char *h = x->header;
     size_t hu = (size_t)snprintf(h, ROW_MAX, "run");
@@ -658,6 +746,9 @@ static void make_header(sweep *x)
              x->req.n ? x->req.term[0].joint : x->sc.joint[0],
              lag_metric_table[x->req.n ? x->req.term[0].metric : LAG_METRIC_IAE].name);
     if (!x->metric) x->metric = x->default_metric;
+    if (x->png && header_column(x->header, x->metric) < 0)
+        return die("--metric %s: no such column (JOINT.METRIC, e.g. theta.settle)", x->metric);
+    return -1;
 }
 
 /* ---------------------------------------------------------------- a worker */
@@ -821,7 +912,6 @@ static void collect_rows(const sweep *x, rows *r)
         fclose(f);
         unlink(path);
     }
-    rmdir(x->tmpdir);
 }
 
 static int count_passed(const sweep *x, const rows *r)
@@ -840,9 +930,16 @@ static int count_passed(const sweep *x, const rows *r)
 static int sweep_run(sweep *x)
 {
     char err[2048];
-    FILE *fcsv = NULL;
+    FILE *fcsv = NULL, *fpng = NULL;
     const char *in[2] = {x->config, x->suite};
+    /* every output opened (and so refused, when it must be) before the first run: a sweep
+     * never runs for hours to lose its results at the end */
     if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, 2))) return 2;
+    if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, 2))) {
+        if (fcsv) fclose(fcsv), unlink(x->csv);
+        return 2;
+    }
+    if (fpng) fclose(fpng); /* gnuplot writes it at the end */
     snprintf(x->tmpdir, sizeof x->tmpdir, "/tmp/lagsim-sweep.XXXXXX");
     if (!mkdtemp(x->tmpdir)) {
         fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
@@ -855,8 +952,8 @@ static int sweep_run(sweep *x)
         status = 2;
     summary(x->header, &r);
     bool all = count_passed(x, &r) == r.n;
-    if (x->png && plot(x->png, x->force, x->config, x->header, &r, x->nv, x->metric))
-        status = 2;
+    if (x->png && plot(x->png, x->tmpdir, x->header, &r, x->nv, x->metric)) status = 2;
+    rmdir(x->tmpdir);
     rows_free(&r);
     return status ? status : all ? 0 : 1;
 }
@@ -871,6 +968,6 @@ int main(int argc, char **argv)
     if ((rc = parse_options(&x, argc, argv)) >= 0 || (rc = check_options(&x, argc, argv)) >= 0 ||
         (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0)
         return rc;
-    make_header(&x);
+    if ((rc = make_header(&x)) >= 0) return rc;
     return sweep_run(&x);
 }

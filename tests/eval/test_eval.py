@@ -144,11 +144,20 @@ def case_require():
     p = run("--suite", SUITE, "--case", "tilt", "--require",
             "theta.settle < 7 and theta.peak_error <= 0.1 and x.effort_peak < 10")
     check(p.returncode == 0, "--require that holds: exit 0")
-    p = run("--suite", SUITE, "--case", "tilt", "--require", "theta.settle<2")
-    check(p.returncode == 1 and "theta.settle < 2 fails" in p.stdout,
-          "--require that does not hold: exit 1, the term named")
+    with tempfile.TemporaryDirectory() as d:
+        p = run("--suite", SUITE, "--case", "tilt", "--require", "theta.settle<2",
+                "--report", d)
+        check(p.returncode == 1 and "theta.settle < 2 fails" in p.stdout,
+              "--require that does not hold: exit 1, the term named")
+        # the report's title says what the table says: UNMET and the term
+        title = [l for l in open(os.path.join(d, "tilt.gp")) if "multiplot layout" in l]
+        check(len(title) == 1 and "UNMET" in title[0] and "theta.settle < 2 fails" in title[0]
+              and "passed" not in title[0], "the report's title: UNMET and the term (%s)"
+              % title)
+        check("Warning" not in p.stderr, "gnuplot said nothing on stderr")
     p = run("--suite", SUITE, "--case", "tilt", "--require", "phi.settle<2")
     check(p.returncode == 2 and "no joint 'phi'" in p.stderr, "unknown joint: exit 2")
+    check(p.stderr.count("--require") == 1, "--require said once: %r" % p.stderr.strip())
     p = run("--suite", SUITE, "--case", "tilt", "--require", "theta.settling<2")
     check(p.returncode == 2 and "settle" in p.stderr, "unknown metric: exit 2")
 
@@ -158,8 +167,12 @@ BAD = [
     ("cases:\n  - name: a\n    duration: 1\n    set: [\"initial.q\"]\n", ":4:11:",
      "key=value"),
     ("cases:\n  - name: a\n    duration: 1\n    colour: red\n", ":4:5:", "unknown key"),
-    ("cases:\n  - name: a\n    duration: 1\n    set: [\"parameters.m1=-3\"]\n", "case a",
-     "parameters.m1"),
+    ("cases:\n  - name: a\n    duration: 1\n    set: [\"parameters.m1=-3\"]\n",
+     ":4:11: cases[0].set[0]:", "parameters.m1"),
+    # an override's YAML mistake: at the override's place in the case file
+    ("cases:\n  - name: a\n    duration: 1\n  - name: b\n    duration: 1\n"
+     "    set: [\"initial.qd=[0, 0]\",\n          \"initial.q=[0,\"]\n",
+     ":7:11: cases[1].set[1]:", "initial.q"),
     ("cases:\n  - name: a\n    duration: 1\n    bounds: {phi: 1}\n", "case a", "no joint"),
 ]
 
@@ -187,6 +200,25 @@ def case_errors():
           in p.stdout and time.monotonic() - t0 < 60,
           "a controller that does not start: the case fails within a minute (%.1f s, exit %d)"
           % (time.monotonic() - t0, p.returncode))
+    # a controller on another prefix than the run's never answers: the run ends at
+    # --timeout, and the reason says what to look at; the report of a run that never left
+    # t = 0 draws without gnuplot's warnings
+    with tempfile.TemporaryDirectory() as d:
+        p = subprocess.run([EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt",
+                            "--timeout", "5", "--report", d, "--controller",
+                            os.path.join(BIN, "lqr_balance") +
+                            " -q --prefix NOT_THE_RUNS --timeout 60"],  # waits past --timeout
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=120)
+        print(p.stdout, p.stderr)
+        check(p.returncode == 1 and "no command answered the first state" in p.stdout and
+              "LAGSIM_PREFIX" in p.stdout,
+              "a controller on another prefix: exit 1, the reason names the prefix")
+        title = [l for l in open(os.path.join(d, "tilt.gp")) if "multiplot layout" in l]
+        check(len(title) == 1 and "FAIL" in title[0] and "no command answered" in title[0],
+              "its report's title: FAIL and why (%s)" % title)
+        check("Warning" not in p.stderr and os.path.getsize(os.path.join(d, "tilt.png")) > 5000,
+              "its report drawn, gnuplot said nothing on stderr")
 
 
 def case_scene():

@@ -7,8 +7,10 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             ones inside their range and not all equal; a run's metrics equal lagsim-eval's
             for the same overrides; --seed changes the drawn values
   slurm     the job-array script: shell syntax, two array tasks run outside Slurm with
-            Slurm's variables set, merged, equal to the whole sweep
-  merge     merge refuses a run twice and shards of another sweep (exit 2); a varied
+            Slurm's variables set (of an array 3-4 and of a stepped one, 0-2:2), merged,
+            equal to the whole sweep
+  merge     merge refuses a run twice, shards of another sweep and shards that leave
+            runs out (exit 2; --partial merges these); a varied
             coordinate of initial.q lands in the scene; an index on another key is refused
   kept      one lagsimd and one controller per worker (counted through wrappers), a
             process pair per run with --restart; the kept processes give the CSV of a
@@ -66,12 +68,52 @@ def rows(path):
         return list(csv.DictReader(f))
 
 
+def gnuplot_spy(d):
+    """A gnuplot first on PATH that has the real one draw the script as a table too
+    (d/table.txt: each curve's points, 'i' for one drawn inside the plot), then draw it."""
+    real = shutil.which("gnuplot")
+    spy = os.path.join(d, "spy")
+    os.makedirs(spy)
+    with open(os.path.join(spy, "gnuplot"), "w") as f:
+        f.write("#!/bin/sh\nsed -e \"s|^set output .*|set output '/dev/null'\\nset table "
+                "'%s/table.txt'|\" \"$1\" > %s/table.gp\n%s %s/table.gp\nexec %s \"$@\"\n"
+                % (d, d, real, d, real))
+    os.chmod(os.path.join(spy, "gnuplot"), 0o755)
+    return dict(os.environ, PATH=spy + os.pathsep + os.environ["PATH"])
+
+
+def drawn_first_panel(path):
+    """The points drawn inside the first panel of a gnuplot table (its curves up to the
+    next 'Curve 0')."""
+    n, curves = 0, 0
+    for line in open(path):
+        if line.startswith("# Curve 0 of"):
+            curves += 1
+            if curves > 1:
+                break
+        f = line.split()
+        n += len(f) == 3 and f[2] == "i"
+    return n
+
+
 def case_same(d):
     a1, a2, m = (os.path.join(d, n) for n in ("j1.csv", "j2.csv", "merged.csv"))
-    p = run([SWEEP] + ARGS + ["-j1", "--csv", a1, "--plot", os.path.join(d, "s.png")])
+    png = os.path.join(d, "s.png")
+    p = run([SWEEP] + ARGS + ["-j1", "--csv", a1, "--plot", png], env=gnuplot_spy(d))
     check(p.returncode in (0, 1), "the sweep ran (exit %d)" % p.returncode)
     check("8 runs:" in p.stdout and "theta.settle" in p.stdout, "a summary of 8 runs")
-    check(os.path.getsize(os.path.join(d, "s.png")) > 5000, "a PNG of the metric")
+    check(os.path.getsize(png) > 5000, "a PNG of the metric")
+    # every run drawn, those whose metric has no value (never settled) too
+    nan = sum(x["theta.settle"] == "nan" for x in rows(a1))
+    drawn = drawn_first_panel(os.path.join(d, "table.txt"))
+    check(nan > 0 and drawn == 8, "--plot draws all 8 runs, the %d that never settled too "
+          "(%d drawn)" % (nan, drawn))
+    check(not glob.glob(png + ".*"), "no helper file beside the PNG: %s" % glob.glob(png + ".*"))
+    # the outputs are checked before the first run: an existing PNG is refused at once
+    p = run([SWEEP] + ARGS + ["-j1", "--csv", os.path.join(d, "again.csv"), "--plot", png])
+    check(p.returncode == 2 and png in p.stderr and "runs:" not in p.stdout and
+          not os.path.exists(os.path.join(d, "again.csv")),
+          "--plot to an existing PNG without --force: exit 2 before any run, the PNG named")
     run([SWEEP] + ARGS + ["-j2", "--csv", a2])
     check(filecmp.cmp(a1, a2, shallow=False), "-j1 and -j2 give the same CSV, byte for byte")
     # two shards with GNU parallel on this host, then merged
@@ -140,6 +182,19 @@ def case_slurm(d):
     m = os.path.join(d, "merged.csv")
     run([SWEEP, "merge"] + shards + ["-o", m])
     check(filecmp.cmp(whole, m, shallow=False), "the array's shards merged = the whole sweep")
+    # a stepped array (--array=0-2:2): ids 0 and 2, shards 1/2 and 2/2
+    out = os.path.join(d, "stepped")
+    for task in (0, 2):
+        env = dict(os.environ, SLURM_ARRAY_TASK_ID=str(task), SLURM_ARRAY_TASK_MIN="0",
+                   SLURM_ARRAY_TASK_STEP="2", SLURM_ARRAY_TASK_COUNT="2",
+                   SLURM_CPUS_PER_TASK="1", LAGSIM_SWEEP=SWEEP)
+        p = run(["bash", script, out, "--"] + ARGS, env=env)
+        check(p.returncode in (0, 1), "stepped array (0-2:2): task %d ran" % task)
+    shards = sorted(glob.glob(os.path.join(out, "shard-*-of-2.csv")))
+    m = os.path.join(d, "merged_stepped.csv")
+    run([SWEEP, "merge"] + shards + ["-o", m])
+    check(len(shards) == 2 and filecmp.cmp(whole, m, shallow=False),
+          "a stepped array's shards (%s) merged = the whole sweep" % shards)
     p = run(["bash", script, out, "--"] + ARGS, env={"PATH": os.environ["PATH"]})
     check(p.returncode != 0 and "array task" in p.stderr, "outside an array task: refused")
 
@@ -157,6 +212,16 @@ def case_merge(d):
         g.write(f.read().replace("parameters.m0", "parameters.m2"))
     p = run([SWEEP, "merge", a, os.path.join(d, "d.csv"), "-o", os.path.join(d, "m2.csv")])
     check(p.returncode == 2 and "another sweep" in p.stderr, "another sweep's shard: exit 2")
+    # shards that leave runs out: shard 1 of 2 of 4 runs alone holds runs 0 and 2
+    h = os.path.join(d, "h.csv")
+    run([SWEEP] + ARGS + ["--runs", "1", "--shard", "1/2", "--csv", h])
+    mh = os.path.join(d, "mh.csv")
+    p = run([SWEEP, "merge", h, "-o", mh])
+    check(p.returncode == 2 and "missing runs 1 " in p.stderr and not os.path.exists(mh),
+          "shard 1 of 2 alone: exit 2, run 1 named missing, no output")
+    p = run([SWEEP, "merge", h, "--partial", "-o", mh])
+    check(p.returncode == 0 and [x["run"] for x in rows(mh)] == ["0", "2"],
+          "--partial: the runs there are merged (exit %d)" % p.returncode)
     # one coordinate of initial.q varied: joined into the scene's list (x stays 0); the
     # pole released at rest from theta0 under LQR peaks at theta0 itself
     g = os.path.join(d, "g.csv")

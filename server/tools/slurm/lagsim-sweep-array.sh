@@ -5,8 +5,10 @@
 #          --duration 10 --vary 'parameters.m1=uniform(0.4,0.6)' --runs 1000 --seed 1
 #   lagsim-sweep merge OUTDIR/shard-*.csv -o sweep.csv     # once every task is done
 #
-# Task i of an array of N (Slurm's SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT) runs
-# --shard (i - first + 1)/N with -j SLURM_CPUS_PER_TASK workers and writes
+# Task i of an array of N (Slurm's SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_MIN,
+# SLURM_ARRAY_TASK_STEP and SLURM_ARRAY_TASK_COUNT; a stepped array --array=0-15:2 has
+# the ids 0, 2, ..., 14) runs --shard K/N, K = (i - min) / step + 1, with
+# -j SLURM_CPUS_PER_TASK workers and writes
 # OUTDIR/shard-K-of-N.csv; the merge gives the CSV one machine would have written, bit for
 # bit (run i's values come from the seed and i alone). OUTDIR must be on a file system the
 # nodes share. LAGSIM_SWEEP names the program (default: lagsim-sweep on PATH).
@@ -20,7 +22,8 @@ out=$1
 shift 2
 : "${SLURM_ARRAY_TASK_ID:?not an array task (sbatch --array)}"
 : "${SLURM_ARRAY_TASK_COUNT:?not an array task (sbatch --array)}"
-k=$((SLURM_ARRAY_TASK_ID - ${SLURM_ARRAY_TASK_MIN:-0} + 1))
+step=${SLURM_ARRAY_TASK_STEP:-1}
+k=$(((SLURM_ARRAY_TASK_ID - ${SLURM_ARRAY_TASK_MIN:-0}) / step + 1))
 n=$SLURM_ARRAY_TASK_COUNT
 mkdir -p "$out"
 exec "${LAGSIM_SWEEP:-lagsim-sweep}" "$@" --shard "$k/$n" -j "${SLURM_CPUS_PER_TASK:-1}" \
