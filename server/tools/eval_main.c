@@ -93,6 +93,25 @@ static void y_range(FILE *f, const double *const *col, int nc, size_t n)
     else fprintf(f, "set yrange [%.9g:%.9g]\n", lo - 1, hi + 1);
 }
 
+/* The metrics of each joint as labels, right of the report's first panel. */
+static void report_labels(FILE *f, const eval_scene *sc, const eval_result *res)
+{
+    for (int j = 0; j < sc->nj; j++) {
+        char row[512];
+        size_t u = 0;
+        u += (size_t)snprintf(row + u, sizeof row - u, "%s:", sc->joint[j]);
+        for (int m = 0; m < LAG_METRIC_COUNT && u < sizeof row; m++) {
+            if (m == LAG_METRIC_EFFORT_PEAK && !sc->actuated[j]) break;
+            char v[32];
+            eval_fmt(res->m[j].v[m], v, sizeof v);
+            u += (size_t)snprintf(row + u, sizeof row - u, "\\n  %s %s", lag_metric_table[m].name,
+                                  v);
+        }
+        fprintf(f, "set label %d \"%s\" at screen %.3f, screen 0.9 left font ',9'\n", j + 1,
+                row, 0.66 + 0.33 * j / (sc->nj > 1 ? sc->nj : 1));
+    }
+}
+
 /* The PNG of one case: q (solid) and r (dashed) of each joint, the efforts, and the
  * metrics as text; its title says the verdict as the table does (FAIL and why, UNMET and
  * the term that fails, or ok); through gnuplot, from a data file beside it. */
@@ -132,23 +151,7 @@ static int report(const char *dir, bool force, const char *config, const eval_ca
     double t_end = s->n ? s->t[s->n - 1] : 0;
     fprintf(f, "set xrange [0:%.9g]\n", t_end > c->duration ? t_end : c->duration);
     fprintf(f, "set lmargin 10\nset rmargin at screen 0.64\n");
-    /* metrics as labels, right of the first panel */
-    int line = 0;
-    for (int j = 0; j < sc->nj; j++) {
-        char row[512];
-        size_t u = 0;
-        u += (size_t)snprintf(row + u, sizeof row - u, "%s:", sc->joint[j]);
-        for (int m = 0; m < LAG_METRIC_COUNT && u < sizeof row; m++) {
-            if (m == LAG_METRIC_EFFORT_PEAK && !sc->actuated[j]) break;
-            char v[32];
-            eval_fmt(res->m[j].v[m], v, sizeof v);
-            u += (size_t)snprintf(row + u, sizeof row - u, "\\n  %s %s", lag_metric_table[m].name,
-                                  v);
-        }
-        fprintf(f, "set label %d \"%s\" at screen %.3f, screen 0.9 left font ',9'\n", j + 1,
-                row, 0.66 + 0.33 * line / (sc->nj > 1 ? sc->nj : 1));
-        line++;
-    }
+    report_labels(f, sc, res);
     const double *cols[2 * EVAL_JOINTS_MAX];
     int nc = 0;
     for (int j = 0; j < sc->nj; j++) cols[nc++] = s->q[j], cols[nc++] = s->r[j];

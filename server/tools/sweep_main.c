@@ -392,6 +392,40 @@ static bool rows_whole(const rows *r, char *buf, size_t len)
     return gaps == 0 && !negative;
 }
 
+/* Shard number k's rows into r; its header must be the first's (kept in header). 0, or -1
+ * after saying why. */
+static int read_shard(const char *path, int k, char *header, rows *r)
+{
+    char line[ROW_MAX];
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        fprintf(stderr, "%s: %s: %s\n", prog, path, strerror(errno));
+        return -1;
+    }
+    int ln = 0, bad = 0;
+    while (!bad && fgets(line, sizeof line, f)) {
+        ln++;
+        size_t len = strlen(line);
+        if (len && line[len - 1] == '\n') line[--len] = '\0';
+        if (ln == 1) {
+            if (strncmp(line, "run,", 4)) bad = 1;
+            else if (k && strcmp(header, line)) bad = 2;
+            else snprintf(header, ROW_MAX, "%s", line);
+        } else {
+            char *end;
+            long run = strtol(line, &end, 10);
+            if (end == line || *end != ',' || rows_add(r, run, line)) bad = 3;
+        }
+    }
+    fclose(f);
+    if (bad)
+        fprintf(stderr, "%s: %s:%d: %s\n", prog, path, ln,
+                bad == 1 ? "not a lagsim-sweep CSV (its header starts with 'run,')"
+                : bad == 2 ? "another sweep's header than the first file's"
+                           : "expected a row starting with its run number");
+    return bad ? -1 : 0;
+}
+
 static int merge(int argc, char **argv)
 {
     const char *out = NULL;
@@ -418,40 +452,12 @@ static int merge(int argc, char **argv)
     if (!nin) return die("%s", "merge: expected the shards' CSV files (try --help)");
     if (!out) return die("%s", "merge: -o OUT.csv is required");
     rows r = {0};
-    char header[ROW_MAX] = "", line[ROW_MAX];
-    for (int k = 0; k < nin; k++) {
-        FILE *f = fopen(in[k], "r");
-        if (!f) {
-            fprintf(stderr, "%s: %s: %s\n", prog, in[k], strerror(errno));
+    char header[ROW_MAX] = "";
+    for (int k = 0; k < nin; k++)
+        if (read_shard(in[k], k, header, &r)) {
             rows_free(&r);
             return 2;
         }
-        int ln = 0, bad = 0;
-        while (fgets(line, sizeof line, f)) {
-            ln++;
-            size_t len = strlen(line);
-            if (len && line[len - 1] == '\n') line[--len] = '\0';
-            if (ln == 1) {
-                if (strncmp(line, "run,", 4)) bad = 1;
-                else if (k && strcmp(header, line)) bad = 2;
-                else snprintf(header, sizeof header, "%s", line);
-            } else {
-                char *end;
-                long run = strtol(line, &end, 10);
-                if (end == line || *end != ',' || rows_add(&r, run, line)) bad = 3;
-            }
-            if (bad) {
-                fprintf(stderr, "%s: %s:%d: %s\n", prog, in[k], ln,
-                        bad == 1 ? "not a lagsim-sweep CSV (its header starts with 'run,')"
-                        : bad == 2 ? "another sweep's header than the first file's"
-                                   : "expected a row starting with its run number");
-                fclose(f);
-                rows_free(&r);
-                return 2;
-            }
-        }
-        fclose(f);
-    }
     /* a run number is all a row says of its sweep: shards that leave a run out (one
      * forgotten, one of another split) make no whole; the runs a sweep has are not in its
      * CSV, so a missing last shard's runs past the others' cannot be told */
