@@ -78,17 +78,26 @@ static void w_on_command(const lcm_recv_buf_t *rbuf, const char *channel, void *
         w->t_answered = c.sim_time;
 }
 
-/* What came on either URL, waiting up to ms for something on one of them. */
-static int w_handle(eval_worker *w, int ms)
+/* The controller's answers that have come, without waiting. */
+static void drain_answers(eval_worker *w)
+{
+    struct pollfd pf = {w->cmd ? lcm_get_fileno(w->cmd) : -1, POLLIN, 0};
+    while (w->cmd && poll(&pf, 1, 0) > 0 && (pf.revents & POLLIN)) lcm_handle(w->cmd);
+}
+
+/* What came, waiting up to ms for a message on the state URL, or on either URL when
+ * `answers` (between runs: a run's states wake the worker, its answers need not). */
+static int w_handle_on(eval_worker *w, int ms, bool answers)
 {
     struct pollfd pf[2] = {{lag_client_fileno(w->cl), POLLIN, 0},
                            {w->cmd ? lcm_get_fileno(w->cmd) : -1, POLLIN, 0}};
-    if (poll(pf, 2, ms) < 0 && errno != EINTR) return -1;
-    int rc = lag_client_handle(w->cl, 0);
-    while (w->cmd && lcm_handle_timeout(w->cmd, 0) > 0) {
-    }
+    if (poll(pf, answers ? 2 : 1, ms) < 0 && errno != EINTR) return -1;
+    int rc = (pf[0].revents & POLLIN) ? lag_client_handle(w->cl, 0) : LAG_CLIENT_TIMEOUT;
+    drain_answers(w);
     return rc;
 }
+
+static int w_handle(eval_worker *w, int ms) { return w_handle_on(w, ms, true); }
 
 static bool is_run_start(const eval_worker *w, const lag_client_state *st)
 {
@@ -355,7 +364,7 @@ static void follow(eval_worker *w, double t_goal)
     double start = eval_now(), last = start;
     size_t seen = w->s.n;
     while (!(w->s.n && w->s.t[w->s.n - 1] >= t_goal) && !w->fault) {
-        if (w_handle(w, 20) < 0) break;
+        if (w_handle_on(w, 20, false) < 0) break;
         if (w->s.n != seen) seen = w->s.n, last = eval_now();
         if (eval_now() - start > w->env.wall_timeout) break;
         if (eval_now() - last < W_QUIET_S) continue;
