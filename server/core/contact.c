@@ -29,10 +29,7 @@ lag_result lag_impulse_map(lag_sim *s, double *y, int i, double e)
     return LAG_OK;
 }
 
-static int sgn(double v) { return (v > 0) - (v < 0); }
-
-/* Constraint forces with the current locks at state y. OUT: lambda */
-static lag_result lock_forces(lag_sim *s, const double *y, double *lambda)
+lag_result lag_lock_forces(lag_sim *s, const double *y, double *lambda)
 {
     const int n = s->nq;
     double Q[LAG_MAX_DOF], qdd[LAG_MAX_DOF];
@@ -48,11 +45,11 @@ lag_event_kind lag_friction_settle(lag_sim *s, double *y, int i)
     s->mode.locked |= 1u << i;
     s->mode.lock_side[i] = 0;
     double lambda[LAG_MAX_DOF];
-    if (lock_forces(s, y, lambda) == LAG_OK &&
+    if (lag_lock_forces(s, y, lambda) == LAG_OK &&
         fabs(lambda[i]) <= s->def.effects.friction_static[i])
         return LAG_EV_STICK;
     s->mode.locked &= ~(1u << i);
-    s->mode.slip_dir[i] = (int8_t)(-sgn(lambda[i]));
+    s->mode.slip_dir[i] = (int8_t)(-lag_sgn(lambda[i]));
     return LAG_EV_SLIP;
 }
 
@@ -62,7 +59,7 @@ void lag_refresh_slip(lag_sim *s, double *y)
     for (int i = 0; i < n; i++) {
         if (!lag_has_friction(s, i) || (s->mode.locked & (1u << i))) continue;
         double v = y[n + i];
-        if (v != 0.0) s->mode.slip_dir[i] = (int8_t)sgn(v);
+        if (v != 0.0) s->mode.slip_dir[i] = (int8_t)lag_sgn(v);
         else lag_friction_settle(s, y, i);
     }
 }

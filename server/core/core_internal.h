@@ -223,6 +223,9 @@ static inline bool lag_has_friction(const lag_sim *s, int i)
     return (e->enabled & LAG_EFF_FRICTION) &&
            (e->friction_static[i] > 0 || e->friction_kinetic[i] > 0);
 }
+static inline int lag_sgn(double v) { return (v > 0) - (v < 0); }
+/* Constraint forces with the current locks at state y (contact.c). OUT: lambda */
+lag_result lag_lock_forces(lag_sim *s, const double *y, double *lambda);
 lag_event_kind lag_friction_settle(lag_sim *s, double *y, int i);
 void lag_refresh_slip(lag_sim *s, double *y);
 void lag_effects_init_modes(lag_sim *s);

@@ -112,16 +112,6 @@ lag_result lag_event_locate(int N, double H, const double *y0, const double *f0,
     return locate(N, H, y0, f0, y1, f1, ws, v0, eval, ctx, which, theta);
 }
 
-static int sgn(double v) { return (v > 0) - (v < 0); }
-
-/* Constraint forces with the current locks at state y. OUT: lambda */
-static lag_result lock_forces(lag_sim *s, const double *y, double *lambda)
-{
-    const int n = s->nq;
-    double Q[LAG_MAX_DOF], qdd[LAG_MAX_DOF];
-    lag_effects_force(s, y, y + n, Q);
-    return lag_forward_locked(s, y, y + n, Q, qdd, lambda);
-}
 
 /* A hold lets go (its watcher fired): a stop releases the joint (which friction may hold
  * at once); static friction gives way to sliding against the force. */
@@ -130,7 +120,7 @@ static lag_result release_hold(lag_sim *s, int i, double *y, double t)
     const int n = s->nq;
     double lambda[LAG_MAX_DOF];
     lag_result r;
-    if ((r = lock_forces(s, y, lambda)) != LAG_OK) return r;
+    if ((r = lag_lock_forces(s, y, lambda)) != LAG_OK) return r;
     bool stop = s->mode.lock_side[i] != 0;
     s->mode.locked &= ~(1u << i);
     s->mode.lock_side[i] = 0;
@@ -144,7 +134,7 @@ static lag_result release_hold(lag_sim *s, int i, double *y, double t)
             if (k == LAG_EV_STICK) lag_sim_record_event(s, k, i, t, 0.0);
         }
     } else {
-        s->mode.slip_dir[i] = (int8_t)(-sgn(lambda[i]));
+        s->mode.slip_dir[i] = (int8_t)(-lag_sgn(lambda[i]));
         lag_sim_record_event(s, LAG_EV_SLIP, i, t, s->mode.slip_dir[i]);
     }
     return LAG_OK;
