@@ -52,7 +52,7 @@ static void usage(FILE *f)
 "                         normal(MEAN,SD) or grid(A,B,N) (N values from A to B);\n"
 "                         repeatable: grids multiply, random keys are drawn per run\n"
 "  -n, --runs N           runs (per grid point when there are grids; default 1)\n"
-"      --seed S           the seed of every random value (default 1)\n"
+"      --seed S           the random seed of every drawn value (default 1)\n"
 "  -j, --jobs N           runs at once on this machine (default 1)\n"
 "      --shard K/N        only runs i with i mod N = K - 1 (K = 1..N): one machine's\n"
 "                         part; lagsim-sweep merge joins the parts\n"

@@ -10,7 +10,7 @@
 # the ids 0, 2, ..., 14) runs --shard K/N, K = (i - min) / step + 1, with
 # -j SLURM_CPUS_PER_TASK workers and writes
 # OUTDIR/shard-K-of-N.csv; the merge gives the CSV one machine would have written, bit for
-# bit (run i's values come from the seed and i alone). OUTDIR must be on a file system the
+# bit (run i's values come from --seed and i alone). OUTDIR must be on a file system the
 # nodes share. LAGSIM_SWEEP names the program (default: lagsim-sweep on PATH).
 #SBATCH --job-name=lagsim-sweep
 #SBATCH --array=0-15
