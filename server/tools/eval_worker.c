@@ -56,7 +56,7 @@ struct eval_worker {
     long runs;
     /* the run in progress, from the bus */
     eval_series s;
-    bool armed, started, fault, step_done;
+    bool armed, started, fault;
     long missing_refs;   /* states whose reference did not come before them */
     double q0[EVAL_JOINTS_MAX], qd0[EVAL_JOINTS_MAX];
     const char *set_wait; /* "key=value" whose set event is awaited */
@@ -147,7 +147,7 @@ static void w_on_state(const lag_client_state *st, void *user)
 static void w_on_event(const lag_client_event *ev, void *user)
 {
     eval_worker *w = user;
-    if (!strcmp(ev->kind, "step_done")) w->step_done = w->moved = true;
+    if (!strcmp(ev->kind, "step_done")) w->moved = true;
     else if (!strcmp(ev->kind, "numeric_fault") && w->armed) w->fault = true;
     else if (!strcmp(ev->kind, "set") && w->set_wait && !strcmp(ev->detail, w->set_wait))
         w->set_heard = true;
