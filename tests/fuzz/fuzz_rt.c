@@ -358,7 +358,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 g_s.info->name, lag_rt_mode_name(g_sc.realtime.mode),
                 (double)(g_s.now - t0) * 1e-9, (long long)g_s.sim.tick, rt_run_name(g_s.run),
                 (long long)g_s.numeric_faults, (long long)g_s.accepted,
-                (long long)g_s.rejected[RT_REJ_EFFORT_LIMIT], (long long)g_s.controls_rejected,
+                (long long)g_s.rejected[RT_REJ_EFFORT_LIMIT], (long long)g_s.ctl.controls_rejected,
                 (long long)g_c.state, (long long)g_c.status, (long long)g_c.scene,
                 (long long)g_c.event);
     rt_finish(&g_s);

@@ -745,8 +745,8 @@ static void case_set(int arg)
     run_until(g_srv.now + 10 * MS, 1000);
     ENSUREF(n_events("set") - sets == RT_SET_BURST, "%lld of %d applied",
             (long long)(n_events("set") - sets), RT_SET_BURST + 20);
-    ENSURE(g_srv.controls_rejected >= 20);
-    ENSURE(g_srv.live.n == 3); /* m2, the actuator and m1: a key set again replaces itself */
+    ENSURE(g_srv.ctl.controls_rejected >= 20);
+    ENSURE(g_srv.ctl.live.n == 3); /* m2, the actuator and m1: a key set again replaces itself */
     stop_server();
 }
 
@@ -1009,7 +1009,7 @@ static void case_control_flood(int arg)
     ENSURE(n_events("control_rejected") <= 20 && n_events("reset") <= 20);
     ENSURE(ev <= 40);
     ENSURE(st <= 5 + 20 + 5 + 1 && sc <= 2 + 5 + 1 && sa <= 100 + 5 + 20 + 1);
-    ENSURE(g_srv.controls_rejected == bad);
+    ENSURE(g_srv.ctl.controls_rejected == bad);
     /* a while later one more: it says how many went unsaid since the last one, so that
      * the events published plus those they say were suppressed are every rejection */
     run_until(g_srv.now + 2 * SEC, 0);
@@ -1154,13 +1154,13 @@ static void case_lockstep_retry(int arg)
     const int64_t t0 = g_srv.now;
     ENSURE(g_out.state == 1 && g_srv.ls.waiting && !g_srv.ls.answered);
     uint8_t first[RT_BUF_SIZE];
-    unsigned first_len = g_srv.state_len;
-    memcpy(first, g_srv.state_buf, first_len);
+    unsigned first_len = g_srv.pub.state_len;
+    memcpy(first, g_srv.pub.state_buf, first_len);
     run_until(t0 + 110 * MS, 1000);
     /* copies at 20 and 60 ms (the next, at 140 ms, is not due) */
-    ENSUREF(g_srv.lockstep_retries == 2 && g_out.state == 3, "%lld retries, %lld states in 110 ms",
-            (long long)g_srv.lockstep_retries, (long long)g_out.state);
-    ENSURE(g_srv.state_len == first_len && memcmp(first, g_srv.state_buf, first_len) == 0);
+    ENSUREF(g_srv.pub.lockstep_retries == 2 && g_out.state == 3, "%lld retries, %lld states in 110 ms",
+            (long long)g_srv.pub.lockstep_retries, (long long)g_out.state);
+    ENSURE(g_srv.pub.state_len == first_len && memcmp(first, g_srv.pub.state_buf, first_len) == 0);
     ENSURE(g_srv.sim.tick == 0 && g_srv.lockstep_timeouts == 0 && g_out.last_step == 0);
     /* answered twice before the period runs: the second is ignored */
     command(0.0, "theta0", 0.5);
@@ -1177,13 +1177,13 @@ static void case_lockstep_retry(int arg)
     ENSURE(g_srv.rejected[RT_REJ_STALE] == 1 && g_srv.held[0] == 0.5);
     /* no answer for a second: the backed-off copies (20, 60 ms, then every 62.5 ms),
      * then the timeout */
-    int64_t r0 = g_srv.lockstep_retries, want = copies_within(1000 * MS, 20 * MS, 62500000);
+    int64_t r0 = g_srv.pub.lockstep_retries, want = copies_within(1000 * MS, 20 * MS, 62500000);
     run_until(g_srv.now + 1100 * MS, 1000);
     ENSUREF(g_srv.lockstep_timeouts == 1 && g_srv.run == RT_WAITING, "%lld timeouts",
             (long long)g_srv.lockstep_timeouts);
-    ENSUREF(g_srv.lockstep_retries - r0 == want && want == 17,
+    ENSUREF(g_srv.pub.lockstep_retries - r0 == want && want == 17,
             "%lld retries before the timeout, %lld by the rule",
-            (long long)(g_srv.lockstep_retries - r0), (long long)want);
+            (long long)(g_srv.pub.lockstep_retries - r0), (long long)want);
     /* the status says it */
     control(LAGSIM_CONTROL_T_STATUS, 0);
     run_until(g_srv.now + 1 * MS, 1000);
@@ -1197,12 +1197,12 @@ static void case_lockstep_retry(int arg)
     g_sc.realtime.lockstep_retry = 0.02;
     start();
     run_until(g_srv.now + 30 * MS, 1000);
-    ENSURE(g_srv.lockstep_retries == 1);
+    ENSURE(g_srv.pub.lockstep_retries == 1);
     command(0.0, "cart", 1.0);
     ENSURE(g_srv.rejected[RT_REJ_UNKNOWN_JOINT] == 1 && !g_srv.ls.answered);
     run_until(g_srv.now + 900 * MS, 1000);
-    ENSUREF(g_srv.lockstep_retries == 1, "%lld copies after a rejected answer",
-            (long long)g_srv.lockstep_retries);
+    ENSUREF(g_srv.pub.lockstep_retries == 1, "%lld copies after a rejected answer",
+            (long long)g_srv.pub.lockstep_retries);
     stop_server();
 }
 
@@ -1379,7 +1379,7 @@ static void case_lockstep_loss(int arg)
     (void)arg;
     enum { N = 1000 };
     lockstep_run(0.0, N);
-    ENSURE(g_srv.lockstep_retries == 0 && g_ctl.lost_states == 0 && g_ctl.steps == N + 1);
+    ENSURE(g_srv.pub.lockstep_retries == 0 && g_ctl.lost_states == 0 && g_ctl.steps == N + 1);
     static controller ref;
     ref = g_ctl;
     stop_server();
@@ -1389,12 +1389,12 @@ static void case_lockstep_loss(int arg)
         printf("loss %.0f %% each way: %lld states and %lld commands lost, %lld retries, "
                "%lld answers ignored, %lld timeouts, %.2f s of wall time for %d periods\n",
                100 * losses[i], (long long)g_ctl.lost_states, (long long)g_ctl.lost_commands,
-               (long long)g_srv.lockstep_retries, (long long)g_srv.commands_ignored,
+               (long long)g_srv.pub.lockstep_retries, (long long)g_srv.commands_ignored,
                (long long)g_srv.lockstep_timeouts, (double)wall * 1e-9, N);
         ENSURE(g_ctl.lost_states > 0 && g_ctl.lost_commands > 0);
         ENSUREF(g_srv.lockstep_timeouts == 0, "%lld lockstep timeouts",
                 (long long)g_srv.lockstep_timeouts);
-        ENSURE(g_srv.lockstep_retries >= g_ctl.lost_states);
+        ENSURE(g_srv.pub.lockstep_retries >= g_ctl.lost_states);
         ENSURE(g_ctl.steps == N + 1);
         for (int k = 0; k <= N; k++)
             if (!g_ctl.have[k] || memcmp(g_ctl.x[k], ref.x[k], sizeof ref.x[k]) != 0)
@@ -1469,10 +1469,10 @@ static void case_other_plant(int arg)
     ENSUREF(n_events("plant_conflict") == 2, "%lld plant_conflict events for 3001 scenes",
             (long long)n_events("plant_conflict"));
     ENSUREF(n_events("plant_conflict") + n_suppressed("plant_conflict") +
-                    g_srv.lim_event[RT_EV_PLANT_CONFLICT].suppressed == 3001,
+                    g_srv.pub.lim_event[RT_EV_PLANT_CONFLICT].suppressed == 3001,
             "said %lld + suppressed %lld + pending %lld", (long long)n_events("plant_conflict"),
             (long long)n_suppressed("plant_conflict"),
-            (long long)g_srv.lim_event[RT_EV_PLANT_CONFLICT].suppressed);
+            (long long)g_srv.pub.lim_event[RT_EV_PLANT_CONFLICT].suppressed);
     control(LAGSIM_CONTROL_T_STATUS, 0);
     run_until(g_srv.now + 100 * MS, 0);
     ENSURE(g_out.status_conflicts == 3001);
