@@ -126,7 +126,7 @@ static void publish_state(rt_server *s)
 {
     rt_pub_state(&s->pub, s->info, &s->ctl.ref);
     if (s->sc->realtime.mode == LAG_RT_LOCKSTEP)
-        rt_lockstep_published(&s->ls, lag_sim_time(&s->sim), s->now);
+        rt_lockstep_published(&s->ls, s->pub.generation, lag_sim_time(&s->sim), s->now);
 }
 
 /* Lockstep, while a state is waited on and no answer to it has come: the same state goes
@@ -397,6 +397,14 @@ static void mode_fast(rt_server *s)
     period_run(s, &budget);
 }
 
+/* Lockstep, paused: a state published and waited on (the last of a STEP, one after a
+ * reset) still goes out again until an answer to it came, so that a lost state or answer
+ * is not left unanswered while paused (lagsim-sweep waits for that answer between runs). */
+static bool paused_copies(const rt_server *s)
+{
+    return s->run == RT_PAUSED && s->pending_steps == 0 && s->ls.waiting && !s->ls.answered;
+}
+
 /* Lockstep: a period when the state waited on is answered; nothing else advances it.
  * A wait longer than lockstep_timeout means the controller is gone (or late): one
  * lockstep_timeout event, then the daemon waits (RT_WAITING) and republishes the state
@@ -404,6 +412,10 @@ static void mode_fast(rt_server *s)
  * a run that lost its controller for a while ends exactly as one that did not. */
 static void mode_lockstep(rt_server *s)
 {
+    if (paused_copies(s)) {
+        lockstep_retry(s); /* paused: the state waited on, until an answer to it came */
+        return;
+    }
     if (s->run == RT_WAITING && s->pending_steps == 0) {
         if (s->ls.waiting && rt_lockstep_timed_out(&s->ls, s->now))
             s->pub.want_state = true; /* the same state again, through the state bucket */
@@ -468,18 +480,41 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
  * distinct, every effort finite and within the scene's realtime.effort_limit
  * (rt_command.h), and in lockstep it answers the state waited on. Its steps: */
 
+/* A command of a generation other than the current one answers a state of an earlier run
+ * or scene: never applied, in any mode (stale). Generation 0 answers no particular state:
+ * applied in the realtime and fast modes, stale in lockstep (which needs the state). */
+static bool command_of_now(rt_server *s, const lag_wire_joint_command *c)
+{
+    const int64_t now_gen = s->pub.generation;
+    bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
+    if (c->generation == now_gen || (c->generation == 0 && !lockstep)) return true;
+    rt_verdict v = {RT_REJ_STALE, "", c->sim_time, ""};
+    if (c->generation == 0)
+        snprintf(v.what, sizeof v.what, "generation 0 answers no state; lockstep advances on "
+                 "the generation and sim_time of the state waited on (generation %lld)",
+                 (long long)now_gen);
+    else
+        snprintf(v.what, sizeof v.what, "generation %lld, sim_time %.9g (in value): a state "
+                 "of an earlier run or scene; accepted: generation %lld", (long long)c->generation,
+                 c->sim_time, (long long)now_gen);
+    reject(s, &v);
+    return false;
+}
+
 /* Lockstep: the command answers the state waited on (or, not running, the state the sim
- * holds). A second answer to a state already answered (the controller got it twice, a
- * retry crossing its first answer) is not applied: counted, no event. Else stale. */
+ * holds), known by its generation and sim time. A second answer to a state already
+ * answered (the controller got it twice, a retry crossing its first answer) is not
+ * applied: counted, no event. Else stale. */
 static bool command_in_step(rt_server *s, const lag_wire_joint_command *c)
 {
+    if (!command_of_now(s, c)) return false;
     if (s->sc->realtime.mode != LAG_RT_LOCKSTEP) return true;
-    if (rt_lockstep_repeated(&s->ls, c->sim_time)) {
+    if (rt_lockstep_repeated(&s->ls, c->generation, c->sim_time)) {
         s->commands_ignored++;
         rt_log_rx_fate(&s->rec, s->now, RT_RX_REFUSED); /* --log: a sample of them */
         return false;
     }
-    bool waited_on = s->ls.waiting && c->sim_time == s->ls.waiting_time;
+    bool waited_on = rt_lockstep_is_waited(&s->ls, c->generation, c->sim_time);
     if (waited_on || (s->run != RT_RUNNING && c->sim_time == lag_sim_time(&s->sim))) return true;
     rt_verdict v = {RT_REJ_STALE, "", c->sim_time, ""};
     if (s->ls.waiting)
@@ -500,7 +535,7 @@ static void command_apply(rt_server *s, const lag_wire_joint_command *c, const i
     s->accepted++;
     s->have_command = true;
     s->command_tick = s->sim.tick;
-    rt_lockstep_answer(&s->ls, c->sim_time);
+    rt_lockstep_answer(&s->ls, c->generation, c->sim_time);
     if (s->run == RT_WAITING) {
         /* the command the run was waiting for: it goes on from here */
         s->run = RT_RUNNING;
@@ -525,7 +560,7 @@ static void handle_command(rt_server *s, const uint8_t *data, size_t len)
         return;
     }
     /* lockstep: an answer to the state waited on, good or not, came: it needs no copies */
-    rt_lockstep_heard(&s->ls, c.sim_time);
+    rt_lockstep_heard(&s->ls, c.generation, c.sim_time);
     int idx[LAG_MAX_DOF];
     if (!rt_command_entries(s->info, s->nq, s->sc->realtime.effort_limit, &c, idx, &v)) {
         reject(s, &v);
@@ -567,7 +602,7 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
                   kept[0] ? "keeps the changes made while running: " : "the scene file's values",
                   kept, kept[0] ? " (lagsimctl reset --scene, RESET count 1: the scene file's "
                                   "values)" : "");
-    s->pub.want_scene = true;
+    rt_pub_new_generation(&s->pub, s->sc, s->info); /* the scene, before the new state */
     s->pub.want_state = true;
     s->pub.want_status = true;
 }
@@ -626,8 +661,16 @@ static void run_act(rt_server *s, const rt_act *a)
 void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
 {
     rt_log_rx_begin(&s->rec, s->bus.ch_control, data, len);
+    const int64_t gen = s->pub.generation;
     rt_act a = rt_control_handle(&s->ctl, s->run, data, len);
     run_act(s, &a);
+    /* lockstep: a state waited on and not answered belongs to the generation before a
+     * SET; it is published again in the new one (an answer to the old one is stale) */
+    if (s->pub.generation != gen && s->sc->realtime.mode == LAG_RT_LOCKSTEP &&
+        s->ls.waiting && !s->ls.answered) {
+        s->ls.waiting = false;
+        s->pub.want_state = true;
+    }
     rt_log_rx_end(&s->rec, s->now);
 }
 
@@ -831,6 +874,7 @@ int64_t rt_next_wake(const rt_server *s)
             wake = min64(wake, rt_pace_next(&s->pace));
         break;
     case LAG_RT_LOCKSTEP:
+        if (paused_copies(s) && !s->ls.answer_heard) wake = min64(wake, s->ls.next_retry_ns);
         if ((act || s->run == RT_WAITING) && s->ls.waiting && !s->pub.want_state) {
             if (act && s->ls.answered && !log_holds(s)) return now;
             if (act && s->ls.answered) {

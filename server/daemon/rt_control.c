@@ -34,6 +34,7 @@ void rt_control_init(rt_control *c, const lag_scene *sc, const lagsimd_opts *o,
     c->rec = rec;
     c->ref = sc->reference;
     rt_limit_init(&c->lim_set, RT_SET_PER_S, RT_SET_BURST, now);
+    rt_limit_init(&c->lim_reset, RT_RESET_PER_S, RT_RESET_BURST, now);
 }
 
 bool rt_actuator_lagged(const lag_effects_def *fx, int nq)
@@ -75,6 +76,7 @@ static void handle_kick(rt_control *c, const lag_wire_control *m)
     }
     rt_pub_event(c->pub, "kick", lag_model_info_get(c->sim->def.model.kind)->joint_names[k.joint],
                  k.impulse, kv);
+    rt_pub_new_generation(c->pub, c->sc, c->info);
     c->pub->want_status = true;
 }
 
@@ -126,7 +128,7 @@ static void handle_set(rt_control *c, const lag_wire_control *m)
     c->ref = ns.reference; /* SET reference.*: from the next state on */
     live_set_keep(&c->live, kv);
     rt_pub_event(c->pub, "set", "", 0, kv);
-    c->pub->want_scene = true;
+    rt_pub_new_generation(c->pub, c->sc, c->info); /* the new scene, before any state */
     c->pub->want_status = true;
 }
 
@@ -199,10 +201,22 @@ static rt_act control_step(rt_control *c, rt_run run, int64_t count)
     return (rt_act){.kind = RT_ACT_STEP, .count = count};
 }
 
+/* Resets within their bucket (RT_RESET_PER_S); false: refused. */
+static bool reset_allowed(rt_control *c, const char *what)
+{
+    if (rt_limit_take(&c->lim_reset, *c->pub->now)) return true;
+    char why[160];
+    snprintf(why, sizeof why, "%s: more than %d resets a second; this one was not applied",
+             what, RT_RESET_PER_S);
+    rt_control_rejected(c, why);
+    return false;
+}
+
 /* RESET; count 1: the scene file's values too, after a `restore` event (never
  * suppressed: --replay undoes the changes where it says) before the reset's. */
 static rt_act control_reset(rt_control *c, int64_t count)
 {
+    if (!reset_allowed(c, "reset")) return (rt_act){.kind = RT_ACT_NONE};
     if (count == 1 && (c->live.n > 0 || c->live.nk > 0)) {
         char err[512], why[700];
         if (lag_sim_redefine(c->sim, &c->sc->sim, err, sizeof err) != LAG_OK) {
@@ -253,6 +267,7 @@ static rt_act control_reset_to(rt_control *c, const lag_wire_control *m)
                                "floor (h >= 0)");
         return none;
     }
+    if (!reset_allowed(c, "reset_to")) return none;
     rt_act a = {.kind = RT_ACT_RESET, .to = true, .what = "reset to a given state"};
     for (int i = 0; i < c->nq; i++) {
         a.q[i] = m->q[i];

@@ -29,6 +29,12 @@
  * takes one SET per varied key and run. */
 #define RT_SET_PER_S 50
 #define RT_SET_BURST 50
+/* RESET and RESET_TO applied per second and burst: each starts a new generation whose
+ * scene goes out at once (rt_pub_new_generation), so a flood of resets must not become
+ * a flood of scenes; one beyond is refused (control_rejected) and not applied.
+ * lagsim-sweep's kept daemon takes one RESET_TO per run. */
+#define RT_RESET_PER_S 50
+#define RT_RESET_BURST 50
 
 /* RT_WAITING: not advancing, waiting for a command that starts the run (realtime.start:
  * first_command) or, in lockstep, for one that answers the state whose wait timed out; the
@@ -53,6 +59,7 @@ typedef struct rt_control {
      * published on _REFERENCE before each state when ref.n > 0 */
     lag_scene_reference ref;
     rt_limit lim_set;          /* SET requests validated per second */
+    rt_limit lim_reset;        /* RESET and RESET_TO applied per second */
     int64_t controls_rejected; /* counted in status */
 } rt_control;
 

@@ -42,6 +42,7 @@ void rt_pub_init(rt_pub *p, rt_bus *bus, rt_record *rec, rt_term *term, const in
     p->term = term;
     p->now = now;
     p->sim = sim;
+    p->generation = 1;
     for (int k = 0; k < RT_EV_COUNT; k++)
         rt_limit_init(&p->lim_event[k], ev_limits[k].per_s, ev_limits[k].burst, *now);
     rt_limit_init(&p->lim_status, RT_STATUS_PER_S, RT_STATUS_BURST, *now);
@@ -55,7 +56,10 @@ const char *rt_ev_kind(rt_ev ev)
 }
 
 /* Where what is published goes now: the bus and the log (rt_wire.h). */
-static rt_out out(const rt_pub *p) { return (rt_out){p->bus, p->rec, *p->now}; }
+static rt_out out(const rt_pub *p)
+{
+    return (rt_out){p->bus, p->rec, *p->now, p->generation};
+}
 
 void rt_pub_event_at(rt_pub *p, double sim_time, const char *kind, const char *joint,
                      double value, const char *detail, bool effect)
@@ -130,6 +134,13 @@ void rt_pub_scene(rt_pub *p, const lag_scene *sc, const lag_model_info *info)
 {
     rt_out o = out(p);
     rt_publish_scene(&o, sc, p->sim, info);
+}
+
+void rt_pub_new_generation(rt_pub *p, const lag_scene *sc, const lag_model_info *info)
+{
+    p->generation++;
+    rt_pub_scene(p, sc, info);
+    p->want_scene = false; /* a DESCRIBE waiting for its answer has it */
 }
 
 void rt_pub_status(rt_pub *p, lag_wire_status *m)

@@ -65,6 +65,11 @@ typedef struct rt_pub {
     const int64_t *now;        /* the loop's clock */
     const lag_sim *sim;        /* sim time and tick of what is published */
 
+    /* the generation of what is published: 1 at the start, one more at every reset and
+     * every accepted SET or kick (rt_pub_new_generation); states, references and scenes
+     * carry it, and a command carries the generation of the state it answers */
+    int64_t generation;
+
     /* answers owed: published once per wake-up at most, when their bucket allows (a
      * flood of requests gets one answer, not one each) */
     bool want_state, want_scene, want_status;
@@ -108,6 +113,10 @@ bool rt_pub_state(rt_pub *p, const lag_model_info *info, const lag_scene_referen
 void rt_pub_state_again(rt_pub *p);
 /* The scene as it is now. */
 void rt_pub_scene(rt_pub *p, const lag_scene *sc, const lag_model_info *info);
+/* The scene or the run changed (a reset, a SET, a kick): a new generation, whose scene
+ * goes out now, before any state of it, not through the DESCRIBE bucket (what changes
+ * the generation has its own bucket: RT_SET_PER_S, RT_RESET_PER_S). */
+void rt_pub_new_generation(rt_pub *p, const lag_scene *sc, const lag_model_info *info);
 /* The status m (the loop fills it). */
 void rt_pub_status(rt_pub *p, lag_wire_status *m);
 

@@ -794,7 +794,11 @@ static int run_kept(worker *wk, const char *const *sets, int nsets, const eval_s
             return -1;
         int rc = eval_worker_run(wk->kept, &x->c, sets, nsets, rsc->q0, rsc->qd0, res, err,
                                  errlen);
-        if (rc == 0 && !strstr(res->reason, "before the duration")) return 0;
+        /* a stalled run, or a controller that did not answer the run before's last state:
+         * a new worker pair runs it again */
+        if (rc == 0 && !strstr(res->reason, "before the duration") &&
+            !strstr(res->reason, "did not answer the paused state"))
+            return 0;
         eval_worker_stop(wk->kept);
         wk->kept = NULL;
         if (rc == 0) return 0;

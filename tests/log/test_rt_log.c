@@ -56,7 +56,8 @@ static void command(double sim_time, double effort)
 {
     uint8_t buf[256];
     char *names[1] = {"theta0"};
-    lagsim_joint_command_t m = {0, sim_time, 1, names, &effort};
+    /* answers the state of the current generation */
+    lagsim_joint_command_t m = {0, sim_time, 1, names, &effort, g_srv.pub.generation};
     int n = lagsim_joint_command_t_encode(buf, 0, sizeof buf, &m);
     ENSURE(n > 0);
     rt_handle_command(&g_srv, buf, (size_t)n);
