@@ -53,6 +53,8 @@ typedef struct outputs {
     bool nonfinite;
     double last_t;                    /* sim_time of the last state */
     int64_t last_step;
+    int64_t last_gen, scene_gen;      /* the generation of the last state, of the last scene */
+    int64_t state_before_scene;       /* states of a generation whose scene had not come */
     double last_q[LAG_MAX_DOF];
     int64_t status_controls_rejected, status_states, status_overrun_bursts, status_conflicts;
     int64_t status_err_warnings;
@@ -207,6 +209,8 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
             g_out.nonfinite = true;
         g_out.last_t = m.sim_time;
         g_out.last_step = m.step;
+        g_out.last_gen = m.generation;
+        if (m.generation != g_out.scene_gen) g_out.state_before_scene++;
         for (int i = 0; i < m.num_joints && i < LAG_MAX_DOF; i++) g_out.last_q[i] = m.position[i];
         if (g_ctl.on) ctl_state(&m);
     } else if (!strcmp(sfx, "STATUS")) {
@@ -251,6 +255,7 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         }
         if (strcmp(m.prefix, "TL") != 0) return; /* another prefix's (other_plant) */
         g_out.scene++;
+        g_out.scene_gen = m.generation;
         if (rb->data_size <= sizeof g_out.scene_bytes) {
             memcpy(g_out.scene_bytes, rb->data, rb->data_size);
             g_out.scene_len = rb->data_size;
@@ -748,6 +753,105 @@ static void case_set(int arg)
             (long long)(n_events("set") - sets), RT_SET_BURST + 20);
     ENSURE(g_srv.ctl.controls_rejected >= 20);
     ENSURE(g_srv.ctl.live.n == 3); /* m2, the actuator and m1: a key set again replaces itself */
+    stop_server();
+}
+
+/* A command of generation gen answering the state at sim_time. */
+static void command_gen(int64_t gen, double sim_time, const char *joint, double effort)
+{
+    uint8_t buf[256];
+    char *names[1] = {(char *)joint};
+    lagsim_joint_command_t m = {0, sim_time, 1, names, &effort, gen};
+    int n = lagsim_joint_command_t_encode(buf, 0, sizeof buf, &m);
+    ENSURE(n > 0);
+    rt_handle_command(&g_srv, buf, (size_t)n);
+}
+
+/* A state is known by its generation and its sim time. The generation is 1 at the start
+ * and one more at every SET and reset; the scene of a new generation goes out before any
+ * state of it; lockstep takes an answer only when both are those of the state waited on:
+ * an answer of the generation before at the same sim time (a SET's, a reset's) is stale,
+ * never applied, never a step. A 0.1.0 command is refused, saying to rebuild. */
+static void case_generation(int arg)
+{
+    (void)arg;
+    static const char text[] =
+        "model: manipulator\n"
+        "parameters: {m1: 2.0, m2: 0.5, l1: 0.3, I1: 0.02, I2: 0.05, g: 9.81}\n"
+        "initial: {q: [0.3, 0.5], qd: [0, 0]}\n"
+        "realtime: {mode: lockstep, start: paused, lockstep_timeout: 30}\n"
+        "lcm: {prefix: TL}\n";
+    char err[1024];
+    ENSURE(lag_scene_load_buffer("gen.yaml", text, sizeof text - 1, NULL, 0, &g_sc, err,
+                                 sizeof err) == 0);
+    memset(&g_opts, 0, sizeof g_opts);
+    g_opts.quiet = true;
+    g_opts.scene_name = "gen.yaml";
+    g_opts.scene_text = text;
+    g_opts.scene_len = sizeof text - 1;
+    start();
+    ENSURE(g_srv.pub.generation == 1 && g_out.scene_gen == 1 && g_out.last_gen == 1);
+    /* SET while the state at t = 0 is waited on: generation 2, its scene first, and the
+     * state again in generation 2 */
+    set_request("parameters.m2", "1.25");
+    run_until(g_srv.now + 100 * MS, 1000);
+    ENSUREF(g_srv.pub.generation == 2 && g_out.scene_gen == 2 && g_out.last_gen == 2 &&
+                g_out.last_t == 0.0 && g_out.state_before_scene == 0,
+            "generation %lld, scene %lld, state %lld at %g, %lld states before their scene",
+            (long long)g_srv.pub.generation, (long long)g_out.scene_gen,
+            (long long)g_out.last_gen, g_out.last_t, (long long)g_out.state_before_scene);
+    /* an answer to the state of generation 1 at the same sim time: stale */
+    int64_t stale = g_srv.rejected[RT_REJ_STALE];
+    command_gen(1, 0.0, "q1", 9.0);
+    control(LAGSIM_CONTROL_T_STEP, 1);
+    run_until(g_srv.now + 300 * MS, 1000);
+    ENSUREF(g_srv.rejected[RT_REJ_STALE] == stale + 1 && g_srv.sim.tick == 0 &&
+                g_srv.held[0] == 0.0 && strstr(last_detail("command_rejected"), "generation 1"),
+            "stale %lld, tick %lld, held %g: '%s'", (long long)(g_srv.rejected[RT_REJ_STALE] - stale),
+            (long long)g_srv.sim.tick, g_srv.held[0], last_detail("command_rejected"));
+    command_gen(2, 0.0, "q1", 0.5); /* the state's own: the period runs */
+    run_until(g_srv.now + 300 * MS, 1000);
+    ENSURE(g_srv.sim.tick == 10 && g_srv.held[0] == 0.5 && g_out.last_t == 0.01);
+    command_gen(2, 0.01, "q1", 0.25); /* answers the paused state */
+    run_until(g_srv.now + 50 * MS, 1000);
+    /* RESET_TO: generation 3, sim time 0 again; the run before's answer to its own state
+     * at sim time 0, late, is stale */
+    double q[2] = {0.2, 0.4}, qd[2] = {0, 0};
+    lagsim_control_t rm = {0, LAGSIM_CONTROL_T_RESET_TO, 0, 2, q, qd, "", ""};
+    uint8_t buf[512];
+    int n = lagsim_control_t_encode(buf, 0, sizeof buf, &rm);
+    ENSURE(n > 0);
+    rt_handle_control(&g_srv, buf, (size_t)n);
+    run_until(g_srv.now + 100 * MS, 1000);
+    ENSURE(g_srv.pub.generation == 3 && g_out.scene_gen == 3 && g_out.last_gen == 3 &&
+           g_out.last_t == 0.0 && g_out.state_before_scene == 0);
+    command_gen(2, 0.0, "q1", 9.0);
+    control(LAGSIM_CONTROL_T_STEP, 1);
+    run_until(g_srv.now + 300 * MS, 1000);
+    ENSURE(g_srv.rejected[RT_REJ_STALE] == stale + 2 && g_srv.sim.tick == 0);
+    command_gen(3, 0.0, "q1", 0.5);
+    run_until(g_srv.now + 300 * MS, 1000);
+    ENSURE(g_srv.sim.tick == 10 && g_srv.held[0] == 0.5);
+    /* generation 0 answers no state: never a step in lockstep */
+    command_gen(0, 0.01, "q1", 9.0);
+    ENSURE(g_srv.rejected[RT_REJ_STALE] == stale + 3 && g_srv.held[0] == 0.5);
+    /* a command of lagsim 0.1.0's types: refused, and the reason says to rebuild */
+    lag_wire_joint_command jc;
+    memset(&jc, 0, sizeof jc);
+    jc.sim_time = 0.01;
+    jc.num_joints = 1;
+    snprintf(jc.name[0], sizeof jc.name[0], "q1");
+    n = lag_wire_encode(LAG_WIRE_JOINT_COMMAND, &jc, buf, sizeof buf);
+    int64_t fp;
+    ENSURE(n > 8 && lag_wire_old_version(LAG_WIRE_JOINT_COMMAND, 0, NULL, &fp));
+    for (int b = 0; b < 8; b++) buf[b] = (uint8_t)((uint64_t)fp >> (56 - 8 * b));
+    int64_t undecodable = g_srv.rejected[RT_REJ_UNDECODABLE];
+    rt_handle_command(&g_srv, buf, (size_t)n - 8); /* without the generation */
+    run_until(g_srv.now + 300 * MS, 1000);
+    ENSUREF(g_srv.rejected[RT_REJ_UNDECODABLE] == undecodable + 1 &&
+                strstr(last_detail("command_rejected"), "built with lagsim 0.1.0's types and "
+                       "must be rebuilt"),
+            "'%s'", last_detail("command_rejected"));
     stop_server();
 }
 
@@ -1648,6 +1752,7 @@ int main(int argc, char **argv)
         {"other_plant", case_other_plant, 0, 0}, {"messages", case_messages, 0, 0},
         {"reject_names", case_reject_names, 0, 0}, {"waits", case_waits, 0, 0},
         {"live_error", case_live_error, 0, 0},  {"scene_rules", case_scene_rules, 0, 0},
+        {"generation", case_generation, 0, 0},
     };
     /* a failed check ends the case: what follows it needs what failed */
     const lt_program p = {.cases = cases, .n = (int)(sizeof cases / sizeof cases[0]),
