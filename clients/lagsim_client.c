@@ -43,6 +43,7 @@ struct lag_client {
     bool have_state, new_state;  /* new: not yet returned by lag_client_wait_state */
     lag_client_scene scene;
     bool have_scene;
+    lag_client_scene state_scene; /* the scene of the latest state's generation */
     /* a state whose generation is not the scene's: held until the scene of its
      * generation came (asked for by DESCRIBE every LAG_CLIENT_DESCRIBE_S meanwhile) */
     lag_client_state held;
@@ -134,6 +135,7 @@ static void take_state(lag_client *c, const lag_client_state *m)
 {
     c->answer_len = 0;
     c->state = *m;
+    c->state_scene = c->scene; /* its generation's (the scene rule) */
     c->have_state = c->new_state = true;
     if (c->on_state) c->on_state(&c->state, c->on_state_user);
 }
@@ -408,7 +410,7 @@ bool lag_client_latest_state(const lag_client *c, lag_client_state *st)
 
 bool lag_client_latest_scene(const lag_client *c, lag_client_scene *sc)
 {
-    if (c->have_scene && sc) *sc = c->scene;
+    if (c->have_scene && sc) *sc = c->have_state ? c->state_scene : c->scene;
     return c->have_scene;
 }
 

@@ -147,8 +147,9 @@ lag_result lag_client_wait_state(lag_client *c, double timeout_s, lag_client_sta
  * Return false if none has arrived yet. OUT: st */
 bool lag_client_latest_state(const lag_client *c, lag_client_state *st);
 bool lag_client_latest_status(const lag_client *c, lag_client_status *st);
-/* The latest scene: the scene of the latest state's generation once that state was
- * returned (the scene rule above). False if none has arrived. OUT: sc */
+/* The scene of the latest state's generation (the scene rule above; a scene of a later
+ * generation that came since waits for its own state); before any state, the latest scene
+ * received. False if none has arrived. OUT: sc */
 bool lag_client_latest_scene(const lag_client *c, lag_client_scene *sc);
 /* The latest reference (<prefix>_REFERENCE: the scene's `reference:`, r and r' of the
  * joints that have one, which the daemon publishes just before each state with the same
