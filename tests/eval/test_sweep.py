@@ -477,6 +477,10 @@ def scene_same(d, lang):
             a != b for a, b in zip(rows(j1), rows(other)))
         check(same, "%s, m2 varied: %s gives the CSV of -j1, byte for byte (%d rows differ)"
               % (lang, name, differ))
+        if not same and os.path.exists(other):
+            for a, b in [(a, b) for a, b in zip(rows(j1), rows(other)) if a != b][:3]:
+                print("  run %s: -j1 failed=%s %r; %s failed=%s %r" % (
+                    a["run"], a["failed"], a["reason"], name, b["failed"], b["reason"]))
     return j1
 
 
