@@ -32,7 +32,8 @@ target_link_libraries(scene_pd PRIVATE lagsim_controller)
 find_program(LAGSIM_GNU_PARALLEL parallel)
 if(LAGSIM_PYTHON3 AND LAGSIM_GNU_PARALLEL)
   # scene_*: a scene-reactive controller (tests/eval/scene_pd.c, scene_pd.py) over m2
-  foreach(c same slurm merge kept kept_python loss stalled ssh scene_c scene_python scene_loss)
+  foreach(c same slurm merge kept kept_python loss stalled ssh scene_c scene_python scene_loss
+          unanswered)
     add_test(NAME eval_lagsim_sweep_${c}
       COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_sweep.py
               $<TARGET_FILE_DIR:lagsim-sweep> ${PROJECT_SOURCE_DIR} ${c})

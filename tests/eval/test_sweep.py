@@ -34,6 +34,8 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             first state of the run)
   scene_loss  the same two controllers under 10 % datagram loss in a network namespace
             (nftables; root, else skipped): the same CSVs as without loss, byte for byte
+  unanswered  a controller that never answers a run's last state: the worker waits for
+            that answer; the run after fails saying so, and the next gets a new pair
 """
 import csv
 import filecmp
@@ -532,10 +534,36 @@ def case_scene_loss(d):
         subprocess.run(["ip", "netns", "del", ns])
 
 
+def case_unanswered(d):
+    # a controller that never answers a run's last state (the one the daemon pauses at):
+    # the worker does not start the next run on that pair (an answer of the run before
+    # could still be on its way): that run fails, saying why, and the run after it gets a
+    # new pair, as after a stalled run (tests/eval/mute_pd.py)
+    q, env = scene_sweep("c", 3)
+    mute = "python3 %s -q --mute-from 0.5 --prefix {prefix}" % os.path.join(
+        SRC, "tests", "eval", "mute_pd.py")
+    q[q.index("--controller") + 1] = mute
+    q[q.index("--duration") + 1] = "0.5"
+    out = os.path.join(d, "mute.csv")
+    t0 = time.monotonic()
+    p = run([SWEEP] + q + ["-j1", "--csv", out], env=env)
+    took = time.monotonic() - t0
+    said = p.stderr.count("did not answer the paused state")
+    check(said == 1 and "a new lagsimd and controller for the next run" in p.stderr,
+          "the controller's silence on the paused state is said once (%d), a new pair next"
+          % said)
+    r = rows(out) if os.path.exists(out) else []
+    check([x["failed"] for x in r] == ["0", "1", "0"] and
+          "did not answer the paused state" in r[1]["reason"] and took > 10,
+          "run 1 failed with that reason after waiting 10 s for the answer, runs 0 and 2 "
+          "(a new pair) did not (%.1f s)" % took)
+
+
 with tempfile.TemporaryDirectory() as tmp:
     {"same": case_same, "slurm": case_slurm, "merge": case_merge, "kept": case_kept,
      "loss": case_loss, "stalled": case_stalled, "ssh": case_ssh,
      "kept_python": case_kept_python, "scene_c": case_scene_c,
-     "scene_python": case_scene_python, "scene_loss": case_scene_loss}[CASE](tmp)
+     "scene_python": case_scene_python, "scene_loss": case_scene_loss,
+     "unanswered": case_unanswered}[CASE](tmp)
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)
