@@ -26,6 +26,7 @@
 static const char *prog = "lagsim-sweep";
 
 #define VARY_MAX 16
+#define ROW_MAX 8192 /* bytes of the CSV header and of a row at most (a row: < 4000) */
 
 static void usage(FILE *f)
 {
@@ -320,6 +321,7 @@ typedef struct sweep {
     eval_scene sc;
     lag_require req;
     char header[ROW_MAX];
+    char *identity;      /* the CSV's identity lines (sweep_merge.h) */
     char default_metric[160];
     char tmpdir[64];
 } sweep;
@@ -360,9 +362,9 @@ static int parse_options(sweep *x, int argc, char **argv)
         case O_SEED: x->seed = (uint64_t)parse_pos("--seed", optarg, 0, 9e15, &bad); break;
         case 'j': x->jobs = (long)parse_pos("--jobs", optarg, 1, 256, &bad); break;
         case O_SHARD:
-            if (sscanf(optarg, "%ld/%ld", &x->shard_k, &x->shard_n) != 2 || x->shard_n < 1 ||
-                x->shard_k < 1 || x->shard_k > x->shard_n)
-                return die("--shard: expected K/N with 1 <= K <= N, got '%s'", optarg);
+            if (sweep_shard_parse(optarg, &x->shard_k, &x->shard_n))
+                return die("--shard: expected K/N, whole numbers with 1 <= K <= N <= 1e7, got "
+                           "'%s'", optarg);
             break;
         case O_REQUIRE: x->require = optarg; break;
         case O_CSV: x->csv = optarg; break;
@@ -451,24 +453,40 @@ static int make_header(sweep *x)
 {
     char *h = x->header;
     size_t hu = (size_t)snprintf(h, ROW_MAX, "run");
-    for (int k = 0; k < x->nv; k++) {
+    for (int k = 0; k < x->nv && hu < ROW_MAX; k++) {
         if (x->vs[k].index < 0)
             hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",%s", x->vs[k].key);
         else
             hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",%s[%d]", x->vs[k].key,
                                    x->vs[k].index);
     }
-    hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",failed,required,reason");
-    for (int j = 0; j < x->sc.nj; j++)
-        for (int m = 0; m < LAG_METRIC_COUNT; m++)
+    if (hu < ROW_MAX) hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",failed,required,reason");
+    for (int j = 0; j < x->sc.nj && hu < ROW_MAX; j++)
+        for (int m = 0; m < LAG_METRIC_COUNT && hu < ROW_MAX; m++)
             hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",%s.%s", x->sc.joint[j],
                                    lag_metric_table[m].name);
+    if (hu >= ROW_MAX) return die("the CSV's header (the varied keys' names) would pass %s bytes",
+                                  "8191");
     snprintf(x->default_metric, sizeof x->default_metric, "%s.%s",
              x->req.n ? x->req.term[0].joint : x->sc.joint[0],
              lag_metric_table[x->req.n ? x->req.term[0].metric : LAG_METRIC_IAE].name);
     if (!x->metric) x->metric = x->default_metric;
     if (x->png && header_column(x->header, x->metric) < 0)
         return die("--metric %s: no such column (JOINT.METRIC, e.g. theta.settle)", x->metric);
+    return -1;
+}
+
+/* What every shard of the sweep shares, for the CSV's identity lines. -1 or the exit code. */
+static int make_identity(sweep *x)
+{
+    char err[2048];
+    const char *texts[VARY_MAX];
+    for (int k = 0; k < x->nv; k++) texts[k] = x->vs[k].text;
+    sweep_identity id = {.seed = x->seed, .scene = x->config, .c = &x->c, .vary = texts,
+                         .nvary = x->nv, .runs = x->total, .controller = x->controller,
+                         .restart = x->restart, .require = x->require,
+                         .shard_k = x->shard_k, .shard_n = x->shard_n};
+    if (!(x->identity = sweep_identity_text(&id, err, sizeof err))) return die("%s", err);
     return -1;
 }
 
@@ -527,12 +545,8 @@ static void write_row(const worker *wk, long i, const double *val, const eval_re
     fprintf(f, "%ld", i);
     for (int k = 0; k < x->nv; k++) fprintf(f, ",%.17g", val[k]);
     const char *reason = res->failed ? res->reason : met ? "" : why;
-    fprintf(f, ",%d,%d,\"", res->failed, met);
-    for (const char *p = reason; *p; p++) {
-        if (*p == '"') fputc('"', f);
-        fputc(*p == '\n' ? ' ' : *p, f);
-    }
-    fputc('"', f);
+    fprintf(f, ",%d,%d,", res->failed, met);
+    sweep_write_reason(f, reason);
     for (int j = 0; j < x->sc.nj; j++)
         for (int m = 0; m < LAG_METRIC_COUNT; m++) {
             if (isnan(res->m[j].v[m])) fprintf(f, ",nan");
@@ -620,19 +634,21 @@ static int run_workers(sweep *x)
 
 static void collect_rows(const sweep *x, rows *r)
 {
-    char line[ROW_MAX];
+    char *line = NULL;
+    size_t cap = 0;
     for (long w = 0; w < x->jobs; w++) {
         char path[256];
         snprintf(path, sizeof path, "%s/%ld.rows", x->tmpdir, w);
         FILE *f = fopen(path, "r");
         if (!f) continue;
-        while (fgets(line, sizeof line, f)) {
+        while (getline(&line, &cap, f) >= 0) {
             line[strcspn(line, "\n")] = '\0';
             rows_add(r, strtol(line, NULL, 10), line);
         }
         fclose(f);
         unlink(path);
     }
+    free(line);
 }
 
 static int count_passed(const sweep *x, const rows *r)
@@ -669,7 +685,8 @@ static int sweep_run(sweep *x)
     int status = run_workers(x);
     rows r = {0};
     collect_rows(x, &r);
-    if (fcsv && (rows_write(&r, fcsv, x->header, err, sizeof err) || fclose(fcsv) != 0))
+    if (fcsv && (rows_write(&r, fcsv, x->identity, x->header, err, sizeof err) ||
+                 fclose(fcsv) != 0))
         status = 2;
     summary(x->header, &r);
     bool all = count_passed(x, &r) == r.n;
@@ -689,6 +706,8 @@ int main(int argc, char **argv)
     if ((rc = parse_options(&x, argc, argv)) >= 0 || (rc = check_options(&x, argc, argv)) >= 0 ||
         (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0)
         return rc;
-    if ((rc = make_header(&x)) >= 0) return rc;
-    return sweep_run(&x);
+    if ((rc = make_header(&x)) >= 0 || (rc = make_identity(&x)) >= 0) return rc;
+    rc = sweep_run(&x);
+    free(x.identity);
+    return rc;
 }
