@@ -205,7 +205,7 @@ void sweep_write_reason(FILE *f, const char *reason)
 /* A number as %.17g writes one: -?D+(.D+)?(e[+-]DD+)?, or inf, -inf. */
 static bool is_number(const char *s, size_t n)
 {
-    size_t i = s[0] == '-', d;
+    size_t i = n && s[0] == '-', d;
     if (n - i == 3 && !memcmp(s + i, "inf", 3)) return true;
     for (d = i; i < n && isdigit((unsigned char)s[i]); i++) {}
     if (i == d) return false;
