@@ -55,8 +55,8 @@ static void usage(FILE *f)
 "  -n, --runs N           runs (per grid point when there are grids; default 1)\n"
 "      --seed S           the random seed of every drawn value (default 1)\n"
 "  -j, --jobs N           runs at once on this machine (default 1)\n"
-"      --shard K/N        only runs i with i mod N = K - 1 (K = 1..N): one machine's\n"
-"                         part; lagsim-sweep merge joins the parts\n"
+"      --shard K/N        only runs i with i mod N = K - 1 (K = 1..N, N <= 1e7): one\n"
+"                         machine's part; lagsim-sweep merge joins the parts\n"
 "      --restart          a daemon and a controller started for each run, with the\n"
 "                         run's values (default: one of each per worker, started\n"
 "                         with the scene's values; each run's values SET and its\n"
@@ -71,14 +71,16 @@ static void usage(FILE *f)
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a run may take (default 600)\n"
 "  -v, --verbose          pass the daemon's and the controller's output through\n"
-"  -o, --output OUT.csv   merge: the joined CSV\n"
-"      --partial          merge: join shards that leave runs out (default: refused\n"
-"                         unless the runs are exactly 0 to the last one found)\n"
+"  -o, --output OUT.csv   merge: the joined CSV (the whole sweep's, byte for byte); every\n"
+"                         shard's identity lines (# seed:, # scene-sha256:, # vary:, ...)\n"
+"                         must be the first's, every row one of its header, every shard\n"
+"                         and run there\n"
+"      --partial          merge: join shards that leave shards or runs out\n"
 "  -h, --help             this help\n"
 "\n"
 "exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
 "case error, an output that exists (checked before the first run), or shard CSVs that\n"
-"do not belong together or leave runs out\n");
+"do not belong together, hold a malformed row or leave shards or runs out\n");
 }
 
 static int die(const char *fmt, const char *a)

@@ -161,6 +161,20 @@ def case_same(d):
     check(filecmp.cmp(a1, m, shallow=False), "2 shards merged = the whole sweep, byte for byte")
     r = rows(a1)
     check([int(x["run"]) for x in r] == list(range(8)), "8 rows in run order")
+    # the whole sweep's identity lines are each shard's but the shard line
+    check(all(identity(os.path.join(d, "shard-%d.csv" % k)) ==
+              identity(a1) + [("shard", "%d/2" % k)] for k in (1, 2)) and
+          identity(a1)[0][0] == "lagsim-sweep", "identity lines: the shards' = the whole "
+          "sweep's and 'shard: K/2'")
+    # gnuplot reads the CSV as written: the identity lines skipped, the names from the header
+    tbl = os.path.join(d, "read.txt")
+    subprocess.run(["gnuplot", "-e", "set datafile separator ','; set table '%s'; plot '%s' "
+                    "using 'parameters.m0':'theta.iae'" % (tbl, a1)], check=True)
+    pts = [line.split()[:2] for line in open(tbl) if line.strip() and line[0] != "#"]
+    want = [(float(x["parameters.m0"]), float(x["theta.iae"])) for x in r]
+    check(len(pts) == 8 and all(abs(float(p[0]) - w[0]) <= 1e-5 * w[0] and
+                                abs(float(p[1]) - w[1]) <= 1e-5 * w[1] for p, w in zip(pts, want)),
+          "gnuplot reads the CSV by column name, the identity lines skipped: %s" % pts)
     m1 = [float(x["parameters.m1"]) for x in r]
     grid = [0.05 + (0.3 - 0.05) * k / 3 for k in range(4)]
     check(all(abs(m1[i] - grid[i // 2]) < 1e-15 for i in range(8)),

@@ -249,12 +249,64 @@ static void case_identity(int arg)
     ENSURE(sweep_identity_text(&id, err, sizeof err) == NULL && strstr(err, scene));
 }
 
+/* 300 shards of a sweep of 300 runs, one run each, written as lagsim-sweep writes them:
+ * merged, every one of them (merge once kept the first 256 inputs), the output the whole
+ * sweep's CSV. */
+static void case_merge_many(int arg)
+{
+    (void)arg;
+    enum { N = 300 };
+    char dir[] = "/tmp/lagsim-sweep-many.XXXXXX", scene[64], err[256];
+    ENSURE(mkdtemp(dir) != NULL);
+    temp_file(scene, "abc", 3);
+    eval_case c = {.name = "sweep", .duration = 1};
+    const char *vary[] = {"a=uniform(1,2)"};
+    sweep_identity id = {.seed = 1, .scene = scene, .c = &c, .vary = vary, .nvary = 1,
+                         .runs = N, .controller = "ctl", .shard_n = N};
+    static char path[N][96];
+    char *argv[N + 3];
+    argv[0] = "merge";
+    for (int k = 0; k < N; k++) {
+        id.shard_k = k + 1;
+        char *text = sweep_identity_text(&id, err, sizeof err);
+        snprintf(path[k], sizeof path[k], "%s/shard-%d.csv", dir, k + 1);
+        FILE *f = fopen(path[k], "w");
+        ENSURE(text && f);
+        if (!text || !f) return;
+        fprintf(f, "%srun,a,failed,required,reason,x.iae\n%d,1.5,0,1,\"\",nan\n", text, k);
+        fclose(f);
+        free(text);
+        argv[1 + k] = path[k];
+    }
+    char out[96];
+    snprintf(out, sizeof out, "%s/merged.csv", dir);
+    argv[N + 1] = "-o", argv[N + 2] = out;
+    ENSURE(merge(N + 3, argv, NULL) == 0);
+    /* the whole sweep's CSV: the identity of shard 1/1, the header, the 300 rows */
+    id.shard_k = id.shard_n = 1;
+    char *want = NULL, *text = sweep_identity_text(&id, err, sizeof err);
+    size_t wlen = 0;
+    FILE *w = open_memstream(&want, &wlen);
+    fprintf(w, "%srun,a,failed,required,reason,x.iae\n", text);
+    for (int k = 0; k < N; k++) fprintf(w, "%d,1.5,0,1,\"\",nan\n", k);
+    fclose(w);
+    char got[65536] = "";
+    FILE *f = fopen(out, "r");
+    size_t n = f ? fread(got, 1, sizeof got - 1, f) : 0;
+    if (f) fclose(f);
+    ENSUREF(n == wlen && !memcmp(got, want, wlen), "merged (%zu bytes):\n%.400s", n, got);
+    free(want), free(text);
+    for (int k = 0; k < N; k++) unlink(path[k]);
+    unlink(out), unlink(scene), rmdir(dir);
+}
+
 int main(int argc, char **argv)
 {
     static const lt_case cases[] = {
         {"rows", case_rows, 0, 0},         {"reason", case_reason, 0, 0},
         {"shard", case_shard, 0, 0},       {"columns", case_columns, 0, 0},
         {"sha256", case_sha256, 0, 0},     {"identity", case_identity, 0, 0},
+        {"merge_many", case_merge_many, 0, 0},
     };
     return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
 }
