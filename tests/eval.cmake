@@ -16,6 +16,8 @@ target_include_directories(test_eval_sweep_csv PRIVATE ${CMAKE_CURRENT_LIST_DIR}
 target_compile_definitions(test_eval_sweep_csv PRIVATE LAGSIM_VERSION="${PROJECT_VERSION}")
 target_link_libraries(test_eval_sweep_csv PRIVATE lagsim_sweepcsv)
 lagsim_add_test_cases(test_eval_sweep_csv eval_sweep_csv eval 60)
+# merge on arbitrary bytes as a shard (fuzz_sweep_merge_corpus; fuzz_sweep_merge_run)
+lagsim_fuzz_target(sweep_merge LIBS lagsim_sweepcsv)
 
 # lagsim-eval end to end: the cart-pole held by lqr_balance through a small case set
 # (tests/eval/cartpole_cases.yaml); metrics against the logged states, --require's exit

@@ -18,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <glib.h>
@@ -30,6 +31,13 @@
 #endif
 
 static const char *prog = "lagsim-sweep";
+static FILE *messages; /* where merge says why it refuses (NULL: stderr) */
+#define MSG (messages ? messages : stderr)
+
+void sweep_merge_messages(FILE *f)
+{
+    messages = f;
+}
 
 /* ---------------------------------------------------------------- CSV rows */
 
@@ -533,21 +541,21 @@ static int say(const char *path, long ln, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "%s: merge: %s", prog, path);
-    if (ln) fprintf(stderr, ":%ld", ln);
-    fprintf(stderr, ": ");
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    fprintf(MSG, "%s: merge: %s", prog, path);
+    if (ln) fprintf(MSG, ":%ld", ln);
+    fprintf(MSG, ": ");
+    vfprintf(MSG, fmt, ap);
+    fputc('\n', MSG);
     va_end(ap);
     return -1;
 }
 
 static void shard_free(shard *s)
 {
+    if (s->tf) fclose(s->tf); /* first: it writes s->text */
     for (int i = 0; i < s->nid; i++) free(s->key[i]), free(s->val[i]);
     free(s->key), free(s->val), free(s->version), free(s->text), free(s->holds);
     free(s->header);
-    if (s->tf) fclose(s->tf);
     sweep_columns_free(&s->cols);
 }
 
@@ -772,7 +780,7 @@ static int merge_whole(const merging *m)
             u += (size_t)snprintf(buf + u, sizeof buf - u, "%s%ld/%ld", lack > 1 ? ", " : "",
                                   K + 1, s->sn);
     if (lack) {
-        fprintf(stderr, "%s: merge: the shards do not make a whole sweep: missing shard%s %s%s "
+        fprintf(MSG, "%s: merge: the shards do not make a whole sweep: missing shard%s %s%s "
                         "(of the sweep's %ld); give every shard, or --partial to merge only "
                         "these\n", prog, lack > 1 ? "s" : "", buf, lack > 8 ? ", ..." : "",
                 s->sn);
@@ -780,7 +788,7 @@ static int merge_whole(const merging *m)
     }
     missing_runs(m->from, s->runs, buf, sizeof buf);
     if (buf[0]) {
-        fprintf(stderr, "%s: merge: the shards do not make a whole sweep: missing runs %s "
+        fprintf(MSG, "%s: merge: the shards do not make a whole sweep: missing runs %s "
                         "(the sweep has runs 0 to %ld; a shard's sweep stopped early?); "
                         "--partial merges the runs there\n", prog, buf, s->runs - 1);
         return -1;
@@ -809,11 +817,13 @@ static int merge_write(merging *m, const char *out, bool force, const char *cons
         free(ident);
         return -1;
     }
+    struct stat st; /* a half-written file is removed; a device (-o /dev/null) never */
+    bool regular = fstat(fileno(fo), &st) == 0 && S_ISREG(st.st_mode);
     int rc = rows_write(&m->r, fo, ident, s->header, err, sizeof err);
     free(ident);
     if (fclose(fo) != 0 || rc) {
         say(out, 0, "%s", rc ? err : strerror(errno));
-        unlink(out);
+        if (regular) unlink(out);
         return -1;
     }
     return 0;
@@ -826,7 +836,7 @@ static int merge_options(int argc, char **argv, const char **in, int *nin, const
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output")) {
             if (++i == argc) {
-                fprintf(stderr, "%s: merge: %s needs a value\n", prog, argv[i - 1]);
+                fprintf(MSG, "%s: merge: %s needs a value\n", prog, argv[i - 1]);
                 return 2;
             }
             *out = argv[i];
@@ -838,14 +848,14 @@ static int merge_options(int argc, char **argv, const char **in, int *nin, const
             usage(stdout);
             return 0;
         } else if (argv[i][0] == '-') {
-            fprintf(stderr, "%s: merge: unknown option '%s' (try --help)\n", prog, argv[i]);
+            fprintf(MSG, "%s: merge: unknown option '%s' (try --help)\n", prog, argv[i]);
             return 2;
         } else {
             in[(*nin)++] = argv[i];
         }
     }
-    if (!*nin) fprintf(stderr, "%s: merge: expected the shards' CSV files (try --help)\n", prog);
-    else if (!*out) fprintf(stderr, "%s: merge: -o OUT.csv is required\n", prog);
+    if (!*nin) fprintf(MSG, "%s: merge: expected the shards' CSV files (try --help)\n", prog);
+    else if (!*out) fprintf(MSG, "%s: merge: -o OUT.csv is required\n", prog);
     return *nin && *out ? -1 : 2;
 }
 

@@ -110,5 +110,7 @@ int sweep_sha256_file(const char *path, char hex[65], char *err, size_t errlen);
 /* lagsim-sweep merge A.csv B.csv ... -o OUT.csv: argv[0] is "merge"; usage prints --help.
  * Returns the exit status. */
 int merge(int argc, char **argv, void (*usage)(FILE *));
+/* Where merge says why it refuses: f, or stderr (NULL, the default). The fuzz target's. */
+void sweep_merge_messages(FILE *f);
 
 #endif
