@@ -15,7 +15,8 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             others'), a shard that lost its last run (exit 2, no output); --partial merges
             and says which shards it holds, and its output with the missing shard merges
             into the whole sweep byte for byte; a varied coordinate of initial.q lands in
-            the scene; an index on another key is refused
+            the scene; an index on another key is refused; a header past its buffer
+            (16 keys of 497 bytes) is refused before any run
   merge_rows  merge of shard 1/2 with a copy of shard 2/2 made wrong in one way each:
             a row cut in half, 5 or 3 extra columns, a NUL, a CR, failed=7, run 2^64+1,
             -1, 4 (of 4 runs), 0 (shard 1/2's), a metric 0x1p3, a comment among the rows,
