@@ -86,14 +86,27 @@ static void publish_scene(rt_server *s)
     rt_pub_scene(&s->pub, s->sc, s->info);
 }
 
+/* Lockstep, paused: a state published and waited on (the last of a STEP, one after a
+ * reset) still goes out again until an answer to it came, so that a lost state or answer
+ * is not left unanswered while paused (lagsim-sweep waits for that answer between runs). */
+static bool paused_copies(const rt_server *s)
+{
+    return s->run == RT_PAUSED && s->pending_steps == 0 && s->ls.waiting && !s->ls.answered;
+}
+
 /* What the plant waits for now (RT_WAIT_NONE: the run advances), with what came so far:
  * what the waits say (rt_wait.h). */
 static rt_wait_seen wait_seen(const rt_server *s)
 {
-    rt_wait_seen w = {RT_WAIT_NONE, 0, s->rejected, s->bus.commands_wrong_port, s->last_reject};
+    rt_wait_seen w = {RT_WAIT_NONE, 0, s->rejected, s->bus.commands_wrong_port, s->last_reject,
+                      false};
     bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
     if (s->run == RT_FAULT) w.kind = RT_WAIT_RESET;
-    else if (s->run == RT_PAUSED && s->pending_steps == 0) w.kind = RT_WAIT_RESUME;
+    else if (s->run == RT_PAUSED && s->pending_steps == 0) {
+        w.kind = RT_WAIT_RESUME;
+        w.owed = paused_copies(s);
+        w.t = w.owed ? s->ls.waiting_time : 0;
+    }
     else if (s->run == RT_WAITING && s->pending_steps == 0 && !s->have_command) {
         w.kind = RT_WAIT_FIRST;
         w.t = lag_sim_time(&s->sim);
@@ -395,14 +408,6 @@ static void mode_fast(rt_server *s)
     if (log_holds(s)) return;
     int64_t budget = s->tick_budget;
     period_run(s, &budget);
-}
-
-/* Lockstep, paused: a state published and waited on (the last of a STEP, one after a
- * reset) still goes out again until an answer to it came, so that a lost state or answer
- * is not left unanswered while paused (lagsim-sweep waits for that answer between runs). */
-static bool paused_copies(const rt_server *s)
-{
-    return s->run == RT_PAUSED && s->pending_steps == 0 && s->ls.waiting && !s->ls.answered;
 }
 
 /* Lockstep: a period when the state waited on is answered; nothing else advances it.

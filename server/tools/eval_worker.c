@@ -428,18 +428,39 @@ static int from_log(eval_worker *w, off_t from, double t_goal, eval_result *res,
     }
 }
 
-/* The controller's answer to the paused state (the daemon publishes that state again
- * until one comes): heard, or the run fails saying so (true). */
+/* Has the answer to the last state heard come (by its generation and sim time)? */
+static bool answer_heard(const eval_worker *w)
+{
+    return w->g_answered == w->g_heard && w->t_answered == w->t_heard;
+}
+
+/* Does the daemon say, paused (or in the fault state, which publishes no state), that no
+ * answer is owed? What the bus lost on its way to the worker (the run's last states, the
+ * answer) the daemon has had: it publishes the paused state again until answered and says
+ * in its status while an answer is owed. */
+static bool daemon_has_answer(eval_worker *w, double *t)
+{
+    lag_client_status st;
+    if (!fresh_status(w, &st, false)) return false;
+    *t = st.sim_time;
+    return (!strcmp(st.run_state, "paused") || !strcmp(st.run_state, "fault")) &&
+           !strstr(st.waiting_for, "still owed");
+}
+
+/* The controller's answer to the paused state: heard, or said by the daemon's status; else
+ * the run fails saying so (true). */
 static bool paused_answer(eval_worker *w, eval_result *res)
 {
-    double end = eval_now() + W_PAUSED_S;
-    while (!(w->g_answered == w->g_heard && w->t_answered == w->t_heard) && eval_now() < end)
-        w_handle(w, 5);
-    if (w->g_answered == w->g_heard && w->t_answered == w->t_heard) return false;
+    double end = eval_now() + W_PAUSED_S, t = w->t_heard;
+    while (eval_now() < end) {
+        double next = eval_now() + W_ANSWER_S;
+        while (!answer_heard(w) && eval_now() < next) w_handle(w, 5);
+        if (answer_heard(w) || daemon_has_answer(w, &t)) return false;
+    }
     eval_fail(res, "the controller did not answer the paused state (generation %lld, sim time "
               "%.9g s, the last of the run before) within %g s: not started, so that no "
-              "answer of the run before can reach this one", (long long)w->g_heard,
-              w->t_heard, W_PAUSED_S);
+              "answer of the run before can reach this one", (long long)w->g_heard, t,
+              W_PAUSED_S);
     return true;
 }
 

@@ -707,8 +707,11 @@ def scene_same(d, lang):
         ["-j1", "--shard", "{}/2", "--csv", sh, ":::", "1", "2"], env=env)
     run([SWEEP, "merge", sh.format(1), sh.format(2), "-o", m])
     run([SWEEP] + q + ["-j2", "--restart", "--csv", fresh], env=env)
+    def data(path):  # the header and the rows: --restart is in the identity lines
+        return [x for x in open(path) if not x.startswith("#")]
     for name, other in (("-j2", j2), ("two shards merged", m), ("--restart", fresh)):
-        same = os.path.exists(other) and filecmp.cmp(j1, other, shallow=False)
+        same = os.path.exists(other) and (data(j1) == data(other) if name == "--restart"
+                                          else filecmp.cmp(j1, other, shallow=False))
         differ = 0 if not os.path.exists(other) else sum(
             a != b for a, b in zip(rows(j1), rows(other)))
         check(same, "%s, m2 varied: %s gives the CSV of -j1, byte for byte (%d rows differ)"
