@@ -264,6 +264,19 @@ static void check_table(void)
             /* NaN default exactly for the rods' inertias */
             ENSURE(isnan(inf->param_defaults[i]) == rod_inertia);
         }
+        /* what the docs say of it (the generated lists, server/lists): a title, a
+         * summary, the meaning of each parameter and coordinate, and nothing beyond */
+        const lag_model_doc *doc = c->doc;
+        ENSUREF(doc && doc->title && doc->title[0] && doc->summary && doc->summary[0],
+                "model %s: its row has no doc (title, summary)", inf->name);
+        for (int i = 0; doc && i < LAG_MAX_PARAMS; ++i)
+            ENSUREF((i < inf->np) == (doc->params[i] != NULL && doc->params[i][0] != '\0'),
+                    "model %s: doc.params[%d] %s", inf->name, i,
+                    i < inf->np ? "is missing" : "is beyond the parameters");
+        for (int j = 0; doc && j < LAG_MAX_DOF; ++j)
+            ENSUREF((j < inf->nq) == (doc->joints[j] != NULL && doc->joints[j][0] != '\0'),
+                    "model %s: doc.joints[%d] %s", inf->name, j,
+                    j < inf->nq ? "is missing" : "is beyond the coordinates");
         /* g is a parameter of every model (the scene's effects.gravity sets it) */
         int g = lag_model_param_index((lag_model_kind)k, "g");
         ENSURE(g >= 0 && inf->param_rules[g] == LAG_PARAM_NONNEGATIVE &&
