@@ -23,6 +23,7 @@ static void usage(FILE *f)
         "               [--set ...]\n"
         "       lagsimd --config FILE --replay LOG.lcm [--tolerance X] [--set ...]\n"
         "       lagsimd --config FILE --cost [--plot FILE.png] [--set ...]\n"
+        "       lagsimd --list models|methods|effects\n"
         "\n",
         f);
     char models[256]; /* from the core's table: a model added there is named here */
@@ -73,6 +74,9 @@ static void usage(FILE *f)
         "                         if the scene gives none). A scene with integrator.error\n"
         "                         runs with the cheapest setting that meets it\n"
         "      --plot FILE.png    --cost: draw the work-precision diagram (gnuplot)\n"
+        "      --list WHAT        print the names of the core's table, one a line, and exit:\n"
+        "                         models (a scene's model:), methods (integrator.method)\n"
+        "                         or effects (the keys under effects:)\n"
         "  -q, --quiet            no live status line or event lines / offline summary\n"
         "  -h, --help             this help\n"
         "  -V, --version          print the version\n"
@@ -215,9 +219,25 @@ static lag_result reload_with(const char *config, const char *text, size_t len,
     return LAG_OK;
 }
 
+/* --list WHAT: the names of one of the core's tables, one a line, in the table's order
+ * (what scripts iterate: tests/scene/determinism.sh takes the methods from here). */
+static lag_result print_list(const char *what)
+{
+    enum { MODELS, METHODS, EFFECTS } t;
+    if (!strcmp(what, "models")) t = MODELS;
+    else if (!strcmp(what, "methods")) t = METHODS;
+    else if (!strcmp(what, "effects")) t = EFFECTS;
+    else return usage_error("--list: expected models, methods or effects, got '%s'", what);
+    int n = t == MODELS ? LAG_MODEL_COUNT : t == METHODS ? LAG_METHOD_COUNT : LAG_EFF_COUNT;
+    for (int k = 0; k < n; k++)
+        puts(t == MODELS ? lag_model_info_get((lag_model_kind)k)->name
+             : t == METHODS ? lag_method_name((lag_method)k) : lag_effect_info_get(k).name);
+    return LAG_OK;
+}
+
 /* What the command line says. */
 typedef struct cmdline {
-    const char *config, *replay, *plot;
+    const char *config, *replay, *plot, *list;
     bool cost, increment, offline;
     bool have_duration, have_tolerance, have_ring; /* given, for the checks of combinations */
     lagsimd_opts opts;
@@ -226,7 +246,7 @@ typedef struct cmdline {
 } cmdline;
 
 enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE,
-       OPT_COST, OPT_PLOT, OPT_FORCE };
+       OPT_COST, OPT_PLOT, OPT_FORCE, OPT_LIST };
 static const struct option longopts[] = {
     {"config", required_argument, NULL, 'c'},
     {"set", required_argument, NULL, 's'},
@@ -240,6 +260,7 @@ static const struct option longopts[] = {
     {"cost", no_argument, NULL, OPT_COST},
     {"plot", required_argument, NULL, OPT_PLOT},
     {"force", no_argument, NULL, OPT_FORCE},
+    {"list", required_argument, NULL, OPT_LIST},
     {"increment", no_argument, NULL, 'i'},
     {"quiet", no_argument, NULL, 'q'},
     {"help", no_argument, NULL, 'h'},
@@ -289,6 +310,7 @@ static lag_result take_option(cmdline *cl, int c, const char *arg)
     case OPT_COST: cl->cost = true; break;
     case OPT_PLOT: cl->plot = arg; break;
     case OPT_FORCE: cl->opts.force = true; break;
+    case OPT_LIST: cl->list = arg; break;
     case 'i': cl->increment = true; break;
     case 'q': cl->opts.quiet = true; break;
     }
@@ -324,7 +346,10 @@ static lag_result check_options(cmdline *cl)
 {
     const lagsimd_opts *o = &cl->opts;
     const char *why = NULL;
-    if (!cl->config) why = "--config FILE is required";
+    if (cl->list) why = cl->config || cl->nsets || cl->offline || cl->replay || cl->cost || o->log ||
+                            o->csv || cl->plot || cl->have_duration || cl->have_tolerance
+                            ? "--list prints a table and exits: not with other options" : NULL;
+    else if (!cl->config) why = "--config FILE is required";
     else if (cl->offline && cl->replay) why = "--offline and --replay exclude each other";
     else if (o->csv && !cl->offline) why = "--csv needs --offline";
     else if (cl->offline && !cl->have_duration) why = "--offline needs --duration SECONDS";
@@ -417,7 +442,7 @@ static lag_result lagsimd_main(int argc, char **argv)
     bool done = false;
     lag_result rc = read_options(&cl, argc, argv, &done);
     if (rc == LAG_OK && !done) rc = check_options(&cl);
-    if (rc == LAG_OK && !done) rc = run(&cl);
+    if (rc == LAG_OK && !done) rc = cl.list ? print_list(cl.list) : run(&cl);
     free(cl.sets);
     return rc;
 }

@@ -385,6 +385,11 @@ static void check_info(void)
         if (!mi) continue;
         ENSURE(lag_method_from_name(mi->name) == i && strstr(mlist, mi->name) != NULL);
         ENSURE(mi->order >= 1 && lag_method_order((lag_method)i) == mi->order);
+        /* a name: [a-z][a-z0-9-]*, what a scene's integrator.method holds (so that a name
+         * with a space, the scene fixture's unknown method, can never be one) */
+        ENSUREF(mi->name[0] >= 'a' && mi->name[0] <= 'z' &&
+                strspn(mi->name, "abcdefghijklmnopqrstuvwxyz0123456789-") == strlen(mi->name),
+                "method '%s': not a lowercase word that hyphens may join", mi->name);
         ENSURE(!(mi->canonical && !mi->implicit)); /* (q, p) Gauss methods are implicit */
     }
     ENSURE(lag_method_info_get(LAG_METHOD_COUNT) == NULL && strcmp(lag_method_name(LAG_METHOD_COUNT), "unknown") == 0);
