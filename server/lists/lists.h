@@ -11,6 +11,7 @@
  *   a comment  "lagsimd --list WHAT: a | b | c" to the end of the line, after # or //
  *              (WHAT: models, methods or effects): a YAML scene's or an .lcm file's
  *              comment names the list and the command that prints it
+ *   a man page's title line .TH ... "lagsim VERSION": the project's version
  *
  * The build writes the man pages it installs through the same blocks (splice), so an
  * installed page is never stale; the committed files are rewritten only on request

@@ -164,21 +164,51 @@ static const char *tail(splice_job *j, const char *text, const char *at, lbuf *o
     return eol;
 }
 
+/* A man page's title line, `.TH NAME 1 DATE "lagsim VERSION" ...`: the version is the
+ * project's (CMakeLists.txt), so that a new version is one line there. */
+static const char *title_line(splice_job *j, const char *text, const char *at, lbuf *out)
+{
+    const char *eol = at + strcspn(at, "\n"), *v = strstr(at, "\"lagsim ");
+    if (!v || v > eol) {
+        lb_putn(out, at, (size_t)(eol - at));
+        return eol;
+    }
+    v += strlen("\"lagsim ");
+    const char *end = v + strcspn(v, "\"\n");
+    lbuf want = {0};
+    lb_put(&want, LAGSIM_VERSION);
+    if ((size_t)(end - v) != want.n || memcmp(v, want.s, want.n) != 0)
+        say_stale(j, line_of(text, at), "the version (CMakeLists.txt)", v, (size_t)(end - v), &want);
+    lb_putn(out, at, (size_t)(v - at));
+    lb_putn(out, want.s, want.n);
+    lb_free(&want);
+    return end;
+}
+
+/* The first of `pat` at or after p that starts a line; NULL if none. */
+static const char *at_line_start(const char *text, const char *p, const char *pat)
+{
+    const char *q = strstr(p, pat);
+    while (q && q > text && q[-1] != '\n') q = strstr(q + 1, pat);
+    return q;
+}
+
 /* text with every block generated, into out. */
 static void splice(splice_job *j, const char *text, lbuf *out)
 {
     const char *p = text;
     for (;;) {
-        const char *md = strstr(p, k_markdown.open), *tr = strstr(p, k_troff.open);
-        const char *tl = strstr(p, "lagsimd --list ");
-        while (tr && tr > text && tr[-1] != '\n') tr = strstr(tr + 1, k_troff.open);
+        const char *md = strstr(p, k_markdown.open), *tr = at_line_start(text, p, k_troff.open);
+        const char *tl = strstr(p, "lagsimd --list "), *th = at_line_start(text, p, ".TH ");
         const char *at = md;
         if (!at || (tr && tr < at)) at = tr;
         if (!at || (tl && tl < at)) at = tl;
+        if (!at || (th && th < at)) at = th;
         if (!at) break;
         lb_putn(out, p, (size_t)(at - p));
         if (at == md) p = marked(j, text, at, &k_markdown, out);
         else if (at == tr) p = marked(j, text, at, &k_troff, out);
+        else if (at == th) p = title_line(j, text, at, out);
         else p = tail(j, text, at, out);
     }
     lb_put(out, p);
