@@ -371,6 +371,16 @@ static bool gen_method_count(lbuf *out, lists_ctx *cx)
     return true;
 }
 
+static void put_effect(lbuf *b, int k) { lb_put(b, lag_effect_info_get(k).name); }
+
+/* "damping, limits, ... and spring": the effects of the table, in its order */
+static bool gen_effects(lbuf *out, lists_ctx *cx)
+{
+    (void)cx;
+    prose_list(out, LAG_EFF_COUNT, "and", put_effect);
+    return true;
+}
+
 /* The effects whose row may keep state of its own (what a replay restart cannot redo),
  * in the table's order: "limits, floor, friction, actuator" */
 static bool gen_keeps_state(lbuf *out, lists_ctx *cx)
@@ -420,6 +430,7 @@ const lists_block lists_blocks[] = {
     {"configs", true, gen_configs, "the shipped scenes, a row per config/ file (every model has one)"},
     {"methods", true, gen_methods, "the integrators and their properties"},
     {"method-count", false, gen_method_count, "how many integrators, in words"},
+    {"effects", false, gen_effects, "the effects in a sentence"},
     {"keeps-state", false, gen_keeps_state, "the effects that may keep state of their own"},
     {"channels-state", false, gen_channels_state, "the channels on a plant's state URL"},
     {"channels-command", false, gen_channels_command, "the channels on a plant's command URL"},
