@@ -51,8 +51,10 @@ void rt_record_init(rt_record *r, double dt, bool quiet, int64_t now)
     r->quiet = quiet;
     rt_limit_init(&r->lim_said, 1, 1, now);
     rt_limit_init(&r->lim_sample_said, 1, 1, now);
-    r->sample = (rt_log_bucket){RT_LOG_SAMPLE_BPS, RT_LOG_SAMPLE_BPS, 0}; /* full at start */
-    r->accepted = (rt_log_bucket){RT_LOG_ACCEPTED_MIN_BPS, RT_LOG_ACCEPTED_MIN_BPS, 0};
+    /* full at start */
+    r->sample = (rt_log_bucket){.rate = RT_LOG_SAMPLE_BPS, .credit = RT_LOG_SAMPLE_BPS};
+    r->accepted = (rt_log_bucket){.rate = RT_LOG_ACCEPTED_MIN_BPS,
+                                  .credit = RT_LOG_ACCEPTED_MIN_BPS};
 }
 
 /* The accepted messages' rate: RT_LOG_ACCEPTED_PER_PERIOD full commands (every actuated
