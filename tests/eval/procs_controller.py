@@ -1,0 +1,43 @@
+#!/usr/bin/env python3
+"""The cart-pole controller of tests/eval/test_procs.py (PYTHONPATH=<build>/python).
+
+Answers each state with no force, --pace s after it (so that a run lasts), and once it has
+answered --ready-after states writes READY/ready.PREFIX: the run's daemon publishes states
+and its controller answers them. Before the first state it starts two `sleep 600`: one in
+its own process group (a grandchild of the tool, as python3 under `sh -c` is) and one in a
+session of its own (setsid: out of every process group the tool knows). With --hang it
+stops answering after the ready file and ignores SIGINT and SIGTERM: a stalled controller,
+its lockstep plant waiting for an answer.
+"""
+import os
+import signal
+import subprocess
+import sys
+import time
+
+from lagsim_controller import Controller
+
+ctl = Controller("procs_controller", "CARTPOLE", "cartpole")
+ctl.parser.add_argument("--ready", required=True, help="directory of the ready files")
+ctl.parser.add_argument("--ready-after", type=int, default=3)
+ctl.parser.add_argument("--pace", type=float, default=0.01)
+ctl.parser.add_argument("--hang", action="store_true")
+a = ctl.start()
+subprocess.Popen(["sleep", "600"])
+subprocess.Popen(["sleep", "600"], start_new_session=True)
+n = 0
+for st in ctl.states():
+    time.sleep(a.pace)
+    ctl.command(st.sim_time, ["x"], [0.0])
+    n += 1
+    if n == a.ready_after:
+        tmp = os.path.join(a.ready, ".ready.%s" % a.prefix)
+        with open(tmp, "w") as f:
+            f.write("%d\n" % os.getpid())
+        os.rename(tmp, os.path.join(a.ready, "ready.%s" % a.prefix))
+        if a.hang:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            signal.signal(signal.SIGTERM, signal.SIG_IGN)
+            while True:
+                time.sleep(60)
+sys.exit(ctl.finish("answered=%d" % n))
