@@ -52,7 +52,11 @@ static void usage(FILE *f)
 "  -h, --help             this help\n"
 "\n"
 "exit codes: 0 every case ran, none failed and every case met --require; 1 a case\n"
-"failed or missed the requirement; 2 usage, scene or case error (file:line:column)\n");
+"failed or missed the requirement; 2 usage, scene or case error (file:line:column)\n"
+"\n"
+"signals: SIGINT, SIGTERM, SIGHUP stop every process it started (SIGKILL after 2 s)\n"
+"and end it by that signal; after SIGKILL they end within about 2 s. TMPDIR: where\n"
+"the runs' logs go (default /tmp)\n");
 }
 
 static int die(const char *fmt, const char *a)

@@ -340,8 +340,10 @@ static void kill_children(int sig, sent *once)
     ssize_t len = read(fd, buf, sizeof buf - 1);
     close(fd);
     pid_t pid = 0;
-    for (ssize_t i = 0; i <= len; i++) {
-        if (i < len && buf[i] >= '0' && buf[i] <= '9') {
+    /* "PID PID ... ": a number counts once the space after it is read (a list longer than
+     * the buffer is cut; the rest is signalled on the next call) */
+    for (ssize_t i = 0; i < len; i++) {
+        if (buf[i] >= '0' && buf[i] <= '9') {
             pid = pid * 10 + (buf[i] - '0');
             continue;
         }

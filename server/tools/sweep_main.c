@@ -77,7 +77,11 @@ static void usage(FILE *f)
 "\n"
 "exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
 "case error, an output that exists (checked before the first run), or shard CSVs that\n"
-"do not belong together or leave runs out\n");
+"do not belong together or leave runs out\n"
+"\n"
+"signals: SIGINT, SIGTERM, SIGHUP stop every process it started (SIGKILL after 2 s)\n"
+"and end it by that signal; after SIGKILL they end within about 2 s. TMPDIR: where\n"
+"the workers' files go (default /tmp)\n");
 }
 
 static int die(const char *fmt, const char *a)
