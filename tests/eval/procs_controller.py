@@ -5,14 +5,18 @@ Answers each state with no force, --pace s after it (so that a run lasts), and o
 answered --ready-after states writes READY/ready.PREFIX: the run's daemon publishes states
 and its controller answers them. Before the first state it starts two `sleep 600`: one in
 its own process group (a grandchild of the tool, as python3 under `sh -c` is) and one in a
-session of its own (setsid: out of every process group the tool knows). With --hang it
-stops answering after the ready file and ignores SIGINT and SIGTERM: a stalled controller,
-its lockstep plant waiting for an answer.
+session of its own (setsid: out of every process group the tool knows).
+  --hang   after the ready file it stops answering: its lockstep plant waits for it
+  --deaf   it ignores SIGINT and SIGTERM (--hang too)
+  --idle   it writes READY/idle.PREFIX whenever no state came for 0.5 s after its last
+           answer: the plant waits for something other than this controller (a sweep's
+           kept daemon, paused, for its worker's next STEP)
 """
 import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 from lagsim_controller import Controller
@@ -22,22 +26,36 @@ ctl.parser.add_argument("--ready", required=True, help="directory of the ready f
 ctl.parser.add_argument("--ready-after", type=int, default=3)
 ctl.parser.add_argument("--pace", type=float, default=0.01)
 ctl.parser.add_argument("--hang", action="store_true")
+ctl.parser.add_argument("--deaf", action="store_true")
+ctl.parser.add_argument("--idle", action="store_true")
 a = ctl.start()
+if a.deaf or a.hang:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
 subprocess.Popen(["sleep", "600"])
 subprocess.Popen(["sleep", "600"], start_new_session=True)
-n = 0
+
+
+def mark(name):
+    tmp = os.path.join(a.ready, ".%s.%s" % (name, a.prefix))
+    with open(tmp, "w") as f:
+        f.write("%d\n" % os.getpid())
+    os.rename(tmp, os.path.join(a.ready, "%s.%s" % (name, a.prefix)))
+
+
+n, timer = 0, None
 for st in ctl.states():
+    if timer:
+        timer.cancel()
     time.sleep(a.pace)
     ctl.command(st.sim_time, ["x"], [0.0])
     n += 1
+    if a.idle:
+        timer = threading.Timer(0.5, mark, ("idle",))
+        timer.daemon = True
+        timer.start()
     if n == a.ready_after:
-        tmp = os.path.join(a.ready, ".ready.%s" % a.prefix)
-        with open(tmp, "w") as f:
-            f.write("%d\n" % os.getpid())
-        os.rename(tmp, os.path.join(a.ready, "ready.%s" % a.prefix))
-        if a.hang:
-            signal.signal(signal.SIGINT, signal.SIG_IGN)
-            signal.signal(signal.SIGTERM, signal.SIG_IGN)
-            while True:
-                time.sleep(60)
+        mark("ready")
+        while a.hang:
+            time.sleep(60)
 sys.exit(ctl.finish("answered=%d" % n))

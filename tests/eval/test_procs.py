@@ -9,9 +9,10 @@ usage: test_procs.py BIN_DIR SOURCE_DIR TOOL HOW
         sigkill    SIGKILL to the tool alone: no code of the tool runs
         groupkill  SIGKILL to the tool's process group (timeout -s KILL): the tool and its
                    workers at once
-        stalled    the controllers stop answering and ignore SIGTERM (their lockstep
-                   daemons wait for them); sweep: its workers stopped as well (SIGSTOP: the
-                   kept daemons wait for the next STEP); then SIGKILL to the tool
+        stalled    eval: the controller stops answering and ignores SIGTERM (its lockstep
+                   daemon waits for it); sweep: the workers stopped (SIGSTOP) and, once
+                   their kept daemons wait for the next STEP (the controllers, which ignore
+                   SIGTERM, have had no state for 0.5 s), SIGKILL to the tool
         gnuplot    SIGTERM while the tool waits for gnuplot (--report, --plot; a gnuplot
                    first on PATH that starts a grandchild and waits)
 
@@ -77,10 +78,10 @@ def children(pid):
 def command(tmp, ready):
     ctrl = "python3 %s -q --prefix {prefix} --ready %s" % (CTRL, ready)
     if HOW == "stalled":
-        ctrl += " --hang"
+        ctrl += " --hang" if TOOL == "eval" else " --deaf --idle --pace 0"
     if HOW == "gnuplot":
         ctrl += " --pace 0"
-    duration = "1" if HOW == "gnuplot" else "600"
+    duration = "1" if HOW == "gnuplot" else "0.5" if HOW == "stalled" else "600"
     if TOOL == "eval":
         suite = os.path.join(tmp, "suite.yaml")
         with open(suite, "w") as f:
@@ -91,8 +92,8 @@ def command(tmp, ready):
             cmd += ["--report", os.path.join(tmp, "report")]
         return cmd
     cmd = [os.path.join(BIN, "lagsim-sweep"), "--config", SCENE, "--controller", ctrl,
-           "--duration", duration, "--vary", "parameters.m0=uniform(0.9,1.1)", "--runs", "4",
-           "-j", "2"]
+           "--duration", duration, "--vary", "parameters.m0=uniform(0.9,1.1)", "--runs",
+           "1000", "-j", "2"]
     if HOW == "gnuplot":
         cmd += ["--plot", os.path.join(tmp, "sweep.png")]
     return cmd
@@ -110,16 +111,20 @@ def fake_gnuplot(tmp, ready):
 
 def wait_ready(p, ready, n):
     """n ready files of the controllers, or gnuplot's."""
-    deadline = time.monotonic() + READY_WAIT_S
     which = "ready.gnuplot" if HOW == "gnuplot" else "ready.*"
+    return wait_files(p, os.path.join(ready, which), n)
+
+
+def wait_files(p, pattern, n):
+    deadline = time.monotonic() + READY_WAIT_S
     while time.monotonic() < deadline and p.poll() is None:
-        if len(glob.glob(os.path.join(ready, which))) >= n:
+        if len(glob.glob(pattern)) >= n:
             return True
         time.sleep(0.05)
     return False
 
 
-def deliver(p):
+def deliver(p, ready):
     if HOW == "sigint":
         os.killpg(p.pid, signal.SIGINT)
         return -signal.SIGINT
@@ -133,7 +138,10 @@ def deliver(p):
         workers = children(p.pid)
         for w in workers:
             os.kill(w, signal.SIGSTOP)
-        print("workers stopped:", workers)
+        for f in glob.glob(os.path.join(ready, "idle.*")):
+            os.unlink(f)
+        check(wait_files(p, os.path.join(ready, "idle.*"), 2),
+              "workers %s stopped: both kept daemons wait for their next STEP" % workers)
     p.kill()
     return -signal.SIGKILL
 
@@ -163,7 +171,7 @@ def main():
         if not ok:
             return
         print("marked processes before:", *marked(marker), sep="\n  ")
-        expect = deliver(p)
+        expect = deliver(p, ready)
         t0 = time.monotonic()
         try:
             rc = p.wait(30)
