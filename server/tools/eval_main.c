@@ -48,7 +48,7 @@ static void usage(FILE *f)
 "                         not on {prefix} or LAGSIM_PREFIX never answers: its case\n"
 "                         ends here\n"
 "  -v, --verbose          pass the daemon's and the controller's output through, keep\n"
-"                         each run's log in the report directory (or /tmp)\n"
+"                         each run's log in the report directory (or TMPDIR, /tmp)\n"
 "  -h, --help             this help\n"
 "\n"
 "exit codes: 0 every case ran, none failed and every case met --require; 1 a case\n"
