@@ -295,7 +295,13 @@ static void __attribute__((noreturn)) run_command(const keep_plan *p, pid_t keep
     setpgid(0, 0);
     prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (getppid() != keeper) _exit(127);
-    for (int i = 0; i < 3; i++) signal(stop_signals[i], SIG_DFL);
+    /* the tool's handler is not the command's (exec would reset it, but a signal could
+     * come before); a signal ignored when the tool started (nohup) stays ignored */
+    for (int i = 0; i < 3; i++) {
+        struct sigaction cur;
+        if (sigaction(stop_signals[i], NULL, &cur) == 0 && cur.sa_handler != SIG_IGN)
+            signal(stop_signals[i], SIG_DFL);
+    }
     if (p->null_out || p->null_err) {
         int fd = open("/dev/null", O_WRONLY);
         if (fd >= 0 && p->null_out) dup2(fd, 1);
