@@ -171,6 +171,9 @@ def main():
         if not ok:
             return
         print("marked processes before:", *marked(marker), sep="\n  ")
+        made = os.listdir(tooltmp)
+        check(len(made) == 1 and made[0].startswith("lagsim-%s." % TOOL),
+              "the tool's temporary directory is under TMPDIR: %s" % made)
         expect = deliver(p, ready)
         t0 = time.monotonic()
         try:
