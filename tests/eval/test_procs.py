@@ -25,6 +25,7 @@ signal (the shell's 128 + N) with no process of the run left at that moment and 
 temporary directory (under TMPDIR) removed; after a kill no process may be left within
 PROCS_WAIT_S. A process the test started beside the tool must be alive at the end.
 """
+import ctypes
 import glob
 import os
 import signal
@@ -73,6 +74,12 @@ def children(pid):
             return [int(x) for x in f.read().split()]
     except OSError:
         return []
+
+
+def die_with_test():
+    """In the tool before it runs: SIGKILL when this test dies (a ctest timeout), so that
+    what a failed run leaves does not run on."""
+    ctypes.CDLL(None).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
 
 
 def command(tmp, ready):
@@ -163,7 +170,7 @@ def main():
     print("$", " ".join(cmd), flush=True)
     out, err = open(os.path.join(tmp, "out"), "w+"), open(os.path.join(tmp, "err"), "w+")
     p = subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL, stdout=out, stderr=err,
-                         start_new_session=True)
+                         start_new_session=True, preexec_fn=die_with_test)
     try:
         ok = wait_ready(p, ready, want)
         check(ok, "gnuplot runs" if HOW == "gnuplot" else
