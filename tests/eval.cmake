@@ -45,3 +45,19 @@ if(LAGSIM_PYTHON3 AND LAGSIM_GNU_PARALLEL)
                          SKIP_RETURN_CODE 77)
   endforeach()
 endif()
+
+# Nothing lagsim-eval or lagsim-sweep (-j 2, kept workers) starts outlives it: SIGINT to
+# its process group, SIGTERM, SIGKILL, SIGKILL to its group, a stalled run killed (the
+# controller deaf to SIGTERM; the sweep's workers stopped) and SIGTERM while gnuplot runs,
+# each sent once the run's daemon publishes and its controller answers; 0 processes left
+# (found by a marker in their environment), the temporary directory removed on a signal.
+if(LAGSIM_PYTHON3)
+  foreach(tool eval sweep)
+    foreach(how sigint sigterm sigkill groupkill stalled gnuplot)
+      add_test(NAME eval_procs_${tool}_${how}
+        COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_procs.py
+                $<TARGET_FILE_DIR:lagsim-eval> ${PROJECT_SOURCE_DIR} ${tool} ${how})
+      set_tests_properties(eval_procs_${tool}_${how} PROPERTIES LABELS eval TIMEOUT 300)
+    endforeach()
+  endforeach()
+endif()

@@ -80,7 +80,11 @@ static void usage(FILE *f)
 "\n"
 "exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
 "case error, an output that exists (checked before the first run), or shard CSVs that\n"
-"do not belong together, hold a malformed row or leave shards or runs out\n");
+"do not belong together, hold a malformed row or leave shards or runs out\n"
+"\n"
+"signals: SIGINT, SIGTERM, SIGHUP stop every process it started (SIGKILL after 2 s)\n"
+"and end it by that signal; after SIGKILL they end within about 2 s. TMPDIR: where\n"
+"the workers' files go (default /tmp)\n");
 }
 
 static int die(const char *fmt, const char *a)
@@ -325,7 +329,7 @@ typedef struct sweep {
     char header[ROW_MAX];
     char *identity;      /* the CSV's identity lines (sweep_merge.h) */
     char default_metric[160];
-    char tmpdir[64];
+    char tmpdir[160]; /* eval_make_tmpdir: at most 128 + 21 */
 } sweep;
 
 static int parse_options(sweep *x, int argc, char **argv)
@@ -613,23 +617,24 @@ static void worker_main(const sweep *x, long w)
 }
 
 /* ---------------------------------------------------------------- the results */
+/* The workers, forked (each dies with this process: eval_proc_fork), and their ends. */
 static int run_workers(sweep *x)
 {
     pid_t pids[256];
     int status = 0;
     for (long w = 0; w < x->jobs; w++) {
-        fflush(NULL);
-        pids[w] = fork();
+        pids[w] = eval_proc_fork();
         if (pids[w] < 0) {
             fprintf(stderr, "%s: fork: %s\n", prog, strerror(errno));
+            for (long k = 0; k < w; k++) eval_stop_group(pids[k], &(int){0});
             return 2;
         }
         if (pids[w] == 0) worker_main(x, w);
     }
     for (long w = 0; w < x->jobs; w++) {
         int st = 0;
-        waitpid(pids[w], &st, 0);
-        if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) status = 2;
+        if (eval_proc_wait(pids[w], &st) != 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0)
+            status = 2;
     }
     return status;
 }
@@ -679,11 +684,11 @@ static int sweep_run(sweep *x)
         return 2;
     }
     if (fpng) fclose(fpng); /* gnuplot writes it at the end */
-    snprintf(x->tmpdir, sizeof x->tmpdir, "/tmp/lagsim-sweep.XXXXXX");
-    if (!mkdtemp(x->tmpdir)) {
+    if (eval_make_tmpdir("lagsim-sweep", x->tmpdir, sizeof x->tmpdir) != 0) {
         fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
         return 2;
     }
+    if (x->verbose) eval_proc_tmpdir_done(); /* -v keeps the kept daemons' logs */
     int status = run_workers(x);
     rows r = {0};
     collect_rows(x, &r);
@@ -694,6 +699,7 @@ static int sweep_run(sweep *x)
     bool all = count_passed(x, &r) == r.n;
     if (x->png && plot(x->png, x->tmpdir, x->header, &r, x->nv, x->metric)) status = 2;
     rmdir(x->tmpdir);
+    eval_proc_tmpdir_done();
     rows_free(&r);
     return status ? status : all ? 0 : 1;
 }
@@ -701,6 +707,7 @@ static int sweep_run(sweep *x)
 int main(int argc, char **argv)
 {
     if (argc > 1 && !strcmp(argv[1], "merge")) return merge(argc - 1, argv + 1, usage);
+    eval_proc_init(); /* every process it starts ends when it ends (eval_proc.h) */
     static sweep x = {.timeout = 600, .runs = 1, .jobs = 1, .shard_k = 1, .shard_n = 1,
                       .seed = 1};
     eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
