@@ -35,7 +35,8 @@ void lb_putn(lbuf *b, const char *text, size_t n);
 void lb_printf(lbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 void lb_free(lbuf *b);
 
-/* What a block's generator may read besides the core: the source tree (config/). */
+/* What a block's generator may read besides the core's tables (and the bus's channels,
+ * the reference library's kinds): the source tree (config/). */
 typedef struct lists_ctx {
     const char *source; /* the source tree's root */
     char err[512];      /* why a generator failed */

@@ -11,6 +11,7 @@
 
 #include "core_internal.h"
 #include "lagsim_bus.h"
+#include "reference.h"
 #include "lists.h"
 
 /* ---------------------------------------------------------------- strings */
@@ -381,6 +382,15 @@ static bool gen_effects(lbuf *out, lists_ctx *cx)
     return true;
 }
 
+/* "step, ramp, ...": the kinds of reference a scene's reference.<joint>.type takes */
+static bool gen_reference_kinds(lbuf *out, lists_ctx *cx)
+{
+    (void)cx;
+    for (int k = 0; k < LAG_REF_KIND_COUNT; k++)
+        lb_printf(out, "%s%s", k ? ", " : "", lag_ref_kind_table[k].name);
+    return true;
+}
+
 /* The effects whose row may keep state of its own (what a replay restart cannot redo),
  * in the table's order: "limits, floor, friction, actuator" */
 static bool gen_keeps_state(lbuf *out, lists_ctx *cx)
@@ -431,6 +441,7 @@ const lists_block lists_blocks[] = {
     {"methods", true, gen_methods, "the integrators and their properties"},
     {"method-count", false, gen_method_count, "how many integrators, in words"},
     {"effects", false, gen_effects, "the effects in a sentence"},
+    {"reference-kinds", false, gen_reference_kinds, "the kinds of reference (reference.<joint>.type)"},
     {"keeps-state", false, gen_keeps_state, "the effects that may keep state of their own"},
     {"channels-state", false, gen_channels_state, "the channels on a plant's state URL"},
     {"channels-command", false, gen_channels_command, "the channels on a plant's command URL"},

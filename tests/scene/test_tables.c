@@ -18,6 +18,9 @@
  *                  ranges list every row, and name no effect the core does not have
  *                  (prose, written by hand; the lists that can be generated are:
  *                  server/lists, structure_lists)
+ *   docs_keys      every numeric key of the loader's tables, for every model, has its row
+ *                  in docs/scenes.md's table of ranges (reference keys: in the table of
+ *                  the reference's keys), by its pattern (<joint>, <name>, [i])
  *
  * Files are read from the source tree (LAGSIM_SOURCE_DIR).
  */
@@ -371,10 +374,142 @@ static void case_docs(int arg)
     doc_lists("docs/scenes.md", "| key | range | unit |", "\n\n", "`effects.", ".[`", others);
 }
 
+/* ---------------------------------------------------------------- docs_keys */
+
+#define MAX_KEYS 256
+typedef struct keyset {
+    int n;
+    char key[MAX_KEYS][96];
+} keyset;
+
+static void keyset_add(keyset *ks, const char *k)
+{
+    for (int i = 0; i < ks->n; i++)
+        if (strcmp(ks->key[i], k) == 0) return;
+    if (ks->n < MAX_KEYS) snprintf(ks->key[ks->n++], sizeof ks->key[0], "%s", k);
+}
+
+static bool keyset_has(const keyset *ks, const char *k)
+{
+    for (int i = 0; i < ks->n; i++)
+        if (strcmp(ks->key[i], k) == 0) return true;
+    return false;
+}
+
+/* A loader path as the docs write it: a joint of the model as <joint>, a parameter as
+ * <name>, an index as [*] ("effects.damping.theta1" -> "effects.damping.<joint>"). */
+typedef struct key_walk {
+    const lag_model_info *info;
+    keyset *out;
+} key_walk;
+
+static void each_key(void *vc, const char *path, bool integer)
+{
+    (void)integer;
+    key_walk *w = vc;
+    char out[96] = "", part[96];
+    bool params = strncmp(path, "parameters.", 11) == 0;
+    for (const char *p = path; *p;) {
+        size_t len = strcspn(p, ".[");
+        snprintf(part, sizeof part, "%.*s", (int)len, p);
+        bool joint = false;
+        for (int j = 0; j < w->info->nq; j++) joint |= strcmp(part, w->info->joint_names[j]) == 0;
+        const char *as = p != path && params ? "<name>" : joint ? "<joint>" : part;
+        snprintf(out + strlen(out), sizeof out - strlen(out), "%s", as);
+        p += len;
+        if (*p == '[') {
+            snprintf(out + strlen(out), sizeof out - strlen(out), "[*]");
+            p = strchr(p, ']') ? strchr(p, ']') + 1 : p + strlen(p);
+        }
+        if (*p == '.') {
+            snprintf(out + strlen(out), sizeof out - strlen(out), ".");
+            p++;
+        }
+    }
+    keyset_add(w->out, out);
+}
+
+/* The keys docs/scenes.md's table of ranges names in its first column: each `path` (its
+ * [i], [k] as [*]); a `.suffix` after a path replaces as many of that path's last parts
+ * ("`effects.friction.<joint>.static`, `.kinetic`"). */
+static void documented_keys(const char *table, keyset *doc)
+{
+    for (const char *row = table; row && row[0] == '|'; row = strchr(row, '\n') ? strchr(row, '\n') + 1 : NULL) {
+        const char *cell_end = strchr(row + 1, '|');
+        char prev[200] = "";
+        for (const char *p = row; (p = strchr(p, '`')) && cell_end && p < cell_end;) {
+            const char *e = strchr(p + 1, '`');
+            if (!e || e > cell_end) break;
+            char tok[96], key[200];
+            snprintf(tok, sizeof tok, "%.*s", (int)(e - p - 1), p + 1);
+            if (tok[0] == '.' && prev[0]) { /* a suffix of the previous path */
+                int parts = 0;
+                for (const char *c = tok; *c; c++) parts += *c == '.';
+                char *cut = prev + strlen(prev);
+                for (; parts > 0 && cut > prev; parts--) { /* back over one ".part" */
+                    cut--;
+                    while (cut > prev && *cut != '.') cut--;
+                }
+                snprintf(key, sizeof key, "%.*s%s", (int)(cut - prev), prev, tok);
+            } else {
+                snprintf(key, sizeof key, "%s", tok);
+            }
+            char canon[200] = "";
+            for (const char *c = key; *c; c++) { /* [i], [k] -> [*] */
+                if (*c == '[' && strchr(c, ']')) {
+                    strcat(canon, "[*]");
+                    c = strchr(c, ']');
+                } else {
+                    size_t n = strlen(canon);
+                    if (n + 1 < sizeof canon) canon[n] = *c, canon[n + 1] = '\0';
+                }
+            }
+            keyset_add(doc, canon);
+            snprintf(prev, sizeof prev, "%s", key);
+            p = e + 1;
+        }
+    }
+}
+
+static void case_docs_keys(int arg)
+{
+    (void)arg;
+    static keyset loader, doc;
+    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
+        key_walk w = {lag_model_info_get((lag_model_kind)k), &loader};
+        scene_schema_each_number((lag_model_kind)k, each_key, &w);
+    }
+    if (!read_source("docs/scenes.md", g_text, sizeof g_text)) return;
+    const char *ranges = strstr(g_text, "| key | range | unit |");
+    const char *refs = strstr(g_text, "| key | kinds | range | default |");
+    if (!ranges || !refs) {
+        LT_FAIL("docs_keys: docs/scenes.md has no table of ranges or of the reference's keys "
+                "any more (the test's landmarks)");
+        return;
+    }
+    documented_keys(strchr(ranges, '\n') + 1, &doc);
+    int found = 0;
+    for (int i = 0; i < loader.n; i++) {
+        const char *key = loader.key[i];
+        char want[128];
+        bool ref = strncmp(key, "reference.<joint>.", 18) == 0;
+        snprintf(want, sizeof want, "\n| `%s` |", key + (ref ? 18 : 0));
+        bool ok = ref ? strstr(refs, want) != NULL : keyset_has(&doc, key);
+        if (!ok)
+            LT_FAIL("docs_keys: the loader's key %s has no row in docs/scenes.md's %s", key,
+                    ref ? "table of the reference's keys" : "table of ranges");
+        else
+            ENSURE(ok);
+        found += ok;
+    }
+    printf("docs_keys: %d of the loader's %d numeric key patterns documented in docs/scenes.md\n",
+           found, loader.n);
+}
+
 static const lt_case cases[] = {
     {"loader", case_loader, 0, 0},           {"scene_message", case_scene_message, 0, 0},
     {"keeps_state", case_keeps_state, 0, 0}, {"view", case_view, 0, 0},
-    {"docs", case_docs, 0, 0},
+    {"docs", case_docs, 0, 0},              {"docs_keys", case_docs_keys, 0, 0},
 };
 
 int main(int argc, char **argv)
