@@ -18,6 +18,8 @@
  *                  ranges list every row, and name no effect the core does not have
  *                  (prose, written by hand; the lists that can be generated are:
  *                  server/lists, structure_lists)
+ *   docs_channels  docs/server.md's table of channels and lagsimd.1's CHANNELS name the
+ *                  bus's channels (lagsim_bus.c's table), each once, and no other
  *   docs_keys      every numeric key of the loader's tables, for every model, has its row
  *                  in docs/scenes.md's table of ranges (reference keys: in the table of
  *                  the reference's keys), by its pattern (<joint>, <name>, [i])
@@ -374,6 +376,55 @@ static void case_docs(int arg)
     doc_lists("docs/scenes.md", "| key | range | unit |", "\n\n", "`effects.", ".[`", others);
 }
 
+/* ---------------------------------------------------------------- docs_channels */
+
+/* Counts, in `text` from `start` to `end`, each `before SUFFIX after` of the bus's channels
+ * and any other `before X after` of capitals; fails on a channel named other than once. */
+static void doc_channels(const char *file, const char *start, const char *end, const char *before,
+                         const char *after)
+{
+    if (!read_source(file, g_text, sizeof g_text)) return;
+    char *from = strstr(g_text, start), *to = from ? strstr(from, end) : NULL;
+    if (!from || !to) {
+        LT_FAIL("docs_channels: %s has no \"%s\" ... \"%s\" any more (the test's landmarks)", file,
+                start, end);
+        return;
+    }
+    *to = '\0';
+    int seen[LAG_BUS_CHANNEL_COUNT] = {0};
+    for (const char *p = from; (p = strstr(p, before)) != NULL; p++) {
+        const char *w = p + strlen(before);
+        size_t len = strspn(w, "_ABCDEFGHIJKLMNOPQRSTUVWXYZ");
+        if (len == 0 || strncmp(w + len, after, strlen(after)) != 0) continue;
+        int c = -1;
+        for (int k = 0; k < LAG_BUS_CHANNEL_COUNT; k++) {
+            const char *suf = lag_bus_suffix((lag_bus_channel)k);
+            if (strlen(suf) == len && strncmp(suf, w, len) == 0) c = k;
+        }
+        if (c < 0)
+            LT_FAIL("docs_channels: %s names a channel %.*s the bus's table does not have", file,
+                    (int)len, w);
+        else
+            seen[c]++;
+    }
+    for (int k = 0; k < LAG_BUS_CHANNEL_COUNT; k++) {
+        if (seen[k] != 1)
+            LT_FAIL("docs_channels: %s names channel <PREFIX>%s %d times (once, in its list)", file,
+                    lag_bus_suffix((lag_bus_channel)k), seen[k]);
+        else
+            ENSURE(seen[k] == 1);
+    }
+}
+
+static void case_docs_channels(int arg)
+{
+    (void)arg;
+    doc_channels("docs/server.md", "| channel | type |", "\n\n", "\n| `<PREFIX>", "` |");
+    doc_channels("docs/man/lagsimd.1", ".SH CHANNELS", ".SH SIGNALS", "\n.IB PREFIX ", "\n");
+    printf("docs_channels: server.md's table and lagsimd.1 name the bus's %d channels\n",
+           LAG_BUS_CHANNEL_COUNT);
+}
+
 /* ---------------------------------------------------------------- docs_keys */
 
 #define MAX_KEYS 256
@@ -510,6 +561,7 @@ static const lt_case cases[] = {
     {"loader", case_loader, 0, 0},           {"scene_message", case_scene_message, 0, 0},
     {"keeps_state", case_keeps_state, 0, 0}, {"view", case_view, 0, 0},
     {"docs", case_docs, 0, 0},              {"docs_keys", case_docs_keys, 0, 0},
+    {"docs_channels", case_docs_channels, 0, 0},
 };
 
 int main(int argc, char **argv)
