@@ -421,7 +421,7 @@ static void case_docs_channels(int arg)
     (void)arg;
     doc_channels("docs/server.md", "| channel | type |", "\n\n", "\n| `<PREFIX>", "` |");
     doc_channels("docs/man/lagsimd.1", ".SH CHANNELS", ".SH SIGNALS", "\n.IB PREFIX ", "\n");
-    printf("docs_channels: server.md's table and lagsimd.1 name the bus's %d channels\n",
+    printf("docs_channels: the bus's %d channels looked for in server.md's table and lagsimd.1\n",
            LAG_BUS_CHANNEL_COUNT);
 }
 
