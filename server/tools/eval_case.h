@@ -77,6 +77,44 @@ int eval_case_scene_load(const char *config, const char *from, const eval_case *
                          const char *const *extra, int nextra, eval_scene *sc /* OUT */,
                          char *err, size_t errlen);
 
+/* ---------------------------------------------------------------- the keys the tools own */
+/* The scene keys lagsim-eval and lagsim-sweep set on every daemon they start, each for a
+ * guarantee of theirs (lockstep: numbers that do not depend on the machine's load; a bus
+ * and channels of the run's own; nothing from or to the LAN unless --allow-lan). One
+ * table: the daemons' --set strings (eval_owned_sets), the refusal of a case's set: or a
+ * --vary that names one of them or a mapping above one (eval_owned_find), --help and
+ * docs/evaluation.md (eval_lagsim_eval_owned) all come from it. The run's log is the
+ * tools' too: lagsimd's --log, an option no scene key sets. */
+typedef enum eval_owned_row {
+    EVAL_OWN_MODE = 0,
+    EVAL_OWN_START,
+    EVAL_OWN_LOCKSTEP_TIMEOUT,
+    EVAL_OWN_URL,
+    EVAL_OWN_PREFIX,
+    EVAL_OWN_ALLOW_LAN,
+    EVAL_OWN_COUNT
+} eval_owned_row;
+
+typedef struct eval_owned_key {
+    const char *key; /* the dotted path, as lagsimd --set names it */
+    const char *why; /* what the tools set it to, and for what */
+} eval_owned_key;
+
+extern const eval_owned_key eval_owned_keys[EVAL_OWN_COUNT];
+
+/* The owned key that the dotted key path key[0, len) (as --set names it, without its
+ * "=value" or "[i]") is, lies under, or holds (a mapping above it: "realtime", "lcm"),
+ * compared a path segment at a time as the loader grafts it; -1 when none. */
+int eval_owned_find(const char *key, size_t len);
+
+/* 0 when the key path key[0, len) leaves every owned key alone; else -1 with why the
+ * tools refuse it in why ("realtime holds realtime.mode, which lagsim-eval and
+ * lagsim-sweep set themselves (lockstep: ...)"). */
+int eval_owned_check(const char *key, size_t len, char *why, size_t n);
+
+/* The owned keys' rows for --help: "  KEY  WHY" a line. */
+void eval_owned_usage(FILE *f);
+
 typedef struct eval_env {
     const char *lagsimd;     /* the daemon's path */
     const char *config;      /* the scene file */
@@ -84,12 +122,19 @@ typedef struct eval_env {
     const char *workdir;     /* where the run's log goes */
     char url[160];           /* the run's LCM URL */
     char prefix[64];         /* the run's channel prefix */
+    bool allow_lan;          /* --allow-lan: the URL's ttl may be above 0 */
     double wall_timeout;     /* s a run may take before it is stopped (and failed) */
     bool verbose;            /* pass the daemon's and the controller's output through */
 } eval_env;
 
 /* The URL of worker number `slot` of this process: a multicast port of its own. */
 void eval_url(int slot, char *url, size_t len);
+
+/* The --set strings a daemon of the tools gets for the owned keys, one a row in the
+ * table's order: a daemon of one run (starts on the controller's first command), or one
+ * kept for many runs (kept: starts paused, waits for a STEP's answer as long as it takes).
+ * OUT: out */
+void eval_owned_sets(const eval_env *env, bool kept, char out[EVAL_OWN_COUNT][EVAL_SET_LEN]);
 
 /* A joint's samples as logged: t, q, r (0 without a reference channel) and u (the
  * effort held from t[k] to t[k+1]: the next state's effort). */

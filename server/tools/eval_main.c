@@ -51,6 +51,11 @@ static void usage(FILE *f)
 "                         each run's log in the report directory (or /tmp)\n"
 "  -h, --help             this help\n"
 "\n"
+"keys lagsim-eval sets on every run (a case's set: naming one, or a mapping above\n"
+"one, is refused):\n");
+    eval_owned_usage(f);
+    fprintf(f,
+"\n"
 "exit codes: 0 every case ran, none failed and every case met --require; 1 a case\n"
 "failed or missed the requirement; 2 usage, scene or case error (file:line:column)\n");
 }

@@ -75,6 +75,11 @@ static void usage(FILE *f)
 "                         unless the runs are exactly 0 to the last one found)\n"
 "  -h, --help             this help\n"
 "\n"
+"keys lagsim-sweep sets on every run (a case's set: or a --vary naming one, or a\n"
+"mapping above one, is refused):\n");
+    eval_owned_usage(f);
+    fprintf(f,
+"\n"
 "exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
 "case error, an output that exists (checked before the first run), or shard CSVs that\n"
 "do not belong together or leave runs out\n");
@@ -137,6 +142,15 @@ static int parse_vary(const char *text, vary *v)
         return -1;
     }
     return 0;
+}
+
+/* A varied key the tools own (eval_owned_keys) is refused: said, and -1. */
+static int vary_owned(const vary *v)
+{
+    char why[512];
+    if (!eval_owned_check(v->key, strlen(v->key), why, sizeof why)) return 0;
+    fprintf(stderr, "%s: --vary %s: %s: a sweep cannot vary it\n", prog, v->text, why);
+    return -1;
 }
 
 /* splitmix64: one 64-bit mix of (seed, run, key, draw), the only source of randomness */
@@ -640,6 +654,7 @@ static int parse_options(sweep *x, int argc, char **argv)
                 return die("--vary %s: expected KEY=uniform(A,B) (A < B), KEY=normal(MEAN,SD) "
                            "or KEY=grid(A,B,N); an index only on initial.q[i] or "
                            "initial.qd[i]", optarg);
+            if (vary_owned(&x->vs[x->nv - 1])) return 2;
             break;
         case 'n': x->runs = (long)parse_pos("--runs", optarg, 1, 1e7, &bad); break;
         case O_SEED: x->seed = (uint64_t)parse_pos("--seed", optarg, 0, 9e15, &bad); break;

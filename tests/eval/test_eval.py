@@ -11,11 +11,16 @@ usage: test_eval.py BIN_DIR SOURCE_DIR CASE
              or metric (exit 2)
   errors     a case file with a mistake: exit 2 and file:line:column
   scene      cases in the scene file: lagsimd ignores them, lagsim-eval runs them
+  owned      the keys the tools set on every run (their --help's table): a case's set:
+             naming one, or a mapping above one, is refused (exit 2, file:line:column,
+             the key) by lagsim-eval and lagsim-sweep, and so is a --vary of one;
+             docs/evaluation.md and both man pages list exactly the table's keys
 """
 import csv
 import glob
 import math
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -247,7 +252,98 @@ def case_scene():
         check(p.returncode == 0 and "tilt" in p.stdout, "lagsim-eval runs the scene's own cases")
 
 
+def owned_keys(tool):
+    """The keys of the table the tool's --help prints: {key: its text}."""
+    out = subprocess.run([os.path.join(BIN, tool), "--help"], stdout=subprocess.PIPE,
+                         universal_newlines=True).stdout
+    keys, cur, inside = {}, None, False
+    for line in out.splitlines():
+        if line.startswith("keys %s sets on every run" % tool):
+            inside = True
+        elif inside and not line.strip():
+            break
+        elif inside and line.startswith("  ") and not line.startswith("   "):
+            cur = line.split()[0]
+            keys[cur] = " ".join(line.split()[1:])
+        elif inside and cur and line.startswith("   "):
+            keys[cur] += " " + line.strip()
+    return keys
+
+
+# a value the loader takes for each owned key (so that, were it not refused, the case
+# would run with it) and for the mappings above them
+OWNED_VALUES = {"realtime.mode": "realtime", "realtime.start": "paused",
+                "realtime.lockstep_timeout": "5",
+                "lcm.url": "'udpm://239.255.76.67:7667?ttl=0'", "lcm.prefix": "OTHER",
+                "lcm.allow_lan": "true", "realtime": "{mode: realtime}",
+                "lcm": "{prefix: OTHER}"}
+
+
+def case_owned():
+    keys = owned_keys("lagsim-eval")
+    check(len(keys) >= 6 and keys == owned_keys("lagsim-sweep"),
+          "lagsim-eval and lagsim-sweep print one table of owned keys: %s" % sorted(keys))
+    must = {"realtime.mode", "realtime.start", "realtime.lockstep_timeout", "lcm.url",
+            "lcm.prefix", "lcm.allow_lan"}
+    check(must <= set(keys), "the mode, start, lockstep timeout, URL, prefix and LAN access "
+          "are owned")
+    # every key of the table and every mapping above one
+    paths = sorted(set(keys) | must | {k.split(".")[0] for k in set(keys) | must})
+    sweep = os.path.join(BIN, "lagsim-sweep")
+    with tempfile.TemporaryDirectory() as d:
+        for k in paths:
+            check(k in OWNED_VALUES, "the test has a value for %s" % k)
+            text = ('cases:\n  - name: ok\n    duration: 1\n  - name: own\n    duration: 1\n'
+                    '    set: ["initial.q=[0, 0.05]", "%s=%s"]\n'
+                    % (k, OWNED_VALUES.get(k, "1").replace('"', '\\"')))
+            f = os.path.join(d, "suite.yaml")
+            with open(f, "w") as fh:
+                fh.write(text)
+            p = run("--suite", f, "--timeout", "20")
+            check(p.returncode == 2 and "suite.yaml:6:34: cases[1].set[1]:" in p.stderr and
+                  "a case cannot set it" in p.stderr and
+                  (k + " is set by" in p.stderr or k + " holds " in p.stderr),
+                  "lagsim-eval: a case setting %s: exit 2 at its place, the key named (%d)"
+                  % (k, p.returncode))
+            p = subprocess.run([sweep, "--config", SCENE, "--controller", CTRL, "--suite", f,
+                                "--case", "ok", "--vary", "parameters.m1=uniform(0.1,0.2)",
+                                "--timeout", "20"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+            print(p.stderr)
+            check(p.returncode == 2 and "suite.yaml:6:34: cases[1].set[1]:" in p.stderr,
+                  "lagsim-sweep: the same suite refused at the same place (%d)" % p.returncode)
+            p = subprocess.run([sweep, "--config", SCENE, "--controller", CTRL, "--duration",
+                                "1", "--vary", k + "=uniform(0,1)", "--timeout", "20"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               universal_newlines=True, timeout=300)
+            print(p.stderr)
+            check(p.returncode == 2 and "--vary %s=" % k in p.stderr and
+                  "a sweep cannot vary it" in p.stderr,
+                  "lagsim-sweep --vary %s: exit 2, said why (%d)" % (k, p.returncode))
+    # the docs' table and the man pages name the table's keys, no other
+    text = open(os.path.join(SRC, "docs", "evaluation.md")).read()
+    sec = text.split("**What a case cannot change.**", 1)
+    documented = []
+    if len(sec) == 2:
+        lines = sec[1].splitlines()
+        while lines and not lines[0].startswith("|"):  # the text before the table
+            lines.pop(0)
+        for line in lines:
+            if not line.startswith("|"):
+                break
+            cell = line.split("|")[1].strip()
+            if cell.startswith("`"):
+                documented.append(cell.strip("`"))
+    check(sorted(documented) == sorted(keys),
+          "docs/evaluation.md's table of owned keys is the tools' (%s)" % documented)
+    for page in ("lagsim-eval.1", "lagsim-sweep.1"):
+        man = open(os.path.join(SRC, "docs", "man", page)).read().replace("\\", "")
+        sub = man.split(".SS Keys", 1)[-1].split(".SH", 1)[0] if ".SS Keys" in man else ""
+        named = set(re.findall(r"^\.TP\n\.B (\S+)$", sub, re.M))
+        check(named == set(keys), "%s names the owned keys (%s)" % (page, sorted(named)))
+
+
 {"metrics": case_metrics, "require": case_require, "errors": case_errors,
- "scene": case_scene}[CASE]()
+ "scene": case_scene, "owned": case_owned}[CASE]()
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)
