@@ -27,7 +27,7 @@ endif()
 # run here with Slurm's variables (no cluster needed); merge's refusals.
 find_program(LAGSIM_GNU_PARALLEL parallel)
 if(LAGSIM_PYTHON3 AND LAGSIM_GNU_PARALLEL)
-  foreach(c same slurm merge kept kept_python loss stalled ssh)
+  foreach(c same slurm merge kept kept_python loss stalled ssh vary)
     add_test(NAME eval_lagsim_sweep_${c}
       COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_sweep.py
               $<TARGET_FILE_DIR:lagsim-sweep> ${PROJECT_SOURCE_DIR} ${c})

@@ -49,20 +49,24 @@ static size_t segment(const char *p, const char *end)
     return dot ? (size_t)(dot - p) : (size_t)(end - p);
 }
 
+bool eval_key_overlap(const char *a, size_t alen, const char *b, size_t blen)
+{
+    const char *ae = a + alen, *be = b + blen;
+    /* a segment at a time while both agree; one path ending there is the other or holds
+     * it */
+    for (;;) {
+        size_t al = segment(a, ae), bl = segment(b, be);
+        if (al != bl || memcmp(a, b, al)) return false;
+        if (a + al == ae || b + bl == be) return true;
+        a += al + 1, b += bl + 1;
+    }
+}
+
 int eval_owned_find(const char *key, size_t len)
 {
-    for (int r = 0; r < EVAL_OWN_COUNT; r++) {
-        const char *a = key, *ae = key + len;
-        const char *b = eval_owned_keys[r].key, *be = b + strlen(b);
-        /* a segment at a time while both agree; one path ending there is the other or
-         * holds it */
-        for (;;) {
-            size_t al = segment(a, ae), bl = segment(b, be);
-            if (al != bl || memcmp(a, b, al)) break;
-            if (a + al == ae || b + bl == be) return r;
-            a += al + 1, b += bl + 1;
-        }
-    }
+    for (int r = 0; r < EVAL_OWN_COUNT; r++)
+        if (eval_key_overlap(key, len, eval_owned_keys[r].key, strlen(eval_owned_keys[r].key)))
+            return r;
     return -1;
 }
 

@@ -102,6 +102,11 @@ typedef struct eval_owned_key {
 
 extern const eval_owned_key eval_owned_keys[EVAL_OWN_COUNT];
 
+/* Whether the dotted key paths a[0, alen) and b[0, blen) (as --set names them) are one
+ * key or one holds the other ("initial" holds "initial.q"), compared a segment at a time
+ * as the loader grafts them: setting both, the later one overrides (part of) the other. */
+bool eval_key_overlap(const char *a, size_t alen, const char *b, size_t blen);
+
 /* The owned key that the dotted key path key[0, len) (as --set names it, without its
  * "=value" or "[i]") is, lies under, or holds (a mapping above it: "realtime", "lcm"),
  * compared a path segment at a time as the loader grafts it; -1 when none. */

@@ -48,9 +48,11 @@ static void usage(FILE *f)
 "      --suite FILE       take the cases from FILE\n"
 "  -d, --duration S       without --case: a case of S sim seconds and no overrides\n"
 "      --vary KEY=DIST    a scene key (as lagsimd --set; initial.q[i], initial.qd[i]\n"
-"                         for one coordinate) and its values: uniform(A,B),\n"
-"                         normal(MEAN,SD) or grid(A,B,N) (N values from A to B);\n"
-"                         repeatable: grids multiply, random keys are drawn per run\n"
+"                         for one coordinate) and its values: uniform(A,B) (A < B),\n"
+"                         normal(MEAN,SD) (SD > 0) or grid(A,B,N) (N values from A\n"
+"                         up to B > A, N from 2 to 1e6), numbers as plain decimals;\n"
+"                         repeatable, each key once: grids multiply, random keys are\n"
+"                         drawn per run\n"
 "  -n, --runs N           runs (per grid point when there are grids; default 1)\n"
 "      --seed S           the random seed of every drawn value (default 1)\n"
 "  -j, --jobs N           runs at once on this machine (default 1)\n"
@@ -105,40 +107,107 @@ typedef struct vary {
     long n;                   /* grid points */
 } vary;
 
-static int parse_vary(const char *text, vary *v)
+/* The numbers of "NAME(X1, ..., Xn)" at d into x: each a plain decimal as a scene writes
+ * one (lag_scene_read_decimal: not inf, nan, 0x1p3 or 1e999), nothing after the ')'. */
+static bool read_args(const char *d, const char *name, int n, double *x)
 {
-    memset(v, 0, sizeof *v);
-    snprintf(v->text, sizeof v->text, "%s", text);
+    size_t nl = strlen(name);
+    if (strncmp(d, name, nl) || d[nl] != '(') return false;
+    const char *p = d + nl + 1;
+    for (int i = 0; i < n; i++) {
+        size_t len = strcspn(p, i + 1 < n ? "," : ")");
+        char num[64];
+        if (!p[len] || len >= sizeof num) return false;
+        /* blanks around a number are allowed, as in uniform(0.5, 2) */
+        while (len && p[len - 1] == ' ') len--;
+        size_t lead = strspn(p, " ");
+        if (lead >= len) return false;
+        memcpy(num, p + lead, len - lead);
+        num[len - lead] = '\0';
+        if (lag_scene_read_decimal(num, &x[i]) != LAG_OK) return false;
+        p += strcspn(p, i + 1 < n ? "," : ")") + 1;
+    }
+    return p[0] == '\0' && p[-1] == ')';
+}
+
+/* KEY, and its index on initial.q[i] / initial.qd[i] */
+static int parse_vary_key(const char *text, vary *v, char *why, size_t len)
+{
     const char *eq = strchr(text, '=');
-    if (!eq || eq == text || (size_t)(eq - text) >= sizeof v->key) return -1;
+    if (!eq || eq == text || (size_t)(eq - text) >= sizeof v->key)
+        return snprintf(why, len, "expected KEY=DIST"), -1;
     memcpy(v->key, text, (size_t)(eq - text));
     v->index = -1;
     char *br = strchr(v->key, '[');
-    if (br) {
-        char *end;
-        long i = strtol(br + 1, &end, 10);
-        if (end == br + 1 || strcmp(end, "]") || i < 0 || i >= EVAL_JOINTS_MAX) return -1;
-        if (strncmp(v->key, "initial.q[", 10) && strncmp(v->key, "initial.qd[", 11)) return -1;
-        *br = '\0';
-        v->index = (int)i;
-    }
-    const char *d = eq + 1;
-    double a, b, n;
-    char tail;
-    /* the distribution ends at its ')': nothing may follow it */
-    const char *close = strchr(d, ')');
-    if (!close || close[1] != '\0') return -1;
-    if (sscanf(d, "uniform(%lf ,%lf%c", &a, &b, &tail) == 3 && tail == ')' && a < b &&
-        isfinite(a) && isfinite(b)) {
-        v->kind = V_UNIFORM, v->a = a, v->b = b;
-    } else if (sscanf(d, "normal(%lf ,%lf%c", &a, &b, &tail) == 3 && tail == ')' && b >= 0 &&
-               isfinite(a) && isfinite(b)) {
-        v->kind = V_NORMAL, v->a = a, v->b = b;
-    } else if (sscanf(d, "grid(%lf ,%lf ,%lf%c", &a, &b, &n, &tail) == 4 && tail == ')' &&
-               isfinite(a) && isfinite(b) && n >= 1 && n <= 1e6 && n == floor(n) &&
-               (n == 1 || a != b)) {
-        v->kind = V_GRID, v->a = a, v->b = b, v->n = (long)n;
+    if (!br && (!strcmp(v->key, "initial.q") || !strcmp(v->key, "initial.qd")))
+        return snprintf(why, len, "%s is a list: vary one coordinate, %s[i]", v->key,
+                        v->key), -1;
+    if (!br) return 0;
+    char *end;
+    long i = strtol(br + 1, &end, 10);
+    if ((strncmp(v->key, "initial.q[", 10) && strncmp(v->key, "initial.qd[", 11)) ||
+        end == br + 1 || strcmp(end, "]") || !(br[1] >= '0' && br[1] <= '9') || i < 0 ||
+        i >= EVAL_JOINTS_MAX)
+        return snprintf(why, len, "an index only on initial.q[i] or initial.qd[i], i from 0 "
+                        "to %d", EVAL_JOINTS_MAX - 1), -1;
+    *br = '\0';
+    v->index = (int)i;
+    return 0;
+}
+
+/* A --vary: KEY=uniform(A,B), normal(MEAN,SD) or grid(A,B,N). Every value a run can get is
+ * a finite double: A < B (a grid ascends, as uniform's range), B - A finite, SD > 0 and
+ * MEAN +- 9 SD finite (Box-Muller's draws stay within 8.7 SD), N an integer from 2 to
+ * 1e6. -1 with what was expected in why. */
+static int parse_vary(const char *text, vary *v, char *why, size_t len)
+{
+    memset(v, 0, sizeof *v);
+    snprintf(v->text, sizeof v->text, "%s", text);
+    if (parse_vary_key(text, v, why, len)) return -1;
+    const char *d = strchr(text, '=') + 1;
+    double x[3];
+    if (read_args(d, "uniform", 2, x)) {
+        v->kind = V_UNIFORM;
+        if (!(x[0] < x[1]) || !isfinite(x[1] - x[0]))
+            return snprintf(why, len, "uniform(A,B) needs A < B and B - A finite"), -1;
+    } else if (read_args(d, "normal", 2, x)) {
+        v->kind = V_NORMAL;
+        if (!(x[1] > 0) || !isfinite(fabs(x[0]) + 9 * x[1]))
+            return snprintf(why, len, "normal(MEAN,SD) needs SD > 0 and MEAN +- 9 SD finite "
+                            "(the draws reach 8.7 SD)"), -1;
+    } else if (read_args(d, "grid", 3, x)) {
+        v->kind = V_GRID;
+        if (!(x[0] < x[1]) || !isfinite(x[1] - x[0]))
+            return snprintf(why, len, "grid(A,B,N) needs A < B (it goes from A up to B) and "
+                            "B - A finite"), -1;
+        if (!(x[2] >= 2 && x[2] <= 1e6 && x[2] == floor(x[2])))
+            return snprintf(why, len, "grid(A,B,N) needs N, its number of points, an integer "
+                            "from 2 to 1e6"), -1;
+        v->n = (long)x[2];
     } else {
+        return snprintf(why, len, "expected uniform(A,B), normal(MEAN,SD) or grid(A,B,N), "
+                        "each number a plain decimal"), -1;
+    }
+    v->a = x[0], v->b = x[1];
+    return 0;
+}
+
+/* -1 after saying so when v varies a key (or a coordinate) that an earlier --vary of vs
+ * varies too, or holds or lies under it: a run could take only one of the values, and
+ * the CSV would show both. */
+static int vary_twice(const vary *vs, int nv, const vary *v)
+{
+    for (int k = 0; k < nv; k++) {
+        const vary *o = &vs[k];
+        if (!eval_key_overlap(o->key, strlen(o->key), v->key, strlen(v->key))) continue;
+        /* two coordinates of one list are two keys */
+        if (!strcmp(o->key, v->key) && o->index >= 0 && v->index >= 0 && o->index != v->index)
+            continue;
+        bool same = !strcmp(o->key, v->key) && o->index == v->index;
+        fprintf(stderr, "%s: --vary %s: %s that of --vary %s: a run takes one value of a "
+                "key (one of the two CSV columns would be false); vary each key once\n",
+                prog, v->text, same ? "the same key as" : "its key holds or lies in",
+                o->text);
         return -1;
     }
     return 0;
@@ -623,6 +692,34 @@ typedef struct sweep {
     char tmpdir[64];
 } sweep;
 
+/* An integer option: a plain decimal (as a scene writes a number) with no fraction. */
+static double parse_int(const char *opt, const char *s, double lo, double hi, int *bad)
+{
+    double v = 0;
+    if (lag_scene_read_decimal(s, &v) != LAG_OK || v != floor(v) || !(v >= lo && v <= hi)) {
+        fprintf(stderr, "%s: %s: expected an integer from %.0f to %.0f, got '%s'\n", prog, opt,
+                lo, hi, s);
+        *bad = 1;
+    }
+    return v;
+}
+
+/* One --vary: read, not on a key the tools own, not on a key varied already. -1 after
+ * saying why. */
+static int add_vary(sweep *x, const char *text)
+{
+    char why[256];
+    if (x->nv == VARY_MAX) return die("at most %s --vary", "16"), -1;
+    vary *v = &x->vs[x->nv];
+    if (parse_vary(text, v, why, sizeof why)) {
+        fprintf(stderr, "%s: --vary %s: %s\n", prog, text, why);
+        return -1;
+    }
+    if (vary_owned(v) || vary_twice(x->vs, x->nv, v)) return -1;
+    x->nv++;
+    return 0;
+}
+
 static int parse_options(sweep *x, int argc, char **argv)
 {
     enum { O_CASE = 256, O_SUITE, O_VARY, O_SEED, O_SHARD, O_REQUIRE, O_CSV, O_PLOT, O_METRIC,
@@ -649,16 +746,11 @@ static int parse_options(sweep *x, int argc, char **argv)
         case O_SUITE: x->suite = optarg; break;
         case 'd': x->duration = parse_pos("--duration", optarg, 1e-3, 1e6, &bad); break;
         case O_VARY:
-            if (x->nv == VARY_MAX) return die("at most %s --vary", "16");
-            if (parse_vary(optarg, &x->vs[x->nv++]))
-                return die("--vary %s: expected KEY=uniform(A,B) (A < B), KEY=normal(MEAN,SD) "
-                           "or KEY=grid(A,B,N); an index only on initial.q[i] or "
-                           "initial.qd[i]", optarg);
-            if (vary_owned(&x->vs[x->nv - 1])) return 2;
+            if (add_vary(x, optarg)) return 2;
             break;
-        case 'n': x->runs = (long)parse_pos("--runs", optarg, 1, 1e7, &bad); break;
-        case O_SEED: x->seed = (uint64_t)parse_pos("--seed", optarg, 0, 9e15, &bad); break;
-        case 'j': x->jobs = (long)parse_pos("--jobs", optarg, 1, 256, &bad); break;
+        case 'n': x->runs = (long)parse_int("--runs", optarg, 1, 1e7, &bad); break;
+        case O_SEED: x->seed = (uint64_t)parse_int("--seed", optarg, 0, 9e15, &bad); break;
+        case 'j': x->jobs = (long)parse_int("--jobs", optarg, 1, 256, &bad); break;
         case O_SHARD:
             if (sscanf(optarg, "%ld/%ld", &x->shard_k, &x->shard_n) != 2 || x->shard_n < 1 ||
                 x->shard_k < 1 || x->shard_k > x->shard_n)
@@ -739,9 +831,9 @@ static int load_scene(sweep *x)
         x->restart = true;
     }
     x->per_point = x->total = x->runs;
-    for (int k = 0; k < x->nv; k++)
-        if (x->vs[k].kind == V_GRID) x->total *= x->vs[k].n;
-    if (x->total > 10000000) return die("%s", "more than 1e7 runs");
+    for (int k = 0; k < x->nv; k++) /* each factor <= 1e7: checked before it can overflow */
+        if (x->vs[k].kind == V_GRID && (x->total *= x->vs[k].n) > 10000000)
+            return die("%s", "more than 1e7 runs (--runs times the grids' points)");
     return -1;
 }
 
