@@ -1044,12 +1044,17 @@ static int sweep_run(sweep *x)
 {
     char err[2048];
     FILE *fcsv = NULL, *fpng = NULL;
-    const char *in[2] = {x->config, x->suite};
+    /* what the sweep reads (the scene, the suite, the daemon) and its CSV: no output may
+     * be one of them (compared by device and inode) */
+    const char *in[4] = {x->config, x->lagsimd, x->suite, x->csv};
     /* every output opened (and so refused, when it must be) before the first run: a sweep
      * never runs for hours to lose its results at the end */
-    if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, 2))) return 2;
-    if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, 2))) {
-        if (fcsv) fclose(fcsv), unlink(x->csv);
+    struct stat st;
+    bool csv_new = x->csv && lstat(x->csv, &st) != 0;
+    if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, 3))) return 2;
+    if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, 4))) {
+        if (fcsv) fclose(fcsv);
+        if (csv_new) unlink(x->csv); /* a CSV this sweep made, empty */
         return 2;
     }
     if (fpng) fclose(fpng); /* gnuplot writes it at the end */

@@ -15,18 +15,23 @@ usage: test_eval.py BIN_DIR SOURCE_DIR CASE
              naming one, or a mapping above one, is refused (exit 2, file:line:column,
              the key) by lagsim-eval and lagsim-sweep, and so is a --vary of one;
              docs/evaluation.md and both man pages list exactly the table's keys
+  outputs    no output of lagsim-eval or lagsim-sweep is a file they read (the scene, the
+             suite, the daemon; merge's shards) or another of their outputs (the CSV and
+             the report's or the plot's files), whatever its spelling (./, a hard link),
+             with --force too: exit 2 before any run, the file untouched
 """
 import csv
 import glob
 import math
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
 import time
 
-BIN, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
+BIN, SRC, CASE = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2]), sys.argv[3]
 SCENE = os.path.join(SRC, "config", "cartpole.yaml")
 SUITE = os.path.join(SRC, "tests", "eval", "cartpole_cases.yaml")
 CTRL = os.path.join(BIN, "lqr_balance") + " -q --prefix {prefix}"
@@ -343,7 +348,87 @@ def case_owned():
         check(named == set(keys), "%s names the owned keys (%s)" % (page, sorted(named)))
 
 
+def case_outputs():
+    sweep = os.path.join(BIN, "lagsim-sweep")
+    with tempfile.TemporaryDirectory() as d:
+        suite = os.path.join(d, "suite.yaml")
+        text = "cases:\n  - name: a\n    duration: 0.5\n    set: [\"initial.q=[0, 0.05]\"]\n"
+        rep = os.path.join(d, "r")
+        os.mkdir(rep)
+        daemon = os.path.join(d, "lagsimd")
+        shutil.copy(os.path.join(BIN, "lagsimd"), daemon)
+        before = open(daemon, "rb").read()
+
+        def attempt(what, args, victim, tool=EVAL, cwd=None, untouched=True):
+            """runs the tool; exit 2 before any run, victim unchanged (untouched: else one
+            output of the two, which --force lets replace it)"""
+            if victim in (suite, os.path.join(rep, "a.dat"), os.path.join(rep, "a.gp")):
+                with open(victim, "w") as f:
+                    f.write(text)
+            old = open(victim, "rb").read()
+            base = [tool, "--config", SCENE, "--controller", CTRL]
+            p = subprocess.run(base + args + ["--force"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, universal_newlines=True, timeout=300,
+                               cwd=cwd)
+            print("$", " ".join(args), "->", p.returncode, p.stdout[-500:], p.stderr[-800:])
+            check(p.returncode == 2 and "the same file as" in p.stderr and
+                  "refused" in p.stderr and "case " not in p.stdout and "runs:" not in p.stdout
+                  and (open(victim, "rb").read() == old or not untouched),
+                  "%s: exit 2 before any run, %s untouched (%d)"
+                  % (what, os.path.basename(victim), p.returncode))
+
+        with open(suite, "w") as f:
+            f.write(text)
+        attempt("lagsim-eval --csv the suite", ["--suite", suite, "--csv", suite], suite)
+        attempt("lagsim-eval --csv ./suite.yaml", ["--suite", "suite.yaml", "--csv",
+                                                   "./suite.yaml"], suite, cwd=d)
+        link = os.path.join(d, "link.csv")
+        os.link(suite, link)
+        attempt("lagsim-eval --csv a hard link to the suite", ["--suite", suite, "--csv", link],
+                suite)
+        os.unlink(link)
+        for ext in ("dat", "gp"):
+            victim = os.path.join(rep, "a." + ext)
+            attempt("lagsim-eval --report: the suite is its a.%s" % ext,
+                    ["--suite", victim, "--report", rep], victim)
+            os.unlink(victim)
+        png = os.path.join(rep, "a.png")
+        with open(png, "w") as f:
+            f.write("an old PNG")
+        attempt("lagsim-eval --csv the report's PNG", ["--suite", suite, "--csv", png,
+                                                       "--report", rep], png, untouched=False)
+        check(sorted(os.listdir(rep)) == ["a.png"], "a refused run leaves no file it made "
+              "(%s)" % sorted(os.listdir(rep)))
+        os.link(os.path.join(rep, "a.png"), os.path.join(rep, "a.gp"))
+        attempt("lagsim-eval --report: its script a hard link to its PNG",
+                ["--suite", suite, "--report", rep], png)
+        attempt("lagsim-eval --csv the daemon", ["--suite", suite, "--lagsimd", daemon, "--csv",
+                                                 daemon], daemon)
+        # lagsim-sweep
+        sw = ["--suite", suite, "--case", "a", "--vary", "parameters.m1=uniform(0.1,0.2)"]
+        attempt("lagsim-sweep --csv the suite", sw + ["--csv", suite], suite, tool=sweep)
+        out = os.path.join(d, "s.out")
+        with open(out, "w") as f:
+            f.write("an old result")
+        attempt("lagsim-sweep --csv and --plot one file", sw + ["--csv", out, "--plot", out], out,
+                tool=sweep, untouched=False)
+        attempt("lagsim-sweep --csv the daemon", sw + ["--lagsimd", daemon, "--csv", daemon],
+                daemon, tool=sweep)
+        check(open(daemon, "rb").read() == before, "the daemon's copy is whole")
+        # merge: -o never one of its shards
+        shard = os.path.join(d, "shard.csv")
+        with open(shard, "w") as f:
+            f.write("run,x,failed,required,reason\n0,1,0,1,\"\"\n")
+        os.link(shard, os.path.join(d, "merged.csv"))
+        old = open(shard).read()
+        p = subprocess.run([sweep, "merge", shard, "-o", os.path.join(d, "merged.csv"),
+                            "--force"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True)
+        check(p.returncode == 2 and "the same file as" in p.stderr and open(shard).read() == old,
+              "merge -o a hard link to its shard: exit 2, the shard untouched")
+
+
 {"metrics": case_metrics, "require": case_require, "errors": case_errors,
- "scene": case_scene, "owned": case_owned}[CASE]()
+ "scene": case_scene, "owned": case_owned, "outputs": case_outputs}[CASE]()
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)
