@@ -37,9 +37,11 @@ const eval_owned_key eval_owned_keys[EVAL_OWN_COUNT] = {
     [EVAL_OWN_LOCKSTEP_TIMEOUT] = {"realtime.lockstep_timeout",
                                    "0.1 s (3600 s for a kept worker): how often a waiting "
                                    "plant publishes its state again"},
-    [EVAL_OWN_URL] = {"lcm.url", "ports of the run's own: no crosstalk"},
+    [EVAL_OWN_URL] = {"lcm.url", "ports of the run's own, with the group and options of "
+                                 "--url or LCM_DEFAULT_URL: no crosstalk"},
     [EVAL_OWN_PREFIX] = {"lcm.prefix", "channels of the run's own ({prefix}, LAGSIM_PREFIX)"},
-    [EVAL_OWN_ALLOW_LAN] = {"lcm.allow_lan", "false: nothing from or to the network"},
+    [EVAL_OWN_ALLOW_LAN] = {"lcm.allow_lan", "false unless --allow-lan: nothing from or to "
+                                             "the network"},
 };
 
 /* The length of the first segment of the dotted path p[0, end) */
@@ -345,13 +347,64 @@ void eval_owned_sets(const eval_env *env, bool kept, char out[EVAL_OWN_COUNT][EV
 }
 
 /* ---------------------------------------------------------------- processes */
-void eval_url(int slot, char *url, size_t len)
+int eval_bus_init(eval_bus *b, const char *url, bool allow_lan, char *err, size_t errlen)
 {
-    /* a port pair per (process, slot) in 64000..65518, above the ports the tests draw
-     * theirs from (20000..63998): a run never shares a bus with a test whose programs look
-     * for the only plant on it; a prefix of the run's own as well */
-    int port = 64000 + 2 * (int)(((long)getpid() * 61 + slot) % 760);
-    snprintf(url, len, "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304", port);
+    memset(b, 0, sizeof *b);
+    const char *env = getenv("LCM_DEFAULT_URL");
+    b->from = url ? "--url" : env && env[0] ? "LCM_DEFAULT_URL" : "the default URL";
+    if (!url) url = env && env[0] ? env : EVAL_DEFAULT_URL;
+    if (strlen(url) >= sizeof b->base) {
+        snprintf(err, errlen, "%s: an LCM URL of at most %zu characters expected", b->from,
+                 sizeof b->base - 1);
+        return -1;
+    }
+    snprintf(b->base, sizeof b->base, "%s", url);
+    char why[512];
+    /* a plant's URL first (the provider), then the options under a scene's rules, as the
+     * daemon reads its lcm.url */
+    if (lag_url_parse(b->base, 0, &b->u, why, sizeof why) != 0 ||
+        (b->u.provider == LAG_URL_UDPM &&
+         lag_url_parse(b->base, LAG_URL_SCENE_RULES | LAG_URL_ALLOW_LAN, &b->u, why,
+                       sizeof why) != 0)) {
+        snprintf(err, errlen, "%s %s: %s", b->from, url, why);
+        return -1;
+    }
+    if (b->u.provider != LAG_URL_UDPM) {
+        snprintf(err, errlen, "%s %s: the daemon and the controller are processes of their "
+                 "own, which an in-process memq:// bus cannot join: give a udpm:// URL",
+                 b->from, url);
+        return -1;
+    }
+    if (b->u.ttl > 0 && !allow_lan) {
+        snprintf(err, errlen, "%s %s: ttl=%d sends every message of the runs beyond this host "
+                 "and lets the network command their plants (docs/network.md): give "
+                 "--allow-lan if that is meant, or use ttl=0", b->from, url, b->u.ttl);
+        return -1;
+    }
+    return 0;
+}
+
+bool eval_text_plain(const char *s)
+{
+    for (; *s; s++)
+        if (!((*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z') || (*s >= '0' && *s <= '9') ||
+              strchr("_-.:/?=&", *s)))
+            return false;
+    return true;
+}
+
+int eval_bus_take(const eval_bus *b, lag_port_lease *l, char *url, size_t len, char *err,
+                  size_t errlen)
+{
+    if (lag_port_take(l, err, errlen) != 0) return -1;
+    int n = lag_url_format(&b->u, l->port, url, len);
+    if (n < 0 || (size_t)n >= len || !eval_text_plain(url)) {
+        snprintf(err, errlen, "%s %s: the run's URL '%.*s' is too long or has a character "
+                 "that a quote would change", b->from, b->base, (int)len, url);
+        lag_port_release(l);
+        return -1;
+    }
+    return 0;
 }
 
 double eval_now(void) { return lag_clock_mono_s(); }

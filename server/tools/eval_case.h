@@ -28,6 +28,8 @@
 #include <sys/types.h>
 
 #include "lagsim_log.h"
+#include "lagsim_port.h"
+#include "lagsim_url.h"
 #include "metrics.h"
 
 #define EVAL_NAME_LEN 64
@@ -132,8 +134,32 @@ typedef struct eval_env {
     bool verbose;            /* pass the daemon's and the controller's output through */
 } eval_env;
 
-/* The URL of worker number `slot` of this process: a multicast port of its own. */
-void eval_url(int slot, char *url, size_t len);
+/* The bus of the tools' runs: the multicast group and the options of --url, else of
+ * LCM_DEFAULT_URL, else EVAL_DEFAULT_URL's; the ports a pair of the runs' own
+ * (lag_port_take: no two evaluations or sweeps of this host share one, and none joins a
+ * port a program of this host is bound to). */
+#define EVAL_DEFAULT_URL "udpm://239.255.76.67?ttl=0&recv_buf_size=4194304"
+typedef struct eval_bus {
+    char base[256];   /* the URL the group and the options come from */
+    const char *from; /* which: "--url", "LCM_DEFAULT_URL" or "the default URL" */
+    lag_url u;        /* base, read under a scene's rules (u.query points into base) */
+} eval_bus;
+
+/* Reads the base URL (url: --url's, or NULL): udpm:// with only ttl and recv_buf_size
+ * (a scene's rules), ttl above 0 only with allow_lan (--allow-lan). -1 with why, naming
+ * where the URL came from, in err. OUT: b */
+int eval_bus_init(eval_bus *b, const char *url, bool allow_lan, char *err, size_t errlen);
+
+/* Takes a pair of ports of b's own, held in *l until lag_port_release (the caller's
+ * lifetime), and writes its URL to url: checked to hold only characters that mean the
+ * same inside any quotes ({url} is replaced by it as written, docs/evaluation.md). -1 with
+ * why in err. OUT: l, url */
+int eval_bus_take(const eval_bus *b, lag_port_lease *l, char *url, size_t len, char *err,
+                  size_t errlen);
+
+/* Whether s holds only characters that mean themselves inside '...' or "..." in a shell
+ * and in the strings of Octave, MATLAB and Python: letters, digits and _ - . : / ? = &. */
+bool eval_text_plain(const char *s);
 
 /* The --set strings a daemon of the tools gets for the owned keys, one a row in the
  * table's order: a daemon of one run (starts on the controller's first command), or one

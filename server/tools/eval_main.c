@@ -22,7 +22,8 @@ static void usage(FILE *f)
     fprintf(f,
 "usage: lagsim-eval --config SCENE --controller 'COMMAND' [--case NAME ...]\n"
 "                   [--suite FILE] [--require EXPR] [--csv OUT.csv] [--report DIR]\n"
-"                   [--force] [--lagsimd PATH] [--timeout S] [-v]\n"
+"                   [--force] [--url URL] [--allow-lan] [--lagsimd PATH] [--timeout S]\n"
+"                   [-v]\n"
 "\n"
 "Runs each case of a scene (its `cases:` key, or those of a suite file) in lockstep\n"
 "against a controller and reports per joint: rise, settle, overshoot, sse, iae, ise,\n"
@@ -43,6 +44,12 @@ static void usage(FILE *f)
 "      --report DIR       a PNG per case in DIR (gnuplot): response, reference,\n"
 "                         effort and the metrics, titled with the case's result\n"
 "  -f, --force            replace existing output files\n"
+"      --url URL          the runs' multicast group and options (default:\n"
+"                         LCM_DEFAULT_URL's, else udpm://239.255.76.67?ttl=0&\n"
+"                         recv_buf_size=4194304); the ports are lagsim-eval's: a pair\n"
+"                         of its own, held while it runs, that no other evaluation or\n"
+"                         sweep of this host holds and no socket of it is bound to\n"
+"      --allow-lan        accept a URL with ttl above 0 (the runs on the network)\n"
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a case may take (default 600); a controller\n"
 "                         not on {prefix} or LAGSIM_PREFIX never answers: its case\n"
@@ -276,11 +283,14 @@ static int report(run_files *rf, const char *dir, bool force, const eval_case *c
 
 /* A run of lagsim-eval: the options, the scene and its cases, the outputs. */
 typedef struct eval_cli {
-    const char *config, *controller, *suite, *require, *csv, *report_dir;
+    const char *config, *controller, *suite, *require, *csv, *report_dir, *url_opt;
     const char *only[EVAL_CASES_MAX];
     int nonly;
-    bool force, verbose;
+    bool force, verbose, allow_lan;
     double timeout;
+    eval_bus bus;           /* the runs' group and options */
+    lag_port_lease lease;   /* their ports, held while lagsim-eval runs */
+    char url[160];          /* the runs' URL */
     char lagsimd[4096];
     char err[2048];
     eval_scene sc;
@@ -298,13 +308,15 @@ typedef struct eval_cli {
 /* The options. Returns -1 to go on, or the exit code. */
 static int parse_options(eval_cli *x, int argc, char **argv)
 {
-    enum { O_CASE = 256, O_SUITE, O_REQUIRE, O_CSV, O_REPORT, O_LAGSIMD, O_TIMEOUT };
+    enum { O_CASE = 256, O_SUITE, O_REQUIRE, O_CSV, O_REPORT, O_LAGSIMD, O_TIMEOUT, O_URL,
+           O_ALLOW_LAN };
     static const struct option opts[] = {
         {"config", required_argument, 0, 'c'},   {"controller", required_argument, 0, 'C'},
         {"case", required_argument, 0, O_CASE},  {"suite", required_argument, 0, O_SUITE},
         {"require", required_argument, 0, O_REQUIRE}, {"csv", required_argument, 0, O_CSV},
         {"report", required_argument, 0, O_REPORT}, {"force", no_argument, 0, 'f'},
-        {"lagsimd", required_argument, 0, O_LAGSIMD},
+        {"lagsimd", required_argument, 0, O_LAGSIMD}, {"url", required_argument, 0, O_URL},
+        {"allow-lan", no_argument, 0, O_ALLOW_LAN},
         {"timeout", required_argument, 0, O_TIMEOUT}, {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},            {0, 0, 0, 0}};
     int o;
@@ -323,6 +335,8 @@ static int parse_options(eval_cli *x, int argc, char **argv)
         case O_REPORT: x->report_dir = optarg; break;
         case 'f': x->force = true; break;
         case O_LAGSIMD: snprintf(x->lagsimd, sizeof x->lagsimd, "%s", optarg); break;
+        case O_URL: x->url_opt = optarg; break;
+        case O_ALLOW_LAN: x->allow_lan = true; break;
         case O_TIMEOUT: {
             char *end;
             errno = 0;
@@ -340,6 +354,8 @@ static int parse_options(eval_cli *x, int argc, char **argv)
     if (optind < argc) return die("unexpected argument '%s' (try --help)", argv[optind]);
     if (!x->config) return die("%s", "--config SCENE is required (try --help)");
     if (!x->controller) return die("%s", "--controller 'COMMAND' is required (try --help)");
+    if (eval_bus_init(&x->bus, x->url_opt, x->allow_lan, x->err, sizeof x->err))
+        return die("%s", x->err);
     return -1;
 }
 
@@ -403,6 +419,15 @@ static int check_cases(eval_cli *x)
             }
         }
     }
+    return -1;
+}
+
+/* The runs' bus: a pair of ports held for the whole evaluation (the group and options,
+ * of --url or LCM_DEFAULT_URL, were read with the options). Returns -1 or the exit code. */
+static int open_bus(eval_cli *x)
+{
+    if (eval_bus_take(&x->bus, &x->lease, x->url, sizeof x->url, x->err, sizeof x->err))
+        return die("%s", x->err);
     return -1;
 }
 
@@ -477,8 +502,10 @@ static bool run_case(eval_cli *x, int k)
     const eval_case *c = &x->cases[k];
     if (!wanted(x, c)) return true;
     eval_env env = {.lagsimd = x->lagsimd, .config = x->config, .controller = x->controller,
-                    .workdir = x->workdir, .wall_timeout = x->timeout, .verbose = x->verbose};
-    eval_url(k, env.url, sizeof env.url);
+                    .workdir = x->workdir, .wall_timeout = x->timeout, .verbose = x->verbose,
+                    .allow_lan = x->allow_lan};
+    /* the ports of the whole evaluation; a prefix of each case's own */
+    snprintf(env.url, sizeof env.url, "%s", x->url);
     snprintf(env.prefix, sizeof env.prefix, "EVAL%d_%d", (int)getpid(), k);
     eval_result res;
     eval_series s = {0};
@@ -522,12 +549,13 @@ static int run_cases(eval_cli *x)
 
 int main(int argc, char **argv)
 {
-    static eval_cli x = {.timeout = 600};
+    static eval_cli x = {.timeout = 600, .lease = {.port = 0, .fd = -1}};
     eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
     int rc;
     if ((rc = parse_options(&x, argc, argv)) < 0 && (rc = load_cases(&x)) < 0 &&
-        (rc = check_cases(&x)) < 0 && (rc = open_outputs(&x)) < 0)
+        (rc = check_cases(&x)) < 0 && (rc = open_bus(&x)) < 0 && (rc = open_outputs(&x)) < 0)
         rc = run_cases(&x);
+    lag_port_release(&x.lease);
     free(x.cases);
     if (x.fcsv) fclose(x.fcsv); /* refused before its first case */
     files_end(&x.files);

@@ -34,7 +34,8 @@ static void usage(FILE *f)
 "                    --vary KEY=DIST ... [--runs N] [--seed S] [-j N] [--shard K/N]\n"
 "                    [--restart]\n"
 "                    [--suite FILE] [--require EXPR] [--csv OUT.csv] [--plot OUT.png]\n"
-"                    [--metric JOINT.METRIC] [--force] [--lagsimd PATH] [--timeout S] [-v]\n"
+"                    [--metric JOINT.METRIC] [--force] [--url URL] [--allow-lan]\n"
+"                    [--lagsimd PATH] [--timeout S] [-v]\n"
 "       lagsim-sweep merge A.csv B.csv ... -o OUT.csv [--partial] [--force]\n"
 "\n"
 "Runs an evaluation case (lagsim-eval's) over scene keys drawn at random or on a grid,\n"
@@ -69,6 +70,12 @@ static void usage(FILE *f)
 "      --metric J.M       the metric drawn (default: --require's first, else the first\n"
 "                         joint's iae)\n"
 "  -f, --force            replace existing output files\n"
+"      --url URL          the runs' multicast group and options (default:\n"
+"                         LCM_DEFAULT_URL's, else udpm://239.255.76.67?ttl=0&\n"
+"                         recv_buf_size=4194304); the ports are lagsim-sweep's: a pair\n"
+"                         for each worker, held while it runs, that no other sweep or\n"
+"                         evaluation of this host holds and no socket of it is bound to\n"
+"      --allow-lan        accept a URL with ttl above 0 (the runs on the network)\n"
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a run may take (default 600)\n"
 "  -v, --verbose          pass the daemon's and the controller's output through\n"
@@ -680,7 +687,11 @@ typedef struct sweep {
     double duration, timeout;
     long runs, jobs, shard_k, shard_n, per_point, total;
     uint64_t seed;
-    bool force, verbose, restart;
+    const char *url_opt;
+    bool force, verbose, restart, allow_lan;
+    eval_bus bus;                /* the runs' group and options */
+    lag_port_lease lease[256];   /* a pair of ports for each worker, held while it runs */
+    char url[256][160];          /* each worker's URL */
     vary vs[VARY_MAX];
     int nv;
     char lagsimd[4096];
@@ -723,7 +734,7 @@ static int add_vary(sweep *x, const char *text)
 static int parse_options(sweep *x, int argc, char **argv)
 {
     enum { O_CASE = 256, O_SUITE, O_VARY, O_SEED, O_SHARD, O_REQUIRE, O_CSV, O_PLOT, O_METRIC,
-           O_LAGSIMD, O_TIMEOUT, O_RESTART };
+           O_LAGSIMD, O_TIMEOUT, O_RESTART, O_URL, O_ALLOW_LAN };
     static const struct option opts[] = {
         {"config", required_argument, 0, 'c'},      {"controller", required_argument, 0, 'C'},
         {"case", required_argument, 0, O_CASE},     {"suite", required_argument, 0, O_SUITE},
@@ -735,6 +746,7 @@ static int parse_options(sweep *x, int argc, char **argv)
         {"force", no_argument, 0, 'f'},             {"lagsimd", required_argument, 0, O_LAGSIMD},
         {"timeout", required_argument, 0, O_TIMEOUT}, {"verbose", no_argument, 0, 'v'},
         {"restart", no_argument, 0, O_RESTART},     {"help", no_argument, 0, 'h'},
+        {"url", required_argument, 0, O_URL},       {"allow-lan", no_argument, 0, O_ALLOW_LAN},
         {0, 0, 0, 0}};
     int o, bad = 0;
     opterr = 0;
@@ -765,6 +777,8 @@ static int parse_options(sweep *x, int argc, char **argv)
         case O_TIMEOUT: x->timeout = parse_pos("--timeout", optarg, 1, 1e6, &bad); break;
         case 'v': x->verbose = true; break;
         case O_RESTART: x->restart = true; break;
+        case O_URL: x->url_opt = optarg; break;
+        case O_ALLOW_LAN: x->allow_lan = true; break;
         case 'h': usage(stdout); return 0;
         case ':': return die("%s needs a value (try --help)", argv[optind - 1]);
         default: return die("unknown option '%s' (try --help)", argv[optind - 1]);
@@ -774,13 +788,15 @@ static int parse_options(sweep *x, int argc, char **argv)
     return -1; /* go on */
 }
 
-static int check_options(const sweep *x, int argc, char **argv)
+static int check_options(sweep *x, int argc, char **argv)
 {
     if (optind < argc) return die("unexpected argument '%s' (try --help)", argv[optind]);
     if (!x->config) return die("%s", "--config SCENE is required (try --help)");
     if (!x->controller) return die("%s", "--controller 'COMMAND' is required (try --help)");
     if (!x->nv) return die("%s", "at least one --vary KEY=DIST is required (try --help)");
     if (!x->case_name == !x->duration) return die("%s", "give either --case NAME or --duration S");
+    char err[512];
+    if (eval_bus_init(&x->bus, x->url_opt, x->allow_lan, err, sizeof err)) return die("%s", err);
     return -1;
 }
 
@@ -878,8 +894,10 @@ static eval_env worker_env(const worker *wk, long run)
 {
     const sweep *x = wk->x;
     eval_env env = {.lagsimd = x->lagsimd, .config = x->config, .controller = x->controller,
-                    .workdir = x->tmpdir, .wall_timeout = x->timeout, .verbose = x->verbose};
-    eval_url((int)wk->w, env.url, sizeof env.url);
+                    .workdir = x->tmpdir, .wall_timeout = x->timeout, .verbose = x->verbose,
+                    .allow_lan = x->allow_lan};
+    /* the worker's ports, for all its runs; a prefix of each run's own */
+    snprintf(env.url, sizeof env.url, "%s", x->url[wk->w]);
     if (run < 0) snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_W%ld", (int)getpid(), wk->w);
     else snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_%ld", (int)getpid(), run);
     return env;
@@ -1040,6 +1058,24 @@ static int count_passed(const sweep *x, const rows *r)
     return passed;
 }
 
+/* A pair of ports for each worker, held until the sweep ends (its workers, forked, share
+ * the locks). Returns -1 after saying why when the host has too few free. */
+static int take_ports(sweep *x)
+{
+    char err[512];
+    for (long w = 0; w < x->jobs; w++)
+        if (eval_bus_take(&x->bus, &x->lease[w], x->url[w], sizeof x->url[w], err, sizeof err)) {
+            fprintf(stderr, "%s: worker %ld: %s\n", prog, w + 1, err);
+            return -1;
+        }
+    return 0;
+}
+
+static void release_ports(sweep *x)
+{
+    for (long w = 0; w < x->jobs; w++) lag_port_release(&x->lease[w]);
+}
+
 static int sweep_run(sweep *x)
 {
     char err[2048];
@@ -1087,5 +1123,12 @@ int main(int argc, char **argv)
         (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0)
         return rc;
     if ((rc = make_header(&x)) >= 0) return rc;
-    return sweep_run(&x);
+    for (long w = 0; w < x.jobs; w++) x.lease[w] = (lag_port_lease){.port = 0, .fd = -1};
+    if (take_ports(&x)) {
+        release_ports(&x);
+        return 2;
+    }
+    rc = sweep_run(&x);
+    release_ports(&x);
+    return rc;
 }

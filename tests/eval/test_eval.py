@@ -15,6 +15,11 @@ usage: test_eval.py BIN_DIR SOURCE_DIR CASE
              naming one, or a mapping above one, is refused (exit 2, file:line:column,
              the key) by lagsim-eval and lagsim-sweep, and so is a --vary of one;
              docs/evaluation.md and both man pages list exactly the table's keys
+  bus        the runs' URL: the group and options of LCM_DEFAULT_URL or --url, ports of
+             the tools' own (an even pair of 64000..65535): two lagsim-evals and a sweep of
+             two workers run at once on four pairs, each held (its lock file locked) while
+             its controller runs; ttl above 0 only with --allow-lan; memq:// and other
+             providers refused
   outputs    no output of lagsim-eval or lagsim-sweep is a file they read (the scene, the
              suite, the daemon; merge's shards) or another of their outputs (the CSV and
              the report's or the plot's files), whatever its spelling (./, a hard link),
@@ -348,6 +353,88 @@ def case_owned():
         check(named == set(keys), "%s names the owned keys (%s)" % (page, sorted(named)))
 
 
+# A controller that writes its URL and whether the lock file of its state port is held by
+# another (flock -n fails: 99), waits until every controller of the test wrote (the runs
+# overlap in time), then runs lqr_balance
+BUS_CTL = r"""#!/bin/sh
+port=${LCM_DEFAULT_URL##*:}; port=${port%%\?*}
+flock -n -E 99 "/run/lock/lagsim-udp-$port.lock" true; held=$?
+echo "$LCM_DEFAULT_URL $held" >> "$BUS_OUT"
+i=0
+while [ "$(wc -l < "$BUS_OUT")" -lt "$BUS_N" ] && [ $i -lt 300 ]; do sleep 0.1; i=$((i+1)); done
+exec "$@"
+"""
+
+
+def case_bus():
+    sweep = os.path.join(BIN, "lagsim-sweep")
+    with tempfile.TemporaryDirectory() as d:
+        ctl = os.path.join(d, "ctl.sh")
+        with open(ctl, "w") as f:
+            f.write(BUS_CTL)
+        out = os.path.join(d, "urls")
+        open(out, "w").close()
+        env = dict(os.environ, LCM_DEFAULT_URL="udpm://239.255.76.99:7720?ttl=0",
+                   BUS_OUT=out, BUS_N="4")
+        c = "sh %s %s -q --prefix {prefix}" % (ctl, os.path.join(BIN, "lqr_balance"))
+        evals = [[EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt", "--controller",
+                  c] for _ in range(2)]
+        sw = [sweep, "--config", SCENE, "--controller", c, "--duration", "1", "--runs", "4",
+              "-j", "2", "--vary", "parameters.m1=uniform(0.1,0.2)"]
+        procs = [subprocess.Popen(a, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                  universal_newlines=True) for a in evals + [sw]]
+        res = [p.communicate(timeout=300) + (p.returncode,) for p in procs]
+        for o, e, rc in res:
+            print(rc, o[-800:], e[-800:])
+        check(all(rc == 0 for _, _, rc in res), "two lagsim-evals and a sweep ran at once "
+              "(exit %s)" % [rc for _, _, rc in res])
+        lines = [l.split() for l in open(out).read().splitlines()]
+        print(lines)
+        urls = [l[0] for l in lines]
+        m = [re.match(r"^udpm://239\.255\.76\.99:(\d+)\?ttl=0$", u) for u in urls]
+        check(len(urls) == 4 and all(m), "each run's URL has LCM_DEFAULT_URL's group and "
+              "options, nothing added: %s" % urls)
+        ports = [int(x.group(1)) for x in m if x]
+        check(len(set(ports)) == 4 and all(64000 <= p <= 65534 and p % 2 == 0 for p in ports),
+              "four pairs of ports of the tools' range, none shared: %s" % ports)
+        check(all(l[1:] == ["99"] for l in lines), "each pair's lock file held while its runs "
+              "ran (flock -n: 99): %s" % [l[1:] for l in lines])
+        # --url over LCM_DEFAULT_URL; a ttl above 0 only with --allow-lan
+        env = dict(os.environ, LCM_DEFAULT_URL="udpm://239.255.76.99:7720?ttl=1")
+        pr = "echo \"$LCM_DEFAULT_URL\" > %s; exec %s -q --prefix {prefix}" % (
+            out, os.path.join(BIN, "lqr_balance"))
+        base = [EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt", "--controller", pr]
+        p = subprocess.run(base, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        check(p.returncode == 2 and "LCM_DEFAULT_URL" in p.stderr and "ttl=1" in p.stderr and
+              "--allow-lan" in p.stderr, "LCM_DEFAULT_URL with ttl=1: exit 2, --allow-lan named")
+        p = subprocess.run(base + ["--allow-lan"], env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+        u = open(out).read().strip()
+        check(p.returncode == 0 and re.match(r"^udpm://239\.255\.76\.99:\d+\?ttl=1$", u),
+              "with --allow-lan: the run on ttl=1 (%s, exit %d)" % (u, p.returncode))
+        p = subprocess.run(base + ["--url", "udpm://239.255.76.98?ttl=0&recv_buf_size=65536"],
+                           env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        u = open(out).read().strip()
+        check(p.returncode == 0 and
+              re.match(r"^udpm://239\.255\.76\.98:\d+\?ttl=0&recv_buf_size=65536$", u),
+              "--url's group and options over LCM_DEFAULT_URL (%s, exit %d)" % (u, p.returncode))
+        for tool in (EVAL, sweep):
+            for url, what in (("memq://", "memq://"), ("file:///tmp/x", "file://"),
+                              ("udpm://239.255.76.67:7667?ttl=0&foo=1", "foo"),
+                              ("udpm://10.0.0.1:7667?ttl=0", "not a multicast address")):
+                args = [tool, "--config", SCENE, "--suite", SUITE, "--case", "tilt",
+                        "--controller", CTRL, "--url", url]
+                if tool == sweep:
+                    args += ["--vary", "parameters.m1=uniform(0.1,0.2)"]
+                p = subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                   universal_newlines=True, timeout=60)
+                check(p.returncode == 2 and "--url " + url in p.stderr and what in p.stderr,
+                      "%s --url %s: exit 2, said why (%d: %s)"
+                      % (os.path.basename(tool), url, p.returncode, p.stderr.strip()[:200]))
+
+
 def case_outputs():
     sweep = os.path.join(BIN, "lagsim-sweep")
     with tempfile.TemporaryDirectory() as d:
@@ -429,6 +516,6 @@ def case_outputs():
 
 
 {"metrics": case_metrics, "require": case_require, "errors": case_errors,
- "scene": case_scene, "owned": case_owned, "outputs": case_outputs}[CASE]()
+ "scene": case_scene, "owned": case_owned, "outputs": case_outputs, "bus": case_bus}[CASE]()
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)
