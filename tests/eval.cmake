@@ -35,3 +35,21 @@ if(LAGSIM_PYTHON3 AND LAGSIM_GNU_PARALLEL)
                          SKIP_RETURN_CODE 77)
   endforeach()
 endif()
+
+# docs/evaluation.md's controllers in Python and MATLAB/Octave, run as written
+# (tests/clients/readme_recipes.py): the shipped Python DIPC example and the Octave cart-pole
+# under lagsim-eval and lagsim-sweep, {prefix} inside Octave's quotes inside the shell's.
+# Octave starts a JVM for each case and worker: not in the sanitizer pass (label slow).
+if(LAGSIM_PYTHON3)
+  add_test(NAME eval_lagsim_eval_docs_python
+    COMMAND ${LAGSIM_PYTHON3} ${PROJECT_SOURCE_DIR}/tests/clients/readme_recipes.py
+            --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} --timeout 240 eval-python)
+  set_tests_properties(eval_lagsim_eval_docs_python PROPERTIES LABELS eval TIMEOUT 300)
+  find_program(LAGSIM_EVAL_OCTAVE octave)
+  if(LAGSIM_EVAL_OCTAVE AND TARGET lagsim_examples_java)
+    add_test(NAME eval_lagsim_eval_docs_octave
+      COMMAND ${LAGSIM_PYTHON3} ${PROJECT_SOURCE_DIR}/tests/clients/readme_recipes.py
+              --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} --timeout 240 eval-octave)
+    set_tests_properties(eval_lagsim_eval_docs_octave PROPERTIES LABELS "eval;slow" TIMEOUT 300)
+  endif()
+endif()

@@ -462,25 +462,35 @@ void eval_stop_group(pid_t pid, int *status)
     }
 }
 
-/* "{prefix}" and "{url}" in cmd replaced. */
-void eval_expand(const char *cmd, const eval_env *env, char *out, size_t len)
+/* "{prefix}" and "{url}" in cmd replaced by the run's prefix and URL as they are, nothing
+ * added: each is checked to be plain text (eval_text_plain), which means itself inside
+ * the user's own quotes, so the rule is one a user can predict (docs/evaluation.md). */
+int eval_expand(const char *cmd, const eval_env *env, char *out, size_t len, char *err,
+                size_t errlen)
 {
+    if (!eval_text_plain(env->prefix) || !eval_text_plain(env->url)) {
+        snprintf(err, errlen, "the run's prefix '%s' or URL '%s' has a character that a quote "
+                 "would change", env->prefix, env->url);
+        return -1;
+    }
     size_t o = 0;
-    for (const char *p = cmd; *p && o + 1 < len;) {
+    for (const char *p = cmd; *p;) {
         const char *rep = NULL;
         size_t skip = 0;
         if (!strncmp(p, "{prefix}", 8)) rep = env->prefix, skip = 8;
         else if (!strncmp(p, "{url}", 5)) rep = env->url, skip = 5;
-        if (rep) {
-            int w = snprintf(out + o, len - o, "'%s'", rep);
-            o += w > 0 ? (size_t)w : 0;
-            if (o >= len) o = len - 1;
-            p += skip;
-        } else {
-            out[o++] = *p++;
+        size_t n = rep ? strlen(rep) : 1;
+        if (o + n >= len) {
+            snprintf(err, errlen, "the controller's command, {prefix} and {url} replaced, is "
+                     "longer than %zu characters", len - 1);
+            return -1;
         }
+        memcpy(out + o, rep ? rep : p, n);
+        o += n;
+        p += rep ? skip : 1;
     }
     out[o] = '\0';
+    return 0;
 }
 
 void eval_series_free(eval_series *s)
@@ -834,7 +844,7 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
     daemon_argv(&d, env, c, extra, nextra, log);
 
     char cmd[4096];
-    eval_expand(env->controller, env, cmd, sizeof cmd);
+    if (eval_expand(env->controller, env, cmd, sizeof cmd, err, errlen)) return -1;
     /* the controller first: in lockstep it then answers the first state (clients.md) */
     pid_t cpid = eval_spawn(NULL, cmd, env);
     if (cpid < 0) {

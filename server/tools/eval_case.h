@@ -13,8 +13,9 @@
  *
  * A run: lagsimd on the scene and the case's overrides in lockstep, with --log to a file
  * of the run's own, on an LCM URL and a channel prefix of the run's own (no crosstalk),
- * against the controller command (a shell command; {prefix} and {url} in it are replaced,
- * and LCM_DEFAULT_URL and LAGSIM_PREFIX are set in its environment). The log is then read
+ * against the controller command (a shell command; {prefix} and {url} in it are replaced
+ * by the run's prefix and URL as they are, and LCM_DEFAULT_URL and LAGSIM_PREFIX are set
+ * in its environment). The log is then read
  * with the bounded log reader and each joint's series handed to the metrics library
  * (metrics.h): nothing here computes a metric.
  */
@@ -263,7 +264,9 @@ void eval_sleep(double s);
 pid_t eval_spawn(char *const *argv, const char *cmd, const eval_env *env);
 int eval_wait_until(pid_t pid, double deadline, int *status);
 void eval_stop_group(pid_t pid, int *status);
-void eval_expand(const char *cmd, const eval_env *env, char *out, size_t len);
+/* cmd with {prefix} and {url} replaced by env's, as they are; -1 with why in err */
+int eval_expand(const char *cmd, const eval_env *env, char *out, size_t len, char *err,
+                size_t errlen);
 int eval_series_grow(eval_series *s, int nj);
 void eval_fail(eval_result *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 

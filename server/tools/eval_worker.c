@@ -251,7 +251,10 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
     snprintf(w->log, sizeof w->log, "%s/%s.lcm", env->workdir, env->prefix);
     unlink(w->log);
     char cmd[4096];
-    eval_expand(env->controller, env, cmd, sizeof cmd);
+    if (eval_expand(env->controller, env, cmd, sizeof cmd, err, errlen)) {
+        free(w);
+        return NULL;
+    }
     /* the controller first, as eval_run starts them */
     w->cpid = eval_spawn(NULL, cmd, env);
     w->dpid = start_daemon(w, c);

@@ -19,7 +19,7 @@ usage: test_eval.py BIN_DIR SOURCE_DIR CASE
              the tools' own (an even pair of 64000..65535): two lagsim-evals and a sweep of
              two workers run at once on four pairs, each held (its lock file locked) while
              its controller runs; ttl above 0 only with --allow-lan; memq:// and other
-             providers refused
+             providers refused; {prefix} and {url} replaced as they are, inside quotes too
   outputs    no output of lagsim-eval or lagsim-sweep is a file they read (the scene, the
              suite, the daemon; merge's shards) or another of their outputs (the CSV and
              the report's or the plot's files), whatever its spelling (./, a hard link),
@@ -420,6 +420,18 @@ def case_bus():
         check(p.returncode == 0 and
               re.match(r"^udpm://239\.255\.76\.98:\d+\?ttl=0&recv_buf_size=65536$", u),
               "--url's group and options over LCM_DEFAULT_URL (%s, exit %d)" % (u, p.returncode))
+        # {prefix} and {url} replaced as they are, inside the command's own quotes too
+        pr = ("printf '%%s|%%s|%%s|%%s|%%s\\n' '{prefix}' \"{prefix}\" \"$LAGSIM_PREFIX\" "
+              "'{url}' \"$LCM_DEFAULT_URL\" > %s; exec %s -q --prefix {prefix}"
+              % (out, os.path.join(BIN, "lqr_balance")))
+        p = subprocess.run([EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt",
+                            "--controller", pr], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        f = open(out).read().strip().split("|")
+        check(p.returncode == 0 and len(f) == 5 and f[0] == f[1] == f[2] and f[3] == f[4] and
+              re.match(r"^EVAL\d+_0$", f[0]) and f[3].startswith("udpm://"),
+              "'{prefix}', \"{prefix}\" and '{url}' are the run's prefix and URL as they are "
+              "(%s, exit %d)" % (f, p.returncode))
         for tool in (EVAL, sweep):
             for url, what in (("memq://", "memq://"), ("file:///tmp/x", "file://"),
                               ("udpm://239.255.76.67:7667?ttl=0&foo=1", "foo"),
