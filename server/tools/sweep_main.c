@@ -704,7 +704,8 @@ typedef struct sweep {
     char tmpdir[64];
 } sweep;
 
-/* An integer option: a plain decimal (as a scene writes a number) with no fraction. */
+/* An integer option: a plain decimal (as a scene writes a number) with no fraction; lo
+ * when it is not one (so that the caller's conversion to an integer is defined). */
 static double parse_int(const char *opt, const char *s, double lo, double hi, int *bad)
 {
     double v = 0;
@@ -712,6 +713,7 @@ static double parse_int(const char *opt, const char *s, double lo, double hi, in
         fprintf(stderr, "%s: %s: expected an integer from %.0f to %.0f, got '%s'\n", prog, opt,
                 lo, hi, s);
         *bad = 1;
+        return lo;
     }
     return v;
 }
