@@ -5,10 +5,10 @@
  * be one.
  *
  * The cases work in a directory of their own (a lock directory is a parameter) on the
- * ports 61000..61999: above this host's ephemeral ports (32768..60999: an unbound socket
- * that sends is given one), below the tools' 64000..65535, apart from the ranges the other
- * tests draw theirs from (20000..49998). A case whose ports another program binds at the
- * time skips.
+ * ports 61000..61767, 128 a case: above this host's ephemeral ports (32768..60999: an
+ * unbound socket that sends is given one), below the tools' 64000..65535, apart from the
+ * ranges the other tests draw theirs from (20000..49998). A case whose ports another
+ * program binds at the time skips.
  *
  *   test_port [--list | CASE]
  */
@@ -26,8 +26,11 @@
 
 #include "lagsim_port.h"
 
-#define FIRST 61000
-#define LAST 61014 /* 8 pairs */
+/* Each case its ports: 61000 + 128 k to 61127 + 128 k for the case of arg k, so that cases
+ * run at once (ctest -j) do not bind or take each other's. */
+static int base = 61000;
+#define FIRST base
+#define LAST (base + 14) /* 8 pairs */
 
 static char dir[64];
 
@@ -89,7 +92,7 @@ static int bind_udp(int port, bool v6)
  * file every user can open, and it stays. */
 static void case_take(int arg)
 {
-    (void)arg;
+    base = 61000 + 128 * arg;
     if (!ports_free(FIRST, LAST)) return;
     make_dir();
     lag_port_lease a, b, c;
@@ -119,7 +122,7 @@ static void case_take(int arg)
 /* A pair another process holds is skipped, and taken once that process ended. */
 static void case_held(int arg)
 {
-    (void)arg;
+    base = 61000 + 128 * arg;
     if (!ports_free(FIRST, LAST)) return;
     make_dir();
     int up[2], down[2];
@@ -151,7 +154,7 @@ static void case_held(int arg)
 /* A pair with a socket bound to either port is skipped (IPv4 and IPv6 sockets). */
 static void case_bound(int arg)
 {
-    (void)arg;
+    base = 61000 + 128 * arg;
     if (!ports_free(FIRST, LAST)) return;
     make_dir();
     int s1 = bind_udp(FIRST, false);         /* the first pair's state port */
@@ -174,7 +177,7 @@ static void case_bound(int arg)
  * unusable, never the search hang; none free: an error that says why. */
 static void case_unusable(int arg)
 {
-    (void)arg;
+    base = 61000 + 128 * arg;
     if (!ports_free(FIRST, LAST)) return;
     make_dir();
     char path[128];
@@ -268,7 +271,7 @@ static void check_race(uid_t as)
 
 static void case_concurrent(int arg)
 {
-    (void)arg;
+    base = 61000 + 128 * arg;
     if (!ports_free(FIRST, FIRST + 126)) return;
     make_dir();
     check_race(0);
@@ -279,7 +282,7 @@ static void case_concurrent(int arg)
  * user's; a lock file one user made is locked by the other once it is free. Needs root. */
 static void case_users(int arg)
 {
-    (void)arg;
+    base = 61000 + 128 * arg;
     if (geteuid() != 0) {
         lt_skip("needs root to run processes as another user");
         return;
@@ -326,9 +329,9 @@ static void case_host(int arg)
 int main(int argc, char **argv)
 {
     static const lt_case cases[] = {
-        {"take", case_take, 0, 0},       {"held", case_held, 0, 0},
-        {"bound", case_bound, 0, 0},     {"unusable", case_unusable, 0, 0},
-        {"concurrent", case_concurrent, 0, 0}, {"users", case_users, 0, 0},
+        {"take", case_take, 0, 0},       {"held", case_held, 1, 0},
+        {"bound", case_bound, 2, 0},     {"unusable", case_unusable, 3, 0},
+        {"concurrent", case_concurrent, 4, 0}, {"users", case_users, 5, 0},
         {"host", case_host, 0, 0},
     };
     return lt_main(argc, argv, cases, sizeof cases / sizeof cases[0]);
