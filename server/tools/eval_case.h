@@ -28,6 +28,7 @@
 
 #include <sys/types.h>
 
+#include "eval_proc.h"
 #include "lagsim_log.h"
 #include "lagsim_port.h"
 #include "lagsim_url.h"
@@ -259,11 +260,7 @@ void eval_take_record(eval_take *tk, const lag_log_record *rec);
 double eval_now(void);
 double eval_now_wall(void); /* s since the epoch */
 void eval_sleep(double s);
-/* argv (or "sh -c cmd" when argv is NULL) in a process group of its own, with the run's
- * URL and prefix in its environment */
-pid_t eval_spawn(char *const *argv, const char *cmd, const eval_env *env);
-int eval_wait_until(pid_t pid, double deadline, int *status);
-void eval_stop_group(pid_t pid, int *status);
+/* starting, waiting for and stopping processes: eval_proc.h */
 /* cmd with {prefix} and {url} replaced by env's, as they are; -1 with why in err */
 int eval_expand(const char *cmd, const eval_env *env, char *out, size_t len, char *err,
                 size_t errlen);

@@ -516,8 +516,9 @@ def case_outputs():
         check(open(daemon, "rb").read() == before, "the daemon's copy is whole")
         # merge: -o never one of its shards
         shard = os.path.join(d, "shard.csv")
-        with open(shard, "w") as f:
-            f.write("run,x,failed,required,reason\n0,1,0,1,\"\"\n")
+        subprocess.run([sweep, "--config", SCENE, "--controller", CTRL, "--duration", "0.2",
+                        "--vary", "parameters.m1=uniform(0.1,0.2)", "--csv", shard],
+                       stdout=subprocess.PIPE, timeout=300)
         os.link(shard, os.path.join(d, "merged.csv"))
         old = open(shard).read()
         p = subprocess.run([sweep, "merge", shard, "-o", os.path.join(d, "merged.csv"),
