@@ -14,7 +14,9 @@ usage: test_eval.py BIN_DIR SOURCE_DIR CASE
   owned      the keys the tools set on every run (their --help's table): a case's set:
              naming one, or a mapping above one, is refused (exit 2, file:line:column,
              the key) by lagsim-eval and lagsim-sweep, and so is a --vary of one;
-             docs/evaluation.md and both man pages list exactly the table's keys
+             docs/evaluation.md and both man pages list exactly the table's keys; every
+             key of the loader's table is either the tools' or one the test says a case
+             may set (and why), never neither
   bus        the runs' URL: the group and options of LCM_DEFAULT_URL or --url, ports of
              the tools' own (an even pair of 64000..65535): two lagsim-evals and a sweep of
              two workers run at once on four pairs, each held (its lock file locked) while
@@ -289,8 +291,48 @@ OWNED_VALUES = {"realtime.mode": "realtime", "realtime.start": "paused",
                 "lcm": "{prefix: OTHER}"}
 
 
+# The scene keys a case may set, each with why the tools' guarantees hold whatever it says;
+# every other key of the loader's table must be the tools' (their --help table), so that a
+# key added to the loader (a `log:` section, an lcm.interface) is refused in a case until
+# someone decides which it is.
+CASE_KEYS = {
+    "model": "the plant", "parameters": "the plant", "initial": "the plant",
+    "integrator": "the plant", "publish_hz": "the plant", "explode_limit": "the plant",
+    "effects": "the plant", "reference": "what the plant should follow",
+    "cases": "lagsim-eval's own key, which lagsimd ignores",
+    "realtime.rate": "real-time pacing: lockstep does not read it",
+    "realtime.command_timeout": "the watchdog, in sim time: the run stays deterministic",
+    "realtime.lockstep_retry": "when a state is sent again: the states do not change",
+    "realtime.status_hz": "the status rate: no metric reads a status",
+    "realtime.effort_limit": "the plant's actuators",
+}
+
+
+def loader_keys(section):
+    """The keys the loader's table has at the top (section "") or in a section, from
+    lagsimd's refusal of an unknown one ("...; allowed: a, b, c")."""
+    key = (section + "." if section else "") + "no_such_key_here"
+    p = subprocess.run([os.path.join(BIN, "lagsimd"), "--config", SCENE, "--set", key + "=1",
+                        "--offline", "--duration", "0.01", "--csv", "/dev/null"],
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+    m = re.search(r"allowed: (.*)$", p.stderr.strip(), re.M)
+    return [(section + "." if section else "") + k.strip() for k in m.group(1).split(",")] \
+        if m else []
+
+
 def case_owned():
     keys = owned_keys("lagsim-eval")
+    # every key of the loader: the tools' or one a case may set, never neither
+    top = loader_keys("")
+    check(len(top) >= 10, "the loader's top-level keys: %s" % top)
+    every = [k for k in top if k not in ("realtime", "lcm")] + loader_keys("realtime") + \
+        loader_keys("lcm")
+    check(len(every) >= 18, "the loader's keys of the realtime and lcm sections read")
+    for k in every:
+        check((k in keys) != (k in CASE_KEYS),
+              "%s is %s" % (k, "the tools' (--help)" if k in keys else
+                            "a case's: " + CASE_KEYS[k] if k in CASE_KEYS else
+                            "NEITHER the tools' nor a case's: classify it"))
     check(len(keys) >= 6 and keys == owned_keys("lagsim-sweep"),
           "lagsim-eval and lagsim-sweep print one table of owned keys: %s" % sorted(keys))
     must = {"realtime.mode", "realtime.start", "realtime.lockstep_timeout", "lcm.url",
