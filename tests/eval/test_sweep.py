@@ -44,6 +44,11 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             sweep byte for byte (needs root, ip, sshd)
   stalled   the workers stopped and continued again and again (their sockets' queues
             overflow): runs read from the log, the same CSV, byte for byte
+  vary      --vary mistakes refused before any run (exit 2, said why): a key or a
+            coordinate varied twice, a key and one it holds, a reversed or one-point grid,
+            arguments that are no plain decimal or whose values overflow (a grid's step,
+            a normal's tail), a list varied whole, grids of more than 1e7 runs; integer
+            options that are not integers; the spellings the docs use still run
   scene_c, scene_python  a controller that reads its gains from every scene (PD scaled by
             m2: tests/eval/scene_pd.c, scene_pd.py), 40 manipulator runs over
             parameters.m2=uniform(0.3,1.2): -j1, -j2, two shards merged and --restart give
@@ -681,6 +686,63 @@ def case_stalled(d):
           "workers stopped again and again: the same CSV, byte for byte")
 
 
+# (the --vary arguments, what the refusal says)
+BAD_VARY = [
+    (["parameters.m1=uniform(0.1,0.2)", "parameters.m1=uniform(0.2,0.3)"], "the same key as"),
+    (["initial.q[1]=normal(0,0.05)", "initial.q[1]=normal(0,0.1)"], "the same key as"),
+    (["initial.q[1]=normal(0,0.05)", "initial.q[01]=normal(0,0.1)"], "the same key as"),
+    (["parameters.m1=uniform(0.1,0.2)", "parameters=uniform(0,1)"], "holds or lies in"),
+    (["initial.q[1]=normal(0,0.05)", "initial=uniform(0,1)"], "holds or lies in"),
+    (["initial.q=uniform(0,1)"], "a list: vary one coordinate"),
+    (["parameters.m1=grid(1e308,-1e308,3)"], "A < B"),
+    (["parameters.m1=grid(-1e308,1e308,3)"], "B - A finite"),
+    (["parameters.m1=grid(0.3,0.05,4)"], "A < B"),
+    (["parameters.m1=grid(0.05,0.3,1)"], "an integer from 2"),
+    (["parameters.m1=grid(0.05,0.3,2.5)"], "an integer from 2"),
+    (["parameters.m1=grid(0.05,0.3,2000000)"], "an integer from 2"),
+    (["parameters.m1=uniform(-1e308,1e308)"], "B - A finite"),
+    (["parameters.m1=uniform(0.3,0.3)"], "A < B"),
+    (["parameters.m1=uniform(inf,1)"], "plain decimal"),
+    (["parameters.m1=uniform(0,1e999)"], "plain decimal"),
+    (["parameters.m1=uniform(0x1p-3,1)"], "plain decimal"),
+    (["parameters.m1=uniform(nan,1)"], "plain decimal"),
+    (["parameters.m1=normal(0,1e308)"], "9 SD finite"),
+    (["parameters.m1=normal(0.1,0)"], "SD > 0"),
+    (["parameters.m1=normal(0.1,-1)"], "SD > 0"),
+    (["parameters.m1=uniform(0.1,0.2)junk"], "plain decimal"),
+    (["parameters.m1=grid(0.1,0.2,1000)", "parameters.m0=grid(0.5,2,1000)",
+      "initial.q[1]=grid(0,0.1,1000)"], "more than 1e7 runs"),
+    # 1e36 runs: a count that overflowed to a negative one made "0 runs", exit 0
+    (["parameters.m1=grid(0.1,0.2,1000000)", "parameters.m0=grid(0.5,2,1000000)"] +
+     ["initial.%s[%d]=grid(0,0.1,1000000)" % (k, i) for k in ("q", "qd") for i in (0, 1)],
+     "more than 1e7 runs"),
+]
+
+
+def case_vary(d):
+    base = ["--config", SCENE, "--controller", CTRL, "--duration", "0.2"]
+    for vs, why in BAD_VARY:
+        args = sum((["--vary", v] for v in vs), [])
+        p = run([SWEEP] + base + args + ["--csv", os.path.join(d, "v.csv"), "--force"])
+        check(p.returncode == 2 and why in p.stderr and "runs:" not in p.stdout,
+              "--vary %s: exit 2 before any run, %r said (%d)" % (" ".join(vs), why,
+                                                                  p.returncode))
+    for opt, val in (("--runs", "2.5"), ("--jobs", "1.5"), ("--seed", "1.5"),
+                     ("--runs", "0x10"), ("--seed", "1e999")):
+        p = run([SWEEP] + base + ["--vary", "parameters.m1=uniform(0.1,0.2)", opt, val])
+        check(p.returncode == 2 and opt in p.stderr and "an integer" in p.stderr,
+              "%s %s: exit 2, an integer expected (%d)" % (opt, val, p.returncode))
+    # what the docs write runs: blanks after commas, two coordinates of one list, a grid
+    out = os.path.join(d, "ok.csv")
+    p = run([SWEEP] + base + ["--vary", "parameters.m1=grid(0.1, 0.2, 2)", "--vary",
+                              "initial.q[0]=uniform(-0.01, 0.01)", "--vary",
+                              "initial.q[1]=normal(0, 0.01)", "--runs", "2", "--csv", out])
+    check(p.returncode == 0 and [x["parameters.m1"] for x in rows(out)] ==
+          ["0.10000000000000001"] * 2 + ["0.20000000000000001"] * 2,
+          "grid(0.1, 0.2, 2) with blanks, two coordinates of initial.q: 4 runs (%d)"
+          % p.returncode)
+
+
 def scene_sweep(lang, runs=40):
     """The arguments of a sweep of the scene-reactive controller in `lang`, and the env."""
     build_python = os.path.join(os.path.dirname(BIN), "python")
@@ -797,8 +859,9 @@ def case_unanswered(d):
 
 
 with tempfile.TemporaryDirectory() as tmp:
-    {"same": case_same, "slurm": case_slurm, "merge": case_merge, "kept": case_kept,
-     "merge_rows": case_merge_rows, "merge_foreign": case_merge_foreign, "shard": case_shard,
+    {"same": case_same, "vary": case_vary, "slurm": case_slurm, "merge": case_merge,
+     "kept": case_kept, "merge_rows": case_merge_rows, "merge_foreign": case_merge_foreign,
+     "shard": case_shard,
      "loss": case_loss, "stalled": case_stalled, "ssh": case_ssh,
      "kept_python": case_kept_python, "scene_c": case_scene_c,
      "scene_python": case_scene_python, "scene_loss": case_scene_loss,
