@@ -43,13 +43,14 @@ static int write_row(FILE *f, const lag_sim *sim, const lag_scene_reference *ref
         lag_wire_reference m;
         lagsimd_reference_at(ref, sim->def.model.kind, lag_sim_time(sim), sim->tick, &m);
         for (int k = 0; k < m.num_joints; k++)
-            n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g,%.17g", m.r[k], m.rdot[k]);
+            n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g,%.17g,%.17g", m.r[k],
+                          m.rdot[k], m.rddot[k]);
     }
     n += snprintf(line + n, sizeof line - (size_t)n, "\n");
     return fwrite(line, 1, (size_t)n, f) == (size_t)n ? 0 : -1;
 }
 
-/* t, q, q_dot, energy; then <joint>_ref, <joint>_ref_dot for the joints with a
+/* t, q, q_dot, energy; then <joint>_ref, _ref_dot, _ref_ddot for the joints with a
  * reference (none without one: the columns before stay where they were) */
 static void write_header(FILE *f, const lag_model_info *info, const lag_scene_reference *ref)
 {
@@ -60,7 +61,9 @@ static void write_header(FILE *f, const lag_model_info *info, const lag_scene_re
         fprintf(f, ",%s_dot", info->joint_names[i]);
     fputs(",energy", f);
     for (int i = 0; i < info->nq && i < LAG_MAX_DOF; i++)
-        if (ref->on[i]) fprintf(f, ",%s_ref,%s_ref_dot", info->joint_names[i], info->joint_names[i]);
+        if (ref->on[i])
+            fprintf(f, ",%s_ref,%s_ref_dot,%s_ref_ddot", info->joint_names[i],
+                    info->joint_names[i], info->joint_names[i]);
     fputs("\n", f);
 }
 
