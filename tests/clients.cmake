@@ -240,3 +240,37 @@ foreach(t ${clients_tests})
     set_tests_properties(${t} PROPERTIES LABELS clients)
   endif()
 endforeach()
+
+# ---- The client library's version and ABI. test_version links liblagsim_client.so: the
+# version of lagsim/version.h, the core's lag_version(), the shared library's
+# lag_client_version() and project(VERSION) agree; so do the ABI numbers.
+add_executable(test_version ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_version.c)
+target_include_directories(test_version PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common)
+target_link_libraries(test_version PRIVATE lagsim_client_shared lagsim_core)
+lagsim_add_test_cases(test_version clients clients 30 ${PROJECT_VERSION} ${LAGSIM_CLIENT_ABI})
+# clients_abi: the built liblagsim_client.so against the baseline clients/abi/ (abidiff);
+# clients_abi_mutations: the library rebuilt with an incompatible change (a field
+# inserted, one retyped, a function removed) and a compatible one (a field appended, a
+# function added), each judged and refused as it must be (tests/clients/abi_check.py,
+# abi_mutations.py). Not in a sanitizer build: its instrumented library is not what ships.
+find_program(LAGSIM_ABIDIFF abidiff)
+if(LAGSIM_PYTHON3 AND NOT LAGSIM_SANITIZE)
+  if(NOT LAGSIM_ABIDIFF)
+    message(WARNING "abidiff (abigail-tools) not found: clients_abi will fail saying so")
+  endif()
+  add_test(NAME clients_abi
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/abi_check.py
+            --library $<TARGET_FILE:lagsim_client_shared> --headers ${LAGSIM_CLIENT_PUBLIC_HEADERS}
+            --baseline-dir ${PROJECT_SOURCE_DIR}/clients/abi --version ${PROJECT_VERSION}
+            --abi ${LAGSIM_CLIENT_ABI})
+  string(REPLACE ";" " " abi_lcm_libs "${LCM_LINK_LIBRARIES}")
+  string(REPLACE ";" " " abi_lcm_cflags "${LCM_CFLAGS}")
+  add_test(NAME clients_abi_mutations
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/abi_mutations.py
+            --check ${CMAKE_CURRENT_SOURCE_DIR}/clients/abi_check.py
+            --source ${PROJECT_SOURCE_DIR} --build ${CMAKE_BINARY_DIR} --cc ${CMAKE_C_COMPILER}
+            "--objects=$<JOIN:$<TARGET_OBJECTS:lagsim_client_wire_pic>;$<TARGET_OBJECTS:lagsim_lcmtypes_pic>,;>"
+            "--cflags=${abi_lcm_cflags}" "--libs=${abi_lcm_libs} -lm"
+            --version ${PROJECT_VERSION} --abi ${LAGSIM_CLIENT_ABI})
+  set_tests_properties(clients_abi clients_abi_mutations PROPERTIES TIMEOUT 120 LABELS clients)
+endif()
