@@ -831,6 +831,11 @@ lag_client_status *lag_client_status_new(void) { return calloc(1, sizeof(lag_cli
 
 void lag_client_status_free(lag_client_status *st) { free(st); }
 
+void lag_client_status_copy(lag_client_status *dst, const lag_client_status *src)
+{
+    if (dst && src && dst != src) *dst = *src;
+}
+
 const lag_wire_status *lag_wire_of_status(const lag_client_status *st) { return &st->m; }
 
 /* status_t's field `name` in the wire module's table (the .lcm file's fields), or NULL. */

@@ -319,6 +319,7 @@ const char *lag_client_scene_effects(const lag_client_scene *sc);   /* comma-sep
 /* A status of one's own, for lag_client_latest_status; NULL when out of memory. */
 lag_client_status *lag_client_status_new(void);
 void lag_client_status_free(lag_client_status *st);
+void lag_client_status_copy(lag_client_status *dst, const lag_client_status *src);
 
 /* Its fields by their names in lcmtypes/status_t.lcm, so that a field the daemon adds is
  * read without a new function: numbers (integers exact up to 2^53, booleans 0 or 1; NaN

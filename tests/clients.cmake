@@ -50,6 +50,18 @@ foreach(bad "--wn;-1" "--settle;x" "--duration;1e999")
            COMMAND ${expect_exit} 2 "^manipulator_pd: --" $<TARGET_FILE:manipulator_pd> ${bad})
   set_tests_properties(clients_manipulator_pd_usage_${bad_name} PROPERTIES TIMEOUT 10)
 endforeach()
+# the C++ example's options, the same rules
+foreach(bad "--wn;-1" "--settle;x" "--duration;1e999" "--timeout;0" "-z" "stray")
+  string(REGEX REPLACE "^-+" "" bad_name "${bad}")
+  string(REPLACE ";" "_" bad_name "${bad_name}")
+  string(REGEX REPLACE "[.:]" "_" bad_name "${bad_name}")
+  string(REGEX REPLACE "[^A-Za-z0-9_-]" "" bad_name "${bad_name}")
+  add_test(NAME clients_manipulator_ct_usage_${bad_name}
+           COMMAND ${expect_exit} 2 "^manipulator_ct: " $<TARGET_FILE:manipulator_ct> ${bad})
+  set_tests_properties(clients_manipulator_ct_usage_${bad_name} PROPERTIES TIMEOUT 10)
+endforeach()
+add_test(NAME clients_manipulator_ct_help
+         COMMAND ${expect_exit} 0 "--duration S" $<TARGET_FILE:manipulator_ct> --help)
 # --help: exit 0, the options listed
 add_test(NAME clients_dipc_lqr_help
          COMMAND ${expect_exit} 0 "--duration S" $<TARGET_FILE:dipc_lqr> --help)

@@ -175,6 +175,9 @@ def main():
             todo = needs(verdict, base_version, base_abi, a.version, a.abi)
             if verdict and vtuple(a.version) == vtuple(base_version) and a.same_version:
                 todo = [t for t in todo if "minor version" not in t]
+            if todo and vtuple(a.version) == vtuple(base_version) and not a.same_version:
+                todo.append("or, while %s is unreleased (no program was built against its "
+                            "header), run this with --same-version" % a.version)
             if todo:
                 print("REFUSED: the library's ABI has a%s %s change from %s; before recording:\n"
                       "  - %s\n%s" % ("n" if verdict == "incompatible" else "", verdict, where,
