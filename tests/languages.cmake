@@ -260,13 +260,14 @@ endif()
 # command-line arguments (octave --eval "dipc_balance('--prefix', ...)").
 find_program(LAGSIM_OCTAVE octave)
 # They must run in MATLAB as well, which no test here has: no syntax that GNU Octave alone
-# accepts, in clients/octave/*.m and README.md's block (tests/clients/matlab_syntax.py).
+# accepts, in clients/octave/*.m and the blocks of README.md and docs/clients.md
+# (tests/clients/matlab_syntax.py).
 file(GLOB octave_m CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/clients/octave/*.m)
 add_test(NAME clients_octave_matlab_syntax
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/matlab_syntax.py ${octave_m}
           ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_octave_lqr.m ${CMAKE_CURRENT_SOURCE_DIR}/net/plant_urls_octave.m
           ${CMAKE_CURRENT_SOURCE_DIR}/clients/reference/reference_echo.m
-          --readme ${PROJECT_SOURCE_DIR}/README.md)
+          --readme ${PROJECT_SOURCE_DIR}/README.md --readme ${PROJECT_SOURCE_DIR}/docs/clients.md)
 list(APPEND lang_tests clients_octave_matlab_syntax)
 # the jars load in MATLAB's bundled Java 8: every class of LAGSIM_JAVA_RELEASE
 if(TARGET lagsim_examples_java)
@@ -426,8 +427,10 @@ set(readme_run ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_snip
     --lagsimd ${lang_lagsimd} --build ${CMAKE_BINARY_DIR} --readme ${PROJECT_SOURCE_DIR}/README.md
     --readme ${PROJECT_SOURCE_DIR}/docs/clients.md
     --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml)
-# the C block, built as a user would against the client library (and, in a sanitizer
-# build, its runtime)
+# the C and C++ blocks, built as their first line says (pkg-config lagsim-client) with
+# gcc and g++ (and, in a sanitizer build, with the instrumented library's runtime): against
+# the build tree (<build>/pkgconfig) and against an install (cmake --install into a
+# temporary prefix); the C++ block also with clang++, -Werror
 set(readme_c_flags "")
 if(LAGSIM_SANITIZE)
   set(readme_c_flags "-fsanitize=address,undefined,float-cast-overflow")
@@ -435,10 +438,8 @@ endif()
 if(LAGSIM_FUZZ)
   string(APPEND readme_c_flags " -fsanitize=fuzzer-no-link")
 endif()
-string(REPLACE ";" " " readme_lcm_libs "${LCM_LINK_LIBRARIES}")
-set(readme_c_build
-  "--c-build=${CMAKE_C_COMPILER} -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror ${readme_c_flags} {src} -o {out} -I${PROJECT_SOURCE_DIR}/clients -I${PROJECT_SOURCE_DIR}/server/include -I${PROJECT_SOURCE_DIR}/server/wire -I${CMAKE_BINARY_DIR}/lcmtypes/c $<TARGET_FILE:lagsim_client> $<TARGET_FILE:lagsim_wire> $<TARGET_FILE:lagsim_wire_base> $<TARGET_FILE:lagsim_core> $<TARGET_FILE:lagsim_lcmtypes> ${readme_lcm_libs} -lm")
-set(readme_langs c python)
+set(readme_cc --cc ${CMAKE_C_COMPILER} --cxx ${CMAKE_CXX_COMPILER} "--cflags=${readme_c_flags}")
+set(readme_langs c cpp python)
 if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
   list(APPEND readme_langs lua)
 endif()
@@ -449,18 +450,30 @@ endif()
 # 150 ms per answer (20 periods) and of 1.5 s (4 periods): every state answered, no
 # lockstep timeout, the fast run's states bit for bit
 foreach(lang IN LISTS readme_langs)
-  set(extra "")
-  if(lang STREQUAL "c")
-    set(extra "${readme_c_build}")
-  endif()
-  add_test(NAME clients_readme_${lang} COMMAND ${readme_run} ${extra} ${lang}-dipc)
+  add_test(NAME clients_readme_${lang} COMMAND ${readme_run} ${readme_cc} ${lang}-dipc)
   add_test(NAME clients_readme_${lang}_slow_law
-    COMMAND ${readme_run} ${extra} --think 0.15 --periods 20 ${lang}-dipc)
+    COMMAND ${readme_run} ${readme_cc} --think 0.15 --periods 20 ${lang}-dipc)
   add_test(NAME clients_readme_${lang}_slower_law
-    COMMAND ${readme_run} ${extra} --think 1.5 --periods 4 ${lang}-dipc)
+    COMMAND ${readme_run} ${readme_cc} --think 1.5 --periods 4 ${lang}-dipc)
   list(APPEND lang_tests clients_readme_${lang} clients_readme_${lang}_slow_law
     clients_readme_${lang}_slower_law)
 endforeach()
+# the C and C++ blocks against an install; the C++ block with the other C++ compiler
+add_test(NAME clients_readme_c_installed
+  COMMAND ${readme_run} ${readme_cc} --install --periods 20 c-dipc)
+add_test(NAME clients_readme_cpp_installed
+  COMMAND ${readme_run} ${readme_cc} --install --periods 20 cpp-dipc)
+list(APPEND lang_tests clients_readme_c_installed clients_readme_cpp_installed)
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+  find_program(LAGSIM_OTHER_CXX clang++)
+else()
+  find_program(LAGSIM_OTHER_CXX g++)
+endif()
+if(LAGSIM_OTHER_CXX AND NOT LAGSIM_SANITIZE)
+  add_test(NAME clients_readme_cpp_other_compiler
+    COMMAND ${readme_run} --cc ${CMAKE_C_COMPILER} --cxx ${LAGSIM_OTHER_CXX} --periods 20 cpp-dipc)
+  list(APPEND lang_tests clients_readme_cpp_other_compiler)
+endif()
 # the MATLAB/Octave block by a plain octave --eval (the .m files of <build>/octave on the path)
 if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
   add_test(NAME clients_readme_octave COMMAND ${readme_run} octave-dipc)
@@ -489,3 +502,9 @@ add_test(NAME clients_walkthrough
 set_tests_properties(clients_walkthrough PROPERTIES TIMEOUT 200 LABELS clients)
 
 set_tests_properties(${lang_tests} PROPERTIES TIMEOUT 90 LABELS clients)
+# a block built twice and run twice, the second time with a law of 0.15 s or 1.5 s per
+# answer: 65 to 81 s seen beside other tests on the loaded 2-core machine
+foreach(lang IN LISTS readme_langs)
+  set_tests_properties(clients_readme_${lang}_slow_law clients_readme_${lang}_slower_law
+                       PROPERTIES TIMEOUT 150)
+endforeach()

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The MATLAB/Octave clients must run in MATLAB too: no GNU Octave-only syntax.
 
-    matlab_syntax.py FILE.m ... [--readme README.md]
+    matlab_syntax.py FILE.m ... [--readme README.md ...]
 
 GNU Octave accepts a superset of MATLAB's language; what it alone accepts fails in MATLAB,
 and only GNU Octave runs in the tests. Flagged, outside strings and % comments: # comments,
@@ -9,10 +9,11 @@ and only GNU Octave runs in the tests. Flagged, outside strings and % comments: 
 endswitch, end_try_catch, endclassdef, endmethods, endproperties, unwind_protect, double
 quotes (MATLAB reads "..." as a string object, not a char vector), Octave-only functions
 (printf, puts, fputs, fdisp, argv, program_name), and fflush or pkg unless the three lines
-before test exist('OCTAVE_VERSION', 'builtin'). --readme also checks README.md's
+before test exist('OCTAVE_VERSION', 'builtin'). --readme also checks a Markdown file's
 ```matlab blocks. Before the files, the checker runs on lines that must be flagged and
 lines that must pass, so it cannot pass by checking nothing.
 """
+import os
 import re
 import sys
 
@@ -112,9 +113,11 @@ def main():
     while args:
         a = args.pop(0)
         if a == "--readme":
-            text = open(args.pop(0)).read()
+            path = args.pop(0)
+            text = open(path).read()
             for k, m in enumerate(re.finditer(r"```matlab\n(.*?)```", text, re.S)):
-                files.append(("README.md block %d" % (k + 1), m.group(1).splitlines()))
+                files.append(("%s block %d" % (os.path.basename(path), k + 1),
+                              m.group(1).splitlines()))
         else:
             files.append((a, open(a).read().splitlines()))
     if not files:
