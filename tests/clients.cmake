@@ -286,3 +286,19 @@ if(LAGSIM_PYTHON3 AND NOT LAGSIM_SANITIZE)
             --version ${PROJECT_VERSION} --abi ${LAGSIM_CLIENT_ABI})
   set_tests_properties(clients_abi clients_abi_mutations PROPERTIES TIMEOUT 120 LABELS clients)
 endif()
+
+# ---- Stock lcm-gen --cpp types (lcm/lcm-cpp.hpp) against forged states: they take a name
+# without its NUL, bytes after the message and a NaN, as docs/clients.md says; the client
+# library drops each (tests/clients/lcm_cpp_forged.cpp).
+set(lcm_cpp_dir ${CMAKE_CURRENT_BINARY_DIR}/lcm_cpp)
+add_custom_command(OUTPUT ${lcm_cpp_dir}/lagsim/joint_state_t.hpp
+  COMMAND ${CMAKE_COMMAND} -E make_directory ${lcm_cpp_dir}
+  COMMAND ${LCM_GEN} --cpp --cpp-hpath ${lcm_cpp_dir} ${PROJECT_SOURCE_DIR}/lcmtypes/joint_state_t.lcm
+  DEPENDS ${PROJECT_SOURCE_DIR}/lcmtypes/joint_state_t.lcm
+  COMMENT "lcm-gen: C++ types (the stock ones, for clients_lcm_cpp_forged)")
+add_executable(test_lcm_cpp_forged ${CMAKE_CURRENT_SOURCE_DIR}/clients/lcm_cpp_forged.cpp
+                                   ${lcm_cpp_dir}/lagsim/joint_state_t.hpp)
+target_include_directories(test_lcm_cpp_forged PRIVATE ${lcm_cpp_dir})
+target_link_libraries(test_lcm_cpp_forged PRIVATE lagsim_client PkgConfig::LCM)
+add_test(NAME clients_lcm_cpp_forged COMMAND test_lcm_cpp_forged)
+set_tests_properties(clients_lcm_cpp_forged PROPERTIES TIMEOUT 30 LABELS clients)
