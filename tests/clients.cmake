@@ -294,7 +294,9 @@ set(lcm_cpp_dir ${CMAKE_CURRENT_BINARY_DIR}/lcm_cpp)
 add_custom_command(OUTPUT ${lcm_cpp_dir}/lagsim/joint_state_t.hpp
   COMMAND ${CMAKE_COMMAND} -E make_directory ${lcm_cpp_dir}
   COMMAND ${LCM_GEN} --cpp --cpp-hpath ${lcm_cpp_dir} ${PROJECT_SOURCE_DIR}/lcmtypes/joint_state_t.lcm
+          ${PROJECT_SOURCE_DIR}/lcmtypes/joint_command_t.lcm ${PROJECT_SOURCE_DIR}/lcmtypes/event_t.lcm
   DEPENDS ${PROJECT_SOURCE_DIR}/lcmtypes/joint_state_t.lcm
+          ${PROJECT_SOURCE_DIR}/lcmtypes/joint_command_t.lcm ${PROJECT_SOURCE_DIR}/lcmtypes/event_t.lcm
   COMMENT "lcm-gen: C++ types (the stock ones, for clients_lcm_cpp_forged)")
 add_executable(test_lcm_cpp_forged ${CMAKE_CURRENT_SOURCE_DIR}/clients/lcm_cpp_forged.cpp
                                    ${lcm_cpp_dir}/lagsim/joint_state_t.hpp)

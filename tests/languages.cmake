@@ -458,6 +458,11 @@ foreach(lang IN LISTS readme_langs)
   list(APPEND lang_tests clients_readme_${lang} clients_readme_${lang}_slow_law
     clients_readme_${lang}_slower_law)
 endforeach()
+# docs/clients.md's C++ block over stock lcm-gen --cpp types and lcm/lcm-cpp.hpp, built
+# with the types clients_lcm_cpp_forged's target generates (tests/clients.cmake)
+add_test(NAME clients_readme_cpplcm
+  COMMAND ${readme_run} ${readme_cc} --lcm-cpp-types ${CMAKE_BINARY_DIR}/tests/lcm_cpp cpplcm-dipc)
+list(APPEND lang_tests clients_readme_cpplcm)
 # the C and C++ blocks against an install; the C++ block with the other C++ compiler
 add_test(NAME clients_readme_c_installed
   COMMAND ${readme_run} ${readme_cc} --install --periods 20 c-dipc)

@@ -50,6 +50,8 @@ THINK_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "think")
 RUNNERS = {
     "c": ("balance.c", lambda b, f, slow: [os.path.splitext(f)[0]], lambda b: {}),
     "cpp": ("balance.cpp", lambda b, f, slow: [os.path.splitext(f)[0]], lambda b: {}),
+    # stock lcm-gen --cpp types with lcm/lcm-cpp.hpp (docs/clients.md), no lagsim library
+    "cpplcm": ("balance.cpp", lambda b, f, slow: [os.path.splitext(f)[0]], lambda b: {}),
     "python": ("balance.py",
                lambda b, f, slow: ["python3"] + ([os.path.join(THINK_DIR, "think.py")]
                                                  if slow else []) + [f],
@@ -99,6 +101,8 @@ def main():
     ap.add_argument("--cc", default="cc", help="the C block's compiler")
     ap.add_argument("--cxx", default="c++", help="the C++ block's compiler")
     ap.add_argument("--cflags", default="", help="more flags for both (a sanitizer build's)")
+    ap.add_argument("--lcm-cpp-types", default="",
+                    help="where lcm-gen --cpp wrote lagsim's types (the cpplcm block's -Igen)")
     ap.add_argument("--install", action="store_true",
                     help="build the C and C++ blocks against an install of the build tree")
     ap.add_argument("--think", type=float, default=0.0,
@@ -162,18 +166,22 @@ def build_block(a, text, lang, path, think):
     """Compiles the C or C++ block as its first line says, against the client library of
     a.pkg_config_path; with think > 0, with a slow law in front of its sends (think.h)."""
     said = {"c": r"cc balance\.c \$\(pkg-config --cflags --libs lagsim-client\)",
-            "cpp": r"c\+\+ -std=c\+\+17 balance\.cpp \$\(pkg-config --cflags --libs lagsim-client\)"}
+            "cpp": r"c\+\+ -std=c\+\+17 balance\.cpp \$\(pkg-config --cflags --libs lagsim-client\)",
+            "cpplcm": r"c\+\+ -std=c\+\+17 -Igen balance\.cpp \$\(pkg-config --cflags --libs lcm\)"}
     if not re.search(said[lang], text.split("\n")[0] + text.split("\n")[1]):
         print("FAIL: the %s block's first lines do not say how it builds (%s)" % (lang, said[lang]))
         return False
+    pkg = "lcm" if lang == "cpplcm" else "lagsim-client"
     env = dict(os.environ, PKG_CONFIG_PATH=a.pkg_config_path)
-    pc = subprocess.run(["pkg-config", "--cflags", "--libs", "lagsim-client"], env=env,
+    pc = subprocess.run(["pkg-config", "--cflags", "--libs", pkg], env=env,
                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
     if pc.returncode != 0:
-        print("FAIL: PKG_CONFIG_PATH=%s pkg-config --cflags --libs lagsim-client:\n%s"
-              % (a.pkg_config_path, pc.stdout))
+        print("FAIL: PKG_CONFIG_PATH=%s pkg-config --cflags --libs %s:\n%s"
+              % (a.pkg_config_path, pkg, pc.stdout))
         return False
     cmd = ([a.cc] if lang == "c" else [a.cxx, "-std=c++17"]) + ["-Wall", "-Wextra", "-Werror"]
+    if lang == "cpplcm":  # "-Igen": the build's lcm-gen --cpp types
+        cmd.append("-I" + a.lcm_cpp_types)
     cmd += shlex.split(a.cflags)
     if think > 0:  # the same block, built with a slow law in front of its sends
         cmd += ["-include", os.path.join(THINK_DIR, "think.h")]
@@ -201,7 +209,7 @@ def run_block(a, build, text, name, lang, think):
         f.write(text.replace('"DIPC_', '"%s_' % prefix).replace("'DIPC_", "'%s_" % prefix)
                 .replace('"DIPC"', '"%s"' % prefix))
     slow = ""
-    if lang in ("c", "cpp"):
+    if lang in ("c", "cpp", "cpplcm"):
         if not build_block(a, text, lang, path, think):
             return 1, {}
     elif think > 0:
