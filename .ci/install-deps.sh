@@ -14,6 +14,7 @@ pkgs=(build-essential cmake pkg-config clang libclang-rt-14-dev   # gcc pass; cl
       curl                                               # the walkthrough (docs/clients.md) asks lagsim-view for its history
       iproute2 nftables                                  # two hosts on one machine: namespaces, veth, packet loss
       lintian systemd                                    # the Debian package: lintian, systemd-analyze, its unit run by systemd
+      abigail-tools                                      # the client library's ABI check (abidw, abidiff: clients_abi)
       parallel slurm-client                              # lagsim-sweep shards: GNU parallel, sbatch (--test-only, no cluster)
       openssh-server openssh-client                      # ... and parallel --sshlogin, tested against sshd in namespaces
       universal-ctags)                                   # structure_function_length: each C function's first and last line
