@@ -23,7 +23,8 @@ A kick obeys the rules of any disturbance, with the words of the scene loader: o
 stick, kicks the scene loader would refuse as a disturbance (a force held shorter than a
 tick, --duration 1e-6 and 1e-300; an impulse of 1e300; a force impulse/duration above
 1e12 N) are refused with exit 1, and each message is the one `lagsimd` gives for the same
-disturbance written in the scene file; none changes x_dot. A kick spread over 1.5 ticks
+disturbance written in the scene file, and as a SET of effects.disturbance to that
+disturbance says; none changes x_dot. A kick spread over 1.5 ticks
 gives exactly its impulse (m x_dot = 0.5, not the 0.667 of a force 0.5/0.0015 held over two
 whole ticks). A kick of 1e7 N s faults the plant (x_dot past explode_limit, as the same
 impulse in a scene would); a kick in the fault is refused (a reset would end it unapplied:
@@ -113,6 +114,13 @@ def rules(lagsimd, ctl_bin, cfg, prefix, tmp):
         for args, item in bad:
             r = ctl("kick", *args)
             rc, words = scene_words(lagsimd, cfg, tmp, item)
+            rs = ctl("set", "effects.disturbance=[%s]" % item)
+            at = "effects.disturbance[0]."
+            by_set = rs.stderr.strip()
+            by_set = by_set[by_set.find(at) + len(at):] if at in by_set else by_set
+            check(rs.returncode == 1 and by_set == words,
+                  "set effects.disturbance=[%s]: refused (exit %d) with the scene file's words"
+                  % (item, rs.returncode))
             said = r.stderr.strip()
             kv = "kick.%s=" % args[0]
             said = said[said.find(kv):] if kv in said else said
