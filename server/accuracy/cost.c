@@ -271,15 +271,15 @@ static int64_t run_reference(cost_run *c, lag_cost_table *out, char *err, size_t
 
 /* from_current: the target is the error the current setting reaches, times safety (at
  * least TARGET_MIN), over the periods before the first where the references differ by
- * more than that error so far: beyond, the first reference is not known to a tenth of the
- * error it measures. Returns those periods; 0 if its error is not finite (then the target
- * is opts.target). */
+ * more than that error so far (or TARGET_MIN): beyond, the first reference is not known to
+ * a tenth of the error it measures. Returns those periods; 0 if its error is not finite
+ * (then the target is opts.target). */
 static int64_t target_of_current(cost_run *c, lag_cost_table *out)
 {
     const lag_cost_opts *o = c->o;
     char err[256];
     if (run_horizon(c, o->current, NULL, true, err, sizeof err) != LAG_OK) return 0;
-    const double least = TARGET_MIN / o->safety;
+    const double least = TARGET_MIN; /* below, a difference of the references' own */
     double m = 0;
     int64_t k = 0;
     for (; k < c->nper; k++) {
@@ -291,10 +291,9 @@ static int64_t target_of_current(cost_run *c, lag_cost_table *out)
         k = 1;
         m = fmax(c->per[0], c->ref_diff[0]);
     }
-    m = fmax(m, least);
     if (!isfinite(m)) return 0;
-    c->target = o->safety * m;
-    out->agree_tol = m;
+    c->target = fmax(o->safety * m, TARGET_MIN);
+    out->agree_tol = fmax(m, least);
     out->target_from_current = true;
     return k;
 }
