@@ -22,7 +22,7 @@ static void usage(FILE *f)
         "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|- [--force]]\n"
         "               [--set ...]\n"
         "       lagsimd --config FILE --replay LOG.lcm [--tolerance X] [--set ...]\n"
-        "       lagsimd --config FILE --cost [--plot FILE.png] [--set ...]\n"
+        "       lagsimd --config FILE --cost [--plot FILE.png|FILE.gp] [--set ...]\n"
         "\n",
         f);
     char models[256]; /* from the core's table: a model added there is named here */
@@ -69,10 +69,13 @@ static void usage(FILE *f)
         "      --cost             measure what accuracy costs on this scene and machine: each\n"
         "                         integrator setting's error over integrator.horizon against\n"
         "                         a tight reference, its CPU per sim-second, its margin to\n"
-        "                         real time; the error asked for is integrator.error (1e-6\n"
-        "                         if the scene gives none). A scene with integrator.error\n"
-        "                         runs with the cheapest setting that meets it\n"
-        "      --plot FILE.png    --cost: draw the work-precision diagram (gnuplot)\n"
+        "                         real time; the error asked for is integrator.error (if the\n"
+        "                         scene gives none: the error its own integrator reaches).\n"
+        "                         A horizon beyond what two references agree on is cut, and\n"
+        "                         said. A scene with integrator.error runs with the cheapest\n"
+        "                         setting that meets it\n"
+        "      --plot FILE.png    --cost: draw the work-precision diagram (gnuplot); FILE.gp:\n"
+        "                         write the gnuplot script that draws it, data inline\n"
         "  -q, --quiet            no live status line or event lines / offline summary\n"
         "  -h, --help             this help\n"
         "  -V, --version          print the version\n"
