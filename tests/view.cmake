@@ -33,11 +33,13 @@ if(LAGSIM_VIEW_PYTHON3)
            --screenshot ${CMAKE_BINARY_DIR}/view_reference.png)
   add_test(NAME view_charts COMMAND ${view_test} charts)
   add_test(NAME view_history COMMAND ${view_test} history)
+  # every model of the core's table drawn, from its shipped scene
+  add_test(NAME view_models COMMAND ${view_test} models)
   set_tests_properties(view_browser view_hostile view_stick_flight view_cartpole view_reference
-                       view_charts view_history PROPERTIES TIMEOUT 180 LABELS view)
+                       view_charts view_history view_models PROPERTIES TIMEOUT 180 LABELS view)
   if(NOT LAGSIM_CHROMIUM)
     set_tests_properties(view_browser view_stick_flight view_cartpole view_reference view_charts
-                         PROPERTIES ENVIRONMENT "PATH=/nonexistent")
+                         view_models PROPERTIES ENVIRONMENT "PATH=/nonexistent")
   endif()
 endif()
 
@@ -57,4 +59,17 @@ if(LAGSIM_VIEW_PYTHON3)
     set_tests_properties(view_attack_forged view_attack_stalled view_attack_host PROPERTIES
                          ENVIRONMENT "PATH=/nonexistent")
   endif()
+endif()
+
+# lagsim-view stopped by SIGINT or SIGTERM while browsers hold streams, six times each
+# (tests/view/test_view_stop.py): exit 0, no abort in libmicrohttpd, each stream ended.
+if(LAGSIM_VIEW_PYTHON3)
+  foreach(case sigint sigterm)
+    add_test(NAME view_stop_${case}
+             COMMAND ${LAGSIM_VIEW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/view/test_view_stop.py
+                     --view $<TARGET_FILE:lagsim-view> --lagsimd $<TARGET_FILE:lagsimd>
+                     --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml
+                     --types ${CMAKE_BINARY_DIR}/python ${case})
+    set_tests_properties(view_stop_${case} PROPERTIES TIMEOUT 180 LABELS view)
+  endforeach()
 endif()

@@ -212,24 +212,14 @@ static int step_once(eval_worker *w, long n, double seconds)
 /* ---------------------------------------------------------------- start, stop */
 static pid_t start_daemon(eval_worker *w, const eval_case *c)
 {
-    char *argv[2 * EVAL_SETS_MAX + 24];
-    char owned[2][600];
+    char *argv[2 * (EVAL_SETS_MAX + EVAL_OWN_COUNT) + 16];
+    char owned[EVAL_OWN_COUNT][EVAL_SET_LEN]; /* the keys the tools own */
     int na = 0;
     argv[na++] = (char *)w->env.lagsimd;
     argv[na++] = "--config";
     argv[na++] = (char *)w->env.config;
-    /* STEP takes a period without a command once lockstep_timeout passed (as asked): the
-     * longest one, so that a period never goes without its answer, as in a running
-     * lockstep plant (a lost answer costs a retry, docs/server.md) */
-    static const char *const fixed[] = {"realtime.mode=lockstep", "realtime.start=paused",
-                                        "realtime.lockstep_timeout=3600"};
-    for (int i = 0; i < 3; i++) {
-        argv[na++] = "--set";
-        argv[na++] = (char *)fixed[i];
-    }
-    snprintf(owned[0], sizeof owned[0], "lcm.prefix=%s", w->env.prefix);
-    snprintf(owned[1], sizeof owned[1], "lcm.url=%s", w->env.url);
-    for (int i = 0; i < 2; i++) {
+    eval_owned_sets(&w->env, true, owned);
+    for (int i = 0; i < EVAL_OWN_COUNT; i++) {
         argv[na++] = "--set";
         argv[na++] = owned[i];
     }
@@ -261,7 +251,10 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
     snprintf(w->log, sizeof w->log, "%s/%s.lcm", env->workdir, env->prefix);
     unlink(w->log);
     char cmd[4096];
-    eval_expand(env->controller, env, cmd, sizeof cmd);
+    if (eval_expand(env->controller, env, cmd, sizeof cmd, err, errlen)) {
+        free(w);
+        return NULL;
+    }
     /* the controller first, as eval_run starts them */
     w->cpid = eval_spawn(NULL, cmd, env);
     w->dpid = start_daemon(w, c);

@@ -21,11 +21,12 @@
 
 #include "eval_case.h"
 #include "scene.h"
+#include "sweep_merge.h"
 
 static const char *prog = "lagsim-sweep";
 
 #define VARY_MAX 16
-#define ROW_MAX 8192
+#define ROW_MAX 8192 /* bytes of the CSV header and of a row at most (a row: < 4000) */
 
 static void usage(FILE *f)
 {
@@ -34,7 +35,8 @@ static void usage(FILE *f)
 "                    --vary KEY=DIST ... [--runs N] [--seed S] [-j N] [--shard K/N]\n"
 "                    [--restart]\n"
 "                    [--suite FILE] [--require EXPR] [--csv OUT.csv] [--plot OUT.png]\n"
-"                    [--metric JOINT.METRIC] [--force] [--lagsimd PATH] [--timeout S] [-v]\n"
+"                    [--metric JOINT.METRIC] [--force] [--url URL] [--allow-lan]\n"
+"                    [--lagsimd PATH] [--timeout S] [-v]\n"
 "       lagsim-sweep merge A.csv B.csv ... -o OUT.csv [--partial] [--force]\n"
 "\n"
 "Runs an evaluation case (lagsim-eval's) over scene keys drawn at random or on a grid,\n"
@@ -43,19 +45,22 @@ static void usage(FILE *f)
 "\n"
 "options:\n"
 "  -c, --config SCENE     the scene file (lagsimd's)\n"
-"  -C, --controller CMD   the controller's shell command ({prefix}, {url} replaced)\n"
+"  -C, --controller CMD   the controller's shell command; {prefix} and {url} are\n"
+"                         replaced as they are, no quotes added (as lagsim-eval)\n"
 "      --case NAME        the case to vary (from the scene's or the suite's cases:)\n"
 "      --suite FILE       take the cases from FILE\n"
 "  -d, --duration S       without --case: a case of S sim seconds and no overrides\n"
 "      --vary KEY=DIST    a scene key (as lagsimd --set; initial.q[i], initial.qd[i]\n"
-"                         for one coordinate) and its values: uniform(A,B),\n"
-"                         normal(MEAN,SD) or grid(A,B,N) (N values from A to B);\n"
-"                         repeatable: grids multiply, random keys are drawn per run\n"
+"                         for one coordinate) and its values: uniform(A,B) (A < B),\n"
+"                         normal(MEAN,SD) (SD > 0) or grid(A,B,N) (N values from A\n"
+"                         up to B > A, N from 2 to 1e6), numbers as plain decimals;\n"
+"                         repeatable, each key once: grids multiply, random keys are\n"
+"                         drawn per run\n"
 "  -n, --runs N           runs (per grid point when there are grids; default 1)\n"
 "      --seed S           the random seed of every drawn value (default 1)\n"
 "  -j, --jobs N           runs at once on this machine (default 1)\n"
-"      --shard K/N        only runs i with i mod N = K - 1 (K = 1..N): one machine's\n"
-"                         part; lagsim-sweep merge joins the parts\n"
+"      --shard K/N        only runs i with i mod N = K - 1 (K = 1..N, N <= 1e7): one\n"
+"                         machine's part; lagsim-sweep merge joins the parts\n"
 "      --restart          a daemon and a controller started for each run, with the\n"
 "                         run's values (default: one of each per worker, started\n"
 "                         with the scene's values; each run's values SET and its\n"
@@ -67,17 +72,34 @@ static void usage(FILE *f)
 "      --metric J.M       the metric drawn (default: --require's first, else the first\n"
 "                         joint's iae)\n"
 "  -f, --force            replace existing output files\n"
+"      --url URL          the runs' multicast group and options (default:\n"
+"                         LCM_DEFAULT_URL's, else udpm://239.255.76.67?ttl=0&\n"
+"                         recv_buf_size=4194304); the ports are lagsim-sweep's: a pair\n"
+"                         for each worker, held while it runs, that no other sweep or\n"
+"                         evaluation of this host holds and no socket of it is bound to\n"
+"      --allow-lan        accept a URL with ttl above 0 (the runs on the network)\n"
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a run may take (default 600)\n"
 "  -v, --verbose          pass the daemon's and the controller's output through\n"
-"  -o, --output OUT.csv   merge: the joined CSV\n"
-"      --partial          merge: join shards that leave runs out (default: refused\n"
-"                         unless the runs are exactly 0 to the last one found)\n"
+"  -o, --output OUT.csv   merge: the joined CSV (the whole sweep's, byte for byte); every\n"
+"                         shard's identity lines (# seed:, # scene-sha256:, # vary:, ...)\n"
+"                         must be the first's, every row one of its header, every shard\n"
+"                         and run there\n"
+"      --partial          merge: join shards that leave shards or runs out\n"
 "  -h, --help             this help\n"
+"\n"
+"keys lagsim-sweep sets on every run (a case's set: or a --vary naming one, or a\n"
+"mapping above one, is refused):\n");
+    eval_owned_usage(f);
+    fprintf(f,
 "\n"
 "exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
 "case error, an output that exists (checked before the first run), or shard CSVs that\n"
-"do not belong together or leave runs out\n");
+"do not belong together, hold a malformed row or leave shards or runs out\n"
+"\n"
+"signals: SIGINT, SIGTERM, SIGHUP stop every process it started (SIGKILL after 2 s)\n"
+"and end it by that signal; after SIGKILL they end within about 2 s. TMPDIR: where\n"
+"the workers' files go (default /tmp)\n");
 }
 
 static int die(const char *fmt, const char *a)
@@ -100,43 +122,119 @@ typedef struct vary {
     long n;                   /* grid points */
 } vary;
 
-static int parse_vary(const char *text, vary *v)
+/* The numbers of "NAME(X1, ..., Xn)" at d into x: each a plain decimal as a scene writes
+ * one (lag_scene_read_decimal: not inf, nan, 0x1p3 or 1e999), nothing after the ')'. */
+static bool read_args(const char *d, const char *name, int n, double *x)
 {
-    memset(v, 0, sizeof *v);
-    snprintf(v->text, sizeof v->text, "%s", text);
+    size_t nl = strlen(name);
+    if (strncmp(d, name, nl) || d[nl] != '(') return false;
+    const char *p = d + nl + 1;
+    for (int i = 0; i < n; i++) {
+        size_t len = strcspn(p, i + 1 < n ? "," : ")");
+        char num[64];
+        if (!p[len] || len >= sizeof num) return false;
+        /* blanks around a number are allowed, as in uniform(0.5, 2) */
+        while (len && p[len - 1] == ' ') len--;
+        size_t lead = strspn(p, " ");
+        if (lead >= len) return false;
+        memcpy(num, p + lead, len - lead);
+        num[len - lead] = '\0';
+        if (lag_scene_read_decimal(num, &x[i]) != LAG_OK) return false;
+        p += strcspn(p, i + 1 < n ? "," : ")") + 1;
+    }
+    return p[0] == '\0' && p[-1] == ')';
+}
+
+/* KEY, and its index on initial.q[i] / initial.qd[i] */
+static int parse_vary_key(const char *text, vary *v, char *why, size_t len)
+{
     const char *eq = strchr(text, '=');
-    if (!eq || eq == text || (size_t)(eq - text) >= sizeof v->key) return -1;
+    if (!eq || eq == text || (size_t)(eq - text) >= sizeof v->key)
+        return snprintf(why, len, "expected KEY=DIST"), -1;
     memcpy(v->key, text, (size_t)(eq - text));
     v->index = -1;
     char *br = strchr(v->key, '[');
-    if (br) {
-        char *end;
-        long i = strtol(br + 1, &end, 10);
-        if (end == br + 1 || strcmp(end, "]") || i < 0 || i >= EVAL_JOINTS_MAX) return -1;
-        if (strncmp(v->key, "initial.q[", 10) && strncmp(v->key, "initial.qd[", 11)) return -1;
-        *br = '\0';
-        v->index = (int)i;
-    }
-    const char *d = eq + 1;
-    double a, b, n;
-    char tail;
-    /* the distribution ends at its ')': nothing may follow it */
-    const char *close = strchr(d, ')');
-    if (!close || close[1] != '\0') return -1;
-    if (sscanf(d, "uniform(%lf ,%lf%c", &a, &b, &tail) == 3 && tail == ')' && a < b &&
-        isfinite(a) && isfinite(b)) {
-        v->kind = V_UNIFORM, v->a = a, v->b = b;
-    } else if (sscanf(d, "normal(%lf ,%lf%c", &a, &b, &tail) == 3 && tail == ')' && b >= 0 &&
-               isfinite(a) && isfinite(b)) {
-        v->kind = V_NORMAL, v->a = a, v->b = b;
-    } else if (sscanf(d, "grid(%lf ,%lf ,%lf%c", &a, &b, &n, &tail) == 4 && tail == ')' &&
-               isfinite(a) && isfinite(b) && n >= 1 && n <= 1e6 && n == floor(n) &&
-               (n == 1 || a != b)) {
-        v->kind = V_GRID, v->a = a, v->b = b, v->n = (long)n;
+    if (!br && (!strcmp(v->key, "initial.q") || !strcmp(v->key, "initial.qd")))
+        return snprintf(why, len, "%s is a list: vary one coordinate, %s[i]", v->key,
+                        v->key), -1;
+    if (!br) return 0;
+    char *end;
+    long i = strtol(br + 1, &end, 10);
+    if ((strncmp(v->key, "initial.q[", 10) && strncmp(v->key, "initial.qd[", 11)) ||
+        end == br + 1 || strcmp(end, "]") || !(br[1] >= '0' && br[1] <= '9') || i < 0 ||
+        i >= EVAL_JOINTS_MAX)
+        return snprintf(why, len, "an index only on initial.q[i] or initial.qd[i], i from 0 "
+                        "to %d", EVAL_JOINTS_MAX - 1), -1;
+    *br = '\0';
+    v->index = (int)i;
+    return 0;
+}
+
+/* A --vary: KEY=uniform(A,B), normal(MEAN,SD) or grid(A,B,N). Every value a run can get is
+ * a finite double: A < B (a grid ascends, as uniform's range), B - A finite, SD > 0 and
+ * MEAN +- 9 SD finite (Box-Muller's draws stay within 8.7 SD), N an integer from 2 to
+ * 1e6. -1 with what was expected in why. */
+static int parse_vary(const char *text, vary *v, char *why, size_t len)
+{
+    memset(v, 0, sizeof *v);
+    snprintf(v->text, sizeof v->text, "%s", text);
+    if (parse_vary_key(text, v, why, len)) return -1;
+    const char *d = strchr(text, '=') + 1;
+    double x[3];
+    if (read_args(d, "uniform", 2, x)) {
+        v->kind = V_UNIFORM;
+        if (!(x[0] < x[1]) || !isfinite(x[1] - x[0]))
+            return snprintf(why, len, "uniform(A,B) needs A < B and B - A finite"), -1;
+    } else if (read_args(d, "normal", 2, x)) {
+        v->kind = V_NORMAL;
+        if (!(x[1] > 0) || !isfinite(fabs(x[0]) + 9 * x[1]))
+            return snprintf(why, len, "normal(MEAN,SD) needs SD > 0 and MEAN +- 9 SD finite "
+                            "(the draws reach 8.7 SD)"), -1;
+    } else if (read_args(d, "grid", 3, x)) {
+        v->kind = V_GRID;
+        if (!(x[0] < x[1]) || !isfinite(x[1] - x[0]))
+            return snprintf(why, len, "grid(A,B,N) needs A < B (it goes from A up to B) and "
+                            "B - A finite"), -1;
+        if (!(x[2] >= 2 && x[2] <= 1e6 && x[2] == floor(x[2])))
+            return snprintf(why, len, "grid(A,B,N) needs N, its number of points, an integer "
+                            "from 2 to 1e6"), -1;
+        v->n = (long)x[2];
     } else {
+        return snprintf(why, len, "expected uniform(A,B), normal(MEAN,SD) or grid(A,B,N), "
+                        "each number a plain decimal"), -1;
+    }
+    v->a = x[0], v->b = x[1];
+    return 0;
+}
+
+/* -1 after saying so when v varies a key (or a coordinate) that an earlier --vary of vs
+ * varies too, or holds or lies under it: a run could take only one of the values, and
+ * the CSV would show both. */
+static int vary_twice(const vary *vs, int nv, const vary *v)
+{
+    for (int k = 0; k < nv; k++) {
+        const vary *o = &vs[k];
+        if (!eval_key_overlap(o->key, strlen(o->key), v->key, strlen(v->key))) continue;
+        /* two coordinates of one list are two keys */
+        if (!strcmp(o->key, v->key) && o->index >= 0 && v->index >= 0 && o->index != v->index)
+            continue;
+        bool same = !strcmp(o->key, v->key) && o->index == v->index;
+        fprintf(stderr, "%s: --vary %s: %s that of --vary %s: a run takes one value of a "
+                "key (one of the two CSV columns would be false); vary each key once\n",
+                prog, v->text, same ? "the same key as" : "its key holds or lies in",
+                o->text);
         return -1;
     }
     return 0;
+}
+
+/* A varied key the tools own (eval_owned_keys) is refused: said, and -1. */
+static int vary_owned(const vary *v)
+{
+    char why[512];
+    if (!eval_owned_check(v->key, strlen(v->key), why, sizeof why)) return 0;
+    fprintf(stderr, "%s: --vary %s: %s: a sweep cannot vary it\n", prog, v->text, why);
+    return -1;
 }
 
 /* splitmix64: one 64-bit mix of (seed, run, key, draw), the only source of randomness */
@@ -200,291 +298,6 @@ static int run_sets(const vary *vs, int nv, const double *val, const eval_scene 
         n++;
     }
     return n;
-}
-
-/* ---------------------------------------------------------------- CSV rows */
-typedef struct rows {
-    int n, cap;
-    long *run;
-    char **line;
-} rows;
-
-static int rows_add(rows *r, long run, const char *line)
-{
-    if (r->n == r->cap) {
-        int cap = r->cap ? 2 * r->cap : 256;
-        long *ru = realloc(r->run, (size_t)cap * sizeof *ru);
-        if (!ru) return -1;
-        r->run = ru;
-        char **li = realloc(r->line, (size_t)cap * sizeof *li);
-        if (!li) return -1;
-        r->line = li;
-        r->cap = cap;
-    }
-    r->run[r->n] = run;
-    r->line[r->n] = strdup(line);
-    return r->line[r->n++] ? 0 : -1;
-}
-
-static void rows_free(rows *r)
-{
-    for (int i = 0; i < r->n; i++) free(r->line[i]);
-    free(r->run);
-    free(r->line);
-    memset(r, 0, sizeof *r);
-}
-
-static int cmp_long(const void *a, const void *b)
-{
-    long x = *(const long *)a, y = *(const long *)b;
-    return (x > y) - (x < y);
-}
-
-static rows *sort_rows;
-static int by_run(const void *a, const void *b)
-{
-    long x = sort_rows->run[*(const int *)a], y = sort_rows->run[*(const int *)b];
-    return (x > y) - (x < y);
-}
-
-/* Writes the rows in run order; -1 on two rows of one run. */
-static int rows_write(rows *r, FILE *f, const char *header, char *err, size_t errlen)
-{
-    int *ord = malloc((size_t)(r->n ? r->n : 1) * sizeof *ord);
-    if (!ord) return -1;
-    for (int i = 0; i < r->n; i++) ord[i] = i;
-    sort_rows = r;
-    qsort(ord, (size_t)r->n, sizeof *ord, by_run);
-    for (int i = 1; i < r->n; i++)
-        if (r->run[ord[i]] == r->run[ord[i - 1]]) {
-            snprintf(err, errlen, "run %ld appears twice", r->run[ord[i]]);
-            free(ord);
-            return -1;
-        }
-    fprintf(f, "%s\n", header);
-    for (int i = 0; i < r->n; i++) fprintf(f, "%s\n", r->line[ord[i]]);
-    free(ord);
-    return 0;
-}
-
-/* The CSV fields of a line (reason quoted, the others plain): pointers into buf. */
-static int split(char *buf, char **field, int max)
-{
-    int n = 0;
-    char *p = buf;
-    while (n < max) {
-        if (*p == '"') {
-            field[n++] = ++p;
-            while (*p && !(*p == '"' && p[1] != '"')) p += *p == '"' ? 2 : 1;
-            if (*p) *p++ = '\0';
-        } else {
-            field[n++] = p;
-            p += strcspn(p, ",");
-        }
-        if (*p != ',') {
-            *p = '\0';
-            break;
-        }
-        *p++ = '\0';
-    }
-    return n;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double pct(const double *v, int n, double p)
-{
-    double at = p * (n - 1);
-    int lo = (int)floor(at);
-    if (lo >= n - 1) return v[n - 1];
-    return v[lo] + (v[lo + 1] - v[lo]) * (at - lo);
-}
-
-/* Pass rate and percentiles of every metric column, from the CSV's rows. */
-static void summary(const char *header, rows *r)
-{
-    char hb[ROW_MAX];
-    snprintf(hb, sizeof hb, "%s", header);
-    char *hf[512];
-    int nh = split(hb, hf, 512);
-    int c_failed = -1, c_req = -1, c_first = -1;
-    for (int i = 0; i < nh; i++) {
-        if (!strcmp(hf[i], "failed")) c_failed = i;
-        if (!strcmp(hf[i], "required")) c_req = i;
-        if (!strcmp(hf[i], "reason")) c_first = i + 1;
-    }
-    if (c_failed < 0 || c_req < 0 || c_first < 0) return;
-    int pass = 0, failed = 0;
-    double *vals = malloc((size_t)(r->n ? r->n : 1) * (size_t)nh * sizeof *vals);
-    int *nv = calloc((size_t)nh, sizeof *nv);
-    if (!vals || !nv) {
-        free(vals), free(nv);
-        return;
-    }
-    for (int i = 0; i < r->n; i++) {
-        char lb[ROW_MAX];
-        snprintf(lb, sizeof lb, "%s", r->line[i]);
-        char *f[512];
-        int n = split(lb, f, 512);
-        if (n != nh) continue;
-        bool fl = !strcmp(f[c_failed], "1"), ok = !fl && !strcmp(f[c_req], "1");
-        pass += ok, failed += fl;
-        for (int c = c_first; c < nh; c++) {
-            double x = strtod(f[c], NULL);
-            if (isfinite(x)) vals[(size_t)c * (size_t)r->n + (size_t)nv[c]++] = x;
-        }
-    }
-    printf("%d runs: %d passed (%.1f %%), %d failed, %d missed --require\n", r->n, pass,
-           r->n ? 100.0 * pass / r->n : 0.0, failed, r->n - pass - failed);
-    printf("%-22s %6s %12s %12s %12s %12s %12s\n", "metric", "n", "min", "p5", "p50", "p95",
-           "max");
-    for (int c = c_first; c < nh; c++) {
-        double *v = vals + (size_t)c * (size_t)r->n;
-        if (!nv[c]) {
-            printf("%-22s %6d %12s\n", hf[c], 0, "none");
-            continue;
-        }
-        qsort(v, (size_t)nv[c], sizeof *v, cmp_double);
-        printf("%-22s %6d %12.6g %12.6g %12.6g %12.6g %12.6g\n", hf[c], nv[c], v[0],
-               pct(v, nv[c], 0.05), pct(v, nv[c], 0.5), pct(v, nv[c], 0.95), v[nv[c] - 1]);
-    }
-    free(vals);
-    free(nv);
-}
-
-/* ---------------------------------------------------------------- merge */
-/* Whether the rows' run numbers are exactly 0..max (runs found twice are rows_write's to
- * refuse); else the missing ones, as numbers and ranges, in buf. */
-static bool rows_whole(const rows *r, char *buf, size_t len)
-{
-    long *run = malloc((size_t)(r->n ? r->n : 1) * sizeof *run);
-    if (!run) {
-        snprintf(buf, len, "out of memory");
-        return false;
-    }
-    memcpy(run, r->run, (size_t)r->n * sizeof *run);
-    qsort(run, (size_t)r->n, sizeof *run, cmp_long);
-    size_t u = 0;
-    int gaps = 0;
-    long next = 0; /* the first run not yet seen */
-    buf[0] = '\0';
-    for (int i = 0; i <= r->n; i++) {
-        long at = i < r->n ? run[i] : next; /* past the end: no gap after the last */
-        if (at > next) {
-            if (gaps < 12 && u < len)
-                u += (size_t)(at - 1 > next
-                                  ? snprintf(buf + u, len - u, "%s%ld-%ld", gaps ? ", " : "",
-                                             next, at - 1)
-                                  : snprintf(buf + u, len - u, "%s%ld", gaps ? ", " : "", next));
-            else if (gaps == 12 && u < len)
-                u += (size_t)snprintf(buf + u, len - u, ", ...");
-            gaps++;
-        }
-        if (at + 1 > next) next = at + 1;
-    }
-    bool negative = r->n && run[0] < 0;
-    if (negative) snprintf(buf, len, "(a negative run number, %ld)", run[0]);
-    free(run);
-    return gaps == 0 && !negative;
-}
-
-/* Shard number k's rows into r; its header must be the first's (kept in header). 0, or -1
- * after saying why. */
-static int read_shard(const char *path, int k, char *header, rows *r)
-{
-    char line[ROW_MAX];
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        fprintf(stderr, "%s: %s: %s\n", prog, path, strerror(errno));
-        return -1;
-    }
-    int ln = 0, bad = 0;
-    while (!bad && fgets(line, sizeof line, f)) {
-        ln++;
-        size_t len = strlen(line);
-        if (len && line[len - 1] == '\n') line[--len] = '\0';
-        if (ln == 1) {
-            if (strncmp(line, "run,", 4)) bad = 1;
-            else if (k && strcmp(header, line)) bad = 2;
-            else snprintf(header, ROW_MAX, "%s", line);
-        } else {
-            char *end;
-            long run = strtol(line, &end, 10);
-            if (end == line || *end != ',' || rows_add(r, run, line)) bad = 3;
-        }
-    }
-    fclose(f);
-    if (bad)
-        fprintf(stderr, "%s: %s:%d: %s\n", prog, path, ln,
-                bad == 1 ? "not a lagsim-sweep CSV (its header starts with 'run,')"
-                : bad == 2 ? "another sweep's header than the first file's"
-                           : "expected a row starting with its run number");
-    return bad ? -1 : 0;
-}
-
-static int merge(int argc, char **argv)
-{
-    const char *out = NULL;
-    bool force = false, partial = false;
-    const char *in[256];
-    int nin = 0;
-    for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output")) {
-            if (++i == argc) return die("%s needs a value", argv[i - 1]);
-            out = argv[i];
-        } else if (!strcmp(argv[i], "-f") || !strcmp(argv[i], "--force")) {
-            force = true;
-        } else if (!strcmp(argv[i], "--partial")) {
-            partial = true;
-        } else if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
-            usage(stdout);
-            return 0;
-        } else if (argv[i][0] == '-') {
-            return die("merge: unknown option '%s' (try --help)", argv[i]);
-        } else if (nin < 256) {
-            in[nin++] = argv[i];
-        }
-    }
-    if (!nin) return die("%s", "merge: expected the shards' CSV files (try --help)");
-    if (!out) return die("%s", "merge: -o OUT.csv is required");
-    rows r = {0};
-    char header[ROW_MAX] = "";
-    for (int k = 0; k < nin; k++)
-        if (read_shard(in[k], k, header, &r)) {
-            rows_free(&r);
-            return 2;
-        }
-    /* a run number is all a row says of its sweep: shards that leave a run out (one
-     * forgotten, one of another split) make no whole; the runs a sweep has are not in its
-     * CSV, so a missing last shard's runs past the others' cannot be told */
-    char missing[512];
-    if (!partial && !rows_whole(&r, missing, sizeof missing)) {
-        fprintf(stderr, "%s: merge: the shards do not make a whole sweep: missing runs %s "
-                        "(a whole sweep has every run from 0 to its last); give every shard, "
-                        "or --partial to merge only these\n", prog, missing);
-        rows_free(&r);
-        return 2;
-    }
-    FILE *fo = eval_open_out(prog, "-o", out, force, in, nin);
-    if (!fo) {
-        rows_free(&r);
-        return 2;
-    }
-    char err[256];
-    int rc = rows_write(&r, fo, header, err, sizeof err);
-    if (fclose(fo) != 0 || rc) {
-        fprintf(stderr, "%s: merge: %s\n", prog, rc ? err : strerror(errno));
-        unlink(out);
-        rows_free(&r);
-        return 2;
-    }
-    summary(header, &r);
-    rows_free(&r);
-    return 0;
 }
 
 /* ---------------------------------------------------------------- plot */
@@ -597,7 +410,11 @@ typedef struct sweep {
     double duration, timeout;
     long runs, jobs, shard_k, shard_n, per_point, total;
     uint64_t seed;
-    bool force, verbose, restart;
+    const char *url_opt;
+    bool force, verbose, restart, allow_lan;
+    eval_bus bus;                /* the runs' group and options */
+    lag_port_lease lease[256];   /* a pair of ports for each worker, held while it runs */
+    char url[256][160];          /* each worker's URL */
     vary vs[VARY_MAX];
     int nv;
     char lagsimd[4096];
@@ -605,14 +422,45 @@ typedef struct sweep {
     eval_scene sc;
     lag_require req;
     char header[ROW_MAX];
+    char *identity;      /* the CSV's identity lines (sweep_merge.h) */
     char default_metric[160];
-    char tmpdir[64];
+    char tmpdir[160]; /* eval_make_tmpdir: at most 128 + 21 */
 } sweep;
+
+/* An integer option: a plain decimal (as a scene writes a number) with no fraction; lo
+ * when it is not one (so that the caller's conversion to an integer is defined). */
+static double parse_int(const char *opt, const char *s, double lo, double hi, int *bad)
+{
+    double v = 0;
+    if (lag_scene_read_decimal(s, &v) != LAG_OK || v != floor(v) || !(v >= lo && v <= hi)) {
+        fprintf(stderr, "%s: %s: expected an integer from %.0f to %.0f, got '%s'\n", prog, opt,
+                lo, hi, s);
+        *bad = 1;
+        return lo;
+    }
+    return v;
+}
+
+/* One --vary: read, not on a key the tools own, not on a key varied already. -1 after
+ * saying why. */
+static int add_vary(sweep *x, const char *text)
+{
+    char why[256];
+    if (x->nv == VARY_MAX) return die("at most %s --vary", "16"), -1;
+    vary *v = &x->vs[x->nv];
+    if (parse_vary(text, v, why, sizeof why)) {
+        fprintf(stderr, "%s: --vary %s: %s\n", prog, text, why);
+        return -1;
+    }
+    if (vary_owned(v) || vary_twice(x->vs, x->nv, v)) return -1;
+    x->nv++;
+    return 0;
+}
 
 static int parse_options(sweep *x, int argc, char **argv)
 {
     enum { O_CASE = 256, O_SUITE, O_VARY, O_SEED, O_SHARD, O_REQUIRE, O_CSV, O_PLOT, O_METRIC,
-           O_LAGSIMD, O_TIMEOUT, O_RESTART };
+           O_LAGSIMD, O_TIMEOUT, O_RESTART, O_URL, O_ALLOW_LAN };
     static const struct option opts[] = {
         {"config", required_argument, 0, 'c'},      {"controller", required_argument, 0, 'C'},
         {"case", required_argument, 0, O_CASE},     {"suite", required_argument, 0, O_SUITE},
@@ -624,6 +472,7 @@ static int parse_options(sweep *x, int argc, char **argv)
         {"force", no_argument, 0, 'f'},             {"lagsimd", required_argument, 0, O_LAGSIMD},
         {"timeout", required_argument, 0, O_TIMEOUT}, {"verbose", no_argument, 0, 'v'},
         {"restart", no_argument, 0, O_RESTART},     {"help", no_argument, 0, 'h'},
+        {"url", required_argument, 0, O_URL},       {"allow-lan", no_argument, 0, O_ALLOW_LAN},
         {0, 0, 0, 0}};
     int o, bad = 0;
     opterr = 0;
@@ -635,19 +484,15 @@ static int parse_options(sweep *x, int argc, char **argv)
         case O_SUITE: x->suite = optarg; break;
         case 'd': x->duration = parse_pos("--duration", optarg, 1e-3, 1e6, &bad); break;
         case O_VARY:
-            if (x->nv == VARY_MAX) return die("at most %s --vary", "16");
-            if (parse_vary(optarg, &x->vs[x->nv++]))
-                return die("--vary %s: expected KEY=uniform(A,B) (A < B), KEY=normal(MEAN,SD) "
-                           "or KEY=grid(A,B,N); an index only on initial.q[i] or "
-                           "initial.qd[i]", optarg);
+            if (add_vary(x, optarg)) return 2;
             break;
-        case 'n': x->runs = (long)parse_pos("--runs", optarg, 1, 1e7, &bad); break;
-        case O_SEED: x->seed = (uint64_t)parse_pos("--seed", optarg, 0, 9e15, &bad); break;
-        case 'j': x->jobs = (long)parse_pos("--jobs", optarg, 1, 256, &bad); break;
+        case 'n': x->runs = (long)parse_int("--runs", optarg, 1, 1e7, &bad); break;
+        case O_SEED: x->seed = (uint64_t)parse_int("--seed", optarg, 0, 9e15, &bad); break;
+        case 'j': x->jobs = (long)parse_int("--jobs", optarg, 1, 256, &bad); break;
         case O_SHARD:
-            if (sscanf(optarg, "%ld/%ld", &x->shard_k, &x->shard_n) != 2 || x->shard_n < 1 ||
-                x->shard_k < 1 || x->shard_k > x->shard_n)
-                return die("--shard: expected K/N with 1 <= K <= N, got '%s'", optarg);
+            if (sweep_shard_parse(optarg, &x->shard_k, &x->shard_n))
+                return die("--shard: expected K/N, whole numbers with 1 <= K <= N <= 1e7, got "
+                           "'%s'", optarg);
             break;
         case O_REQUIRE: x->require = optarg; break;
         case O_CSV: x->csv = optarg; break;
@@ -658,6 +503,8 @@ static int parse_options(sweep *x, int argc, char **argv)
         case O_TIMEOUT: x->timeout = parse_pos("--timeout", optarg, 1, 1e6, &bad); break;
         case 'v': x->verbose = true; break;
         case O_RESTART: x->restart = true; break;
+        case O_URL: x->url_opt = optarg; break;
+        case O_ALLOW_LAN: x->allow_lan = true; break;
         case 'h': usage(stdout); return 0;
         case ':': return die("%s needs a value (try --help)", argv[optind - 1]);
         default: return die("unknown option '%s' (try --help)", argv[optind - 1]);
@@ -667,13 +514,15 @@ static int parse_options(sweep *x, int argc, char **argv)
     return -1; /* go on */
 }
 
-static int check_options(const sweep *x, int argc, char **argv)
+static int check_options(sweep *x, int argc, char **argv)
 {
     if (optind < argc) return die("unexpected argument '%s' (try --help)", argv[optind]);
     if (!x->config) return die("%s", "--config SCENE is required (try --help)");
     if (!x->controller) return die("%s", "--controller 'COMMAND' is required (try --help)");
     if (!x->nv) return die("%s", "at least one --vary KEY=DIST is required (try --help)");
     if (!x->case_name == !x->duration) return die("%s", "give either --case NAME or --duration S");
+    char err[512];
+    if (eval_bus_init(&x->bus, x->url_opt, x->allow_lan, err, sizeof err)) return die("%s", err);
     return -1;
 }
 
@@ -724,9 +573,9 @@ static int load_scene(sweep *x)
         x->restart = true;
     }
     x->per_point = x->total = x->runs;
-    for (int k = 0; k < x->nv; k++)
-        if (x->vs[k].kind == V_GRID) x->total *= x->vs[k].n;
-    if (x->total > 10000000) return die("%s", "more than 1e7 runs");
+    for (int k = 0; k < x->nv; k++) /* each factor <= 1e7: checked before it can overflow */
+        if (x->vs[k].kind == V_GRID && (x->total *= x->vs[k].n) > 10000000)
+            return die("%s", "more than 1e7 runs (--runs times the grids' points)");
     return -1;
 }
 
@@ -736,24 +585,40 @@ static int make_header(sweep *x)
 {
     char *h = x->header;
     size_t hu = (size_t)snprintf(h, ROW_MAX, "run");
-    for (int k = 0; k < x->nv; k++) {
+    for (int k = 0; k < x->nv && hu < ROW_MAX; k++) {
         if (x->vs[k].index < 0)
             hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",%s", x->vs[k].key);
         else
             hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",%s[%d]", x->vs[k].key,
                                    x->vs[k].index);
     }
-    hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",failed,required,reason");
-    for (int j = 0; j < x->sc.nj; j++)
-        for (int m = 0; m < LAG_METRIC_COUNT; m++)
+    if (hu < ROW_MAX) hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",failed,required,reason");
+    for (int j = 0; j < x->sc.nj && hu < ROW_MAX; j++)
+        for (int m = 0; m < LAG_METRIC_COUNT && hu < ROW_MAX; m++)
             hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",%s.%s", x->sc.joint[j],
                                    lag_metric_table[m].name);
+    if (hu >= ROW_MAX) return die("the CSV's header (the varied keys' names) would pass %s bytes",
+                                  "8191");
     snprintf(x->default_metric, sizeof x->default_metric, "%s.%s",
              x->req.n ? x->req.term[0].joint : x->sc.joint[0],
              lag_metric_table[x->req.n ? x->req.term[0].metric : LAG_METRIC_IAE].name);
     if (!x->metric) x->metric = x->default_metric;
     if (x->png && header_column(x->header, x->metric) < 0)
         return die("--metric %s: no such column (JOINT.METRIC, e.g. theta.settle)", x->metric);
+    return -1;
+}
+
+/* What every shard of the sweep shares, for the CSV's identity lines. -1 or the exit code. */
+static int make_identity(sweep *x)
+{
+    char err[2048];
+    const char *texts[VARY_MAX];
+    for (int k = 0; k < x->nv; k++) texts[k] = x->vs[k].text;
+    sweep_identity id = {.seed = x->seed, .scene = x->config, .c = &x->c, .vary = texts,
+                         .nvary = x->nv, .runs = x->total, .controller = x->controller,
+                         .restart = x->restart, .require = x->require,
+                         .shard_k = x->shard_k, .shard_n = x->shard_n};
+    if (!(x->identity = sweep_identity_text(&id, err, sizeof err))) return die("%s", err);
     return -1;
 }
 
@@ -771,8 +636,10 @@ static eval_env worker_env(const worker *wk, long run)
 {
     const sweep *x = wk->x;
     eval_env env = {.lagsimd = x->lagsimd, .config = x->config, .controller = x->controller,
-                    .workdir = x->tmpdir, .wall_timeout = x->timeout, .verbose = x->verbose};
-    eval_url((int)wk->w, env.url, sizeof env.url);
+                    .workdir = x->tmpdir, .wall_timeout = x->timeout, .verbose = x->verbose,
+                    .allow_lan = x->allow_lan};
+    /* the worker's ports, for all its runs; a prefix of each run's own */
+    snprintf(env.url, sizeof env.url, "%s", x->url[wk->w]);
     if (run < 0) snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_W%ld", (int)getpid(), wk->w);
     else snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_%ld", (int)getpid(), run);
     return env;
@@ -812,12 +679,8 @@ static void write_row(const worker *wk, long i, const double *val, const eval_re
     fprintf(f, "%ld", i);
     for (int k = 0; k < x->nv; k++) fprintf(f, ",%.17g", val[k]);
     const char *reason = res->failed ? res->reason : met ? "" : why;
-    fprintf(f, ",%d,%d,\"", res->failed, met);
-    for (const char *p = reason; *p; p++) {
-        if (*p == '"') fputc('"', f);
-        fputc(*p == '\n' ? ' ' : *p, f);
-    }
-    fputc('"', f);
+    fprintf(f, ",%d,%d,", res->failed, met);
+    sweep_write_reason(f, reason);
     for (int j = 0; j < x->sc.nj; j++)
         for (int m = 0; m < LAG_METRIC_COUNT; m++) {
             if (isnan(res->m[j].v[m])) fprintf(f, ",nan");
@@ -882,42 +745,45 @@ static void worker_main(const sweep *x, long w)
 }
 
 /* ---------------------------------------------------------------- the results */
+/* The workers, forked (each dies with this process: eval_proc_fork), and their ends. */
 static int run_workers(sweep *x)
 {
     pid_t pids[256];
     int status = 0;
     for (long w = 0; w < x->jobs; w++) {
-        fflush(NULL);
-        pids[w] = fork();
+        pids[w] = eval_proc_fork();
         if (pids[w] < 0) {
             fprintf(stderr, "%s: fork: %s\n", prog, strerror(errno));
+            for (long k = 0; k < w; k++) eval_stop_group(pids[k], &(int){0});
             return 2;
         }
         if (pids[w] == 0) worker_main(x, w);
     }
     for (long w = 0; w < x->jobs; w++) {
         int st = 0;
-        waitpid(pids[w], &st, 0);
-        if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) status = 2;
+        if (eval_proc_wait(pids[w], &st) != 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0)
+            status = 2;
     }
     return status;
 }
 
 static void collect_rows(const sweep *x, rows *r)
 {
-    char line[ROW_MAX];
+    char *line = NULL;
+    size_t cap = 0;
     for (long w = 0; w < x->jobs; w++) {
         char path[256];
         snprintf(path, sizeof path, "%s/%ld.rows", x->tmpdir, w);
         FILE *f = fopen(path, "r");
         if (!f) continue;
-        while (fgets(line, sizeof line, f)) {
+        while (getline(&line, &cap, f) >= 0) {
             line[strcspn(line, "\n")] = '\0';
             rows_add(r, strtol(line, NULL, 10), line);
         }
         fclose(f);
         unlink(path);
     }
+    free(line);
 }
 
 static int count_passed(const sweep *x, const rows *r)
@@ -933,40 +799,66 @@ static int count_passed(const sweep *x, const rows *r)
     return passed;
 }
 
+/* A pair of ports for each worker, held until the sweep ends (its workers, forked, share
+ * the locks). Returns -1 after saying why when the host has too few free. */
+static int take_ports(sweep *x)
+{
+    char err[512];
+    for (long w = 0; w < x->jobs; w++)
+        if (eval_bus_take(&x->bus, &x->lease[w], x->url[w], sizeof x->url[w], err, sizeof err)) {
+            fprintf(stderr, "%s: worker %ld: %s\n", prog, w + 1, err);
+            return -1;
+        }
+    return 0;
+}
+
+static void release_ports(sweep *x)
+{
+    for (long w = 0; w < x->jobs; w++) lag_port_release(&x->lease[w]);
+}
+
 static int sweep_run(sweep *x)
 {
     char err[2048];
     FILE *fcsv = NULL, *fpng = NULL;
-    const char *in[2] = {x->config, x->suite};
+    /* what the sweep reads (the scene, the suite, the daemon) and its CSV: no output may
+     * be one of them (compared by device and inode) */
+    const char *in[4] = {x->config, x->lagsimd, x->suite, x->csv};
     /* every output opened (and so refused, when it must be) before the first run: a sweep
      * never runs for hours to lose its results at the end */
-    if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, 2))) return 2;
-    if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, 2))) {
-        if (fcsv) fclose(fcsv), unlink(x->csv);
+    struct stat st;
+    bool csv_new = x->csv && lstat(x->csv, &st) != 0;
+    if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, 3))) return 2;
+    if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, 4))) {
+        if (fcsv) fclose(fcsv);
+        if (csv_new) unlink(x->csv); /* a CSV this sweep made, empty */
         return 2;
     }
     if (fpng) fclose(fpng); /* gnuplot writes it at the end */
-    snprintf(x->tmpdir, sizeof x->tmpdir, "/tmp/lagsim-sweep.XXXXXX");
-    if (!mkdtemp(x->tmpdir)) {
+    if (eval_make_tmpdir("lagsim-sweep", x->tmpdir, sizeof x->tmpdir) != 0) {
         fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
         return 2;
     }
+    if (x->verbose) eval_proc_tmpdir_done(); /* -v keeps the kept daemons' logs */
     int status = run_workers(x);
     rows r = {0};
     collect_rows(x, &r);
-    if (fcsv && (rows_write(&r, fcsv, x->header, err, sizeof err) || fclose(fcsv) != 0))
+    if (fcsv && (rows_write(&r, fcsv, x->identity, x->header, err, sizeof err) ||
+                 fclose(fcsv) != 0))
         status = 2;
     summary(x->header, &r);
     bool all = count_passed(x, &r) == r.n;
     if (x->png && plot(x->png, x->tmpdir, x->header, &r, x->nv, x->metric)) status = 2;
     rmdir(x->tmpdir);
+    eval_proc_tmpdir_done();
     rows_free(&r);
     return status ? status : all ? 0 : 1;
 }
 
 int main(int argc, char **argv)
 {
-    if (argc > 1 && !strcmp(argv[1], "merge")) return merge(argc - 1, argv + 1);
+    if (argc > 1 && !strcmp(argv[1], "merge")) return merge(argc - 1, argv + 1, usage);
+    eval_proc_init(); /* every process it starts ends when it ends (eval_proc.h) */
     static sweep x = {.timeout = 600, .runs = 1, .jobs = 1, .shard_k = 1, .shard_n = 1,
                       .seed = 1};
     eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
@@ -974,6 +866,10 @@ int main(int argc, char **argv)
     if ((rc = parse_options(&x, argc, argv)) >= 0 || (rc = check_options(&x, argc, argv)) >= 0 ||
         (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0)
         return rc;
-    if ((rc = make_header(&x)) >= 0) return rc;
-    return sweep_run(&x);
+    if ((rc = make_header(&x)) >= 0 || (rc = make_identity(&x)) >= 0) return rc;
+    for (long w = 0; w < x.jobs; w++) x.lease[w] = (lag_port_lease){.port = 0, .fd = -1};
+    rc = take_ports(&x) ? 2 : sweep_run(&x);
+    release_ports(&x);
+    free(x.identity);
+    return rc;
 }

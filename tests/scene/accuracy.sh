@@ -59,7 +59,10 @@ rc=$?
 [ $rc -eq 0 ] && ok "--cost exit 0" || bad "--cost exit $rc"
 n=$(grep -c "meets, chosen" "$work/cost.txt")
 [ "$n" = 1 ] && ok "one chosen row" || bad "$n chosen rows"
-for m in euler semi-implicit-euler rk4 dopri5 implicit-midpoint gauss4; do
+# a row per method of the core's table (lagsimd --list methods)
+methods=$("$lagsimd" --list methods) || bad "lagsimd --list methods: exit $?"
+[ "$(echo "$methods" | wc -w)" -ge 2 ] || bad "lagsimd --list methods: '$methods'"
+for m in $methods; do
   grep -q "^$m " "$work/cost.txt" || bad "--cost has no row of $m"
 done
 head -c 8 "$work/cost.png" | od -An -c | grep -q "P   N   G" && ok "--plot wrote a PNG" \

@@ -46,14 +46,14 @@ extern "C" {
  *                                       newton_tol
  *   explode_limit
  *   effects                             the set of effects itself (unknown bits)
- *   effects.damping.<joint>
- *   effects.friction.<joint>.static | .kinetic
- *   effects.limits.<joint>.lower | .upper | .restitution,  effects.limits.rest_velocity
- *   effects.floor.restitution | .rest_velocity
- *   effects.actuator.<joint>.max | .lag
- *   effects.disturbance[k].t | .joint | .impulse | .force | .duration
- *   effects.noise.q.<joint> | effects.noise.qd.<joint>
- *   effects.spring.<joint>.k | .rest
+ *   effects.<effect>...                 a setting of an effect of the table, by its scene
+ *                                       key: .<joint> (one number per joint, e.g.
+ *                                       effects.damping.theta1), .<joint>.<key>
+ *                                       (effects.friction.x.static), .<key>
+ *                                       (effects.floor.restitution), [k].<key>
+ *                                       (effects.disturbance[0].t), .<key>.<joint>
+ *                                       (effects.noise.q.phi); the keys of each:
+ *                                       docs/scenes.md, "Numbers and their ranges"
  * `field` is "" when no single value is at fault. `message` says what is expected and
  * what was found, without repeating the field. */
 #define LAG_FIELD_MAX 64
