@@ -269,30 +269,35 @@ static int64_t run_reference(cost_run *c, lag_cost_table *out, char *err, size_t
     return ran;
 }
 
-/* from_current: the target is the error the current setting reaches, times safety (at
- * least TARGET_MIN), over the periods before the first where the references differ by
- * more than that error so far (or TARGET_MIN): beyond, the first reference is not known to
- * a tenth of the error it measures. Returns those periods; 0 if its error is not finite
- * (then the target is opts.target). */
+/* from_current: the target is the error the current setting reaches, times safety, over
+ * the periods before the first where the references differ by more than that error so
+ * far: beyond, the first reference is not known to a tenth of the error it measures. A
+ * difference within a hundred times the second's tolerance is its own error, not a parting
+ * (a pair at 1e-13 and 1e-12 differs by 1e-12 to 5e-12 over 1 s of the shipped scenes),
+ * and an error below the references' difference cannot be told from it: the target is
+ * then safety times that difference (at least TARGET_MIN). Returns those periods; 0 if
+ * the current setting's error is not finite (then the target is opts.target). */
 static int64_t target_of_current(cost_run *c, lag_cost_table *out)
 {
     const lag_cost_opts *o = c->o;
     char err[256];
     if (run_horizon(c, o->current, NULL, true, err, sizeof err) != LAG_OK) return 0;
-    const double least = TARGET_MIN; /* below, a difference of the references' own */
-    double m = 0;
+    const double least = fmax(TARGET_MIN, 100 * out->ref2.tol);
+    double m = 0, d = 0;
     int64_t k = 0;
     for (; k < c->nper; k++) {
         double mk = fmax(m, c->per[k]);
         if (!(c->ref_diff[k] <= fmax(mk, least))) break;
         m = mk;
+        d = fmax(d, c->ref_diff[k]);
     }
     if (k == 0) { /* not one period: the references' own difference there is the least */
         k = 1;
-        m = fmax(c->per[0], c->ref_diff[0]);
+        m = c->per[0];
+        d = c->ref_diff[0];
     }
-    if (!isfinite(m)) return 0;
-    c->target = fmax(o->safety * m, TARGET_MIN);
+    if (!isfinite(m) || !isfinite(d)) return 0;
+    c->target = fmax(o->safety * fmax(m, d), TARGET_MIN);
     out->agree_tol = fmax(m, least);
     out->target_from_current = true;
     return k;

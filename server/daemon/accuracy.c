@@ -347,10 +347,18 @@ static void cost_header(const lag_scene *sc, const lag_cost_table *t)
                "times to spare),\n", t->target, t->horizon, o.safety);
     else if (t->target_from_current) {
         char d[96] = "?";
-        if (t->current >= 0) lag_cost_row_describe(&t->row[t->current], d, sizeof d);
+        double e = t->target / o.safety;
+        if (t->current >= 0) {
+            lag_cost_row_describe(&t->row[t->current], d, sizeof d);
+            e = t->row[t->current].error;
+        }
+        char why[120] = "";
+        if (e * o.safety < t->target * (1 - 1e-9))
+            snprintf(why, sizeof why, ": %g times the references' own difference, below "
+                     "which no error is told", o.safety);
         printf("no error asked for: a setting meets when it is as accurate as\n# the scene's "
-               "integrator, %s, error %.3g over %g s (as if integrator.error were %.3g),\n",
-               d, t->target / o.safety, t->horizon, t->target);
+               "integrator, %s, error %.3g over %g s (as if integrator.error were %.3g%s),\n",
+               d, e, t->horizon, t->target, why);
     }
     else
         printf("no error asked for, and its integrator's error not measured: rows marked at "

@@ -25,9 +25,11 @@
  *
  * The scene's own integrator (current_<scene>: no error asked for): its row is there and
  * marked, its error is the one against rk4 at period / 1024 (not the calibration's
- * dopri5) to 1e-3 of it plus 1e-12, the least error the calibration measures; the rows
- * are marked at safety times it (at least 1e-12), and the setting that would be chosen is
- * at least as accurate and no dearer.
+ * dopri5) to 1e-3 of it plus 1e-10 (rk4 at period / 1024 takes 1e5 steps a second, whose
+ * rounding alone reaches about 1e-11: on the flying stick, whose motion rk4 integrates
+ * exactly, it is 7e-12 from rk4 at the scene's 1 ms); the rows are marked at safety times
+ * it, or the references' own difference where that is larger (at least 1e-12); the
+ * setting that would be chosen meets that and is no dearer.
  */
 #include <dirent.h>
 
@@ -235,11 +237,12 @@ static void case_current(int s)
            "at %.3g%s\n", scene_names[s], d, cur->error, e, t.target,
            t.target_from_current ? "" : " (not from it)");
     ENSURE(t.target_from_current && !t.horizon_cut);
-    ENSURE_NEAR(cur->error, e, 1e-3 * e + 1e-12, "%s: the scene's integrator's error", d);
-    ENSURE_NEAR(t.target, fmax(o.safety * cur->error, 1e-12), 1e-12 * t.target, "target");
+    ENSURE_NEAR(cur->error, e, 1e-3 * e + 1e-10, "%s: the scene's integrator's error", d);
+    ENSURE_NEAR(t.target, fmax(o.safety * fmax(cur->error, t.ref_diff), 1e-12), 1e-12 * t.target,
+                "target");
     ENSURE(cur->meets && t.chosen >= 0);
     if (t.chosen < 0) return;
-    ENSURE(t.row[t.chosen].error <= cur->error);
+    ENSURE(t.row[t.chosen].meets);
     ENSURE(t.row[t.chosen].cpu_per_sim_s <= cur->cpu_per_sim_s);
 }
 
