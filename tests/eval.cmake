@@ -32,13 +32,19 @@ if(LAGSIM_PYTHON3)
   endforeach()
 endif()
 
+# A controller that reads its gains from every scene (lagsim-sweep's scene_* cases).
+add_executable(scene_pd ${CMAKE_CURRENT_LIST_DIR}/eval/scene_pd.c)
+target_link_libraries(scene_pd PRIVATE lagsim_controller)
+
 # lagsim-sweep end to end: 8 runs of the cart-pole over its masses; the CSV the same for
 # -j1, -j2, two shards run by GNU parallel and merged, and a Slurm job array's two tasks
 # run here with Slurm's variables (no cluster needed); merge's refusals.
 find_program(LAGSIM_GNU_PARALLEL parallel)
 if(LAGSIM_PYTHON3 AND LAGSIM_GNU_PARALLEL)
+  # scene_*, unanswered: a scene-reactive controller (tests/eval/scene_pd.c, scene_pd.py)
+  # over m2, one that leaves the paused state unanswered (mute_pd.py)
   foreach(c same slurm merge merge_rows merge_foreign shard kept kept_python loss stalled ssh
-          vary)
+          vary scene_c scene_python scene_loss unanswered)
     add_test(NAME eval_lagsim_sweep_${c}
       COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_sweep.py
               $<TARGET_FILE_DIR:lagsim-sweep> ${PROJECT_SOURCE_DIR} ${c})

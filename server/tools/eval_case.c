@@ -527,7 +527,8 @@ static int read_reference(const lag_log_record *rec, const eval_scene *sc, doubl
         return 0;
     static _Alignas(max_align_t) unsigned char buf[1 << 16];
     if (size > sizeof buf ||
-        lag_wire_decode((lag_wire_type)type, rec->data, rec->size, EVAL_JOINTS_MAX, buf) != 0)
+        lag_wire_decode_any((lag_wire_type)type, rec->data, rec->size, EVAL_JOINTS_MAX, buf,
+                            NULL) != 0)
         return 0;
     memcpy(t, buf + f_t->offset, sizeof *t);
     int16_t n;
@@ -572,7 +573,7 @@ static void take_state(eval_take *tk, const lag_log_record *rec)
     const eval_scene *sc = tk->sc;
     eval_series *s = tk->s;
     lag_wire_joint_state st;
-    if (lag_wire_decode_joint_state(rec->data, rec->size, sc->nj, &st) != 0 ||
+    if (lag_wire_decode_any(LAG_WIRE_JOINT_STATE, rec->data, rec->size, sc->nj, &st, NULL) != 0 ||
         st.num_joints != sc->nj)
         return;
     /* a state published again (a lockstep retry, a status request) is one sample; a

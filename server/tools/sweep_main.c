@@ -661,7 +661,13 @@ static int run_kept(worker *wk, const char *const *sets, int nsets, const eval_s
             return -1;
         int rc = eval_worker_run(wk->kept, &x->c, sets, nsets, rsc->q0, rsc->qd0, res, err,
                                  errlen);
-        if (rc == 0 && !strstr(res->reason, "before the duration")) return 0;
+        /* a stalled run, or a controller that did not answer the run before's last state:
+         * the run fails, and the next one gets a new worker pair */
+        bool unanswered = rc == 0 && strstr(res->reason, "did not answer the paused state");
+        if (rc == 0 && !strstr(res->reason, "before the duration") && !unanswered) return 0;
+        if (unanswered) /* the run fails, and it is said: never a silent restart */
+            fprintf(stderr, "%s: worker %ld: a run failed: %s; a new lagsimd and controller "
+                    "for the next run\n", prog, wk->w, res->reason);
         eval_worker_stop(wk->kept);
         wk->kept = NULL;
         if (rc == 0) return 0;
