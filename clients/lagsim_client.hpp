@@ -279,12 +279,16 @@ private:
 };
 
 /* A connection to one plant (lag_client): its URL (empty: LCM's default, honouring
- * LCM_DEFAULT_URL) and channel prefix. Movable, not copyable. */
+ * LCM_DEFAULT_URL) and channel prefix; Error LAG_ERR_ARG for a prefix that is empty or
+ * 64 bytes or more, LAG_ERR_LCM when LCM cannot be opened on the URL. Movable, not
+ * copyable. */
 class Client {
 public:
     explicit Client(const std::string &prefix, const std::string &url = "")
         : cb_(std::make_unique<Callbacks>())
     {
+        if (prefix.empty() || prefix.size() >= LAG_CLIENT_NAME_LEN)
+            throw Error(LAG_ERR_ARG, "LAG_ERR_ARG: a prefix of 1 to 63 characters, not '" + prefix + "'");
         char err[256] = "";
         c_.reset(lag_client_create(url.empty() ? nullptr : url.c_str(), prefix.c_str(), err,
                                    sizeof err));

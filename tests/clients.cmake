@@ -304,3 +304,12 @@ target_include_directories(test_lcm_cpp_forged PRIVATE ${lcm_cpp_dir})
 target_link_libraries(test_lcm_cpp_forged PRIVATE lagsim_client PkgConfig::LCM)
 add_test(NAME clients_lcm_cpp_forged COMMAND test_lcm_cpp_forged)
 set_tests_properties(clients_lcm_cpp_forged PROPERTIES TIMEOUT 30 LABELS clients)
+
+# ---- lagsim_client.hpp: errors as lagsim::Error with the library's codes, callbacks'
+# exceptions out of the next call (never through C), scene views and copies, the fields
+# as the C library reads them (tests/clients/test_client_hpp.cpp, memq://)
+add_executable(test_client_hpp ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client_hpp.cpp)
+target_link_libraries(test_client_hpp PRIVATE lagsim_client)
+target_compile_options(test_client_hpp PRIVATE -Wpedantic)
+add_test(NAME clients_cpp_header COMMAND test_client_hpp)
+set_tests_properties(clients_cpp_header PROPERTIES TIMEOUT 30 LABELS clients)
