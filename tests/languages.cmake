@@ -267,7 +267,7 @@ add_test(NAME clients_octave_matlab_syntax
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/matlab_syntax.py ${octave_m}
           ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_octave_lqr.m ${CMAKE_CURRENT_SOURCE_DIR}/net/plant_urls_octave.m
           ${CMAKE_CURRENT_SOURCE_DIR}/clients/reference/reference_echo.m
-          --readme ${PROJECT_SOURCE_DIR}/README.md --readme ${PROJECT_SOURCE_DIR}/docs/clients.md)
+          --readme ${PROJECT_SOURCE_DIR}/README.md --snippets ${PROJECT_SOURCE_DIR}/docs/clients.md)
 list(APPEND lang_tests clients_octave_matlab_syntax)
 # the jars load in MATLAB's bundled Java 8: every class of LAGSIM_JAVA_RELEASE
 if(TARGET lagsim_examples_java)
