@@ -477,7 +477,13 @@ endif()
 if(LAGSIM_OTHER_CXX AND NOT LAGSIM_SANITIZE)
   add_test(NAME clients_readme_cpp_other_compiler
     COMMAND ${readme_run} --cc ${CMAKE_C_COMPILER} --cxx ${LAGSIM_OTHER_CXX} --periods 20 cpp-dipc)
-  list(APPEND lang_tests clients_readme_cpp_other_compiler)
+  # the C++ example and lagsim_client.hpp, -Werror with the other compiler too, built as a
+  # user builds it (pkg-config lagsim-client from the build tree)
+  add_test(NAME clients_manipulator_ct_other_compiler
+    COMMAND sh -c "${LAGSIM_OTHER_CXX} -std=c++17 -Wall -Wextra -Wpedantic -Wshadow -Werror -o \"$1\" \"$2\" $(PKG_CONFIG_PATH=$3 pkg-config --cflags --libs lagsim-client) && \"$1\" --help"
+            sh ${CMAKE_CURRENT_BINARY_DIR}/manipulator_ct_other ${PROJECT_SOURCE_DIR}/clients/manipulator_ct.cpp
+            ${CMAKE_BINARY_DIR}/pkgconfig)
+  list(APPEND lang_tests clients_readme_cpp_other_compiler clients_manipulator_ct_other_compiler)
 endif()
 # the MATLAB/Octave block by a plain octave --eval (the .m files of <build>/octave on the path)
 if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
