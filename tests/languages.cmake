@@ -471,10 +471,11 @@ add_test(NAME clients_readme_evaluate
 set_tests_properties(clients_readme_evaluate PROPERTIES TIMEOUT 560 LABELS "clients;slow")
 # docs/clients.md's newcomer walkthrough, its balance.py and commands as written: the
 # cart-pole balanced by Python for 10 s, logged, replayed, converted, plotted, and played
-# back to lagsim-view (which binds the walkthrough's port 8765)
+# back to lagsim-view (which binds the walkthrough's port 8765); then the same balance.py in
+# lockstep (a command without the state's generation is never taken there)
 add_test(NAME clients_walkthrough
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_recipes.py
-          --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} walkthrough)
+          --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} walkthrough walkthrough-lockstep)
 set_tests_properties(clients_walkthrough PROPERTIES TIMEOUT 200 LABELS clients)
 
 set_tests_properties(${lang_tests} PROPERTIES TIMEOUT 90 LABELS clients)
