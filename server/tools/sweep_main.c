@@ -579,6 +579,30 @@ static int load_scene(sweep *x)
     return -1;
 }
 
+/* Every varied key as the scene loader takes it, before any run: the scene with the case's
+ * overrides and one key set to its distribution's centre (uniform and grid: (A + B) / 2;
+ * normal: MEAN), a key at a time, so that an unknown key, a key of another type or a centre
+ * the scene refuses is said at once with the loader's words and exit 2, not found in every
+ * run's row. A value the scene refuses for part of the range only (a negative mass drawn
+ * by normal) stays a failed run of its own. -1 or the exit code. */
+static int check_vary_keys(const sweep *x)
+{
+    char err[2048], sets[2][EVAL_SET_LEN];
+    for (int k = 0; k < x->nv; k++) {
+        const vary *v = &x->vs[k];
+        double centre = v->kind == V_NORMAL ? v->a : v->a + 0.5 * (v->b - v->a);
+        int n = run_sets(v, 1, &centre, &x->sc, sets);
+        const char *extra[2] = {sets[0], sets[1]};
+        eval_scene sc;
+        if (eval_case_scene_load(x->config, x->suite ? x->suite : x->config, &x->c, extra, n,
+                                 &sc, err, sizeof err) == 0)
+            continue;
+        fprintf(stderr, "%s: --vary %s: the scene refuses %s: %s\n", prog, v->text, sets[0], err);
+        return 2;
+    }
+    return -1;
+}
+
 /* The CSV's header: run, the keys, the verdict, each joint's metrics; the metric to plot
  * among its columns. Returns -1 or the exit code. */
 static int make_header(sweep *x)
@@ -870,7 +894,8 @@ int main(int argc, char **argv)
     eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
     int rc;
     if ((rc = parse_options(&x, argc, argv)) >= 0 || (rc = check_options(&x, argc, argv)) >= 0 ||
-        (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0)
+        (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0 ||
+        (rc = check_vary_keys(&x)) >= 0)
         return rc;
     if ((rc = make_header(&x)) >= 0 || (rc = make_identity(&x)) >= 0) return rc;
     for (long w = 0; w < x.jobs; w++) x.lease[w] = (lag_port_lease){.port = 0, .fd = -1};

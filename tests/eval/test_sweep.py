@@ -710,6 +710,15 @@ BAD_VARY = [
     (["parameters.m1=normal(0.1,0)"], "SD > 0"),
     (["parameters.m1=normal(0.1,-1)"], "SD > 0"),
     (["parameters.m1=uniform(0.1,0.2)junk"], "plain decimal"),
+    # the keys as the scene loader takes them, before any run (before, every run failed
+    # with the loader's words in the CSV's reason, and the sweep exited 1)
+    (["parameters.M1=uniform(0.05,0.3)"], "--vary parameters.M1=uniform(0.05,0.3): the scene "
+     "refuses parameters.M1=0.17499999999999999: case sweep: --set parameters.M1: unknown "
+     "parameter 'M1'"),
+    (["parameters.m1=uniform(-3,-1)"], "refuses parameters.m1=-2: case sweep: --set "
+     "parameters.m1: expected a number > 0"),
+    (["initial.q[1]=uniform(0,0.1)", "effects.friction=grid(0,1,3)"], "--vary "
+     "effects.friction=grid(0,1,3): the scene refuses effects.friction=0.5"),
     (["parameters.m1=grid(0.1,0.2,1000)", "parameters.m0=grid(0.5,2,1000)",
       "initial.q[1]=grid(0,0.1,1000)"], "more than 1e7 runs"),
     # 1e36 runs: a count that overflowed to a negative one made "0 runs", exit 0
