@@ -64,6 +64,7 @@ import filecmp
 import glob
 import hashlib
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -750,6 +751,26 @@ def case_vary(d):
           ["0.10000000000000001"] * 2 + ["0.20000000000000001"] * 2,
           "grid(0.1, 0.2, 2) with blanks, two coordinates of initial.q: 4 runs (%d)"
           % p.returncode)
+    # a value refused for part of the range only: a failed run of its own, and the terminal
+    # summary (and merge's, made from the rows) says why runs failed, with their counts
+    out = os.path.join(d, "part.csv")
+    p = run([SWEEP] + base + ["--vary", "parameters.m1=normal(0.01,0.1)", "--runs", "8",
+                              "--seed", "3", "--csv", out])
+    r = rows(out)
+    bad = [x for x in r if x["failed"] == "1"]
+    shown = re.findall(r"^  (\d+) failed: (.*)$", p.stdout, re.M)
+    more = re.search(r"^  \.\.\. and (\d+) other reasons? \((\d+) runs?\)$", p.stdout, re.M)
+    counted = sum(int(n) for n, _ in shown) + (int(more.group(2)) if more else 0)
+    check(p.returncode == 1 and 0 < len(bad) < 8 and
+          all(x["reason"].startswith("refused: --set parameters.m1: expected a number > 0")
+              for x in bad) and counted == len(bad) and
+          {w for _, w in shown} <= {x["reason"] for x in bad} and len(shown) == min(5, len(bad)),
+          "normal(0.01,0.1): %d of 8 runs refused by the scene, each a failed run, the terminal "
+          "says why (%d reasons shown, %d runs counted)" % (len(bad), len(shown), counted))
+    m = run([SWEEP, "merge", out, "-o", os.path.join(d, "part-m.csv")])
+    check(m.returncode == 0 and re.findall(r"^  \d+ failed: .*$", m.stdout, re.M) ==
+          re.findall(r"^  \d+ failed: .*$", p.stdout, re.M),
+          "merge's summary says the same reasons")
 
 
 def scene_sweep(lang, runs=40):
