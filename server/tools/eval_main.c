@@ -309,6 +309,7 @@ typedef struct eval_cli {
     char tmpdir[256];
     const char *workdir;
     int failures, status;
+    char cmd_files[EVAL_CMD_FILES_MAX][1024]; /* the files the controller command names */
 } eval_cli;
 
 /* The options. Returns -1 to go on, or the exit code. */
@@ -444,6 +445,10 @@ static int open_outputs(eval_cli *x)
     if (files_add(&x->files, x->config, NULL, 0) || files_add(&x->files, x->lagsimd, NULL, 0) ||
         (x->suite && files_add(&x->files, x->suite, NULL, 0)))
         return die("%s", "out of memory");
+    /* and what the controller command names (its script): read by every run */
+    int ncf = eval_command_files(x->controller, x->cmd_files, EVAL_CMD_FILES_MAX);
+    for (int k = 0; k < ncf; k++)
+        if (files_add(&x->files, x->cmd_files[k], NULL, 0)) return die("%s", "out of memory");
     if (x->report_dir && mkdir(x->report_dir, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "%s: --report %s: %s\n", prog, x->report_dir, strerror(errno));
         return 2;

@@ -425,6 +425,7 @@ typedef struct sweep {
     char *identity;      /* the CSV's identity lines (sweep_merge.h) */
     char default_metric[160];
     char tmpdir[160]; /* eval_make_tmpdir: at most 128 + 21 */
+    char cmd_files[EVAL_CMD_FILES_MAX][1024]; /* the files the controller command names */
 } sweep;
 
 /* An integer option: a plain decimal (as a scene writes a number) with no fraction; lo
@@ -853,13 +854,17 @@ static int sweep_run(sweep *x)
     FILE *fcsv = NULL, *fpng = NULL;
     /* what the sweep reads (the scene, the suite, the daemon) and its CSV: no output may
      * be one of them (compared by device and inode) */
-    const char *in[4] = {x->config, x->lagsimd, x->suite, x->csv};
+    const char *in[4 + EVAL_CMD_FILES_MAX] = {x->config, x->lagsimd, x->suite ? x->suite : x->config};
+    /* and what the controller command names (its script): read by every run */
+    int nin = 3 + eval_command_files(x->controller, x->cmd_files, EVAL_CMD_FILES_MAX);
+    for (int k = 3; k < nin; k++) in[k] = x->cmd_files[k - 3];
+    in[nin] = x->csv;
     /* every output opened (and so refused, when it must be) before the first run: a sweep
      * never runs for hours to lose its results at the end */
     struct stat st;
     bool csv_new = x->csv && lstat(x->csv, &st) != 0;
-    if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, 3))) return 2;
-    if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, 4))) {
+    if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, nin))) return 2;
+    if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, nin + 1))) {
         if (fcsv) fclose(fcsv);
         if (csv_new) unlink(x->csv); /* a CSV this sweep made, empty */
         return 2;
