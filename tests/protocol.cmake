@@ -95,3 +95,10 @@ foreach(neg
       -- ${proto_minimal} --break ${rule})
   set_tests_properties(protocol_broken_${trace}_${rule} PROPERTIES TIMEOUT 120 LABELS clients)
 endforeach()
+
+# The traces read, use only play.py's steps and their own messages; docs/protocol.md's
+# tables of traces and of steps are the directory's and the player's; every trace has its
+# negative test above, with the rule the table names; the earlier versions' fingerprints
+# forged are docs/wire.md's (tests/protocol/check_traces.py).
+add_test(NAME protocol_traces COMMAND ${LAGSIM_PYTHON3} ${proto_dir}/check_traces.py ${PROJECT_SOURCE_DIR})
+set_tests_properties(protocol_traces PROPERTIES TIMEOUT 30 LABELS clients)
