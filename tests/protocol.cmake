@@ -7,8 +7,9 @@
 # tests/protocol/minimal.py, a controller written from docs/protocol.md alone, passes
 # every trace (protocol_minimal_<trace>); broken on purpose (--break RULE) it must fail each
 # trace at the step that guards that rule (protocol_broken_<trace>_<rule>).
-# Label clients; the JVM's and Octave's also slow: they test no C code, so the sanitizer
-# pass leaves them out, and each starts a JVM.
+# Label clients; the JVM's and Octave's, minimal.py's and the broken ones also slow: they
+# run no C code of lagsim (the sanitizer pass would check nothing in them, so it leaves them
+# out), and the JVM's start a JVM each.
 if(NOT LAGSIM_PYTHON3)
   return()
 endif()
@@ -68,7 +69,7 @@ endif()
 # A controller from docs/protocol.md alone passes every trace ...
 set(proto_minimal ${LAGSIM_PYTHON3} ${proto_dir}/minimal.py --types ${CMAKE_BINARY_DIR}/python
     --prefix {prefix} --url {url})
-protocol_conformance(minimal clients ${proto_minimal})
+protocol_conformance(minimal "clients;slow" ${proto_minimal})
 # ... and, broken on purpose, fails each at the step that guards the rule it breaks:
 # TRACE:RULE:STEP
 foreach(neg
@@ -93,7 +94,7 @@ foreach(neg
   add_test(NAME protocol_broken_${trace}_${rule}
     COMMAND ${proto_play} --expect-failure ${step} ${proto_dir}/traces/${trace}.trace
       -- ${proto_minimal} --break ${rule})
-  set_tests_properties(protocol_broken_${trace}_${rule} PROPERTIES TIMEOUT 120 LABELS clients)
+  set_tests_properties(protocol_broken_${trace}_${rule} PROPERTIES TIMEOUT 120 LABELS "clients;slow")
 endforeach()
 
 # The traces read, use only play.py's steps and their own messages; docs/protocol.md's
