@@ -7,7 +7,8 @@
   play.py knows, sends and expects only messages it defined, and names its steps'
   ids once;
 - docs/protocol.md's table of traces has a row for each trace file and for no other,
-  and its format table a row for each step play.py knows and for no other;
+  its format table a row for each step play.py knows and for no other, and its table of
+  types a row for each file of lcmtypes/ and for no other;
 - each trace has a negative test in tests/protocol.cmake (a controller broken on purpose
   that must fail it at one of its steps), with the rule the table names for it;
 - each fingerprint a trace forges as an earlier version's is one that docs/wire.md's
@@ -105,6 +106,10 @@ def main():
     for t in documented:
         if t not in traces:
             fail("docs/protocol.md's table of traces names %s, which is no trace" % t)
+    lcm = sorted(f[:-4] for f in os.listdir(os.path.join(root, "lcmtypes")) if f.endswith(".lcm"))
+    types = sorted(r[0].strip("`") for r in (table_rows(doc, "| type | file | carries |") or []))
+    if types != lcm:
+        fail("docs/protocol.md's table of types has %s; lcmtypes/ has %s" % (types, lcm))
     fmt = table_rows(doc, "| step | does |") or []
     in_doc = set()
     for r in fmt:
