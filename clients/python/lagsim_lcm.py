@@ -105,7 +105,7 @@ def _load():
     last = None
     for name in names:
         try:
-            lib = ctypes.CDLL(name, use_errno=True)  # EINTR: a signal, not an error
+            lib = ctypes.CDLL(name, use_errno=True)
             break
         except OSError as e:  # try the next name
             last = e
@@ -192,6 +192,7 @@ class LCM(object):
         KeyboardInterrupt it raises reaches the caller) and the wait goes on, as
         Python's own blocking calls do (PEP 475)."""
         while True:
+            ctypes.set_errno(0)
             rc = self._lib.lcm_handle(self._lcm)
             self._raise_pending()
             if rc == 0:
@@ -202,8 +203,9 @@ class LCM(object):
     def handle_timeout(self, timeout_ms):
         """Handles at most one message, waiting up to timeout_ms milliseconds.
         True if a message was handled, False on timeout or when a signal ended the wait
-        (its Python handler has run by then: a loop that checks a flag the handler sets
-        sees it at once)."""
+        (its Python handler runs as this returns: a controller's SIGTERM handler ends its
+        run instead of an error), as the C client's lag_client_handle."""
+        ctypes.set_errno(0)
         rc = self._lib.lcm_handle_timeout(self._lcm, int(max(0, timeout_ms)))
         self._raise_pending()
         if rc < 0:
