@@ -65,7 +65,7 @@ extern "C" {
                                                       names them) */
 
 /* The messages, as the wire module decodes them (every field of the .lcm types; the
- * field meanings are in lcmtypes/<type>.lcm and docs/messages.md). */
+ * field meanings are in lcmtypes/<type>.lcm and docs/server.md, "Messages"). */
 typedef lag_wire_scene lag_client_scene;        /* scene_t */
 typedef lag_wire_joint_state lag_client_state;  /* joint_state_t */
 typedef lag_wire_status lag_client_status;      /* status_t */

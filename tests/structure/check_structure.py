@@ -219,6 +219,112 @@ def check_docs(src, tests):
     # the tests' CMake files though no ctest of this build carries it
     for l in sorted(table - labels - declared_labels(src)):
         bad.append(f'docs/testing.md: the label table names {l}, which no ctest carries')
+    return bad + check_named_files(src)
+
+
+# ---------------------------------------------------------------- files named
+
+# Where a file is named: the tree's own directories (a path is read from one of these on)
+TREE_TOPS = ('server', 'clients', 'bench', 'tests', 'docs', 'config', 'lcmtypes', 'cmake',
+             '.ci')
+PATH_RE = re.compile(r'(?<![\w./<>{}$@-])((?:' + '|'.join(re.escape(t) for t in TREE_TOPS) +
+                     r')/[A-Za-z0-9_./@+-]*[A-Za-z0-9_/@+-])')
+# a bare file name in a comment, of the kinds the tree is made of
+BARE_RE = re.compile(r'(?<![\w./@<>{}$*-])([A-Za-z0-9_@+-]+\.(?:c|h|py|sh|cmake|lua|java))'
+                     r'(?![\w./(@-])')
+LINK_RE = re.compile(r'\]\(([^)\s#]+)(?:#[^)\s]*)?\)')
+# Files not in the tree that a comment may name by their bare name (what they are): other
+# projects' files, a user's files that a doc's recipe writes.
+FOREIGN_FILES = {
+    'balance.py': "the controller docs/clients.md's walkthrough has its reader write",
+    'lcm_udpm.c': "LCM's UDP multicast provider (the URL grammar lagsim_url.h makes strict)",
+    'lcmgen.c': "lcm-gen's source (the type fingerprint)",
+    'complex.h': "the C library's header",
+    'ae.c': "redis's event loop (the daemon's loop takes it for a model)",
+    'extra.c': "an example argument in lagsim_fuzz_target's usage",
+}
+COMMENT_RE = {
+    ('.c', '.h', '.java', '.js'): re.compile(r'/\*.*?\*/|//[^\n]*', re.S),
+    ('.py', '.sh', '.cmake', '.txt', '.yaml', '.gp', '.in'): re.compile(r'#[^\n]*'),
+    ('.lua',): re.compile(r'--[^\n]*'),
+    ('.m',): re.compile(r'%[^\n]*'),
+}
+
+
+def tree_files(src):
+    """{relative path} of the tree's own files (the directories TREE_TOPS and README.md)."""
+    out = {'README.md', 'CMakeLists.txt'}
+    for top in TREE_TOPS:
+        for dirpath, dirs, names in os.walk(os.path.join(src, top)):
+            out.add(os.path.relpath(dirpath, src))
+            out.update(os.path.relpath(os.path.join(dirpath, n), src) for n in names)
+    return out
+
+
+def named_paths(rel, text):
+    """(line, path, is_bare) of each file a doc (every line) or a source file (its comments)
+    names."""
+    ext = os.path.splitext(rel)[1]
+    if os.path.basename(rel) == 'CMakeLists.txt':
+        ext = '.cmake'
+    if ext == '.md':
+        spans = [(0, text)]
+    else:
+        rx = next((r for exts, r in COMMENT_RE.items() if ext in exts), None)
+        spans = [(m.start(), m.group(0)) for m in rx.finditer(text)] if rx else []
+    for start, span in spans:
+        for m in PATH_RE.finditer(span):
+            after = span[m.end():m.end() + 2]
+            if after[:1] in ('<', '*', '{', '$') or after == '.{':
+                continue  # a pattern: tests/fuzz/<name>/corpus, docs/*.md, a.{c,h}
+            path = m.group(1).rstrip('.')
+            if re.search(r'(^|/)[A-Z][A-Z0-9_]*(\.|/|$)', path):
+                continue  # a placeholder: config/NAME.yaml
+            yield text.count('\n', 0, start + m.start()) + 1, path, False
+        if ext == '.md':
+            for m in LINK_RE.finditer(span):
+                target = m.group(1)
+                if re.match(r'^[a-z]+:', target):
+                    continue  # https:, mailto:
+                path = os.path.normpath(os.path.join(os.path.dirname(rel), target))
+                yield text.count('\n', 0, start + m.start()) + 1, path, False
+        else:
+            for m in BARE_RE.finditer(span):
+                name = m.group(1)
+                if re.match(r'^[A-Z][A-Z0-9_]*\.', name) or name in FOREIGN_FILES:
+                    continue
+                yield text.count('\n', 0, start + m.start()) + 1, name, True
+
+
+def check_named_files(src):
+    """A file named in a doc or in a source file's comment exists: a path from one of the
+    tree's directories (server/daemon/rt_pace.c, docs/server.md, tests/net/), a link of a
+    page, or a bare file name of a kind the tree is made of (rhs.c, exit_docs.py) in a
+    comment, which must be some file's name."""
+    have = tree_files(src)
+    bases = {os.path.basename(f) for f in have}
+    bad = []
+    readers = ['README.md'] + sorted(f for f in have if f.endswith('.md') and
+                                     f.startswith('docs' + os.sep))
+    readers += sorted(f for f in have if f.split(os.sep)[0] in TREE_TOPS[:4] + ('cmake', '.ci',
+                                                                              'lcmtypes')
+                      and not f.endswith('.md') and '/corpus/' not in f and '/crash/' not in f
+                      and os.path.isfile(os.path.join(src, f)))
+    for rel in readers:
+        try:
+            text = open(os.path.join(src, rel), encoding='utf-8').read()
+        except (OSError, UnicodeDecodeError):
+            continue
+        for line, path, bare in named_paths(rel, text):
+            if bare:
+                if path not in bases:
+                    bad.append(f'{rel}:{line}: names {path}, which is no file of the tree')
+                continue
+            p = path.rstrip('/')
+            # a module named without its extension (server/wire/lagsim_bus: .c and .h)
+            if p in have or any(f.startswith(p + '.') for f in have):
+                continue
+            bad.append(f'{rel}:{line}: names {path}, which does not exist')
     return bad
 
 
