@@ -10,12 +10,15 @@
   check_structure.py names BUILD_DIR [--ctest CTEST | --json FILE]
       Every ctest's name is lowercase words joined by "_" (a word may hold a "-": a model's
       name such as flying-stick, a number such as -1 or 1e-04; never a "." or a capital),
-      and every ctest has a label.
+      every ctest has a label, and exactly one tier (a label of LAGSIM_TIERS,
+      tests/common/tiers.cmake, given by the rules there).
   check_structure.py docs SOURCE_DIR BUILD_DIR [--ctest CTEST | --json FILE]
       Every test name the docs (README.md, docs/**/*.md) give in backquotes is a ctest
       (`a_{b,c}` is two names, `a_*` must match one, `_b` after `a_x` is a_b, `a` alone the
-      family of the ctests a_*; a dotted word is a key, not a name), and the label
-      table of docs/testing.md has exactly the labels the ctests carry.
+      family of the ctests a_*; a dotted word is a key, not a name); the tier table of
+      docs/testing.md has exactly the tiers of tests/common/tiers.cmake, its label table
+      exactly the other labels the ctests carry; and every file a doc or a source file's
+      comment names exists (check_named_files).
   check_structure.py function_length SOURCE_DIR [--max 80]
       No C function in server/, clients/, bench/ is longer than 80 lines (universal-ctags:
       from the line of its name to the line of its closing brace).
@@ -103,14 +106,28 @@ def load_tests(build, ctest, json_file):
     return tests
 
 
-def check_names(tests):
+def load_tiers(path):
+    """The tiers tests/common/tiers.cmake defines (set(LAGSIM_TIERS ...))."""
+    m = re.search(r'set\(LAGSIM_TIERS\s+([a-z_\s]+)\)', open(path, encoding='utf-8').read())
+    return m.group(1).split() if m else []
+
+
+def check_names(tests, tiers):
     bad = []
+    if not tiers:
+        bad.append('tests/common/tiers.cmake: no set(LAGSIM_TIERS ...)')
     for name, labels in tests:
         if not NAME.match(name):
             bad.append(f'{name}: not lowercase words joined by "_" (no ".", no capital, '
                        'no empty word)')
         if not labels:
             bad.append(f'{name}: no label')
+        has = [l for l in labels if l in tiers]
+        if tiers and not has:
+            bad.append(f'{name}: no tier (none of {" ".join(tiers)}): no rule of '
+                       'tests/common/tiers.cmake matches it; add one')
+        elif len(has) > 1:
+            bad.append(f'{name}: more than one tier ({" ".join(has)})')
     if not tests:
         bad.append('no ctest at all')
     return bad
@@ -199,20 +216,18 @@ def check_docs(src, tests):
                                 prev = name
                         elif name not in words:
                             bad.append(f'{rel}:{lineno}: `{name}` names no ctest')
-    # docs/testing.md's label table against the labels the ctests carry
-    labels = {l for _, ls in tests for l in ls}
-    table = set()
-    in_table = False
-    for line in open(os.path.join(src, 'docs', 'testing.md'), encoding='utf-8'):
-        if re.match(r'^\| label \|', line):
-            in_table = True
-            continue
-        if in_table:
-            if not line.startswith('|'):
-                break
-            m = re.match(r'^\| `([a-z_]+)` \|', line)
-            if m:
-                table.add(m.group(1))
+    # docs/testing.md's tier table against tests/common/tiers.cmake, its label table against
+    # the other labels the ctests carry
+    tiers = load_tiers(os.path.join(src, 'tests', 'common', 'tiers.cmake'))
+    tier_table = doc_table(src, 'tier')
+    for t in tiers:
+        if t not in tier_table:
+            bad.append(f'docs/testing.md: the tier {t} has no row in the tier table')
+    for t in sorted(tier_table - set(tiers)):
+        bad.append(f'docs/testing.md: the tier table names {t}, which tests/common/tiers.cmake '
+                   'does not define')
+    labels = {l for _, ls in tests for l in ls} - set(tiers)
+    table = doc_table(src, 'label')
     for l in sorted(labels - table):
         bad.append(f'docs/testing.md: the label {l} has no row in the label table')
     # a label of another build (bench off, fuzzing on, root's package tests) is declared in
@@ -326,6 +341,23 @@ def check_named_files(src):
                 continue
             bad.append(f'{rel}:{line}: names {path}, which does not exist')
     return bad
+
+
+def doc_table(src, head):
+    """The first column's names of docs/testing.md's table headed `| HEAD |`."""
+    table = set()
+    in_table = False
+    for line in open(os.path.join(src, 'docs', 'testing.md'), encoding='utf-8'):
+        if re.match(r'^\| ' + head + r' \|', line):
+            in_table = True
+            continue
+        if in_table:
+            if not line.startswith('|'):
+                break
+            m = re.match(r'^\| `([a-z_]+)` \|', line)
+            if m:
+                table.add(m.group(1))
+    return table
 
 
 def declared_labels(src):
@@ -460,11 +492,14 @@ def main():
     ap.add_argument('--ctest', default='ctest')
     ap.add_argument('--json', help="ctest --show-only=json-v1's output, instead of running it")
     ap.add_argument('--max', type=int, default=80)
+    ap.add_argument('--tiers', default=os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                                    '..', 'common', 'tiers.cmake'),
+                    help="the tiers' table (names: tests/common/tiers.cmake)")
     a = ap.parse_args()
     if a.rule == 'harness':
         bad = check_harness(a.dirs[0])
     elif a.rule == 'names':
-        bad = check_names(load_tests(a.dirs[0], a.ctest, a.json))
+        bad = check_names(load_tests(a.dirs[0], a.ctest, a.json), load_tiers(a.tiers))
     elif a.rule == 'docs':
         bad = check_docs(a.dirs[0], load_tests(a.dirs[1], a.ctest, a.json))
     elif a.rule == 'ticks':

@@ -1,0 +1,148 @@
+# The tiers: every ctest carries exactly one tier label, given here and nowhere else
+# (docs/testing.md, "Tiers", says what each holds; structure_names fails on a ctest with
+# no tier or with two, and structure_docs on a tier the table there lacks).
+#
+#   quick      waits on no wall clock: the core, scenes, the wire, replays, the bounded
+#              decoders, made-up clocks, lockstep runs; `tests/run.sh` (the developer's loop)
+#   wallclock  paces or waits in real time: real-time runs, silences, timeouts, slow laws,
+#              a daemon that must still be waiting after N seconds, attacks that take time
+#   browser    drives headless Chromium
+#   octave     starts GNU Octave
+#   root       network namespaces, nftables, sshd per namespace (skipped when not root)
+#   package    installs the Debian package (dpkg: one at a time)
+#   slow       long computations (10^8 ticks, 200-run sweeps); not in the sanitizer pass
+#   bench      benchmarks' quick checks (no sanitizer build)
+#   fuzz_run   bounded fuzzing (the sanitizer pass only)
+#
+# A tier comes from the first rule below that matches the test, by one of its labels
+# (LABEL: the area says it all: a new core_* test is quick by nature) or by its name
+# (NAME, for the areas that hold several natures). A test no rule matches gets no tier and
+# fails structure_names: add its rule here, in the tier its nature says.
+#
+# Read at configure time (lagsim_apply_tiers, for add_test's tests) and by ctest
+# (tests/common/cases.cmake's include files, for the cases a test program lists): so plain
+# script commands only.
+include_guard(GLOBAL)
+
+set(LAGSIM_TIERS quick wallclock browser octave root package slow bench fuzz_run)
+
+set(LAGSIM_TIER_RULES
+  "slow      LABEL ^slow$"
+  "fuzz_run  LABEL ^fuzz_run$"
+  "bench     LABEL ^bench$"
+  "package   LABEL ^package$"
+  "quick     LABEL ^(core|effects|wire|result|structure|fuzz|accuracy)$"
+  # scene: every loader check; shipped_wait watches each shipped scene wait 2 s for its
+  # first command
+  "wallclock NAME  ^scene_shipped_wait$"
+  "quick     LABEL ^scene$"
+  # net: namespaces need root; the URL rule in each language, the receive filter over LCM
+  "root      NAME  ^net_two_hosts_"
+  "octave    NAME  ^net_plant_urls_octave$"
+  "quick     NAME  ^net_(plant_urls|filter)_"
+  # server: the loop, the pacer and the floors on made-up clocks or none; the daemon's
+  # lockstep, fast and offline references; every other server_test case runs lagsimd in
+  # real time (watchdog, floods, signals, plants that conflict)
+  "quick     NAME  ^server_(loop|pace)_"
+  "quick     NAME  ^server_daemon_floors$"
+  "quick     NAME  ^server_reference_(lockstep|fast|offline|manipulator)$"
+  "wallclock NAME  ^server_"
+  # log: the writer on a made-up clock; lockstep and fast runs logged, read, converted;
+  # the terminal's live line and waits in real time
+  "quick     NAME  ^log_(rt|outputs)_"
+  "quick     NAME  ^log_(lqr|lqr_effects|gaps|readers|cli|flood)$"
+  "wallclock NAME  ^log_term_"
+  # view: the log tools; Chromium; attacks that take time or namespaces
+  "quick     NAME  ^view_log2csv_"
+  "wallclock NAME  ^view_attack_(slowloris|stalled)$"
+  "root      NAME  ^view_attack_lan$"
+  "browser   NAME  ^view_(browser|hostile|stick_flight|cartpole|reference|charts|history|attack_forged|attack_host)$"
+  # eval: unit tests; lagsim-eval and lagsim-sweep in lockstep; --timeout, a stalled
+  # controller; packet loss and ssh hosts in namespaces
+  "quick     NAME  ^eval_(metrics|reference)_"
+  "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene)$"
+  "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|kept|kept_python)$"
+  "wallclock NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
+  "root      NAME  ^eval_lagsim_sweep_(loss|ssh)$"
+  # clients, ctl, install
+  "quick     NAME  ^clients_octave_matlab_syntax$"
+  "octave    NAME  ^clients_(octave_|readme_octave$)"
+  "wallclock NAME  _(realtime|ends_on_stop|ends_on_silence|late_controller|slow_law|slower_law)$"
+  "wallclock NAME  ^clients_(readme_recipes|walkthrough)$"
+  "wallclock NAME  ^ctl_"
+  "quick     NAME  ^install_"
+  "quick     NAME  ^clients_(lqr|status_fields|hostile_messages|library|not_built)$"
+  "quick     NAME  ^clients_[a-z_]+_(usage_.*|help)$"
+  "quick     NAME  ^clients_(python|lua)_(lcm|types)$"
+  "quick     NAME  ^clients_java_release$"
+  "quick     NAME  _(lockstep|hostile|push|reference_lost)$"
+  "quick     NAME  ^clients_cross_language_(dipc|manipulator)$"
+  "quick     NAME  ^clients_readme_(c|python|lua|java)$"
+)
+
+# What a test of each tier takes of the machine's cores: tests/run.sh runs ctest with
+# -j 3 x cores and a resource spec file of one "cpu" pool of as many slots as cores, so
+# that the tiers that compute run one per core (two for Chromium) while the tests that
+# mostly wait (a real-time run, a slow law, a silence, an attack holding connections, two
+# hosts in namespaces) run beside them, three per core in all. A plain `ctest -j N` (no
+# --resource-spec-file) ignores this and runs N tests of any tier at once.
+set(LAGSIM_TIER_CPU_quick 1)
+set(LAGSIM_TIER_CPU_slow 1)
+set(LAGSIM_TIER_CPU_bench 1)
+set(LAGSIM_TIER_CPU_fuzz_run 1)
+set(LAGSIM_TIER_CPU_package 1)
+set(LAGSIM_TIER_CPU_octave 1)
+set(LAGSIM_TIER_CPU_browser 2)
+
+# lagsim_tier_of(NAME "LABELS" OUT): OUT = the tier of the first rule that matches, or "".
+function(lagsim_tier_of name labels out)
+  foreach(rule IN LISTS LAGSIM_TIER_RULES)
+    string(REGEX MATCH "^([a-z_]+) +(LABEL|NAME) +(.+)$" m "${rule}")
+    set(tier ${CMAKE_MATCH_1})
+    set(kind ${CMAKE_MATCH_2})
+    set(rx "${CMAKE_MATCH_3}")
+    if(kind STREQUAL "NAME")
+      if(name MATCHES "${rx}")
+        set(${out} ${tier} PARENT_SCOPE)
+        return()
+      endif()
+    else()
+      foreach(l IN LISTS labels)
+        if(l MATCHES "${rx}")
+          set(${out} ${tier} PARENT_SCOPE)
+          return()
+        endif()
+      endforeach()
+    endif()
+  endforeach()
+  set(${out} "" PARENT_SCOPE)
+endfunction()
+
+# lagsim_tier_properties(TIER OUT): what set_tests_properties(... PROPERTIES ...) gives a
+# test of TIER (its share of the cpu pool).
+function(lagsim_tier_properties tier out)
+  if(LAGSIM_TIER_CPU_${tier})
+    set(${out} RESOURCE_GROUPS cpu:${LAGSIM_TIER_CPU_${tier}} PARENT_SCOPE)
+  else()
+    set(${out} "" PARENT_SCOPE)
+  endif()
+endfunction()
+
+# Gives every test of this directory made by add_test its tier (the cases a program lists
+# get theirs when ctest reads them: cases.cmake).
+function(lagsim_apply_tiers)
+  get_property(tests DIRECTORY PROPERTY TESTS)
+  foreach(t IN LISTS tests)
+    get_test_property(${t} LABELS labels)
+    if(NOT labels)
+      set(labels "")
+    endif()
+    lagsim_tier_of(${t} "${labels}" tier)
+    if(tier)
+      list(APPEND labels ${tier})
+      list(REMOVE_DUPLICATES labels)
+      lagsim_tier_properties(${tier} props)
+      set_tests_properties(${t} PROPERTIES LABELS "${labels}" ${props})
+    endif()
+  endforeach()
+endfunction()
