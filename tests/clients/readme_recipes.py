@@ -20,6 +20,8 @@ import re
 import subprocess
 import sys
 import tempfile
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 DOCS = ("README.md", os.path.join("docs", "clients.md"))
@@ -177,7 +179,7 @@ def main():
                 f.write(text)
             print("---- %s written as given" % fname)
         env = dict(os.environ)
-        env["LCM_DEFAULT_URL"] = "udpm://239.255.76.67:%d?ttl=0" % (30000 + 2 * (os.getpid() % 10000))
+        env["LCM_DEFAULT_URL"] = lcm_url()
         print("---- recipe %s in %s, LCM_DEFAULT_URL=%s\n%s" % (name, tmp, env["LCM_DEFAULT_URL"], script))
         try:
             r = subprocess.run(["bash", "-c", script], cwd=tmp, env=env, stdout=subprocess.PIPE,

@@ -25,12 +25,16 @@
 #ifndef LAGSIM_TEST_H
 #define LAGSIM_TEST_H
 
+#include <fcntl.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 static int lt_failures = 0;
 static int lt_checks = 0;
@@ -217,6 +221,86 @@ static inline int lt_main(int argc, char **argv, const lt_case *cases, int n)
 {
     const lt_program p = {.cases = cases, .n = n};
     return lt_run(argc, argv, &p);
+}
+
+/* ------------------------------------------------------------------ LCM ports */
+/* n UDP ports in a row, P .. P + n - 1 (P even, in [20000, 60000)), this process's own
+ * until it ends: the rule of tests/common/lcm_port.py (which says why), for the C tests.
+ * Each port's lock file LOCK_DIR/PORT.lock ($LAGSIM_PORT_LOCK_DIR, else
+ * /tmp/lagsim-ports) held with flock, no socket of this host bound to it
+ * (/proc/net/udp, udp6). Returns P, or -1 when none is free. */
+static inline bool lt_udp_bound(int port)
+{
+    static const char *const files[] = {"/proc/net/udp", "/proc/net/udp6"};
+    for (int f = 0; f < 2; f++) {
+        FILE *in = fopen(files[f], "r");
+        if (!in) continue;
+        char line[512];
+        bool found = false;
+        while (!found && fgets(line, sizeof line, in)) {
+            char local[128];
+            unsigned p;
+            if (sscanf(line, " %*s %127s", local) == 1) {
+                char *colon = strrchr(local, ':');
+                found = colon && sscanf(colon + 1, "%x", &p) == 1 && (int)p == port;
+            }
+        }
+        fclose(in);
+        if (found) return true;
+    }
+    return false;
+}
+
+static inline int lt_port_lock(int port)
+{
+    const char *dir = getenv("LAGSIM_PORT_LOCK_DIR");
+    if (!dir || !*dir) dir = "/tmp/lagsim-ports";
+    if (mkdir(dir, 0777) == 0) chmod(dir, 01777); /* every user's tests take ports here */
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%d.lock", dir, port);
+    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (fd < 0) return -1;
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd; /* open until the process ends: the lock goes with it */
+}
+
+static inline int lt_lcm_ports(int n)
+{
+    const int first = 20000, end = 60000, blocks = (end - first) / 2 - (n - 1) / 2;
+    const int start = (int)(((long long)getpid() * 7919) % blocks);
+    for (int k = 0; k < blocks; k++) {
+        int p = first + 2 * ((start + k) % blocks), fds[16], got = 0;
+        if (n > 16) return -1;
+        bool ok = true;
+        for (int q = 0; q < n && ok; q++) ok = !lt_udp_bound(p + q);
+        for (int q = 0; q < n && ok; q++) {
+            fds[got] = lt_port_lock(p + q);
+            ok = fds[got] >= 0;
+            if (ok) got++;
+        }
+        for (int q = 0; q < n && ok; q++) ok = !lt_udp_bound(p + q); /* bound meanwhile */
+        if (ok) return p;
+        while (got > 0) close(fds[--got]);
+    }
+    return -1;
+}
+
+/* LCM_DEFAULT_URL set to udpm://239.255.76.67:P?ttl=0&recv_buf_size=4194304 on a port pair
+ * of this process's own (lt_lcm_ports(2)): every LCM user the test starts or creates that
+ * names no URL meets on it, and hears nothing of any other run on the machine. */
+static inline void lt_private_lcm(void)
+{
+    int port = lt_lcm_ports(2);
+    if (port < 0) {
+        fprintf(stderr, "no free LCM port pair (lt_lcm_ports)\n");
+        exit(1);
+    }
+    char url[96];
+    snprintf(url, sizeof url, "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304", port);
+    setenv("LCM_DEFAULT_URL", url, 1);
 }
 
 /* ------------------------------------------------------------------ seeded RNG */
