@@ -15,25 +15,25 @@
 #   tests/run.sh --label L      ctest -L L in pass 1 (a regular expression, as ctest takes it)
 #   tests/run.sh --sanitize ... pass 2's build instead of pass 1's (with --tier or --label)
 #
-# Inside a pass ctest runs 3 x cores tests at once, but the tiers that compute take a slot
-# of a "cpu" pool of one slot per core (tests/common/tiers.cmake): the tests that mostly
-# wait run beside them. Every pass runs even when one before failed; the exit status is
-# non-zero when any failed, after every summary.
+# Inside a pass the tiers that wait (wallclock, root: tests/common/tiers.cmake) run at
+# normal priority, 2 x cores at once, beside the tiers that compute, which run at nice 10,
+# one per core. Every pass runs even when one before failed; the exit status is non-zero
+# when any failed, after every summary.
 #   LAGSIM_SKIP_SANITIZE=1   --full without pass 2
-#   LAGSIM_JOBS=N            ctest -j N (default 3 x cores); LAGSIM_CPUS=N the pool's slots
+#   LAGSIM_WAIT_JOBS=N       how many tests of the waiting tiers at once (2 x cores)
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root" || exit 2
 
 mode=quick
-select=()
+select=""
 sanitize=0
 while [ $# -gt 0 ]; do
   case $1 in
     --full) mode=full ;;
     --quick) mode=quick ;;
-    --tier) mode=some; shift; select=(-L "^(${1//,/|})\$") ;;
-    --label) mode=some; shift; select=(-L "$1") ;;
+    --tier) mode=some; shift; select="^(${1//,/|})\$" ;;
+    --label) mode=some; shift; select=$1 ;;
     --sanitize) sanitize=1 ;;
     -h | --help) sed -n '2,/^set -uo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "tests/run.sh: unknown argument '$1' (--help)" >&2; exit 2 ;;
@@ -43,39 +43,84 @@ done
 
 "$root/.ci/install-deps.sh" "$([ "${CI:-}" = true ] && echo ci || echo tests)" || exit 1
 cores=$(nproc)
-cpus=${LAGSIM_CPUS:-$cores}
-jobs=${LAGSIM_JOBS:-$((3 * cores))}
+wait_jobs=${LAGSIM_WAIT_JOBS:-$((2 * cores))}
 summaries=()
 failed=0
 
-# run_pass NAME BUILD_DIR "CTEST ARGS" CMAKE ARGS...   (CTEST ARGS "-" : build only)
+# The tiers whose tests mostly wait (tests/common/tiers.cmake's LAGSIM_WAITING_TIERS).
+waiting=$(sed -n 's/^set(LAGSIM_WAITING_TIERS \(.*\))$/\1/p' "$root/tests/common/tiers.cmake")
+waiting_rx="^(${waiting// /|})\$"
+
+# ctest_half DIR LOG NICE JOBS ARGS...: ctest of one half of a pass, its output in LOG
+ctest_half() {
+  local dir=$1 log=$2 nice=$3 jobs=$4
+  shift 4
+  (cd "$dir" && nice -n "$nice" ctest --output-on-failure -j"$jobs" "$@") >"$log" 2>&1
+}
+total_passed=0
+total_failed=0
+
+# run_pass NAME BUILD_DIR TIMEOUT SELECT EXCLUDE CMAKE ARGS...
+#   SELECT: a label regex the tests must match ("" all); EXCLUDE: tiers left out ("" none);
+#   TIMEOUT "-": build only.
+# The tests of the waiting tiers run at normal priority, 2 x cores at once, beside the
+# others, which run at nice 10, one per core: a real-time test's control loop is scheduled
+# before a computing test's work, and the computing tests keep the cores busy while the
+# others wait. Two ctest processes; each one's output is printed when it ends.
 run_pass() {
-  local name=$1 dir=$2 ctest_args=$3
-  shift 3
-  local log="$root/$dir/ctest.log" result start=$SECONDS
+  local name=$1 dir=$2 timeout=$3 sel=$4 excl=$5
+  shift 5
+  local start=$SECONDS result rc_w rc_c half
   echo "==== $name"
   if ! cmake -S . -B "$dir" "$@" >/dev/null || ! cmake --build "$dir" -j"$cores"; then
     summaries+=("$name: BUILD FAILED")
     failed=1
     return
   fi
-  if [ "$ctest_args" = - ]; then
+  if [ "$timeout" = - ]; then
     summaries+=("$name: built, warning-free ($((SECONDS - start)) s)")
     return
   fi
-  printf '{"version": {"major": 1, "minor": 0}, "local": [{"cpu": [{"id": "0", "slots": %d}]}]}\n' \
-    "$cpus" >"$root/$dir/resources.json"
-  # shellcheck disable=SC2086
-  (cd "$dir" && ctest --output-on-failure -j"$jobs" --resource-spec-file resources.json \
-     $ctest_args) 2>&1 | tee "$log"
-  if [ "${PIPESTATUS[0]}" -eq 0 ]; then
-    result=$(grep -E "tests passed" "$log" | tail -1)
-    summaries+=("$name: $result ($((SECONDS - start)) s)")
-  else
-    failed=1
-    result=$(grep -E "tests passed|tests failed" "$log" | tail -1)
-    summaries+=("$name: ${result:-ctest failed} ($((SECONDS - start)) s)"$'\n'"$(sed -n '/The following tests FAILED/,$p' "$log" | grep -E '^\s+[0-9]+ - ')")
-  fi
+  local common=(--timeout "$timeout") waits=(-L "$waiting_rx") computes
+  [ -n "$sel" ] && common+=(-L "$sel")
+  [ -n "$excl" ] && waits+=(-LE "^(${excl// /|})\$")
+  computes=(-LE "^(${waiting// /|}${excl:+|${excl// /|}})\$")
+  : >"$root/$dir/ctest-computing.log"
+  ctest_half "$dir" "$root/$dir/ctest-waiting.log" 0 "$wait_jobs" "${common[@]}" "${waits[@]}" &
+  local waiter=$!
+  ctest_half "$dir" "$root/$dir/ctest-computing.log" 10 "$cores" "${common[@]}" "${computes[@]}" &
+  local computer=$!
+  tail -n +1 --pid="$computer" -f "$root/$dir/ctest-computing.log" 2>/dev/null  # shown as it runs
+  wait "$computer"
+  rc_c=$?
+  wait "$waiter"
+  rc_w=$?
+  for half in computing waiting; do
+    local log="$root/$dir/ctest-$half.log" rc=$rc_c
+    [ $half = waiting ] && rc=$rc_w
+    if [ $half = waiting ]; then
+      echo "---- $name, waiting tiers (run beside the above)"
+      cat "$log"
+    fi
+    if grep -q "No tests were found" "$log"; then
+      continue
+    fi
+    local counts
+    counts=$(sed -n 's/.*tests passed, \([0-9]*\) tests\{0,1\} failed out of \([0-9]*\).*/\1 \2/p' "$log" | tail -1)
+    if [ -n "$counts" ]; then
+      total_failed=$((total_failed + ${counts% *}))
+      total_passed=$((total_passed + ${counts#* } - ${counts% *}))
+    fi
+    if [ "$rc" -eq 0 ]; then
+      result=$(grep -E "tests passed" "$log" | tail -1)
+      summaries+=("$name, $half tiers: $result")
+    else
+      failed=1
+      result=$(grep -E "tests passed|tests failed" "$log" | tail -1)
+      summaries+=("$name, $half tiers: ${result:-ctest failed}"$'\n'"$(sed -n '/The following tests FAILED/,$p' "$log" | grep -E '^\s+[0-9]+ - ')")
+    fi
+  done
+  summaries+=("$name: $((SECONDS - start)) s")
 }
 
 gcc_args=(-DCMAKE_C_COMPILER=gcc -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLAGSIM_WERROR=ON)
@@ -85,26 +130,25 @@ asan_env() { export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1
 
 case $mode in
   quick)
-    run_pass "quick tier (gcc -Werror)" build "--timeout 300 -L ^quick\$" "${gcc_args[@]}" ;;
+    run_pass "quick tier (gcc -Werror)" build 300 "^quick\$" "" "${gcc_args[@]}" ;;
   some)
     if [ $sanitize -eq 1 ]; then
       asan_env
-      run_pass "clang ASan+UBSan+libFuzzer: ${select[*]}" build-asan "--timeout 600 ${select[*]}" \
-        "${asan_args[@]}"
+      run_pass "clang ASan+UBSan+libFuzzer: $select" build-asan 600 "$select" "" "${asan_args[@]}"
     else
-      run_pass "gcc -Werror: ${select[*]}" build "--timeout 300 ${select[*]}" "${gcc_args[@]}"
+      run_pass "gcc -Werror: $select" build 300 "$select" "" "${gcc_args[@]}"
     fi ;;
   full)
-    run_pass "pass 1 (gcc -Werror)" build "--timeout 300" "${gcc_args[@]}"
+    run_pass "pass 1 (gcc -Werror)" build 300 "" "" "${gcc_args[@]}"
     if [ "${LAGSIM_SKIP_SANITIZE:-0}" != 1 ]; then
       asan_env
-      run_pass "pass 2 (clang ASan+UBSan+libFuzzer)" build-asan \
-        "--timeout 600 -LE ^slow\$" "${asan_args[@]}"
+      run_pass "pass 2 (clang ASan+UBSan+libFuzzer)" build-asan 600 "" "slow" "${asan_args[@]}"
     fi
-    run_pass "pass 3 (gcc -Werror Release, build only)" build-release - \
+    run_pass "pass 3 (gcc -Werror Release, build only)" build-release - "" "" \
       -DCMAKE_C_COMPILER=gcc -DCMAKE_BUILD_TYPE=Release -DLAGSIM_WERROR=ON ;;
 esac
 
 echo "==== summary"
 for s in "${summaries[@]}"; do echo "$s"; done
+echo "tests: $total_passed passed, $total_failed failed"
 exit $failed

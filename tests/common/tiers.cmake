@@ -80,19 +80,11 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^clients_readme_(c|python|lua|java)$"
 )
 
-# What a test of each tier takes of the machine's cores: tests/run.sh runs ctest with
-# -j 3 x cores and a resource spec file of one "cpu" pool of as many slots as cores, so
-# that the tiers that compute run one per core (two for Chromium) while the tests that
-# mostly wait (a real-time run, a slow law, a silence, an attack holding connections, two
-# hosts in namespaces) run beside them, three per core in all. A plain `ctest -j N` (no
-# --resource-spec-file) ignores this and runs N tests of any tier at once.
-set(LAGSIM_TIER_CPU_quick 1)
-set(LAGSIM_TIER_CPU_slow 1)
-set(LAGSIM_TIER_CPU_bench 1)
-set(LAGSIM_TIER_CPU_fuzz_run 1)
-set(LAGSIM_TIER_CPU_package 1)
-set(LAGSIM_TIER_CPU_octave 1)
-set(LAGSIM_TIER_CPU_browser 2)
+# The tiers whose tests mostly wait (a real-time run, a law that sleeps, a silence, a
+# deadline, connections held open, hosts in namespaces) rather than compute:
+# tests/run.sh runs them at normal priority beside the others, which it runs at nice 10,
+# one per core (docs/testing.md, "Tiers").
+set(LAGSIM_WAITING_TIERS wallclock root)
 
 # lagsim_tier_of(NAME "LABELS" OUT): OUT = the tier of the first rule that matches, or "".
 function(lagsim_tier_of name labels out)
@@ -118,16 +110,6 @@ function(lagsim_tier_of name labels out)
   set(${out} "" PARENT_SCOPE)
 endfunction()
 
-# lagsim_tier_properties(TIER OUT): what set_tests_properties(... PROPERTIES ...) gives a
-# test of TIER (its share of the cpu pool).
-function(lagsim_tier_properties tier out)
-  if(LAGSIM_TIER_CPU_${tier})
-    set(${out} RESOURCE_GROUPS cpu:${LAGSIM_TIER_CPU_${tier}} PARENT_SCOPE)
-  else()
-    set(${out} "" PARENT_SCOPE)
-  endif()
-endfunction()
-
 # Gives every test of this directory made by add_test its tier (the cases a program lists
 # get theirs when ctest reads them: cases.cmake).
 function(lagsim_apply_tiers)
@@ -141,8 +123,7 @@ function(lagsim_apply_tiers)
     if(tier)
       list(APPEND labels ${tier})
       list(REMOVE_DUPLICATES labels)
-      lagsim_tier_properties(${tier} props)
-      set_tests_properties(${t} PROPERTIES LABELS "${labels}" ${props})
+      set_tests_properties(${t} PROPERTIES LABELS "${labels}")
     endif()
   endforeach()
 endfunction()
