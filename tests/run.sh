@@ -15,12 +15,11 @@
 #   tests/run.sh --label L      ctest -L L in pass 1 (a regular expression, as ctest takes it)
 #   tests/run.sh --sanitize ... pass 2's build instead of pass 1's (with --tier or --label)
 #
-# Inside a pass the tiers that wait (wallclock, root: tests/common/tiers.cmake) run at
-# normal priority, 2 x cores at once, beside the tiers that compute, which run at nice 10,
-# one per core. Every pass runs even when one before failed; the exit status is non-zero
-# when any failed, after every summary.
+# Inside a pass the tier that only waits (waits: tests/common/tiers.cmake) runs 2 x cores
+# tests at once beside the others, which run one per core. Every pass runs even when one
+# before failed; the exit status is non-zero when any failed, after every summary.
 #   LAGSIM_SKIP_SANITIZE=1   --full without pass 2
-#   LAGSIM_WAIT_JOBS=N       how many tests of the waiting tiers at once (2 x cores)
+#   LAGSIM_WAIT_JOBS=N       how many tests of the tier waits at once (2 x cores)
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root" || exit 2
@@ -51,11 +50,11 @@ failed=0
 waiting=$(sed -n 's/^set(LAGSIM_WAITING_TIERS \(.*\))$/\1/p' "$root/tests/common/tiers.cmake")
 waiting_rx="^(${waiting// /|})\$"
 
-# ctest_half DIR LOG NICE JOBS ARGS...: ctest of one half of a pass, its output in LOG
+# ctest_half DIR LOG JOBS ARGS...: ctest of one half of a pass, its output in LOG
 ctest_half() {
-  local dir=$1 log=$2 nice=$3 jobs=$4
-  shift 4
-  (cd "$dir" && nice -n "$nice" ctest --output-on-failure -j"$jobs" "$@") >"$log" 2>&1
+  local dir=$1 log=$2 jobs=$3
+  shift 3
+  (cd "$dir" && ctest --output-on-failure -j"$jobs" "$@") >"$log" 2>&1
 }
 total_passed=0
 total_failed=0
@@ -63,10 +62,10 @@ total_failed=0
 # run_pass NAME BUILD_DIR TIMEOUT SELECT EXCLUDE CMAKE ARGS...
 #   SELECT: a label regex the tests must match ("" all); EXCLUDE: tiers left out ("" none);
 #   TIMEOUT "-": build only.
-# The tests of the waiting tiers run at normal priority, 2 x cores at once, beside the
-# others, which run at nice 10, one per core: a real-time test's control loop is scheduled
-# before a computing test's work, and the computing tests keep the cores busy while the
-# others wait. Two ctest processes; each one's output is printed when it ends.
+# The tests of the waiting tier (waits) run 2 x cores at once beside the others, which run
+# one per core as before (a test that computes, or a real-time loop that must be scheduled
+# every period, has a core): the waiting ones sleep while the others keep the cores busy.
+# Two ctest processes; the computing one's output is shown as it runs, the other's after.
 run_pass() {
   local name=$1 dir=$2 timeout=$3 sel=$4 excl=$5
   shift 5
@@ -86,9 +85,9 @@ run_pass() {
   [ -n "$excl" ] && waits+=(-LE "^(${excl// /|})\$")
   computes=(-LE "^(${waiting// /|}${excl:+|${excl// /|}})\$")
   : >"$root/$dir/ctest-computing.log"
-  ctest_half "$dir" "$root/$dir/ctest-waiting.log" 0 "$wait_jobs" "${common[@]}" "${waits[@]}" &
+  ctest_half "$dir" "$root/$dir/ctest-waiting.log" "$wait_jobs" "${common[@]}" "${waits[@]}" &
   local waiter=$!
-  ctest_half "$dir" "$root/$dir/ctest-computing.log" 10 "$cores" "${common[@]}" "${computes[@]}" &
+  ctest_half "$dir" "$root/$dir/ctest-computing.log" "$cores" "${common[@]}" "${computes[@]}" &
   local computer=$!
   tail -n +1 --pid="$computer" -f "$root/$dir/ctest-computing.log" 2>/dev/null  # shown as it runs
   wait "$computer"

@@ -4,8 +4,11 @@
 #
 #   quick      waits on no wall clock: the core, scenes, the wire, replays, the bounded
 #              decoders, made-up clocks, lockstep runs; `tests/run.sh` (the developer's loop)
-#   wallclock  paces or waits in real time: real-time runs, silences, timeouts, slow laws,
-#              a daemon that must still be waiting after N seconds, attacks that take time
+#   wallclock  paces in real time: a control loop or a daemon that must be scheduled
+#              every period (real-time runs, lagsimctl against a running plant, floods and
+#              signals to a real daemon, the terminal's live line)
+#   waits      waits on the wall clock with next to nothing to compute: a law that sleeps,
+#              a silence, a deadline, a stalled peer, connections held open
 #   browser    drives headless Chromium
 #   octave     starts GNU Octave
 #   root       network namespaces, nftables, sshd per namespace (skipped when not root)
@@ -24,7 +27,7 @@
 # script commands only.
 include_guard(GLOBAL)
 
-set(LAGSIM_TIERS quick wallclock browser octave root package slow bench fuzz_run)
+set(LAGSIM_TIERS quick wallclock waits browser octave root package slow bench fuzz_run)
 
 set(LAGSIM_TIER_RULES
   "slow      LABEL ^slow$"
@@ -32,9 +35,17 @@ set(LAGSIM_TIER_RULES
   "bench     LABEL ^bench$"
   "package   LABEL ^package$"
   "quick     LABEL ^(core|effects|wire|result|structure|fuzz|accuracy)$"
-  # scene: every loader check; shipped_wait watches each shipped scene wait 2 s for its
-  # first command
-  "wallclock NAME  ^scene_shipped_wait$"
+  # what only waits, in any area (first: some of these names match the rules below)
+  "waits     NAME  ^clients_readme_(c|python|lua|java)_slow(er)?_law$"
+  "waits     NAME  ^clients_cross_language_slow(er)?_law$"
+  "waits     NAME  ^clients_(c|python|lua|java)_[a-z_]+_ends_on_(stop|silence)$"
+  "waits     NAME  ^clients_(python|java)_dipc_late_controller$"
+  "waits     NAME  ^view_attack_(slowloris|stalled)$"
+  "waits     NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
+  "waits     NAME  ^scene_shipped_wait$"
+  "waits     NAME  ^log_term_waits$"
+  "waits     NAME  ^ctl_discover$"
+  # scene: every loader check
   "quick     LABEL ^scene$"
   # net: namespaces need root; the URL rule in each language, the receive filter over LCM
   "root      NAME  ^net_two_hosts_"
@@ -80,11 +91,9 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^clients_readme_(c|python|lua|java)$"
 )
 
-# The tiers whose tests mostly wait (a real-time run, a law that sleeps, a silence, a
-# deadline, connections held open, hosts in namespaces) rather than compute:
-# tests/run.sh runs them at normal priority beside the others, which it runs at nice 10,
-# one per core (docs/testing.md, "Tiers").
-set(LAGSIM_WAITING_TIERS wallclock root)
+# The tiers whose tests only wait: tests/run.sh runs them, 2 x cores at once, beside the
+# others, which it runs one per core (docs/testing.md, "Tiers").
+set(LAGSIM_WAITING_TIERS waits)
 
 # lagsim_tier_of(NAME "LABELS" OUT): OUT = the tier of the first rule that matches, or "".
 function(lagsim_tier_of name labels out)
