@@ -16,7 +16,9 @@ argument to the daemon's command line (e.g. --duration 2: the daemon
 stops by itself and announces it); --kill-daemon-after S kills it with SIGKILL after S
 wall seconds (it goes silent without a word). The controller's last line
 "... summary key=value ..." is parsed and every --check expression (Python, over those
-keys; `wall` is the controller's wall time after the daemon ended, s) must hold.
+keys; `wall` is the time from the daemon's end to the controller's summary line, s; with
+--kill-daemon-after, `silent` is the time from the last state this harness heard on the
+bus to that line, s: the silence the controller measured) must hold.
 --hostile DIR (repeatable) publishes every file of DIR (the fuzz_client corpus layout: the
 first byte chooses the channel, _STATE, _STATUS, _EVENT or _SCENE, the rest is the payload)
 on the run's channels: three times once the controller is subscribed, before the daemon
@@ -128,6 +130,8 @@ def main():
     n_hostile = 0
     t_daemon_end = t_client_end = t_summary = None
     lines = []
+    last_state = [None]  # when the last state was heard (--kill-daemon-after)
+    wth = None
     try:
         if a.daemon_first is not None:
             dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
@@ -178,6 +182,23 @@ def main():
 
             fth = threading.Thread(target=flood, daemon=True)
             fth.start()
+        if a.kill_daemon_after is not None:
+            # the last state on the bus, heard as the controller hears it: the start of the
+            # silence it must count (the kill may come long after it when a loaded machine
+            # stalls the daemon: seen 0.6 s before the kill, under a sanitizer build)
+            watcher = hostile_lcm(env["LCM_DEFAULT_URL"])
+
+            def heard(channel, data):
+                last_state[0] = time.monotonic()
+
+            watcher.subscribe(prefix + "_STATE", heard)
+
+            def watch():
+                while not done.is_set():
+                    watcher.handle_timeout(20)
+
+            wth = threading.Thread(target=watch, daemon=True)
+            wth.start()
         if dproc is None:
             dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                      universal_newlines=True, env=env)
@@ -207,6 +228,8 @@ def main():
         done.set()
         if fth:
             fth.join(5.0)
+        if wth:
+            wth.join(5.0)
         stop(cproc)
         stop(dproc)
     out = "".join(lines)
@@ -237,6 +260,11 @@ def main():
         names["wall"] = end - t_daemon_end
         print("wall = %.3f s from the daemon's end to the controller's summary line (its exit: "
               "%.3f s)" % (names["wall"], t_client_end - t_daemon_end))
+    if a.kill_daemon_after is not None and last_state[0] is not None:
+        names["silent"] = (t_summary if t_summary is not None else t_client_end) - last_state[0]
+        print("silent = %.3f s from the last state heard to the controller's summary line "
+              "(the last state %.3f s before the kill)"
+              % (names["silent"], t_daemon_end - last_state[0]))
     names["math"] = math
     names["out"] = out  # the client's stdout, for checks of what it prints
     for expr in a.check:

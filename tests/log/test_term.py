@@ -79,6 +79,12 @@ class Daemon:
                     return
                 self.out += chunk
 
+    def read_until(self, done, limit=30.0):
+        """Reads until done(text) holds (the event a check waits for), at most `limit` s."""
+        end = time.monotonic() + limit
+        while not done(self.text()) and time.monotonic() < end and self.p.poll() is None:
+            self.read(0.05)
+
     def stop(self):
         if self.p.poll() is None:
             self.p.send_signal(signal.SIGTERM)
@@ -259,7 +265,11 @@ def case_waits(a):
     state_url, command_url = plant_urls()
     d = Daemon(a, os.path.join(a.source, "config", "dipc.yaml"), prefix)
     s = Sender(a, prefix)
-    d.read(4.0)
+    # the events, not fixed times: the first wait line (3 s after the daemon's start, which
+    # a loaded machine delays: after a fixed 4 s the sanitizer build had printed none), then
+    # 0.5 s more, in which no second line may come
+    d.read_until(lambda t: len(wait_lines(t, prefix)[1]) >= 1)
+    d.read(0.5)
     ok, lines = wait_lines(d.text(), prefix)
     for l in lines:
         print("  wait line:", l)
@@ -270,7 +280,8 @@ def case_waits(a):
     s.command(name="cart")
     wrong = LCM(state_url)
     s.command(lc=wrong)  # a controller publishing on the state URL's port
-    d.read(3.5)
+    d.read_until(lambda t: len(wait_lines(t, prefix)[1]) >= 2)  # the line after 6 s
+    d.read(0.5)
     rc = d.stop()
     wrong.close()
     ok, lines = wait_lines(d.text(), prefix)
