@@ -6,8 +6,8 @@
 #                               every test of the tier quick (docs/testing.md, "Tiers")
 #   tests/run.sh --full         what CI runs (.ci/run), in three passes:
 #                                1. gcc, -Werror, optimized (build/): every test;
-#                                2. clang, -Werror, ASan + UBSan (with float-cast-overflow)
-#                                   + libFuzzer (build-asan/): every test but the tier slow
+#                                2. clang, -Werror, -O1, ASan + UBSan (float-cast-overflow
+#                                   too) + libFuzzer (build-asan/): every test but the tier slow
 #                                   (no bench or package test is made there), and each
 #                                   fuzz target for LAGSIM_FUZZ_SECONDS (default 20);
 #                                3. gcc, -Werror, Release (build-release/): built, not run.
@@ -123,8 +123,11 @@ run_pass() {
 }
 
 gcc_args=(-DCMAKE_C_COMPILER=gcc -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLAGSIM_WERROR=ON)
-asan_args=(-DCMAKE_C_COMPILER=clang -DCMAKE_BUILD_TYPE=Debug -DLAGSIM_WERROR=ON
-           -DLAGSIM_SANITIZE=ON -DLAGSIM_FUZZ=ON -DLAGSIM_BENCH=OFF)
+# -O1 with the sanitizers (as AddressSanitizer's documentation advises): the same checks,
+# its physics tests 2.1 to 2.3 times as fast as at -O0 (test_hard chaos 20.7 s -> 9.1 s,
+# test_accuracy_cost dipc_1e-04 11.5 s -> 5.5 s); assertions stay (no NDEBUG)
+asan_args=(-DCMAKE_C_COMPILER=clang -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_C_FLAGS_DEBUG=-g -O1"
+           -DLAGSIM_WERROR=ON -DLAGSIM_SANITIZE=ON -DLAGSIM_FUZZ=ON -DLAGSIM_BENCH=OFF)
 asan_env() { export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1; }
 
 case $mode in
