@@ -97,12 +97,12 @@ run_pass() {
   for half in computing waiting; do
     local log="$root/$dir/ctest-$half.log" rc=$rc_c
     [ $half = waiting ] && rc=$rc_w
-    if [ $half = waiting ]; then
-      echo "---- $name, waiting tiers (run beside the above)"
-      cat "$log"
-    fi
     if grep -q "No tests were found" "$log"; then
       continue
+    fi
+    if [ $half = waiting ]; then
+      echo "---- $name, the tier waits (run beside the above)"
+      cat "$log"
     fi
     local counts
     counts=$(sed -n 's/.*tests passed, \([0-9]*\) tests\{0,1\} failed out of \([0-9]*\).*/\1 \2/p' "$log" | tail -1)
@@ -112,11 +112,11 @@ run_pass() {
     fi
     if [ "$rc" -eq 0 ]; then
       result=$(grep -E "tests passed" "$log" | tail -1)
-      summaries+=("$name, $half tiers: $result")
+      summaries+=("$name, $half: $result")
     else
       failed=1
       result=$(grep -E "tests passed|tests failed" "$log" | tail -1)
-      summaries+=("$name, $half tiers: ${result:-ctest failed}"$'\n'"$(sed -n '/The following tests FAILED/,$p' "$log" | grep -E '^\s+[0-9]+ - ')")
+      summaries+=("$name, $half: ${result:-ctest failed}"$'\n'"$(sed -n '/The following tests FAILED/,$p' "$log" | grep -E '^\s+[0-9]+ - ')")
     fi
   done
   summaries+=("$name: $((SECONDS - start)) s")
