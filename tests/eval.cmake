@@ -9,6 +9,16 @@ foreach(t metrics reference)
   lagsim_add_test_cases(test_eval_${t} eval_${t} eval 60)
 endforeach()
 
+# lagsim-sweep's CSV without a sweep: rows against their header, --shard's parser, the
+# identity lines, the scene's SHA-256 against FIPS 180-2's vectors.
+add_executable(test_eval_sweep_csv ${CMAKE_CURRENT_LIST_DIR}/eval/test_sweep_csv.c)
+target_include_directories(test_eval_sweep_csv PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
+target_compile_definitions(test_eval_sweep_csv PRIVATE LAGSIM_VERSION="${PROJECT_VERSION}")
+target_link_libraries(test_eval_sweep_csv PRIVATE lagsim_sweepcsv)
+lagsim_add_test_cases(test_eval_sweep_csv eval_sweep_csv eval 60)
+# merge on arbitrary bytes as a shard (fuzz_sweep_merge_corpus; fuzz_sweep_merge_run)
+lagsim_fuzz_target(sweep_merge LIBS lagsim_sweepcsv)
+
 # lagsim-eval end to end: the cart-pole held by lqr_balance through a small case set
 # (tests/eval/cartpole_cases.yaml); metrics against the logged states, --require's exit
 # codes, case files with mistakes.
@@ -27,11 +37,27 @@ endif()
 # run here with Slurm's variables (no cluster needed); merge's refusals.
 find_program(LAGSIM_GNU_PARALLEL parallel)
 if(LAGSIM_PYTHON3 AND LAGSIM_GNU_PARALLEL)
-  foreach(c same slurm merge kept kept_python loss stalled ssh)
+  foreach(c same slurm merge merge_rows merge_foreign shard kept kept_python loss stalled ssh)
     add_test(NAME eval_lagsim_sweep_${c}
       COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_sweep.py
               $<TARGET_FILE_DIR:lagsim-sweep> ${PROJECT_SOURCE_DIR} ${c})
     set_tests_properties(eval_lagsim_sweep_${c} PROPERTIES LABELS eval TIMEOUT 600
                          SKIP_RETURN_CODE 77)
+  endforeach()
+endif()
+
+# Nothing lagsim-eval or lagsim-sweep (-j 2, kept workers) starts outlives it: SIGINT to
+# its process group, SIGTERM, SIGKILL, SIGKILL to its group, a stalled run killed (the
+# controller deaf to SIGTERM; the sweep's workers stopped) and SIGTERM while gnuplot runs,
+# each sent once the run's daemon publishes and its controller answers; 0 processes left
+# (found by a marker in their environment), the temporary directory removed on a signal.
+if(LAGSIM_PYTHON3)
+  foreach(tool eval sweep)
+    foreach(how sigint sigterm sigkill groupkill stalled gnuplot)
+      add_test(NAME eval_procs_${tool}_${how}
+        COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_procs.py
+                $<TARGET_FILE_DIR:lagsim-eval> ${PROJECT_SOURCE_DIR} ${tool} ${how})
+      set_tests_properties(eval_procs_${tool}_${how} PROPERTIES LABELS eval TIMEOUT 300)
+    endforeach()
   endforeach()
 endif()

@@ -10,7 +10,7 @@ lagsim_add_test_cases(test_rt_log log_rt log 120)
 # copies that lost states; the options. (The README's record recipe: clients_readme_recipes.)
 find_program(LAGSIM_LOG_PYTHON3 python3)
 if(LAGSIM_LOG_PYTHON3)
-  foreach(case lqr lqr_effects gaps readers cli flood)
+  foreach(case lqr lqr_effects gaps readers cli flood flood_applied)
     add_test(NAME log_${case}
              COMMAND ${LAGSIM_LOG_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/log/test_log.py
                      --bin ${CMAKE_BINARY_DIR}/bin --types ${CMAKE_BINARY_DIR}/python
@@ -38,5 +38,17 @@ if(LAGSIM_LOG_PYTHON3)
              COMMAND ${LAGSIM_LOG_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/log/test_outputs.py
                      --bin ${CMAKE_BINARY_DIR}/bin --source ${PROJECT_SOURCE_DIR} ${writer})
     set_tests_properties(log_outputs_${writer} PROPERTIES TIMEOUT 120 LABELS log)
+  endforeach()
+endif()
+
+# lagsimd --log FILE --increment: the series FILE.000000, ... (lagsim_out.h): numbering that
+# never runs out, --keep removing only the series' own oldest, --split-mb, a file-size limit.
+if(LAGSIM_LOG_PYTHON3)
+  foreach(case numbering keep split options)
+    add_test(NAME log_series_${case}
+             COMMAND ${LAGSIM_LOG_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/log/test_series.py
+                     --bin ${CMAKE_BINARY_DIR}/bin --types ${CMAKE_BINARY_DIR}/python
+                     --source ${PROJECT_SOURCE_DIR} ${case})
+    set_tests_properties(log_series_${case} PROPERTIES TIMEOUT 120 LABELS log)
   endforeach()
 endif()

@@ -58,3 +58,16 @@ if(LAGSIM_VIEW_PYTHON3)
                          ENVIRONMENT "PATH=/nonexistent")
   endif()
 endif()
+
+# lagsim-view stopped by SIGINT or SIGTERM while browsers hold streams, six times each
+# (tests/view/test_view_stop.py): exit 0, no abort in libmicrohttpd, each stream ended.
+if(LAGSIM_VIEW_PYTHON3)
+  foreach(case sigint sigterm)
+    add_test(NAME view_stop_${case}
+             COMMAND ${LAGSIM_VIEW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/view/test_view_stop.py
+                     --view $<TARGET_FILE:lagsim-view> --lagsimd $<TARGET_FILE:lagsimd>
+                     --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml
+                     --types ${CMAKE_BINARY_DIR}/python ${case})
+    set_tests_properties(view_stop_${case} PROPERTIES TIMEOUT 180 LABELS view)
+  endforeach()
+endif()

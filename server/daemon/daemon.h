@@ -6,6 +6,7 @@
 #define LAGSIMD_DAEMON_H
 
 #include <stdbool.h>
+#include <stdint.h>
 #include "lagsim_wire.h"
 #include "scene.h"
 
@@ -22,6 +23,9 @@ typedef struct lagsimd_opts {
     int nsets;
     const char *log;     /* --log: the real-time server's LCM log, NULL = none */
     size_t log_ring;     /* --log-buffer: bytes between the loop and the writer, 0 = default */
+    bool log_increment;  /* --increment: the next file of the series FILE.000000, ... */
+    int log_keep;        /* --keep N: the series' newest N files kept, 0 = all */
+    int64_t log_split;   /* --split-mb: bytes per file of the series, 0 = one file */
     double tolerance;    /* --replay: the largest difference that passes (default 0) */
     bool force;          /* --force: --log and --csv may replace an existing file */
 } lagsimd_opts;

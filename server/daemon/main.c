@@ -5,20 +5,23 @@
  * returns a lag_result and main() ends with lag_result_exit, the one mapping.
  */
 #include <getopt.h>
-#include <sys/stat.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 
 #include "daemon.h"
+#include "rt_log.h"
 
 
 static void usage(FILE *f)
 {
     fputs(
         "usage: lagsimd --config FILE [--set KEY=VALUE ...] [-q] [--duration SECONDS]\n"
-        "               [--log FILE.lcm [--log-buffer MIB] [--force | --increment]]\n"
+        "               [--log FILE.lcm [--log-buffer MIB]\n"
+        "                [--force | --increment [--keep N] [--split-mb MIB]]]\n"
         "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|- [--force]]\n"
         "               [--set ...]\n"
         "       lagsimd --config FILE --replay LOG.lcm [--tolerance X] [--set ...]\n"
@@ -46,20 +49,32 @@ static void usage(FILE *f)
         "                         (and <joint>_ref,<joint>_ref_dot with a reference)\n"
         "      --csv PATH|-       offline CSV destination (- = stdout; absent = no CSV,\n"
         "                         only the summary line on stderr)\n"
-        "      --log FILE.lcm     real-time server: write every message published and\n"
-        "                         every command and control request applied to FILE (LCM\n"
-        "                         log format), in order, from the first state; refused and\n"
-        "                         undecodable ones and status/describe requests are counted\n"
-        "                         and a sample of them written (at most 64 KiB a second);\n"
+        "      --log FILE.lcm     real-time server: write every message published and the\n"
+        "                         commands and control requests received to FILE (LCM log\n"
+        "                         format), in order, from the first state; received ones\n"
+        "                         are counted and written while a byte budget allows:\n"
+        "                         applied ones, two full commands a control period (8 KiB\n"
+        "                         a second at least); refused ones and status/describe\n"
+        "                         requests, 8 KiB a second; so no flood fills the disk;\n"
         "                         never makes the loop wait in realtime mode (what a slow\n"
         "                         disk loses is counted and said; exit 1 if anything was\n"
         "                         lost)\n"
         "      --force            --log, --csv, --plot: replace FILE if it exists (else refused,\n"
         "                         exit 2); never a symbolic link (not followed) nor the\n"
         "                         scene file itself, --force or not\n"
-        "  -i, --increment        --log: if FILE exists, write FILE.00, FILE.01, ... (the\n"
-        "                         first free name), as lcm-logger -i: a service restarted\n"
-        "                         with the same --log keeps every run's record\n"
+        "  -i, --increment        --log: write the next file of the series FILE.000000,\n"
+        "                         FILE.000001, ... (one past the highest number there; FILE\n"
+        "                         itself untouched), as lcm-logger -i but never running out\n"
+        "                         (past 999999 the number widens): a service restarted with\n"
+        "                         the same --log keeps every run's record\n"
+        "      --keep N           --increment: keep the series' N newest files (this one\n"
+        "                         included), 1 to 1000000; the older ones are removed at\n"
+        "                         start and at each new file: only regular files of this\n"
+        "                         user named exactly FILE.<number> (never a symbolic link)\n"
+        "      --split-mb MIB     --increment: go on in the series' next file once a file\n"
+        "                         holds MIB mebibytes (at a record's end), as lcm-logger\n"
+        "                         --split-mb; 0.0625 to 1048576. With --keep, the log takes\n"
+        "                         at most about N x MIB on disk\n"
         "      --log-buffer MIB   memory between the loop and the log writer, 0.25 to 1024\n"
         "                         (default 16)\n"
         "      --replay LOG.lcm   re-simulate a run recorded by --log or lcm-logger from the\n"
@@ -154,27 +169,6 @@ static lag_result resolve_default_url(lag_scene *sc)
     return LAG_OK;
 }
 
-/* --increment: *path, or when it exists the first of path.00 ... path.99 that does not
- * (lstat: a dangling symbolic link is a name taken too). Returns LAG_OK, or LAG_ERR_FILE
- * after saying why. */
-static lag_result next_free_name(const char **path)
-{
-    static char name[4096];
-    struct stat st;
-    if (lstat(*path, &st) != 0) return LAG_OK;
-    for (int k = 0; k < 100; k++) {
-        if (snprintf(name, sizeof name, "%s.%02d", *path, k) >= (int)sizeof name) break;
-        if (lstat(name, &st) != 0) {
-            fprintf(stderr, "lagsimd: --log %s exists: writing %s\n", *path, name);
-            *path = name;
-            return LAG_OK;
-        }
-    }
-    fprintf(stderr, "lagsimd: --log %s and %s.00 to .99 exist: move them away or give --force\n",
-            *path, *path);
-    return LAG_ERR_FILE;
-}
-
 /* Whether the --set overrides give integrator.method (a scene's integrator.error then
  * chooses nothing: the run is told). */
 static bool integrator_given(const char *const *sets, int nsets)
@@ -218,7 +212,7 @@ static lag_result reload_with(const char *config, const char *text, size_t len,
 /* What the command line says. */
 typedef struct cmdline {
     const char *config, *replay, *plot;
-    bool cost, increment, offline;
+    bool cost, offline;
     bool have_duration, have_tolerance, have_ring; /* given, for the checks of combinations */
     lagsimd_opts opts;
     const char **sets; /* the --set overrides, and room for a calibration's choice */
@@ -226,7 +220,7 @@ typedef struct cmdline {
 } cmdline;
 
 enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE,
-       OPT_COST, OPT_PLOT, OPT_FORCE };
+       OPT_COST, OPT_PLOT, OPT_FORCE, OPT_KEEP, OPT_SPLIT };
 static const struct option longopts[] = {
     {"config", required_argument, NULL, 'c'},
     {"set", required_argument, NULL, 's'},
@@ -241,6 +235,8 @@ static const struct option longopts[] = {
     {"plot", required_argument, NULL, OPT_PLOT},
     {"force", no_argument, NULL, OPT_FORCE},
     {"increment", no_argument, NULL, 'i'},
+    {"keep", required_argument, NULL, OPT_KEEP},
+    {"split-mb", required_argument, NULL, OPT_SPLIT},
     {"quiet", no_argument, NULL, 'q'},
     {"help", no_argument, NULL, 'h'},
     {"version", no_argument, NULL, 'V'},
@@ -260,6 +256,16 @@ static lag_result take_number(cmdline *cl, int c, const char *arg)
                                "got '%s'", arg);
         cl->opts.duration = v;
         cl->have_duration = true;
+    } else if (c == OPT_KEEP) {
+        if (!plain || !(v >= 1) || !(v <= 1000000) || v != floor(v))
+            return usage_error("--keep: expected a whole number of files from 1 to 1000000, "
+                               "got '%s'", arg);
+        cl->opts.log_keep = (int)v;
+    } else if (c == OPT_SPLIT) {
+        if (!plain || !(v >= 0.0625) || !(v <= 1048576))
+            return usage_error("--split-mb: expected a number of MiB from 0.0625 to 1048576, "
+                               "got '%s'", arg);
+        cl->opts.log_split = (int64_t)(v * 1048576.0);
     } else if (c == OPT_LOG_BUFFER) {
         if (!plain || !(v >= 0.25) || !(v <= 1024))
             return usage_error("--log-buffer: expected a number of MiB from 0.25 to 1024, "
@@ -281,7 +287,8 @@ static lag_result take_option(cmdline *cl, int c, const char *arg)
     switch (c) {
     case 'c': cl->config = arg; break;
     case 's': cl->sets[cl->nsets++] = arg; break;
-    case 'd': case OPT_LOG_BUFFER: case OPT_TOLERANCE: return take_number(cl, c, arg);
+    case 'd': case OPT_LOG_BUFFER: case OPT_TOLERANCE: case OPT_KEEP: case OPT_SPLIT:
+        return take_number(cl, c, arg);
     case OPT_OFFLINE: cl->offline = true; break;
     case OPT_CSV: cl->opts.csv = arg; break;
     case OPT_REPLAY: cl->replay = arg; break;
@@ -289,7 +296,7 @@ static lag_result take_option(cmdline *cl, int c, const char *arg)
     case OPT_COST: cl->cost = true; break;
     case OPT_PLOT: cl->plot = arg; break;
     case OPT_FORCE: cl->opts.force = true; break;
-    case 'i': cl->increment = true; break;
+    case 'i': cl->opts.log_increment = true; break;
     case 'q': cl->opts.quiet = true; break;
     }
     return LAG_OK;
@@ -318,8 +325,7 @@ static lag_result read_options(cmdline *cl, int argc, char **argv, bool *done)
     return LAG_OK;
 }
 
-/* The options that need or exclude each other (said as a usage error), and --increment's
- * free name. */
+/* The options that need or exclude each other (said as a usage error). */
 static lag_result check_options(cmdline *cl)
 {
     const lagsimd_opts *o = &cl->opts;
@@ -335,9 +341,11 @@ static lag_result check_options(cmdline *cl)
     else if (cl->cost && (cl->offline || cl->replay || o->log))
         why = "--cost measures the scene and exits: not with --offline, --replay or --log";
     else if (cl->plot && !cl->cost) why = "--plot needs --cost";
-    else if (cl->increment && (!o->log || o->force))
-        why = "--increment picks a free name for --log FILE: give --log, and not --force";
-    else if (cl->increment && next_free_name(&cl->opts.log) != LAG_OK) return LAG_ERR_FILE;
+    else if (o->log_increment && (!o->log || o->force))
+        why = "--increment writes the next file of --log FILE's series: give --log, and not "
+              "--force";
+    else if ((o->log_keep || o->log_split) && !o->log_increment)
+        why = "--keep and --split-mb act on the series of --log FILE --increment: give both";
     else if (o->force && !o->log && !o->csv && !cl->plot)
         why = "--force replaces the file of --log, --csv or --plot: give one";
     return why ? usage_error("%s", why) : LAG_OK;
@@ -405,8 +413,32 @@ static lag_result run(cmdline *cl)
     return rc;
 }
 
+/* --log under a file-size limit (RLIMIT_FSIZE; a unit's LimitFSIZE): the limit is an error
+ * said (EFBIG: SIGXFSZ is ignored), never a kill. A series split where a file can reach the
+ * limit is refused; a log that cannot split is told where it stops. */
+static lag_result check_file_limit(const lagsimd_opts *o)
+{
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_FSIZE, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY) return LAG_OK;
+    double ring = (double)(o->log_ring ? o->log_ring : RT_LOG_RING_DEFAULT);
+    double lim = (double)rl.rlim_cur;
+    if (o->log_split > 0 && (double)o->log_split + ring > lim) {
+        fprintf(stderr, "lagsimd: --split-mb %.6g: a file of the series may hold it plus the "
+                "--log-buffer ring (%.6g MiB), above the file-size limit of this process "
+                "(RLIMIT_FSIZE, a unit's LimitFSIZE): %.6g MiB; give a smaller --split-mb\n",
+                (double)o->log_split / 1048576.0, ring / 1048576.0, lim / 1048576.0);
+        return LAG_ERR_USAGE;
+    }
+    if (o->log_split == 0)
+        fprintf(stderr, "lagsimd: --log %s: files are limited to %.6g MiB here (RLIMIT_FSIZE): "
+                "the log stops there, said (--increment --split-mb goes on in a new file "
+                "before it)\n", o->log, lim / 1048576.0);
+    return LAG_OK;
+}
+
 static lag_result lagsimd_main(int argc, char **argv)
 {
+    signal(SIGXFSZ, SIG_IGN); /* a file-size limit: EFBIG, said by the writer, not a kill */
     cmdline cl = {.opts = {.quiet = false, .duration = 0.0, .csv = NULL}};
     /* the --set overrides, and room for a calibration's choice (lagsimd_choice) */
     cl.sets = calloc((size_t)argc + 1 + 4, sizeof *cl.sets);
@@ -417,6 +449,7 @@ static lag_result lagsimd_main(int argc, char **argv)
     bool done = false;
     lag_result rc = read_options(&cl, argc, argv, &done);
     if (rc == LAG_OK && !done) rc = check_options(&cl);
+    if (rc == LAG_OK && !done && cl.opts.log) rc = check_file_limit(&cl.opts);
     if (rc == LAG_OK && !done) rc = run(&cl);
     free(cl.sets);
     return rc;

@@ -1103,9 +1103,7 @@ static int open_parts(rt_server *s, const lagsimd_opts *o, char *err, size_t err
         s->rec.input = actuator_lagged(&sc->sim.effects, s->nq);
         lag_bus_channel_name(s->rec.ch_input, sizeof s->rec.ch_input, sc->lcm.prefix,
                              LAG_BUS_INPUT);
-        s->rec.log = rt_log_open(o->log, o->log_ring ? o->log_ring : RT_LOG_RING_DEFAULT,
-                                 o->force, o->scene_name, err, errlen);
-        if (!s->rec.log) return LAGSIMD_EXIT_USAGE;
+        if (rt_record_open(&s->rec, sc, o, err, errlen) != 0) return LAGSIMD_EXIT_USAGE;
     }
     return LAGSIMD_EXIT_OK;
 }

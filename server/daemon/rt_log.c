@@ -35,10 +35,12 @@
 #include "lagsim_out.h"
 
 #define RT_LOG_BATCH_MS 100 /* the writer's longest sleep with records waiting */
+#define RT_LOG_CUTS 64      /* --split-mb: files the writer may be behind by and still cut each
+                             * where it was due (more: a file grows by what it is behind) */
 
 struct rt_log {
     int fd;
-    char path[256];
+    char path[4096];           /* --log FILE */
     uint8_t *ring;
     size_t cap;
     _Atomic uint64_t head;     /* bytes put: written by the loop only */
@@ -49,6 +51,19 @@ struct rt_log {
     sem_t wake;
     pthread_t thread;
     bool thread_started;
+    /* a series: what the writer does when it goes on in the next file */
+    bool series;
+    int keep;
+    int64_t split;             /* bytes per file, 0: never split */
+    uint64_t first;            /* the first file's number */
+    _Atomic uint64_t number;   /* the current file's number: written by the writer only */
+    /* the loop's marks, in order: the writer goes on in the next file at each position
+     * (bytes put); a queue of one producer and one consumer, as the ring */
+    _Atomic uint64_t cuts[RT_LOG_CUTS];
+    _Atomic uint64_t cuts_put, cuts_taken;
+    _Atomic int64_t files, removed, removed_bytes;
+    _Atomic int prune_error;
+    uint64_t file_start;       /* the loop's: the position its current file began at */
     /* the loop's own counters */
     int64_t records, dropped_full, dropped_in, dropped_failed, too_large;
 };
@@ -79,6 +94,46 @@ static void nap(rt_log *l, uint64_t tail)
     atomic_store(&l->sleeping, 0);
 }
 
+/* --keep: the series' oldest beyond `keep` removed, counted; a failure is kept (said by
+ * the loop) and stops nothing. */
+static void prune(rt_log *l, uint64_t current)
+{
+    if (!l->series || l->keep < 1) return;
+    char err[512];
+    int64_t freed = 0;
+    int n = lag_out_series_prune("--log", l->path, l->keep, current, &freed, err, sizeof err);
+    if (n < 0) {
+        atomic_store(&l->prune_error, errno ? errno : EIO);
+        return;
+    }
+    atomic_fetch_add(&l->removed, n);
+    atomic_fetch_add(&l->removed_bytes, freed);
+}
+
+/* The writer goes on in the series' next file (the loop's mark reached). False, with
+ * l->error set, when it cannot. */
+static bool next_file(rt_log *l)
+{
+    char name[4096], err[512];
+    uint64_t number;
+    int fd = lag_out_series_open("--log", l->path, 0, name, sizeof name, &number, err,
+                                 sizeof err);
+    int e = errno;
+    if (fd < 0 || close(l->fd) != 0) {
+        if (fd >= 0) {
+            e = errno;
+            close(fd);
+        }
+        atomic_store(&l->error, e ? e : EIO);
+        return false;
+    }
+    l->fd = fd;
+    atomic_store(&l->number, number);
+    atomic_fetch_add(&l->files, 1);
+    prune(l, number);
+    return true;
+}
+
 static void *writer(void *arg)
 {
     rt_log *l = arg;
@@ -86,15 +141,24 @@ static void *writer(void *arg)
     bool napped = false; /* a nap since the last write: what is there goes out */
     for (;;) {
         uint64_t head = atomic_load_explicit(&l->head, memory_order_acquire);
+        uint64_t taken = atomic_load(&l->cuts_taken);
+        uint64_t cut = taken < atomic_load(&l->cuts_put) /* stored after head: cut <= head */
+                       ? atomic_load(&l->cuts[taken % RT_LOG_CUTS]) : 0;
         bool closing = atomic_load(&l->closing);
         if (head == tail && closing) break;
-        if (head == tail || (head - tail < l->cap / 8 && !napped && !closing)) {
+        if (cut != 0 && tail == cut) {
+            if (!next_file(l)) break;
+            atomic_store(&l->cuts_taken, taken + 1);
+            continue;
+        }
+        uint64_t end = cut != 0 && cut < head ? cut : head;
+        if (end == tail || (end - tail < l->cap / 8 && !napped && !closing && end == head)) {
             nap(l, tail);
             napped = true;
             continue;
         }
         napped = false;
-        size_t n = (size_t)(head - tail), off = (size_t)(tail % l->cap);
+        size_t n = (size_t)(end - tail), off = (size_t)(tail % l->cap);
         size_t first = n < l->cap - off ? n : l->cap - off;
         struct iovec iov[2] = {{l->ring + off, first}, {l->ring, n - first}};
         ssize_t w = writev(l->fd, iov, n > first ? 2 : 1); /* a cancellation point */
@@ -126,28 +190,63 @@ static rt_log *fail_open(rt_log *l, char *err, size_t errlen, const char *fmt, .
     return NULL;
 }
 
-rt_log *rt_log_open(const char *path, size_t ring_bytes, bool force, const char *input,
-                    char *err, size_t errlen)
+/* The file: FILE by lag_out_open's rules, or the series' next file (then --keep). Returns
+ * its descriptor, or -1 with err (and *refused for a refusal by the rules). */
+static int open_file(rt_log *l, const rt_log_conf *c, bool *refused, char *err,
+                     size_t errlen)
 {
+    /* O_NONBLOCK: a FIFO without a reader fails at once (ENXIO) instead of blocking the
+     * start; it is cleared afterwards, so that only the writer thread ever waits */
+    int fd;
+    if (c->series) {
+        char name[4096];
+        uint64_t number;
+        fd = lag_out_series_open("--log", c->path, O_NONBLOCK, name, sizeof name, &number,
+                                 err, errlen);
+        if (fd >= 0) {
+            l->first = number;
+            atomic_store(&l->number, number);
+        }
+    } else {
+        const char *inputs[1] = {c->input};
+        fd = lag_out_open("--log", c->path, c->force, inputs, 1, O_NONBLOCK, err, errlen);
+    }
+    if (fd == LAG_OUT_REFUSED && refused) *refused = true;
+    if (fd < 0) return -1;
+    int fl = fcntl(fd, F_GETFL);
+    if (fl < 0 || fcntl(fd, F_SETFL, fl & ~O_NONBLOCK) < 0) {
+        snprintf(err, errlen, "--log %s: %s", c->path, strerror(errno));
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+rt_log *rt_log_open(const rt_log_conf *c, bool *refused, char *err, size_t errlen)
+{
+    size_t ring_bytes = c->ring;
+    if (refused) *refused = false;
     if (ring_bytes < RT_LOG_RING_MIN) ring_bytes = RT_LOG_RING_MIN;
     if (ring_bytes > RT_LOG_RING_MAX) ring_bytes = RT_LOG_RING_MAX;
+    const char *path = c->path;
     rt_log *l = calloc(1, sizeof *l);
     if (!l) return fail_open(NULL, err, errlen, "--log %s: out of memory", path);
     l->fd = -1;
-    snprintf(l->path, sizeof l->path, "%s", path);
-    /* O_NONBLOCK: a FIFO without a reader fails at once (ENXIO) instead of blocking the
-     * start; it is cleared afterwards, so that only the writer thread ever waits */
-    const char *inputs[1] = {input};
+    if (snprintf(l->path, sizeof l->path, "%s", path) >= (int)sizeof l->path)
+        return fail_open(l, err, errlen, "--log: a path longer than %zu bytes",
+                         sizeof l->path - 1);
+    l->series = c->series;
+    l->keep = c->series ? c->keep : 0;
+    l->split = c->series ? c->split : 0;
     char oerr[512];
-    l->fd = lag_out_open("--log", path, force, inputs, 1, O_NONBLOCK, oerr, sizeof oerr);
+    l->fd = open_file(l, c, refused, oerr, sizeof oerr);
     if (l->fd < 0) return fail_open(l, err, errlen, "%s", oerr);
-    int fl = fcntl(l->fd, F_GETFL);
-    if (fl < 0 || fcntl(l->fd, F_SETFL, fl & ~O_NONBLOCK) < 0)
-        return fail_open(l, err, errlen, "--log %s: %s", path, strerror(errno));
+    atomic_store(&l->files, 1);
     l->ring = malloc(ring_bytes);
     if (!l->ring) return fail_open(l, err, errlen, "--log %s: cannot allocate a ring of %zu bytes",
                                    path, ring_bytes);
     l->cap = ring_bytes;
+    prune(l, l->first); /* before the writer starts: nothing else touches the counters */
     if (sem_init(&l->wake, 0, 0) != 0)
         return fail_open(l, err, errlen, "--log %s: %s", path, strerror(errno));
     int rc = pthread_create(&l->thread, NULL, writer, l);
@@ -253,6 +352,17 @@ bool rt_log_put(rt_log *l, rt_log_dir dir, int64_t timestamp_us, const char *cha
     ring_copy(l, head + sizeof h, channel, chlen);
     if (len) ring_copy(l, head + sizeof h + chlen, data, len);
     atomic_store(&l->head, head + need); /* seq_cst: see the comment at the top */
+    /* --split-mb: the file holds `split` bytes once this record is written; the writer
+     * goes on in the next one after it (a writer more than RT_LOG_CUTS files behind makes
+     * a file longer, by at most the ring) */
+    if (l->split > 0 && head + need - l->file_start >= (uint64_t)l->split) {
+        uint64_t put = atomic_load_explicit(&l->cuts_put, memory_order_relaxed);
+        if (put - atomic_load(&l->cuts_taken) < RT_LOG_CUTS) {
+            l->file_start = head + need;
+            atomic_store(&l->cuts[put % RT_LOG_CUTS], head + need);
+            atomic_store(&l->cuts_put, put + 1);
+        }
+    }
     if (used + need >= l->cap / 8 && atomic_load(&l->sleeping)) sem_post(&l->wake);
     l->records++;
     return true;
@@ -278,6 +388,19 @@ void rt_log_get_stats(const rt_log *l, rt_log_stats *st)
     st->too_large = l->too_large;
     st->error = atomic_load(&l->error);
     st->ring = l->cap;
+    st->series = l->series;
+    st->first = l->first;
+    st->number = atomic_load(&l->number);
+    st->files = atomic_load(&l->files);
+    st->removed = atomic_load(&l->removed);
+    st->removed_bytes = atomic_load(&l->removed_bytes);
+    st->prune_error = atomic_load(&l->prune_error);
 }
 
 const char *rt_log_path(const rt_log *l) { return l->path; }
+
+void rt_log_file(const rt_log *l, char *name, size_t n)
+{
+    if (!l->series || lag_out_series_name(l->path, atomic_load(&l->number), name, n) != 0)
+        snprintf(name, n, "%s", l->path);
+}

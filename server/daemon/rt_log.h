@@ -18,8 +18,14 @@
  * full: those runs slow down to the disk's pace instead of losing records. In realtime
  * mode the loop never waits: a disk slower than the run loses records, counted.
  *
- * A write that fails (a full disk: ENOSPC; a FIFO whose reader left: EPIPE) stops the
- * writer for good; from then on every put is refused and counted (dropped_failed) and
+ * A series (--increment) goes on in its next file when the one being written holds
+ * `split` bytes (--split-mb): the loop marks the end of the record that crossed it, the
+ * writer writes up to that mark, opens the next file (lagsim_out.h's series), removes the
+ * series' oldest beyond `keep`, and goes on; each file is an LCM log on its own, its
+ * records numbered on from the previous one's.
+ *
+ * A write that fails (a full disk: ENOSPC; a FIFO whose reader left: EPIPE; a file-size
+ * limit: EFBIG; the next file of a series that cannot be made) stops the writer for good; from then on every put is refused and counted (dropped_failed) and
  * rt_log_stats.error holds the errno. The writer uses write(2), not stdio, so that a
  * stalled device can be abandoned at close (the thread is cancelled) without exit()
  * flushing into it.
@@ -49,15 +55,37 @@ typedef struct rt_log_stats {
     int64_t too_large;       /* records larger than a quarter of the ring */
     int error;               /* errno of the write that failed, 0 if none */
     size_t ring;             /* the ring's size, bytes */
+    /* a series (--increment): the numbers of the first and of the current file, files
+     * begun (1 + splits), the older files --keep removed and their bytes, and the errno
+     * of the last removal that failed (0 if none: a failed removal stops nothing) */
+    bool series;
+    uint64_t first, number;
+    int64_t files, removed, removed_bytes;
+    int prune_error;
 } rt_log_stats;
 
-/* Opens path by lag_out_open's rules (lagsim_out.h: a symbolic link, the scene file
- * `input` and, without force, an existing regular file are refused), allocates a ring of
- * ring_bytes (clamped to [RT_LOG_RING_MIN, RT_LOG_RING_MAX]) and starts the writer
- * thread, which inherits the caller's signal mask. Opening never blocks (a FIFO without a
- * reader is an error). Returns NULL with a message in err on failure. */
-rt_log *rt_log_open(const char *path, size_t ring_bytes, bool force, const char *input,
-                    char *err, size_t errlen);
+/* What --log asks for. */
+typedef struct rt_log_conf {
+    const char *path;     /* --log FILE */
+    size_t ring;          /* bytes between the loop and the writer, clamped to
+                           * [RT_LOG_RING_MIN, RT_LOG_RING_MAX] */
+    bool force;           /* --force: an existing regular FILE may be replaced */
+    bool series;          /* --increment: FILE.000000, FILE.000001, ... (lagsim_out.h's
+                           * series: the next number at open) instead of FILE */
+    int keep;             /* --keep N (series): at each new file, the series' N newest kept
+                           * and the older removed; 0: none removed */
+    int64_t split;        /* --split-mb (series): bytes after which the writer goes on in the
+                           * next file of the series, at a record's end; 0: never */
+    const char *input;    /* the scene file: never written */
+} rt_log_conf;
+
+/* Opens the log by lag_out_open's rules (lagsim_out.h: a symbolic link, the scene file
+ * and, without force, an existing regular file are refused), or the series' next file
+ * (then --keep's removals are made), allocates the ring and starts the writer thread,
+ * which inherits the caller's signal mask. Opening never blocks (a FIFO without a reader
+ * is an error). Returns NULL with a message in err on failure; *refused (may be NULL)
+ * tells a refusal by the rules (a usage error) from a failure of the system. */
+rt_log *rt_log_open(const rt_log_conf *c, bool *refused, char *err, size_t errlen);
 /* Puts one record (timestamp in us) in the ring; false when it was not, counted in the
  * stats by reason. Never blocks, never allocates. The producer's only call besides
  * rt_log_room and rt_log_get_stats. */
@@ -68,8 +96,10 @@ bool rt_log_put(rt_log *l, rt_log_dir dir, int64_t timestamp_us, const char *cha
 bool rt_log_room(const rt_log *l);
 /* The counters so far. OUT: st */
 void rt_log_get_stats(const rt_log *l, rt_log_stats *st);
-/* The path given at open. */
+/* The path given at open (--log FILE). */
 const char *rt_log_path(const rt_log *l);
+/* The file being written: the path, or the series' current file. OUT: name */
+void rt_log_file(const rt_log *l, char *name, size_t n);
 /* Lets the writer write everything put so far, waiting as long as it makes progress; a
  * writer that makes none for stall_ms is cancelled and what it held is lost. Closes the
  * file and frees l (NULL: nothing). Returns 0 when every record put reached the file,

@@ -251,51 +251,6 @@ void eval_sleep(double s)
     nanosleep(&ts, NULL);
 }
 
-/* Starts argv (or "sh -c cmd" when argv is NULL) in its own process group. */
-pid_t eval_spawn(char *const *argv, const char *cmd, const eval_env *env)
-{
-    fflush(NULL); /* nothing buffered is written twice */
-    pid_t pid = fork();
-    if (pid != 0) return pid;
-    setpgid(0, 0);
-    setenv("LCM_DEFAULT_URL", env->url, 1);
-    setenv("LAGSIM_PREFIX", env->prefix, 1);
-    if (!env->verbose) {
-        FILE *f = freopen("/dev/null", "w", stdout);
-        (void)f;
-        if (argv) {
-            f = freopen("/dev/null", "w", stderr);
-            (void)f;
-        }
-    }
-    if (argv)
-        execv(argv[0], argv);
-    else
-        execl("/bin/sh", "sh", "-c", cmd, (char *)NULL);
-    _exit(127);
-}
-
-/* Waits for pid until `deadline` (monotonic s); 1 and *status when it ended, 0 if not. */
-int eval_wait_until(pid_t pid, double deadline, int *status)
-{
-    for (;;) {
-        pid_t r = waitpid(pid, status, WNOHANG);
-        if (r == pid) return 1;
-        if (r < 0 && errno != EINTR) return 1;
-        if (eval_now() >= deadline) return 0;
-        eval_sleep(0.005);
-    }
-}
-
-void eval_stop_group(pid_t pid, int *status)
-{
-    kill(-pid, SIGTERM);
-    if (!eval_wait_until(pid, eval_now() + 2.0, status)) {
-        kill(-pid, SIGKILL);
-        waitpid(pid, status, 0);
-    }
-}
-
 /* "{prefix}" and "{url}" in cmd replaced. */
 void eval_expand(const char *cmd, const eval_env *env, char *out, size_t len)
 {
@@ -644,7 +599,7 @@ static bool wait_run(const eval_env *env, pid_t dpid, pid_t cpid, eval_result *r
     bool daemon_done = false, controller_done = false;
     while (!daemon_done && eval_now() < t0 + env->wall_timeout) {
         daemon_done = eval_wait_until(dpid, eval_now() + 0.05, dst);
-        if (!daemon_done && !controller_done && waitpid(cpid, &cst, WNOHANG) == cpid) {
+        if (!daemon_done && !controller_done && eval_wait_until(cpid, 0, &cst)) {
             controller_done = true;
             if (!eval_wait_until(dpid, eval_now() + 5.0, dst)) {
                 eval_stop_group(dpid, dst);
@@ -797,20 +752,4 @@ FILE *eval_open_out(const char *prog, const char *what, const char *path, bool f
         return NULL;
     }
     return fdopen(fd, "w");
-}
-
-int eval_gnuplot(const char *prog, const char *gp)
-{
-    fflush(NULL); /* nothing buffered is written twice */
-    pid_t pid = fork();
-    if (pid == 0) {
-        execlp("gnuplot", "gnuplot", gp, (char *)NULL);
-        _exit(127);
-    }
-    int st = 0;
-    if (pid < 0 || waitpid(pid, &st, 0) < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-        fprintf(stderr, "%s: gnuplot failed on %s\n", prog, gp);
-        return -1;
-    }
-    return 0;
 }

@@ -27,6 +27,7 @@
 
 #include <sys/types.h>
 
+#include "eval_proc.h"
 #include "lagsim_log.h"
 #include "metrics.h"
 
@@ -182,11 +183,7 @@ void eval_take_record(eval_take *tk, const lag_log_record *rec);
 double eval_now(void);
 double eval_now_wall(void); /* s since the epoch */
 void eval_sleep(double s);
-/* argv (or "sh -c cmd" when argv is NULL) in a process group of its own, with the run's
- * URL and prefix in its environment */
-pid_t eval_spawn(char *const *argv, const char *cmd, const eval_env *env);
-int eval_wait_until(pid_t pid, double deadline, int *status);
-void eval_stop_group(pid_t pid, int *status);
+/* starting, waiting for and stopping processes: eval_proc.h */
 void eval_expand(const char *cmd, const eval_env *env, char *out, size_t len);
 int eval_series_grow(eval_series *s, int nj);
 void eval_fail(eval_result *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

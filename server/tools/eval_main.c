@@ -48,11 +48,15 @@ static void usage(FILE *f)
 "                         not on {prefix} or LAGSIM_PREFIX never answers: its case\n"
 "                         ends here\n"
 "  -v, --verbose          pass the daemon's and the controller's output through, keep\n"
-"                         each run's log in the report directory (or /tmp)\n"
+"                         each run's log in the report directory (or TMPDIR, /tmp)\n"
 "  -h, --help             this help\n"
 "\n"
 "exit codes: 0 every case ran, none failed and every case met --require; 1 a case\n"
-"failed or missed the requirement; 2 usage, scene or case error (file:line:column)\n");
+"failed or missed the requirement; 2 usage, scene or case error (file:line:column)\n"
+"\n"
+"signals: SIGINT, SIGTERM, SIGHUP stop every process it started (SIGKILL after 2 s)\n"
+"and end it by that signal; after SIGKILL they end within about 2 s. TMPDIR: where\n"
+"the runs' logs go (default /tmp)\n");
 }
 
 static int die(const char *fmt, const char *a)
@@ -201,7 +205,7 @@ typedef struct eval_cli {
     int ncases;
     eval_scene csc[EVAL_CASES_MAX]; /* each case's scene, its overrides applied */
     FILE *fcsv;
-    char tmpdir[32];
+    char tmpdir[256];
     const char *workdir;
     int failures, status;
 } eval_cli;
@@ -324,8 +328,10 @@ static int open_outputs(eval_cli *x)
             fprintf(x->fcsv, ",%s", lag_metric_table[m].name);
         fprintf(x->fcsv, ",max_abs_q,states,t_end\n");
     }
-    snprintf(x->tmpdir, sizeof x->tmpdir, "%s", "/tmp/lagsim-eval.XXXXXX");
-    x->workdir = x->report_dir && x->verbose ? x->report_dir : mkdtemp(x->tmpdir);
+    x->workdir = x->report_dir && x->verbose ? x->report_dir
+                 : eval_make_tmpdir("lagsim-eval", x->tmpdir, sizeof x->tmpdir) == 0 ? x->tmpdir
+                                                                                    : NULL;
+    if (x->verbose) eval_proc_tmpdir_done(); /* -v keeps the runs' logs, even on a signal */
     if (!x->workdir) {
         fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
         return 2;
@@ -403,7 +409,7 @@ static int run_cases(eval_cli *x)
         fprintf(stderr, "%s: --csv %s: %s\n", prog, x->csv, strerror(errno));
         x->status = 2;
     }
-    if (x->workdir == x->tmpdir) rmdir(x->tmpdir);
+    if (x->workdir == x->tmpdir) rmdir(x->tmpdir), eval_proc_tmpdir_done();
     if (x->status) return x->status;
     return x->failures ? 1 : 0;
 }
@@ -411,6 +417,7 @@ static int run_cases(eval_cli *x)
 int main(int argc, char **argv)
 {
     static eval_cli x = {.timeout = 600};
+    eval_proc_init(); /* every process it starts ends when it ends (eval_proc.h) */
     eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
     int rc;
     if ((rc = parse_options(&x, argc, argv)) < 0 && (rc = load_cases(&x)) < 0 &&

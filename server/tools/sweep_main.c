@@ -21,11 +21,12 @@
 
 #include "eval_case.h"
 #include "scene.h"
+#include "sweep_merge.h"
 
 static const char *prog = "lagsim-sweep";
 
 #define VARY_MAX 16
-#define ROW_MAX 8192
+#define ROW_MAX 8192 /* bytes of the CSV header and of a row at most (a row: < 4000) */
 
 static void usage(FILE *f)
 {
@@ -54,8 +55,8 @@ static void usage(FILE *f)
 "  -n, --runs N           runs (per grid point when there are grids; default 1)\n"
 "      --seed S           the random seed of every drawn value (default 1)\n"
 "  -j, --jobs N           runs at once on this machine (default 1)\n"
-"      --shard K/N        only runs i with i mod N = K - 1 (K = 1..N): one machine's\n"
-"                         part; lagsim-sweep merge joins the parts\n"
+"      --shard K/N        only runs i with i mod N = K - 1 (K = 1..N, N <= 1e7): one\n"
+"                         machine's part; lagsim-sweep merge joins the parts\n"
 "      --restart          a daemon and a controller started for each run, with the\n"
 "                         run's values (default: one of each per worker, started\n"
 "                         with the scene's values; each run's values SET and its\n"
@@ -70,14 +71,20 @@ static void usage(FILE *f)
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a run may take (default 600)\n"
 "  -v, --verbose          pass the daemon's and the controller's output through\n"
-"  -o, --output OUT.csv   merge: the joined CSV\n"
-"      --partial          merge: join shards that leave runs out (default: refused\n"
-"                         unless the runs are exactly 0 to the last one found)\n"
+"  -o, --output OUT.csv   merge: the joined CSV (the whole sweep's, byte for byte); every\n"
+"                         shard's identity lines (# seed:, # scene-sha256:, # vary:, ...)\n"
+"                         must be the first's, every row one of its header, every shard\n"
+"                         and run there\n"
+"      --partial          merge: join shards that leave shards or runs out\n"
 "  -h, --help             this help\n"
 "\n"
 "exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
 "case error, an output that exists (checked before the first run), or shard CSVs that\n"
-"do not belong together or leave runs out\n");
+"do not belong together, hold a malformed row or leave shards or runs out\n"
+"\n"
+"signals: SIGINT, SIGTERM, SIGHUP stop every process it started (SIGKILL after 2 s)\n"
+"and end it by that signal; after SIGKILL they end within about 2 s. TMPDIR: where\n"
+"the workers' files go (default /tmp)\n");
 }
 
 static int die(const char *fmt, const char *a)
@@ -202,291 +209,6 @@ static int run_sets(const vary *vs, int nv, const double *val, const eval_scene 
     return n;
 }
 
-/* ---------------------------------------------------------------- CSV rows */
-typedef struct rows {
-    int n, cap;
-    long *run;
-    char **line;
-} rows;
-
-static int rows_add(rows *r, long run, const char *line)
-{
-    if (r->n == r->cap) {
-        int cap = r->cap ? 2 * r->cap : 256;
-        long *ru = realloc(r->run, (size_t)cap * sizeof *ru);
-        if (!ru) return -1;
-        r->run = ru;
-        char **li = realloc(r->line, (size_t)cap * sizeof *li);
-        if (!li) return -1;
-        r->line = li;
-        r->cap = cap;
-    }
-    r->run[r->n] = run;
-    r->line[r->n] = strdup(line);
-    return r->line[r->n++] ? 0 : -1;
-}
-
-static void rows_free(rows *r)
-{
-    for (int i = 0; i < r->n; i++) free(r->line[i]);
-    free(r->run);
-    free(r->line);
-    memset(r, 0, sizeof *r);
-}
-
-static int cmp_long(const void *a, const void *b)
-{
-    long x = *(const long *)a, y = *(const long *)b;
-    return (x > y) - (x < y);
-}
-
-static rows *sort_rows;
-static int by_run(const void *a, const void *b)
-{
-    long x = sort_rows->run[*(const int *)a], y = sort_rows->run[*(const int *)b];
-    return (x > y) - (x < y);
-}
-
-/* Writes the rows in run order; -1 on two rows of one run. */
-static int rows_write(rows *r, FILE *f, const char *header, char *err, size_t errlen)
-{
-    int *ord = malloc((size_t)(r->n ? r->n : 1) * sizeof *ord);
-    if (!ord) return -1;
-    for (int i = 0; i < r->n; i++) ord[i] = i;
-    sort_rows = r;
-    qsort(ord, (size_t)r->n, sizeof *ord, by_run);
-    for (int i = 1; i < r->n; i++)
-        if (r->run[ord[i]] == r->run[ord[i - 1]]) {
-            snprintf(err, errlen, "run %ld appears twice", r->run[ord[i]]);
-            free(ord);
-            return -1;
-        }
-    fprintf(f, "%s\n", header);
-    for (int i = 0; i < r->n; i++) fprintf(f, "%s\n", r->line[ord[i]]);
-    free(ord);
-    return 0;
-}
-
-/* The CSV fields of a line (reason quoted, the others plain): pointers into buf. */
-static int split(char *buf, char **field, int max)
-{
-    int n = 0;
-    char *p = buf;
-    while (n < max) {
-        if (*p == '"') {
-            field[n++] = ++p;
-            while (*p && !(*p == '"' && p[1] != '"')) p += *p == '"' ? 2 : 1;
-            if (*p) *p++ = '\0';
-        } else {
-            field[n++] = p;
-            p += strcspn(p, ",");
-        }
-        if (*p != ',') {
-            *p = '\0';
-            break;
-        }
-        *p++ = '\0';
-    }
-    return n;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double pct(const double *v, int n, double p)
-{
-    double at = p * (n - 1);
-    int lo = (int)floor(at);
-    if (lo >= n - 1) return v[n - 1];
-    return v[lo] + (v[lo + 1] - v[lo]) * (at - lo);
-}
-
-/* Pass rate and percentiles of every metric column, from the CSV's rows. */
-static void summary(const char *header, rows *r)
-{
-    char hb[ROW_MAX];
-    snprintf(hb, sizeof hb, "%s", header);
-    char *hf[512];
-    int nh = split(hb, hf, 512);
-    int c_failed = -1, c_req = -1, c_first = -1;
-    for (int i = 0; i < nh; i++) {
-        if (!strcmp(hf[i], "failed")) c_failed = i;
-        if (!strcmp(hf[i], "required")) c_req = i;
-        if (!strcmp(hf[i], "reason")) c_first = i + 1;
-    }
-    if (c_failed < 0 || c_req < 0 || c_first < 0) return;
-    int pass = 0, failed = 0;
-    double *vals = malloc((size_t)(r->n ? r->n : 1) * (size_t)nh * sizeof *vals);
-    int *nv = calloc((size_t)nh, sizeof *nv);
-    if (!vals || !nv) {
-        free(vals), free(nv);
-        return;
-    }
-    for (int i = 0; i < r->n; i++) {
-        char lb[ROW_MAX];
-        snprintf(lb, sizeof lb, "%s", r->line[i]);
-        char *f[512];
-        int n = split(lb, f, 512);
-        if (n != nh) continue;
-        bool fl = !strcmp(f[c_failed], "1"), ok = !fl && !strcmp(f[c_req], "1");
-        pass += ok, failed += fl;
-        for (int c = c_first; c < nh; c++) {
-            double x = strtod(f[c], NULL);
-            if (isfinite(x)) vals[(size_t)c * (size_t)r->n + (size_t)nv[c]++] = x;
-        }
-    }
-    printf("%d runs: %d passed (%.1f %%), %d failed, %d missed --require\n", r->n, pass,
-           r->n ? 100.0 * pass / r->n : 0.0, failed, r->n - pass - failed);
-    printf("%-22s %6s %12s %12s %12s %12s %12s\n", "metric", "n", "min", "p5", "p50", "p95",
-           "max");
-    for (int c = c_first; c < nh; c++) {
-        double *v = vals + (size_t)c * (size_t)r->n;
-        if (!nv[c]) {
-            printf("%-22s %6d %12s\n", hf[c], 0, "none");
-            continue;
-        }
-        qsort(v, (size_t)nv[c], sizeof *v, cmp_double);
-        printf("%-22s %6d %12.6g %12.6g %12.6g %12.6g %12.6g\n", hf[c], nv[c], v[0],
-               pct(v, nv[c], 0.05), pct(v, nv[c], 0.5), pct(v, nv[c], 0.95), v[nv[c] - 1]);
-    }
-    free(vals);
-    free(nv);
-}
-
-/* ---------------------------------------------------------------- merge */
-/* Whether the rows' run numbers are exactly 0..max (runs found twice are rows_write's to
- * refuse); else the missing ones, as numbers and ranges, in buf. */
-static bool rows_whole(const rows *r, char *buf, size_t len)
-{
-    long *run = malloc((size_t)(r->n ? r->n : 1) * sizeof *run);
-    if (!run) {
-        snprintf(buf, len, "out of memory");
-        return false;
-    }
-    memcpy(run, r->run, (size_t)r->n * sizeof *run);
-    qsort(run, (size_t)r->n, sizeof *run, cmp_long);
-    size_t u = 0;
-    int gaps = 0;
-    long next = 0; /* the first run not yet seen */
-    buf[0] = '\0';
-    for (int i = 0; i <= r->n; i++) {
-        long at = i < r->n ? run[i] : next; /* past the end: no gap after the last */
-        if (at > next) {
-            if (gaps < 12 && u < len)
-                u += (size_t)(at - 1 > next
-                                  ? snprintf(buf + u, len - u, "%s%ld-%ld", gaps ? ", " : "",
-                                             next, at - 1)
-                                  : snprintf(buf + u, len - u, "%s%ld", gaps ? ", " : "", next));
-            else if (gaps == 12 && u < len)
-                u += (size_t)snprintf(buf + u, len - u, ", ...");
-            gaps++;
-        }
-        if (at + 1 > next) next = at + 1;
-    }
-    bool negative = r->n && run[0] < 0;
-    if (negative) snprintf(buf, len, "(a negative run number, %ld)", run[0]);
-    free(run);
-    return gaps == 0 && !negative;
-}
-
-/* Shard number k's rows into r; its header must be the first's (kept in header). 0, or -1
- * after saying why. */
-static int read_shard(const char *path, int k, char *header, rows *r)
-{
-    char line[ROW_MAX];
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        fprintf(stderr, "%s: %s: %s\n", prog, path, strerror(errno));
-        return -1;
-    }
-    int ln = 0, bad = 0;
-    while (!bad && fgets(line, sizeof line, f)) {
-        ln++;
-        size_t len = strlen(line);
-        if (len && line[len - 1] == '\n') line[--len] = '\0';
-        if (ln == 1) {
-            if (strncmp(line, "run,", 4)) bad = 1;
-            else if (k && strcmp(header, line)) bad = 2;
-            else snprintf(header, ROW_MAX, "%s", line);
-        } else {
-            char *end;
-            long run = strtol(line, &end, 10);
-            if (end == line || *end != ',' || rows_add(r, run, line)) bad = 3;
-        }
-    }
-    fclose(f);
-    if (bad)
-        fprintf(stderr, "%s: %s:%d: %s\n", prog, path, ln,
-                bad == 1 ? "not a lagsim-sweep CSV (its header starts with 'run,')"
-                : bad == 2 ? "another sweep's header than the first file's"
-                           : "expected a row starting with its run number");
-    return bad ? -1 : 0;
-}
-
-static int merge(int argc, char **argv)
-{
-    const char *out = NULL;
-    bool force = false, partial = false;
-    const char *in[256];
-    int nin = 0;
-    for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output")) {
-            if (++i == argc) return die("%s needs a value", argv[i - 1]);
-            out = argv[i];
-        } else if (!strcmp(argv[i], "-f") || !strcmp(argv[i], "--force")) {
-            force = true;
-        } else if (!strcmp(argv[i], "--partial")) {
-            partial = true;
-        } else if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
-            usage(stdout);
-            return 0;
-        } else if (argv[i][0] == '-') {
-            return die("merge: unknown option '%s' (try --help)", argv[i]);
-        } else if (nin < 256) {
-            in[nin++] = argv[i];
-        }
-    }
-    if (!nin) return die("%s", "merge: expected the shards' CSV files (try --help)");
-    if (!out) return die("%s", "merge: -o OUT.csv is required");
-    rows r = {0};
-    char header[ROW_MAX] = "";
-    for (int k = 0; k < nin; k++)
-        if (read_shard(in[k], k, header, &r)) {
-            rows_free(&r);
-            return 2;
-        }
-    /* a run number is all a row says of its sweep: shards that leave a run out (one
-     * forgotten, one of another split) make no whole; the runs a sweep has are not in its
-     * CSV, so a missing last shard's runs past the others' cannot be told */
-    char missing[512];
-    if (!partial && !rows_whole(&r, missing, sizeof missing)) {
-        fprintf(stderr, "%s: merge: the shards do not make a whole sweep: missing runs %s "
-                        "(a whole sweep has every run from 0 to its last); give every shard, "
-                        "or --partial to merge only these\n", prog, missing);
-        rows_free(&r);
-        return 2;
-    }
-    FILE *fo = eval_open_out(prog, "-o", out, force, in, nin);
-    if (!fo) {
-        rows_free(&r);
-        return 2;
-    }
-    char err[256];
-    int rc = rows_write(&r, fo, header, err, sizeof err);
-    if (fclose(fo) != 0 || rc) {
-        fprintf(stderr, "%s: merge: %s\n", prog, rc ? err : strerror(errno));
-        unlink(out);
-        rows_free(&r);
-        return 2;
-    }
-    summary(header, &r);
-    rows_free(&r);
-    return 0;
-}
-
 /* ---------------------------------------------------------------- plot */
 /* The column of a metric in the CSV's header, or -1. */
 static int header_column(const char *header, const char *name)
@@ -605,8 +327,9 @@ typedef struct sweep {
     eval_scene sc;
     lag_require req;
     char header[ROW_MAX];
+    char *identity;      /* the CSV's identity lines (sweep_merge.h) */
     char default_metric[160];
-    char tmpdir[64];
+    char tmpdir[160]; /* eval_make_tmpdir: at most 128 + 21 */
 } sweep;
 
 static int parse_options(sweep *x, int argc, char **argv)
@@ -645,9 +368,9 @@ static int parse_options(sweep *x, int argc, char **argv)
         case O_SEED: x->seed = (uint64_t)parse_pos("--seed", optarg, 0, 9e15, &bad); break;
         case 'j': x->jobs = (long)parse_pos("--jobs", optarg, 1, 256, &bad); break;
         case O_SHARD:
-            if (sscanf(optarg, "%ld/%ld", &x->shard_k, &x->shard_n) != 2 || x->shard_n < 1 ||
-                x->shard_k < 1 || x->shard_k > x->shard_n)
-                return die("--shard: expected K/N with 1 <= K <= N, got '%s'", optarg);
+            if (sweep_shard_parse(optarg, &x->shard_k, &x->shard_n))
+                return die("--shard: expected K/N, whole numbers with 1 <= K <= N <= 1e7, got "
+                           "'%s'", optarg);
             break;
         case O_REQUIRE: x->require = optarg; break;
         case O_CSV: x->csv = optarg; break;
@@ -736,24 +459,40 @@ static int make_header(sweep *x)
 {
     char *h = x->header;
     size_t hu = (size_t)snprintf(h, ROW_MAX, "run");
-    for (int k = 0; k < x->nv; k++) {
+    for (int k = 0; k < x->nv && hu < ROW_MAX; k++) {
         if (x->vs[k].index < 0)
             hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",%s", x->vs[k].key);
         else
             hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",%s[%d]", x->vs[k].key,
                                    x->vs[k].index);
     }
-    hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",failed,required,reason");
-    for (int j = 0; j < x->sc.nj; j++)
-        for (int m = 0; m < LAG_METRIC_COUNT; m++)
+    if (hu < ROW_MAX) hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",failed,required,reason");
+    for (int j = 0; j < x->sc.nj && hu < ROW_MAX; j++)
+        for (int m = 0; m < LAG_METRIC_COUNT && hu < ROW_MAX; m++)
             hu += (size_t)snprintf(h + hu, ROW_MAX - hu, ",%s.%s", x->sc.joint[j],
                                    lag_metric_table[m].name);
+    if (hu >= ROW_MAX) return die("the CSV's header (the varied keys' names) would pass %s bytes",
+                                  "8191");
     snprintf(x->default_metric, sizeof x->default_metric, "%s.%s",
              x->req.n ? x->req.term[0].joint : x->sc.joint[0],
              lag_metric_table[x->req.n ? x->req.term[0].metric : LAG_METRIC_IAE].name);
     if (!x->metric) x->metric = x->default_metric;
     if (x->png && header_column(x->header, x->metric) < 0)
         return die("--metric %s: no such column (JOINT.METRIC, e.g. theta.settle)", x->metric);
+    return -1;
+}
+
+/* What every shard of the sweep shares, for the CSV's identity lines. -1 or the exit code. */
+static int make_identity(sweep *x)
+{
+    char err[2048];
+    const char *texts[VARY_MAX];
+    for (int k = 0; k < x->nv; k++) texts[k] = x->vs[k].text;
+    sweep_identity id = {.seed = x->seed, .scene = x->config, .c = &x->c, .vary = texts,
+                         .nvary = x->nv, .runs = x->total, .controller = x->controller,
+                         .restart = x->restart, .require = x->require,
+                         .shard_k = x->shard_k, .shard_n = x->shard_n};
+    if (!(x->identity = sweep_identity_text(&id, err, sizeof err))) return die("%s", err);
     return -1;
 }
 
@@ -812,12 +551,8 @@ static void write_row(const worker *wk, long i, const double *val, const eval_re
     fprintf(f, "%ld", i);
     for (int k = 0; k < x->nv; k++) fprintf(f, ",%.17g", val[k]);
     const char *reason = res->failed ? res->reason : met ? "" : why;
-    fprintf(f, ",%d,%d,\"", res->failed, met);
-    for (const char *p = reason; *p; p++) {
-        if (*p == '"') fputc('"', f);
-        fputc(*p == '\n' ? ' ' : *p, f);
-    }
-    fputc('"', f);
+    fprintf(f, ",%d,%d,", res->failed, met);
+    sweep_write_reason(f, reason);
     for (int j = 0; j < x->sc.nj; j++)
         for (int m = 0; m < LAG_METRIC_COUNT; m++) {
             if (isnan(res->m[j].v[m])) fprintf(f, ",nan");
@@ -882,42 +617,45 @@ static void worker_main(const sweep *x, long w)
 }
 
 /* ---------------------------------------------------------------- the results */
+/* The workers, forked (each dies with this process: eval_proc_fork), and their ends. */
 static int run_workers(sweep *x)
 {
     pid_t pids[256];
     int status = 0;
     for (long w = 0; w < x->jobs; w++) {
-        fflush(NULL);
-        pids[w] = fork();
+        pids[w] = eval_proc_fork();
         if (pids[w] < 0) {
             fprintf(stderr, "%s: fork: %s\n", prog, strerror(errno));
+            for (long k = 0; k < w; k++) eval_stop_group(pids[k], &(int){0});
             return 2;
         }
         if (pids[w] == 0) worker_main(x, w);
     }
     for (long w = 0; w < x->jobs; w++) {
         int st = 0;
-        waitpid(pids[w], &st, 0);
-        if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) status = 2;
+        if (eval_proc_wait(pids[w], &st) != 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0)
+            status = 2;
     }
     return status;
 }
 
 static void collect_rows(const sweep *x, rows *r)
 {
-    char line[ROW_MAX];
+    char *line = NULL;
+    size_t cap = 0;
     for (long w = 0; w < x->jobs; w++) {
         char path[256];
         snprintf(path, sizeof path, "%s/%ld.rows", x->tmpdir, w);
         FILE *f = fopen(path, "r");
         if (!f) continue;
-        while (fgets(line, sizeof line, f)) {
+        while (getline(&line, &cap, f) >= 0) {
             line[strcspn(line, "\n")] = '\0';
             rows_add(r, strtol(line, NULL, 10), line);
         }
         fclose(f);
         unlink(path);
     }
+    free(line);
 }
 
 static int count_passed(const sweep *x, const rows *r)
@@ -946,27 +684,30 @@ static int sweep_run(sweep *x)
         return 2;
     }
     if (fpng) fclose(fpng); /* gnuplot writes it at the end */
-    snprintf(x->tmpdir, sizeof x->tmpdir, "/tmp/lagsim-sweep.XXXXXX");
-    if (!mkdtemp(x->tmpdir)) {
+    if (eval_make_tmpdir("lagsim-sweep", x->tmpdir, sizeof x->tmpdir) != 0) {
         fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
         return 2;
     }
+    if (x->verbose) eval_proc_tmpdir_done(); /* -v keeps the kept daemons' logs */
     int status = run_workers(x);
     rows r = {0};
     collect_rows(x, &r);
-    if (fcsv && (rows_write(&r, fcsv, x->header, err, sizeof err) || fclose(fcsv) != 0))
+    if (fcsv && (rows_write(&r, fcsv, x->identity, x->header, err, sizeof err) ||
+                 fclose(fcsv) != 0))
         status = 2;
     summary(x->header, &r);
     bool all = count_passed(x, &r) == r.n;
     if (x->png && plot(x->png, x->tmpdir, x->header, &r, x->nv, x->metric)) status = 2;
     rmdir(x->tmpdir);
+    eval_proc_tmpdir_done();
     rows_free(&r);
     return status ? status : all ? 0 : 1;
 }
 
 int main(int argc, char **argv)
 {
-    if (argc > 1 && !strcmp(argv[1], "merge")) return merge(argc - 1, argv + 1);
+    if (argc > 1 && !strcmp(argv[1], "merge")) return merge(argc - 1, argv + 1, usage);
+    eval_proc_init(); /* every process it starts ends when it ends (eval_proc.h) */
     static sweep x = {.timeout = 600, .runs = 1, .jobs = 1, .shard_k = 1, .shard_n = 1,
                       .seed = 1};
     eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
@@ -974,6 +715,8 @@ int main(int argc, char **argv)
     if ((rc = parse_options(&x, argc, argv)) >= 0 || (rc = check_options(&x, argc, argv)) >= 0 ||
         (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0)
         return rc;
-    if ((rc = make_header(&x)) >= 0) return rc;
-    return sweep_run(&x);
+    if ((rc = make_header(&x)) >= 0 || (rc = make_identity(&x)) >= 0) return rc;
+    rc = sweep_run(&x);
+    free(x.identity);
+    return rc;
 }

@@ -169,7 +169,8 @@ int view_http_timeout_ms(view_http *h);
 void view_http_run(view_http *h);
 /* Streams open now. */
 unsigned view_http_streams(const view_http *h);
-/* Stops: resumes every stream first (libmicrohttpd requires it), then closes. */
+/* Stops: every stream ends (its last chunk) and is resumed first, libmicrohttpd aborting in
+ * MHD_stop_daemon while a connection is suspended; then closes. Within about 1 s. */
 void view_http_stop(view_http *h);
 
 /* What one stream has been sent. */

@@ -37,6 +37,7 @@
 #include <linux/tcp.h> /* struct tcp_info with tcpi_bytes_acked */
 #include <microhttpd.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -56,6 +57,7 @@
 #define VIEW_CHECK_NS 250000000LL        /* deadlines and stalls looked at this often */
 #define VIEW_REQUEST_MEMORY (16 * 1024)  /* one request's headers and buffers */
 #define VIEW_STATE_JSON (64 * 1024)
+#define VIEW_STOP_NS 1000000000LL        /* streams get this long to end when the view stops */
 
 /* Every connection, from accept to close (libmicrohttpd's connection notifications): what
  * it waits for and until when. */
@@ -94,6 +96,7 @@ struct view_http {
     conn *conns;             /* every open connection */
     int64_t last_check_ns;
     int64_t n_header_timeouts, n_stalled, n_frames_cut, n_bad_host;
+    bool stopping;           /* streams end instead of waiting: the view stops */
     /* Host header names accepted (lower case; IPv6 in brackets), the port apart */
     char hosts[VIEW_HOSTS_MAX][VIEW_HOST_LEN];
     int n_hosts;
@@ -232,6 +235,8 @@ static ssize_t stream_read(void *cls, uint64_t pos, char *buf, size_t max)
     int64_t now = lag_clock_mono_ns();
     if (s->off >= s->len) {
         s->len = s->off = 0;
+        /* the view stops: the stream ends (its last chunk) rather than waits */
+        if (h->stopping) return MHD_CONTENT_READER_END_OF_STREAM;
         if (now >= s->next_frame_ns) {
             s->len = view_frame(h->vb, h->o.hz, &s->cur, s->buf, sizeof s->buf, &h->n_frames_cut);
             if (s->len == 0 && now - s->last_write_ns >= VIEW_KEEPALIVE_NS) {
@@ -265,6 +270,7 @@ static void stream_free(void *cls)
 
 static enum MHD_Result open_stream(view_http *h, struct MHD_Connection *c, conn *rec)
 {
+    if (h->stopping) return reply_text(c, 503, "the view is stopping\n");
     if (h->n_streams >= h->o.max_streams)
         return reply_text(c, 503, "too many open views (see lagsim-view --max-views)\n");
     stream *s = calloc(1, sizeof *s);
@@ -717,15 +723,41 @@ void view_http_run(view_http *h)
     MHD_run(h->d);
 }
 
-void view_http_stop(view_http *h)
+/* Resumes every suspended stream: each then ends (h->stopping) instead of suspending
+ * again. Returns how many were suspended. */
+static unsigned resume_all(view_http *h)
 {
-    if (!h) return;
+    unsigned n = 0;
     for (stream *s = h->streams; s; s = s->next)
         if (s->suspended) {
             s->suspended = false;
             MHD_resume_connection(s->conn);
+            n++;
         }
-    MHD_run(h->d);
-    MHD_stop_daemon(h->d); /* frees every stream through stream_free */
+    return n;
+}
+
+/* libmicrohttpd aborts the process in MHD_stop_daemon while a connection is suspended, and
+ * a resumed stream asked for its next bytes suspends itself again when there is nothing
+ * new: so every stream is first made to end (its last chunk sent) and resumed, and the
+ * loop runs until the streams are gone, or for VIEW_STOP_NS (a client that does not read
+ * keeps its stream, never suspended: MHD_stop_daemon closes it). The MHD_run after the
+ * last resume is what takes the resumed connections off libmicrohttpd's suspended list. */
+void view_http_stop(view_http *h)
+{
+    if (!h) return;
+    h->stopping = true;
+    int64_t until = lag_clock_mono_ns() + VIEW_STOP_NS;
+    do {
+        resume_all(h);
+        MHD_run(h->d);
+        if (!h->streams) break;
+        struct pollfd pf = {view_http_fd(h), POLLIN, 0};
+        poll(&pf, 1, 10);
+    } while (lag_clock_mono_ns() < until);
+    /* none is suspended now (the MHD_run after a resume takes it off the list, and a
+     * stream no longer suspends itself); made sure of, as MHD_stop_daemon would abort */
+    if (resume_all(h)) MHD_run(h->d);
+    MHD_stop_daemon(h->d); /* frees every stream left through stream_free */
     free(h);
 }

@@ -21,6 +21,9 @@ Cases:
   cli            option errors: exit 2 with the option named, nothing run
   flood          3 s of refused commands on a logged realtime run: a bounded sample of them
                  logged, every state, the counts in the log and the summary, replay exact
+  flood_applied  3 s of commands and pause/resume requests, each applied: the received
+                 records' bytes within their buckets over the log's clock, every state,
+                 the counts said, replay exact
 """
 import argparse
 import ctypes
@@ -387,8 +390,8 @@ def case_cli(r, a, tmp):
 def case_flood(r, a, tmp):
     """A flood of refused commands (unknown joints, and undecodable bytes) for 3 s on a
     realtime run logged with --log: the log keeps every state and every message the daemon
-    published, and of the flood only a sample of at most 64 KiB a second (the sample's
-    bucket: 64 KiB at start, 64 KiB more each second); the counts are in the log (the
+    published, and of the flood only a sample of at most 8 KiB a second (the sample's
+    bucket: 8 KiB at start, 8 KiB more each second); the counts are in the log (the
     last status's rejected_* fields, a log_sampled event) and in the summary on stderr;
     --replay gives difference 0."""
     sys.path.insert(0, a.types)
@@ -427,11 +430,11 @@ def case_flood(r, a, tmp):
           f"({last.rejected_unknown_joint} unknown joint, {last.rejected_undecodable} undecodable); "
           f"log {size} bytes: {cmd_bytes} of commands, {rest} of the rest; "
           f"every refused one written would be {received * each} bytes")
-    # the bound: the sample's bucket can have given at most 64 KiB at start plus 64 KiB for
-    # each second of the run (the run is run_s of sim time at rate 1, plus the start)
-    bound = 64 * 1024 * (1 + run_s + 1)
+    # the bound: the sample's bucket can have given at most 8 KiB at start plus 8 KiB for
+    # each second of the log's clock (the run is run_s of sim time at rate 1, plus the start)
+    bound = 8 * 1024 * (1 + run_s + 1)
     check(received > 20000, f"the flood reached the daemon ({received} refused commands counted)")
-    check(cmd_bytes <= bound, f"commands in the log: {cmd_bytes} bytes <= {bound} (64 KiB a "
+    check(cmd_bytes <= bound, f"commands in the log: {cmd_bytes} bytes <= {bound} (8 KiB a "
           f"second of the run and one at start)")
     check(size <= rest + bound and size < 2 * 1024 * 1024,
           f"the log: {size} bytes (< 2 MiB; written whole it would be over {received * each})")
@@ -441,13 +444,16 @@ def case_flood(r, a, tmp):
     check(sampled and "counted only" in sampled[-1].detail and sampled[-1].value > 0,
           f"log_sampled events in the log ({len(sampled)}): "
           f"'{sampled[-1].detail if sampled else ''}'")
-    m = re.search(r"received (\d+) refused commands and control requests \((\d+) undecodable\)"
-                  r" and \d+ status or describe requests: (\d+) written as a sample, (\d+) counted only", err)
+    m = re.search(r"complete; received (\d+) refused commands and control requests \((\d+) "
+                  r"undecodable\) and \d+ status or describe requests: (\d+) written as a sample, "
+                  r"(\d+) counted only", err)  # the summary at exit
+    in_log = sum(1 for _, _, ch, _ in recs if ch == prefix + "_COMMAND")
     check(m is not None and int(m.group(1)) == received
-          and int(m.group(2)) == last.rejected_undecodable
-          and int(m.group(3)) == sum(1 for _, _, ch, _ in recs if ch == prefix + "_COMMAND"),
+          and int(m.group(2)) == last.rejected_undecodable and int(m.group(3)) == in_log,
           "the summary on stderr: refused received (as the last status counts them), "
-          "undecodable, written as a sample (as the log holds), counted only")
+          "undecodable, written as a sample (as the log holds), counted only: %s; status: %d "
+          "refused, %d undecodable; log: %d" % (m.groups() if m else None, received,
+                                                last.rejected_undecodable, in_log))
     rp = r.lagsimd("--config", config, "--set", f"lcm.prefix={prefix}", "--set",
                    "realtime.start=running", "--replay", log)
     n, gaps, diff, _ = replay_report(rp)
@@ -455,8 +461,93 @@ def case_flood(r, a, tmp):
           f"replay: {n} states compared, {gaps} gaps, difference {diff}, exit {rp.returncode}")
 
 
+def case_flood_applied(r, a, tmp):
+    """A flood of messages the daemon applies, for 3 s on a realtime run logged with --log:
+    good commands (a new effort each), and pause and resume requests. Each changes the run,
+    so none is refused; the log still grows by a bounded amount: the received records'
+    bytes are within their two buckets (applied ones: room for 2 full commands a control
+    period, at least 8 KiB a second; refused ones and queries: 8 KiB a second; each full at
+    start) over the span of the log's own clock or the run's wall time, whichever is
+    longer, whatever was sent. The full command's size
+    is computed here from lcm-gen's types. Every state is logged, the counts are said (a
+    log_sampled event, the summary), and --replay gives difference 0."""
+    sys.path.insert(0, a.types)
+    from lagsim_lcm import LCM, plant_urls
+    prefix = f"LG{os.getpid()}A"
+    log = os.path.join(tmp, "applied.lcm")
+    config = os.path.join(a.source, "config", "dipc.yaml")
+    hz, run_s, flood_s = 100, 5.0, 3.0
+    d = subprocess.Popen([os.path.join(r.bin, "lagsimd"), "--config", config, "--set",
+                          f"lcm.prefix={prefix}", "--set", "realtime.start=running", "--set",
+                          f"publish_hz={hz}", "--duration", str(run_s), "--log", log],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    t_start = time.monotonic()
+    time.sleep(0.8)
+    _, command_url = plant_urls()
+    lc = LCM(command_url)
+    cmd = r.t.joint_command_t()
+    cmd.num_joints, cmd.name = 1, ["theta0"]
+    ctl = r.t.control_t()
+    payloads = []
+    for k in range(50):
+        cmd.effort = [0.001 * k]
+        payloads.append((prefix + "_COMMAND", cmd.encode()))
+    for req in (r.t.control_t.PAUSE, r.t.control_t.RESUME):
+        ctl.request = req
+        payloads.append((prefix + "_CONTROL", ctl.encode()))
+    sent, t_end = 0, time.time() + flood_s
+    while time.time() < t_end:
+        for _ in range(200):
+            lc.publish(*payloads[sent % len(payloads)])
+            sent += 1
+    ctl.request = r.t.control_t.RESUME  # the flood may end paused
+    for _ in range(3):
+        lc.publish(prefix + "_CONTROL", ctl.encode())
+        time.sleep(0.1)
+    out, err = d.communicate(timeout=120)
+    wall = time.monotonic() - t_start
+    print("\n".join(l for l in err.splitlines() if "log" in l)[-2000:])
+    check(d.returncode == 0, f"lagsimd: exit {d.returncode}")
+    recs = read_log(log)
+    rx = [(ts, 28 + len(ch) + len(data)) for _, ts, ch, data in recs
+          if ch in (prefix + "_COMMAND", prefix + "_CONTROL")]
+    span = (recs[-1][1] - recs[0][1]) * 1e-6
+    full = r.t.joint_command_t()
+    full.num_joints, full.name, full.effort = 1, ["theta0"], [0.0]
+    record = 28 + len(prefix + "_COMMAND") + len(full.encode())
+    applied_bps = max(8192, 2 * hz * record)
+    bound = (applied_bps + 8192) * (1 + max(span, wall))
+    got = sum(b for _, b in rx)
+    m = re.search(r"complete; received \d+ refused .* counted only; applied (\d+) commands and "
+                  r"control requests: (\d+) written \(at most (\d+) bytes a second\), (\d+) "
+                  r"counted only", err)
+    print(f"  flood: {sent} sent in {flood_s} s; log {os.path.getsize(log)} bytes over "
+          f"{span:.2f} s of its clock ({wall:.2f} s of wall time); received records: {len(rx)}, {got} bytes; bound "
+          f"{bound:.0f} ({applied_bps} + 8192 bytes a second); summary: "
+          f"{m.groups() if m else None}")
+    check(m is not None and int(m.group(1)) > 20000,
+          f"the flood reached the daemon and was applied ({m.group(1) if m else '?'} counted)")
+    check(m is not None and int(m.group(3)) == applied_bps,
+          f"the applied messages' bucket: {m.group(3) if m else '?'} bytes a second, as "
+          f"computed here ({applied_bps}: 2 x {hz} Hz x {record} bytes)")
+    check(got <= bound, f"received records in the log: {got} bytes <= {bound:.0f}")
+    sampled = [r.t.event_t.decode(dt) for _, _, ch, dt in recs if ch == prefix + "_EVENT"]
+    sampled = [e for e in sampled if e.kind == "log_sampled" and "applied" in e.detail]
+    check(len(sampled) >= 2, f"log_sampled events say so ({len(sampled)})")
+    n = len(r.states(recs, prefix))
+    steps = [s.step for s in r.states(recs, prefix)]
+    check(steps[-1] == 5000 and all(b - a in (0, 10) for a, b in zip(steps, steps[1:])),
+          f"{n} states logged: every period's (paused ones repeat), to step {steps[-1]}")
+    rp = r.lagsimd("--config", config, "--set", f"lcm.prefix={prefix}", "--set",
+                   "realtime.start=running", "--set", f"publish_hz={hz}", "--replay", log)
+    _, gaps, diff, _ = replay_report(rp)
+    check(rp.returncode == 0 and gaps == 0 and diff == 0.0,
+          f"replay: {gaps} gaps, difference {diff}, exit {rp.returncode}")
+
+
 CASES = {"lqr": case_lqr, "lqr_effects": case_lqr_effects, "gaps": case_gaps,
-         "readers": case_readers, "cli": case_cli, "flood": case_flood}
+         "readers": case_readers, "cli": case_cli, "flood": case_flood,
+         "flood_applied": case_flood_applied}
 
 
 def main():

@@ -16,7 +16,8 @@ The cases: FILE is the input itself (and a hard link to it), with and without --
 refused, the input unchanged; FILE is a symbolic link to a file whose content must
 survive, with --force: refused, the target unchanged; FILE exists: refused without
 --force (unchanged), replaced with it; FILE is new: written. lagsimd --log --increment
-writes FILE.00, FILE.01, ... beside an existing FILE, which it keeps.
+writes FILE.000000, FILE.000001, ... beside an existing FILE, which it keeps (the series:
+test_series.py).
 """
 import argparse
 import hashlib
@@ -183,20 +184,21 @@ def main():
         check(p.returncode == 0 and w.wrote(new),
               f"{name}: a new file: exit {p.returncode} {p.stderr.strip()}")
 
-        # 5. lagsimd --log --increment: an existing record kept, the next free name written
-        #    (FILE.00, then FILE.01), a dangling symbolic link counted as a name taken
+        # 5. lagsimd --log --increment: FILE kept, the series' next file written (FILE.000000,
+        #    then FILE.000001); a symbolic link's name is a number taken, its target untouched
+        #    (the series itself: test_series.py)
         if a.writer == "lagsimd_log":
             before = digest(new)
-            for k in ("00", "01"):
+            for k in ("000000", "000001"):
                 p = w.lagsimd("--log", new, "--increment")
                 nxt = f"{new}.{k}"
                 check(p.returncode == 0 and digest(new) == before and os.path.exists(nxt)
                       and w.wrote(nxt) and f"writing {nxt}" in p.stderr,
                       f"{name}: --increment with the record there: exit {p.returncode}, kept: "
                       f"{digest(new) == before}, wrote {nxt}: {os.path.exists(nxt)}; {p.stderr.strip()}")
-            os.symlink(precious, f"{new}.02")
+            os.symlink(precious, f"{new}.000002")
             p = w.lagsimd("--log", new, "--increment")
-            check(p.returncode == 0 and os.path.exists(f"{new}.03") and
+            check(p.returncode == 0 and os.path.exists(f"{new}.000003") and
                   open(precious).read() == "results of a week\n",
                   f"{name}: --increment skips a symbolic link's name: exit {p.returncode}")
             p = w.lagsimd("--log", new, "--increment", "--force")

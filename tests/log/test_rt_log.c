@@ -6,7 +6,7 @@
  * reached the file is read back with the wire module's bounded reader.
  *
  *   test_rt_log CASE    CASE: file clock realtime_stalled fast_stalled lockstep_stalled
- *                             full flood_in flood_refused (--list)
+ *                             full flood_in flood_refused flood_accepted split (--list)
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -457,18 +458,27 @@ static void case_full(int arg)
 }
 
 /* A flood on the input channels cannot push the states out: received messages go in
- * only while the ring is at most 3/4 full, what the daemon publishes up to the full ring. */
+ * only while the ring is at most 3/4 full, what the daemon publishes up to the full ring.
+ * (The ring's own rule, below the buckets that bound what the loop hands it: records put
+ * straight into the ring as the loop puts received ones.) */
 static void case_flood_in(int arg)
 {
     (void)arg;
     scene(LAG_RT_REALTIME, 100);
     start(fifo_open(), RT_LOG_RING_MIN);
-    for (int k = 0; k < 10000; k++) command(0.0, 0.0);
+    uint8_t buf[256];
+    char *names[1] = {"theta0"};
+    double effort = 0.0;
+    lagsim_joint_command_t m = {0, 0.0, 1, names, &effort};
+    int n = lagsim_joint_command_t_encode(buf, 0, sizeof buf, &m);
+    ENSURE(n > 0);
+    int64_t put = 0;
+    for (int k = 0; k < 10000; k++)
+        put += rt_log_put(g_srv.rec.log, RT_LOG_IN, 1, "TRL_COMMAND", buf, (size_t)n);
     rt_log_stats st = stats();
-    printf("flood: %lld commands, %lld logged, %lld not (ring 3/4 full)\n",
-           (long long)g_commands_sent, (long long)(g_commands_sent - st.dropped_in),
-           (long long)st.dropped_in);
-    ENSURE(st.dropped_in > 1000 && st.dropped_full == 0);
+    printf("flood: 10000 commands put, %lld logged, %lld not (ring 3/4 full)\n",
+           (long long)put, (long long)st.dropped_in);
+    ENSURE(st.dropped_in > 1000 && st.dropped_in == 10000 - put && st.dropped_full == 0);
     int64_t r0 = st.records;
     run_until(g_srv.now + 500 * MS, 1000);
     st = stats();
@@ -562,6 +572,160 @@ static void case_flood_refused(int arg)
     ENSURE(lagsimd_replay(&g_sc, g_file, &ro) == 0);
 }
 
+/* A flood of accepted messages cannot fill the disk either: for 3 s of the made-up clock,
+ * every millisecond 10 good commands (each applied: the efforts change) and every 10 ms
+ * one answering the state as a controller does. Every state and event is logged, every
+ * command counted; the commands' bytes in the log are within their bucket (room for
+ * RT_LOG_ACCEPTED_PER_PERIOD full commands a control period, the size computed here from
+ * the wire format; at least RT_LOG_ACCEPTED_MIN_BPS), all of it used; log_sampled events
+ * say how many were not written; the replay gives difference 0. */
+static void case_flood_accepted(int arg)
+{
+    (void)arg;
+    scene(LAG_RT_REALTIME, 100);
+    g_sc.realtime.start = LAG_RT_START_RUNNING;
+    snprintf(g_file, sizeof g_file, "/tmp/lagsim_rt_log_%d.lcm", (int)getpid());
+    unlink(g_file);
+    start(g_file, 0);
+    const int64_t t0 = g_srv.now;
+    for (int ms = 1; ms <= 3000; ms++) {
+        run_until(t0 + ms * MS, 1000);
+        for (int k = 0; k < 10; k++) command(g_srv.ls.waiting_time, 0.01 * k);
+    }
+    run_until(t0 + 3500 * MS, 1000);
+    ENSURE(g_srv.rec.rx_accepted == 30000 && g_srv.rec.rx_refused == 0);
+    int64_t written = g_srv.rec.rx_accepted_written, bytes = g_srv.rec.rx_accepted_bytes;
+    ENSURE(finish() == 0); /* complete: the rest was counted by design */
+    logfacts f;
+    read_log(g_file, &f);
+    /* a full command of the DIPC: its one actuated joint named, as lcm-gen encodes it */
+    uint8_t buf[256];
+    char *names[1] = {"theta0"};
+    double e = 0.0;
+    lagsim_joint_command_t m = {0, 0.0, 1, names, &e};
+    int n = lagsim_joint_command_t_encode(buf, 0, sizeof buf, &m);
+    double record = LAG_LOG_HEADER_SIZE + (double)strlen("TRL_COMMAND") + n;
+    double rate = RT_LOG_ACCEPTED_PER_PERIOD * 100 * record;
+    if (rate < RT_LOG_ACCEPTED_MIN_BPS) rate = RT_LOG_ACCEPTED_MIN_BPS;
+    int64_t in_bytes = f.commands * (int64_t)record, ev_sampled = 0;
+    char err[256];
+    lag_log *lg = lag_log_open(g_file, 65536, err, sizeof err);
+    ENSUREF(lg, "%s", err);
+    lag_log_record r;
+    while (lag_log_next(lg, &r) == LAG_LOG_OK) {
+        lag_wire_event ev;
+        if (strcmp(r.channel, "TRL_EVENT") == 0 &&
+            lag_wire_decode_event(r.data, r.size, &ev) == LAG_WIRE_OK &&
+            !strcmp(ev.kind, "log_sampled") &&
+            strstr(ev.detail, "applied") && strstr(ev.detail, "counted only"))
+            ev_sampled++;
+    }
+    lag_log_close(lg);
+    printf("flood: 30000 commands applied in 3 s: %lld written (%lld bytes; bucket %.0f bytes "
+           "a second), %lld log_sampled events; log of %lld records, %lld states\n",
+           (long long)f.commands, (long long)in_bytes, rate, (long long)ev_sampled,
+           (long long)f.records, (long long)f.states);
+    ENSURE(f.commands == written && in_bytes == bytes);
+    /* a full bucket at start and 3 s of the log's clock (sim time: the run is running) */
+    ENSUREF(in_bytes <= 4 * rate + record && in_bytes > 4 * rate - 2 * record,
+            "%lld bytes of commands (the bucket: %.0f at start + 3 s x %.0f/s)",
+            (long long)in_bytes, rate, rate);
+    ENSURE(f.states == 351 && f.gaps == 0 && f.other == 0);
+    ENSURE(ev_sampled >= 3 && ev_sampled <= 5); /* at most one a second */
+    lagsimd_opts ro = g_opts;
+    ro.log = NULL;
+    ENSURE(lagsimd_replay(&g_sc, g_file, &ro) == 0);
+}
+
+/* --increment --split-mb --keep: a run of 3 s (about 60 kB) split every 8 KiB. Each file
+ * is a whole LCM log (nothing damaged or cut short), holds at most 8 KiB plus its last
+ * record, and follows the one before: record numbers and state steps go on across files,
+ * every state of the run is in one of them. With --keep 3 only the 3 newest are left. */
+static int series_files(const char *dir, char names[][64], int max)
+{
+    DIR *d = opendir(dir);
+    ENSURE(d);
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL)
+        if (e->d_name[0] != '.' && n < max) snprintf(names[n++], 64, "%.63s", e->d_name);
+    closedir(d);
+    qsort(names, (size_t)n, 64, (int (*)(const void *, const void *))strcmp);
+    return n;
+}
+
+static void split_run(const char *dir, int keep)
+{
+    char base[160];
+    snprintf(base, sizeof base, "%s/run.lcm", dir);
+    scene(LAG_RT_REALTIME, 100);
+    g_sc.realtime.start = LAG_RT_START_RUNNING;
+    g_opts.log_increment = true;
+    g_opts.log_split = 8192;
+    g_opts.log_keep = keep;
+    start(base, 0);
+    for (int k = 0; k < 30; k++) {
+        run_until(g_srv.now + 100 * MS, 1000);
+        usleep(20000); /* let the writer go on: files are cut where they were due */
+    }
+    ENSURE(finish() == 0);
+}
+
+static void case_split(int arg)
+{
+    (void)arg;
+    char dir[] = "/tmp/lagsim_rt_split_XXXXXX", names[64][64], path[256];
+    ENSURE(mkdtemp(dir));
+    split_run(dir, 0);
+    int n = series_files(dir, names, 64);
+    int64_t number = 0, states = 0, prev_step = -1;
+    for (int i = 0; i < n; i++) {
+        char want[64];
+        snprintf(want, sizeof want, "run.lcm.%06d", i);
+        ENSUREF(!strcmp(names[i], want), "%s: expected %s", names[i], want);
+        snprintf(path, sizeof path, "%.100s/%.63s", dir, names[i]);
+        char err[256];
+        lag_log *lg = lag_log_open(path, 65536, err, sizeof err);
+        ENSUREF(lg, "%s", err);
+        lag_log_record r;
+        size_t last = 0;
+        while (lag_log_next(lg, &r) == LAG_LOG_OK) {
+            ENSUREF(r.event_number == number, "%s: record %lld numbered %lld", names[i],
+                    (long long)number, (long long)r.event_number);
+            number++;
+            last = LAG_LOG_HEADER_SIZE + strlen(r.channel) + r.size;
+            lag_wire_joint_state m;
+            if (strcmp(r.channel, "TRL_STATE") != 0) continue;
+            ENSURE(lag_wire_decode_joint_state(r.data, r.size, 3, &m) == LAG_WIRE_OK);
+            ENSURE(prev_step < 0 || m.step == prev_step + g_sc.ticks_per_period);
+            prev_step = m.step;
+            states++;
+        }
+        lag_log_stats ls;
+        lag_log_get_stats(lg, &ls);
+        lag_log_close(lg);
+        struct stat st;
+        ENSURE(stat(path, &st) == 0);
+        ENSUREF(ls.damaged == 0 && ls.truncated_bytes == 0 &&
+                (i == n - 1 || (st.st_size >= 8192 && (size_t)st.st_size < 8192 + last)),
+                "%s: %lld bytes, damaged %lld, cut short %lld", names[i],
+                (long long)st.st_size, (long long)ls.damaged, (long long)ls.truncated_bytes);
+        unlink(path);
+    }
+    printf("split: %d files of at most 8 KiB and a record, %lld records, %lld states\n", n,
+           (long long)number, (long long)states);
+    ENSURE(n >= 6 && states == 301);
+    split_run(dir, 3); /* numbers go on from the highest: none left, so 0 again */
+    n = series_files(dir, names, 64);
+    printf("split --keep 3: %d files left: %s ... %s\n", n, names[0], names[n - 1]);
+    ENSURE(n == 3 && strcmp(names[0], "run.lcm.000000") != 0);
+    for (int i = 0; i < n; i++) {
+        snprintf(path, sizeof path, "%.100s/%.63s", dir, names[i]);
+        unlink(path);
+    }
+    ENSURE(rmdir(dir) == 0);
+}
+
 static void setup(void)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -581,6 +745,8 @@ int main(int argc, char **argv)
         {"full", case_full, 0, 0},
         {"flood_in", case_flood_in, 0, 0},
         {"flood_refused", case_flood_refused, 0, 0},
+        {"flood_accepted", case_flood_accepted, 0, 0},
+        {"split", case_split, 0, 0},
     };
     /* a failed check ends the case (its files removed): what follows it needs what failed */
     const lt_program p = {.cases = cases, .n = (int)(sizeof cases / sizeof cases[0]),

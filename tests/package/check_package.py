@@ -12,8 +12,10 @@ build (any user):
   should (python3's and lua5.2's own search paths name the directories); programs are
   stripped, everything is root's; Depends names the package of every shared library the
   programs need (readelf + dpkg -S) and python3; the maintainer scripts parse; the
-  unit has the hardening asked of it, passes `systemd-analyze verify` and
-  `systemd-analyze security --offline=yes` scores at most EXPOSURE_MAX; lintian reports
+  unit has the hardening asked of it, each resource limit has its row in docs/deploy.md's
+  hardening table and its header example is the one docs/deploy.md gives, it passes
+  `systemd-analyze verify` and `systemd-analyze security --offline=yes` scores at most
+  EXPOSURE_MAX; lintian reports
   no error (its warnings are printed).
 install (root only, else skipped with exit 77; also skipped when a lagsim package is
   installed already, which this test would replace and remove):
@@ -29,11 +31,13 @@ service (root only, else skipped; skipped too when this host cannot start system
   installs the .deb, then runs systemd 252 as PID 1 of a new PID and mount namespace (the
   host's own units hidden: only the installed lagsimd@.service, journald and empty
   targets are on its unit path, /run and the journal on tmpfs) and, as docs/deploy.md
-  says, puts a scene in /etc/lagsim and starts lagsimd@NAME: the installed dipc_lqr
-  balances it from outside; the daemon runs as a dynamic user without capabilities,
-  with no_new_privs and a seccomp filter; its events are in the journal; --log (from
-  /etc/lagsim/NAME.env) writes into /var/lib/lagsim/NAME and replays exactly; a SIGKILL
-  is followed by a restart, `systemctl stop` by exit 0; a bad scene fails with exit 2
+  says, puts a scene in /etc/lagsim and starts lagsimd@NAME with the unit header's example
+  LAGSIMD_ARGS (in /etc/lagsim/NAME.env): the installed dipc_lqr balances it from outside;
+  the daemon runs as a dynamic user without capabilities, with no_new_privs and a seccomp
+  filter, and under the unit's limits (/proc/PID/limits, MemoryMax, TasksMax); its events
+  are in the journal; --log writes into /var/lib/lagsim/NAME and replays exactly; a
+  SIGKILL is followed by a restart and `systemctl restart` by another, each writing a new
+  file of the series while the earlier stay; `systemctl stop` gives exit 0; a bad scene fails with exit 2
   and is not restarted; `dpkg --purge` run there stops an enabled, running instance and
   removes its link. Then the checks after the purge, as in install.
 One run at a time on a host: a lock file (LOCK) is held for the whole of it.
@@ -55,9 +59,19 @@ LOCK = "/var/lock/lagsim-package-test.lock"
 SKIP = 77
 # the unit's settings the deployment relies on (docs/deploy.md)
 UNIT_MUST = ["ExecStart=/usr/bin/lagsimd --config /etc/lagsim/%i.yaml $LAGSIMD_ARGS",
-             "Restart=on-failure", "DynamicUser=yes", "ProtectSystem=strict",
-             "NoNewPrivileges=yes", "StateDirectory=lagsim/%i",
-             "RestrictAddressFamilies=AF_INET"]
+             "Restart=on-failure", "RestartPreventExitStatus=2", "DynamicUser=yes",
+             "ProtectSystem=strict", "NoNewPrivileges=yes", "StateDirectory=lagsim/%i",
+             "RestrictAddressFamilies=AF_INET", "MemoryMax=256M", "TasksMax=16",
+             "LimitFSIZE=4G", "LimitCORE=0"]
+# the unit's resource limits: each has its reason in docs/deploy.md's hardening table
+LIMIT_RE = re.compile(r"^(Memory(?:Max|High|SwapMax)|TasksMax|Limit\w+)=\S+$")
+
+
+def unit_example(text):
+    """The LAGSIMD_ARGS the unit's header gives as its example (the one fact; docs/deploy.md
+    quotes it and this test runs it)."""
+    m = re.search(r"^#\s+(LAGSIMD_ARGS=.*\S)\s*$", text, re.M)
+    return m.group(1)[len("LAGSIMD_ARGS="):] if m else None
 
 fails = 0
 
@@ -208,6 +222,15 @@ def do_build(a):
     lines = [l.strip() for l in text.splitlines()]
     no = [u for u in UNIT_MUST if u not in lines]
     check(not no, "lagsimd@.service says %s" % (", ".join(UNIT_MUST) if not no else "; lacks " + " ".join(no)))
+    limits = [l for l in lines if LIMIT_RE.match(l)]
+    with open(os.path.join(a.source, "docs", "deploy.md")) as f:
+        deploy = f.read()
+    rows = [l for l in limits if not re.search(r"^\| `%s` \|" % re.escape(l), deploy, re.M)]
+    check(limits and not rows, "each resource limit of the unit (%s) has its row, with its reason, "
+          "in docs/deploy.md's hardening table%s" % (", ".join(limits), "; missing: " + " ".join(rows) if rows else ""))
+    example = unit_example(text)
+    check(example and ("    LAGSIMD_ARGS=%s\n" % example) in deploy,
+          "the unit's header example (LAGSIMD_ARGS=%s) is the one docs/deploy.md gives" % example)
     # verify before installation: the build's lagsimd in ExecStart and its man page on MANPATH
     vdir = os.path.join(tmp, "verify")
     os.makedirs(os.path.join(vdir, "man", "man1"))
@@ -445,8 +468,14 @@ def service_checks(a, tmp):
     os.makedirs("/etc/lagsim", exist_ok=True)
     shutil.copy("/usr/share/lagsim/config/dipc.yaml", ours[0])        # as docs/deploy.md says
     os.chmod(ours[0], 0o644)
+    with open("/usr/lib/systemd/system/lagsimd@.service") as f:
+        example = unit_example(f.read())   # the unit's own example, as an admin copies it
+    if not check(example is not None and "--log run.lcm" in example,
+                 "the installed unit's header gives an example LAGSIMD_ARGS with --log run.lcm: %s"
+                 % example):
+        return 0
     with open(ours[1], "w") as f:
-        f.write("LAGSIMD_ARGS=--set lcm.prefix=%s --log run.lcm --increment\n" % prefix)
+        f.write("LAGSIMD_ARGS=--set lcm.prefix=%s %s\n" % (prefix, example))
     with open(ours[2], "w") as f:
         f.write("model: dipc\nbogus: 1\n")
     os.chmod(ours[2], 0o644)
@@ -488,32 +517,68 @@ def service_checks(a, tmp):
         j = sd.sh(["journalctl", "-u", unit, "--no-pager", "-o", "cat"]).stdout
         check("listening on" in j and "event stop" in j and "SIGTERM" in j,
               "journalctl -u %s: the daemon's lines (listening on ..., event stop ... SIGTERM)" % unit, j)
-        log = "/var/lib/lagsim/%s/run.lcm" % name
+        state = "/var/lib/lagsim/%s" % name
+        log = state + "/run.lcm.000000"    # the example's --increment: the series' first file
         rp = run(["/usr/bin/lagsimd", "--config", "/usr/share/lagsim/config/dipc.yaml", "--set",
                   "lcm.prefix=" + prefix, "--replay", log], env=env, cwd=tmp)
-        check(os.path.exists(log) and rp.returncode == 0, "--log run.lcm wrote %s (%s bytes): "
-              "--replay exact (exit %d)" % (log, os.path.getsize(log) if os.path.exists(log) else "no",
-                                              rp.returncode), rp.stdout)
+        check(os.path.exists(log) and rp.returncode == 0, "%s wrote %s (%s bytes): --replay exact "
+              "(exit %d)" % (example, log, os.path.getsize(log) if os.path.exists(log) else "no",
+                             rp.returncode), rp.stdout)
         first_size = os.path.getsize(log) if os.path.exists(log) else -1
-        # a crash: killed, it comes back (a second run, which writes run.lcm.00 beside the
-        # first run's record, --increment)
+
+        def series():
+            return sorted(n for n in os.listdir(state) if n.startswith("run.lcm.")) \
+                if os.path.isdir(state) else []
+
+        def grows(name):
+            """The daemon is writing `name`: it grows while the plant runs (states at 100 Hz)."""
+            path = os.path.join(state, name)
+            size0 = os.path.getsize(path) if os.path.exists(path) else -1
+            deadline = time.monotonic() + 10
+            while time.monotonic() < deadline:
+                time.sleep(0.5)
+                if os.path.exists(path) and os.path.getsize(path) > size0 + 1000:
+                    return True
+            return False
+
+        # the limits the unit sets, as the kernel and systemd apply them to the daemon
         sd.ctl("start", unit)
-        time.sleep(1)
         pid = sd.show(unit, "MainPID")
-        r = sd.ctl("kill", "-s", "SIGKILL", unit)
-        deadline, restarted = time.monotonic() + 20, False
-        while time.monotonic() < deadline and not restarted:
-            time.sleep(0.5)
-            newpid = sd.show(unit, "MainPID")
-            restarted = sd.show(unit, "NRestarts") == "1" and newpid not in ("0", pid) and \
-                sd.show(unit, "ActiveState") == "active"
-        check(restarted, "killed (SIGKILL), it is restarted (Restart=on-failure): NRestarts %s"
-              % sd.show(unit, "NRestarts"))
+        lim = sd.sh(["cat", "/proc/%s/limits" % pid]).stdout
+        lims = {k: re.search(r"^%s\s+(\S+)" % k, lim, re.M) for k in
+                ("Max file size", "Max core file size", "Max open files")}
+        lims = {k: v.group(1) if v else None for k, v in lims.items()}
+        mem, tasks = sd.show(unit, "MemoryMax"), sd.show(unit, "TasksMax")
+        check(lims == {"Max file size": str(4 << 30), "Max core file size": "0",
+                       "Max open files": "128"} and mem == str(256 << 20) and tasks == "16",
+              "the unit's limits on the daemon: %s, MemoryMax %s, TasksMax %s" % (lims, mem, tasks), lim)
+        # restarts with the example: a crash (SIGKILL) restarts it, and a start after a
+        # crash goes on logging in a new file; `systemctl restart` once more, the same
+        for k in range(1, 4):
+            name = "run.lcm.%06d" % k
+            if k == 2:
+                r = sd.ctl("kill", "-s", "SIGKILL", unit)
+                deadline, restarted = time.monotonic() + 20, False
+                while time.monotonic() < deadline and not restarted:
+                    time.sleep(0.5)
+                    newpid = sd.show(unit, "MainPID")
+                    restarted = sd.show(unit, "NRestarts") == "1" and newpid not in ("0", pid) and \
+                        sd.show(unit, "ActiveState") == "active"
+                check(restarted, "killed (SIGKILL), it is restarted (Restart=on-failure): NRestarts %s"
+                      % sd.show(unit, "NRestarts"))
+            elif k == 3:
+                r = sd.ctl("restart", unit)
+                check(r.returncode == 0, "systemctl restart %s" % unit, r.stdout)
+            pid = sd.show(unit, "MainPID")
+            check(sd.show(unit, "ActiveState") == "active" and grows(name),
+                  "start %d with the example: active, writing %s (it grows)" % (k + 1, name))
         sd.ctl("stop", unit)
-        kept = [os.path.exists(log + s) for s in ("", ".00", ".01")]
-        check(all(kept) and os.path.getsize(log) == first_size,
-              "each start kept its own record (--increment): run.lcm unchanged, run.lcm.00, "
-              "run.lcm.01: %s" % kept)
+        j = sd.sh(["journalctl", "-u", unit, "--no-pager", "-o", "cat"]).stdout
+        files = series()
+        check(files == ["run.lcm.%06d" % k for k in range(4)] and
+              os.path.getsize(log) == first_size and "writing run.lcm.000003" in j,
+              "each start kept its own record (--increment): the first unchanged, one new file a "
+              "start, each named in the journal: %s" % files, j)
         ubad = "lagsimd@%s.service" % bad
         sd.ctl("start", ubad)
         time.sleep(7)   # longer than RestartSec

@@ -10,8 +10,11 @@
 # the ids 0, 2, ..., 14) runs --shard K/N, K = (i - min) / step + 1, with
 # -j SLURM_CPUS_PER_TASK workers and writes
 # OUTDIR/shard-K-of-N.csv; the merge gives the CSV one machine would have written, bit for
-# bit (run i's values come from --seed and i alone). OUTDIR must be on a file system the
-# nodes share. LAGSIM_SWEEP names the program (default: lagsim-sweep on PATH).
+# bit (run i's values come from --seed and i alone). Each shard carries the sweep's
+# identity lines (--seed, the scene's SHA-256, the case, --vary, runs, K/N, ...): merge
+# refuses a file of another sweep or another array left in OUTDIR, and names the shard
+# of a task that failed or has not finished (missing shard K/N). OUTDIR must be on a file
+# system the nodes share. LAGSIM_SWEEP names the program (default: lagsim-sweep on PATH).
 #SBATCH --job-name=lagsim-sweep
 #SBATCH --array=0-15
 #SBATCH --cpus-per-task=2
