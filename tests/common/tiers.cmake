@@ -42,6 +42,7 @@ set(LAGSIM_TIER_RULES
   "waits     NAME  ^clients_(python|java)_dipc_late_controller$"
   "waits     NAME  ^view_attack_(slowloris|stalled)$"
   "waits     NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
+  "waits     NAME  ^eval_procs_(eval|sweep)_(stalled|gnuplot)$"
   "waits     NAME  ^scene_shipped_wait$"
   "waits     NAME  ^log_term_waits$"
   "waits     NAME  ^ctl_discover$"
@@ -61,18 +62,21 @@ set(LAGSIM_TIER_RULES
   # log: the writer on a made-up clock; lockstep and fast runs logged, read, converted;
   # the terminal's live line and waits in real time
   "quick     NAME  ^log_(rt|outputs)_"
-  "quick     NAME  ^log_(lqr|lqr_effects|gaps|readers|cli|flood)$"
+  "quick     NAME  ^log_(lqr|lqr_effects|gaps|readers|cli|flood|flood_applied)$"
+  "quick     NAME  ^log_series_"
   "wallclock NAME  ^log_term_"
   # view: the log tools; Chromium; attacks that take time or namespaces
   "quick     NAME  ^view_log2csv_"
+  "quick     NAME  ^view_stop_"
   "wallclock NAME  ^view_attack_(slowloris|stalled)$"
   "root      NAME  ^view_attack_lan$"
   "browser   NAME  ^view_(browser|hostile|stick_flight|cartpole|reference|charts|history|attack_forged|attack_host)$"
   # eval: unit tests; lagsim-eval and lagsim-sweep in lockstep; --timeout, a stalled
   # controller; packet loss and ssh hosts in namespaces
-  "quick     NAME  ^eval_(metrics|reference)_"
+  "quick     NAME  ^eval_(metrics|reference|sweep_csv)_"
+  "quick     NAME  ^eval_procs_(eval|sweep)_(sigint|sigterm|sigkill|groupkill)$"
   "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene)$"
-  "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|kept|kept_python)$"
+  "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|merge_rows|merge_foreign|shard|kept|kept_python)$"
   "wallclock NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
   "root      NAME  ^eval_lagsim_sweep_(loss|ssh)$"
   # clients, ctl, install
