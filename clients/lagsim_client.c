@@ -43,6 +43,12 @@ struct lag_client {
     bool have_state, new_state;  /* new: not yet returned by lag_client_wait_state */
     lag_client_scene scene;
     bool have_scene;
+    lag_client_scene state_scene; /* the scene of the latest state's generation */
+    /* a state whose generation is not the scene's: held until the scene of its
+     * generation came (asked for by DESCRIBE every LAG_CLIENT_DESCRIBE_S meanwhile) */
+    lag_client_state held;
+    bool have_held;
+    double next_describe;        /* monotonic s: when a held state asks again */
     lag_client_status status;
     bool have_status;
     lag_client_reference reference; /* latest reference */
@@ -124,37 +130,72 @@ static bool decode(lag_client *c, lag_wire_type t, const void *data, size_t len)
     return false;
 }
 
+/* A state becomes the latest: returned once (wait_state), passed to on_state. */
+static void take_state(lag_client *c, const lag_client_state *m)
+{
+    c->answer_len = 0;
+    c->state = *m;
+    c->state_scene = c->scene; /* its generation's (the scene rule) */
+    c->have_state = c->new_state = true;
+    if (c->on_state) c->on_state(&c->state, c->on_state_user);
+}
+
+/* A held state asks for its scene: DESCRIBE now and every LAG_CLIENT_DESCRIBE_S (the
+ * scene comes with the first state of a generation; this is for when UDP lost it). */
+static void ask_scene(lag_client *c, bool now)
+{
+    double t = lag_client_now();
+    if (!now && t < c->next_describe) return;
+    c->next_describe = t + LAG_CLIENT_DESCRIBE_S;
+    if (lag_client_request_describe(c) == LAG_CLIENT_OK) c->counters.describes++;
+}
+
+/* A state, decoded into c->tmp.state. Each state once: a copy of the latest state (the
+ * same generation, step, sim_time and utime: in lockstep the daemon publishes a state
+ * again until an answer to it arrives) is neither returned nor passed to on_state, so the
+ * control law runs once per state and a law slower than the copies never falls behind on
+ * them; a command already sent for it goes out again at once (the first may have been
+ * lost). A state of a generation other than the scene's is held until that scene came:
+ * a control law never answers a state with the parameters of another run or scene. */
+static void on_state_msg(lag_client *c)
+{
+    const lag_wire_joint_state *m = &c->tmp.state;
+    c->counters.states++; /* received and valid: kept (or held) */
+    if (c->have_state && m->generation == c->state.generation && m->utime == c->state.utime &&
+        m->step == c->state.step && m->sim_time == c->state.sim_time) {
+        c->counters.copies++;
+        if (c->answer_len > 0 &&
+            lcm_publish(c->lcm_cmd, c->ch_command, c->answer, c->answer_len) == 0)
+            c->counters.repeats++;
+        return;
+    }
+    if (!c->have_scene || m->generation != c->scene.generation) {
+        bool first = !c->have_held || c->held.generation != m->generation;
+        c->held = *m; /* the newest of its generation */
+        c->have_held = true;
+        c->counters.held++;
+        ask_scene(c, first && c->have_scene); /* the scene may be just behind the state */
+        return;
+    }
+    take_state(c, m);
+}
+
 /* One message from `channel`: decoded, kept, passed to the callback. */
 static lag_result dispatch(lag_client *c, const char *channel, const void *data, size_t len)
 {
     if (!strcmp(channel, c->ch_state)) {
-        if (!decode(c, LAG_WIRE_JOINT_STATE, data, len)) return LAG_CLIENT_OK;
-        /* Each state once: a copy of the latest state (the same utime, step and sim_time:
-         * in lockstep the daemon publishes a state again until an answer to it arrives)
-         * is neither returned nor passed to on_state, so the control law runs once per
-         * state and a law slower than the copies never falls behind on them; a command
-         * already sent for it goes out again at once (the first may have been lost). */
-        const lag_wire_joint_state *m = &c->tmp.state;
-        if (c->have_state && m->utime == c->state.utime && m->step == c->state.step &&
-            m->sim_time == c->state.sim_time) {
-            c->counters.states++; /* received and valid: kept, as the state it copies */
-            c->counters.copies++;
-            if (c->answer_len > 0 &&
-                lcm_publish(c->lcm_cmd, c->ch_command, c->answer, c->answer_len) == 0)
-                c->counters.repeats++;
-            return LAG_CLIENT_OK;
-        }
-        c->answer_len = 0;
-        c->state = c->tmp.state;
-        c->have_state = c->new_state = true;
-        c->counters.states++;
-        if (c->on_state) c->on_state(&c->state, c->on_state_user);
+        if (decode(c, LAG_WIRE_JOINT_STATE, data, len)) on_state_msg(c);
     } else if (!strcmp(channel, c->ch_scene)) {
         if (!decode(c, LAG_WIRE_SCENE, data, len)) return LAG_CLIENT_OK;
         c->scene = c->tmp.scene;
         c->have_scene = true;
         c->counters.scenes++;
         if (c->on_scene) c->on_scene(&c->scene, c->on_scene_user);
+        if (c->have_held && c->held.generation == c->scene.generation) {
+            c->have_held = false; /* its scene came: it goes on */
+            lag_client_state h = c->held;
+            take_state(c, &h);
+        }
     } else if (!strcmp(channel, c->ch_status)) {
         if (!decode(c, LAG_WIRE_STATUS, data, len)) return LAG_CLIENT_OK;
         c->status = c->tmp.status;
@@ -299,6 +340,7 @@ lag_result lag_client_handle(lag_client *c, int timeout_ms)
     if (timeout_ms < 0) timeout_ms = 0;
     errno = 0;
     int rc = lcm_handle_timeout(c->lcm, timeout_ms);
+    if (c->have_held) ask_scene(c, false); /* a held state's scene, at the describe pace */
     if (rc < 0 && errno == EINTR) return LAG_CLIENT_TIMEOUT; /* a signal (e.g. SIGINT) */
     if (rc < 0) {
         set_err(c, "lcm_handle_timeout failed");
@@ -327,7 +369,7 @@ lag_result lag_client_wait_scene(lag_client *c, double timeout_s, lag_client_sce
     while (!c->have_scene) {
         int rc = lag_client_request_describe(c);
         if (rc < 0) return rc;
-        double next = lag_client_now() + 0.25;
+        double next = lag_client_now() + LAG_CLIENT_DESCRIBE_S;
         rc = handle_until(c, &c->have_scene, next < deadline ? next : deadline);
         if (rc < 0) return rc;
         if (!c->have_scene && lag_client_now() >= deadline) {
@@ -364,6 +406,12 @@ bool lag_client_latest_state(const lag_client *c, lag_client_state *st)
 {
     if (c->have_state && st) *st = c->state;
     return c->have_state;
+}
+
+bool lag_client_latest_scene(const lag_client *c, lag_client_scene *sc)
+{
+    if (c->have_scene && sc) *sc = c->have_state ? c->state_scene : c->scene;
+    return c->have_scene;
 }
 
 bool lag_client_latest_status(const lag_client *c, lag_client_status *st)
@@ -407,6 +455,9 @@ lag_result lag_client_send_command(lag_client *c, double sim_time, int n, const 
     memset(&m, 0, sizeof m);
     m.utime = lag_clock_wall_us();
     m.sim_time = sim_time;
+    /* the generation of the state it answers: the latest state's (the only one a command
+     * can answer in lockstep; 0 before any state: "no particular state") */
+    m.generation = c->have_state ? c->state.generation : 0;
     m.num_joints = (int16_t)n;
     for (int i = 0; i < n; i++) {
         if (!names[i] || !copy_str(m.name[i], sizeof m.name[i], names[i])) {

@@ -28,11 +28,21 @@
  * bytes or more, is refused (LAG_CLIENT_ERR_ARG), never sent.
  *
  * Lockstep contract (realtime.mode: lockstep): the daemon advances one control period
- * only when a command whose sim_time equals the last published state's sim_time arrives,
- * so answer every state with lag_client_send_command(c, state.sim_time, ...). The
- * daemon sends the state again until an answer arrives; the client returns each state
- * once and answers a copy with the command already sent for it (counters: copies,
- * repeats), so a slow control law never falls behind on copies.
+ * only when a command answering the last published state arrives: a state is known by
+ * its generation (one more at every reset and every accepted SET: docs/server.md) and its
+ * sim_time, so answer every state with lag_client_send_command(c, state.sim_time, ...),
+ * which stamps the state's generation. The daemon sends the state again until an answer
+ * arrives; the client returns each state once and answers a copy (same generation,
+ * step, sim_time) with the command already sent for it (counters: copies, repeats), so a
+ * slow control law never falls behind on copies.
+ *
+ * Scene rule: a state whose generation is not the generation of the scene the client
+ * holds is held (counters: held), not returned nor passed to on_state, until the scene of
+ * that generation arrived; the daemon publishes it just before the first state of a
+ * generation, and while a state is held the client asks for it (DESCRIBE) at once and
+ * every LAG_CLIENT_DESCRIBE_S, for when UDP lost it. So a controller that reads its
+ * parameters from the scene (lag_client_latest_scene, on_scene) always answers a state
+ * with the scene that state belongs to.
  */
 #ifndef LAGSIM_CLIENT_H
 #define LAGSIM_CLIENT_H
@@ -51,6 +61,7 @@ extern "C" {
 #define LAG_CLIENT_MAX_JOINTS LAG_WIRE_MAX_JOINTS   /* 8 */
 #define LAG_CLIENT_MAX_PARAMS LAG_WIRE_MAX_PARAMS   /* 16 */
 #define LAG_CLIENT_NAME_LEN LAG_WIRE_NAME_LEN       /* 64: 63 bytes + NUL */
+#define LAG_CLIENT_DESCRIBE_S 0.25  /* the pace of DESCRIBE while a scene is awaited */
 
 /* Result codes: the one space of lagsim/result.h (lag_result). The client's names stay,
  * as aliases of its codes, with the values they always had. */
@@ -80,6 +91,8 @@ typedef struct lag_client_counters {
                        * returned again, not passed to on_state */
     int64_t repeats;  /* of them, answered again with the command sent for that state */
     int64_t references;                        /* references received and kept */
+    int64_t held;     /* states held until the scene of their generation came */
+    int64_t describes; /* DESCRIBE requests sent for a held state's scene */
 } lag_client_counters;
 
 typedef struct lag_client lag_client;
@@ -134,6 +147,10 @@ lag_result lag_client_wait_state(lag_client *c, double timeout_s, lag_client_sta
  * Return false if none has arrived yet. OUT: st */
 bool lag_client_latest_state(const lag_client *c, lag_client_state *st);
 bool lag_client_latest_status(const lag_client *c, lag_client_status *st);
+/* The scene of the latest state's generation (the scene rule above; a scene of a later
+ * generation that came since waits for its own state); before any state, the latest scene
+ * received. False if none has arrived. OUT: sc */
+bool lag_client_latest_scene(const lag_client *c, lag_client_scene *sc);
 /* The latest reference (<prefix>_REFERENCE: the scene's `reference:`, r and r' of the
  * joints that have one, which the daemon publishes just before each state with the same
  * sim_time; so when a state arrives its reference has arrived already, unless UDP lost
@@ -143,8 +160,10 @@ bool lag_client_latest_reference(const lag_client *c, lag_client_reference *ref)
 
 /* Publishes a command on <prefix>_COMMAND: efforts for n joints named in names (N or
  * N m), answering the state at sim_time (lockstep advances on it; pass the sim_time of
- * the state the effort was computed from). Joints not named keep their effort. A
- * non-finite effort or sim_time, or a name of 64 bytes or more, is refused. */
+ * the state the effort was computed from), stamped with the generation of the latest
+ * state (0 before any: a command that answers no state, which lockstep never takes).
+ * Joints not named keep their effort. A non-finite effort or sim_time, or a name of 64
+ * bytes or more, is refused. */
 lag_result lag_client_send_command(lag_client *c, double sim_time, int n, const char *const *names,
                                    const double *effort);
 

@@ -373,6 +373,17 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
     return 0;
 }
 
+/* A state of another generation (a reset, a SET): the client returned it with its
+ * scene (lagsim_client.h, the scene rule), which becomes ctl->scene and ctl->model. */
+static int scene_changed(lag_ctl *ctl)
+{
+    lag_client_latest_scene(ctl->client, &ctl->scene);
+    if (model_from_scene(ctl, ctl->scene.model) == 0) return 0;
+    ctl->failed = true;
+    ctl->end = "error";
+    return LAG_ERR_RUNTIME;
+}
+
 int lag_ctl_next_state(lag_ctl *ctl, lag_client_state *st)
 {
     if (ctl->end) return LAG_CLIENT_TIMEOUT;
@@ -390,6 +401,8 @@ int lag_ctl_next_state(lag_ctl *ctl, lag_client_state *st)
         /* a copy of a state already returned never comes back: the client answers it
          * with the same command (lagsim_client.c), so the law runs once per state */
         if (rc == LAG_CLIENT_OK) {
+            if (st->generation != ctl->scene.generation && (rc = scene_changed(ctl)) != 0)
+                return rc;
             if (ctl->states++ == 0) ctl->t_first = st->sim_time;
             ctl->current = *st;
             return LAG_CLIENT_OK;

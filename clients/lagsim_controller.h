@@ -128,9 +128,11 @@ int lag_ctl_start(lag_ctl *ctl, const char *model);
 
 /* The newest state not yet returned: LAG_CLIENT_OK, or LAG_CLIENT_TIMEOUT when the run
  * has ended (ctl->end says why), or a negative error (message on stderr). A copy of the
- * state answered last (same step and sim time: the daemon published it again because no
- * answer reached it) is answered at once with the same command and not returned: every
- * state received is answered, and the control law runs once per state. OUT: st */
+ * state answered last (same generation, step and sim time: the daemon published it again
+ * because no answer reached it) is answered at once with the same command and not
+ * returned: every state received is answered, and the control law runs once per state.
+ * A state of a new generation (a reset, a SET) comes with its scene: ctl->scene and
+ * ctl->model are that scene's when it is returned. OUT: st */
 int lag_ctl_next_state(lag_ctl *ctl, lag_client_state *st);
 
 /* Answers state st with efforts for n named joints; a non-finite effort is sent as 0

@@ -68,9 +68,9 @@ install(FILES ${_cfg} DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/config)
 # lagsim-sweep's Slurm job array (docs/evaluation.md)
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/server/tools/slurm/lagsim-sweep-array.sh
         DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/slurm)
-# one page per program in bin/ (tests/install/check_man.py holds each to its --help)
-file(GLOB _man CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/docs/man/*.1)
-install(FILES ${_man} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+# one page per program in bin/ (tests/install/check_man.py holds each to its --help), as
+# the build wrote it: docs/man/*.1 with its lists generated from the tables (server/lists)
+install(FILES ${LAGSIM_MAN_PAGES} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
 
 # The systemd template unit lagsimd@NAME (/etc/lagsim/NAME.yaml), naming the lagsimd of
 # the prefix it is installed into: made at install time, since `cpack` installs into

@@ -16,7 +16,7 @@ set(LAGSIM_DEB_MAINTAINER "lagsim maintainers <maintainers@lagsim.example>" CACH
     "the .deb's Maintainer field: who builds it (e.g. a lab's admin)")
 set(CPACK_PACKAGE_CONTACT "${LAGSIM_DEB_MAINTAINER}")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
-set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)          # lagsim_0.1.0_amd64.deb
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)          # lagsim_<version>_<arch>.deb
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "real-time simulation server for Lagrangian models over LCM")
 # Debian's extended description (the summary above is its first line)
 set(CPACK_DEBIAN_PACKAGE_DESCRIPTION "lagsimd steps a sliding stick, a rotary/prismatic manipulator, a double

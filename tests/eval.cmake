@@ -24,7 +24,7 @@ lagsim_fuzz_target(sweep_merge LIBS lagsim_sweepcsv)
 # codes, case files with mistakes.
 find_program(LAGSIM_PYTHON3 python3)
 if(LAGSIM_PYTHON3)
-  foreach(c metrics require errors scene)
+  foreach(c metrics require errors scene owned outputs bus)
     add_test(NAME eval_lagsim_eval_${c}
       COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_eval.py
               $<TARGET_FILE_DIR:lagsim-eval> ${PROJECT_SOURCE_DIR} ${c})
@@ -32,12 +32,19 @@ if(LAGSIM_PYTHON3)
   endforeach()
 endif()
 
+# A controller that reads its gains from every scene (lagsim-sweep's scene_* cases).
+add_executable(scene_pd ${CMAKE_CURRENT_LIST_DIR}/eval/scene_pd.c)
+target_link_libraries(scene_pd PRIVATE lagsim_controller)
+
 # lagsim-sweep end to end: 8 runs of the cart-pole over its masses; the CSV the same for
 # -j1, -j2, two shards run by GNU parallel and merged, and a Slurm job array's two tasks
 # run here with Slurm's variables (no cluster needed); merge's refusals.
 find_program(LAGSIM_GNU_PARALLEL parallel)
 if(LAGSIM_PYTHON3 AND LAGSIM_GNU_PARALLEL)
-  foreach(c same slurm merge merge_rows merge_foreign shard kept kept_python loss stalled ssh)
+  # scene_*, unanswered: a scene-reactive controller (tests/eval/scene_pd.c, scene_pd.py)
+  # over m2, one that leaves the paused state unanswered (mute_pd.py)
+  foreach(c same slurm merge merge_rows merge_foreign shard kept kept_python loss stalled ssh
+          vary scene_c scene_python scene_loss unanswered)
     add_test(NAME eval_lagsim_sweep_${c}
       COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_sweep.py
               $<TARGET_FILE_DIR:lagsim-sweep> ${PROJECT_SOURCE_DIR} ${c})
@@ -60,4 +67,22 @@ if(LAGSIM_PYTHON3)
       set_tests_properties(eval_procs_${tool}_${how} PROPERTIES LABELS eval TIMEOUT 300)
     endforeach()
   endforeach()
+endif()
+
+# docs/evaluation.md's controllers in Python and MATLAB/Octave, run as written
+# (tests/clients/readme_recipes.py): the shipped Python DIPC example and the Octave cart-pole
+# under lagsim-eval and lagsim-sweep, {prefix} inside Octave's quotes inside the shell's.
+# Octave starts a JVM for each case and worker: not in the sanitizer pass (label slow).
+if(LAGSIM_PYTHON3)
+  add_test(NAME eval_lagsim_eval_docs_python
+    COMMAND ${LAGSIM_PYTHON3} ${PROJECT_SOURCE_DIR}/tests/clients/readme_recipes.py
+            --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} --timeout 240 eval-python)
+  set_tests_properties(eval_lagsim_eval_docs_python PROPERTIES LABELS eval TIMEOUT 300)
+  find_program(LAGSIM_EVAL_OCTAVE octave)
+  if(LAGSIM_EVAL_OCTAVE AND TARGET lagsim_examples_java)
+    add_test(NAME eval_lagsim_eval_docs_octave
+      COMMAND ${LAGSIM_PYTHON3} ${PROJECT_SOURCE_DIR}/tests/clients/readme_recipes.py
+              --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} --timeout 240 eval-octave)
+    set_tests_properties(eval_lagsim_eval_docs_octave PROPERTIES LABELS "eval;slow" TIMEOUT 300)
+  endif()
 endif()

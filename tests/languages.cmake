@@ -368,6 +368,27 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_ja
   list(APPEND lang_tests clients_cross_language_dipc)
 endif()
 
+# ---- A state is known by its generation, in every language (tests/clients/generation_rule.py
+# plays the daemon): a state of the next generation at the same step, sim time and utime is
+# answered anew, never taken for a copy; one whose scene has not come waits for it
+# (DESCRIBE asked); the answers carry the generation; C, Python, Lua, Java and
+# MATLAB/Octave (under GNU Octave) answer bit for bit alike.
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
+  set(octave_gen "")
+  if(LAGSIM_OCTAVE)
+    set(octave_gen --run octave "${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh ${CMAKE_BINARY_DIR}/octave dipc_balance --prefix {prefix} -q --timeout 60 --k ${lang_K}")
+  endif()
+  add_test(NAME clients_cross_language_generation
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/generation_rule.py
+      --types ${CMAKE_BINARY_DIR}/python
+      --run c "$<TARGET_FILE:dipc_lqr> --prefix {prefix} -q --timeout 60 --k ${lang_K}"
+      --run python "${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} -q --timeout 60 --k ${lang_K}"
+      --run lua "${LAGSIM_LUA52} ${lua_dir}/dipc_balance.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} -q --timeout 60 --k ${lang_K}"
+      --run java "java -cp /usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${CMAKE_BINARY_DIR}/lagsim_examples.jar lagsim.examples.DipcBalance --prefix {prefix} -q --timeout 60 --k ${lang_K}"
+      ${octave_gen})
+  list(APPEND lang_tests clients_cross_language_generation)
+endif()
+
 # ---- The shipped Python, Lua and Java controllers with a slow law (tests/clients/think/: every
 # command they build takes 0.15 s, or 1.5 s, first): the same states as the C controller's
 # fast run, bit for bit, every state answered (the law runs once per state, a re-sent copy

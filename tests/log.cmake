@@ -41,6 +41,16 @@ if(LAGSIM_LOG_PYTHON3)
   endforeach()
 endif()
 
+# A log written by lagsim 0.1.0 (tests/log/fixtures): --replay and lagsim-log2csv read it.
+if(LAGSIM_LOG_PYTHON3)
+  foreach(case replay log2csv)
+    add_test(NAME log_old_version_${case}
+             COMMAND ${LAGSIM_LOG_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/log/test_old_log.py
+                     ${CMAKE_BINARY_DIR}/bin ${PROJECT_SOURCE_DIR} ${case})
+    set_tests_properties(log_old_version_${case} PROPERTIES TIMEOUT 120 LABELS log)
+  endforeach()
+endif()
+
 # lagsimd --log FILE --increment: the series FILE.000000, ... (lagsim_out.h): numbering that
 # never runs out, --keep removing only the series' own oldest, --split-mb, a file-size limit.
 if(LAGSIM_LOG_PYTHON3)

@@ -22,3 +22,10 @@ if(LAGSIM_STRUCTURE_PYTHON3)
                        structure_function_length structure_ticks
                        PROPERTIES TIMEOUT 120 LABELS structure)
 endif()
+
+# Every generated list in the committed docs, man pages, .lcm comments and scenes is what
+# the core's tables give (server/lists); a stale block fails, naming itself and the command
+# that rewrites it (cmake --build BUILD --target lists). Every model has a shipped scene.
+add_test(NAME structure_lists
+         COMMAND lagsim_lists check ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(structure_lists PROPERTIES TIMEOUT 60 LABELS structure)

@@ -33,11 +33,13 @@ if(LAGSIM_VIEW_PYTHON3)
            --screenshot ${CMAKE_BINARY_DIR}/view_reference.png)
   add_test(NAME view_charts COMMAND ${view_test} charts)
   add_test(NAME view_history COMMAND ${view_test} history)
+  # every model of the core's table drawn, from its shipped scene
+  add_test(NAME view_models COMMAND ${view_test} models)
   set_tests_properties(view_browser view_hostile view_stick_flight view_cartpole view_reference
-                       view_charts view_history PROPERTIES TIMEOUT 180 LABELS view)
+                       view_charts view_history view_models PROPERTIES TIMEOUT 180 LABELS view)
   if(NOT LAGSIM_CHROMIUM)
     set_tests_properties(view_browser view_stick_flight view_cartpole view_reference view_charts
-                         PROPERTIES ENVIRONMENT "PATH=/nonexistent")
+                         view_models PROPERTIES ENVIRONMENT "PATH=/nonexistent")
   endif()
 endif()
 

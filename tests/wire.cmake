@@ -47,6 +47,14 @@ foreach(case bus scene one_rule fields)
   set_tests_properties(wire_url_${case} PROPERTIES TIMEOUT 30 LABELS wire)
 endforeach()
 
+# Pairs of UDP ports held by lock files (server/wire/lagsim_port.c), the evaluation tools'
+# buses: never shared by two holders, across processes and users; never one a socket of
+# this host is bound to; no hang on a lock file that cannot be one (tests/wire/test_port.c).
+add_executable(test_port ${CMAKE_CURRENT_LIST_DIR}/wire/test_port.c)
+target_include_directories(test_port PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
+target_link_libraries(test_port PRIVATE lagsim_wire_base)
+lagsim_add_test_cases(test_port wire_port wire 120)
+
 # One clock, one URL reader, one table of channel suffixes in the wire layer
 # (tests/wire/one_place.py): a second copy anywhere in server/, clients/ or bench/ fails.
 find_program(LAGSIM_WIRE_PYTHON3 python3)

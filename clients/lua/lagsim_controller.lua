@@ -25,6 +25,7 @@ local Controller = {}
 Controller.__index = Controller
 
 local WAIT_MS = 50
+local DESCRIBE_MS = 250 -- the pace of DESCRIBE while a scene is awaited (the C client's too)
 
 function Controller.new(name, default_prefix, model, description)
   local self = setmetatable({ name = name, model = model, description = description or '',
@@ -162,7 +163,12 @@ function Controller:start(argv)
   self.silent_ms = 0
   self.lc:subscribe(ch .. 'SCENE', function(_, data)
     self.silent_ms = 0
-    self.scene = self:decode(t.scene_t, data) or self.scene
+    local sc = self:decode(t.scene_t, data)
+    if sc then
+      self.scene = sc
+      self.params = {}
+      for k = 1, sc.num_params do self.params[sc.param_name[k]] = sc.param_value[k] end
+    end
   end)
   self.lc:subscribe(ch .. 'STATE', function(_, data)
     self.silent_ms = 0
@@ -189,28 +195,52 @@ function Controller:start(argv)
                                   ch, o.timeout))
     end
     if waited >= next_ask then -- DESCRIBE every 0.25 s until the scene comes
-      local req = t.control_t:new()
-      req.request = t.control_t.DESCRIBE
-      self.lc_cmd:publish(ch .. 'CONTROL', req:encode())
-      next_ask = next_ask + 250
+      self:ask_scene()
+      next_ask = next_ask + DESCRIBE_MS
     end
     if not self.lc:handle_timeout(WAIT_MS) then waited = waited + WAIT_MS end
   end
   if self.scene.model ~= self.model then
     fail(self, 1, string.format('prefix %s runs model %s, not %s', o.prefix, self.scene.model, self.model))
   end
-  self.params = {}
-  for k = 1, self.scene.num_params do
-    self.params[self.scene.param_name[k]] = self.scene.param_value[k]
-  end
   return o
 end
 
+function Controller:ask_scene()
+  local req = self.t.control_t:new()
+  req.request = self.t.control_t.DESCRIBE
+  self.lc_cmd:publish(self.o.prefix .. '_CONTROL', req:encode())
+end
+
+-- st, or the newest state since, once the scene of its generation came (the daemon
+-- publishes it just before the first state of a generation; DESCRIBE asks for it again
+-- every 0.25 s, for when UDP lost it); nil when the run ended first. So the control law
+-- never answers a state with another run's or scene's parameters (docs/clients.md).
+local function with_scene(self, st)
+  local o, next_ask, waited = self.o, 0, 0
+  while st.generation ~= self.scene.generation do
+    if self.stopped then self.end_reason = 'stop' return nil end
+    if self.silent_ms >= o.timeout * 1000 then self.end_reason = 'silence' return nil end
+    if waited >= next_ask then
+      self:ask_scene()
+      next_ask = waited + DESCRIBE_MS
+    end
+    if not self.lc:handle_timeout(WAIT_MS) then
+      self.silent_ms = self.silent_ms + WAIT_MS
+      waited = waited + WAIT_MS
+    end
+    if self.state then st, self.state = self.state, nil end -- a newer state: that one
+  end
+  return st
+end
+
 -- Iterator over states: each newest state once, until the run ends. A copy of the state
--- answered last (same step and sim time: the daemon published it again because no answer
--- reached it) is answered at once with the same command and not returned: every state
--- received is answered, the control law runs once per state (a law run for every copy
--- would cost a think time per copy and fall behind for good: docs/clients.md, the rule).
+-- answered last (same generation, step and sim time: the daemon published it again
+-- because no answer reached it) is answered at once with the same command and not
+-- returned: every state received is answered, the control law runs once per state (a law
+-- run for every copy would cost a think time per copy and fall behind for good:
+-- docs/clients.md, the rule). A state is returned only once self.scene (and self.params)
+-- is the scene of its generation.
 function Controller:states()
   local o = self.o
   local t_first
@@ -227,10 +257,15 @@ function Controller:states()
       st = self.state
       self.state = nil
       local last = self.last
-      if last and st.step == last.step and st.sim_time == last.sim_time then
+      if last and st.generation == last.generation and st.step == last.step and
+          st.sim_time == last.sim_time then
         self.lc_cmd:publish(o.prefix .. '_COMMAND', last.data)
         self.repeats = self.repeats + 1
         st = nil
+      elseif st.generation ~= self.scene.generation then
+        self.held = (self.held or 0) + 1
+        st = with_scene(self, st)
+        if not st then return nil end
       end
     until st
     self.current = st
@@ -246,6 +281,8 @@ function Controller:command(sim_time, names, efforts)
   local cmd = self.t.joint_command_t:new()
   cmd.utime = os.time() * 1000000 -- informational; Lua's clock has whole seconds
   cmd.sim_time = sim_time
+  local st = self.current
+  cmd.generation = st and st.generation or 0 -- of the state it answers (0: none yet)
   cmd.num_joints = #names
   cmd.name = names
   cmd.effort = {}
@@ -256,9 +293,8 @@ function Controller:command(sim_time, names, efforts)
   end
   local data = cmd:encode()
   self.lc_cmd:publish(self.o.prefix .. '_COMMAND', data)
-  local st = self.current
   if st and st.sim_time == sim_time then
-    self.last = { step = st.step, sim_time = sim_time, data = data }
+    self.last = { generation = st.generation, step = st.step, sim_time = sim_time, data = data }
   end
   if self.trace and st and st.sim_time == sim_time then
     -- sim_time, positions, velocities, efforts sent: %.17g reads back to the same double

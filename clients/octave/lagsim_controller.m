@@ -48,6 +48,7 @@ classdef lagsim_controller < handle
         end_reason = '' % stop, silence or duration, once the run has ended
         dropped = 0     % messages on the plant's channels that did not decode whole
         repeats = 0     % copies of the state answered last, answered again (see next_state)
+        held = 0        % states held until the scene of their generation came
         % the scene's reference for the state next_state returned last, as a struct
         % (sim_time, step, name: a cell of joint names, r, rdot: columns): the one
         % published with it (the same sim_time), or, when UDP lost that one, the last one
@@ -196,9 +197,7 @@ classdef lagsim_controller < handle
                           'running with this prefix?)'], obj.name, ch, obj.timeout);
                 end
                 if toc(started) - asked >= 0.25   % DESCRIBE every 0.25 s until the scene comes
-                    describe = javaObject('lagsim.control_t');
-                    obj.lc_cmd.publish([ch 'CONTROL'], ...
-                        javaMethod('control', 'lagsim.examples.Messages', describe.DESCRIBE));
+                    obj.ask_scene();
                     asked = toc(started);
                 end
                 obj.pump(50);
@@ -207,20 +206,52 @@ classdef lagsim_controller < handle
                 error('lagsim:model', '%s: prefix %s runs model %s, not %s', obj.name, ...
                       obj.prefix, char(obj.scene.model), obj.model);
             end
-            names = obj.scene.param_name;   % a Java array: copied before indexing
-            values = obj.scene.param_value;
-            for k = 1:numel(values)
-                if isvarname(char(names(k)))
-                    obj.params.(char(names(k))) = values(k);
-                end
-            end
             ok = true;
         end
 
+        function ask_scene(obj)
+            % DESCRIBE: the daemon answers with its scene.
+            describe = javaObject('lagsim.control_t');
+            obj.lc_cmd.publish([obj.prefix '_CONTROL'], ...
+                javaMethod('control', 'lagsim.examples.Messages', describe.DESCRIBE));
+        end
+
+        function s = with_scene(obj, s)
+            % S, or the newest state since, once the scene of its generation came (the
+            % daemon publishes it just before the first state of a generation; DESCRIBE
+            % asks for it again every 0.25 s, for when UDP lost it); [] when the run ended
+            % first. So the law never answers a state with another run's or scene's
+            % parameters (docs/clients.md, the scene rule).
+            asked = -Inf;
+            started = tic;
+            while double(s.generation) ~= double(obj.scene.generation)
+                if obj.stopped
+                    obj.end_reason = 'stop';
+                    s = [];
+                    return;
+                end
+                if toc(obj.heard) > obj.timeout
+                    obj.end_reason = 'silence';
+                    s = [];
+                    return;
+                end
+                if toc(started) - asked >= 0.25
+                    obj.ask_scene();
+                    asked = toc(started);
+                end
+                obj.pump(20);
+                if ~isempty(obj.latest)   % a newer state: that one is answered
+                    s = obj.latest;
+                    obj.latest = [];
+                end
+            end
+        end
+
         function st = next_state(obj)
-            % The newest state not yet handled, as a struct (sim_time, step, name: a cell
-            % of joint names, position, velocity, effort: columns), or [] once the run has
-            % ended (obj.end_reason says why).
+            % The newest state not yet handled, as a struct (sim_time, step, generation,
+            % name: a cell of joint names, position, velocity, effort: columns), or [] once
+            % the run has ended (obj.end_reason says why). It comes only once obj.scene
+            % (and obj.params) is the scene of its generation.
             %
             % Each sim_time is answered once by the control law, and only the newest state
             % is: what queued behind a newer state is dropped unanswered. A controller that
@@ -251,8 +282,19 @@ classdef lagsim_controller < handle
                 s = obj.latest;
                 r = obj.ref_latest;
                 obj.latest = [];
-                if isempty(obj.current) || double(s.step) ~= obj.current.step ...
+                % a state is known by its generation and sim time: every run starts again
+                % at sim time 0
+                if isempty(obj.current) || double(s.generation) ~= obj.current.generation ...
+                        || double(s.step) ~= obj.current.step ...
                         || s.sim_time ~= obj.current.sim_time || isempty(obj.last_cmd)
+                    if double(s.generation) ~= double(obj.scene.generation)
+                        obj.held = obj.held + 1;
+                        s = obj.with_scene(s);
+                        if isempty(s)
+                            return;
+                        end
+                        r = obj.ref_latest;
+                    end
                     break;
                 end
                 obj.lc_cmd.publish([obj.prefix '_COMMAND'], obj.last_cmd);
@@ -264,6 +306,7 @@ classdef lagsim_controller < handle
             velocity = s.velocity;
             effort = s.effort;
             st = struct('sim_time', s.sim_time, 'step', double(s.step), ...
+                        'generation', double(s.generation), ...
                         'name', {cell(1, numel(names))}, 'position', double(position(:)), ...
                         'velocity', double(velocity(:)), 'effort', double(effort(:)));
             for k = 1:numel(names)
@@ -304,13 +347,19 @@ classdef lagsim_controller < handle
             if ischar(names)
                 names = {names};
             end
+            st = obj.current;
+            gen = 0;   % the generation of the state it answers (0: none yet)
+            if ~isempty(st)
+                gen = st.generation;
+            end
             if numel(names) == 1   % a one-element vector reaches Java as a scalar
-                cmd = javaMethod('command', 'lagsim.examples.Messages', sim_time, names{1}, efforts);
+                cmd = javaMethod('command', 'lagsim.examples.Messages', gen, sim_time, ...
+                                 names{1}, efforts);
             else
-                cmd = javaMethod('command', 'lagsim.examples.Messages', sim_time, names, efforts);
+                cmd = javaMethod('command', 'lagsim.examples.Messages', gen, sim_time, ...
+                                 names, efforts);
             end
             obj.lc_cmd.publish([obj.prefix '_COMMAND'], cmd);
-            st = obj.current;
             if ~isempty(st) && st.sim_time == sim_time
                 obj.last_cmd = cmd;
                 if obj.trace >= 0
@@ -410,6 +459,14 @@ classdef lagsim_controller < handle
                 obj.ref_newest = msg;
             elseif strcmp(kind, 'SCENE')
                 obj.scene = msg;
+                obj.params = struct();
+                names = msg.param_name;   % a Java array: copied before indexing
+                values = msg.param_value;
+                for k = 1:numel(values)
+                    if isvarname(char(names(k)))
+                        obj.params.(char(names(k))) = values(k);
+                    end
+                end
             elseif strcmp(kind, 'EVENT') && strcmp(char(msg.kind), 'stop')
                 obj.stopped = true;
             end

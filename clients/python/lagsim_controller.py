@@ -26,6 +26,8 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from lagsim_lcm import LCM, plant_urls  # noqa: E402
 
+DESCRIBE_S = 0.25  # the pace of DESCRIBE while a scene is awaited (the C client's too)
+
 
 def _import_types(types_dir, name):
     if types_dir:
@@ -84,8 +86,9 @@ class Controller(object):
         self.t = _import_types(a.types, self.name)
         self._trace = open(a.trace, "w") if a.trace else None
         self._current = None
-        self._last = None  # (step, sim_time, encoded command) of the last answer
+        self._last = None  # (generation, step, sim_time, encoded command) of the last answer
         self.repeats = 0   # copies of a state answered again
+        self.held = 0      # states held until the scene of their generation came
         self._stop = False
 
         def on_signal(signum, frame):
@@ -121,11 +124,8 @@ class Controller(object):
                                  "with this prefix?)\n" % (self.name, ch, a.timeout))
                 sys.exit(1)
             if now >= next_ask:  # DESCRIBE every 0.25 s until the scene comes
-                req = self.t.control_t()
-                req.utime = int(time.time() * 1e6)
-                req.request = self.t.control_t.DESCRIBE
-                self.lc_cmd.publish(ch + "CONTROL", req.encode())
-                next_ask = now + 0.25
+                self._ask_scene()
+                next_ask = now + DESCRIBE_S
             self.lc.handle_timeout(50)
         if self.scene is None:
             sys.exit(1)
@@ -210,11 +210,47 @@ class Controller(object):
         self.dropped += 1
         return None
 
+    def _ask_scene(self):
+        req = self.t.control_t()
+        req.utime = int(time.time() * 1e6)
+        req.request = self.t.control_t.DESCRIBE
+        self.lc_cmd.publish(self.args.prefix + "_CONTROL", req.encode())
+
     def _on_scene(self, channel, data):
         self._heard = time.monotonic()
         sc = self._decode(self.t.scene_t, data)
         if sc is not None:
             self.scene = sc
+            self.params = dict(zip(sc.param_name, sc.param_value))
+
+    def _ended(self):
+        """Why the run ended (and self.end set), or None while it goes on."""
+        if self._stop:
+            self.end = "signal"
+        elif self._stopped:
+            self.end = "stop"
+        elif time.monotonic() - self._heard > self.args.timeout:
+            self.end = "silence"
+        return self.end
+
+    def _with_scene(self, st):
+        """st, or the newest state since, once the scene of its generation came (the
+        daemon publishes it just before the first state of a generation; DESCRIBE asks
+        for it again every 0.25 s, for when UDP lost it); None when the run ended first.
+        So the control law never answers a state with another run's or scene's
+        parameters (docs/clients.md, the scene rule)."""
+        next_ask = 0.0
+        while st.generation != self.scene.generation:
+            if self._ended():
+                return None
+            now = time.monotonic()
+            if now >= next_ask:
+                self._ask_scene()
+                next_ask = now + DESCRIBE_S
+            self.lc.handle_timeout(20)
+            if self._state is not None:  # a newer state: that one is answered
+                st, self._state = self._state, None
+        return st
 
     def _on_state(self, channel, data):
         self._heard = time.monotonic()
@@ -240,33 +276,32 @@ class Controller(object):
 
     def states(self):
         """Yields each newest state once until the run ends (self.end says why). A copy of
-        the state answered last (same step and sim time: the daemon published it again
-        because no answer reached it) is answered at once with the same command and not
-        yielded: every state received is answered, the control law runs once per state (a
-        law run for every copy would cost a think time per copy and fall behind for good:
-        docs/clients.md, the rule)."""
+        the state answered last (same generation, step and sim time: the daemon published
+        it again because no answer reached it) is answered at once with the same command
+        and not yielded: every state received is answered, the control law runs once per
+        state (a law run for every copy would cost a think time per copy and fall behind
+        for good: docs/clients.md, the rule). A state is yielded only once self.scene (and
+        self.params) is the scene of its generation."""
         a = self.args
         t_first = None
         while True:
             while self._state is None:
-                if self._stop:
-                    self.end = "signal"
-                    return
-                if self._stopped:
-                    self.end = "stop"
-                    return
-                if time.monotonic() - self._heard > a.timeout:
-                    self.end = "silence"
+                if self._ended():
                     return
                 self.lc.handle_timeout(50)
             while self.lc.handle_timeout(0):  # drain what is queued: answer the newest
                 pass
             st, self._state = self._state, None
             last = self._last
-            if last is not None and st.step == last[0] and st.sim_time == last[1]:
-                self.lc_cmd.publish(self.args.prefix + "_COMMAND", last[2])
+            if last is not None and (st.generation, st.step, st.sim_time) == last[:3]:
+                self.lc_cmd.publish(self.args.prefix + "_COMMAND", last[3])
                 self.repeats += 1
                 continue
+            if st.generation != self.scene.generation:
+                self.held += 1
+                st = self._with_scene(st)
+                if st is None:
+                    return
             self._current = st
             if t_first is None:
                 t_first = st.sim_time
@@ -280,14 +315,16 @@ class Controller(object):
         cmd = self.t.joint_command_t()
         cmd.utime = int(time.time() * 1e6)
         cmd.sim_time = sim_time
+        st = self._current
+        # the generation of the state it answers (0: none yet, answers no state)
+        cmd.generation = st.generation if st is not None else 0
         cmd.num_joints = len(names)
         cmd.name = list(names)
         cmd.effort = [x if math.isfinite(x) else 0.0 for x in efforts]  # never send NaN
         data = cmd.encode()
         self.lc_cmd.publish(self.args.prefix + "_COMMAND", data)
-        st = self._current
         if st is not None and st.sim_time == sim_time:
-            self._last = (st.step, sim_time, data)
+            self._last = (st.generation, st.step, sim_time, data)
         if self._trace and st is not None and st.sim_time == sim_time:
             # sim_time, positions, velocities, efforts sent: %.17g reads back to the same double
             f = [st.sim_time] + list(st.position) + list(st.velocity) + cmd.effort

@@ -13,8 +13,20 @@
 /* One model kind: its facts and its closed forms, one row of the core's model table
  * (model.c). All arrays are n x n row-major (n = nq); p is lag_model.p. Every member is
  * required (core_models_info checks that no row has a hole). */
+/* What the documentation says of a model, written in the model's file beside its facts:
+ * every list of models in the man pages and the docs is generated from the table and
+ * these (server/lists: `cmake --build build --target lists`), never written by hand. */
+typedef struct lag_model_doc {
+    const char *title;                  /* a noun phrase, no article: "cart-pole" */
+    const char *summary;                /* a few words, with its article: "a pendulum on a
+                                           cart" (lagsimd.1's list of models) */
+    const char *params[LAG_MAX_PARAMS]; /* each parameter's meaning: "cart mass" */
+    const char *joints[LAG_MAX_DOF];    /* each coordinate's meaning: "cart position" */
+} lag_model_doc;
+
 typedef struct lag_model_class {
     const lag_model_info *info;
+    const lag_model_doc *doc;
     void (*mass)(const double *p, const double *q, double *M);
     void (*mass_deriv)(const double *p, const double *q, double *dM);
     void (*coriolis)(const double *p, const double *q, const double *qd, double *C);
@@ -37,6 +49,9 @@ extern const lag_model_class *const lag_models[];
 extern const lag_model_class lag_flying_stick_ends[2];
 /* The stick's parameters, one rod, as both its models (sliding, flying) describe them in
  * their lag_model_info. */
+/* ... and their meanings (lag_model_doc.params). */
+#define LAG_STICK_PARAMS_DOC                                                       \
+    .params = {"mass", "length", "inertia about the centre of mass", "gravity"}
 #define LAG_STICK_PARAMS_INFO                                                      \
     .np = LAG_STICK_NP, .param_names = {"m", "l", "I", "g"},                       \
     .param_defaults = {1.0, 1.0, NAN, 9.81},                                       \

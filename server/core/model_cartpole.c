@@ -108,9 +108,17 @@ static const lag_model_info info = {
     .angular = {false, true},
 };
 
+static const lag_model_doc doc = {
+    .title = "cart-pole",
+    .summary = "a pendulum on a cart",
+    .params = {"cart mass", "pole mass", "pole length", "pole inertia about its centre", "gravity"},
+    .joints = {"cart position", "pole angle from the upward vertical"},
+};
+
 /* The model table's row (model.c). */
 const lag_model_class lag_cartpole_model = {
     .info = &info,
+    .doc = &doc,
     .mass = cp_mass,
     .mass_deriv = cp_mass_deriv,
     .coriolis = cp_coriolis,

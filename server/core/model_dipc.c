@@ -149,9 +149,21 @@ static const lag_model_info info = {
     .angular = {false, true, true},
 };
 
+static const lag_model_doc doc = {
+    .title = "double inverted pendulum on a cart (DIPC)",
+    .summary = "a double inverted pendulum on a cart",
+    .params = {"cart mass", "lower rod mass", "upper rod mass", "lower rod length",
+               "upper rod length", "lower rod inertia about its centre",
+               "upper rod inertia about its centre", "gravity",
+               "height of the lower pivot above the track"},
+    .joints = {"cart position", "lower rod angle from the upward vertical",
+               "upper rod angle from the upward vertical (absolute, not from the lower rod)"},
+};
+
 /* The model table's row (model.c). */
 const lag_model_class lag_dipc_model = {
     .info = &info,
+    .doc = &doc,
     .mass = dipc_mass,
     .mass_deriv = dipc_mass_deriv,
     .coriolis = dipc_coriolis,

@@ -148,7 +148,7 @@ static inline double fs_potential(double sig, const double *p, const double *q)
     static double potential##SUFFIX(const double *p, const double *q)                     \
     { return fs_potential(S, p, q); }
 #define FS_CLASS(SUFFIX)                                                                   \
-    {.info = &info, .mass = mass##SUFFIX, .mass_deriv = mass_deriv##SUFFIX,                \
+    {.info = &info, .doc = &doc, .mass = mass##SUFFIX, .mass_deriv = mass_deriv##SUFFIX,  \
      .coriolis = coriolis##SUFFIX, .gravity = gravity##SUFFIX,                             \
      .mass_bias = mass_bias##SUFFIX, .forward = forward##SUFFIX,                           \
      .kinetic = kinetic##SUFFIX, .potential = potential##SUFFIX}
@@ -165,6 +165,14 @@ static const lag_model_info info = {
     .joint_names = {"x", "phi", "h"},
     .actuated = {true, true, false},
     .angular = {false, true, false},
+};
+
+static const lag_model_doc doc = {
+    .title = "flying stick",
+    .summary = "the stick free in the plane",
+    LAG_STICK_PARAMS_DOC,
+    .joints = {"horizontal position of the centre of mass", "angle between stick and floor",
+               "height of end A above the floor (the stick's floor, flying it, switches ends)"},
 };
 
 /* The model table's row (model.c). */

@@ -94,9 +94,20 @@ static const lag_model_info info = {
     .angular = {true, false},
 };
 
+static const lag_model_doc doc = {
+    .title = "rotary/prismatic manipulator",
+    .summary = "a revolute arm with a prismatic arm along it",
+    .params = {"arm 1 mass", "arm 2 mass", "axis to arm 1's centre of mass",
+               "arm 1 inertia about its centre of mass", "arm 2 inertia about its centre of mass",
+               "gravity"},
+    .joints = {"arm 1 angle from the horizontal",
+               "distance of arm 2's centre of mass from the axis"},
+};
+
 /* The model table's row (model.c). */
 const lag_model_class lag_manipulator_model = {
     .info = &info,
+    .doc = &doc,
     .mass = manip_mass,
     .mass_deriv = manip_mass_deriv,
     .coriolis = manip_coriolis,

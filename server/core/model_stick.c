@@ -90,9 +90,17 @@ static const lag_model_info info = {
     .angular = {false, true},
 };
 
+static const lag_model_doc doc = {
+    .title = "sliding stick",
+    .summary = "a stick sliding on a frictionless floor",
+    LAG_STICK_PARAMS_DOC,
+    .joints = {"horizontal position of the centre of mass", "angle between stick and floor"},
+};
+
 /* The model table's row (model.c). */
 const lag_model_class lag_stick_model = {
     .info = &info,
+    .doc = &doc,
     .mass = stick_mass,
     .mass_deriv = stick_mass_deriv,
     .coriolis = stick_coriolis,

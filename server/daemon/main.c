@@ -16,6 +16,77 @@
 #include "rt_log.h"
 
 
+/* --help after the synopsis and the models */
+static const char k_options[] =
+    "Default: the real-time LCM server (states out, effort commands in) until SIGINT.\n"
+    "\n"
+    "options:\n"
+    "  -c, --config FILE      YAML scene file (required; see config/*.yaml)\n"
+    "  -s, --set KEY=VALUE    override a scene key by its dotted path after the file\n"
+    "                         is read; VALUE is YAML, e.g. --set integrator.method=dopri5\n"
+    "                         --set initial.q=[0,0.1,-0.1]; repeatable, applied in order,\n"
+    "                         validated like the file\n"
+    "  -d, --duration S       sim seconds to run, 0 to 1e9 (real-time: 0 or absent =\n"
+    "                         until stopped; offline: required); time spent waiting\n"
+    "                         (for the first command, a lockstep answer, paused) does\n"
+    "                         not count: sim time does not advance then\n"
+    "      --offline          no LCM: simulate as fast as possible, write CSV rows at\n"
+    "                         t = 0 and every 1/publish_hz: t,q...,q_dot...,energy\n"
+    "                         (and <joint>_ref,<joint>_ref_dot with a reference)\n"
+    "      --csv PATH|-       offline CSV destination (- = stdout; absent = no CSV,\n"
+    "                         only the summary line on stderr)\n"
+    "      --log FILE.lcm     real-time server: write every message published and the\n"
+    "                         commands and control requests received to FILE (LCM log\n"
+    "                         format), in order, from the first state; received ones\n"
+    "                         are counted and written while a byte budget allows:\n"
+    "                         applied ones, two full commands a control period (8 KiB\n"
+    "                         a second at least); refused ones and status/describe\n"
+    "                         requests, 8 KiB a second; so no flood fills the disk;\n"
+    "                         never makes the loop wait in realtime mode (what a slow\n"
+    "                         disk loses is counted and said; exit 1 if anything was\n"
+    "                         lost)\n"
+    "      --force            --log, --csv, --plot: replace FILE if it exists (else refused,\n"
+    "                         exit 2); never a symbolic link (not followed) nor the\n"
+    "                         scene file itself, --force or not\n"
+    "  -i, --increment        --log: write the next file of the series FILE.000000,\n"
+    "                         FILE.000001, ... (one past the highest number there; FILE\n"
+    "                         itself untouched), as lcm-logger -i but never running out\n"
+    "                         (past 999999 the number widens): a service restarted with\n"
+    "                         the same --log keeps every run's record\n"
+    "      --keep N           --increment: keep the series' N newest files (this one\n"
+    "                         included), 1 to 1000000; the older ones are removed at\n"
+    "                         start and at each new file: only regular files of this\n"
+    "                         user named exactly FILE.<number> (never a symbolic link)\n"
+    "      --split-mb MIB     --increment: go on in the series' next file once a file\n"
+    "                         holds MIB mebibytes (at a record's end), as lcm-logger\n"
+    "                         --split-mb; 0.0625 to 1048576. With --keep, the log takes\n"
+    "                         at most about N x MIB on disk\n"
+    "      --log-buffer MIB   memory between the loop and the log writer, 0.25 to 1024\n"
+    "                         (default 16)\n"
+    "      --replay LOG.lcm   re-simulate a run recorded by --log or lcm-logger from the\n"
+    "                         efforts in its logged states; print the largest difference\n"
+    "      --tolerance X      --replay: exit 1 when the largest difference is above X\n"
+    "                         (default 0: a log of the same scene and build is exact)\n"
+    "      --cost             measure what accuracy costs on this scene and machine: each\n"
+    "                         integrator setting's error over integrator.horizon against\n"
+    "                         a tight reference, its CPU per sim-second, its margin to\n"
+    "                         real time; the error asked for is integrator.error (if the\n"
+    "                         scene gives none: the error its own integrator reaches).\n"
+    "                         A horizon beyond what two references agree on is cut, and\n"
+    "                         said. A scene with integrator.error runs with the cheapest\n"
+    "                         setting that meets it\n"
+    "      --plot FILE.png    --cost: draw the work-precision diagram (gnuplot); FILE.gp:\n"
+    "                         write the gnuplot script that draws it, data inline\n"
+    "      --list WHAT        print the names of the core's table, one a line, and exit:\n"
+    "                         models (a scene's model:), methods (integrator.method)\n"
+    "                         or effects (the keys under effects:)\n"
+    "  -q, --quiet            no live status line or event lines / offline summary\n"
+    "  -h, --help             this help\n"
+    "  -V, --version          print the version\n"
+    "\n"
+    "exit codes: 0 ok, 1 runtime failure (e.g. a numeric fault), 2 usage or scene\n"
+    "error (reported as file:line:column: what was expected; nothing runs)\n";
+
 static void usage(FILE *f)
 {
     fputs(
@@ -25,76 +96,14 @@ static void usage(FILE *f)
         "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|- [--force]]\n"
         "               [--set ...]\n"
         "       lagsimd --config FILE --replay LOG.lcm [--tolerance X] [--set ...]\n"
-        "       lagsimd --config FILE --cost [--plot FILE.png] [--set ...]\n"
+        "       lagsimd --config FILE --cost [--plot FILE.png|FILE.gp] [--set ...]\n"
+        "       lagsimd --list models|methods|effects\n"
         "\n",
         f);
     char models[256]; /* from the core's table: a model added there is named here */
     fprintf(f, "Steps one Lagrangian model (%s)\ndescribed by a YAML scene.\n",
             lag_model_names(models, sizeof models));
-    fputs(
-        "Default: the real-time LCM server (states out, effort commands in) until SIGINT.\n"
-        "\n"
-        "options:\n"
-        "  -c, --config FILE      YAML scene file (required; see config/*.yaml)\n"
-        "  -s, --set KEY=VALUE    override a scene key by its dotted path after the file\n"
-        "                         is read; VALUE is YAML, e.g. --set integrator.method=dopri5\n"
-        "                         --set initial.q=[0,0.1,-0.1]; repeatable, applied in order,\n"
-        "                         validated like the file\n"
-        "  -d, --duration S       sim seconds to run, 0 to 1e9 (real-time: 0 or absent =\n"
-        "                         until stopped; offline: required); time spent waiting\n"
-        "                         (for the first command, a lockstep answer, paused) does\n"
-        "                         not count: sim time does not advance then\n"
-        "      --offline          no LCM: simulate as fast as possible, write CSV rows at\n"
-        "                         t = 0 and every 1/publish_hz: t,q...,q_dot...,energy\n"
-        "                         (and <joint>_ref,<joint>_ref_dot with a reference)\n"
-        "      --csv PATH|-       offline CSV destination (- = stdout; absent = no CSV,\n"
-        "                         only the summary line on stderr)\n"
-        "      --log FILE.lcm     real-time server: write every message published and the\n"
-        "                         commands and control requests received to FILE (LCM log\n"
-        "                         format), in order, from the first state; received ones\n"
-        "                         are counted and written while a byte budget allows:\n"
-        "                         applied ones, two full commands a control period (8 KiB\n"
-        "                         a second at least); refused ones and status/describe\n"
-        "                         requests, 8 KiB a second; so no flood fills the disk;\n"
-        "                         never makes the loop wait in realtime mode (what a slow\n"
-        "                         disk loses is counted and said; exit 1 if anything was\n"
-        "                         lost)\n"
-        "      --force            --log, --csv, --plot: replace FILE if it exists (else refused,\n"
-        "                         exit 2); never a symbolic link (not followed) nor the\n"
-        "                         scene file itself, --force or not\n"
-        "  -i, --increment        --log: write the next file of the series FILE.000000,\n"
-        "                         FILE.000001, ... (one past the highest number there; FILE\n"
-        "                         itself untouched), as lcm-logger -i but never running out\n"
-        "                         (past 999999 the number widens): a service restarted with\n"
-        "                         the same --log keeps every run's record\n"
-        "      --keep N           --increment: keep the series' N newest files (this one\n"
-        "                         included), 1 to 1000000; the older ones are removed at\n"
-        "                         start and at each new file: only regular files of this\n"
-        "                         user named exactly FILE.<number> (never a symbolic link)\n"
-        "      --split-mb MIB     --increment: go on in the series' next file once a file\n"
-        "                         holds MIB mebibytes (at a record's end), as lcm-logger\n"
-        "                         --split-mb; 0.0625 to 1048576. With --keep, the log takes\n"
-        "                         at most about N x MIB on disk\n"
-        "      --log-buffer MIB   memory between the loop and the log writer, 0.25 to 1024\n"
-        "                         (default 16)\n"
-        "      --replay LOG.lcm   re-simulate a run recorded by --log or lcm-logger from the\n"
-        "                         efforts in its logged states; print the largest difference\n"
-        "      --tolerance X      --replay: exit 1 when the largest difference is above X\n"
-        "                         (default 0: a log of the same scene and build is exact)\n"
-        "      --cost             measure what accuracy costs on this scene and machine: each\n"
-        "                         integrator setting's error over integrator.horizon against\n"
-        "                         a tight reference, its CPU per sim-second, its margin to\n"
-        "                         real time; the error asked for is integrator.error (1e-6\n"
-        "                         if the scene gives none). A scene with integrator.error\n"
-        "                         runs with the cheapest setting that meets it\n"
-        "      --plot FILE.png    --cost: draw the work-precision diagram (gnuplot)\n"
-        "  -q, --quiet            no live status line or event lines / offline summary\n"
-        "  -h, --help             this help\n"
-        "  -V, --version          print the version\n"
-        "\n"
-        "exit codes: 0 ok, 1 runtime failure (e.g. a numeric fault), 2 usage or scene\n"
-        "error (reported as file:line:column: what was expected; nothing runs)\n",
-        f);
+    fputs(k_options, f);
 }
 
 static lag_result usage_error(const char *fmt, const char *arg)
@@ -209,9 +218,25 @@ static lag_result reload_with(const char *config, const char *text, size_t len,
     return LAG_OK;
 }
 
+/* --list WHAT: the names of one of the core's tables, one a line, in the table's order
+ * (what scripts iterate: tests/scene/determinism.sh takes the methods from here). */
+static lag_result print_list(const char *what)
+{
+    enum { MODELS, METHODS, EFFECTS } t;
+    if (!strcmp(what, "models")) t = MODELS;
+    else if (!strcmp(what, "methods")) t = METHODS;
+    else if (!strcmp(what, "effects")) t = EFFECTS;
+    else return usage_error("--list: expected models, methods or effects, got '%s'", what);
+    int n = t == MODELS ? LAG_MODEL_COUNT : t == METHODS ? LAG_METHOD_COUNT : LAG_EFF_COUNT;
+    for (int k = 0; k < n; k++)
+        puts(t == MODELS ? lag_model_info_get((lag_model_kind)k)->name
+             : t == METHODS ? lag_method_name((lag_method)k) : lag_effect_info_get(k).name);
+    return LAG_OK;
+}
+
 /* What the command line says. */
 typedef struct cmdline {
-    const char *config, *replay, *plot;
+    const char *config, *replay, *plot, *list;
     bool cost, offline;
     bool have_duration, have_tolerance, have_ring; /* given, for the checks of combinations */
     lagsimd_opts opts;
@@ -220,7 +245,7 @@ typedef struct cmdline {
 } cmdline;
 
 enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE,
-       OPT_COST, OPT_PLOT, OPT_FORCE, OPT_KEEP, OPT_SPLIT };
+       OPT_COST, OPT_PLOT, OPT_FORCE, OPT_KEEP, OPT_SPLIT, OPT_LIST };
 static const struct option longopts[] = {
     {"config", required_argument, NULL, 'c'},
     {"set", required_argument, NULL, 's'},
@@ -234,6 +259,7 @@ static const struct option longopts[] = {
     {"cost", no_argument, NULL, OPT_COST},
     {"plot", required_argument, NULL, OPT_PLOT},
     {"force", no_argument, NULL, OPT_FORCE},
+    {"list", required_argument, NULL, OPT_LIST},
     {"increment", no_argument, NULL, 'i'},
     {"keep", required_argument, NULL, OPT_KEEP},
     {"split-mb", required_argument, NULL, OPT_SPLIT},
@@ -296,6 +322,7 @@ static lag_result take_option(cmdline *cl, int c, const char *arg)
     case OPT_COST: cl->cost = true; break;
     case OPT_PLOT: cl->plot = arg; break;
     case OPT_FORCE: cl->opts.force = true; break;
+    case OPT_LIST: cl->list = arg; break;
     case 'i': cl->opts.log_increment = true; break;
     case 'q': cl->opts.quiet = true; break;
     }
@@ -330,7 +357,11 @@ static lag_result check_options(cmdline *cl)
 {
     const lagsimd_opts *o = &cl->opts;
     const char *why = NULL;
-    if (!cl->config) why = "--config FILE is required";
+    if (cl->list) why = cl->config || cl->nsets || cl->offline || cl->replay || cl->cost || o->log ||
+                            o->csv || cl->plot || cl->have_duration || cl->have_tolerance ||
+                            o->log_increment || o->log_keep || o->log_split || o->force
+                            ? "--list prints a table and exits: not with other options" : NULL;
+    else if (!cl->config) why = "--config FILE is required";
     else if (cl->offline && cl->replay) why = "--offline and --replay exclude each other";
     else if (o->csv && !cl->offline) why = "--csv needs --offline";
     else if (cl->offline && !cl->have_duration) why = "--offline needs --duration SECONDS";
@@ -449,8 +480,8 @@ static lag_result lagsimd_main(int argc, char **argv)
     bool done = false;
     lag_result rc = read_options(&cl, argc, argv, &done);
     if (rc == LAG_OK && !done) rc = check_options(&cl);
-    if (rc == LAG_OK && !done && cl.opts.log) rc = check_file_limit(&cl.opts);
-    if (rc == LAG_OK && !done) rc = run(&cl);
+    if (rc == LAG_OK && !done && cl.opts.log && !cl.list) rc = check_file_limit(&cl.opts);
+    if (rc == LAG_OK && !done) rc = cl.list ? print_list(cl.list) : run(&cl);
     free(cl.sets);
     return rc;
 }

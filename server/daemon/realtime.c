@@ -51,40 +51,6 @@
 #define RT_TICK_BUDGET 4096       /* ticks advanced per wake-up at most */
 #define RT_LINE_NS 250000000LL    /* live status line refresh */
 #define RT_STATUS_NS_MIN 10000000LL /* periodic status at most every 10 ms (100 Hz) */
-#define RT_CONFLICT_EVERY_S 5     /* another plant's scenes: said at most once in 5 s */
-
-/* The buckets of the limited events (rt_ev): name, answers per second, burst. */
-static const struct {
-    const char *kind;
-    double per_s;
-    int burst;
-} ev_limits[RT_EV_COUNT] = {
-    [RT_EV_COMMAND_REJECTED] = {"command_rejected", 10, 10},
-    [RT_EV_CONTROL_REJECTED] = {"control_rejected", 10, 10},
-    [RT_EV_PAUSE] = {"pause", 10, 10},
-    [RT_EV_RESUME] = {"resume", 10, 10},
-    [RT_EV_STEP] = {"step", 10, 10},
-    [RT_EV_STEP_DONE] = {"step_done", 10, 10},
-    [RT_EV_RESET] = {"reset", 10, 10},
-    [RT_EV_WATCHDOG_TRIP] = {"watchdog_trip", 10, 10},
-    [RT_EV_WATCHDOG_CLEAR] = {"watchdog_clear", 10, 10},
-    [RT_EV_LOCKSTEP_TIMEOUT] = {"lockstep_timeout", 10, 10},
-    [RT_EV_OVERRUN_BURST] = {"overrun_burst", 1, 3},
-    [RT_EV_NUMERIC_FAULT] = {"numeric_fault", 10, 10},
-    [RT_EV_EVENTS_DROPPED] = {"events_dropped", 1, 3},
-    /* one in RT_CONFLICT_EVERY_S however many scenes a forger or a log player sends */
-    [RT_EV_PLANT_CONFLICT] = {"plant_conflict", 1.0 / RT_CONFLICT_EVERY_S, 1},
-    [RT_EV_ERROR_ESTIMATE] = {"error_estimate", 1, 3},
-};
-_Static_assert(sizeof ev_limits / sizeof ev_limits[0] == RT_EV_COUNT, "one bucket per rt_ev");
-
-/* Answers to control requests beyond events: per second and burst. */
-#define RT_STATUS_PER_S 20
-#define RT_STATUS_BURST 5
-#define RT_SCENE_PER_S 5
-#define RT_SCENE_BURST 2
-#define RT_STATE_PER_S 20  /* states published because of a reset (not the periods' own) */
-#define RT_STATE_BURST 5
 
 /* ---------------------------------------------------------------- small helpers */
 static bool state_finite(const lag_sim *sim)
@@ -106,54 +72,41 @@ static int64_t min64(int64_t a, int64_t b) { return a < b ? a : b; }
  * state, and not in the middle of a period (whose end publishes one anyway). */
 static bool state_wanted(const rt_server *s)
 {
-    return s->want_state && s->run != RT_FAULT && s->period_left == 0;
-}
-
-const char *rt_run_name(rt_run r)
-{
-    switch (r) {
-    case RT_RUNNING: return "running";
-    case RT_PAUSED: return "paused";
-    case RT_WAITING: return "waiting";
-    case RT_FAULT: return "fault";
-    }
-    return "?";
-}
-
-/* Where what the loop publishes goes now: the bus and the log (rt_wire.h). */
-static rt_out out(rt_server *s) { return (rt_out){&s->bus, &s->rec, s->now}; }
-
-/* Every event goes out through here: on the bus (and --log), and on the terminal;
- * `effect`: one of the effects' events, located in a tick at sim_time. */
-static void event_at(rt_server *s, double sim_time, const char *kind, const char *joint,
-                     double value, const char *detail, bool effect)
-{
-    lag_wire_event m;
-    rt_out o = out(s);
-    rt_publish_event(&o, sim_time, s->sim.tick, kind, joint, value, detail, &m);
-    rt_term_event(&s->term, s->now, m.sim_time, m.kind, m.joint, m.value, m.detail, effect);
+    return s->pub.want_state && s->run != RT_FAULT && s->period_left == 0;
 }
 
 static void event(rt_server *s, const char *kind, const char *joint, double value,
                   const char *detail)
 {
-    event_at(s, lag_sim_time(&s->sim), kind, joint, value, detail, false);
+    rt_pub_event(&s->pub, kind, joint, value, detail);
 }
 
 static void publish_scene(rt_server *s)
 {
-    rt_out o = out(s);
-    rt_publish_scene(&o, s->sc, &s->sim, s->info);
+    rt_pub_scene(&s->pub, s->sc, s->info);
+}
+
+/* Lockstep, paused: a state published and waited on (the last of a STEP, one after a
+ * reset) still goes out again until an answer to it came, so that a lost state or answer
+ * is not left unanswered while paused (lagsim-sweep waits for that answer between runs). */
+static bool paused_copies(const rt_server *s)
+{
+    return s->run == RT_PAUSED && s->pending_steps == 0 && s->ls.waiting && !s->ls.answered;
 }
 
 /* What the plant waits for now (RT_WAIT_NONE: the run advances), with what came so far:
  * what the waits say (rt_wait.h). */
 static rt_wait_seen wait_seen(const rt_server *s)
 {
-    rt_wait_seen w = {RT_WAIT_NONE, 0, s->rejected, s->bus.commands_wrong_port, s->last_reject};
+    rt_wait_seen w = {RT_WAIT_NONE, 0, s->rejected, s->bus.commands_wrong_port, s->last_reject,
+                      false};
     bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
     if (s->run == RT_FAULT) w.kind = RT_WAIT_RESET;
-    else if (s->run == RT_PAUSED && s->pending_steps == 0) w.kind = RT_WAIT_RESUME;
+    else if (s->run == RT_PAUSED && s->pending_steps == 0) {
+        w.kind = RT_WAIT_RESUME;
+        w.owed = paused_copies(s);
+        w.t = w.owed ? s->ls.waiting_time : 0;
+    }
     else if (s->run == RT_WAITING && s->pending_steps == 0 && !s->have_command) {
         w.kind = RT_WAIT_FIRST;
         w.t = lag_sim_time(&s->sim);
@@ -181,72 +134,20 @@ static void term_view(void *ctx, rt_term_view *v)
                         rt_run_name(s->run)};
 }
 
-/* An unlimited event (start, stop). */
-static void eventf(rt_server *s, const char *kind, double value, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-static void eventf(rt_server *s, const char *kind, double value, const char *fmt, ...)
-{
-    char detail[256];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(detail, sizeof detail, fmt, ap);
-    va_end(ap);
-    event(s, kind, "", value, detail);
-}
-
-/* A limited event: published if its kind's bucket has a token, else counted as
- * suppressed; the next one that gets through says how many were suppressed before it. */
-static void limited_event(rt_server *s, rt_ev ev, const char *joint, double value,
-                          const char *fmt, ...) __attribute__((format(printf, 5, 6)));
-static void limited_event(rt_server *s, rt_ev ev, const char *joint, double value,
-                          const char *fmt, ...)
-{
-    rt_limit *l = &s->lim_event[ev];
-    int64_t suppressed = l->suppressed;
-    if (!rt_limit_take(l, s->now)) return;
-    l->suppressed = 0;
-    /* the note on what was suppressed always fits: the sentence is cut first */
-    char note[96] = "", detail[LAG_WIRE_TEXT_LEN];
-    if (suppressed > 0)
-        snprintf(note, sizeof note, " (%lld more %s events suppressed before this one)",
-                 (long long)suppressed, ev_limits[ev].kind);
-    size_t room = sizeof detail - strlen(note);
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(detail, room, fmt, ap);
-    va_end(ap);
-    if (n < 0) detail[0] = '\0';
-    strcat(detail, note);
-    event(s, ev_limits[ev].kind, joint, value, detail);
-}
-
 /* Every state goes out through here: in lockstep a published state is waited on. */
 static void publish_state(rt_server *s)
 {
-    rt_out o = out(s);
-    int n = rt_publish_state(&o, &s->sim, s->info, &s->ref, &s->ref_sent);
-    if (n > 0) {
-        s->states_published++;
-        memcpy(s->state_buf, s->bus.buf, (size_t)n); /* as sent: a lockstep retry sends it again */
-        s->state_len = (unsigned)n;
-    }
-    s->want_state = false;
+    rt_pub_state(&s->pub, s->info, &s->ctl.ref);
     if (s->sc->realtime.mode == LAG_RT_LOCKSTEP)
-        rt_lockstep_published(&s->ls, lag_sim_time(&s->sim), s->now);
+        rt_lockstep_published(&s->ls, s->pub.generation, lag_sim_time(&s->sim), s->now);
 }
 
 /* Lockstep, while a state is waited on and no answer to it has come: the same state goes
  * out again, byte for byte, at the gaps rt_lockstep.c explains. */
 static void lockstep_retry(rt_server *s)
 {
-    if (s->state_len == 0 || !rt_lockstep_retry(&s->ls, s->now)) return;
-    /* straight to LCM, not through rt_wire's publish: a copy for the network, which --log
-     * (the run's record, one state per period) does not keep; its reference just before
-     * it, as the first time (the reference may have been lost with it) */
-    if (s->ref_sent.len > 0)
-        lcm_publish(s->bus.lcm, s->bus.ch_reference, s->ref_sent.buf, s->ref_sent.len);
-    lcm_publish(s->bus.lcm, s->bus.ch_state, s->state_buf, s->state_len);
-    s->lockstep_retries++;
+    if (s->pub.state_len == 0 || !rt_lockstep_retry(&s->ls, s->now)) return;
+    rt_pub_state_again(&s->pub);
 }
 
 /* The status: the sim's figures (rt_status_base), the loop's counters, what the plant
@@ -272,14 +173,14 @@ static void status_message(const rt_server *s, int64_t now, lag_wire_status *m)
     m->rejected_undecodable = s->rejected[RT_REJ_UNDECODABLE];
     m->rejected_stale = s->rejected[RT_REJ_STALE];
     m->rejected_effort_limit = s->rejected[RT_REJ_EFFORT_LIMIT];
-    m->controls_rejected = s->controls_rejected;
+    m->controls_rejected = s->ctl.controls_rejected;
     m->watchdog_tripped = s->watchdog_tripped;
     m->watchdog_trips = s->watchdog_trips;
     m->lockstep_timeouts = s->lockstep_timeouts;
     m->numeric_faults = s->numeric_faults;
     m->overrun_bursts = s->overrun_bursts;
-    m->states_published = s->states_published;
-    m->lockstep_retries = s->lockstep_retries;
+    m->states_published = s->pub.states_published;
+    m->lockstep_retries = s->pub.lockstep_retries;
     m->commands_ignored = s->commands_ignored;
     m->plant_conflicts = s->plant_conflicts;
     rt_wait_seen w = wait_seen(s);
@@ -300,10 +201,8 @@ static void publish_status(rt_server *s)
     int64_t now = lag_clock_mono_ns();
     lag_wire_status m;
     status_message(s, now, &m);
-    rt_out o = out(s);
-    rt_publish_status(&o, &m);
+    rt_pub_status(&s->pub, &m);
     s->rtf = m.rtf;
-    s->want_status = false;
     if ((double)(now - s->last_status_ns) * 1e-9 < 0.05 && s->run == RT_RUNNING) return;
     s->last_status_ns = now;
     s->ticks_since_status = 0;
@@ -321,7 +220,7 @@ static void enter_fault(rt_server *s, lag_result r)
     s->pending_steps = 0;
     s->period_left = 0;
     s->ls.waiting = false;
-    s->want_state = false;
+    s->pub.want_state = false;
     s->numeric_faults++;
     char why[LAG_WIRE_TEXT_LEN] = "";
     if (r != LAG_OK) lag_sim_fault_describe(&s->sim, why, sizeof why);
@@ -337,10 +236,10 @@ static void enter_fault(rt_server *s, lag_result r)
         if (k < 0) break;
         n += (size_t)k;
     }
-    limited_event(s, RT_EV_NUMERIC_FAULT, "", lag_sim_time(&s->sim),
+    rt_pub_limited(&s->pub, RT_EV_NUMERIC_FAULT, "", lag_sim_time(&s->sim),
                   "fault (efforts held: %s): %s; paused until reset or reset_to",
                   n ? eff : "none", why);
-    s->want_status = true;
+    s->pub.want_status = true;
 }
 
 /* The effects' events of the last chunk (impact, limit, saturation, ...), with the sim
@@ -352,11 +251,11 @@ static void publish_effect_events(rt_server *s)
         const char *joint = ev.joint >= 0 && ev.joint < s->nq ? s->info->joint_names[ev.joint] : "";
         char detail[96];
         snprintf(detail, sizeof detail, "%s at t = %.9g s", lag_event_kind_name(ev.kind), ev.t);
-        event_at(s, ev.t, lag_event_kind_name(ev.kind), joint, ev.value, detail, true);
+        rt_pub_event_at(&s->pub, ev.t, lag_event_kind_name(ev.kind), joint, ev.value, detail, true);
     }
     if (s->sim.events_dropped > s->effect_events_dropped) {
         int64_t lost = s->sim.events_dropped - s->effect_events_dropped;
-        limited_event(s, RT_EV_EVENTS_DROPPED, "", (double)lost,
+        rt_pub_limited(&s->pub, RT_EV_EVENTS_DROPPED, "", (double)lost,
                       "%lld effect events dropped (more than the step records per period)",
                       (long long)lost);
         s->effect_events_dropped = s->sim.events_dropped;
@@ -378,7 +277,7 @@ static void period_begin(rt_server *s, int64_t budget)
         s->watchdog_tripped = true;
         s->watchdog_trips++;
         for (int i = 0; i < s->nq; i++) s->held[i] = 0.0;
-        limited_event(s, RT_EV_WATCHDOG_TRIP, "", age,
+        rt_pub_limited(&s->pub, RT_EV_WATCHDOG_TRIP, "", age,
                       "no command for %.6g s of sim time (command_timeout %.6g s): efforts zeroed",
                       age, sc->realtime.command_timeout);
     }
@@ -400,7 +299,7 @@ static void estimate_error(rt_server *s)
     if (!rt_estimate_period(&s->est, &s->sim)) return;
     const int j = s->est.joint;
     const double err = s->est.err, budget = s->est.budget;
-    limited_event(s, RT_EV_ERROR_ESTIMATE, s->info->joint_names[j], err,
+    rt_pub_limited(&s->pub, RT_EV_ERROR_ESTIMATE, s->info->joint_names[j], err,
                   "the integration added an estimated %.3g to %s over the period ending at "
                   "t = %.9g s, %.3g times its budget %.3g (integrator.error %g over %g s)",
                   err, s->info->joint_names[j], lag_sim_time(&s->sim), err / budget, budget,
@@ -415,8 +314,8 @@ static void period_end(rt_server *s)
     s->step_us_n++;
     publish_state(s);
     if (s->pending_steps > 0 && --s->pending_steps == 0) {
-        limited_event(s, RT_EV_STEP_DONE, "", 0, "step done: paused");
-        s->want_status = true;
+        rt_pub_limited(&s->pub, RT_EV_STEP_DONE, "", 0, "step done: paused");
+        s->pub.want_status = true;
     }
     if (s->stop_tick > 0 && s->sim.tick >= s->stop_tick) {
         s->stop = true;
@@ -477,7 +376,7 @@ static void mode_realtime(rt_server *s)
     s->overruns += d.overruns;
     if (d.rebase) {
         s->overrun_bursts++;
-        limited_event(s, RT_EV_OVERRUN_BURST, "", (double)d.due,
+        rt_pub_limited(&s->pub, RT_EV_OVERRUN_BURST, "", (double)d.due,
                       "%lld periods behind wall clock: cannot catch up, re-basing the clock "
                       "(sim time lags wall time by %.3g s more)",
                       (long long)d.due, (double)d.due * (double)s->pace.period_ns * 1e-9);
@@ -518,9 +417,13 @@ static void mode_fast(rt_server *s)
  * a run that lost its controller for a while ends exactly as one that did not. */
 static void mode_lockstep(rt_server *s)
 {
+    if (paused_copies(s)) {
+        lockstep_retry(s); /* paused: the state waited on, until an answer to it came */
+        return;
+    }
     if (s->run == RT_WAITING && s->pending_steps == 0) {
         if (s->ls.waiting && rt_lockstep_timed_out(&s->ls, s->now))
-            s->want_state = true; /* the same state again, through the state bucket */
+            s->pub.want_state = true; /* the same state again, through the state bucket */
         return;
     }
     if (!active(s) || !s->ls.waiting) return;
@@ -530,12 +433,12 @@ static void mode_lockstep(rt_server *s)
         } else {
             s->lockstep_timeouts++;
             s->run = RT_WAITING;
-            limited_event(s, RT_EV_LOCKSTEP_TIMEOUT, "", s->ls.waiting_time,
+            rt_pub_limited(&s->pub, RT_EV_LOCKSTEP_TIMEOUT, "", s->ls.waiting_time,
                           "no command answered sim time %.9g s within %.6g s: waiting for one "
                           "(the state is published again every %.6g s)", s->ls.waiting_time,
                           s->sc->realtime.lockstep_timeout, s->sc->realtime.lockstep_timeout);
-            s->want_state = true;
-            s->want_status = true;
+            s->pub.want_state = true;
+            s->pub.want_status = true;
             return;
         }
     }
@@ -552,11 +455,6 @@ static void mode_lockstep(rt_server *s)
 /* ---------------------------------------------------------------- commands */
 static void lockstep_rewait(rt_server *s);
 
-static const char *joint_list(const rt_server *s, bool actuated_only, char *buf, size_t n)
-{
-    return rt_joint_list(s->info, s->nq, actuated_only, buf, n);
-}
-
 /* A rejected command (rt_command.h's verdict): counted by reason, and a command_rejected
  * event (limited) whose detail says what was wrong and what would be accepted. */
 static void reject(rt_server *s, const rt_verdict *v)
@@ -570,7 +468,7 @@ static void reject(rt_server *s, const rt_verdict *v)
     snprintf(detail, sizeof detail, "%s: %s", rt_reject_name[why], what);
     if (why != RT_REJ_STALE) memcpy(s->last_reject, detail, sizeof detail); /* waits say it */
     /* a flood is counted in status, not echoed one for one */
-    limited_event(s, RT_EV_COMMAND_REJECTED, v->joint, v->value, "command rejected: %s", detail);
+    rt_pub_limited(&s->pub, RT_EV_COMMAND_REJECTED, v->joint, v->value, "command rejected: %s", detail);
 }
 
 static void handle_command(rt_server *s, const uint8_t *data, size_t len);
@@ -587,18 +485,41 @@ void rt_handle_command(rt_server *s, const uint8_t *data, size_t len)
  * distinct, every effort finite and within the scene's realtime.effort_limit
  * (rt_command.h), and in lockstep it answers the state waited on. Its steps: */
 
+/* A command of a generation other than the current one answers a state of an earlier run
+ * or scene: never applied, in any mode (stale). Generation 0 answers no particular state:
+ * applied in the realtime and fast modes, stale in lockstep (which needs the state). */
+static bool command_of_now(rt_server *s, const lag_wire_joint_command *c)
+{
+    const int64_t now_gen = s->pub.generation;
+    bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
+    if (c->generation == now_gen || (c->generation == 0 && !lockstep)) return true;
+    rt_verdict v = {RT_REJ_STALE, "", c->sim_time, ""};
+    if (c->generation == 0)
+        snprintf(v.what, sizeof v.what, "generation 0 answers no state; lockstep advances on "
+                 "the generation and sim_time of the state waited on (generation %lld)",
+                 (long long)now_gen);
+    else
+        snprintf(v.what, sizeof v.what, "generation %lld, sim_time %.9g (in value): a state "
+                 "of an earlier run or scene; accepted: generation %lld", (long long)c->generation,
+                 c->sim_time, (long long)now_gen);
+    reject(s, &v);
+    return false;
+}
+
 /* Lockstep: the command answers the state waited on (or, not running, the state the sim
- * holds). A second answer to a state already answered (the controller got it twice, a
- * retry crossing its first answer) is not applied: counted, no event. Else stale. */
+ * holds), known by its generation and sim time. A second answer to a state already
+ * answered (the controller got it twice, a retry crossing its first answer) is not
+ * applied: counted, no event. Else stale. */
 static bool command_in_step(rt_server *s, const lag_wire_joint_command *c)
 {
+    if (!command_of_now(s, c)) return false;
     if (s->sc->realtime.mode != LAG_RT_LOCKSTEP) return true;
-    if (rt_lockstep_repeated(&s->ls, c->sim_time)) {
+    if (rt_lockstep_repeated(&s->ls, c->generation, c->sim_time)) {
         s->commands_ignored++;
         rt_log_rx_fate(&s->rec, s->now, RT_RX_REFUSED); /* --log: a sample of them */
         return false;
     }
-    bool waited_on = s->ls.waiting && c->sim_time == s->ls.waiting_time;
+    bool waited_on = rt_lockstep_is_waited(&s->ls, c->generation, c->sim_time);
     if (waited_on || (s->run != RT_RUNNING && c->sim_time == lag_sim_time(&s->sim))) return true;
     rt_verdict v = {RT_REJ_STALE, "", c->sim_time, ""};
     if (s->ls.waiting)
@@ -619,19 +540,19 @@ static void command_apply(rt_server *s, const lag_wire_joint_command *c, const i
     s->accepted++;
     s->have_command = true;
     s->command_tick = s->sim.tick;
-    rt_lockstep_answer(&s->ls, c->sim_time);
+    rt_lockstep_answer(&s->ls, c->generation, c->sim_time);
     if (s->run == RT_WAITING) {
         /* the command the run was waiting for: it goes on from here */
         s->run = RT_RUNNING;
         s->restart_pace = true; /* realtime: deadlines start now, not at the daemon's start */
         if (s->sc->realtime.mode == LAG_RT_LOCKSTEP && !s->ls.answered) lockstep_rewait(s);
-        limited_event(s, RT_EV_RESUME, "", lag_sim_time(&s->sim),
+        rt_pub_limited(&s->pub, RT_EV_RESUME, "", lag_sim_time(&s->sim),
                       "a command arrived at sim time %.9g s: running", lag_sim_time(&s->sim));
-        s->want_status = true;
+        s->pub.want_status = true;
     }
     if (s->watchdog_tripped) {
         s->watchdog_tripped = false;
-        limited_event(s, RT_EV_WATCHDOG_CLEAR, "", 0, "a good command arrived: efforts held again");
+        rt_pub_limited(&s->pub, RT_EV_WATCHDOG_CLEAR, "", 0, "a good command arrived: efforts held again");
     }
 }
 
@@ -644,7 +565,7 @@ static void handle_command(rt_server *s, const uint8_t *data, size_t len)
         return;
     }
     /* lockstep: an answer to the state waited on, good or not, came: it needs no copies */
-    rt_lockstep_heard(&s->ls, c.sim_time);
+    rt_lockstep_heard(&s->ls, c.generation, c.sim_time);
     int idx[LAG_MAX_DOF];
     if (!rt_command_entries(s->info, s->nq, s->sc->realtime.effort_limit, &c, idx, &v)) {
         reject(s, &v);
@@ -655,13 +576,15 @@ static void handle_command(rt_server *s, const uint8_t *data, size_t len)
 }
 
 /* ---------------------------------------------------------------- control requests */
+/* What a control request asks of the run (rt_control.c checked it and made its changes
+ * to the scene); a status follows where it says (want_status). */
 static void do_reset(rt_server *s, const double *q, const double *qd, const char *what)
 {
-    if (s->live.nk > 0) { /* sim time starts over: the kicks are the old run's */
+    if (s->ctl.live.nk > 0) { /* sim time starts over: the kicks are the old run's */
         char detail[96];
         snprintf(detail, sizeof detail, "a reset ends the %d kick(s) of the run before it",
-                 s->live.nk);
-        live_kicks_clear(&s->live, &s->sim);
+                 s->ctl.live.nk);
+        live_kicks_clear(&s->ctl.live, &s->sim);
         event(s, "kicks_cleared", "", 0, detail); /* --replay applies it here */
     }
     lag_sim_reset(&s->sim, q, qd);
@@ -675,112 +598,18 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
     s->ls.have_answered = false;
     if (s->run == RT_FAULT) s->run = RT_PAUSED;
     char kept[200];
-    live_set_describe(&s->live, kept, sizeof kept);
+    live_set_describe(&s->ctl.live, kept, sizeof kept);
     /* which changes made while running the reset keeps (a reset with count 1 keeps none) */
-    limited_event(s, RT_EV_RESET, "", 0, "%s: sim time 0, efforts zero, %s; %s%s%s", what,
+    rt_pub_limited(&s->pub, RT_EV_RESET, "", 0, "%s: sim time 0, efforts zero, %s; %s%s%s", what,
                   s->run == RT_PAUSED    ? "paused (resume to run)"
                   : s->run == RT_WAITING ? "waiting for a command"
                                          : "running",
                   kept[0] ? "keeps the changes made while running: " : "the scene file's values",
                   kept, kept[0] ? " (lagsimctl reset --scene, RESET count 1: the scene file's "
                                   "values)" : "");
-    s->want_scene = true;
-    s->want_state = true;
-    s->want_status = true;
-}
-
-static void control_rejected(rt_server *s, const char *why)
-{
-    s->controls_rejected++;
-    rt_log_rx_fate(&s->rec, s->now, RT_RX_REFUSED); /* --log: a sample of them */
-    limited_event(s, RT_EV_CONTROL_REJECTED, "", 0, "%s", why);
-    s->want_status = true;
-}
-
-/* Does any joint's actuator have a lag? */
-static bool actuator_lagged(const lag_effects_def *fx, int nq)
-{
-    for (int i = 0; (fx->enabled & LAG_EFF_ACTUATOR) && i < nq; i++)
-        if (fx->actuator_tau[i] > 0) return true;
-    return false;
-}
-
-/* A kick (SET key "kick.<joint>", value "<impulse>[,<duration>]"): a disturbance from
- * the current tick on, added to the scene's and to the kicks not over yet (live_set.c).
- * The answer: a `kick` event whose detail is exactly "kick.<joint>=<value>" and whose step
- * is the tick it starts at (what --replay re-applies), then a status. */
-static void handle_kick(rt_server *s, const lag_wire_control *c)
-{
-    char kv[LIVE_SET_LEN], why[1024];
-    if (snprintf(kv, sizeof kv, "%s=%s", c->key, c->value) >= (int)sizeof kv) {
-        control_rejected(s, "kick: key=value is too long");
-        return;
-    }
-    if (!rt_limit_take(&s->lim_set, s->now)) {
-        snprintf(why, sizeof why, "%s: more than %d changes a second; this one was not "
-                                  "applied", kv, RT_SET_PER_S);
-        control_rejected(s, why);
-        return;
-    }
-    live_kick k;
-    if (live_kick_apply(&s->live, &s->sim, kv, &k, why, sizeof why) != 0) {
-        control_rejected(s, why);
-        return;
-    }
-    event(s, "kick", lag_model_info_get(s->sim.def.model.kind)->joint_names[k.joint],
-                     k.impulse, kv);
-    s->want_status = true;
-}
-
-/* SET key=value: the change is validated by the scene loader itself, on the scene's own
- * bytes with its --set overrides, the changes already made and this one after them (so
- * every rule of a scene file holds, with its message: live_set.c), then by the core
- * against the state the run is in; it takes effect at once, at the current tick. Only
- * keys under parameters and effects change while running. The answer: a `set` event
- * whose detail is exactly "key=value" and whose step is the tick it took effect at (what
- * --replay re-applies), and the new scene. A refusal is a control_rejected whose detail
- * names the change and the reason. */
-static void handle_set(rt_server *s, const lag_wire_control *c)
-{
-    char kv[LIVE_SET_LEN], err[512], why[1024];
-    if (live_is_kick(c->key)) {
-        handle_kick(s, c);
-        return;
-    }
-    if (live_set_parse(c->key, c->value, kv, why, sizeof why) != 0) {
-        control_rejected(s, why);
-        return;
-    }
-    if (!rt_limit_take(&s->lim_set, s->now)) {
-        snprintf(why, sizeof why, "set %s: more than %d changes a second; this one was not "
-                                  "applied", kv, RT_SET_PER_S);
-        control_rejected(s, why);
-        return;
-    }
-    static lag_scene ns; /* large: not on the stack; used by this function only */
-    if (live_set_load(s->opts, &s->live, kv, &ns, why, sizeof why) != 0) {
-        control_rejected(s, why);
-        return;
-    }
-    /* A lag's actuator state lives within periods: --log records the commanded inputs
-     * that let --replay run it only when the scene starts with a lag. */
-    if (!actuator_lagged(&s->sc->sim.effects, s->nq) && actuator_lagged(&ns.sim.effects, s->nq)) {
-        snprintf(why, sizeof why, "set %s: an actuator lag cannot be switched on while "
-                                  "running (a replay could not reproduce the run); give the "
-                                  "scene's actuator a lag to start with", kv);
-        control_rejected(s, why);
-        return;
-    }
-    if (lag_sim_redefine(&s->sim, &ns.sim, err, sizeof err) != LAG_OK) {
-        snprintf(why, sizeof why, "set %s: %s", kv, err);
-        control_rejected(s, why);
-        return;
-    }
-    s->ref = ns.reference; /* SET reference.*: from the next state on */
-    live_set_keep(&s->live, kv);
-    event(s, "set", "", 0, kv);
-    s->want_scene = true;
-    s->want_status = true;
+    rt_pub_new_generation(&s->pub, s->sc, s->info); /* the scene, before the new state */
+    s->pub.want_state = true;
+    s->pub.want_status = true;
 }
 
 /* Lockstep, when the run goes on (resume, step): the state already published is waited
@@ -789,197 +618,65 @@ static void lockstep_rewait(rt_server *s)
 {
     if (s->sc->realtime.mode != LAG_RT_LOCKSTEP) return;
     if (s->ls.waiting) s->ls.wait_start_ns = s->now;
-    else if (s->period_left == 0) s->want_state = true;
+    else if (s->period_left == 0) s->pub.want_state = true;
 }
 
-static void handle_control(rt_server *s, const uint8_t *data, size_t len);
-
-/* --log: as received, once its fate is known (rt_log_rx_*) */
-
-/* The requests of control_t, by value (lcmtypes/control_t.lcm): what a rejection of an
- * unknown one offers. */
-static const char *control_requests(void)
+static void run_pause(rt_server *s)
 {
-    static const char *const names[] = {
-        [LAGSIM_CONTROL_T_PAUSE] = "PAUSE", [LAGSIM_CONTROL_T_RESUME] = "RESUME",
-        [LAGSIM_CONTROL_T_STEP] = "STEP", [LAGSIM_CONTROL_T_RESET] = "RESET",
-        [LAGSIM_CONTROL_T_RESET_TO] = "RESET_TO", [LAGSIM_CONTROL_T_STATUS] = "STATUS",
-        [LAGSIM_CONTROL_T_DESCRIBE] = "DESCRIBE", [LAGSIM_CONTROL_T_SET] = "SET"};
-    static char list[160];
-    if (!list[0]) {
-        size_t k = 0;
-        for (size_t i = 0; i < sizeof names / sizeof names[0] && k < sizeof list; i++) {
-            if (!names[i]) continue;
-            int w = snprintf(list + k, sizeof list - k, "%s%s = %zu", k ? ", " : "", names[i], i);
-            if (w < 0) break;
-            k += (size_t)w;
-        }
-    }
-    return list;
-}
-
-void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
-{
-    rt_log_rx_begin(&s->rec, s->bus.ch_control, data, len);
-    handle_control(s, data, len);
-    rt_log_rx_end(&s->rec, s->now);
-}
-
-/* A control request, decoded into c; one that does not decode is rejected (false). Any
- * count a message may carry decodes; reset_to checks it against the model's. */
-static bool control_decode(rt_server *s, const uint8_t *data, size_t len, lag_wire_control *c)
-{
-    int d = lag_wire_decode_control(data, len, LAG_WIRE_MAX_JOINTS, c);
-    if (d == LAG_WIRE_OK) return true;
-    if (d != LAG_WIRE_ECOUNT) rt_log_rx_fate(&s->rec, s->now, RT_RX_UNDECODABLE);
-    char why[LAG_WIRE_TEXT_LEN];
-    if (d == LAG_WIRE_ECOUNT)
-        snprintf(why, sizeof why, "control: num_joints out of range; accepted: 0, or %d "
-                 "for reset_to (the joints of %s)", s->nq, s->info->name);
-    else
-        snprintf(why, sizeof why, "control: %zu bytes that are no lagsim.control_t; "
-                 "accepted: a control_t as lcm-gen encodes it (lcmtypes/control_t.lcm)", len);
-    control_rejected(s, why);
-    return false;
-}
-
-/* The requests, one step each; a status follows the handler's own answer where it says
- * (want_status). */
-static void control_pause(rt_server *s)
-{
-    if (s->run == RT_FAULT) {
-        control_rejected(s, "pause: in fault state (reset first)");
-        return;
-    }
     s->run = RT_PAUSED;
     s->pending_steps = 0;
     s->restart_pace = true; /* the held state is republished from now on */
-    limited_event(s, RT_EV_PAUSE, "", 0, "paused");
-    s->want_status = true;
+    rt_pub_limited(&s->pub, RT_EV_PAUSE, "", 0, "paused");
+    s->pub.want_status = true;
 }
 
-static void control_resume(rt_server *s)
+static void run_resume(rt_server *s)
 {
-    if (s->run == RT_FAULT) {
-        control_rejected(s, "resume: in fault state (reset first)");
-        return;
-    }
     s->run = RT_RUNNING;
     s->pending_steps = 0;
     s->restart_pace = true; /* deadlines restart from now */
     lockstep_rewait(s);
-    limited_event(s, RT_EV_RESUME, "", 0, "running");
-    s->want_status = true;
+    rt_pub_limited(&s->pub, RT_EV_RESUME, "", 0, "running");
+    s->pub.want_status = true;
 }
 
 /* STEP N: step_done (and its status) follow when the steps are done. */
-static void control_step(rt_server *s, int64_t count)
+static void run_step(rt_server *s, int64_t count)
 {
-    if (s->run != RT_PAUSED && s->run != RT_WAITING) {
-        control_rejected(s, s->run == RT_FAULT ? "step: in fault state (reset first)"
-                                               : "step: only while paused or waiting "
-                                                 "(pause first)");
-        return;
-    }
-    if (count < 1) {
-        char why[96];
-        snprintf(why, sizeof why, "step: count %lld; accepted: a count >= 1", (long long)count);
-        control_rejected(s, why);
-        return;
-    }
     s->pending_steps = count;
     s->restart_pace = true; /* realtime: the first period ends one period from now */
     lockstep_rewait(s);
-    limited_event(s, RT_EV_STEP, "", (double)count,
+    rt_pub_limited(&s->pub, RT_EV_STEP, "", (double)count,
                   "stepping %lld control periods at the %s mode's pace", (long long)count,
                   lag_rt_mode_name(s->sc->realtime.mode));
 }
 
-/* RESET; count 1: the scene file's values too, after a `restore` event (never
- * suppressed: --replay undoes the changes where it says) before the reset's. */
-static void control_reset(rt_server *s, int64_t count)
+static void run_act(rt_server *s, const rt_act *a)
 {
-    if (count == 1 && (s->live.n > 0 || s->live.nk > 0)) {
-        char err[512], why[700];
-        if (lag_sim_redefine(&s->sim, &s->sc->sim, err, sizeof err) != LAG_OK) {
-            snprintf(why, sizeof why, "reset to the scene file's values: %s", err);
-            control_rejected(s, why);
-            return;
-        }
-        char undone[180], detail[LAG_WIRE_TEXT_LEN];
-        live_set_describe(&s->live, undone, sizeof undone);
-        snprintf(detail, sizeof detail, "the scene file's values again: undone %s%s%d "
-                 "kick(s)", undone, undone[0] ? ", " : "", s->live.nk);
-        event(s, "restore", "", (double)s->live.n, detail);
-        memset(&s->live, 0, sizeof s->live);
-        s->ref = s->sc->reference;
+    switch (a->kind) {
+    case RT_ACT_NONE: return;
+    case RT_ACT_PAUSE: run_pause(s); return;
+    case RT_ACT_RESUME: run_resume(s); return;
+    case RT_ACT_STEP: run_step(s, a->count); return;
+    case RT_ACT_RESET: do_reset(s, a->to ? a->q : NULL, a->to ? a->qd : NULL, a->what); return;
     }
-    do_reset(s, NULL, NULL, count == 1 ? "reset to the scene file's initial state and "
-                                         "values" : "reset to the scene's initial state");
 }
 
-/* RESET_TO: a state of the model's joints, finite, within explode_limit, where the mass
- * matrix is positive definite and the stick is not below the floor. */
-static void control_reset_to(rt_server *s, const lag_wire_control *c)
+/* --log: as received, once its fate is known (rt_log_rx_*) */
+void rt_handle_control(rt_server *s, const uint8_t *data, size_t len)
 {
-    if (c->num_joints != s->nq) {
-        char why[LAG_WIRE_TEXT_LEN], all[160];
-        snprintf(why, sizeof why, "reset_to: num_joints %d; accepted: %d, the joints of %s "
-                 "in this order: %s", c->num_joints, s->nq, s->info->name,
-                 joint_list(s, false, all, sizeof all));
-        control_rejected(s, why);
-        return;
+    rt_log_rx_begin(&s->rec, s->bus.ch_control, data, len);
+    const int64_t gen = s->pub.generation;
+    rt_act a = rt_control_handle(&s->ctl, s->run, data, len);
+    run_act(s, &a);
+    /* lockstep: a state waited on and not answered belongs to the generation before a
+     * SET; it is published again in the new one (an answer to the old one is stale) */
+    if (s->pub.generation != gen && s->sc->realtime.mode == LAG_RT_LOCKSTEP &&
+        s->ls.waiting && !s->ls.answered) {
+        s->ls.waiting = false;
+        s->pub.want_state = true;
     }
-    double lim = s->sc->sim.explode_limit;
-    for (int i = 0; i < s->nq; i++)
-        if (!isfinite(c->q[i]) || !isfinite(c->qd[i]) || fabs(c->q[i]) > lim ||
-            fabs(c->qd[i]) > lim) {
-            control_rejected(s, "reset_to: q and qd must be finite and within explode_limit");
-            return;
-        }
-    double qdd[LAG_MAX_DOF];
-    if (lag_model_forward(&s->sim.model, c->q, c->qd, NULL, qdd) != LAG_OK) {
-        control_rejected(s, "reset_to: mass matrix not positive definite at q");
-        return;
-    }
-    if (lag_sim_contact(&s->sim)[0] && c->q[2] < 0) {
-        control_rejected(s, "reset_to: h, the stick's lower end, must not be below the "
-                            "floor (h >= 0)");
-        return;
-    }
-    do_reset(s, c->q, c->qd, "reset to a given state");
-}
-
-/* STATUS and DESCRIBE change nothing (--log: a sample of them); their answer is a status
- * or the scene, through its bucket. */
-static void control_query(rt_server *s, bool scene)
-{
-    rt_log_rx_fate(&s->rec, s->now, RT_RX_QUERY);
-    if (scene) s->want_scene = true;
-    else s->want_status = true;
-}
-
-static void handle_control(rt_server *s, const uint8_t *data, size_t len)
-{
-    lag_wire_control c;
-    if (!control_decode(s, data, len, &c)) return;
-    switch (c.request) {
-    case LAGSIM_CONTROL_T_PAUSE: control_pause(s); return;
-    case LAGSIM_CONTROL_T_RESUME: control_resume(s); return;
-    case LAGSIM_CONTROL_T_STEP: control_step(s, c.count); return;
-    case LAGSIM_CONTROL_T_RESET: control_reset(s, c.count); return;
-    case LAGSIM_CONTROL_T_RESET_TO: control_reset_to(s, &c); return;
-    case LAGSIM_CONTROL_T_STATUS: control_query(s, false); return;
-    case LAGSIM_CONTROL_T_DESCRIBE: control_query(s, true); return;
-    case LAGSIM_CONTROL_T_SET: handle_set(s, &c); return;
-    default: {
-        char why[LAG_WIRE_TEXT_LEN];
-        snprintf(why, sizeof why, "control: unknown request %d; accepted: %s", c.request,
-                 control_requests());
-        control_rejected(s, why);
-        return;
-    }
-    }
+    rt_log_rx_end(&s->rec, s->now);
 }
 
 /* ---------------------------------------------------------------- one plant per prefix */
@@ -989,8 +686,8 @@ void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len)
     /* running: one datagram from any process must not stop a plant that may be driving an
      * experiment; the conflict is counted and said, rate-limited, and the run goes on */
     s->plant_conflicts++;
-    rt_limit *l = &s->lim_event[RT_EV_PLANT_CONFLICT];
-    limited_event(s, RT_EV_PLANT_CONFLICT, "", (double)s->plant_conflicts,
+    rt_limit *l = &s->pub.lim_event[RT_EV_PLANT_CONFLICT];
+    rt_pub_limited(&s->pub, RT_EV_PLANT_CONFLICT, "", (double)s->plant_conflicts,
                   "another plant publishes on prefix %s (%s): %lld such scenes so far (in "
                   "value); running on; one plant per prefix: stop the other, or give one "
                   "another lcm.prefix", s->sc->lcm.prefix, s->bus.other_plant,
@@ -1000,7 +697,7 @@ void rt_handle_scene(rt_server *s, const uint8_t *data, size_t len)
             fprintf(stderr, "lagsimd: another plant publishes on prefix %s (%s): %lld such "
                     "scenes so far; running on\n", s->sc->lcm.prefix, s->bus.other_plant,
                     (long long)s->plant_conflicts);
-        s->want_status = true;
+        s->pub.want_status = true;
     }
 }
 
@@ -1073,17 +770,6 @@ static void open_clocks(rt_server *s, bool quiet)
     rt_lockstep_init(&s->ls, sc->realtime.lockstep_timeout, sc->realtime.lockstep_retry);
 }
 
-/* The answers' and events' buckets, full at `now`. */
-static void open_limits(rt_server *s, int64_t now)
-{
-    for (int k = 0; k < RT_EV_COUNT; k++)
-        rt_limit_init(&s->lim_event[k], ev_limits[k].per_s, ev_limits[k].burst, now);
-    rt_limit_init(&s->lim_status, RT_STATUS_PER_S, RT_STATUS_BURST, now);
-    rt_limit_init(&s->lim_scene, RT_SCENE_PER_S, RT_SCENE_BURST, now);
-    rt_limit_init(&s->lim_state, RT_STATE_PER_S, RT_STATE_BURST, now);
-    rt_limit_init(&s->lim_set, RT_SET_PER_S, RT_SET_BURST, now);
-}
-
 /* The parts: the bus's URLs and channels (by the rule every client follows,
  * lagsim_bus.h), the terminal, the waits, the log's bookkeeping; then --log itself, last:
  * nothing after it can fail. */
@@ -1100,7 +786,7 @@ static int open_parts(rt_server *s, const lagsimd_opts *o, char *err, size_t err
     rt_wait_init(&s->wait, &s->bus.urls, sc->lcm.prefix, sc->realtime.mode == LAG_RT_LOCKSTEP);
     rt_record_init(&s->rec, sc->sim.integrator.dt, quiet, s->now);
     if (o && o->log) {
-        s->rec.input = actuator_lagged(&sc->sim.effects, s->nq);
+        s->rec.input = rt_actuator_lagged(&sc->sim.effects, s->nq);
         lag_bus_channel_name(s->rec.ch_input, sizeof s->rec.ch_input, sc->lcm.prefix,
                              LAG_BUS_INPUT);
         if (rt_record_open(&s->rec, sc, o, err, errlen) != 0) return LAGSIMD_EXIT_USAGE;
@@ -1130,9 +816,10 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
     s->nq = s->sim.nq;
     s->info = lag_sim_info(&s->sim); /* the joints published: a stick that may fly has h */
     rt_estimate_init(&s->est, lag_scene_estimate_every(sc), rt_error_budget(sc));
-    s->ref = sc->reference;
     s->tick_budget = RT_TICK_BUDGET;
-    open_limits(s, now);
+    /* the publisher and the control requests, full buckets at `now` */
+    rt_pub_init(&s->pub, &s->bus, &s->rec, &s->term, &s->now, &s->sim);
+    rt_control_init(&s->ctl, sc, o, s->info, &s->sim, &s->pub, &s->rec, now);
     return open_parts(s, o, err, errlen);
 }
 
@@ -1159,7 +846,7 @@ void rt_begin(rt_server *s)
              : sc->realtime.start == LAG_RT_START_FIRST_COMMAND ? RT_WAITING
                                                                 : RT_RUNNING;
     publish_scene(s);
-    eventf(s, "start", 0, "%s, %s, dt %.6g s, control period %.6g s, mode %s, rate %.6g: %s",
+    rt_pub_eventf(&s->pub, "start", 0, "%s, %s, dt %.6g s, control period %.6g s, mode %s, rate %.6g: %s",
            lag_model_info_get(sc->sim.model.kind)->name, lag_method_name(sc->sim.integrator.method), sc->sim.integrator.dt,
            (double)sc->ticks_per_period * sc->sim.integrator.dt,
            lag_rt_mode_name(sc->realtime.mode), sc->realtime.rate,
@@ -1190,7 +877,8 @@ int64_t rt_next_wake(const rt_server *s)
             wake = min64(wake, rt_pace_next(&s->pace));
         break;
     case LAG_RT_LOCKSTEP:
-        if ((act || s->run == RT_WAITING) && s->ls.waiting && !s->want_state) {
+        if (paused_copies(s) && !s->ls.answer_heard) wake = min64(wake, s->ls.next_retry_ns);
+        if ((act || s->run == RT_WAITING) && s->ls.waiting && !s->pub.want_state) {
             if (act && s->ls.answered && !log_holds(s)) return now;
             if (act && s->ls.answered) {
                 wake = min64(wake, rt_sat_add(now, RT_LOG_HOLD_NS));
@@ -1202,9 +890,9 @@ int64_t rt_next_wake(const rt_server *s)
         }
         break;
     }
-    if (state_wanted(s)) wake = min64(wake, rt_limit_ready(&s->lim_state, now));
-    if (s->want_scene) wake = min64(wake, rt_limit_ready(&s->lim_scene, now));
-    if (s->want_status) wake = min64(wake, rt_limit_ready(&s->lim_status, now));
+    if (state_wanted(s)) wake = min64(wake, rt_limit_ready(&s->pub.lim_state, now));
+    if (s->pub.want_scene) wake = min64(wake, rt_limit_ready(&s->pub.lim_scene, now));
+    if (s->pub.want_status) wake = min64(wake, rt_limit_ready(&s->pub.lim_status, now));
     if (s->term.live_line) wake = min64(wake, s->next_line_ns);
     wake = min64(wake, rt_wait_next(&s->wait));
     return wake;
@@ -1221,17 +909,17 @@ static void log_check(rt_server *s, bool running)
 /* Answers held back by their bucket go out when it allows, one for many requests. */
 static void flush_answers(rt_server *s)
 {
-    if (state_wanted(s) && rt_limit_ready(&s->lim_state, s->now) <= s->now) {
-        rt_limit_take(&s->lim_state, s->now);
+    if (state_wanted(s) && rt_limit_ready(&s->pub.lim_state, s->now) <= s->now) {
+        rt_limit_take(&s->pub.lim_state, s->now);
         publish_state(s);
     }
-    if (s->want_scene && rt_limit_ready(&s->lim_scene, s->now) <= s->now) {
-        rt_limit_take(&s->lim_scene, s->now);
+    if (s->pub.want_scene && rt_limit_ready(&s->pub.lim_scene, s->now) <= s->now) {
+        rt_limit_take(&s->pub.lim_scene, s->now);
         publish_scene(s);
-        s->want_scene = false;
+        s->pub.want_scene = false;
     }
-    if (s->want_status && rt_limit_ready(&s->lim_status, s->now) <= s->now) {
-        rt_limit_take(&s->lim_status, s->now);
+    if (s->pub.want_status && rt_limit_ready(&s->pub.lim_status, s->now) <= s->now) {
+        rt_limit_take(&s->pub.lim_status, s->now);
         publish_status(s);
     }
 }
@@ -1273,7 +961,7 @@ void rt_process(rt_server *s)
         if (s->opts && s->opts->quiet) return;
         fprintf(stderr, "lagsimd: %s t=%.3f s RTF %.3f overruns %lld states %lld commands %lld "
                 "energy %+.6e J %s\n", s->sc->lcm.prefix, lag_sim_time(&s->sim), s->rtf,
-                (long long)s->overruns, (long long)s->states_published, (long long)s->accepted,
+                (long long)s->overruns, (long long)s->pub.states_published, (long long)s->accepted,
                 lag_sim_energy(&s->sim), rt_run_name(s->run));
     }
 }
@@ -1281,7 +969,7 @@ void rt_process(rt_server *s)
 void rt_signal(rt_server *s, int signo)
 {
     if (signo == SIGUSR1 || signo == SIGUSR2) {
-        s->want_status = true;
+        s->pub.want_status = true;
         s->report_line = true;
         return;
     }
@@ -1309,14 +997,14 @@ void rt_finish(rt_server *s)
 {
     switch (s->stop_reason) {
     case RT_STOP_SIGNAL:
-        eventf(s, "stop", (double)s->stop_signal, "%s (%d): stopping", signal_name(s->stop_signal),
+        rt_pub_eventf(&s->pub, "stop", (double)s->stop_signal, "%s (%d): stopping", signal_name(s->stop_signal),
                s->stop_signal);
         break;
     case RT_STOP_DURATION:
-        eventf(s, "stop", lag_sim_time(&s->sim), "duration reached");
+        rt_pub_eventf(&s->pub, "stop", lag_sim_time(&s->sim), "duration reached");
         break;
     default:
-        eventf(s, "stop", 0, "stopping");
+        rt_pub_eventf(&s->pub, "stop", 0, "stopping");
         break;
     }
     publish_status(s);

@@ -136,7 +136,7 @@ static bool decode_input(const lag_log_record *rec, const lag_model_info *info, 
                          double *u, double *t)
 {
     lag_wire_joint_command c;
-    if (!rec->data || lag_wire_decode_joint_command(rec->data, rec->size, nq, &c) != LAG_WIRE_OK ||
+    if (!rec->data || lag_wire_decode_any(LAG_WIRE_JOINT_COMMAND, rec->data, rec->size, nq, &c, NULL) != LAG_WIRE_OK ||
         !lag_wire_all_finite(LAG_WIRE_JOINT_COMMAND, &c))
         return false;
     for (int i = 0; i < nq; i++) u[i] = 0.0;
@@ -409,8 +409,8 @@ static void replay_reference(replay_run *run, const lag_log_record *rec)
 {
     run->refs_seen++;
     lag_wire_reference lr, cr;
-    if (!rec->data || lag_wire_decode_reference(rec->data, rec->size, LAG_WIRE_MAX_JOINTS,
-                                                &lr) != LAG_WIRE_OK) {
+    if (!rec->data || lag_wire_decode_any(LAG_WIRE_REFERENCE, rec->data, rec->size,
+                                          LAG_WIRE_MAX_JOINTS, &lr, NULL) != LAG_WIRE_OK) {
         run->refs_bad++;
         return;
     }
@@ -516,7 +516,7 @@ static bool replay_decode_state(replay_run *run, const lag_log_record *rec,
 {
     run->seen++;
     if (!rec->data ||
-        lag_wire_decode_joint_state(rec->data, rec->size, LAG_WIRE_MAX_JOINTS, m) != LAG_WIRE_OK) {
+        lag_wire_decode_any(LAG_WIRE_JOINT_STATE, rec->data, rec->size, LAG_WIRE_MAX_JOINTS, m, NULL) != LAG_WIRE_OK) {
         run->undecodable++;
         return false;
     }

@@ -65,6 +65,13 @@ bool rt_command_decode(const lag_model_info *info, int nq, const uint8_t *data, 
     if (d == LAG_WIRE_ETOOLONG) /* a well-formed name longer than any joint's */
         return refuse(v, RT_REJ_UNKNOWN_JOINT, "", 0, "a name of 64 bytes or more; joints of "
                       "%s: %s", info->name, rt_joint_list(info, nq, false, all, sizeof all));
+    const char *old = NULL;
+    if (d == LAG_WIRE_EFINGERPRINT && lag_wire_identify_any(data, len, &old) ==
+        LAG_WIRE_JOINT_COMMAND && old)
+        return refuse(v, RT_REJ_UNDECODABLE, "", (double)len,
+                      "a joint_command_t of lagsim %s: the controller was built with lagsim "
+                      "%s's types and must be rebuilt with lagsim %s's (client library and "
+                      "lcmtypes)", old, old, lag_wire_version());
     if (d != LAG_WIRE_OK)
         return refuse(v, RT_REJ_UNDECODABLE, "", (double)len,
                       "%zu bytes (in value) that are no lagsim.joint_command_t; accepted: a "

@@ -6,7 +6,8 @@
  * the way costs a retry instead of a timeout, and a controller that thinks long per state
  * gets a copy every 62.5 ms at most (default scene), not one per lockstep_retry. Once any
  * command for that sim_time arrived (applied or rejected) the controller has the state: no
- * more copies. A controller answers each state once and a copy of it with the same
+ * more copies. A state is known by its generation and sim time (every run starts again
+ * at sim time 0). A controller answers each state once and a copy of it with the same
  * answer; a second answer to a state already answered is ignored (commands_ignored), so
  * the run does not depend on how many copies arrived.
  */
@@ -22,11 +23,12 @@ void rt_lockstep_init(rt_lockstep *l, double timeout_s, double retry_s)
     l->retry_cap_ns = l->wait_ns / 16 > l->retry_ns ? l->wait_ns / 16 : l->retry_ns;
 }
 
-void rt_lockstep_published(rt_lockstep *l, double t, int64_t now)
+void rt_lockstep_published(rt_lockstep *l, int64_t gen, double t, int64_t now)
 {
     l->waiting = true;
     l->answered = false;
     l->waiting_time = t;
+    l->waiting_gen = gen;
     l->wait_start_ns = now;
     l->answer_heard = false;
     l->retry_gap_ns = l->retry_ns;
@@ -47,21 +49,28 @@ bool rt_lockstep_retry(rt_lockstep *l, int64_t now)
     return true;
 }
 
-void rt_lockstep_heard(rt_lockstep *l, double t)
+bool rt_lockstep_is_waited(const rt_lockstep *l, int64_t gen, double t)
 {
-    if (l->waiting && t == l->waiting_time) l->answer_heard = true;
+    return l->waiting && gen == l->waiting_gen && t == l->waiting_time;
 }
 
-void rt_lockstep_answer(rt_lockstep *l, double t)
+void rt_lockstep_heard(rt_lockstep *l, int64_t gen, double t)
 {
-    if (!l->waiting || t != l->waiting_time) return;
+    if (rt_lockstep_is_waited(l, gen, t)) l->answer_heard = true;
+}
+
+void rt_lockstep_answer(rt_lockstep *l, int64_t gen, double t)
+{
+    if (!rt_lockstep_is_waited(l, gen, t)) return;
     l->answered = true;
     l->answered_time = t;
+    l->answered_gen = gen;
     l->have_answered = true;
 }
 
-bool rt_lockstep_repeated(const rt_lockstep *l, double t)
+bool rt_lockstep_repeated(const rt_lockstep *l, int64_t gen, double t)
 {
-    bool waited_on = l->waiting && t == l->waiting_time;
-    return (waited_on && l->answered) || (!waited_on && l->have_answered && t == l->answered_time);
+    bool waited_on = rt_lockstep_is_waited(l, gen, t);
+    return (waited_on && l->answered) ||
+           (!waited_on && l->have_answered && t == l->answered_time && gen == l->answered_gen);
 }

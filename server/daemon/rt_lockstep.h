@@ -16,6 +16,7 @@
 
 typedef struct rt_lockstep {
     double waiting_time;       /* sim_time of the state being waited on */
+    int64_t waiting_gen;       /* its generation: a state is known by both */
     bool waiting;              /* a state was published and not yet answered */
     bool answered;
     int64_t wait_start_ns;     /* when the wait began */
@@ -27,23 +28,30 @@ typedef struct rt_lockstep {
     bool answer_heard;         /* a command for the state waited on came (applied or not):
                                 * no more copies of it */
     double answered_time;      /* sim_time of the last state a command answered */
+    int64_t answered_gen;      /* and its generation */
     bool have_answered;        /* answered_time holds one (since start or reset) */
 } rt_lockstep;
 
 /* realtime.lockstep_timeout and lockstep_retry (s; a retry of 0: none). */
 void rt_lockstep_init(rt_lockstep *l, double timeout_s, double retry_s);
-/* A state at sim time t went out at `now`: it is waited on. */
-void rt_lockstep_published(rt_lockstep *l, double t, int64_t now);
+/* A state of generation gen at sim time t went out at `now`: it is waited on. States
+ * are told apart by (generation, sim time): every run starts again at sim time 0, and a
+ * SET changes the scene without changing the sim time. */
+void rt_lockstep_published(rt_lockstep *l, int64_t gen, double t, int64_t now);
 /* The wait began lockstep_timeout ago or more. */
 bool rt_lockstep_timed_out(const rt_lockstep *l, int64_t now);
 /* Whether a copy of the state waited on is due at `now` (none once an answer was heard);
  * when it is, the next copy is booked (the gap doubles up to retry_cap_ns). */
 bool rt_lockstep_retry(rt_lockstep *l, int64_t now);
-/* A command for sim time t heard (good or not): the state waited on needs no copies. */
-void rt_lockstep_heard(rt_lockstep *l, double t);
-/* A command for sim time t applied: the state waited on, if it was that one, is answered. */
-void rt_lockstep_answer(rt_lockstep *l, double t);
+/* Is (gen, t) the state waited on? */
+bool rt_lockstep_is_waited(const rt_lockstep *l, int64_t gen, double t);
+/* A command for the state (gen, t) heard (good or not): the state waited on, if it was
+ * that one, needs no copies. */
+void rt_lockstep_heard(rt_lockstep *l, int64_t gen, double t);
+/* A command for the state (gen, t) applied: the state waited on, if it was that one, is
+ * answered. */
+void rt_lockstep_answer(rt_lockstep *l, int64_t gen, double t);
 /* A second answer to a state already answered (not applied). */
-bool rt_lockstep_repeated(const rt_lockstep *l, double t);
+bool rt_lockstep_repeated(const rt_lockstep *l, int64_t gen, double t);
 
 #endif

@@ -5,7 +5,11 @@
  * each with its own header and struct, none of which includes this one:
  *
  *   rt_bus.h       LCM, subscriptions, channels, the encode buffer, the plant watch
- *   rt_wire.h      what is published (on the bus and the log)
+ *   rt_publish.h   what is published, through one place each: events and their
+ *                  buckets, states (the last as sent), the scene, statuses, the answers
+ *                  owed
+ *   rt_control.h   the control requests: checked, their changes to the scene made
+ *   rt_wire.h      the encoders of what is published (on the bus and the log)
  *   rt_record.h    --log: its clock, the sample of refused messages, its notes
  *   rt_term.h      the terminal: event lines and the live line
  *   rt_wait.h      what the plant waits for, and its lines
@@ -32,51 +36,15 @@
 #include "lagsim_wire.h"
 #include "rt_bus.h"
 #include "rt_command.h"
+#include "rt_control.h"
 #include "rt_estimate.h"
 #include "rt_lockstep.h"
 #include "rt_pace.h"
+#include "rt_publish.h"
 #include "rt_record.h"
 #include "rt_term.h"
 #include "rt_wait.h"
 #include "rt_wire.h"
-
-/* SET requests validated per second and burst (each parses the scene: about 0.05 ms for
- * the DIPC's, so 50 a second take a quarter of a percent of a core): a SET is either
- * applied and announced by its `set` event, which is never suppressed (replay re-applies
- * it), or refused; so `set` events stay within this bucket. lagsim-sweep's kept daemon
- * takes one SET per varied key and run. */
-#define RT_SET_PER_S 50
-#define RT_SET_BURST 50
-
-/* RT_WAITING: not advancing, waiting for a command that starts the run (realtime.start:
- * first_command) or, in lockstep, for one that answers the state whose wait timed out; the
- * state is republished meanwhile, and such a command (or RESUME) makes it RT_RUNNING. */
-typedef enum rt_run { RT_RUNNING = 0, RT_PAUSED, RT_FAULT, RT_WAITING } rt_run;
-
-/* Events the daemon publishes in answer to what arrives or about its own pacing: each
- * kind has its own token bucket (rt_limit), so that no input, however fast, makes the
- * daemon publish more than a few of them per second. What a bucket suppressed is counted
- * and said by the next event of that kind that gets through. `start`, `stop` and the
- * effects' events (at most a fixed number per period, located by the core) are not
- * limited. */
-typedef enum rt_ev {
-    RT_EV_COMMAND_REJECTED = 0,
-    RT_EV_CONTROL_REJECTED,
-    RT_EV_PAUSE,
-    RT_EV_RESUME,
-    RT_EV_STEP,
-    RT_EV_STEP_DONE,
-    RT_EV_RESET,
-    RT_EV_WATCHDOG_TRIP,
-    RT_EV_WATCHDOG_CLEAR,
-    RT_EV_LOCKSTEP_TIMEOUT,
-    RT_EV_OVERRUN_BURST,
-    RT_EV_NUMERIC_FAULT,
-    RT_EV_EVENTS_DROPPED,
-    RT_EV_PLANT_CONFLICT,     /* a scene of another plant heard on this prefix while running */
-    RT_EV_ERROR_ESTIMATE,     /* the live error estimate over the scene's budget per period */
-    RT_EV_COUNT
-} rt_ev;
 
 /* Why the server stopped. */
 typedef enum rt_stop {
@@ -92,9 +60,6 @@ typedef struct rt_server {
     const lag_model_info *info;
     lag_sim sim;
     int nq;
-    /* the scene's reference with the changes made while running (SET reference.*):
-     * published on _REFERENCE before each state when ref.n > 0 */
-    lag_scene_reference ref;
 
     /* the loop's clock: CLOCK_MONOTONIC ns, read once per wake-up (tests set it by hand);
      * every decision of the loop, the handlers and the parts uses it */
@@ -109,8 +74,9 @@ typedef struct rt_server {
     rt_estimate est;           /* the live error estimate (rt_estimate.h) */
     rt_pace pace;              /* pacing of periods (realtime) and of the paused
                                 * republication (realtime, fast) */
-    live_sets live;            /* changes made while running (control_t SET), in the
-                                * order they were applied */
+    rt_pub pub;                /* what is published, the answers owed (rt_publish.h) */
+    rt_control ctl;            /* control requests, the changes made while running and
+                                * the reference they give (rt_control.h) */
 
     /* run state */
     rt_run run;
@@ -135,25 +101,15 @@ typedef struct rt_server {
     bool watchdog_tripped;
     char last_reject[LAG_WIRE_TEXT_LEN];  /* why the last command was rejected (not stale) */
 
-    /* answers: published once per wake-up at most, when their bucket allows (a flood of
-     * requests gets one answer, not one each) */
-    bool want_state, want_scene, want_status;
-    rt_limit lim_state, lim_scene, lim_status;
-    rt_limit lim_set;          /* SET requests validated per second */
-    rt_limit lim_event[RT_EV_COUNT];
-
     /* counters published in status */
     int64_t overruns;
     int64_t overrun_bursts;
     int64_t accepted;
     int64_t rejected[RT_REJ_COUNT];
-    int64_t controls_rejected;
     int64_t watchdog_trips;
     int64_t lockstep_timeouts;
-    int64_t lockstep_retries;  /* states published again, no answer having come */
     int64_t commands_ignored;  /* answers to a state already answered */
     int64_t numeric_faults;
-    int64_t states_published;
     int64_t effect_events_dropped; /* sim.events_dropped already reported */
     int64_t plant_conflicts;   /* scenes of another plant heard on this prefix while running */
 
@@ -169,13 +125,7 @@ typedef struct rt_server {
     int64_t next_line_ns;
     double rtf;                /* real-time factor of the last status period */
     bool report_line;          /* SIGUSR1/SIGUSR2: one status line on stderr */
-
-    uint8_t state_buf[RT_BUF_SIZE]; /* the last state published, as sent (lockstep retries) */
-    rt_sent ref_sent;               /* its reference, as sent (lockstep retries) */
-    unsigned state_len;
 } rt_server;
-
-const char *rt_run_name(rt_run r);
 
 /* realtime.c: the server in pieces (lagsimd_realtime strings them together; tests and
  * the fuzz target drive them with their own clock and LCM, e.g. memq://). */

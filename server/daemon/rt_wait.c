@@ -106,7 +106,11 @@ double rt_wait_describe(const rt_wait *w, int64_t now, const rt_wait_seen *seen,
                  ch_command, curl);
         break;
     case RT_WAIT_RESUME:
-        snprintf(what, whatlen, "RESUME or STEP on %s at %s (paused)", ch_control, curl);
+        if (seen->owed) /* lockstep: the state waited on goes out again until answered */
+            snprintf(what, whatlen, "RESUME or STEP on %s at %s (paused; the answer to "
+                     "sim_time %.9g still owed on %s)", ch_control, curl, t, ch_command);
+        else
+            snprintf(what, whatlen, "RESUME or STEP on %s at %s (paused)", ch_control, curl);
         break;
     case RT_WAIT_RESET:
         snprintf(what, whatlen, "RESET or RESET_TO on %s at %s (numeric fault)", ch_control,

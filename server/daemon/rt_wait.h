@@ -33,6 +33,8 @@ typedef struct rt_wait_seen {
     const int64_t *rejected;    /* [RT_REJ_COUNT]: commands rejected, by reason */
     int64_t wrong_port;         /* commands heard on the state URL */
     const char *last_reject;    /* why the last command was rejected (not stale) */
+    bool owed;                  /* RT_WAIT_RESUME in lockstep: the state waited on (at t)
+                                 * has not been answered yet */
 } rt_wait_seen;
 
 typedef struct rt_wait {

@@ -55,6 +55,7 @@ static void publish_reference(const rt_out *o, const lag_sim *sim,
     lag_wire_reference m;
     lagsimd_reference_at(ref, sim->def.model.kind, lag_sim_time(sim), sim->tick, &m);
     m.utime = lag_clock_wall_us();
+    m.generation = o->generation;
     int n = publish(o, o->bus->ch_reference, LAG_WIRE_REFERENCE, &m);
     if (sent && n > 0) {
         memcpy(sent->buf, o->bus->buf, (size_t)n);
@@ -74,6 +75,7 @@ int rt_publish_state(const rt_out *o, const lag_sim *sim, const lag_model_info *
     m.utime = lag_clock_wall_us();
     m.sim_time = fin(lag_sim_time(sim));
     m.step = sim->tick;
+    m.generation = o->generation;
     m.num_joints = (int16_t)sim->nq;
     for (int i = 0; i < sim->nq; i++) {
         PUT(m.name[i], info->joint_names[i]);
@@ -176,6 +178,7 @@ void rt_publish_scene(const rt_out *o, const lag_scene *sc, const lag_sim *sim,
     PUT(m.mode, lag_rt_mode_name(sc->realtime.mode));
     m.rate = fin(sc->realtime.rate);
     m.command_timeout = fin(sc->realtime.command_timeout);
+    m.generation = o->generation;
     int n = publish(o, o->bus->ch_scene, LAG_WIRE_SCENE, &m);
     /* remembered, so that the plant watch knows it when it comes back */
     if (n > 0) rt_bus_sent_scene(o->bus, o->bus->buf, (size_t)n);

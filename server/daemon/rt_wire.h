@@ -21,6 +21,7 @@ typedef struct rt_out {
     rt_bus *bus;
     rt_record *rec;
     int64_t now;
+    int64_t generation;  /* stamped on states, references and scenes */
 } rt_out;
 
 /* The error a period may add (m or rad): integrator.error * period / integrator.horizon

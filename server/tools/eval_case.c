@@ -28,6 +28,80 @@
 #include "scene.h"
 #include "scene_yaml.h"
 
+/* ---------------------------------------------------------------- the keys the tools own */
+const eval_owned_key eval_owned_keys[EVAL_OWN_COUNT] = {
+    [EVAL_OWN_MODE] = {"realtime.mode", "lockstep: a run's numbers do not depend on the "
+                                        "controller's speed or the machine's load"},
+    [EVAL_OWN_START] = {"realtime.start", "first_command (paused for a kept lagsim-sweep "
+                                          "worker): a run starts with its controller"},
+    [EVAL_OWN_LOCKSTEP_TIMEOUT] = {"realtime.lockstep_timeout",
+                                   "0.1 s (3600 s for a kept worker): how often a waiting "
+                                   "plant publishes its state again"},
+    [EVAL_OWN_URL] = {"lcm.url", "ports of the run's own, with the group and options of "
+                                 "--url or LCM_DEFAULT_URL: no crosstalk"},
+    [EVAL_OWN_PREFIX] = {"lcm.prefix", "channels of the run's own ({prefix}, LAGSIM_PREFIX)"},
+    [EVAL_OWN_ALLOW_LAN] = {"lcm.allow_lan", "false unless --allow-lan: nothing from or to "
+                                             "the network"},
+};
+
+/* The length of the first segment of the dotted path p[0, end) */
+static size_t segment(const char *p, const char *end)
+{
+    const char *dot = memchr(p, '.', (size_t)(end - p));
+    return dot ? (size_t)(dot - p) : (size_t)(end - p);
+}
+
+bool eval_key_overlap(const char *a, size_t alen, const char *b, size_t blen)
+{
+    const char *ae = a + alen, *be = b + blen;
+    /* a segment at a time while both agree; one path ending there is the other or holds
+     * it */
+    for (;;) {
+        size_t al = segment(a, ae), bl = segment(b, be);
+        if (al != bl || memcmp(a, b, al)) return false;
+        if (a + al == ae || b + bl == be) return true;
+        a += al + 1, b += bl + 1;
+    }
+}
+
+int eval_owned_find(const char *key, size_t len)
+{
+    for (int r = 0; r < EVAL_OWN_COUNT; r++)
+        if (eval_key_overlap(key, len, eval_owned_keys[r].key, strlen(eval_owned_keys[r].key)))
+            return r;
+    return -1;
+}
+
+int eval_owned_check(const char *key, size_t len, char *why, size_t n)
+{
+    int r = eval_owned_find(key, len);
+    if (r < 0) return 0;
+    const eval_owned_key *o = &eval_owned_keys[r];
+    if (len < strlen(o->key))
+        snprintf(why, n, "%.*s holds %s, which lagsim-eval and lagsim-sweep set themselves "
+                 "(%s)", (int)len, key, o->key, o->why);
+    else
+        snprintf(why, n, "%s is set by lagsim-eval and lagsim-sweep themselves (%s)", o->key,
+                 o->why);
+    return -1;
+}
+
+void eval_owned_usage(FILE *f)
+{
+    enum { INDENT = 29, WIDTH = 80 };
+    for (int r = 0; r < EVAL_OWN_COUNT; r++) {
+        int col = fprintf(f, "  %-26s", eval_owned_keys[r].key);
+        /* the reason's words, wrapped under each other */
+        for (const char *w = eval_owned_keys[r].why; *w;) {
+            int n = (int)strcspn(w, " ");
+            if (col + 1 + n > WIDTH) col = fprintf(f, "\n%*s", INDENT - 1, "") - 1;
+            col += fprintf(f, " %.*s", n, w);
+            w += n + (w[n] == ' ');
+        }
+        fputc('\n', f);
+    }
+}
+
 /* ---------------------------------------------------------------- cases */
 static const char *const k_case_keys = "name, duration, set, bounds";
 
@@ -50,6 +124,32 @@ static int read_text(errbuf *e, const ynode *nd, const char *what, char *out, si
     if (strlen(nd->text) >= len)
         return yfail(e, nd, NULL, "%s: longer than %zu characters", what, len - 1);
     snprintf(out, len, "%s", nd->text);
+    return 0;
+}
+
+/* A case's `set:`: "key=value" overrides, as lagsimd --set takes them, none of them on a
+ * key the tools own (eval_owned_keys), each kept with its place in the file. */
+static int read_sets(errbuf *e, const ynode *v, eval_case *c)
+{
+    if (v->kind != YN_SEQ)
+        return yfail(e, v, NULL,
+                     "set: expected a list of \"key=value\" overrides (as lagsimd --set), "
+                     "got %s", ynode_kind_name(v));
+    if (v->n > EVAL_SETS_MAX) return yfail(e, v, NULL, "set: at most %d overrides", EVAL_SETS_MAX);
+    for (int i = 0; i < v->n; i++) {
+        const ynode *it = v->items[i];
+        if (read_text(e, it, "set", c->set[i], sizeof c->set[i])) return -1;
+        c->set_line[i] = it->line;
+        c->set_col[i] = it->col;
+        if (!strchr(c->set[i], '=') || c->set[i][0] == '=')
+            return yfail(e, it, NULL, "set: expected \"key=value\" (as lagsimd --set), got '%s'",
+                         c->set[i]);
+        char why[512];
+        if (eval_owned_check(c->set[i], strcspn(c->set[i], "="), why, sizeof why))
+            return yfail(e, it, NULL, "cases[%d].set[%d]: '%s': %s: a case cannot set it",
+                         c->index, i, c->set[i], why);
+    }
+    c->nsets = v->n;
     return 0;
 }
 
@@ -76,22 +176,7 @@ static int read_case(errbuf *e, const ynode *nd, int index, eval_case *c)
             if (read_number(e, v, "duration", 1e-3, 1e6, &c->duration)) return -1;
             has_duration = true;
         } else if (!strcmp(en->key, "set")) {
-            if (v->kind != YN_SEQ)
-                return yfail(e, v, NULL,
-                             "set: expected a list of \"key=value\" overrides (as lagsimd "
-                             "--set), got %s", ynode_kind_name(v));
-            if (v->n > EVAL_SETS_MAX)
-                return yfail(e, v, NULL, "set: at most %d overrides", EVAL_SETS_MAX);
-            for (int i = 0; i < v->n; i++) {
-                if (read_text(e, v->items[i], "set", c->set[i], sizeof c->set[i])) return -1;
-                c->set_line[i] = v->items[i]->line;
-                c->set_col[i] = v->items[i]->col;
-                if (!strchr(c->set[i], '=') || c->set[i][0] == '=')
-                    return yfail(e, v->items[i], NULL,
-                                 "set: expected \"key=value\" (as lagsimd --set), got '%s'",
-                                 c->set[i]);
-            }
-            c->nsets = v->n;
+            if (read_sets(e, v, c)) return -1;
         } else if (!strcmp(en->key, "bounds")) {
             if (v->kind != YN_MAP)
                 return yfail(e, v, NULL,
@@ -231,14 +316,95 @@ int eval_case_scene_load(const char *config, const char *from, const eval_case *
     return -1;
 }
 
-/* ---------------------------------------------------------------- processes */
-void eval_url(int slot, char *url, size_t len)
+void eval_owned_sets(const eval_env *env, bool kept, char out[EVAL_OWN_COUNT][EVAL_SET_LEN])
 {
-    /* a port pair per (process, slot) in 64000..65518, above the ports the tests draw
-     * theirs from (20000..63998): a run never shares a bus with a test whose programs look
-     * for the only plant on it; a prefix of the run's own as well */
-    int port = 64000 + 2 * (int)(((long)getpid() * 61 + slot) % 760);
-    snprintf(url, len, "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304", port);
+    for (int r = 0; r < EVAL_OWN_COUNT; r++) {
+        const char *key = eval_owned_keys[r].key;
+        char *o = out[r];
+        switch ((eval_owned_row)r) {
+        case EVAL_OWN_MODE: snprintf(o, EVAL_SET_LEN, "%s=lockstep", key); break;
+        /* lockstep waits at t = 0 for the controller's first command (a kept daemon
+         * waits paused for the worker's STEP) */
+        case EVAL_OWN_START:
+            snprintf(o, EVAL_SET_LEN, "%s=%s", key, kept ? "paused" : "first_command");
+            break;
+        /* a waiting plant publishes its state again every lockstep_timeout: a controller
+         * that finds the plant after the first one (by discovery) waits at most this
+         * long. A kept daemon's STEP takes a period without a command once it passed (as
+         * asked): the longest one there, so that a period never goes without its answer
+         * (a lost answer costs a retry, docs/server.md). The results depend on neither. */
+        case EVAL_OWN_LOCKSTEP_TIMEOUT:
+            snprintf(o, EVAL_SET_LEN, "%s=%s", key, kept ? "3600" : "0.1");
+            break;
+        case EVAL_OWN_URL: snprintf(o, EVAL_SET_LEN, "%s=%s", key, env->url); break;
+        case EVAL_OWN_PREFIX: snprintf(o, EVAL_SET_LEN, "%s=%s", key, env->prefix); break;
+        case EVAL_OWN_ALLOW_LAN:
+            snprintf(o, EVAL_SET_LEN, "%s=%s", key, env->allow_lan ? "true" : "false");
+            break;
+        case EVAL_OWN_COUNT: break;
+        }
+    }
+}
+
+/* ---------------------------------------------------------------- processes */
+int eval_bus_init(eval_bus *b, const char *url, bool allow_lan, char *err, size_t errlen)
+{
+    memset(b, 0, sizeof *b);
+    const char *env = getenv("LCM_DEFAULT_URL");
+    b->from = url ? "--url" : env && env[0] ? "LCM_DEFAULT_URL" : "the default URL";
+    if (!url) url = env && env[0] ? env : EVAL_DEFAULT_URL;
+    if (strlen(url) >= sizeof b->base) {
+        snprintf(err, errlen, "%s: an LCM URL of at most %zu characters expected", b->from,
+                 sizeof b->base - 1);
+        return -1;
+    }
+    snprintf(b->base, sizeof b->base, "%s", url);
+    char why[512];
+    /* a plant's URL first (the provider), then the options under a scene's rules, as the
+     * daemon reads its lcm.url */
+    if (lag_url_parse(b->base, 0, &b->u, why, sizeof why) != 0 ||
+        (b->u.provider == LAG_URL_UDPM &&
+         lag_url_parse(b->base, LAG_URL_SCENE_RULES | LAG_URL_ALLOW_LAN, &b->u, why,
+                       sizeof why) != 0)) {
+        snprintf(err, errlen, "%s %s: %s", b->from, url, why);
+        return -1;
+    }
+    if (b->u.provider != LAG_URL_UDPM) {
+        snprintf(err, errlen, "%s %s: the daemon and the controller are processes of their "
+                 "own, which an in-process memq:// bus cannot join: give a udpm:// URL",
+                 b->from, url);
+        return -1;
+    }
+    if (b->u.ttl > 0 && !allow_lan) {
+        snprintf(err, errlen, "%s %s: ttl=%d sends every message of the runs beyond this host "
+                 "and lets the network command their plants (docs/network.md): give "
+                 "--allow-lan if that is meant, or use ttl=0", b->from, url, b->u.ttl);
+        return -1;
+    }
+    return 0;
+}
+
+bool eval_text_plain(const char *s)
+{
+    for (; *s; s++)
+        if (!((*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z') || (*s >= '0' && *s <= '9') ||
+              strchr("_-.:/?=&", *s)))
+            return false;
+    return true;
+}
+
+int eval_bus_take(const eval_bus *b, lag_port_lease *l, char *url, size_t len, char *err,
+                  size_t errlen)
+{
+    if (lag_port_take(l, err, errlen) != 0) return -1;
+    int n = lag_url_format(&b->u, l->port, url, len);
+    if (n < 0 || (size_t)n >= len || !eval_text_plain(url)) {
+        snprintf(err, errlen, "%s %s: the run's URL '%.*s' is too long or has a character "
+                 "that a quote would change", b->from, b->base, (int)len, url);
+        lag_port_release(l);
+        return -1;
+    }
+    return 0;
 }
 
 double eval_now(void) { return lag_clock_mono_s(); }
@@ -251,25 +417,35 @@ void eval_sleep(double s)
     nanosleep(&ts, NULL);
 }
 
-/* "{prefix}" and "{url}" in cmd replaced. */
-void eval_expand(const char *cmd, const eval_env *env, char *out, size_t len)
+/* "{prefix}" and "{url}" in cmd replaced by the run's prefix and URL as they are, nothing
+ * added: each is checked to be plain text (eval_text_plain), which means itself inside
+ * the user's own quotes, so the rule is one a user can predict (docs/evaluation.md). */
+int eval_expand(const char *cmd, const eval_env *env, char *out, size_t len, char *err,
+                size_t errlen)
 {
+    if (!eval_text_plain(env->prefix) || !eval_text_plain(env->url)) {
+        snprintf(err, errlen, "the run's prefix '%s' or URL '%s' has a character that a quote "
+                 "would change", env->prefix, env->url);
+        return -1;
+    }
     size_t o = 0;
-    for (const char *p = cmd; *p && o + 1 < len;) {
+    for (const char *p = cmd; *p;) {
         const char *rep = NULL;
         size_t skip = 0;
         if (!strncmp(p, "{prefix}", 8)) rep = env->prefix, skip = 8;
         else if (!strncmp(p, "{url}", 5)) rep = env->url, skip = 5;
-        if (rep) {
-            int w = snprintf(out + o, len - o, "'%s'", rep);
-            o += w > 0 ? (size_t)w : 0;
-            if (o >= len) o = len - 1;
-            p += skip;
-        } else {
-            out[o++] = *p++;
+        size_t n = rep ? strlen(rep) : 1;
+        if (o + n >= len) {
+            snprintf(err, errlen, "the controller's command, {prefix} and {url} replaced, is "
+                     "longer than %zu characters", len - 1);
+            return -1;
         }
+        memcpy(out + o, rep ? rep : p, n);
+        o += n;
+        p += rep ? skip : 1;
     }
     out[o] = '\0';
+    return 0;
 }
 
 void eval_series_free(eval_series *s)
@@ -351,7 +527,8 @@ static int read_reference(const lag_log_record *rec, const eval_scene *sc, doubl
         return 0;
     static _Alignas(max_align_t) unsigned char buf[1 << 16];
     if (size > sizeof buf ||
-        lag_wire_decode((lag_wire_type)type, rec->data, rec->size, EVAL_JOINTS_MAX, buf) != 0)
+        lag_wire_decode_any((lag_wire_type)type, rec->data, rec->size, EVAL_JOINTS_MAX, buf,
+                            NULL) != 0)
         return 0;
     memcpy(t, buf + f_t->offset, sizeof *t);
     int16_t n;
@@ -396,7 +573,7 @@ static void take_state(eval_take *tk, const lag_log_record *rec)
     const eval_scene *sc = tk->sc;
     eval_series *s = tk->s;
     lag_wire_joint_state st;
-    if (lag_wire_decode_joint_state(rec->data, rec->size, sc->nj, &st) != 0 ||
+    if (lag_wire_decode_any(LAG_WIRE_JOINT_STATE, rec->data, rec->size, sc->nj, &st, NULL) != 0 ||
         st.num_joints != sc->nj)
         return;
     /* a state published again (a lockstep retry, a status request) is one sample; a
@@ -538,6 +715,7 @@ enum { ARGS_MAX = 2 * (EVAL_SETS_MAX * 2 + 16) };
 typedef struct daemon_args {
     char *argv[ARGS_MAX];
     char owned[8][600];
+    char owned_sets[EVAL_OWN_COUNT][EVAL_SET_LEN];
     int na, no;
 } daemon_args;
 
@@ -554,22 +732,11 @@ static void daemon_argv(daemon_args *d, const eval_env *env, const eval_case *c,
     arg(d, env->lagsimd);
     arg(d, "--config");
     arg(d, env->config);
-    arg(d, "--set");
-    arg(d, "realtime.mode=lockstep");
-    /* lockstep waits at t = 0 for the controller's first command and publishes that
-     * state again every lockstep_timeout: a controller that finds the plant after the
-     * first one (by discovery) then waits at most this long; the results do not depend
-     * on it (docs/server.md, lockstep) */
-    arg(d, "--set");
-    arg(d, "realtime.lockstep_timeout=0.1");
-    char *o = own(d);
-    snprintf(o, OWN_CAP, "lcm.prefix=%s", env->prefix);
-    arg(d, "--set");
-    arg(d, o);
-    o = own(d);
-    snprintf(o, OWN_CAP, "lcm.url=%s", env->url);
-    arg(d, "--set");
-    arg(d, o);
+    eval_owned_sets(env, false, d->owned_sets);
+    for (int i = 0; i < EVAL_OWN_COUNT; i++) {
+        arg(d, "--set");
+        arg(d, d->owned_sets[i]);
+    }
     for (int i = 0; i < c->nsets && d->na + 2 < ARGS_MAX - 8; i++) {
         arg(d, "--set");
         arg(d, c->set[i]);
@@ -578,7 +745,7 @@ static void daemon_argv(daemon_args *d, const eval_env *env, const eval_case *c,
         arg(d, "--set");
         arg(d, extra[i]);
     }
-    o = own(d);
+    char *o = own(d);
     snprintf(o, OWN_CAP, "%.17g", c->duration);
     arg(d, "--duration");
     arg(d, o);
@@ -633,7 +800,7 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
     daemon_argv(&d, env, c, extra, nextra, log);
 
     char cmd[4096];
-    eval_expand(env->controller, env, cmd, sizeof cmd);
+    if (eval_expand(env->controller, env, cmd, sizeof cmd, err, errlen)) return -1;
     /* the controller first: in lockstep it then answers the first state (clients.md) */
     pid_t cpid = eval_spawn(NULL, cmd, env);
     if (cpid < 0) {

@@ -13,8 +13,9 @@
  *
  * A run: lagsimd on the scene and the case's overrides in lockstep, with --log to a file
  * of the run's own, on an LCM URL and a channel prefix of the run's own (no crosstalk),
- * against the controller command (a shell command; {prefix} and {url} in it are replaced,
- * and LCM_DEFAULT_URL and LAGSIM_PREFIX are set in its environment). The log is then read
+ * against the controller command (a shell command; {prefix} and {url} in it are replaced
+ * by the run's prefix and URL as they are, and LCM_DEFAULT_URL and LAGSIM_PREFIX are set
+ * in its environment). The log is then read
  * with the bounded log reader and each joint's series handed to the metrics library
  * (metrics.h): nothing here computes a metric.
  */
@@ -29,6 +30,8 @@
 
 #include "eval_proc.h"
 #include "lagsim_log.h"
+#include "lagsim_port.h"
+#include "lagsim_url.h"
 #include "metrics.h"
 
 #define EVAL_NAME_LEN 64
@@ -78,6 +81,49 @@ int eval_case_scene_load(const char *config, const char *from, const eval_case *
                          const char *const *extra, int nextra, eval_scene *sc /* OUT */,
                          char *err, size_t errlen);
 
+/* ---------------------------------------------------------------- the keys the tools own */
+/* The scene keys lagsim-eval and lagsim-sweep set on every daemon they start, each for a
+ * guarantee of theirs (lockstep: numbers that do not depend on the machine's load; a bus
+ * and channels of the run's own; nothing from or to the LAN unless --allow-lan). One
+ * table: the daemons' --set strings (eval_owned_sets), the refusal of a case's set: or a
+ * --vary that names one of them or a mapping above one (eval_owned_find), --help and
+ * docs/evaluation.md (eval_lagsim_eval_owned) all come from it. The run's log is the
+ * tools' too: lagsimd's --log, an option no scene key sets. */
+typedef enum eval_owned_row {
+    EVAL_OWN_MODE = 0,
+    EVAL_OWN_START,
+    EVAL_OWN_LOCKSTEP_TIMEOUT,
+    EVAL_OWN_URL,
+    EVAL_OWN_PREFIX,
+    EVAL_OWN_ALLOW_LAN,
+    EVAL_OWN_COUNT
+} eval_owned_row;
+
+typedef struct eval_owned_key {
+    const char *key; /* the dotted path, as lagsimd --set names it */
+    const char *why; /* what the tools set it to, and for what */
+} eval_owned_key;
+
+extern const eval_owned_key eval_owned_keys[EVAL_OWN_COUNT];
+
+/* Whether the dotted key paths a[0, alen) and b[0, blen) (as --set names them) are one
+ * key or one holds the other ("initial" holds "initial.q"), compared a segment at a time
+ * as the loader grafts them: setting both, the later one overrides (part of) the other. */
+bool eval_key_overlap(const char *a, size_t alen, const char *b, size_t blen);
+
+/* The owned key that the dotted key path key[0, len) (as --set names it, without its
+ * "=value" or "[i]") is, lies under, or holds (a mapping above it: "realtime", "lcm"),
+ * compared a path segment at a time as the loader grafts it; -1 when none. */
+int eval_owned_find(const char *key, size_t len);
+
+/* 0 when the key path key[0, len) leaves every owned key alone; else -1 with why the
+ * tools refuse it in why ("realtime holds realtime.mode, which lagsim-eval and
+ * lagsim-sweep set themselves (lockstep: ...)"). */
+int eval_owned_check(const char *key, size_t len, char *why, size_t n);
+
+/* The owned keys' rows for --help: "  KEY  WHY" a line. */
+void eval_owned_usage(FILE *f);
+
 typedef struct eval_env {
     const char *lagsimd;     /* the daemon's path */
     const char *config;      /* the scene file */
@@ -85,12 +131,43 @@ typedef struct eval_env {
     const char *workdir;     /* where the run's log goes */
     char url[160];           /* the run's LCM URL */
     char prefix[64];         /* the run's channel prefix */
+    bool allow_lan;          /* --allow-lan: the URL's ttl may be above 0 */
     double wall_timeout;     /* s a run may take before it is stopped (and failed) */
     bool verbose;            /* pass the daemon's and the controller's output through */
 } eval_env;
 
-/* The URL of worker number `slot` of this process: a multicast port of its own. */
-void eval_url(int slot, char *url, size_t len);
+/* The bus of the tools' runs: the multicast group and the options of --url, else of
+ * LCM_DEFAULT_URL, else EVAL_DEFAULT_URL's; the ports a pair of the runs' own
+ * (lag_port_take: no two evaluations or sweeps of this host share one, and none joins a
+ * port a program of this host is bound to). */
+#define EVAL_DEFAULT_URL "udpm://239.255.76.67?ttl=0&recv_buf_size=4194304"
+typedef struct eval_bus {
+    char base[256];   /* the URL the group and the options come from */
+    const char *from; /* which: "--url", "LCM_DEFAULT_URL" or "the default URL" */
+    lag_url u;        /* base, read under a scene's rules (u.query points into base) */
+} eval_bus;
+
+/* Reads the base URL (url: --url's, or NULL): udpm:// with only ttl and recv_buf_size
+ * (a scene's rules), ttl above 0 only with allow_lan (--allow-lan). -1 with why, naming
+ * where the URL came from, in err. OUT: b */
+int eval_bus_init(eval_bus *b, const char *url, bool allow_lan, char *err, size_t errlen);
+
+/* Takes a pair of ports of b's own, held in *l until lag_port_release (the caller's
+ * lifetime), and writes its URL to url: checked to hold only characters that mean the
+ * same inside any quotes ({url} is replaced by it as written, docs/evaluation.md). -1 with
+ * why in err. OUT: l, url */
+int eval_bus_take(const eval_bus *b, lag_port_lease *l, char *url, size_t len, char *err,
+                  size_t errlen);
+
+/* Whether s holds only characters that mean themselves inside '...' or "..." in a shell
+ * and in the strings of Octave, MATLAB and Python: letters, digits and _ - . : / ? = &. */
+bool eval_text_plain(const char *s);
+
+/* The --set strings a daemon of the tools gets for the owned keys, one a row in the
+ * table's order: a daemon of one run (starts on the controller's first command), or one
+ * kept for many runs (kept: starts paused, waits for a STEP's answer as long as it takes).
+ * OUT: out */
+void eval_owned_sets(const eval_env *env, bool kept, char out[EVAL_OWN_COUNT][EVAL_SET_LEN]);
 
 /* A joint's samples as logged: t, q, r (0 without a reference channel) and u (the
  * effort held from t[k] to t[k+1]: the next state's effort). */
@@ -184,7 +261,9 @@ double eval_now(void);
 double eval_now_wall(void); /* s since the epoch */
 void eval_sleep(double s);
 /* starting, waiting for and stopping processes: eval_proc.h */
-void eval_expand(const char *cmd, const eval_env *env, char *out, size_t len);
+/* cmd with {prefix} and {url} replaced by env's, as they are; -1 with why in err */
+int eval_expand(const char *cmd, const eval_env *env, char *out, size_t len, char *err,
+                size_t errlen);
 int eval_series_grow(eval_series *s, int nj);
 void eval_fail(eval_result *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 

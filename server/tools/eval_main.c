@@ -22,7 +22,8 @@ static void usage(FILE *f)
     fprintf(f,
 "usage: lagsim-eval --config SCENE --controller 'COMMAND' [--case NAME ...]\n"
 "                   [--suite FILE] [--require EXPR] [--csv OUT.csv] [--report DIR]\n"
-"                   [--force] [--lagsimd PATH] [--timeout S] [-v]\n"
+"                   [--force] [--url URL] [--allow-lan] [--lagsimd PATH] [--timeout S]\n"
+"                   [-v]\n"
 "\n"
 "Runs each case of a scene (its `cases:` key, or those of a suite file) in lockstep\n"
 "against a controller and reports per joint: rise, settle, overshoot, sse, iae, ise,\n"
@@ -33,8 +34,10 @@ static void usage(FILE *f)
 "  -c, --config SCENE     the scene file (lagsimd's)\n"
 "  -C, --controller CMD   shell command of the controller, started for each case;\n"
 "                         {prefix} and {url} in it are replaced by the run's channel\n"
-"                         prefix and LCM URL, which its environment also holds\n"
-"                         (LAGSIM_PREFIX, LCM_DEFAULT_URL)\n"
+"                         prefix and LCM URL as they are, no quotes added (both are\n"
+"                         letters, digits and _ - . : / ? = & only: the same inside\n"
+"                         your own quotes; quote {url}, which has ? and &), and its\n"
+"                         environment holds them (LAGSIM_PREFIX, LCM_DEFAULT_URL)\n"
 "      --case NAME        run only this case (repeatable; default: every case)\n"
 "      --suite FILE       take the cases from FILE's `cases:` instead of the scene's\n"
 "      --require EXPR     exit 1 unless every case meets EXPR, e.g.\n"
@@ -43,6 +46,12 @@ static void usage(FILE *f)
 "      --report DIR       a PNG per case in DIR (gnuplot): response, reference,\n"
 "                         effort and the metrics, titled with the case's result\n"
 "  -f, --force            replace existing output files\n"
+"      --url URL          the runs' multicast group and options (default:\n"
+"                         LCM_DEFAULT_URL's, else udpm://239.255.76.67?ttl=0&\n"
+"                         recv_buf_size=4194304); the ports are lagsim-eval's: a pair\n"
+"                         of its own, held while it runs, that no other evaluation or\n"
+"                         sweep of this host holds and no socket of it is bound to\n"
+"      --allow-lan        accept a URL with ttl above 0 (the runs on the network)\n"
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a case may take (default 600); a controller\n"
 "                         not on {prefix} or LAGSIM_PREFIX never answers: its case\n"
@@ -50,6 +59,11 @@ static void usage(FILE *f)
 "  -v, --verbose          pass the daemon's and the controller's output through, keep\n"
 "                         each run's log in the report directory (or TMPDIR, /tmp)\n"
 "  -h, --help             this help\n"
+"\n"
+"keys lagsim-eval sets on every run (a case's set: naming one, or a mapping above\n"
+"one, is refused):\n");
+    eval_owned_usage(f);
+    fprintf(f,
 "\n"
 "exit codes: 0 every case ran, none failed and every case met --require; 1 a case\n"
 "failed or missed the requirement; 2 usage, scene or case error (file:line:column)\n"
@@ -67,11 +81,84 @@ static int die(const char *fmt, const char *a)
     return 2;
 }
 
-/* An output of this run: never the scene file it reads (eval_open_out). */
-static FILE *open_out(const char *what, const char *path, bool force, const char *config)
+/* The files of a run that no output of it may be (lagsim_out.h compares them by device and
+ * inode, so a hard link or another spelling of one is caught): those it reads (the scene,
+ * the suite, the daemon), then every output it opened. */
+typedef struct run_files {
+    const char **path; /* [0, nin) the inputs; then the outputs (copies of their own) */
+    const char **what; /* the option of each output ("--csv", "--report") */
+    unsigned char *state; /* each output's: F_NEW (made by this run), F_DONE (written) */
+    int nin, n, cap;
+} run_files;
+enum { F_NEW = 1, F_DONE = 2 };
+
+static int files_add(run_files *rf, const char *path, const char *what, unsigned state)
 {
-    const char *inputs[1] = {config};
-    return eval_open_out(prog, what, path, force, inputs, 1);
+    if (rf->n == rf->cap) {
+        int cap = rf->cap ? 2 * rf->cap : 16;
+        const char **p = realloc(rf->path, (size_t)cap * sizeof *p);
+        if (p) rf->path = p;
+        const char **w = p ? realloc(rf->what, (size_t)cap * sizeof *w) : NULL;
+        if (w) rf->what = w;
+        unsigned char *st = w ? realloc(rf->state, (size_t)cap) : NULL;
+        if (!st) return -1;
+        rf->state = st, rf->cap = cap;
+    }
+    rf->path[rf->n] = what ? strdup(path) : path;
+    rf->what[rf->n] = what;
+    rf->state[rf->n] = (unsigned char)state;
+    if (!rf->path[rf->n]) return -1;
+    rf->n++;
+    if (!what) rf->nin = rf->n;
+    return 0;
+}
+
+/* The output `path` of option `what` is written: kept at the end. */
+static void files_done(run_files *rf, const char *what, const char *path)
+{
+    for (int i = rf->nin; i < rf->n; i++)
+        if (!strcmp(rf->what[i], what) && !strcmp(rf->path[i], path)) rf->state[i] |= F_DONE;
+}
+
+/* The end: an output this run made and never wrote (the report of a case that did not
+ * run; a CSV of a run refused before its first case) is removed. */
+static void files_end(run_files *rf)
+{
+    for (int i = rf->nin; i < rf->n; i++) {
+        if (rf->state[i] == F_NEW) unlink(rf->path[i]);
+        free((char *)rf->path[i]);
+    }
+    free(rf->path);
+    free(rf->what);
+    free(rf->state);
+    memset(rf, 0, sizeof *rf);
+}
+
+/* An output of this run, by the rules of every lagsim output (eval_open_out): never one
+ * of its inputs, nor another of its outputs; one opened before (a report file made before
+ * the first run) is opened again as this run's own. NULL after saying why. */
+static FILE *open_out(run_files *rf, const char *what, const char *path, bool force)
+{
+    const char **others = malloc((size_t)(rf->n + 1) * sizeof *others);
+    if (!others) return NULL;
+    int k = 0;
+    bool again = false;
+    for (int i = 0; i < rf->n; i++) {
+        if (i >= rf->nin && !strcmp(rf->what[i], what) && !strcmp(rf->path[i], path))
+            again = true;
+        else
+            others[k++] = rf->path[i];
+    }
+    struct stat st;
+    bool existed = lstat(path, &st) == 0;
+    FILE *f = eval_open_out(prog, what, path, force || again, others, k);
+    free(others);
+    if (f && !again && files_add(rf, path, what, existed ? 0 : F_NEW)) {
+        fprintf(stderr, "%s: out of memory\n", prog);
+        fclose(f);
+        return NULL;
+    }
+    return f;
 }
 
 /* text in a double-quoted gnuplot string: '"' and '\\' escaped */
@@ -116,18 +203,25 @@ static void report_labels(FILE *f, const eval_scene *sc, const eval_result *res)
     }
 }
 
+/* The report's files of case c in dir: its data, its gnuplot script and its PNG. */
+static void report_paths(const char *dir, const eval_case *c, char dat[1024], char gp[1024],
+                         char png[1024])
+{
+    snprintf(dat, 1024, "%s/%s.dat", dir, c->name);
+    snprintf(gp, 1024, "%s/%s.gp", dir, c->name);
+    snprintf(png, 1024, "%s/%s.png", dir, c->name);
+}
+
 /* The PNG of one case: q (solid) and r (dashed) of each joint, the efforts, and the
  * metrics as text; its title says the verdict as the table does (FAIL and why, UNMET and
  * the term that fails, or ok); through gnuplot, from a data file beside it. */
-static int report(const char *dir, bool force, const char *config, const eval_case *c,
+static int report(run_files *rf, const char *dir, bool force, const eval_case *c,
                   const eval_scene *sc, const eval_series *s, const eval_result *res,
                   bool met, const char *why)
 {
     char dat[1024], gp[1024], png[1024];
-    snprintf(dat, sizeof dat, "%s/%s.dat", dir, c->name);
-    snprintf(gp, sizeof gp, "%s/%s.gp", dir, c->name);
-    snprintf(png, sizeof png, "%s/%s.png", dir, c->name);
-    FILE *f = open_out("--report", dat, force, config);
+    report_paths(dir, c, dat, gp, png);
+    FILE *f = open_out(rf, "--report", dat, force);
     if (!f) return -1;
     fprintf(f, "# t");
     for (int j = 0; j < sc->nj; j++)
@@ -140,7 +234,7 @@ static int report(const char *dir, bool force, const char *config, const eval_ca
         fputc('\n', f);
     }
     fclose(f);
-    f = open_out("--report", gp, force, config);
+    f = open_out(rf, "--report", gp, force);
     if (!f) return -1;
     fprintf(f, "set terminal pngcairo noenhanced size 1200,640 font ',10'\n");
     fprintf(f, "set output '%s'\n", png);
@@ -184,19 +278,25 @@ static int report(const char *dir, bool force, const char *config, const eval_ca
     fprintf(f, "\nunset multiplot\n");
     fclose(f);
     /* the PNG itself obeys the output rules too: opened (and refused) here first */
-    f = open_out("--report", png, force, config);
+    f = open_out(rf, "--report", png, force);
     if (!f) return -1;
     fclose(f);
+    files_done(rf, "--report", dat);
+    files_done(rf, "--report", gp);
+    files_done(rf, "--report", png);
     return eval_gnuplot(prog, gp);
 }
 
 /* A run of lagsim-eval: the options, the scene and its cases, the outputs. */
 typedef struct eval_cli {
-    const char *config, *controller, *suite, *require, *csv, *report_dir;
+    const char *config, *controller, *suite, *require, *csv, *report_dir, *url_opt;
     const char *only[EVAL_CASES_MAX];
     int nonly;
-    bool force, verbose;
+    bool force, verbose, allow_lan;
     double timeout;
+    eval_bus bus;           /* the runs' group and options */
+    lag_port_lease lease;   /* their ports, held while lagsim-eval runs */
+    char url[160];          /* the runs' URL */
     char lagsimd[4096];
     char err[2048];
     eval_scene sc;
@@ -205,6 +305,7 @@ typedef struct eval_cli {
     int ncases;
     eval_scene csc[EVAL_CASES_MAX]; /* each case's scene, its overrides applied */
     FILE *fcsv;
+    run_files files;
     char tmpdir[256];
     const char *workdir;
     int failures, status;
@@ -213,13 +314,15 @@ typedef struct eval_cli {
 /* The options. Returns -1 to go on, or the exit code. */
 static int parse_options(eval_cli *x, int argc, char **argv)
 {
-    enum { O_CASE = 256, O_SUITE, O_REQUIRE, O_CSV, O_REPORT, O_LAGSIMD, O_TIMEOUT };
+    enum { O_CASE = 256, O_SUITE, O_REQUIRE, O_CSV, O_REPORT, O_LAGSIMD, O_TIMEOUT, O_URL,
+           O_ALLOW_LAN };
     static const struct option opts[] = {
         {"config", required_argument, 0, 'c'},   {"controller", required_argument, 0, 'C'},
         {"case", required_argument, 0, O_CASE},  {"suite", required_argument, 0, O_SUITE},
         {"require", required_argument, 0, O_REQUIRE}, {"csv", required_argument, 0, O_CSV},
         {"report", required_argument, 0, O_REPORT}, {"force", no_argument, 0, 'f'},
-        {"lagsimd", required_argument, 0, O_LAGSIMD},
+        {"lagsimd", required_argument, 0, O_LAGSIMD}, {"url", required_argument, 0, O_URL},
+        {"allow-lan", no_argument, 0, O_ALLOW_LAN},
         {"timeout", required_argument, 0, O_TIMEOUT}, {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},            {0, 0, 0, 0}};
     int o;
@@ -238,6 +341,8 @@ static int parse_options(eval_cli *x, int argc, char **argv)
         case O_REPORT: x->report_dir = optarg; break;
         case 'f': x->force = true; break;
         case O_LAGSIMD: snprintf(x->lagsimd, sizeof x->lagsimd, "%s", optarg); break;
+        case O_URL: x->url_opt = optarg; break;
+        case O_ALLOW_LAN: x->allow_lan = true; break;
         case O_TIMEOUT: {
             char *end;
             errno = 0;
@@ -255,6 +360,8 @@ static int parse_options(eval_cli *x, int argc, char **argv)
     if (optind < argc) return die("unexpected argument '%s' (try --help)", argv[optind]);
     if (!x->config) return die("%s", "--config SCENE is required (try --help)");
     if (!x->controller) return die("%s", "--controller 'COMMAND' is required (try --help)");
+    if (eval_bus_init(&x->bus, x->url_opt, x->allow_lan, x->err, sizeof x->err))
+        return die("%s", x->err);
     return -1;
 }
 
@@ -288,6 +395,14 @@ static int load_cases(eval_cli *x)
     return -1;
 }
 
+/* Whether case c runs: every case, or those --case names. */
+static bool wanted(const eval_cli *x, const eval_case *c)
+{
+    bool yes = x->nonly == 0;
+    for (int i = 0; i < x->nonly; i++) yes |= !strcmp(x->only[i], c->name);
+    return yes;
+}
+
 /* Every case's overrides validated before anything runs; joint bounds named. Returns -1
  * or the exit code. */
 static int check_cases(eval_cli *x)
@@ -313,15 +428,39 @@ static int check_cases(eval_cli *x)
     return -1;
 }
 
+/* The runs' bus: a pair of ports held for the whole evaluation (the group and options,
+ * of --url or LCM_DEFAULT_URL, were read with the options). Returns -1 or the exit code. */
+static int open_bus(eval_cli *x)
+{
+    if (eval_bus_take(&x->bus, &x->lease, x->url, sizeof x->url, x->err, sizeof x->err))
+        return die("%s", x->err);
+    return -1;
+}
+
 /* The report directory, the CSV (with its header) and the work directory. Returns -1 or
  * the exit code. */
 static int open_outputs(eval_cli *x)
 {
+    if (files_add(&x->files, x->config, NULL, 0) || files_add(&x->files, x->lagsimd, NULL, 0) ||
+        (x->suite && files_add(&x->files, x->suite, NULL, 0)))
+        return die("%s", "out of memory");
     if (x->report_dir && mkdir(x->report_dir, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "%s: --report %s: %s\n", prog, x->report_dir, strerror(errno));
         return 2;
     }
-    if (x->csv && !(x->fcsv = open_out("--csv", x->csv, x->force, x->config))) return 2;
+    if (x->csv && !(x->fcsv = open_out(&x->files, "--csv", x->csv, x->force))) return 2;
+    /* the report's files too, before the first run: an evaluation that cannot write its
+     * results refuses at once */
+    for (int k = 0; x->report_dir && k < x->ncases; k++) {
+        if (!wanted(x, &x->cases[k])) continue;
+        char p[3][1024];
+        report_paths(x->report_dir, &x->cases[k], p[0], p[1], p[2]);
+        for (int i = 0; i < 3; i++) {
+            FILE *f = open_out(&x->files, "--report", p[i], x->force);
+            if (!f) return 2;
+            fclose(f);
+        }
+    }
     if (x->fcsv) {
         fprintf(x->fcsv, "case,joint,failed,required,reason");
         for (int m = 0; m < LAG_METRIC_COUNT; m++)
@@ -369,12 +508,12 @@ static void write_rows(eval_cli *x, const eval_case *c, const eval_scene *csc,
 static bool run_case(eval_cli *x, int k)
 {
     const eval_case *c = &x->cases[k];
-    int wanted = x->nonly == 0;
-    for (int i = 0; i < x->nonly; i++) wanted |= !strcmp(x->only[i], c->name);
-    if (!wanted) return true;
+    if (!wanted(x, c)) return true;
     eval_env env = {.lagsimd = x->lagsimd, .config = x->config, .controller = x->controller,
-                    .workdir = x->workdir, .wall_timeout = x->timeout, .verbose = x->verbose};
-    eval_url(k, env.url, sizeof env.url);
+                    .workdir = x->workdir, .wall_timeout = x->timeout, .verbose = x->verbose,
+                    .allow_lan = x->allow_lan};
+    /* the ports of the whole evaluation; a prefix of each case's own */
+    snprintf(env.url, sizeof env.url, "%s", x->url);
     snprintf(env.prefix, sizeof env.prefix, "EVAL%d_%d", (int)getpid(), k);
     eval_result res;
     eval_series s = {0};
@@ -392,7 +531,7 @@ static bool run_case(eval_cli *x, int k)
     else if (!met) printf("  %s: --require: %s\n", c->name, why);
     fflush(stdout);
     if (x->report_dir &&
-        report(x->report_dir, x->force, x->config, c, &x->csc[k], &s, &res, met, why))
+        report(&x->files, x->report_dir, x->force, c, &x->csc[k], &s, &res, met, why))
         x->status = 2;
     eval_series_free(&s);
     return true;
@@ -409,6 +548,8 @@ static int run_cases(eval_cli *x)
         fprintf(stderr, "%s: --csv %s: %s\n", prog, x->csv, strerror(errno));
         x->status = 2;
     }
+    x->fcsv = NULL;
+    if (x->csv) files_done(&x->files, "--csv", x->csv);
     if (x->workdir == x->tmpdir) rmdir(x->tmpdir), eval_proc_tmpdir_done();
     if (x->status) return x->status;
     return x->failures ? 1 : 0;
@@ -416,13 +557,16 @@ static int run_cases(eval_cli *x)
 
 int main(int argc, char **argv)
 {
-    static eval_cli x = {.timeout = 600};
+    static eval_cli x = {.timeout = 600, .lease = {.port = 0, .fd = -1}};
     eval_proc_init(); /* every process it starts ends when it ends (eval_proc.h) */
     eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
     int rc;
     if ((rc = parse_options(&x, argc, argv)) < 0 && (rc = load_cases(&x)) < 0 &&
-        (rc = check_cases(&x)) < 0 && (rc = open_outputs(&x)) < 0)
+        (rc = check_cases(&x)) < 0 && (rc = open_bus(&x)) < 0 && (rc = open_outputs(&x)) < 0)
         rc = run_cases(&x);
+    lag_port_release(&x.lease);
     free(x.cases);
+    if (x.fcsv) fclose(x.fcsv); /* refused before its first case */
+    files_end(&x.files);
     return rc;
 }

@@ -13,14 +13,16 @@
  * has written it. So a run's series is always the one its daemon computed.
  *
  * The worker's daemon starts paused at the scene's initial state; one period is stepped
- * first, so that no answer of the controller to that first state (sim time 0) can be taken
- * for an answer to a run's first state. Lockstep matches an answer to a state by its sim
- * time alone, so an answer to an earlier run's state still on its way (a controller behind
- * on copies of a state it got while it started) could be taken for the answer to this run's
- * state at the same sim time: before each RESET_TO the worker hears the controller's answer
- * to the paused state, the last it was sent. The controller answers in order and the
- * daemon gets the answers and the worker's requests on one socket in the order they were
- * sent, so every earlier answer reaches the daemon before the RESET_TO.
+ * first. Lockstep matches an answer to its state by the state's generation and sim time
+ * (the generation changes at every SET and reset: docs/server.md), so an answer to an
+ * earlier run's state can never be taken for an answer to this run's; and the client
+ * library answers a state only with the scene of its generation, so a controller that
+ * reads its parameters from the scene computes every run with that run's. Before each
+ * run the worker hears the controller's answer to the paused state (the last state of the
+ * run before, which the daemon publishes again until it is answered): a run never starts
+ * while the controller is still busy with the run before. A controller that does not
+ * answer it within W_PAUSED_S fails the run, with that reason (the sweep starts a new
+ * worker pair and runs it again, as for a stalled run).
  */
 #include <errno.h>
 #include <math.h>
@@ -46,6 +48,7 @@
 #define W_SET_REFUSALS 500 /* SETs refused for the daemon's rate, 20 ms apart: 10 s */
 #define W_QUIET_S 0.25  /* a run with no new state for this long: a status is asked for */
 #define W_LOG_WAIT_S 3.0 /* the log's writer writes within 0.1 s; this is its margin */
+#define W_PAUSED_S 10.0 /* the controller's answer to the paused state, at most this late */
 
 struct eval_worker {
     eval_env env;
@@ -62,10 +65,12 @@ struct eval_worker {
     const char *set_wait; /* "key=value" whose set event is awaited */
     bool set_heard, set_refused;
     double t_heard;       /* the sim time of the last state heard */
+    int64_t g_heard;      /* and its generation */
     bool moved;           /* a state after sim time 0 heard since the STEP */
     lcm_t *cmd;           /* the command URL: the controller's answers, as the daemon gets
                            * them */
     double t_answered;    /* the sim time of the last answer heard */
+    int64_t g_answered;   /* and the generation it carried */
 };
 
 /* ---------------------------------------------------------------- from the bus */
@@ -74,8 +79,10 @@ static void w_on_command(const lcm_recv_buf_t *rbuf, const char *channel, void *
     (void)channel;
     eval_worker *w = user;
     lag_wire_joint_command c;
-    if (lag_wire_decode_joint_command(rbuf->data, rbuf->data_size, EVAL_JOINTS_MAX, &c) == 0)
+    if (lag_wire_decode_joint_command(rbuf->data, rbuf->data_size, EVAL_JOINTS_MAX, &c) == 0) {
         w->t_answered = c.sim_time;
+        w->g_answered = c.generation;
+    }
 }
 
 /* The controller's answers that have come, without waiting. */
@@ -124,6 +131,7 @@ static void w_on_state(const lag_client_state *st, void *user)
 {
     eval_worker *w = user;
     w->t_heard = st->sim_time;
+    w->g_heard = st->generation;
     if (st->sim_time > 0) w->moved = true;
     if (!w->armed || st->num_joints != w->sc.nj) return;
     if (!w->started && !(w->started = is_run_start(w, st))) return;
@@ -212,24 +220,14 @@ static int step_once(eval_worker *w, long n, double seconds)
 /* ---------------------------------------------------------------- start, stop */
 static pid_t start_daemon(eval_worker *w, const eval_case *c)
 {
-    char *argv[2 * EVAL_SETS_MAX + 24];
-    char owned[2][600];
+    char *argv[2 * (EVAL_SETS_MAX + EVAL_OWN_COUNT) + 16];
+    char owned[EVAL_OWN_COUNT][EVAL_SET_LEN]; /* the keys the tools own */
     int na = 0;
     argv[na++] = (char *)w->env.lagsimd;
     argv[na++] = "--config";
     argv[na++] = (char *)w->env.config;
-    /* STEP takes a period without a command once lockstep_timeout passed (as asked): the
-     * longest one, so that a period never goes without its answer, as in a running
-     * lockstep plant (a lost answer costs a retry, docs/server.md) */
-    static const char *const fixed[] = {"realtime.mode=lockstep", "realtime.start=paused",
-                                        "realtime.lockstep_timeout=3600"};
-    for (int i = 0; i < 3; i++) {
-        argv[na++] = "--set";
-        argv[na++] = (char *)fixed[i];
-    }
-    snprintf(owned[0], sizeof owned[0], "lcm.prefix=%s", w->env.prefix);
-    snprintf(owned[1], sizeof owned[1], "lcm.url=%s", w->env.url);
-    for (int i = 0; i < 2; i++) {
+    eval_owned_sets(&w->env, true, owned);
+    for (int i = 0; i < EVAL_OWN_COUNT; i++) {
         argv[na++] = "--set";
         argv[na++] = owned[i];
     }
@@ -261,7 +259,10 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
     snprintf(w->log, sizeof w->log, "%s/%s.lcm", env->workdir, env->prefix);
     unlink(w->log);
     char cmd[4096];
-    eval_expand(env->controller, env, cmd, sizeof cmd);
+    if (eval_expand(env->controller, env, cmd, sizeof cmd, err, errlen)) {
+        free(w);
+        return NULL;
+    }
     /* the controller first, as eval_run starts them */
     w->cpid = eval_spawn(NULL, cmd, env);
     w->dpid = start_daemon(w, c);
@@ -346,6 +347,7 @@ static int reset_to(eval_worker *w, const double *q0, const double *qd0, char *e
     memcpy(w->qd0, qd0, sizeof w->qd0);
     w->armed = true;
     w->t_answered = NAN;
+    w->g_answered = -1;
     for (int t = 0; t < W_TRIES && !w->started; t++)
         if (lag_client_reset_to(w->cl, w->sc.nj, q0, qd0) != LAG_CLIENT_OK ||
             (w_wait(w, &w->started, W_ANSWER_S) && t == W_TRIES - 1)) {
@@ -419,6 +421,42 @@ static int from_log(eval_worker *w, off_t from, double t_goal, eval_result *res,
     }
 }
 
+/* Has the answer to the last state heard come (by its generation and sim time)? */
+static bool answer_heard(const eval_worker *w)
+{
+    return w->g_answered == w->g_heard && w->t_answered == w->t_heard;
+}
+
+/* Does the daemon say, paused (or in the fault state, which publishes no state), that no
+ * answer is owed? What the bus lost on its way to the worker (the run's last states, the
+ * answer) the daemon has had: it publishes the paused state again until answered and says
+ * in its status while an answer is owed. */
+static bool daemon_has_answer(eval_worker *w, double *t)
+{
+    lag_client_status st;
+    if (!fresh_status(w, &st, false)) return false;
+    *t = st.sim_time;
+    return (!strcmp(st.run_state, "paused") || !strcmp(st.run_state, "fault")) &&
+           !strstr(st.waiting_for, "still owed");
+}
+
+/* The controller's answer to the paused state: heard, or said by the daemon's status; else
+ * the run fails saying so (true). */
+static bool paused_answer(eval_worker *w, eval_result *res)
+{
+    double end = eval_now() + W_PAUSED_S, t = w->t_heard;
+    while (eval_now() < end) {
+        double next = eval_now() + W_ANSWER_S;
+        while (!answer_heard(w) && eval_now() < next) w_handle(w, 5);
+        if (answer_heard(w) || daemon_has_answer(w, &t)) return false;
+    }
+    eval_fail(res, "the controller did not answer the paused state (generation %lld, sim time "
+              "%.9g s, the last of the run before) within %g s: not started, so that no "
+              "answer of the run before can reach this one", (long long)w->g_heard, t,
+              W_PAUSED_S);
+    return true;
+}
+
 int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets, int nsets,
                     const double *q0, const double *qd0, eval_result *res, char *err,
                     size_t errlen)
@@ -428,10 +466,7 @@ int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets,
     w->fault = w->armed = w->started = false;
     w->missing_refs = 0;
     w->runs++;
-    /* the answer to the paused state: every earlier answer has reached the daemon (at most
-     * W_ANSWER_S: a lost one is not sent again, nor anything before it) */
-    double end = eval_now() + W_ANSWER_S;
-    while (w->t_answered != w->t_heard && eval_now() < end) w_handle(w, 5);
+    if (paused_answer(w, res)) return 0;
     /* every varied key is SET in every run, so nothing of the run before stays */
     if (set_keys(w, sets, nsets, err, errlen)) return -1;
     struct stat sb;

@@ -221,7 +221,7 @@ static chan *scene_of(l2c *c, const chan *state)
 static void header_state(FILE *f, const lag_wire_joint_state *m)
 {
     static const char *const suffix[] = {"", "_dot", "_effort"};
-    fputs("t,wall_time,log_time,step", f);
+    fputs("t,wall_time,log_time,step,generation", f);
     for (int k = 0; k < 3; k++)
         for (int i = 0; i < m->num_joints; i++) {
             fputc(',', f);
@@ -287,6 +287,7 @@ static bool write_state(l2c *c, chan *h, const lag_log_record *r, const lag_wire
     put_us(f, m->utime, false);
     put_us(f, r->timestamp, false);
     put_i(f, m->step);
+    put_i(f, m->generation);
     for (int i = 0; i < m->num_joints; i++) put_d(f, m->position[i]);
     for (int i = 0; i < m->num_joints; i++) put_d(f, m->velocity[i]);
     for (int i = 0; i < m->num_joints; i++) put_d(f, m->effort[i]);
@@ -303,7 +304,7 @@ static bool write_reference(l2c *c, chan *h, const lag_log_record *r,
         h->nj = m->num_joints;
         for (int i = 0; i < m->num_joints; i++) snprintf(h->joint[i], L2C_NAME, "%s", m->name[i]);
         if (!(h->csv = open_csv(c, h))) return false;
-        fputs("t,wall_time,log_time,step", h->csv);
+        fputs("t,wall_time,log_time,step,generation", h->csv);
         for (int k = 0; k < 2; k++)
             for (int i = 0; i < m->num_joints; i++) {
                 fputc(',', h->csv);
@@ -322,6 +323,7 @@ static bool write_reference(l2c *c, chan *h, const lag_log_record *r,
     put_us(f, m->utime, false);
     put_us(f, r->timestamp, false);
     put_i(f, m->step);
+    put_i(f, m->generation);
     for (int i = 0; i < m->num_joints; i++) put_d(f, m->r[i]);
     for (int i = 0; i < m->num_joints; i++) put_d(f, m->rdot[i]);
     fputc('\n', f);
@@ -415,7 +417,7 @@ static bool write_scene(l2c *c, chan *h, const lag_log_record *r, const lag_wire
     if (!h->csv) {
         if (!(h->csv = open_csv(c, h))) return false;
         fputs("wall_time,log_time,model,prefix,dt,control_period,integrator,mode,rate,"
-              "command_timeout,effects,parameters,joints\n", h->csv);
+              "command_timeout,effects,parameters,joints,generation\n", h->csv);
     }
     FILE *f = h->csv;
     char params[LAG_WIRE_MAX_PARAMS * (L2C_NAME + 32)], joints[L2C_JOINTS * (L2C_NAME + 192)];
@@ -451,6 +453,7 @@ static bool write_scene(l2c *c, chan *h, const lag_log_record *r, const lag_wire
     put_s(f, m->effects);
     put_s(f, params);
     put_s(f, joints);
+    put_i(f, m->generation);
     fputc('\n', f);
     return true;
 }
@@ -460,7 +463,7 @@ static bool write_command(l2c *c, chan *h, const lag_log_record *r,
 {
     if (!h->csv) {
         if (!(h->csv = open_csv(c, h))) return false;
-        fputs("t,wall_time,log_time,joint,effort\n", h->csv);
+        fputs("t,wall_time,log_time,generation,joint,effort\n", h->csv);
     }
     FILE *f = h->csv;
     /* one row per named joint (a command with no joint: one row, joint and effort empty) */
@@ -468,6 +471,7 @@ static bool write_command(l2c *c, chan *h, const lag_log_record *r,
         fprintf(f, "%.17g", m->sim_time);
         put_us(f, m->utime, false);
         put_us(f, r->timestamp, false);
+        put_i(f, m->generation);
         if (m->num_joints > 0) {
             put_s(f, m->name[i]);
             put_d(f, m->effort[i]);
@@ -543,7 +547,7 @@ static bool record(l2c *c, const lag_log_record *r)
         if (h->type != L2C_NONE) h->undecodable++;
         return true;
     }
-    int t = lag_wire_identify(r->data, r->size);
+    int t = lag_wire_identify_any(r->data, r->size, NULL); /* any version (wire.md) */
     if (h->type == L2C_NONE) {
         if (t < 0) return true; /* not lagsim's (yet): counted as other */
         h->type = t;
@@ -562,7 +566,8 @@ static bool record(l2c *c, const lag_log_record *r)
         lag_wire_control ct;
         lag_wire_reference rf;
     } m;
-    int d = lag_wire_decode((lag_wire_type)t, r->data, r->size, LAG_WIRE_MAX_JOINTS, &m);
+    int d = lag_wire_decode_any((lag_wire_type)t, r->data, r->size, LAG_WIRE_MAX_JOINTS, &m,
+                                NULL);
     /* an event's over-long detail is kept, cut (the rest of the event decoded) */
     if (d == LAG_WIRE_ETOOLONG && t == LAG_WIRE_EVENT) d = LAG_WIRE_OK;
     if (d != LAG_WIRE_OK) {

@@ -35,7 +35,8 @@ static void usage(FILE *f)
 "                    --vary KEY=DIST ... [--runs N] [--seed S] [-j N] [--shard K/N]\n"
 "                    [--restart]\n"
 "                    [--suite FILE] [--require EXPR] [--csv OUT.csv] [--plot OUT.png]\n"
-"                    [--metric JOINT.METRIC] [--force] [--lagsimd PATH] [--timeout S] [-v]\n"
+"                    [--metric JOINT.METRIC] [--force] [--url URL] [--allow-lan]\n"
+"                    [--lagsimd PATH] [--timeout S] [-v]\n"
 "       lagsim-sweep merge A.csv B.csv ... -o OUT.csv [--partial] [--force]\n"
 "\n"
 "Runs an evaluation case (lagsim-eval's) over scene keys drawn at random or on a grid,\n"
@@ -44,14 +45,17 @@ static void usage(FILE *f)
 "\n"
 "options:\n"
 "  -c, --config SCENE     the scene file (lagsimd's)\n"
-"  -C, --controller CMD   the controller's shell command ({prefix}, {url} replaced)\n"
+"  -C, --controller CMD   the controller's shell command; {prefix} and {url} are\n"
+"                         replaced as they are, no quotes added (as lagsim-eval)\n"
 "      --case NAME        the case to vary (from the scene's or the suite's cases:)\n"
 "      --suite FILE       take the cases from FILE\n"
 "  -d, --duration S       without --case: a case of S sim seconds and no overrides\n"
 "      --vary KEY=DIST    a scene key (as lagsimd --set; initial.q[i], initial.qd[i]\n"
-"                         for one coordinate) and its values: uniform(A,B),\n"
-"                         normal(MEAN,SD) or grid(A,B,N) (N values from A to B);\n"
-"                         repeatable: grids multiply, random keys are drawn per run\n"
+"                         for one coordinate) and its values: uniform(A,B) (A < B),\n"
+"                         normal(MEAN,SD) (SD > 0) or grid(A,B,N) (N values from A\n"
+"                         up to B > A, N from 2 to 1e6), numbers as plain decimals;\n"
+"                         repeatable, each key once: grids multiply, random keys are\n"
+"                         drawn per run\n"
 "  -n, --runs N           runs (per grid point when there are grids; default 1)\n"
 "      --seed S           the random seed of every drawn value (default 1)\n"
 "  -j, --jobs N           runs at once on this machine (default 1)\n"
@@ -68,6 +72,12 @@ static void usage(FILE *f)
 "      --metric J.M       the metric drawn (default: --require's first, else the first\n"
 "                         joint's iae)\n"
 "  -f, --force            replace existing output files\n"
+"      --url URL          the runs' multicast group and options (default:\n"
+"                         LCM_DEFAULT_URL's, else udpm://239.255.76.67?ttl=0&\n"
+"                         recv_buf_size=4194304); the ports are lagsim-sweep's: a pair\n"
+"                         for each worker, held while it runs, that no other sweep or\n"
+"                         evaluation of this host holds and no socket of it is bound to\n"
+"      --allow-lan        accept a URL with ttl above 0 (the runs on the network)\n"
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a run may take (default 600)\n"
 "  -v, --verbose          pass the daemon's and the controller's output through\n"
@@ -77,6 +87,11 @@ static void usage(FILE *f)
 "                         and run there\n"
 "      --partial          merge: join shards that leave shards or runs out\n"
 "  -h, --help             this help\n"
+"\n"
+"keys lagsim-sweep sets on every run (a case's set: or a --vary naming one, or a\n"
+"mapping above one, is refused):\n");
+    eval_owned_usage(f);
+    fprintf(f,
 "\n"
 "exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
 "case error, an output that exists (checked before the first run), or shard CSVs that\n"
@@ -107,43 +122,119 @@ typedef struct vary {
     long n;                   /* grid points */
 } vary;
 
-static int parse_vary(const char *text, vary *v)
+/* The numbers of "NAME(X1, ..., Xn)" at d into x: each a plain decimal as a scene writes
+ * one (lag_scene_read_decimal: not inf, nan, 0x1p3 or 1e999), nothing after the ')'. */
+static bool read_args(const char *d, const char *name, int n, double *x)
 {
-    memset(v, 0, sizeof *v);
-    snprintf(v->text, sizeof v->text, "%s", text);
+    size_t nl = strlen(name);
+    if (strncmp(d, name, nl) || d[nl] != '(') return false;
+    const char *p = d + nl + 1;
+    for (int i = 0; i < n; i++) {
+        size_t len = strcspn(p, i + 1 < n ? "," : ")");
+        char num[64];
+        if (!p[len] || len >= sizeof num) return false;
+        /* blanks around a number are allowed, as in uniform(0.5, 2) */
+        while (len && p[len - 1] == ' ') len--;
+        size_t lead = strspn(p, " ");
+        if (lead >= len) return false;
+        memcpy(num, p + lead, len - lead);
+        num[len - lead] = '\0';
+        if (lag_scene_read_decimal(num, &x[i]) != LAG_OK) return false;
+        p += strcspn(p, i + 1 < n ? "," : ")") + 1;
+    }
+    return p[0] == '\0' && p[-1] == ')';
+}
+
+/* KEY, and its index on initial.q[i] / initial.qd[i] */
+static int parse_vary_key(const char *text, vary *v, char *why, size_t len)
+{
     const char *eq = strchr(text, '=');
-    if (!eq || eq == text || (size_t)(eq - text) >= sizeof v->key) return -1;
+    if (!eq || eq == text || (size_t)(eq - text) >= sizeof v->key)
+        return snprintf(why, len, "expected KEY=DIST"), -1;
     memcpy(v->key, text, (size_t)(eq - text));
     v->index = -1;
     char *br = strchr(v->key, '[');
-    if (br) {
-        char *end;
-        long i = strtol(br + 1, &end, 10);
-        if (end == br + 1 || strcmp(end, "]") || i < 0 || i >= EVAL_JOINTS_MAX) return -1;
-        if (strncmp(v->key, "initial.q[", 10) && strncmp(v->key, "initial.qd[", 11)) return -1;
-        *br = '\0';
-        v->index = (int)i;
-    }
-    const char *d = eq + 1;
-    double a, b, n;
-    char tail;
-    /* the distribution ends at its ')': nothing may follow it */
-    const char *close = strchr(d, ')');
-    if (!close || close[1] != '\0') return -1;
-    if (sscanf(d, "uniform(%lf ,%lf%c", &a, &b, &tail) == 3 && tail == ')' && a < b &&
-        isfinite(a) && isfinite(b)) {
-        v->kind = V_UNIFORM, v->a = a, v->b = b;
-    } else if (sscanf(d, "normal(%lf ,%lf%c", &a, &b, &tail) == 3 && tail == ')' && b >= 0 &&
-               isfinite(a) && isfinite(b)) {
-        v->kind = V_NORMAL, v->a = a, v->b = b;
-    } else if (sscanf(d, "grid(%lf ,%lf ,%lf%c", &a, &b, &n, &tail) == 4 && tail == ')' &&
-               isfinite(a) && isfinite(b) && n >= 1 && n <= 1e6 && n == floor(n) &&
-               (n == 1 || a != b)) {
-        v->kind = V_GRID, v->a = a, v->b = b, v->n = (long)n;
+    if (!br && (!strcmp(v->key, "initial.q") || !strcmp(v->key, "initial.qd")))
+        return snprintf(why, len, "%s is a list: vary one coordinate, %s[i]", v->key,
+                        v->key), -1;
+    if (!br) return 0;
+    char *end;
+    long i = strtol(br + 1, &end, 10);
+    if ((strncmp(v->key, "initial.q[", 10) && strncmp(v->key, "initial.qd[", 11)) ||
+        end == br + 1 || strcmp(end, "]") || !(br[1] >= '0' && br[1] <= '9') || i < 0 ||
+        i >= EVAL_JOINTS_MAX)
+        return snprintf(why, len, "an index only on initial.q[i] or initial.qd[i], i from 0 "
+                        "to %d", EVAL_JOINTS_MAX - 1), -1;
+    *br = '\0';
+    v->index = (int)i;
+    return 0;
+}
+
+/* A --vary: KEY=uniform(A,B), normal(MEAN,SD) or grid(A,B,N). Every value a run can get is
+ * a finite double: A < B (a grid ascends, as uniform's range), B - A finite, SD > 0 and
+ * MEAN +- 9 SD finite (Box-Muller's draws stay within 8.7 SD), N an integer from 2 to
+ * 1e6. -1 with what was expected in why. */
+static int parse_vary(const char *text, vary *v, char *why, size_t len)
+{
+    memset(v, 0, sizeof *v);
+    snprintf(v->text, sizeof v->text, "%s", text);
+    if (parse_vary_key(text, v, why, len)) return -1;
+    const char *d = strchr(text, '=') + 1;
+    double x[3];
+    if (read_args(d, "uniform", 2, x)) {
+        v->kind = V_UNIFORM;
+        if (!(x[0] < x[1]) || !isfinite(x[1] - x[0]))
+            return snprintf(why, len, "uniform(A,B) needs A < B and B - A finite"), -1;
+    } else if (read_args(d, "normal", 2, x)) {
+        v->kind = V_NORMAL;
+        if (!(x[1] > 0) || !isfinite(fabs(x[0]) + 9 * x[1]))
+            return snprintf(why, len, "normal(MEAN,SD) needs SD > 0 and MEAN +- 9 SD finite "
+                            "(the draws reach 8.7 SD)"), -1;
+    } else if (read_args(d, "grid", 3, x)) {
+        v->kind = V_GRID;
+        if (!(x[0] < x[1]) || !isfinite(x[1] - x[0]))
+            return snprintf(why, len, "grid(A,B,N) needs A < B (it goes from A up to B) and "
+                            "B - A finite"), -1;
+        if (!(x[2] >= 2 && x[2] <= 1e6 && x[2] == floor(x[2])))
+            return snprintf(why, len, "grid(A,B,N) needs N, its number of points, an integer "
+                            "from 2 to 1e6"), -1;
+        v->n = (long)x[2];
     } else {
+        return snprintf(why, len, "expected uniform(A,B), normal(MEAN,SD) or grid(A,B,N), "
+                        "each number a plain decimal"), -1;
+    }
+    v->a = x[0], v->b = x[1];
+    return 0;
+}
+
+/* -1 after saying so when v varies a key (or a coordinate) that an earlier --vary of vs
+ * varies too, or holds or lies under it: a run could take only one of the values, and
+ * the CSV would show both. */
+static int vary_twice(const vary *vs, int nv, const vary *v)
+{
+    for (int k = 0; k < nv; k++) {
+        const vary *o = &vs[k];
+        if (!eval_key_overlap(o->key, strlen(o->key), v->key, strlen(v->key))) continue;
+        /* two coordinates of one list are two keys */
+        if (!strcmp(o->key, v->key) && o->index >= 0 && v->index >= 0 && o->index != v->index)
+            continue;
+        bool same = !strcmp(o->key, v->key) && o->index == v->index;
+        fprintf(stderr, "%s: --vary %s: %s that of --vary %s: a run takes one value of a "
+                "key (one of the two CSV columns would be false); vary each key once\n",
+                prog, v->text, same ? "the same key as" : "its key holds or lies in",
+                o->text);
         return -1;
     }
     return 0;
+}
+
+/* A varied key the tools own (eval_owned_keys) is refused: said, and -1. */
+static int vary_owned(const vary *v)
+{
+    char why[512];
+    if (!eval_owned_check(v->key, strlen(v->key), why, sizeof why)) return 0;
+    fprintf(stderr, "%s: --vary %s: %s: a sweep cannot vary it\n", prog, v->text, why);
+    return -1;
 }
 
 /* splitmix64: one 64-bit mix of (seed, run, key, draw), the only source of randomness */
@@ -319,7 +410,11 @@ typedef struct sweep {
     double duration, timeout;
     long runs, jobs, shard_k, shard_n, per_point, total;
     uint64_t seed;
-    bool force, verbose, restart;
+    const char *url_opt;
+    bool force, verbose, restart, allow_lan;
+    eval_bus bus;                /* the runs' group and options */
+    lag_port_lease lease[256];   /* a pair of ports for each worker, held while it runs */
+    char url[256][160];          /* each worker's URL */
     vary vs[VARY_MAX];
     int nv;
     char lagsimd[4096];
@@ -332,10 +427,40 @@ typedef struct sweep {
     char tmpdir[160]; /* eval_make_tmpdir: at most 128 + 21 */
 } sweep;
 
+/* An integer option: a plain decimal (as a scene writes a number) with no fraction; lo
+ * when it is not one (so that the caller's conversion to an integer is defined). */
+static double parse_int(const char *opt, const char *s, double lo, double hi, int *bad)
+{
+    double v = 0;
+    if (lag_scene_read_decimal(s, &v) != LAG_OK || v != floor(v) || !(v >= lo && v <= hi)) {
+        fprintf(stderr, "%s: %s: expected an integer from %.0f to %.0f, got '%s'\n", prog, opt,
+                lo, hi, s);
+        *bad = 1;
+        return lo;
+    }
+    return v;
+}
+
+/* One --vary: read, not on a key the tools own, not on a key varied already. -1 after
+ * saying why. */
+static int add_vary(sweep *x, const char *text)
+{
+    char why[256];
+    if (x->nv == VARY_MAX) return die("at most %s --vary", "16"), -1;
+    vary *v = &x->vs[x->nv];
+    if (parse_vary(text, v, why, sizeof why)) {
+        fprintf(stderr, "%s: --vary %s: %s\n", prog, text, why);
+        return -1;
+    }
+    if (vary_owned(v) || vary_twice(x->vs, x->nv, v)) return -1;
+    x->nv++;
+    return 0;
+}
+
 static int parse_options(sweep *x, int argc, char **argv)
 {
     enum { O_CASE = 256, O_SUITE, O_VARY, O_SEED, O_SHARD, O_REQUIRE, O_CSV, O_PLOT, O_METRIC,
-           O_LAGSIMD, O_TIMEOUT, O_RESTART };
+           O_LAGSIMD, O_TIMEOUT, O_RESTART, O_URL, O_ALLOW_LAN };
     static const struct option opts[] = {
         {"config", required_argument, 0, 'c'},      {"controller", required_argument, 0, 'C'},
         {"case", required_argument, 0, O_CASE},     {"suite", required_argument, 0, O_SUITE},
@@ -347,6 +472,7 @@ static int parse_options(sweep *x, int argc, char **argv)
         {"force", no_argument, 0, 'f'},             {"lagsimd", required_argument, 0, O_LAGSIMD},
         {"timeout", required_argument, 0, O_TIMEOUT}, {"verbose", no_argument, 0, 'v'},
         {"restart", no_argument, 0, O_RESTART},     {"help", no_argument, 0, 'h'},
+        {"url", required_argument, 0, O_URL},       {"allow-lan", no_argument, 0, O_ALLOW_LAN},
         {0, 0, 0, 0}};
     int o, bad = 0;
     opterr = 0;
@@ -358,15 +484,11 @@ static int parse_options(sweep *x, int argc, char **argv)
         case O_SUITE: x->suite = optarg; break;
         case 'd': x->duration = parse_pos("--duration", optarg, 1e-3, 1e6, &bad); break;
         case O_VARY:
-            if (x->nv == VARY_MAX) return die("at most %s --vary", "16");
-            if (parse_vary(optarg, &x->vs[x->nv++]))
-                return die("--vary %s: expected KEY=uniform(A,B) (A < B), KEY=normal(MEAN,SD) "
-                           "or KEY=grid(A,B,N); an index only on initial.q[i] or "
-                           "initial.qd[i]", optarg);
+            if (add_vary(x, optarg)) return 2;
             break;
-        case 'n': x->runs = (long)parse_pos("--runs", optarg, 1, 1e7, &bad); break;
-        case O_SEED: x->seed = (uint64_t)parse_pos("--seed", optarg, 0, 9e15, &bad); break;
-        case 'j': x->jobs = (long)parse_pos("--jobs", optarg, 1, 256, &bad); break;
+        case 'n': x->runs = (long)parse_int("--runs", optarg, 1, 1e7, &bad); break;
+        case O_SEED: x->seed = (uint64_t)parse_int("--seed", optarg, 0, 9e15, &bad); break;
+        case 'j': x->jobs = (long)parse_int("--jobs", optarg, 1, 256, &bad); break;
         case O_SHARD:
             if (sweep_shard_parse(optarg, &x->shard_k, &x->shard_n))
                 return die("--shard: expected K/N, whole numbers with 1 <= K <= N <= 1e7, got "
@@ -381,6 +503,8 @@ static int parse_options(sweep *x, int argc, char **argv)
         case O_TIMEOUT: x->timeout = parse_pos("--timeout", optarg, 1, 1e6, &bad); break;
         case 'v': x->verbose = true; break;
         case O_RESTART: x->restart = true; break;
+        case O_URL: x->url_opt = optarg; break;
+        case O_ALLOW_LAN: x->allow_lan = true; break;
         case 'h': usage(stdout); return 0;
         case ':': return die("%s needs a value (try --help)", argv[optind - 1]);
         default: return die("unknown option '%s' (try --help)", argv[optind - 1]);
@@ -390,13 +514,15 @@ static int parse_options(sweep *x, int argc, char **argv)
     return -1; /* go on */
 }
 
-static int check_options(const sweep *x, int argc, char **argv)
+static int check_options(sweep *x, int argc, char **argv)
 {
     if (optind < argc) return die("unexpected argument '%s' (try --help)", argv[optind]);
     if (!x->config) return die("%s", "--config SCENE is required (try --help)");
     if (!x->controller) return die("%s", "--controller 'COMMAND' is required (try --help)");
     if (!x->nv) return die("%s", "at least one --vary KEY=DIST is required (try --help)");
     if (!x->case_name == !x->duration) return die("%s", "give either --case NAME or --duration S");
+    char err[512];
+    if (eval_bus_init(&x->bus, x->url_opt, x->allow_lan, err, sizeof err)) return die("%s", err);
     return -1;
 }
 
@@ -447,9 +573,9 @@ static int load_scene(sweep *x)
         x->restart = true;
     }
     x->per_point = x->total = x->runs;
-    for (int k = 0; k < x->nv; k++)
-        if (x->vs[k].kind == V_GRID) x->total *= x->vs[k].n;
-    if (x->total > 10000000) return die("%s", "more than 1e7 runs");
+    for (int k = 0; k < x->nv; k++) /* each factor <= 1e7: checked before it can overflow */
+        if (x->vs[k].kind == V_GRID && (x->total *= x->vs[k].n) > 10000000)
+            return die("%s", "more than 1e7 runs (--runs times the grids' points)");
     return -1;
 }
 
@@ -510,8 +636,10 @@ static eval_env worker_env(const worker *wk, long run)
 {
     const sweep *x = wk->x;
     eval_env env = {.lagsimd = x->lagsimd, .config = x->config, .controller = x->controller,
-                    .workdir = x->tmpdir, .wall_timeout = x->timeout, .verbose = x->verbose};
-    eval_url((int)wk->w, env.url, sizeof env.url);
+                    .workdir = x->tmpdir, .wall_timeout = x->timeout, .verbose = x->verbose,
+                    .allow_lan = x->allow_lan};
+    /* the worker's ports, for all its runs; a prefix of each run's own */
+    snprintf(env.url, sizeof env.url, "%s", x->url[wk->w]);
     if (run < 0) snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_W%ld", (int)getpid(), wk->w);
     else snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_%ld", (int)getpid(), run);
     return env;
@@ -533,7 +661,13 @@ static int run_kept(worker *wk, const char *const *sets, int nsets, const eval_s
             return -1;
         int rc = eval_worker_run(wk->kept, &x->c, sets, nsets, rsc->q0, rsc->qd0, res, err,
                                  errlen);
-        if (rc == 0 && !strstr(res->reason, "before the duration")) return 0;
+        /* a stalled run, or a controller that did not answer the run before's last state:
+         * the run fails, and the next one gets a new worker pair */
+        bool unanswered = rc == 0 && strstr(res->reason, "did not answer the paused state");
+        if (rc == 0 && !strstr(res->reason, "before the duration") && !unanswered) return 0;
+        if (unanswered) /* the run fails, and it is said: never a silent restart */
+            fprintf(stderr, "%s: worker %ld: a run failed: %s; a new lagsimd and controller "
+                    "for the next run\n", prog, wk->w, res->reason);
         eval_worker_stop(wk->kept);
         wk->kept = NULL;
         if (rc == 0) return 0;
@@ -671,16 +805,39 @@ static int count_passed(const sweep *x, const rows *r)
     return passed;
 }
 
+/* A pair of ports for each worker, held until the sweep ends (its workers, forked, share
+ * the locks). Returns -1 after saying why when the host has too few free. */
+static int take_ports(sweep *x)
+{
+    char err[512];
+    for (long w = 0; w < x->jobs; w++)
+        if (eval_bus_take(&x->bus, &x->lease[w], x->url[w], sizeof x->url[w], err, sizeof err)) {
+            fprintf(stderr, "%s: worker %ld: %s\n", prog, w + 1, err);
+            return -1;
+        }
+    return 0;
+}
+
+static void release_ports(sweep *x)
+{
+    for (long w = 0; w < x->jobs; w++) lag_port_release(&x->lease[w]);
+}
+
 static int sweep_run(sweep *x)
 {
     char err[2048];
     FILE *fcsv = NULL, *fpng = NULL;
-    const char *in[2] = {x->config, x->suite};
+    /* what the sweep reads (the scene, the suite, the daemon) and its CSV: no output may
+     * be one of them (compared by device and inode) */
+    const char *in[4] = {x->config, x->lagsimd, x->suite, x->csv};
     /* every output opened (and so refused, when it must be) before the first run: a sweep
      * never runs for hours to lose its results at the end */
-    if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, 2))) return 2;
-    if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, 2))) {
-        if (fcsv) fclose(fcsv), unlink(x->csv);
+    struct stat st;
+    bool csv_new = x->csv && lstat(x->csv, &st) != 0;
+    if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, 3))) return 2;
+    if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, 4))) {
+        if (fcsv) fclose(fcsv);
+        if (csv_new) unlink(x->csv); /* a CSV this sweep made, empty */
         return 2;
     }
     if (fpng) fclose(fpng); /* gnuplot writes it at the end */
@@ -716,7 +873,9 @@ int main(int argc, char **argv)
         (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0)
         return rc;
     if ((rc = make_header(&x)) >= 0 || (rc = make_identity(&x)) >= 0) return rc;
-    rc = sweep_run(&x);
+    for (long w = 0; w < x.jobs; w++) x.lease[w] = (lag_port_lease){.port = 0, .fd = -1};
+    rc = take_ports(&x) ? 2 : sweep_run(&x);
+    release_ports(&x);
     free(x.identity);
     return rc;
 }

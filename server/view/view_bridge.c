@@ -63,7 +63,8 @@ static void on_state(const lcm_recv_buf_t *rb, const char *ch, void *user)
     view_bridge *vb = user;
     if (vb->discard) return; /* came in before the socket filter */
     lag_wire_joint_state m;
-    if (lag_wire_decode_joint_state(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) {
+    if (lag_wire_decode_any(LAG_WIRE_JOINT_STATE, rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS,
+                            &m, NULL) != LAG_WIRE_OK) {
         vb->n_undecodable++;
         return;
     }
@@ -86,7 +87,8 @@ static void on_reference(const lcm_recv_buf_t *rb, const char *ch, void *user)
     view_bridge *vb = user;
     if (vb->discard) return; /* came in before the socket filter */
     lag_wire_reference m;
-    if (lag_wire_decode_reference(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) {
+    if (lag_wire_decode_any(LAG_WIRE_REFERENCE, rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS,
+                            &m, NULL) != LAG_WIRE_OK) {
         vb->n_undecodable++;
         return;
     }
@@ -137,7 +139,8 @@ static void on_scene(const lcm_recv_buf_t *rb, const char *ch, void *user)
     view_bridge *vb = user;
     if (vb->discard) return; /* came in before the socket filter */
     lag_wire_scene m;
-    if (lag_wire_decode_scene(rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) != LAG_WIRE_OK) {
+    if (lag_wire_decode_any(LAG_WIRE_SCENE, rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m,
+                            NULL) != LAG_WIRE_OK) {
         vb->n_undecodable++;
         return;
     }

@@ -61,8 +61,8 @@ int lag_out_open(const char *what, const char *path, bool force, const char *con
         if (!inputs[i] || stat(inputs[i], &in) != 0) continue;
         if (in.st_dev == st.st_dev && in.st_ino == st.st_ino)
             return refuse(fd, LAG_OUT_REFUSED, err, errlen, "%s %s: the same file as %s, "
-                          "which this run reads: refused, with --force too; write elsewhere",
-                          what, path, inputs[i]);
+                          "which this run reads or writes: refused, with --force too; write "
+                          "elsewhere", what, path, inputs[i]);
     }
     if (!S_ISREG(st.st_mode)) return fd; /* a FIFO, a device: nothing stored is lost */
     if (!force)

@@ -7,7 +7,8 @@
  *   - a symbolic link is never followed (O_NOFOLLOW): writing through it would truncate
  *     its target, whatever that is;
  *   - a file that is one of the program's inputs (the same st_dev and st_ino: the scene
- *     file, the log being read, a hard link to either) is refused, even with force;
+ *     file, the log being read, a hard link to either) is refused, even with force; so is
+ *     one of its other outputs, when the program lists them among the inputs;
  *   - an existing regular file is refused unless force (lcm-logger's -f), and only then
  *     truncated;
  *   - a FIFO or a device (/dev/null, /dev/full, a pipe to another program) holds nothing

@@ -178,3 +178,9 @@ int lag_url_parse(const char *url, int flags, lag_url *u, char *err, size_t errl
     bool ok = read_group(&r) && read_port(&r) && read_end_of_address(&r) && read_options(&r);
     return ok ? 0 : -1;
 }
+
+int lag_url_format(const lag_url *u, int port, char *out, size_t len)
+{
+    if (u->provider == LAG_URL_MEMQ) return snprintf(out, len, "memq://");
+    return snprintf(out, len, "udpm://%s:%d%s", u->group, port, u->query);
+}

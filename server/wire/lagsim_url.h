@@ -51,6 +51,11 @@ typedef struct lag_url {
  * with what was expected in err. OUT: u */
 int lag_url_parse(const char *url, int flags, lag_url *u, char *err, size_t errlen);
 
+/* The URL of u (read by lag_url_parse, its URL still there: u->query points into it) on
+ * another port: "udpm://GROUP:PORT" and u's options as given, or "memq://". Returns what
+ * snprintf returns (>= len: cut short). OUT: out */
+int lag_url_format(const lag_url *u, int port, char *out, size_t len);
+
 #ifdef __cplusplus
 }
 #endif

@@ -43,6 +43,7 @@ static const lag_wire_field joint_state_fields[] = {
     ARRAY(JS, LAG_WIRE_DOUBLE, position, 3),
     ARRAY(JS, LAG_WIRE_DOUBLE, velocity, 3),
     ARRAY(JS, LAG_WIRE_DOUBLE, effort, 3),
+    SCALAR(JS, LAG_WIRE_INT64, generation),                     /* 0.2.0 */
 };
 
 typedef lag_wire_reference RF;
@@ -54,6 +55,7 @@ static const lag_wire_field reference_fields[] = {
     ARRAY(RF, LAG_WIRE_STRING, name, 3),
     ARRAY(RF, LAG_WIRE_DOUBLE, r, 3),
     ARRAY(RF, LAG_WIRE_DOUBLE, rdot, 3),
+    SCALAR(RF, LAG_WIRE_INT64, generation),                     /* 0.2.0 */
 };
 
 typedef lag_wire_joint_command JC;
@@ -63,6 +65,7 @@ static const lag_wire_field joint_command_fields[] = {
     COUNT(JC, num_joints, LAG_WIRE_MAX_JOINTS, true),           /* 2 */
     ARRAY(JC, LAG_WIRE_STRING, name, 2),
     ARRAY(JC, LAG_WIRE_DOUBLE, effort, 2),
+    SCALAR(JC, LAG_WIRE_INT64, generation),                     /* 0.2.0 */
 };
 
 typedef lag_wire_control CT;
@@ -154,6 +157,7 @@ static const lag_wire_field scene_fields[] = {
     ARRAY(SC, LAG_WIRE_BOOLEAN, limit_on, 6),
     ARRAY(SC, LAG_WIRE_DOUBLE, limit_lower, 6),
     ARRAY(SC, LAG_WIRE_DOUBLE, limit_upper, 6),
+    SCALAR(SC, LAG_WIRE_INT64, generation),                     /* 0.2.0 */
 };
 
 /* The C storage of each kind must be what the decoder writes. */
@@ -161,26 +165,45 @@ _Static_assert(sizeof(bool) == 1, "booleans are stored in one byte");
 _Static_assert(MEMBER_SIZE(JS, num_joints) == 2 && MEMBER_SIZE(SC, num_params) == 2,
                "counts are int16_t");
 
+/* An earlier version of a type: the lagsim version whose types it is, how many of
+ * today's fields it had (a type changes only by fields appended at its end), and the
+ * fingerprint lcm-gen gave it (a unit test recomputes it from those fields). Appended,
+ * never removed: a log of any earlier version stays readable. */
+typedef struct old_version {
+    const char *lagsim;
+    int nfields;
+    int64_t fingerprint;
+} old_version;
+
+#define OLD_MAX 4
 typedef struct type_info {
     const char *name;
     const lag_wire_field *fields;
     int nfields;
     size_t struct_size;
     int64_t (*fingerprint)(void);
+    old_version old[OLD_MAX]; /* oldest first; lagsim NULL: no more */
 } type_info;
 
-#define TYPE(n, f, T, h) {n, f, (int)(sizeof f / sizeof f[0]), sizeof(T), h}
+/* lagsim 0.1.0's types: today's without `generation` */
+#define V010(f, fp) {"0.1.0", (int)(sizeof f / sizeof f[0]) - 1, (int64_t)fp}
+
+#define TYPE(n, f, T, h, ...) {n, f, (int)(sizeof f / sizeof f[0]), sizeof(T), h, {__VA_ARGS__}}
 static const type_info types[LAG_WIRE_TYPE_COUNT] = {
     [LAG_WIRE_JOINT_STATE] = TYPE("joint_state_t", joint_state_fields, JS,
-                                  __lagsim_joint_state_t_get_hash),
+                                  __lagsim_joint_state_t_get_hash,
+                                  V010(joint_state_fields, 0x30d0440423c83571)),
     [LAG_WIRE_JOINT_COMMAND] = TYPE("joint_command_t", joint_command_fields, JC,
-                                    __lagsim_joint_command_t_get_hash),
+                                    __lagsim_joint_command_t_get_hash,
+                                    V010(joint_command_fields, 0xf7fc3ec714ff2ae8)),
     [LAG_WIRE_CONTROL] = TYPE("control_t", control_fields, CT, __lagsim_control_t_get_hash),
     [LAG_WIRE_EVENT] = TYPE("event_t", event_fields, EV, __lagsim_event_t_get_hash),
     [LAG_WIRE_STATUS] = TYPE("status_t", status_fields, ST, __lagsim_status_t_get_hash),
-    [LAG_WIRE_SCENE] = TYPE("scene_t", scene_fields, SC, __lagsim_scene_t_get_hash),
+    [LAG_WIRE_SCENE] = TYPE("scene_t", scene_fields, SC, __lagsim_scene_t_get_hash,
+                            V010(scene_fields, 0x1ab54f27e2c0e262)),
     [LAG_WIRE_REFERENCE] = TYPE("reference_t", reference_fields, RF,
-                                __lagsim_reference_t_get_hash),
+                                __lagsim_reference_t_get_hash,
+                                V010(reference_fields, 0x450a576ca1059690)),
 };
 _Static_assert(sizeof types / sizeof types[0] == LAG_WIRE_TYPE_COUNT,
                "one table per message type");
@@ -279,9 +302,25 @@ static int count_value(const uint8_t *msg, const lag_wire_field *f)
     return n;
 }
 
-int lag_wire_decode(lag_wire_type t, const void *data, size_t len, int max_joints, void *out)
+/* The number of fields of the version of ti whose fingerprint is `hash` (today's, or,
+ * when `old` allows, an earlier one's, named in *written_by), or -1. */
+static int version_fields(const type_info *ti, int64_t hash, bool old, const char **written_by)
+{
+    if (written_by) *written_by = NULL;
+    if (hash == ti->fingerprint()) return ti->nfields;
+    for (int k = 0; old && k < OLD_MAX && ti->old[k].lagsim; k++)
+        if (hash == ti->old[k].fingerprint) {
+            if (written_by) *written_by = ti->old[k].lagsim;
+            return ti->old[k].nfields;
+        }
+    return -1;
+}
+
+static int decode(lag_wire_type t, const void *data, size_t len, int max_joints, void *out,
+                  bool old, const char **written_by)
 {
     const type_info *ti = type_get(t);
+    if (written_by) *written_by = NULL;
     if (!ti || !out) return LAG_WIRE_EARG;
     uint8_t *msg = out;
     memset(msg, 0, ti->struct_size);
@@ -290,9 +329,11 @@ int lag_wire_decode(lag_wire_type t, const void *data, size_t len, int max_joint
     if (max_joints > LAG_WIRE_MAX_JOINTS) max_joints = LAG_WIRE_MAX_JOINTS;
     rd r = {data, len, 0};
     uint64_t hash;
-    if (!rd_u(&r, 8, &hash) || (int64_t)hash != ti->fingerprint()) return LAG_WIRE_EFINGERPRINT;
+    if (!rd_u(&r, 8, &hash)) return LAG_WIRE_EFINGERPRINT;
+    int nfields = version_fields(ti, (int64_t)hash, old, written_by);
+    if (nfields < 0) return LAG_WIRE_EFINGERPRINT;
     bool too_long = false;
-    for (int k = 0; k < ti->nfields; k++) {
+    for (int k = 0; k < nfields; k++) {
         const lag_wire_field *f = &ti->fields[k];
         uint8_t *dst = msg + f->offset;
         int n = 1;
@@ -311,6 +352,17 @@ int lag_wire_decode(lag_wire_type t, const void *data, size_t len, int max_joint
     }
     if (r.pos != r.len) return LAG_WIRE_ETRAILING;
     return too_long ? LAG_WIRE_ETOOLONG : LAG_WIRE_OK;
+}
+
+int lag_wire_decode(lag_wire_type t, const void *data, size_t len, int max_joints, void *out)
+{
+    return decode(t, data, len, max_joints, out, false, NULL);
+}
+
+int lag_wire_decode_any(lag_wire_type t, const void *data, size_t len, int max_joints,
+                        void *out, const char **written_by)
+{
+    return decode(t, data, len, max_joints, out, true, written_by);
 }
 
 /* ---------------------------------------------------------------- bounded writer */
@@ -473,6 +525,36 @@ int lag_wire_identify(const void *data, size_t len)
     return -1;
 }
 
+int lag_wire_identify_any(const void *data, size_t len, const char **written_by)
+{
+    rd r = {data, len, 0};
+    uint64_t hash;
+    if (written_by) *written_by = NULL;
+    if (!data || !rd_u(&r, 8, &hash)) return -1;
+    for (int t = 0; t < LAG_WIRE_TYPE_COUNT; t++)
+        if (version_fields(&types[t], (int64_t)hash, true, written_by) >= 0) return t;
+    return -1;
+}
+
+const char *lag_wire_version(void) { return LAGSIM_VERSION; }
+
+int lag_wire_old_versions(lag_wire_type t)
+{
+    const type_info *ti = type_get(t);
+    int n = 0;
+    while (ti && n < OLD_MAX && ti->old[n].lagsim) n++;
+    return n;
+}
+
+const char *lag_wire_old_version(lag_wire_type t, int k, int *nfields, int64_t *fingerprint)
+{
+    if (k < 0 || k >= lag_wire_old_versions(t)) return NULL;
+    const old_version *v = &types[t].old[k];
+    if (nfields) *nfields = v->nfields;
+    if (fingerprint) *fingerprint = v->fingerprint;
+    return v->lagsim;
+}
+
 int64_t lag_wire_fingerprint(lag_wire_type t)
 {
     const type_info *ti = type_get(t);
@@ -509,9 +591,15 @@ static uint64_t hash_string(uint64_t v, const char *s)
 int64_t lag_wire_table_fingerprint(lag_wire_type t)
 {
     const type_info *ti = type_get(t);
-    if (!ti) return 0;
+    return ti ? lag_wire_table_fingerprint_n(t, ti->nfields) : 0;
+}
+
+int64_t lag_wire_table_fingerprint_n(lag_wire_type t, int nfields)
+{
+    const type_info *ti = type_get(t);
+    if (!ti || nfields < 0 || nfields > ti->nfields) return 0;
     uint64_t v = 0x12345678;
-    for (int k = 0; k < ti->nfields; k++) {
+    for (int k = 0; k < nfields; k++) {
         const lag_wire_field *f = &ti->fields[k];
         v = hash_string(v, f->name);
         v = hash_string(v, lag_wire_kind_name(f->kind)); /* every field is a primitive */

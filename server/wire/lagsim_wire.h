@@ -90,6 +90,8 @@ typedef struct lag_wire_joint_state {
     double position[LAG_WIRE_MAX_JOINTS];            /* q: m or rad */
     double velocity[LAG_WIRE_MAX_JOINTS];            /* qd: m/s or rad/s */
     double effort[LAG_WIRE_MAX_JOINTS];              /* N or N m */
+    int64_t generation;                              /* the run and scene it belongs to
+                                                      * (0 in a 0.1.0 log) */
 } lag_wire_joint_state;
 
 /* <PREFIX>_COMMAND: a controller's efforts. */
@@ -99,6 +101,7 @@ typedef struct lag_wire_joint_command {
     int16_t num_joints;
     char name[LAG_WIRE_MAX_JOINTS][LAG_WIRE_NAME_LEN];
     double effort[LAG_WIRE_MAX_JOINTS];
+    int64_t generation;                              /* of the state it answers; 0: none */
 } lag_wire_joint_command;
 
 /* <PREFIX>_CONTROL: pause, resume, step, reset, reset_to, status, describe, set. */
@@ -190,6 +193,7 @@ typedef struct lag_wire_scene {
     bool limit_on[LAG_WIRE_MAX_JOINTS];              /* the joint has stops */
     double limit_lower[LAG_WIRE_MAX_JOINTS];         /* m or rad, 0 where no stops */
     double limit_upper[LAG_WIRE_MAX_JOINTS];
+    int64_t generation;                              /* the generation it describes */
 } lag_wire_scene;
 
 /* <PREFIX>_REFERENCE: what the joints with a reference should follow, at a state's time. */
@@ -201,6 +205,7 @@ typedef struct lag_wire_reference {
     char name[LAG_WIRE_MAX_JOINTS][LAG_WIRE_NAME_LEN];
     double r[LAG_WIRE_MAX_JOINTS];                   /* m or rad */
     double rdot[LAG_WIRE_MAX_JOINTS];                /* m/s or rad/s */
+    int64_t generation;                              /* the state's generation */
 } lag_wire_reference;
 
 /* ---------------------------------------------------------------- per type */
@@ -232,6 +237,30 @@ int lag_wire_decode(lag_wire_type t, const void *data, size_t len, int max_joint
 int lag_wire_encode(lag_wire_type t, const void *m, void *buf, size_t cap);
 /* The type whose fingerprint the payload starts with, or -1. */
 int lag_wire_identify(const void *data, size_t len);
+
+/* Earlier versions of the types (docs/wire.md, "How message types evolve"): a type
+ * changes only by fields appended at its end, and the wire module keeps, for each version
+ * that changed it, how many of today's fields that version had and its fingerprint (what
+ * lcm-gen gave it). Live traffic is today's version only (lag_wire_decode); what was
+ * recorded (logs) is read in any version: */
+/* The type and version of a payload, today's or an earlier one's: the type (or -1), and
+ * in *written_by NULL for today's version or the lagsim version whose types wrote it
+ * ("0.1.0"). */
+int lag_wire_identify_any(const void *data, size_t len, const char **written_by);
+/* lag_wire_decode for a message of today's version or an earlier one: the fields that
+ * version did not have are 0 (a 0.1.0 state: generation 0); *written_by as above (may be
+ * NULL). */
+int lag_wire_decode_any(lag_wire_type t, const void *data, size_t len, int max_joints,
+                        void *out, const char **written_by);
+/* The lagsim version whose types these are (project(VERSION), "0.2.0"). */
+const char *lag_wire_version(void);
+/* The earlier versions of t: how many (0 for a type never changed), and the k-th's lagsim
+ * version, field count and fingerprint (as lcm-gen gave it then). */
+int lag_wire_old_versions(lag_wire_type t);
+const char *lag_wire_old_version(lag_wire_type t, int k, int *nfields, int64_t *fingerprint);
+/* LCM's fingerprint of the first nfields fields of t's table (the whole table: as
+ * lag_wire_table_fingerprint). */
+int64_t lag_wire_table_fingerprint_n(lag_wire_type t, int nfields);
 /* The fingerprint a message of type t starts with (lcm-gen's). */
 int64_t lag_wire_fingerprint(lag_wire_type t);
 /* The fingerprint LCM's algorithm gives for the field table of t (equal to the above

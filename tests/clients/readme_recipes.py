@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
-"""Runs the shell recipes of README.md and docs/clients.md as written, so that they cannot
-drift from the programs.
+"""Runs the shell recipes of README.md, docs/clients.md and docs/evaluation.md as written,
+so that they cannot drift from the programs.
 
     readme_recipes.py --build DIR --source DIR NAME...
 
 A recipe is marked with <!-- recipe: NAME --> on the line before its ```sh fence; a file
 it needs with <!-- recipe-file: NAME FILE --> before any fence (its text is written to
-FILE first). The block runs in bash in a fresh temporary directory, with `build/` and
-`config/` pointing into this tree's build and sources; a line that builds (`cmake ...`)
+FILE first). The block runs in bash in a fresh temporary directory, with `build/`, and
+`config/`, `tests/`, `clients/` pointing into this tree's build and sources; a line that builds (`cmake ...`)
 or installs the Debian packages (`.ci/install-deps.sh`) is left out, the tree being built
 already. LCM_DEFAULT_URL gets a multicast port of this run's own (ttl=0), which every
 program of the recipe honours, so that the recipe's default prefix cannot meet another
@@ -24,7 +24,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
-DOCS = ("README.md", os.path.join("docs", "clients.md"))
+DOCS = ("README.md", os.path.join("docs", "clients.md"), os.path.join("docs", "evaluation.md"))
 
 
 def recipes(src):
@@ -141,11 +141,38 @@ def check_walkthrough(out, tmp):
     return checks
 
 
+def eval_checks(out, cases, runs):
+    """lagsim-eval measured each of the cases, ok (none failed or unmet); lagsim-sweep ran
+    every run and each passed"""
+    checks = []
+    for case, joint in cases:
+        checks.append((re.search(r"^%s\s+%s\s+ok\b" % (case, joint), out, re.M) is not None,
+                       "lagsim-eval: case %s measured, ok" % case))
+    checks.append(("UNMET" not in out and "FAIL" not in out, "lagsim-eval: no case failed or unmet"))
+    m = re.search(r"^%d runs: %d passed \(100\.0 %%\), 0 failed, 0 missed --require" % (runs, runs),
+                  out, re.M)
+    checks.append((m is not None, "lagsim-sweep: %d runs, all passed" % runs))
+    return checks
+
+
+def check_eval_python(out, tmp):
+    """docs/evaluation.md: the shipped Python DIPC controller under lagsim-eval (two cases of
+    the suite written from the page) and lagsim-sweep (20 runs)"""
+    return eval_checks(out, [("tilt", "theta0"), ("push", "theta0")], 20)
+
+
+def check_eval_octave(out, tmp):
+    """docs/evaluation.md: the Octave cart-pole controller, {prefix} inside Octave's quotes
+    inside the shell's, under lagsim-eval (case tilt) and lagsim-sweep (4 runs)"""
+    return eval_checks(out, [("tilt", "x")], 4)
+
+
 # a recipe's exit status when it is not 0, as its doc says (the last command's)
 EXIT = {"evaluate": 1}
 
 CHECKS = {"by-hand": check_by_hand, "record": check_record, "evaluate": check_evaluate,
-          "walkthrough": check_walkthrough}
+          "walkthrough": check_walkthrough, "eval-python": check_eval_python,
+          "eval-octave": check_eval_octave}
 
 
 def main():
@@ -171,6 +198,7 @@ def main():
             line = re.sub(r"(^|[\s;&(='])build/", r"\g<1>%s/" % build, line)
             line = re.sub(r"(^|[\s;&(=])config/", r"\g<1>%s/config/" % src, line)
             line = re.sub(r"(^|[\s;&(=])tests/", r"\g<1>%s/tests/" % src, line)
+            line = re.sub(r"(^|[\s;&(='])clients/", r"\g<1>%s/clients/" % src, line)
             lines.append(line)
         script = "\n".join(lines) + "\n"
         tmp = tempfile.mkdtemp(prefix="lagsim_recipe_")

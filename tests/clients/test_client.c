@@ -71,6 +71,8 @@ static void pump(lcm_t *peer, lag_client *c, int ms)
     }
 }
 
+static int64_t g_gen; /* the generation of the states publish_state sends */
+
 static void publish_state(lcm_t *peer, const char *ch, int n, const char *long_name, double t,
                           double p0)
 {
@@ -84,8 +86,27 @@ static void publish_state(lcm_t *peer, const char *ch, int n, const char *long_n
     }
     lagsim_joint_state_t m = {.utime = 42, .sim_time = t, .step = (int64_t)(t * 1000),
                               .num_joints = (int16_t)n, .name = names, .position = pos,
-                              .velocity = vel, .effort = eff};
+                              .velocity = vel, .effort = eff, .generation = g_gen};
     lagsim_joint_state_t_publish(peer, ch, &m);
+}
+
+/* A manipulator scene of generation gen, as the daemon publishes it. */
+static void publish_scene(lcm_t *peer, const char *prefix, int64_t gen, double m2)
+{
+    char ch[128];
+    snprintf(ch, sizeof ch, "%s_SCENE", prefix);
+    char *pn[3] = {"m1", "g", "m2"}, *jn[2] = {"q1", "q2"};
+    double pv[3] = {2.0, 9.81, m2}, iq[2] = {0.0, 0.5}, iqd[2] = {0, 0};
+    int8_t act[2] = {1, 0}, lim_on[2] = {0, 0};
+    double lim[2] = {0, 0};
+    lagsim_scene_t s = {.utime = 1, .model = "manipulator", .prefix = (char *)prefix,
+                        .num_params = 3, .param_name = pn, .param_value = pv, .num_joints = 2,
+                        .joint_name = jn, .actuated = act, .initial_q = iq,
+                        .initial_qd = iqd, .dt = 0.001, .control_period = 0.01,
+                        .integrator = "rk4", .mode = "lockstep", .rate = 1.0,
+                        .command_timeout = 0.5, .effects = "", .limit_on = lim_on,
+                        .limit_lower = lim, .limit_upper = lim, .generation = gen};
+    lagsim_scene_t_publish(peer, ch, &s);
 }
 
 static void case_library(int arg)
@@ -118,6 +139,9 @@ static void case_library(int arg)
     pump(peer, c, 50);
     ENSURE(describes >= 2); /* at once and every 0.25 s */
 
+    /* the scene of the states below (generation 0): a state is returned only with it */
+    publish_scene(peer, prefix, 0, 0.5);
+    pump(peer, c, 50);
     /* odd states, then a valid one */
     snprintf(ch, sizeof ch, "%s_STATE", prefix);
     const char junk[] = "not an LCM message at all";
@@ -242,21 +266,9 @@ static void case_library(int arg)
     ENSURE(cnt2.dropped == cnt.dropped + 1 && cnt2.events == cnt.events);
 
     /* a scene description */
-    snprintf(ch, sizeof ch, "%s_SCENE", prefix);
-    char *pn[2] = {"m1", "g"}, *jn[2] = {"q1", "q2"};
-    double pv[2] = {2.0, 9.81}, iq[2] = {0.0, 0.5}, iqd[2] = {0, 0};
-    int8_t act[2] = {1, 0}, lim_on[2] = {0, 0};
-    double lim[2] = {0, 0};
-    lagsim_scene_t s = {.utime = 1, .model = "manipulator", .prefix = prefix, .num_params = 2,
-                        .param_name = pn, .param_value = pv, .num_joints = 2,
-                        .joint_name = jn, .actuated = act, .initial_q = iq,
-                        .initial_qd = iqd, .dt = 0.001, .control_period = 0.01,
-                        .integrator = "rk4", .mode = "lockstep", .rate = 1.0,
-                        .command_timeout = 0.5, .effects = "", .limit_on = lim_on,
-                        .limit_lower = lim, .limit_upper = lim};
-    lagsim_scene_t_publish(peer, ch, &s);
+    publish_scene(peer, prefix, 0, 0.5);
     ENSURE(lag_client_wait_scene(c, 2.0, &sc) == LAG_CLIENT_OK);
-    ENSURE(strcmp(sc.prefix, prefix) == 0 && sc.num_params == 2 && sc.num_joints == 2);
+    ENSURE(strcmp(sc.prefix, prefix) == 0 && sc.num_params == 3 && sc.num_joints == 2);
     ENSURE(strcmp(sc.model, "manipulator") == 0 && strcmp(sc.mode, "lockstep") == 0);
     ENSURE(lag_client_scene_param(&sc, "g") == 9.81 && isnan(lag_client_scene_param(&sc, "zz")));
     ENSURE(lag_client_scene_joint(&sc, "q2") == 1 && sc.actuated[0] && !sc.actuated[1]);
@@ -270,8 +282,93 @@ static void case_library(int arg)
     lcm_destroy(peer_in);
 }
 
+/* A state is known by its generation (one more at every reset and SET) and its step and
+ * sim time: a state of the next run at the same step, sim time and utime as the one
+ * answered last is no copy of it. A state whose generation is not the scene's is held,
+ * not returned, until the scene of its generation came; meanwhile the client asks for it
+ * (DESCRIBE, at once and every LAG_CLIENT_DESCRIBE_S). Commands carry the generation of
+ * the state they answer. */
+static void case_generation(int arg)
+{
+    (void)arg;
+    char prefix[64], ch[128], err[256];
+    snprintf(prefix, sizeof prefix, "CLTGEN_%d", (int)getpid());
+    lag_client *c = lag_client_create(NULL, prefix, err, sizeof err);
+    lag_bus bus;
+    ENSURE(c && lag_bus_init(&bus, NULL, prefix, err, sizeof err) == 0);
+    lcm_t *peer = lcm_create(bus.state_url);
+    peer_in = lcm_create(bus.command_url);
+    ENSURE(peer != NULL && peer_in != NULL);
+    lcm_subscribe(peer_in, bus.channel[LAG_BUS_CONTROL], on_control, NULL);
+    lcm_subscribe(peer_in, bus.channel[LAG_BUS_COMMAND], on_command, NULL);
+    snprintf(ch, sizeof ch, "%s_STATE", prefix);
+    const char *names[1] = {"q1"};
+    double u1 = 1.5, u2 = -2.5;
+    lag_client_state st;
+    lag_client_scene sc;
+    lag_client_counters cnt;
+
+    /* generation 1: the scene, then its state, returned */
+    publish_scene(peer, prefix, 1, 0.5);
+    g_gen = 1;
+    publish_state(peer, ch, 2, NULL, 0.0, 0.1);
+    ENSURE(lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK && st.generation == 1);
+    ENSURE(lag_client_latest_scene(c, &sc) && sc.generation == 1);
+    ENSURE(lag_client_send_command(c, 0.0, 1, names, &u1) == LAG_CLIENT_OK);
+    pump(peer, c, 100);
+    ENSUREF(last_cmd.generation == 1 && last_cmd.sim_time == 0.0 && last_cmd.effort[0] == 1.5,
+            "the command carries generation %lld", (long long)last_cmd.generation);
+    int cmds = commands, asked = describes;
+
+    /* generation 2, the same step, sim time and utime, its scene lost: no copy (no answer
+     * sent again), held, its scene asked for */
+    g_gen = 2;
+    publish_state(peer, ch, 2, NULL, 0.0, 0.1);
+    ENSURE(lag_client_wait_state(c, 0.6, &st) == LAG_CLIENT_TIMEOUT);
+    pump(peer, c, 50);
+    lag_client_get_counters(c, &cnt);
+    ENSUREF(commands == cmds && cnt.repeats == 0 && cnt.held == 1,
+            "a state of the next generation taken for a copy: %d answers sent again, %lld "
+            "repeats, %lld held", commands - cmds, (long long)cnt.repeats, (long long)cnt.held);
+    ENSUREF(describes >= asked + 2 && cnt.describes >= 2,
+            "%d DESCRIBE while the scene of generation 2 was awaited", describes - asked);
+    ENSURE(lag_client_latest_state(c, &st) && st.generation == 1); /* still the last returned */
+    /* its scene: the held state is returned, with the new scene */
+    publish_scene(peer, prefix, 2, 1.25);
+    ENSURE(lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK && st.generation == 2);
+    ENSURE(lag_client_latest_scene(c, &sc) && sc.generation == 2 &&
+           lag_client_scene_param(&sc, "m2") == 1.25);
+    ENSURE(lag_client_send_command(c, 0.0, 1, names, &u2) == LAG_CLIENT_OK);
+    pump(peer, c, 100);
+    ENSURE(last_cmd.generation == 2 && last_cmd.effort[0] == -2.5);
+    /* a copy of it (same generation): answered again with that command, not returned */
+    cmds = commands;
+    publish_state(peer, ch, 2, NULL, 0.0, 0.1);
+    pump(peer, c, 100);
+    ENSURE(lag_client_wait_state(c, 0.1, &st) == LAG_CLIENT_TIMEOUT);
+    lag_client_get_counters(c, &cnt);
+    ENSURE(commands == cmds + 1 && last_cmd.generation == 2 && last_cmd.effort[0] == -2.5 &&
+           cnt.repeats == 1);
+
+    /* generation 3 with its scene first (as the daemon sends them): returned at once, no
+     * DESCRIBE */
+    asked = describes;
+    publish_scene(peer, prefix, 3, 0.75);
+    g_gen = 3;
+    publish_state(peer, ch, 2, NULL, 0.0, 0.1);
+    ENSURE(lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK && st.generation == 3);
+    pump(peer, c, 300);
+    ENSURE(describes == asked);
+    ENSURE(lag_client_latest_scene(c, &sc) && lag_client_scene_param(&sc, "m2") == 0.75);
+    g_gen = 0;
+    lag_client_destroy(c);
+    lcm_destroy(peer);
+    lcm_destroy(peer_in);
+}
+
 int main(int argc, char **argv)
 {
-    static const lt_case cases[] = {{"library", case_library, 0, 0}};
-    return lt_main(argc, argv, cases, 1);
+    static const lt_case cases[] = {{"library", case_library, 0, 0},
+                                    {"generation", case_generation, 0, 0}};
+    return lt_main(argc, argv, cases, 2);
 }

@@ -4,16 +4,20 @@
  *
  * For each model: the bodies' centres of mass r_c(q), their velocities v_c = d r_c / dt
  * written out by the chain rule, the bodies' angular velocities omega, masses and
- * inertias. From these alone
- *     T = sum_b 1/2 m_b v_b . v_b + 1/2 I_b omega_b^2,   U = sum_b m_b g y_b,
+ * inertias, and its potential energy U as a function of q and those bodies. From these
+ * alone
+ *     T = sum_b 1/2 m_b v_b . v_b + 1/2 I_b omega_b^2,   U = the row's potential,
  * in complex arithmetic, so that tests/core/test_core.h can take derivatives by complex
- * steps, and tests/effects can read energies and momenta.
+ * steps, and tests/effects can read energies and momenta. A model whose only potential is
+ * gravity names tc_U_gravity (sum_b m_b g y_b); one with more (a spring in a joint, a
+ * magnet...) writes its own, e.g. tc_U_gravity plus 1/2 k q_i^2, and its parameters (a
+ * stiffness in N m/rad or N/m) get random values as masses do (test_core.h).
  *
  * One row per model of the core's table (tc_refs, indexed by kind): a model without its
- * row does not build, and a kind asked for that has none stops the test (abort), never
- * falls back on another model's kinematics. A row also gives a smooth unforced motion
- * (the conservation and convergence tests run it) and the positions where the structure
- * tests start their random motions.
+ * row does not build, and a kind asked for that has none, or whose row lacks its
+ * kinematics or its potential, stops the test (abort), never falls back on another
+ * model's. A row also gives a smooth unforced motion (the conservation and convergence
+ * tests run it) and the positions where the structure tests start their random motions.
  */
 #ifndef LAGSIM_REF_MODELS_H
 #define LAGSIM_REF_MODELS_H
@@ -173,9 +177,23 @@ static inline void tc_kin_flying_stick(const lag_model *m, const cplx *q, const 
     b->w[0] = qd[1];
 }
 
+/* ------------------------------------------------------------------ potentials */
+
+/* U = sum_b m_b g y_b: gravity on the bodies (at q: b holds them there). */
+static inline cplx tc_U_gravity(const lag_model *m, const cplx *q, const tc_bodies *b)
+{
+    (void)q;
+    cplx U = 0;
+    double g = tc_p(m, "g");
+    for (int i = 0; i < b->nb; ++i) U += b->mass[i] * g * b->y[i];
+    return U;
+}
+
 /* ------------------------------------------------------------------ the table */
 typedef struct tc_ref {
     void (*kinematics)(const lag_model *m, const cplx *q, const cplx *qd, tc_bodies *b);
+    /* U(q), written from the bodies at q (b) and the model's own stored energies */
+    cplx (*potential)(const lag_model *m, const cplx *q, const tc_bodies *b);
     /* A smooth unforced motion with the model's default parameters: start, horizon T (s,
      * a multiple of 1 ms; short enough that the tests' coarsest steps resolve it). */
     double q0[LAG_MAX_DOF], qd0[LAG_MAX_DOF], T;
@@ -185,18 +203,25 @@ typedef struct tc_ref {
 
 static const tc_ref tc_refs[] = {
     /* the stick falls from 1.2 rad to near the floor (0.4 s) while sliding at 0.5 m/s */
-    [LAG_MODEL_STICK] = {tc_kin_stick, {0.0, 1.2}, {0.5, 0.0}, 0.4, {-2, 0.3}, {2, 1.3}},
+    [LAG_MODEL_STICK] = {.kinematics = tc_kin_stick, .potential = tc_U_gravity,
+                         .q0 = {0.0, 1.2}, .qd0 = {0.5, 0.0}, .T = 0.4,
+                         .qlo = {-2, 0.3}, .qhi = {2, 1.3}},
     /* the arm swings below the horizontal with the slider moving in */
-    [LAG_MODEL_MANIPULATOR] = {tc_kin_manipulator, {-TC_PI / 2 + 0.4, 0.5}, {0.0, -0.3}, 1.0,
-                               {-TC_PI, 0.3}, {TC_PI, 1.0}},
+    [LAG_MODEL_MANIPULATOR] = {.kinematics = tc_kin_manipulator, .potential = tc_U_gravity,
+                               .q0 = {-TC_PI / 2 + 0.4, 0.5}, .qd0 = {0.0, -0.3}, .T = 1.0,
+                               .qlo = {-TC_PI, 0.3}, .qhi = {TC_PI, 1.0}},
     /* both rods hanging and swinging, the cart free */
-    [LAG_MODEL_DIPC] = {tc_kin_dipc, {0.0, TC_PI + 0.3, TC_PI - 0.2}, {0.0, 0.0, 0.0}, 1.0,
-                        {-2, -TC_PI, -TC_PI}, {2, TC_PI, TC_PI}},
+    [LAG_MODEL_DIPC] = {.kinematics = tc_kin_dipc, .potential = tc_U_gravity,
+                        .q0 = {0.0, TC_PI + 0.3, TC_PI - 0.2}, .qd0 = {0.0, 0.0, 0.0}, .T = 1.0,
+                        .qlo = {-2, -TC_PI, -TC_PI}, .qhi = {2, TC_PI, TC_PI}},
     /* the pole hanging and swinging, the cart free */
-    [LAG_MODEL_CARTPOLE] = {tc_kin_cartpole, {0.0, TC_PI + 0.5}, {0.2, 0.0}, 1.0, {-2, -TC_PI}, {2, TC_PI}},
+    [LAG_MODEL_CARTPOLE] = {.kinematics = tc_kin_cartpole, .potential = tc_U_gravity,
+                            .q0 = {0.0, TC_PI + 0.5}, .qd0 = {0.2, 0.0}, .T = 1.0,
+                            .qlo = {-2, -TC_PI}, .qhi = {2, TC_PI}},
     /* thrown up spinning, no floor: the centre on its parabola, the angle turning */
-    [LAG_MODEL_FLYING_STICK] = {tc_kin_flying_stick, {0.0, 0.3, 1.0}, {0.5, 3.0, 2.0}, 1.0,
-                                {-2, -TC_PI, 0.0}, {2, TC_PI, 2.0}},
+    [LAG_MODEL_FLYING_STICK] = {.kinematics = tc_kin_flying_stick, .potential = tc_U_gravity,
+                                .q0 = {0.0, 0.3, 1.0}, .qd0 = {0.5, 3.0, 2.0}, .T = 1.0,
+                                .qlo = {-2, -TC_PI, 0.0}, .qhi = {2, TC_PI, 2.0}},
 };
 _Static_assert(sizeof tc_refs / sizeof tc_refs[0] == LAG_MODEL_COUNT,
                "tests/common/ref_models.h needs a reference row for every model of the core");
@@ -204,9 +229,10 @@ _Static_assert(sizeof tc_refs / sizeof tc_refs[0] == LAG_MODEL_COUNT,
 /* The reference of a kind; stops the test if it has none. */
 static inline const tc_ref *tc_ref_of(lag_model_kind kind)
 {
-    if ((int)kind < 0 || kind >= LAG_MODEL_COUNT || !tc_refs[kind].kinematics) {
-        fprintf(stderr, "no reference kinematics for model kind %d: add a row to "
-                        "tests/common/ref_models.h\n", (int)kind);
+    if ((int)kind < 0 || kind >= LAG_MODEL_COUNT || !tc_refs[kind].kinematics ||
+        !tc_refs[kind].potential) {
+        fprintf(stderr, "no reference kinematics and potential for model kind %d: add a row "
+                        "with both to tests/common/ref_models.h\n", (int)kind);
         abort();
     }
     return &tc_refs[kind];
@@ -230,16 +256,13 @@ static inline cplx tc_T_c(const lag_model *m, const cplx *q, const cplx *qd)
     return T;
 }
 
-/* U = sum m g y_c. */
+/* U(q): the row's potential, from the bodies at q. */
 static inline cplx tc_U_c(const lag_model *m, const cplx *q)
 {
     cplx zero[LAG_MAX_DOF] = {0};
     tc_bodies b;
     tc_kinematics(m, q, zero, &b);
-    cplx U = 0;
-    double g = tc_p(m, "g");
-    for (int i = 0; i < b.nb; ++i) U += b.mass[i] * g * b.y[i];
-    return U;
+    return tc_ref_of(m->kind)->potential(m, q, &b);
 }
 
 static inline void tc_to_c(int n, const double *x, cplx *z)

@@ -10,7 +10,8 @@
  *
  * which has no subtractive cancellation: for h this small the truncation term is below
  * 1e-40 and the result is exact to a few ulps of the terms of f. T and U are then
- *     T = sum_b 1/2 m_b v_b . v_b + 1/2 I_b omega_b^2,   U = sum_b m_b g y_b,
+ *     T = sum_b 1/2 m_b v_b . v_b + 1/2 I_b omega_b^2,   U = the row's potential
+ * (sum_b m_b g y_b, plus what the model stores besides: tests/common/ref_models.h),
  * and M, dM/dq, g, dL/dq, dL/dqd follow from T and U by complex steps alone.
  *
  * Checks and cases: tests/common/lagsim_test.h.
@@ -38,8 +39,9 @@ static inline int tc_nq(lag_model_kind k) { return lag_model_info_get(k)->nq; }
 
 /* Random but physical parameters, from the model's own table of units and rules: masses
  * 0.2..3 kg, lengths 0.2..2 m, inertias 0.01..1 kg m^2 (or, one model in two, every rod's
- * uniform-rod value m l^2 / 12), g 1..20 m/s^2, parameters that may take any value (h0)
- * 0..1. A unit without a range stops the test: give it one here. */
+ * uniform-rod value m l^2 / 12), g 1..20 m/s^2, stiffnesses 0.5..20 N m/rad or N/m,
+ * parameters that may take any value (h0) 0..1. A unit without a range stops the test:
+ * give it one here. */
 static inline void tc_random_model(lt_rng *r, lag_model_kind kind, lag_model *m)
 {
     const lag_model_info *inf = lag_model_info_get(kind);
@@ -52,6 +54,7 @@ static inline void tc_random_model(lt_rng *r, lag_model_kind kind, lag_model *m)
         else if (!strcmp(u, "m")) m->p[i] = lt_uniform(r, 0.2, 2);
         else if (!strcmp(u, "kg m^2")) m->p[i] = lt_uniform(r, 0.01, 1);
         else if (!strcmp(u, "m/s^2")) m->p[i] = lt_uniform(r, 1, 20);
+        else if (!strcmp(u, "N m/rad") || !strcmp(u, "N/m")) m->p[i] = lt_uniform(r, 0.5, 20);
         else {
             fprintf(stderr, "test_core.h: no random range for unit '%s' (%s.%s)\n", u, inf->name,
                     inf->param_names[i]);

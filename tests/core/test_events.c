@@ -280,6 +280,14 @@ static void check_table(int arg)
         /* one bit each, distinct (the rows' order is the dispatch order, not the bits') */
         ENSURE(r->bit != 0 && (r->bit & (r->bit - 1)) == 0 && !(all & r->bit) && inf.bit == r->bit);
         ENSURE(r->name && r->name[0] && inf.name == r->name && lag_effect_from_name(r->name) == k);
+        /* a name: [a-z][a-z0-9-]*, a key under a scene's effects: that is not gravity's (the
+         * model's g) and fits the scene message's comma-separated list; a name with a
+         * space (the scene fixture's unknown effect) can never be one */
+        ENSUREF(r->name && r->name[0] >= 'a' && r->name[0] <= 'z' &&
+                strspn(r->name, "abcdefghijklmnopqrstuvwxyz0123456789-") == strlen(r->name) &&
+                strcmp(r->name, "gravity") != 0,
+                "effect '%s': not a lowercase word that hyphens may join, or gravity's key",
+                r->name ? r->name : "(null)");
         ENSURE(r->validate != NULL);
         ENSURE(inf.per_tick == (r->pre_tick != NULL || r->watch != NULL));
         ENSURE(inf.events == (r->watch != NULL) && inf.force == (r->force != NULL) &&
@@ -290,7 +298,7 @@ static void check_table(int arg)
         all |= r->bit;
     }
     ENSURE(all == (1u << LAG_EFF_COUNT) - 1 && lag_effects_known() == all);
-    ENSURE(lag_effect_info_get(LAG_EFF_COUNT).name == NULL && lag_effect_from_name("nope") == -1);
+    ENSURE(lag_effect_info_get(LAG_EFF_COUNT).name == NULL && lag_effect_from_name("no such effect") == -1);
     /* the classes of the effects known when these were written by hand */
     ENSURE(lag_effects_per_tick(all) == (LAG_EFF_FRICTION | LAG_EFF_LIMITS | LAG_EFF_FLOOR |
                                          LAG_EFF_ACTUATOR | LAG_EFF_DISTURBANCE));

@@ -264,6 +264,19 @@ static void check_table(void)
             /* NaN default exactly for the rods' inertias */
             ENSURE(isnan(inf->param_defaults[i]) == rod_inertia);
         }
+        /* what the docs say of it (the generated lists, server/lists): a title, a
+         * summary, the meaning of each parameter and coordinate, and nothing beyond */
+        const lag_model_doc *doc = c->doc;
+        ENSUREF(doc && doc->title && doc->title[0] && doc->summary && doc->summary[0],
+                "model %s: its row has no doc (title, summary)", inf->name);
+        for (int i = 0; doc && i < LAG_MAX_PARAMS; ++i)
+            ENSUREF((i < inf->np) == (doc->params[i] != NULL && doc->params[i][0] != '\0'),
+                    "model %s: doc.params[%d] %s", inf->name, i,
+                    i < inf->np ? "is missing" : "is beyond the parameters");
+        for (int j = 0; doc && j < LAG_MAX_DOF; ++j)
+            ENSUREF((j < inf->nq) == (doc->joints[j] != NULL && doc->joints[j][0] != '\0'),
+                    "model %s: doc.joints[%d] %s", inf->name, j,
+                    j < inf->nq ? "is missing" : "is beyond the coordinates");
         /* g is a parameter of every model (the scene's effects.gravity sets it) */
         int g = lag_model_param_index((lag_model_kind)k, "g");
         ENSURE(g >= 0 && inf->param_rules[g] == LAG_PARAM_NONNEGATIVE &&
@@ -372,6 +385,11 @@ static void check_info(void)
         if (!mi) continue;
         ENSURE(lag_method_from_name(mi->name) == i && strstr(mlist, mi->name) != NULL);
         ENSURE(mi->order >= 1 && lag_method_order((lag_method)i) == mi->order);
+        /* a name: [a-z][a-z0-9-]*, what a scene's integrator.method holds (so that a name
+         * with a space, the scene fixture's unknown method, can never be one) */
+        ENSUREF(mi->name[0] >= 'a' && mi->name[0] <= 'z' &&
+                strspn(mi->name, "abcdefghijklmnopqrstuvwxyz0123456789-") == strlen(mi->name),
+                "method '%s': not a lowercase word that hyphens may join", mi->name);
         ENSURE(!(mi->canonical && !mi->implicit)); /* (q, p) Gauss methods are implicit */
     }
     ENSURE(lag_method_info_get(LAG_METHOD_COUNT) == NULL && strcmp(lag_method_name(LAG_METHOD_COUNT), "unknown") == 0);

@@ -11,17 +11,34 @@ usage: test_eval.py BIN_DIR SOURCE_DIR CASE
              or metric (exit 2)
   errors     a case file with a mistake: exit 2 and file:line:column
   scene      cases in the scene file: lagsimd ignores them, lagsim-eval runs them
+  owned      the keys the tools set on every run (their --help's table): a case's set:
+             naming one, or a mapping above one, is refused (exit 2, file:line:column,
+             the key) by lagsim-eval and lagsim-sweep, and so is a --vary of one;
+             docs/evaluation.md and both man pages list exactly the table's keys; every
+             key of the loader's table is either the tools' or one the test says a case
+             may set (and why), never neither
+  bus        the runs' URL: the group and options of LCM_DEFAULT_URL or --url, ports of
+             the tools' own (an even pair of 64000..65535): two lagsim-evals and a sweep of
+             two workers run at once on four pairs, each held (its lock file locked) while
+             its controller runs; ttl above 0 only with --allow-lan; memq:// and other
+             providers refused; {prefix} and {url} replaced as they are, inside quotes too
+  outputs    no output of lagsim-eval or lagsim-sweep is a file they read (the scene, the
+             suite, the daemon; merge's shards) or another of their outputs (the CSV and
+             the report's or the plot's files), whatever its spelling (./, a hard link),
+             with --force too: exit 2 before any run, the file untouched
 """
 import csv
 import glob
 import math
 import os
+import re
+import shutil
 import subprocess
 import sys
 import tempfile
 import time
 
-BIN, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
+BIN, SRC, CASE = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2]), sys.argv[3]
 SCENE = os.path.join(SRC, "config", "cartpole.yaml")
 SUITE = os.path.join(SRC, "tests", "eval", "cartpole_cases.yaml")
 CTRL = os.path.join(BIN, "lqr_balance") + " -q --prefix {prefix}"
@@ -247,7 +264,313 @@ def case_scene():
         check(p.returncode == 0 and "tilt" in p.stdout, "lagsim-eval runs the scene's own cases")
 
 
+def owned_keys(tool):
+    """The keys of the table the tool's --help prints: {key: its text}."""
+    out = subprocess.run([os.path.join(BIN, tool), "--help"], stdout=subprocess.PIPE,
+                         universal_newlines=True).stdout
+    keys, cur, inside = {}, None, False
+    for line in out.splitlines():
+        if line.startswith("keys %s sets on every run" % tool):
+            inside = True
+        elif inside and not line.strip():
+            break
+        elif inside and line.startswith("  ") and not line.startswith("   "):
+            cur = line.split()[0]
+            keys[cur] = " ".join(line.split()[1:])
+        elif inside and cur and line.startswith("   "):
+            keys[cur] += " " + line.strip()
+    return keys
+
+
+# a value the loader takes for each owned key (so that, were it not refused, the case
+# would run with it) and for the mappings above them
+OWNED_VALUES = {"realtime.mode": "realtime", "realtime.start": "paused",
+                "realtime.lockstep_timeout": "5",
+                "lcm.url": "'udpm://239.255.76.67:7667?ttl=0'", "lcm.prefix": "OTHER",
+                "lcm.allow_lan": "true", "realtime": "{mode: realtime}",
+                "lcm": "{prefix: OTHER}"}
+
+
+# The scene keys a case may set, each with why the tools' guarantees hold whatever it says;
+# every other key of the loader's table must be the tools' (their --help table), so that a
+# key added to the loader (a `log:` section, an lcm.interface) is refused in a case until
+# someone decides which it is.
+CASE_KEYS = {
+    "model": "the plant", "parameters": "the plant", "initial": "the plant",
+    "integrator": "the plant", "publish_hz": "the plant", "explode_limit": "the plant",
+    "effects": "the plant", "reference": "what the plant should follow",
+    "cases": "lagsim-eval's own key, which lagsimd ignores",
+    "realtime.rate": "real-time pacing: lockstep does not read it",
+    "realtime.command_timeout": "the watchdog, in sim time: the run stays deterministic",
+    "realtime.lockstep_retry": "when a state is sent again: the states do not change",
+    "realtime.status_hz": "the status rate: no metric reads a status",
+    "realtime.effort_limit": "the plant's actuators",
+}
+
+
+def loader_keys(section):
+    """The keys the loader's table has at the top (section "") or in a section, from
+    lagsimd's refusal of an unknown one ("...; allowed: a, b, c")."""
+    key = (section + "." if section else "") + "no_such_key_here"
+    p = subprocess.run([os.path.join(BIN, "lagsimd"), "--config", SCENE, "--set", key + "=1",
+                        "--offline", "--duration", "0.01", "--csv", "/dev/null"],
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+    m = re.search(r"allowed: (.*)$", p.stderr.strip(), re.M)
+    return [(section + "." if section else "") + k.strip() for k in m.group(1).split(",")] \
+        if m else []
+
+
+def case_owned():
+    keys = owned_keys("lagsim-eval")
+    # every key of the loader: the tools' or one a case may set, never neither
+    top = loader_keys("")
+    check(len(top) >= 10, "the loader's top-level keys: %s" % top)
+    every = [k for k in top if k not in ("realtime", "lcm")] + loader_keys("realtime") + \
+        loader_keys("lcm")
+    check(len(every) >= 18, "the loader's keys of the realtime and lcm sections read")
+    for k in every:
+        check((k in keys) != (k in CASE_KEYS),
+              "%s is %s" % (k, "the tools' (--help)" if k in keys else
+                            "a case's: " + CASE_KEYS[k] if k in CASE_KEYS else
+                            "NEITHER the tools' nor a case's: classify it"))
+    check(len(keys) >= 6 and keys == owned_keys("lagsim-sweep"),
+          "lagsim-eval and lagsim-sweep print one table of owned keys: %s" % sorted(keys))
+    must = {"realtime.mode", "realtime.start", "realtime.lockstep_timeout", "lcm.url",
+            "lcm.prefix", "lcm.allow_lan"}
+    check(must <= set(keys), "the mode, start, lockstep timeout, URL, prefix and LAN access "
+          "are owned")
+    # every key of the table and every mapping above one
+    paths = sorted(set(keys) | must | {k.split(".")[0] for k in set(keys) | must})
+    sweep = os.path.join(BIN, "lagsim-sweep")
+    with tempfile.TemporaryDirectory() as d:
+        for k in paths:
+            check(k in OWNED_VALUES, "the test has a value for %s" % k)
+            text = ('cases:\n  - name: ok\n    duration: 1\n  - name: own\n    duration: 1\n'
+                    '    set: ["initial.q=[0, 0.05]", "%s=%s"]\n'
+                    % (k, OWNED_VALUES.get(k, "1").replace('"', '\\"')))
+            f = os.path.join(d, "suite.yaml")
+            with open(f, "w") as fh:
+                fh.write(text)
+            p = run("--suite", f, "--timeout", "20")
+            check(p.returncode == 2 and "suite.yaml:6:34: cases[1].set[1]:" in p.stderr and
+                  "a case cannot set it" in p.stderr and
+                  (k + " is set by" in p.stderr or k + " holds " in p.stderr),
+                  "lagsim-eval: a case setting %s: exit 2 at its place, the key named (%d)"
+                  % (k, p.returncode))
+            p = subprocess.run([sweep, "--config", SCENE, "--controller", CTRL, "--suite", f,
+                                "--case", "ok", "--vary", "parameters.m1=uniform(0.1,0.2)",
+                                "--timeout", "20"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+            print(p.stderr)
+            check(p.returncode == 2 and "suite.yaml:6:34: cases[1].set[1]:" in p.stderr,
+                  "lagsim-sweep: the same suite refused at the same place (%d)" % p.returncode)
+            p = subprocess.run([sweep, "--config", SCENE, "--controller", CTRL, "--duration",
+                                "1", "--vary", k + "=uniform(0,1)", "--timeout", "20"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               universal_newlines=True, timeout=300)
+            print(p.stderr)
+            check(p.returncode == 2 and "--vary %s=" % k in p.stderr and
+                  "a sweep cannot vary it" in p.stderr,
+                  "lagsim-sweep --vary %s: exit 2, said why (%d)" % (k, p.returncode))
+    # the docs' table and the man pages name the table's keys, no other
+    text = open(os.path.join(SRC, "docs", "evaluation.md")).read()
+    sec = text.split("**What a case cannot change.**", 1)
+    documented = []
+    if len(sec) == 2:
+        lines = sec[1].splitlines()
+        while lines and not lines[0].startswith("|"):  # the text before the table
+            lines.pop(0)
+        for line in lines:
+            if not line.startswith("|"):
+                break
+            cell = line.split("|")[1].strip()
+            if cell.startswith("`"):
+                documented.append(cell.strip("`"))
+    check(sorted(documented) == sorted(keys),
+          "docs/evaluation.md's table of owned keys is the tools' (%s)" % documented)
+    for page in ("lagsim-eval.1", "lagsim-sweep.1"):
+        man = open(os.path.join(SRC, "docs", "man", page)).read().replace("\\", "")
+        sub = man.split(".SS Keys", 1)[-1].split(".SH", 1)[0] if ".SS Keys" in man else ""
+        named = set(re.findall(r"^\.TP\n\.B (\S+)$", sub, re.M))
+        check(named == set(keys), "%s names the owned keys (%s)" % (page, sorted(named)))
+
+
+# A controller that writes its URL and whether the lock file of its state port is held by
+# another (flock -n fails: 99), waits until every controller of the test wrote (the runs
+# overlap in time), then runs lqr_balance
+BUS_CTL = r"""#!/bin/sh
+port=${LCM_DEFAULT_URL##*:}; port=${port%%\?*}
+flock -n -E 99 "/run/lock/lagsim-udp-$port.lock" true; held=$?
+echo "$LCM_DEFAULT_URL $held" >> "$BUS_OUT"
+i=0
+while [ "$(wc -l < "$BUS_OUT")" -lt "$BUS_N" ] && [ $i -lt 300 ]; do sleep 0.1; i=$((i+1)); done
+exec "$@"
+"""
+
+
+def case_bus():
+    sweep = os.path.join(BIN, "lagsim-sweep")
+    with tempfile.TemporaryDirectory() as d:
+        ctl = os.path.join(d, "ctl.sh")
+        with open(ctl, "w") as f:
+            f.write(BUS_CTL)
+        out = os.path.join(d, "urls")
+        open(out, "w").close()
+        env = dict(os.environ, LCM_DEFAULT_URL="udpm://239.255.76.99:7720?ttl=0",
+                   BUS_OUT=out, BUS_N="4")
+        c = "sh %s %s -q --prefix {prefix}" % (ctl, os.path.join(BIN, "lqr_balance"))
+        evals = [[EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt", "--controller",
+                  c] for _ in range(2)]
+        sw = [sweep, "--config", SCENE, "--controller", c, "--duration", "1", "--runs", "4",
+              "-j", "2", "--vary", "parameters.m1=uniform(0.1,0.2)"]
+        procs = [subprocess.Popen(a, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                  universal_newlines=True) for a in evals + [sw]]
+        res = [p.communicate(timeout=300) + (p.returncode,) for p in procs]
+        for o, e, rc in res:
+            print(rc, o[-800:], e[-800:])
+        check(all(rc == 0 for _, _, rc in res), "two lagsim-evals and a sweep ran at once "
+              "(exit %s)" % [rc for _, _, rc in res])
+        lines = [l.split() for l in open(out).read().splitlines()]
+        print(lines)
+        urls = [l[0] for l in lines]
+        m = [re.match(r"^udpm://239\.255\.76\.99:(\d+)\?ttl=0$", u) for u in urls]
+        check(len(urls) == 4 and all(m), "each run's URL has LCM_DEFAULT_URL's group and "
+              "options, nothing added: %s" % urls)
+        ports = [int(x.group(1)) for x in m if x]
+        check(len(set(ports)) == 4 and all(64000 <= p <= 65534 and p % 2 == 0 for p in ports),
+              "four pairs of ports of the tools' range, none shared: %s" % ports)
+        check(all(l[1:] == ["99"] for l in lines), "each pair's lock file held while its runs "
+              "ran (flock -n: 99): %s" % [l[1:] for l in lines])
+        # --url over LCM_DEFAULT_URL; a ttl above 0 only with --allow-lan
+        env = dict(os.environ, LCM_DEFAULT_URL="udpm://239.255.76.99:7720?ttl=1")
+        pr = "echo \"$LCM_DEFAULT_URL\" > %s; exec %s -q --prefix {prefix}" % (
+            out, os.path.join(BIN, "lqr_balance"))
+        base = [EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt", "--controller", pr]
+        p = subprocess.run(base, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        check(p.returncode == 2 and "LCM_DEFAULT_URL" in p.stderr and "ttl=1" in p.stderr and
+              "--allow-lan" in p.stderr, "LCM_DEFAULT_URL with ttl=1: exit 2, --allow-lan named")
+        p = subprocess.run(base + ["--allow-lan"], env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+        u = open(out).read().strip()
+        check(p.returncode == 0 and re.match(r"^udpm://239\.255\.76\.99:\d+\?ttl=1$", u),
+              "with --allow-lan: the run on ttl=1 (%s, exit %d)" % (u, p.returncode))
+        p = subprocess.run(base + ["--url", "udpm://239.255.76.98?ttl=0&recv_buf_size=65536"],
+                           env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        u = open(out).read().strip()
+        check(p.returncode == 0 and
+              re.match(r"^udpm://239\.255\.76\.98:\d+\?ttl=0&recv_buf_size=65536$", u),
+              "--url's group and options over LCM_DEFAULT_URL (%s, exit %d)" % (u, p.returncode))
+        # {prefix} and {url} replaced as they are, inside the command's own quotes too
+        pr = ("printf '%%s|%%s|%%s|%%s|%%s\\n' '{prefix}' \"{prefix}\" \"$LAGSIM_PREFIX\" "
+              "'{url}' \"$LCM_DEFAULT_URL\" > %s; exec %s -q --prefix {prefix}"
+              % (out, os.path.join(BIN, "lqr_balance")))
+        p = subprocess.run([EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt",
+                            "--controller", pr], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        f = open(out).read().strip().split("|")
+        check(p.returncode == 0 and len(f) == 5 and f[0] == f[1] == f[2] and f[3] == f[4] and
+              re.match(r"^EVAL\d+_0$", f[0]) and f[3].startswith("udpm://"),
+              "'{prefix}', \"{prefix}\" and '{url}' are the run's prefix and URL as they are "
+              "(%s, exit %d)" % (f, p.returncode))
+        for tool in (EVAL, sweep):
+            for url, what in (("memq://", "memq://"), ("file:///tmp/x", "file://"),
+                              ("udpm://239.255.76.67:7667?ttl=0&foo=1", "foo"),
+                              ("udpm://10.0.0.1:7667?ttl=0", "not a multicast address")):
+                args = [tool, "--config", SCENE, "--suite", SUITE, "--case", "tilt",
+                        "--controller", CTRL, "--url", url]
+                if tool == sweep:
+                    args += ["--vary", "parameters.m1=uniform(0.1,0.2)"]
+                p = subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                   universal_newlines=True, timeout=60)
+                check(p.returncode == 2 and "--url " + url in p.stderr and what in p.stderr,
+                      "%s --url %s: exit 2, said why (%d: %s)"
+                      % (os.path.basename(tool), url, p.returncode, p.stderr.strip()[:200]))
+
+
+def case_outputs():
+    sweep = os.path.join(BIN, "lagsim-sweep")
+    with tempfile.TemporaryDirectory() as d:
+        suite = os.path.join(d, "suite.yaml")
+        text = "cases:\n  - name: a\n    duration: 0.5\n    set: [\"initial.q=[0, 0.05]\"]\n"
+        rep = os.path.join(d, "r")
+        os.mkdir(rep)
+        daemon = os.path.join(d, "lagsimd")
+        shutil.copy(os.path.join(BIN, "lagsimd"), daemon)
+        before = open(daemon, "rb").read()
+
+        def attempt(what, args, victim, tool=EVAL, cwd=None, untouched=True):
+            """runs the tool; exit 2 before any run, victim unchanged (untouched: else one
+            output of the two, which --force lets replace it)"""
+            if victim in (suite, os.path.join(rep, "a.dat"), os.path.join(rep, "a.gp")):
+                with open(victim, "w") as f:
+                    f.write(text)
+            old = open(victim, "rb").read()
+            base = [tool, "--config", SCENE, "--controller", CTRL]
+            p = subprocess.run(base + args + ["--force"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, universal_newlines=True, timeout=300,
+                               cwd=cwd)
+            print("$", " ".join(args), "->", p.returncode, p.stdout[-500:], p.stderr[-800:])
+            check(p.returncode == 2 and "the same file as" in p.stderr and
+                  "refused" in p.stderr and "case " not in p.stdout and "runs:" not in p.stdout
+                  and (open(victim, "rb").read() == old or not untouched),
+                  "%s: exit 2 before any run, %s untouched (%d)"
+                  % (what, os.path.basename(victim), p.returncode))
+
+        with open(suite, "w") as f:
+            f.write(text)
+        attempt("lagsim-eval --csv the suite", ["--suite", suite, "--csv", suite], suite)
+        attempt("lagsim-eval --csv ./suite.yaml", ["--suite", "suite.yaml", "--csv",
+                                                   "./suite.yaml"], suite, cwd=d)
+        link = os.path.join(d, "link.csv")
+        os.link(suite, link)
+        attempt("lagsim-eval --csv a hard link to the suite", ["--suite", suite, "--csv", link],
+                suite)
+        os.unlink(link)
+        for ext in ("dat", "gp"):
+            victim = os.path.join(rep, "a." + ext)
+            attempt("lagsim-eval --report: the suite is its a.%s" % ext,
+                    ["--suite", victim, "--report", rep], victim)
+            os.unlink(victim)
+        png = os.path.join(rep, "a.png")
+        with open(png, "w") as f:
+            f.write("an old PNG")
+        attempt("lagsim-eval --csv the report's PNG", ["--suite", suite, "--csv", png,
+                                                       "--report", rep], png, untouched=False)
+        check(sorted(os.listdir(rep)) == ["a.png"], "a refused run leaves no file it made "
+              "(%s)" % sorted(os.listdir(rep)))
+        os.link(os.path.join(rep, "a.png"), os.path.join(rep, "a.gp"))
+        attempt("lagsim-eval --report: its script a hard link to its PNG",
+                ["--suite", suite, "--report", rep], png)
+        attempt("lagsim-eval --csv the daemon", ["--suite", suite, "--lagsimd", daemon, "--csv",
+                                                 daemon], daemon)
+        # lagsim-sweep
+        sw = ["--suite", suite, "--case", "a", "--vary", "parameters.m1=uniform(0.1,0.2)"]
+        attempt("lagsim-sweep --csv the suite", sw + ["--csv", suite], suite, tool=sweep)
+        out = os.path.join(d, "s.out")
+        with open(out, "w") as f:
+            f.write("an old result")
+        attempt("lagsim-sweep --csv and --plot one file", sw + ["--csv", out, "--plot", out], out,
+                tool=sweep, untouched=False)
+        attempt("lagsim-sweep --csv the daemon", sw + ["--lagsimd", daemon, "--csv", daemon],
+                daemon, tool=sweep)
+        check(open(daemon, "rb").read() == before, "the daemon's copy is whole")
+        # merge: -o never one of its shards
+        shard = os.path.join(d, "shard.csv")
+        subprocess.run([sweep, "--config", SCENE, "--controller", CTRL, "--duration", "0.2",
+                        "--vary", "parameters.m1=uniform(0.1,0.2)", "--csv", shard],
+                       stdout=subprocess.PIPE, timeout=300)
+        os.link(shard, os.path.join(d, "merged.csv"))
+        old = open(shard).read()
+        p = subprocess.run([sweep, "merge", shard, "-o", os.path.join(d, "merged.csv"),
+                            "--force"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True)
+        check(p.returncode == 2 and "the same file as" in p.stderr and open(shard).read() == old,
+              "merge -o a hard link to its shard: exit 2, the shard untouched")
+
+
 {"metrics": case_metrics, "require": case_require, "errors": case_errors,
- "scene": case_scene}[CASE]()
+ "scene": case_scene, "owned": case_owned, "outputs": case_outputs, "bus": case_bus}[CASE]()
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)

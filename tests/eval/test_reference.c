@@ -156,8 +156,14 @@ static void case_check(int arg)
         if (k == LAG_REF_WAYPOINTS) s.n_points = 1;
         ENSURE(lag_reference_check(&s, key, sizeof key, msg, sizeof msg) == 0);
         ENSURE(lag_ref_kind_from_name(lag_ref_kind_table[k].name) == k);
+        /* a kind's name is a lowercase word, so that a name with a space (the scene
+         * fixture's unknown kind) can never be one */
+        const char *name = lag_ref_kind_table[k].name;
+        ENSUREF(name && name[0] >= 'a' && name[0] <= 'z' &&
+                strspn(name, "abcdefghijklmnopqrstuvwxyz0123456789-") == strlen(name),
+                "reference kind '%s': not a lowercase word", name ? name : "(null)");
     }
-    ENSURE(lag_ref_kind_from_name("triangle") == -1);
+    ENSURE(lag_ref_kind_from_name("no such type") == -1 && lag_ref_kind_from_name("") == -1);
     lag_reference s = lag_reference_default(LAG_REF_SINE);
     s.frequency = 0;
     ENSURE(lag_reference_check(&s, key, sizeof key, msg, sizeof msg) == -1 && !strcmp(key, "frequency"));

@@ -44,6 +44,20 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             sweep byte for byte (needs root, ip, sshd)
   stalled   the workers stopped and continued again and again (their sockets' queues
             overflow): runs read from the log, the same CSV, byte for byte
+  vary      --vary mistakes refused before any run (exit 2, said why): a key or a
+            coordinate varied twice, a key and one it holds, a reversed or one-point grid,
+            arguments that are no plain decimal or whose values overflow (a grid's step,
+            a normal's tail), a list varied whole, grids of more than 1e7 runs; integer
+            options that are not integers; the spellings the docs use still run
+  scene_c, scene_python  a controller that reads its gains from every scene (PD scaled by
+            m2: tests/eval/scene_pd.c, scene_pd.py), 40 manipulator runs over
+            parameters.m2=uniform(0.3,1.2): -j1, -j2, two shards merged and --restart give
+            the same CSV, byte for byte (a run's scene reaches the controller before the
+            first state of the run)
+  scene_loss  the same two controllers under 10 % datagram loss in a network namespace
+            (nftables; root, else skipped): the same CSVs as without loss, byte for byte
+  unanswered  a controller that never answers a run's last state: the worker waits for
+            that answer; the run after fails saying so, and the next gets a new pair
 """
 import csv
 import filecmp
@@ -672,10 +686,185 @@ def case_stalled(d):
           "workers stopped again and again: the same CSV, byte for byte")
 
 
+# (the --vary arguments, what the refusal says)
+BAD_VARY = [
+    (["parameters.m1=uniform(0.1,0.2)", "parameters.m1=uniform(0.2,0.3)"], "the same key as"),
+    (["initial.q[1]=normal(0,0.05)", "initial.q[1]=normal(0,0.1)"], "the same key as"),
+    (["initial.q[1]=normal(0,0.05)", "initial.q[01]=normal(0,0.1)"], "the same key as"),
+    (["parameters.m1=uniform(0.1,0.2)", "parameters=uniform(0,1)"], "holds or lies in"),
+    (["initial.q[1]=normal(0,0.05)", "initial=uniform(0,1)"], "holds or lies in"),
+    (["initial.q=uniform(0,1)"], "a list: vary one coordinate"),
+    (["parameters.m1=grid(1e308,-1e308,3)"], "A < B"),
+    (["parameters.m1=grid(-1e308,1e308,3)"], "B - A finite"),
+    (["parameters.m1=grid(0.3,0.05,4)"], "A < B"),
+    (["parameters.m1=grid(0.05,0.3,1)"], "an integer from 2"),
+    (["parameters.m1=grid(0.05,0.3,2.5)"], "an integer from 2"),
+    (["parameters.m1=grid(0.05,0.3,2000000)"], "an integer from 2"),
+    (["parameters.m1=uniform(-1e308,1e308)"], "B - A finite"),
+    (["parameters.m1=uniform(0.3,0.3)"], "A < B"),
+    (["parameters.m1=uniform(inf,1)"], "plain decimal"),
+    (["parameters.m1=uniform(0,1e999)"], "plain decimal"),
+    (["parameters.m1=uniform(0x1p-3,1)"], "plain decimal"),
+    (["parameters.m1=uniform(nan,1)"], "plain decimal"),
+    (["parameters.m1=normal(0,1e308)"], "9 SD finite"),
+    (["parameters.m1=normal(0.1,0)"], "SD > 0"),
+    (["parameters.m1=normal(0.1,-1)"], "SD > 0"),
+    (["parameters.m1=uniform(0.1,0.2)junk"], "plain decimal"),
+    (["parameters.m1=grid(0.1,0.2,1000)", "parameters.m0=grid(0.5,2,1000)",
+      "initial.q[1]=grid(0,0.1,1000)"], "more than 1e7 runs"),
+    # 1e36 runs: a count that overflowed to a negative one made "0 runs", exit 0
+    (["parameters.m1=grid(0.1,0.2,1000000)", "parameters.m0=grid(0.5,2,1000000)"] +
+     ["initial.%s[%d]=grid(0,0.1,1000000)" % (k, i) for k in ("q", "qd") for i in (0, 1)],
+     "more than 1e7 runs"),
+]
+
+
+def case_vary(d):
+    base = ["--config", SCENE, "--controller", CTRL, "--duration", "0.2"]
+    for vs, why in BAD_VARY:
+        args = sum((["--vary", v] for v in vs), [])
+        p = run([SWEEP] + base + args + ["--csv", os.path.join(d, "v.csv"), "--force"])
+        check(p.returncode == 2 and why in p.stderr and "runs:" not in p.stdout,
+              "--vary %s: exit 2 before any run, %r said (%d)" % (" ".join(vs), why,
+                                                                  p.returncode))
+    for opt, val in (("--runs", "2.5"), ("--jobs", "1.5"), ("--seed", "1.5"),
+                     ("--runs", "0x10"), ("--seed", "1e999")):
+        p = run([SWEEP] + base + ["--vary", "parameters.m1=uniform(0.1,0.2)", opt, val])
+        check(p.returncode == 2 and opt in p.stderr and "an integer" in p.stderr,
+              "%s %s: exit 2, an integer expected (%d)" % (opt, val, p.returncode))
+    # what the docs write runs: blanks after commas, two coordinates of one list, a grid
+    out = os.path.join(d, "ok.csv")
+    p = run([SWEEP] + base + ["--vary", "parameters.m1=grid(0.1, 0.2, 2)", "--vary",
+                              "initial.q[0]=uniform(-0.01, 0.01)", "--vary",
+                              "initial.q[1]=normal(0, 0.01)", "--runs", "2", "--csv", out])
+    check(p.returncode == 0 and [x["parameters.m1"] for x in rows(out)] ==
+          ["0.10000000000000001"] * 2 + ["0.20000000000000001"] * 2,
+          "grid(0.1, 0.2, 2) with blanks, two coordinates of initial.q: 4 runs (%d)"
+          % p.returncode)
+
+
+def scene_sweep(lang, runs=40):
+    """The arguments of a sweep of the scene-reactive controller in `lang`, and the env."""
+    build_python = os.path.join(os.path.dirname(BIN), "python")
+    env = dict(os.environ, PYTHONPATH=build_python)
+    ctrl = (os.path.join(BIN, "scene_pd") if lang == "c" else
+            "python3 " + os.path.join(SRC, "tests", "eval", "scene_pd.py")) + " -q --prefix {prefix}"
+    q = ["--config", os.path.join(SRC, "config", "manipulator.yaml"), "--controller", ctrl,
+         "--duration", "1.5", "--vary", "parameters.m2=uniform(0.3,1.2)", "--runs", str(runs),
+         "--seed", "11"]
+    return q, env
+
+
+def scene_same(d, lang):
+    q, env = scene_sweep(lang)
+    j1, j2, m, fresh = (os.path.join(d, lang + n) for n in
+                        ("j1.csv", "j2.csv", "merged.csv", "restart.csv"))
+    p = run([SWEEP] + q + ["-j1", "--csv", j1], env=env)
+    check(p.returncode in (0, 1) and len(rows(j1)) == 40, "%s: 40 runs with -j1" % lang)
+    m2 = [float(x["parameters.m2"]) for x in rows(j1)]
+    check(all(0.3 < v < 1.2 for v in m2) and len(set(m2)) == 40, "%s: 40 masses drawn" % lang)
+    run([SWEEP] + q + ["-j2", "--csv", j2], env=env)
+    sh = os.path.join(d, lang + "shard-{}.csv")
+    run(["parallel", "--will-cite", "-j2", SWEEP] + ["'%s'" % a for a in q] +
+        ["-j1", "--shard", "{}/2", "--csv", sh, ":::", "1", "2"], env=env)
+    run([SWEEP, "merge", sh.format(1), sh.format(2), "-o", m])
+    run([SWEEP] + q + ["-j2", "--restart", "--csv", fresh], env=env)
+    def data(path):  # the header and the rows: --restart is in the identity lines
+        return [x for x in open(path) if not x.startswith("#")]
+    for name, other in (("-j2", j2), ("two shards merged", m), ("--restart", fresh)):
+        same = os.path.exists(other) and (data(j1) == data(other) if name == "--restart"
+                                          else filecmp.cmp(j1, other, shallow=False))
+        differ = 0 if not os.path.exists(other) else sum(
+            a != b for a, b in zip(rows(j1), rows(other)))
+        check(same, "%s, m2 varied: %s gives the CSV of -j1, byte for byte (%d rows differ)"
+              % (lang, name, differ))
+        if not same and os.path.exists(other):
+            for a, b in [(a, b) for a, b in zip(rows(j1), rows(other)) if a != b][:3]:
+                print("  run %s: -j1 failed=%s %r; %s failed=%s %r" % (
+                    a["run"], a["failed"], a["reason"], name, b["failed"], b["reason"]))
+    return j1
+
+
+def case_scene_c(d):
+    scene_same(d, "c")
+
+
+def case_scene_python(d):
+    scene_same(d, "python")
+
+
+def case_scene_loss(d):
+    if os.geteuid() != 0 or not shutil.which("nft") or not shutil.which("ip"):
+        print("skipped: needs root, ip and nft")
+        sys.exit(77)
+    ns = "lgscene%d" % os.getpid()
+    if subprocess.run(["ip", "netns", "add", ns]).returncode != 0:
+        print("skipped: cannot make a network namespace here")
+        sys.exit(77)
+    try:
+        inns = ["ip", "netns", "exec", ns]
+        for c in (["ip", "link", "set", "lo", "up"],
+                  ["ip", "route", "add", "224.0.0.0/4", "dev", "lo"],
+                  ["nft", "add", "table", "inet", "loss"],
+                  ["nft", "add", "chain", "inet", "loss", "in",
+                   "{ type filter hook input priority 0; }"]):
+            subprocess.run(inns + c, check=True)
+        for lang in ("c", "python"):
+            q, env = scene_sweep(lang, 20)
+            clean, lossy = (os.path.join(d, lang + n) for n in ("clean.csv", "lossy.csv"))
+            subprocess.run(inns + ["nft", "flush", "chain", "inet", "loss", "in"], check=True)
+            run(inns + [SWEEP] + q + ["-j2", "--csv", clean], env=env)
+            # 1 datagram in 10 dropped on the plants' ports, both ways
+            subprocess.run(inns + ["nft", "add", "rule", "inet", "loss", "in", "udp", "dport",
+                                   "64000-65535", "numgen", "random", "mod", "10", "==", "0",
+                                   "counter", "drop"], check=True)
+            p = run(inns + [SWEEP] + q + ["-j2", "-v", "--csv", lossy], env=env)
+            dropped = subprocess.run(inns + ["nft", "list", "chain", "inet", "loss", "in"],
+                                     stdout=subprocess.PIPE, universal_newlines=True).stdout
+            print(dropped)
+            check(" drop" in dropped and "packets 0 " not in dropped,
+                  "%s: datagrams were dropped" % lang)
+            check(p.returncode in (0, 1) and len(rows(lossy)) == 20,
+                  "%s: the sweep ran under loss (exit %d)" % (lang, p.returncode))
+            check(filecmp.cmp(clean, lossy, shallow=False),
+                  "%s, m2 varied, 10 %% of datagrams lost: the CSV without loss, byte for byte"
+                  % lang)
+    finally:
+        subprocess.run(["ip", "netns", "del", ns])
+
+
+def case_unanswered(d):
+    # a controller that never answers a run's last state (the one the daemon pauses at):
+    # the worker does not start the next run on that pair (an answer of the run before
+    # could still be on its way): that run fails, saying why, and the run after it gets a
+    # new pair, as after a stalled run (tests/eval/mute_pd.py)
+    q, env = scene_sweep("c", 3)
+    mute = "python3 %s -q --mute-from 0.5 --prefix {prefix}" % os.path.join(
+        SRC, "tests", "eval", "mute_pd.py")
+    q[q.index("--controller") + 1] = mute
+    q[q.index("--duration") + 1] = "0.5"
+    out = os.path.join(d, "mute.csv")
+    t0 = time.monotonic()
+    p = run([SWEEP] + q + ["-j1", "--csv", out], env=env)
+    took = time.monotonic() - t0
+    said = p.stderr.count("did not answer the paused state")
+    check(said == 1 and "a new lagsimd and controller for the next run" in p.stderr,
+          "the controller's silence on the paused state is said once (%d), a new pair next"
+          % said)
+    r = rows(out) if os.path.exists(out) else []
+    check([x["failed"] for x in r] == ["0", "1", "0"] and
+          "did not answer the paused state" in r[1]["reason"] and took > 10,
+          "run 1 failed with that reason after waiting 10 s for the answer, runs 0 and 2 "
+          "(a new pair) did not (%.1f s)" % took)
+
+
 with tempfile.TemporaryDirectory() as tmp:
-    {"same": case_same, "slurm": case_slurm, "merge": case_merge, "kept": case_kept,
-     "merge_rows": case_merge_rows, "merge_foreign": case_merge_foreign, "shard": case_shard,
+    {"same": case_same, "vary": case_vary, "slurm": case_slurm, "merge": case_merge,
+     "kept": case_kept, "merge_rows": case_merge_rows, "merge_foreign": case_merge_foreign,
+     "shard": case_shard,
      "loss": case_loss, "stalled": case_stalled, "ssh": case_ssh,
-     "kept_python": case_kept_python}[CASE](tmp)
+     "kept_python": case_kept_python, "scene_c": case_scene_c,
+     "scene_python": case_scene_python, "scene_loss": case_scene_loss,
+     "unanswered": case_unanswered}[CASE](tmp)
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)

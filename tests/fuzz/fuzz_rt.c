@@ -191,8 +191,12 @@ static void wake(void)
 
 static void handler_done(int64_t before)
 {
+    int64_t scenes = g_c.scene;
     drain();
-    if (out_total() - before > 1) bad("a handler call published more than one message");
+    /* one answer, and the scene of a new generation (a SET, a kick, a reset) before it */
+    if (g_c.scene - scenes > 1) bad("a handler call published more than one scene");
+    if (out_total() - before - (g_c.scene - scenes) > 1)
+        bad("a handler call published more than one message besides a new generation's scene");
     check_state();
 }
 
@@ -358,7 +362,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 g_s.info->name, lag_rt_mode_name(g_sc.realtime.mode),
                 (double)(g_s.now - t0) * 1e-9, (long long)g_s.sim.tick, rt_run_name(g_s.run),
                 (long long)g_s.numeric_faults, (long long)g_s.accepted,
-                (long long)g_s.rejected[RT_REJ_EFFORT_LIMIT], (long long)g_s.controls_rejected,
+                (long long)g_s.rejected[RT_REJ_EFFORT_LIMIT], (long long)g_s.ctl.controls_rejected,
                 (long long)g_c.state, (long long)g_c.status, (long long)g_c.scene,
                 (long long)g_c.event);
     rt_finish(&g_s);
@@ -378,7 +382,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if ((double)g_c.ev_kind[RT_EV_COUNT + 1] > RT_SET_BURST + RT_SET_PER_S * secs + 1) bad("too many set events");
     /* statuses: the first and the last, bucket 5 + 20/s, periodic at most 100/s */
     if ((double)g_c.status > 2 + 5 + 20 * secs + 100 * secs + 1) bad("too many statuses");
-    if ((double)g_c.scene > 1 + 2 + 5 * secs + 1) bad("too many scene descriptions");
+    /* scenes: the first; DESCRIBE's bucket (2 + 5/s); one per new generation, which SET's
+     * and RESET's buckets bound */
+    if ((double)g_c.scene > 1 + 2 + 5 * secs + RT_SET_BURST + RT_SET_PER_S * secs +
+                                RT_RESET_BURST + RT_RESET_PER_S * secs + 1)
+        bad("too many scene descriptions");
     /* states: per wake-up a burst of periods (or a republication), the initial one, and
      * the resets' bucket */
     if ((double)g_c.state > 1 + (double)wakes * RT_MAX_BURST + 5 + 20 * secs + 1) bad("too many states");

@@ -13,7 +13,7 @@ pages:  every program in bin/ has a man page in share/man/man1 (a ".so" page fol
 models: the lists of models, each against the core's table (BIN prints it) name for
         name, missing and extra names alike: lagsimd --help's list, the list of lagsimd.1's
         DESCRIPTION (its .B names between the two dashes) and the comment of scene_t.model
-        in scene_t.lcm (the names after "table:"). Besides these, any run of two or more
+        in scene_t.lcm (the names after "lagsimd --list models:"). Besides these, any run of two or more
         of the table's names joined by commas, "or" or "and" (the table's spelling, whole
         words) in each installed program's --help, the Python, Lua and Java examples'
         --help, every installed man page and every installed .lcm file's comments is a
@@ -161,7 +161,8 @@ def page_list(troff):
 
 
 def lcm_list(text):
-    """scene_t.lcm: the comment of `model` and its continuation lines, after "table:"."""
+    """scene_t.lcm: the comment of `model` and its continuation lines, after "lagsimd --list
+    models:" (the names a | b | c, generated from the table: server/lists)."""
     lines = text.splitlines()
     for i, line in enumerate(lines):
         if re.match(r"\s*string\s+model;", line):
@@ -170,8 +171,8 @@ def lcm_list(text):
                 if not more.strip().startswith("//"):
                     break
                 comment += " " + more.strip()[2:]
-            if "table:" in comment:
-                return split_names(comment.split("table:", 1)[1])
+            if "lagsimd --list models:" in comment:
+                return [n.strip() for n in comment.split("lagsimd --list models:", 1)[1].split("|")]
     return None
 
 

@@ -57,7 +57,8 @@ static void command(double sim_time, double effort)
 {
     uint8_t buf[256];
     char *names[1] = {"theta0"};
-    lagsim_joint_command_t m = {0, sim_time, 1, names, &effort};
+    /* answers the state of the current generation */
+    lagsim_joint_command_t m = {0, sim_time, 1, names, &effort, g_srv.pub.generation};
     int n = lagsim_joint_command_t_encode(buf, 0, sizeof buf, &m);
     ENSURE(n > 0);
     rt_handle_command(&g_srv, buf, (size_t)n);
@@ -278,7 +279,7 @@ static void case_file(int arg)
     }
     control(LAGSIM_CONTROL_T_STATUS);
     run_until(g_srv.now + 5 * MS, 1000);
-    int64_t published = g_srv.states_published;
+    int64_t published = g_srv.pub.states_published;
     ENSURE(finish() == 0);
     logfacts f;
     read_log(g_file, &f);
@@ -398,8 +399,8 @@ static void stalled_no_deadline(lag_rt_mode mode)
     ENSURE(!rt_log_room(g_srv.rec.log));
     ENSUREF(rt_next_wake(&g_srv) > g_srv.now, "wake in %lld ns: waiting %d answered %d "
             "period_left %lld want %d%d%d", (long long)(rt_next_wake(&g_srv) - g_srv.now),
-            g_srv.ls.waiting, g_srv.ls.answered, (long long)g_srv.period_left, g_srv.want_state,
-            g_srv.want_scene, g_srv.want_status); /* it sleeps while held */
+            g_srv.ls.waiting, g_srv.ls.answered, (long long)g_srv.period_left, g_srv.pub.want_state,
+            g_srv.pub.want_scene, g_srv.pub.want_status); /* it sleeps while held */
     run_until(g_srv.now + 2 * SEC, 1000);
     ENSUREF(g_states == held, "%lld states while held, then %lld", (long long)held,
             (long long)g_states);

@@ -83,7 +83,7 @@ e() { "$expect" "$lagsimd" "$cfg/dipc.yaml" "$@" || fail=1; }
 e --expect "--set integrator.dt: expected a finite number > 0 (s), got -1" -- --set integrator.dt=-1
 e --expect "--set integrator.dt: missing value: expected a number" -- --set integrator.dt=
 e --expect "--set integrator: integrator.dt: expected a finite number > 0 (s), got -1" -- --set "integrator={dt: -1}"
-e --expect "--set integrator.method: unknown method 'rk5'" -- --set integrator.method=rk5
+e --expect "--set integrator.method: unknown method 'no such method'" -- --set "integrator.method=no such method"
 e --expect "--set initial.q: expected a sequence of 3 numbers (theta0, theta1, theta2) for model dipc, got 2" -- --set "initial.q=[0,0.1]"
 e --expect "--set parameters.m9: unknown parameter 'm9' for model dipc" -- --set parameters.m9=1
 e --expect "--set parameters.m0: expected a number > 0 (kg), got -1.5" -- --set parameters.m0=-1.5
@@ -92,7 +92,7 @@ e --expect "--set realtime.mode: unknown mode 'slow'" -- --set realtime.mode=slo
 e --expect "--set lcm.prefix: YAML syntax error" -- --set "lcm.prefix=[a"
 e --expect "--set integrator..dt: empty key in the dotted path" -- --set integrator..dt=1
 e --expect "--set effects.damping: expected a mapping of joints (theta0, theta1, theta2), got a scalar" -- --set effects.damping=1
-e --expect "--set effects.drag: unknown effect 'drag' in effects" -- --set effects.drag=1
+e --expect "--set effects.no such effect: unknown effect 'no such effect' in effects" -- --set "effects.no such effect=1"
 e --expect "--set lcm.url: ttl=1 sends every message beyond this host" -- --set "lcm.url=udpm://239.255.76.67:7667?ttl=1"
 e --expect "--set lcm.url: udpm option 'ttl' given twice" -- --set lcm.allow_lan=true --set "lcm.url=udpm://239.255.76.67?ttl=0&ttl=1"
 e --expect "--set lcm.url: memq:// takes no address or options" -- --set "lcm.url=memq://x"

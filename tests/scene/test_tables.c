@@ -11,13 +11,18 @@
  *   keeps_state    a row that says it keeps no state of its own restarts exactly from
  *                  (q, qd, tick), state and published state, which is what replay takes
  *                  it at (replay.c)
- *   view           every effect the browser view asks about (view.js, hasEffect) is a row
+ *   view           every effect the browser view asks about (view.js, hasEffect) is a row,
+ *                  and its table of drawings (DRAW) has one per model of the core's model
+ *                  table and none besides
  *   docs           docs/effects.md's table of effects and docs/scenes.md's table of
- *                  ranges list every row, and name no effect the core does not have;
- *                  docs/server.md's list of the effects a replay restart cannot
- *                  reproduce is the rows with keeps_state
- *   docs_models    docs/scenes.md names every model of the core's model table, and
- *                  README.md's first paragraph each model (by a phrase of its prose)
+ *                  ranges list every row, and name no effect the core does not have
+ *                  (prose, written by hand; the lists that can be generated are:
+ *                  server/lists, structure_lists)
+ *   docs_channels  docs/server.md's table of channels and lagsimd.1's CHANNELS name the
+ *                  bus's channels (lagsim_bus.c's table), each once, and no other
+ *   docs_keys      every numeric key of the loader's tables, for every model, has its row
+ *                  in docs/scenes.md's table of ranges (reference keys: in the table of
+ *                  the reference's keys), by its pattern (<joint>, <name>, [i])
  *
  * Files are read from the source tree (LAGSIM_SOURCE_DIR).
  */
@@ -262,6 +267,45 @@ static void case_keeps_state(int arg)
 
 static char g_text[1 << 20];
 
+/* view.js's DRAW = { name: function, "a-name": function, ... }: its keys are exactly the
+ * core's models (a model without a drawing shows only its numbers; a key no model has is
+ * dead code). */
+static void view_drawings(void)
+{
+    const char *p = strstr(g_text, "const DRAW = {");
+    const char *end = p ? strstr(p, "};") : NULL;
+    if (!p || !end) {
+        LT_FAIL("view: view.js has no `const DRAW = { ... };` any more (the test's landmark)");
+        return;
+    }
+    bool drawn[LAG_MODEL_COUNT] = {false};
+    for (p += strlen("const DRAW = {"); p < end;) {
+        p += strspn(p, " \n,\"");
+        size_t len = strcspn(p, "\": ");
+        if (p >= end || len == 0) break;
+        int k = -1;
+        for (int m = 0; m < LAG_MODEL_COUNT; m++) {
+            const char *name = lag_model_info_get((lag_model_kind)m)->name;
+            if (strlen(name) == len && strncmp(name, p, len) == 0) k = m;
+        }
+        if (k < 0)
+            LT_FAIL("view: view.js draws a model '%.*s' the core's table does not have", (int)len, p);
+        else
+            drawn[k] = true;
+        p = strchr(p, ',') ? strchr(p, ',') : end; /* past its function */
+    }
+    int n = 0;
+    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
+        if (!drawn[k])
+            LT_FAIL("view: view.js has no drawing for model '%s' (a DRAW entry, "
+                    "server/view/page/view.js)", lag_model_info_get((lag_model_kind)k)->name);
+        else
+            ENSURE(drawn[k]);
+        n += drawn[k];
+    }
+    printf("view: a drawing for %d of the %d models of the core's table\n", n, LAG_MODEL_COUNT);
+}
+
 static void case_view(int arg)
 {
     (void)arg;
@@ -278,6 +322,7 @@ static void case_view(int arg)
             ENSURE(true);
     }
     printf("view: %d questions about effects, each by a name of the core's table\n", asked);
+    view_drawings();
 }
 
 /* The part of `file` from `start` to the next `end`: every row of the core's table appears
@@ -319,54 +364,6 @@ static void doc_lists(const char *file, const char *start, const char *end, cons
     }
 }
 
-/* docs/server.md ("Gaps") lists the effects a restart from a logged state cannot
- * reproduce as "(`lag_effect_info.keeps_state`: a, b, c)": exactly the rows that may keep
- * state of their own, which is what replay.c takes. */
-static void doc_keeps_state(void)
-{
-    static const char file[] = "docs/server.md", start[] = "(`lag_effect_info.keeps_state`: ";
-    if (!read_source(file, g_text, sizeof g_text)) return;
-    const char *p = strstr(g_text, start);
-    if (!p) {
-        LT_FAIL("docs: %s has no \"%s\" any more (the test's landmark)", file, start);
-        return;
-    }
-    p += strlen(start);
-    const char *end = p + strcspn(p, ")");
-    bool listed[LAG_EFF_COUNT] = {false};
-    static const char seps[] = ", \n";
-    for (p += strspn(p, seps); p < end; p += strspn(p, seps)) {
-        size_t len = strcspn(p, seps);
-        if (p + len > end) len = (size_t)(end - p);
-        if (len == 3 && strncmp(p, "and", 3) == 0) { /* "a, b and c" */
-            p += len;
-            continue;
-        }
-        int row = -1;
-        for (int k = 0; k < LAG_EFF_COUNT; k++) {
-            const char *r = lag_effect_info_get(k).name;
-            if (strlen(r) == len && strncmp(r, p, len) == 0) row = k;
-        }
-        if (row < 0)
-            LT_FAIL("docs: %s lists '%.*s' among the effects that keep state; the core's table "
-                    "has no such effect", file, (int)len, p);
-        else if (!lag_effect_info_get(row).keeps_state)
-            LT_FAIL("docs: %s lists effect '%s' as keeping state; its row keeps none", file,
-                    lag_effect_info_get(row).name);
-        else
-            listed[row] = true;
-        p += len;
-    }
-    for (int k = 0; k < LAG_EFF_COUNT; k++) {
-        lag_effect_info e = lag_effect_info_get(k);
-        if (e.keeps_state && !listed[k])
-            LT_FAIL("docs: %s does not list effect '%s', whose row keeps state, among those a "
-                    "replay restart cannot reproduce", file, e.name);
-        else
-            ENSURE(listed[k] == e.keeps_state);
-    }
-}
-
 static void case_docs(int arg)
 {
     (void)arg;
@@ -377,89 +374,194 @@ static void case_docs(int arg)
     doc_lists("docs/effects.md", "```yaml\neffects:\n", "```", "\n  ", ":", others);
     /* scenes.md: the table of ranges */
     doc_lists("docs/scenes.md", "| key | range | unit |", "\n\n", "`effects.", ".[`", others);
-    /* server.md: the effects a replay restart cannot reproduce */
-    doc_keeps_state();
 }
 
-/* How README.md's first paragraph names each model in its prose (it names them as a reader
- * knows them, not by the table's names); a model of the core's table without a phrase
- * here fails: name it in the README and give its phrase. */
-static const char *const readme_phrase[LAG_MODEL_COUNT] = {
-    [LAG_MODEL_STICK] = "sliding stick",
-    [LAG_MODEL_MANIPULATOR] = "manipulator",
-    [LAG_MODEL_DIPC] = "double inverted pendulum on a cart (DIPC)",
-    [LAG_MODEL_CARTPOLE] = "cart-pole",
-    [LAG_MODEL_FLYING_STICK] = "can leave its floor", /* the sliding stick, flying */
-};
+/* ---------------------------------------------------------------- docs_channels */
 
-static void readme_models(void)
+/* Counts, in `text` from `start` to `end`, each `before SUFFIX after` of the bus's channels
+ * and any other `before X after` of capitals; fails on a channel named other than once. */
+static void doc_channels(const char *file, const char *start, const char *end, const char *before,
+                         const char *after)
 {
-    if (!read_source("README.md", g_text, sizeof g_text)) return;
-    /* the first paragraph after the title, its whitespace and emphasis folded */
-    char para[2048];
-    size_t n = 0;
-    const char *p = strstr(g_text, "\n\n");
-    p = p ? p + 2 : g_text;
-    for (; *p && !(p[0] == '\n' && p[1] == '\n') && n + 1 < sizeof para; p++) {
-        if (*p == '*') continue;
-        char c = (*p == '\n') ? ' ' : *p;
-        if (c == ' ' && n && para[n - 1] == ' ') continue;
-        para[n++] = c;
-    }
-    para[n] = '\0';
-    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
-        const char *name = lag_model_info_get((lag_model_kind)k)->name;
-        if (!readme_phrase[k])
-            LT_FAIL("docs: README.md: the test knows no phrase for model '%s' (name it in the "
-                    "README's first paragraph and give the phrase in readme_phrase)", name);
-        else if (!strstr(para, readme_phrase[k]))
-            LT_FAIL("docs: README.md's first paragraph does not name model '%s' (\"%s\")", name,
-                    readme_phrase[k]);
-        else
-            ENSURE(true);
-    }
-}
-
-/* docs/scenes.md names every model of the core's table where it lists them: the comment
- * of `model:` in the scene reference, and a row of the parameters' table per model. */
-static void case_docs_models(int arg)
-{
-    (void)arg;
-    if (!read_source("docs/scenes.md", g_text, sizeof g_text)) return;
-    const char *line = strstr(g_text, "\nmodel: dipc ");
-    const char *table = strstr(g_text, "| model | key | default | unit | meaning |");
-    if (!line || !table) {
-        LT_FAIL("docs: docs/scenes.md has no `model:` line or parameters table any more");
+    if (!read_source(file, g_text, sizeof g_text)) return;
+    char *from = strstr(g_text, start), *to = from ? strstr(from, end) : NULL;
+    if (!from || !to) {
+        LT_FAIL("docs_channels: %s has no \"%s\" ... \"%s\" any more (the test's landmarks)", file,
+                start, end);
         return;
     }
-    size_t llen = strcspn(line + 1, "\n") + 1;
-    const char *tend = strstr(table, "\n\n");
-    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
-        const char *name = lag_model_info_get((lag_model_kind)k)->name;
-        char cell[64];
-        bool in_line = false;
-        for (const char *p = line; (p = strstr(p, name)) && p < line + llen; p++) {
-            char after = p[strlen(name)];
-            in_line |= (p[-1] == ' ') && (after == ' ' || after == '\n');
+    *to = '\0';
+    int seen[LAG_BUS_CHANNEL_COUNT] = {0};
+    for (const char *p = from; (p = strstr(p, before)) != NULL; p++) {
+        const char *w = p + strlen(before);
+        size_t len = strspn(w, "_ABCDEFGHIJKLMNOPQRSTUVWXYZ");
+        if (len == 0 || strncmp(w + len, after, strlen(after)) != 0) continue;
+        int c = -1;
+        for (int k = 0; k < LAG_BUS_CHANNEL_COUNT; k++) {
+            const char *suf = lag_bus_suffix((lag_bus_channel)k);
+            if (strlen(suf) == len && strncmp(suf, w, len) == 0) c = k;
         }
-        snprintf(cell, sizeof cell, "\n| %s |", name);
-        const char *row = strstr(table, cell);
-        if (!in_line)
-            LT_FAIL("docs: docs/scenes.md's `model:` line does not name model '%s'", name);
+        if (c < 0)
+            LT_FAIL("docs_channels: %s names a channel %.*s the bus's table does not have", file,
+                    (int)len, w);
         else
-            ENSURE(in_line);
-        if (!row || (tend && row > tend))
-            LT_FAIL("docs: docs/scenes.md's parameters table has no row for model '%s'", name);
-        else
-            ENSURE(row);
+            seen[c]++;
     }
-    readme_models();
+    for (int k = 0; k < LAG_BUS_CHANNEL_COUNT; k++) {
+        if (seen[k] != 1)
+            LT_FAIL("docs_channels: %s names channel <PREFIX>%s %d times (once, in its list)", file,
+                    lag_bus_suffix((lag_bus_channel)k), seen[k]);
+        else
+            ENSURE(seen[k] == 1);
+    }
+}
+
+static void case_docs_channels(int arg)
+{
+    (void)arg;
+    doc_channels("docs/server.md", "| channel | type |", "\n\n", "\n| `<PREFIX>", "` |");
+    doc_channels("docs/man/lagsimd.1", ".SH CHANNELS", ".SH SIGNALS", "\n.IB PREFIX ", "\n");
+    printf("docs_channels: the bus's %d channels looked for in server.md's table and lagsimd.1\n",
+           LAG_BUS_CHANNEL_COUNT);
+}
+
+/* ---------------------------------------------------------------- docs_keys */
+
+#define MAX_KEYS 256
+typedef struct keyset {
+    int n;
+    char key[MAX_KEYS][96];
+} keyset;
+
+static void keyset_add(keyset *ks, const char *k)
+{
+    for (int i = 0; i < ks->n; i++)
+        if (strcmp(ks->key[i], k) == 0) return;
+    if (ks->n < MAX_KEYS) snprintf(ks->key[ks->n++], sizeof ks->key[0], "%s", k);
+}
+
+static bool keyset_has(const keyset *ks, const char *k)
+{
+    for (int i = 0; i < ks->n; i++)
+        if (strcmp(ks->key[i], k) == 0) return true;
+    return false;
+}
+
+/* A loader path as the docs write it: a joint of the model as <joint>, a parameter as
+ * <name>, an index as [*] ("effects.damping.theta1" -> "effects.damping.<joint>"). */
+typedef struct key_walk {
+    const lag_model_info *info;
+    keyset *out;
+} key_walk;
+
+static void each_key(void *vc, const char *path, bool integer)
+{
+    (void)integer;
+    key_walk *w = vc;
+    char out[96] = "", part[96];
+    bool params = strncmp(path, "parameters.", 11) == 0;
+    for (const char *p = path; *p;) {
+        size_t len = strcspn(p, ".[");
+        snprintf(part, sizeof part, "%.*s", (int)len, p);
+        bool joint = false;
+        for (int j = 0; j < w->info->nq; j++) joint |= strcmp(part, w->info->joint_names[j]) == 0;
+        const char *as = p != path && params ? "<name>" : joint ? "<joint>" : part;
+        snprintf(out + strlen(out), sizeof out - strlen(out), "%s", as);
+        p += len;
+        if (*p == '[') {
+            snprintf(out + strlen(out), sizeof out - strlen(out), "[*]");
+            p = strchr(p, ']') ? strchr(p, ']') + 1 : p + strlen(p);
+        }
+        if (*p == '.') {
+            snprintf(out + strlen(out), sizeof out - strlen(out), ".");
+            p++;
+        }
+    }
+    keyset_add(w->out, out);
+}
+
+/* The keys docs/scenes.md's table of ranges names in its first column: each `path` (its
+ * [i], [k] as [*]); a `.suffix` after a path replaces as many of that path's last parts
+ * ("`effects.friction.<joint>.static`, `.kinetic`"). */
+static void documented_keys(const char *table, keyset *doc)
+{
+    for (const char *row = table; row && row[0] == '|'; row = strchr(row, '\n') ? strchr(row, '\n') + 1 : NULL) {
+        const char *cell_end = strchr(row + 1, '|');
+        char prev[200] = "";
+        for (const char *p = row; (p = strchr(p, '`')) && cell_end && p < cell_end;) {
+            const char *e = strchr(p + 1, '`');
+            if (!e || e > cell_end) break;
+            char tok[96], key[200];
+            snprintf(tok, sizeof tok, "%.*s", (int)(e - p - 1), p + 1);
+            if (tok[0] == '.' && prev[0]) { /* a suffix of the previous path */
+                int parts = 0;
+                for (const char *c = tok; *c; c++) parts += *c == '.';
+                char *cut = prev + strlen(prev);
+                for (; parts > 0 && cut > prev; parts--) { /* back over one ".part" */
+                    cut--;
+                    while (cut > prev && *cut != '.') cut--;
+                }
+                snprintf(key, sizeof key, "%.*s%s", (int)(cut - prev), prev, tok);
+            } else {
+                snprintf(key, sizeof key, "%s", tok);
+            }
+            char canon[200] = "";
+            for (const char *c = key; *c; c++) { /* [i], [k] -> [*] */
+                if (*c == '[' && strchr(c, ']')) {
+                    strcat(canon, "[*]");
+                    c = strchr(c, ']');
+                } else {
+                    size_t n = strlen(canon);
+                    if (n + 1 < sizeof canon) canon[n] = *c, canon[n + 1] = '\0';
+                }
+            }
+            keyset_add(doc, canon);
+            snprintf(prev, sizeof prev, "%s", key);
+            p = e + 1;
+        }
+    }
+}
+
+static void case_docs_keys(int arg)
+{
+    (void)arg;
+    static keyset loader, doc;
+    for (int k = 0; k < LAG_MODEL_COUNT; k++) {
+        key_walk w = {lag_model_info_get((lag_model_kind)k), &loader};
+        scene_schema_each_number((lag_model_kind)k, each_key, &w);
+    }
+    if (!read_source("docs/scenes.md", g_text, sizeof g_text)) return;
+    const char *ranges = strstr(g_text, "| key | range | unit |");
+    const char *refs = strstr(g_text, "| key | kinds | range | default |");
+    if (!ranges || !refs) {
+        LT_FAIL("docs_keys: docs/scenes.md has no table of ranges or of the reference's keys "
+                "any more (the test's landmarks)");
+        return;
+    }
+    documented_keys(strchr(ranges, '\n') + 1, &doc);
+    int found = 0;
+    for (int i = 0; i < loader.n; i++) {
+        const char *key = loader.key[i];
+        char want[128];
+        bool ref = strncmp(key, "reference.<joint>.", 18) == 0;
+        snprintf(want, sizeof want, "\n| `%s` |", key + (ref ? 18 : 0));
+        bool ok = ref ? strstr(refs, want) != NULL : keyset_has(&doc, key);
+        if (!ok)
+            LT_FAIL("docs_keys: the loader's key %s has no row in docs/scenes.md's %s", key,
+                    ref ? "table of the reference's keys" : "table of ranges");
+        else
+            ENSURE(ok);
+        found += ok;
+    }
+    printf("docs_keys: %d of the loader's %d numeric key patterns documented in docs/scenes.md\n",
+           found, loader.n);
 }
 
 static const lt_case cases[] = {
     {"loader", case_loader, 0, 0},           {"scene_message", case_scene_message, 0, 0},
     {"keeps_state", case_keeps_state, 0, 0}, {"view", case_view, 0, 0},
-    {"docs", case_docs, 0, 0},              {"docs_models", case_docs_models, 0, 0},
+    {"docs", case_docs, 0, 0},              {"docs_keys", case_docs_keys, 0, 0},
+    {"docs_channels", case_docs_channels, 0, 0},
 };
 
 int main(int argc, char **argv)

@@ -53,6 +53,8 @@ typedef struct outputs {
     bool nonfinite;
     double last_t;                    /* sim_time of the last state */
     int64_t last_step;
+    int64_t last_gen, scene_gen;      /* the generation of the last state, of the last scene */
+    int64_t state_before_scene;       /* states of a generation whose scene had not come */
     double last_q[LAG_MAX_DOF];
     int64_t status_controls_rejected, status_states, status_overrun_bursts, status_conflicts;
     int64_t status_err_warnings;
@@ -207,6 +209,8 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
             g_out.nonfinite = true;
         g_out.last_t = m.sim_time;
         g_out.last_step = m.step;
+        g_out.last_gen = m.generation;
+        if (m.generation != g_out.scene_gen) g_out.state_before_scene++;
         for (int i = 0; i < m.num_joints && i < LAG_MAX_DOF; i++) g_out.last_q[i] = m.position[i];
         if (g_ctl.on) ctl_state(&m);
     } else if (!strcmp(sfx, "STATUS")) {
@@ -251,6 +255,7 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
         }
         if (strcmp(m.prefix, "TL") != 0) return; /* another prefix's (other_plant) */
         g_out.scene++;
+        g_out.scene_gen = m.generation;
         if (rb->data_size <= sizeof g_out.scene_bytes) {
             memcpy(g_out.scene_bytes, rb->data, rb->data_size);
             g_out.scene_len = rb->data_size;
@@ -342,7 +347,8 @@ static void command(double sim_time, const char *joint, double effort)
 {
     uint8_t buf[256];
     char *names[1] = {(char *)joint};
-    lagsim_joint_command_t m = {0, sim_time, 1, names, &effort};
+    /* answers the state of the current generation */
+    lagsim_joint_command_t m = {0, sim_time, 1, names, &effort, g_srv.pub.generation};
     int n = lagsim_joint_command_t_encode(buf, 0, sizeof buf, &m);
     ENSURE(n > 0);
     rt_handle_command(&g_srv, buf, (size_t)n);
@@ -745,8 +751,107 @@ static void case_set(int arg)
     run_until(g_srv.now + 10 * MS, 1000);
     ENSUREF(n_events("set") - sets == RT_SET_BURST, "%lld of %d applied",
             (long long)(n_events("set") - sets), RT_SET_BURST + 20);
-    ENSURE(g_srv.controls_rejected >= 20);
-    ENSURE(g_srv.live.n == 3); /* m2, the actuator and m1: a key set again replaces itself */
+    ENSURE(g_srv.ctl.controls_rejected >= 20);
+    ENSURE(g_srv.ctl.live.n == 3); /* m2, the actuator and m1: a key set again replaces itself */
+    stop_server();
+}
+
+/* A command of generation gen answering the state at sim_time. */
+static void command_gen(int64_t gen, double sim_time, const char *joint, double effort)
+{
+    uint8_t buf[256];
+    char *names[1] = {(char *)joint};
+    lagsim_joint_command_t m = {0, sim_time, 1, names, &effort, gen};
+    int n = lagsim_joint_command_t_encode(buf, 0, sizeof buf, &m);
+    ENSURE(n > 0);
+    rt_handle_command(&g_srv, buf, (size_t)n);
+}
+
+/* A state is known by its generation and its sim time. The generation is 1 at the start
+ * and one more at every SET and reset; the scene of a new generation goes out before any
+ * state of it; lockstep takes an answer only when both are those of the state waited on:
+ * an answer of the generation before at the same sim time (a SET's, a reset's) is stale,
+ * never applied, never a step. A 0.1.0 command is refused, saying to rebuild. */
+static void case_generation(int arg)
+{
+    (void)arg;
+    static const char text[] =
+        "model: manipulator\n"
+        "parameters: {m1: 2.0, m2: 0.5, l1: 0.3, I1: 0.02, I2: 0.05, g: 9.81}\n"
+        "initial: {q: [0.3, 0.5], qd: [0, 0]}\n"
+        "realtime: {mode: lockstep, start: paused, lockstep_timeout: 30}\n"
+        "lcm: {prefix: TL}\n";
+    char err[1024];
+    ENSURE(lag_scene_load_buffer("gen.yaml", text, sizeof text - 1, NULL, 0, &g_sc, err,
+                                 sizeof err) == 0);
+    memset(&g_opts, 0, sizeof g_opts);
+    g_opts.quiet = true;
+    g_opts.scene_name = "gen.yaml";
+    g_opts.scene_text = text;
+    g_opts.scene_len = sizeof text - 1;
+    start();
+    ENSURE(g_srv.pub.generation == 1 && g_out.scene_gen == 1 && g_out.last_gen == 1);
+    /* SET while the state at t = 0 is waited on: generation 2, its scene first, and the
+     * state again in generation 2 */
+    set_request("parameters.m2", "1.25");
+    run_until(g_srv.now + 100 * MS, 1000);
+    ENSUREF(g_srv.pub.generation == 2 && g_out.scene_gen == 2 && g_out.last_gen == 2 &&
+                g_out.last_t == 0.0 && g_out.state_before_scene == 0,
+            "generation %lld, scene %lld, state %lld at %g, %lld states before their scene",
+            (long long)g_srv.pub.generation, (long long)g_out.scene_gen,
+            (long long)g_out.last_gen, g_out.last_t, (long long)g_out.state_before_scene);
+    /* an answer to the state of generation 1 at the same sim time: stale */
+    int64_t stale = g_srv.rejected[RT_REJ_STALE];
+    command_gen(1, 0.0, "q1", 9.0);
+    control(LAGSIM_CONTROL_T_STEP, 1);
+    run_until(g_srv.now + 300 * MS, 1000);
+    ENSUREF(g_srv.rejected[RT_REJ_STALE] == stale + 1 && g_srv.sim.tick == 0 &&
+                g_srv.held[0] == 0.0 && strstr(last_detail("command_rejected"), "generation 1"),
+            "stale %lld, tick %lld, held %g: '%s'", (long long)(g_srv.rejected[RT_REJ_STALE] - stale),
+            (long long)g_srv.sim.tick, g_srv.held[0], last_detail("command_rejected"));
+    command_gen(2, 0.0, "q1", 0.5); /* the state's own: the period runs */
+    run_until(g_srv.now + 300 * MS, 1000);
+    ENSURE(g_srv.sim.tick == 10 && g_srv.held[0] == 0.5 && g_out.last_t == 0.01);
+    command_gen(2, 0.01, "q1", 0.25); /* answers the paused state */
+    run_until(g_srv.now + 50 * MS, 1000);
+    /* RESET_TO: generation 3, sim time 0 again; the run before's answer to its own state
+     * at sim time 0, late, is stale */
+    double q[2] = {0.2, 0.4}, qd[2] = {0, 0};
+    lagsim_control_t rm = {0, LAGSIM_CONTROL_T_RESET_TO, 0, 2, q, qd, "", ""};
+    uint8_t buf[512];
+    int n = lagsim_control_t_encode(buf, 0, sizeof buf, &rm);
+    ENSURE(n > 0);
+    rt_handle_control(&g_srv, buf, (size_t)n);
+    run_until(g_srv.now + 100 * MS, 1000);
+    ENSURE(g_srv.pub.generation == 3 && g_out.scene_gen == 3 && g_out.last_gen == 3 &&
+           g_out.last_t == 0.0 && g_out.state_before_scene == 0);
+    command_gen(2, 0.0, "q1", 9.0);
+    control(LAGSIM_CONTROL_T_STEP, 1);
+    run_until(g_srv.now + 300 * MS, 1000);
+    ENSURE(g_srv.rejected[RT_REJ_STALE] == stale + 2 && g_srv.sim.tick == 0);
+    command_gen(3, 0.0, "q1", 0.5);
+    run_until(g_srv.now + 300 * MS, 1000);
+    ENSURE(g_srv.sim.tick == 10 && g_srv.held[0] == 0.5);
+    /* generation 0 answers no state: never a step in lockstep */
+    command_gen(0, 0.01, "q1", 9.0);
+    ENSURE(g_srv.rejected[RT_REJ_STALE] == stale + 3 && g_srv.held[0] == 0.5);
+    /* a command of lagsim 0.1.0's types: refused, and the reason says to rebuild */
+    lag_wire_joint_command jc;
+    memset(&jc, 0, sizeof jc);
+    jc.sim_time = 0.01;
+    jc.num_joints = 1;
+    snprintf(jc.name[0], sizeof jc.name[0], "q1");
+    n = lag_wire_encode(LAG_WIRE_JOINT_COMMAND, &jc, buf, sizeof buf);
+    int64_t fp;
+    ENSURE(n > 8 && lag_wire_old_version(LAG_WIRE_JOINT_COMMAND, 0, NULL, &fp));
+    for (int b = 0; b < 8; b++) buf[b] = (uint8_t)((uint64_t)fp >> (56 - 8 * b));
+    int64_t undecodable = g_srv.rejected[RT_REJ_UNDECODABLE];
+    rt_handle_command(&g_srv, buf, (size_t)n - 8); /* without the generation */
+    run_until(g_srv.now + 300 * MS, 1000);
+    ENSUREF(g_srv.rejected[RT_REJ_UNDECODABLE] == undecodable + 1 &&
+                strstr(last_detail("command_rejected"), "built with lagsim 0.1.0's types and "
+                       "must be rebuilt"),
+            "'%s'", last_detail("command_rejected"));
     stop_server();
 }
 
@@ -986,15 +1091,15 @@ static void case_control_flood(int arg)
     start();
     run_until(g_srv.now + 100 * MS, 0);
     outputs before = g_out;
-    const int64_t t_flood = g_srv.now;
-    int bad = 0;
+    const int64_t t_flood = g_srv.now, gen0 = g_srv.pub.generation;
+    int bad = 0, resets = 0;
     for (int k = 0; k < 20000; k++) {
         switch (k % 6) {
         case 0: rt_handle_control(&g_srv, (const uint8_t *)"garbage", 7); bad++; break;
         case 1: control(99, 0); bad++; break;
         case 2: control(LAGSIM_CONTROL_T_STATUS, 0); break;
         case 3: control(LAGSIM_CONTROL_T_DESCRIBE, 0); break;
-        case 4: control(LAGSIM_CONTROL_T_RESET, 0); break;
+        case 4: control(LAGSIM_CONTROL_T_RESET, 0); resets++; break;
         case 5: control(LAGSIM_CONTROL_T_STEP, 5); bad++; break; /* refused: running */
         }
         if (k % 20 == 19) run_until(t_flood + (k + 1) * 50000, 0); /* 50 us a message */
@@ -1005,11 +1110,18 @@ static void case_control_flood(int arg)
     printf("control flood: 20000 requests in 1 s -> %lld events, %lld statuses, %lld scenes, "
            "%lld states\n", (long long)ev, (long long)st, (long long)sc, (long long)sa);
     /* each limited kind: its burst (10) + 10/s; statuses: burst 5 + 20/s + 5 periodic;
-     * scenes: 2 + 5/s; states: the 100 periods + resets' 5 + 20/s */
+     * scenes: 2 + 5/s for DESCRIBE and one per reset applied (a new generation), which
+     * RESET's bucket bounds; states: the 100 periods + resets' 5 + 20/s */
+    const int64_t applied = g_srv.pub.generation - gen0;
+    ENSUREF(applied >= RT_RESET_BURST && applied <= RT_RESET_BURST + RT_RESET_PER_S + 1,
+            "%lld resets applied of %d", (long long)applied, resets);
     ENSURE(n_events("control_rejected") <= 20 && n_events("reset") <= 20);
     ENSURE(ev <= 40);
-    ENSURE(st <= 5 + 20 + 5 + 1 && sc <= 2 + 5 + 1 && sa <= 100 + 5 + 20 + 1);
-    ENSURE(g_srv.controls_rejected == bad);
+    ENSUREF(st <= 5 + 20 + 5 + 1 && sc <= 2 + 5 + applied + 1 && sa <= 100 + 5 + 20 + 1,
+            "%lld statuses, %lld scenes, %lld states", (long long)st, (long long)sc,
+            (long long)sa);
+    /* every request refused is counted: the bad ones and the resets over their bucket */
+    ENSURE(g_srv.ctl.controls_rejected == bad + (resets - applied));
     /* a while later one more: it says how many went unsaid since the last one, so that
      * the events published plus those they say were suppressed are every rejection */
     run_until(g_srv.now + 2 * SEC, 0);
@@ -1019,11 +1131,12 @@ static void case_control_flood(int arg)
     ENSURE(n_events("control_rejected") == published + 1);
     ENSUREF(strstr(last_detail("control_rejected"), "more control_rejected events suppressed"),
             "detail '%s'", last_detail("control_rejected"));
-    ENSUREF(n_events("control_rejected") + n_suppressed("control_rejected") == bad + 1,
-            "%lld events + %lld suppressed, %d rejected", (long long)n_events("control_rejected"),
-            (long long)n_suppressed("control_rejected"), bad + 1);
+    const int64_t refused = bad + (resets - applied) + 1;
+    ENSUREF(n_events("control_rejected") + n_suppressed("control_rejected") == refused,
+            "%lld events + %lld suppressed, %lld rejected", (long long)n_events("control_rejected"),
+            (long long)n_suppressed("control_rejected"), (long long)refused);
     run_until(g_srv.now + 100 * MS, 0);
-    ENSURE(g_out.status_controls_rejected == bad + 1);
+    ENSURE(g_out.status_controls_rejected == refused);
     stop_server();
 }
 
@@ -1154,13 +1267,13 @@ static void case_lockstep_retry(int arg)
     const int64_t t0 = g_srv.now;
     ENSURE(g_out.state == 1 && g_srv.ls.waiting && !g_srv.ls.answered);
     uint8_t first[RT_BUF_SIZE];
-    unsigned first_len = g_srv.state_len;
-    memcpy(first, g_srv.state_buf, first_len);
+    unsigned first_len = g_srv.pub.state_len;
+    memcpy(first, g_srv.pub.state_buf, first_len);
     run_until(t0 + 110 * MS, 1000);
     /* copies at 20 and 60 ms (the next, at 140 ms, is not due) */
-    ENSUREF(g_srv.lockstep_retries == 2 && g_out.state == 3, "%lld retries, %lld states in 110 ms",
-            (long long)g_srv.lockstep_retries, (long long)g_out.state);
-    ENSURE(g_srv.state_len == first_len && memcmp(first, g_srv.state_buf, first_len) == 0);
+    ENSUREF(g_srv.pub.lockstep_retries == 2 && g_out.state == 3, "%lld retries, %lld states in 110 ms",
+            (long long)g_srv.pub.lockstep_retries, (long long)g_out.state);
+    ENSURE(g_srv.pub.state_len == first_len && memcmp(first, g_srv.pub.state_buf, first_len) == 0);
     ENSURE(g_srv.sim.tick == 0 && g_srv.lockstep_timeouts == 0 && g_out.last_step == 0);
     /* answered twice before the period runs: the second is ignored */
     command(0.0, "theta0", 0.5);
@@ -1177,13 +1290,13 @@ static void case_lockstep_retry(int arg)
     ENSURE(g_srv.rejected[RT_REJ_STALE] == 1 && g_srv.held[0] == 0.5);
     /* no answer for a second: the backed-off copies (20, 60 ms, then every 62.5 ms),
      * then the timeout */
-    int64_t r0 = g_srv.lockstep_retries, want = copies_within(1000 * MS, 20 * MS, 62500000);
+    int64_t r0 = g_srv.pub.lockstep_retries, want = copies_within(1000 * MS, 20 * MS, 62500000);
     run_until(g_srv.now + 1100 * MS, 1000);
     ENSUREF(g_srv.lockstep_timeouts == 1 && g_srv.run == RT_WAITING, "%lld timeouts",
             (long long)g_srv.lockstep_timeouts);
-    ENSUREF(g_srv.lockstep_retries - r0 == want && want == 17,
+    ENSUREF(g_srv.pub.lockstep_retries - r0 == want && want == 17,
             "%lld retries before the timeout, %lld by the rule",
-            (long long)(g_srv.lockstep_retries - r0), (long long)want);
+            (long long)(g_srv.pub.lockstep_retries - r0), (long long)want);
     /* the status says it */
     control(LAGSIM_CONTROL_T_STATUS, 0);
     run_until(g_srv.now + 1 * MS, 1000);
@@ -1197,12 +1310,12 @@ static void case_lockstep_retry(int arg)
     g_sc.realtime.lockstep_retry = 0.02;
     start();
     run_until(g_srv.now + 30 * MS, 1000);
-    ENSURE(g_srv.lockstep_retries == 1);
+    ENSURE(g_srv.pub.lockstep_retries == 1);
     command(0.0, "cart", 1.0);
     ENSURE(g_srv.rejected[RT_REJ_UNKNOWN_JOINT] == 1 && !g_srv.ls.answered);
     run_until(g_srv.now + 900 * MS, 1000);
-    ENSUREF(g_srv.lockstep_retries == 1, "%lld copies after a rejected answer",
-            (long long)g_srv.lockstep_retries);
+    ENSUREF(g_srv.pub.lockstep_retries == 1, "%lld copies after a rejected answer",
+            (long long)g_srv.pub.lockstep_retries);
     stop_server();
 }
 
@@ -1281,9 +1394,8 @@ static void case_waits(int arg)
     g_sc.realtime.lockstep_timeout = 10.0;
     start();
     /* the command URL: the state URL's group on the next port (lagsim_bus.h, tested there) */
-    char on_cmd[400], on_ctl[400];
+    char on_cmd[400];
     snprintf(on_cmd, sizeof on_cmd, "on TL_COMMAND at %s", g_srv.bus.urls.command_url);
-    snprintf(on_ctl, sizeof on_ctl, "on TL_CONTROL at %s (paused)", g_srv.bus.urls.command_url);
     ENSURE(strstr(g_srv.bus.urls.command_url, ":7668"));
     run_until(g_srv.now + 2 * SEC, 1000);
     status_now();
@@ -1319,7 +1431,11 @@ static void case_waits(int arg)
     run_until(g_srv.now + 1 * SEC, 1000);
     status_now();
     expect_has(g_out.status_waiting_for, "RESUME or STEP ", __LINE__);
-    expect_has(g_out.status_waiting_for, on_ctl, __LINE__);
+    /* lockstep: paused while the state at 0.01 is waited on, its answer still owed */
+    char owed[500];
+    snprintf(owed, sizeof owed, "on TL_CONTROL at %s (paused; the answer to sim_time 0.01 "
+             "still owed on TL_COMMAND)", g_srv.bus.urls.command_url);
+    expect_has(g_out.status_waiting_for, owed, __LINE__);
     ENSURE(g_out.status_waiting_s >= 1.0 && g_out.status_waiting_s < 1.2);
     /* a wait nobody answers: its lines thin out, at 3, 6, 12, 24, 48, 96 s of the wait,
      * then a minute apart */
@@ -1379,7 +1495,7 @@ static void case_lockstep_loss(int arg)
     (void)arg;
     enum { N = 1000 };
     lockstep_run(0.0, N);
-    ENSURE(g_srv.lockstep_retries == 0 && g_ctl.lost_states == 0 && g_ctl.steps == N + 1);
+    ENSURE(g_srv.pub.lockstep_retries == 0 && g_ctl.lost_states == 0 && g_ctl.steps == N + 1);
     static controller ref;
     ref = g_ctl;
     stop_server();
@@ -1389,12 +1505,12 @@ static void case_lockstep_loss(int arg)
         printf("loss %.0f %% each way: %lld states and %lld commands lost, %lld retries, "
                "%lld answers ignored, %lld timeouts, %.2f s of wall time for %d periods\n",
                100 * losses[i], (long long)g_ctl.lost_states, (long long)g_ctl.lost_commands,
-               (long long)g_srv.lockstep_retries, (long long)g_srv.commands_ignored,
+               (long long)g_srv.pub.lockstep_retries, (long long)g_srv.commands_ignored,
                (long long)g_srv.lockstep_timeouts, (double)wall * 1e-9, N);
         ENSURE(g_ctl.lost_states > 0 && g_ctl.lost_commands > 0);
         ENSUREF(g_srv.lockstep_timeouts == 0, "%lld lockstep timeouts",
                 (long long)g_srv.lockstep_timeouts);
-        ENSURE(g_srv.lockstep_retries >= g_ctl.lost_states);
+        ENSURE(g_srv.pub.lockstep_retries >= g_ctl.lost_states);
         ENSURE(g_ctl.steps == N + 1);
         for (int k = 0; k <= N; k++)
             if (!g_ctl.have[k] || memcmp(g_ctl.x[k], ref.x[k], sizeof ref.x[k]) != 0)
@@ -1469,10 +1585,10 @@ static void case_other_plant(int arg)
     ENSUREF(n_events("plant_conflict") == 2, "%lld plant_conflict events for 3001 scenes",
             (long long)n_events("plant_conflict"));
     ENSUREF(n_events("plant_conflict") + n_suppressed("plant_conflict") +
-                    g_srv.lim_event[RT_EV_PLANT_CONFLICT].suppressed == 3001,
+                    g_srv.pub.lim_event[RT_EV_PLANT_CONFLICT].suppressed == 3001,
             "said %lld + suppressed %lld + pending %lld", (long long)n_events("plant_conflict"),
             (long long)n_suppressed("plant_conflict"),
-            (long long)g_srv.lim_event[RT_EV_PLANT_CONFLICT].suppressed);
+            (long long)g_srv.pub.lim_event[RT_EV_PLANT_CONFLICT].suppressed);
     control(LAGSIM_CONTROL_T_STATUS, 0);
     run_until(g_srv.now + 100 * MS, 0);
     ENSURE(g_out.status_conflicts == 3001);
@@ -1639,6 +1755,7 @@ int main(int argc, char **argv)
         {"other_plant", case_other_plant, 0, 0}, {"messages", case_messages, 0, 0},
         {"reject_names", case_reject_names, 0, 0}, {"waits", case_waits, 0, 0},
         {"live_error", case_live_error, 0, 0},  {"scene_rules", case_scene_rules, 0, 0},
+        {"generation", case_generation, 0, 0},
     };
     /* a failed check ends the case: what follows it needs what failed */
     const lt_program p = {.cases = cases, .n = (int)(sizeof cases / sizeof cases[0]),

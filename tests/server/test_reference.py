@@ -235,15 +235,16 @@ def case_lockstep(t):
     rows = open(os.path.join(out, prefix + "_REFERENCE.csv")).read().splitlines()
     sent = [t.t.reference_t.decode(d) for ch, d, _ in recs if ch == prefix + "_REFERENCE"]
     same = len(rows) == len(sent) + 1 and all(
-        [float(x) for x in row.split(",")[4:]] == list(m.r) + list(m.rdot) and
+        [float(x) for x in row.split(",")[5:]] == list(m.r) + list(m.rdot) and
+        int(row.split(",")[4]) == m.generation and
         float(row.split(",")[0]) == m.sim_time for row, m in zip(rows[1:], sent))
-    check(p.returncode == 0 and rows[0] == 't,wall_time,log_time,step,"theta0","theta1",'
+    check(p.returncode == 0 and rows[0] == 't,wall_time,log_time,step,generation,"theta0","theta1",'
           '"theta0_dot","theta1_dot"' and same,
           f"lagsim-log2csv: {prefix}_REFERENCE.csv, {len(rows) - 1} rows equal to the "
           f"{len(sent)} references logged: {rows[0]}")
     plot_has_reference(t, os.path.join(out, prefix + "_STATE.csv"), prefix + "_REFERENCE.csv",
-                       {"theta0 ref": 5, "theta1 ref (right)": 6, "theta0_dot ref": 7,
-                        "theta1_dot ref (right)": 8})
+                       {"theta0 ref": 6, "theta1 ref (right)": 7, "theta0_dot ref": 8,
+                        "theta1_dot ref (right)": 9})
     # one ulp more in the 100th reference's r of theta0: the replay fails
     refs = [k for k, (ch, _, _) in enumerate(recs) if ch == prefix + "_REFERENCE"]
     b = bytearray(open(log, "rb").read())

@@ -51,7 +51,8 @@ def case_exact(a, t, tmp):
                     "T_STATUS.csv"], f"one CSV per lagsim channel, none for others: {files}")
 
     st = rows(os.path.join(out, "T_STATE.csv"))
-    check(list(st[0].keys()) == ["t", "wall_time", "log_time", "step", "theta0", "theta1", "theta2",
+    check(list(st[0].keys()) == ["t", "wall_time", "log_time", "step", "generation", "theta0",
+                                 "theta1", "theta2",
                                  "theta0_dot", "theta1_dot", "theta2_dot", "theta0_effort",
                                  "theta1_effort", "theta2_effort"], "state columns: joints by name")
     check(len(st) == 6, f"6 states written ({len(st)})")
@@ -233,9 +234,10 @@ def case_injection(a, t, tmp):
     st = tables.get("T_STATE.csv")
     if st:
         names = [as_text(n) for n in j]
-        check(st[0] == ["t", "wall_time", "log_time", "step"] + names + [n + "_dot" for n in names] +
-              [n + "_effort" for n in names], f"state header: every joint's name kept, as text ({st[0][4:6]})")
-        check(st[1][4] == "-0.5" and st[3][4] == "-2.5" and st[1][12] == "-1e-300" and st[1][20] == "-2",
+        check(st[0] == ["t", "wall_time", "log_time", "step", "generation"] + names +
+              [n + "_dot" for n in names] + [n + "_effort" for n in names],
+              f"state header: every joint's name kept, as text ({st[0][5:7]})")
+        check(st[1][5] == "-0.5" and st[3][5] == "-2.5" and st[1][13] == "-1e-300" and st[1][21] == "-2",
               "state cells: negative numbers stay numbers")
     ev = tables.get("T_EVENT.csv")
     if ev:
@@ -244,8 +246,8 @@ def case_injection(a, t, tmp):
               f"events: kind, joint, detail as text, value a number ({ev[1][4:8]})")
     cm = tables.get("T_COMMAND.csv")
     if cm:
-        check([r[3:5] for r in cm[1:3]] == [[as_text(j[1]), "-1.5"], [as_text(j[6]), "2.5"]],
-              f"commands: joint as text, effort a number ({cm[1][3:5]})")
+        check([r[4:6] for r in cm[1:3]] == [[as_text(j[1]), "-1.5"], [as_text(j[6]), "2.5"]],
+              f"commands: joint as text, effort a number ({cm[1][4:6]})")
     sc = tables.get("T_SCENE.csv")
     if sc:
         check(sc[1][2] == as_text("=cmd|'/C calc'!A0") and sc[1][10] == "'+limits" and
@@ -269,9 +271,9 @@ def case_injection(a, t, tmp):
     script = open(gp).read() if os.path.exists(gp) else ""
     for i, n in enumerate(j):
         title = as_text(n).replace("\\", "\\\\").replace('"', '\\"')
-        check(re.search(r'using 1:%d (axes x1y1 )?with lines (lt \d+ )?lw 1.5 title "%s"' % (5 + i, re.escape(title)), script) and
-              re.search(r'using 1:%d (axes x1y1 )?with lines (lt \d+ )?lw 1.5 title "%s_dot"' % (13 + i, re.escape(title)), script),
-              f"lagsim-plot: joint {i} ({n!r}) drawn from columns {5 + i} and {13 + i}")
+        check(re.search(r'using 1:%d (axes x1y1 )?with lines (lt \d+ )?lw 1.5 title "%s"' % (6 + i, re.escape(title)), script) and
+              re.search(r'using 1:%d (axes x1y1 )?with lines (lt \d+ )?lw 1.5 title "%s_dot"' % (14 + i, re.escape(title)), script),
+              f"lagsim-plot: joint {i} ({n!r}) drawn from columns {6 + i} and {14 + i}")
 
 
 def plot_script(a, csv_path, tmp, name):
@@ -334,12 +336,12 @@ def case_plot(a, t, tmp):
     if len(ps) == 4:
         q, qd, eff, en = ps
         check("set ylabel 'q (m)'" in q and "set y2label 'q (rad)'" in q and
-              re.search(r"using 1:5 axes x1y1 .*title \"x\"", q) and re.search(r"using 1:6 axes x1y2 .*title \"theta", q),
+              re.search(r"using 1:6 axes x1y1 .*title \"x\"", q) and re.search(r"using 1:7 axes x1y2 .*title \"theta", q),
               "q: x on the left axis in m, theta on the right one in rad")
         check("set ylabel 'q dot (m/s)'" in qd and "set y2label 'q dot (rad/s)'" in qd and
-              re.search(r"using 1:7 axes x1y1", qd) and re.search(r"using 1:8 axes x1y2", qd),
+              re.search(r"using 1:8 axes x1y1", qd) and re.search(r"using 1:9 axes x1y2", qd),
               "q dot: m/s left, rad/s right")
-        check("using 1:9 " in eff and "using 1:10 " not in eff and "theta_effort" not in script and
+        check("using 1:10 " in eff and "using 1:11 " not in eff and "theta_effort" not in script and
               "set ylabel 'effort (N)'" in eff, "effort: the cart's force (N); the free pole's zero effort not drawn")
         check("yrange" not in q and "yrange" not in qd and "yrange" not in eff,
               "a real motion (0.1 m, 0.05 rad, 1 N) is scaled by gnuplot, no span forced")
@@ -356,7 +358,7 @@ def case_plot(a, t, tmp):
     script = plot_script(a, os.path.join(alone, "T_STATE.csv"), tmp, "alone")
     check("set ylabel 'q (m or rad)'" in script and "axes x1y2" not in script,
           "without a scene: one axis, m or rad")
-    check("using 1:9 " in script and "using 1:10 " not in script,
+    check("using 1:10 " in script and "using 1:11 " not in script,
           "without a scene: the effort column that is zero throughout is not drawn")
 
 

@@ -404,14 +404,15 @@ def case_cartpole(a):
             chrome.screenshot(sid, a.screenshot)
         # a model the page has no drawing for (a scene from a newer daemon): a note, the
         # coordinates as numbers, the charts still growing
-        chrome.eval(sid, "window.lagsimView.scene.model = 'newmodel'; window.lagsimView.dirty = true; 0")
-        chrome.wait_for(sid, "window.lagsimView.drawn.model === 'newmodel'", 5, "a frame of the unknown model")
+        # (a name no model of the core's table can have: core_models_info's name rule)
+        chrome.eval(sid, "window.lagsimView.scene.model = 'no such model'; window.lagsimView.dirty = true; 0")
+        chrome.wait_for(sid, "window.lagsimView.drawn.model === 'no such model'", 5, "a frame of the unknown model")
         u1 = drawn(chrome, sid)
         n1 = chrome.eval(sid, "window.lagsimView.charts.q.length")
         time.sleep(0.5)
         u2 = drawn(chrome, sid)
         n2 = chrome.eval(sid, "window.lagsimView.charts.q.length")
-        check(u2["note"] is not None and "newmodel" in u2["note"] and u2["points"] is None,
+        check(u2["note"] is not None and "no such model" in u2["note"] and u2["points"] is None,
               "an unknown model: a note instead of a drawing (%r)" % u2["note"])
         check(u2["sim_time"] > u1["sim_time"] and n2 > n1,
               "an unknown model: the states still come and are charted (%d -> %d samples)" % (n1, n2))
@@ -621,6 +622,54 @@ def case_charts(a):
         rig.close()
 
 
+def case_models(a):
+    """Every model of the core's table is drawn: each shipped scene (every model has one,
+    structure_lists) run beside the view, the page draws its model (no "no drawing" note),
+    at finite points, and keeps drawing the states that come. The flying stick is drawn at
+    its published state: h is the height of end A, the centre of mass h + (l/2) sin phi
+    above the floor's level."""
+    models = subprocess.run([a.lagsimd, "--list", "models"], stdout=subprocess.PIPE, text=True,
+                            check=True).stdout.split()
+    cfgdir = os.path.dirname(a.config)
+    seen = []
+    chrome = cdp.Chrome()
+    try:
+        for f in sorted(os.listdir(cfgdir)):
+            if not f.endswith(".yaml"):
+                continue
+            # the flying stick turning backwards: phi < 0 when drawn, where end A is the upper
+            # end (a drawing of the lower end's height would put the centre too high)
+            sets = ("initial.qd=[0.5,-3,2]",) if f == "flying-stick.yaml" else ()
+            rig = Rig(a, "VIEWM", os.path.join(cfgdir, f), sets=sets)
+            try:
+                s = rig.wait_api(lambda s: s["scene"] and s["state"], what="%s: scene, state" % f)
+                model = s["scene"]["model"] if s and s["scene"] else None
+                _, sid = chrome.open(rig.base + "/")
+                chrome.wait_for(sid, "window.lagsimView.drawn && window.lagsimView.drawn.sim_time > 0",
+                                15, "%s: a frame" % f)
+                d1 = drawn(chrome, sid)
+                pts = d1["points"] or []
+                check(d1["model"] == model and d1["note"] is None and len(pts) >= 2 and
+                      all(math.isfinite(c) for p in pts for c in p),
+                      "%s: model %s drawn at %d finite points (note: %r)" % (f, model, len(pts), d1["note"]))
+                if model == "flying-stick" and len(pts) == 3:
+                    l = s["scene"]["params"]["l"]
+                    x, phi, h = d1["q"]
+                    check(abs(pts[1][0] - x) < 1e-12 and abs(pts[1][1] - (h + 0.5 * l * math.sin(phi))) < 1e-9,
+                          "%s: the centre drawn at (x, h + l/2 sin phi) = (%.6f, %.6f)" % (f, pts[1][0], pts[1][1]))
+                time.sleep(0.5)
+                d2 = drawn(chrome, sid)
+                check(d2["sim_time"] > d1["sim_time"] and d2["points"],
+                      "%s: still drawn as states come (sim time %.3f -> %.3f s)" % (f, d1["sim_time"], d2["sim_time"]))
+                seen.append(model)
+            finally:
+                rig.close()
+    finally:
+        chrome.quit()
+    check(sorted(set(seen)) == sorted(models),
+          "the shipped scenes drew every model of the core's table (%s; table: %s)" % (seen, models))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lagsimd", required=True)
@@ -628,14 +677,14 @@ def main():
     ap.add_argument("--config", required=True)
     ap.add_argument("--screenshot")
     ap.add_argument("case", choices=["browser", "hostile", "stick_flight", "cartpole", "reference",
-                                     "charts", "history"])
+                                     "charts", "history", "models"])
     a = ap.parse_args()
     # every process here meets on LCM's default URL, a port pair of this run's own
     # (tests/common/lcm_port.py): nothing of another run on the machine is heard
     os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")
     {"browser": case_browser, "hostile": case_hostile, "stick_flight": case_stick_flight,
      "cartpole": case_cartpole, "reference": case_reference, "charts": case_charts,
-     "history": case_history}[a.case](a)
+     "history": case_history, "models": case_models}[a.case](a)
     print("%s: %d failure(s)" % ("FAILED" if failures else "passed", failures))
     return 1 if failures else 0
 

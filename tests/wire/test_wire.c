@@ -524,10 +524,75 @@ static void check_encoder(void)
         ENSURE(strcmp(lag_wire_result_string(r), "unknown result") != 0);
 }
 
+/* Each type's earlier versions (docs/wire.md, "How message types evolve"): the
+ * fingerprint kept for lagsim 0.1.0 is what LCM's algorithm gives today's table without
+ * its appended fields (and what 0.1.0's lcm-gen gave: the constants are 0.1.0's), only
+ * appended fields changed, and a message of that version decodes in logs (the new fields
+ * 0) but not on the bus (lag_wire_decode: today's version only). */
+static void check_old_versions(void)
+{
+    int changed = 0;
+    for (int t = 0; t < LAG_WIRE_TYPE_COUNT; t++) {
+        const lag_wire_type ty = (lag_wire_type)t;
+        const char *tn = lag_wire_type_name(ty);
+        int n;
+        lag_wire_fields(ty, &n);
+        for (int k = 0; k < lag_wire_old_versions(ty); k++) {
+            int nf;
+            int64_t fp;
+            const char *v = lag_wire_old_version(ty, k, &nf, &fp);
+            changed++;
+            ENSUREF(v && nf > 0 && nf < n, "%s: version %d keeps %d of %d fields", tn, k, nf, n);
+            ENSUREF(lag_wire_table_fingerprint_n(ty, nf) == fp,
+                    "%s %s: the fingerprint kept %016llx is not that of its %d fields %016llx",
+                    tn, v, (unsigned long long)fp, nf,
+                    (unsigned long long)lag_wire_table_fingerprint_n(ty, nf));
+            /* a message of that version: today's bytes without the appended fields, under
+             * the old fingerprint (every field after nf is an int64 generation here) */
+            static _Alignas(max_align_t) uint8_t m[8192], back[8192];
+            uint8_t buf[LAG_WIRE_BUF_SIZE];
+            memset(m, 0, sizeof m);
+            const lag_wire_field *f = lag_wire_fields(ty, &n);
+            for (int j = nf; j < n; j++) {
+                ENSUREF(f[j].kind == LAG_WIRE_INT64 && f[j].count_field < 0,
+                        "%s.%s: an appended field other than a scalar int64", tn, f[j].name);
+                int64_t g = 77;
+                memcpy(m + f[j].offset, &g, sizeof g);
+            }
+            int len = lag_wire_encode(ty, m, buf, sizeof buf);
+            ENSURE(len > 8 + 8 * (n - nf));
+            len -= 8 * (n - nf);
+            for (int b = 0; b < 8; b++) buf[b] = (uint8_t)((uint64_t)fp >> (56 - 8 * b));
+            const char *by = "?";
+            ENSURE(lag_wire_decode(ty, buf, (size_t)len, LAG_WIRE_MAX_JOINTS, back) ==
+                   LAG_WIRE_EFINGERPRINT);
+            ENSURE(lag_wire_identify(buf, (size_t)len) == -1);
+            ENSUREF(lag_wire_decode_any(ty, buf, (size_t)len, LAG_WIRE_MAX_JOINTS, back, &by) ==
+                        LAG_WIRE_OK && by && !strcmp(by, v),
+                    "%s %s: not read as that version", tn, v);
+            ENSURE(lag_wire_identify_any(buf, (size_t)len, &by) == t && !strcmp(by, v));
+            for (int j = nf; j < n; j++) {
+                int64_t g;
+                memcpy(&g, back + f[j].offset, sizeof g);
+                ENSUREF(g == 0, "%s.%s of a %s message: %lld, not 0", tn, f[j].name, v,
+                        (long long)g);
+            }
+            /* today's bytes read as today's, by both */
+            len = lag_wire_encode(ty, m, buf, sizeof buf);
+            ENSURE(lag_wire_decode_any(ty, buf, (size_t)len, LAG_WIRE_MAX_JOINTS, back, &by) ==
+                   LAG_WIRE_OK && by == NULL);
+        }
+    }
+    /* 0.2.0 appended the generation to the state, the reference, the scene, the command */
+    ENSUREF(changed == 4, "%d types with an earlier version", changed);
+    ENSURE(strcmp(lag_wire_version(), "0.1.0") > 0); /* today's types are newer */
+}
+
 static void case_messages(int arg)
 {
     (void)arg;
     check_tables(lt_arg(0));
+    check_old_versions();
     check_agreement();
     check_hostile();
     check_encoder();

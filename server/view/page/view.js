@@ -282,21 +282,24 @@ function drawCartRods(g, w, h) {
 
 // Stick: centre of mass at x, angle phi from the floor, length l, lower end on the floor
 // (y = 0) unless the scene publishes a height: a joint "y" (centre of mass height) or any
-// other third joint (height of the lower end above the floor).
-function drawStick(g, w, h) {
+// other third joint (height of the lower end above the floor; with endA, the flying
+// stick's, height of end A, at the centre minus l/2 along the stick).
+function drawStick(g, w, h, endA) {
   const l = P("l"), x = joint("x"), phi = joint("phi");
   let yc = NaN;
   if (view.state && view.state.name.includes("y")) yc = joint("y");
   else if (view.state && view.state.name.length > 2) {
-    const hh = view.state.q[2];
-    yc = (hh === null ? 0 : hh) + 0.5 * l * Math.abs(Math.sin(phi));
+    const hh = view.state.q[2], s = Math.sin(phi);
+    yc = (hh === null ? 0 : hh) + 0.5 * l * (endA ? s : Math.abs(s));
   } else yc = 0.5 * l * Math.sin(phi);
   const top = Math.max(1.15 * l, Number.isFinite(yc) ? yc + 0.65 * l : 0);
   const scale = Math.min(h / (top + 0.25 * l), w / (2.6 * l));
   const cx = follow(Number.isFinite(x) ? x : 0, w / (2 * scale));
   const m = worldMap(w, h, cx, (top - 0.25 * l) / 2, scale);
   ground(g, m, w, 0, hasEffect("floor"),
-         hasEffect("floor") ? "floor (impacts on)" : "floor: the model keeps the lower end on it");
+         hasEffect("floor") ? "floor (impacts on)"
+           : endA ? "the floor's level: no floor (the stick passes it)"
+           : "floor: the model keeps the lower end on it");
   const lim = limitOf("x");
   if (lim) { g.strokeStyle = "#c62828"; g.lineWidth = 4; for (const s of lim) line(g, m, s, 0, s, 0.3 * l); }
   if (![l, x, phi, yc].every(Number.isFinite)) return null;
@@ -340,7 +343,16 @@ function drawManipulator(g, w, h) {
   return { m, points: [[0, 0], [2 * l1 * c, 2 * l1 * s], [q2 * c, q2 * s]] };
 }
 
-const DRAW = { dipc: drawCartRods, cartpole: drawCartRods, stick: drawStick, manipulator: drawManipulator };
+// The flying stick named by a scene (no floor: model stick's floor publishes model stick):
+// its third joint h is end A's height.
+function drawFlyingStick(g, w, h) { return drawStick(g, w, h, true); }
+
+// A drawing per model of the core's table, by its name (scene_tables_view: every model of
+// the table has one here, and nothing else is here).
+const DRAW = {
+  stick: drawStick, manipulator: drawManipulator, dipc: drawCartRods, cartpole: drawCartRods,
+  "flying-stick": drawFlyingStick,
+};
 
 function drawModel() {
   const { g, w, h } = fit($("model"));

@@ -69,8 +69,12 @@ public final class Controller {
     public long referencesStale;
     // the last command sent and the state it answered (a copy of it is answered again)
     private joint_command_t lastCmd;
-    private long lastStep;
+    private long lastGeneration, lastStep;
     private double lastTime;
+    /** States held until the scene of their generation came. */
+    public long held;
+    /** The pace of DESCRIBE while a scene is awaited (the C client's too). */
+    static final long DESCRIBE_NS = 250_000_000L;
     /** Copies of a state answered again with the same command. */
     public long repeats;
     private boolean stopped;
@@ -184,6 +188,9 @@ public final class Controller {
                             refNewest = BoundedInput.decode(ins, reference_t::new);
                         } else if (channel.endsWith("_SCENE")) {
                             scene = BoundedInput.decode(ins, scene_t::new);
+                            params.clear();
+                            for (int k = 0; k < scene.num_params; k++)
+                                params.put(scene.param_name[k], scene.param_value[k]);
                         } else if (channel.endsWith("_EVENT")) {
                             if (BoundedInput.decode(ins, event_t::new).kind.equals("stop")) stopped = true;
                         }
@@ -208,29 +215,54 @@ public final class Controller {
                     fail(String.format("no scene on %sSCENE within %g s (is lagsimd running with this prefix?)",
                                        ch, timeout));
                 if (now >= nextAsk) { // DESCRIBE every 0.25 s until the scene comes
-                    control_t req = new control_t();
-                    req.utime = System.currentTimeMillis() * 1000;
-                    req.request = control_t.DESCRIBE;
-                    req.q = new double[0];
-                    req.qd = new double[0];
-                    req.key = "";
-                    req.value = "";
-                    lcmCmd.publish(ch + "CONTROL", req);
-                    nextAsk = now + 250_000_000L;
+                    askScene();
+                    nextAsk = now + DESCRIBE_NS;
                 }
                 lock.wait(50);
             }
         }
         if (!scene.model.equals(model)) fail("prefix " + prefix + " runs model " + scene.model + ", not " + model);
-        for (int k = 0; k < scene.num_params; k++) params.put(scene.param_name[k], scene.param_value[k]);
+    }
+
+    private void askScene() {
+        control_t req = new control_t();
+        req.utime = System.currentTimeMillis() * 1000;
+        req.request = control_t.DESCRIBE;
+        req.q = new double[0];
+        req.qd = new double[0];
+        req.key = "";
+        req.value = "";
+        lcmCmd.publish(prefix + "_CONTROL", req);
+    }
+
+    /** st, or the newest state since, once the scene of its generation came (the daemon
+     *  publishes it just before the first state of a generation; DESCRIBE asks for it again
+     *  every 0.25 s, for when UDP lost it); null when the run ended first. So the law never
+     *  answers a state with another run's or scene's parameters (docs/clients.md). Called
+     *  holding the lock. */
+    private joint_state_t withScene(joint_state_t st) throws InterruptedException {
+        long nextAsk = System.nanoTime();
+        while (st.generation != scene.generation) {
+            if (stopped) { endReason = "stop"; return null; }
+            long now = System.nanoTime();
+            if (now - heardNanos > (long) (timeout * 1e9)) { endReason = "silence"; return null; }
+            if (now >= nextAsk) {
+                askScene();
+                nextAsk = now + DESCRIBE_NS;
+            }
+            lock.wait(20);
+            if (latest != null) { st = latest; latest = null; } // a newer state: that one
+        }
+        return st;
     }
 
     /** The newest state not yet returned, or null when the run has ended (see endReason).
-     *  A copy of the state answered last (same step and sim time: the daemon published it
-     *  again because no answer reached it) is answered at once with the same command and
-     *  not returned: every state received is answered, the law runs once per state (a law
-     *  run for every copy would cost a think time per copy and fall behind for good:
-     *  docs/clients.md, the rule). */
+     *  A copy of the state answered last (same generation, step and sim time: the daemon
+     *  published it again because no answer reached it) is answered at once with the same
+     *  command and not returned: every state received is answered, the law runs once per
+     *  state (a law run for every copy would cost a think time per copy and fall behind for
+     *  good: docs/clients.md, the rule). A state is returned only once scene (and params)
+     *  is the scene of its generation. */
     public joint_state_t nextState() throws InterruptedException {
         synchronized (lock) {
             if (endReason != null) return null;
@@ -246,7 +278,13 @@ public final class Controller {
                 }
                 st = latest;
                 latest = null;
-                if (lastCmd == null || st.step != lastStep || st.sim_time != lastTime) break;
+                if (lastCmd == null || st.generation != lastGeneration || st.step != lastStep ||
+                    st.sim_time != lastTime) {
+                    if (st.generation == scene.generation) break;
+                    held++;
+                    if ((st = withScene(st)) == null) return null;
+                    break;
+                }
                 lcmCmd.publish(prefix + "_COMMAND", lastCmd);
                 repeats++;
             }
@@ -265,16 +303,18 @@ public final class Controller {
         joint_command_t cmd = new joint_command_t();
         cmd.utime = System.currentTimeMillis() * 1000;
         cmd.sim_time = simTime;
+        joint_state_t st = current;
+        cmd.generation = st != null ? st.generation : 0; // of the state it answers (0: none yet)
         cmd.num_joints = (short) names.length;
         cmd.name = names.clone();
         cmd.effort = new double[efforts.length];
         for (int k = 0; k < efforts.length; k++) // never send NaN
             cmd.effort[k] = Double.isFinite(efforts[k]) ? efforts[k] : 0.0;
         lcmCmd.publish(prefix + "_COMMAND", cmd);
-        joint_state_t st = current;
         if (st != null && st.sim_time == simTime) {
             synchronized (lock) {
                 lastCmd = cmd;
+                lastGeneration = st.generation;
                 lastStep = st.step;
                 lastTime = simTime;
             }

@@ -11,7 +11,7 @@ import lagsim.joint_command_t;
  * controllers (clients/octave) build their commands and control requests here:
  *
  * <pre>
- *     cmd = javaMethod('command', 'lagsim.examples.Messages', st_time, {'theta0'}, u);
+ *     cmd = javaMethod('command', 'lagsim.examples.Messages', st.generation, st.sim_time, {'theta0'}, u);
  *     lc.publish('DIPC_COMMAND', cmd);
  * </pre>
  *
@@ -22,14 +22,18 @@ public final class Messages {
 
     private static long now() { return System.currentTimeMillis() * 1000; }
 
-    /** A command answering the state at {@code simTime}: {@code efforts[k]} for joint
-     *  {@code names[k]} (N or N m). Arrays of different lengths throw IllegalArgumentException. */
-    public static joint_command_t command(double simTime, String[] names, double[] efforts) {
+    /** A command answering the state of generation {@code generation} at {@code simTime}
+     *  (a state is known by both: docs/server.md): {@code efforts[k]} for joint
+     *  {@code names[k]} (N or N m). Arrays of different lengths throw IllegalArgumentException.
+     *  The generation is a double, as MATLAB and Octave hand numbers over (exact to 2^53). */
+    public static joint_command_t command(double generation, double simTime, String[] names,
+                                          double[] efforts) {
         if (names.length != efforts.length || names.length > Short.MAX_VALUE)
             throw new IllegalArgumentException(names.length + " names for " + efforts.length + " efforts");
         joint_command_t cmd = new joint_command_t();
         cmd.utime = now();
         cmd.sim_time = simTime;
+        cmd.generation = (long) generation;
         cmd.num_joints = (short) names.length;
         cmd.name = names.clone();
         cmd.effort = efforts.clone();
@@ -37,8 +41,9 @@ public final class Messages {
     }
 
     /** A command for one joint (a one-element vector reaches Java as a scalar). */
-    public static joint_command_t command(double simTime, String name, double effort) {
-        return command(simTime, new String[] {name}, new double[] {effort});
+    public static joint_command_t command(double generation, double simTime, String name,
+                                          double effort) {
+        return command(generation, simTime, new String[] {name}, new double[] {effort});
     }
 
     /** A control request without arguments: control_t.DESCRIBE, PAUSE, RESUME, STATUS ... */
