@@ -25,6 +25,7 @@
 #ifndef LAGSIM_TEST_H
 #define LAGSIM_TEST_H
 
+#include <errno.h>
 #include <fcntl.h>
 #include <math.h>
 #include <stdbool.h>
@@ -225,9 +226,10 @@ static inline int lt_main(int argc, char **argv, const lt_case *cases, int n)
 
 /* ------------------------------------------------------------------ LCM ports */
 /* n UDP ports in a row, P .. P + n - 1 (P even, in [20000, 60000)), this process's own
- * until it ends: the rule of tests/common/lcm_port.py (which says why), for the C tests.
- * Each port's lock file LOCK_DIR/PORT.lock ($LAGSIM_PORT_LOCK_DIR, else
- * /tmp/lagsim-ports) held with flock, no socket of this host bound to it
+ * until it ends: the rule of tests/common/lcm_port.py (which says why), held as
+ * lagsim-eval and lagsim-sweep hold theirs (server/wire/lagsim_port.h), pair by pair: an
+ * exclusive flock on LOCK_DIR/lagsim-udp-P.lock (the first of /run/lock, /var/lock, /tmp),
+ * opened read-only and created if missing, and no socket of this host bound to a port
  * (/proc/net/udp, udp6). Returns P, or -1 when none is free. */
 static inline bool lt_udp_bound(int port)
 {
@@ -251,16 +253,24 @@ static inline bool lt_udp_bound(int port)
     return false;
 }
 
-static inline int lt_port_lock(int port)
+static inline int lt_pair_lock(int port)
 {
-    const char *dir = getenv("LAGSIM_PORT_LOCK_DIR");
-    if (!dir || !*dir) dir = "/tmp/lagsim-ports";
-    if (mkdir(dir, 0777) == 0) chmod(dir, 01777); /* every user's tests take ports here */
+    static const char *const dirs[] = {"/run/lock", "/var/lock", "/tmp"};
+    const char *dir = "/tmp";
+    struct stat st;
+    for (int k = 0; k < 3; k++)
+        if (stat(dirs[k], &st) == 0 && S_ISDIR(st.st_mode)) {
+            dir = dirs[k];
+            break;
+        }
     char path[4096];
-    snprintf(path, sizeof path, "%s/%d.lock", dir, port);
-    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    snprintf(path, sizeof path, "%s/lagsim-udp-%d.lock", dir, port);
+    const int flags = O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC;
+    int fd = open(path, flags);
+    if (fd < 0 && errno == ENOENT) fd = open(path, flags | O_CREAT | O_EXCL, 0644);
+    if (fd < 0 && errno == EEXIST) fd = open(path, flags); /* another made it meanwhile */
     if (fd < 0) return -1;
-    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || flock(fd, LOCK_EX | LOCK_NB) != 0) {
         close(fd);
         return -1;
     }
@@ -269,19 +279,20 @@ static inline int lt_port_lock(int port)
 
 static inline int lt_lcm_ports(int n)
 {
-    const int first = 20000, end = 60000, blocks = (end - first) / 2 - (n - 1) / 2;
+    const int first = 20000, end = 60000, pairs = (n + 1) / 2;
+    const int blocks = (end - first) / 2 - (pairs - 1);
     const int start = (int)(((long long)getpid() * 7919) % blocks);
+    if (pairs > 8) return -1;
     for (int k = 0; k < blocks; k++) {
-        int p = first + 2 * ((start + k) % blocks), fds[16], got = 0;
-        if (n > 16) return -1;
+        int p = first + 2 * ((start + k) % blocks), fds[8], got = 0;
         bool ok = true;
-        for (int q = 0; q < n && ok; q++) ok = !lt_udp_bound(p + q);
-        for (int q = 0; q < n && ok; q++) {
-            fds[got] = lt_port_lock(p + q);
+        for (int q = 0; q < 2 * pairs && ok; q++) ok = !lt_udp_bound(p + q);
+        for (int q = 0; q < pairs && ok; q++) {
+            fds[got] = lt_pair_lock(p + 2 * q);
             ok = fds[got] >= 0;
             if (ok) got++;
         }
-        for (int q = 0; q < n && ok; q++) ok = !lt_udp_bound(p + q); /* bound meanwhile */
+        for (int q = 0; q < 2 * pairs && ok; q++) ok = !lt_udp_bound(p + q); /* bound meanwhile */
         if (ok) return p;
         while (got > 0) close(fds[--got]);
     }

@@ -6,26 +6,29 @@
 
 A plant uses two ports: its URL's (states, status, events, scenes) and the next one
 (commands, control requests). On one port every socket gets every datagram, so two tests
-on one port hear each other (a flood, a plant another test's lagsimctl would find). A
-port pair is taken here by the one rule every test of the suite follows (and
-tests/common/lagsim_test.h's lt_lcm_port, for the C tests):
+on one port hear each other (a flood, a plant another test's lagsimctl would find). The
+pairs are held as lagsim-eval and lagsim-sweep hold theirs (server/wire/lagsim_port.h),
+with the same lock files, so that no test and no tool ever share a pair; tests take theirs
+from another range (tests/common/lagsim_test.h's lt_lcm_ports does the same in C):
 
-  - an even port P in [20000, 60000), P and P + 1 (or the n ports a test asks for) free:
-    a lock file of each, LOCK_DIR/P.lock, LOCK_DIR/P+1.lock, ... (LOCK_DIR:
-    $LAGSIM_PORT_LOCK_DIR, else /tmp/lagsim-ports), held with flock(LOCK_EX | LOCK_NB) by
-    this process until it ends (the lock goes with the process, however it ends), and no
-    UDP socket of this host bound to any of them (/proc/net/udp, /proc/net/udp6: a plant
-    someone runs by hand);
+  - a pair P, P + 1 (P even, in [20000, 60000); the tools use 64000 and up), or the n
+    ports P .. P + n - 1 a test asks for, pair by pair;
+  - held by an exclusive flock on the pair's lock file LOCK_DIR/lagsim-udp-P.lock
+    (LOCK_DIR: the first of /run/lock, /var/lock, /tmp that exists), opened read-only
+    (every user can lock a file another made) and created if missing, never removed; the
+    lock goes with the process, however it ends (close-on-exec: not with its children);
+  - no UDP socket of this host bound to any of the ports (/proc/net/udp, /proc/net/udp6: a
+    plant someone runs by hand);
   - the search starts at a place drawn from the process id and goes up, wrapping around.
 
 So tests run at once, by one ctest -j or by several people's suites on one machine, never
 share a port, whatever their process ids.
 """
 import errno
-import fcntl
 import os
+import stat
 
-LOCK_DIR = os.environ.get("LAGSIM_PORT_LOCK_DIR", "/tmp/lagsim-ports")
+LOCK_DIR = next((d for d in ("/run/lock", "/var/lock", "/tmp") if os.path.isdir(d)), "/tmp")
 FIRST, END = 20000, 60000   # even ports P of [FIRST, END): pairs P, P + 1
 GROUP = "239.255.76.67"     # LCM's default multicast group
 
@@ -49,40 +52,51 @@ def udp_ports_bound():
 
 
 def _lock(port):
-    if not os.path.isdir(LOCK_DIR):
-        os.makedirs(LOCK_DIR, exist_ok=True)
-        try:
-            os.chmod(LOCK_DIR, 0o1777)  # every user's tests take their ports here
-        except OSError:
-            pass
-    path = os.path.join(LOCK_DIR, "%d.lock" % port)
-    fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
+    """The pair at `port` (even) held: its lock file's descriptor, or None when another
+    holds it or no lock file can be had."""
+    import fcntl
+    path = os.path.join(LOCK_DIR, "lagsim-udp-%d.lock" % port)
+    flags = os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC
     try:
+        try:
+            fd = os.open(path, flags)
+        except FileNotFoundError:
+            try:
+                fd = os.open(path, flags | os.O_CREAT | os.O_EXCL, 0o644)
+            except FileExistsError:
+                fd = os.open(path, flags)  # another made it meanwhile
+    except OSError:
+        return None  # a symbolic link, a file we may not read: this pair is not usable
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise OSError(errno.EINVAL, "not a regular file")
+        if st.st_uid == os.geteuid() and st.st_mode & 0o444 != 0o444:
+            os.fchmod(fd, 0o644)  # readable by every user, whatever the umask
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError as e:
+    except OSError:
         os.close(fd)
-        if e.errno in (errno.EWOULDBLOCK, errno.EAGAIN):
-            return None
-        raise
+        return None
     return fd
 
 
 def lcm_port(n=2):
-    """An even port P with P .. P + n - 1 this process's own (locked until it ends)."""
-    blocks = (END - FIRST) // 2 - (n - 1) // 2
+    """An even port P with P .. P + n - 1 this process's own (held until it ends)."""
+    pairs = (n + 1) // 2
+    blocks = (END - FIRST) // 2 - (pairs - 1)
     start = (os.getpid() * 7919) % blocks
     for k in range(blocks):
         p = FIRST + 2 * ((start + k) % blocks)
-        ports = range(p, p + n)
-        if set(ports) & udp_ports_bound():
+        ports = set(range(p, p + 2 * pairs))
+        if ports & udp_ports_bound():
             continue
         fds = []
-        for q in ports:
+        for q in range(p, p + 2 * pairs, 2):
             fd = _lock(q)
             if fd is None:
                 break
             fds.append(fd)
-        if len(fds) == n and not set(ports) & udp_ports_bound():  # none bound meanwhile
+        if len(fds) == pairs and not ports & udp_ports_bound():  # none bound meanwhile
             _held.extend(fds)
             return p
         for fd in fds:
