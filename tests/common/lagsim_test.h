@@ -225,7 +225,8 @@ static inline int lt_main(int argc, char **argv, const lt_case *cases, int n)
 }
 
 /* ------------------------------------------------------------------ LCM ports */
-/* n UDP ports in a row, P .. P + n - 1 (P even, in [20000, 60000)), this process's own
+/* n UDP ports in a row, P .. P + n - 1 (P even, in [20000, 60000) below the kernel's
+ * ephemeral ports), this process's own
  * until it ends: the rule of tests/common/lcm_port.py (which says why), held as
  * lagsim-eval and lagsim-sweep hold theirs (server/wire/lagsim_port.h), pair by pair: an
  * exclusive flock on LOCK_DIR/lagsim-udp-P.lock (the first of /run/lock, /var/lock, /tmp),
@@ -277,9 +278,25 @@ static inline int lt_pair_lock(int port)
     return fd; /* open until the process ends: the lock goes with it */
 }
 
+/* The first of the kernel's ephemeral ports (a sender's socket gets one, bound without
+ * SO_REUSEADDR: a bus there fails to bind): the tests' range ends below it. */
+static inline int lt_ephemeral_low(void)
+{
+    int low = 32768, high;
+    FILE *f = fopen("/proc/sys/net/ipv4/ip_local_port_range", "r");
+    if (f) {
+        if (fscanf(f, "%d %d", &low, &high) != 2) low = 32768;
+        fclose(f);
+    }
+    return low;
+}
+
 static inline int lt_lcm_ports(int n)
 {
-    const int first = 20000, end = 60000, pairs = (n + 1) / 2;
+    const int first = 20000, pairs = (n + 1) / 2;
+    int end = lt_ephemeral_low();
+    if (end > 60000) end = 60000;
+    if (end < first + 2000) end = first + 2000;
     const int blocks = (end - first) / 2 - (pairs - 1);
     const int start = (int)(((long long)getpid() * 7919) % blocks);
     if (pairs > 8) return -1;

@@ -11,7 +11,8 @@ pairs are held as lagsim-eval and lagsim-sweep hold theirs (server/wire/lagsim_p
 with the same lock files, so that no test and no tool ever share a pair; tests take theirs
 from another range (tests/common/lagsim_test.h's lt_lcm_ports does the same in C):
 
-  - a pair P, P + 1 (P even, in [20000, 60000); the tools use 64000 and up), or the n
+  - a pair P, P + 1 (P even, in [20000, 60000) below the kernel's ephemeral ports, from
+    32768 by default; the tools use 64000 and up), or the n
     ports P .. P + n - 1 a test asks for, pair by pair;
   - held by an exclusive flock on the pair's lock file LOCK_DIR/lagsim-udp-P.lock
     (LOCK_DIR: the first of /run/lock, /var/lock, /tmp that exists), opened read-only
@@ -29,7 +30,21 @@ import os
 import stat
 
 LOCK_DIR = next((d for d in ("/run/lock", "/var/lock", "/tmp") if os.path.isdir(d)), "/tmp")
-FIRST, END = 20000, 60000   # even ports P of [FIRST, END): pairs P, P + 1
+FIRST, END = 20000, 60000   # even ports P of [FIRST, END): pairs P, P + 1 ...
+
+
+def _ephemeral_low():
+    """The first port the kernel hands out to sockets bound to none (a sender's socket):
+    a port taken that way is bound without SO_REUSEADDR, and a bus on it fails to bind
+    (seen: "bind: Address already in use" on 50091). The range ends below it."""
+    try:
+        with open("/proc/sys/net/ipv4/ip_local_port_range") as f:
+            return int(f.read().split()[0])
+    except (OSError, ValueError, IndexError):
+        return 32768
+
+
+END = max(FIRST + 2000, min(END, _ephemeral_low()))
 GROUP = "239.255.76.67"     # LCM's default multicast group
 
 _held = []  # the lock files of the pairs this process took: open until it ends
