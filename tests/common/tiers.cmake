@@ -35,12 +35,15 @@ set(LAGSIM_TIER_RULES
   "bench     LABEL ^bench$"
   "package   LABEL ^package$"
   "quick     LABEL ^(core|effects|wire|result|structure|fuzz|accuracy)$"
+  # the protocol's conformance traces, played against each language's controller
+  "quick     NAME  ^protocol_"
   # what only waits, in any area (first: some of these names match the rules below)
   # (not Java's: a JVM starting and classes compiled for the slow law compute; run beside
   # the others and two busy processes, clients_readme_java_slower_law and
   # clients_cross_language_slower_law ran past their 90 s)
   "waits     NAME  ^clients_readme_(c|python|lua)_slow(er)?_law$"
   "waits     NAME  ^clients_(c|python|lua|java)_[a-z_]+_ends_on_(stop|silence)$"
+  "waits     NAME  ^clients_(c|python|lua|java)_ends_on_signal$"
   "waits     NAME  ^clients_(python|java)_dipc_late_controller$"
   "waits     NAME  ^view_attack_(slowloris|stalled)$"
   "waits     NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
