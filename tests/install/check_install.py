@@ -29,6 +29,8 @@ import shutil
 import subprocess
 import sys
 import tempfile
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def main():
@@ -40,6 +42,9 @@ def main():
     ap.add_argument("--abi", type=int, required=True, help="LAGSIM_CLIENT_ABI")
     ap.add_argument("--cflags", default="", help="extra compiler flags (a sanitizer build's)")
     a = ap.parse_args()
+    # every process here meets on LCM's default URL, a port pair of this run's own
+    # (tests/common/lcm_port.py): nothing of another run on the machine is heard
+    os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")
     build, src = os.path.abspath(a.build), os.path.abspath(a.source)
     tmp = tempfile.mkdtemp(prefix="lagsim_install_")
     prefix = os.path.join(tmp, "prefix")
