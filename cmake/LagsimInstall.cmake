@@ -3,8 +3,9 @@
 #   bin/                     lagsimd, lagsimctl, lagsim-view, lagsim-log2csv, lagsim-plot,
 #                            lagsim-eval, lagsim-sweep and the C example controllers
 #                            (each when the build has it)
-#   include/lagsim/          lagsim_client.h, lagsim_client.hpp, version.h, result.h (the
-#                            client library); lagsim.h (the core), lagsim_controller.h,
+#   include/lagsim/          lagsim_client.h, lagsim_client.hpp, result.h and the version
+#                            header the build writes from version.h.in (the client
+#                            library); lagsim.h (the core), lagsim_controller.h,
 #                            lagsim_wire.h, lagsim_log.h, lagsim_bus.h, the generated C types
 #   lib/                     liblagsim_client.so.<ABI> (SONAME) and .so, liblagsim_client.a;
 #                            liblagsim_controller.a, liblagsim_core.a and what they link
