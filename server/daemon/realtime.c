@@ -1037,6 +1037,7 @@ lag_result lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
     /* LCM: publishing on the state URL, receiving on the command URL */
     opened = true;
     rt_bus_handlers h = handlers(s);
+    s->bus.quiet = quiet;
     rc = rt_bus_open(&s->bus, &h, err, sizeof err);
     if (rc != LAGSIMD_EXIT_OK) {
         fprintf(stderr, "lagsimd: %s\n", err);

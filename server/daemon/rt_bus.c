@@ -236,8 +236,9 @@ int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
         return rc;
     }
     if (!u->udpm) {
-        fprintf(stderr, "lagsimd: %s: on %s (this process only)\n", b->sc->lcm.prefix,
-                u->state_url);
+        if (!b->quiet)
+            fprintf(stderr, "lagsimd: %s: on %s (this process only)\n", b->sc->lcm.prefix,
+                    u->state_url);
         return LAGSIMD_EXIT_OK;
     }
     rc = look_for_other_plant(b, err, errlen);
@@ -255,12 +256,13 @@ int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
         fprintf(stderr, "lagsimd: warning: LCM url '%s' has ttl=%d: states, status and events "
                 "leave this host (multicast to the local network%s)\n", u->state_url, ttl,
                 ttl > 1 ? " and beyond routers" : "");
+    /* -q: only what warns (the network can reach the plant), as the ttl warning above */
     if (b->sc->lcm.allow_lan)
         fprintf(stderr, "lagsimd: %s: listening on %s for commands and control from the "
                 "network (lcm.allow_lan: true: any host that reaches %s can command this "
                 "plant) on %s; states on %s\n", b->sc->lcm.prefix, ifname, ifname,
                 u->command_url, u->state_url);
-    else
+    else if (!b->quiet)
         fprintf(stderr, "lagsimd: %s: listening on %s for commands and control from this "
                 "host only (lcm.allow_lan: false) on %s; states on %s%s\n", b->sc->lcm.prefix,
                 ifname, u->command_url, u->state_url,

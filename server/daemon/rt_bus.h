@@ -47,6 +47,8 @@ typedef struct rt_bus {
                                 * LCM's queues may hold datagrams that came in before the
                                 * filter */
     int64_t commands_wrong_port; /* joint_command_t heard on the state URL */
+    bool quiet;                /* -q: rt_bus_open says where it listens only when the
+                                * network can reach it (a warning) */
     /* one plant per prefix: the scenes this daemon published (FNV-1a of their bytes, which
      * include utime), and what was heard from another plant */
     uint64_t scene_sent[RT_SCENES_KEPT];

@@ -99,7 +99,8 @@ int rt_record_open(rt_record *r, const lag_scene *sc, const lagsimd_opts *o, cha
                  st.prune_error ? ", a removal failed: " : "",
                  st.prune_error ? strerror(st.prune_error) : "");
     r->prune_said = st.prune_error;
-    fprintf(stderr, "lagsimd: --log %s --increment: writing %s%s\n", o->log, name, kept);
+    if (!r->quiet || st.prune_error) /* -q: only a failed removal */
+        fprintf(stderr, "lagsimd: --log %s --increment: writing %s%s\n", o->log, name, kept);
     return 0;
 }
 
