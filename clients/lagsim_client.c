@@ -25,6 +25,7 @@
 #include "lagsim/lagsim_control_t.h"
 #include "lagsim_bus.h"
 #include "lagsim_clock.h"
+#include "lagsim_num.h"
 
 struct lag_client {
     lcm_t *lcm;                  /* the state URL: states, status, events, scene in */
@@ -542,9 +543,11 @@ lag_result lag_client_kick(lag_client *c, const char *joint, double impulse, dou
         set_err(c, "kick: a joint name, a finite impulse and a duration >= 0 (s)");
         return LAG_CLIENT_ERR_ARG;
     }
-    /* %.17g: the daemon reads back the same doubles */
-    if (duration > 0) snprintf(value, sizeof value, "%.17g,%.17g", impulse, duration);
-    else snprintf(value, sizeof value, "%.17g", impulse);
+    /* the shortest decimals the daemon reads back to the same doubles: the kick event's
+     * detail says 0.1, as the user wrote it (lagsim_num.h) */
+    char a[LAG_NUM_LEN], b[LAG_NUM_LEN];
+    if (duration > 0) snprintf(value, sizeof value, "%s,%s", lag_num(impulse, a), lag_num(duration, b));
+    else snprintf(value, sizeof value, "%s", lag_num(impulse, a));
     return lag_client_set(c, key, value);
 }
 

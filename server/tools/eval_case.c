@@ -1,6 +1,7 @@
 /* lagsim-eval's and lagsim-sweep's cases and runs (eval_case.h). */
 
 #include "eval_case.h"
+#include "lagsim_num.h"
 
 #include <errno.h>
 #include <libgen.h>
@@ -746,7 +747,8 @@ static void daemon_argv(daemon_args *d, const eval_env *env, const eval_case *c,
         arg(d, extra[i]);
     }
     char *o = own(d);
-    snprintf(o, OWN_CAP, "%.17g", c->duration);
+    char num[LAG_NUM_LEN];
+    snprintf(o, OWN_CAP, "%s", lag_num(c->duration, num));
     arg(d, "--duration");
     arg(d, o);
     arg(d, "--log");

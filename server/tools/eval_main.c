@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "eval_case.h"
+#include "lagsim_num.h"
 
 static const char *prog = "lagsim-eval";
 
@@ -492,14 +493,17 @@ static void write_rows(eval_cli *x, const eval_case *c, const eval_scene *csc,
         }
         printf("\n");
         if (!x->fcsv) continue;
+        char num[LAG_NUM_LEN];
         fprintf(x->fcsv, "%s,%s,%d,%d,\"%s\"", c->name, csc->joint[j], res->failed, met,
                 res->failed ? res->reason : why);
         for (int m = 0; m < LAG_METRIC_COUNT; m++) {
-            /* the CSV is read by programs: every digit of the double */
+            /* the CSV is read by programs: the double exactly (lagsim_num.h) */
             if (isnan(res->m[j].v[m])) fprintf(x->fcsv, ",nan");
-            else fprintf(x->fcsv, ",%.17g", res->m[j].v[m]);
+            else fprintf(x->fcsv, ",%s", lag_num(res->m[j].v[m], num));
         }
-        fprintf(x->fcsv, ",%.17g,%zu,%.17g\n", res->max_abs_q[j], res->states, res->t_end);
+        char t_end[LAG_NUM_LEN];
+        fprintf(x->fcsv, ",%s,%zu,%s\n", lag_num(res->max_abs_q[j], num), res->states,
+                lag_num(res->t_end, t_end));
     }
 }
 

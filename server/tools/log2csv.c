@@ -4,8 +4,8 @@
  * One pass over the log. Each channel takes the lagsim type of its first decodable
  * message; its CSV is opened then, with a header from that message (a state's joint
  * names). A later message of another type or other joints on the same channel is not
- * written, only counted. Every number is written "%.17g" (a reread gives the same
- * double); every string from the log (names, kinds, details, in headers and cells) is
+ * written, only counted. Every number is written as the shortest decimal that reads
+ * back to the same double (lagsim_num.h); every string from the log (names, kinds, details, in headers and cells) is
  * quoted and kept from reading as a spreadsheet formula (put_text).
  *
  * Per-channel facts for the summary: counts, log-time span and rate, undecodable
@@ -14,6 +14,7 @@
  * again, as while paused); for status the last counters; for events a count per kind.
  */
 #include "log2csv.h"
+#include "lagsim_num.h"
 #include "lagsim/lagsim.h"
 
 #include <errno.h>
@@ -75,7 +76,17 @@ typedef struct l2c {
 } l2c;
 
 /* ---------------------------------------------------------------- CSV helpers */
-static void put_d(FILE *f, double x) { fprintf(f, ",%.17g", x); }
+static void put_d(FILE *f, double x)
+{
+    char b[LAG_NUM_LEN];
+    fprintf(f, ",%s", lag_num(x, b));
+}
+/* A row's first number: its sim time. */
+static void put_t(FILE *f, double t)
+{
+    char b[LAG_NUM_LEN];
+    fputs(lag_num(t, b), f);
+}
 static void put_i(FILE *f, int64_t x) { fprintf(f, ",%" PRId64, x); }
 /* One text field from a log (a name, a kind, a detail), RFC 4180: always in double quotes,
  * a quote doubled; control characters become spaces, so one record is one line. A field
@@ -104,7 +115,7 @@ static void put_s(FILE *f, const char *s)
     fputc(',', f);
     put_text(f, s, NULL);
 }
-/* A list of numbers this tool formatted ("%.17g" joined by spaces): quoted, and not
+/* A list of numbers this tool formatted (lag_num's, joined by spaces): quoted, and not
  * marked as text, a leading minus sign included (digits, signs, '.', 'e', "inf", "nan"
  * and spaces make no formula that reaches anything). */
 static void put_numbers(FILE *f, const char *s) { fprintf(f, ",\"%s\"", s); }
@@ -283,7 +294,7 @@ static bool write_state(l2c *c, chan *h, const lag_log_record *r, const lag_wire
     }
     track_steps(c, h, m);
     FILE *f = h->csv;
-    fprintf(f, "%.17g", m->sim_time);
+    put_t(f, m->sim_time);
     put_us(f, m->utime, false);
     put_us(f, r->timestamp, false);
     put_i(f, m->step);
@@ -319,7 +330,7 @@ static bool write_reference(l2c *c, chan *h, const lag_log_record *r,
         return true;
     }
     FILE *f = h->csv;
-    fprintf(f, "%.17g", m->sim_time);
+    put_t(f, m->sim_time);
     put_us(f, m->utime, false);
     put_us(f, r->timestamp, false);
     put_i(f, m->step);
@@ -352,7 +363,7 @@ static bool write_status(l2c *c, chan *h, const lag_log_record *r, const lag_wir
         fputc('\n', h->csv);
     }
     FILE *f = h->csv;
-    fprintf(f, "%.17g", m->sim_time);
+    put_t(f, m->sim_time);
     put_us(f, m->utime, false);
     put_us(f, r->timestamp, false);
     for (int i = 0; i < n; i++) {
@@ -380,7 +391,7 @@ static bool write_event(l2c *c, chan *h, const lag_log_record *r, const lag_wire
         fputs("t,wall_time,log_time,step,kind,joint,value,detail\n", h->csv);
     }
     FILE *f = h->csv;
-    fprintf(f, "%.17g", m->sim_time);
+    put_t(f, m->sim_time);
     put_us(f, m->utime, false);
     put_us(f, r->timestamp, false);
     put_i(f, m->step);
@@ -421,21 +432,22 @@ static bool write_scene(l2c *c, chan *h, const lag_log_record *r, const lag_wire
     }
     FILE *f = h->csv;
     char params[LAG_WIRE_MAX_PARAMS * (L2C_NAME + 32)], joints[L2C_JOINTS * (L2C_NAME + 192)];
+    char a[LAG_NUM_LEN], b[LAG_NUM_LEN];
     size_t n = 0;
     params[0] = joints[0] = '\0';
     const lag_model_info *info = scene_model(m);
     for (int i = 0; i < m->num_params; i++)
-        n += (size_t)snprintf(params + n, sizeof params - n, "%s%s=%.17g", i ? " " : "",
-                              m->param_name[i], m->param_value[i]);
+        n += (size_t)snprintf(params + n, sizeof params - n, "%s%s=%s", i ? " " : "",
+                              m->param_name[i], lag_num(m->param_value[i], a));
     n = 0;
     for (int i = 0; i < m->num_joints; i++) {
-        n += (size_t)snprintf(joints + n, sizeof joints - n, "%s%s:%s:q0=%.17g:qd0=%.17g",
+        n += (size_t)snprintf(joints + n, sizeof joints - n, "%s%s:%s:q0=%s:qd0=%s",
                               i ? " " : "", m->joint_name[i],
-                              m->actuated[i] ? "actuated" : "free", m->initial_q[i],
-                              m->initial_qd[i]);
+                              m->actuated[i] ? "actuated" : "free", lag_num(m->initial_q[i], a),
+                              lag_num(m->initial_qd[i], b));
         if (m->limit_on[i])
-            n += (size_t)snprintf(joints + n, sizeof joints - n, ":limits=%.17g..%.17g",
-                                  m->limit_lower[i], m->limit_upper[i]);
+            n += (size_t)snprintf(joints + n, sizeof joints - n, ":limits=%s..%s",
+                                  lag_num(m->limit_lower[i], a), lag_num(m->limit_upper[i], b));
         if (info)
             n += (size_t)snprintf(joints + n, sizeof joints - n, ":unit=%s",
                                   info->angular[i] ? "rad" : "m");
@@ -468,7 +480,7 @@ static bool write_command(l2c *c, chan *h, const lag_log_record *r,
     FILE *f = h->csv;
     /* one row per named joint (a command with no joint: one row, joint and effort empty) */
     for (int i = 0; i < (m->num_joints > 0 ? m->num_joints : 1); i++) {
-        fprintf(f, "%.17g", m->sim_time);
+        put_t(f, m->sim_time);
         put_us(f, m->utime, false);
         put_us(f, r->timestamp, false);
         put_i(f, m->generation);
@@ -505,8 +517,10 @@ static bool write_control(l2c *c, chan *h, const lag_log_record *r, const lag_wi
     char q[L2C_JOINTS * 26] = "", qd[L2C_JOINTS * 26] = "";
     size_t nq = 0, nqd = 0;
     for (int i = 0; i < m->num_joints; i++) {
-        nq += (size_t)snprintf(q + nq, sizeof q - nq, "%s%.17g", i ? " " : "", m->q[i]);
-        nqd += (size_t)snprintf(qd + nqd, sizeof qd - nqd, "%s%.17g", i ? " " : "", m->qd[i]);
+        char a[LAG_NUM_LEN];
+        nq += (size_t)snprintf(q + nq, sizeof q - nq, "%s%s", i ? " " : "", lag_num(m->q[i], a));
+        nqd += (size_t)snprintf(qd + nqd, sizeof qd - nqd, "%s%s", i ? " " : "",
+                                lag_num(m->qd[i], a));
     }
     put_us(f, m->utime, true);
     put_us(f, r->timestamp, false);

@@ -227,7 +227,7 @@ static void case_identity(int arg)
         "# seed: 9000000000000000\n"
         "# scene-sha256: ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad\n"
         "# case: tilt\n"
-        "# duration: 0.10000000000000001\n"
+        "# duration: 0.1\n"
         "# set: initial.q=[0, 0.1]\n"
         "# bound: theta=0.5\n"
         "# vary: parameters.m0=uniform(0.5,2)\n"
