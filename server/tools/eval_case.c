@@ -879,18 +879,29 @@ int eval_require_check(const lag_require *req, const eval_scene *sc, char *err, 
 bool eval_require_holds(const lag_require *req, const eval_scene *sc, const eval_result *res,
                         char *why, size_t len)
 {
+    size_t n = 0;
+    int failed = 0, said = 0;
+    if (len) why[0] = '\0';
     for (int i = 0; i < req->n; i++) {
         int j = joint_index(sc, req->term[i].joint);
-        if (j < 0 || !lag_require_term_holds(&req->term[i], &res->m[j])) {
-            char t[160];
-            lag_require_term_format(&req->term[i], t, sizeof t);
-            char v[32];
-            eval_fmt(j < 0 ? NAN : res->m[j].v[req->term[i].metric], v, sizeof v);
-            snprintf(why, len, "%s fails (%s)", t, v);
-            return false;
+        if (j >= 0 && lag_require_term_holds(&req->term[i], &res->m[j])) continue;
+        failed++;
+        char t[160], v[32], one[220];
+        lag_require_term_format(&req->term[i], t, sizeof t);
+        eval_fmt(j < 0 ? NAN : res->m[j].v[req->term[i].metric], v, sizeof v);
+        int w = snprintf(one, sizeof one, "%s%s fails (%s)", said ? "; " : "", t, v);
+        /* every failing term, as long as the caller's buffer keeps room to say how many
+         * more there are */
+        if (w > 0 && n + (size_t)w + 40 < len) {
+            memcpy(why + n, one, (size_t)w + 1);
+            n += (size_t)w;
+            said++;
         }
     }
-    return true;
+    if (failed > said && n + 40 <= len)
+        snprintf(why + n, len - n, "%sand %d more term%s fail", said ? "; " : "", failed - said,
+                 failed - said > 1 ? "s" : "");
+    return failed == 0;
 }
 
 void eval_fmt(double v, char *buf, size_t len)

@@ -209,7 +209,9 @@ int eval_read_log(const char *path, const char *prefix, const eval_scene *sc, do
 int eval_score(const eval_series *s, const eval_case *c, const eval_scene *sc,
                eval_result *res, char *err, size_t errlen);
 
-/* Whether a requirement holds for a result; the first term that fails written to why. */
+/* Whether a requirement holds for a result; every term that fails written to why, each
+ * with its value ("theta.settle < 2 fails (5.5); x.settle < 2 fails (5.85)"): as many as
+ * fit in len bytes, then how many more fail. */
 bool eval_require_holds(const lag_require *req, const eval_scene *sc, const eval_result *res,
                         char *why, size_t len);
 

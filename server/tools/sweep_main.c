@@ -682,7 +682,7 @@ static void write_row(const worker *wk, long i, const double *val, const eval_re
 {
     const sweep *x = wk->x;
     FILE *f = wk->rows;
-    char why[512] = "";
+    char why[2048] = "";
     bool met = !x->require || eval_require_holds(&x->req, &x->sc, res, why, sizeof why);
     /* one line per run: the run number first (the parent sorts by it) */
     fprintf(f, "%ld", i);

@@ -172,6 +172,24 @@ def case_require():
               and "passed" not in title[0], "the report's title: UNMET and the term (%s)"
               % title)
         check("Warning" not in p.stderr, "gnuplot said nothing on stderr")
+        # every term that fails, each with its value, in the notes, the CSV and the title;
+        # the one that holds (theta.peak_error <= 0.1) not
+        out = os.path.join(d, "two.csv")
+        p = run("--suite", SUITE, "--case", "tilt", "--require",
+                "theta.settle < 2 and theta.peak_error <= 0.1 and x.settle < 3", "--csv", out,
+                "--report", d, "--force")
+        note = [l for l in p.stdout.splitlines() if "--require:" in l]
+        both = re.compile(r"theta\.settle < 2 fails \(5\.5\d*\); x\.settle < 3 fails \(5\.8\d*\)")
+        check(p.returncode == 1 and len(note) == 1 and both.search(note[0]) and
+              "peak_error" not in note[0], "two terms fail: both named with their values (%s)"
+              % note)
+        r = read_csv(out)
+        check(len(r) == 2 and all(both.fullmatch(x["reason"]) for x in r),
+              "the CSV's reason: both terms (%s)" % [x["reason"] for x in r])
+        title = [l for l in open(os.path.join(d, "tilt.gp")) if "multiplot layout" in l]
+        check(len(title) == 1 and "theta.settle < 2 fails" in title[0] and
+              "\\nx.settle < 3 fails" in title[0], "the report's title: each term on its line (%s)"
+              % title)
     p = run("--suite", SUITE, "--case", "tilt", "--require", "phi.settle<2")
     check(p.returncode == 2 and "no joint 'phi'" in p.stderr, "unknown joint: exit 2")
     check(p.stderr.count("--require") == 1, "--require said once: %r" % p.stderr.strip())
