@@ -58,7 +58,9 @@ static void usage(FILE *f)
 "                         not on {prefix} or LAGSIM_PREFIX never answers: its case\n"
 "                         ends here\n"
 "  -v, --verbose          pass the daemon's and the controller's output through, keep\n"
-"                         each run's log in the report directory (or TMPDIR, /tmp)\n"
+"                         each run's log in the report directory (or TMPDIR, /tmp);\n"
+"                         without it their stderr goes to files of the run, and a\n"
+"                         case that fails shows their last lines under its note\n"
 "  -h, --help             this help\n"
 "\n"
 "keys lagsim-eval sets on every run (a case's set: naming one, or a mapping above\n"
@@ -557,6 +559,14 @@ static bool run_case(eval_cli *x, int k)
     write_rows(x, c, &x->csc[k], &res, met, why);
     if (res.failed) printf("  %s failed: %s\n", c->name, res.reason);
     else if (!met) printf("  %s: --require: %s\n", c->name, why);
+    /* a failed run: what its controller and lagsimd said last (their stderr went to files
+     * of the run; -v passes it through) */
+    for (const char *l = res.output; *l;) {
+        const char *nl = strchr(l, '\n');
+        int len = nl ? (int)(nl - l) : (int)strlen(l);
+        printf("    %.*s\n", len, l);
+        l += len + (nl != NULL);
+    }
     fflush(stdout);
     if (x->report_dir &&
         report(&x->files, x->report_dir, x->force, c, &x->csc[k], &s, &res, met, why))

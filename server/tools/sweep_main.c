@@ -81,7 +81,9 @@ static void usage(FILE *f)
 "      --allow-lan        accept a URL with ttl above 0 (the runs on the network)\n"
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a run may take (default 600)\n"
-"  -v, --verbose          pass the daemon's and the controller's output through\n"
+"  -v, --verbose          pass the daemon's and the controller's output through;\n"
+"                         without it their stderr goes to files of the run, and the\n"
+"                         first failed run of each worker shows their last lines\n"
 "  -o, --output OUT.csv   merge: the joined CSV (the whole sweep's, byte for byte); every\n"
 "                         shard's identity lines (# seed:, # scene-sha256:, # vary:, ...)\n"
 "                         must be the first's, every row one of its header, every shard\n"
@@ -633,6 +635,7 @@ typedef struct worker {
     long w;          /* its number */
     eval_worker *kept; /* the daemon and the controller kept for its runs */
     FILE *rows;
+    bool said_output;  /* the output of a failed run said (once a worker) */
 } worker;
 
 static eval_env worker_env(const worker *wk, long run)
@@ -733,6 +736,12 @@ static int run_one(worker *wk, long i)
     if (rc) {
         fprintf(stderr, "%s: run %ld: %s\n", prog, i, err);
         return 4;
+    }
+    if (res.output[0] && !wk->said_output) { /* a worker's first failed run: what its
+                                               * controller and lagsimd said last */
+        wk->said_output = true;
+        fprintf(stderr, "%s: run %ld failed: %s\n%s(the output of later runs that fail: "
+                "-v passes every run's through)\n", prog, i, res.reason, res.output);
     }
     write_row(wk, i, val, &res);
     return 0;
