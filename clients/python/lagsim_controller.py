@@ -6,7 +6,8 @@ answer states until the run ends, a summary line.
     ctl.parser.add_argument(...)                 # the example's own options
     a = ctl.start()                              # parses argv, connects, waits for the scene
     for st in ctl.states():                      # each newest state once, until the end
-        ctl.command(st.sim_time, ["theta0"], [u])
+        m0 = ctl.params["m0"]                    # the scene's parameters, of this state's
+        ctl.command(st.sim_time, ["theta0"], [u])  # scene (ctl.scene: the whole scene_t)
     ctl.finish("states=%d ..." % n)              # prints "<name>: summary end=... states=..."
 
 A run ends (and states() returns) when the daemon publishes its `stop` event, when
