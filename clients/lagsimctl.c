@@ -896,8 +896,11 @@ static lag_result lagsimctl_main(int argc, char **argv)
         fprintf(stderr, "lagsimctl: %s\n", lag_client_errmsg(c));
         code = EXIT_NOANSWER;
     } else if (rc == LAG_CLIENT_TIMEOUT && !g_signal) {
-        fprintf(stderr, "lagsimctl: no answer on %s_* within %g s (is lagsimd running with "
-                        "lcm.prefix %s?)\n", o.prefix, o.timeout, o.prefix);
+        /* a prefix nobody has (misspelt): who is on the bus instead */
+        char instead[1500];
+        lag_client_plants_instead(o.url, o.prefix, 1.0, instead, sizeof instead);
+        fprintf(stderr, "lagsimctl: no answer on %s_* within %g s: %s\n", o.prefix, o.timeout,
+                instead);
         code = EXIT_NOANSWER;
     } else if (a.refused) {
         fprintf(stderr, "lagsimctl: the daemon refused: %s\n", a.ev.detail);

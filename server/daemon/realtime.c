@@ -99,7 +99,7 @@ static bool paused_copies(const rt_server *s)
 static rt_wait_seen wait_seen(const rt_server *s)
 {
     rt_wait_seen w = {RT_WAIT_NONE, 0, s->rejected, s->bus.commands_wrong_port, s->last_reject,
-                      false};
+                      &s->bus.foreign, false};
     bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
     if (s->run == RT_FAULT) w.kind = RT_WAIT_RESET;
     else if (s->run == RT_PAUSED && s->pending_steps == 0) {
@@ -779,6 +779,7 @@ static int open_parts(rt_server *s, const lagsimd_opts *o, char *err, size_t err
     char berr[256];
     if (rt_bus_init(&s->bus, sc, berr, sizeof berr) != 0)
         return open_error(err, errlen, "bad scene: lcm.url: %s", berr);
+    s->bus.now = &s->now;
     bool quiet = o && o->quiet; /* the terminal's and the log's -q */
     rt_term_init(&s->term, quiet, s->bus.ch_event, s->now);
     s->term.view = term_view;

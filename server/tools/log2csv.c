@@ -26,7 +26,6 @@
 
 #include "lagsim_bus.h"
 #include "lagsim_out.h"
-#include "lagsim/lagsim_control_t.h" /* the requests' constants */
 
 #define L2C_MAX_CHANNELS 256
 #define L2C_MAX_KINDS 48
@@ -495,16 +494,14 @@ static bool write_command(l2c *c, chan *h, const lag_log_record *r,
     return true;
 }
 
-/* control_t's requests by their constants (lcmtypes/control_t.lcm) */
-static const char *request_name(int r)
+/* control_t's requests by their constants (lag_wire_request_name), in lower case */
+static const char *request_name(int r, char *buf, size_t len)
 {
-    static const char *const names[] = {
-        [LAGSIM_CONTROL_T_PAUSE] = "pause", [LAGSIM_CONTROL_T_RESUME] = "resume",
-        [LAGSIM_CONTROL_T_STEP] = "step", [LAGSIM_CONTROL_T_RESET] = "reset",
-        [LAGSIM_CONTROL_T_RESET_TO] = "reset_to", [LAGSIM_CONTROL_T_STATUS] = "status",
-        [LAGSIM_CONTROL_T_DESCRIBE] = "describe", [LAGSIM_CONTROL_T_SET] = "set"};
-    const int n = (int)(sizeof names / sizeof names[0]);
-    return r >= 0 && r < n && names[r] ? names[r] : "unknown";
+    const char *n = lag_wire_request_name(r);
+    size_t k = 0;
+    for (; n && n[k] && k + 1 < len; k++) buf[k] = (char)(n[k] >= 'A' && n[k] <= 'Z' ? n[k] + 32 : n[k]);
+    buf[k] = '\0';
+    return n ? buf : "unknown";
 }
 
 static bool write_control(l2c *c, chan *h, const lag_log_record *r, const lag_wire_control *m)
@@ -525,7 +522,8 @@ static bool write_control(l2c *c, chan *h, const lag_log_record *r, const lag_wi
     put_us(f, m->utime, true);
     put_us(f, r->timestamp, false);
     put_i(f, m->request);
-    put_s(f, request_name(m->request));
+    char name[32];
+    put_s(f, request_name(m->request, name, sizeof name));
     put_i(f, m->count);
     put_numbers(f, q);
     put_numbers(f, qd);
