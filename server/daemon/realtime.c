@@ -317,7 +317,9 @@ static void period_end(rt_server *s)
         rt_pub_limited(&s->pub, RT_EV_STEP_DONE, "", 0, "step done: paused");
         s->pub.want_status = true;
     }
-    if (s->stop_tick > 0 && s->sim.tick >= s->stop_tick) {
+    /* --duration: the sim time this run has advanced, a reset's sim time starting over
+     * or not (docs/server.md) */
+    if (s->stop_tick > 0 && rt_sat_add(s->ticks_before_reset, s->sim.tick) >= s->stop_tick) {
         s->stop = true;
         s->stop_reason = RT_STOP_DURATION;
     }
@@ -587,6 +589,7 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
         live_kicks_clear(&s->ctl.live, &s->sim);
         event(s, "kicks_cleared", "", 0, detail); /* --replay applies it here */
     }
+    s->ticks_before_reset = rt_sat_add(s->ticks_before_reset, s->sim.tick); /* --duration */
     lag_sim_reset(&s->sim, q, qd);
     s->effect_events_dropped = s->sim.events_dropped;
     for (int i = 0; i < s->nq; i++) s->held[i] = 0.0;

@@ -84,7 +84,9 @@ typedef struct rt_server {
     bool stop;                 /* signal, --duration reached, or a fatal error */
     rt_stop stop_reason;
     int stop_signal;
-    int64_t stop_tick;         /* --duration in ticks, 0 = none */
+    int64_t stop_tick;         /* --duration in ticks, 0 = none: of the whole run, resets
+                                * included (ticks_before_reset + sim.tick) */
+    int64_t ticks_before_reset; /* ticks run before the last reset (RESET, RESET_TO) */
 
     /* the control period in progress: a period of many ticks runs in chunks of at most
      * tick_budget ticks per wake-up, so that signals and LCM are served in between */

@@ -1157,7 +1157,7 @@ static void case_command_flood(int arg)
 }
 
 /* --duration: 1e300 s or 1e16 s is refused (more ticks than a run counts exactly);
- * 0.5 s stops after the period that reaches it. */
+ * 0.5 s stops after the period that reaches it, the sim time before a reset counted. */
 static void case_duration(int arg)
 {
     (void)arg;
@@ -1172,6 +1172,27 @@ static void case_duration(int arg)
     ENSURE(g_srv.stop && g_srv.stop_reason == RT_STOP_DURATION && g_srv.sim.tick == 500);
     stop_server();
     ENSURE(n_events("stop") == 1 && !strcmp(last_detail("stop"), "duration reached"));
+    /* the run's sim time counts, resets included: 0.3 s, a RESET, 0.1 s, a RESET_TO, and
+     * the run of 0.5 s ends 0.1 s after it (realtime: the made-up clock paces it) */
+    scene(LAG_RT_REALTIME);
+    g_opts.duration = 0.5;
+    ENSURE(try_start(0) == 0);
+    run_until(g_srv.now + 300 * MS, 1000);
+    int64_t t1 = g_srv.sim.tick;
+    control(LAGSIM_CONTROL_T_RESET, 0);
+    run_until(g_srv.now + 100 * MS, 1000);
+    int64_t t2 = g_srv.sim.tick;
+    uint8_t buf[256];
+    double q[3] = {0, 0.05, 0}, qd[3] = {0};
+    lagsim_control_t m = {0, LAGSIM_CONTROL_T_RESET_TO, 0, 3, q, qd, "", ""};
+    int n = lagsim_control_t_encode(buf, 0, sizeof buf, &m);
+    rt_handle_control(&g_srv, buf, (size_t)n);
+    run_until(g_srv.now + 100 * SEC, 1000);
+    ENSUREF(g_srv.stop && g_srv.stop_reason == RT_STOP_DURATION && t1 > 0 && t2 > 0 &&
+                t1 + t2 + g_srv.sim.tick == 500,
+            "stopped after %lld + %lld + %lld ticks (500 in all)", (long long)t1, (long long)t2,
+            (long long)g_srv.sim.tick);
+    stop_server();
 }
 
 /* Signals: SIGHUP, SIGQUIT, SIGINT and SIGTERM stop with a stop event naming the signal
