@@ -5,13 +5,17 @@
  * message; its CSV is opened then, with a header from that message (a state's joint
  * names). A later message of another type or other joints on the same channel is not
  * written, only counted. Every number is written as the shortest decimal that reads
- * back to the same double (lagsim_num.h); every string from the log (names, kinds, details, in headers and cells) is
- * quoted and kept from reading as a spreadsheet formula (put_text).
+ * back to the same double (lagsim_num.h); every string from the log (names, kinds,
+ * details, in headers and cells) is quoted only where RFC 4180 needs it and kept from
+ * reading as a spreadsheet formula (put_text). A state sent again unchanged (the state at
+ * t = 0 while the plant waits for its first command, a paused state: the same generation,
+ * step, sim time and numbers) is one row; the copies are counted in the summary.
  *
  * Per-channel facts for the summary: counts, log-time span and rate, undecodable
  * messages; for states the step sequence (gaps: a step increase other than one control
- * period, with the states missing; resets: the step going back; repeats: the same step
- * again, as while paused); for status the last counters; for events a count per kind.
+ * period, with the states missing; resets: the step going back; copies: the same state
+ * again, not written; repeats: the same step again with other numbers, written); for
+ * status the last counters; for events a count per kind.
  */
 #include "log2csv.h"
 #include "lagsim_num.h"
@@ -47,7 +51,8 @@ typedef struct chan {
     int64_t prev_step, first_step, last_step;
     int64_t period_ticks;       /* 0 = unknown yet */
     bool period_from_scene;
-    int64_t gaps, missing, resets, repeats;
+    int64_t gaps, missing, resets, repeats, copies;
+    lag_wire_joint_state last; /* the state of the last row (copies are not written) */
     double first_sim, last_sim;
     /* status */
     lag_wire_status last_status;
@@ -87,37 +92,41 @@ static void put_t(FILE *f, double t)
     fputs(lag_num(t, b), f);
 }
 static void put_i(FILE *f, int64_t x) { fprintf(f, ",%" PRId64, x); }
-/* One text field from a log (a name, a kind, a detail), RFC 4180: always in double quotes,
- * a quote doubled; control characters become spaces, so one record is one line. A field
- * whose first non-blank character would start a formula in a spreadsheet (=, +, -, @;
- * tab and CR are spaces by then) is written as text: a leading apostrophe, as OWASP's
- * CSV-injection guidance asks. `suffix` (may be NULL) is appended inside the quotes: a
- * header's "<joint>_dot". Numbers never pass here: they stay numbers. */
+/* One text field from a log (a name, a kind, a detail), RFC 4180: control characters
+ * become spaces, so one record is one line; in double quotes (a quote doubled) only when
+ * it holds a comma or a quote, as RFC 4180 needs, so that a plain name reads as itself
+ * everywhere (Octave's importdata keeps quotes it is given: "theta"). A field whose
+ * first non-blank character would start a formula in a spreadsheet (=, +, -, @; tab and
+ * CR are spaces by then) is written as text: a leading apostrophe, as OWASP's
+ * CSV-injection guidance asks (the apostrophe needs no quotes). `suffix` (may be NULL) is
+ * appended to it: a header's "<joint>_dot". Numbers never pass here: they stay numbers. */
 static void put_text(FILE *f, const char *s, const char *suffix)
 {
     const char *p = s;
     while (*p == ' ' || *p == 0x7f || ((unsigned char)*p < 0x20 && *p)) p++; /* all blank out */
     bool formula = *p == '=' || *p == '+' || *p == '-' || *p == '@';
-    fputc('"', f);
+    const char *sfx = suffix ? suffix : "";
+    bool quote = strpbrk(s, ",\"") || strpbrk(sfx, ",\""); /* CR and LF are spaces by now */
+    if (quote) fputc('"', f);
     if (formula) fputc('\'', f);
     for (int pass = 0; pass < 2; pass++)
-        for (const char *q = pass ? (suffix ? suffix : "") : s; *q; q++) {
+        for (const char *q = pass ? sfx : s; *q; q++) {
             unsigned char c = (unsigned char)*q;
             if (c == '"') fputs("\"\"", f);
             else if (c < 0x20 || c == 0x7f) fputc(' ', f);
             else fputc(c, f);
         }
-    fputc('"', f);
+    if (quote) fputc('"', f);
 }
 static void put_s(FILE *f, const char *s)
 {
     fputc(',', f);
     put_text(f, s, NULL);
 }
-/* A list of numbers this tool formatted (lag_num's, joined by spaces): quoted, and not
- * marked as text, a leading minus sign included (digits, signs, '.', 'e', "inf", "nan"
- * and spaces make no formula that reaches anything). */
-static void put_numbers(FILE *f, const char *s) { fprintf(f, ",\"%s\"", s); }
+/* A list of numbers this tool formatted (lag_num's, joined by spaces): no comma or quote,
+ * so no quotes, and not marked as text, a leading minus sign included (digits, signs, '.',
+ * 'e', "inf", "nan" and spaces make no formula that reaches anything). */
+static void put_numbers(FILE *f, const char *s) { fprintf(f, ",%s", s); }
 /* Log timestamp and utime in seconds since the epoch (us resolution). */
 static void put_us(FILE *f, int64_t us, bool first)
 {
@@ -240,6 +249,18 @@ static void header_state(FILE *f, const lag_wire_joint_state *m)
     fputc('\n', f);
 }
 
+/* Whether m is the state of the last row sent again: the same generation, step, sim time
+ * and numbers (the daemon publishes the state it waits at anew while it waits). */
+static bool is_copy(const chan *h, const lag_wire_joint_state *m)
+{
+    const lag_wire_joint_state *l = &h->last;
+    size_t n = (size_t)m->num_joints * sizeof(double);
+    return h->have_prev && m->generation == l->generation && m->step == l->step &&
+           !memcmp(&m->sim_time, &l->sim_time, sizeof m->sim_time) &&
+           m->num_joints == l->num_joints && !memcmp(m->position, l->position, n) &&
+           !memcmp(m->velocity, l->velocity, n) && !memcmp(m->effort, l->effort, n);
+}
+
 /* Step bookkeeping of a state channel (gaps, resets, repeats). */
 static void track_steps(l2c *c, chan *h, const lag_wire_joint_state *m)
 {
@@ -291,7 +312,12 @@ static bool write_state(l2c *c, chan *h, const lag_log_record *r, const lag_wire
         h->mismatched++;
         return true;
     }
+    if (is_copy(h, m)) { /* one row per state: the copy counted, not written */
+        h->copies++;
+        return true;
+    }
     track_steps(c, h, m);
+    h->last = *m;
     FILE *f = h->csv;
     put_t(f, m->sim_time);
     put_us(f, m->utime, false);
@@ -658,11 +684,12 @@ static void summarize(l2c *c, const lag_log_stats *ls, FILE *f)
             if (h->have_prev)
                 fprintf(f, "  sim time %.9g .. %.9g s, step %" PRId64 " .. %" PRId64
                            "; gaps %" PRId64 " (%" PRId64 " states missing; period %" PRId64
-                           " ticks%s), resets %" PRId64 ", repeats %" PRId64 "\n",
+                           " ticks%s), resets %" PRId64 ", repeats %" PRId64 "; copies %"
+                           PRId64 " (a state sent again unchanged: one row)\n",
                         h->first_sim, h->last_sim, h->first_step, h->last_step, h->gaps,
                         h->missing, h->period_ticks,
                         h->period_from_scene ? ", from the scene" : ", inferred",
-                        h->resets, h->repeats);
+                        h->resets, h->repeats, h->copies);
             break;
         case LAG_WIRE_STATUS:
             if (h->have_status) summarize_status(&h->last_status, f);
