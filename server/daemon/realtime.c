@@ -508,6 +508,27 @@ static bool command_of_now(rt_server *s, const lag_wire_joint_command *c)
     return false;
 }
 
+/* The copy rule (docs/clients.md: run the law once per state; answer a copy, the same
+ * generation and sim_time sent again until answered, at once with the command already
+ * sent). A controller that runs its law on every copy answers the copies one law time
+ * apart, long after the state's first answer (a controller that keeps the rule answers
+ * the copies it got meanwhile at once, within a millisecond or so), and falls behind: its
+ * answers to copies come late, and those to older states stale. Once they number 10 and
+ * at least one for every two states answered, an event (and so a line on the terminal)
+ * says so, once. */
+#define RT_COPY_LATE_NS (20 * RT_NS_PER_S / 1000)
+static void late_answer(rt_server *s)
+{
+    if (++s->late_answers < 10 || 2 * s->late_answers < s->accepted || s->copy_rule_said) return;
+    s->copy_rule_said = true;
+    rt_pub_eventf(&s->pub, "copy_rule", (double)s->late_answers, "the law seems to run again "
+                  "on copies: %lld answers came 20 ms or more after their state was answered "
+                  "(%lld states answered); answer a copy (same generation, sim_time) at once "
+                  "with the command sent (docs/clients.md: the rule)", (long long)s->late_answers,
+                  (long long)s->accepted);
+    s->pub.want_status = true;
+}
+
 /* Lockstep: the command answers the state waited on (or, not running, the state the sim
  * holds), known by its generation and sim time. A second answer to a state already
  * answered (the controller got it twice, a retry crossing its first answer) is not
@@ -519,8 +540,10 @@ static bool command_in_step(rt_server *s, const lag_wire_joint_command *c)
     if (rt_lockstep_repeated(&s->ls, c->generation, c->sim_time)) {
         s->commands_ignored++;
         rt_log_rx_fate(&s->rec, s->now, RT_RX_REFUSED); /* --log: a sample of them */
+        if (s->now - s->ls.answered_ns >= RT_COPY_LATE_NS) late_answer(s);
         return false;
     }
+    if (s->ls.have_answered && c->sim_time < s->ls.answered_time) late_answer(s);
     bool waited_on = rt_lockstep_is_waited(&s->ls, c->generation, c->sim_time);
     if (waited_on || (s->run != RT_RUNNING && c->sim_time == lag_sim_time(&s->sim))) return true;
     rt_verdict v = {RT_REJ_STALE, "", c->sim_time, ""};
@@ -542,7 +565,7 @@ static void command_apply(rt_server *s, const lag_wire_joint_command *c, const i
     s->accepted++;
     s->have_command = true;
     s->command_tick = s->sim.tick;
-    rt_lockstep_answer(&s->ls, c->generation, c->sim_time);
+    rt_lockstep_answer(&s->ls, c->generation, c->sim_time, s->now);
     if (s->run == RT_WAITING) {
         /* the command the run was waiting for: it goes on from here */
         s->run = RT_RUNNING;

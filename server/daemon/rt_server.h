@@ -111,6 +111,11 @@ typedef struct rt_server {
     int64_t watchdog_trips;
     int64_t lockstep_timeouts;
     int64_t commands_ignored;  /* answers to a state already answered */
+    int64_t late_answers;      /* lockstep: answers to a state already answered that came
+                                * RT_COPY_LATE_NS or more after its first, or to a state
+                                * older than the last answered (the law run again on each
+                                * copy: the copy rule's hint, said once) */
+    bool copy_rule_said;
     int64_t numeric_faults;
     int64_t effect_events_dropped; /* sim.events_dropped already reported */
     int64_t plant_conflicts;   /* scenes of another plant heard on this prefix while running */

@@ -13,7 +13,7 @@
  *                           long_period chunks
  *                           step_paced control_flood command_flood duration signals
  *                           fault_effort lockstep_retry lockstep_loss other_plant
- *                           reject_names waits foreign (--list)
+ *                           reject_names waits foreign copy_rule (--list)
  */
 #include <math.h>
 #include <signal.h>
@@ -1578,6 +1578,48 @@ static void case_foreign(int arg)
     stop_server();
 }
 
+/* The copy rule's hint: a controller that runs its law again on every copy answers the
+ * copies one law time apart, long after the first answer: once 10 such late answers (and
+ * answers to states older than the last answered) make one for every two states
+ * answered, a copy_rule event says so, once. A controller that answers the copies it got
+ * at once (1 ms after its first answer here) never sees it. */
+static void case_copy_rule(int arg)
+{
+    (void)arg;
+    for (int law_again = 0; law_again < 2; law_again++) {
+        scene(LAG_RT_LOCKSTEP);
+        g_sc.realtime.start = LAG_RT_START_RUNNING;
+        g_sc.realtime.lockstep_timeout = 10.0;
+        start();
+        for (int k = 0; k < 40; k++) {
+            double t = g_out.last_t;              /* the state waited on */
+            run_until(g_srv.now + 5 * MS, 1000);  /* the law's time */
+            command(t, "theta0", 0.0);
+            /* a copy answered again: at once by the rule, 50 ms (a law) later without it */
+            run_until(g_srv.now + (law_again ? 50 : 1) * MS, 1000);
+            command(t, "theta0", 0.0);
+            drain();
+            rt_process(&g_srv);
+        }
+        run_until(g_srv.now + 10 * MS, 1000);
+        printf("%s: %lld states answered, %lld ignored, %lld late; copy_rule events %lld: %s\n",
+               law_again ? "the law again" : "the rule", (long long)g_srv.accepted,
+               (long long)g_srv.commands_ignored, (long long)g_srv.late_answers,
+               (long long)n_events("copy_rule"), last_detail("copy_rule"));
+        ENSURE(g_srv.accepted == 40 && g_srv.commands_ignored == 40);
+        if (law_again)
+            ENSUREF(n_events("copy_rule") == 1 &&
+                        strstr(last_detail("copy_rule"), "the law seems to run again on copies: "
+                               "10 answers came 20 ms or more after their state was answered "
+                               "(10 states answered); answer a copy (same generation, sim_time) "
+                               "at once with the command sent (docs/clients.md: the rule)"),
+                    "%lld copy_rule events", (long long)n_events("copy_rule"));
+        else
+            ENSURE(n_events("copy_rule") == 0 && g_srv.late_answers == 0);
+        stop_server();
+    }
+}
+
 /* Runs a lockstep DIPC for `periods` periods with the test's controller losing `loss` of
  * the states and of the commands; returns the wall time (ns of the made-up clock). */
 static int64_t lockstep_run(double loss, int periods)
@@ -1866,7 +1908,7 @@ int main(int argc, char **argv)
         {"lockstep_retry", case_lockstep_retry, 0, 0}, {"lockstep_loss", case_lockstep_loss, 0, 0},
         {"other_plant", case_other_plant, 0, 0}, {"messages", case_messages, 0, 0},
         {"reject_names", case_reject_names, 0, 0}, {"waits", case_waits, 0, 0},
-        {"foreign", case_foreign, 0, 0},
+        {"foreign", case_foreign, 0, 0},        {"copy_rule", case_copy_rule, 0, 0},
         {"live_error", case_live_error, 0, 0},  {"scene_rules", case_scene_rules, 0, 0},
         {"generation", case_generation, 0, 0},
     };
