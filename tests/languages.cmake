@@ -257,6 +257,15 @@ add_test(NAME clients_octave_matlab_syntax
           ${CMAKE_CURRENT_SOURCE_DIR}/clients/reference/reference_echo.m
           --readme ${PROJECT_SOURCE_DIR}/README.md)
 list(APPEND lang_tests clients_octave_matlab_syntax)
+# lagsim.examples.Messages for MATLAB/Octave users: docs/clients.md's table of its methods
+# against the class, listed in GNU Octave by lagsim_methods.m (the jars on the dynamic class
+# path) and by methods() (on the static one) (tests/clients/messages_methods.py)
+if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
+  add_test(NAME clients_octave_messages_methods
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/messages_methods.py
+            --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR})
+  list(APPEND lang_tests clients_octave_messages_methods)
+endif()
 # the jars load in MATLAB's bundled Java 8: every class of LAGSIM_JAVA_RELEASE
 if(TARGET lagsim_examples_java)
   add_test(NAME clients_java_release
