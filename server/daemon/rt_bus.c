@@ -4,7 +4,8 @@
  *                 opens a receive socket for it and the daemon never reads back its own
  *                 states (in fast mode, tens of thousands a second);
  *   b->lcm_in     the command URL: _COMMAND and _CONTROL. Its receive socket gets a
- *                 filter (lagsim_net.h): only this plant's two channels, and unless
+ *                 filter (lagsim_net.h): only this plant's two channels (and every
+ *                 prefix's _CONTROL, below), and unless
  *                 lcm.allow_lan only datagrams sent from this host;
  * For memq:// (tests, one process) one lcm_t is both.
  *
