@@ -99,7 +99,7 @@ static bool paused_copies(const rt_server *s)
 static rt_wait_seen wait_seen(const rt_server *s)
 {
     rt_wait_seen w = {RT_WAIT_NONE, 0, s->rejected, s->bus.commands_wrong_port, s->last_reject,
-                      &s->bus.foreign, false};
+                      &s->bus.foreign, false, s->stale};
     bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
     if (s->run == RT_FAULT) w.kind = RT_WAIT_RESET;
     else if (s->run == RT_PAUSED && s->pending_steps == 0) {
@@ -496,6 +496,7 @@ static bool command_of_now(rt_server *s, const lag_wire_joint_command *c)
     bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
     if (c->generation == now_gen || (c->generation == 0 && !lockstep)) return true;
     rt_verdict v = {RT_REJ_STALE, "", c->sim_time, ""};
+    s->stale[c->generation == 0 ? RT_STALE_NO_GENERATION : RT_STALE_GENERATION]++;
     if (c->generation == 0)
         snprintf(v.what, sizeof v.what, "generation 0 answers no state; lockstep advances on "
                  "the generation and sim_time of the state waited on (generation %lld)",
@@ -508,9 +509,9 @@ static bool command_of_now(rt_server *s, const lag_wire_joint_command *c)
     return false;
 }
 
-/* The copy rule (docs/clients.md: run the law once per state; answer a copy, the same
- * generation and sim_time sent again until answered, at once with the command already
- * sent). A controller that runs its law on every copy answers the copies one law time
+/* The copy rule (docs/protocol.md, Lockstep: run the law once per state; answer a copy,
+ * the same generation and sim_time sent again until answered, at once with the command
+ * already sent). A controller that runs its law on every copy answers the copies one law time
  * apart, long after the state's first answer (a controller that keeps the rule answers
  * the copies it got meanwhile at once, within a millisecond or so), and falls behind: its
  * answers to copies come late, and those to older states stale. Once they number 10 and
@@ -524,7 +525,7 @@ static void late_answer(rt_server *s)
     rt_pub_eventf(&s->pub, "copy_rule", (double)s->late_answers, "the law seems to run again "
                   "on copies: %lld answers came 20 ms or more after their state was answered "
                   "(%lld states answered); answer a copy (same generation, sim_time) at once "
-                  "with the command sent (docs/clients.md: the rule)", (long long)s->late_answers,
+                  "with the command sent (docs/protocol.md: the copy rule)", (long long)s->late_answers,
                   (long long)s->accepted);
     s->pub.want_status = true;
 }
@@ -547,6 +548,7 @@ static bool command_in_step(rt_server *s, const lag_wire_joint_command *c)
     bool waited_on = rt_lockstep_is_waited(&s->ls, c->generation, c->sim_time);
     if (waited_on || (s->run != RT_RUNNING && c->sim_time == lag_sim_time(&s->sim))) return true;
     rt_verdict v = {RT_REJ_STALE, "", c->sim_time, ""};
+    s->stale[RT_STALE_SIM_TIME]++;
     if (s->ls.waiting)
         snprintf(v.what, sizeof v.what, "sim_time %.9g (in value); accepted: %.9g, the state "
                  "waited on", c->sim_time, s->ls.waiting_time);

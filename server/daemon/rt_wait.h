@@ -38,6 +38,7 @@ typedef struct rt_wait_seen {
                                  * (NULL: none kept) */
     bool owed;                  /* RT_WAIT_RESUME in lockstep: the state waited on (at t)
                                  * has not been answered yet */
+    const int64_t *stale;       /* [RT_STALE_COUNT]: the stale rejections, by kind */
 } rt_wait_seen;
 
 typedef struct rt_wait {
@@ -49,6 +50,7 @@ typedef struct rt_wait {
     int64_t since_ns;           /* when the wait began */
     int64_t next_line_ns;       /* its next line on stderr */
     int64_t rejected0[RT_REJ_COUNT]; /* the counters when it began */
+    int64_t stale0[RT_STALE_COUNT];
     int64_t wrong_port0;
     rt_foreign foreign0;        /* the requests heard elsewhere when it began */
 } rt_wait;
