@@ -336,10 +336,13 @@ static int report(run_files *rf, const char *dir, bool force, const eval_case *c
     f = open_out(rf, "--report", png, force);
     if (!f) return -1;
     fclose(f);
+    /* the case's report is done once gnuplot has drawn it: a signal while gnuplot runs
+     * finds all three unfinished (remove_unfinished) */
+    int rc = eval_gnuplot(prog, gp);
     files_done(rf, "--report", dat);
     files_done(rf, "--report", gp);
     files_done(rf, "--report", png);
-    return eval_gnuplot(prog, gp);
+    return rc;
 }
 
 /* A run of lagsim-eval: the options, the scene and its cases, the outputs. */
