@@ -500,8 +500,8 @@ add_test(NAME clients_walkthrough
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_recipes.py
           --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} walkthrough walkthrough-lockstep)
 set_tests_properties(clients_walkthrough PROPERTIES TIMEOUT 200 LABELS clients)
-# docs/clients.md's law that reads the scene's parameters (ctl.params, Python), its hold.py
-# and commands as written: the manipulator held through a SET of m2
+# docs/clients.md's law that reads the scene's parameters (ctl.params, Python), the page's
+# controller file and commands as written: the manipulator held through a SET of m2
 add_test(NAME clients_scene_params
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_recipes.py
           --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} scene-params)
