@@ -715,7 +715,7 @@ BAD_VARY = [
     # the keys as the scene loader takes them, before any run (before, every run failed
     # with the loader's words in the CSV's reason, and the sweep exited 1)
     (["parameters.M1=uniform(0.05,0.3)"], "--vary parameters.M1=uniform(0.05,0.3): the scene "
-     "refuses parameters.M1=0.17499999999999999: case sweep: --set parameters.M1: unknown "
+     "refuses parameters.M1=0.175: case sweep: --set parameters.M1: unknown "
      "parameter 'M1'"),
     (["parameters.m1=uniform(-3,-1)"], "refuses parameters.m1=-2: case sweep: --set "
      "parameters.m1: expected a number > 0"),
