@@ -283,6 +283,15 @@ add_test(NAME clients_octave_matlab_syntax
           ${CMAKE_CURRENT_SOURCE_DIR}/clients/reference/reference_echo.m
           --readme ${PROJECT_SOURCE_DIR}/README.md --snippets ${PROJECT_SOURCE_DIR}/docs/clients.md)
 list(APPEND lang_tests clients_octave_matlab_syntax)
+# lagsim.examples.Messages for MATLAB/Octave users: docs/clients.md's table of its methods
+# against the class, listed in GNU Octave by lagsim_methods.m (the jars on the dynamic class
+# path) and by methods() (on the static one) (tests/clients/messages_methods.py)
+if(LAGSIM_OCTAVE AND TARGET lagsim_examples_java)
+  add_test(NAME clients_octave_messages_methods
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/messages_methods.py
+            --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR})
+  list(APPEND lang_tests clients_octave_messages_methods)
+endif()
 # the jars load in MATLAB's bundled Java 8: every class of LAGSIM_JAVA_RELEASE
 if(TARGET lagsim_examples_java)
   add_test(NAME clients_java_release
@@ -526,6 +535,12 @@ add_test(NAME clients_walkthrough
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_recipes.py
           --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} walkthrough walkthrough-lockstep)
 set_tests_properties(clients_walkthrough PROPERTIES TIMEOUT 200 LABELS clients)
+# docs/clients.md's law that reads the scene's parameters (ctl.params, Python), the page's
+# controller file and commands as written: the manipulator held through a SET of m2
+add_test(NAME clients_scene_params
+  COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_recipes.py
+          --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} scene-params)
+set_tests_properties(clients_scene_params PROPERTIES TIMEOUT 120 LABELS clients)
 
 set_tests_properties(${lang_tests} PROPERTIES TIMEOUT 90 LABELS clients)
 # a block built twice and run twice, the second time with a law of 0.15 s or 1.5 s per

@@ -55,6 +55,7 @@ struct eval_worker {
     eval_env env;
     eval_scene sc;
     char log[1024];
+    char cerr[1100], derr[1100]; /* the pair's stderr without -v (eval_stderr_paths) */
     pid_t dpid, cpid;
     lag_client *cl;
     lag_client_status *status; /* the latest status, read whole (lagsim_client_wire.h) */
@@ -73,6 +74,7 @@ struct eval_worker {
                            * them */
     double t_answered;    /* the sim time of the last answer heard */
     int64_t g_answered;   /* and the generation it carried */
+    char ended[96];       /* the controller ended while a STEP was awaited: how */
 };
 
 /* ---------------------------------------------------------------- from the bus */
@@ -213,6 +215,14 @@ static int step_once(eval_worker *w, long n, double seconds)
     if (lag_client_step(w->cl, n) != LAG_CLIENT_OK) return -1;
     while (!w->moved) {
         if (eval_now() > end) return -1;
+        int st;
+        if (w->cpid > 0 && eval_wait_until(w->cpid, 0, &st)) { /* nothing will answer */
+            snprintf(w->ended, sizeof w->ended, "the controller ended (%s %d)",
+                     WIFEXITED(st) ? "exit status" : "signal",
+                     WIFEXITED(st) ? WEXITSTATUS(st) : WTERMSIG(st));
+            w->cpid = 0;
+            return -1;
+        }
         double next = eval_now() + W_ANSWER_S;
         while (!w->moved && eval_now() < next) w_handle(w, 5);
         if (!w->moved && still_at_start(w) && lag_client_step(w->cl, n) != LAG_CLIENT_OK)
@@ -243,12 +253,37 @@ static pid_t start_daemon(eval_worker *w, const eval_case *c)
     argv[na++] = w->log;
     argv[na++] = "-q";
     argv[na] = NULL;
-    return eval_spawn(argv, NULL, &w->env);
+    return eval_spawn(argv, NULL, &w->env, w->derr);
 }
 
+/* Stops the pair: the daemon, then the controller (which ends on its stop). */
+static void stop_pair(eval_worker *w)
+{
+    int st;
+    if (w->dpid > 0) {
+        kill(w->dpid, SIGTERM);
+        if (!eval_wait_until(w->dpid, eval_now() + 3.0, &st)) eval_stop_group(w->dpid, &st);
+    }
+    /* a controller ends on the daemon's stop; one that does not is stopped */
+    if (w->cpid > 0 && !eval_wait_until(w->cpid, eval_now() + 3.0, &st))
+        eval_stop_group(w->cpid, &st);
+    w->dpid = w->cpid = 0;
+}
+
+/* A pair that could not start: why, and (without -v) what the two said last. */
 static eval_worker *start_failed(eval_worker *w, char *err, size_t errlen, const char *why)
 {
-    if (why != err) snprintf(err, errlen, "%s", why); /* err may hold it already */
+    char said[EVAL_OUTPUT_LEN] = "";
+    stop_pair(w);
+    if (!w->env.verbose && w->cerr[0]) {
+        eval_stderr_tail(w->cerr, "the controller", said, sizeof said);
+        eval_stderr_tail(w->derr, "lagsimd", said, sizeof said);
+    }
+    char first[512];
+    snprintf(first, sizeof first, "%s", why);
+    snprintf(err, errlen, "%s%s%s", first, said[0] ? "\n" : "", said);
+    size_t n = strlen(err);
+    if (n && err[n - 1] == '\n') err[n - 1] = '\0';
     eval_worker_stop(w);
     return NULL;
 }
@@ -267,8 +302,9 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
         free(w);
         return NULL;
     }
+    eval_stderr_paths(env, w->cerr, w->derr, sizeof w->cerr);
     /* the controller first, as eval_run starts them */
-    w->cpid = eval_spawn(NULL, cmd, env);
+    w->cpid = eval_spawn(NULL, cmd, env, w->cerr);
     w->dpid = start_daemon(w, c);
     w->cl = lag_client_create(env->url, env->prefix, err, errlen);
     w->status = lag_client_status_new();
@@ -285,27 +321,28 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
         return start_failed(w, err, errlen, "cannot listen to the controller's answers");
     if (lag_client_wait_scene(w->cl, 10.0, NULL) != LAG_CLIENT_OK)
         return start_failed(w, err, errlen, "no scene from the kept lagsimd");
-    if (step_once(w, 1, 30))
-        return start_failed(w, err, errlen, "the kept lagsimd did not step");
+    if (step_once(w, 1, 30)) {
+        char why[160];
+        snprintf(why, sizeof why, "the kept lagsimd did not step%s%s", w->ended[0] ? ": " : "",
+                 w->ended);
+        return start_failed(w, err, errlen, why);
+    }
     return w;
 }
 
 void eval_worker_stop(eval_worker *w)
 {
     if (!w) return;
-    int st;
-    if (w->dpid > 0) {
-        kill(w->dpid, SIGTERM);
-        if (!eval_wait_until(w->dpid, eval_now() + 3.0, &st)) eval_stop_group(w->dpid, &st);
-    }
-    /* a controller ends on the daemon's stop; one that does not is stopped */
-    if (w->cpid > 0 && !eval_wait_until(w->cpid, eval_now() + 3.0, &st))
-        eval_stop_group(w->cpid, &st);
+    stop_pair(w);
     if (w->cl) lag_client_destroy(w->cl);
     lag_client_status_free(w->status);
     if (w->cmd) lcm_destroy(w->cmd);
     eval_series_free(&w->s);
-    if (!w->env.verbose) unlink(w->log);
+    if (!w->env.verbose) {
+        unlink(w->log);
+        if (w->cerr[0]) unlink(w->cerr);
+        if (w->derr[0]) unlink(w->derr);
+    }
     free(w);
 }
 
@@ -464,9 +501,9 @@ static bool paused_answer(eval_worker *w, eval_result *res)
     return true;
 }
 
-int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets, int nsets,
-                    const double *q0, const double *qd0, eval_result *res, char *err,
-                    size_t errlen)
+static int worker_run(eval_worker *w, const eval_case *c, const char *const *sets, int nsets,
+                      const double *q0, const double *qd0, eval_result *res, char *err,
+                      size_t errlen)
 {
     memset(res, 0, sizeof *res);
     eval_series_free(&w->s);
@@ -508,4 +545,16 @@ int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets,
         eval_fail(res, "stopped at t = %.6g s before the duration %.6g s", res->t_end,
                   c->duration);
     return eval_score(&w->s, c, &w->sc, res, err, errlen);
+}
+
+int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets, int nsets,
+                    const double *q0, const double *qd0, eval_result *res, char *err,
+                    size_t errlen)
+{
+    int rc = worker_run(w, c, sets, nsets, q0, qd0, res, err, errlen);
+    if ((rc != 0 || res->failed) && !w->env.verbose) { /* what the kept pair said last */
+        eval_stderr_tail(w->cerr, "the controller", res->output, sizeof res->output);
+        eval_stderr_tail(w->derr, "lagsimd", res->output, sizeof res->output);
+    }
+    return rc;
 }

@@ -208,7 +208,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     the fast run's slowest answer); prints its checks. Returns (failures, {sim_time: the
     state's positions and velocities}, the slowest answer in s)."""
     from lagsim_lcm import LCM, plant_urls
-    from lagsim import joint_command_t, joint_state_t, status_t
+    from lagsim import event_t, joint_command_t, joint_state_t, status_t
     fname, cmd, env_extra = RUNNERS[lang]
     prefix = "RDME%s_%d" % (lang.upper(), os.getpid())
     tmp = tempfile.mkdtemp(prefix="lagsim_readme_")
@@ -248,6 +248,11 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     def on_status(ch, data):
         heard["status"] = status_t.decode(data)
 
+    heard["copy_rule"] = 0
+
+    def on_event(ch, data):  # the daemon's hint that the law runs again on copies
+        heard["copy_rule"] += event_t.decode(data).kind == "copy_rule"
+
     def on_command(ch, data):
         t = joint_command_t.decode(data).sim_time
         if t == -1.0:
@@ -265,6 +270,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     stray.subscribe(prefix + "_.*", on_stray)
     lc.subscribe(prefix + "_STATE", on_state)
     lc.subscribe(prefix + "_STATUS", on_status)
+    lc.subscribe(prefix + "_EVENT", on_event)
     lc_cmd.subscribe(prefix + "_COMMAND", on_command)
     heard["ready"] = False
     listening = [True]
@@ -346,6 +352,8 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
         checks.append((periods + 1 <= laws <= periods + 2,
                        "its law ran %d times for the probe and %d states (once per sim_time: "
                        "%d or %d)" % (laws, periods + 1, periods + 1, periods + 2)))
+        checks.append((heard["copy_rule"] == 0, "the daemon saw the copy rule kept (%d "
+                       "copy_rule events)" % heard["copy_rule"]))
     print("---- %s (%s)%s" % (name, path, " with a law of %g s per answer" % think if think else ""))
     if out.strip():
         print(out.rstrip())

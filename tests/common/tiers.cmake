@@ -73,6 +73,7 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^log_old_version_"
   "wallclock NAME  ^log_term_"
   # view: the log tools; Chromium; attacks that take time or namespaces
+  "wallclock NAME  ^view_log2csv_load$"  # a real-time run recorded, then loaded
   "quick     NAME  ^view_log2csv_"
   "quick     NAME  ^view_stop_"
   "wallclock NAME  ^view_attack_(slowloris|stalled)$"
@@ -82,7 +83,7 @@ set(LAGSIM_TIER_RULES
   # controller; packet loss and ssh hosts in namespaces
   "quick     NAME  ^eval_(metrics|reference|sweep_csv)_"
   "quick     NAME  ^eval_procs_(eval|sweep)_(sigint|sigterm|sigkill|groupkill)$"
-  "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene|owned|outputs|bus|docs_python)$"
+  "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene|owned|outputs|bus|docs_python|stderr)$"
   "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|merge_rows|merge_foreign|shard|kept|kept_python|vary|scene_c|scene_python)$"
   "wallclock NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
   "root      NAME  ^eval_lagsim_sweep_(loss|ssh|scene_loss)$"
@@ -91,7 +92,7 @@ set(LAGSIM_TIER_RULES
   "octave    NAME  ^clients_(octave_|readme_octave$)"
   "octave    NAME  ^clients_cross_language_generation$"  # C, Python, Lua, Java and Octave
   "wallclock NAME  _(realtime|ends_on_stop|ends_on_silence|late_controller|slow_law|slower_law)$"
-  "wallclock NAME  ^clients_(readme_recipes|walkthrough)$"
+  "wallclock NAME  ^clients_(readme_recipes|walkthrough|scene_params)$"
   "wallclock NAME  ^ctl_"
   "quick     NAME  ^install_"
   "quick     NAME  ^clients_(lqr|status_fields|hostile_messages|library|generation|not_built)$"

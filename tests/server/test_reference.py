@@ -240,8 +240,8 @@ def case_lockstep(t):
         [float(x) for x in row.split(",")[5:]] == list(m.r) + list(m.rdot) + list(m.rddot) and
         int(row.split(",")[4]) == m.generation and
         float(row.split(",")[0]) == m.sim_time for row, m in zip(rows[1:], sent))
-    check(p.returncode == 0 and rows[0] == 't,wall_time,log_time,step,generation,"theta0","theta1",'
-          '"theta0_dot","theta1_dot","theta0_ddot","theta1_ddot"' and same,
+    check(p.returncode == 0 and rows[0] == 't,wall_time,log_time,step,generation,theta0,theta1,'
+          'theta0_dot,theta1_dot,theta0_ddot,theta1_ddot' and same,
           f"lagsim-log2csv: {prefix}_REFERENCE.csv, {len(rows) - 1} rows equal to the "
           f"{len(sent)} references logged: {rows[0]}")
     plot_has_reference(t, os.path.join(out, prefix + "_STATE.csv"), prefix + "_REFERENCE.csv",
