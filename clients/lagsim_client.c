@@ -1294,12 +1294,12 @@ static int nearness(const char *heard, const char *asked)
 int lag_client_plants_instead(const char *url, const char *prefix, double wait_s, char *out,
                               size_t len)
 {
-    static lag_client_plant p[LAG_CLIENT_MAX_PLANTS];
+    lag_client_plant p[LAG_CLIENT_MAX_PLANTS]; /* on the stack: any thread may ask */
     int n = 0;
     char err[256] = "";
     if (!out || len == 0 || !prefix) return LAG_CLIENT_ERR_ARG;
-    lag_result rc = lag_client_discover(url, wait_s, 0.5, p, LAG_CLIENT_MAX_PLANTS, &n, err,
-                                        sizeof err);
+    lag_result rc = lag_client_discover(url, wait_s, 0.5, p, LAG_CLIENT_MAX_PLANTS, sizeof p[0],
+                                        &n, err, sizeof err);
     if (rc != LAG_CLIENT_OK) {
         snprintf(out, len, "%s", err);
         return rc;
