@@ -212,6 +212,32 @@ else()
   message(WARNING "lua5.2 or liblcm-lua missing: the Lua clients' tests are not registered")
 endif()
 
+# ---- Go, through the C ABI alone (clients/go/dipc_balance.go over liblagsim_client.so.1 by
+# cgo): the given gain balances the DIPC in lockstep (the bounds above that need no design:
+# the linearized loop's prediction is dipc_lqr's and the other examples'); forged messages
+# dropped by the library with the same states; how a run ends (the daemon's stop, a silent
+# daemon, SIGINT and SIGTERM). Its bits are C's in the cross-language tests below.
+set(go_xl "")
+set(go_gen "")
+if(TARGET dipc_balance_go)
+  set(go_dipc ${CMAKE_BINARY_DIR}/bin/dipc_balance_go --k ${lang_K})
+  set(go_dipc_checks --check "states == 2001" --check "t_first == 0 and t_last >= 20 - 1e-9"
+      --check "max_abs_theta1 >= 0.0499" --check "abs(end_theta1) < 1e-3 and abs(end_theta2) < 1e-3"
+      --check "max_abs_theta0 < 1.0" --check "end == 'duration'")
+  add_test(NAME clients_go_dipc_lockstep
+    COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLGODIPC --timeout 60
+      ${go_dipc_checks} --check "dropped == 0" -- ${go_dipc} --prefix {prefix} --duration 20 -q)
+  add_test(NAME clients_go_dipc_hostile
+    COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLHOSTGO --timeout 60
+      --hostile ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/client/crash ${go_dipc_checks} --check "dropped >= 21"
+      -- ${go_dipc} --prefix {prefix} --duration 20 -q)
+  list(APPEND lang_tests clients_go_dipc_lockstep clients_go_dipc_hostile)
+  lang_end_tests(go dipc "${lang_dipc_cfg}" ${go_dipc})
+  lang_signal_test(go "${lang_dipc_cfg}" ${go_dipc})
+  set(go_xl --run go 0 "${CMAKE_BINARY_DIR}/bin/dipc_balance_go --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}")
+  set(go_gen --run go "${CMAKE_BINARY_DIR}/bin/dipc_balance_go --prefix {prefix} -q --timeout 60 --k ${lang_K}")
+endif()
+
 # ---- The manipulator's computed torque (r, r', r'' from the reference) in C (M and the bias
 # from the core), C++ (manipulator_ct.cpp: the client library alone, M, C and g written in
 # closed form with the core's operations in the core's order), Python and Lua (the same
@@ -386,7 +412,8 @@ endif()
 
 # ---- Cross-language: the DIPC balanced in lockstep for 10 s by u = -K x with the same K,
 # the product summed in the same order (0 - k0 x0 - ... - k5 x5) in C (dipc_lqr --k),
-# Python, Lua, Java and MATLAB/Octave (under GNU Octave), IEEE doubles everywhere: the states must agree bit for bit.
+# Python, Lua, Java, MATLAB/Octave (under GNU Octave) and Go (through the C ABI, when go is
+# found), IEEE doubles everywhere: the states must agree bit for bit.
 if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
   set(octave_xl "")
   if(LAGSIM_OCTAVE)   # MATLAB/Octave too, under GNU Octave
@@ -398,15 +425,15 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_ja
       --run python 0 "${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}"
       --run lua 0 "${LAGSIM_LUA52} ${lua_dir}/dipc_balance.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}"
       --run java 0 "java -cp /usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${CMAKE_BINARY_DIR}/lagsim_examples.jar lagsim.examples.DipcBalance --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}"
-      ${octave_xl})
+      ${octave_xl} ${go_xl})
   list(APPEND lang_tests clients_cross_language_dipc)
 endif()
 
 # ---- A state is known by its generation, in every language (tests/clients/generation_rule.py
 # plays the daemon): a state of the next generation at the same step, sim time and utime is
 # answered anew, never taken for a copy; one whose scene has not come waits for it
-# (DESCRIBE asked); the answers carry the generation; C, Python, Lua, Java and
-# MATLAB/Octave (under GNU Octave) answer bit for bit alike.
+# (DESCRIBE asked); the answers carry the generation; C, Python, Lua, Java,
+# MATLAB/Octave (under GNU Octave) and Go answer bit for bit alike.
 if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
   set(octave_gen "")
   if(LAGSIM_OCTAVE)
@@ -419,7 +446,7 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_ja
       --run python "${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} -q --timeout 60 --k ${lang_K}"
       --run lua "${LAGSIM_LUA52} ${lua_dir}/dipc_balance.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} -q --timeout 60 --k ${lang_K}"
       --run java "java -cp /usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${CMAKE_BINARY_DIR}/lagsim_examples.jar lagsim.examples.DipcBalance --prefix {prefix} -q --timeout 60 --k ${lang_K}"
-      ${octave_gen})
+      ${octave_gen} ${go_gen})
   list(APPEND lang_tests clients_cross_language_generation)
 endif()
 
@@ -468,6 +495,10 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
 endif()
 if(TARGET lagsim_lcmtypes_java)
   list(APPEND readme_langs java)
+endif()
+if(TARGET dipc_balance_go)  # docs/clients.md's Go block, built by go build (cgo)
+  list(APPEND readme_langs go)
+  list(APPEND readme_cc --go ${LAGSIM_GO})
 endif()
 # each block as written; then beside a run of it as written, the same block with a law of
 # 150 ms per answer (20 periods) and of 1.5 s (4 periods): every state answered, no
