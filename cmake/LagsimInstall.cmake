@@ -125,7 +125,12 @@ if(LAGSIM_PYTHON3)
   endif()
   install(DIRECTORY ${CMAKE_BINARY_DIR}/python/
           DESTINATION "\${_lagsim_pydir}" FILES_MATCHING PATTERN "*.py"
-          PATTERN "__pycache__" EXCLUDE)
+          PATTERN "__pycache__" EXCLUDE PATTERN "lagsim_client_path.py" EXCLUDE)
+  # lagsim_client.py's pointer to the installed library (the build tree's is not installed)
+  install(CODE "set(_lagsim_lib \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_LIBDIR}/liblagsim_client.so.${LAGSIM_CLIENT_ABI}\")
+    file(WRITE \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/\${_lagsim_pydir}/lagsim_client_path.py\"
+      \"# Where lagsim_client.py finds the client library: the installed one (written by cmake --install).\\nLIBRARY = \\\"\${_lagsim_lib}\\\"\\n\")
+    message(STATUS \"Installing: \$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/\${_lagsim_pydir}/lagsim_client_path.py\")")
   install(PROGRAMS ${PROJECT_SOURCE_DIR}/clients/python/dipc_balance.py
                    ${PROJECT_SOURCE_DIR}/clients/python/manipulator_pd.py
           DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/examples/python)
