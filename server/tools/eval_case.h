@@ -68,7 +68,13 @@ typedef struct eval_scene {
     double period;                          /* s, 1 / publish_hz */
     double q0[EVAL_JOINTS_MAX], qd0[EVAL_JOINTS_MAX]; /* initial state */
     bool has_reference;                     /* publishes <PREFIX>_REFERENCE */
+    bool reference[EVAL_JOINTS_MAX];        /* joint j has one (the others: r = 0) */
 } eval_scene;
+
+/* The joints of a scene that has a reference for some but not all (those are scored
+ * against r = 0), as "q2" or "theta1 and theta2" in buf; false (buf "") when every joint
+ * or none has one. */
+bool eval_scene_unreferenced(const eval_scene *sc, char *buf, size_t len);
 
 /* Loads CONFIG with the overrides (nsets of them); -1 and the loader's message in err. */
 int eval_scene_load(const char *config, const char *const *sets, int nsets,
@@ -162,6 +168,12 @@ int eval_bus_take(const eval_bus *b, lag_port_lease *l, char *url, size_t len, c
 /* Whether s holds only characters that mean themselves inside '...' or "..." in a shell
  * and in the strings of Octave, MATLAB and Python: letters, digits and _ - . : / ? = &. */
 bool eval_text_plain(const char *s);
+
+/* Why a controller that ended before its run did may have been cut by the shell: when the
+ * command has {url} outside quotes and the run's URL holds a character the shell reads
+ * there ('&' ends the command, '?' is a pattern), a sentence saying so and to write
+ * '{url}' into buf (starting "; "); else "". */
+void eval_url_hint(const char *cmd, const char *url, char *buf, size_t len);
 
 /* The --set strings a daemon of the tools gets for the owned keys, one a row in the
  * table's order: a daemon of one run (starts on the controller's first command), or one

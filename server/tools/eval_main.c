@@ -59,6 +59,7 @@ static void usage(FILE *f)
 "                         ends here\n"
 "  -v, --verbose          pass the daemon's and the controller's output through, keep\n"
 "                         each run's log in the report directory (or TMPDIR, /tmp)\n"
+"                         and say where\n"
 "  -h, --help             this help\n"
 "\n"
 "keys lagsim-eval sets on every run (a case's set: naming one, or a mapping above\n"
@@ -513,6 +514,9 @@ static int open_outputs(eval_cli *x)
         fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
         return 2;
     }
+    if (x->verbose) /* kept: said where, once */
+        fprintf(stderr, "%s: -v: each case's log (EVAL%d_<case's index>.lcm) is kept in %s\n",
+                prog, (int)getpid(), x->workdir);
     return -1;
 }
 
@@ -541,6 +545,19 @@ static void write_rows(eval_cli *x, const eval_case *c, const eval_scene *csc,
     }
 }
 
+/* A case whose scene has a reference for some joints and not for others: the table's
+ * notes say which are scored against r = 0 (an sse of -0.5 for a joint held at 0.5 by the
+ * controller's own setpoint is that, not an error of the controller). */
+static void note_unreferenced(const eval_case *c, const eval_scene *csc)
+{
+    char names[EVAL_JOINTS_MAX * (EVAL_NAME_LEN + 6)];
+    if (!eval_scene_unreferenced(csc, names, sizeof names)) return;
+    bool one = !strchr(names, ' ');
+    printf("  %s: %s %s no reference (the scene's reference: names the other joints): %s "
+           "metrics measure %s against r = 0\n", c->name, names, one ? "has" : "have",
+           one ? "its" : "their", one ? "it" : "them");
+}
+
 /* Runs case k (if wanted) and reports it. Returns false when the run could not be made
  * (status 2: no further case runs). */
 static bool run_case(eval_cli *x, int k)
@@ -567,6 +584,7 @@ static bool run_case(eval_cli *x, int k)
     write_rows(x, c, &x->csc[k], &res, met, why);
     if (res.failed) printf("  %s failed: %s\n", c->name, res.reason);
     else if (!met) printf("  %s: --require: %s\n", c->name, why);
+    note_unreferenced(c, &x->csc[k]);
     fflush(stdout);
     if (x->report_dir &&
         report(&x->files, x->report_dir, x->force, c, &x->csc[k], &s, &res, met, why))

@@ -80,7 +80,8 @@ static void usage(FILE *f)
 "      --allow-lan        accept a URL with ttl above 0 (the runs on the network)\n"
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a run may take (default 600)\n"
-"  -v, --verbose          pass the daemon's and the controller's output through\n"
+"  -v, --verbose          pass the daemon's and the controller's output through, keep\n"
+"                         the daemons' logs in the temporary directory and say where\n"
 "  -o, --output OUT.csv   merge: the joined CSV (the whole sweep's, byte for byte); every\n"
 "                         shard's identity lines (# seed:, # scene-sha256:, # vary:, ...)\n"
 "                         must be the first's, every row one of its header, every shard\n"
@@ -848,6 +849,18 @@ static void release_ports(sweep *x)
     for (long w = 0; w < x->jobs; w++) lag_port_release(&x->lease[w]);
 }
 
+/* A scene with a reference for some joints and not for others: the summary's note says
+ * which are scored against r = 0 (as lagsim-eval's table says it). */
+static void note_unreferenced(const eval_scene *sc)
+{
+    char names[EVAL_JOINTS_MAX * (EVAL_NAME_LEN + 6)];
+    if (!eval_scene_unreferenced(sc, names, sizeof names)) return;
+    bool one = !strchr(names, ' ');
+    printf("note: %s %s no reference (the scene's reference: names the other joints): %s "
+           "metrics measure %s against r = 0\n", names, one ? "has" : "have",
+           one ? "its" : "their", one ? "it" : "them");
+}
+
 static int sweep_run(sweep *x)
 {
     char err[2048];
@@ -874,7 +887,12 @@ static int sweep_run(sweep *x)
         fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
         return 2;
     }
-    if (x->verbose) eval_proc_tmpdir_done(); /* -v keeps the kept daemons' logs */
+    if (x->verbose) { /* -v keeps the daemons' logs: said where, once */
+        eval_proc_tmpdir_done();
+        fprintf(stderr, "%s: -v: the daemons' logs (SWEEP%d_W<worker>.lcm for a worker's kept "
+                "pair, SWEEP%d_<run>.lcm for a run's own) are kept in %s\n", prog,
+                (int)getpid(), (int)getpid(), x->tmpdir);
+    }
     int status = run_workers(x);
     rows r = {0};
     collect_rows(x, &r);
@@ -882,6 +900,7 @@ static int sweep_run(sweep *x)
                  fclose(fcsv) != 0))
         status = 2;
     summary(x->header, &r);
+    note_unreferenced(&x->sc);
     bool all = count_passed(x, &r) == r.n;
     if (x->png && plot(x->png, x->tmpdir, x->header, &r, x->nv, x->metric)) status = 2;
     rmdir(x->tmpdir);

@@ -684,6 +684,14 @@ static int ident_end(shard *s, long ln, const char *line)
     return 0;
 }
 
+/* How a CSV's sweep is split, in words: "the whole sweep (no --shard)" or "shards of N
+ * (--shard K/N)". */
+static void split_text(long sn, char *buf, size_t len)
+{
+    if (sn == 1) snprintf(buf, len, "the whole sweep (no --shard)");
+    else snprintf(buf, len, "shards of %ld (--shard K/%ld)", sn, sn);
+}
+
 /* The first key (in the table's order) whose values differ between shards a and b: 0, or
  * -1 after naming it and both values. */
 static int ident_compare(const shard *a, const shard *b)
@@ -707,9 +715,13 @@ static int ident_compare(const shard *a, const shard *b)
     }
     if (strcmp(a->header, b->header))
         return say(b->path, 0, "not a shard of %s's sweep: another header", a->path);
-    if (a->sn != b->sn)
-        return say(b->path, 0, "not a shard of %s's sweep: shards of %ld there (1: the whole "
-                               "sweep), of %ld here", a->path, a->sn, b->sn);
+    if (a->sn != b->sn) {
+        char sa[64], sb[64];
+        split_text(a->sn, sa, sizeof sa);
+        split_text(b->sn, sb, sizeof sb);
+        return say(b->path, 0, "not a shard of %s's sweep: another split: %s holds %s, this "
+                               "file %s", a->path, a->path, sa, sb);
+    }
     return 0;
 }
 

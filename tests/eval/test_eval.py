@@ -22,6 +22,11 @@ usage: test_eval.py BIN_DIR SOURCE_DIR CASE
              two workers run at once on four pairs, each held (its lock file locked) while
              its controller runs; ttl above 0 only with --allow-lan; memq:// and other
              providers refused; {prefix} and {url} replaced as they are, inside quotes too
+  notes      what a new user misread, said: -v names the directory where it keeps the
+             runs' logs; a case with a reference for q1 and none for q2 says in the
+             table's notes that q2 is scored against r = 0 (a case with both: no note); a
+             controller command with {url} outside quotes that ends before its run says
+             to write '{url}' (the URL's '&' ended the command), quoted: no such words
   outputs    no output of lagsim-eval or lagsim-sweep is a file they read (the scene, the
              suite, the daemon; merge's shards) or another of their outputs (the CSV and
              the report's or the plot's files), whatever its spelling (./, a hard link),
@@ -588,7 +593,58 @@ def case_outputs():
               "merge -o a hard link to its shard: exit 2, the shard untouched")
 
 
-{"metrics": case_metrics, "require": case_require, "errors": case_errors,
+def case_notes():
+    manip = os.path.join(SRC, "config", "manipulator.yaml")
+    pd = os.path.join(BIN, "manipulator_pd") + " -q --prefix {prefix}"
+    with tempfile.TemporaryDirectory() as d:
+        env = dict(os.environ, TMPDIR=d)
+        # -v keeps the runs' logs: where, said once
+        p = subprocess.run([EVAL, "--config", SCENE, "--controller", CTRL, "--suite", SUITE,
+                            "--case", "tilt", "-v"], env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+        m = re.search(r"^lagsim-eval: -v: each case's log \(EVAL\d+_<case's index>\.lcm\) is "
+                      r"kept in (\S+)$", p.stderr, re.M)
+        logs = glob.glob(os.path.join(m.group(1), "EVAL*_*.lcm")) if m else []
+        check(p.returncode == 0 and m and m.group(1).startswith(d) and len(logs) == 1 and
+              p.stderr.count("is kept in") == 1,
+              "-v: the directory of the kept logs said once, the log there (%s, %s)"
+              % (m.group(1) if m else None, logs))
+        # a reference for q1 alone: q2 is scored against r = 0, and the notes say it
+        suite = os.path.join(d, "ref.yaml")
+        with open(suite, "w") as f:
+            f.write('cases:\n  - name: q1_only\n    duration: 1\n'
+                    '    set: ["reference={q1: {type: step, amplitude: 0.2}}"]\n'
+                    '  - name: both\n    duration: 1\n')
+        p = subprocess.run([EVAL, "--config", manip, "--controller", pd, "--suite", suite],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        print(p.stdout, p.stderr)
+        notes = re.findall(r"^  (\S+): (.*r = 0.*)$", p.stdout, re.M)
+        check(len(notes) == 1 and notes[0][0] == "q1_only" and
+              notes[0][1].startswith("q2 has no reference") and "q1 has" not in notes[0][1],
+              "a reference for q1 alone: a note says q2 is scored against r = 0, none for the "
+              "case with both (%s)" % notes)
+    # {url} outside quotes: the URL's '&' ends the shell command, and lqr_balance (sent to
+    # the background) ends with it; the reason says to quote it
+    url = "udpm://239.255.76.67?ttl=0&recv_buf_size=4194304"
+    bare = os.path.join(BIN, "lqr_balance") + " -q --prefix {prefix} --url {url}"
+    p = subprocess.run([EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt", "--url",
+                        url, "--controller", bare], stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+    print(p.stdout, p.stderr)
+    check(p.returncode == 1 and "the controller ended (exit status 0) before the run did; "
+          "{url} stands outside quotes" in p.stdout and "write '{url}'" in p.stdout and
+          "'&'" in p.stdout, "a bare {url} whose '&' ended the command: the reason says to "
+          "write '{url}' (exit %d)" % p.returncode)
+    quoted = bare.replace("{url}", "'{url}'")
+    p = subprocess.run([EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt", "--url",
+                        url, "--controller", quoted], stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+    check(p.returncode == 0 and "{url}" not in p.stdout,
+          "'{url}' quoted: the case runs, no such words (exit %d)" % p.returncode)
+
+
+{"metrics": case_metrics, "require": case_require, "errors": case_errors, "notes": case_notes,
  "scene": case_scene, "owned": case_owned, "outputs": case_outputs, "bus": case_bus}[CASE]()
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)

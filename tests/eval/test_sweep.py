@@ -26,6 +26,9 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             content, case, case override, --vary distribution, controller command,
             --restart, --require, --runs, version line, split (2/3), and a CSV without
             identity lines: exit 2 naming the first field that differs and both values
+  notes     -v names the directory where it keeps the daemons' logs (they are there); a
+            reference for q1 and none for q2: the summary's note says q2 is scored against
+            r = 0
   shard     --shard refuses 1/2x, 0/2, 3/2, 1/0, spaces, signs, leading zeros, 1/2/3,
             numbers past 1e7 or 2^64 (exit 2 before any run); 4/4 runs run 3 alone
   kept      one lagsimd and one controller per worker (counted through wrappers), a
@@ -452,7 +455,15 @@ def case_merge_foreign(d):
     s3 = os.path.join(d, "third.csv")
     run([SWEEP] + base + ["--shard", "2/3", "--csv", s3])
     p, o = merge(d, s1, s3, out="foreign.csv")
-    refused(p, o, "shard 2/3 with 1/2", "shards of 2 there", "of 3 here")
+    refused(p, o, "shard 2/3 with 1/2", "another split: %s holds shards of 2 (--shard K/2), "
+            "this file shards of 3 (--shard K/3)" % s1)
+    # the whole sweep with a shard: said in words (it was "shards of 1 there (1: the whole
+    # sweep)")
+    w = os.path.join(d, "whole.csv")
+    run([SWEEP] + base + ["--csv", w])
+    p, o = merge(d, w, s3, out="foreign.csv")
+    refused(p, o, "a shard with the whole sweep", "another split: %s holds the whole sweep "
+            "(no --shard), this file shards of 3 (--shard K/3)" % w)
     # a CSV without identity lines (the rows alone)
     plain = os.path.join(d, "plain.csv")
     with open(plain, "w") as f:
@@ -889,6 +900,33 @@ def case_unanswered(d):
           "(a new pair) did not (%.1f s)" % took)
 
 
+def case_notes(d):
+    manip = os.path.join(SRC, "config", "manipulator.yaml")
+    pd = os.path.join(BIN, "manipulator_pd") + " -q --prefix {prefix}"
+    env = dict(os.environ, TMPDIR=d)
+    p = run([SWEEP, "--config", manip, "--controller", pd, "--duration", "0.5", "--vary",
+             "parameters.m2=uniform(0.4,0.6)", "--runs", "2", "-v"], env=env)
+    m = re.search(r"^lagsim-sweep: -v: the daemons' logs .* are kept in (\S+)$", p.stderr, re.M)
+    logs = glob.glob(os.path.join(m.group(1), "SWEEP*_W0.lcm")) if m else []
+    check(p.returncode == 0 and m and m.group(1).startswith(d) and len(logs) == 1,
+          "-v: the directory of the kept logs said, the kept pair's log there (%s)" % logs)
+    check("no reference" not in p.stdout, "both joints with a reference: no note")
+    p = run([SWEEP, "--config", manip, "--controller", pd, "--vary",
+             "parameters.m2=uniform(0.4,0.6)", "--runs", "2", "--suite", write_ref_suite(d),
+             "--case", "q1_only"])
+    check(p.returncode in (0, 1) and re.search(r"^note: q2 has no reference .*r = 0$",
+                                               p.stdout, re.M),
+          "a reference for q1 alone: the summary's note says q2 is scored against r = 0")
+
+
+def write_ref_suite(d):
+    path = os.path.join(d, "ref.yaml")
+    with open(path, "w") as f:
+        f.write('cases:\n  - name: q1_only\n    duration: 0.5\n'
+                '    set: ["reference={q1: {type: step, amplitude: 0.2}}"]\n')
+    return path
+
+
 with tempfile.TemporaryDirectory() as tmp:
     {"same": case_same, "vary": case_vary, "slurm": case_slurm, "merge": case_merge,
      "kept": case_kept, "merge_rows": case_merge_rows, "merge_foreign": case_merge_foreign,
@@ -896,6 +934,6 @@ with tempfile.TemporaryDirectory() as tmp:
      "loss": case_loss, "stalled": case_stalled, "ssh": case_ssh,
      "kept_python": case_kept_python, "scene_c": case_scene_c,
      "scene_python": case_scene_python, "scene_loss": case_scene_loss,
-     "unanswered": case_unanswered}[CASE](tmp)
+     "unanswered": case_unanswered, "notes": case_notes}[CASE](tmp)
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)
