@@ -805,6 +805,20 @@ static void daemon_argv(daemon_args *d, const eval_env *env, const eval_case *c,
     d->argv[d->na] = NULL;
 }
 
+/* The controller has ended: whether the daemon ends by itself within 5 s (a controller
+ * ends on the daemon's stop event, a moment before the daemon exits). A daemon whose
+ * status says it waits for a command never will (nothing else answers it): false at
+ * once. OUT: dst */
+static bool daemon_after(eval_watch *watch, pid_t dpid, int *dst)
+{
+    double since = eval_now_wall(), end = eval_now() + 5.0;
+    while (eval_now() < end) {
+        if (eval_wait_until(dpid, eval_now() + 0.05, dst)) return true;
+        if (eval_watch_stuck(watch, since)) return false;
+    }
+    return false;
+}
+
 /* Waits for the daemon's end, or the controller's (true when --timeout ended it): a controller that ends first (it could
  * not start, it crashed) leaves a lockstep plant waiting for ever, so the daemon gets a
  * few seconds to end on its own (a controller ends on the daemon's stop event, a moment
@@ -814,11 +828,13 @@ static bool wait_run(const eval_env *env, pid_t dpid, pid_t cpid, eval_result *r
     int cst = 0;
     double t0 = eval_now();
     bool daemon_done = false, controller_done = false;
+    eval_watch *watch = eval_watch_start(env, env->who[0] ? env->who : NULL);
     while (!daemon_done && eval_now() < t0 + env->wall_timeout) {
         daemon_done = eval_wait_until(dpid, eval_now() + 0.05, dst);
+        eval_watch_poll(watch);
         if (!daemon_done && !controller_done && eval_wait_until(cpid, 0, &cst)) {
             controller_done = true;
-            if (!eval_wait_until(dpid, eval_now() + 5.0, dst)) {
+            if (!daemon_after(watch, dpid, dst)) {
                 eval_stop_group(dpid, dst);
                 char hint[200];
                 eval_url_hint(env->controller, env->url, hint, sizeof hint);
@@ -829,6 +845,7 @@ static bool wait_run(const eval_env *env, pid_t dpid, pid_t cpid, eval_result *r
             daemon_done = true;
         }
     }
+    eval_watch_stop(watch);
     bool timed_out = !daemon_done;
     if (timed_out) {
         eval_stop_group(dpid, dst);

@@ -140,7 +140,26 @@ typedef struct eval_env {
     bool allow_lan;          /* --allow-lan: the URL's ttl may be above 0 */
     double wall_timeout;     /* s a run may take before it is stopped (and failed) */
     bool verbose;            /* pass the daemon's and the controller's output through */
+    char who[96];            /* "lagsim-eval: case tilt": the start of a line saying that
+                              * the plant still waits for its first answer (eval_watch);
+                              * "": said nothing */
 } eval_env;
+
+/* ---------------------------------------------------------------- watching a run */
+/* A client on a run's URL and prefix (eval_watch.c): its states, its daemon's statuses. */
+#define EVAL_WAIT_SAY_S 5.0 /* a plant still at t = 0 after this: said once (env->who) */
+typedef struct eval_watch eval_watch;
+/* NULL when no client could be made (the run goes on without one). */
+eval_watch *eval_watch_start(const eval_env *env, const char *who);
+/* What came; once the plant has waited EVAL_WAIT_SAY_S at t = 0, a line saying what it
+ * waits for (its status's words), once. */
+void eval_watch_poll(eval_watch *w);
+/* Whether a status of after `since` (wall s) says the daemon waits for a command: with its
+ * controller gone, it never ends by itself. Asks for one when due. */
+bool eval_watch_stuck(eval_watch *w, double since);
+void eval_watch_stop(eval_watch *w);
+/* A line on stderr (printf), the terminal's progress line cleared first. */
+void eval_say(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 
 /* The bus of the tools' runs: the multicast group and the options of --url, else of
  * LCM_DEFAULT_URL, else EVAL_DEFAULT_URL's; the ports a pair of the runs' own
@@ -296,8 +315,11 @@ void eval_fail(eval_result *res, const char *fmt, ...) __attribute__((format(pri
  * run's numbers are those of a daemon started for it with the same values set live. */
 typedef struct eval_worker eval_worker;
 
+/* NULL with why in err when the pair cannot run: *controller says that the controller is
+ * why (it ended before it answered its first state, or never answered it: the daemon's
+ * status says what it waits for), which no later pair would do otherwise. */
 eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const eval_scene *sc,
-                               char *err, size_t errlen);
+                               bool *controller, char *err, size_t errlen);
 /* One run: sets are "key=value" (initial.* ones skipped: q0/qd0 carry them), q0 and qd0
  * the run's initial state. Returns 0 when the run could be evaluated (failed or not), -1
  * with a message when the worker is lost (stop it and start another). OUT: res */
@@ -306,6 +328,8 @@ int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets,
                     size_t errlen);
 /* Runs since the worker started (its log grows with them). */
 long eval_worker_runs(const eval_worker *w);
+/* Whether its controller has ended (a run failed saying so): the pair cannot go on. */
+bool eval_worker_lost(const eval_worker *w);
 void eval_worker_stop(eval_worker *w);
 
 #endif

@@ -570,6 +570,7 @@ static bool run_case(eval_cli *x, int k)
     /* the ports of the whole evaluation; a prefix of each case's own */
     snprintf(env.url, sizeof env.url, "%s", x->url);
     snprintf(env.prefix, sizeof env.prefix, "EVAL%d_%d", (int)getpid(), k);
+    snprintf(env.who, sizeof env.who, "%s: case %s", prog, c->name);
     eval_result res;
     eval_series s = {0};
     if (eval_run(&env, c, NULL, 0, &x->csc[k], &res, &s, x->err, sizeof x->err)) {

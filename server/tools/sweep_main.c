@@ -95,8 +95,9 @@ static void usage(FILE *f)
     fprintf(f,
 "\n"
 "exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
-"case error, an output that exists (checked before the first run), or shard CSVs that\n"
-"do not belong together, hold a malformed row or leave shards or runs out\n"
+"case error, an output that exists (checked before the first run), a controller that\n"
+"cannot answer the first state of a worker's first lagsimd, or shard CSVs that do not\n"
+"belong together, hold a malformed row or leave shards or runs out\n"
 "\n"
 "signals: SIGINT, SIGTERM, SIGHUP stop every process it started (SIGKILL after 2 s)\n"
 "and end it by that signal; after SIGKILL they end within about 2 s. TMPDIR: where\n"
@@ -427,6 +428,7 @@ typedef struct sweep {
     char default_metric[160];
     char tmpdir[160]; /* eval_make_tmpdir: at most 128 + 21 */
     char cmd_files[EVAL_CMD_FILES_MAX][1024]; /* the files the controller command names */
+    bool stopping;       /* the sweep stops before its end (a controller that cannot run) */
 } sweep;
 
 /* An integer option: a plain decimal (as a scene writes a number) with no fraction; lo
@@ -656,7 +658,24 @@ typedef struct worker {
     long w;          /* its number */
     eval_worker *kept; /* the daemon and the controller kept for its runs */
     FILE *rows;
+    long pairs;      /* kept pairs that started (answered their first state) */
+    int refused;     /* new pairs in a row whose controller could not answer */
+    long ran;        /* --restart: runs started */
 } worker;
+
+#define PAIR_REFUSALS 3 /* new pairs in a row whose controller cannot answer: the sweep stops */
+#define RUN_FATAL (-2)  /* the controller cannot run the sweep: it stops (exit 2) */
+#define WORKER_FATAL 5  /* a worker's exit status for it; its words in tmpdir/W.fatal */
+
+/* A run that did not run: failed, every metric none. */
+static void fail_unrun(eval_result *res, int nj, const char *why)
+{
+    memset(res, 0, sizeof *res);
+    res->nj = nj;
+    for (int j = 0; j < nj; j++)
+        for (int m = 0; m < LAG_METRIC_COUNT; m++) res->m[j].v[m] = NAN;
+    eval_fail(res, "%s", why);
+}
 
 static eval_env worker_env(const worker *wk, long run)
 {
@@ -671,8 +690,32 @@ static eval_env worker_env(const worker *wk, long run)
     return env;
 }
 
+/* A new kept pair for the worker: 1 when it runs. A controller that cannot answer its
+ * first state (it ended, or listens elsewhere) in the worker's first pair, or in
+ * PAIR_REFUSALS new pairs in a row, cannot run the sweep: RUN_FATAL, why in err. In a
+ * later pair (it ran before) the run fails with that reason (0), and the next run tries
+ * another pair. -1: the pair could not start for another reason. */
+static int start_pair(worker *wk, eval_result *res, char *err, size_t errlen)
+{
+    const sweep *x = wk->x;
+    bool controller;
+    eval_env env = worker_env(wk, -1);
+    if ((wk->kept = eval_worker_start(&env, &x->c, &x->sc, &controller, err, errlen))) {
+        wk->pairs++, wk->refused = 0;
+        return 1;
+    }
+    if (!controller) return -1;
+    if (wk->pairs == 0 || ++wk->refused >= PAIR_REFUSALS) return RUN_FATAL;
+    char why[sizeof res->reason];
+    snprintf(why, sizeof why, "a new lagsimd and controller for this run: %.200s", err);
+    fail_unrun(res, x->sc.nj, why);
+    fprintf(stderr, "%s: worker %ld: %s\n", prog, wk->w, why);
+    return 0;
+}
+
 /* A run on the kept processes: started when there are none, started again after
- * KEEP_RUNS runs, after a run that stalled, and once for a run the kept ones lost. */
+ * KEEP_RUNS runs, after a run that stalled or whose controller ended, and once for a run
+ * the kept ones lost. */
 static int run_kept(worker *wk, const char *const *sets, int nsets, const eval_scene *rsc,
                     eval_result *res, char *err, size_t errlen)
 {
@@ -682,16 +725,18 @@ static int run_kept(worker *wk, const char *const *sets, int nsets, const eval_s
             eval_worker_stop(wk->kept);
             wk->kept = NULL;
         }
-        eval_env env = worker_env(wk, -1);
-        if (!wk->kept && !(wk->kept = eval_worker_start(&env, &x->c, &x->sc, err, errlen)))
-            return -1;
+        int started = wk->kept ? 1 : start_pair(wk, res, err, errlen);
+        if (started != 1) return started;
         int rc = eval_worker_run(wk->kept, &x->c, sets, nsets, rsc->q0, rsc->qd0, res, err,
                                  errlen);
-        /* a stalled run, or a controller that did not answer the run before's last state:
-         * the run fails, and the next one gets a new worker pair */
+        /* a stalled run, a controller that did not answer the run before's last state or
+         * that ended: the run fails, and the next one gets a new worker pair (a stalled run
+         * is run again on it first) */
         bool unanswered = rc == 0 && strstr(res->reason, "did not answer the paused state");
-        if (rc == 0 && !strstr(res->reason, "before the duration") && !unanswered) return 0;
-        if (unanswered) /* the run fails, and it is said: never a silent restart */
+        bool lost = rc == 0 && eval_worker_lost(wk->kept);
+        if (rc == 0 && !strstr(res->reason, "before the duration") && !unanswered && !lost)
+            return 0;
+        if (unanswered || lost) /* the run fails, and it is said: never a silent restart */
             fprintf(stderr, "%s: worker %ld: a run failed: %s; a new lagsimd and controller "
                     "for the next run\n", prog, wk->w, res->reason);
         eval_worker_stop(wk->kept);
@@ -722,6 +767,18 @@ static void write_row(const worker *wk, long i, const double *val, const eval_re
     fflush(f);
 }
 
+/* The controller cannot run the sweep (run i found it): its words for the parent, which
+ * says them once and stops every worker. WORKER_FATAL. */
+static int worker_fatal(const worker *wk, long i, const char *err)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/%ld.fatal", wk->x->tmpdir, wk->w);
+    FILE *f = fopen(path, "w");
+    if (f) fprintf(f, "run %ld, worker %ld: %s", i, wk->w, err), fclose(f);
+    else fprintf(stderr, "%s: run %ld: %s\n", prog, i, err);
+    return WORKER_FATAL;
+}
+
 /* Run i: its values, then a failed row for values the scene refuses (a negative mass),
  * else the run on the kept processes or on processes of its own. */
 static int run_one(worker *wk, long i)
@@ -741,17 +798,18 @@ static int run_one(worker *wk, long i)
     eval_scene rsc;
     int rc = 0;
     if (eval_scene_load(x->config, xp, x->c.nsets + nx, &rsc, err, sizeof err)) {
-        res.failed = true;
-        snprintf(res.reason, sizeof res.reason, "refused: %.240s", err);
-        res.nj = x->sc.nj;
-        for (int j = 0; j < x->sc.nj; j++)
-            for (int m = 0; m < LAG_METRIC_COUNT; m++) res.m[j].v[m] = NAN;
+        char why[sizeof res.reason];
+        snprintf(why, sizeof why, "refused: %.240s", err);
+        fail_unrun(&res, x->sc.nj, why);
     } else if (!x->restart) {
         rc = run_kept(wk, xp + x->c.nsets, nx, &rsc, &res, err, sizeof err);
     } else {
         eval_env env = worker_env(wk, i);
+        if (!wk->ran++) /* its first run says a plant that waits for its first answer */
+            snprintf(env.who, sizeof env.who, "%s: run %ld", prog, i);
         rc = eval_run(&env, &x->c, xp + x->c.nsets, nx, &rsc, &res, NULL, err, sizeof err);
     }
+    if (rc == RUN_FATAL) return worker_fatal(wk, i, err);
     if (rc) {
         fprintf(stderr, "%s: run %ld: %s\n", prog, i, err);
         return 4;
@@ -777,11 +835,50 @@ static void worker_main(const sweep *x, long w)
 }
 
 /* ---------------------------------------------------------------- the results */
+/* A worker that found the controller cannot run the sweep: its words said once, the
+ * other workers stopped. */
+static void say_fatal(const sweep *x, long w)
+{
+    char path[256], text[4096] = "";
+    snprintf(path, sizeof path, "%s/%ld.fatal", x->tmpdir, w);
+    FILE *f = fopen(path, "r");
+    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
+    text[n] = '\0';
+    if (f) fclose(f);
+    unlink(path);
+    fprintf(stderr, "%s: %s\n%s: the sweep stops: a controller that cannot answer the "
+            "first state of its lagsimd fails every run\n", prog, text, prog);
+}
+
+/* The workers' ends, as they come: one that stops the sweep stops the others. 0, or 2
+ * when a worker failed. */
+static int wait_workers(sweep *x, const pid_t *pids)
+{
+    bool alive[256];
+    long left = x->jobs;
+    int status = 0;
+    for (long w = 0; w < x->jobs; w++) alive[w] = true;
+    while (left) {
+        for (long w = 0; w < x->jobs; w++) {
+            int st = 0;
+            if (!alive[w] || !eval_wait_until(pids[w], 0, &st)) continue;
+            alive[w] = false, left--;
+            if (WIFEXITED(st) && WEXITSTATUS(st) == 0) continue;
+            bool fatal = WIFEXITED(st) && WEXITSTATUS(st) == WORKER_FATAL;
+            if (fatal && !x->stopping) say_fatal(x, w);
+            if (fatal) x->stopping = true;
+            status = 2;
+        }
+        for (long w = 0; x->stopping && w < x->jobs; w++) /* the others end now */
+            if (alive[w]) eval_stop_group(pids[w], &(int){0}), alive[w] = false, left--;
+        if (left) eval_sleep(0.02);
+    }
+    return status;
+}
 /* The workers, forked (each dies with this process: eval_proc_fork), and their ends. */
 static int run_workers(sweep *x)
 {
     pid_t pids[256];
-    int status = 0;
     for (long w = 0; w < x->jobs; w++) {
         pids[w] = eval_proc_fork();
         if (pids[w] < 0) {
@@ -791,12 +888,7 @@ static int run_workers(sweep *x)
         }
         if (pids[w] == 0) worker_main(x, w);
     }
-    for (long w = 0; w < x->jobs; w++) {
-        int st = 0;
-        if (eval_proc_wait(pids[w], &st) != 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0)
-            status = 2;
-    }
-    return status;
+    return wait_workers(x, pids);
 }
 
 static void collect_rows(const sweep *x, rows *r)
@@ -899,8 +991,10 @@ static int sweep_run(sweep *x)
     if (fcsv && (rows_write(&r, fcsv, x->identity, x->header, err, sizeof err) ||
                  fclose(fcsv) != 0))
         status = 2;
-    summary(x->header, &r);
-    note_unreferenced(&x->sc);
+    if (r.n || !x->stopping) { /* a sweep stopped before any run has nothing to sum */
+        summary(x->header, &r);
+        note_unreferenced(&x->sc);
+    }
     bool all = count_passed(x, &r) == r.n;
     if (x->png && plot(x->png, x->tmpdir, x->header, &r, x->nv, x->metric)) status = 2;
     rmdir(x->tmpdir);

@@ -61,6 +61,12 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             (nftables; root, else skipped): the same CSVs as without loss, byte for byte
   unanswered  a controller that never answers a run's last state: the worker waits for
             that answer; the run after fails saying so, and the next gets a new pair
+  controller_exit  a controller that cannot run the sweep stops it (exit 2, said once, in
+            seconds): one that exits at once ('exit 3': its exit status named), one on
+            another prefix (the daemon's status says what it waits for); one that dies in
+            the runs of a large m2 (tests/eval/mute_pd.py --exit-above) fails those runs
+            (a row each, its exit status in the reason) and the next run gets a new pair;
+            with --restart a controller that exits at once fails each run at once
 """
 import csv
 import filecmp
@@ -927,6 +933,60 @@ def write_ref_suite(d):
     return path
 
 
+def case_controller_exit(d):
+    base = ["--config", SCENE, "--duration", "1", "--vary", "parameters.m1=uniform(0.1,0.2)",
+            "--runs", "4", "-j2"]
+    # a controller that cannot start: the sweep stops at once, exit 2, the exit status said
+    out = os.path.join(d, "exit3.csv")
+    t0 = time.monotonic()
+    p = run([SWEEP] + base + ["--controller", "exit 3", "--csv", out])
+    took = time.monotonic() - t0
+    check(p.returncode == 2 and p.stderr.count("the controller ended (exit status 3) before "
+                                               "it answered") == 1 and
+          "the sweep stops" in p.stderr and took < 20,
+          "'exit 3': exit 2, the controller's exit status said once, in %.1f s" % took)
+    # a controller on another prefix (alive: it waits 100 s for its scene): the daemon says
+    # what it waits for, within the worker's first 30 s
+    p = run([SWEEP] + base + ["-j1", "--controller", os.path.join(BIN, "lqr_balance") +
+                              " -q --prefix NOT_THE_RUNS --timeout 100"])
+    check(p.returncode == 2 and "did not answer the kept lagsimd's first state" in p.stderr and
+          re.search(r"lagsimd waits \d+ s for a command answering sim_time 0 on "
+                    r"SWEEP\d+_W0_COMMAND at udpm://", p.stderr) and "{prefix}" in p.stderr,
+          "a controller on another prefix: exit 2, the daemon's wait said")
+    # a controller that dies in some runs (m2 above 0.6): those fail, a row each, and the
+    # next run gets a new pair
+    q, env = scene_sweep("c", 8)
+    q[q.index("--controller") + 1] = "python3 %s -q --exit-above 0.6 --prefix {prefix}" % (
+        os.path.join(SRC, "tests", "eval", "mute_pd.py"))
+    out = os.path.join(d, "dies.csv")
+    t0 = time.monotonic()
+    p = run([SWEEP] + q + ["-j1", "--csv", out], env=env)
+    took = time.monotonic() - t0
+    r = rows(out) if os.path.exists(out) else []
+    big = [x for x in r if float(x["parameters.m2"]) > 0.6]
+    small = [x for x in r if float(x["parameters.m2"]) <= 0.6]
+    check(len(r) == 8 and big and small and
+          all(x["failed"] == "1" and re.match(r"the controller ended \(exit status 7\) at "
+                                              r"t = 0\.2 s, before the run did$", x["reason"])
+              for x in big) and all(x["failed"] == "0" for x in small),
+          "a controller that dies at t = 0.2 in the %d runs of m2 > 0.6: those fail with its "
+          "exit status, the %d others pass (%s)" % (len(big), len(small),
+                                                   [(x["run"], x["reason"]) for x in r]))
+    check(p.stderr.count("a new lagsimd and controller for the next run") == len(big) and
+          took < 120, "each death said, a new pair for the next run (%.1f s)" % took)
+    # --restart: each run's controller exits at once: a failed row each, without the 5 s a
+    # daemon gets to end after its controller (it says it waits: stopped at once)
+    out = os.path.join(d, "restart.csv")
+    t0 = time.monotonic()
+    p = run([SWEEP] + base + ["--restart", "--controller", "exit 3", "--csv", out])
+    took = time.monotonic() - t0
+    r = rows(out) if os.path.exists(out) else []
+    check(p.returncode == 1 and len(r) == 4 and
+          all(x["reason"] == "the controller ended (exit status 3) before the run did"
+              for x in r) and took < 10,
+          "--restart, 'exit 3': 4 failed rows naming exit status 3, in %.1f s" % took)
+
+
 with tempfile.TemporaryDirectory() as tmp:
     {"same": case_same, "vary": case_vary, "slurm": case_slurm, "merge": case_merge,
      "kept": case_kept, "merge_rows": case_merge_rows, "merge_foreign": case_merge_foreign,
@@ -934,6 +994,7 @@ with tempfile.TemporaryDirectory() as tmp:
      "loss": case_loss, "stalled": case_stalled, "ssh": case_ssh,
      "kept_python": case_kept_python, "scene_c": case_scene_c,
      "scene_python": case_scene_python, "scene_loss": case_scene_loss,
-     "unanswered": case_unanswered, "notes": case_notes}[CASE](tmp)
+     "unanswered": case_unanswered, "notes": case_notes,
+     "controller_exit": case_controller_exit}[CASE](tmp)
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)
