@@ -253,6 +253,8 @@ int sch_get_int(conv *cv, const ynode *nd, const char *path, long long lo, long 
 int sch_get_string(conv *cv, const ynode *nd, const char *path, const char *what,
                    const char **out)
 {
+    *out = NULL; /* set on every path: callers read it only on success, and an optimizer that
+                  * cannot see yfail's -1 (another file) must not find it unset */
     if (ynode_is_null(nd))
         return yfail(cv->err, nd, path, "missing value: expected %s", what);
     if (nd->kind != YN_SCALAR)

@@ -665,7 +665,7 @@ static void take_event(eval_take *tk, const lag_log_record *rec)
 }
 
 /* A RESET_TO the daemon took (the log holds what it received with its fate: an input
- * record is in the log only when accepted, docs/logging.md) */
+ * record is in the log only when accepted: docs/server.md, "Record, replay, watch") */
 static bool is_reset_to(const eval_take *tk, const lag_log_record *rec)
 {
     if (strcmp(rec->channel, tk->ch_control)) return false;

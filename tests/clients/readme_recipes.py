@@ -21,6 +21,8 @@ import signal
 import subprocess
 import sys
 import tempfile
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 DOCS = ("README.md", os.path.join("docs", "clients.md"), os.path.join("docs", "evaluation.md"))
@@ -219,7 +221,7 @@ def main():
                 f.write(text)
             print("---- %s written as given" % fname)
         env = dict(os.environ)
-        env["LCM_DEFAULT_URL"] = "udpm://239.255.76.67:%d?ttl=0" % (30000 + 2 * (os.getpid() % 10000))
+        env["LCM_DEFAULT_URL"] = lcm_url()
         print("---- recipe %s in %s, LCM_DEFAULT_URL=%s\n%s" % (name, tmp, env["LCM_DEFAULT_URL"], script))
         # a session of its own: a recipe that hangs is stopped whole, its background jobs too
         p = subprocess.Popen(["bash", "-c", script], cwd=tmp, env=env, stdout=subprocess.PIPE,

@@ -43,6 +43,8 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lcm_log import read_log, write_log  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
 
@@ -164,8 +166,7 @@ def main():
     cfg = os.path.join(a.source, "config", "stick.yaml")
     prefix = "KICK_%d" % os.getpid()
     # a multicast port of this run's own (ttl=0: this host)
-    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0" %
-                                     (34000 + 2 * (os.getpid() % 6000)))
+    os.environ["LCM_DEFAULT_URL"] = lcm_url()
     tmp = tempfile.mkdtemp(prefix="lagsim_kick_")
     log = os.path.join(tmp, "kick.lcm")
 

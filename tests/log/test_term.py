@@ -31,6 +31,8 @@ import subprocess
 import sys
 import termios
 import time
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 failures = 0
 
@@ -76,6 +78,12 @@ class Daemon:
                 if not chunk:
                     return
                 self.out += chunk
+
+    def read_until(self, done, limit=30.0):
+        """Reads until done(text) holds (the event a check waits for), at most `limit` s."""
+        end = time.monotonic() + limit
+        while not done(self.text()) and time.monotonic() < end and self.p.poll() is None:
+            self.read(0.05)
 
     def stop(self):
         if self.p.poll() is None:
@@ -257,7 +265,11 @@ def case_waits(a):
     state_url, command_url = plant_urls()
     d = Daemon(a, os.path.join(a.source, "config", "dipc.yaml"), prefix)
     s = Sender(a, prefix)
-    d.read(4.0)
+    # the events, not fixed times: the first wait line (3 s after the daemon's start, which
+    # a loaded machine delays: after a fixed 4 s the sanitizer build had printed none), then
+    # 0.5 s more, in which no second line may come
+    d.read_until(lambda t: len(wait_lines(t, prefix)[1]) >= 1)
+    d.read(0.5)
     ok, lines = wait_lines(d.text(), prefix)
     for l in lines:
         print("  wait line:", l)
@@ -268,7 +280,8 @@ def case_waits(a):
     s.command(name="cart")
     wrong = LCM(state_url)
     s.command(lc=wrong)  # a controller publishing on the state URL's port
-    d.read(3.5)
+    d.read_until(lambda t: len(wait_lines(t, prefix)[1]) >= 2)  # the line after 6 s
+    d.read(0.5)
     rc = d.stop()
     wrong.close()
     ok, lines = wait_lines(d.text(), prefix)
@@ -299,8 +312,7 @@ def main():
     # a multicast port of this test's own (ttl=0: this host) for every process it starts,
     # through LCM_DEFAULT_URL: on one port every socket gets every datagram, and another
     # test's fast-mode daemon would flood this one's sockets; 4 MB receive buffers
-    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
-                                     % (20000 + 2 * (os.getpid() % 6000)))  # and the next port: commands
+    os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")  # and the next port: commands
     a.bin, a.python, a.source = (os.path.abspath(x) for x in (a.bin, a.python, a.source))
     CASES[a.case](a)
     print(f"{a.case}: {'FAILED' if failures else 'passed'} ({failures} failures)")

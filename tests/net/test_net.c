@@ -24,8 +24,17 @@
 
 #define GROUP "239.255.76.67"
 
-/* A port of this process's own, away from the other tests' (20000..31999). */
-static int test_port(int k) { return 40000 + 4 * (int)(getpid() % 5000) + k; }
+/* Port k (0..3) of four of this process's own (lt_lcm_ports, lagsim_test.h). */
+static int test_port(int k)
+{
+    static int base = -1;
+    if (base < 0) base = lt_lcm_ports(4);
+    if (base < 0) {
+        fprintf(stderr, "no four free UDP ports in a row (lt_lcm_ports)\n");
+        exit(1);
+    }
+    return base + k;
+}
 
 /* A UDP socket bound to port, member of GROUP (as LCM's receive socket is). */
 static int member_socket(int port)

@@ -38,6 +38,8 @@ import subprocess
 import sys
 import tempfile
 import time
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 failures = 0
 SYNC = 0xEDA1DA01
@@ -406,8 +408,7 @@ def main():
     ap.add_argument("case", choices=sorted(CASES))
     a = ap.parse_args()
     # a multicast port of this test's own (ttl=0: this host), and the next one for commands
-    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
-                                     % (32000 + 2 * (os.getpid() % 6000)))
+    os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")
     t = T(a)
     with tempfile.TemporaryDirectory() as tmp:
         t.tmp = tmp
