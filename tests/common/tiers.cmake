@@ -49,6 +49,8 @@ set(LAGSIM_TIER_RULES
   "waits     NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
   "waits     NAME  ^eval_procs_(eval|sweep)_(stalled|gnuplot)$"
   "waits     NAME  ^eval_lagsim_sweep_unanswered$"
+  # a controller on another prefix: 30 s of a kept pair's wait for its first answer
+  "waits     NAME  ^eval_lagsim_sweep_controller_exit$"
   "waits     NAME  ^scene_shipped_wait$"
   "waits     NAME  ^log_term_waits$"
   "waits     NAME  ^ctl_discover$"
@@ -82,8 +84,8 @@ set(LAGSIM_TIER_RULES
   # controller; packet loss and ssh hosts in namespaces
   "quick     NAME  ^eval_(metrics|reference|sweep_csv)_"
   "quick     NAME  ^eval_procs_(eval|sweep)_(sigint|sigterm|sigkill|groupkill)$"
-  "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene|owned|outputs|bus|docs_python)$"
-  "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|merge_rows|merge_foreign|shard|kept|kept_python|vary|scene_c|scene_python)$"
+  "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene|owned|outputs|bus|docs_python|notes)$"
+  "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|merge_rows|merge_foreign|shard|kept|kept_python|vary|scene_c|scene_python|notes)$"
   "wallclock NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
   "root      NAME  ^eval_lagsim_sweep_(loss|ssh|scene_loss)$"
   # clients, ctl, install
