@@ -11,6 +11,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
+#include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,6 +22,7 @@
 
 #include "eval_case.h"
 #include "scene.h"
+#include "sweep_live.h"
 #include "sweep_merge.h"
 
 static const char *prog = "lagsim-sweep";
@@ -28,12 +30,14 @@ static const char *prog = "lagsim-sweep";
 #define VARY_MAX 16
 #define ROW_MAX 8192 /* bytes of the CSV header and of a row at most (a row: < 4000) */
 
+static void usage_end(FILE *f);
+
 static void usage(FILE *f)
 {
     fprintf(f,
 "usage: lagsim-sweep --config SCENE --controller 'COMMAND' (--case NAME | --duration S)\n"
 "                    --vary KEY=DIST ... [--runs N] [--seed S] [-j N] [--shard K/N]\n"
-"                    [--restart]\n"
+"                    [--only RUNS] [--restart] [--progress]\n"
 "                    [--suite FILE] [--require EXPR] [--csv OUT.csv] [--plot OUT.png]\n"
 "                    [--metric JOINT.METRIC] [--force] [--url URL] [--allow-lan]\n"
 "                    [--lagsimd PATH] [--timeout S] [-v]\n"
@@ -61,6 +65,9 @@ static void usage(FILE *f)
 "  -j, --jobs N           runs at once on this machine (default 1)\n"
 "      --shard K/N        only runs i with i mod N = K - 1 (K = 1..N, N <= 1e7): one\n"
 "                         machine's part; lagsim-sweep merge joins the parts\n"
+"      --only RUNS        only these runs (of the shard's), as a CSV's held line writes\n"
+"                         them: A-B,C (a sweep stopped before its end says which runs to\n"
+"                         give it); merge joins its CSV with the others\n"
 "      --restart          a daemon and a controller started for each run, with the\n"
 "                         run's values (default: one of each per worker, started\n"
 "                         with the scene's values; each run's values SET and its\n"
@@ -80,6 +87,9 @@ static void usage(FILE *f)
 "      --allow-lan        accept a URL with ttl above 0 (the runs on the network)\n"
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a run may take (default 600)\n"
+"      --progress         the progress line (runs done, failed, rate, ETA) on stderr when\n"
+"                         it is no terminal too: a line every 10 s (on a terminal it is\n"
+"                         drawn without it, up to 4 times a second, unless -v)\n"
 "  -v, --verbose          pass the daemon's and the controller's output through, keep\n"
 "                         the daemons' logs in the temporary directory and say where\n"
 "  -o, --output OUT.csv   merge: the joined CSV (the whole sweep's, byte for byte); every\n"
@@ -92,6 +102,12 @@ static void usage(FILE *f)
 "keys lagsim-sweep sets on every run (a case's set: or a --vary naming one, or a\n"
 "mapping above one, is refused):\n");
     eval_owned_usage(f);
+    usage_end(f);
+}
+
+/* --help's end: the exit codes and the signals. */
+static void usage_end(FILE *f)
+{
     fprintf(f,
 "\n"
 "exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
@@ -99,9 +115,12 @@ static void usage(FILE *f)
 "cannot answer the first state of a worker's first lagsimd, or shard CSVs that do not\n"
 "belong together, hold a malformed row or leave shards or runs out\n"
 "\n"
-"signals: SIGINT, SIGTERM, SIGHUP stop every process it started (SIGKILL after 2 s)\n"
-"and end it by that signal; after SIGKILL they end within about 2 s. TMPDIR: where\n"
-"the workers' files go (default /tmp)\n");
+"signals: SIGINT, SIGTERM, SIGHUP stop every process it started (SIGKILL after 2 s),\n"
+"write the rows of the runs that ended to --csv in run order (its held line says\n"
+"which, stderr how to run the others: --only) and end it by that signal; after\n"
+"SIGKILL they end within about 2 s, and --csv holds the rows of the runs that had\n"
+"ended (written as each ended; held: unknown). TMPDIR: where the workers' files go\n"
+"(default /tmp)\n");
 }
 
 static int die(const char *fmt, const char *a)
@@ -429,6 +448,15 @@ typedef struct sweep {
     char tmpdir[160]; /* eval_make_tmpdir: at most 128 + 21 */
     char cmd_files[EVAL_CMD_FILES_MAX][1024]; /* the files the controller command names */
     bool stopping;       /* the sweep stops before its end (a controller that cannot run) */
+    const char *only;    /* --only RUNS */
+    const char *self;    /* argv[0]: the command, as it was run */
+    const char *duration_text, *timeout_text; /* as given: the command that finishes it */
+    bool progress, lagsimd_given;
+    unsigned char *shards, *want; /* shards[K - 1]: --shard's K (all: the whole sweep);
+                                   * want[run]: this sweep runs it (its shard, --only) */
+    long nwant;
+    sweep_live live;     /* the rows as they come, the CSV, the progress */
+    bool png_new;        /* --plot made by this sweep (empty until its end) */
 } sweep;
 
 /* An integer option: a plain decimal (as a scene writes a number) with no fraction; lo
@@ -464,7 +492,7 @@ static int add_vary(sweep *x, const char *text)
 static int parse_options(sweep *x, int argc, char **argv)
 {
     enum { O_CASE = 256, O_SUITE, O_VARY, O_SEED, O_SHARD, O_REQUIRE, O_CSV, O_PLOT, O_METRIC,
-           O_LAGSIMD, O_TIMEOUT, O_RESTART, O_URL, O_ALLOW_LAN };
+           O_LAGSIMD, O_TIMEOUT, O_RESTART, O_URL, O_ALLOW_LAN, O_ONLY, O_PROGRESS };
     static const struct option opts[] = {
         {"config", required_argument, 0, 'c'},      {"controller", required_argument, 0, 'C'},
         {"case", required_argument, 0, O_CASE},     {"suite", required_argument, 0, O_SUITE},
@@ -477,6 +505,7 @@ static int parse_options(sweep *x, int argc, char **argv)
         {"timeout", required_argument, 0, O_TIMEOUT}, {"verbose", no_argument, 0, 'v'},
         {"restart", no_argument, 0, O_RESTART},     {"help", no_argument, 0, 'h'},
         {"url", required_argument, 0, O_URL},       {"allow-lan", no_argument, 0, O_ALLOW_LAN},
+        {"only", required_argument, 0, O_ONLY},     {"progress", no_argument, 0, O_PROGRESS},
         {0, 0, 0, 0}};
     int o, bad = 0;
     opterr = 0;
@@ -486,7 +515,10 @@ static int parse_options(sweep *x, int argc, char **argv)
         case 'C': x->controller = optarg; break;
         case O_CASE: x->case_name = optarg; break;
         case O_SUITE: x->suite = optarg; break;
-        case 'd': x->duration = parse_pos("--duration", optarg, 1e-3, 1e6, &bad); break;
+        case 'd':
+            x->duration = parse_pos("--duration", optarg, 1e-3, 1e6, &bad);
+            x->duration_text = optarg;
+            break;
         case O_VARY:
             if (add_vary(x, optarg)) return 2;
             break;
@@ -503,8 +535,16 @@ static int parse_options(sweep *x, int argc, char **argv)
         case O_PLOT: x->png = optarg; break;
         case O_METRIC: x->metric = optarg; break;
         case 'f': x->force = true; break;
-        case O_LAGSIMD: snprintf(x->lagsimd, sizeof x->lagsimd, "%s", optarg); break;
-        case O_TIMEOUT: x->timeout = parse_pos("--timeout", optarg, 1, 1e6, &bad); break;
+        case O_LAGSIMD:
+            snprintf(x->lagsimd, sizeof x->lagsimd, "%s", optarg);
+            x->lagsimd_given = true;
+            break;
+        case O_TIMEOUT:
+            x->timeout = parse_pos("--timeout", optarg, 1, 1e6, &bad);
+            x->timeout_text = optarg;
+            break;
+        case O_ONLY: x->only = optarg; break;
+        case O_PROGRESS: x->progress = true; break;
         case 'v': x->verbose = true; break;
         case O_RESTART: x->restart = true; break;
         case O_URL: x->url_opt = optarg; break;
@@ -650,6 +690,27 @@ static int make_identity(sweep *x)
     return -1;
 }
 
+/* The runs this sweep runs: its shard's (--shard K/N: i mod N = K - 1), of those --only's
+ * (ranges counted in the shard's runs, as a held line writes them). -1 or the exit code. */
+static int make_want(sweep *x)
+{
+    if (!(x->shards = calloc((size_t)x->shard_n, 1)) || !(x->want = calloc((size_t)x->total, 1)))
+        return die("%s", "out of memory");
+    x->shards[x->shard_k - 1] = 1;
+    if (x->only && sweep_runs_parse(x->only, x->total, x->want)) {
+        fprintf(stderr, "%s: --only %s: expected runs as A-B,C (ascending, from 0 to %ld), as "
+                "a CSV's held line writes them\n", prog, x->only, x->total - 1);
+        return 2;
+    }
+    for (long i = 0; i < x->total; i++) {
+        x->want[i] = (!x->only || x->want[i]) && i % x->shard_n == x->shard_k - 1;
+        x->nwant += x->want[i];
+    }
+    if (x->nwant == 0)
+        return die("--only %s: no run of this sweep (of its shard) in it", x->only);
+    return -1;
+}
+
 /* ---------------------------------------------------------------- a worker */
 #define KEEP_RUNS 200 /* a kept daemon is started again after this many runs (its log) */
 
@@ -709,7 +770,7 @@ static int start_pair(worker *wk, eval_result *res, char *err, size_t errlen)
     char why[sizeof res->reason];
     snprintf(why, sizeof why, "a new lagsimd and controller for this run: %.200s", err);
     fail_unrun(res, x->sc.nj, why);
-    fprintf(stderr, "%s: worker %ld: %s\n", prog, wk->w, why);
+    eval_say("%s: worker %ld: %s\n", prog, wk->w, why);
     return 0;
 }
 
@@ -737,8 +798,8 @@ static int run_kept(worker *wk, const char *const *sets, int nsets, const eval_s
         if (rc == 0 && !strstr(res->reason, "before the duration") && !unanswered && !lost)
             return 0;
         if (unanswered || lost) /* the run fails, and it is said: never a silent restart */
-            fprintf(stderr, "%s: worker %ld: a run failed: %s; a new lagsimd and controller "
-                    "for the next run\n", prog, wk->w, res->reason);
+            eval_say("%s: worker %ld: a run failed: %s; a new lagsimd and controller for the "
+                     "next run\n", prog, wk->w, res->reason);
         eval_worker_stop(wk->kept);
         wk->kept = NULL;
         if (rc == 0) return 0;
@@ -775,7 +836,7 @@ static int worker_fatal(const worker *wk, long i, const char *err)
     snprintf(path, sizeof path, "%s/%ld.fatal", wk->x->tmpdir, wk->w);
     FILE *f = fopen(path, "w");
     if (f) fprintf(f, "run %ld, worker %ld: %s", i, wk->w, err), fclose(f);
-    else fprintf(stderr, "%s: run %ld: %s\n", prog, i, err);
+    else eval_say("%s: run %ld: %s\n", prog, i, err);
     return WORKER_FATAL;
 }
 
@@ -811,15 +872,15 @@ static int run_one(worker *wk, long i)
     }
     if (rc == RUN_FATAL) return worker_fatal(wk, i, err);
     if (rc) {
-        fprintf(stderr, "%s: run %ld: %s\n", prog, i, err);
+        eval_say("%s: run %ld: %s\n", prog, i, err);
         return 4;
     }
     write_row(wk, i, val, &res);
     return 0;
 }
 
-/* Worker w runs this shard's runs i with (i / shard_n) mod jobs = w; its rows go to a
- * file of its own. Never returns. */
+/* Worker w runs the sweep's runs it wants (its shard's, --only's) number w, w + jobs, ...
+ * of them; its rows go to a file of its own. Never returns. */
 static void worker_main(const sweep *x, long w)
 {
     char path[256];
@@ -827,8 +888,8 @@ static void worker_main(const sweep *x, long w)
     worker wk = {.x = x, .w = w, .rows = fopen(path, "w")};
     if (!wk.rows) _exit(3);
     int rc = 0;
-    for (long i = x->shard_k - 1; i < x->total && !rc; i += x->shard_n)
-        if ((i / x->shard_n) % x->jobs == w) rc = run_one(&wk, i);
+    for (long i = 0, k = 0; i < x->total && !rc; i++)
+        if (x->want[i] && k++ % x->jobs == w) rc = run_one(&wk, i);
     eval_worker_stop(wk.kept);
     fclose(wk.rows);
     _exit(rc);
@@ -846,8 +907,8 @@ static void say_fatal(const sweep *x, long w)
     text[n] = '\0';
     if (f) fclose(f);
     unlink(path);
-    fprintf(stderr, "%s: %s\n%s: the sweep stops: a controller that cannot answer the "
-            "first state of its lagsimd fails every run\n", prog, text, prog);
+    eval_say("%s: %s\n%s: the sweep stops: a controller that cannot answer the first state "
+             "of its lagsimd fails every run\n", prog, text, prog);
 }
 
 /* The workers' ends, as they come: one that stops the sweep stops the others. 0, or 2
@@ -859,6 +920,11 @@ static int wait_workers(sweep *x, const pid_t *pids)
     int status = 0;
     for (long w = 0; w < x->jobs; w++) alive[w] = true;
     while (left) {
+        sweep_live_poll(&x->live);
+        if (eval_proc_pending()) { /* a signal: every worker stopped, what ended kept */
+            eval_proc_stop_children();
+            return 2;
+        }
         for (long w = 0; w < x->jobs; w++) {
             int st = 0;
             if (!alive[w] || !eval_wait_until(pids[w], 0, &st)) continue;
@@ -891,23 +957,106 @@ static int run_workers(sweep *x)
     return wait_workers(x, pids);
 }
 
-static void collect_rows(const sweep *x, rows *r)
+/* A word of the command, quoted for sh when it needs it. */
+static void sh_word(FILE *f, const char *w)
 {
-    char *line = NULL;
-    size_t cap = 0;
-    for (long w = 0; w < x->jobs; w++) {
-        char path[256];
-        snprintf(path, sizeof path, "%s/%ld.rows", x->tmpdir, w);
-        FILE *f = fopen(path, "r");
-        if (!f) continue;
-        while (getline(&line, &cap, f) >= 0) {
-            line[strcspn(line, "\n")] = '\0';
-            rows_add(r, strtol(line, NULL, 10), line);
-        }
-        fclose(f);
-        unlink(path);
+    if (w[0] && strspn(w, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                          "_-./:=,+@%") == strlen(w)) {
+        fputs(w, f);
+        return;
     }
-    free(line);
+    fputc('\'', f);
+    for (const char *p = w; *p; p++) {
+        if (*p == '\'') fputs("'\\''", f);
+        else fputc(*p, f);
+    }
+    fputc('\'', f);
+}
+
+static void sh_opt(FILE *f, const char *opt, const char *value)
+{
+    fprintf(f, " %s ", opt);
+    sh_word(f, value);
+}
+
+/* The sweep's command again, for the runs `only` alone, to CSV rest: every option that
+ * makes the runs what they are (the identity's), as given. */
+static void finish_command(FILE *f, const sweep *x, const char *only, const char *rest)
+{
+    char num[32];
+    fputs("  ", f);
+    sh_word(f, x->self);
+    sh_opt(f, "--config", x->config);
+    sh_opt(f, "--controller", x->controller);
+    if (x->suite) sh_opt(f, "--suite", x->suite);
+    if (x->case_name) sh_opt(f, "--case", x->case_name);
+    else sh_opt(f, "--duration", x->duration_text);
+    for (int k = 0; k < x->nv; k++) sh_opt(f, "--vary", x->vs[k].text);
+    snprintf(num, sizeof num, "%ld", x->runs), sh_opt(f, "--runs", num);
+    snprintf(num, sizeof num, "%llu", (unsigned long long)x->seed), sh_opt(f, "--seed", num);
+    snprintf(num, sizeof num, "%ld", x->jobs), sh_opt(f, "-j", num);
+    if (x->shard_n > 1) fprintf(f, " --shard %ld/%ld", x->shard_k, x->shard_n);
+    if (x->restart) fputs(" --restart", f); /* said, or forced by a key: the same either way */
+    if (x->require) sh_opt(f, "--require", x->require);
+    if (x->url_opt) sh_opt(f, "--url", x->url_opt);
+    if (x->allow_lan) fputs(" --allow-lan", f);
+    if (x->lagsimd_given) sh_opt(f, "--lagsimd", x->lagsimd);
+    if (x->timeout_text) sh_opt(f, "--timeout", x->timeout_text);
+    sh_opt(f, "--only", only);
+    sh_opt(f, "--csv", rest);
+    fputc('\n', f);
+}
+
+/* The CSV holds some of the runs (why: a signal, a worker that failed): which, and how to
+ * run the others and merge them (--only), on stderr. */
+static void say_held(const sweep *x, const char *why)
+{
+    const sweep_live *l = &x->live;
+    char *held = sweep_live_held(l), *miss = sweep_live_missing(l);
+    char of[64] = "";
+    if (x->shard_n > 1) snprintf(of, sizeof of, " of shard %ld/%ld", x->shard_k, x->shard_n);
+    if (!x->csv || !held || !miss) {
+        eval_say("%s: %s: %ld of the %ld runs%s had ended; without --csv they are kept "
+                 "nowhere (their summary: above)\n", prog, why, l->done, x->nwant, of);
+        free(held), free(miss);
+        return;
+    }
+    eval_say("%s: %s: %s holds %ld of the %ld runs%s (held: %.200s%s), in run order; the "
+             "runs missing: %.200s%s. To finish the sweep, run them and merge:\n", prog, why,
+             x->csv, l->done, x->nwant, of, held, strlen(held) > 200 ? "..." : "", miss,
+             strlen(miss) > 200 ? "..." : "");
+    char rest[1100], whole[1100];
+    const char *dot = strrchr(x->csv, '.');
+    int base = dot && !strchr(dot, '/') ? (int)(dot - x->csv) : (int)strlen(x->csv);
+    snprintf(rest, sizeof rest, "%.*s-rest.csv", base, x->csv);
+    snprintf(whole, sizeof whole, "%.*s-whole.csv", base, x->csv);
+    finish_command(stderr, x, miss, rest);
+    fputs("  ", stderr);
+    sh_word(stderr, x->self);
+    /* a shard's or --only's runs made whole are still a part: --partial joins them */
+    fputs(x->shard_n > 1 || x->only ? " merge --partial " : " merge ", stderr);
+    sh_word(stderr, x->csv);
+    fputc(' ', stderr);
+    sh_word(stderr, rest);
+    fprintf(stderr, " -o ");
+    sh_word(stderr, whole);
+    fprintf(stderr, "\n");
+    free(held), free(miss);
+}
+
+/* A signal stopped the sweep (its workers too, and the CSV holds the rows of the runs
+ * that ended): their summary, which runs the CSV holds and how to run the others; a PNG
+ * it made and never drew removed; then it ends by the signal. */
+static void __attribute__((noreturn)) stop_by(sweep *x, int sig)
+{
+    if (x->live.r.n) summary(x->header, &x->live.r);
+    fflush(stdout);
+    char why[64];
+    snprintf(why, sizeof why, "stopped by %s", sig == SIGINT ? "SIGINT" : sig == SIGTERM ?
+             "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "a signal");
+    say_held(x, why);
+    if (x->png_new) unlink(x->png);
+    eval_proc_end(sig);
 }
 
 static int count_passed(const sweep *x, const rows *r)
@@ -953,6 +1102,23 @@ static void note_unreferenced(const eval_scene *sc)
            one ? "its" : "their", one ? "it" : "them");
 }
 
+/* What sweep_live needs from the sweep. */
+static void live_setup(sweep *x, FILE *fcsv)
+{
+    bool tty = isatty(STDERR_FILENO);
+    x->live = (sweep_live){.tmpdir = x->tmpdir, .jobs = x->jobs, .csv = fcsv,
+                           .identity = x->identity, .header = x->header, .runs = x->total,
+                           .sn = x->shard_n, .shards = x->shards, .want = x->want,
+                           .nwant = x->nwant, .nvary = x->nv, .tty = tty && !x->verbose,
+                           .progress = x->progress || (tty && !x->verbose),
+                           .require = x->require != NULL};
+}
+
+static void say_csv(const sweep *x, const char *why)
+{
+    eval_say("%s: --csv %s: %s\n", prog, x->csv, why);
+}
+
 static int sweep_run(sweep *x)
 {
     char err[2048];
@@ -968,6 +1134,7 @@ static int sweep_run(sweep *x)
      * never runs for hours to lose its results at the end */
     struct stat st;
     bool csv_new = x->csv && lstat(x->csv, &st) != 0;
+    bool png_new = x->png && lstat(x->png, &st) != 0;
     if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, nin))) return 2;
     if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, nin + 1))) {
         if (fcsv) fclose(fcsv);
@@ -985,21 +1152,33 @@ static int sweep_run(sweep *x)
                 "pair, SWEEP%d_<run>.lcm for a run's own) are kept in %s\n", prog,
                 (int)getpid(), (int)getpid(), x->tmpdir);
     }
+    x->png_new = png_new;
+    /* a signal from here on is the sweep's to act on: the rows of the runs that ended go
+     * to the CSV before it ends (stop_by) */
+    eval_proc_defer(true);
+    live_setup(x, fcsv);
+    if (sweep_live_start(&x->live, err, sizeof err)) {
+        fprintf(stderr, "%s: %s\n", prog, err);
+        eval_proc_defer(false);
+        if (eval_proc_pending()) eval_proc_end(eval_proc_pending());
+        return 2;
+    }
     int status = run_workers(x);
-    rows r = {0};
-    collect_rows(x, &r);
-    if (fcsv && (rows_write(&r, fcsv, x->identity, x->header, err, sizeof err) ||
-                 fclose(fcsv) != 0))
-        status = 2;
-    if (r.n || !x->stopping) { /* a sweep stopped before any run has nothing to sum */
-        summary(x->header, &r);
+    if (sweep_live_finish(&x->live, err, sizeof err)) status = 2, say_csv(x, err);
+    if (fcsv && fclose(fcsv) != 0) status = 2, say_csv(x, strerror(errno));
+    eval_proc_defer(false);
+    if (eval_proc_pending()) stop_by(x, eval_proc_pending());
+    rows *r = &x->live.r;
+    if (r->n || !x->stopping) { /* a sweep stopped before any run has nothing to sum */
+        summary(x->header, r);
         note_unreferenced(&x->sc);
     }
-    bool all = count_passed(x, &r) == r.n;
-    if (x->png && plot(x->png, x->tmpdir, x->header, &r, x->nv, x->metric)) status = 2;
+    if (x->live.done < x->nwant) say_held(x, "not every run ended");
+    bool all = count_passed(x, r) == r->n;
+    if (x->png && plot(x->png, x->tmpdir, x->header, r, x->nv, x->metric)) status = 2;
     rmdir(x->tmpdir);
     eval_proc_tmpdir_done();
-    rows_free(&r);
+    sweep_live_free(&x->live);
     return status ? status : all ? 0 : 1;
 }
 
@@ -1010,15 +1189,18 @@ int main(int argc, char **argv)
     static sweep x = {.timeout = 600, .runs = 1, .jobs = 1, .shard_k = 1, .shard_n = 1,
                       .seed = 1};
     eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
+    x.self = argv[0];
     int rc;
     if ((rc = parse_options(&x, argc, argv)) >= 0 || (rc = check_options(&x, argc, argv)) >= 0 ||
         (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0 ||
         (rc = check_vary_keys(&x)) >= 0)
         return rc;
-    if ((rc = make_header(&x)) >= 0 || (rc = make_identity(&x)) >= 0) return rc;
+    if ((rc = make_header(&x)) >= 0 || (rc = make_identity(&x)) >= 0 ||
+        (rc = make_want(&x)) >= 0)
+        return rc;
     for (long w = 0; w < x.jobs; w++) x.lease[w] = (lag_port_lease){.port = 0, .fd = -1};
     rc = take_ports(&x) ? 2 : sweep_run(&x);
     release_ports(&x);
-    free(x.identity);
+    free(x.identity), free(x.shards), free(x.want);
     return rc;
 }

@@ -27,6 +27,11 @@ usage: test_eval.py BIN_DIR SOURCE_DIR CASE
              table's notes that q2 is scored against r = 0 (a case with both: no note); a
              controller command with {url} outside quotes that ends before its run says
              to write '{url}' (the URL's '&' ended the command), quoted: no such words
+  waits      a controller on another prefix (alive, waiting for its scene): within
+             seconds of the case's start, long before --timeout, one line on stderr says in
+             the daemon's words what the plant waits for (the first command, on the run's
+             <PREFIX>_COMMAND at its command URL) and to give the command {prefix}; a
+             controller on the run's prefix: no such line
   outputs    no output of lagsim-eval or lagsim-sweep is a file they read (the scene, the
              suite, the daemon; merge's shards) or another of their outputs (the CSV and
              the report's or the plot's files), whatever its spelling (./, a hard link),
@@ -37,6 +42,7 @@ import glob
 import math
 import os
 import re
+import select
 import shutil
 import subprocess
 import sys
@@ -644,7 +650,46 @@ def case_notes():
           "'{url}' quoted: the case runs, no such words (exit %d)" % p.returncode)
 
 
+def case_waits():
+    # lqr_balance waits 100 s for a scene on its own prefix: it never answers the run's
+    # plant, which waits at t = 0 for the first command
+    wrong = os.path.join(BIN, "lqr_balance") + " -q --prefix NOT_THE_RUNS --timeout 100"
+    p = subprocess.Popen([EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt",
+                          "--timeout", "120", "--controller", wrong], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, universal_newlines=True)
+    t0, text = time.monotonic(), ""
+    while time.monotonic() < t0 + 30 and "has not left" not in text:  # at most 30 s
+        if select.select([p.stderr], [], [], 0.2)[0]:
+            chunk = os.read(p.stderr.fileno(), 65536).decode(errors="replace")
+            if not chunk:
+                break
+            text += chunk
+    took = time.monotonic() - t0
+    p.terminate()
+    while "\n" not in text[text.find("has not left"):] and "has not left" in text:
+        chunk = os.read(p.stderr.fileno(), 65536).decode(errors="replace")
+        if not chunk:
+            break
+        text += chunk
+    lines = text.splitlines(True)
+    line = next((x for x in lines if "has not left" in x), "")
+    rest = "".join(lines[lines.index(line) + 1:]) if line else text
+    p.wait(timeout=60)
+    rest += p.stderr.read()
+    print(line, rest)
+    check(re.match(r"^lagsim-eval: case tilt: the plant has not left t = 0 after 5 s: lagsimd "
+                   r"waits \d+ s for the first command \(sim_time 0\) on EVAL\d+_0_COMMAND at "
+                   r"udpm://[0-9.]+:\d+\?\S+; .*give the command \{prefix\} or LAGSIM_PREFIX "
+                   r"\(else the run ends at --timeout, 120 s\)$", line) and took < 30,
+          "a controller on another prefix: said in %.1f s (--timeout 120): %r" % (took, line))
+    check("has not left" not in rest, "said once")
+    p = run("--suite", SUITE, "--case", "tilt")
+    check(p.returncode == 0 and "has not left" not in p.stderr,
+          "a controller on the run's prefix: no such line")
+
+
 {"metrics": case_metrics, "require": case_require, "errors": case_errors, "notes": case_notes,
+ "waits": case_waits,
  "scene": case_scene, "owned": case_owned, "outputs": case_outputs, "bus": case_bus}[CASE]()
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)
