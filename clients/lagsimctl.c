@@ -23,8 +23,8 @@
  *   param <name>=<value>
  *   joint <name> actuated=... initial_q=... ...  (every per-joint field of scene_t)
  *   state t=... step=... <joint>=<q> ... <joint>_dot=<qd> ... <joint>_effort=<effort> ...
- * Numbers are printed with %.17g (they read back to the same double) unless --digits
- * says otherwise.
+ * Numbers are printed as the shortest decimal that reads back to the same double
+ * (lagsim_num.h: 0.1, not 0.10000000000000001) unless --digits says otherwise.
  */
 #include <errno.h>
 #include <getopt.h>
@@ -35,7 +35,9 @@
 #include <string.h>
 
 #include "lagsim_client.h"
+#include "lagsim_client_wire.h"
 #include "lagsim_bus.h"
+#include "lagsim_num.h"
 #include "lagsim_wire.h"
 
 /* What lagsimctl ends with: codes of the one space (lagsim/result.h); main() turns them
@@ -48,7 +50,7 @@
 static volatile sig_atomic_t g_signal = 0;
 static void on_signal(int sig) { g_signal = sig; }
 
-static int g_digits = 17;
+static int g_digits = 0; /* 0: the shortest that reads back */
 static bool g_json = false;
 static bool g_digits_set = false;
 static const char *g_prefix = "";  /* the plant's, for the status's first line */
@@ -87,8 +89,9 @@ static void usage(FILE *f)
             "  -j, --json           one JSON object a message (for scripts)\n"
             "  -u, --url URL        LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)\n"
             "  -t, --timeout S      wall s to wait for the answer (default 2)\n"
-            "  -d, --digits N       significant digits of numbers (default 17: exact; the\n"
-            "                       status for people: 6)\n"
+            "  -d, --digits N       significant digits of numbers (default: exact, the\n"
+            "                       shortest decimal that reads back; the status for\n"
+            "                       people: 6)\n"
             "  -h, --help           this text\n"
             "  -V, --version        print the version\n"
             "exit status: 0 done, 1 the daemon refused (its reason on stderr), 2 bad usage\n"
@@ -97,7 +100,12 @@ static void usage(FILE *f)
 }
 
 /* ---------------------------------------------------------------- printing */
-static void put_num(double x) { printf("%.*g", g_digits, x); }
+static void put_num(double x)
+{
+    char b[LAG_NUM_LEN];
+    if (g_digits) printf("%.*g", g_digits, x);
+    else printf("%s", lag_num(x, b));
+}
 
 /* A string as a token: bare if it has no space, quote or '=', else in double quotes with
  * '"' and '\' escaped. */
@@ -152,14 +160,16 @@ static void put_json_str(const char *s)
     putchar('"');
 }
 
-/* One value of a field as JSON (numbers: %.17g, exact; the decoder keeps only finite). */
+/* One value of a field as JSON (numbers exact, the shortest that reads back; the decoder
+ * keeps only finite ones). */
 static void put_json_value(const lag_wire_field *f, const char *p)
 {
+    char num[LAG_NUM_LEN];
     switch (f->kind) {
     case LAG_WIRE_INT8: printf("%d", *(const int8_t *)p); break;
     case LAG_WIRE_INT16: printf("%d", *(const int16_t *)p); break;
     case LAG_WIRE_INT64: printf("%lld", (long long)*(const int64_t *)p); break;
-    case LAG_WIRE_DOUBLE: printf("%.17g", *(const double *)p); break;
+    case LAG_WIRE_DOUBLE: printf("%s", lag_num(*(const double *)p, num)); break;
     case LAG_WIRE_BOOLEAN: printf("%s", *(const bool *)p ? "true" : "false"); break;
     case LAG_WIRE_STRING: put_json_str(p); break;
     }
@@ -216,7 +226,7 @@ static const char *status_unit(const char *name)
 
 /* The status for people: one field a line, names aligned, numbers with 6 significant
  * digits (--digits N: N) and their units; the counters that are 0 on one line. */
-static void print_status_human(const lag_client_status *st)
+static void print_status_human(const lag_wire_status *st)
 {
     int n, width = 0;
     const lag_wire_field *f = lag_wire_fields(LAG_WIRE_STATUS, &n);
@@ -255,7 +265,9 @@ static void print_status_human(const lag_client_status *st)
 static void print_event(const lag_client_event *ev)
 {
     if (g_json) {
-        print_json("event", LAG_WIRE_EVENT, ev);
+        lag_wire_event w;
+        lag_wire_of_event(ev, &w);
+        print_json("event", LAG_WIRE_EVENT, &w);
         return;
     }
     printf("event %s t=", ev->kind);
@@ -270,9 +282,10 @@ static void print_event(const lag_client_event *ev)
     fflush(stdout);
 }
 
-static void print_status(const lag_client_status *st)
+static void print_status(const lag_client_status *status)
 {
     static const char *const skip[] = {"utime", "sim_time", "step", NULL};
+    const lag_wire_status *st = lag_wire_of_status(status); /* every field, from its table */
     if (g_json) {
         print_json("status", LAG_WIRE_STATUS, st);
         return;
@@ -292,7 +305,9 @@ static void print_status(const lag_client_status *st)
 static void print_state(const lag_client_state *st)
 {
     if (g_json) {
-        print_json("state", LAG_WIRE_JOINT_STATE, st);
+        lag_wire_joint_state w;
+        lag_wire_of_state(st, &w);
+        print_json("state", LAG_WIRE_JOINT_STATE, &w);
         return;
     }
     printf("state t=");
@@ -331,9 +346,10 @@ static void put_elem(const lag_wire_field *f, const void *m, int i)
 /* The scene: a line of its scalar fields, then one line per parameter
  * ("param <name>=<value>") and one per joint ("joint <name> <field>=<value>..." for every
  * array counted by num_joints), so that fields added to scene_t show up by themselves. */
-static void print_scene(const lag_client_scene *sc)
+static void print_scene(const lag_client_scene *scene)
 {
     static const char *const skip[] = {"utime", NULL};
+    const lag_wire_scene *sc = lag_wire_of_scene(scene); /* every field, from its table */
     if (g_json) {
         print_json("scene", LAG_WIRE_SCENE, sc);
         return;
@@ -470,10 +486,12 @@ static bool step_done(const answer *a) { return a->refused || (a->got_event2 && 
 /* Every plant on the bus, a table for people (or a JSON array): exit 0, or 3 if none. */
 static lag_result list_plants(const char *url, double wait_s)
 {
+    char num[LAG_NUM_LEN];
     static lag_client_plant p[LAG_CLIENT_MAX_PLANTS];
     int n = 0;
     char err[256];
-    int rc = lag_client_discover(url, wait_s, -1.0, p, LAG_CLIENT_MAX_PLANTS, &n, err, sizeof err);
+    int rc = lag_client_discover(url, wait_s, -1.0, p, LAG_CLIENT_MAX_PLANTS, sizeof p[0], &n,
+                                 err, sizeof err);
     if (rc != LAG_CLIENT_OK) {
         fprintf(stderr, "lagsimctl: %s\n", err);
         return EXIT_NOANSWER;
@@ -490,7 +508,7 @@ static lag_result list_plants(const char *url, double wait_s)
                 printf("%s\"%s\": ", j ? ", " : "", k[j]);
                 put_json_str(v[j]);
             }
-            printf(", \"sim_time\": %.17g}", p[i].sim_time);
+            printf(", \"sim_time\": %s}", lag_num(p[i].sim_time, num));
         }
         printf("]\n");
     } else if (n > 0) {
@@ -719,7 +737,8 @@ static lag_client *connect_plant(options *o, lag_client_plant *chosen, int *code
     char err[1200];
     if (!o->prefix) {
         /* the only plant on the bus */
-        int rc = lag_client_pick_plant(o->url, NULL, o->timeout, chosen, err, sizeof err);
+        int rc = lag_client_pick_plant(o->url, NULL, o->timeout, chosen, sizeof *chosen, err,
+                                       sizeof err);
         if (rc != LAG_CLIENT_OK) {
             fprintf(stderr, "lagsimctl: %s\n", err);
             *code = rc == LAG_CLIENT_ERR_AMBIGUOUS ? EXIT_USAGE : EXIT_NOANSWER;
@@ -834,9 +853,10 @@ static int send_request(lag_client *c, answer *a, const request *r, double timeo
 {
     int rc = LAG_CLIENT_OK;
     if (!strcmp(r->cmd, "describe")) {
-        lag_client_scene sc;
-        rc = lag_client_wait_scene(c, timeout, &sc);
-        if (rc == LAG_CLIENT_OK) print_scene(&sc);
+        lag_client_scene *sc = lag_client_scene_new();
+        rc = sc ? lag_client_wait_scene(c, timeout, sc) : LAG_CLIENT_ERR_NOMEM;
+        if (rc == LAG_CLIENT_OK) print_scene(sc);
+        lag_client_scene_free(sc);
     } else if (!strcmp(r->cmd, "status")) {
         a->want_status = true;
         rc = lag_client_request_status(c);
@@ -888,8 +908,11 @@ static lag_result lagsimctl_main(int argc, char **argv)
         fprintf(stderr, "lagsimctl: %s\n", lag_client_errmsg(c));
         code = EXIT_NOANSWER;
     } else if (rc == LAG_CLIENT_TIMEOUT && !g_signal) {
-        fprintf(stderr, "lagsimctl: no answer on %s_* within %g s (is lagsimd running with "
-                        "lcm.prefix %s?)\n", o.prefix, o.timeout, o.prefix);
+        /* a prefix nobody has (misspelt): who is on the bus instead */
+        char instead[1500];
+        lag_client_plants_instead(o.url, o.prefix, 1.0, instead, sizeof instead);
+        fprintf(stderr, "lagsimctl: no answer on %s_* within %g s: %s\n", o.prefix, o.timeout,
+                instead);
         code = EXIT_NOANSWER;
     } else if (a.refused) {
         fprintf(stderr, "lagsimctl: the daemon refused: %s\n", a.ev.detail);

@@ -24,11 +24,13 @@
 
 #include "eval_case.h"
 #include "lagsim_client.h"
+#include "lagsim_client_wire.h"
 
 #define WATCH_ASK_S 0.25 /* a status asked for at most this often */
 
 struct eval_watch {
     lag_client *cl;
+    lag_client_status *status; /* the latest status's copy */
     const char *who;       /* the line's start ("lagsim-eval: case tilt"), NULL: say nothing */
     double t0;             /* monotonic s when the run's processes started */
     double asked;          /* monotonic s of the last status request */
@@ -54,7 +56,11 @@ eval_watch *eval_watch_start(const eval_env *env, const char *who)
     eval_watch *w = calloc(1, sizeof *w);
     if (!w) return NULL;
     w->cl = lag_client_create(env->url, env->prefix, NULL, 0);
-    if (!w->cl) { /* the run goes on without it: nothing to say, the grace as before */
+    w->status = lag_client_status_new();
+    if (!w->cl || !w->status) { /* the run goes on without it: nothing to say, the grace
+                                 * as before */
+        if (w->cl) lag_client_destroy(w->cl);
+        lag_client_status_free(w->status);
         free(w);
         return NULL;
     }
@@ -68,6 +74,7 @@ void eval_watch_stop(eval_watch *w)
 {
     if (!w) return;
     lag_client_destroy(w->cl);
+    lag_client_status_free(w->status);
     free(w);
 }
 
@@ -76,7 +83,7 @@ static void take(eval_watch *w, bool ask)
 {
     while (lag_client_handle(w->cl, 0) == LAG_CLIENT_OK) {}
     lag_client_state st;
-    if (lag_client_latest_state(w->cl, &st) && st.sim_time > 0) w->moved = true;
+    if (lag_client_latest_state(w->cl, &st, sizeof st) && st.sim_time > 0) w->moved = true;
     if (ask && eval_now() >= w->asked + WATCH_ASK_S) {
         w->asked = eval_now();
         lag_client_request_status(w->cl);
@@ -88,10 +95,9 @@ void eval_watch_poll(eval_watch *w)
     if (!w) return;
     bool due = !w->said && !w->moved && w->who && eval_now() >= w->t0 + EVAL_WAIT_SAY_S;
     take(w, due);
-    lag_client_status st;
-    if (!due || w->moved || !lag_client_latest_status(w->cl, &st) || !st.waiting_for[0] ||
-        st.sim_time != 0)
-        return;
+    if (!due || w->moved || !lag_client_latest_status(w->cl, w->status)) return;
+    const lag_wire_status st = *lag_wire_of_status(w->status);
+    if (!st.waiting_for[0] || st.sim_time != 0) return;
     w->said = true;
     eval_say("%s: the plant has not left t = 0 after %.0f s: lagsimd waits %.0f s for %s; "
              "%s%s. A controller on another prefix never answers it: give the command "
@@ -105,7 +111,8 @@ bool eval_watch_stuck(eval_watch *w, double since)
 {
     if (!w) return false;
     take(w, true);
-    lag_client_status st;
-    return lag_client_latest_status(w->cl, &st) && 1e-6 * (double)st.utime >= since &&
-           !strcmp(st.run_state, "waiting") && st.waiting_for[0];
+    if (!lag_client_latest_status(w->cl, w->status)) return false;
+    const lag_wire_status *st = lag_wire_of_status(w->status);
+    return 1e-6 * (double)st->utime >= since && !strcmp(st->run_state, "waiting") &&
+           st->waiting_for[0];
 }

@@ -41,6 +41,7 @@
 #include "lagsim/lagsim.h"
 #include "lagsim_bus.h"
 #include "lagsim_client.h"
+#include "lagsim_client_wire.h"
 #include "lagsim_wire.h"
 
 #define W_ANSWER_S 0.5  /* a SET or RESET_TO unanswered this long is sent again */
@@ -55,8 +56,10 @@ struct eval_worker {
     eval_env env;
     eval_scene sc;
     char log[1024];
+    char cerr[1100], derr[1100]; /* the pair's stderr without -v (eval_stderr_paths) */
     pid_t dpid, cpid;
     lag_client *cl;
+    lag_client_status *status; /* the latest status, read whole (lagsim_client_wire.h) */
     long runs;
     /* the run in progress, from the bus */
     eval_series s;
@@ -136,7 +139,7 @@ static bool reference_at(const eval_worker *w, double t, double *r)
 {
     lag_client_reference ref;
     for (int j = 0; j < w->sc.nj; j++) r[j] = 0;
-    if (!lag_client_latest_reference(w->cl, &ref) || ref.sim_time != t) return false;
+    if (!lag_client_latest_reference(w->cl, &ref, sizeof ref) || ref.sim_time != t) return false;
     for (int j = 0; j < w->sc.nj; j++) {
         int k = lag_client_reference_joint(&ref, w->sc.joint[j]);
         if (k >= 0 && isfinite(ref.r[k])) r[j] = ref.r[k];
@@ -194,7 +197,7 @@ static int w_wait(eval_worker *w, const bool *flag, double seconds)
 
 /* A status newer than now; false when none came within W_ANSWER_S or a state after sim
  * time 0 came first (the daemon moved: the question is answered). OUT: st */
-static bool fresh_status(eval_worker *w, lag_client_status *st, bool stop_on_move)
+static bool fresh_status(eval_worker *w, lag_wire_status *st, bool stop_on_move)
 {
     int64_t asked = (int64_t)(eval_now_wall() * 1e6);
     if (lag_client_request_status(w->cl) != LAG_CLIENT_OK) return false;
@@ -202,7 +205,9 @@ static bool fresh_status(eval_worker *w, lag_client_status *st, bool stop_on_mov
     while (eval_now() < end) {
         w_handle(w, 5);
         if (stop_on_move && w->moved) return false;
-        if (lag_client_latest_status(w->cl, st) && st->utime >= asked) return true;
+        if (lag_client_latest_status(w->cl, w->status) &&
+            (*st = *lag_wire_of_status(w->status)).utime >= asked)
+            return true;
     }
     return false;
 }
@@ -211,7 +216,7 @@ static bool fresh_status(eval_worker *w, lag_client_status *st, bool stop_on_mov
  * is under way it waits for answers instead)? */
 static bool still_at_start(eval_worker *w)
 {
-    lag_client_status st;
+    lag_wire_status st;
     return fresh_status(w, &st, true) && st.sim_time == 0 &&
            !strncmp(st.waiting_for, "RESUME or STEP", 14);
 }
@@ -256,12 +261,37 @@ static pid_t start_daemon(eval_worker *w, const eval_case *c)
     argv[na++] = w->log;
     argv[na++] = "-q";
     argv[na] = NULL;
-    return eval_spawn(argv, NULL, &w->env);
+    return eval_spawn(argv, NULL, &w->env, w->derr);
 }
 
+/* Stops the pair: the daemon, then the controller (which ends on its stop). */
+static void stop_pair(eval_worker *w)
+{
+    int st;
+    if (w->dpid > 0) {
+        kill(w->dpid, SIGTERM);
+        if (!eval_wait_until(w->dpid, eval_now() + 3.0, &st)) eval_stop_group(w->dpid, &st);
+    }
+    /* a controller ends on the daemon's stop; one that does not is stopped */
+    if (w->cpid > 0 && !eval_wait_until(w->cpid, eval_now() + 3.0, &st))
+        eval_stop_group(w->cpid, &st);
+    w->dpid = w->cpid = 0;
+}
+
+/* A pair that could not start: why, and (without -v) what the two said last. */
 static eval_worker *start_failed(eval_worker *w, char *err, size_t errlen, const char *why)
 {
-    snprintf(err, errlen, "%s", why);
+    char said[EVAL_OUTPUT_LEN] = "";
+    stop_pair(w);
+    if (!w->env.verbose && w->cerr[0]) {
+        eval_stderr_tail(w->cerr, "the controller", said, sizeof said);
+        eval_stderr_tail(w->derr, "lagsimd", said, sizeof said);
+    }
+    char first[512];
+    snprintf(first, sizeof first, "%s", why);
+    snprintf(err, errlen, "%s%s%s", first, said[0] ? "\n" : "", said);
+    size_t n = strlen(err);
+    if (n && err[n - 1] == '\n') err[n - 1] = '\0';
     eval_worker_stop(w);
     return NULL;
 }
@@ -274,7 +304,7 @@ static eval_worker *no_first_answer(eval_worker *w, bool *controller, char *err,
                                     size_t errlen)
 {
     char hint[200] = "", why[1024];
-    lag_client_status st;
+    lag_wire_status st;
     *controller = true;
     if (controller_gone(w)) {
         eval_url_hint(w->env.controller, w->env.url, hint, sizeof hint);
@@ -308,12 +338,16 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
         free(w);
         return NULL;
     }
+    eval_stderr_paths(env, w->cerr, w->derr, sizeof w->cerr);
     /* the controller first, as eval_run starts them */
-    w->cpid = eval_spawn(NULL, cmd, env);
+    w->cpid = eval_spawn(NULL, cmd, env, w->cerr);
     w->dpid = start_daemon(w, c);
     w->cl = lag_client_create(env->url, env->prefix, err, errlen);
-    if (w->cpid < 0 || w->dpid < 0 || !w->cl)
-        return start_failed(w, err, errlen, w->cl ? "cannot start the processes" : err);
+    w->status = lag_client_status_new();
+    if (w->cpid < 0 || w->dpid < 0 || !w->cl || !w->status)
+        return start_failed(w, err, errlen, !w->cl      ? err
+                                            : w->status ? "cannot start the processes"
+                                                        : "out of memory");
     lag_client_on_state(w->cl, w_on_state, w);
     lag_client_on_event(w->cl, w_on_event, w);
     lag_bus bus;
@@ -321,8 +355,7 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
         !(w->cmd = lcm_create(bus.command_url)) ||
         !lcm_subscribe(w->cmd, bus.channel[LAG_BUS_COMMAND], w_on_command, w))
         return start_failed(w, err, errlen, "cannot listen to the controller's answers");
-    lag_client_scene scene;
-    if (lag_client_wait_scene(w->cl, 10.0, &scene) != LAG_CLIENT_OK)
+    if (lag_client_wait_scene(w->cl, 10.0, NULL) != LAG_CLIENT_OK)
         return start_failed(w, err, errlen, "no scene from the kept lagsimd");
     if (step_once(w, 1, W_FIRST_S)) return no_first_answer(w, controller, err, errlen);
     return w;
@@ -331,18 +364,16 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
 void eval_worker_stop(eval_worker *w)
 {
     if (!w) return;
-    int st;
-    if (w->dpid > 0) {
-        kill(w->dpid, SIGTERM);
-        if (!eval_wait_until(w->dpid, eval_now() + 3.0, &st)) eval_stop_group(w->dpid, &st);
-    }
-    /* a controller ends on the daemon's stop; one that does not is stopped */
-    if (w->cpid > 0 && !eval_wait_until(w->cpid, eval_now() + 3.0, &st))
-        eval_stop_group(w->cpid, &st);
+    stop_pair(w);
     if (w->cl) lag_client_destroy(w->cl);
+    lag_client_status_free(w->status);
     if (w->cmd) lcm_destroy(w->cmd);
     eval_series_free(&w->s);
-    if (!w->env.verbose) unlink(w->log);
+    if (!w->env.verbose) {
+        unlink(w->log);
+        if (w->cerr[0]) unlink(w->cerr);
+        if (w->derr[0]) unlink(w->derr);
+    }
     free(w);
 }
 
@@ -416,7 +447,7 @@ static void follow(eval_worker *w, double t_goal)
         if (w->s.n != seen) seen = w->s.n, last = eval_now();
         if (eval_now() - start > w->env.wall_timeout) break;
         if (eval_now() - last < W_QUIET_S) continue;
-        lag_client_status st;
+        lag_wire_status st;
         if (fresh_status(w, &st, false) &&
             (!strcmp(st.run_state, "fault") ||
              (st.sim_time >= t_goal && !strncmp(st.waiting_for, "RESUME or STEP", 14))))
@@ -479,7 +510,7 @@ static bool answer_heard(const eval_worker *w)
  * in its status while an answer is owed. */
 static bool daemon_has_answer(eval_worker *w, double *t)
 {
-    lag_client_status st;
+    lag_wire_status st;
     if (!fresh_status(w, &st, false)) return false;
     *t = st.sim_time;
     return (!strcmp(st.run_state, "paused") || !strcmp(st.run_state, "fault")) &&
@@ -507,9 +538,9 @@ static bool paused_answer(eval_worker *w, eval_result *res)
     return true;
 }
 
-int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets, int nsets,
-                    const double *q0, const double *qd0, eval_result *res, char *err,
-                    size_t errlen)
+static int worker_run(eval_worker *w, const eval_case *c, const char *const *sets, int nsets,
+                      const double *q0, const double *qd0, eval_result *res, char *err,
+                      size_t errlen)
 {
     memset(res, 0, sizeof *res);
     eval_series_free(&w->s);
@@ -553,4 +584,16 @@ int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets,
         eval_fail(res, "stopped at t = %.6g s before the duration %.6g s", res->t_end,
                   c->duration);
     return eval_score(&w->s, c, &w->sc, res, err, errlen);
+}
+
+int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets, int nsets,
+                    const double *q0, const double *qd0, eval_result *res, char *err,
+                    size_t errlen)
+{
+    int rc = worker_run(w, c, sets, nsets, q0, qd0, res, err, errlen);
+    if ((rc != 0 || res->failed) && !w->env.verbose) { /* what the kept pair said last */
+        eval_stderr_tail(w->cerr, "the controller", res->output, sizeof res->output);
+        eval_stderr_tail(w->derr, "lagsimd", res->output, sizeof res->output);
+    }
+    return rc;
 }

@@ -204,7 +204,7 @@ static int pick_prefix(view_opts *o)
 {
     static lag_client_plant found;
     char err[1200];
-    int pr = lag_client_pick_plant(o->url, NULL, 2.0, &found, err, sizeof err);
+    int pr = lag_client_pick_plant(o->url, NULL, 2.0, &found, sizeof found, err, sizeof err);
     if (pr == LAG_CLIENT_ERR_AMBIGUOUS) {
         fprintf(stderr, "lagsim-view: %s\n", err);
         return LAG_ERR_AMBIGUOUS;

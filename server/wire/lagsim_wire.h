@@ -206,6 +206,7 @@ typedef struct lag_wire_reference {
     double r[LAG_WIRE_MAX_JOINTS];                   /* m or rad */
     double rdot[LAG_WIRE_MAX_JOINTS];                /* m/s or rad/s */
     int64_t generation;                              /* the state's generation */
+    double rddot[LAG_WIRE_MAX_JOINTS];               /* m/s^2 or rad/s^2 */
 } lag_wire_reference;
 
 /* ---------------------------------------------------------------- per type */
@@ -268,6 +269,9 @@ int64_t lag_wire_fingerprint(lag_wire_type t);
 int64_t lag_wire_table_fingerprint(lag_wire_type t);
 /* "joint_state_t", ... (NULL for an unknown type). */
 const char *lag_wire_type_name(lag_wire_type t);
+/* A control_t request by its value: "PAUSE", ..., "SET", the constants of
+ * lcmtypes/control_t.lcm (NULL for a value that is none of them). */
+const char *lag_wire_request_name(int request);
 /* sizeof the type's struct (0 for an unknown type). */
 size_t lag_wire_struct_size(lag_wire_type t);
 /* Largest encoding of a message of type t (every array and string full). */

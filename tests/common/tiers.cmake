@@ -41,8 +41,8 @@ set(LAGSIM_TIER_RULES
   # (not Java's: a JVM starting and classes compiled for the slow law compute; run beside
   # the others and two busy processes, clients_readme_java_slower_law and
   # clients_cross_language_slower_law ran past their 90 s)
-  "waits     NAME  ^clients_readme_(c|python|lua)_slow(er)?_law$"
-  "waits     NAME  ^clients_(c|python|lua|java)_[a-z_]+_ends_on_(stop|silence)$"
+  "waits     NAME  ^clients_readme_(c|cpp|python|lua)_slow(er)?_law$"
+  "waits     NAME  ^clients_(c|cpp|python|lua|java)_[a-z_]+_ends_on_(stop|silence)$"
   "waits     NAME  ^clients_(c|python|lua|java)_ends_on_signal$"
   "waits     NAME  ^clients_(python|java)_dipc_late_controller$"
   "waits     NAME  ^view_attack_(slowloris|stalled)$"
@@ -76,6 +76,7 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^log_old_version_"
   "wallclock NAME  ^log_term_"
   # view: the log tools; Chromium; attacks that take time or namespaces
+  "wallclock NAME  ^view_log2csv_load$"  # a real-time run recorded, then loaded
   "quick     NAME  ^view_log2csv_"
   "quick     NAME  ^view_stop_"
   "wallclock NAME  ^view_attack_(slowloris|stalled)$"
@@ -85,7 +86,7 @@ set(LAGSIM_TIER_RULES
   # controller; packet loss and ssh hosts in namespaces
   "quick     NAME  ^eval_(metrics|reference|sweep_csv)_"
   "quick     NAME  ^eval_procs_(eval|sweep)_(sigint|sigterm|sigkill|groupkill)$"
-  "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene|owned|outputs|bus|docs_python|notes)$"
+  "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene|owned|outputs|bus|docs_python|notes|stderr)$"
   "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|merge_rows|merge_foreign|shard|kept|kept_python|vary|scene_c|scene_python|notes|interrupt)$"
   "wallclock NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
   # the progress line on a terminal: drawn against the wall clock
@@ -96,7 +97,7 @@ set(LAGSIM_TIER_RULES
   "octave    NAME  ^clients_(octave_|readme_octave$)"
   "octave    NAME  ^clients_cross_language_generation$"  # C, Python, Lua, Java and Octave
   "wallclock NAME  _(realtime|ends_on_stop|ends_on_silence|late_controller|slow_law|slower_law)$"
-  "wallclock NAME  ^clients_(readme_recipes|walkthrough)$"
+  "wallclock NAME  ^clients_(readme_recipes|walkthrough|scene_params)$"
   "wallclock NAME  ^ctl_"
   "quick     NAME  ^install_"
   "quick     NAME  ^clients_(lqr|status_fields|hostile_messages|library|generation|not_built)$"
@@ -105,7 +106,12 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^clients_java_release$"
   "quick     NAME  _(lockstep|hostile|push|reference_lost)$"
   "quick     NAME  ^clients_cross_language_(dipc|manipulator)$"
-  "quick     NAME  ^clients_readme_(c|python|lua|java)$"
+  "quick     NAME  ^clients_readme_(c|cpp|cpplcm|python|lua|java)$"
+  # the client library: its version, its ABI, its C++ header, the README's C and C++ blocks
+  # against an install and by the other C++ compiler (lockstep runs, compilations)
+  "quick     NAME  ^clients_(versions|abi|abi_mutations|cpp_header|lcm_cpp_forged)$"
+  "quick     NAME  ^clients_readme_(c|cpp)_installed$"
+  "quick     NAME  ^clients_(readme_cpp|manipulator_ct)_other_compiler$"
 )
 
 # The tiers whose tests only wait: tests/run.sh runs them, 2 x cores at once, beside the

@@ -203,6 +203,11 @@ def main():
         check(r1.returncode == 0 and r2.returncode == 0 and e1 and e2 and
               e1[0]["step"] == 50 and e2[0]["step"] == 50,
               "two kicks with --duration 0.05 at step 50: exit 0 each")
+        # the numbers as typed: the shortest decimal that reads back, not %.17g's
+        # 0.050000000000000003 (lagsim_num.h)
+        check(e1 and e1[0]["detail"] == "kick.x=0.25,0.05" and e2 and
+              e2[0]["detail"] == "kick.x=0.125,0.05",
+              "the kicks' details as typed: %r, %r" % (e1 and e1[0]["detail"], e2 and e2[0]["detail"]))
         check(ctl("step", "10").returncode == 0, "step 10")
         r = ctl("kick", "cart", "1")
         check(r.returncode == 1 and "unknown joint 'cart' for model stick; allowed: x, phi" in

@@ -12,7 +12,9 @@ Cases:
             first; nothing wider than the terminal
   effects   the stick on its floor: each impact (and the rest) on its own line, with the
             sim time the core locates
-  quiet     -q: no live line and no event line (only the line saying where it listens)
+  quiet     -q: nothing on stderr (no live line, no event line, no line saying where it
+            listens), with lcm.allow_lan only that line (a warning: the network reaches the
+            plant)
   pipe      stderr not a terminal: event lines only, no live line, no control codes
   waits     no controller: every 3 s a line says what the plant waits for (the first
             command, on <PREFIX>_COMMAND at the command URL) and, once a command for an
@@ -223,11 +225,17 @@ def case_quiet(a):
     s.command(name="nope")
     d.read(1.5)
     rc = d.stop()
-    # what stays: the start line saying where the daemon listens (docs/network.md)
+    # -q: only warnings and errors; a rejected command and waiting are neither
+    check(rc == 0 and d.out == b"", f"-q: nothing at all ({d.out[:300]!r}), exit {rc}")
+    # with lcm.allow_lan the line saying that the network reaches the plant is a warning
+    d = Daemon(a, os.path.join(a.source, "config", "dipc.yaml"), prefix + "L", "-q", "--set",
+               "lcm.allow_lan=true")
+    d.read(1.0)
+    rc = d.stop()
     left = [l for l in d.text().splitlines() if l]
-    check(rc == 0 and len(left) == 1 and f"lagsimd: {prefix}: listening on " in left[0]
-          and "\r" not in d.text() and "\x1b" not in d.text(),
-          f"-q: no live line, no event line, only where it listens ({d.out[:300]!r}), exit {rc}")
+    check(rc == 0 and len(left) == 1 and f"lagsimd: {prefix}L: listening on " in left[0]
+          and "from the network" in left[0] and "\r" not in d.text(),
+          f"-q, lcm.allow_lan: only the line saying the network reaches it ({d.out[:300]!r}), exit {rc}")
 
 
 def case_pipe(a):

@@ -103,8 +103,8 @@ host_local_run() { # allow_lan ttl tag [local]: with "local", a sender in A as w
     $inA lcm-logger -q -f --lcm-url "$url" "$work/$tag.lcm" & pids+=($!); local logger=$!
     sleep 0.5
     $inA "$lagsimd" --config "$config" --set lcm.prefix=$prefix --set lcm.allow_lan=$lan \
-        --set "lcm.url=$url" --set realtime.command_timeout=100 -q \
-        2>"$work/$tag.err" & pids+=($!); local d=$!
+        --set "lcm.url=$url" --set realtime.command_timeout=100 \
+        2>"$work/$tag.err" & pids+=($!); local d=$!   # not -q: its start line is waited on, checked
     started "$work/$tag.err"
     for port in 7668 7667; do
         $inB $netpeer send --raw --types "$types" --url "udpm://239.255.76.67:$port?ttl=1" \
