@@ -12,7 +12,7 @@ if(LAGSIM_NET_PYTHON3)
   add_test(NAME net_plant_urls_python
     COMMAND ${CMAKE_COMMAND} -E env --unset=LCM_DEFAULT_URL ${LAGSIM_NET_PYTHON3}
             ${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.py ${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.txt
-            ${CMAKE_BINARY_DIR}/python)  # the build's modules: lagsim_client_path.py names the library
+            ${CMAKE_BINARY_DIR}/python)  # the build's modules, which name the build's library
   set_tests_properties(net_plant_urls_python PROPERTIES TIMEOUT 30 LABELS net)
 endif()
 if(LAGSIM_NET_LUA52)
