@@ -168,6 +168,9 @@ class Controller(object):
         t_first = None
         heard, count = self.client.now(), self._heard()
         while True:
+            if self._stop:  # a signal ends the run even while states keep coming
+                self.end = "signal"
+                return
             st = self.client.wait_state(0.05)
             n = self._heard()
             if n != count:
