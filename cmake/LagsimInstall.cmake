@@ -11,11 +11,14 @@
 #                            liblagsim_controller.a, liblagsim_core.a and what they link
 #   lib/pkgconfig/           lagsim-client.pc (the client library), lagsim-core.pc (the
 #                            core and the C examples' setup, static, no stable ABI)
-#   lib/python3.X/dist-packages/   lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
+#   lib/python3.X/dist-packages/   lagsim (lcm-gen types), lagsim_lcm, lagsim_client,
+#                            lagsim_controller
 #                            (on Debian's sys.path for prefix /usr/local; for prefix /usr,
 #                            lib/python3/dist-packages)
 #   share/lua/5.2/           lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
 #                            (on lua5.2's default path for prefix /usr/local)
+#   lib/lua/5.2/             lagsim_client.so, the client library's Lua module (on lua5.2's
+#                            default C path for /usr/local; lib/<triplet>/lua/5.2 under /usr)
 #   share/java/              lagsim_types.jar, lagsim_examples.jar
 #   share/lagsim/            config/*.yaml, lcmtypes/*.lcm, examples/{python,lua}/,
 #                            slurm/lagsim-sweep-array.sh
@@ -138,7 +141,16 @@ endif()
 
 # Lua 5.2: types and helpers where lua5.2 looks, examples in share/lagsim/examples.
 install(DIRECTORY ${CMAKE_BINARY_DIR}/lua/ DESTINATION ${CMAKE_INSTALL_DATADIR}/lua/5.2
-        FILES_MATCHING PATTERN "*.lua")
+        FILES_MATCHING PATTERN "*.lua" PATTERN "lagsim_client_path.lua" EXCLUDE)
+# The client library's Lua module (an architecture's file: where lua5.2 looks for C modules,
+# lib/lua/5.2, Debian's lib/<triplet>/lua/5.2 under /usr), and lagsim_lcm.lua's pointer to
+# it (the build tree's is not installed)
+if(TARGET lagsim_client_lua)
+  install(TARGETS lagsim_client_lua LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/lua/5.2)
+  install(CODE "file(WRITE \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_DATADIR}/lua/5.2/lagsim_client_path.lua\"
+      \"-- Where lagsim_lcm.lua finds the client library's Lua module: the installed one (written by cmake --install).\\nreturn '\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_LIBDIR}/lua/5.2/lagsim_client.so'\\n\")
+    message(STATUS \"Installing: \$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_DATADIR}/lua/5.2/lagsim_client_path.lua\")")
+endif()
 install(FILES ${PROJECT_SOURCE_DIR}/clients/lua/dipc_balance.lua
               ${PROJECT_SOURCE_DIR}/clients/lua/manipulator_pd.lua
         DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/examples/lua)
