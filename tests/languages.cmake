@@ -192,7 +192,7 @@ lang_signal_test(c "${lang_manip_cfg}" $<TARGET_FILE:manipulator_pd>)
 
 # ---- Lua 5.2
 set(lua_manip_xl "")
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua)
   add_test(NAME clients_lua_lcm
     COMMAND ${LAGSIM_LUA52} ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_lua_lcm.lua ${lua_dir})
   add_test(NAME clients_lua_manipulator_lockstep
@@ -209,7 +209,7 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
   list(APPEND lang_tests clients_lua_dipc_hostile)
   set(lua_manip_xl --run lua 0 "${LAGSIM_LUA52} ${lua_dir}/manipulator_pd.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} --duration 10 -q --trace {trace}")
 else()
-  message(WARNING "lua5.2 or liblcm-lua missing: the Lua clients' tests are not registered")
+  message(WARNING "lua5.2, liblcm-lua or liblua5.2-dev missing: the Lua clients' tests are not registered")
 endif()
 
 # ---- Go, through the C ABI alone (clients/go/dipc_balance.go over liblagsim_client.so.1 by
@@ -414,7 +414,7 @@ endif()
 # the product summed in the same order (0 - k0 x0 - ... - k5 x5) in C (dipc_lqr --k),
 # Python, Lua, Java, MATLAB/Octave (under GNU Octave) and Go (through the C ABI, when go is
 # found), IEEE doubles everywhere: the states must agree bit for bit.
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua AND TARGET lagsim_examples_java)
   set(octave_xl "")
   if(LAGSIM_OCTAVE)   # MATLAB/Octave too, under GNU Octave
     set(octave_xl --run octave 0 "${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh ${CMAKE_BINARY_DIR}/octave dipc_balance --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}")
@@ -434,7 +434,7 @@ endif()
 # answered anew, never taken for a copy; one whose scene has not come waits for it
 # (DESCRIBE asked); the answers carry the generation; C, Python, Lua, Java,
 # MATLAB/Octave (under GNU Octave) and Go answer bit for bit alike.
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua AND TARGET lagsim_examples_java)
   set(octave_gen "")
   if(LAGSIM_OCTAVE)
     set(octave_gen --run octave "${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh ${CMAKE_BINARY_DIR}/octave dipc_balance --prefix {prefix} -q --timeout 60 --k ${lang_K}")
@@ -454,7 +454,7 @@ endif()
 # command they build takes 0.15 s, or 1.5 s, first): the same states as the C controller's
 # fast run, bit for bit, every state answered (the law runs once per state, a re-sent copy
 # gets the same answer); a law slower than lockstep_timeout is late by definition
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua AND TARGET lagsim_examples_java)
   set(think_dir ${CMAKE_CURRENT_SOURCE_DIR}/clients/think)
   foreach(pair "slow_law:0.15:21:0.2" "slower_law:1.5:5:0.04")
     string(REPLACE ":" ";" p "${pair}")
@@ -490,7 +490,7 @@ if(LAGSIM_FUZZ)
 endif()
 set(readme_cc --cc ${CMAKE_C_COMPILER} --cxx ${CMAKE_CXX_COMPILER} "--cflags=${readme_c_flags}")
 set(readme_langs c cpp python)
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua)
   list(APPEND readme_langs lua)
 endif()
 if(TARGET lagsim_lcmtypes_java)

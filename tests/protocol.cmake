@@ -42,7 +42,7 @@ protocol_conformance(python clients ${LAGSIM_PYTHON3} ${proto_dir}/conformance/c
   --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --url {url})
 
 # Lua 5.2 (clients/lua/lagsim_controller.lua)
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua)
   protocol_conformance(lua clients ${LAGSIM_LUA52} ${proto_dir}/conformance/conformance.lua
     --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} --url {url})
 endif()
