@@ -213,29 +213,33 @@ else()
 endif()
 
 # ---- Go, through the C ABI alone (clients/go/dipc_balance.go over liblagsim_client.so.1 by
-# cgo): the given gain balances the DIPC in lockstep (the bounds above that need no design:
-# the linearized loop's prediction is dipc_lqr's and the other examples'); forged messages
-# dropped by the library with the same states; how a run ends (the daemon's stop, a silent
-# daemon, SIGINT and SIGTERM). Its bits are C's in the cross-language tests below.
+# cgo): its own design balances the DIPC in lockstep with the bounds of the other
+# examples; forged messages are dropped by the library with the same states; how a run
+# ends (the daemon's stop, a silent daemon, SIGINT and SIGTERM); its design is Python's
+# line for line, so the gains must be equal to the last bit (tolerance 0). Its answers are
+# C's bit for bit in the cross-language tests below.
 set(go_xl "")
 set(go_gen "")
 if(TARGET dipc_balance_go)
-  set(go_dipc ${CMAKE_BINARY_DIR}/bin/dipc_balance_go --k ${lang_K})
-  set(go_dipc_checks --check "states == 2001" --check "t_first == 0 and t_last >= 20 - 1e-9"
-      --check "max_abs_theta1 >= 0.0499" --check "abs(end_theta1) < 1e-3 and abs(end_theta2) < 1e-3"
-      --check "max_abs_theta0 < 1.0" --check "end == 'duration'")
+  set(go_dipc ${CMAKE_BINARY_DIR}/bin/dipc_balance_go)
   add_test(NAME clients_go_dipc_lockstep
     COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLGODIPC --timeout 60
-      ${go_dipc_checks} --check "dropped == 0" -- ${go_dipc} --prefix {prefix} --duration 20 -q)
+      ${lang_dipc_checks} -- ${go_dipc} --prefix {prefix} --duration 20 -q)
   add_test(NAME clients_go_dipc_hostile
     COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLHOSTGO --timeout 60
-      --hostile ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/client/crash ${go_dipc_checks} --check "dropped >= 21"
-      -- ${go_dipc} --prefix {prefix} --duration 20 -q)
-  list(APPEND lang_tests clients_go_dipc_lockstep clients_go_dipc_hostile)
+      ${lang_hostile_checks} -- ${go_dipc} --prefix {prefix} --duration 20 -q)
+  add_test(NAME clients_go_dipc_gain
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/same_gain.py
+      --lagsimd ${lang_lagsimd} --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml --tol 0
+      --run python "discrete LQR \\(h = [^)]*\\): K = \\[([^]]*)\\]"
+        "${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --duration 0.05 -q"
+      --run go "discrete LQR \\(h = [^)]*\\): K = \\[([^]]*)\\]"
+        "${go_dipc} --prefix {prefix} --duration 0.05 -q")
+  list(APPEND lang_tests clients_go_dipc_lockstep clients_go_dipc_hostile clients_go_dipc_gain)
   lang_end_tests(go dipc "${lang_dipc_cfg}" ${go_dipc})
   lang_signal_test(go "${lang_dipc_cfg}" ${go_dipc})
-  set(go_xl --run go 0 "${CMAKE_BINARY_DIR}/bin/dipc_balance_go --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}")
-  set(go_gen --run go "${CMAKE_BINARY_DIR}/bin/dipc_balance_go --prefix {prefix} -q --timeout 60 --k ${lang_K}")
+  set(go_xl --run go 0 "${go_dipc} --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}")
+  set(go_gen --run go "${go_dipc} --prefix {prefix} -q --timeout 60 --k ${lang_K}")
 endif()
 
 # ---- The manipulator's computed torque (r, r', r'' from the reference) in C (M and the bias

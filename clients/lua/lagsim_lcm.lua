@@ -29,7 +29,7 @@ local LCM = {}
 LCM.__index = LCM
 
 -- The client library's Lua module (lagsim_client_lua.c: the protocol's rules, in C), loaded
--- once: from the path CMake wrote into lagsim_client_path.lua beside this file (the build
+-- once: from the path CMake wrote into <build>/lua/lagsim_client_path.lua (the build
 -- tree's module, or the installed one), else by require('lagsim_client') through
 -- package.cpath (LUA_CPATH). An error names every place tried.
 local client_module
