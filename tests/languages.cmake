@@ -212,6 +212,17 @@ else()
   message(WARNING "lua5.2, liblcm-lua or liblua5.2-dev missing: the Lua clients' tests are not registered")
 endif()
 
+# ---- How the Python and Lua bindings find the client library: the build's path, an
+# environment variable, and a clear error naming every place tried (tests/clients/binding_lookup.py)
+set(lookup_lua "")
+if(LAGSIM_LUA52 AND TARGET lagsim_client_lua)
+  set(lookup_lua --lua ${LAGSIM_LUA52})
+endif()
+add_test(NAME clients_binding_lookup
+  COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/binding_lookup.py
+    --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} ${lookup_lua})
+list(APPEND lang_tests clients_binding_lookup)
+
 # ---- Go, through the C ABI alone (clients/go/dipc_balance.go over liblagsim_client.so.1 by
 # cgo): its own design balances the DIPC in lockstep with the bounds of the other
 # examples; forged messages are dropped by the library with the same states; how a run
