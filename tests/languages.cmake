@@ -247,6 +247,16 @@ if(TARGET dipc_balance_go)
       --run go "discrete LQR \\(h = [^)]*\\): K = \\[([^]]*)\\]"
         "${go_dipc} --prefix {prefix} --duration 0.05 -q")
   list(APPEND lang_tests clients_go_dipc_lockstep clients_go_dipc_hostile clients_go_dipc_gain)
+  # the Go sources as gofmt writes them, and clean by go vet (cgo's rules: no Go pointer
+  # held by C, no misuse of unsafe.Pointer)
+  find_program(LAGSIM_GOFMT gofmt)
+  if(LAGSIM_GOFMT)
+    add_test(NAME clients_go_vet
+      COMMAND sh -c "out=$(\"$1\" -l \"$3\" \"$4\") && test -z \"$out\" || { echo \"not gofmt'ed: $out\"; exit 1; }; for f in \"$3\" \"$4\"; do (cd \"$(dirname \"$f\")\" && env GOCACHE=$5/go/cache GOPATH=$5/go/path GOTOOLCHAIN=local GOENV=off GOFLAGS= PKG_CONFIG_PATH=$5/pkgconfig \"$2\" vet \"$(basename \"$f\")\") || exit 1; done; echo ok"
+              sh ${LAGSIM_GOFMT} ${LAGSIM_GO} ${PROJECT_SOURCE_DIR}/clients/go/dipc_balance.go
+              ${CMAKE_CURRENT_SOURCE_DIR}/protocol/conformance/conformance.go ${CMAKE_BINARY_DIR})
+    list(APPEND lang_tests clients_go_vet)
+  endif()
   lang_end_tests(go dipc "${lang_dipc_cfg}" ${go_dipc})
   lang_signal_test(go "${lang_dipc_cfg}" ${go_dipc})
   set(go_xl --run go 0 "${go_dipc} --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}")

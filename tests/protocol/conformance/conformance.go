@@ -13,6 +13,7 @@ package main
 
 /*
 #cgo pkg-config: lagsim-client
+#include <stdint.h>
 #include <stdlib.h>
 #include "lagsim_client.h"
 
@@ -28,12 +29,13 @@ import (
 	"unsafe"
 )
 
-// goOnEvent: the handle's event callback; user is a cgo.Handle of the *bool it sets.
+// goOnEvent: the handle's event callback; user points to C memory holding a cgo.Handle
+// of the *bool it sets (C never holds a pointer to Go memory).
 //
 //export goOnEvent
 func goOnEvent(ev *C.lag_client_event, user unsafe.Pointer) {
 	if C.GoString(&ev.kind[0]) == "stop" {
-		*cgo.Handle(uintptr(user)).Value().(*bool) = true
+		*cgo.Handle(*(*C.uintptr_t)(user)).Value().(*bool) = true
 	}
 }
 
@@ -60,7 +62,9 @@ func main() {
 	}
 	stopped := false
 	h := cgo.NewHandle(&stopped) // a Go value C may hold: its handle, never its pointer
-	C.lag_client_on_event(c, C.lag_client_event_fn(C.goOnEvent), unsafe.Pointer(uintptr(h)))
+	user := C.malloc(C.size_t(unsafe.Sizeof(C.uintptr_t(0))))
+	*(*C.uintptr_t)(user) = C.uintptr_t(h)
+	C.lag_client_on_event(c, C.lag_client_event_fn(C.goOnEvent), user)
 	if C.lag_client_wait_scene(c, C.double(*timeout), nil) != C.LAG_CLIENT_OK {
 		fmt.Fprintf(os.Stderr, "conformance_go: %s\n", C.GoString(C.lag_client_errmsg(c)))
 		C.lag_client_destroy(c)
@@ -123,5 +127,6 @@ func main() {
 	C.free(unsafe.Pointer(kd))
 	C.lag_client_scene_free(sc)
 	C.lag_client_destroy(c)
+	C.free(user)
 	h.Delete()
 }
