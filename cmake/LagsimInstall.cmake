@@ -18,7 +18,7 @@
 #   share/lua/5.2/           lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
 #                            (on lua5.2's default path for prefix /usr/local)
 #   lib/lua/5.2/             lagsim_client.so, the client library's Lua module (on lua5.2's
-#                            default C path for /usr/local; lib/<triplet>/lua/5.2 under /usr)
+#                            default C path for /usr/local and /usr)
 #   share/java/              lagsim_types.jar, lagsim_examples.jar
 #   share/lagsim/            config/*.yaml, lcmtypes/*.lcm, examples/{python,lua}/,
 #                            slurm/lagsim-sweep-array.sh
@@ -142,9 +142,9 @@ endif()
 # Lua 5.2: types and helpers where lua5.2 looks, examples in share/lagsim/examples.
 install(DIRECTORY ${CMAKE_BINARY_DIR}/lua/ DESTINATION ${CMAKE_INSTALL_DATADIR}/lua/5.2
         FILES_MATCHING PATTERN "*.lua" PATTERN "lagsim_client_path.lua" EXCLUDE)
-# The client library's Lua module (an architecture's file: where lua5.2 looks for C modules,
-# lib/lua/5.2, Debian's lib/<triplet>/lua/5.2 under /usr), and lagsim_lcm.lua's pointer to
-# it (the build tree's is not installed)
+# The client library's Lua module (an architecture's file: in the library directory's
+# lua/5.2, where lua5.2 looks for C modules under /usr/local and /usr), and lagsim_lcm.lua's
+# pointer to it (the build tree's is not installed)
 if(TARGET lagsim_client_lua)
   install(TARGETS lagsim_client_lua LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/lua/5.2)
   install(CODE "file(WRITE \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_DATADIR}/lua/5.2/lagsim_client_path.lua\"
