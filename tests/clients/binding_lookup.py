@@ -47,7 +47,10 @@ def main():
         print("%s: %s%s" % ("ok  " if cond else "FAIL", what, "" if cond else "\n" + detail))
         fails += 0 if cond else 1
 
-    lib = os.path.join(a.build, "lib", "liblagsim_client.so.1")
+    # the library the build's path file names (in a sanitizer build the uninstrumented copy)
+    lib = {}
+    exec(open(os.path.join(a.build, "python", "lagsim_client_path.py")).read(), lib)
+    lib = lib["LIBRARY"]
     py_src = os.path.join(a.source, "clients", "python")
     rc, out, err = run([sys.executable, "-c", PY], {"PYTHONPATH": os.path.join(a.build, "python")})
     check(rc == 0 and out == WANT, "Python from <build>/python: the library the build wrote", err)
