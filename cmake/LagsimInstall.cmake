@@ -49,7 +49,14 @@ endforeach()
 # static libraries of the core and of the C examples' shared setup (lagsim_controller.h,
 # lagsim.h, lagsim_wire.h, ...) and lagsim-core.pc: for building lagsim's own examples
 # against an install, without a stable ABI (docs/clients.md, "The ABI").
-install(TARGETS lagsim_client_shared LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+# (A sanitizer build installs the uninstrumented copy the bindings load: installed Python
+# and Lua controllers run in interpreters without a sanitizer runtime; a C program built
+# against it with the sanitizers' flags has their runtime itself.)
+if(LAGSIM_SANITIZE)
+  install(TARGETS lagsim_client_bindings LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+else()
+  install(TARGETS lagsim_client_shared LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+endif()
 foreach(t lagsim_client lagsim_controller lagsim_wire lagsim_wire_base lagsim_lcmtypes lagsim_core)
   install(TARGETS ${t} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endforeach()
