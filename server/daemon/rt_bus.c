@@ -11,7 +11,7 @@
  * One plant per prefix: the state URL's lcm_t subscribes to _SCENE (its receive socket
  * filtered to that channel and _COMMAND, so the kernel drops the daemon's own states
  * instead of handing them back; a command sent there, to the wrong port, is counted). Before it publishes anything, the daemon asks its prefix for a
- * scene (DESCRIBE) and listens RT_LOOK_MS (look_for_other_plant); another plant's scene
+ * scene (DESCRIBE) and listens RT_LOOK_MS (rt_bus_open); another plant's scene
  * (rt_bus_foreign_scene: one that decodes, names this prefix and is not one of the
  * daemon's own) makes it refuse to start, and later makes it stop. Whom it hears follows the
  * command URL's rule: this host only unless lcm.allow_lan.
@@ -178,13 +178,10 @@ static int filter_input(rt_bus *b, char *err, size_t errlen)
     return LAGSIMD_EXIT_OK;
 }
 
-#define RT_LOOK_MS 200 /* how long a starting daemon listens for another plant */
-
 /* Before the daemon publishes anything: filters the state URL's receive socket to _SCENE
- * (the plant watch), asks the prefix for its scene (DESCRIBE on the command URL; a daemon
- * there answers on the state URL) and listens RT_LOOK_MS for another plant's. Returns 0,
- * or an exit code with a message. */
-static int look_for_other_plant(rt_bus *b, char *err, size_t errlen)
+ * (the plant watch) and asks the prefix for its scene (DESCRIBE on the command URL; a
+ * daemon there answers on the state URL). Returns 0, or an exit code with a message. */
+static int ask_for_other_plant(rt_bus *b, char *err, size_t errlen)
 {
     const lag_bus *u = &b->urls;
     bool host_only = !b->sc->lcm.allow_lan;
@@ -204,19 +201,10 @@ static int look_for_other_plant(rt_bus *b, char *err, size_t errlen)
     c.request = LAGSIM_CONTROL_T_DESCRIBE;
     int len = lag_wire_encode(LAG_WIRE_CONTROL, &c, b->buf, RT_BUF_SIZE);
     if (len > 0) lcm_publish(b->lcm_in, b->ch_control, b->buf, (unsigned)len);
-    int64_t end = lag_clock_mono_ns() + RT_LOOK_MS * 1000000LL;
-    for (int64_t left; !b->other_plant[0] && (left = end - lag_clock_mono_ns()) > 0;)
-        lcm_handle_timeout(b->lcm, (int)(left / 1000000) + 1);
-    if (b->other_plant[0]) {
-        snprintf(err, errlen, "another plant publishes on prefix %s (%s): refusing to start; "
-                 "one plant per prefix (give this one another lcm.prefix, or stop the other)",
-                 b->sc->lcm.prefix, b->other_plant);
-        return LAGSIMD_EXIT_RUNTIME;
-    }
     return LAGSIMD_EXIT_OK;
 }
 
-int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
+int rt_bus_open_start(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
 {
     const lag_bus *u = &b->urls;
     lag_net_note_inherited(); /* a parent's sockets are not filtered */
@@ -235,18 +223,15 @@ int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
         b->lcm = b->lcm_in = NULL;
         return rc;
     }
-    if (!u->udpm) {
-        fprintf(stderr, "lagsimd: %s: on %s (this process only)\n", b->sc->lcm.prefix,
-                u->state_url);
-        return LAGSIMD_EXIT_OK;
-    }
-    rc = look_for_other_plant(b, err, errlen);
-    if (rc == LAGSIMD_EXIT_OK) rc = filter_input(b, err, errlen);
-    if (rc != LAGSIMD_EXIT_OK) {
-        rt_bus_close(b);
-        return rc;
-    }
-    /* where the daemon listens, and who can reach it */
+    if (u->udpm) rc = ask_for_other_plant(b, err, errlen);
+    if (rc != LAGSIMD_EXIT_OK) rt_bus_close(b);
+    return rc;
+}
+
+/* Where the daemon listens, and who can reach it (said at start). */
+static void say_where(const rt_bus *b)
+{
+    const lag_bus *u = &b->urls;
     char ifname[64];
     if (lag_net_group_iface(u->group, ifname, sizeof ifname) != 0)
         snprintf(ifname, sizeof ifname, "no interface (no route to %s)", u->group);
@@ -265,7 +250,40 @@ int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
                 "host only (lcm.allow_lan: false) on %s; states on %s%s\n", b->sc->lcm.prefix,
                 ifname, u->command_url, u->state_url,
                 ttl == 0 ? ", which stay on this host (ttl=0)" : "");
+}
+
+int rt_bus_open_finish(rt_bus *b, char *err, size_t errlen)
+{
+    const lag_bus *u = &b->urls;
+    if (!u->udpm) {
+        fprintf(stderr, "lagsimd: %s: on %s (this process only)\n", b->sc->lcm.prefix,
+                u->state_url);
+        return LAGSIMD_EXIT_OK;
+    }
+    int rc = LAGSIMD_EXIT_OK;
+    if (b->other_plant[0]) {
+        snprintf(err, errlen, "another plant publishes on prefix %s (%s): refusing to start; "
+                 "one plant per prefix (give this one another lcm.prefix, or stop the other)",
+                 b->sc->lcm.prefix, b->other_plant);
+        rc = LAGSIMD_EXIT_RUNTIME;
+    }
+    if (rc == LAGSIMD_EXIT_OK) rc = filter_input(b, err, errlen);
+    if (rc != LAGSIMD_EXIT_OK) {
+        rt_bus_close(b);
+        return rc;
+    }
+    say_where(b);
     return LAGSIMD_EXIT_OK;
+}
+
+int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
+{
+    int rc = rt_bus_open_start(b, h, err, errlen);
+    if (rc != LAGSIMD_EXIT_OK) return rc;
+    int64_t end = lag_clock_mono_ns() + RT_LOOK_MS * 1000000LL;
+    for (int64_t left; b->urls.udpm && !b->other_plant[0] && (left = end - lag_clock_mono_ns()) > 0;)
+        lcm_handle_timeout(b->lcm, (int)(left / 1000000) + 1);
+    return rt_bus_open_finish(b, err, errlen);
 }
 
 void rt_bus_close(rt_bus *b)

@@ -69,8 +69,18 @@ void rt_bus_detach(rt_bus *b);
  * command URL (one lcm_t for memq://), attached with `h`; before anything is published,
  * the look for another plant on the prefix; and what the daemon says about them at start.
  * Leaves b->discard set (the loop clears it at the start). Returns 0, or an exit code with
- * a message in err; rt_bus_close detaches and destroys what rt_bus_open made. */
+ * a message in err; rt_bus_close detaches and destroys what rt_bus_open made.
+ *
+ * In two steps, for a loop that serves other plants during the look: rt_bus_open_start
+ * makes the instances, filters the state URL's receive socket to the plant watch and asks
+ * the prefix for its scene (DESCRIBE); the caller then handles b->lcm for RT_LOOK_MS
+ * (another plant's scene is noted in b->other_plant); rt_bus_open_finish refuses the
+ * start if one came, else filters the command URL and says where the plant listens. Each
+ * closes what it made when it fails. rt_bus_open is the three in a row. */
+#define RT_LOOK_MS 200 /* how long a starting daemon listens for another plant */
 int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen);
+int rt_bus_open_start(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen);
+int rt_bus_open_finish(rt_bus *b, char *err, size_t errlen);
 void rt_bus_close(rt_bus *b);
 
 /* FNV-1a, 64 bits: how a published scene is remembered. */

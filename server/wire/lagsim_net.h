@@ -39,7 +39,9 @@ int lag_net_filter(int port, bool host_only, const char *const *channels, int n,
 
 /* Notes the UDP sockets this process has now, before it creates its LCM instances:
  * lag_net_filter leaves them alone (a parent that forked without close-on-exec shares
- * them, and a filter would cut the parent's own traffic). */
+ * them, and a filter would cut the parent's own traffic). The first call notes; the later
+ * ones do nothing (by then the process has sockets of its own: a host's plants each call
+ * it before making theirs). */
 void lag_net_note_inherited(void);
 
 /* Sends a marker on LAG_NET_MARKER_CHANNEL through lcm and handles lcm's messages until it
