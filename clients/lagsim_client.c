@@ -617,6 +617,7 @@ typedef struct disc {
     union {
         lag_wire_scene scene;
         lag_wire_status status;
+        lag_wire_event event;
     } tmp;
 } disc;
 
@@ -661,6 +662,15 @@ static void on_disc(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
             copy_str(p->model, sizeof p->model, d->tmp.scene.model);
             copy_str(p->mode, sizeof p->mode, d->tmp.scene.mode);
             d->scene[i] = true;
+        } else if (outs[k] == LAG_BUS_EVENT &&
+                   lag_wire_decode(LAG_WIRE_EVENT, rbuf->data, rbuf->data_size,
+                                   LAG_WIRE_MAX_JOINTS, &d->tmp) == LAG_WIRE_OK &&
+                   !strcmp(d->tmp.event.kind, "plant")) {
+            /* a host's directory: the plant runs on the state URL its `plant` event names */
+            lag_bus b;
+            char berr[8];
+            if (lag_bus_init(&b, d->tmp.event.detail, p->prefix, berr, sizeof berr) == 0)
+                copy_str(p->url, sizeof p->url, b.state_url);
         } else if (outs[k] == LAG_BUS_STATUS &&
                    lag_wire_decode(LAG_WIRE_STATUS, rbuf->data, rbuf->data_size,
                                    LAG_WIRE_MAX_JOINTS, &d->tmp) == LAG_WIRE_OK &&

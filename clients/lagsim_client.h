@@ -202,7 +202,7 @@ int lag_client_reference_joint(const lag_client_reference *ref, const char *name
 
 /* ---------------------------------------------------------------- finding plants */
 
-#define LAG_CLIENT_MAX_PLANTS 32
+#define LAG_CLIENT_MAX_PLANTS 1024 /* a lab host's plants (lagsimd --plants) */
 
 /* One plant heard on the bus. */
 typedef struct lag_client_plant {
@@ -212,7 +212,9 @@ typedef struct lag_client_plant {
     char run_state[LAG_CLIENT_NAME_LEN]; /* from its status: running, paused, waiting, fault */
     char host[LAG_CLIENT_NAME_LEN];      /* who sends its messages: this host's name, or
                                           * the sender's IPv4 address ("" if not seen) */
-    char url[320];                       /* its state URL (commands: the next port) */
+    char url[320];                       /* its state URL (commands: the next port): the
+                                          * URL it was heard on, or the one a host's
+                                          * directory names for it (a `plant` event) */
     double sim_time;                     /* s, from its status */
 } lag_client_plant;
 

@@ -54,9 +54,10 @@ endif()
 # A host of plants (lagsimd --plants DIR, several --config) over real LCM, each case on port
 # pairs of its own held by lock files (tests/server/test_host.py): isolation from a hostile
 # neighbour (states bit for bit those of the plant alone; the neighbour's input budget),
-# bad scenes skipped, a directory's files added, changed and removed while running.
+# bad scenes skipped, a directory's files added, changed and removed while running,
+# lagsimctl list through the host's directory.
 if(LAGSIM_PYTHON3)
-  foreach(case isolation bad_scene reload)
+  foreach(case isolation bad_scene reload list)
     add_test(NAME server_host_${case}
              COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/server/test_host.py
                      --bin ${CMAKE_BINARY_DIR}/bin --types ${CMAKE_BINARY_DIR}/python

@@ -34,7 +34,10 @@
 #include "host.h"
 #include "lagsim_bus.h"
 #include "lagsim_clock.h"
+#include "lagsim_net.h"
 #include "lagsim_url.h"
+#include "lagsim_wire.h"
+#include "lagsim/lagsim_control_t.h"
 #include "realtime.h"
 #include "rt_io.h"
 #include "rt_pace.h"
@@ -48,6 +51,8 @@
 #define HOST_INPUT_BURST 256.0
 #define HOST_RESCAN_NS 200000000LL   /* a quiet 0.2 s after inotify's last word */
 #define HOST_LOG_RING_DEFAULT (1u << 20) /* a host's plant's --log ring: 1 MiB */
+#define HOST_ANNOUNCE_NS 500000000LL /* each plant's `plant` event on the directory */
+#define HOST_DIR_PER_S 5.0           /* directory answers per plant: 5 a second, 5 at once */
 
 typedef enum plant_phase { PLANT_LOOKING, PLANT_RUNNING } plant_phase;
 
@@ -80,6 +85,10 @@ typedef struct plant {
     double tokens;
     int64_t tokens_ns, published;
     int64_t parked_times;
+    /* the host's directory */
+    int64_t announce_ns;        /* its next `plant` event */
+    rt_limit dir_lim;           /* its answers there */
+    char state_url[LAG_BUS_URL_LEN];
 } plant;
 
 /* A file of DIR that failed to load, remembered so that a reading of DIR does not say it
@@ -100,6 +109,12 @@ struct host {
     int nfail;
     int notify_fd;
     rt_io_src notify;
+    /* the directory: LCM_DEFAULT_URL's (or LCM's default) bus, where lagsimctl list
+     * listens unless told otherwise */
+    lag_bus dir;
+    lcm_t *dir_out, *dir_in;
+    rt_io_src dir_src;
+    uint8_t dir_buf[LAG_WIRE_BUF_SIZE];
     int64_t rescan_at;          /* INT64_MAX: none due */
     bool stopping;              /* a stop signal came: no plant starts any more */
     lag_result rc;
@@ -155,9 +170,10 @@ static int prefix_of_name(plant *p)
     return 0;
 }
 
-/* The state ports in use by the host's plants but `self`'s (0: none). */
+/* Whether a pair at `port` overlaps the host's directory or a plant's but `self`'s. */
 static bool port_used(const host *h, const plant *self, int port)
 {
+    if (h->dir_in && port > h->dir.state_port - 2 && port < h->dir.state_port + 2) return true;
     for (int i = 0; i < h->n; i++) {
         const plant *q = h->p[i];
         if (q != self && q->port > 0 && port > q->port - 2 && port < q->port + 2) return true;
@@ -232,6 +248,13 @@ static int plant_conflicts(host *h, plant *p)
         return -1;
     }
     p->port = b.udpm ? b.state_port : 0;
+    snprintf(p->state_url, sizeof p->state_url, "%s", b.state_url);
+    if (h->dir_in && p->port > h->dir.state_port - 2 && p->port < h->dir.state_port + 2) {
+        fprintf(stderr, "lagsimd: %s: ports %d and %d are the host's directory (%s, where "
+                "lagsimctl list looks): give the plant another lcm.url, or --port-base "
+                "(not started)\n", p->file, p->port, p->port + 1, h->dir.state_url);
+        return -1;
+    }
     for (int i = 0; i < h->n; i++) {
         const plant *q = h->p[i];
         if (q == p) continue;
@@ -379,6 +402,107 @@ static int add_source(host *h, rt_io_src *src, lcm_t *l, void (*ready)(void *), 
     return rt_io_add(&h->io, src);
 }
 
+/* ---------------------------------------------------------------- the directory */
+/* A host of a directory's plants (--plants, --port-base) keeps a directory on the bus of
+ * LCM_DEFAULT_URL (else LCM's default): where lagsimctl list, the view and the
+ * controllers look for plants unless told a URL. Every HOST_ANNOUNCE_NS each plant sends
+ * there a `plant` event on <PREFIX>_EVENT, its state URL in detail and its state port in
+ * value (the clients' discovery takes the plant's URL from it); a STATUS or DESCRIBE
+ * request there for one of the host's plants is answered there with the last status or
+ * scene the plant published (HOST_DIR_PER_S a second for each). Nothing else is done
+ * there: the plant's own URL takes its commands and the other requests. No plant runs on
+ * the directory's port pair. */
+static plant *plant_of_prefix(host *h, const char *pre, size_t len)
+{
+    for (int i = 0; i < h->n; i++)
+        if (strlen(h->p[i]->sc.lcm.prefix) == len && !strncmp(h->p[i]->sc.lcm.prefix, pre, len))
+            return h->p[i];
+    return NULL;
+}
+
+/* A request on the directory: STATUS and DESCRIBE of a running plant answered. */
+static void dir_control(const lcm_recv_buf_t *rb, const char *channel, void *user)
+{
+    host *h = user;
+    static lag_wire_control m;
+    const char *suffix = lag_bus_suffix(LAG_BUS_CONTROL);
+    size_t cl = strlen(channel), sl = strlen(suffix);
+    plant *p = cl > sl ? plant_of_prefix(h, channel, cl - sl) : NULL;
+    if (!p || p->phase != PLANT_RUNNING ||
+        lag_wire_decode(LAG_WIRE_CONTROL, rb->data, rb->data_size, LAG_WIRE_MAX_JOINTS, &m) !=
+            LAG_WIRE_OK ||
+        (m.request != LAGSIM_CONTROL_T_STATUS && m.request != LAGSIM_CONTROL_T_DESCRIBE) ||
+        !rt_limit_take(&p->dir_lim, h->now))
+        return;
+    bool status = m.request == LAGSIM_CONTROL_T_STATUS;
+    const uint8_t *data;
+    unsigned len = rt_plant_last(p->s, status, &data);
+    char ch[LAG_BUS_CHANNEL_LEN];
+    lag_bus_channel_name(ch, sizeof ch, p->sc.lcm.prefix, status ? LAG_BUS_STATUS : LAG_BUS_SCENE);
+    if (len > 0) lcm_publish(h->dir_out, ch, data, len);
+}
+
+static void on_directory(void *ctx)
+{
+    host *h = ctx;
+    for (int k = 0; k < HOST_DRAIN_MAX && lcm_handle_timeout(h->dir_in, 0) > 0; k++) {}
+}
+
+/* Plant p's `plant` event on the directory. */
+static void announce(host *h, plant *p)
+{
+    lag_wire_event m;
+    memset(&m, 0, sizeof m);
+    m.utime = lag_clock_wall_us();
+    snprintf(m.kind, sizeof m.kind, "plant");
+    m.value = p->port;
+    memcpy(m.detail, p->state_url, strnlen(p->state_url, sizeof m.detail - 1)); /* < 256 */
+    int n = lag_wire_encode(LAG_WIRE_EVENT, &m, h->dir_buf, sizeof h->dir_buf);
+    char ch[LAG_BUS_CHANNEL_LEN];
+    lag_bus_channel_name(ch, sizeof ch, p->sc.lcm.prefix, LAG_BUS_EVENT);
+    if (n > 0) lcm_publish(h->dir_out, ch, h->dir_buf, (unsigned)n);
+    p->announce_ns = rt_sat_add(h->now, HOST_ANNOUNCE_NS);
+}
+
+/* Opens the directory (said when it cannot: the host runs without one). */
+static void dir_open(host *h)
+{
+    char err[256];
+    if (lag_bus_init(&h->dir, NULL, "X", err, sizeof err) != 0 || !h->dir.udpm) {
+        fprintf(stderr, "lagsimd: no directory of the host's plants (LCM_DEFAULT_URL: %s)\n",
+                h->dir.udpm ? err : "not udpm://");
+        return;
+    }
+    h->dir_out = lcm_create(h->dir.state_url);
+    h->dir_in = h->dir_out ? lcm_create(h->dir.command_url) : NULL;
+    lcm_subscription_t *sub = h->dir_in ? lcm_subscribe(h->dir_in, ".*_CONTROL", dir_control, h)
+                                        : NULL;
+    if (sub) lcm_subscription_set_queue_capacity(sub, 1000);
+    h->dir_src = (rt_io_src){h->dir_in ? lcm_get_fileno(h->dir_in) : -1, on_directory, h,
+                             false, false};
+    err[0] = '\0';
+    int nf = sub ? lag_net_filter(h->dir.command_port, true, NULL, 0, err, sizeof err) : -1;
+    if (nf == 0) snprintf(err, sizeof err, "LCM's receive socket was not found");
+    if (nf < 1 || rt_io_add(&h->io, &h->dir_src) != 0) {
+        fprintf(stderr, "lagsimd: no directory of the host's plants on %s: %s\n",
+                h->dir.state_url, sub ? err : "cannot make LCM there");
+        if (h->dir_in) lcm_destroy(h->dir_in);
+        if (h->dir_out) lcm_destroy(h->dir_out);
+        h->dir_in = h->dir_out = NULL;
+        return;
+    }
+    fprintf(stderr, "lagsimd: the host's directory is on %s: lagsimctl list shows every plant "
+            "with its URL\n", h->dir.state_url);
+}
+
+static void dir_close(host *h)
+{
+    rt_io_remove(&h->io, &h->dir_src);
+    if (h->dir_in) lcm_destroy(h->dir_in);
+    if (h->dir_out) lcm_destroy(h->dir_out);
+    h->dir_in = h->dir_out = NULL;
+}
+
 /* ---------------------------------------------------------------- a plant's life */
 /* Opens a loaded plant and adds it to the host: its server opened, the look for another
  * plant on its prefix begun. 0, or -1 (said; the plant freed; a daemon of one plant keeps
@@ -416,6 +540,10 @@ opened:
     p->look_end = rt_sat_add(h->now, rt_plant_look_ns(p->s));
     p->tokens = HOST_INPUT_BURST;
     p->tokens_ns = h->now;
+    rt_limit_init(&p->dir_lim, HOST_DIR_PER_S, (int)HOST_DIR_PER_S, h->now);
+    p->announce_ns = rt_sat_add(h->now, (int64_t)(hash_bytes(p->sc.lcm.prefix,
+                                                             strlen(p->sc.lcm.prefix)) %
+                                                  (uint64_t)HOST_ANNOUNCE_NS));
     if (add_source(h, &p->in, rt_plant_lcm(p->s, RT_PLANT_IN), on_input, p) != 0 ||
         add_source(h, &p->watch, rt_plant_lcm(p->s, RT_PLANT_WATCH), on_watch, p) != 0)
         rt_plant_stop(p->s, RT_STOP_ERROR);
@@ -478,6 +606,7 @@ static void host_pass(host *h)
             plant_end(h, i, RT_STOP_NONE);
             continue;
         }
+        if (h->dir_out && p->phase == PLANT_RUNNING && h->now >= p->announce_ns) announce(h, p);
         i++;
     }
 }
@@ -492,6 +621,7 @@ static int64_t host_next_wake(const host *h)
         if (rt_plant_stopped(p->s) || p->marked) return h->now;
         wake = min64(wake, p->phase == PLANT_LOOKING ? p->look_end : p->wake);
         if (p->in.parked) wake = min64(wake, budget_ready(p));
+        if (h->dir_out && p->phase == PLANT_RUNNING) wake = min64(wake, p->announce_ns);
     }
     return wake;
 }
@@ -703,6 +833,7 @@ static host *host_new(const host_conf *c, bool one)
 static lag_result host_close(host *h)
 {
     while (h->n > 0) plant_end(h, h->n - 1, RT_STOP_ERROR);
+    dir_close(h);
     rt_io_close(&h->io);
     if (h->notify_fd >= 0) close(h->notify_fd);
     lag_result rc = h->rc;
@@ -720,6 +851,8 @@ lag_result lagsimd_host(const host_conf *c)
         return host_close(h);
     }
     h->now = lag_clock_mono_ns();
+    lag_net_note_inherited(); /* before any LCM instance of the host's: a parent's sockets */
+    if (c->dir || c->port_base) dir_open(h);
     if (c->dir) watch_dir(h); /* else said: SIGHUP reads it again */
     for (int i = 0; i < c->nconfigs; i++) plant_add(h, c->configs[i], NULL, 0);
     host_rescan(h); /* DIR's files, in the order of their names */

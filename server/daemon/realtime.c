@@ -1120,3 +1120,10 @@ void rt_plant_input_limited(rt_server *s, int64_t times, const char *why)
                    "the plant can use", s->bus.ch_command, s->bus.ch_control, why,
                    (long long)times);
 }
+
+unsigned rt_plant_last(const rt_server *s, bool status, const uint8_t **data)
+{
+    const rt_sent *k = status ? &s->pub.last_status : &s->pub.last_scene;
+    *data = k->buf;
+    return k->len;
+}

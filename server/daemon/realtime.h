@@ -80,6 +80,10 @@ int64_t rt_plant_published(const rt_server *s);
  * input_limited event (limited: 3, then 1 a second), `times` in its value. */
 void rt_plant_input_limited(rt_server *s, int64_t times, const char *why);
 
+/* The last scene (status false) or status the plant published, as sent: its length (0:
+ * none yet), the bytes in *data (valid until the plant publishes the next). OUT: data */
+unsigned rt_plant_last(const rt_server *s, bool status, const uint8_t **data);
+
 /* When the loop must next wake up for this plant (absolute ns; <= now: at once). Pure. */
 int64_t rt_next_wake(const rt_server *s);
 /* Everything due at the plant's clock: the mode's periods, pending answers, the periodic

@@ -82,6 +82,7 @@ typedef struct rt_pub {
     int64_t lockstep_retries;  /* states published again, no answer having come */
 
     uint8_t state_buf[RT_BUF_SIZE]; /* the last state published, as sent (lockstep retries) */
+    rt_sent last_scene, last_status; /* the last of each, as sent (a host's directory) */
     rt_sent ref_sent;               /* its reference, as sent (lockstep retries) */
     unsigned state_len;
 } rt_pub;

@@ -77,7 +77,7 @@ static int build(prog *p, bool host_only, const char *const *channels, int n, ch
                  size_t errlen)
 {
     p->n = 0;
-    int total = 2 /* magic */ + 1 /* drop */ + (host_only ? 4 : 0);
+    int total = 2 /* magic */ + 1 /* drop */ + (host_only ? 4 : 0) + (n == 0 /* accept */);
     for (int i = 0; i < n; i++) {
         size_t len = strlen(channels[i]) + 1;
         if (len > 64 + 8 + 1) {
@@ -102,6 +102,7 @@ static int build(prog *p, bool host_only, const char *const *channels, int n, ch
     emit(p, BPF_LD | BPF_W | BPF_ABS, 0, 0, OFF_MAGIC);
     emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, (uint8_t)(total - here - 2 - 1), LCM_MAGIC_SHORT);
     for (int i = 0; i < n; i++) emit_channel(p, channels[i]);
+    if (n == 0) emit(p, BPF_RET | BPF_K, 0, 0, 0xffffffffu); /* any channel */
     emit(p, BPF_RET | BPF_K, 0, 0, 0);
     if (p->n != total) {
         snprintf(err, errlen, "filter program: %d instructions, expected %d", p->n, total);
@@ -184,8 +185,8 @@ static int attach_one(int fd, void *user)
 int lag_net_filter(int port, bool host_only, const char *const *channels, int n, char *err,
                   size_t errlen)
 {
-    if (n < 1 || n > LAG_NET_MAX_FILTER_CHANNELS) {
-        snprintf(err, errlen, "filter: 1 to %d channels", LAG_NET_MAX_FILTER_CHANNELS);
+    if (n < 0 || n > LAG_NET_MAX_FILTER_CHANNELS) {
+        snprintf(err, errlen, "filter: 0 to %d channels", LAG_NET_MAX_FILTER_CHANNELS);
         return -1;
     }
     static prog p; /* one thread sets filters, at start */

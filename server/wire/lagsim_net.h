@@ -31,8 +31,8 @@
 /* Attaches the filter to every UDP socket of this process bound to `port`, but those
  * noted by lag_net_note_inherited (LCM's receive
  * socket of an lcm_t for that port, once it has a subscription): keep only LCM short
- * messages on one of the n channels (exact names), and with host_only only those sent
- * from this host. Returns the number of sockets filtered (0: none found), or -1 with a
+ * messages on one of the n channels (exact names; n = 0: on any channel), and with
+ * host_only only those sent from this host. Returns the number of sockets filtered (0: none found), or -1 with a
  * message in err. */
 int lag_net_filter(int port, bool host_only, const char *const *channels, int n, char *err,
                   size_t errlen);

@@ -160,14 +160,17 @@ class T:
         import lagsim
         self.t = lagsim
         self.procs = []
+        self.directory = take_pairs(1)  # the hosts' directory (LCM_DEFAULT_URL's bus)
 
     def prog(self, name):
         return os.path.join(self.a.bin, name)
 
-    def start(self, args, **kw):
-        """A child whose stderr goes to a file (a pipe nobody reads could stall it)."""
+    def start(self, args, stdout=subprocess.DEVNULL, **kw):
+        """A child whose stderr goes to a file (a pipe nobody reads could stall it), with
+        LCM_DEFAULT_URL the case's directory bus (set_directory)."""
         err = tempfile.TemporaryFile(mode="w+")
-        p = subprocess.Popen(args, stderr=err, stdout=subprocess.DEVNULL, text=True, **kw)
+        env = dict(os.environ, LCM_DEFAULT_URL=url(self.directory))
+        p = subprocess.Popen(args, stderr=err, stdout=stdout, text=True, env=env, **kw)
         p.err_file = err
         self.procs.append(p)
         return p
@@ -459,6 +462,51 @@ class T:
                       "SIGTERM: %s's stop event" % pre)
             check("changed, but its new scene cannot run" in err and "bob.yaml:2:" in err,
                   "the bad new bob.yaml is said, with its file:line:column")
+
+
+    # ------------------------------------------------------------------ lagsimctl list
+    def ctl(self, *args):
+        env = dict(os.environ, LCM_DEFAULT_URL=url(self.directory))
+        p = subprocess.run([self.prog("lagsimctl"), *args], capture_output=True, text=True,
+                           timeout=60, env=env)
+        print("$ lagsimctl %s\n  exit %d\n%s" % (" ".join(args), p.returncode, "".join(
+            "  | %s\n" % l for l in (p.stdout + p.stderr).splitlines()[:12])), flush=True)
+        return p
+
+    def case_list(self):
+        base = take_pairs(3)
+        with tempfile.TemporaryDirectory() as d:
+            lab = os.path.join(d, "lab")
+            os.mkdir(lab)
+            for name in ("alice", "bob", "carol"):
+                open(os.path.join(lab, name + ".yaml"), "w").write(PLANT)
+            open(os.path.join(lab, "dir.yaml"), "w").write(
+                PLANT + "lcm: {url: '%s'}\n" % url(self.directory))
+            bus = Bus(self.t, [("ALICE", base), ("BOB", base + 2), ("CAROL", base + 4)])
+            host = self.start([self.prog("lagsimd"), "--plants", lab, "--port-base", str(base)])
+            for pre in ("ALICE", "BOB", "CAROL"):
+                check(bus.wait_event(pre, "start", 0, 10), "%s starts" % pre)
+            p = self.ctl("list")
+            rows = {l.split()[0]: l.split()[-1] for l in p.stdout.splitlines()[1:] if l.strip()}
+            want = {"ALICE": url(base), "BOB": url(base + 2), "CAROL": url(base + 4)}
+            check(p.returncode == 0 and rows == want,
+                  "lagsimctl list on the directory: each plant with its own URL %s" % rows)
+            p = self.ctl("--json", "list")
+            check(p.returncode == 0 and all('"url": "%s"' % u in p.stdout for u in want.values()),
+                  "--json list: the same URLs")
+            p = self.ctl("--prefix", "BOB", "status")
+            check(p.returncode == 0 and "status of BOB" in p.stdout and "running" in p.stdout,
+                  "status through the directory: BOB's last status")
+            p = self.ctl("--url", url(base + 2), "--prefix", "BOB", "pause")
+            check(p.returncode == 0, "pause on BOB's own URL: exit 0")
+            p = self.ctl("--prefix", "ALICE", "--timeout", "1", "pause")
+            check(p.returncode == 3, "pause through the directory: not done there (exit 3)")
+            host.send_signal(signal.SIGTERM)
+            rc, err = self.finish_pumping(host, bus, 30)
+            check("dir.yaml: ports %d and %d are the host's directory" %
+                  (self.directory, self.directory + 1) in err,
+                  "a plant on the directory's ports refused, said")
+            check(rc == 0, "SIGTERM: exit 0")
 
 
 def main():
