@@ -25,6 +25,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "lagsim_bus.h"
 #include "lagsim_clock.h"
 #include "lagsim_wire.h"
 
@@ -33,6 +34,7 @@
 typedef struct probe_plant {
     int fd;
     char prefix[16];
+    char ch_state[LAG_BUS_CHANNEL_LEN], ch_status[LAG_BUS_CHANNEL_LEN], ch_event[LAG_BUS_CHANNEL_LEN];
     bool heard, stop_seen, stopped; /* stopped: the status after the stop event came */
     int64_t last_utime, last_step, states, overruns;
     int64_t step_per_period;
@@ -83,9 +85,7 @@ static void on_datagram(probe_plant *p, const uint8_t *d, size_t n, int64_t peri
     if (cl == n - 8) return;
     const uint8_t *pay = d + 8 + cl + 1;
     size_t plen = n - 8 - cl - 1;
-    size_t pl = strlen(p->prefix);
-    if (cl <= pl || strncmp(ch, p->prefix, pl)) return;
-    if (!strcmp(ch + pl, "_STATE") &&
+    if (!strcmp(ch, p->ch_state) &&
         lag_wire_decode(LAG_WIRE_JOINT_STATE, pay, plen, LAG_WIRE_MAX_JOINTS, &m) == LAG_WIRE_OK) {
         if (p->heard && m.st.step > p->last_step) {
             int64_t dsteps = m.st.step - p->last_step;
@@ -97,11 +97,11 @@ static void on_datagram(probe_plant *p, const uint8_t *d, size_t n, int64_t peri
         p->states++;
         p->last_utime = m.st.utime;
         p->last_step = m.st.step;
-    } else if (!strcmp(ch + pl, "_STATUS") &&
+    } else if (!strcmp(ch, p->ch_status) &&
                lag_wire_decode(LAG_WIRE_STATUS, pay, plen, LAG_WIRE_MAX_JOINTS, &m) == LAG_WIRE_OK) {
         p->overruns = m.status.overruns;
         if (p->stop_seen) p->stopped = true;
-    } else if (!strcmp(ch + pl, "_EVENT") &&
+    } else if (!strcmp(ch, p->ch_event) &&
                lag_wire_decode(LAG_WIRE_EVENT, pay, plen, LAG_WIRE_MAX_JOINTS, &m) == LAG_WIRE_OK &&
                !strcmp(m.ev.kind, "stop")) {
         p->stop_seen = true;
@@ -167,6 +167,9 @@ int main(int argc, char **argv)
     }
     for (int i = 0; i < n; i++) {
         snprintf(g_p[i].prefix, sizeof g_p[i].prefix, "P%03d", i);
+        lag_bus_channel_name(g_p[i].ch_state, LAG_BUS_CHANNEL_LEN, g_p[i].prefix, LAG_BUS_STATE);
+        lag_bus_channel_name(g_p[i].ch_status, LAG_BUS_CHANNEL_LEN, g_p[i].prefix, LAG_BUS_STATUS);
+        lag_bus_channel_name(g_p[i].ch_event, LAG_BUS_CHANNEL_LEN, g_p[i].prefix, LAG_BUS_EVENT);
         g_p[i].fd = open_port(argv[1], base + 2 * i);
     }
     listen_all(n, seconds, period_us);

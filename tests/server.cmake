@@ -18,6 +18,11 @@ add_executable(test_pace ${CMAKE_CURRENT_LIST_DIR}/server/test_pace.c)
 target_include_directories(test_pace PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_pace PRIVATE lagsimd_internal)
 lagsim_add_test_cases(test_pace server_pace server 30)
+# A plant's input read by the loop (rt_rx.c) against LCM's own datagrams.
+add_executable(test_rx ${CMAKE_CURRENT_LIST_DIR}/server/test_rx.c)
+target_include_directories(test_rx PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
+target_link_libraries(test_rx PRIVATE lagsimd_internal)
+lagsim_add_test_cases(test_rx server_rx server 30)
 add_executable(test_loop ${CMAKE_CURRENT_LIST_DIR}/server/test_loop.c)
 target_include_directories(test_loop PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_loop PRIVATE lagsimd_internal)
@@ -57,7 +62,7 @@ endif()
 # bad scenes skipped, a directory's files added, changed and removed while running,
 # lagsimctl list through the host's directory.
 if(LAGSIM_PYTHON3)
-  foreach(case isolation bad_scene reload list)
+  foreach(case isolation bad_scene reload list many)
     add_test(NAME server_host_${case}
              COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/server/test_host.py
                      --bin ${CMAKE_BINARY_DIR}/bin --types ${CMAKE_BINARY_DIR}/python

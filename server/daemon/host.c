@@ -393,10 +393,10 @@ static void on_watch(void *ctx)
     p->marked = true;
 }
 
-static int add_source(host *h, rt_io_src *src, lcm_t *l, void (*ready)(void *), plant *p)
+static int add_source(host *h, rt_io_src *src, int fd, void (*ready)(void *), plant *p)
 {
-    if (!l) return 0;
-    src->fd = lcm_get_fileno(l);
+    if (fd < 0) return 0;
+    src->fd = fd;
     src->ready = ready;
     src->ctx = p;
     return rt_io_add(&h->io, src);
@@ -544,8 +544,8 @@ opened:
     p->announce_ns = rt_sat_add(h->now, (int64_t)(hash_bytes(p->sc.lcm.prefix,
                                                              strlen(p->sc.lcm.prefix)) %
                                                   (uint64_t)HOST_ANNOUNCE_NS));
-    if (add_source(h, &p->in, rt_plant_lcm(p->s, RT_PLANT_IN), on_input, p) != 0 ||
-        add_source(h, &p->watch, rt_plant_lcm(p->s, RT_PLANT_WATCH), on_watch, p) != 0)
+    if (add_source(h, &p->in, rt_plant_fd(p->s, RT_PLANT_IN), on_input, p) != 0 ||
+        add_source(h, &p->watch, rt_plant_fd(p->s, RT_PLANT_WATCH), on_watch, p) != 0)
         rt_plant_stop(p->s, RT_STOP_ERROR);
     return 0;
 }
@@ -630,8 +630,9 @@ static int64_t host_next_wake(const host *h)
 static void on_signal(void *ctx, int signo)
 {
     host *h = ctx;
-    if (signo == SIGHUP && !h->one) { /* a host reads its files again */
-        h->rescan_at = h->now;
+    if (signo == SIGHUP && !h->one) { /* a host reads its files again, and tries again */
+        h->rescan_at = h->now;       /* those that failed (a port taken meanwhile ...) */
+        h->nfail = 0;
         return;
     }
     bool stops = signo != SIGUSR1 && signo != SIGUSR2;
@@ -716,7 +717,7 @@ static void plant_add(host *h, const char *path, const char *name, int keep)
         failed_seen(h, key, hv, true);
         h->skipped++;
         fprintf(stderr, "lagsimd: %s: skipped (the reason is above); the other plants run; "
-                "it is tried again when it changes%s\n", path, h->c->dir ? "" : " and on SIGHUP");
+                "it is tried again when it changes and on SIGHUP\n", path);
         return;
     }
     failed_forget(h, key);

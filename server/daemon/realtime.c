@@ -798,6 +798,7 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
             char *err, size_t errlen)
 {
     memset(s, 0, sizeof *s);
+    s->bus.rx_in.fd = s->bus.rx_watch.fd = -1; /* no socket yet (rt_bus_close) */
     s->sc = sc;
     s->opts = o;
     s->now = now;
@@ -1052,19 +1053,16 @@ int64_t rt_plant_look_ns(const rt_server *s)
     return s->bus.urls.udpm ? RT_LOOK_MS * 1000000LL : 0;
 }
 
-lcm_t *rt_plant_lcm(rt_server *s, rt_plant_lcm_which which)
+int rt_plant_fd(const rt_server *s, rt_plant_input which)
 {
-    if (which == RT_PLANT_IN) return s->bus.lcm_in;
-    return s->bus.lcm != s->bus.lcm_in ? s->bus.lcm : NULL;
+    return rt_bus_fd(&s->bus, which == RT_PLANT_WATCH);
 }
 
-int rt_plant_drain(rt_server *s, rt_plant_lcm_which which, int64_t now, int max)
+int rt_plant_drain(rt_server *s, rt_plant_input which, int64_t now, int max)
 {
-    lcm_t *l = rt_plant_lcm(s, which);
-    int n = 0;
     s->now = now;
-    while (l && n < max && !s->stop && lcm_handle_timeout(l, 0) > 0) n++;
-    return n;
+    if (s->stop) return 0;
+    return rt_bus_read(&s->bus, which == RT_PLANT_WATCH, max);
 }
 
 int rt_plant_start(rt_server *s, int64_t now, bool live_line, char *err, size_t errlen)

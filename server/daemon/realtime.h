@@ -7,8 +7,9 @@
  *
  *     s = rt_plant_new()
  *     rt_plant_open(s, scene, opts, now, ...)   scene checked, sim made, --log opened,
- *                                               LCM made, the prefix asked for its scene
- *     ... the loop handles rt_plant_lcm(s, RT_PLANT_WATCH) for RT_LOOK_MS ...
+ *                                               the bus made, the prefix asked for its
+ *                                               scene
+ *     ... the loop reads rt_plant_fd(s, RT_PLANT_WATCH) for rt_plant_look_ns ...
  *     rt_plant_start(s, now, ...)               refused if another plant answered; else
  *                                               the command URL filtered, the start
  *                                               published
@@ -38,9 +39,9 @@ typedef enum rt_stop {
     RT_STOP_CHANGED,   /* a host: its scene file changed (the plant starts again from it) */
 } rt_stop;
 
-/* A plant's two LCM instances: the command URL's (commands, control requests) and the
- * state URL's (the plant watch: another plant's scene on the prefix). */
-typedef enum rt_plant_lcm_which { RT_PLANT_IN = 0, RT_PLANT_WATCH } rt_plant_lcm_which;
+/* What a plant reads: its input on the command URL (commands, control requests), and the
+ * plant watch on the state URL (another plant's scene on the prefix). */
+typedef enum rt_plant_input { RT_PLANT_IN = 0, RT_PLANT_WATCH } rt_plant_input;
 
 /* A plant's struct, zeroed (large: allocated once per plant, never in the stepping path);
  * NULL when out of memory. */
@@ -55,11 +56,11 @@ int rt_plant_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int6
 /* How long the loop listens for another plant on the prefix before rt_plant_start (ns;
  * 0: nothing to look for, memq://). */
 int64_t rt_plant_look_ns(const rt_server *s);
-/* The instance `which` (NULL: none of its own, e.g. memq://'s one instance is RT_PLANT_IN). */
-lcm_t *rt_plant_lcm(rt_server *s, rt_plant_lcm_which which);
+/* The descriptor the loop waits on for `which` (-1: none, e.g. memq://'s plant watch). */
+int rt_plant_fd(const rt_server *s, rt_plant_input which);
 /* Handles what `which` holds, at most `max` messages, at the loop's clock `now`; none once
- * the plant stopped. Returns the number handled. */
-int rt_plant_drain(rt_server *s, rt_plant_lcm_which which, int64_t now, int max);
+ * the plant stopped. Returns the number read. */
+int rt_plant_drain(rt_server *s, rt_plant_input which, int64_t now, int max);
 /* After the look: refused (1, message in err, LCM closed) when another plant answered on
  * the prefix; else the command URL filtered and the plant started at `now`: its scene, a
  * start event, its first state (rt_begin). live_line: the live status line on stderr. */

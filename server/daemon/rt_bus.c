@@ -1,26 +1,31 @@
 /*
- * The daemon's LCM instances (lagsim_bus.h gives the URLs):
- *   b->lcm        the state URL, publishing only: it never subscribes, so LCM never
- *                 opens a receive socket for it and the daemon never reads back its own
- *                 states (in fast mode, tens of thousands a second);
- *   b->lcm_in     the command URL: _COMMAND and _CONTROL. Its receive socket gets a
- *                 filter (lagsim_net.h): only this plant's two channels, and unless
- *                 lcm.allow_lan only datagrams sent from this host;
- * For memq:// (tests, one process) one lcm_t is both.
+ * The daemon's bus (lagsim_bus.h gives the URLs). On udpm://:
+ *   b->lcm        publishes on the state URL;
+ *   b->lcm_in     publishes on the command URL (DESCRIBE at start, the sync marker);
+ *                 neither subscribes, so LCM makes no thread, pipe wait or select(2) for
+ *                 them;
+ *   b->rx_in      the plant's own receive socket on the command URL (rt_rx.h), read by the
+ *                 loop: _COMMAND and _CONTROL. Its socket filter (lagsim_net.h) keeps only
+ *                 those two channels, and unless lcm.allow_lan only datagrams sent from
+ *                 this host;
+ *   b->rx_watch   the plant watch on the state URL: _SCENE (and _COMMAND sent to the wrong
+ *                 port, counted), its filter dropping the daemon's own states in the kernel.
+ * For memq:// (tests, one process) one lcm_t is both, with LCM's subscriptions.
  *
- * One plant per prefix: the state URL's lcm_t subscribes to _SCENE (its receive socket
- * filtered to that channel and _COMMAND, so the kernel drops the daemon's own states
- * instead of handing them back; a command sent there, to the wrong port, is counted). Before it publishes anything, the daemon asks its prefix for a
+ * One plant per prefix: before it publishes anything, the daemon asks its prefix for a
  * scene (DESCRIBE) and listens RT_LOOK_MS (rt_bus_open); another plant's scene
  * (rt_bus_foreign_scene: one that decodes, names this prefix and is not one of the
- * daemon's own) makes it refuse to start, and later makes it stop. Whom it hears follows the
- * command URL's rule: this host only unless lcm.allow_lan.
+ * daemon's own) makes it refuse to start, and later is counted and said. Whom it hears
+ * follows the command URL's rule: this host only unless lcm.allow_lan.
  */
+#include <poll.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "lagsim_clock.h"
 #include "lagsim_net.h"
+#include "lagsim_url.h"
 #include "daemon.h"
 #include "rt_bus.h"
 #include "rt_pace.h"
@@ -148,8 +153,20 @@ bool rt_bus_foreign_scene(rt_bus *b, const uint8_t *data, size_t len)
 }
 
 /* ---------------------------------------------------------------- opening the bus */
-/* Filters the receive socket of the command URL's lcm_t, then reads until a marker sent
- * after the filter comes back, discarding whatever came before it (it may have come in
+/* The sync marker: sent on the command URL, read back by the plant's own socket. */
+typedef struct sync_marker {
+    rt_bus *b;
+    char text[96];
+} sync_marker;
+
+static void send_marker(void *ctx)
+{
+    sync_marker *m = ctx;
+    lcm_publish(m->b->lcm_in, LAG_NET_MARKER_CHANNEL, m->text, (unsigned)strlen(m->text));
+}
+
+/* Filters the plant's receive socket on the command URL, then reads until a marker sent
+ * after the filter comes back, dropping whatever came before it (it may have come in
  * before the filter did). Returns 0, or an exit code with a message in err. */
 static int filter_input(rt_bus *b, char *err, size_t errlen)
 {
@@ -160,19 +177,24 @@ static int filter_input(rt_bus *b, char *err, size_t errlen)
     int n = lag_net_filter(u->command_port, host_only, with_marker, 3, ferr, sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s%s: cannot restrict the command URL %s to %s", n < 0 ? ferr :
-                 "LCM's receive socket for the command port was not found",
+                 "the receive socket for the command port was not found",
                  host_only ? "" : " (lcm.allow_lan: true)", u->command_url,
                  host_only ? "this host (lcm.allow_lan: false)" : "this plant's channels");
         return LAGSIMD_EXIT_RUNTIME;
     }
-    if (lag_net_sync(b->lcm_in, 3000) != 0) {
+    static unsigned counter;
+    sync_marker m = {b, ""};
+    int64_t t = lag_clock_mono_ns();
+    snprintf(m.text, sizeof m.text, "lagsimd %ld %s sync %u %lld", (long)getpid(),
+             b->sc->lcm.prefix, ++counter, (long long)t);
+    if (rt_rx_sync(&b->rx_in, LAG_NET_MARKER_CHANNEL, m.text, send_marker, &m, 3000) != 0) {
         snprintf(err, errlen, "LCM on %s does not hear its own messages (is there a multicast "
                  "route? docs/network.md)", u->command_url);
         return LAGSIMD_EXIT_RUNTIME;
     }
     n = lag_net_filter(u->command_port, host_only, with_marker, 2, ferr, sizeof ferr);
     if (n <= 0) {
-        snprintf(err, errlen, "%s", n < 0 ? ferr : "LCM's receive socket went away");
+        snprintf(err, errlen, "%s", n < 0 ? ferr : "the receive socket went away");
         return LAGSIMD_EXIT_RUNTIME;
     }
     return LAGSIMD_EXIT_OK;
@@ -191,7 +213,7 @@ static int ask_for_other_plant(rt_bus *b, char *err, size_t errlen)
     int n = lag_net_filter(u->state_port, host_only, out, 2, ferr, sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s: cannot filter the state URL %s for the plant watch",
-                 n < 0 ? ferr : "LCM's receive socket for the state port was not found",
+                 n < 0 ? ferr : "the receive socket for the state port was not found",
                  u->state_url);
         return LAGSIMD_EXIT_RUNTIME;
     }
@@ -204,10 +226,59 @@ static int ask_for_other_plant(rt_bus *b, char *err, size_t errlen)
     return LAGSIMD_EXIT_OK;
 }
 
+/* rt_rx's handlers: the plant's own sockets (udpm://). */
+static void rx_command(void *ctx, const uint8_t *data, size_t len)
+{
+    rt_bus *b = ctx;
+    if (!b->discard) b->on.command(b->on.ctx, data, len);
+}
+
+static void rx_control(void *ctx, const uint8_t *data, size_t len)
+{
+    rt_bus *b = ctx;
+    if (!b->discard) b->on.control(b->on.ctx, data, len);
+}
+
+static void rx_scene(void *ctx, const uint8_t *data, size_t len)
+{
+    rt_bus *b = ctx;
+    b->on.scene(b->on.ctx, data, len);
+}
+
+static void rx_wrong_port(void *ctx, const uint8_t *data, size_t len)
+{
+    (void)data, (void)len;
+    rt_bus *b = ctx;
+    if (!b->discard) b->commands_wrong_port++;
+}
+
+/* udpm://: the plant's two receive sockets (rt_rx.h): _COMMAND and _CONTROL on the command
+ * URL; the plant watch (_SCENE, and _COMMAND sent to the wrong port) on the state URL. */
+static int open_receivers(rt_bus *b, char *err, size_t errlen)
+{
+    const lag_bus *u = &b->urls;
+    lag_url url;
+    long rcvbuf = lag_url_parse(u->state_url, LAG_URL_SCENE_RULES | LAG_URL_ALLOW_LAN, &url,
+                                err, errlen) == 0 ? url.recv_buf_size : 0;
+    b->rx_in = (rt_rx){-1, 2, {"", ""}, {rx_command, rx_control}, b, 0};
+    b->rx_watch = (rt_rx){-1, 2, {"", ""}, {rx_scene, rx_wrong_port}, b, 0};
+    snprintf(b->rx_in.ch[0], sizeof b->rx_in.ch[0], "%s", b->ch_command);
+    snprintf(b->rx_in.ch[1], sizeof b->rx_in.ch[1], "%s", b->ch_control);
+    snprintf(b->rx_watch.ch[0], sizeof b->rx_watch.ch[0], "%s", b->ch_scene);
+    snprintf(b->rx_watch.ch[1], sizeof b->rx_watch.ch[1], "%s", b->ch_command);
+    if (rt_rx_open(&b->rx_in, u->group, u->command_port, rcvbuf, err, errlen) != 0 ||
+        rt_rx_open(&b->rx_watch, u->group, u->state_port, rcvbuf, err, errlen) != 0)
+        return LAGSIMD_EXIT_RUNTIME;
+    return LAGSIMD_EXIT_OK;
+}
+
 int rt_bus_open_start(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
 {
     const lag_bus *u = &b->urls;
     lag_net_note_inherited(); /* a parent's sockets are not filtered */
+    b->rx_in.fd = b->rx_watch.fd = -1;
+    /* udpm: two publishers (no subscription: LCM makes no thread for them) and the plant's
+     * own receive sockets; memq://: one lcm_t, LCM's subscriptions */
     lcm_t *out = lcm_create(u->state_url);
     lcm_t *in = !u->udpm ? out : out ? lcm_create(u->command_url) : NULL;
     if (!out || !in) {
@@ -216,16 +287,37 @@ int rt_bus_open_start(rt_bus *b, const rt_bus_handlers *h, char *err, size_t err
         return LAGSIMD_EXIT_RUNTIME;
     }
     b->discard = true; /* until rt_begin: nothing that arrives before the start counts */
-    int rc = rt_bus_attach(b, out, in, h, err, errlen);
-    if (rc != LAGSIMD_EXIT_OK) {
-        if (in != out) lcm_destroy(in);
-        lcm_destroy(out);
-        b->lcm = b->lcm_in = NULL;
-        return rc;
+    int rc;
+    if (u->udpm) {
+        b->on = *h;
+        b->lcm = out;
+        b->lcm_in = in;
+        rc = open_receivers(b, err, errlen);
+        if (rc == LAGSIMD_EXIT_OK) rc = ask_for_other_plant(b, err, errlen);
+    } else {
+        rc = rt_bus_attach(b, out, in, h, err, errlen);
+        if (rc != LAGSIMD_EXIT_OK) {
+            lcm_destroy(out);
+            b->lcm = b->lcm_in = NULL;
+            return rc;
+        }
     }
-    if (u->udpm) rc = ask_for_other_plant(b, err, errlen);
     if (rc != LAGSIMD_EXIT_OK) rt_bus_close(b);
     return rc;
+}
+
+int rt_bus_fd(const rt_bus *b, bool watch)
+{
+    if (b->urls.udpm) return watch ? b->rx_watch.fd : b->rx_in.fd;
+    return watch || !b->lcm_in ? -1 : lcm_get_fileno(b->lcm_in);
+}
+
+int rt_bus_read(rt_bus *b, bool watch, int max)
+{
+    if (b->urls.udpm) return rt_rx_read(watch ? &b->rx_watch : &b->rx_in, max);
+    int n = 0;
+    while (!watch && b->lcm_in && n < max && lcm_handle_timeout(b->lcm_in, 0) > 0) n++;
+    return n;
 }
 
 /* Where the daemon listens, and who can reach it (said at start). */
@@ -281,14 +373,19 @@ int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
     int rc = rt_bus_open_start(b, h, err, errlen);
     if (rc != LAGSIMD_EXIT_OK) return rc;
     int64_t end = lag_clock_mono_ns() + RT_LOOK_MS * 1000000LL;
-    for (int64_t left; b->urls.udpm && !b->other_plant[0] && (left = end - lag_clock_mono_ns()) > 0;)
-        lcm_handle_timeout(b->lcm, (int)(left / 1000000) + 1);
+    for (int64_t left; b->urls.udpm && !b->other_plant[0] && (left = end - lag_clock_mono_ns()) > 0;) {
+        struct pollfd pf = {b->rx_watch.fd, POLLIN, 0};
+        poll(&pf, 1, (int)(left / 1000000) + 1);
+        rt_rx_read(&b->rx_watch, 16);
+    }
     return rt_bus_open_finish(b, err, errlen);
 }
 
 void rt_bus_close(rt_bus *b)
 {
     rt_bus_detach(b);
+    rt_rx_close(&b->rx_in);
+    rt_rx_close(&b->rx_watch);
     if (b->lcm_in && b->lcm_in != b->lcm) lcm_destroy(b->lcm_in);
     if (b->lcm) lcm_destroy(b->lcm);
     b->lcm = b->lcm_in = NULL;
