@@ -8,16 +8,22 @@
 # nothing is asserted (docs/benchmarks.md, "A lab host").
 #
 #   bench/lab_host.sh [-n N] [-s SECONDS] [-b BUILD] [-p PORT_BASE] [-m host|separate|both]
+#                     [-N NICE]
 #
-# Ports PORT_BASE .. PORT_BASE + 2N - 1 (default 30000; refused if any is bound), group of
+# -N: the daemons' nice value in both configurations (below 0 needs root, as the unit's
+# Nice= has; default 0).
+#
+# Ports PORT_BASE - 2 .. PORT_BASE + 2N - 1 (default 30000; refused if any is bound: the
+# pair below the base is the host's directory, LCM_DEFAULT_URL of its run), group of
 # LCM_DEFAULT_URL (default 239.255.76.67), ttl 0. Every process it starts ends with it.
 set -u
 root=$(cd "$(dirname "$0")/.." && pwd)
-n=100 secs=60 build=$root/build base=30000 modes=both
-while getopts "n:s:b:p:m:" o; do
+n=100 secs=60 build=$root/build base=30000 modes=both nice=0
+while getopts "n:s:b:p:m:N:" o; do
     case $o in
     n) n=$OPTARG ;; s) secs=$OPTARG ;; b) build=$OPTARG ;; p) base=$OPTARG ;; m) modes=$OPTARG ;;
-    *) sed -n '2,14p' "$0"; exit 2 ;;
+    N) nice=$OPTARG ;;
+    *) sed -n '2,20p' "$0"; exit 2 ;;
     esac
 done
 [ "$modes" = both ] && modes="host separate"
@@ -31,8 +37,9 @@ for f in lagsimd dipc_lqr lab_probe; do
     [ -x "$bin/$f" ] || { echo "lab_host: $bin/$f missing (build first)" >&2; exit 2; }
 done
 [ -x /usr/bin/time ] || { echo "lab_host: needs /usr/bin/time (apt-get install time)" >&2; exit 2; }
-# no socket of this host on the ports (another bench or plant would mix in)
-for ((p = base; p < base + 2 * n; p++)); do
+# no socket of this host on the ports (another bench or plant would mix in); the pair below
+# the base is the host's directory (LCM_DEFAULT_URL of its run)
+for ((p = base - 2; p < base + 2 * n; p++)); do
     if awk -v p="$(printf '%04X' "$p")" 'NR > 1 && $2 ~ ":"p"$" { f = 1 } END { exit !f }' \
         /proc/net/udp; then
         echo "lab_host: port $p is bound already: give another -p" >&2
@@ -42,7 +49,8 @@ done
 work=$(mktemp -d)
 pids=()
 cleanup() {
-    for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
+    # /usr/bin/time does not pass a signal on: its child first, then it
+    for p in "${pids[@]}"; do kill $(pgrep -P "$p") "$p" 2>/dev/null; done
     wait 2>/dev/null
     rm -rf "$work"
 }
@@ -72,13 +80,13 @@ run_mode() {
         pids+=($!)
     done
     if [ "$mode" = host ]; then
-        LCM_DEFAULT_URL="udpm://$group:$base?ttl=0" /usr/bin/time -f '%e %U %S' -o "$d/d.0" \
-            "$bin/lagsimd" --plants "$work/lab" --port-base "$base" --duration "$secs" -q \
+        LCM_DEFAULT_URL="udpm://$group:$((base - 2))?ttl=0" /usr/bin/time -f '%e %U %S' -o "$d/d.0" \
+            nice -n "$nice" "$bin/lagsimd" --plants "$work/lab" --port-base "$base" --duration "$secs" -q \
             2>"$d/daemon.err" &
         pids+=($!)
     else
         for ((i = 0; i < n; i++)); do
-            /usr/bin/time -f '%e %U %S' -o "$d/d.$i" "$bin/lagsimd" --config \
+            /usr/bin/time -f '%e %U %S' -o "$d/d.$i" nice -n "$nice" "$bin/lagsimd" --config \
                 "$work/lab/$(printf 'p%03d' "$i").yaml" --set "lcm.prefix=$(printf 'P%03d' "$i")" \
                 --set "lcm.url=udpm://$group:$((base + 2 * i))?ttl=0" --duration "$secs" -q \
                 2>>"$d/daemon.err" &
@@ -95,8 +103,8 @@ run_mode() {
     printf '%-8s N=%d %s; daemon CPU %s s = %.1f us per plant-period; controllers %s s = %.1f us; load %s -> %s\n' \
         "$mode" "$n" "$(cat "$d/probe.out")" "$dcpu" "$(awk -v c="$dcpu" -v p="$periods" 'BEGIN { print c / p * 1e6 }')" \
         "$ccpu" "$(awk -v c="$ccpu" -v p="$periods" 'BEGIN { print c / p * 1e6 }')" "$load0" "$load1"
-    grep -v -e 'listening on' -e 'event start' -e 'plants starting' "$d/daemon.err" | head -5
+    grep -v -e 'listening on' -e 'event start' -e 'plants starting' -e "host's directory" "$d/daemon.err" | head -5
 }
 
-echo "lab_host: $n DIPC plants at 100 Hz, a dipc_lqr each, $secs s; $(nproc) cores; $(date -u '+%Y-%m-%d %H:%M UTC')"
+echo "lab_host: $n DIPC plants at 100 Hz, a dipc_lqr each, $secs s, daemons at nice $nice; $(nproc) cores; $(date -u '+%Y-%m-%d %H:%M UTC')"
 for m in $modes; do run_mode "$m"; done

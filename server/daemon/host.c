@@ -118,6 +118,7 @@ struct host {
     int64_t rescan_at;          /* INT64_MAX: none due */
     bool stopping;              /* a stop signal came: no plant starts any more */
     lag_result rc;
+    int port_base;              /* --port-base, or the directory's next pair (--plants) */
     int started;                /* plants started so far */
     int skipped;                /* files that could not start */
 };
@@ -196,11 +197,11 @@ static int port_from_base(host *h, plant *p, int keep)
         return -1;
     }
     int port = keep;
-    for (int k = 0; port == 0 && h->c->port_base + 2 * k + 1 <= 65535; k++)
-        if (!port_used(h, p, h->c->port_base + 2 * k)) port = h->c->port_base + 2 * k;
+    for (int k = 0; port == 0 && h->port_base + 2 * k + 1 <= 65535; k++)
+        if (!port_used(h, p, h->port_base + 2 * k)) port = h->port_base + 2 * k;
     if (port == 0) {
         fprintf(stderr, "lagsimd: %s: no free port pair from --port-base %d up to 65535\n",
-                p->file, h->c->port_base);
+                p->file, h->port_base);
         return -1;
     }
     lag_url_format(&u, port, p->set_url + 8, sizeof p->set_url - 8);
@@ -227,7 +228,7 @@ static int plant_scene(host *h, plant *p, int keep)
     if (scene_run_load(p->file, p->text, p->len, p->sets, &p->nsets, plain, &p->choice,
                        &p->sc) != LAG_OK)
         return -1;
-    if (!p->sc.lcm.url[0] && c->port_base > 0) {
+    if (!p->sc.lcm.url[0] && h->port_base > 0) {
         if (port_from_base(h, p, keep) != 0) return -1;
         p->sets[p->nsets++] = p->set_url;
     }
@@ -854,6 +855,8 @@ lag_result lagsimd_host(const host_conf *c)
     h->now = lag_clock_mono_ns();
     lag_net_note_inherited(); /* before any LCM instance of the host's: a parent's sockets */
     if (c->dir || c->port_base) dir_open(h);
+    /* --plants without --port-base: the pairs after the directory's */
+    h->port_base = c->port_base ? c->port_base : c->dir && h->dir_in ? h->dir.state_port + 2 : 0;
     if (c->dir) watch_dir(h); /* else said: SIGHUP reads it again */
     for (int i = 0; i < c->nconfigs; i++) plant_add(h, c->configs[i], NULL, 0);
     host_rescan(h); /* DIR's files, in the order of their names */

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 
 #include "daemon.h"
 #include "host.h"
@@ -31,7 +32,10 @@ static const char k_options[] =
     "                         restarts it, a removed one stops it; no other is touched)\n"
     "      --port-base P      a host's plants whose scene has no lcm.url get port pairs\n"
     "                         of their own: P, P + 2, ... (the first free), on the group\n"
-    "                         of LCM_DEFAULT_URL (lagsimctl list shows each plant's URL)\n"
+    "                         of LCM_DEFAULT_URL (lagsimctl list shows each plant's URL);\n"
+    "                         default with --plants: the pairs after LCM_DEFAULT_URL's\n"
+    "      --instance BASE    the unit's form (lagsimd@NAME): BASE.yaml as one plant\n"
+    "                         (--config), or BASE.d/ as a host (--plants); not both\n"
     "  -s, --set KEY=VALUE    override a scene key by its dotted path after the file\n"
     "                         is read; VALUE is YAML, e.g. --set integrator.method=dopri5\n"
     "                         --set initial.q=[0,0.1,-0.1]; repeatable, applied in order,\n"
@@ -190,6 +194,8 @@ typedef struct cmdline {
     const char **configs;   /* every --config, in order */
     int nconfigs;
     const char *plants;     /* --plants DIR */
+    const char *instance;   /* --instance BASE */
+    char instance_path[4096];
     int port_base;          /* --port-base P, 0: none */
     bool cost, offline;
     bool have_duration, have_tolerance, have_ring; /* given, for the checks of combinations */
@@ -200,7 +206,7 @@ typedef struct cmdline {
 
 enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE,
        OPT_COST, OPT_PLOT, OPT_FORCE, OPT_KEEP, OPT_SPLIT, OPT_LIST, OPT_PLANTS,
-       OPT_PORT_BASE };
+       OPT_PORT_BASE, OPT_INSTANCE };
 static const struct option longopts[] = {
     {"config", required_argument, NULL, 'c'},
     {"set", required_argument, NULL, 's'},
@@ -217,6 +223,7 @@ static const struct option longopts[] = {
     {"list", required_argument, NULL, OPT_LIST},
     {"plants", required_argument, NULL, OPT_PLANTS},
     {"port-base", required_argument, NULL, OPT_PORT_BASE},
+    {"instance", required_argument, NULL, OPT_INSTANCE},
     {"increment", no_argument, NULL, 'i'},
     {"keep", required_argument, NULL, OPT_KEEP},
     {"split-mb", required_argument, NULL, OPT_SPLIT},
@@ -281,6 +288,7 @@ static lag_result take_option(cmdline *cl, int c, const char *arg)
         if (cl->plants) return usage_error("--plants: one directory (got a second: '%s')", arg);
         cl->plants = arg;
         break;
+    case OPT_INSTANCE: cl->instance = arg; break;
     case 's': cl->sets[cl->nsets++] = arg; break;
     case 'd': case OPT_LOG_BUFFER: case OPT_TOLERANCE: case OPT_KEEP: case OPT_SPLIT:
     case OPT_PORT_BASE:
@@ -322,12 +330,42 @@ static lag_result read_options(cmdline *cl, int argc, char **argv, bool *done)
     return LAG_OK;
 }
 
+/* --instance BASE: BASE.yaml (one plant) or BASE.d/ (a host), exactly one of them. */
+static lag_result take_instance(cmdline *cl)
+{
+    if (!cl->instance) return LAG_OK;
+    if (cl->config || cl->plants)
+        return usage_error("%s", "--instance names the scene or the directory: not with --config "
+                           "or --plants");
+    struct stat y, d;
+    char yaml[4096];
+    bool has_y = snprintf(yaml, sizeof yaml, "%s.yaml", cl->instance) < (int)sizeof yaml &&
+                 stat(yaml, &y) == 0;
+    bool has_d = snprintf(cl->instance_path, sizeof cl->instance_path, "%s.d", cl->instance) <
+                     (int)sizeof cl->instance_path &&
+                 stat(cl->instance_path, &d) == 0 && S_ISDIR(d.st_mode);
+    if (has_y == has_d) {
+        fprintf(stderr, "lagsimd: --instance %s: %s %s.yaml %s %s.d/ (one plant, or a host of "
+                "plants: one of them)\n", cl->instance, has_y ? "both" : "neither",
+                cl->instance, has_y ? "and" : "nor", cl->instance);
+        return LAGSIMD_EXIT_USAGE;
+    }
+    if (has_y) {
+        snprintf(cl->instance_path, sizeof cl->instance_path, "%s", yaml);
+        cl->config = cl->instance_path;
+        cl->configs[cl->nconfigs++] = cl->instance_path;
+    } else {
+        cl->plants = cl->instance_path;
+    }
+    return LAG_OK;
+}
+
 /* The options that need or exclude each other (said as a usage error). */
 static lag_result check_options(cmdline *cl)
 {
     const lagsimd_opts *o = &cl->opts;
     const char *why = NULL;
-    if (cl->list) why = cl->config || cl->plants || cl->port_base || cl->nsets || cl->offline || cl->replay || cl->cost || o->log ||
+    if (cl->list) why = cl->config || cl->plants || cl->instance || cl->port_base || cl->nsets || cl->offline || cl->replay || cl->cost || o->log ||
                             o->csv || cl->plot || cl->have_duration || cl->have_tolerance ||
                             o->log_increment || o->log_keep || o->log_split || o->force
                             ? "--list prints a table and exits: not with other options" : NULL;
@@ -448,6 +486,7 @@ static lag_result lagsimd_main(int argc, char **argv)
     }
     bool done = false;
     lag_result rc = read_options(&cl, argc, argv, &done);
+    if (rc == LAG_OK && !done) rc = take_instance(&cl);
     if (rc == LAG_OK && !done) rc = check_options(&cl);
     if (rc == LAG_OK && !done && cl.opts.log && !cl.list) rc = check_file_limit(&cl.opts);
     if (rc == LAG_OK && !done) rc = cl.list ? print_list(cl.list) : run(&cl);
