@@ -130,9 +130,11 @@ static bool decode(lag_client *c, lag_wire_type t, const void *data, size_t len)
     return false;
 }
 
-/* A state becomes the latest: returned once (wait_state), passed to on_state. */
+/* A state becomes the latest: returned once (wait_state), passed to on_state. A state
+ * held for its scene is older: it is dropped, and asks for nothing more. */
 static void take_state(lag_client *c, const lag_client_state *m)
 {
+    c->have_held = false;
     c->answer_len = 0;
     c->state = *m;
     c->state_scene = c->scene; /* its generation's (the scene rule) */

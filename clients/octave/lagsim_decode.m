@@ -10,6 +10,11 @@ function msg = lagsim_decode(data, type)
 %   Decoded by lagsim's bounded Java decoder (lagsim.examples.BoundedInput): a string
 %   length is checked before anything is allocated for it (lcm-gen's own decoder
 %   allocates a forged length of 2^31-1 first), and only a message that encodes back to
-%   the very bytes received, every number finite, is kept.
+%   the very bytes received, every number finite, no string with a NUL inside, is kept.
+%   No bytes at all are no message: [] (Octave would hand Java a null array).
+msg = [];
+if isempty(data)
+    return;
+end
 msg = javaMethod('tryDecode', 'lagsim.examples.BoundedInput', data, ['lagsim.' type]);
 end

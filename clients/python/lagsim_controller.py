@@ -41,11 +41,15 @@ def _import_types(types_dir, name):
         sys.exit(2)
 
 
-def _finite(v):
+def _sound(v):
+    """Every number finite; no string with a NUL inside (lcm-gen's decoder strips the one
+    NUL a string ends with and keeps any other, which encodes back to the same bytes)."""
     if isinstance(v, float):
         return math.isfinite(v)
+    if isinstance(v, str):
+        return "\0" not in v
     if isinstance(v, (list, tuple)):
-        return all(_finite(x) for x in v)
+        return all(_sound(x) for x in v)
     return True
 
 
@@ -195,15 +199,16 @@ class Controller(object):
         """The message of type `cls` in `data`, or None (counted in `dropped`). Like the C
         client, it keeps only a message that decodes whole: lcm-gen's decoder reads a
         string without its NUL, or with bytes left over, as if nothing were wrong, so the
-        message must encode back to the very bytes that came; and every number in it must
-        be finite. (lcm-gen gives boolean arrays as one-shot `map` iterators: they become
+        message must encode back to the very bytes that came; every number in it must be
+        finite, and no string may hold a NUL but the one it ends with (the C wire module's
+        rule). (lcm-gen gives boolean arrays as one-shot `map` iterators: they become
         lists.)"""
         try:
             m = cls.decode(data)
             for k in m.__slots__:
                 if isinstance(getattr(m, k), map):
                     setattr(m, k, list(getattr(m, k)))
-            if m.encode() == data and all(_finite(getattr(m, k)) for k in m.__slots__):
+            if m.encode() == data and all(_sound(getattr(m, k)) for k in m.__slots__):
                 return m
         except Exception:
             pass

@@ -32,6 +32,7 @@ Not thread-safe, like lcm_t itself: use one LCM per thread.
 """
 import ctypes
 import ctypes.util
+import errno
 import os
 import re
 
@@ -101,7 +102,7 @@ def _load():
     last = None
     for name in names:
         try:
-            lib = ctypes.CDLL(name)
+            lib = ctypes.CDLL(name, use_errno=True)
             break
         except OSError as e:  # try the next name
             last = e
@@ -192,10 +193,15 @@ class LCM(object):
 
     def handle_timeout(self, timeout_ms):
         """Handles at most one message, waiting up to timeout_ms milliseconds.
-        True if a message was handled, False on timeout."""
+        True if a message was handled, False on timeout or when a signal ended the wait
+        (its Python handler runs as this returns: a controller's SIGTERM handler ends its
+        run instead of an error), as the C client's lag_client_handle."""
+        ctypes.set_errno(0)
         rc = self._lib.lcm_handle_timeout(self._lcm, int(max(0, timeout_ms)))
         self._raise_pending()
         if rc < 0:
+            if ctypes.get_errno() == errno.EINTR:
+                return False
             raise LCMError("lcm_handle_timeout failed")
         return rc > 0
 

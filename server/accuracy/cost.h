@@ -21,6 +21,17 @@
  * The cost of a setting is the CPU time one sim-second takes on this machine (the least
  * of a few timed batches; the clock is the caller's, so tests may make one up); its
  * real-time margin is period's wall time over its cost, 1 / cost.
+ *
+ * What cannot be known: a second reference runs beside the first, dopri5 at ten times its
+ * tolerance (with a floor or stops, whose tick bounds dopri5's steps so that the tolerance
+ * changes nothing, rk4 at the same tick). Where they differ by more than the error asked
+ * for, the reference itself is not known to that error (a chaotic scene, or a motion that
+ * passes near an unstable equilibrium, amplifies any difference, the arithmetic's too):
+ * the pair is tried again a hundred times tighter, down to 1e-13; if even the tightest
+ * pair differs by more than the error before the horizon's end, the scene is predictable
+ * to that error only for the periods before (lag_cost_table.horizon), every setting is
+ * measured over those alone, and the table says the horizon was cut. Without an error
+ * asked for (from_current), the pair may differ by at most the current setting's error.
  */
 #ifndef LAGSIM_COST_H
 #define LAGSIM_COST_H
@@ -35,7 +46,8 @@
 typedef struct lag_cost_row {
     lag_method method;
     double dt;               /* s: the step of a fixed-step method; dopri5's tick */
-    double tol;              /* dopri5: rtol = atol; 0 for fixed-step methods */
+    double tol;              /* dopri5: rtol (= atol unless atol is set); 0 for fixed-step methods */
+    double atol;             /* dopri5: atol when it differs from tol (a scene's own); else 0 */
     double error;            /* max |q - q_ref| over the horizon (joint's unit); inf on a fault */
     double energy_error;     /* max |E - E_ref| over the horizon (J) */
     double cpu_per_sim_s;    /* CPU seconds per sim-second */
@@ -52,6 +64,11 @@ typedef struct lag_cost_opts {
     bool complete;      /* refine every method until it meets the target (or the budget
                            ends), not only while it could still be the cheapest: a whole
                            work-precision curve per method (lagsimd --cost) */
+    const lag_integrator_def *current; /* the scene's own setting: measured as a row too
+                                          and marked (lag_cost_table.current); NULL: none */
+    bool from_current;  /* no error asked for: the target is the error `current` reaches
+                           over the horizon, times safety (a setting meets it when it is at
+                           least as accurate); `target` when that is not finite */
     double (*clock)(void *ctx); /* CPU seconds; NULL: the process's CPU clock */
     void *clock_ctx;
 } lag_cost_opts;
@@ -64,16 +81,33 @@ typedef struct lag_cost_table {
     lag_cost_row row[LAG_COST_MAX_ROWS];
     int chosen;            /* the cheapest row that meets the target; -1 if none does */
     int best;              /* the row of least error (what is offered when none meets) */
+    int current;           /* the row of opts.current; -1 without one */
+    double target;         /* the error the rows are marked at (opts.target, or the
+                              current setting's error times safety with from_current) */
+    bool target_from_current; /* target is the current setting's */
+    double horizon;        /* s measured: opts.horizon, or the part of it the references
+                              agree on within the target (horizon_cut) */
+    bool horizon_cut;      /* the tightest references differ by more than the target
+                              after `horizon` s: the scene is not predictable to the target
+                              over opts.horizon; the rows are measured over `horizon` */
     double ref_tol;        /* the reference's dopri5 tolerance */
+    lag_cost_row ref2;     /* the second reference's setting: dopri5 at 10 ref_tol, or with
+                              a floor or stops (whose tick bounds dopri5's steps, so that its
+                              tolerance changes nothing) rk4 at the reference's tick */
+    double agree_tol;      /* how far the references may differ: the target, or with
+                              from_current the current setting's error (the reference is then
+                              known to about a tenth of the error it measures) */
+    double ref_diff;       /* their largest difference over `horizon` (joint's unit) */
     double spent;          /* CPU seconds the calibration took */
     bool budget_hit;       /* it stopped early: rows are missing */
 } lag_cost_table;
 
 /*
- * Measures the settings for DEF (its integrator is ignored; its model, effects, initial
- * state and input held at zero are used) and chooses. Returns LAG_OK, or LAG_ERR_ARG
- * with a message when the options or the definition cannot be measured, or the
- * reference itself faults (then nothing can be said of the error).
+ * Measures the settings for DEF (its integrator is ignored but as opts.current; its
+ * model, effects, initial state and input held at zero are used) and chooses. Returns
+ * LAG_OK, or LAG_ERR_ARG with a message when the options or the definition cannot be
+ * measured, the reference itself faults, or the scene is not predictable to the target
+ * over even one period (then nothing can be said of the error).
  */
 lag_result lag_cost_measure(const lag_sim_def *def, const lag_cost_opts *o,
                             lag_cost_table *out /* OUT */, char *err, size_t errlen);

@@ -241,32 +241,70 @@ static void actuator_pre_tick(lag_sim *s)
 /* Scheduled generalized impulses (at the first tick boundary at or after t) and forces
  * held over [t, t + duration). */
 
+/* field = "<at>.<key>", or the key alone */
+static const char *dfield(char *buf, const char *at, const char *key)
+{
+    snprintf(buf, LAG_FIELD_MAX, "%s%s%s", at && at[0] ? at : "", at && at[0] ? "." : "", key);
+    return buf;
+}
+
+lag_result lag_disturbance_check(const lag_sim_def *def, const lag_disturbance *dist,
+                                 const char *at, lag_diag *d)
+{
+    char f[LAG_FIELD_MAX];
+    const double dt = def->integrator.dt;
+    if (!(dist->t >= 0 && dist->t <= LAG_TIME_MAX))
+        return lag_diag_fail(d, dfield(f, at, "t"), "expected a time from 0 to %g s, got %g",
+                             LAG_TIME_MAX, dist->t);
+    if (dist->joint < 0 || dist->joint >= def->model.nq)
+        return lag_diag_fail(d, dfield(f, at, "joint"), "no joint %d in model %s", dist->joint,
+                             lag_model_info_get(def->model.kind)->name);
+    if (dist->impulse && dist->duration != 0)
+        return lag_diag_fail(d, dfield(f, at, "duration"), "an impulse takes no duration, got "
+                             "%g s", dist->duration);
+    /* held over the ticks that start in [t, t + duration): shorter than a tick, it would
+     * be held over one whole tick, and give more than the impulse it stands for */
+    if (!dist->impulse && !(dist->duration >= dt && dist->duration <= LAG_TIME_MAX))
+        return lag_diag_fail(d, dfield(f, at, "duration"), "expected a duration from %g s "
+                             "(integrator.dt: a force acts for whole ticks; a shorter push is "
+                             "an impulse) to %g s, got %g", dt, LAG_TIME_MAX, dist->duration);
+    if (!(fabs(dist->value) <= LAG_FORCE_MAX))
+        return lag_diag_fail(d, dfield(f, at, dist->impulse ? "impulse" : "force"),
+                             "expected a number from %g to %g (%s), got %g", -LAG_FORCE_MAX,
+                             LAG_FORCE_MAX, dist->impulse ? "N s or N m s" : "N or N m",
+                             dist->value);
+    return LAG_OK;
+}
+
+lag_result lag_disturbance_joint(const lag_sim_def *def, const char *name, const char *at,
+                                 int *joint, lag_diag *d)
+{
+    const lag_model_info *mi = lag_model_info_get(def->model.kind);
+    char f[LAG_FIELD_MAX], names[128] = "";
+    for (int i = 0; i < mi->nq; i++) {
+        if (name && strcmp(name, mi->joint_names[i]) == 0) {
+            *joint = i;
+            return LAG_OK;
+        }
+        size_t u = strlen(names);
+        snprintf(names + u, sizeof names - u, "%s%s", i ? ", " : "", mi->joint_names[i]);
+    }
+    *joint = -1;
+    return lag_diag_fail(d, dfield(f, at, "joint"), "unknown joint '%.40s' for model %s; "
+                         "allowed: %s", name ? name : "", mi->name, names);
+}
+
 static lag_result disturbance_validate(const lag_sim_def *def, lag_diag *d)
 {
     const lag_effects_def *e = &def->effects;
-    char f[LAG_FIELD_MAX];
     if (e->n_disturbances < 0 || e->n_disturbances > LAG_MAX_DISTURBANCES)
         return lag_diag_fail(d, "effects.disturbance", "expected at most %d disturbances, got %d",
                              LAG_MAX_DISTURBANCES, e->n_disturbances);
     for (int k = 0; k < e->n_disturbances; k++) {
-        const lag_disturbance *dk = &e->disturbances[k];
-        if (!(isfinite(dk->t) && dk->t >= 0)) {
-            snprintf(f, sizeof f, "effects.disturbance[%d].t", k);
-            return lag_diag_fail(d, f, "expected a finite time >= 0 (s), got %g", dk->t);
-        }
-        if (dk->joint < 0 || dk->joint >= def->model.nq) {
-            snprintf(f, sizeof f, "effects.disturbance[%d].joint", k);
-            return lag_diag_fail(d, f, "no joint %d in model %s", dk->joint,
-                                 lag_model_info_get(def->model.kind)->name);
-        }
-        if (!isfinite(dk->value)) {
-            snprintf(f, sizeof f, "effects.disturbance[%d].%s", k, dk->impulse ? "impulse" : "force");
-            return lag_diag_fail(d, f, "expected a finite number, got %g", dk->value);
-        }
-        if (!dk->impulse && !(isfinite(dk->duration) && dk->duration > 0)) {
-            snprintf(f, sizeof f, "effects.disturbance[%d].duration", k);
-            return lag_diag_fail(d, f, "expected a finite number > 0 (s), got %g", dk->duration);
-        }
+        char at[LAG_FIELD_MAX];
+        snprintf(at, sizeof at, "effects.disturbance[%d]", k);
+        lag_result r = lag_disturbance_check(def, &e->disturbances[k], at, d);
+        if (r != LAG_OK) return r;
     }
     return LAG_OK;
 }

@@ -144,6 +144,21 @@ static void without_kicks(const live_sets *ls, lag_sim_def *def)
     def->effects.n_disturbances = n < 0 ? 0 : n;
 }
 
+/* A kick's disturbance: an impulse at its tick, or a force held over the whole ticks from
+ * it that start before its end, n = ceil(duration / dt) of them, at impulse / (n dt): the
+ * impulse given is the one asked for, whatever the duration. */
+static lag_disturbance kick_disturbance(const live_kick *k, double dt)
+{
+    lag_disturbance d = {.t = (double)k->step * dt, .joint = k->joint, .impulse = true,
+                         .value = k->impulse}; /* lag_ticks_ceil gives k->step back */
+    if (k->duration == 0) return d;
+    int64_t n = lag_ticks_ceil(k->duration, dt);
+    d.impulse = false;
+    d.duration = (double)(n > 1 ? n : 1) * dt;
+    d.value = k->impulse / d.duration;
+    return d;
+}
+
 int live_kicks_append(const live_sets *ls, lag_sim_def *def, char *why, size_t whylen)
 {
     lag_effects_def *e = &def->effects;
@@ -153,17 +168,8 @@ int live_kicks_append(const live_sets *ls, lag_sim_def *def, char *why, size_t w
                  "exceed %d", e->n_disturbances, ls->nk, LAG_MAX_DISTURBANCES);
         return -1;
     }
-    const double dt = def->integrator.dt;
-    for (int k = 0; k < ls->nk; k++) {
-        const live_kick *kk = &ls->kick[k];
-        lag_disturbance *d = &e->disturbances[e->n_disturbances++];
-        memset(d, 0, sizeof *d);
-        d->t = (double)kk->step * dt; /* lag_ticks_ceil gives kk->step back */
-        d->joint = kk->joint;
-        d->impulse = !(kk->duration > 0);
-        d->value = d->impulse ? kk->impulse : kk->impulse / kk->duration;
-        d->duration = d->impulse ? 0.0 : kk->duration;
-    }
+    for (int k = 0; k < ls->nk; k++)
+        e->disturbances[e->n_disturbances++] = kick_disturbance(&ls->kick[k], def->integrator.dt);
     e->enabled |= LAG_EFF_DISTURBANCE;
     return 0;
 }
@@ -172,8 +178,9 @@ int live_kicks_append(const live_sets *ls, lag_sim_def *def, char *why, size_t w
  * disturbance_pre_tick decides, so that a kick is dropped only when it acts no more. */
 static bool kick_over(const live_kick *k, int64_t tick, double dt)
 {
-    if (!(k->duration > 0)) return tick > k->step;
-    return tick >= lag_ticks_ceil((double)k->step * dt + k->duration, dt);
+    lag_disturbance d = kick_disturbance(k, dt);
+    if (d.impulse) return tick > k->step;
+    return tick >= lag_ticks_ceil(d.t + d.duration, dt);
 }
 
 /* sim's definition with ls's kicks (after its own without those it carried before). */
@@ -192,42 +199,58 @@ static int redefine(const live_sets *old, const live_sets *ls, lag_sim *sim, cha
     return 0;
 }
 
-int live_kick_apply(live_sets *ls, lag_sim *sim, const char *kv, live_kick *k, char *why,
-                    size_t whylen)
+/* "kick.<joint>=<impulse>[,<duration>]" into k (its step: sim's tick), with the rules of
+ * any disturbance (lag_disturbance_check: a scene's words), on the kick as asked: an
+ * impulse, or a force impulse/duration held for duration s. */
+static int kick_parse(const lag_sim *sim, const char *kv, live_kick *k, char *why, size_t whylen)
 {
-    const lag_model_info *mi = lag_model_info_get(sim->def.model.kind);
     const char *eq = strchr(kv, '=');
-    size_t jlen = eq ? (size_t)(eq - kv) - 5 : 0;
+    char name[LIVE_SET_LEN];
+    size_t jlen = eq && live_is_kick(kv) ? (size_t)(eq - kv) - 5 : 0;
+    snprintf(name, sizeof name, "%.*s", (int)jlen, kv + (jlen ? 5 : 0));
     memset(k, 0, sizeof *k);
-    k->joint = -1;
-    for (int i = 0; eq && live_is_kick(kv) && i < mi->nq; i++)
-        if (strlen(mi->joint_names[i]) == jlen && !strncmp(kv + 5, mi->joint_names[i], jlen))
-            k->joint = i;
-    if (k->joint < 0) {
-        char names[256] = "";
-        for (int i = 0; i < mi->nq; i++)
-            snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s%s", i ? ", " : "",
-                     mi->joint_names[i], mi->actuated[i] ? " (actuated)" : "");
-        snprintf(why, whylen, "%s: unknown joint '%.*s' for model %s; joints: %s", kv, (int)jlen,
-                 eq ? kv + 5 : "", mi->name, names);
+    lag_diag d;
+    if (lag_disturbance_joint(&sim->def, name, NULL, &k->joint, &d) != LAG_OK) {
+        snprintf(why, whylen, "%s: %s", kv, d.message);
         return -1;
     }
     char *end;
     errno = 0;
     k->impulse = strtod(eq + 1, &end);
-    bool ok = end != eq + 1 && !errno && isfinite(k->impulse);
+    bool ok = end != eq + 1 && !errno;
     if (ok && *end == ',') {
         const char *p = end + 1;
         k->duration = strtod(p, &end);
-        ok = end != p && !errno && isfinite(k->duration) && k->duration >= 0 &&
-             k->duration <= 1e9;
+        ok = end != p && !errno;
     }
     if (!ok || *end) {
-        snprintf(why, whylen, "%s: expected IMPULSE or IMPULSE,DURATION (finite numbers, N s "
-                 "or N m s, and s >= 0)", kv);
+        snprintf(why, whylen, "%s: expected IMPULSE or IMPULSE,DURATION (numbers: N s or N m "
+                 "s, and s)", kv);
         return -1;
     }
     k->step = sim->tick;
+    const double dt = sim->def.integrator.dt;
+    lag_disturbance asked = {.t = (double)k->step * dt, .joint = k->joint,
+                             .impulse = k->duration == 0, .value = k->impulse,
+                             .duration = k->duration};
+    if (!asked.impulse) asked.value = k->impulse / k->duration;
+    if (lag_disturbance_check(&sim->def, &asked, NULL, &d) != LAG_OK) {
+        snprintf(why, whylen, "%s: %s%s: %s", kv, d.field,
+                 strcmp(d.field, "force") ? "" : " (impulse/duration)", d.message);
+        return -1;
+    }
+    return 0;
+}
+
+int live_kick_apply(live_sets *ls, lag_sim *sim, const char *kv, live_kick *k, char *why,
+                    size_t whylen)
+{
+    if (kick_parse(sim, kv, k, why, whylen) != 0) return -1;
+    /* a reset ends the fault and every kick: one now would be ended unapplied */
+    if (sim->fault.code != LAG_OK) {
+        snprintf(why, whylen, "%s: in fault state (reset first)", kv);
+        return -1;
+    }
     const double dt = sim->def.integrator.dt;
     static live_sets next; /* large: not on the stack */
     next = *ls;

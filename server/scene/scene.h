@@ -97,10 +97,11 @@ typedef struct lag_scene {
 #define LAG_SCENE_MAX_SCALAR 4096         /* bytes of one scalar (key or value) */
 
 /* The longest sim time a scene or the command line may name (a disturbance's t, a
- * force's duration, realtime.command_timeout, lagsimd --duration): about 31.7 years.
- * With integrator.dt >= 1e-6 s any such time is at most 1e15 ticks: an exact integer in
- * a double, far from int64's limit, so no conversion to ticks can overflow. */
-#define LAG_SCENE_MAX_TIME 1e9
+ * force's duration, realtime.command_timeout, lagsimd --duration): the core's
+ * (LAG_TIME_MAX, about 31.7 years). With integrator.dt >= 1e-6 s any such time is at most
+ * 1e15 ticks: an exact integer in a double, far from int64's limit, so no conversion to
+ * ticks can overflow. */
+#define LAG_SCENE_MAX_TIME LAG_TIME_MAX
 
 /* Default realtime.effort_limit, N or N m: far above what any controller of these models
  * commands, far below where the arithmetic of a step stops being finite. */

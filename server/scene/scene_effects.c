@@ -229,10 +229,13 @@ static int key_effect_actuator(conv *cv, const ynode *nd, const char *path)
     return sch_per_joint(cv, nd, path, actuator_joint);
 }
 
-/* disturbance: [{t, joint, impulse | force + duration}, ...] */
+/* disturbance: [{t, joint, impulse | force + duration}, ...]. The values' rules (t's
+ * bounds, the joint, the impulse's and force's bounds, a force's duration against dt) are
+ * the core's one check of a disturbance (lag_disturbance_check, also a kick's), reported
+ * at the key; the loader reads the numbers and the joint's name, and checks the shape. */
 static int dist_t(conv *cv, const ynode *nd, const char *path)
 {
-    return sch_get_magnitude(cv, nd, path, &R_TIME, &cv->cur_dist->t);
+    return sch_get_number(cv, nd, path, &cv->cur_dist->t);
 }
 
 static int dist_joint(conv *cv, const ynode *nd, const char *path)
@@ -244,10 +247,9 @@ static int dist_joint(conv *cv, const ynode *nd, const char *path)
     snprintf(what, sizeof what, "a joint name (%s)", names);
     if (sch_get_string(cv, nd, path, what, &name) < 0)
         return -1;
-    int j = sch_joint_index(cv, name);
-    if (j < 0)
-        return yfail(cv->err, nd, path, "unknown joint '%s'; allowed: %s", name, names);
-    cv->cur_dist->joint = j;
+    lag_diag d;
+    if (lag_disturbance_joint(&cv->sc->sim, name, NULL, &cv->cur_dist->joint, &d) != LAG_OK)
+        return yfail(cv->err, nd, path, "%s", d.message);
     return 0;
 }
 
@@ -255,28 +257,19 @@ static int dist_impulse(conv *cv, const ynode *nd, const char *path)
 {
     cv->cur_dist_kind |= 1;
     cv->cur_dist->impulse = true;
-    return sch_get_in(cv, nd, path, -F_MAX, F_MAX, false, "N s or N m s", &cv->cur_dist->value);
+    return sch_get_number(cv, nd, path, &cv->cur_dist->value);
 }
 
 static int dist_force(conv *cv, const ynode *nd, const char *path)
 {
     cv->cur_dist_kind |= 2;
     cv->cur_dist->impulse = false;
-    return sch_get_in(cv, nd, path, -F_MAX, F_MAX, false, "N or N m", &cv->cur_dist->value);
+    return sch_get_number(cv, nd, path, &cv->cur_dist->value);
 }
 
-/* A force acts over whole ticks: at least one dt (a shorter push is an impulse). */
 static int dist_duration(conv *cv, const ynode *nd, const char *path)
 {
-    double dt = cv->sc->sim.integrator.dt;
-    if (sch_get_number(cv, nd, path, &cv->cur_dist->duration) < 0)
-        return -1;
-    double v = fabs(cv->cur_dist->duration); /* > 0: the core's check */
-    if (v != 0.0 && (!(v >= dt) || !(v <= T_MAX)))
-        return yfail(cv->err, nd, path, "expected a magnitude from %.6g (integrator.dt: a force "
-                     "acts for whole ticks; a shorter push is an impulse) to %.6g (s), got %s",
-                     dt, T_MAX, nd->text);
-    return 0;
+    return sch_get_number(cv, nd, path, &cv->cur_dist->duration);
 }
 
 static const keyrow k_dist_keys[] = {
@@ -318,6 +311,12 @@ static int key_effect_disturbance(conv *cv, const ynode *nd, const char *path)
             return yfail(cv->err, it, sub, "a force needs a duration (s)");
         if (cv->cur_dist_kind == 1 && cv->cur_dist->duration != 0)
             return yfail(cv->err, it, sub, "an impulse takes no duration");
+        lag_diag d; /* the core's check, at once: at this disturbance's key */
+        if (lag_disturbance_check(&cv->sc->sim, cv->cur_dist, NULL, &d) != LAG_OK) {
+            char key[sizeof sub + LAG_FIELD_MAX + 1];
+            snprintf(key, sizeof key, "%s.%s", sub, d.field);
+            return yfail(cv->err, ytree_lookup(it, d.field), key, "%s", d.message);
+        }
     }
     return 0;
 }

@@ -15,10 +15,9 @@
 
 /* The longest sim time (scene.h explains the bound). */
 #define T_MAX LAG_SCENE_MAX_TIME
-/* The largest force-like value (N or N m, N s or N m s, N s/m): far beyond any load
- * these models are meant for (a 1e6 kg mass under 1e3 m/s^2 weighs 1e9 N) and small
- * enough that accelerations and energies computed from it stay finite. */
-#define F_MAX 1e12
+/* The largest force-like value (N or N m, N s or N m s, N s/m): the core's bound on a
+ * disturbance (lagsim.h says why), for every such key. */
+#define F_MAX LAG_FORCE_MAX
 
 /* A number's range, with its unit for the message; each is written next to the key that
  * reads it, with the reason for its bounds. */

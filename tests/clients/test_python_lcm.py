@@ -7,9 +7,17 @@ In-process (memq://), no network:
   - an exception in a handler is raised again by the handle_timeout() / handle() call
     that ran it (type and message intact), and the LCM works afterwards;
   - unsubscribe() stops delivery.
+And on udpm:// (a port from the process id, ttl=0): a signal whose Python handler runs
+while handle_timeout() waits ends the wait (False) and the handler runs, as the C client's
+lag_client_handle; it raised LCMError, so a controller's SIGTERM handler ended in a
+traceback instead of its summary.
 usage: test_python_lcm.py CLIENTS_PYTHON_DIR
 """
+import os
+import signal
 import sys
+import threading
+import time
 
 sys.path.insert(0, sys.argv[1])
 from lagsim_lcm import LCM  # noqa: E402
@@ -80,5 +88,23 @@ lc.publish("RX_D", b"z")
 drain(lc)
 check(got == [], "unsubscribe() stops delivery")
 lc.close()
+
+# a signal during the wait: handle_timeout() returns False, the handler has run
+seen = []
+signal.signal(signal.SIGUSR1, lambda signum, frame: seen.append(signum))
+udp = LCM("udpm://239.255.76.67:%d?ttl=0" % (30000 + 2 * (os.getpid() % 10000)))
+udp.subscribe("NOTHING_COMES", lambda ch, data: None)
+main = threading.get_ident()
+threading.Thread(target=lambda: (time.sleep(0.2), signal.pthread_kill(main, signal.SIGUSR1)),
+                 daemon=True).start()
+t0 = time.monotonic()
+try:
+    got_one = udp.handle_timeout(5000)
+    check(not got_one and seen == [signal.SIGUSR1] and time.monotonic() - t0 < 4,
+          "a signal ends handle_timeout()'s wait with False, its handler run (%s after %.2f s)"
+          % (seen, time.monotonic() - t0))
+except Exception as e:
+    check(False, "a signal ends handle_timeout()'s wait with False, not %r" % e)
+udp.close()
 print("%d failure(s)" % fails)
 sys.exit(1 if fails else 0)

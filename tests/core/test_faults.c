@@ -112,7 +112,7 @@ static void check_impulse(int arg)
     d.q0[1] = 1.0;
     d.effects.enabled = LAG_EFF_DISTURBANCE;
     d.effects.n_disturbances = 1;
-    d.effects.disturbances[0] = (lag_disturbance){0.005, 0, true, 1e300, 0};
+    d.effects.disturbances[0] = (lag_disturbance){0.005, 0, true, LAG_FORCE_MAX, 0};
     lag_sim s;
     if (tc_sim_init(&s, &d)) return;
     lag_result r = LAG_OK;

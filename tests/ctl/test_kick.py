@@ -17,7 +17,18 @@ changes only by the impulses given on x (T = 1/2 m x_dot^2 + ...: docs/models.md
   reset --scene                               -> a restore event; the scene says m = 1 again
 Then `lagsimd --replay` of the log applies every kick, the kicks_cleared and the restore
 at their steps and must give a largest difference of exactly 0; the same log without its
-events must not (the kicks mattered). The same for a run under control: the cart-pole of
+events must not (the kicks mattered).
+
+A kick obeys the rules of any disturbance, with the words of the scene loader: on a second
+stick, kicks the scene loader would refuse as a disturbance (a force held shorter than a
+tick, --duration 1e-6 and 1e-300; an impulse of 1e300; a force impulse/duration above
+1e12 N) are refused with exit 1, and each message is the one `lagsimd` gives for the same
+disturbance written in the scene file, and as a SET of effects.disturbance to that
+disturbance says; none changes x_dot. A kick spread over 1.5 ticks
+gives exactly its impulse (m x_dot = 0.5, not the 0.667 of a force 0.5/0.0015 held over two
+whole ticks). A kick of 1e7 N s faults the plant (x_dot past explode_limit, as the same
+impulse in a scene would); a kick in the fault is refused (a reset would end it unapplied:
+"in fault state (reset first)", as resume and step), and after the reset one is accepted. The same for a run under control: the cart-pole of
 config/cartpole.yaml balanced by lqr_balance in real time for 3 s, kicked on theta (an
 impulse) and on x (a force over 0.3 s) while it runs, logged with --log.
 """
@@ -57,6 +68,91 @@ def decode_state(data):
     q = struct.unpack_from(">%dd" % n, data, i)
     qd = struct.unpack_from(">%dd" % n, data, i + 8 * n)
     return {"step": step, "t": t, "names": names, "q": q, "qd": qd}
+
+
+def scene_words(lagsimd, cfg, tmp, item):
+    """What lagsimd says of the disturbance `item` (flow YAML) in cfg's scene file: the
+    message after "effects.disturbance[0].", and the exit status."""
+    path = os.path.join(tmp, "disturbance.yaml")
+    with open(cfg) as f:
+        text = f.read()
+    assert text.rstrip().splitlines()[-1].startswith("    ") and "\neffects:\n" in text
+    with open(path, "w") as f:
+        f.write(text.rstrip() + "\n  disturbance:\n    - %s\n" % item)
+    r = subprocess.run([lagsimd, "--config", path, "--offline", "--duration", "0.01"],
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True,
+                       timeout=60)
+    at = "effects.disturbance[0]."
+    err = r.stderr.strip()
+    return r.returncode, err[err.find(at) + len(at):] if at in err else err
+
+
+def rules(lagsimd, ctl_bin, cfg, prefix, tmp):
+    """Kicks under the rules of a disturbance, on config/stick.yaml (m = 1 kg, dt 1 ms)."""
+    log = os.path.join(tmp, "rules.lcm")
+
+    def ctl(*args):
+        r = subprocess.run([ctl_bin, "--prefix", prefix, "--timeout", "5"] + list(args),
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=60)
+        print("$ lagsimctl %s   -> exit %d %s" % (" ".join(args), r.returncode,
+                                                    r.stderr.strip()[:300]))
+        return r
+
+    # (kick arguments, the same disturbance in a scene file)
+    bad = [(["x", "0.5", "--duration", "1e-6"], "{t: 0, joint: x, force: 5e5, duration: 1e-6}"),
+           (["x", "0.5", "--duration", "1e-300"],
+            "{t: 0, joint: x, force: 5e299, duration: 1e-300}"),
+           (["x", "1e300"], "{t: 0, joint: x, impulse: 1e300}"),
+           (["x", "1e12", "--duration", "0.5"], "{t: 0, joint: x, force: 2e12, duration: 0.5}"),
+           (["cart", "1"], "{t: 0, joint: cart, impulse: 1}")]
+    d = subprocess.Popen([lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix, "-q",
+                          "--set", "realtime.start=paused", "--log", log],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        time.sleep(0.5)
+        for args, item in bad:
+            r = ctl("kick", *args)
+            rc, words = scene_words(lagsimd, cfg, tmp, item)
+            rs = ctl("set", "effects.disturbance=[%s]" % item)
+            at = "effects.disturbance[0]."
+            by_set = rs.stderr.strip()
+            by_set = by_set[by_set.find(at) + len(at):] if at in by_set else by_set
+            check(rs.returncode == 1 and by_set == words,
+                  "set effects.disturbance=[%s]: refused (exit %d) with the scene file's words"
+                  % (item, rs.returncode))
+            said = r.stderr.strip()
+            kv = "kick.%s=" % args[0]
+            said = said[said.find(kv):] if kv in said else said
+            said = said[said.find(": ") + 2:].replace(" (impulse/duration)", "", 1)
+            if words.startswith("joint: "):  # a kick names its joint in its key, kick.<joint>
+                words = words[len("joint: "):]
+            check(r.returncode == 1 and rc == 2 and said == words,
+                  "kick %s: refused (exit %d) with the words of the scene file's %s (exit %d): "
+                  "'%s' / '%s'" % (" ".join(args), r.returncode, item, rc, said, words))
+        r = ctl("--json", "kick", "x", "0.5", "--duration", "0.0015")
+        check(r.returncode == 0, "kick x 0.5 --duration 0.0015 (1.5 ticks): accepted")
+        check(ctl("step", "5").returncode == 0, "step 5")
+        check(ctl("kick", "x", "1e7").returncode == 0, "kick x 1e7: accepted (within 1e12)")
+        ctl("step", "1")
+        st = ctl("--json", "status")
+        run_state = [json.loads(l).get("run_state") for l in st.stdout.splitlines()
+                     if l.startswith("{")]
+        check(run_state[-1:] == ["fault"], "the kick of 1e7 N s faults the plant "
+              "(x_dot past explode_limit): run_state %s" % run_state[-1:])
+        r = ctl("kick", "x", "0.5")
+        check(r.returncode == 1 and "kick.x=0.5: in fault state (reset first)" in r.stderr,
+              "kick x 0.5 in the fault: refused, 'in fault state (reset first)'")
+        check(ctl("reset").returncode == 0, "reset")
+        check(ctl("kick", "x", "0.5").returncode == 0, "kick x 0.5 after the reset: accepted")
+    finally:
+        d.terminate()
+        d.wait(10)
+    states = [decode_state(data) for _, ch, data in read_log(log) if ch == prefix + "_STATE"]
+    v = [s["qd"][s["names"].index("x")] for s in states if s["step"] == 50]
+    check(bool(v) and abs(1.0 * v[0] - 0.5) <= 1e-12,
+          "m x_dot after the refused kicks and kick x 0.5 over 1.5 ticks: %r (exactly the "
+          "impulse 0.5 N s)" % (v[0] if v else None))
 
 
 def main():
@@ -108,8 +204,8 @@ def main():
               "two kicks with --duration 0.05 at step 50: exit 0 each")
         check(ctl("step", "10").returncode == 0, "step 10")
         r = ctl("kick", "cart", "1")
-        check(r.returncode == 1 and "unknown joint 'cart'" in r.stderr and
-              "x (actuated)" in r.stderr, "kick cart 1: exit 1, the joints named")
+        check(r.returncode == 1 and "unknown joint 'cart' for model stick; allowed: x, phi" in
+              r.stderr, "kick cart 1: exit 1, the joints named")
         r = ctl("kick", "x")
         check(r.returncode == 2, "kick x (no impulse): exit 2")
         r = ctl("set", "parameters.m=2")
@@ -224,6 +320,8 @@ def main():
     r, diff = replay_cfg(cfg_cp, pcp, bare_cp)
     check(r.returncode == 1 and diff is not None and diff > 0,
           "the same log without its events: difference %r, not 0" % diff)
+
+    rules(lagsimd, ctl_bin, cfg, prefix + "R", tmp)
 
     r, diff = replay(log)
     check(r.returncode == 0 and diff == 0.0 and "7 change(s) made while running" in r.stdout,

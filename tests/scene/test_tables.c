@@ -18,7 +18,7 @@
  *                  ranges list every row, and name no effect the core does not have
  *                  (prose, written by hand; the lists that can be generated are:
  *                  server/lists, structure_lists)
- *   docs_channels  docs/server.md's table of channels and lagsimd.1's CHANNELS name the
+ *   docs_channels  docs/protocol.md's table of channels and lagsimd.1's CHANNELS name the
  *                  bus's channels (lagsim_bus.c's table), each once, and no other
  *   docs_keys      every numeric key of the loader's tables, for every model, has its row
  *                  in docs/scenes.md's table of ranges (reference keys: in the table of
@@ -419,9 +419,9 @@ static void doc_channels(const char *file, const char *start, const char *end, c
 static void case_docs_channels(int arg)
 {
     (void)arg;
-    doc_channels("docs/server.md", "| channel | type |", "\n\n", "\n| `<PREFIX>", "` |");
+    doc_channels("docs/protocol.md", "| channel | type |", "\n\n", "\n| `<PREFIX>", "` |");
     doc_channels("docs/man/lagsimd.1", ".SH CHANNELS", ".SH SIGNALS", "\n.IB PREFIX ", "\n");
-    printf("docs_channels: the bus's %d channels looked for in server.md's table and lagsimd.1\n",
+    printf("docs_channels: the bus's %d channels looked for in protocol.md's table and lagsimd.1\n",
            LAG_BUS_CHANNEL_COUNT);
 }
 

@@ -268,6 +268,16 @@ lag_effect_info lag_effect_info_get(int index);
 int lag_effect_from_name(const char *name);
 #define LAG_MAX_DISTURBANCES 16
 
+/* The largest magnitude of a disturbance's impulse (N s or N m s) or force (N or N m), and
+ * of every force-like value of a scene: far beyond any load these models are meant for (a
+ * 1e6 kg mass under 1e3 m/s^2 weighs 1e9 N), small enough that accelerations and energies
+ * computed from it stay finite. */
+#define LAG_FORCE_MAX 1e12
+/* The longest sim time a disturbance (its t, a force's duration) or a scene may name:
+ * about 31.7 years. With a dt >= 1e-6 s any such time is at most 1e15 ticks, an exact
+ * integer in a double far from int64's limit, so no conversion to ticks can overflow. */
+#define LAG_TIME_MAX 1e9
+
 typedef struct lag_disturbance {
     double t;        /* sim time it starts, s (applied at the tick boundary at or after t) */
     int joint;       /* coordinate index */
@@ -360,6 +370,21 @@ lag_sim_def lag_default_sim_def(lag_model_kind kind);
 lag_result lag_sim_def_check(const lag_sim_def *def, lag_diag *d);
 /* The same, with "field: message" written into err (what lag_sim_init reports). */
 lag_result lag_sim_def_validate(const lag_sim_def *def, char *err, size_t errlen);
+
+/* The one check of a disturbance, whether a scene's schedule, a change made while running
+ * or a kick asks for it (lag_effects_check calls it for each of def's; the scene loader
+ * reports its message at the key, the daemon on the bus): t in [0, LAG_TIME_MAX]; joint
+ * one of def's model's; an impulse has no duration; a force is held for a duration from
+ * def's integrator.dt (a force acts over whole ticks: a shorter push is an impulse) to
+ * LAG_TIME_MAX; the value a number of magnitude at most LAG_FORCE_MAX. Returns LAG_OK, or
+ * LAG_ERR_ARG with d's field `at`.<key> (key: t, joint, duration, impulse or force; the key
+ * alone when `at` is NULL or ""). OUT: d */
+lag_result lag_disturbance_check(const lag_sim_def *def, const lag_disturbance *dist,
+                                 const char *at, lag_diag *d);
+/* The joint of def's model named `name`, for a disturbance: its index in *joint, or
+ * LAG_ERR_ARG with field `at`.joint and the words that name the model's joints. OUT: joint, d */
+lag_result lag_disturbance_joint(const lag_sim_def *def, const char *name, const char *at,
+                                 int *joint, lag_diag *d);
 
 /* What the last refused tick ran into (see lag_sim_fault_describe). */
 typedef struct lag_fault {

@@ -41,8 +41,9 @@ public final class BoundedInput implements DataInput {
      * The message in the unread bytes of {@code ins}, decoded by {@code decoder} with its
      * string lengths checked; IOException unless it decodes whole: lcm-gen's decoder reads
      * a string without its NUL, or with bytes left over, as if nothing were wrong, so the
-     * message must encode back to the very bytes that came; and every double in it must
-     * be finite. Whatever the bytes, the only exception is IOException: one that escaped a
+     * message must encode back to the very bytes that came; every double in it must be
+     * finite, and no string may hold a NUL but the one it ends with (lcm-gen's decoder
+     * keeps an inner one, which encodes back to the same bytes). Whatever the bytes, the only exception is IOException: one that escaped a
      * handler would end LCM's receive thread.
      */
     public static <T extends LCMEncodable> T decode(LCMDataInputStream ins, Decoder<T> decoder)
@@ -67,6 +68,11 @@ public final class BoundedInput implements DataInput {
                 if (v instanceof double[])
                     for (double x : (double[]) v)
                         if (!Double.isFinite(x)) throw new IOException("non-finite " + f.getName());
+                if (v instanceof String && ((String) v).indexOf('\0') >= 0)
+                    throw new IOException("a NUL inside " + f.getName());
+                if (v instanceof String[])
+                    for (String x : (String[]) v)
+                        if (x.indexOf('\0') >= 0) throw new IOException("a NUL inside " + f.getName());
             }
         } catch (IllegalAccessException e) {
             throw new IOException(e);
