@@ -256,8 +256,12 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
     if (!w) return NULL;
     w->env = *env;
     w->sc = *sc;
-    snprintf(w->log, sizeof w->log, "%s/%s.lcm", env->workdir, env->prefix);
-    unlink(w->log);
+    if (env->attach_log) { /* a plant of the sweep's host: its log is the host's */
+        snprintf(w->log, sizeof w->log, "%s", env->attach_log);
+    } else {
+        snprintf(w->log, sizeof w->log, "%s/%s.lcm", env->workdir, env->prefix);
+        unlink(w->log);
+    }
     char cmd[4096];
     if (eval_expand(env->controller, env, cmd, sizeof cmd, err, errlen)) {
         free(w);
@@ -265,7 +269,7 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
     }
     /* the controller first, as eval_run starts them */
     w->cpid = eval_spawn(NULL, cmd, env);
-    w->dpid = start_daemon(w, c);
+    w->dpid = env->attach_log ? 0 : start_daemon(w, c);
     w->cl = lag_client_create(env->url, env->prefix, err, errlen);
     if (w->cpid < 0 || w->dpid < 0 || !w->cl)
         return start_failed(w, err, errlen, w->cl ? "cannot start the processes" : err);
@@ -279,6 +283,9 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
     lag_client_scene scene;
     if (lag_client_wait_scene(w->cl, 10.0, &scene) != LAG_CLIENT_OK)
         return start_failed(w, err, errlen, "no scene from the kept lagsimd");
+    /* a host's plant a worker before may have left in the middle of a run: paused first
+     * (a plant paused already refuses it, harmlessly) */
+    if (env->attach_log) lag_client_pause(w->cl);
     if (step_once(w, 1, 30))
         return start_failed(w, err, errlen, "the kept lagsimd did not step");
     return w;
@@ -298,7 +305,7 @@ void eval_worker_stop(eval_worker *w)
     if (w->cl) lag_client_destroy(w->cl);
     if (w->cmd) lcm_destroy(w->cmd);
     eval_series_free(&w->s);
-    if (!w->env.verbose) unlink(w->log);
+    if (!w->env.verbose && !w->env.attach_log) unlink(w->log);
     free(w);
 }
 
