@@ -23,6 +23,11 @@ Cases:
               file removed stops its plant, SIGHUP stops nothing; the other plants never get
               a stop, a start or a new generation; SIGTERM stops every plant (a stop event
               each), exit 0
+  list        lagsimctl list through the host's directory: every plant with its own URL;
+              status through it, pause only on the plant's own URL; lagsim-view --prefix P
+              finds P's URL there; a plant on the directory's ports refused
+  many        120 plants in one process (LCM's receive path aborted it at about 85),
+              lagsimctl list naming each on its own pair, SIGTERM stopping all
 """
 import argparse
 import fcntl
@@ -505,6 +510,14 @@ class T:
             check(p.returncode == 0, "pause on BOB's own URL: exit 0")
             p = self.ctl("--prefix", "ALICE", "--timeout", "1", "pause")
             check(p.returncode == 3, "pause through the directory: not done there (exit 3)")
+            view = self.start([self.prog("lagsim-view"), "--prefix", "CAROL", "--port", "0"],
+                              stdout=subprocess.PIPE)
+            line = view.stdout.readline()
+            view.send_signal(signal.SIGTERM)
+            self.finish(view, 10)
+            check("(prefix CAROL on %s)" % url(base + 4) in line,
+                  "lagsim-view --prefix CAROL watches CAROL on the URL the directory names: %s"
+                  % line.strip())
             host.send_signal(signal.SIGTERM)
             rc, err = self.finish_pumping(host, bus, 30)
             check("dir.yaml: ports %d and %d are the host's directory" %
