@@ -6,7 +6,7 @@ pkgs=(build-essential cmake pkg-config clang libclang-rt-14-dev   # gcc pass; cl
       liblcm-dev liblcm-bin libglib2.0-dev libyaml-dev   # LCM (lcm.pc needs glib's dev package) and libyaml
       liblapacke-dev                                     # the example controllers' LQR design (LAPACK)
       python3                                            # the stdlib-only Python client and some tests
-      lua5.2 liblcm-lua                                  # the Lua 5.2 clients (liblcm-lua is built for 5.2 only)
+      lua5.2 liblcm-lua lua-posix                        # the Lua 5.2 clients (liblcm-lua is built for 5.2 only; lua-posix: their SIGINT, SIGTERM)
       libmujoco-dev libsundials-dev gnuplot-nox          # benchmark peers and plots
       liblcm-java libjchart2d-java default-jdk-headless  # the Java clients; lcm-spy with lagsim's types
       octave octave-control                              # the MATLAB/Octave clients (dlqr, lqr) and their tests

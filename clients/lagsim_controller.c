@@ -315,10 +315,12 @@ static int wait_scene(lag_ctl *ctl)
         double left = deadline - lag_client_now();
         int rc = lag_client_wait_scene(ctl->client, left < 0.25 ? left : 0.25, &ctl->scene);
         if (rc == LAG_CLIENT_OK) return 0;
-        if (rc < 0 || g_signal || !(left > 0.25)) {
-            if (g_signal)
-                fprintf(stderr, "%s: interrupted while waiting for the scene\n", ctl->name);
-            else if (rc < 0)
+        if (g_signal) {
+            ctl->end = "signal"; /* lag_ctl_fail: the summary, exit 0 */
+            return 1;
+        }
+        if (rc < 0 || !(left > 0.25)) {
+            if (rc < 0)
                 fprintf(stderr, "%s: %s\n", ctl->name, lag_client_errmsg(ctl->client));
             else
                 fprintf(stderr, "%s: no scene description on %s_SCENE within %g s (is lagsimd "
@@ -467,6 +469,8 @@ int lag_ctl_finish(lag_ctl *ctl, const char *fmt, ...)
 
 int lag_ctl_fail(lag_ctl *ctl)
 {
+    /* SIGINT or SIGTERM while waiting for the scene: a run that ended, no failure */
+    if (ctl->end && strcmp(ctl->end, "signal") == 0) return lag_ctl_finish(ctl, "states=0");
     if (ctl->trace) fclose(ctl->trace);
     ctl->trace = NULL;
     lag_client_destroy(ctl->client);

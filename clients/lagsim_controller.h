@@ -147,7 +147,9 @@ int lag_ctl_command(lag_ctl *ctl, const lag_client_state *st, int n, const char 
 int lag_ctl_finish(lag_ctl *ctl, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /* Closes the trace and the client without a summary (a run that could not start).
- * Returns the exit status (lag_result_exit): 1, or 2 when several plants could be meant. */
+ * Returns the exit status (lag_result_exit): 1, or 2 when several plants could be meant.
+ * A start that SIGINT or SIGTERM ended while it waited for the scene is no failure: the
+ * summary (end=signal states=0) as lag_ctl_finish prints it, and 0. */
 int lag_ctl_fail(lag_ctl *ctl);
 
 #ifdef __cplusplus

@@ -111,6 +111,16 @@ function(lang_end_tests lang example cfg)
   set(lang_tests ${lang_tests} clients_${lang}_${example}_ends_on_stop
       clients_${lang}_${example}_ends_on_silence PARENT_SCOPE)
 endfunction()
+# SIGINT and SIGTERM, each while the controller waits for its scene and in the middle of a
+# lockstep run: end=signal, the summary, exit 0 (tests/clients/signal_end.py), for each
+# language's controller setup.
+function(lang_signal_test lang cfg)
+  add_test(NAME clients_${lang}_ends_on_signal
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/signal_end.py
+      --lagsimd ${lang_lagsimd} ${cfg} -- ${ARGN} --prefix {prefix} -q)
+  set_tests_properties(clients_${lang}_ends_on_signal PROPERTIES TIMEOUT 200 LABELS clients)
+endfunction()
+lang_signal_test(python "${lang_manip_cfg}" ${LAGSIM_PYTHON3} ${py_dir}/manipulator_pd.py ${py_types})
 lang_end_tests(python dipc "${lang_dipc_cfg}" ${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py ${py_types})
 lang_end_tests(python manipulator "${lang_manip_cfg}"
                ${LAGSIM_PYTHON3} ${py_dir}/manipulator_pd.py ${py_types})
@@ -177,6 +187,7 @@ add_test(NAME clients_c_stick_push_lockstep
 list(APPEND lang_tests clients_c_stick_push_lockstep)
 set(lang_stick_cfg --config ${PROJECT_SOURCE_DIR}/config/stick.yaml)
 lang_end_tests(c stick "${lang_stick_cfg}" $<TARGET_FILE:stick_push>)
+lang_signal_test(c "${lang_manip_cfg}" $<TARGET_FILE:manipulator_pd>)
 
 # ---- Lua 5.2
 if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
@@ -188,6 +199,7 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
       -- ${LAGSIM_LUA52} ${lua_dir}/manipulator_pd.lua ${lua_types} --prefix {prefix} --duration 10 -q)
   list(APPEND lang_tests clients_lua_lcm clients_lua_manipulator_lockstep)
   lang_end_tests(lua manipulator "${lang_manip_cfg}" ${LAGSIM_LUA52} ${lua_dir}/manipulator_pd.lua ${lua_types})
+  lang_signal_test(lua "${lang_manip_cfg}" ${LAGSIM_LUA52} ${lua_dir}/manipulator_pd.lua ${lua_types})
   lang_end_tests(lua dipc "${lang_dipc_cfg}" ${LAGSIM_LUA52} ${lua_dir}/dipc_balance.lua ${lua_types})
   add_test(NAME clients_lua_dipc_hostile
     COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLHOSTLUA --timeout 60 ${lang_hostile_checks}
@@ -216,6 +228,7 @@ if(TARGET lagsim_examples_java)
       -- ${java_run} lagsim.examples.DipcBalance --prefix {prefix} --duration 20 -q)
   list(APPEND lang_tests clients_java_dipc_lockstep)
   lang_end_tests(java dipc "${lang_dipc_cfg}" ${java_run} lagsim.examples.DipcBalance)
+  lang_signal_test(java "${lang_dipc_cfg}" ${java_run} lagsim.examples.DipcBalance)
   add_test(NAME clients_java_dipc_hostile
     COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLHOSTJ --timeout 60 ${lang_hostile_checks}
       -- ${java_run} lagsim.examples.DipcBalance --prefix {prefix} --duration 20 -q)
@@ -471,10 +484,11 @@ add_test(NAME clients_readme_evaluate
 set_tests_properties(clients_readme_evaluate PROPERTIES TIMEOUT 560 LABELS "clients;slow")
 # docs/clients.md's newcomer walkthrough, its balance.py and commands as written: the
 # cart-pole balanced by Python for 10 s, logged, replayed, converted, plotted, and played
-# back to lagsim-view (which binds the walkthrough's port 8765)
+# back to lagsim-view (which binds the walkthrough's port 8765); then the same balance.py in
+# lockstep (a command without the state's generation is never taken there)
 add_test(NAME clients_walkthrough
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_recipes.py
-          --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} walkthrough)
+          --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} walkthrough walkthrough-lockstep)
 set_tests_properties(clients_walkthrough PROPERTIES TIMEOUT 200 LABELS clients)
 
 set_tests_properties(${lang_tests} PROPERTIES TIMEOUT 90 LABELS clients)

@@ -13,7 +13,9 @@ wait for the scene, answer states until the run ends, a summary line.
 
 A run ends when the daemon publishes its `stop` event, when nothing came from the daemon
 (no state, status or event) for --timeout s of waiting, or after --duration s of sim
-time from the first state; ctl.end_reason says which (stop, silence, duration). Exit
+time from the first state, or on SIGINT or SIGTERM (through Debian's lua-posix; without
+it the signal ends the process); ctl.end_reason says which (stop, silence, duration,
+signal; a signal while it waits for the scene prints the summary with states=0). Exit
 status: 0 for these; 1 when no scene came within --timeout or it is another model's;
 2 bad usage. Common options: --prefix, --url, --duration, --timeout, --types DIR (where
 the lcm-gen Lua package `lagsim` is), --trace FILE (one line per answered state: sim time,
@@ -161,6 +163,9 @@ function Controller:start(argv)
   self.lc_cmd = command_url ~= state_url and lagsim_lcm.new(command_url) or self.lc
   local ch = o.prefix .. '_'
   self.silent_ms = 0
+  -- SIGINT, SIGTERM: the run ends (end=signal), with its summary, exit 0
+  self.signalled = false
+  lagsim_lcm.on_signals(function() self.signalled = true end)
   self.lc:subscribe(ch .. 'SCENE', function(_, data)
     self.silent_ms = 0
     local sc = self:decode(t.scene_t, data)
@@ -190,6 +195,10 @@ function Controller:start(argv)
   io.stdout:flush()
   local waited, next_ask = 0, 0
   while not self.scene do
+    if self.signalled then -- a run that ended before its scene came: no failure
+      self.end_reason = 'signal'
+      os.exit(self:finish('states=0'))
+    end
     if waited >= o.timeout * 1000 then
       fail(self, 1, string.format('no scene on %sSCENE within %g s (is lagsimd running with this prefix?)',
                                   ch, o.timeout))
@@ -219,6 +228,7 @@ end
 local function with_scene(self, st)
   local o, next_ask, waited = self.o, 0, 0
   while st.generation ~= self.scene.generation do
+    if self.signalled then self.end_reason = 'signal' return nil end
     if self.stopped then self.end_reason = 'stop' return nil end
     if self.silent_ms >= o.timeout * 1000 then self.end_reason = 'silence' return nil end
     if waited >= next_ask then
@@ -249,6 +259,7 @@ function Controller:states()
     local st
     repeat
       while not self.state do
+        if self.signalled then self.end_reason = 'signal' return nil end
         if self.stopped then self.end_reason = 'stop' return nil end
         if self.silent_ms >= o.timeout * 1000 then self.end_reason = 'silence' return nil end
         if not self.lc:handle_timeout(WAIT_MS) then self.silent_ms = self.silent_ms + WAIT_MS end

@@ -9,6 +9,8 @@ Debian's `lcm` module (liblcm-lua, for Lua 5.2 only: lua5.3 and later cannot loa
     lc:handle()                              -- waits for one message, runs its handlers
     lc:handle_timeout(ms)                    -- true if one was handled, false on timeout
     lc:timedhandle(s)                        -- old form of handle_timeout (seconds)
+(a signal that interrupts a wait raises an error there too; this wrapper's handle_timeout
+returns false instead when the signal is one of M.on_signals', whose handler has run)
 Channels are LCM's regular expressions (anchored). The raw module has one trap: an error
 raised inside a handler unwinds through liblcm's C code and leaves the lcm_t unusable (the
 next handle aborts the process). This wrapper has the same methods but runs each handler
@@ -103,8 +105,31 @@ function LCM:handle()
   raise_pending(self)
 end
 
+-- Signals taken by M.on_signals: a wait that one of them interrupts is no error.
+local signals = 0
+
+-- Calls fn(signo) on SIGINT and SIGTERM instead of ending the process (lua-posix's
+-- posix.signal; Debian's lua-posix). A handle_timeout that a signal interrupts returns
+-- false, as on a timeout, the handler having run. false when lua-posix is absent.
+function M.on_signals(fn)
+  local ok, ps = pcall(require, 'posix.signal')
+  if not ok then return false end
+  for _, signo in ipairs({ ps.SIGINT, ps.SIGTERM }) do
+    ps.signal(signo, function(s)
+      signals = signals + 1
+      fn(s)
+    end)
+  end
+  return true
+end
+
 function LCM:handle_timeout(ms)
-  local r = self.lc:handle_timeout(math.floor(ms))
+  local before = signals
+  local ok, r = pcall(self.lc.handle_timeout, self.lc, math.floor(ms))
+  if not ok then
+    if signals == before then error(r, 0) end
+    r = false -- liblcm-lua raises on EINTR: a signal ended the wait
+  end
   raise_pending(self)
   return r
 end

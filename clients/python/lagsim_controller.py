@@ -131,8 +131,9 @@ class Controller(object):
                 self._ask_scene()
                 next_ask = now + DESCRIBE_S
             self.lc.handle_timeout(50)
-        if self.scene is None:
-            sys.exit(1)
+        if self.scene is None:  # SIGINT or SIGTERM while waiting: a run that ended, cleanly
+            self.end = "signal"
+            sys.exit(self.finish("states=0"))
         if self.scene.model != self.model:
             sys.stderr.write("%s: prefix %s runs model %r, not %s\n"
                              % (self.name, a.prefix, self.scene.model, self.model))

@@ -26,7 +26,10 @@ The methods follow LCM's own Python binding:
   handle() or handle_timeout() call that ran the handler, with its traceback: it never
   unwinds through C and is never swallowed.
 - handle() blocks until one message has been handled; handle_timeout(ms) waits at most
-  ms milliseconds; fileno() gives the socket for select()/poll().
+  ms milliseconds; fileno() gives the socket for select()/poll(). A signal that
+  interrupts the wait is no error: its Python handler runs and handle_timeout() returns
+  False (handle() waits on), so a loop that checks a flag set by a handler of SIGINT or
+  SIGTERM ends cleanly.
 
 Not thread-safe, like lcm_t itself: use one LCM per thread.
 """
@@ -185,11 +188,17 @@ class LCM(object):
             raise e
 
     def handle(self):
-        """Waits for one message and runs its handlers."""
-        rc = self._lib.lcm_handle(self._lcm)
-        self._raise_pending()
-        if rc != 0:
-            raise LCMError("lcm_handle failed")
+        """Waits for one message and runs its handlers. A signal's handler runs (a
+        KeyboardInterrupt it raises reaches the caller) and the wait goes on, as
+        Python's own blocking calls do (PEP 475)."""
+        while True:
+            ctypes.set_errno(0)
+            rc = self._lib.lcm_handle(self._lcm)
+            self._raise_pending()
+            if rc == 0:
+                return
+            if ctypes.get_errno() != errno.EINTR:
+                raise LCMError("lcm_handle failed")
 
     def handle_timeout(self, timeout_ms):
         """Handles at most one message, waiting up to timeout_ms milliseconds.

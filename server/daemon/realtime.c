@@ -99,7 +99,7 @@ static bool paused_copies(const rt_server *s)
 static rt_wait_seen wait_seen(const rt_server *s)
 {
     rt_wait_seen w = {RT_WAIT_NONE, 0, s->rejected, s->bus.commands_wrong_port, s->last_reject,
-                      false};
+                      false, s->stale};
     bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
     if (s->run == RT_FAULT) w.kind = RT_WAIT_RESET;
     else if (s->run == RT_PAUSED && s->pending_steps == 0) {
@@ -494,6 +494,7 @@ static bool command_of_now(rt_server *s, const lag_wire_joint_command *c)
     bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
     if (c->generation == now_gen || (c->generation == 0 && !lockstep)) return true;
     rt_verdict v = {RT_REJ_STALE, "", c->sim_time, ""};
+    s->stale[c->generation == 0 ? RT_STALE_NO_GENERATION : RT_STALE_GENERATION]++;
     if (c->generation == 0)
         snprintf(v.what, sizeof v.what, "generation 0 answers no state; lockstep advances on "
                  "the generation and sim_time of the state waited on (generation %lld)",
@@ -522,6 +523,7 @@ static bool command_in_step(rt_server *s, const lag_wire_joint_command *c)
     bool waited_on = rt_lockstep_is_waited(&s->ls, c->generation, c->sim_time);
     if (waited_on || (s->run != RT_RUNNING && c->sim_time == lag_sim_time(&s->sim))) return true;
     rt_verdict v = {RT_REJ_STALE, "", c->sim_time, ""};
+    s->stale[RT_STALE_SIM_TIME]++;
     if (s->ls.waiting)
         snprintf(v.what, sizeof v.what, "sim_time %.9g (in value); accepted: %.9g, the state "
                  "waited on", c->sim_time, s->ls.waiting_time);

@@ -29,6 +29,15 @@ typedef enum rt_reject {
 /* The reasons of rt_reject, by index. */
 extern const char *const rt_reject_name[RT_REJ_COUNT];
 
+/* What a stale command answered instead of the state waited on (RT_REJ_STALE's kinds,
+ * indexing rt_server.stale): the waits say which, for the fix of each differs. */
+typedef enum rt_stale {
+    RT_STALE_SIM_TIME = 0,    /* the right generation, another sim_time */
+    RT_STALE_GENERATION,      /* another generation: a state of an earlier run or scene */
+    RT_STALE_NO_GENERATION,   /* generation 0: the command carries none (lockstep) */
+    RT_STALE_COUNT
+} rt_stale;
+
 /* A refusal: its reason, the joint and value its event carries, and what was wrong and
  * what would be accepted (the event's detail after the reason's name). */
 typedef struct rt_verdict {

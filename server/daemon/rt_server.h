@@ -99,6 +99,7 @@ typedef struct rt_server {
     int64_t overrun_bursts;
     int64_t accepted;
     int64_t rejected[RT_REJ_COUNT];
+    int64_t stale[RT_STALE_COUNT]; /* rejected[RT_REJ_STALE] by kind (the waits say them) */
     int64_t watchdog_trips;
     int64_t lockstep_timeouts;
     int64_t commands_ignored;  /* answers to a state already answered */

@@ -13,8 +13,10 @@
  * a lockstep round trip is a wait too, a short one), RESUME or STEP while paused, RESET
  * while in the fault state. What came instead, since the wait began: commands rejected
  * (by reason, and the last one's reason), commands heard on the state URL (the port
- * before the command port: a controller that publishes on the wrong port), answers to
- * another sim_time (stale).
+ * before the command port: a controller that publishes on the wrong port), answers that
+ * are stale, by what they answered instead: another sim_time, another generation, or no
+ * generation at all (a command of generation 0, which lockstep never takes: a controller
+ * that builds its commands by hand and copies the state's sim_time alone).
  */
 #include <stdarg.h>
 #include <stdio.h>
@@ -44,6 +46,7 @@ void rt_wait_update(rt_wait *w, int64_t now, const rt_wait_seen *seen, rt_term *
         w->since_ns = now;
         w->next_line_ns = rt_sat_add(now, RT_WAIT_LINE_NS);
         memcpy(w->rejected0, seen->rejected, sizeof w->rejected0);
+        memcpy(w->stale0, seen->stale, sizeof w->stale0);
         w->wrong_port0 = seen->wrong_port;
     }
     if (k == RT_WAIT_NONE || now < w->next_line_ns) return;
@@ -77,6 +80,29 @@ static size_t add(char *buf, size_t cap, size_t n, const char *fmt, ...)
     va_end(ap);
     if (w < 0) return n;
     return n + (size_t)w < cap ? n + (size_t)w : cap - 1;
+}
+
+/* The stale answers since the wait began, by what they answered: another sim_time, another
+ * generation, or none (generation 0: lockstep needs the state's, which the command did not
+ * copy). Appended to got (holding n bytes); returns its new length. */
+static size_t add_stale(const rt_wait *w, const rt_wait_seen *seen, char *got, size_t gotlen,
+                        size_t n)
+{
+    int64_t d[RT_STALE_COUNT];
+    for (int k = 0; k < RT_STALE_COUNT; k++) d[k] = seen->stale[k] - w->stale0[k];
+    if (d[RT_STALE_SIM_TIME] > 0)
+        n = add(got, gotlen, n, "%s%lld answer%s to another sim_time", n ? "; " : "",
+                (long long)d[RT_STALE_SIM_TIME], d[RT_STALE_SIM_TIME] > 1 ? "s" : "");
+    if (d[RT_STALE_GENERATION] > 0)
+        n = add(got, gotlen, n, "%s%lld answer%s of another generation (a state of an earlier "
+                "run or scene)", n ? "; " : "", (long long)d[RT_STALE_GENERATION],
+                d[RT_STALE_GENERATION] > 1 ? "s" : "");
+    if (d[RT_STALE_NO_GENERATION] > 0)
+        n = add(got, gotlen, n, "%s%lld answer%s of generation 0 (the command carries none: "
+                "it copies the state's generation with its sim_time; docs/server.md, "
+                "Generations)", n ? "; " : "",
+                (long long)d[RT_STALE_NO_GENERATION], d[RT_STALE_NO_GENERATION] > 1 ? "s" : "");
+    return n;
 }
 
 double rt_wait_describe(const rt_wait *w, int64_t now, const rt_wait_seen *seen, char *what,
@@ -141,8 +167,6 @@ double rt_wait_describe(const rt_wait *w, int64_t now, const rt_wait_seen *seen,
         n = add(got, gotlen, n, "%s%lld command%s on %s at the state port %d (commands go to "
                 "port %d)", n ? "; " : "", (long long)wrong, wrong > 1 ? "s" : "", ch_command,
                 w->bus->state_port, w->bus->command_port);
-    if (stale > 0)
-        n = add(got, gotlen, n, "%s%lld answer%s to another sim_time", n ? "; " : "",
-                (long long)stale, stale > 1 ? "s" : "");
+    if (stale > 0) n = add_stale(w, seen, got, gotlen, n);
     return waited;
 }

@@ -35,6 +35,7 @@ typedef struct rt_wait_seen {
     const char *last_reject;    /* why the last command was rejected (not stale) */
     bool owed;                  /* RT_WAIT_RESUME in lockstep: the state waited on (at t)
                                  * has not been answered yet */
+    const int64_t *stale;       /* [RT_STALE_COUNT]: the stale rejections, by kind */
 } rt_wait_seen;
 
 typedef struct rt_wait {
@@ -46,6 +47,7 @@ typedef struct rt_wait {
     int64_t since_ns;           /* when the wait began */
     int64_t next_line_ns;       /* its next line on stderr */
     int64_t rejected0[RT_REJ_COUNT]; /* the counters when it began */
+    int64_t stale0[RT_STALE_COUNT];
     int64_t wrong_port0;
 } rt_wait;
 

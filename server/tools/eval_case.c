@@ -920,3 +920,39 @@ FILE *eval_open_out(const char *prog, const char *what, const char *path, bool f
     }
     return fdopen(fd, "w");
 }
+
+/* The next word of a shell command at *p into w (of 1024 bytes): quotes removed, a word
+ * cut at 1023 bytes. false at the command's end. */
+static bool shell_word(const char **p, char *w)
+{
+    const char *s = *p;
+    while (*s && (strchr(" \t\n;&|<>()", *s))) s++;
+    if (!*s) return false;
+    size_t n = 0;
+    char quote = 0;
+    for (; *s && (quote || !strchr(" \t\n;&|<>()", *s)); s++) {
+        char c = *s;
+        if (quote == '\'') {
+            if (c == '\'') { quote = 0; continue; }
+        } else if (c == '\\' && s[1] && (!quote || strchr("\"\\$`", s[1]))) {
+            c = *++s;
+        } else if (c == '"' || (c == '\'' && !quote)) {
+            quote = quote ? 0 : c;
+            continue;
+        }
+        if (n < 1023) w[n++] = c;
+    }
+    w[n] = '\0';
+    *p = s;
+    return true;
+}
+
+int eval_command_files(const char *cmd, char (*out)[1024], int max)
+{
+    char w[1024];
+    int n = 0;
+    struct stat st;
+    while (n < max && shell_word(&cmd, w))
+        if (stat(w, &st) == 0 && S_ISREG(st.st_mode)) snprintf(out[n++], 1024, "%s", w);
+    return n;
+}

@@ -235,6 +235,13 @@ void eval_default_lagsimd(char *buf, size_t len);
 FILE *eval_open_out(const char *prog, const char *what, const char *path, bool force,
                     const char *const *in, int nin);
 
+/* The words of a controller command, split as sh would (blanks and ; & | < > ( ) end a
+ * word; '...', "..." and \ quote), that name an existing regular file: the files the
+ * command reads (a script, its data), which no output may be, with --force either. At
+ * most max, into out; returns how many. */
+#define EVAL_CMD_FILES_MAX 16
+int eval_command_files(const char *cmd, char (*out)[1024], int max);
+
 /* ---------------------------------------------------------------- a run's records */
 /* What a run's log records make: each joint's series, and why the run failed. Fed the
  * records of a run's own log (eval_read_log) or, from a daemon kept for many runs, those

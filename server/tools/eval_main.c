@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -92,7 +93,21 @@ typedef struct run_files {
 } run_files;
 enum { F_NEW = 1, F_DONE = 2 };
 
+static int files_add_now(run_files *rf, const char *path, const char *what, unsigned state);
+
+/* files_add_now with SIGINT, SIGTERM and SIGHUP held off: remove_unfinished reads the list */
 static int files_add(run_files *rf, const char *path, const char *what, unsigned state)
+{
+    sigset_t s, old;
+    sigemptyset(&s);
+    sigaddset(&s, SIGINT), sigaddset(&s, SIGTERM), sigaddset(&s, SIGHUP);
+    sigprocmask(SIG_BLOCK, &s, &old);
+    int rc = files_add_now(rf, path, what, state);
+    sigprocmask(SIG_SETMASK, &old, NULL);
+    return rc;
+}
+
+static int files_add_now(run_files *rf, const char *path, const char *what, unsigned state)
 {
     if (rf->n == rf->cap) {
         int cap = rf->cap ? 2 * rf->cap : 16;
@@ -111,6 +126,19 @@ static int files_add(run_files *rf, const char *path, const char *what, unsigned
     rf->n++;
     if (!what) rf->nin = rf->n;
     return 0;
+}
+
+/* The outputs a signal finds unfinished: those this run made and has not written (a
+ * report of the case in progress or of one not run yet), removed before the tool ends by
+ * the signal (eval_proc_at_stop; unlink only). The CSV stays: it holds the rows of the
+ * cases that ended before, each written whole. */
+static const run_files *stop_files;
+
+static void remove_unfinished(void)
+{
+    const run_files *rf = stop_files;
+    for (int i = rf ? rf->nin : 0; rf && i < rf->n; i++)
+        if (rf->state[i] == F_NEW && strcmp(rf->what[i], "--csv") != 0) unlink(rf->path[i]);
 }
 
 /* The output `path` of option `what` is written: kept at the end. */
@@ -281,10 +309,13 @@ static int report(run_files *rf, const char *dir, bool force, const eval_case *c
     f = open_out(rf, "--report", png, force);
     if (!f) return -1;
     fclose(f);
+    /* the case's report is done once gnuplot has drawn it: a signal while gnuplot runs
+     * finds all three unfinished (remove_unfinished) */
+    int rc = eval_gnuplot(prog, gp);
     files_done(rf, "--report", dat);
     files_done(rf, "--report", gp);
     files_done(rf, "--report", png);
-    return eval_gnuplot(prog, gp);
+    return rc;
 }
 
 /* A run of lagsim-eval: the options, the scene and its cases, the outputs. */
@@ -309,6 +340,7 @@ typedef struct eval_cli {
     char tmpdir[256];
     const char *workdir;
     int failures, status;
+    char cmd_files[EVAL_CMD_FILES_MAX][1024]; /* the files the controller command names */
 } eval_cli;
 
 /* The options. Returns -1 to go on, or the exit code. */
@@ -441,9 +473,15 @@ static int open_bus(eval_cli *x)
  * the exit code. */
 static int open_outputs(eval_cli *x)
 {
+    stop_files = &x->files; /* a signal removes what this run made and did not finish */
+    eval_proc_at_stop(remove_unfinished);
     if (files_add(&x->files, x->config, NULL, 0) || files_add(&x->files, x->lagsimd, NULL, 0) ||
         (x->suite && files_add(&x->files, x->suite, NULL, 0)))
         return die("%s", "out of memory");
+    /* and what the controller command names (its script): read by every run */
+    int ncf = eval_command_files(x->controller, x->cmd_files, EVAL_CMD_FILES_MAX);
+    for (int k = 0; k < ncf; k++)
+        if (files_add(&x->files, x->cmd_files[k], NULL, 0)) return die("%s", "out of memory");
     if (x->report_dir && mkdir(x->report_dir, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "%s: --report %s: %s\n", prog, x->report_dir, strerror(errno));
         return 2;
@@ -567,6 +605,7 @@ int main(int argc, char **argv)
     lag_port_release(&x.lease);
     free(x.cases);
     if (x.fcsv) fclose(x.fcsv); /* refused before its first case */
+    eval_proc_at_stop(NULL);
     files_end(&x.files);
     return rc;
 }

@@ -171,10 +171,15 @@ static void remove_tmpdir(void)
     have_tmpdir = 0;
 }
 
+static void (*volatile at_stop)(void);
+
+void eval_proc_at_stop(void (*fn)(void)) { at_stop = fn; }
+
 static void on_stop(int sig)
 {
     stop_children();
     remove_tmpdir();
+    if (at_stop) at_stop();
     signal(sig, SIG_DFL);
     raise(sig); /* pending (sig is blocked in its handler) until the mask is restored */
     sigset_t s;

@@ -54,4 +54,9 @@ void eval_stop_group(pid_t pid, int *status);
 int eval_make_tmpdir(const char *name, char *buf, size_t len);
 void eval_proc_tmpdir_done(void);
 
+/* fn runs when a signal stops the tool, once its children have ended and before it ends
+ * by the signal: async-signal-safe work only (unlink the outputs it made and did not
+ * finish). One at a time; NULL: none. */
+void eval_proc_at_stop(void (*fn)(void));
+
 #endif

@@ -441,6 +441,7 @@ typedef struct sweep {
     char *identity;      /* the CSV's identity lines (sweep_merge.h) */
     char default_metric[160];
     char tmpdir[160]; /* eval_make_tmpdir: at most 128 + 21 */
+    char cmd_files[EVAL_CMD_FILES_MAX][1024]; /* the files the controller command names */
 } sweep;
 
 /* An integer option: a plain decimal (as a scene writes a number) with no fraction; lo
@@ -600,6 +601,30 @@ static int load_scene(sweep *x)
     for (int k = 0; k < x->nv; k++) /* each factor <= 1e7: checked before it can overflow */
         if (x->vs[k].kind == V_GRID && (x->total *= x->vs[k].n) > 10000000)
             return die("%s", "more than 1e7 runs (--runs times the grids' points)");
+    return -1;
+}
+
+/* Every varied key as the scene loader takes it, before any run: the scene with the case's
+ * overrides and one key set to its distribution's centre (uniform and grid: (A + B) / 2;
+ * normal: MEAN), a key at a time, so that an unknown key, a key of another type or a centre
+ * the scene refuses is said at once with the loader's words and exit 2, not found in every
+ * run's row. A value the scene refuses for part of the range only (a negative mass drawn
+ * by normal) stays a failed run of its own. -1 or the exit code. */
+static int check_vary_keys(const sweep *x)
+{
+    char err[2048], sets[2][EVAL_SET_LEN];
+    for (int k = 0; k < x->nv; k++) {
+        const vary *v = &x->vs[k];
+        double centre = v->kind == V_NORMAL ? v->a : v->a + 0.5 * (v->b - v->a);
+        int n = run_sets(v, 1, &centre, &x->sc, sets);
+        const char *extra[2] = {sets[0], sets[1]};
+        eval_scene sc;
+        if (eval_case_scene_load(x->config, x->suite ? x->suite : x->config, &x->c, extra, n,
+                                 &sc, err, sizeof err) == 0)
+            continue;
+        fprintf(stderr, "%s: --vary %s: the scene refuses %s: %s\n", prog, v->text, sets[0], err);
+        return 2;
+    }
     return -1;
 }
 
@@ -992,13 +1017,17 @@ static int sweep_run(sweep *x)
     FILE *fcsv = NULL, *fpng = NULL;
     /* what the sweep reads (the scene, the suite, the daemon) and its CSV: no output may
      * be one of them (compared by device and inode) */
-    const char *in[4] = {x->config, x->lagsimd, x->suite, x->csv};
+    const char *in[4 + EVAL_CMD_FILES_MAX] = {x->config, x->lagsimd, x->suite ? x->suite : x->config};
+    /* and what the controller command names (its script): read by every run */
+    int nin = 3 + eval_command_files(x->controller, x->cmd_files, EVAL_CMD_FILES_MAX);
+    for (int k = 3; k < nin; k++) in[k] = x->cmd_files[k - 3];
+    in[nin] = x->csv;
     /* every output opened (and so refused, when it must be) before the first run: a sweep
      * never runs for hours to lose its results at the end */
     struct stat st;
     bool csv_new = x->csv && lstat(x->csv, &st) != 0;
-    if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, 3))) return 2;
-    if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, 4))) {
+    if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, nin))) return 2;
+    if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, nin + 1))) {
         if (fcsv) fclose(fcsv);
         if (csv_new) unlink(x->csv); /* a CSV this sweep made, empty */
         return 2;
@@ -1035,7 +1064,8 @@ int main(int argc, char **argv)
     eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
     int rc;
     if ((rc = parse_options(&x, argc, argv)) >= 0 || (rc = check_options(&x, argc, argv)) >= 0 ||
-        (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0)
+        (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0 ||
+        (rc = check_vary_keys(&x)) >= 0)
         return rc;
     if ((rc = make_header(&x)) >= 0 || (rc = make_identity(&x)) >= 0) return rc;
     for (long w = 0; w < x.jobs; w++) x.lease[w] = (lag_port_lease){.port = 0, .fd = -1};

@@ -154,6 +154,65 @@ static void summary_collect(const rows *r, int nh, int c_failed, int c_req, int 
     free(f);
 }
 
+/* A failure's reason and how many runs failed with it. */
+typedef struct reason_count {
+    const char *text;
+    long n;
+} reason_count;
+
+static int cmp_text(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+static int cmp_count(const void *a, const void *b)
+{
+    const reason_count *x = a, *y = b;
+    if (x->n != y->n) return x->n < y->n ? 1 : -1;
+    return strcmp(x->text, y->text);
+}
+
+#define REASONS_SHOWN 5 /* the commonest reasons printed; the others counted */
+
+/* Why the runs failed: each distinct reason of the failed rows with its count, the
+ * commonest first (REASONS_SHOWN of them, then how many more), so that a sweep whose runs
+ * failed says why without its CSV. Reasons are compared as written ("" for a quote). */
+static void summary_reasons(const rows *r, int nh, int c_failed, int c_reason)
+{
+    char **why = malloc((size_t)(r->n ? r->n : 1) * sizeof *why);
+    char **f = malloc((size_t)(nh + 1) * sizeof *f);
+    long nw = 0;
+    for (int i = 0; why && f && i < r->n; i++) {
+        char *lb = strdup(r->line[i]);
+        if (lb && split(lb, f, nh + 1) == nh && !strcmp(f[c_failed], "1") &&
+            (why[nw] = strdup(f[c_reason])))
+            nw++;
+        free(lb);
+    }
+    free(f);
+    reason_count *d = why && nw ? malloc((size_t)nw * sizeof *d) : NULL;
+    long nd = 0;
+    if (d) {
+        qsort(why, (size_t)nw, sizeof *why, cmp_text);
+        for (long i = 0; i < nw; i++) {
+            if (nd && !strcmp(d[nd - 1].text, why[i])) d[nd - 1].n++;
+            else d[nd++] = (reason_count){why[i], 1};
+        }
+        qsort(d, (size_t)nd, sizeof *d, cmp_count);
+        long rest = 0;
+        for (long i = 0; i < nd; i++) {
+            if (i < REASONS_SHOWN) printf("  %ld failed: %s\n", d[i].n, d[i].text);
+            else rest += d[i].n;
+        }
+        if (nd > REASONS_SHOWN)
+            printf("  ... and %ld other reason%s (%ld run%s)\n", nd - REASONS_SHOWN,
+                   nd - REASONS_SHOWN > 1 ? "s" : "", rest, rest > 1 ? "s" : "");
+    }
+    for (long i = 0; why && i < nw; i++) free(why[i]);
+    free(why);
+    free(d);
+}
+
 void summary(const char *header, rows *r)
 {
     char *hb = strdup(header);
@@ -177,6 +236,7 @@ void summary(const char *header, rows *r)
     summary_collect(r, nh, c_failed, c_req, c_first, vals, nv, &pass, &failed);
     printf("%d runs: %d passed (%.1f %%), %d failed, %d missed --require\n", r->n, pass,
            r->n ? 100.0 * pass / r->n : 0.0, failed, r->n - pass - failed);
+    if (failed) summary_reasons(r, nh, c_failed, c_first - 1);
     printf("%-22s %6s %12s %12s %12s %12s %12s\n", "metric", "n", "min", "p5", "p50", "p95",
            "max");
     for (int c = c_first; c < nh; c++) {

@@ -52,7 +52,8 @@ int rows_write(rows *r, FILE *f, const char *identity, const char *header, char 
                size_t errlen);
 /* The CSV fields of a line (reason quoted, the others plain): pointers into buf. */
 int split(char *buf, char **field, int max);
-/* Pass rate and percentiles of every metric column, from the CSV's rows, on stdout. */
+/* Pass rate, why runs failed (each reason with its count, the commonest first) and
+ * percentiles of every metric column, from the CSV's rows, on stdout. */
 void summary(const char *header, rows *r);
 
 /* ---------------------------------------------------------------- what a row holds */

@@ -6,7 +6,7 @@ so that they cannot drift from the programs.
 
 A recipe is marked with <!-- recipe: NAME --> on the line before its ```sh fence; a file
 it needs with <!-- recipe-file: NAME FILE --> before any fence (its text is written to
-FILE first). The block runs in bash in a fresh temporary directory, with `build/`, and
+FILE first; NAME,NAME... for a file of several recipes). The block runs in bash in a fresh temporary directory, with `build/`, and
 `config/`, `tests/`, `clients/` pointing into this tree's build and sources; a line that builds (`cmake ...`)
 or installs the Debian packages (`.ci/install-deps.sh`) is left out, the tree being built
 already. LCM_DEFAULT_URL gets a multicast port of this run's own (ttl=0), which every
@@ -17,6 +17,7 @@ import argparse
 import csv
 import os
 import re
+import signal
 import subprocess
 import sys
 import tempfile
@@ -33,7 +34,8 @@ def recipes(src):
         for m in re.finditer(r"<!-- recipe: (\S+) -->\s*\n```sh\n(.*?)\n```", text, re.S):
             found[m.group(1)] = m.group(2)
         for m in re.finditer(r"<!-- recipe-file: (\S+) (\S+) -->\s*\n```\w*\n(.*?\n)```", text, re.S):
-            files.setdefault(m.group(1), []).append((m.group(2), m.group(3)))
+            for name in m.group(1).split(","):  # NAME,NAME...: a file several recipes use
+                files.setdefault(name, []).append((m.group(2), m.group(3)))
     return found, files
 
 
@@ -139,6 +141,15 @@ def check_walkthrough(out, tmp):
     return checks
 
 
+def check_walkthrough_lockstep(out, tmp):
+    """the walkthrough's balance.py, unchanged, in lockstep: the daemon stepped on its answers
+    (which carry the state's generation) to the end and balance.py ended on the stop"""
+    return [("balance.py: the plant stopped at t = 2.00 s" in out,
+             "balance.py answered every state in lockstep and ended on the stop at t = 2 s"),
+            ("of generation 0" not in out and "another sim_time" not in out,
+             "lagsimd refused none of its answers")]
+
+
 def eval_checks(out, cases, runs):
     """lagsim-eval measured each of the cases, ok (none failed or unmet); lagsim-sweep ran
     every run and each passed"""
@@ -167,9 +178,12 @@ def check_eval_octave(out, tmp):
 
 # a recipe's exit status when it is not 0, as its doc says (the last command's)
 EXIT = {"evaluate": 1}
+# wall s a recipe may take when it is not --timeout (a short run: a hang fails soon)
+TIMEOUT = {"walkthrough-lockstep": 60}
 
 CHECKS = {"by-hand": check_by_hand, "record": check_record, "evaluate": check_evaluate,
-          "walkthrough": check_walkthrough, "eval-python": check_eval_python,
+          "walkthrough": check_walkthrough, "walkthrough-lockstep": check_walkthrough_lockstep,
+          "eval-python": check_eval_python,
           "eval-octave": check_eval_octave}
 
 
@@ -207,12 +221,25 @@ def main():
         env = dict(os.environ)
         env["LCM_DEFAULT_URL"] = "udpm://239.255.76.67:%d?ttl=0" % (30000 + 2 * (os.getpid() % 10000))
         print("---- recipe %s in %s, LCM_DEFAULT_URL=%s\n%s" % (name, tmp, env["LCM_DEFAULT_URL"], script))
+        # a session of its own: a recipe that hangs is stopped whole, its background jobs too
+        p = subprocess.Popen(["bash", "-c", script], cwd=tmp, env=env, stdout=subprocess.PIPE,
+                             stderr=subprocess.STDOUT, universal_newlines=True,
+                             start_new_session=True)
         try:
-            r = subprocess.run(["bash", "-c", script], cwd=tmp, env=env, stdout=subprocess.PIPE,
-                               stderr=subprocess.STDOUT, universal_newlines=True, timeout=a.timeout)
-            out, code = r.stdout, r.returncode
-        except subprocess.TimeoutExpired as e:
-            out, code = (e.stdout or b"").decode() if isinstance(e.stdout, bytes) else (e.stdout or ""), -1
+            out, _ = p.communicate(timeout=TIMEOUT.get(name, a.timeout))
+            code = p.returncode
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGTERM)
+            try:
+                out, _ = p.communicate(timeout=5)
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
+                out, _ = p.communicate()
+            out, code = (out or "") + "\n(timed out: stopped)", -1
+        try:
+            os.killpg(p.pid, signal.SIGKILL)  # whatever the recipe left running
+        except ProcessLookupError:
+            pass
         print(out.rstrip()[-3000:])
         want = EXIT.get(name, 0)
         checks = [(code == want, "the recipe exited %d (%d)" % (want, code))] + CHECKS[name](out, tmp)

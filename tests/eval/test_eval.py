@@ -556,6 +556,24 @@ def case_outputs():
         attempt("lagsim-sweep --csv the daemon", sw + ["--lagsimd", daemon, "--csv", daemon],
                 daemon, tool=sweep)
         check(open(daemon, "rb").read() == before, "the daemon's copy is whole")
+        # the controller command's own files (its script, bare or quoted, a path into d):
+        # read by every run, so never an output, with --force either
+        script = os.path.join(d, "gs copy.py")
+        with open(script, "w") as f:
+            f.write("# a controller's script\n")
+        ctl_old = open(script).read()
+        for tool, args in ((EVAL, ["--suite", suite]), (sweep, sw)):
+            for ctl, out in (("python3 'gs copy.py' --prefix {prefix}", "gs copy.py"),
+                             ('cd . && python3 "%s" --prefix {prefix}' % script, script),
+                             ("python3 gs\\ copy.py -q", "./gs copy.py")):
+                p = subprocess.run([tool, "--config", SCENE, "--controller", ctl, "--csv", out,
+                                    "--force"] + args, stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, universal_newlines=True, timeout=300,
+                                   cwd=d)
+                check(p.returncode == 2 and "the same file as" in p.stderr and
+                      open(script).read() == ctl_old,
+                      "%s --controller %r --csv %r --force: exit 2, the script untouched (%d)"
+                      % (os.path.basename(tool), ctl, out, p.returncode))
         # merge: -o never one of its shards
         shard = os.path.join(d, "shard.csv")
         subprocess.run([sweep, "--config", SCENE, "--controller", CTRL, "--duration", "0.2",

@@ -93,9 +93,11 @@ def command(tmp, ready):
         suite = os.path.join(tmp, "suite.yaml")
         with open(suite, "w") as f:
             f.write("cases:\n  - name: long\n    duration: %s\n" % duration)
+            if HOW in ("sigint", "sigterm"):  # a case not run yet: its report made, unwritten
+                f.write("  - name: long2\n    duration: %s\n" % duration)
         cmd = [os.path.join(BIN, "lagsim-eval"), "--config", SCENE, "--suite", suite,
                "--controller", ctrl]
-        if HOW == "gnuplot":
+        if HOW in ("gnuplot", "sigint", "sigterm"):
             cmd += ["--report", os.path.join(tmp, "report")]
         return cmd
     cmd = [os.path.join(BIN, "lagsim-sweep"), "--config", SCENE, "--controller", ctrl,
@@ -194,6 +196,10 @@ def main():
             check(not left, "no process of the run left when the tool ended: %s" % left)
             check(os.listdir(tooltmp) == [], "its temporary directory removed: %s"
                   % os.listdir(tooltmp))
+            if TOOL == "eval":  # the report files of the case in progress and of the next
+                rep = os.listdir(os.path.join(tmp, "report"))
+                check(rep == [], "the report's files it made and did not finish removed: %s"
+                      % sorted(rep))
         while left and time.monotonic() < t0 + PROCS_WAIT_S:
             time.sleep(0.1)
             left = marked(marker)

@@ -65,6 +65,7 @@ import filecmp
 import glob
 import hashlib
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -345,12 +346,13 @@ def case_merge(d):
           "initial.q[1] varied: theta starts there (peak error = the value)")
     p = run([SWEEP] + ARGS + ["--vary", "initial.x[0]=normal(0,1)"])
     check(p.returncode == 2 and "initial.q[i]" in p.stderr, "an index on another key: exit 2")
-    # 16 varied keys of 497 bytes: a header past its buffer (8192 bytes) is refused before
-    # any run (it was written past the buffer)
+    # 16 varied keys of 497 bytes: refused before any run (a header past its buffer, 8192
+    # bytes, was written past it); the loader's key limit (255) now refuses them first
     keys = sum((["--vary", "parameters.%s%02d=uniform(0,1)" % ("k" * 484, k)] for k in range(16)),
                [])
     p = run([SWEEP, "--config", SCENE, "--controller", CTRL, "--duration", "1"] + keys)
-    check(p.returncode == 2 and "header" in p.stderr and "runs:" not in p.stdout,
+    check(p.returncode == 2 and ("header" in p.stderr or "at most 255" in p.stderr)
+          and "runs:" not in p.stdout,
           "varied keys' names too long for the header: exit 2 before any run (exit %d)"
           % p.returncode)
 
@@ -717,6 +719,15 @@ BAD_VARY = [
     (["parameters.m1=normal(0.1,0)"], "SD > 0"),
     (["parameters.m1=normal(0.1,-1)"], "SD > 0"),
     (["parameters.m1=uniform(0.1,0.2)junk"], "plain decimal"),
+    # the keys as the scene loader takes them, before any run (before, every run failed
+    # with the loader's words in the CSV's reason, and the sweep exited 1)
+    (["parameters.M1=uniform(0.05,0.3)"], "--vary parameters.M1=uniform(0.05,0.3): the scene "
+     "refuses parameters.M1=0.17499999999999999: case sweep: --set parameters.M1: unknown "
+     "parameter 'M1'"),
+    (["parameters.m1=uniform(-3,-1)"], "refuses parameters.m1=-2: case sweep: --set "
+     "parameters.m1: expected a number > 0"),
+    (["initial.q[1]=uniform(0,0.1)", "effects.friction=grid(0,1,3)"], "--vary "
+     "effects.friction=grid(0,1,3): the scene refuses effects.friction=0.5"),
     (["parameters.m1=grid(0.1,0.2,1000)", "parameters.m0=grid(0.5,2,1000)",
       "initial.q[1]=grid(0,0.1,1000)"], "more than 1e7 runs"),
     # 1e36 runs: a count that overflowed to a negative one made "0 runs", exit 0
@@ -748,6 +759,26 @@ def case_vary(d):
           ["0.10000000000000001"] * 2 + ["0.20000000000000001"] * 2,
           "grid(0.1, 0.2, 2) with blanks, two coordinates of initial.q: 4 runs (%d)"
           % p.returncode)
+    # a value refused for part of the range only: a failed run of its own, and the terminal
+    # summary (and merge's, made from the rows) says why runs failed, with their counts
+    out = os.path.join(d, "part.csv")
+    p = run([SWEEP] + base + ["--vary", "parameters.m1=normal(0.01,0.1)", "--runs", "8",
+                              "--seed", "3", "--csv", out])
+    r = rows(out)
+    bad = [x for x in r if x["failed"] == "1"]
+    shown = re.findall(r"^  (\d+) failed: (.*)$", p.stdout, re.M)
+    more = re.search(r"^  \.\.\. and (\d+) other reasons? \((\d+) runs?\)$", p.stdout, re.M)
+    counted = sum(int(n) for n, _ in shown) + (int(more.group(2)) if more else 0)
+    check(p.returncode == 1 and 0 < len(bad) < 8 and
+          all(x["reason"].startswith("refused: --set parameters.m1: expected a number > 0")
+              for x in bad) and counted == len(bad) and
+          {w for _, w in shown} <= {x["reason"] for x in bad} and len(shown) == min(5, len(bad)),
+          "normal(0.01,0.1): %d of 8 runs refused by the scene, each a failed run, the terminal "
+          "says why (%d reasons shown, %d runs counted)" % (len(bad), len(shown), counted))
+    m = run([SWEEP, "merge", out, "-o", os.path.join(d, "part-m.csv")])
+    check(m.returncode == 0 and re.findall(r"^  \d+ failed: .*$", m.stdout, re.M) ==
+          re.findall(r"^  \d+ failed: .*$", p.stdout, re.M),
+          "merge's summary says the same reasons")
 
 
 def scene_sweep(lang, runs=40):

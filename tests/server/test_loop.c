@@ -88,6 +88,7 @@ typedef struct controller {
 } controller;
 static controller g_ctl;
 static void command(double sim_time, const char *joint, double effort);
+static void command_gen(int64_t gen, double sim_time, const char *joint, double effort);
 
 static bool ctl_lose(void)
 {
@@ -1426,6 +1427,16 @@ static void case_waits(int arg)
     expect_has(g_out.status_waiting_for, on_cmd, __LINE__);
     ENSURE(g_out.status_waiting_s >= 1.5 && g_out.status_waiting_s < 2.2);
     ENSURE(!strcmp(g_out.status_waiting_got, ""));
+    /* answers to the right sim_time of another generation, or of none (a command built by
+     * hand that copies the sim_time alone): each said as what it is, not "another sim_time" */
+    command_gen(0, 0.01, "theta0", 1.0);
+    command_gen(0, 0.01, "theta0", 1.0);
+    command_gen(g_srv.pub.generation + 7, 0.01, "theta0", 1.0);
+    status_now();
+    expect_has(g_out.status_waiting_got, "1 answer of another generation (a state of an earlier "
+               "run or scene); 2 answers of generation 0 (the command carries none: it copies the "
+               "state's generation with its sim_time", __LINE__);
+    ENSURE(!strstr(g_out.status_waiting_got, "another sim_time"));
     /* paused */
     control(LAGSIM_CONTROL_T_PAUSE, 0);
     run_until(g_srv.now + 1 * SEC, 1000);

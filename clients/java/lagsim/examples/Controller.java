@@ -42,8 +42,9 @@ import lcm.lcm.LCMSubscriber;
  * keep the newest state and reference and note the daemon's stop, and the caller's thread
  * does the work. A run ends when the daemon publishes its stop event, when nothing came from the
  * daemon (state, status or event) for --timeout wall seconds, or after --duration s of
- * sim time from the first state; endReason says which (stop, silence, duration). Exit
- * status: 0 for these; 1 when no scene came within --timeout or it is another model's;
+ * sim time from the first state, or on SIGINT or SIGTERM; endReason says which (stop,
+ * silence, duration, signal; a signal while it waits for the scene prints the summary with
+ * states=0). Exit status: 0 for these; 1 when no scene came within --timeout or it is another model's;
  * 2 bad usage.
  */
 public final class Controller {
@@ -208,8 +209,13 @@ public final class Controller {
         System.out.flush();
         long deadline = System.nanoTime() + (long) (timeout * 1e9);
         long nextAsk = System.nanoTime();
+        Signals.install(); // SIGINT, SIGTERM: endReason "signal", not the JVM's end
         synchronized (lock) {
             while (scene == null) {
+                if (Signals.signalled()) { // a run that ended before its scene came: no failure
+                    endReason = "signal";
+                    break;
+                }
                 long now = System.nanoTime();
                 if (now >= deadline)
                     fail(String.format("no scene on %sSCENE within %g s (is lagsimd running with this prefix?)",
@@ -221,6 +227,7 @@ public final class Controller {
                 lock.wait(50);
             }
         }
+        if (scene == null) System.exit(finish("states=0"));
         if (!scene.model.equals(model)) fail("prefix " + prefix + " runs model " + scene.model + ", not " + model);
     }
 
@@ -243,6 +250,7 @@ public final class Controller {
     private joint_state_t withScene(joint_state_t st) throws InterruptedException {
         long nextAsk = System.nanoTime();
         while (st.generation != scene.generation) {
+            if (Signals.signalled()) { endReason = "signal"; return null; }
             if (stopped) { endReason = "stop"; return null; }
             long now = System.nanoTime();
             if (now - heardNanos > (long) (timeout * 1e9)) { endReason = "silence"; return null; }
@@ -269,6 +277,7 @@ public final class Controller {
             joint_state_t st;
             for (;;) {
                 while (latest == null) {
+                    if (Signals.signalled()) { endReason = "signal"; return null; }
                     if (stopped) { endReason = "stop"; return null; }
                     if (System.nanoTime() - heardNanos > (long) (timeout * 1e9)) {
                         endReason = "silence";
