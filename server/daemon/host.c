@@ -5,19 +5,20 @@
  *         wake = the earliest of every plant's rt_next_wake (cached: a plant's is
  *                computed again only after it was processed), the looks of plants
  *                starting, a reading of the directory due
- *         rt_io_wait(io, wake)     epoll on every plant's LCM instances and inotify, one
- *                                  timerfd, one signalfd; a plant whose instance is ready
- *                                  handles at most HOST_DRAIN_MAX messages and is marked
+ *         rt_io_wait(io, wake)     epoll on every plant's receive sockets (rt_rx.h), the
+ *                                  host's directory and inotify, one timerfd, one
+ *                                  signalfd; a plant whose socket is ready reads at most
+ *                                  HOST_DRAIN_MAX messages and is marked
  *         host_pass(h)             every plant due or marked: rt_process, its wake again;
  *                                  plants whose look is over start; stopped ones end
  *
  * A plant's input budget (a host's plants only; a daemon of one plant reads as before):
  * HOST_INPUT_PER_STATE messages for every state it publishes, HOST_INPUT_PER_S more a
  * second, HOST_INPUT_BURST at once. A controller needs one command per state (a copy of
- * a state, one more); a flood beyond the budget is left unread: the plant's instance is
- * parked until the budget allows again (LCM's queue of 1000 drops the rest), so that the
- * flood costs the loop, and every other plant, nothing more. Lockstep at any speed keeps
- * its budget, which grows with the states it publishes.
+ * a state, one more); a flood beyond the budget is left unread: the plant's socket is
+ * parked until the budget allows again (the kernel drops what the socket's buffer cannot
+ * hold), so that the flood costs the loop, and every other plant, nothing more. Lockstep
+ * at any speed keeps its budget, which grows with the states it publishes.
  */
 #include <dirent.h>
 #include <errno.h>
@@ -364,7 +365,7 @@ static void budget_park(plant *p)
     rt_io_park(&p->h->io, &p->in, true);
     rt_plant_input_limited(p->s, ++p->parked_times, "a budget of 8 messages a state "
                            "published, 100 a second more, 256 at once: reading paused until "
-                           "it allows; LCM drops what its queue of 1000 cannot hold");
+                           "it allows; the kernel drops what the socket cannot hold");
 }
 
 /* ---------------------------------------------------------------- sources */

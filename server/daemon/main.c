@@ -372,7 +372,8 @@ static lag_result check_options(cmdline *cl)
                             o->csv || cl->plot || cl->have_duration || cl->have_tolerance ||
                             o->log_increment || o->log_keep || o->log_split || o->force
                             ? "--list prints a table and exits: not with other options" : NULL;
-    else if (!cl->config && !cl->plants) why = "--config FILE (or --plants DIR) is required";
+    else if (!cl->config && !cl->plants)
+        why = "--config FILE is required (or --plants DIR: a host of plants)";
     else if ((cl->plants || cl->nconfigs > 1) && (cl->offline || cl->replay || cl->cost))
         why = "--plants and several --config run a host of real-time plants: not with "
               "--offline, --replay or --cost";

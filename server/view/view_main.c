@@ -18,6 +18,7 @@
 #include <sys/signalfd.h>
 #include <unistd.h>
 
+#include "lagsim_bus.h"
 #include "lagsim_client.h"
 #include "view.h"
 
@@ -198,6 +199,15 @@ static int block_signals(void)
     return sig_fd;
 }
 
+/* Whether a plant heard on LCM's default bus runs on another URL (a host's plant: its
+ * directory names its URL). */
+static bool elsewhere(const char *url)
+{
+    lag_bus b;
+    char err[64];
+    return lag_bus_init(&b, NULL, "X", err, sizeof err) == 0 && strcmp(b.state_url, url) != 0;
+}
+
 /* Without --prefix: the only plant on the bus; none yet: DIPC, watched until it comes.
  * GO_ON, else the result to exit with. */
 static int pick_prefix(view_opts *o)
@@ -211,7 +221,7 @@ static int pick_prefix(view_opts *o)
     }
     if (pr == LAG_CLIENT_OK) {
         o->prefix = found.prefix;
-        o->url = found.url; /* a host's plant: the URL its directory names */
+        if (!o->url && elsewhere(found.url)) o->url = found.url; /* a host's plant */
     } else {
         o->prefix = "DIPC";
         fprintf(stderr, "lagsim-view: %s; watching prefix %s\n", err, o->prefix);
@@ -232,7 +242,7 @@ static void plant_url(view_opts *o)
                                       sizeof err) != LAG_CLIENT_OK)
         return;
     for (int i = 0; i < n; i++)
-        if (!strcmp(all[i].prefix, o->prefix)) {
+        if (!strcmp(all[i].prefix, o->prefix) && elsewhere(all[i].url)) {
             snprintf(url, sizeof url, "%s", all[i].url);
             o->url = url;
             return;
