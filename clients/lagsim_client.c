@@ -19,12 +19,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include <lcm/lcm.h>
 
 #include "lagsim/lagsim_control_t.h"
 #include "lagsim_bus.h"
 #include "lagsim_clock.h"
+#include "lagsim_num.h"
 
 struct lag_client {
     lcm_t *lcm;                  /* the state URL: states, status, events, scene in */
@@ -544,9 +546,11 @@ lag_result lag_client_kick(lag_client *c, const char *joint, double impulse, dou
         set_err(c, "kick: a joint name, a finite impulse and a duration >= 0 (s)");
         return LAG_CLIENT_ERR_ARG;
     }
-    /* %.17g: the daemon reads back the same doubles */
-    if (duration > 0) snprintf(value, sizeof value, "%.17g,%.17g", impulse, duration);
-    else snprintf(value, sizeof value, "%.17g", impulse);
+    /* the shortest decimals the daemon reads back to the same doubles: the kick event's
+     * detail says 0.1, as the user wrote it (lagsim_num.h) */
+    char a[LAG_NUM_LEN], b[LAG_NUM_LEN];
+    if (duration > 0) snprintf(value, sizeof value, "%s,%s", lag_num(impulse, a), lag_num(duration, b));
+    else snprintf(value, sizeof value, "%s", lag_num(impulse, a));
     return lag_client_set(c, key, value);
 }
 
@@ -921,4 +925,73 @@ lag_result lag_client_pick_plant(const char *url, const char *model, double wait
                  model ? model : "", model ? " " : "", where, mine);
     }
     return LAG_CLIENT_ERR_AMBIGUOUS;
+}
+
+/* ---------------------------------------------------------------- a prefix nobody has */
+/* Edits (insert, delete, substitute) between a and b, capped at 3 (more: 3). */
+static int edits(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    if (la > LAG_CLIENT_NAME_LEN || lb > LAG_CLIENT_NAME_LEN) return 3;
+    int row[LAG_CLIENT_NAME_LEN + 1];
+    for (size_t j = 0; j <= lb; j++) row[j] = (int)j;
+    for (size_t i = 1; i <= la; i++) {
+        int diag = row[0];
+        row[0] = (int)i;
+        for (size_t j = 1; j <= lb; j++) {
+            int up = row[j];
+            int best = diag + (a[i - 1] != b[j - 1]);
+            if (up + 1 < best) best = up + 1;
+            if (row[j - 1] + 1 < best) best = row[j - 1] + 1;
+            row[j] = best;
+            diag = up;
+        }
+    }
+    return row[lb] < 3 ? row[lb] : 3;
+}
+
+/* How near a heard prefix is to the one asked: 0 the same but for letter case, 1 it
+ * starts with it, 2 + edits; -1 not near. */
+static int nearness(const char *heard, const char *asked)
+{
+    if (!strcasecmp(heard, asked)) return 0;
+    if (asked[0] && !strncasecmp(heard, asked, strlen(asked))) return 1;
+    int e = edits(heard, asked);
+    return e <= 2 ? 2 + e : -1;
+}
+
+int lag_client_plants_instead(const char *url, const char *prefix, double wait_s, char *out,
+                              size_t len)
+{
+    static lag_client_plant p[LAG_CLIENT_MAX_PLANTS];
+    int n = 0;
+    char err[256] = "";
+    if (!out || len == 0 || !prefix) return LAG_CLIENT_ERR_ARG;
+    lag_result rc = lag_client_discover(url, wait_s, 0.5, p, LAG_CLIENT_MAX_PLANTS, &n, err,
+                                        sizeof err);
+    if (rc != LAG_CLIENT_OK) {
+        snprintf(out, len, "%s", err);
+        return rc;
+    }
+    lag_bus b;
+    char berr[8];
+    const char *where = lag_bus_init(&b, url, "X", berr, sizeof berr) == 0 ? b.state_url : "?";
+    if (n == 0) {
+        snprintf(out, len, "no plant heard on %s within %.3g s (is lagsimd running on this "
+                 "LCM URL?)", where, wait_s);
+        return 0;
+    }
+    size_t o = (size_t)snprintf(out, len, "no plant on prefix %s; plants heard on %s: ", prefix,
+                                where);
+    int best = -1, near = -1;
+    for (int i = 0; i < n && o < len; i++) {
+        o += (size_t)snprintf(out + o, len - o, "%s%s (%s%s%s%s%s)", i ? ", " : "", p[i].prefix,
+                              p[i].model[0] ? p[i].model : "model unknown",
+                              p[i].mode[0] ? ", " : "", p[i].mode,
+                              p[i].run_state[0] ? ", " : "", p[i].run_state);
+        int k = nearness(p[i].prefix, prefix);
+        if (k >= 0 && (near < 0 || k < near)) near = k, best = i;
+    }
+    if (best >= 0 && o < len) snprintf(out + o, len - o, "; did you mean %s?", p[best].prefix);
+    return n;
 }

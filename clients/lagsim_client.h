@@ -237,6 +237,16 @@ lag_result lag_client_discover(const char *url, double wait_s, double settle_s,
 lag_result lag_client_pick_plant(const char *url, const char *model, double wait_s,
                                  lag_client_plant *out, char *err, size_t errlen);
 
+/* What the bus at url has instead of a plant on `prefix`, for the message of a program
+ * that asked `prefix` and got no answer (a misspelt --prefix): listens up to wait_s
+ * (lag_client_discover) and writes "no plant on prefix P; plants heard on URL: A
+ * (model, mode, run state), B (...); did you mean A?" (the suggestion when a heard prefix
+ * is P in other letter case, starts with P, or is at most 2 edits from it), or "no plant
+ * heard on URL within S s (is lagsimd running on this LCM URL?)". Returns the number of
+ * plants heard (>= 0), or an error with a message in out. OUT: out */
+int lag_client_plants_instead(const char *url, const char *prefix, double wait_s, char *out,
+                              size_t len);
+
 /* Wall clock (CLOCK_MONOTONIC) in seconds, for controllers' own timing. */
 double lag_client_now(void);
 

@@ -305,6 +305,15 @@ static int connect_client(lag_ctl *ctl)
     return 0;
 }
 
+/* No scene came on the prefix: who is on the bus instead (a misspelt --prefix). */
+static void say_no_scene(const lag_ctl *ctl)
+{
+    char instead[1500];
+    lag_client_plants_instead(ctl->url, ctl->prefix, 1.0, instead, sizeof instead);
+    fprintf(stderr, "%s: no scene description on %s_SCENE within %g s: %s\n", ctl->name,
+            ctl->prefix, ctl->timeout, instead);
+}
+
 static int wait_scene(lag_ctl *ctl)
 {
     /* subscribed: from here on no state is missed (test harnesses wait for this line) */
@@ -323,9 +332,7 @@ static int wait_scene(lag_ctl *ctl)
             if (rc < 0)
                 fprintf(stderr, "%s: %s\n", ctl->name, lag_client_errmsg(ctl->client));
             else
-                fprintf(stderr, "%s: no scene description on %s_SCENE within %g s (is lagsimd "
-                                "running with lcm.prefix %s on the same LCM URL?)\n",
-                        ctl->name, ctl->prefix, ctl->timeout, ctl->prefix);
+                say_no_scene(ctl);
             return 1;
         }
     }

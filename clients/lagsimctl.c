@@ -23,8 +23,8 @@
  *   param <name>=<value>
  *   joint <name> actuated=... initial_q=... ...  (every per-joint field of scene_t)
  *   state t=... step=... <joint>=<q> ... <joint>_dot=<qd> ... <joint>_effort=<effort> ...
- * Numbers are printed with %.17g (they read back to the same double) unless --digits
- * says otherwise.
+ * Numbers are printed as the shortest decimal that reads back to the same double
+ * (lagsim_num.h: 0.1, not 0.10000000000000001) unless --digits says otherwise.
  */
 #include <errno.h>
 #include <getopt.h>
@@ -36,6 +36,7 @@
 
 #include "lagsim_client.h"
 #include "lagsim_bus.h"
+#include "lagsim_num.h"
 #include "lagsim_wire.h"
 
 /* What lagsimctl ends with: codes of the one space (lagsim/result.h); main() turns them
@@ -48,7 +49,7 @@
 static volatile sig_atomic_t g_signal = 0;
 static void on_signal(int sig) { g_signal = sig; }
 
-static int g_digits = 17;
+static int g_digits = 0; /* 0: the shortest that reads back */
 static bool g_json = false;
 static bool g_digits_set = false;
 static const char *g_prefix = "";  /* the plant's, for the status's first line */
@@ -87,8 +88,9 @@ static void usage(FILE *f)
             "  -j, --json           one JSON object a message (for scripts)\n"
             "  -u, --url URL        LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)\n"
             "  -t, --timeout S      wall s to wait for the answer (default 2)\n"
-            "  -d, --digits N       significant digits of numbers (default 17: exact; the\n"
-            "                       status for people: 6)\n"
+            "  -d, --digits N       significant digits of numbers (default: exact, the\n"
+            "                       shortest decimal that reads back; the status for\n"
+            "                       people: 6)\n"
             "  -h, --help           this text\n"
             "  -V, --version        print the version\n"
             "exit status: 0 done, 1 the daemon refused (its reason on stderr), 2 bad usage\n"
@@ -97,7 +99,12 @@ static void usage(FILE *f)
 }
 
 /* ---------------------------------------------------------------- printing */
-static void put_num(double x) { printf("%.*g", g_digits, x); }
+static void put_num(double x)
+{
+    char b[LAG_NUM_LEN];
+    if (g_digits) printf("%.*g", g_digits, x);
+    else printf("%s", lag_num(x, b));
+}
 
 /* A string as a token: bare if it has no space, quote or '=', else in double quotes with
  * '"' and '\' escaped. */
@@ -152,14 +159,16 @@ static void put_json_str(const char *s)
     putchar('"');
 }
 
-/* One value of a field as JSON (numbers: %.17g, exact; the decoder keeps only finite). */
+/* One value of a field as JSON (numbers exact, the shortest that reads back; the decoder
+ * keeps only finite ones). */
 static void put_json_value(const lag_wire_field *f, const char *p)
 {
+    char num[LAG_NUM_LEN];
     switch (f->kind) {
     case LAG_WIRE_INT8: printf("%d", *(const int8_t *)p); break;
     case LAG_WIRE_INT16: printf("%d", *(const int16_t *)p); break;
     case LAG_WIRE_INT64: printf("%lld", (long long)*(const int64_t *)p); break;
-    case LAG_WIRE_DOUBLE: printf("%.17g", *(const double *)p); break;
+    case LAG_WIRE_DOUBLE: printf("%s", lag_num(*(const double *)p, num)); break;
     case LAG_WIRE_BOOLEAN: printf("%s", *(const bool *)p ? "true" : "false"); break;
     case LAG_WIRE_STRING: put_json_str(p); break;
     }
@@ -470,6 +479,7 @@ static bool step_done(const answer *a) { return a->refused || (a->got_event2 && 
 /* Every plant on the bus, a table for people (or a JSON array): exit 0, or 3 if none. */
 static lag_result list_plants(const char *url, double wait_s)
 {
+    char num[LAG_NUM_LEN];
     static lag_client_plant p[LAG_CLIENT_MAX_PLANTS];
     int n = 0;
     char err[256];
@@ -490,7 +500,7 @@ static lag_result list_plants(const char *url, double wait_s)
                 printf("%s\"%s\": ", j ? ", " : "", k[j]);
                 put_json_str(v[j]);
             }
-            printf(", \"sim_time\": %.17g}", p[i].sim_time);
+            printf(", \"sim_time\": %s}", lag_num(p[i].sim_time, num));
         }
         printf("]\n");
     } else if (n > 0) {
@@ -888,8 +898,11 @@ static lag_result lagsimctl_main(int argc, char **argv)
         fprintf(stderr, "lagsimctl: %s\n", lag_client_errmsg(c));
         code = EXIT_NOANSWER;
     } else if (rc == LAG_CLIENT_TIMEOUT && !g_signal) {
-        fprintf(stderr, "lagsimctl: no answer on %s_* within %g s (is lagsimd running with "
-                        "lcm.prefix %s?)\n", o.prefix, o.timeout, o.prefix);
+        /* a prefix nobody has (misspelt): who is on the bus instead */
+        char instead[1500];
+        lag_client_plants_instead(o.url, o.prefix, 1.0, instead, sizeof instead);
+        fprintf(stderr, "lagsimctl: no answer on %s_* within %g s: %s\n", o.prefix, o.timeout,
+                instead);
         code = EXIT_NOANSWER;
     } else if (a.refused) {
         fprintf(stderr, "lagsimctl: the daemon refused: %s\n", a.ev.detail);

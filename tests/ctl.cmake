@@ -42,3 +42,14 @@ if(LAGSIM_PYTHON3)
             --bin $<TARGET_FILE_DIR:lagsimd> --source ${PROJECT_SOURCE_DIR})
   set_tests_properties(ctl_discover PROPERTIES TIMEOUT 120 LABELS clients)
 endif()
+
+# A prefix nobody has (a misspelt one): lagsimctl, manipulator_pd in C and in Python name
+# the plants heard and the one meant; the plant's wait line and status name the requests
+# for the misspelt prefixes and its own on the wrong port, never another plant's
+# (tests/ctl/test_misspelt.py).
+if(LAGSIM_PYTHON3)
+  add_test(NAME ctl_misspelt_prefix
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/ctl/test_misspelt.py
+            --bin $<TARGET_FILE_DIR:lagsimd> --source ${PROJECT_SOURCE_DIR})
+  set_tests_properties(ctl_misspelt_prefix PROPERTIES TIMEOUT 120 LABELS clients)
+endif()

@@ -24,7 +24,7 @@ lagsim_fuzz_target(sweep_merge LIBS lagsim_sweepcsv)
 # codes, case files with mistakes.
 find_program(LAGSIM_PYTHON3 python3)
 if(LAGSIM_PYTHON3)
-  foreach(c metrics require errors scene owned outputs bus)
+  foreach(c metrics require errors scene owned outputs bus stderr)
     add_test(NAME eval_lagsim_eval_${c}
       COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_eval.py
               $<TARGET_FILE_DIR:lagsim-eval> ${PROJECT_SOURCE_DIR} ${c})

@@ -1,55 +1,156 @@
 #!/usr/bin/env bash
-# The test command: installs what it needs, then runs two passes and reports both.
-#   1. gcc, warnings as errors, optimized: every test.
-#   2. clang, warnings as errors, AddressSanitizer + UndefinedBehaviorSanitizer (with
-#      float-cast-overflow) + libFuzzer: every test except those labelled "slow" (they
-#      pace in wall-clock time), every kept fuzz input, and each fuzz target for
-#      LAGSIM_FUZZ_SECONDS (default 20).
-# The second pass runs even when the first failed; the exit status is non-zero when
-# either failed, after both summaries.
-# usage: tests/run.sh            (from anywhere)
-#   LAGSIM_SKIP_SANITIZE=1  first pass only
+# The test command. Installs what the tests need when it is missing (.ci/install-deps.sh
+# tests; under CI=true, ci), builds, runs ctest, and prints a summary per pass.
+#
+#   tests/run.sh                the quick tier (a developer's loop): gcc -Werror build,
+#                               every test of the tier quick (docs/testing.md, "Tiers")
+#   tests/run.sh --full         what CI runs (.ci/run), in three passes:
+#                                1. gcc, -Werror, optimized (build/): every test;
+#                                2. clang, -Werror, -O1, ASan + UBSan (float-cast-overflow
+#                                   too) + libFuzzer (build-asan/): every test but the tier slow
+#                                   (no bench or package test is made there), and each
+#                                   fuzz target for LAGSIM_FUZZ_SECONDS (default 20);
+#                                3. gcc, -Werror, Release (build-release/): built, not run.
+#   tests/run.sh --tier T,...   those tiers of pass 1 (e.g. --tier quick,wallclock)
+#   tests/run.sh --label L      ctest -L L in pass 1 (a regular expression, as ctest takes it)
+#   tests/run.sh --sanitize ... pass 2's build instead of pass 1's (with --tier or --label)
+#
+# Inside a pass the tier that only waits (waits: tests/common/tiers.cmake) runs 2 x cores
+# tests at once beside the others, which run one per core. Every pass runs even when one
+# before failed; the exit status is non-zero when any failed, after every summary.
+#   LAGSIM_SKIP_SANITIZE=1   --full without pass 2
+#   LAGSIM_WAIT_JOBS=N       how many tests of the tier waits at once (2 x cores)
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-cd "$root"
-"$root/.ci/install-deps.sh" || exit 1
-jobs=$(nproc)
+cd "$root" || exit 2
+
+mode=quick
+select=""
+sanitize=0
+while [ $# -gt 0 ]; do
+  case $1 in
+    --full) mode=full ;;
+    --quick) mode=quick ;;
+    --tier) mode=some; shift; select="^(${1//,/|})\$" ;;
+    --label) mode=some; shift; select=$1 ;;
+    --sanitize) sanitize=1 ;;
+    -h | --help) sed -n '2,/^set -uo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
+    *) echo "tests/run.sh: unknown argument '$1' (--help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+
+"$root/.ci/install-deps.sh" "$([ "${CI:-}" = true ] && echo ci || echo tests)" || exit 1
+cores=$(nproc)
+wait_jobs=${LAGSIM_WAIT_JOBS:-$((2 * cores))}
 summaries=()
 failed=0
 
-# run_pass NAME BUILD_DIR "CTEST ARGS" CMAKE ARGS...
-run_pass() {
-  local name=$1 dir=$2 ctest_args=$3
+# The tiers whose tests mostly wait (tests/common/tiers.cmake's LAGSIM_WAITING_TIERS).
+waiting=$(sed -n 's/^set(LAGSIM_WAITING_TIERS \(.*\))$/\1/p' "$root/tests/common/tiers.cmake")
+waiting_rx="^(${waiting// /|})\$"
+
+# ctest_half DIR LOG JOBS ARGS...: ctest of one half of a pass, its output in LOG
+ctest_half() {
+  local dir=$1 log=$2 jobs=$3
   shift 3
-  local log="$root/$dir/ctest.log" result
+  (cd "$dir" && ctest --output-on-failure -j"$jobs" "$@") >"$log" 2>&1
+}
+total_passed=0
+total_failed=0
+
+# run_pass NAME BUILD_DIR TIMEOUT SELECT EXCLUDE CMAKE ARGS...
+#   SELECT: a label regex the tests must match ("" all); EXCLUDE: tiers left out ("" none);
+#   TIMEOUT "-": build only.
+# The tests of the waiting tier (waits) run 2 x cores at once beside the others, which run
+# one per core as before (a test that computes, or a real-time loop that must be scheduled
+# every period, has a core): the waiting ones sleep while the others keep the cores busy.
+# Two ctest processes; the computing one's output is shown as it runs, the other's after.
+run_pass() {
+  local name=$1 dir=$2 timeout=$3 sel=$4 excl=$5
+  shift 5
+  local start=$SECONDS result rc_w rc_c half
   echo "==== $name"
-  if ! cmake -S . -B "$dir" "$@" >/dev/null || ! cmake --build "$dir" -j"$jobs"; then
+  if ! cmake -S . -B "$dir" "$@" >/dev/null || ! cmake --build "$dir" -j"$cores"; then
     summaries+=("$name: BUILD FAILED")
     failed=1
     return
   fi
-  # shellcheck disable=SC2086
-  (cd "$dir" && ctest --output-on-failure -j"$jobs" $ctest_args) 2>&1 | tee "$log"
-  if [ "${PIPESTATUS[0]}" -eq 0 ]; then
-    result=$(grep -E "tests passed" "$log" | tail -1)
-    summaries+=("$name: $result")
-  else
-    failed=1
-    result=$(grep -E "tests passed|tests failed" "$log" | tail -1)
-    summaries+=("$name: ${result:-ctest failed}"$'\n'"$(sed -n '/The following tests FAILED/,$p' "$log" | grep -E '^\s+[0-9]+ - ')")
+  if [ "$timeout" = - ]; then
+    summaries+=("$name: built, warning-free ($((SECONDS - start)) s)")
+    return
   fi
+  local common=(--timeout "$timeout") waits=(-L "$waiting_rx") computes
+  [ -n "$sel" ] && common+=(-L "$sel")
+  [ -n "$excl" ] && waits+=(-LE "^(${excl// /|})\$")
+  computes=(-LE "^(${waiting// /|}${excl:+|${excl// /|}})\$")
+  : >"$root/$dir/ctest-computing.log"
+  ctest_half "$dir" "$root/$dir/ctest-waiting.log" "$wait_jobs" "${common[@]}" "${waits[@]}" &
+  local waiter=$!
+  ctest_half "$dir" "$root/$dir/ctest-computing.log" "$cores" "${common[@]}" "${computes[@]}" &
+  local computer=$!
+  tail -n +1 --pid="$computer" -f "$root/$dir/ctest-computing.log" 2>/dev/null  # shown as it runs
+  wait "$computer"
+  rc_c=$?
+  wait "$waiter"
+  rc_w=$?
+  for half in computing waiting; do
+    local log="$root/$dir/ctest-$half.log" rc=$rc_c
+    [ $half = waiting ] && rc=$rc_w
+    if grep -q "No tests were found" "$log"; then
+      continue
+    fi
+    if [ $half = waiting ]; then
+      echo "---- $name, the tier waits (run beside the above)"
+      cat "$log"
+    fi
+    local counts
+    counts=$(sed -n 's/.*tests passed, \([0-9]*\) tests\{0,1\} failed out of \([0-9]*\).*/\1 \2/p' "$log" | tail -1)
+    if [ -n "$counts" ]; then
+      total_failed=$((total_failed + ${counts% *}))
+      total_passed=$((total_passed + ${counts#* } - ${counts% *}))
+    fi
+    if [ "$rc" -eq 0 ]; then
+      result=$(grep -E "tests passed" "$log" | tail -1)
+      summaries+=("$name, $half: $result")
+    else
+      failed=1
+      result=$(grep -E "tests passed|tests failed" "$log" | tail -1)
+      summaries+=("$name, $half: ${result:-ctest failed}"$'\n'"$(sed -n '/The following tests FAILED/,$p' "$log" | grep -E '^\s+[0-9]+ - ')")
+    fi
+  done
+  summaries+=("$name: $((SECONDS - start)) s")
 }
 
-run_pass "pass 1 (gcc -Werror)" build "--timeout 300" \
-  -DCMAKE_C_COMPILER=gcc -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLAGSIM_WERROR=ON
+gcc_args=(-DCMAKE_C_COMPILER=gcc -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLAGSIM_WERROR=ON)
+# -O1 with the sanitizers (as AddressSanitizer's documentation advises): the same checks,
+# its physics tests 2.1 to 2.3 times as fast as at -O0 (test_hard chaos 20.7 s -> 9.1 s,
+# test_accuracy_cost dipc_1e-04 11.5 s -> 5.5 s); assertions stay (no NDEBUG)
+asan_args=(-DCMAKE_C_COMPILER=clang -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_C_FLAGS_DEBUG=-g -O1"
+           -DLAGSIM_WERROR=ON -DLAGSIM_SANITIZE=ON -DLAGSIM_FUZZ=ON -DLAGSIM_BENCH=OFF)
+asan_env() { export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1; }
 
-if [ "${LAGSIM_SKIP_SANITIZE:-0}" != 1 ]; then
-  export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1
-  run_pass "pass 2 (clang ASan+UBSan+libFuzzer)" build-asan "--timeout 600 -LE slow" \
-    -DCMAKE_C_COMPILER=clang -DCMAKE_BUILD_TYPE=Debug -DLAGSIM_WERROR=ON \
-    -DLAGSIM_SANITIZE=ON -DLAGSIM_FUZZ=ON -DLAGSIM_BENCH=OFF
-fi
+case $mode in
+  quick)
+    run_pass "quick tier (gcc -Werror)" build 300 "^quick\$" "" "${gcc_args[@]}" ;;
+  some)
+    if [ $sanitize -eq 1 ]; then
+      asan_env
+      run_pass "clang ASan+UBSan+libFuzzer: $select" build-asan 600 "$select" "" "${asan_args[@]}"
+    else
+      run_pass "gcc -Werror: $select" build 300 "$select" "" "${gcc_args[@]}"
+    fi ;;
+  full)
+    run_pass "pass 1 (gcc -Werror)" build 300 "" "" "${gcc_args[@]}"
+    if [ "${LAGSIM_SKIP_SANITIZE:-0}" != 1 ]; then
+      asan_env
+      run_pass "pass 2 (clang ASan+UBSan+libFuzzer)" build-asan 600 "" "slow" "${asan_args[@]}"
+    fi
+    run_pass "pass 3 (gcc -Werror Release, build only)" build-release - "" "" \
+      -DCMAKE_C_COMPILER=gcc -DCMAKE_BUILD_TYPE=Release -DLAGSIM_WERROR=ON ;;
+esac
 
 echo "==== summary"
 for s in "${summaries[@]}"; do echo "$s"; done
+echo "tests: $total_passed passed, $total_failed failed"
 exit $failed

@@ -1,14 +1,15 @@
 # The project's structure rules (tests/structure/check_structure.py), label structure:
 # one test harness for the C tests, one naming rule for ctests (lowercase words joined by
-# "_", a label on each), docs that name only ctests that exist and docs/testing.md's label
-# table, functions of at most 80 lines in server/, clients/, bench/, and time to ticks
-# converted by the core's helpers alone.
+# "_", a label and one tier on each), docs that name only ctests and files that exist and
+# docs/testing.md's tier and label tables, functions of at most 80 lines in server/,
+# clients/, bench/, and time to ticks converted by the core's helpers alone.
 find_program(LAGSIM_STRUCTURE_PYTHON3 python3)
 if(LAGSIM_STRUCTURE_PYTHON3)
   set(structure_check ${LAGSIM_STRUCTURE_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/structure/check_structure.py)
   add_test(NAME structure_harness COMMAND ${structure_check} harness ${PROJECT_SOURCE_DIR})
   add_test(NAME structure_names
-           COMMAND ${structure_check} names ${CMAKE_BINARY_DIR} --ctest ${CMAKE_CTEST_COMMAND})
+           COMMAND ${structure_check} names ${CMAKE_BINARY_DIR} --ctest ${CMAKE_CTEST_COMMAND}
+                   --tiers ${CMAKE_CURRENT_LIST_DIR}/common/tiers.cmake)
   add_test(NAME structure_docs
            COMMAND ${structure_check} docs ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR}
                    --ctest ${CMAKE_CTEST_COMMAND})

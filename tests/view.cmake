@@ -14,6 +14,12 @@ if(LAGSIM_VIEW_PYTHON3)
                      ${case})
     set_tests_properties(view_log2csv_${case} PROPERTIES TIMEOUT 120 LABELS view)
   endforeach()
+  # a real run's state CSV loaded as docs/view.md says: Octave's importdata and csvread,
+  # Python's csv, pandas (tests/view/test_log2csv_load.py)
+  add_test(NAME view_log2csv_load
+           COMMAND ${LAGSIM_VIEW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/view/test_log2csv_load.py
+                   --bin $<TARGET_FILE_DIR:lagsimd> --source ${PROJECT_SOURCE_DIR})
+  set_tests_properties(view_log2csv_load PROPERTIES TIMEOUT 180 LABELS view)
 endif()
 
 # lagsim-view: Chromium (Debian's chromium, installed by .ci/install-deps.sh) drives the

@@ -55,11 +55,18 @@ target_include_directories(test_port PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_port PRIVATE lagsim_wire_base)
 lagsim_add_test_cases(test_port wire_port wire 120)
 
+# How a number is printed to read back (server/wire/lagsim_num.c): the shortest decimal
+# that strtod reads back to the same double (tests/wire/test_num.c).
+add_executable(test_num ${CMAKE_CURRENT_LIST_DIR}/wire/test_num.c)
+target_include_directories(test_num PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
+target_link_libraries(test_num PRIVATE lagsim_wire_base)
+lagsim_add_test_cases(test_num wire_num wire 60)
+
 # One clock, one URL reader, one table of channel suffixes in the wire layer
 # (tests/wire/one_place.py): a second copy anywhere in server/, clients/ or bench/ fails.
 find_program(LAGSIM_WIRE_PYTHON3 python3)
 if(LAGSIM_WIRE_PYTHON3)
-  foreach(check clock url channels)
+  foreach(check clock url channels num)
     add_test(NAME wire_one_place_${check}
              COMMAND ${LAGSIM_WIRE_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/wire/one_place.py
                      ${PROJECT_SOURCE_DIR} ${check})

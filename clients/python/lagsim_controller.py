@@ -6,7 +6,8 @@ answer states until the run ends, a summary line.
     ctl.parser.add_argument(...)                 # the example's own options
     a = ctl.start()                              # parses argv, connects, waits for the scene
     for st in ctl.states():                      # each newest state once, until the end
-        ctl.command(st.sim_time, ["theta0"], [u])
+        m0 = ctl.params["m0"]                    # the scene's parameters, of this state's
+        ctl.command(st.sim_time, ["theta0"], [u])  # scene (ctl.scene: the whole scene_t)
     ctl.finish("states=%d ..." % n)              # prints "<name>: summary end=... states=..."
 
 A run ends (and states() returns) when the daemon publishes its `stop` event, when
@@ -39,6 +40,29 @@ def _import_types(types_dir, name):
         sys.stderr.write("%s: cannot import the lcm-gen Python types 'lagsim'; set "
                          "PYTHONPATH=<build>/python or pass --types DIR\n" % name)
         sys.exit(2)
+
+
+def _edits(a, b):
+    """Edits (insert, delete, substitute) between a and b, capped at 3."""
+    row = list(range(len(b) + 1))
+    for i in range(1, len(a) + 1):
+        diag, row[0] = row[0], i
+        for j in range(1, len(b) + 1):
+            up = row[j]
+            row[j] = min(diag + (a[i - 1] != b[j - 1]), up + 1, row[j - 1] + 1)
+            diag = up
+    return min(row[len(b)], 3)
+
+
+def _nearness(heard, asked):
+    """0 the same but for letter case, 1 it starts with the asked prefix, 2 + edits (at
+    most 2); -1 not near (lag_client_plants_instead's rule)."""
+    if heard.lower() == asked.lower():
+        return 0
+    if asked and heard.lower().startswith(asked.lower()):
+        return 1
+    e = _edits(heard, asked)
+    return 2 + e if e <= 2 else -1
 
 
 def _sound(v):
@@ -124,8 +148,8 @@ class Controller(object):
         while self.scene is None and not self._stop:
             now = time.monotonic()
             if now >= deadline:
-                sys.stderr.write("%s: no scene on %sSCENE within %g s (is lagsimd running "
-                                 "with this prefix?)\n" % (self.name, ch, a.timeout))
+                sys.stderr.write("%s: no scene on %sSCENE within %g s: %s\n"
+                                 % (self.name, ch, a.timeout, self._instead(state_url)))
                 sys.exit(1)
             if now >= next_ask:  # DESCRIBE every 0.25 s until the scene comes
                 self._ask_scene()
@@ -148,6 +172,42 @@ class Controller(object):
         comes; listens 1 s at most, 0.5 s after the first plant once all are described.
         Returns its prefix; None when there is none (the caller waits on its default: a
         controller may start before its plant); several: named, exit 2."""
+        found = self._plants()
+        mine = sorted(p for p, m in found.items() if m == self.model)
+        heard = ", ".join("%s (%s)" % (p, found[p] or "model unknown") for p in sorted(found))
+        if len(mine) == 1:
+            print("%s: the only %s plant on the bus: prefix %s" % (self.name, self.model, mine[0]),
+                  flush=True)
+            return mine[0]
+        if len(mine) > 1:
+            sys.stderr.write("%s: %d %s plants on %s: %s; choose one with --prefix\n"
+                             % (self.name, len(mine), self.model, state_url,
+                                ", ".join(mine)))
+            sys.exit(2)
+        print("%s: no %s plant on %s%s; waiting for prefix %s"
+              % (self.name, self.model, state_url, " (heard: %s)" % heard if found else "",
+                 self.default_prefix), flush=True)
+        return None
+
+    def _instead(self, state_url):
+        """What the bus has instead of a plant on --prefix (no scene came: a misspelt
+        prefix?), as the C library says it (lag_client_plants_instead): the plants heard
+        and the one meant when a heard prefix is the asked one in other letter case,
+        starts with it, or is at most 2 edits from it."""
+        asked = self.args.prefix
+        found = self._plants()
+        if not found:
+            return "no plant heard on %s within 1 s (is lagsimd running on this LCM URL?)" \
+                % state_url
+        heard = ", ".join("%s (%s)" % (p, found[p] or "model unknown") for p in sorted(found))
+        near = [(_nearness(p, asked), p) for p in sorted(found)]
+        near = sorted((k, p) for k, p in near if k >= 0)
+        return "no plant on prefix %s; plants heard on %s: %s%s" % (
+            asked, state_url, heard, "; did you mean %s?" % near[0][1] if near else "")
+
+    def _plants(self):
+        """{prefix: model (None until its scene came)} of the plants heard on the bus: 1 s
+        at most, 0.5 s after the first once every one is described."""
         found, asked = {}, {}   # prefix -> model (None until its scene came); last ask
 
         def on_any(channel, data):
@@ -180,21 +240,7 @@ class Controller(object):
             self.lc.handle_timeout(50)
         self.lc.unsubscribe(sub)
         self.dropped = dropped  # other plants' messages are not this run's
-        mine = sorted(p for p, m in found.items() if m == self.model)
-        heard = ", ".join("%s (%s)" % (p, found[p] or "model unknown") for p in sorted(found))
-        if len(mine) == 1:
-            print("%s: the only %s plant on the bus: prefix %s" % (self.name, self.model, mine[0]),
-                  flush=True)
-            return mine[0]
-        if len(mine) > 1:
-            sys.stderr.write("%s: %d %s plants on %s: %s; choose one with --prefix\n"
-                             % (self.name, len(mine), self.model, state_url,
-                                ", ".join(mine)))
-            sys.exit(2)
-        print("%s: no %s plant on %s%s; waiting for prefix %s"
-              % (self.name, self.model, state_url, " (heard: %s)" % heard if found else "",
-                 self.default_prefix), flush=True)
-        return None
+        return found
 
     def _decode(self, cls, data):
         """The message of type `cls` in `data`, or None (counted in `dropped`). Like the C

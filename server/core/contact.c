@@ -1,8 +1,10 @@
 /*
  * Contact: impulses at a joint, holds (a joint held at rest by a stop or by static
- * friction) and their forces, friction's stick/slip settling, and the stop's map that the
- * limits and the floor share. What the effects' maps and the event engine build on; it
- * calls only the right-hand side (rhs.c) and the event queue.
+ * friction) and the constraint forces that hold them (lag_lock_forces, under the current
+ * locks), friction's stick/slip settling, the stop's map that the limits and the floor
+ * share, and the check of the rest velocity they share. What the effects' maps and the
+ * event engine build on; it calls the right-hand side (rhs.c), the effects' generalized
+ * forces (effects.c), the event queue (event_queue.c) and the diagnostics (model.c).
  */
 #include <math.h>
 #include <string.h>

@@ -244,7 +244,10 @@ static void actuator_pre_tick(lag_sim *s)
 /* field = "<at>.<key>", or the key alone */
 static const char *dfield(char *buf, const char *at, const char *key)
 {
-    snprintf(buf, LAG_FIELD_MAX, "%s%s%s", at && at[0] ? at : "", at && at[0] ? "." : "", key);
+    int n = snprintf(buf, LAG_FIELD_MAX, "%s%s%s", at && at[0] ? at : "", at && at[0] ? "." : "",
+                     key);
+    if (n >= LAG_FIELD_MAX) /* a path longer than a field name: cut, and said to be */
+        memcpy(buf + LAG_FIELD_MAX - 4, "...", 4);
     return buf;
 }
 

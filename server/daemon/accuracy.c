@@ -13,6 +13,7 @@
 
 #include "cost.h"
 #include "daemon.h"
+#include "lagsim_num.h"
 #include "lagsim_out.h"
 
 /* The real-time margin a chosen setting must keep at least: the daemon also serves LCM,
@@ -75,11 +76,12 @@ static void apply(lagsimd_choice *ch, const lag_cost_row *row)
 {
     ch->n = 0;
     snprintf(ch->kv[ch->n++], sizeof ch->kv[0], "integrator.method=%s", lag_method_name(row->method));
-    snprintf(ch->kv[ch->n++], sizeof ch->kv[0], "integrator.dt=%.17g", row->dt);
+    char num[LAG_NUM_LEN];
+    snprintf(ch->kv[ch->n++], sizeof ch->kv[0], "integrator.dt=%s", lag_num(row->dt, num));
     if (row->tol > 0) {
-        snprintf(ch->kv[ch->n++], sizeof ch->kv[0], "integrator.rtol=%.17g", row->tol);
-        snprintf(ch->kv[ch->n++], sizeof ch->kv[0], "integrator.atol=%.17g",
-                 row->atol > 0 ? row->atol : row->tol);
+        snprintf(ch->kv[ch->n++], sizeof ch->kv[0], "integrator.rtol=%s", lag_num(row->tol, num));
+        snprintf(ch->kv[ch->n++], sizeof ch->kv[0], "integrator.atol=%s",
+                 lag_num(row->atol > 0 ? row->atol : row->tol, num));
     }
 }
 

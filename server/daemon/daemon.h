@@ -11,7 +11,7 @@
 #include "scene.h"
 
 typedef struct lagsimd_opts {
-    bool quiet;          /* -q: no live status line, no event lines */
+    bool quiet;          /* -q: only warnings and errors on stderr */
     double duration;     /* --duration: sim seconds to run, <= 0 = until stopped */
     const char *csv;     /* --offline: CSV path, "-" = stdout, NULL = no CSV */
     /* where the scene came from, for changes made while running (control_t SET): the

@@ -483,7 +483,11 @@ static void dir_open(host *h)
     h->dir_src = (rt_io_src){h->dir_in ? lcm_get_fileno(h->dir_in) : -1, on_directory, h,
                              false, false};
     err[0] = '\0';
-    int nf = sub ? lag_net_filter(h->dir.command_port, true, NULL, 0, err, sizeof err) : -1;
+    /* every prefix's _CONTROL, from this host (the marker: no other channel is needed) */
+    const char *marker[] = {LAG_NET_MARKER_CHANNEL}, *requests[] = {lag_bus_suffix(LAG_BUS_CONTROL)};
+    int nf = sub ? lag_net_filter_suffixes(h->dir.command_port, true, marker, 1, requests, 1, err,
+                                           sizeof err)
+                 : -1;
     if (nf == 0) snprintf(err, sizeof err, "LCM's receive socket was not found");
     if (nf < 1 || rt_io_add(&h->io, &h->dir_src) != 0) {
         fprintf(stderr, "lagsimd: no directory of the host's plants on %s: %s\n",

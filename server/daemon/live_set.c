@@ -191,11 +191,10 @@ static int redefine(const live_sets *old, const live_sets *ls, lag_sim *sim, cha
     def = sim->def;
     without_kicks(old, &def);
     if (live_kicks_append(ls, &def, why, whylen) != 0) return -1;
-    char err[512];
-    if (lag_sim_redefine(sim, &def, err, sizeof err) != LAG_OK) {
-        snprintf(why, whylen, "kick: %s", err);
-        return -1;
-    }
+    /* the core's message straight after the prefix: no second buffer to cut it twice */
+    int n = snprintf(why, whylen, "kick: ");
+    size_t at = n > 0 && (size_t)n < whylen ? (size_t)n : 0;
+    if (lag_sim_redefine(sim, &def, why + at, whylen - at) != LAG_OK) return -1;
     return 0;
 }
 

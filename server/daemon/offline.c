@@ -2,9 +2,9 @@
  * Offline runs: simulate a scene as fast as possible (no LCM) and write CSV.
  *
  * Rows at t = 0 and every output period (ticks_per_period * dt = 1/publish_hz) up to the
- * duration: t, q..., qd..., energy (T + U), every number "%.17g" so that a reread gives the
- * same double. A numeric fault stops the run: the rows so far stay, LAG_ERR_RUNTIME (exit 1). So does
- * SIGINT, SIGTERM or SIGHUP: the run stops within one chunk of ticks, the rows so far are
+ * duration: t, q..., qd..., energy (T + U), every number the shortest decimal that reads
+ * back to the same double (lagsim_num.h). A numeric fault stops the run: the rows so far
+ * stay, LAG_ERR_RUNTIME (exit 1). So does SIGINT, SIGTERM or SIGHUP: the run stops within one chunk of ticks, the rows so far are
  * flushed and the summary says where it stopped.
  */
 #include <errno.h>
@@ -17,6 +17,7 @@
 
 #include "daemon.h"
 #include "lagsim_clock.h"
+#include "lagsim_num.h"
 #include "lagsim_out.h"
 #include "rt_pace.h"
 
@@ -30,20 +31,21 @@ static void on_stop_signal(int signo) { g_stop_signal = signo; }
  * one (as lagsimd publishes them on <PREFIX>_REFERENCE). Returns <0 on write error. */
 static int write_row(FILE *f, const lag_sim *sim, const lag_scene_reference *ref)
 {
-    char line[1024];
+    char line[1024], a[LAG_NUM_LEN], b[LAG_NUM_LEN];
     double q[LAG_MAX_DOF], qd[LAG_MAX_DOF];
     lag_sim_observe(sim, q, qd);
-    int n = snprintf(line, sizeof line, "%.17g", lag_sim_time(sim));
+    int n = snprintf(line, sizeof line, "%s", lag_num(lag_sim_time(sim), a));
     for (int i = 0; i < sim->nq; i++)
-        n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g", q[i]);
+        n += snprintf(line + n, sizeof line - (size_t)n, ",%s", lag_num(q[i], a));
     for (int i = 0; i < sim->nq; i++)
-        n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g", qd[i]);
-    n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g", lag_sim_energy(sim));
+        n += snprintf(line + n, sizeof line - (size_t)n, ",%s", lag_num(qd[i], a));
+    n += snprintf(line + n, sizeof line - (size_t)n, ",%s", lag_num(lag_sim_energy(sim), a));
     if (ref->n > 0) {
         lag_wire_reference m;
         lagsimd_reference_at(ref, sim->def.model.kind, lag_sim_time(sim), sim->tick, &m);
         for (int k = 0; k < m.num_joints; k++)
-            n += snprintf(line + n, sizeof line - (size_t)n, ",%.17g,%.17g", m.r[k], m.rdot[k]);
+            n += snprintf(line + n, sizeof line - (size_t)n, ",%s,%s", lag_num(m.r[k], a),
+                          lag_num(m.rdot[k], b));
     }
     n += snprintf(line + n, sizeof line - (size_t)n, "\n");
     return fwrite(line, 1, (size_t)n, f) == (size_t)n ? 0 : -1;
@@ -170,10 +172,12 @@ static void offline_loop(offline_run *run)
     for (; run->k < run->nperiods && !g_stop_signal; run->k++) {
         lag_result r = offline_period(run);
         if (r != LAG_OK) {
-            fprintf(stderr, "lagsimd: numeric fault at t = %.17g s (last good state): %s "
-                            "(method %s, dt %g s)\n",
-                    lag_sim_time(run->sim), lag_result_string(r),
-                    lag_method_name(sc->sim.integrator.method), sc->sim.integrator.dt);
+            char t[LAG_NUM_LEN], dt[LAG_NUM_LEN];
+            fprintf(stderr, "lagsimd: numeric fault at t = %s s (last good state): %s "
+                            "(method %s, dt %s s)\n",
+                    lag_num(lag_sim_time(run->sim), t), lag_result_string(r),
+                    lag_method_name(sc->sim.integrator.method),
+                    lag_num(sc->sim.integrator.dt, dt));
             run->rc = LAG_ERR_RUNTIME;
             break;
         }
@@ -182,8 +186,9 @@ static void offline_loop(offline_run *run)
             break; /* reported by offline_close_csv */
     }
     if (g_stop_signal) {
-        fprintf(stderr, "lagsimd: stopped by signal %d at t = %.17g s (%lld of %lld periods)\n",
-                (int)g_stop_signal, lag_sim_time(run->sim), (long long)run->k,
+        char t[LAG_NUM_LEN];
+        fprintf(stderr, "lagsimd: stopped by signal %d at t = %s s (%lld of %lld periods)\n",
+                (int)g_stop_signal, lag_num(lag_sim_time(run->sim), t), (long long)run->k,
                 (long long)run->nperiods);
         run->rc = LAG_ERR_RUNTIME;
     }
@@ -210,14 +215,16 @@ static void offline_summary(const offline_run *run, double e0, double cpu)
     const lag_scene *sc = run->sc;
     const lag_sim *sim = run->sim;
     double e1 = lag_sim_energy(sim);
+    char dt[LAG_NUM_LEN], a[LAG_NUM_LEN], b[LAG_NUM_LEN];
     fprintf(stderr,
-            "lagsimd: offline %s, %s dt %g s: %.6g s of sim time, %lld rows, "
+            "lagsimd: offline %s, %s dt %s s: %.6g s of sim time, %lld rows, "
             "%lld steps (%lld rejected), %lld rhs evals, %lld events, %.3g s CPU; "
-            "energy %.17g -> %.17g J (change %.3g)\n",
+            "energy %s -> %s J (change %.3g)\n",
             lag_model_info_get(sc->sim.model.kind)->name, lag_method_name(sc->sim.integrator.method),
-            sc->sim.integrator.dt, lag_sim_time(sim), (long long)(run->k + 1),
+            lag_num(sc->sim.integrator.dt, dt), lag_sim_time(sim), (long long)(run->k + 1),
             (long long)sim->stats.steps_accepted, (long long)sim->stats.steps_rejected,
-            (long long)sim->stats.rhs_evals, (long long)run->nevents, cpu, e0, e1, e1 - e0);
+            (long long)sim->stats.rhs_evals, (long long)run->nevents, cpu, lag_num(e0, a),
+            lag_num(e1, b), e1 - e0);
 }
 
 lag_result lagsimd_offline(const lag_scene *sc, const lagsimd_opts *o)

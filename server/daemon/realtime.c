@@ -99,7 +99,7 @@ static bool paused_copies(const rt_server *s)
 static rt_wait_seen wait_seen(const rt_server *s)
 {
     rt_wait_seen w = {RT_WAIT_NONE, 0, s->rejected, s->bus.commands_wrong_port, s->last_reject,
-                      false, s->stale};
+                      &s->bus.foreign, false, s->stale};
     bool lockstep = s->sc->realtime.mode == LAG_RT_LOCKSTEP;
     if (s->run == RT_FAULT) w.kind = RT_WAIT_RESET;
     else if (s->run == RT_PAUSED && s->pending_steps == 0) {
@@ -317,7 +317,9 @@ static void period_end(rt_server *s)
         rt_pub_limited(&s->pub, RT_EV_STEP_DONE, "", 0, "step done: paused");
         s->pub.want_status = true;
     }
-    if (s->stop_tick > 0 && s->sim.tick >= s->stop_tick) {
+    /* --duration: the sim time this run has advanced, a reset's sim time starting over
+     * or not (docs/server.md) */
+    if (s->stop_tick > 0 && rt_sat_add(s->ticks_before_reset, s->sim.tick) >= s->stop_tick) {
         s->stop = true;
         s->stop_reason = RT_STOP_DURATION;
     }
@@ -507,6 +509,27 @@ static bool command_of_now(rt_server *s, const lag_wire_joint_command *c)
     return false;
 }
 
+/* The copy rule (docs/protocol.md, Lockstep: run the law once per state; answer a copy,
+ * the same generation and sim_time sent again until answered, at once with the command
+ * already sent). A controller that runs its law on every copy answers the copies one law time
+ * apart, long after the state's first answer (a controller that keeps the rule answers
+ * the copies it got meanwhile at once, within a millisecond or so), and falls behind: its
+ * answers to copies come late, and those to older states stale. Once they number 10 and
+ * at least one for every two states answered, an event (and so a line on the terminal)
+ * says so, once. */
+#define RT_COPY_LATE_NS (20 * RT_NS_PER_S / 1000)
+static void late_answer(rt_server *s)
+{
+    if (++s->late_answers < 10 || 2 * s->late_answers < s->accepted || s->copy_rule_said) return;
+    s->copy_rule_said = true;
+    rt_pub_eventf(&s->pub, "copy_rule", (double)s->late_answers, "the law seems to run again "
+                  "on copies: %lld answers came 20 ms or more after their state was answered "
+                  "(%lld states answered); answer a copy (same generation, sim_time) at once "
+                  "with the command sent (docs/protocol.md: the copy rule)", (long long)s->late_answers,
+                  (long long)s->accepted);
+    s->pub.want_status = true;
+}
+
 /* Lockstep: the command answers the state waited on (or, not running, the state the sim
  * holds), known by its generation and sim time. A second answer to a state already
  * answered (the controller got it twice, a retry crossing its first answer) is not
@@ -518,8 +541,10 @@ static bool command_in_step(rt_server *s, const lag_wire_joint_command *c)
     if (rt_lockstep_repeated(&s->ls, c->generation, c->sim_time)) {
         s->commands_ignored++;
         rt_log_rx_fate(&s->rec, s->now, RT_RX_REFUSED); /* --log: a sample of them */
+        if (s->now - s->ls.answered_ns >= RT_COPY_LATE_NS) late_answer(s);
         return false;
     }
+    if (s->ls.have_answered && c->sim_time < s->ls.answered_time) late_answer(s);
     bool waited_on = rt_lockstep_is_waited(&s->ls, c->generation, c->sim_time);
     if (waited_on || (s->run != RT_RUNNING && c->sim_time == lag_sim_time(&s->sim))) return true;
     rt_verdict v = {RT_REJ_STALE, "", c->sim_time, ""};
@@ -542,7 +567,7 @@ static void command_apply(rt_server *s, const lag_wire_joint_command *c, const i
     s->accepted++;
     s->have_command = true;
     s->command_tick = s->sim.tick;
-    rt_lockstep_answer(&s->ls, c->generation, c->sim_time);
+    rt_lockstep_answer(&s->ls, c->generation, c->sim_time, s->now);
     if (s->run == RT_WAITING) {
         /* the command the run was waiting for: it goes on from here */
         s->run = RT_RUNNING;
@@ -589,6 +614,7 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
         live_kicks_clear(&s->ctl.live, &s->sim);
         event(s, "kicks_cleared", "", 0, detail); /* --replay applies it here */
     }
+    s->ticks_before_reset = rt_sat_add(s->ticks_before_reset, s->sim.tick); /* --duration */
     lag_sim_reset(&s->sim, q, qd);
     s->effect_events_dropped = s->sim.events_dropped;
     for (int i = 0; i < s->nq; i++) s->held[i] = 0.0;
@@ -781,6 +807,7 @@ static int open_parts(rt_server *s, const lagsimd_opts *o, char *err, size_t err
     char berr[256];
     if (rt_bus_init(&s->bus, sc, berr, sizeof berr) != 0)
         return open_error(err, errlen, "bad scene: lcm.url: %s", berr);
+    s->bus.now = &s->now;
     bool quiet = o && o->quiet; /* the terminal's and the log's -q */
     rt_term_init(&s->term, quiet, s->bus.ch_event, s->now);
     s->term.view = term_view;
@@ -1045,6 +1072,7 @@ int rt_plant_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int6
     s->term.who = who;
     /* LCM: publishing on the state URL, receiving on the command URL */
     rt_bus_handlers h = handlers(s);
+    s->bus.quiet = quiet;
     rc = rt_bus_open_start(&s->bus, &h, err, errlen);
     if (rc != LAGSIMD_EXIT_OK) rt_log_end(&s->rec);
     return rc;

@@ -65,6 +65,7 @@
 #include "daemon.h"
 #include "lagsim_bus.h"
 #include "lagsim_log.h"
+#include "lagsim_num.h"
 #include "lagsim_wire.h"
 #include "live_set.h"
 
@@ -667,13 +668,15 @@ static lag_result replay_checked(const replay_run *run, double *max_diff)
  * (a reference not this scene's, a difference above the tolerance). */
 static lag_result replay_verdict(const replay_run *run, double max_diff)
 {
-    printf("max |q - q_log| = %.17g\nmax |qd - qd_log| = %.17g\n", run->max_dq, run->max_dqd);
-    if (run->use_input) printf("max |effort - effort_log| = %.17g\n", run->max_deff);
+    char a[LAG_NUM_LEN], b[LAG_NUM_LEN];
+    printf("max |q - q_log| = %s\nmax |qd - qd_log| = %s\n", lag_num(run->max_dq, a),
+           lag_num(run->max_dqd, b));
+    if (run->use_input) printf("max |effort - effort_log| = %s\n", lag_num(run->max_deff, a));
     if (run->refs_seen > 0 || run->sc->reference.n > 0) {
         printf("%lld references compared on %s (%lld of other joints, another time or "
-               "undecodable)\nmax |r - r_log|, |rdot - rdot_log| = %.17g\n",
+               "undecodable)\nmax |r - r_log|, |rdot - rdot_log| = %s\n",
                (long long)run->refs_compared, run->ch_ref, (long long)run->refs_bad,
-               run->max_dr);
+               lag_num(run->max_dr, a));
         if (run->max_dr > max_diff || isnan(run->max_dr)) max_diff = run->max_dr;
         if (run->refs_bad > 0) {
             fprintf(stderr, "lagsimd: --replay: FAILED: %lld reference(s) on %s are not "
@@ -682,11 +685,11 @@ static lag_result replay_verdict(const replay_run *run, double max_diff)
             return LAG_ERR_MISMATCH;
         }
     }
-    printf("max difference = %.17g\n", max_diff);
+    printf("max difference = %s\n", lag_num(max_diff, a));
     const double tolerance = run->o ? run->o->tolerance : 0.0;
     if (!(max_diff <= tolerance)) {
-        fprintf(stderr, "lagsimd: --replay: FAILED: the largest difference %.17g is above "
-                        "the tolerance %.17g: %s\n", max_diff, tolerance,
+        fprintf(stderr, "lagsimd: --replay: FAILED: the largest difference %s is above "
+                        "the tolerance %s: %s\n", lag_num(max_diff, a), lag_num(tolerance, b),
                 run->anchor ? "the replay of this log is approximate (see the note above)"
                             : "the log does not match this scene and build (wrong --config "
                               "or --set, another build, or a changed log)");

@@ -1,13 +1,13 @@
 /*
  * The daemon's bus (lagsim_bus.h gives the URLs). On udpm://:
  *   b->lcm        publishes on the state URL;
- *   b->lcm_in     publishes on the command URL (DESCRIBE at start, the sync marker);
- *                 neither subscribes, so LCM makes no thread, pipe wait or select(2) for
- *                 them;
+ *   b->lcm_in     publishes on the command URL (DESCRIBE at start, the sync marker, the
+ *                 probes of rt_foreign.h); neither subscribes, so LCM makes no thread,
+ *                 pipe wait or select(2) for them;
  *   b->rx_in      the plant's own receive socket on the command URL (rt_rx.h), read by the
- *                 loop: _COMMAND and _CONTROL. Its socket filter (lagsim_net.h) keeps only
- *                 those two channels, and unless lcm.allow_lan only datagrams sent from
- *                 this host;
+ *                 loop: _COMMAND and _CONTROL (and every prefix's _CONTROL, below). Its
+ *                 socket filter (lagsim_net.h) keeps only those, and unless lcm.allow_lan
+ *                 only datagrams sent from this host;
  *   b->rx_watch   the plant watch on the state URL: _SCENE (and _COMMAND sent to the wrong
  *                 port, counted), its filter dropping the daemon's own states in the kernel.
  * For memq:// (tests, one process) one lcm_t is both, with LCM's subscriptions.
@@ -17,6 +17,12 @@
  * (rt_bus_foreign_scene: one that decodes, names this prefix and is not one of the
  * daemon's own) makes it refuse to start, and later is counted and said. Whom it hears
  * follows the command URL's rule: this host only unless lcm.allow_lan.
+ *
+ * What is asked where the plant listens but not of it is heard too (rt_foreign.h): every
+ * <P>_CONTROL on both ports (another prefix's: a misspelt one; this plant's on the state
+ * port: the wrong port) and every <P>_SCENE on the state port (a prefix asked that has a
+ * plant of its own). The filters keep them by their suffix; control requests are rare, and
+ * a flood of them costs what a flood on this plant's own _CONTROL costs, bounded the same.
  */
 #include <poll.h>
 #include <stdio.h>
@@ -70,6 +76,63 @@ static void on_wrong_port(const lcm_recv_buf_t *rb, const char *ch, void *user)
     if (!b->discard) b->commands_wrong_port++;
 }
 
+/* Every <P>_CONTROL on the command URL (this plant's own is on_control's) and on the
+ * state URL, every <P>_SCENE on the state URL: rt_foreign.h. */
+/* A control request heard on channel ch (state_port: on the state URL): counted; a prefix
+ * heard for the first time is asked for its scene (the probe, within its bucket), so that
+ * another plant's prefix is known as such (rt_foreign.h). */
+static void foreign_request(rt_bus *b, const uint8_t *data, size_t size, const char *ch,
+                            bool state_port)
+{
+    if (b->discard) return;
+    rt_foreign_prefix *e =
+        rt_foreign_request(&b->foreign, ch, b->ch_control, state_port, data, size);
+    int64_t now = b->now ? *b->now : lag_clock_mono_ns();
+    if (!e || !rt_limit_take(&b->probes, now)) return; /* asked again at its next request */
+    lag_wire_control c;
+    memset(&c, 0, sizeof c);
+    c.utime = lag_clock_wall_us();
+    c.request = LAGSIM_CONTROL_T_DESCRIBE;
+    uint8_t buf[256];
+    int len = lag_wire_encode(LAG_WIRE_CONTROL, &c, buf, sizeof buf);
+    char channel[RT_CHANNEL_MAX];
+    int w = lag_bus_channel_name(channel, sizeof channel, e->prefix, LAG_BUS_CONTROL);
+    if (w < 0 || (size_t)w >= sizeof channel) return;
+    if (len > 0 && lcm_publish(b->lcm_in, channel, buf, (unsigned)len) == 0)
+        rt_foreign_probed(&b->foreign, e, now, c.utime);
+}
+
+static void on_foreign_in(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    foreign_request(user, rb->data, rb->data_size, ch, false);
+}
+
+static void on_foreign_out(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    foreign_request(user, rb->data, rb->data_size, ch, true);
+}
+
+static void on_foreign_scene(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    (void)rb;
+    rt_bus *b = user;
+    if (!b->discard) rt_foreign_scene(&b->foreign, ch, b->ch_scene);
+}
+
+/* The three subscriptions of rt_foreign.h (none is needed to run: a failure is silent). */
+static void subscribe_foreign(rt_bus *b, lcm_t *out, lcm_t *in)
+{
+    char control[32], scene[32]; /* every prefix's (LCM's channel patterns are regexes) */
+    snprintf(control, sizeof control, ".*%s", lag_bus_suffix(LAG_BUS_CONTROL));
+    snprintf(scene, sizeof scene, ".*%s", lag_bus_suffix(LAG_BUS_SCENE));
+    b->sub_foreign_in = lcm_subscribe(in, control, on_foreign_in, b);
+    b->sub_foreign_scene = lcm_subscribe(out, scene, on_foreign_scene, b);
+    if (out != in) b->sub_foreign_out = lcm_subscribe(out, control, on_foreign_out, b);
+    lcm_subscription_t *subs[] = {b->sub_foreign_in, b->sub_foreign_scene, b->sub_foreign_out};
+    for (int i = 0; i < 3; i++)
+        if (subs[i]) lcm_subscription_set_queue_capacity(subs[i], 16);
+}
+
 static void on_control(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     (void)ch;
@@ -107,6 +170,9 @@ int rt_bus_attach(rt_bus *b, lcm_t *out, lcm_t *in, const rt_bus_handlers *h, ch
         b->sub_wrong_port = lcm_subscribe(out, b->ch_command, on_wrong_port, b);
         if (b->sub_wrong_port) lcm_subscription_set_queue_capacity(b->sub_wrong_port, 16);
     }
+    subscribe_foreign(b, out, in);
+    rt_limit_init(&b->probes, RT_FOREIGN_PROBES_PER_S, RT_FOREIGN_PROBES_PER_S,
+                  b->now ? *b->now : lag_clock_mono_ns());
     return LAGSIMD_EXIT_OK;
 }
 
@@ -116,7 +182,10 @@ void rt_bus_detach(rt_bus *b)
     if (b->sub_control) lcm_unsubscribe(b->lcm_in, b->sub_control);
     if (b->sub_scene) lcm_unsubscribe(b->lcm, b->sub_scene);
     if (b->sub_wrong_port) lcm_unsubscribe(b->lcm, b->sub_wrong_port);
-    b->sub_wrong_port = NULL;
+    if (b->sub_foreign_in) lcm_unsubscribe(b->lcm_in, b->sub_foreign_in);
+    if (b->sub_foreign_out) lcm_unsubscribe(b->lcm, b->sub_foreign_out);
+    if (b->sub_foreign_scene) lcm_unsubscribe(b->lcm, b->sub_foreign_scene);
+    b->sub_wrong_port = b->sub_foreign_in = b->sub_foreign_out = b->sub_foreign_scene = NULL;
     b->sub_command = b->sub_control = NULL;
     b->sub_scene = NULL;
 }
@@ -173,8 +242,10 @@ static int filter_input(rt_bus *b, char *err, size_t errlen)
     const lag_bus *u = &b->urls;
     bool host_only = !b->sc->lcm.allow_lan;
     const char *with_marker[] = {b->ch_command, b->ch_control, LAG_NET_MARKER_CHANNEL};
+    const char *requests[] = {lag_bus_suffix(LAG_BUS_CONTROL)}; /* any prefix's: rt_foreign.h */
     char ferr[256];
-    int n = lag_net_filter(u->command_port, host_only, with_marker, 3, ferr, sizeof ferr);
+    int n = lag_net_filter_suffixes(u->command_port, host_only, with_marker, 3, requests, 1,
+                                    ferr, sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s%s: cannot restrict the command URL %s to %s", n < 0 ? ferr :
                  "the receive socket for the command port was not found",
@@ -192,7 +263,8 @@ static int filter_input(rt_bus *b, char *err, size_t errlen)
                  "route? docs/network.md)", u->command_url);
         return LAGSIMD_EXIT_RUNTIME;
     }
-    n = lag_net_filter(u->command_port, host_only, with_marker, 2, ferr, sizeof ferr);
+    n = lag_net_filter_suffixes(u->command_port, host_only, with_marker, 2, requests, 1, ferr,
+                                sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s", n < 0 ? ferr : "the receive socket went away");
         return LAGSIMD_EXIT_RUNTIME;
@@ -207,10 +279,13 @@ static int ask_for_other_plant(rt_bus *b, char *err, size_t errlen)
 {
     const lag_bus *u = &b->urls;
     bool host_only = !b->sc->lcm.allow_lan;
-    /* and _COMMAND: a command sent to the state port is counted (rt_wait.c says so) */
+    /* and _COMMAND: a command sent to the state port is counted (rt_wait.c says so); any
+     * prefix's _CONTROL and _SCENE: rt_foreign.h */
     const char *out[] = {b->ch_scene, b->ch_command};
+    const char *requests[] = {lag_bus_suffix(LAG_BUS_CONTROL), lag_bus_suffix(LAG_BUS_SCENE)};
     char ferr[256];
-    int n = lag_net_filter(u->state_port, host_only, out, 2, ferr, sizeof ferr);
+    int n = lag_net_filter_suffixes(u->state_port, host_only, out, 2, requests, 2, ferr,
+                                    sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s: cannot filter the state URL %s for the plant watch",
                  n < 0 ? ferr : "the receive socket for the state port was not found",
@@ -252,6 +327,28 @@ static void rx_wrong_port(void *ctx, const uint8_t *data, size_t len)
     if (!b->discard) b->commands_wrong_port++;
 }
 
+/* Whether channel ch ends in the suffix of `which` after a prefix. */
+static bool ends_in(const char *ch, lag_bus_channel which)
+{
+    const char *suf = lag_bus_suffix(which);
+    size_t n = strlen(ch), k = strlen(suf);
+    return n > k && !strcmp(ch + n - k, suf);
+}
+
+/* Every datagram of the plant's sockets, as LCM's subscriptions to every prefix's
+ * _CONTROL (both ports) and _SCENE (the state port) would hear them: rt_foreign.h. */
+static void rx_foreign_in(void *ctx, const char *ch, const uint8_t *data, size_t len)
+{
+    if (ends_in(ch, LAG_BUS_CONTROL)) foreign_request(ctx, data, len, ch, false);
+}
+
+static void rx_foreign_out(void *ctx, const char *ch, const uint8_t *data, size_t len)
+{
+    rt_bus *b = ctx;
+    if (ends_in(ch, LAG_BUS_CONTROL)) foreign_request(b, data, len, ch, true);
+    else if (ends_in(ch, LAG_BUS_SCENE) && !b->discard) rt_foreign_scene(&b->foreign, ch, b->ch_scene);
+}
+
 /* udpm://: the plant's two receive sockets (rt_rx.h): _COMMAND and _CONTROL on the command
  * URL; the plant watch (_SCENE, and _COMMAND sent to the wrong port) on the state URL. */
 static int open_receivers(rt_bus *b, char *err, size_t errlen)
@@ -260,8 +357,8 @@ static int open_receivers(rt_bus *b, char *err, size_t errlen)
     lag_url url;
     long rcvbuf = lag_url_parse(u->state_url, LAG_URL_SCENE_RULES | LAG_URL_ALLOW_LAN, &url,
                                 err, errlen) == 0 ? url.recv_buf_size : 0;
-    b->rx_in = (rt_rx){-1, 2, {"", ""}, {rx_command, rx_control}, b, 0};
-    b->rx_watch = (rt_rx){-1, 2, {"", ""}, {rx_scene, rx_wrong_port}, b, 0};
+    b->rx_in = (rt_rx){-1, 2, {"", ""}, {rx_command, rx_control}, rx_foreign_in, b, 0};
+    b->rx_watch = (rt_rx){-1, 2, {"", ""}, {rx_scene, rx_wrong_port}, rx_foreign_out, b, 0};
     snprintf(b->rx_in.ch[0], sizeof b->rx_in.ch[0], "%s", b->ch_command);
     snprintf(b->rx_in.ch[1], sizeof b->rx_in.ch[1], "%s", b->ch_control);
     snprintf(b->rx_watch.ch[0], sizeof b->rx_watch.ch[0], "%s", b->ch_scene);
@@ -292,6 +389,8 @@ int rt_bus_open_start(rt_bus *b, const rt_bus_handlers *h, char *err, size_t err
         b->on = *h;
         b->lcm = out;
         b->lcm_in = in;
+        rt_limit_init(&b->probes, RT_FOREIGN_PROBES_PER_S, RT_FOREIGN_PROBES_PER_S,
+                      b->now ? *b->now : lag_clock_mono_ns());
         rc = open_receivers(b, err, errlen);
         if (rc == LAGSIMD_EXIT_OK) rc = ask_for_other_plant(b, err, errlen);
     } else {
@@ -332,12 +431,13 @@ static void say_where(const rt_bus *b)
         fprintf(stderr, "lagsimd: warning: LCM url '%s' has ttl=%d: states, status and events "
                 "leave this host (multicast to the local network%s)\n", u->state_url, ttl,
                 ttl > 1 ? " and beyond routers" : "");
+    /* -q: only what warns (the network can reach the plant), as the ttl warning above */
     if (b->sc->lcm.allow_lan)
         fprintf(stderr, "lagsimd: %s: listening on %s for commands and control from the "
                 "network (lcm.allow_lan: true: any host that reaches %s can command this "
                 "plant) on %s; states on %s\n", b->sc->lcm.prefix, ifname, ifname,
                 u->command_url, u->state_url);
-    else
+    else if (!b->quiet)
         fprintf(stderr, "lagsimd: %s: listening on %s for commands and control from this "
                 "host only (lcm.allow_lan: false) on %s; states on %s%s\n", b->sc->lcm.prefix,
                 ifname, u->command_url, u->state_url,
@@ -348,8 +448,9 @@ int rt_bus_open_finish(rt_bus *b, char *err, size_t errlen)
 {
     const lag_bus *u = &b->urls;
     if (!u->udpm) {
-        fprintf(stderr, "lagsimd: %s: on %s (this process only)\n", b->sc->lcm.prefix,
-                u->state_url);
+        if (!b->quiet)
+            fprintf(stderr, "lagsimd: %s: on %s (this process only)\n", b->sc->lcm.prefix,
+                    u->state_url);
         return LAGSIMD_EXIT_OK;
     }
     int rc = LAGSIMD_EXIT_OK;

@@ -15,6 +15,8 @@
 #include <lcm/lcm.h>
 #include "lagsim_bus.h"
 #include "lagsim_wire.h"
+#include "rt_foreign.h"
+#include "rt_pace.h"
 #include "rt_rx.h"
 #include "scene.h"
 
@@ -47,11 +49,20 @@ typedef struct rt_bus {
     lcm_subscription_t *sub_command, *sub_control;
     lcm_subscription_t *sub_scene; /* _SCENE on the state URL: another plant's (plant watch) */
     lcm_subscription_t *sub_wrong_port; /* _COMMAND on the state URL: counted, not applied */
+    lcm_subscription_t *sub_foreign_in, *sub_foreign_out, *sub_foreign_scene; /* every
+                                * <P>_CONTROL on the command URL and on the state URL, every
+                                * <P>_SCENE on the state URL: requests not for this plant
+                                * where it listens (rt_foreign.h) */
     rt_bus_handlers on;
     bool discard;              /* drop commands and control requests: before the start,
                                 * LCM's queues may hold datagrams that came in before the
                                 * filter */
     int64_t commands_wrong_port; /* joint_command_t heard on the state URL */
+    rt_foreign foreign;        /* control requests for other prefixes, or on the state URL */
+    rt_limit probes;           /* its DESCRIBEs to those prefixes (rt_foreign.h) */
+    const int64_t *now;        /* the loop's clock (NULL: CLOCK_MONOTONIC) */
+    bool quiet;                /* -q: rt_bus_open says where it listens only when the
+                                * network can reach it (a warning) */
     /* one plant per prefix: the scenes this daemon published (FNV-1a of their bytes, which
      * include utime), and what was heard from another plant */
     uint64_t scene_sent[RT_SCENES_KEPT];

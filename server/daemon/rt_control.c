@@ -136,17 +136,13 @@ static void handle_set(rt_control *c, const lag_wire_control *m)
  * unknown one offers. */
 static const char *control_requests(void)
 {
-    static const char *const names[] = {
-        [LAGSIM_CONTROL_T_PAUSE] = "PAUSE", [LAGSIM_CONTROL_T_RESUME] = "RESUME",
-        [LAGSIM_CONTROL_T_STEP] = "STEP", [LAGSIM_CONTROL_T_RESET] = "RESET",
-        [LAGSIM_CONTROL_T_RESET_TO] = "RESET_TO", [LAGSIM_CONTROL_T_STATUS] = "STATUS",
-        [LAGSIM_CONTROL_T_DESCRIBE] = "DESCRIBE", [LAGSIM_CONTROL_T_SET] = "SET"};
     static char list[160];
     if (!list[0]) {
         size_t k = 0;
-        for (size_t i = 0; i < sizeof names / sizeof names[0] && k < sizeof list; i++) {
-            if (!names[i]) continue;
-            int w = snprintf(list + k, sizeof list - k, "%s%s = %zu", k ? ", " : "", names[i], i);
+        for (int i = 0; i < 128 && k < sizeof list; i++) {
+            const char *name = lag_wire_request_name(i);
+            if (!name) continue;
+            int w = snprintf(list + k, sizeof list - k, "%s%s = %d", k ? ", " : "", name, i);
             if (w < 0) break;
             k += (size_t)w;
         }

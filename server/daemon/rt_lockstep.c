@@ -59,9 +59,10 @@ void rt_lockstep_heard(rt_lockstep *l, int64_t gen, double t)
     if (rt_lockstep_is_waited(l, gen, t)) l->answer_heard = true;
 }
 
-void rt_lockstep_answer(rt_lockstep *l, int64_t gen, double t)
+void rt_lockstep_answer(rt_lockstep *l, int64_t gen, double t, int64_t now)
 {
     if (!rt_lockstep_is_waited(l, gen, t)) return;
+    l->answered_ns = now;
     l->answered = true;
     l->answered_time = t;
     l->answered_gen = gen;

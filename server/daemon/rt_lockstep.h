@@ -30,6 +30,7 @@ typedef struct rt_lockstep {
     double answered_time;      /* sim_time of the last state a command answered */
     int64_t answered_gen;      /* and its generation */
     bool have_answered;        /* answered_time holds one (since start or reset) */
+    int64_t answered_ns;       /* when it was answered (the copy rule's hint: realtime.c) */
 } rt_lockstep;
 
 /* realtime.lockstep_timeout and lockstep_retry (s; a retry of 0: none). */
@@ -50,7 +51,7 @@ bool rt_lockstep_is_waited(const rt_lockstep *l, int64_t gen, double t);
 void rt_lockstep_heard(rt_lockstep *l, int64_t gen, double t);
 /* A command for the state (gen, t) applied: the state waited on, if it was that one, is
  * answered. */
-void rt_lockstep_answer(rt_lockstep *l, int64_t gen, double t);
+void rt_lockstep_answer(rt_lockstep *l, int64_t gen, double t, int64_t now);
 /* A second answer to a state already answered (not applied). */
 bool rt_lockstep_repeated(const rt_lockstep *l, int64_t gen, double t);
 

@@ -99,6 +99,7 @@ int rt_record_open(rt_record *r, const lag_scene *sc, const lagsimd_opts *o, cha
                  st.prune_error ? ", a removal failed: " : "",
                  st.prune_error ? strerror(st.prune_error) : "");
     r->prune_said = st.prune_error;
+    /* with -q too: which file of the series this run writes is not said anywhere else */
     fprintf(stderr, "lagsimd: --log %s --increment: writing %s%s\n", o->log, name, kept);
     return 0;
 }

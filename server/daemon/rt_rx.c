@@ -57,13 +57,15 @@ static void hand_on(rt_rx *r, const uint8_t *d, size_t n)
     const char *ch;
     const uint8_t *payload;
     size_t len;
-    if (rt_rx_parse(d, n, &ch, &payload, &len))
-        for (int k = 0; k < r->nch; k++)
-            if (!strcmp(ch, r->ch[k])) {
-                r->on[k](r->ctx, payload, len);
-                return;
-            }
-    r->dropped++;
+    if (!rt_rx_parse(d, n, &ch, &payload, &len)) {
+        r->dropped++;
+        return;
+    }
+    int k = 0;
+    while (k < r->nch && strcmp(ch, r->ch[k]) != 0) k++;
+    if (k < r->nch) r->on[k](r->ctx, payload, len);
+    else if (!r->other) r->dropped++;
+    if (r->other) r->other(r->ctx, ch, payload, len);
 }
 
 int rt_rx_read(rt_rx *r, int max)

@@ -15,8 +15,9 @@
  * recv_buf_size as SO_RCVBUF. Only LCM short messages ("LC02", a sequence number, the
  * channel and its NUL, the payload: every message a controller sends a plant fits one
  * datagram) on the socket's channels are handed on; anything else (another channel, a
- * fragment of a long message "LC03", a datagram cut short) is counted and dropped. The
- * socket filter (lagsim_net.h) drops most of it in the kernel before.
+ * fragment of a long message "LC03", a datagram cut short) is counted and dropped; `other`,
+ * when set, sees every short message. The socket filter (lagsim_net.h) drops most of the
+ * rest in the kernel before.
  */
 #ifndef LAGSIMD_RT_RX_H
 #define LAGSIMD_RT_RX_H
@@ -34,6 +35,9 @@ typedef struct rt_rx {
     int nch;
     char ch[RT_RX_CHANNELS][80];
     void (*on[RT_RX_CHANNELS])(void *ctx, const uint8_t *data, size_t len);
+    /* every short message, its channel's handler or not (NULL: none): what a
+     * subscription to a pattern would hear */
+    void (*other)(void *ctx, const char *channel, const uint8_t *data, size_t len);
     void *ctx;
     int64_t dropped;            /* datagrams not handed on (not LC02, another channel) */
 } rt_rx;

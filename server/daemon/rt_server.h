@@ -77,7 +77,9 @@ typedef struct rt_server {
     bool stop;                 /* signal, --duration reached, or a fatal error */
     rt_stop stop_reason;
     int stop_signal;
-    int64_t stop_tick;         /* --duration in ticks, 0 = none */
+    int64_t stop_tick;         /* --duration in ticks, 0 = none: of the whole run, resets
+                                * included (ticks_before_reset + sim.tick) */
+    int64_t ticks_before_reset; /* ticks run before the last reset (RESET, RESET_TO) */
 
     /* the control period in progress: a period of many ticks runs in chunks of at most
      * tick_budget ticks per wake-up, so that signals and LCM are served in between */
@@ -103,6 +105,11 @@ typedef struct rt_server {
     int64_t watchdog_trips;
     int64_t lockstep_timeouts;
     int64_t commands_ignored;  /* answers to a state already answered */
+    int64_t late_answers;      /* lockstep: answers to a state already answered that came
+                                * RT_COPY_LATE_NS or more after its first, or to a state
+                                * older than the last answered (the law run again on each
+                                * copy: the copy rule's hint, said once) */
+    bool copy_rule_said;
     int64_t numeric_faults;
     int64_t effect_events_dropped; /* sim.events_dropped already reported */
     int64_t plant_conflicts;   /* scenes of another plant heard on this prefix while running */

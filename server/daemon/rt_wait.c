@@ -16,7 +16,13 @@
  * before the command port: a controller that publishes on the wrong port), answers that
  * are stale, by what they answered instead: another sim_time, another generation, or no
  * generation at all (a command of generation 0, which lockstep never takes: a controller
- * that builds its commands by hand and copies the state's sim_time alone).
+ * that builds its commands by hand and copies the state's sim_time alone), this plant's
+ * control requests on the state URL, and control requests for a prefix no plant here
+ * has (rt_foreign.h: a controller or a tool on a misspelt prefix), by request:
+ *
+ *   lagsimd: MANIPULATOR waits 3 s for the first command on MANIPULATOR_COMMAND at
+ *   udpm://239.255.76.67:7668?ttl=0; got instead: requests for a prefix no plant here
+ *   has, on the command port 7668: MANIPULATR (DESCRIBE 12); this plant is MANIPULATOR
  */
 #include <stdarg.h>
 #include <stdio.h>
@@ -48,6 +54,8 @@ void rt_wait_update(rt_wait *w, int64_t now, const rt_wait_seen *seen, rt_term *
         memcpy(w->rejected0, seen->rejected, sizeof w->rejected0);
         memcpy(w->stale0, seen->stale, sizeof w->stale0);
         w->wrong_port0 = seen->wrong_port;
+        if (seen->foreign) rt_foreign_copy(&w->foreign0, seen->foreign);
+        else memset(&w->foreign0, 0, sizeof w->foreign0);
     }
     if (k == RT_WAIT_NONE || now < w->next_line_ns) return;
     /* 3, 6, 12, 24, 48 s, then every minute: a wait nobody answers does not fill the
@@ -80,6 +88,67 @@ static size_t add(char *buf, size_t cap, size_t n, const char *fmt, ...)
     va_end(ap);
     if (w < 0) return n;
     return n + (size_t)w < cap ? n + (size_t)w : cap - 1;
+}
+
+/* "DESCRIBE 12, STATUS 1": the requests counted since the wait began (now - then). */
+static size_t add_requests(char *buf, size_t cap, size_t n, const int64_t *now,
+                           const int64_t *then)
+{
+    bool first = true;
+    for (int r = 1; r <= RT_FOREIGN_REQUESTS; r++) {
+        int k = r % RT_FOREIGN_REQUESTS; /* 0 (undecodable) last */
+        int64_t d = now[k] - (then ? then[k] : 0);
+        if (d <= 0) continue;
+        const char *name = lag_wire_request_name(k);
+        n = add(buf, cap, n, "%s%s %lld", first ? "" : ", ", name ? name : "undecodable",
+                (long long)d);
+        first = false;
+    }
+    return n;
+}
+
+/* What came for other prefixes, and this plant's requests on the state port, since the
+ * wait began: at most 3 prefixes named (the table keeps RT_FOREIGN_MAX). */
+static size_t add_foreign(const rt_wait *w, int64_t now, const rt_foreign *f, char *got,
+                          size_t gotlen, size_t n)
+{
+    const rt_foreign *f0 = &w->foreign0;
+    int64_t own = f->own_state_port_total - f0->own_state_port_total;
+    if (own > 0) {
+        n = add(got, gotlen, n, "%s%lld control request%s (", n ? "; " : "", (long long)own,
+                own > 1 ? "s" : "");
+        n = add_requests(got, gotlen, n, f->own_state_port, f0->own_state_port);
+        n = add(got, gotlen, n, ") on %s at the state port %d (requests go to port %d)",
+                w->bus->channel[LAG_BUS_CONTROL], w->bus->state_port, w->bus->command_port);
+    }
+    /* the prefixes to name, the most recently heard first */
+    const rt_foreign_prefix *named[RT_FOREIGN_MAX];
+    int64_t delta[RT_FOREIGN_MAX];
+    const int64_t *then[RT_FOREIGN_MAX];
+    int k = 0;
+    for (int i = 0; i < RT_FOREIGN_MAX; i++) {
+        const rt_foreign_prefix *p = &f->p[i];
+        const rt_foreign_prefix *p0 = p->prefix[0] ? rt_foreign_find(f0, p->prefix) : NULL;
+        int64_t d = p->total - (p0 ? p0->total : 0);
+        if (!rt_foreign_unanswered(p, now) || d <= 0) continue;
+        int j = k++;
+        for (; j > 0 && named[j - 1]->heard < p->heard; j--) {
+            named[j] = named[j - 1], delta[j] = delta[j - 1], then[j] = then[j - 1];
+        }
+        named[j] = p, delta[j] = d, then[j] = p0 ? p0->requests : NULL;
+    }
+    if (k == 0) return n;
+    n = add(got, gotlen, n, "%srequests for %s no plant here has, on the command port %d: ",
+            n ? "; " : "", k > 1 ? "prefixes" : "a prefix", w->bus->command_port);
+    for (int j = 0; j < k && j < 3; j++) {
+        n = add(got, gotlen, n, "%s%s (", j ? ", " : "", named[j]->prefix);
+        n = add_requests(got, gotlen, n, named[j]->requests, then[j]);
+        if (named[j]->state_port)
+            n = add(got, gotlen, n, ", some to the state port %d", w->bus->state_port);
+        n = add(got, gotlen, n, ")");
+    }
+    if (k > 3) n = add(got, gotlen, n, " and %d more", k - 3);
+    return add(got, gotlen, n, "; this plant is %s", w->prefix);
 }
 
 /* The stale answers since the wait began, by what they answered: another sim_time, another
@@ -168,5 +237,6 @@ double rt_wait_describe(const rt_wait *w, int64_t now, const rt_wait_seen *seen,
                 "port %d)", n ? "; " : "", (long long)wrong, wrong > 1 ? "s" : "", ch_command,
                 w->bus->state_port, w->bus->command_port);
     if (stale > 0) n = add_stale(w, seen, got, gotlen, n);
+    if (seen->foreign) add_foreign(w, now, seen->foreign, got, gotlen, n);
     return waited;
 }

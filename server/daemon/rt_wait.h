@@ -15,6 +15,7 @@
 #include <stdint.h>
 #include "lagsim_bus.h"
 #include "rt_command.h"
+#include "rt_foreign.h"
 #include "rt_term.h"
 
 /* What a plant that does not advance waits for. */
@@ -33,6 +34,8 @@ typedef struct rt_wait_seen {
     const int64_t *rejected;    /* [RT_REJ_COUNT]: commands rejected, by reason */
     int64_t wrong_port;         /* commands heard on the state URL */
     const char *last_reject;    /* why the last command was rejected (not stale) */
+    const rt_foreign *foreign;  /* control requests for other prefixes, or on the state URL
+                                 * (NULL: none kept) */
     bool owed;                  /* RT_WAIT_RESUME in lockstep: the state waited on (at t)
                                  * has not been answered yet */
     const int64_t *stale;       /* [RT_STALE_COUNT]: the stale rejections, by kind */
@@ -49,6 +52,7 @@ typedef struct rt_wait {
     int64_t rejected0[RT_REJ_COUNT]; /* the counters when it began */
     int64_t stale0[RT_STALE_COUNT];
     int64_t wrong_port0;
+    rt_foreign foreign0;        /* the requests heard elsewhere when it began */
 } rt_wait;
 
 void rt_wait_init(rt_wait *w, const lag_bus *bus, const char *prefix, bool lockstep);

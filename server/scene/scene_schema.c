@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lagsim_num.h"
 #include "scene_keys.h"
 #include "scene_schema.h"
 
@@ -253,6 +254,8 @@ int sch_get_int(conv *cv, const ynode *nd, const char *path, long long lo, long 
 int sch_get_string(conv *cv, const ynode *nd, const char *path, const char *what,
                    const char **out)
 {
+    *out = NULL; /* set on every path: callers read it only on success, and an optimizer that
+                  * cannot see yfail's -1 (another file) must not find it unset */
     if (ynode_is_null(nd))
         return yfail(cv->err, nd, path, "missing value: expected %s", what);
     if (nd->kind != YN_SCALAR)
@@ -837,9 +840,11 @@ static int ref_points(conv *cv, const ynode *nd, const char *path)
             return yfail(cv->err, it, sub, "expected a point [t, w] (two numbers)");
         snprintf(el, sizeof el, "%s[0]", sub);
         if (sch_get_range(cv, it->items[0], el, &R_REF_START, &ref->point_t[k]) < 0) return -1;
+        char a[LAG_NUM_LEN], b[LAG_NUM_LEN];
         if (k > 0 && !(ref->point_t[k] > ref->point_t[k - 1]))
             return yfail(cv->err, it->items[0], el, "the points' times must increase strictly "
-                         "(%.17g after %.17g)", ref->point_t[k], ref->point_t[k - 1]);
+                         "(%s after %s)", lag_num(ref->point_t[k], a),
+                         lag_num(ref->point_t[k - 1], b));
         snprintf(el, sizeof el, "%s[1]", sub);
         if (sch_get_within_explode(cv, it->items[1], el, &ref->point_w[k]) < 0) return -1;
     }
@@ -978,20 +983,23 @@ static int check_period(conv *cv)
     const char *atpath = cv->publish_hz ? "publish_hz"
                        : cv->dt ? "integrator.dt"
                        : cv->integrator ? "integrator" : NULL;
+    char p_s[LAG_NUM_LEN], dt_s[LAG_NUM_LEN];
+    lag_num(period, p_s);
+    lag_num(dt, dt_s);
     if (!(r >= 1.0 - 1e-9))
         return yfail(cv->err, at, atpath,
-                     "1/publish_hz = %.17g s must be an integer multiple (>= 1) of "
-                     "integrator.dt = %.17g s", period, dt);
+                     "1/publish_hz = %s s must be an integer multiple (>= 1) of "
+                     "integrator.dt = %s s", p_s, dt_s);
     double ticks = floor(r + 0.5);
     if (fabs(r - ticks) > 1e-9 * r)
         return yfail(cv->err, at, atpath,
-                     "1/publish_hz = %.17g s must be an integer multiple of integrator.dt = "
-                     "%.17g s (it is %.6g dt)", period, dt, r);
+                     "1/publish_hz = %s s must be an integer multiple of integrator.dt = "
+                     "%s s (it is %.6g dt)", p_s, dt_s, r);
     if (ticks > TICKS_MAX)
         return yfail(cv->err, at, atpath,
-                     "1/publish_hz = %.17g s is %.0f ticks of integrator.dt = %.17g s: at most "
+                     "1/publish_hz = %s s is %.0f ticks of integrator.dt = %s s: at most "
                      "%d ticks per control period (one period is one uninterrupted call)",
-                     period, ticks, dt, TICKS_MAX);
+                     p_s, ticks, dt_s, TICKS_MAX);
     sc->ticks_per_period = (int64_t)ticks;
     return 0; /* dt_min <= dt: the core's check */
 }

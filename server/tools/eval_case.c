@@ -1,6 +1,7 @@
 /* lagsim-eval's and lagsim-sweep's cases and runs (eval_case.h). */
 
 #include "eval_case.h"
+#include "lagsim_num.h"
 
 #include <errno.h>
 #include <libgen.h>
@@ -615,7 +616,7 @@ static void take_event(eval_take *tk, const lag_log_record *rec)
 }
 
 /* A RESET_TO the daemon took (the log holds what it received with its fate: an input
- * record is in the log only when accepted, docs/logging.md) */
+ * record is in the log only when accepted: docs/server.md, "Record, replay, watch") */
 static bool is_reset_to(const eval_take *tk, const lag_log_record *rec)
 {
     if (strcmp(rec->channel, tk->ch_control)) return false;
@@ -746,7 +747,8 @@ static void daemon_argv(daemon_args *d, const eval_env *env, const eval_case *c,
         arg(d, extra[i]);
     }
     char *o = own(d);
-    snprintf(o, OWN_CAP, "%.17g", c->duration);
+    char num[LAG_NUM_LEN];
+    snprintf(o, OWN_CAP, "%s", lag_num(c->duration, num));
     arg(d, "--duration");
     arg(d, o);
     arg(d, "--log");
@@ -787,6 +789,67 @@ static bool wait_run(const eval_env *env, pid_t dpid, pid_t cpid, eval_result *r
     return timed_out;
 }
 
+void eval_stderr_paths(const eval_env *env, char *controller, char *daemon, size_t len)
+{
+    snprintf(controller, len, "%s/%s.controller.stderr", env->workdir, env->prefix);
+    snprintf(daemon, len, "%s/%s.lagsimd.stderr", env->workdir, env->prefix);
+}
+
+#define TAIL_LINES 8
+#define TAIL_LINE_MAX 200
+
+void eval_stderr_tail(const char *path, const char *who, char *out, size_t cap)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) return;
+    char buf[4096];
+    long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    long from = size > (long)sizeof buf - 1 ? size - (long)sizeof buf + 1 : 0;
+    size_t n = size > 0 && fseek(f, from, SEEK_SET) == 0 ? fread(buf, 1, sizeof buf - 1, f) : 0;
+    fclose(f);
+    while (n > 0 && (buf[n - 1] == '\n' || buf[n - 1] == '\r')) n--;
+    if (n == 0) return;
+    buf[n] = '\0';
+    /* the start of the last TAIL_LINES lines (a line cut by the read's start counts) */
+    size_t start = n;
+    int lines = 1;
+    for (; start > 0; start--)
+        if (buf[start - 1] == '\n' && lines++ == TAIL_LINES) {
+            lines = TAIL_LINES;
+            break;
+        }
+    size_t u = strlen(out);
+    int w = snprintf(out + u, cap - u, "%s's stderr, its last %d line%s:\n", who, lines,
+                     lines > 1 ? "s" : "");
+    for (char *line = buf + start; w >= 0 && (u = strlen(out)) + 4 < cap;) {
+        char *nl = strchr(line, '\n');
+        size_t len = nl ? (size_t)(nl - line) : strlen(line);
+        char one[TAIL_LINE_MAX + 1];
+        size_t k = 0;
+        for (; k < len && k < TAIL_LINE_MAX; k++) {
+            unsigned char ch = (unsigned char)line[k];
+            one[k] = ch < 0x20 || ch == 0x7f ? ' ' : (char)ch;
+        }
+        one[k] = '\0';
+        w = snprintf(out + u, cap - u, "| %s\n", one);
+        if (!nl) break;
+        line = nl + 1;
+    }
+}
+
+/* Without -v: a failed run keeps the last lines of what its processes said; the files go. */
+static void stderr_done(const eval_env *env, const char *cerr, const char *derr,
+                        eval_result *res, bool keep)
+{
+    if (env->verbose) return;
+    if (keep) {
+        eval_stderr_tail(cerr, "the controller", res->output, sizeof res->output);
+        eval_stderr_tail(derr, "lagsimd", res->output, sizeof res->output);
+    }
+    unlink(cerr);
+    unlink(derr);
+}
+
 int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, int nextra,
              const eval_scene *sc, eval_result *res, eval_series *out, char *err,
              size_t errlen)
@@ -799,31 +862,36 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
     daemon_args d;
     daemon_argv(&d, env, c, extra, nextra, log);
 
-    char cmd[4096];
+    char cmd[4096], cerr[1100], derr[1100];
     if (eval_expand(env->controller, env, cmd, sizeof cmd, err, errlen)) return -1;
+    eval_stderr_paths(env, cerr, derr, sizeof cerr);
     /* the controller first: in lockstep it then answers the first state (clients.md) */
-    pid_t cpid = eval_spawn(NULL, cmd, env);
+    pid_t cpid = eval_spawn(NULL, cmd, env, cerr);
     if (cpid < 0) {
         snprintf(err, errlen, "cannot start the controller: %s", strerror(errno));
         return -1;
     }
-    pid_t dpid = eval_spawn(d.argv, NULL, env);
+    pid_t dpid = eval_spawn(d.argv, NULL, env, derr);
     if (dpid < 0) {
         snprintf(err, errlen, "cannot start %s: %s", env->lagsimd, strerror(errno));
         int st;
         eval_stop_group(cpid, &st);
+        stderr_done(env, cerr, derr, res, false);
         return -1;
     }
     int dst = 0;
     bool timed_out = wait_run(env, dpid, cpid, res, &dst);
 
     if (WIFEXITED(dst) && WEXITSTATUS(dst) == 2) {
-        snprintf(err, errlen, "lagsimd refused the case '%s' (exit 2; rerun with -v)",
-                 c->name);
+        stderr_done(env, cerr, derr, res, true); /* lagsimd says why */
+        snprintf(err, errlen, "lagsimd refused the case '%s' (exit 2)%s%.*s", c->name,
+                 res->output[0] ? ":\n" : "; rerun with -v", (int)(errlen > 64 ? errlen - 64 : 0),
+                 res->output);
         unlink(log);
         return -1;
     }
     if (WIFEXITED(dst) && WEXITSTATUS(dst) == 127) {
+        stderr_done(env, cerr, derr, res, false);
         snprintf(err, errlen, "cannot run %s", env->lagsimd);
         return -1;
     }
@@ -847,6 +915,7 @@ int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, 
     }
     if (!out) eval_series_free(&local);
     if (!env->verbose) unlink(log);
+    stderr_done(env, cerr, derr, res, rc != 0 || res->failed);
     return rc;
 }
 
@@ -877,18 +946,29 @@ int eval_require_check(const lag_require *req, const eval_scene *sc, char *err, 
 bool eval_require_holds(const lag_require *req, const eval_scene *sc, const eval_result *res,
                         char *why, size_t len)
 {
+    size_t n = 0;
+    int failed = 0, said = 0;
+    if (len) why[0] = '\0';
     for (int i = 0; i < req->n; i++) {
         int j = joint_index(sc, req->term[i].joint);
-        if (j < 0 || !lag_require_term_holds(&req->term[i], &res->m[j])) {
-            char t[160];
-            lag_require_term_format(&req->term[i], t, sizeof t);
-            char v[32];
-            eval_fmt(j < 0 ? NAN : res->m[j].v[req->term[i].metric], v, sizeof v);
-            snprintf(why, len, "%s fails (%s)", t, v);
-            return false;
+        if (j >= 0 && lag_require_term_holds(&req->term[i], &res->m[j])) continue;
+        failed++;
+        char t[160], v[32], one[220];
+        lag_require_term_format(&req->term[i], t, sizeof t);
+        eval_fmt(j < 0 ? NAN : res->m[j].v[req->term[i].metric], v, sizeof v);
+        int w = snprintf(one, sizeof one, "%s%s fails (%s)", said ? "; " : "", t, v);
+        /* every failing term, as long as the caller's buffer keeps room to say how many
+         * more there are */
+        if (w > 0 && n + (size_t)w + 40 < len) {
+            memcpy(why + n, one, (size_t)w + 1);
+            n += (size_t)w;
+            said++;
         }
     }
-    return true;
+    if (failed > said && n + 40 <= len)
+        snprintf(why + n, len - n, "%sand %d more term%s fail", said ? "; " : "", failed - said,
+                 failed - said > 1 ? "s" : "");
+    return failed == 0;
 }
 
 void eval_fmt(double v, char *buf, size_t len)

@@ -185,9 +185,14 @@ typedef struct eval_series {
 
 void eval_series_free(eval_series *s);
 
+#define EVAL_OUTPUT_LEN 2048
+
 typedef struct eval_result {
     bool failed;
     char reason[256];        /* why it failed ("" if it did not) */
+    char output[EVAL_OUTPUT_LEN]; /* a failed run's last lines of the controller's and
+                              * lagsimd's stderr, "| " before each, under a line naming
+                              * whose ("" if none, or with -v: they passed through) */
     int nj;
     lag_metrics m[EVAL_JOINTS_MAX];
     double max_abs_q[EVAL_JOINTS_MAX];
@@ -195,8 +200,18 @@ typedef struct eval_result {
     size_t states;
 } eval_result;
 
+/* The stderr files of a run's (or a kept pair's) controller and lagsimd, without -v:
+ * <workdir>/<prefix>.controller.stderr, .lagsimd.stderr. */
+void eval_stderr_paths(const eval_env *env, char *controller, char *daemon, size_t len);
+/* Appends to out (cap bytes, NUL-terminated) the last lines (at most 8) of file `path`,
+ * written by `who`: "<who>'s stderr, its last N lines:\n| ...\n"; nothing when the file
+ * is empty or absent. Control bytes become spaces, a line is cut at 200 bytes. */
+void eval_stderr_tail(const char *path, const char *who, char *out, size_t cap);
+
 /* Runs a case (its overrides and `extra` ones after them) and fills res and, when s is
- * not NULL, the series. Returns 0 when the run could be evaluated (failed or not), -1
+ * not NULL, the series. Without -v the controller's and lagsimd's stderr go to files of
+ * the run (eval_stderr_paths), whose last lines res->output holds when the run failed; the
+ * files are removed. Returns 0 when the run could be evaluated (failed or not), -1
  * with a message in err when it could not be run at all. */
 int eval_run(const eval_env *env, const eval_case *c, const char *const *extra, int nextra,
              const eval_scene *sc, eval_result *res /* OUT */, eval_series *s /* OUT */,
@@ -212,7 +227,9 @@ int eval_read_log(const char *path, const char *prefix, const eval_scene *sc, do
 int eval_score(const eval_series *s, const eval_case *c, const eval_scene *sc,
                eval_result *res, char *err, size_t errlen);
 
-/* Whether a requirement holds for a result; the first term that fails written to why. */
+/* Whether a requirement holds for a result; every term that fails written to why, each
+ * with its value ("theta.settle < 2 fails (5.5); x.settle < 2 fails (5.85)"): as many as
+ * fit in len bytes, then how many more fail. */
 bool eval_require_holds(const lag_require *req, const eval_scene *sc, const eval_result *res,
                         char *why, size_t len);
 

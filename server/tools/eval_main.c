@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "eval_case.h"
+#include "lagsim_num.h"
 
 static const char *prog = "lagsim-eval";
 
@@ -58,7 +59,9 @@ static void usage(FILE *f)
 "                         not on {prefix} or LAGSIM_PREFIX never answers: its case\n"
 "                         ends here\n"
 "  -v, --verbose          pass the daemon's and the controller's output through, keep\n"
-"                         each run's log in the report directory (or TMPDIR, /tmp)\n"
+"                         each run's log in the report directory (or TMPDIR, /tmp);\n"
+"                         without it their stderr goes to files of the run, and a\n"
+"                         case that fails shows their last lines under its note\n"
 "  -h, --help             this help\n"
 "\n"
 "keys lagsim-eval sets on every run (a case's set: naming one, or a mapping above\n"
@@ -198,6 +201,30 @@ static void gp_text(FILE *f, const char *t)
     }
 }
 
+/* A title: as gp_text, each of the terms that fail ("; " between them) on a line of its
+ * own. */
+static void gp_title(FILE *f, const char *t)
+{
+    for (const char *semi; (semi = strstr(t, "; ")) != NULL; t = semi + 2) {
+        char part[512];
+        snprintf(part, sizeof part, "%.*s", (int)(semi - t), t);
+        gp_text(f, part);
+        fputs("\\n", f);
+    }
+    gp_text(f, t);
+}
+
+/* A CSV field (RFC 4180): in double quotes, a quote doubled, a control byte a space. */
+static void csv_text(FILE *f, const char *t)
+{
+    fputc('"', f);
+    for (; *t; t++) {
+        if (*t == '"') fputc('"', f);
+        fputc((unsigned char)*t < 0x20 || *t == 0x7f ? ' ' : *t, f);
+    }
+    fputc('"', f);
+}
+
 /* A y range that is never empty: [lo, hi] of the finite values of the nc columns (each
  * n long), widened by 1 each way when they are all equal (a plant that never moved);
  * gnuplot would otherwise warn of an empty range. */
@@ -269,7 +296,7 @@ static int report(run_files *rf, const char *dir, bool force, const eval_case *c
     fprintf(f, "set multiplot layout 2,1 title \"%s: case %s: ", sc->model, c->name);
     if (res->failed) fprintf(f, "FAIL: ");
     else if (!met) fprintf(f, "UNMET --require: ");
-    gp_text(f, res->failed ? res->reason : met ? "ok" : why);
+    gp_title(f, res->failed ? res->reason : met ? "ok" : why);
     fprintf(f, "\"\n");
     fprintf(f, "set grid\nset key top right\nset xlabel 'sim time (s)'\n");
     /* the case's time, whatever the run reached: a run that never left t = 0 is no empty
@@ -530,14 +557,17 @@ static void write_rows(eval_cli *x, const eval_case *c, const eval_scene *csc,
         }
         printf("\n");
         if (!x->fcsv) continue;
-        fprintf(x->fcsv, "%s,%s,%d,%d,\"%s\"", c->name, csc->joint[j], res->failed, met,
-                res->failed ? res->reason : why);
+        char num[LAG_NUM_LEN];
+        fprintf(x->fcsv, "%s,%s,%d,%d,", c->name, csc->joint[j], res->failed, met);
+        csv_text(x->fcsv, res->failed ? res->reason : why);
         for (int m = 0; m < LAG_METRIC_COUNT; m++) {
-            /* the CSV is read by programs: every digit of the double */
+            /* the CSV is read by programs: the double exactly (lagsim_num.h) */
             if (isnan(res->m[j].v[m])) fprintf(x->fcsv, ",nan");
-            else fprintf(x->fcsv, ",%.17g", res->m[j].v[m]);
+            else fprintf(x->fcsv, ",%s", lag_num(res->m[j].v[m], num));
         }
-        fprintf(x->fcsv, ",%.17g,%zu,%.17g\n", res->max_abs_q[j], res->states, res->t_end);
+        char t_end[LAG_NUM_LEN];
+        fprintf(x->fcsv, ",%s,%zu,%s\n", lag_num(res->max_abs_q[j], num), res->states,
+                lag_num(res->t_end, t_end));
     }
 }
 
@@ -561,12 +591,20 @@ static bool run_case(eval_cli *x, int k)
         x->status = 2;
         return false;
     }
-    char why[256] = "";
+    char why[2048] = "";
     bool met = !x->require || eval_require_holds(&x->req, &x->csc[k], &res, why, sizeof why);
     if (res.failed || !met) x->failures++;
     write_rows(x, c, &x->csc[k], &res, met, why);
     if (res.failed) printf("  %s failed: %s\n", c->name, res.reason);
     else if (!met) printf("  %s: --require: %s\n", c->name, why);
+    /* a failed run: what its controller and lagsimd said last (their stderr went to files
+     * of the run; -v passes it through) */
+    for (const char *l = res.output; *l;) {
+        const char *nl = strchr(l, '\n');
+        int len = nl ? (int)(nl - l) : (int)strlen(l);
+        printf("    %.*s\n", len, l);
+        l += len + (nl != NULL);
+    }
     fflush(stdout);
     if (x->report_dir &&
         report(&x->files, x->report_dir, x->force, c, &x->csc[k], &s, &res, met, why))

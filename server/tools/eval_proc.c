@@ -290,6 +290,7 @@ typedef struct keep_plan {
     char *const *argv;
     char *const *envp;
     bool null_out, null_err;
+    const char *err_file; /* stderr to this file (made 0600, emptied), or NULL */
     sigset_t mask;        /* the spawner's signal mask, the command's again */
     pid_t spawner;
 } keep_plan;
@@ -311,6 +312,11 @@ static void __attribute__((noreturn)) run_command(const keep_plan *p, pid_t keep
         int fd = open("/dev/null", O_WRONLY);
         if (fd >= 0 && p->null_out) dup2(fd, 1);
         if (fd >= 0 && p->null_err) dup2(fd, 2);
+        if (fd > 2) close(fd);
+    }
+    if (p->err_file) { /* in the tool's own temporary directory; never through a link */
+        int fd = open(p->err_file, O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW, 0600);
+        if (fd >= 0) dup2(fd, 2);
         if (fd > 2) close(fd);
     }
     sigprocmask(SIG_SETMASK, &p->mask, NULL);
@@ -498,7 +504,7 @@ static char **run_environ(const eval_env *env, char vars[2][256])
     return e;
 }
 
-pid_t eval_spawn(char *const *argv, const char *cmd, const eval_env *env)
+pid_t eval_spawn(char *const *argv, const char *cmd, const eval_env *env, const char *err_file)
 {
     char vars[2][256];
     char **envp = run_environ(env, vars);
@@ -507,7 +513,8 @@ pid_t eval_spawn(char *const *argv, const char *cmd, const eval_env *env)
     /* a daemon named without a directory is looked up on PATH */
     const char *path = !argv ? "/bin/sh" : strchr(argv[0], '/') ? argv[0] : NULL;
     keep_plan p = {.path = path, .argv = argv ? argv : sh, .envp = envp,
-                   .null_out = !env->verbose, .null_err = !env->verbose && argv};
+                   .null_out = !env->verbose, .null_err = !env->verbose && argv && !err_file,
+                   .err_file = env->verbose ? NULL : err_file};
     pid_t pid = keep_spawn(&p);
     free(envp);
     return pid;

@@ -29,9 +29,12 @@ struct eval_env;
 void eval_proc_init(void);
 
 /* argv (argv[0] a path), or "sh -c cmd" when argv is NULL, with the run's URL and prefix in
- * its environment (LCM_DEFAULT_URL, LAGSIM_PREFIX), under a keeper; stdout (and for argv
- * stderr too) to /dev/null unless env->verbose. The keeper's pid, or -1. */
-pid_t eval_spawn(char *const *argv, const char *cmd, const struct eval_env *env);
+ * its environment (LCM_DEFAULT_URL, LAGSIM_PREFIX), under a keeper. Unless env->verbose
+ * (which passes both through): stdout to /dev/null, stderr to err_file (emptied; the
+ * caller shows its last lines when the run fails: eval_stderr_tail), or with no err_file
+ * to /dev/null for argv and through for cmd. The keeper's pid, or -1. */
+pid_t eval_spawn(char *const *argv, const char *cmd, const struct eval_env *env,
+                 const char *err_file);
 
 /* argv (argv[0] looked up on PATH) under a keeper, its output passed through. */
 pid_t eval_spawn_plain(char *const *argv);

@@ -54,6 +54,7 @@ struct eval_worker {
     eval_env env;
     eval_scene sc;
     char log[1024];
+    char cerr[1100], derr[1100]; /* the pair's stderr without -v (eval_stderr_paths) */
     pid_t dpid, cpid;
     lag_client *cl;
     long runs;
@@ -71,6 +72,7 @@ struct eval_worker {
                            * them */
     double t_answered;    /* the sim time of the last answer heard */
     int64_t g_answered;   /* and the generation it carried */
+    char ended[96];       /* the controller ended while a STEP was awaited: how */
 };
 
 /* ---------------------------------------------------------------- from the bus */
@@ -209,6 +211,14 @@ static int step_once(eval_worker *w, long n, double seconds)
     if (lag_client_step(w->cl, n) != LAG_CLIENT_OK) return -1;
     while (!w->moved) {
         if (eval_now() > end) return -1;
+        int st;
+        if (w->cpid > 0 && eval_wait_until(w->cpid, 0, &st)) { /* nothing will answer */
+            snprintf(w->ended, sizeof w->ended, "the controller ended (%s %d)",
+                     WIFEXITED(st) ? "exit status" : "signal",
+                     WIFEXITED(st) ? WEXITSTATUS(st) : WTERMSIG(st));
+            w->cpid = 0;
+            return -1;
+        }
         double next = eval_now() + W_ANSWER_S;
         while (!w->moved && eval_now() < next) w_handle(w, 5);
         if (!w->moved && still_at_start(w) && lag_client_step(w->cl, n) != LAG_CLIENT_OK)
@@ -239,12 +249,38 @@ static pid_t start_daemon(eval_worker *w, const eval_case *c)
     argv[na++] = w->log;
     argv[na++] = "-q";
     argv[na] = NULL;
-    return eval_spawn(argv, NULL, &w->env);
+    return eval_spawn(argv, NULL, &w->env, w->derr);
 }
 
+/* Stops the pair: the daemon, then the controller (which ends on its stop). */
+static void stop_pair(eval_worker *w)
+{
+    int st;
+    if (w->dpid > 0) {
+        kill(w->dpid, SIGTERM);
+        if (!eval_wait_until(w->dpid, eval_now() + 3.0, &st)) eval_stop_group(w->dpid, &st);
+    }
+    /* a controller ends on the daemon's stop; one that does not is stopped (on a host's
+     * plant, which runs on, at once) */
+    if (w->cpid > 0 && (w->env.attach_log || !eval_wait_until(w->cpid, eval_now() + 3.0, &st)))
+        eval_stop_group(w->cpid, &st);
+    w->dpid = w->cpid = 0;
+}
+
+/* A pair that could not start: why, and (without -v) what the two said last. */
 static eval_worker *start_failed(eval_worker *w, char *err, size_t errlen, const char *why)
 {
-    snprintf(err, errlen, "%s", why);
+    char said[EVAL_OUTPUT_LEN] = "";
+    stop_pair(w);
+    if (!w->env.verbose && w->cerr[0]) {
+        eval_stderr_tail(w->cerr, "the controller", said, sizeof said);
+        eval_stderr_tail(w->derr, "lagsimd", said, sizeof said);
+    }
+    char first[512];
+    snprintf(first, sizeof first, "%s", why);
+    snprintf(err, errlen, "%s%s%s", first, said[0] ? "\n" : "", said);
+    size_t n = strlen(err);
+    if (n && err[n - 1] == '\n') err[n - 1] = '\0';
     eval_worker_stop(w);
     return NULL;
 }
@@ -267,8 +303,9 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
         free(w);
         return NULL;
     }
+    eval_stderr_paths(env, w->cerr, w->derr, sizeof w->cerr);
     /* the controller first, as eval_run starts them */
-    w->cpid = eval_spawn(NULL, cmd, env);
+    w->cpid = eval_spawn(NULL, cmd, env, w->cerr);
     w->dpid = env->attach_log ? 0 : start_daemon(w, c);
     w->cl = lag_client_create(env->url, env->prefix, err, errlen);
     if (w->cpid < 0 || w->dpid < 0 || !w->cl)
@@ -286,26 +323,27 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
     /* a host's plant a worker before may have left in the middle of a run: paused first
      * (a plant paused already refuses it, harmlessly) */
     if (env->attach_log) lag_client_pause(w->cl);
-    if (step_once(w, 1, 30))
-        return start_failed(w, err, errlen, "the kept lagsimd did not step");
+    if (step_once(w, 1, 30)) {
+        char why[160];
+        snprintf(why, sizeof why, "the kept lagsimd did not step%s%s", w->ended[0] ? ": " : "",
+                 w->ended);
+        return start_failed(w, err, errlen, why);
+    }
     return w;
 }
 
 void eval_worker_stop(eval_worker *w)
 {
     if (!w) return;
-    int st;
-    if (w->dpid > 0) {
-        kill(w->dpid, SIGTERM);
-        if (!eval_wait_until(w->dpid, eval_now() + 3.0, &st)) eval_stop_group(w->dpid, &st);
-    }
-    /* a controller ends on the daemon's stop; one that does not is stopped */
-    if (w->cpid > 0 && !eval_wait_until(w->cpid, eval_now() + 3.0, &st))
-        eval_stop_group(w->cpid, &st);
+    stop_pair(w);
     if (w->cl) lag_client_destroy(w->cl);
     if (w->cmd) lcm_destroy(w->cmd);
     eval_series_free(&w->s);
-    if (!w->env.verbose && !w->env.attach_log) unlink(w->log);
+    if (!w->env.verbose) {
+        if (!w->env.attach_log) unlink(w->log); /* a host's plant's: the sweep's to remove */
+        if (w->cerr[0]) unlink(w->cerr);
+        if (w->derr[0]) unlink(w->derr);
+    }
     free(w);
 }
 
@@ -464,9 +502,9 @@ static bool paused_answer(eval_worker *w, eval_result *res)
     return true;
 }
 
-int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets, int nsets,
-                    const double *q0, const double *qd0, eval_result *res, char *err,
-                    size_t errlen)
+static int worker_run(eval_worker *w, const eval_case *c, const char *const *sets, int nsets,
+                      const double *q0, const double *qd0, eval_result *res, char *err,
+                      size_t errlen)
 {
     memset(res, 0, sizeof *res);
     eval_series_free(&w->s);
@@ -508,4 +546,16 @@ int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets,
         eval_fail(res, "stopped at t = %.6g s before the duration %.6g s", res->t_end,
                   c->duration);
     return eval_score(&w->s, c, &w->sc, res, err, errlen);
+}
+
+int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets, int nsets,
+                    const double *q0, const double *qd0, eval_result *res, char *err,
+                    size_t errlen)
+{
+    int rc = worker_run(w, c, sets, nsets, q0, qd0, res, err, errlen);
+    if ((rc != 0 || res->failed) && !w->env.verbose) { /* what the kept pair said last */
+        eval_stderr_tail(w->cerr, "the controller", res->output, sizeof res->output);
+        eval_stderr_tail(w->derr, "lagsimd", res->output, sizeof res->output);
+    }
+    return rc;
 }

@@ -4,16 +4,21 @@
  * One pass over the log. Each channel takes the lagsim type of its first decodable
  * message; its CSV is opened then, with a header from that message (a state's joint
  * names). A later message of another type or other joints on the same channel is not
- * written, only counted. Every number is written "%.17g" (a reread gives the same
- * double); every string from the log (names, kinds, details, in headers and cells) is
- * quoted and kept from reading as a spreadsheet formula (put_text).
+ * written, only counted. Every number is written as the shortest decimal that reads
+ * back to the same double (lagsim_num.h); every string from the log (names, kinds,
+ * details, in headers and cells) is quoted only where RFC 4180 needs it and kept from
+ * reading as a spreadsheet formula (put_text). A state sent again unchanged (the state at
+ * t = 0 while the plant waits for its first command, a paused state: the same generation,
+ * step, sim time and numbers) is one row; the copies are counted in the summary.
  *
  * Per-channel facts for the summary: counts, log-time span and rate, undecodable
  * messages; for states the step sequence (gaps: a step increase other than one control
- * period, with the states missing; resets: the step going back; repeats: the same step
- * again, as while paused); for status the last counters; for events a count per kind.
+ * period, with the states missing; resets: the step going back; copies: the same state
+ * again, not written; repeats: the same step again with other numbers, written); for
+ * status the last counters; for events a count per kind.
  */
 #include "log2csv.h"
+#include "lagsim_num.h"
 #include "lagsim/lagsim.h"
 
 #include <errno.h>
@@ -25,7 +30,6 @@
 
 #include "lagsim_bus.h"
 #include "lagsim_out.h"
-#include "lagsim/lagsim_control_t.h" /* the requests' constants */
 
 #define L2C_MAX_CHANNELS 256
 #define L2C_MAX_KINDS 48
@@ -47,7 +51,8 @@ typedef struct chan {
     int64_t prev_step, first_step, last_step;
     int64_t period_ticks;       /* 0 = unknown yet */
     bool period_from_scene;
-    int64_t gaps, missing, resets, repeats;
+    int64_t gaps, missing, resets, repeats, copies;
+    lag_wire_joint_state last; /* the state of the last row (copies are not written) */
     double first_sim, last_sim;
     /* status */
     lag_wire_status last_status;
@@ -75,39 +80,53 @@ typedef struct l2c {
 } l2c;
 
 /* ---------------------------------------------------------------- CSV helpers */
-static void put_d(FILE *f, double x) { fprintf(f, ",%.17g", x); }
+static void put_d(FILE *f, double x)
+{
+    char b[LAG_NUM_LEN];
+    fprintf(f, ",%s", lag_num(x, b));
+}
+/* A row's first number: its sim time. */
+static void put_t(FILE *f, double t)
+{
+    char b[LAG_NUM_LEN];
+    fputs(lag_num(t, b), f);
+}
 static void put_i(FILE *f, int64_t x) { fprintf(f, ",%" PRId64, x); }
-/* One text field from a log (a name, a kind, a detail), RFC 4180: always in double quotes,
- * a quote doubled; control characters become spaces, so one record is one line. A field
- * whose first non-blank character would start a formula in a spreadsheet (=, +, -, @;
- * tab and CR are spaces by then) is written as text: a leading apostrophe, as OWASP's
- * CSV-injection guidance asks. `suffix` (may be NULL) is appended inside the quotes: a
- * header's "<joint>_dot". Numbers never pass here: they stay numbers. */
+/* One text field from a log (a name, a kind, a detail), RFC 4180: control characters
+ * become spaces, so one record is one line; in double quotes (a quote doubled) only when
+ * it holds a comma or a quote, as RFC 4180 needs, so that a plain name reads as itself
+ * everywhere (Octave's importdata keeps quotes it is given: "theta"). A field whose
+ * first non-blank character would start a formula in a spreadsheet (=, +, -, @; tab and
+ * CR are spaces by then) is written as text: a leading apostrophe, as OWASP's
+ * CSV-injection guidance asks (the apostrophe needs no quotes). `suffix` (may be NULL) is
+ * appended to it: a header's "<joint>_dot". Numbers never pass here: they stay numbers. */
 static void put_text(FILE *f, const char *s, const char *suffix)
 {
     const char *p = s;
     while (*p == ' ' || *p == 0x7f || ((unsigned char)*p < 0x20 && *p)) p++; /* all blank out */
     bool formula = *p == '=' || *p == '+' || *p == '-' || *p == '@';
-    fputc('"', f);
+    const char *sfx = suffix ? suffix : "";
+    bool quote = strpbrk(s, ",\"") || strpbrk(sfx, ",\""); /* CR and LF are spaces by now */
+    if (quote) fputc('"', f);
     if (formula) fputc('\'', f);
     for (int pass = 0; pass < 2; pass++)
-        for (const char *q = pass ? (suffix ? suffix : "") : s; *q; q++) {
+        for (const char *q = pass ? sfx : s; *q; q++) {
             unsigned char c = (unsigned char)*q;
             if (c == '"') fputs("\"\"", f);
             else if (c < 0x20 || c == 0x7f) fputc(' ', f);
             else fputc(c, f);
         }
-    fputc('"', f);
+    if (quote) fputc('"', f);
 }
 static void put_s(FILE *f, const char *s)
 {
     fputc(',', f);
     put_text(f, s, NULL);
 }
-/* A list of numbers this tool formatted ("%.17g" joined by spaces): quoted, and not
- * marked as text, a leading minus sign included (digits, signs, '.', 'e', "inf", "nan"
- * and spaces make no formula that reaches anything). */
-static void put_numbers(FILE *f, const char *s) { fprintf(f, ",\"%s\"", s); }
+/* A list of numbers this tool formatted (lag_num's, joined by spaces): no comma or quote,
+ * so no quotes, and not marked as text, a leading minus sign included (digits, signs, '.',
+ * 'e', "inf", "nan" and spaces make no formula that reaches anything). */
+static void put_numbers(FILE *f, const char *s) { fprintf(f, ",%s", s); }
 /* Log timestamp and utime in seconds since the epoch (us resolution). */
 static void put_us(FILE *f, int64_t us, bool first)
 {
@@ -230,6 +249,18 @@ static void header_state(FILE *f, const lag_wire_joint_state *m)
     fputc('\n', f);
 }
 
+/* Whether m is the state of the last row sent again: the same generation, step, sim time
+ * and numbers (the daemon publishes the state it waits at anew while it waits). */
+static bool is_copy(const chan *h, const lag_wire_joint_state *m)
+{
+    const lag_wire_joint_state *l = &h->last;
+    size_t n = (size_t)m->num_joints * sizeof(double);
+    return h->have_prev && m->generation == l->generation && m->step == l->step &&
+           !memcmp(&m->sim_time, &l->sim_time, sizeof m->sim_time) &&
+           m->num_joints == l->num_joints && !memcmp(m->position, l->position, n) &&
+           !memcmp(m->velocity, l->velocity, n) && !memcmp(m->effort, l->effort, n);
+}
+
 /* Step bookkeeping of a state channel (gaps, resets, repeats). */
 static void track_steps(l2c *c, chan *h, const lag_wire_joint_state *m)
 {
@@ -281,9 +312,14 @@ static bool write_state(l2c *c, chan *h, const lag_log_record *r, const lag_wire
         h->mismatched++;
         return true;
     }
+    if (is_copy(h, m)) { /* one row per state: the copy counted, not written */
+        h->copies++;
+        return true;
+    }
     track_steps(c, h, m);
+    h->last = *m;
     FILE *f = h->csv;
-    fprintf(f, "%.17g", m->sim_time);
+    put_t(f, m->sim_time);
     put_us(f, m->utime, false);
     put_us(f, r->timestamp, false);
     put_i(f, m->step);
@@ -319,7 +355,7 @@ static bool write_reference(l2c *c, chan *h, const lag_log_record *r,
         return true;
     }
     FILE *f = h->csv;
-    fprintf(f, "%.17g", m->sim_time);
+    put_t(f, m->sim_time);
     put_us(f, m->utime, false);
     put_us(f, r->timestamp, false);
     put_i(f, m->step);
@@ -352,7 +388,7 @@ static bool write_status(l2c *c, chan *h, const lag_log_record *r, const lag_wir
         fputc('\n', h->csv);
     }
     FILE *f = h->csv;
-    fprintf(f, "%.17g", m->sim_time);
+    put_t(f, m->sim_time);
     put_us(f, m->utime, false);
     put_us(f, r->timestamp, false);
     for (int i = 0; i < n; i++) {
@@ -380,7 +416,7 @@ static bool write_event(l2c *c, chan *h, const lag_log_record *r, const lag_wire
         fputs("t,wall_time,log_time,step,kind,joint,value,detail\n", h->csv);
     }
     FILE *f = h->csv;
-    fprintf(f, "%.17g", m->sim_time);
+    put_t(f, m->sim_time);
     put_us(f, m->utime, false);
     put_us(f, r->timestamp, false);
     put_i(f, m->step);
@@ -421,21 +457,22 @@ static bool write_scene(l2c *c, chan *h, const lag_log_record *r, const lag_wire
     }
     FILE *f = h->csv;
     char params[LAG_WIRE_MAX_PARAMS * (L2C_NAME + 32)], joints[L2C_JOINTS * (L2C_NAME + 192)];
+    char a[LAG_NUM_LEN], b[LAG_NUM_LEN];
     size_t n = 0;
     params[0] = joints[0] = '\0';
     const lag_model_info *info = scene_model(m);
     for (int i = 0; i < m->num_params; i++)
-        n += (size_t)snprintf(params + n, sizeof params - n, "%s%s=%.17g", i ? " " : "",
-                              m->param_name[i], m->param_value[i]);
+        n += (size_t)snprintf(params + n, sizeof params - n, "%s%s=%s", i ? " " : "",
+                              m->param_name[i], lag_num(m->param_value[i], a));
     n = 0;
     for (int i = 0; i < m->num_joints; i++) {
-        n += (size_t)snprintf(joints + n, sizeof joints - n, "%s%s:%s:q0=%.17g:qd0=%.17g",
+        n += (size_t)snprintf(joints + n, sizeof joints - n, "%s%s:%s:q0=%s:qd0=%s",
                               i ? " " : "", m->joint_name[i],
-                              m->actuated[i] ? "actuated" : "free", m->initial_q[i],
-                              m->initial_qd[i]);
+                              m->actuated[i] ? "actuated" : "free", lag_num(m->initial_q[i], a),
+                              lag_num(m->initial_qd[i], b));
         if (m->limit_on[i])
-            n += (size_t)snprintf(joints + n, sizeof joints - n, ":limits=%.17g..%.17g",
-                                  m->limit_lower[i], m->limit_upper[i]);
+            n += (size_t)snprintf(joints + n, sizeof joints - n, ":limits=%s..%s",
+                                  lag_num(m->limit_lower[i], a), lag_num(m->limit_upper[i], b));
         if (info)
             n += (size_t)snprintf(joints + n, sizeof joints - n, ":unit=%s",
                                   info->angular[i] ? "rad" : "m");
@@ -468,7 +505,7 @@ static bool write_command(l2c *c, chan *h, const lag_log_record *r,
     FILE *f = h->csv;
     /* one row per named joint (a command with no joint: one row, joint and effort empty) */
     for (int i = 0; i < (m->num_joints > 0 ? m->num_joints : 1); i++) {
-        fprintf(f, "%.17g", m->sim_time);
+        put_t(f, m->sim_time);
         put_us(f, m->utime, false);
         put_us(f, r->timestamp, false);
         put_i(f, m->generation);
@@ -483,16 +520,14 @@ static bool write_command(l2c *c, chan *h, const lag_log_record *r,
     return true;
 }
 
-/* control_t's requests by their constants (lcmtypes/control_t.lcm) */
-static const char *request_name(int r)
+/* control_t's requests by their constants (lag_wire_request_name), in lower case */
+static const char *request_name(int r, char *buf, size_t len)
 {
-    static const char *const names[] = {
-        [LAGSIM_CONTROL_T_PAUSE] = "pause", [LAGSIM_CONTROL_T_RESUME] = "resume",
-        [LAGSIM_CONTROL_T_STEP] = "step", [LAGSIM_CONTROL_T_RESET] = "reset",
-        [LAGSIM_CONTROL_T_RESET_TO] = "reset_to", [LAGSIM_CONTROL_T_STATUS] = "status",
-        [LAGSIM_CONTROL_T_DESCRIBE] = "describe", [LAGSIM_CONTROL_T_SET] = "set"};
-    const int n = (int)(sizeof names / sizeof names[0]);
-    return r >= 0 && r < n && names[r] ? names[r] : "unknown";
+    const char *n = lag_wire_request_name(r);
+    size_t k = 0;
+    for (; n && n[k] && k + 1 < len; k++) buf[k] = (char)(n[k] >= 'A' && n[k] <= 'Z' ? n[k] + 32 : n[k]);
+    buf[k] = '\0';
+    return n ? buf : "unknown";
 }
 
 static bool write_control(l2c *c, chan *h, const lag_log_record *r, const lag_wire_control *m)
@@ -505,13 +540,16 @@ static bool write_control(l2c *c, chan *h, const lag_log_record *r, const lag_wi
     char q[L2C_JOINTS * 26] = "", qd[L2C_JOINTS * 26] = "";
     size_t nq = 0, nqd = 0;
     for (int i = 0; i < m->num_joints; i++) {
-        nq += (size_t)snprintf(q + nq, sizeof q - nq, "%s%.17g", i ? " " : "", m->q[i]);
-        nqd += (size_t)snprintf(qd + nqd, sizeof qd - nqd, "%s%.17g", i ? " " : "", m->qd[i]);
+        char a[LAG_NUM_LEN];
+        nq += (size_t)snprintf(q + nq, sizeof q - nq, "%s%s", i ? " " : "", lag_num(m->q[i], a));
+        nqd += (size_t)snprintf(qd + nqd, sizeof qd - nqd, "%s%s", i ? " " : "",
+                                lag_num(m->qd[i], a));
     }
     put_us(f, m->utime, true);
     put_us(f, r->timestamp, false);
     put_i(f, m->request);
-    put_s(f, request_name(m->request));
+    char name[32];
+    put_s(f, request_name(m->request, name, sizeof name));
     put_i(f, m->count);
     put_numbers(f, q);
     put_numbers(f, qd);
@@ -646,11 +684,12 @@ static void summarize(l2c *c, const lag_log_stats *ls, FILE *f)
             if (h->have_prev)
                 fprintf(f, "  sim time %.9g .. %.9g s, step %" PRId64 " .. %" PRId64
                            "; gaps %" PRId64 " (%" PRId64 " states missing; period %" PRId64
-                           " ticks%s), resets %" PRId64 ", repeats %" PRId64 "\n",
+                           " ticks%s), resets %" PRId64 ", repeats %" PRId64 "; copies %"
+                           PRId64 " (a state sent again unchanged: one row)\n",
                         h->first_sim, h->last_sim, h->first_step, h->last_step, h->gaps,
                         h->missing, h->period_ticks,
                         h->period_from_scene ? ", from the scene" : ", inferred",
-                        h->resets, h->repeats);
+                        h->resets, h->repeats, h->copies);
             break;
         case LAG_WIRE_STATUS:
             if (h->have_status) summarize_status(&h->last_status, f);

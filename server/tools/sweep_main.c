@@ -24,6 +24,7 @@
 #include "lagsim_url.h"
 #include "scene.h"
 #include "sweep_merge.h"
+#include "lagsim_num.h"
 
 static const char *prog = "lagsim-sweep";
 
@@ -86,7 +87,9 @@ static void usage(FILE *f)
 "      --allow-lan        accept a URL with ttl above 0 (the runs on the network)\n"
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a run may take (default 600)\n"
-"  -v, --verbose          pass the daemon's and the controller's output through\n"
+"  -v, --verbose          pass the daemon's and the controller's output through;\n"
+"                         without it their stderr goes to files of the run, and the\n"
+"                         first failed run of each worker shows their last lines\n"
 "  -o, --output OUT.csv   merge: the joined CSV (the whole sweep's, byte for byte); every\n"
 "                         shard's identity lines (# seed:, # scene-sha256:, # vary:, ...)\n"
 "                         must be the first's, every row one of its header, every shard\n"
@@ -281,13 +284,14 @@ static int run_sets(const vary *vs, int nv, const double *val, const eval_scene 
                     char sets[][EVAL_SET_LEN])
 {
     int n = 0;
+    char num[LAG_NUM_LEN];
     double q[EVAL_JOINTS_MAX], qd[EVAL_JOINTS_MAX];
     bool has_q = false, has_qd = false;
     memcpy(q, sc->q0, sizeof q);
     memcpy(qd, sc->qd0, sizeof qd);
     for (int k = 0; k < nv; k++) {
         if (vs[k].index < 0) {
-            snprintf(sets[n++], EVAL_SET_LEN, "%s=%.17g", vs[k].key, val[k]);
+            snprintf(sets[n++], EVAL_SET_LEN, "%s=%s", vs[k].key, lag_num(val[k], num));
         } else if (!strcmp(vs[k].key, "initial.q")) {
             q[vs[k].index] = val[k], has_q = true;
         } else {
@@ -299,7 +303,8 @@ static int run_sets(const vary *vs, int nv, const double *val, const eval_scene 
         const double *x = w ? qd : q;
         size_t u = (size_t)snprintf(sets[n], EVAL_SET_LEN, "initial.%s=[", w ? "qd" : "q");
         for (int j = 0; j < sc->nj && u < EVAL_SET_LEN; j++)
-            u += (size_t)snprintf(sets[n] + u, EVAL_SET_LEN - u, "%s%.17g", j ? ", " : "", x[j]);
+            u += (size_t)snprintf(sets[n] + u, EVAL_SET_LEN - u, "%s%s", j ? ", " : "",
+                                  lag_num(x[j], num));
         if (u < EVAL_SET_LEN) snprintf(sets[n] + u, EVAL_SET_LEN - u, "]");
         n++;
     }
@@ -679,6 +684,7 @@ typedef struct worker {
     long w;          /* its number */
     eval_worker *kept; /* the daemon and the controller kept for its runs */
     FILE *rows;
+    bool said_output;  /* the output of a failed run said (once a worker) */
 } worker;
 
 /* Worker w's plant of its group's host: prefix SWEEP<pid>_W<w> (w in three digits, so
@@ -742,18 +748,19 @@ static void write_row(const worker *wk, long i, const double *val, const eval_re
 {
     const sweep *x = wk->x;
     FILE *f = wk->rows;
-    char why[512] = "";
+    char why[2048] = "";
     bool met = !x->require || eval_require_holds(&x->req, &x->sc, res, why, sizeof why);
     /* one line per run: the run number first (the parent sorts by it) */
     fprintf(f, "%ld", i);
-    for (int k = 0; k < x->nv; k++) fprintf(f, ",%.17g", val[k]);
+    char num[LAG_NUM_LEN];
+    for (int k = 0; k < x->nv; k++) fprintf(f, ",%s", lag_num(val[k], num));
     const char *reason = res->failed ? res->reason : met ? "" : why;
     fprintf(f, ",%d,%d,", res->failed, met);
     sweep_write_reason(f, reason);
     for (int j = 0; j < x->sc.nj; j++)
         for (int m = 0; m < LAG_METRIC_COUNT; m++) {
             if (isnan(res->m[j].v[m])) fprintf(f, ",nan");
-            else fprintf(f, ",%.17g", res->m[j].v[m]);
+            else fprintf(f, ",%s", lag_num(res->m[j].v[m], num));
         }
     fputc('\n', f);
     fflush(f);
@@ -792,6 +799,12 @@ static int run_one(worker *wk, long i)
     if (rc) {
         fprintf(stderr, "%s: run %ld: %s\n", prog, i, err);
         return 4;
+    }
+    if (res.output[0] && !wk->said_output) { /* a worker's first failed run: what its
+                                               * controller and lagsimd said last */
+        wk->said_output = true;
+        fprintf(stderr, "%s: run %ld failed: %s\n%s(the output of later runs that fail: "
+                "-v passes every run's through)\n", prog, i, res.reason, res.output);
     }
     write_row(wk, i, val, &res);
     return 0;
@@ -965,7 +978,7 @@ static int start_host(sweep *x, long g, const char *text, size_t len)
     argv[na++] = log;
     argv[na++] = "-q";
     argv[na] = NULL;
-    x->host[g] = eval_spawn(argv, NULL, &env);
+    x->host[g] = eval_spawn(argv, NULL, &env, NULL);
     return x->host[g] > 0 ? 0 : -1;
 }
 

@@ -25,6 +25,7 @@
 
 #include "eval_case.h"
 #include "sweep_merge.h"
+#include "lagsim_num.h"
 
 #ifndef LAGSIM_VERSION
 #error "LAGSIM_VERSION (the project's version) must be defined"
@@ -270,7 +271,7 @@ void sweep_write_reason(FILE *f, const char *reason)
     fputc('"', f);
 }
 
-/* A number as %.17g writes one: -?D+(.D+)?(e[+-]DD+)?, or inf, -inf. */
+/* A number as lag_num (printf's %g) writes one: -?D+(.D+)?(e[+-]DD+)?, or inf, -inf. */
 static bool is_number(const char *s, size_t n)
 {
     size_t i = n && s[0] == '-', d;
@@ -537,7 +538,7 @@ int sweep_sha256_file(const char *path, char hex[65], char *err, size_t errlen)
 
 char *sweep_identity_text(const sweep_identity *id, char *err, size_t errlen)
 {
-    char hex[65], num[64];
+    char hex[65], num[64], n17[LAG_NUM_LEN];
     if (sweep_sha256_file(id->scene, hex, err, errlen)) return NULL;
     char *buf = NULL;
     size_t len = 0;
@@ -549,12 +550,12 @@ char *sweep_identity_text(const sweep_identity *id, char *err, size_t errlen)
     fprintf(f, IDENT_VERSION "%s\n# seed: %" PRIu64 "\n", LAGSIM_VERSION, id->seed);
     ident_line(f, "scene-sha256", hex);
     ident_line(f, "case", id->c->name);
-    snprintf(num, sizeof num, "%.17g", id->c->duration);
+    snprintf(num, sizeof num, "%s", lag_num(id->c->duration, n17));
     ident_line(f, "duration", num);
     for (int k = 0; k < id->c->nsets; k++) ident_line(f, "set", id->c->set[k]);
     for (int k = 0; k < id->c->nbounds; k++) {
         char b[EVAL_NAME_LEN + 40];
-        snprintf(b, sizeof b, "%s=%.17g", id->c->bound_joint[k], id->c->bound[k]);
+        snprintf(b, sizeof b, "%s=%s", id->c->bound_joint[k], lag_num(id->c->bound[k], n17));
         ident_line(f, "bound", b);
     }
     for (int k = 0; k < id->nvary; k++) ident_line(f, "vary", id->vary[k]);

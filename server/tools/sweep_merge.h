@@ -77,7 +77,7 @@ void sweep_columns_free(sweep_columns *c);
 
 /* Whether line (len bytes, its end of line removed) is a row of those columns in a sweep
  * of `runs` runs, as lagsim-sweep writes one: the run number an integer in [0, runs) as
- * %ld writes it, the values numbers as %.17g writes them, failed and required 0 or 1, the
+ * %ld writes it, the values numbers as lag_num writes them (%g's form), failed and required 0 or 1, the
  * reason quoted, the metrics numbers or nan; no control byte. 0 with *run set, or -1 with
  * what is wrong (the field named) in why. */
 int sweep_row_check(const sweep_columns *c, const char *line, size_t len, long runs,

@@ -15,6 +15,7 @@
 #include "lagsim/lagsim_control_t.h"
 #include "lagsim_bus.h"
 #include "lagsim_net.h"
+#include "lagsim_num.h"
 
 #define VIEW_DRAIN_MAX 512        /* messages handled per poll at most */
 #define VIEW_LCM_QUEUE 200        /* LCM's queue per subscription */
@@ -299,8 +300,9 @@ int view_bridge_kick(view_bridge *vb, const char *joint, const char *impulse,
         *why = "too many control requests: at most 10 per second";
         return 429;
     }
-    if (d > 0) snprintf(m.value, sizeof m.value, "%.17g,%.17g", j, d);
-    else snprintf(m.value, sizeof m.value, "%.17g", j);
+    char a[LAG_NUM_LEN], b[LAG_NUM_LEN]; /* the kick event says 0.1, as typed */
+    if (d > 0) snprintf(m.value, sizeof m.value, "%s,%s", lag_num(j, a), lag_num(d, b));
+    else snprintf(m.value, sizeof m.value, "%s", lag_num(j, a));
     m.utime = lag_clock_wall_us();
     m.request = LAGSIM_CONTROL_T_SET;
     uint8_t buf[LAG_WIRE_BUF_SIZE];

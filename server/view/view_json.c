@@ -12,6 +12,7 @@
 
 #include "lagsim/lagsim.h"
 #include "view.h"
+#include "lagsim_num.h"
 
 void jb_init(jbuf *b, char *mem, size_t cap)
 {
@@ -133,7 +134,10 @@ void jb_str(jbuf *b, const char *s) { jb_str_max(b, s, VIEW_JSON_NAME_MAX); }
 void jb_num(jbuf *b, double x)
 {
     if (!isfinite(x)) jb_raw(b, "null");
-    else jb_fmt(b, "%.17g", x);
+    else {
+        char s[LAG_NUM_LEN];
+        jb_raw(b, lag_num(x, s));
+    }
 }
 
 void jb_key(jbuf *b, const char *key, bool first)

@@ -4,7 +4,7 @@
  * view and the tests all take them from here; the Python, Lua and Java helpers
  * (clients/python/lagsim_lcm.py plant_urls, clients/lua/lagsim_lcm.lua plant_urls,
  * clients/java/lagsim/examples/PlantUrls.java) follow the same rule and are checked
- * against the same table of cases (tests/clients/plant_urls.txt).
+ * against the same table of cases (tests/net/plant_urls.txt).
  *
  * The rule (docs/network.md):
  *   - the base URL is the scene's lcm.url, or LCM_DEFAULT_URL, or LCM's default

@@ -25,7 +25,8 @@
 #define OFF_MAGIC 8
 #define OFF_CHANNEL 16
 #define LCM_MAGIC_SHORT 0x4c433032u /* "LC02" */
-#define MAX_INSNS 512
+#define MAX_INSNS 1024 /* the kernel takes up to BPF_MAXINSNS, 4096 */
+#define MAX_CHANNEL 63 /* LCM's longest channel name (without its NUL) */
 
 typedef struct prog {
     struct sock_filter in[MAX_INSNS];
@@ -37,75 +38,96 @@ static void emit(prog *p, uint16_t code, uint8_t jt, uint8_t jf, uint32_t k)
     if (p->n < MAX_INSNS) p->in[p->n++] = (struct sock_filter){code, jt, jf, k};
 }
 
-/* The compares of one channel name (with its NUL): words, then a half word, then a byte. */
-static int channel_compares(size_t len_with_nul)
+/* The compares of a name of len bytes: words, then a half word, then a byte. */
+static int name_compares(size_t len)
 {
-    return (int)(len_with_nul / 4) + (len_with_nul % 4 >= 2) + (int)(len_with_nul % 2);
+    return (int)(len / 4) + (len % 4 >= 2) + (int)(len % 2);
 }
 
-/* Emits: if the channel at OFF_CHANNEL is `name`, accept; else fall through to the next
- * block. */
+/* Emits the compares of the len bytes of `name` against the datagram at `at` (absolute,
+ * or after X with ind), each jumping `miss` instructions past the last compare when it
+ * differs; falls through when all are equal. */
+static void emit_compares(prog *p, const uint8_t *name, size_t len, uint32_t at, bool ind,
+                          int miss)
+{
+    int block = 2 * name_compares(len), done = 0;
+    uint16_t mode = ind ? BPF_IND : BPF_ABS;
+    for (size_t off = 0; off < len; done += 2) {
+        size_t w = len - off >= 4 ? 4 : len - off >= 2 ? 2 : 1;
+        uint32_t v = 0;
+        for (size_t i = 0; i < w; i++) v = v << 8 | name[off + i];
+        uint16_t size = w == 4 ? BPF_W : w == 2 ? BPF_H : BPF_B;
+        emit(p, BPF_LD | size | mode, 0, 0, at + (uint32_t)off);
+        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, (uint8_t)(block - done - 2 + miss), v);
+        off += w;
+    }
+}
+
+/* Emits: if the channel at OFF_CHANNEL is `name` (with its NUL), accept; else fall
+ * through to the next block. */
 static void emit_channel(prog *p, const char *name)
 {
-    size_t len = strlen(name) + 1;
-    const uint8_t *b = (const uint8_t *)name; /* b[len - 1] is the NUL */
-    int nc = channel_compares(len);
-    int block = 2 * nc + 1, at = 0;
-    size_t off = 0;
-    for (; off + 4 <= len; off += 4, at += 2) {
-        uint32_t w = (uint32_t)b[off] << 24 | (uint32_t)b[off + 1] << 16 |
-                     (uint32_t)b[off + 2] << 8 | b[off + 3];
-        emit(p, BPF_LD | BPF_W | BPF_ABS, 0, 0, (uint32_t)(OFF_CHANNEL + off));
-        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, (uint8_t)(block - at - 2), w);
-    }
-    if (len - off >= 2) {
-        uint32_t h = (uint32_t)b[off] << 8 | b[off + 1];
-        emit(p, BPF_LD | BPF_H | BPF_ABS, 0, 0, (uint32_t)(OFF_CHANNEL + off));
-        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, (uint8_t)(block - at - 2), h);
-        off += 2;
-        at += 2;
-    }
-    if (len - off == 1) {
-        emit(p, BPF_LD | BPF_B | BPF_ABS, 0, 0, (uint32_t)(OFF_CHANNEL + off));
-        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, (uint8_t)(block - at - 2), b[off]);
-    }
+    emit_compares(p, (const uint8_t *)name, strlen(name) + 1, OFF_CHANNEL, false, 1);
     emit(p, BPF_RET | BPF_K, 0, 0, 0xffffffffu);
 }
 
-/* The whole program: [from this host] LC02, one of the channels; else drop. */
-static int build(prog *p, bool host_only, const char *const *channels, int n, char *err,
-                 size_t errlen)
+/* Emits the channels that end in one of the suffixes: the channel's NUL found by a look
+ * at each length 1 to MAX_CHANNEL (its length into X), then each suffix compared right
+ * before it (with at least one byte of prefix before the suffix); else drop. */
+static void emit_suffixes(prog *p, const char *const *suffixes, int ns)
+{
+    int check = p->n + 4 * MAX_CHANNEL + 1; /* where the suffixes are compared */
+    for (int len = 1; len <= MAX_CHANNEL; len++) {
+        emit(p, BPF_LD | BPF_B | BPF_ABS, 0, 0, (uint32_t)(OFF_CHANNEL + len));
+        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, 2, 0);
+        emit(p, BPF_LDX | BPF_W | BPF_IMM, 0, 0, (uint32_t)len);
+        emit(p, BPF_JMP | BPF_JA, 0, 0, (uint32_t)(check - p->n - 1));
+    }
+    emit(p, BPF_RET | BPF_K, 0, 0, 0); /* no NUL within LCM's longest name */
+    for (int i = 0; i < ns; i++) {
+        size_t m = strlen(suffixes[i]);
+        int block = 2 * name_compares(m) + 1; /* the compares and the accept */
+        emit(p, BPF_MISC | BPF_TXA, 0, 0, 0);
+        emit(p, BPF_JMP | BPF_JGE | BPF_K, 0, (uint8_t)block, (uint32_t)(m + 1));
+        /* the suffix's first byte at OFF_CHANNEL + X - m */
+        emit_compares(p, (const uint8_t *)suffixes[i], m, (uint32_t)(OFF_CHANNEL - (int)m), true,
+                      1);
+        emit(p, BPF_RET | BPF_K, 0, 0, 0xffffffffu);
+    }
+    emit(p, BPF_RET | BPF_K, 0, 0, 0);
+}
+
+/* The whole program: [from this host] LC02, one of the channels or a channel ending in
+ * one of the suffixes; else drop. Every jump is short (a drop next to what fails), but the
+ * suffixes' jumps to their compares (BPF_JA takes 32 bits). */
+static int build(prog *p, bool host_only, const char *const *channels, int n,
+                 const char *const *suffixes, int ns, char *err, size_t errlen)
 {
     p->n = 0;
-    int total = 2 /* magic */ + 1 /* drop */ + (host_only ? 4 : 0) + (n == 0 /* accept */);
-    for (int i = 0; i < n; i++) {
-        size_t len = strlen(channels[i]) + 1;
-        if (len > 64 + 8 + 1) {
-            snprintf(err, errlen, "channel name '%s' too long for the filter", channels[i]);
+    for (int i = 0; i < n + ns; i++) { /* a name the compares can hold; a suffix LCM can */
+        const char *name = i < n ? channels[i] : suffixes[i - n];
+        if (strlen(name) > (i < n ? 64 + 8 : MAX_CHANNEL - 1) || !name[0]) {
+            snprintf(err, errlen, "channel name '%s' too long for the filter", name);
             return -1;
         }
-        total += 2 * channel_compares(len) + 1;
-    }
-    if (total > MAX_INSNS || total - 5 > 255) { /* the longest jump: to the drop at the end */
-        snprintf(err, errlen, "too many channels for the filter");
-        return -1;
     }
     if (host_only) {
         unsigned lo = if_nametoindex("lo");
         /* looped back from a local sender, or in on the loopback interface */
         emit(p, BPF_LD | BPF_W | BPF_ABS, 0, 0, (uint32_t)(SKF_AD_OFF + SKF_AD_PKTTYPE));
-        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 2, 0, PACKET_LOOPBACK);
+        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 3, 0, PACKET_LOOPBACK);
         emit(p, BPF_LD | BPF_W | BPF_ABS, 0, 0, (uint32_t)(SKF_AD_OFF + SKF_AD_IFINDEX));
-        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, (uint8_t)(total - 4 - 1), lo ? lo : 1);
+        emit(p, BPF_JMP | BPF_JEQ | BPF_K, 1, 0, lo ? lo : 1);
+        emit(p, BPF_RET | BPF_K, 0, 0, 0);
     }
-    int here = p->n;
     emit(p, BPF_LD | BPF_W | BPF_ABS, 0, 0, OFF_MAGIC);
-    emit(p, BPF_JMP | BPF_JEQ | BPF_K, 0, (uint8_t)(total - here - 2 - 1), LCM_MAGIC_SHORT);
-    for (int i = 0; i < n; i++) emit_channel(p, channels[i]);
-    if (n == 0) emit(p, BPF_RET | BPF_K, 0, 0, 0xffffffffu); /* any channel */
+    emit(p, BPF_JMP | BPF_JEQ | BPF_K, 1, 0, LCM_MAGIC_SHORT);
     emit(p, BPF_RET | BPF_K, 0, 0, 0);
-    if (p->n != total) {
-        snprintf(err, errlen, "filter program: %d instructions, expected %d", p->n, total);
+    for (int i = 0; i < n; i++) emit_channel(p, channels[i]);
+    if (ns > 0) emit_suffixes(p, suffixes, ns);
+    else emit(p, BPF_RET | BPF_K, 0, 0, 0);
+    if (p->n >= MAX_INSNS) {
+        snprintf(err, errlen, "too many channels for the filter");
         return -1;
     }
     return 0;
@@ -185,12 +207,19 @@ static int attach_one(int fd, void *user)
 int lag_net_filter(int port, bool host_only, const char *const *channels, int n, char *err,
                   size_t errlen)
 {
-    if (n < 0 || n > LAG_NET_MAX_FILTER_CHANNELS) {
-        snprintf(err, errlen, "filter: 0 to %d channels", LAG_NET_MAX_FILTER_CHANNELS);
+    return lag_net_filter_suffixes(port, host_only, channels, n, NULL, 0, err, errlen);
+}
+
+int lag_net_filter_suffixes(int port, bool host_only, const char *const *channels, int n,
+                            const char *const *suffixes, int ns, char *err, size_t errlen)
+{
+    if (n < 1 || n > LAG_NET_MAX_FILTER_CHANNELS || ns < 0 || ns > LAG_NET_MAX_FILTER_CHANNELS) {
+        snprintf(err, errlen, "filter: 1 to %d channels, 0 to %d suffixes",
+                 LAG_NET_MAX_FILTER_CHANNELS, LAG_NET_MAX_FILTER_CHANNELS);
         return -1;
     }
     static prog p; /* one thread sets filters, at start */
-    if (build(&p, host_only, channels, n, err, errlen) < 0) return -1;
+    if (build(&p, host_only, channels, n, suffixes, ns, err, errlen) < 0) return -1;
     attach a = {{(unsigned short)p.n, p.in}, 0};
     int rc = each_udp_socket(port, attach_one, &a);
     if (rc < 0) {

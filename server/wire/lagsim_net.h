@@ -12,8 +12,10 @@
  *     it back from a local sender (pkttype PACKET_LOOPBACK) or it arrived on the loopback
  *     interface (a route 224.0.0.0/4 dev lo); what comes in from a network is dropped by
  *     the kernel before LCM reads it;
- *   - channels: only LCM short messages ("LC02") on the named channels are kept, so a
- *     flood on another prefix's channels costs this process nothing.
+ *   - channels: only LCM short messages ("LC02") on the named channels (and, for
+ *     lag_net_filter_suffixes, on any channel with one of the named suffixes) are kept,
+ *     so a flood on another prefix's channels costs this process nothing (but on the
+ *     suffixes it names).
  * A datagram already queued when the filter is attached went past it: lag_net_sync reads
  * until a marker sent after the attachment comes back, so that the caller can discard
  * everything that arrived before.
@@ -31,11 +33,19 @@
 /* Attaches the filter to every UDP socket of this process bound to `port`, but those
  * noted by lag_net_note_inherited (LCM's receive
  * socket of an lcm_t for that port, once it has a subscription): keep only LCM short
- * messages on one of the n channels (exact names; n = 0: on any channel), and with
+ * messages on one of the n channels (exact names), and with
  * host_only only those sent from this host. Returns the number of sockets filtered (0: none found), or -1 with a
  * message in err. */
 int lag_net_filter(int port, bool host_only, const char *const *channels, int n, char *err,
                   size_t errlen);
+
+/* lag_net_filter, keeping also every channel whose name ends in one of the ns suffixes
+ * after a prefix of at least one byte ("_CONTROL": every plant's control requests), so
+ * that a program hears what is asked of a prefix that is not its own (a misspelt one).
+ * What a suffix lets in costs this process a wake-up a datagram: name only the channels
+ * of requests, never a plant's stream of states or commands. */
+int lag_net_filter_suffixes(int port, bool host_only, const char *const *channels, int n,
+                            const char *const *suffixes, int ns, char *err, size_t errlen);
 
 /* Notes the UDP sockets this process has now, before it creates its LCM instances:
  * lag_net_filter leaves them alone (a parent that forked without close-on-exec shares

@@ -615,6 +615,17 @@ int64_t lag_wire_table_fingerprint_n(lag_wire_type t, int nfields)
     return (int64_t)((v << 1) + ((v >> 63) & 1));
 }
 
+const char *lag_wire_request_name(int request)
+{
+    static const char *const names[] = {
+        [LAGSIM_CONTROL_T_PAUSE] = "PAUSE", [LAGSIM_CONTROL_T_RESUME] = "RESUME",
+        [LAGSIM_CONTROL_T_STEP] = "STEP", [LAGSIM_CONTROL_T_RESET] = "RESET",
+        [LAGSIM_CONTROL_T_RESET_TO] = "RESET_TO", [LAGSIM_CONTROL_T_STATUS] = "STATUS",
+        [LAGSIM_CONTROL_T_DESCRIBE] = "DESCRIBE", [LAGSIM_CONTROL_T_SET] = "SET"};
+    const int n = (int)(sizeof names / sizeof names[0]);
+    return request >= 0 && request < n ? names[request] : NULL;
+}
+
 const char *lag_wire_type_name(lag_wire_type t)
 {
     const type_info *ti = type_get(t);

@@ -268,6 +268,9 @@ int64_t lag_wire_fingerprint(lag_wire_type t);
 int64_t lag_wire_table_fingerprint(lag_wire_type t);
 /* "joint_state_t", ... (NULL for an unknown type). */
 const char *lag_wire_type_name(lag_wire_type t);
+/* A control_t request by its value: "PAUSE", ..., "SET", the constants of
+ * lcmtypes/control_t.lcm (NULL for a value that is none of them). */
+const char *lag_wire_request_name(int request);
 /* sizeof the type's struct (0 for an unknown type). */
 size_t lag_wire_struct_size(lag_wire_type t);
 /* Largest encoding of a message of type t (every array and string full). */

@@ -21,6 +21,8 @@ import signal
 import subprocess
 import sys
 import tempfile
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 DOCS = ("README.md", os.path.join("docs", "clients.md"), os.path.join("docs", "evaluation.md"))
@@ -176,6 +178,22 @@ def check_eval_octave(out, tmp):
     return eval_checks(out, [("tilt", "x")], 4)
 
 
+def check_scene_params(out, tmp):
+    """docs/clients.md: hold.py reads the manipulator's parameters from ctl.params: it says
+    m2 = 1 at the start and m2 = 2 at the first state after lagsimctl's SET, and holds the
+    arm at its targets through the change (within 1 mm and 1 mrad at the end)"""
+    checks = [("t = 0.00 s: m2 = 1 kg, g = 9.81 m/s^2" in out, "hold.py read m2 = 1 at t = 0")]
+    m = re.search(r"t = (\d+\.\d\d) s: m2 = 2 kg", out)
+    checks.append((m is not None and float(m.group(1)) > 0, "and m2 = 2 after the SET (%s)"
+                   % (m.group(0) if m else "not said")))
+    m = re.search(r"hold\.py: summary end=stop q1=(\S+) q2=(\S+)", out)
+    checks.append((m is not None and abs(float(m.group(1)) - 0.3) < 1e-3 and
+                   abs(float(m.group(2)) - 0.6) < 1e-3,
+                   "held at q1 = 0.3 rad, q2 = 0.6 m to the end (%s)" % (m.group(0) if m else
+                                                                        "no summary")))
+    return checks
+
+
 # a recipe's exit status when it is not 0, as its doc says (the last command's)
 EXIT = {"evaluate": 1}
 # wall s a recipe may take when it is not --timeout (a short run: a hang fails soon)
@@ -184,7 +202,7 @@ TIMEOUT = {"walkthrough-lockstep": 60}
 CHECKS = {"by-hand": check_by_hand, "record": check_record, "evaluate": check_evaluate,
           "walkthrough": check_walkthrough, "walkthrough-lockstep": check_walkthrough_lockstep,
           "eval-python": check_eval_python,
-          "eval-octave": check_eval_octave}
+          "eval-octave": check_eval_octave, "scene-params": check_scene_params}
 
 
 def main():
@@ -219,7 +237,7 @@ def main():
                 f.write(text)
             print("---- %s written as given" % fname)
         env = dict(os.environ)
-        env["LCM_DEFAULT_URL"] = "udpm://239.255.76.67:%d?ttl=0" % (30000 + 2 * (os.getpid() % 10000))
+        env["LCM_DEFAULT_URL"] = lcm_url()
         print("---- recipe %s in %s, LCM_DEFAULT_URL=%s\n%s" % (name, tmp, env["LCM_DEFAULT_URL"], script))
         # a session of its own: a recipe that hangs is stopped whole, its background jobs too
         p = subprocess.Popen(["bash", "-c", script], cwd=tmp, env=env, stdout=subprocess.PIPE,

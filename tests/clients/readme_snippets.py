@@ -26,7 +26,12 @@ states of the fast run bit for bit. In lockstep
 the daemon publishes a state again until an answer arrives: a block that ran its law for
 every copy would fall behind by a copy's worth of thinking per state and never catch up.
 A law slower than realtime.lockstep_timeout is late by definition, so that timeout is
-set to at least three think times.
+set to at least three think times, and to at least the think time plus 20 times the
+slowest answer of the fast run just before (the time from a state's first copy to its
+first command, measured here: what this machine takes to schedule the block, LCM and the
+daemon now; a loaded machine or a sanitizer build gets the patience it needs, an idle one
+keeps 1 s). A run that answers copies by thinking again falls further behind with every
+state and meets any finite timeout; the law counted once per sim_time is the direct check.
 """
 import argparse
 import math
@@ -38,6 +43,8 @@ import sys
 import tempfile
 import threading
 import time
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 THINK_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "think")
 # name: (file, command line (build, file, slow: the think wrapper, or ""), environment)
@@ -104,8 +111,7 @@ def main():
     # ctest of another snippet, a fast-mode daemon, a flood test) would be heard here and
     # fill these sockets. The prefix stays unique as well. Receive buffers of 4 MB, as the
     # other client tests (run_e2e.py).
-    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
-                                     % (20000 + 2 * (os.getpid() % 6000)))  # and the next port
+    os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")  # and the next port
     print("LCM_DEFAULT_URL=%s" % os.environ["LCM_DEFAULT_URL"])
     sys.path.insert(0, os.path.join(build, "python"))
 
@@ -121,8 +127,9 @@ def main():
             continue
         thinks = [0.0] + ([a.think] if a.think > 0 else [])
         runs = []
+        slowest = 0.0  # the fast run's slowest answer (s)
         for think in thinks:
-            bad, states = run_block(a, build, found[name], name, lang, think)
+            bad, states, slowest = run_block(a, build, found[name], name, lang, think, slowest)
             fails += bad
             runs.append(states)
         if len(runs) == 2:
@@ -137,12 +144,13 @@ def main():
     return 1 if fails else 0
 
 
-def run_block(a, build, text, name, lang, think):
+def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     """Runs one block against lagsimd for a.periods periods in lockstep, its law taking
-    `think` wall s per answer; prints its checks. Returns (failures, {sim_time: the
-    state's positions and velocities})."""
+    `think` wall s per answer (the daemon's lockstep_timeout from think and fast_slowest,
+    the fast run's slowest answer); prints its checks. Returns (failures, {sim_time: the
+    state's positions and velocities}, the slowest answer in s)."""
     from lagsim_lcm import LCM, plant_urls
-    from lagsim import joint_command_t, joint_state_t, status_t
+    from lagsim import event_t, joint_command_t, joint_state_t, status_t
     fname, cmd, env_extra = RUNNERS[lang]
     prefix = "RDME%s_%d" % (lang.upper(), os.getpid())
     tmp = tempfile.mkdtemp(prefix="lagsim_readme_")
@@ -160,7 +168,7 @@ def run_block(a, build, text, name, lang, think):
                             stderr=subprocess.STDOUT, universal_newlines=True)
         if cc.returncode != 0:
             print("FAIL: the C block does not build:\n" + cc.stdout)
-            return 1, {}
+            return 1, {}, 0.0
     elif think > 0:
         slow = java_think_classes(build, tmp) if lang == "java" else "yes"
     env = dict(os.environ)
@@ -172,11 +180,13 @@ def run_block(a, build, text, name, lang, think):
     state_url, command_url = plant_urls()
     lc, lc_cmd = LCM(state_url), LCM(command_url)
     heard = {"states": 0, "max_th": 0.0, "t": -1.0, "status": None, "by_time": {}}
+    first_state, first_command = {}, {}  # sim_time: the monotonic time first heard
 
     def on_state(ch, data):
         st = joint_state_t.decode(data)
         if st.sim_time < 0:
             return
+        first_state.setdefault(st.sim_time, time.monotonic())
         heard["states"] += 1
         heard["t"] = max(heard["t"], st.sim_time)
         heard["max_th"] = max([heard["max_th"]] + [abs(x) for x in st.position[1:3]])
@@ -185,9 +195,17 @@ def run_block(a, build, text, name, lang, think):
     def on_status(ch, data):
         heard["status"] = status_t.decode(data)
 
+    heard["copy_rule"] = 0
+
+    def on_event(ch, data):  # the daemon's hint that the law runs again on copies
+        heard["copy_rule"] += event_t.decode(data).kind == "copy_rule"
+
     def on_command(ch, data):
-        if joint_command_t.decode(data).sim_time == -1.0:
+        t = joint_command_t.decode(data).sim_time
+        if t == -1.0:
             heard["ready"] = True
+        else:
+            first_command.setdefault(t, time.monotonic())
 
     # LCM's own default URL must hear nothing of this run: it is on its own port
     stray = LCM("udpm://239.255.76.67:7667?ttl=0")
@@ -199,6 +217,7 @@ def run_block(a, build, text, name, lang, think):
     stray.subscribe(prefix + "_.*", on_stray)
     lc.subscribe(prefix + "_STATE", on_state)
     lc.subscribe(prefix + "_STATUS", on_status)
+    lc.subscribe(prefix + "_EVENT", on_event)
     lc_cmd.subscribe(prefix + "_COMMAND", on_command)
     heard["ready"] = False
     listening = [True]
@@ -228,10 +247,11 @@ def run_block(a, build, text, name, lang, think):
         time.sleep(0.2 + 1.5 * think)
     heard["states"] = 0
     periods = a.periods
+    patience = max(1.0, 3 * think, think + 20 * fast_slowest) if think > 0 else 1.0
     daemon = subprocess.Popen(
         [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
          "--set", "realtime.mode=lockstep",
-         "--set", "realtime.lockstep_timeout=%r" % max(1.0, 3 * think),
+         "--set", "realtime.lockstep_timeout=%r" % patience,
          "--duration", repr(periods * 0.01), "-q"],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
     budget = 30 + 3 * think * periods  # three think times a state, and 30 s to start
@@ -255,6 +275,8 @@ def run_block(a, build, text, name, lang, think):
     lc_cmd.close()
     stray.close()
     st = heard["status"]
+    answers = [first_command[t] - first_state[t] for t in first_state if t in first_command]
+    slowest = max(answers) if answers else 0.0
     acc = st.commands_accepted if st else -1
     lto = st.lockstep_timeouts if st else -1
     checks = [
@@ -262,8 +284,8 @@ def run_block(a, build, text, name, lang, think):
          "lagsimd ran %d periods within %g s and exited 0" % (periods, budget)),
         (snip.returncode == 0, "the snippet exited 0 after the daemon's stop"),
         (acc == periods and lto == 0,
-         "answered %d of the %d states before t = %g s, %d lockstep timeout(s)"
-         % (acc, periods, periods * 0.01, lto)),
+         "answered %d of the %d states before t = %g s, %d lockstep timeout(s) (lockstep_timeout "
+         "%.3g s; slowest answer %.3f s)" % (acc, periods, periods * 0.01, lto, patience, slowest)),
         (heard["states"] > 0 and heard["max_th"] < 0.1 and math.isfinite(heard["max_th"]),
          "balanced: %d states heard, largest |theta1|, |theta2| %.4f rad"
          % (heard["states"], heard["max_th"])),
@@ -277,6 +299,8 @@ def run_block(a, build, text, name, lang, think):
         checks.append((periods + 1 <= laws <= periods + 2,
                        "its law ran %d times for the probe and %d states (once per sim_time: "
                        "%d or %d)" % (laws, periods + 1, periods + 1, periods + 2)))
+        checks.append((heard["copy_rule"] == 0, "the daemon saw the copy rule kept (%d "
+                       "copy_rule events)" % heard["copy_rule"]))
     print("---- %s (%s)%s" % (name, path, " with a law of %g s per answer" % think if think else ""))
     if out.strip():
         print(out.rstrip())
@@ -285,7 +309,7 @@ def run_block(a, build, text, name, lang, think):
         print("%s: %s" % ("ok  " if good else "FAIL", what))
         fails += 0 if good else 1
     sys.stdout.flush()
-    return fails, heard["by_time"]
+    return fails, heard["by_time"], slowest
 
 
 if __name__ == "__main__":

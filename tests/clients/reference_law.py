@@ -49,6 +49,8 @@ sys.path.insert(0, os.path.join(HERE, "..", "..", "clients", "python"))
 from lcm_log import read_log  # noqa: E402
 from lagsim_lcm import LCM  # noqa: E402
 from run_e2e import parse_summary, stop  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def url(port):
@@ -199,8 +201,8 @@ def main():
     tmp = tempfile.mkdtemp(prefix="lagsim_reflaw_")
     log = os.path.join(tmp, "run.lcm")
     # the client's bus: a multicast port of this run's own (run_e2e.py says why); the
-    # daemon's, with a relay, another: that of the client's process id
-    port_b = 20000 + 2 * (os.getpid() % 6000)
+    # daemon's, with a relay, another of its own
+    port_b = lcm_port()
     env = dict(os.environ, LCM_DEFAULT_URL=url(port_b))
     print("client:", " ".join(client), flush=True)
     cproc = dproc = relay = fth = None
@@ -225,9 +227,7 @@ def main():
             return 1
         port_a = port_b
         if a.lose_every:
-            port_a = 20000 + 2 * (cproc.pid % 6000)
-            if port_a == port_b:
-                port_a = 20000 + 2 * ((cproc.pid + 1) % 6000)
+            port_a = lcm_port()
             relay = Relay(t, prefix, port_a, port_b, a.lose_every)
         if a.hostile:
             forged = forged_references(t)

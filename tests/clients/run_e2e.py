@@ -16,7 +16,9 @@ argument to the daemon's command line (e.g. --duration 2: the daemon
 stops by itself and announces it); --kill-daemon-after S kills it with SIGKILL after S
 wall seconds (it goes silent without a word). The controller's last line
 "... summary key=value ..." is parsed and every --check expression (Python, over those
-keys; `wall` is the controller's wall time after the daemon ended, s) must hold.
+keys; `wall` is the time from the daemon's end to the controller's summary line, s; with
+--kill-daemon-after, `silent` is the time from the last state this harness heard on the
+bus to that line, s: the silence the controller measured) must hold.
 --hostile DIR (repeatable) publishes every file of DIR (the fuzz_client corpus layout: the
 first byte chooses the channel, _STATE, _STATUS, _EVENT or _SCENE, the rest is the payload)
 on the run's channels: three times once the controller is subscribed, before the daemon
@@ -32,6 +34,8 @@ import subprocess
 import sys
 import threading
 import time
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def stop(proc, grace=3.0):
@@ -107,8 +111,7 @@ def main():
     # datagram costs a socket about 1 kB of buffer, and a controller kept off a core by a
     # loaded machine must not lose a lockstep burst.
     env = dict(os.environ)
-    env["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
-                              % (20000 + 2 * (os.getpid() % 6000)))  # and the next port
+    env["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")  # and the next port
     client = [c.replace("{prefix}", prefix) for c in client]
     dcmd = [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
             "--set", "realtime.mode=" + a.mode, "-q"]
@@ -125,8 +128,10 @@ def main():
     cproc = dproc = fth = None
     done = threading.Event()
     n_hostile = 0
-    t_daemon_end = t_client_end = None
+    t_daemon_end = t_client_end = t_summary = None
     lines = []
+    last_state = [None]  # when the last state was heard (--kill-daemon-after)
+    wth = None
     try:
         if a.daemon_first is not None:
             dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
@@ -136,21 +141,28 @@ def main():
                                  universal_newlines=True, env=env)
         # read the client's stdout in a thread; start the daemon once the client says it
         # is subscribed ("waiting for the scene"), so that it sees the very first state
+        # (bounded by --timeout: a JVM, Octave or a compile first takes what the machine's
+        # load makes it take; only a client that never gets ready fails here)
         ready = threading.Event()
 
         def reader():
+            nonlocal t_summary
             for line in cproc.stdout:
                 lines.append(line)
                 if "waiting for the scene" in line:
                     ready.set()
+                if t_summary is None and " summary " in line:
+                    t_summary = time.monotonic()
             ready.set()
 
         th = threading.Thread(target=reader, daemon=True)
         th.start()
-        if not ready.wait(15.0) or cproc.poll() is not None:
+        t0 = time.monotonic()
+        if not ready.wait(a.timeout) or cproc.poll() is not None:
             print("".join(lines))
-            print("FAIL: the client did not get ready")
+            print("FAIL: the client did not get ready within %g s" % a.timeout)
             return 1
+        print("client ready after %.1f s" % (time.monotonic() - t0), flush=True)
         if a.hostile:
             forged = hostile_payloads(a.hostile, prefix)
             hlc = hostile_lcm(env["LCM_DEFAULT_URL"])
@@ -170,6 +182,23 @@ def main():
 
             fth = threading.Thread(target=flood, daemon=True)
             fth.start()
+        if a.kill_daemon_after is not None:
+            # the last state on the bus, heard as the controller hears it: the start of the
+            # silence it must count (the kill may come long after it when a loaded machine
+            # stalls the daemon: seen 0.6 s before the kill, under a sanitizer build)
+            watcher = hostile_lcm(env["LCM_DEFAULT_URL"])
+
+            def heard(channel, data):
+                last_state[0] = time.monotonic()
+
+            watcher.subscribe(prefix + "_STATE", heard)
+
+            def watch():
+                while not done.is_set():
+                    watcher.handle_timeout(20)
+
+            wth = threading.Thread(target=watch, daemon=True)
+            wth.start()
         if dproc is None:
             dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                      universal_newlines=True, env=env)
@@ -199,6 +228,8 @@ def main():
         done.set()
         if fth:
             fth.join(5.0)
+        if wth:
+            wth.join(5.0)
         stop(cproc)
         stop(dproc)
     out = "".join(lines)
@@ -221,8 +252,19 @@ def main():
         names["hostile"] = n_hostile
         print("hostile: %d forged messages published" % n_hostile)
     if t_daemon_end is not None:
-        names["wall"] = t_client_end - t_daemon_end
-        print("wall = %.3f s from the daemon's end to the controller's" % names["wall"])
+        # the controller's end is its summary line, the event that says how the run ended
+        # (every client library flushes it as it decides), not its process's exit: what a
+        # JVM or Octave takes to shut down afterwards is no part of the contract (seen on
+        # a loaded machine: Octave's exit 5.7 s after the daemon's kill, past 2 + 3 s)
+        end = t_summary if t_summary is not None else t_client_end
+        names["wall"] = end - t_daemon_end
+        print("wall = %.3f s from the daemon's end to the controller's summary line (its exit: "
+              "%.3f s)" % (names["wall"], t_client_end - t_daemon_end))
+    if a.kill_daemon_after is not None and last_state[0] is not None:
+        names["silent"] = (t_summary if t_summary is not None else t_client_end) - last_state[0]
+        print("silent = %.3f s from the last state heard to the controller's summary line "
+              "(the last state %.3f s before the kill)"
+              % (names["silent"], t_daemon_end - last_state[0]))
     names["math"] = math
     names["out"] = out  # the client's stdout, for checks of what it prints
     for expr in a.check:

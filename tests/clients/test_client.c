@@ -114,6 +114,7 @@ static void case_library(int arg)
     (void)arg;
     char prefix[64], ch[128], err[256];
     snprintf(prefix, sizeof prefix, "CLTCLIENT_%d", (int)getpid());
+    lt_private_lcm(); /* the default URL: a port pair of this process's own */
 
     ENSURE(lag_client_create(NULL, "", err, sizeof err) == NULL && err[0] != '\0');
     ENSURE(lag_client_create("nosuchprovider://x", prefix, err, sizeof err) == NULL);

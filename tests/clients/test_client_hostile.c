@@ -46,6 +46,7 @@ static void case_hostile_messages(int arg)
     (void)arg;
     char prefix[64], ch[128], err[256];
     snprintf(prefix, sizeof prefix, "CLHOSTILE_%d", (int)getpid());
+    lt_private_lcm(); /* the default URL: a port pair of this process's own */
     lag_client *c = lag_client_create(NULL, prefix, err, sizeof err);
     lcm_t *peer = lcm_create(NULL);
     ENSURE(c != NULL && peer != NULL);

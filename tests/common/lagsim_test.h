@@ -25,12 +25,17 @@
 #ifndef LAGSIM_TEST_H
 #define LAGSIM_TEST_H
 
+#include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 static int lt_failures = 0;
 static int lt_checks = 0;
@@ -217,6 +222,113 @@ static inline int lt_main(int argc, char **argv, const lt_case *cases, int n)
 {
     const lt_program p = {.cases = cases, .n = n};
     return lt_run(argc, argv, &p);
+}
+
+/* ------------------------------------------------------------------ LCM ports */
+/* n UDP ports in a row, P .. P + n - 1 (P even, in [20000, 60000) below the kernel's
+ * ephemeral ports), this process's own
+ * until it ends: the rule of tests/common/lcm_port.py (which says why), held as
+ * lagsim-eval and lagsim-sweep hold theirs (server/wire/lagsim_port.h), pair by pair: an
+ * exclusive flock on LOCK_DIR/lagsim-udp-P.lock (the first of /run/lock, /var/lock, /tmp),
+ * opened read-only and created if missing, and no socket of this host bound to a port
+ * (/proc/net/udp, udp6). Returns P, or -1 when none is free. */
+static inline bool lt_udp_bound(int port)
+{
+    static const char *const files[] = {"/proc/net/udp", "/proc/net/udp6"};
+    for (int f = 0; f < 2; f++) {
+        FILE *in = fopen(files[f], "r");
+        if (!in) continue;
+        char line[512];
+        bool found = false;
+        while (!found && fgets(line, sizeof line, in)) {
+            char local[128];
+            unsigned p;
+            if (sscanf(line, " %*s %127s", local) == 1) {
+                char *colon = strrchr(local, ':');
+                found = colon && sscanf(colon + 1, "%x", &p) == 1 && (int)p == port;
+            }
+        }
+        fclose(in);
+        if (found) return true;
+    }
+    return false;
+}
+
+static inline int lt_pair_lock(int port)
+{
+    static const char *const dirs[] = {"/run/lock", "/var/lock", "/tmp"};
+    const char *dir = "/tmp";
+    struct stat st;
+    for (int k = 0; k < 3; k++)
+        if (stat(dirs[k], &st) == 0 && S_ISDIR(st.st_mode)) {
+            dir = dirs[k];
+            break;
+        }
+    char path[4096];
+    snprintf(path, sizeof path, "%s/lagsim-udp-%d.lock", dir, port);
+    const int flags = O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC;
+    int fd = open(path, flags);
+    if (fd < 0 && errno == ENOENT) fd = open(path, flags | O_CREAT | O_EXCL, 0644);
+    if (fd < 0 && errno == EEXIST) fd = open(path, flags); /* another made it meanwhile */
+    if (fd < 0) return -1;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd; /* open until the process ends: the lock goes with it */
+}
+
+/* The first of the kernel's ephemeral ports (a sender's socket gets one, bound without
+ * SO_REUSEADDR: a bus there fails to bind): the tests' range ends below it. */
+static inline int lt_ephemeral_low(void)
+{
+    int low = 32768, high;
+    FILE *f = fopen("/proc/sys/net/ipv4/ip_local_port_range", "r");
+    if (f) {
+        if (fscanf(f, "%d %d", &low, &high) != 2) low = 32768;
+        fclose(f);
+    }
+    return low;
+}
+
+static inline int lt_lcm_ports(int n)
+{
+    const int first = 20000, pairs = (n + 1) / 2;
+    int end = lt_ephemeral_low();
+    if (end > 60000) end = 60000;
+    if (end < first + 2000) end = first + 2000;
+    const int blocks = (end - first) / 2 - (pairs - 1);
+    const int start = (int)(((long long)getpid() * 7919) % blocks);
+    if (pairs > 8) return -1;
+    for (int k = 0; k < blocks; k++) {
+        int p = first + 2 * ((start + k) % blocks), fds[8], got = 0;
+        bool ok = true;
+        for (int q = 0; q < 2 * pairs && ok; q++) ok = !lt_udp_bound(p + q);
+        for (int q = 0; q < pairs && ok; q++) {
+            fds[got] = lt_pair_lock(p + 2 * q);
+            ok = fds[got] >= 0;
+            if (ok) got++;
+        }
+        for (int q = 0; q < 2 * pairs && ok; q++) ok = !lt_udp_bound(p + q); /* bound meanwhile */
+        if (ok) return p;
+        while (got > 0) close(fds[--got]);
+    }
+    return -1;
+}
+
+/* LCM_DEFAULT_URL set to udpm://239.255.76.67:P?ttl=0&recv_buf_size=4194304 on a port pair
+ * of this process's own (lt_lcm_ports(2)): every LCM user the test starts or creates that
+ * names no URL meets on it, and hears nothing of any other run on the machine. */
+static inline void lt_private_lcm(void)
+{
+    int port = lt_lcm_ports(2);
+    if (port < 0) {
+        fprintf(stderr, "no free LCM port pair (lt_lcm_ports)\n");
+        exit(1);
+    }
+    char url[96];
+    snprintf(url, sizeof url, "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304", port);
+    setenv("LCM_DEFAULT_URL", url, 1);
 }
 
 /* ------------------------------------------------------------------ seeded RNG */

@@ -31,6 +31,8 @@ import subprocess
 import sys
 import threading
 import time
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
 
@@ -62,7 +64,7 @@ def main():
     b = lambda p: os.path.join(a.bin, p)
     pid = os.getpid()
     cp, st, dp = "CP_%d" % pid, "ST_%d" % pid, "DP_%d" % pid
-    url = "udpm://239.255.76.67:%d?ttl=0" % (46000 + 2 * (pid % 6000))
+    url = lcm_url()
     os.environ["LCM_DEFAULT_URL"] = url
     daemons = {}
     for prefix, cfg, start in ((cp, "cartpole.yaml", "first_command"), (st, "stick.yaml", "paused"),
@@ -159,7 +161,7 @@ def main():
             if d.poll() is None:
                 d.terminate()
                 d.wait(10)
-    os.environ["LCM_DEFAULT_URL"] = "udpm://239.255.76.67:%d?ttl=0" % (58000 + 2 * (pid % 3000))
+    os.environ["LCM_DEFAULT_URL"] = lcm_url()  # another port of its own: a bus with no plant
     r = run([b("lagsimctl"), "--timeout", "0.5", "list"])
     check(r.returncode == 3 and "no plant heard" in r.stderr,
           "list with no plant on the bus: exit 3, said")

@@ -43,6 +43,8 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lcm_log import read_log, write_log  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
 
@@ -164,8 +166,7 @@ def main():
     cfg = os.path.join(a.source, "config", "stick.yaml")
     prefix = "KICK_%d" % os.getpid()
     # a multicast port of this run's own (ttl=0: this host)
-    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0" %
-                                     (34000 + 2 * (os.getpid() % 6000)))
+    os.environ["LCM_DEFAULT_URL"] = lcm_url()
     tmp = tempfile.mkdtemp(prefix="lagsim_kick_")
     log = os.path.join(tmp, "kick.lcm")
 
@@ -202,6 +203,11 @@ def main():
         check(r1.returncode == 0 and r2.returncode == 0 and e1 and e2 and
               e1[0]["step"] == 50 and e2[0]["step"] == 50,
               "two kicks with --duration 0.05 at step 50: exit 0 each")
+        # the numbers as typed: the shortest decimal that reads back, not %.17g's
+        # 0.050000000000000003 (lagsim_num.h)
+        check(e1 and e1[0]["detail"] == "kick.x=0.25,0.05" and e2 and
+              e2[0]["detail"] == "kick.x=0.125,0.05",
+              "the kicks' details as typed: %r, %r" % (e1 and e1[0]["detail"], e2 and e2[0]["detail"]))
         check(ctl("step", "10").returncode == 0, "step 10")
         r = ctl("kick", "cart", "1")
         check(r.returncode == 1 and "unknown joint 'cart' for model stick; allowed: x, phi" in

@@ -31,6 +31,8 @@ import re
 import subprocess
 import sys
 import time
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
 
@@ -59,8 +61,7 @@ def main():
     # a multicast port of this run's own (ttl=0: this host), through LCM_DEFAULT_URL, which
     # lagsimd and lagsimctl read: another run on the machine is not heard (nor floods these
     # sockets), nothing of this one is heard elsewhere
-    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
-                                     % (20000 + 2 * (os.getpid() % 6000)))
+    os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")
 
     def ctl(*args, timeout=20):
         r = subprocess.run([a.lagsimctl, "--prefix", prefix] + list(args),

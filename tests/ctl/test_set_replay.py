@@ -21,6 +21,8 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lcm_log import read_log, write_log  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
 
@@ -58,8 +60,7 @@ def main():
     # a multicast port of this run's own (ttl=0: this host), through LCM_DEFAULT_URL, which
     # every process here reads: nothing else on the machine is heard, nothing of this run
     # is heard elsewhere; 4 MB receive buffers so that the logger keeps up
-    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
-                                     % (20000 + 2 * (os.getpid() % 6000)))
+    os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")
     print("LCM_DEFAULT_URL=%s" % os.environ["LCM_DEFAULT_URL"])
     tmp = tempfile.mkdtemp(prefix="lagsim_set_replay_")
     logs = []

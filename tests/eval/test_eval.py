@@ -22,6 +22,11 @@ usage: test_eval.py BIN_DIR SOURCE_DIR CASE
              two workers run at once on four pairs, each held (its lock file locked) while
              its controller runs; ttl above 0 only with --allow-lan; memq:// and other
              providers refused; {prefix} and {url} replaced as they are, inside quotes too
+  stderr     without -v the controller's stderr is the run's, not the terminal's: a
+             controller that talks on stderr and works says nothing through lagsim-eval
+             or lagsim-sweep; one that fails has its last 8 lines shown under the case's
+             note (lagsim-sweep: a worker's first failed run, on stderr); -v passes it
+             through
   outputs    no output of lagsim-eval or lagsim-sweep is a file they read (the scene, the
              suite, the daemon; merge's shards) or another of their outputs (the CSV and
              the report's or the plot's files), whatever its spelling (./, a hard link),
@@ -172,11 +177,83 @@ def case_require():
               and "passed" not in title[0], "the report's title: UNMET and the term (%s)"
               % title)
         check("Warning" not in p.stderr, "gnuplot said nothing on stderr")
+        # every term that fails, each with its value, in the notes, the CSV and the title;
+        # the one that holds (theta.peak_error <= 0.1) not
+        out = os.path.join(d, "two.csv")
+        p = run("--suite", SUITE, "--case", "tilt", "--require",
+                "theta.settle < 2 and theta.peak_error <= 0.1 and x.settle < 3", "--csv", out,
+                "--report", d, "--force")
+        note = [l for l in p.stdout.splitlines() if "--require:" in l]
+        both = re.compile(r"theta\.settle < 2 fails \(5\.5\d*\); x\.settle < 3 fails \(5\.8\d*\)")
+        check(p.returncode == 1 and len(note) == 1 and both.search(note[0]) and
+              "peak_error" not in note[0], "two terms fail: both named with their values (%s)"
+              % note)
+        r = read_csv(out)
+        check(len(r) == 2 and all(both.fullmatch(x["reason"]) for x in r),
+              "the CSV's reason: both terms (%s)" % [x["reason"] for x in r])
+        title = [l for l in open(os.path.join(d, "tilt.gp")) if "multiplot layout" in l]
+        check(len(title) == 1 and "theta.settle < 2 fails" in title[0] and
+              "\\nx.settle < 3 fails" in title[0], "the report's title: each term on its line (%s)"
+              % title)
     p = run("--suite", SUITE, "--case", "tilt", "--require", "phi.settle<2")
     check(p.returncode == 2 and "no joint 'phi'" in p.stderr, "unknown joint: exit 2")
     check(p.stderr.count("--require") == 1, "--require said once: %r" % p.stderr.strip())
     p = run("--suite", SUITE, "--case", "tilt", "--require", "theta.settling<2")
     check(p.returncode == 2 and "settle" in p.stderr, "unknown metric: exit 2")
+
+
+def case_stderr():
+    talk = "echo EVAL-TALKS >&2; " + CTRL          # works, and talks on stderr
+    # fails at once after 12 lines on stderr
+    fail = "for i in 1 2 3 4 5 6 7 8 9 10 11 12; do echo EVAL-LINE-$i >&2; done; exit 3"
+    base = [EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt", "--timeout", "20"]
+    p = subprocess.run(base + ["--controller", talk], stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+    print(p.stdout, p.stderr)
+    check(p.returncode == 0 and "EVAL-TALKS" not in p.stderr + p.stdout,
+          "a controller that works: its stderr not on lagsim-eval's (%r)" % p.stderr[-200:])
+    p = subprocess.run(base + ["--controller", fail], stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+    print(p.stdout, p.stderr)
+    lines = re.findall(r"^    \| EVAL-LINE-(\d+)$", p.stdout, re.M)
+    check(p.returncode == 1 and "tilt failed: the controller ended (exit status 3)" in p.stdout
+          and "    the controller's stderr, its last 8 lines:" in p.stdout and
+          lines == [str(i) for i in range(5, 13)] and "EVAL-LINE" not in p.stderr,
+          "a controller that fails: its last 8 lines under the note (%s)" % lines)
+    p = subprocess.run(base + ["--controller", talk, "-v"], stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+    check(p.returncode == 0 and "EVAL-TALKS" in p.stderr, "-v: passed through")
+    sweep = [os.path.join(BIN, "lagsim-sweep"), "--config", SCENE, "--duration", "1",
+             "--runs", "2", "--seed", "1", "--timeout", "20", "--vary",
+             "parameters.m0=uniform(1,1.5)"]
+    with tempfile.TemporaryDirectory() as d:
+        p = subprocess.run(sweep + ["--controller", talk, "--csv", os.path.join(d, "a.csv")],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        print(p.stdout[-500:], p.stderr)
+        check(p.returncode == 0 and "EVAL-TALKS" not in p.stderr + p.stdout,
+              "lagsim-sweep, a controller that works: its stderr not on the sweep's")
+        tail = "the controller's stderr, its last 8 lines:\n" + "".join(
+            "| EVAL-LINE-%d\n" % i for i in range(5, 13))
+        # a pair kept for the runs: it cannot start (the sweep ends, exit 2), said at once
+        p = subprocess.run(sweep + ["--controller", fail, "--csv", os.path.join(d, "b.csv")],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        print(p.stdout[-300:], p.stderr)
+        check(p.returncode == 2 and "run 0: the kept lagsimd did not step: the controller "
+              "ended (exit status 3)\n" + tail in p.stderr,
+              "lagsim-sweep, a kept pair whose controller fails: why, and its last 8 lines")
+        # a pair a run: the run fails, the sweep goes on; the first failure's lines, once
+        p = subprocess.run(sweep + ["--restart", "--controller", fail, "--csv",
+                                    os.path.join(d, "c.csv")],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        print(p.stdout[-300:], p.stderr)
+        check(p.returncode == 1 and p.stderr.count("failed: ") == 1 and
+              "run 0 failed: the controller ended (exit status 3) before the run did\n" + tail
+              in p.stderr and "-v passes" in p.stderr,
+              "lagsim-sweep --restart, a controller that fails: the first failed run's last "
+              "8 lines, once")
 
 
 BAD = [
@@ -589,6 +666,7 @@ def case_outputs():
 
 
 {"metrics": case_metrics, "require": case_require, "errors": case_errors,
- "scene": case_scene, "owned": case_owned, "outputs": case_outputs, "bus": case_bus}[CASE]()
+ "scene": case_scene, "owned": case_owned, "outputs": case_outputs, "bus": case_bus,
+ "stderr": case_stderr}[CASE]()
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)

@@ -2,7 +2,8 @@
  * lagsim-sweep's CSV (server/tools/sweep_merge.h) without a sweep: the check of a row
  * against its header (every malformed row merge must refuse, and the rows the writer
  * writes), the reason as the writer quotes it, --shard's parser, the header's columns, the
- * identity lines and the scene's SHA-256 against the FIPS 180-2 test vectors.
+ * identity lines and the scene's SHA-256 against the FIPS 180-2 test vectors; the reason
+ * a --require gives (every term that fails, as the reason column of both tools holds it).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -227,7 +228,7 @@ static void case_identity(int arg)
         "# seed: 9000000000000000\n"
         "# scene-sha256: ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad\n"
         "# case: tilt\n"
-        "# duration: 0.10000000000000001\n"
+        "# duration: 0.1\n"
         "# set: initial.q=[0, 0.1]\n"
         "# bound: theta=0.5\n"
         "# vary: parameters.m0=uniform(0.5,2)\n"
@@ -300,9 +301,48 @@ static void case_merge_many(int arg)
     unlink(out), unlink(scene), rmdir(dir);
 }
 
+/* --require's reason (eval_require_holds, lagsim-eval's and lagsim-sweep's): every term that
+ * fails with its value, none that holds; cut short at the caller's buffer with how many
+ * more fail, never past it. */
+static void case_require(int arg)
+{
+    (void)arg;
+    eval_scene sc = {.model = "cartpole", .nj = 2, .joint = {"x", "theta"}};
+    eval_result res = {.nj = 2};
+    for (int j = 0; j < 2; j++)
+        for (int m = 0; m < LAG_METRIC_COUNT; m++) res.m[j].v[m] = 1.0;
+    res.m[1].v[LAG_METRIC_SETTLE] = 5.5;
+    res.m[0].v[LAG_METRIC_SETTLE] = NAN;
+    lag_require req;
+    char err[256], why[2048];
+    ENSUREF(lag_require_parse("theta.settle < 2 and theta.rise < 3 and x.settle < 3", &req, err,
+                              sizeof err) == 0, "%s", err);
+    ENSURE(!eval_require_holds(&req, &sc, &res, why, sizeof why));
+    ENSUREF(!strcmp(why, "theta.settle < 2 fails (5.5); x.settle < 3 fails (nan)"), "%s", why);
+    ENSURE(lag_require_parse("theta.rise < 3", &req, err, sizeof err) == 0);
+    ENSURE(eval_require_holds(&req, &sc, &res, why, sizeof why) && why[0] == '\0');
+    /* 32 terms that fail in 300 bytes: those that fit, then the count of the rest */
+    char text[2048] = "";
+    for (int i = 0; i < LAG_REQUIRE_MAX; i++)
+        snprintf(text + strlen(text), sizeof text - strlen(text), "%stheta.settle > %d",
+                 i ? " and " : "", 10 + i);
+    ENSUREF(lag_require_parse(text, &req, err, sizeof err) == 0 && req.n == 32, "%s", err);
+    char small[300];
+    memset(small, 'X', sizeof small);
+    ENSURE(!eval_require_holds(&req, &sc, &res, small, 280));
+    int said = 0;
+    for (const char *p = small; (p = strstr(p, " fails (5.5)")) != NULL; p++) said++;
+    char tail[64];
+    snprintf(tail, sizeof tail, "; and %d more terms fail", 32 - said);
+    ENSUREF(said >= 5 && strlen(small) < 280 && strstr(small, tail) &&
+            !strcmp(small + strlen(small) - strlen(tail), tail) && small[299] == 'X',
+            "%d said: %s", said, small);
+}
+
 int main(int argc, char **argv)
 {
     static const lt_case cases[] = {
+        {"require", case_require, 0, 0},
         {"rows", case_rows, 0, 0},         {"reason", case_reason, 0, 0},
         {"shard", case_shard, 0, 0},       {"columns", case_columns, 0, 0},
         {"sha256", case_sha256, 0, 0},     {"identity", case_identity, 0, 0},

@@ -24,6 +24,8 @@ import shutil
 import subprocess
 import sys
 import tempfile
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def main():
@@ -33,6 +35,9 @@ def main():
     ap.add_argument("--cc", default="cc")
     ap.add_argument("--cflags", default="", help="extra compiler flags (a sanitizer build's)")
     a = ap.parse_args()
+    # every process here meets on LCM's default URL, a port pair of this run's own
+    # (tests/common/lcm_port.py): nothing of another run on the machine is heard
+    os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")
     build, src = os.path.abspath(a.build), os.path.abspath(a.source)
     tmp = tempfile.mkdtemp(prefix="lagsim_install_")
     prefix = os.path.join(tmp, "prefix")

@@ -36,6 +36,8 @@ import sys
 import tempfile
 import time
 import zlib
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 failures = 0
 
@@ -558,8 +560,7 @@ def main():
     # a multicast port of this test's own (ttl=0: this host) for every process it starts,
     # through LCM_DEFAULT_URL: on one port every socket gets every datagram, and another
     # test's fast-mode daemon would flood this one's sockets; 4 MB receive buffers
-    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
-                                     % (20000 + 2 * (os.getpid() % 6000)))  # and the next port: commands
+    os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")  # and the next port: commands
     a.bin, a.types, a.source = (os.path.abspath(x) for x in (a.bin, a.types, a.source))
     tmp = tempfile.mkdtemp(prefix="lagsim_log_")
     try:

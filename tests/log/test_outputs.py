@@ -26,6 +26,8 @@ import shutil
 import subprocess
 import sys
 import tempfile
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 failures = 0
 
@@ -118,8 +120,7 @@ def main():
     ap.add_argument("writer", choices=["lagsimd_log", "lagsimd_csv", "log2csv", "plot"])
     a = ap.parse_args()
     # a multicast port of this test's own (the --log runs publish in fast mode)
-    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0"
-                                     % (30000 + 2 * (os.getpid() % 4000)))
+    os.environ["LCM_DEFAULT_URL"] = lcm_url()
     tmp = tempfile.mkdtemp(prefix="lagsim_outputs_")
     try:
         w = Writer(a, tmp, a.writer)

@@ -32,6 +32,8 @@ import struct
 import subprocess
 import sys
 import tempfile
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_url  # noqa: E402  (tests/common/lcm_port.py)
 
 failures = 0
 SYNC = 0xEDA1DA01
@@ -228,8 +230,7 @@ def main():
     ap.add_argument("--source", required=True)
     ap.add_argument("case", choices=sorted(CASES))
     a = ap.parse_args()
-    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0"
-                                     % (20000 + 2 * (os.getpid() % 6000)))
+    os.environ["LCM_DEFAULT_URL"] = lcm_url()  # a port pair of this process's own
     a.bin, a.types, a.source = (os.path.abspath(x) for x in (a.bin, a.types, a.source))
     tmp = tempfile.mkdtemp(prefix="lagsim_series_")
     try:

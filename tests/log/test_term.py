@@ -12,7 +12,9 @@ Cases:
             first; nothing wider than the terminal
   effects   the stick on its floor: each impact (and the rest) on its own line, with the
             sim time the core locates
-  quiet     -q: no live line and no event line (only the line saying where it listens)
+  quiet     -q: nothing on stderr (no live line, no event line, no line saying where it
+            listens), with lcm.allow_lan only that line (a warning: the network reaches the
+            plant)
   pipe      stderr not a terminal: event lines only, no live line, no control codes
   waits     no controller: every 3 s a line says what the plant waits for (the first
             command, on <PREFIX>_COMMAND at the command URL) and, once a command for an
@@ -31,6 +33,8 @@ import subprocess
 import sys
 import termios
 import time
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 failures = 0
 
@@ -76,6 +80,12 @@ class Daemon:
                 if not chunk:
                     return
                 self.out += chunk
+
+    def read_until(self, done, limit=30.0):
+        """Reads until done(text) holds (the event a check waits for), at most `limit` s."""
+        end = time.monotonic() + limit
+        while not done(self.text()) and time.monotonic() < end and self.p.poll() is None:
+            self.read(0.05)
 
     def stop(self):
         if self.p.poll() is None:
@@ -215,11 +225,17 @@ def case_quiet(a):
     s.command(name="nope")
     d.read(1.5)
     rc = d.stop()
-    # what stays: the start line saying where the daemon listens (docs/network.md)
+    # -q: only warnings and errors; a rejected command and waiting are neither
+    check(rc == 0 and d.out == b"", f"-q: nothing at all ({d.out[:300]!r}), exit {rc}")
+    # with lcm.allow_lan the line saying that the network reaches the plant is a warning
+    d = Daemon(a, os.path.join(a.source, "config", "dipc.yaml"), prefix + "L", "-q", "--set",
+               "lcm.allow_lan=true")
+    d.read(1.0)
+    rc = d.stop()
     left = [l for l in d.text().splitlines() if l]
-    check(rc == 0 and len(left) == 1 and f"lagsimd: {prefix}: listening on " in left[0]
-          and "\r" not in d.text() and "\x1b" not in d.text(),
-          f"-q: no live line, no event line, only where it listens ({d.out[:300]!r}), exit {rc}")
+    check(rc == 0 and len(left) == 1 and f"lagsimd: {prefix}L: listening on " in left[0]
+          and "from the network" in left[0] and "\r" not in d.text(),
+          f"-q, lcm.allow_lan: only the line saying the network reaches it ({d.out[:300]!r}), exit {rc}")
 
 
 def case_pipe(a):
@@ -257,7 +273,11 @@ def case_waits(a):
     state_url, command_url = plant_urls()
     d = Daemon(a, os.path.join(a.source, "config", "dipc.yaml"), prefix)
     s = Sender(a, prefix)
-    d.read(4.0)
+    # the events, not fixed times: the first wait line (3 s after the daemon's start, which
+    # a loaded machine delays: after a fixed 4 s the sanitizer build had printed none), then
+    # 0.5 s more, in which no second line may come
+    d.read_until(lambda t: len(wait_lines(t, prefix)[1]) >= 1)
+    d.read(0.5)
     ok, lines = wait_lines(d.text(), prefix)
     for l in lines:
         print("  wait line:", l)
@@ -268,7 +288,8 @@ def case_waits(a):
     s.command(name="cart")
     wrong = LCM(state_url)
     s.command(lc=wrong)  # a controller publishing on the state URL's port
-    d.read(3.5)
+    d.read_until(lambda t: len(wait_lines(t, prefix)[1]) >= 2)  # the line after 6 s
+    d.read(0.5)
     rc = d.stop()
     wrong.close()
     ok, lines = wait_lines(d.text(), prefix)
@@ -299,8 +320,7 @@ def main():
     # a multicast port of this test's own (ttl=0: this host) for every process it starts,
     # through LCM_DEFAULT_URL: on one port every socket gets every datagram, and another
     # test's fast-mode daemon would flood this one's sockets; 4 MB receive buffers
-    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
-                                     % (20000 + 2 * (os.getpid() % 6000)))  # and the next port: commands
+    os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")  # and the next port: commands
     a.bin, a.python, a.source = (os.path.abspath(x) for x in (a.bin, a.python, a.source))
     CASES[a.case](a)
     print(f"{a.case}: {'FAILED' if failures else 'passed'} ({failures} failures)")

@@ -36,20 +36,23 @@ def load(types, clients_python):
     return lagsim, LCM, plant_urls
 
 
-def read_log(path):
-    """Records of an LCM log file: (channel, data). The format: sync word 0xEDA1DA01,
-    event number (8 bytes), timestamp (8), channel length (4), data length (4), channel,
-    data; all big-endian."""
+def read_log(path, stamps=None):
+    """Records of an LCM log file: (channel, data); their timestamps (us) appended to the
+    list `stamps` if one is given. The format: sync word 0xEDA1DA01, event number (8
+    bytes), timestamp (8), channel length (4), data length (4), channel, data; all
+    big-endian."""
     out = []
     with open(path, "rb") as f:
         buf = f.read()
     i = 0
     while i + 28 <= len(buf):
-        sync, _, _, clen, dlen = struct.unpack(">IqqII", buf[i:i + 28])
+        sync, _, utime, clen, dlen = struct.unpack(">IqqII", buf[i:i + 28])
         if sync != 0xEDA1DA01 or i + 28 + clen + dlen > len(buf):
             break
         ch = buf[i + 28:i + 28 + clen].decode("ascii", "replace")
         out.append((ch, buf[i + 28 + clen:i + 28 + clen + dlen]))
+        if stamps is not None:
+            stamps.append(utime)
         i += 28 + clen + dlen
     return out
 
@@ -100,9 +103,11 @@ def cmd_summary(a):
     lagsim, _, _ = load(a.types, a.clients)
     states, dup, events, status, nonfinite = {}, 0, [], None, 0
     statuses = 0
-    for ch, data in read_log(a.log):
+    stamps, first_seen = [], {}  # the logger's receive time of each step's first copy
+    for k, (ch, data) in enumerate(read_log(a.log, stamps)):
         if ch == a.prefix + "_STATE":
             st = lagsim.joint_state_t.decode(data)
+            first_seen.setdefault(st.step, stamps[k])
             nums = [st.sim_time] + list(st.position) + list(st.velocity) + list(st.effort)
             nonfinite += sum(1 for x in nums if not math.isfinite(x))
             key = st.step
@@ -125,7 +130,11 @@ def cmd_summary(a):
                 nonfinite += 0 if math.isfinite(x) else 1
             status = {k: getattr(s, k) for k in s.__slots__} if hasattr(s, "__slots__") else vars(s)
     steps = sorted(states)
+    # the longest wall time from one state to the next (in lockstep: an answer's round
+    # trip), from the second state on (the first waits for the controller to start)
+    gaps = [first_seen[b] - first_seen[a] for a, b in zip(steps[1:], steps[2:])]
     print(json.dumps({"states": len(states), "duplicates": dup,
+                      "slowest_step_s": max(gaps) * 1e-6 if gaps else None,
                       "first_step": steps[0] if steps else None,
                       "last_step": steps[-1] if steps else None,
                       "last_state": states[steps[-1]] if steps else None,

@@ -3,10 +3,11 @@
  * which LCM datagrams the filter keeps (exact channel names of every length, short
  * messages only, from this host), that it finds LCM's own receive socket, that a marker
  * sent after the filter comes back (and does not when the filter keeps it out), and the
- * interface of the route to a group. That a datagram from another host is dropped needs
+ * interface of the route to a group; with suffixes, every channel that ends in one of them
+ * after a prefix, at every length LCM allows, and no other. That a datagram from another host is dropped needs
  * a second host: tests/net/two_hosts.sh (net_two_hosts).
  *
- *   test_net [CASE]      cases: channels lcm_socket sync route
+ *   test_net [CASE]      cases: channels suffixes lcm_socket sync route
  */
 #include <arpa/inet.h>
 #include <net/if.h>
@@ -24,8 +25,17 @@
 
 #define GROUP "239.255.76.67"
 
-/* A port of this process's own, away from the other tests' (20000..31999). */
-static int test_port(int k) { return 40000 + 4 * (int)(getpid() % 5000) + k; }
+/* Port k (0..3) of four of this process's own (lt_lcm_ports, lagsim_test.h). */
+static int test_port(int k)
+{
+    static int base = -1;
+    if (base < 0) base = lt_lcm_ports(4);
+    if (base < 0) {
+        fprintf(stderr, "no four free UDP ports in a row (lt_lcm_ports)\n");
+        exit(1);
+    }
+    return base + k;
+}
 
 /* A UDP socket bound to port, member of GROUP (as LCM's receive socket is). */
 static int member_socket(int port)
@@ -120,6 +130,65 @@ static void case_channels(int arg)
     close(fd);
 }
 
+/* With suffixes (lag_net_filter_suffixes): the named channels, and every channel that
+ * ends in a suffix after at least one byte of prefix, at every prefix length up to LCM's
+ * longest name (63); not the suffix alone, not a channel that only starts with one, not
+ * a fragment, not one without its NUL. */
+static void case_suffixes(int arg)
+{
+    (void)arg;
+    int port = test_port(3), fd = member_socket(port), tx = sender();
+    ENSURE(fd >= 0 && tx >= 0);
+    if (fd < 0 || tx < 0) return;
+    char err[256];
+    const char *chans[] = {"OWN_STATE"}, *sfx[] = {"_CONTROL", "_SCENE"};
+    for (int host_only = 0; host_only < 2; host_only++) {
+        int n = lag_net_filter_suffixes(port, host_only, chans, 1, sfx, 2, err, sizeof err);
+        ENSUREF(n == 1, "filter: %s", n < 0 ? err : "no socket found");
+        if (n != 1) break;
+        int want = 0;
+        for (int len = 1; len + 8 <= 63; len++) { /* a prefix of len bytes */
+            char pre[64], ch[80];
+            for (int i = 0; i < len; i++) pre[i] = (char)('A' + (i * 5 + len) % 26);
+            pre[len] = '\0';
+            snprintf(ch, sizeof ch, "%s_CONTROL", pre);
+            send_lcm(tx, port, 0x4c433032u, ch, 0), want++;          /* kept */
+            if (len + 6 <= 63) {
+                snprintf(ch, sizeof ch, "%s_SCENE", pre);
+                send_lcm(tx, port, 0x4c433032u, ch, 0), want++;      /* kept */
+            }
+            snprintf(ch, sizeof ch, "%s_CONTROLS", pre);
+            send_lcm(tx, port, 0x4c433032u, ch, 0);                  /* longer: no */
+            snprintf(ch, sizeof ch, "%s_CONTROL", pre);
+            ch[strlen(ch) - 1] = 'X';
+            send_lcm(tx, port, 0x4c433032u, ch, 0);                  /* last byte: no */
+            snprintf(ch, sizeof ch, "%s_STATE", pre);
+            send_lcm(tx, port, 0x4c433032u, ch, 0);                  /* another suffix */
+            snprintf(ch, sizeof ch, "%s_CONTROL", pre);
+            send_lcm(tx, port, 0x4c433033u, ch, 0);                  /* a fragment */
+            send_lcm(tx, port, 0x4c433032u, ch, 8 + strlen(ch));     /* cut before the NUL */
+            int got = drain(fd, 300);
+            if (got != want) {
+                LT_FAIL("prefix of %d bytes: %d datagrams kept, expected %d", len, got, want);
+                break;
+            }
+            want = 0;
+        }
+        send_lcm(tx, port, 0x4c433032u, "_CONTROL", 0);  /* no prefix */
+        send_lcm(tx, port, 0x4c433032u, "_SCENE", 0);
+        send_lcm(tx, port, 0x4c433032u, "OWN_STATE", 0); /* the channel named: kept */
+        char huge[80];                                   /* 64 bytes and more: no NUL seen */
+        memset(huge, 'Q', sizeof huge);
+        snprintf(huge + 56, sizeof huge - 56, "_CONTROL");
+        send_lcm(tx, port, 0x4c433032u, huge, 0);
+        int got = drain(fd, 300);
+        ENSUREF(got == 1, "the suffixes alone, a 64-byte channel: %d kept, expected 1 (OWN_STATE)",
+                got);
+    }
+    close(tx);
+    close(fd);
+}
+
 /* LCM's own receive socket for a URL is found once the lcm_t has a subscription (and
  * not before: LCM opens it then); the filter then decides what LCM hands over. */
 static int handled;
@@ -192,6 +261,7 @@ int main(int argc, char **argv)
 {
     static const lt_case cases[] = {
         {"channels", case_channels, 0, 0},
+        {"suffixes", case_suffixes, 0, 0},
         {"lcm_socket", case_lcm_socket, 0, 0},
         {"sync", case_sync, 0, 0},
         {"route", case_route, 0, 0},

@@ -4,7 +4,7 @@
  * programs' exit statuses are the ones their docs give.
  *
  *   test_result             runs the cases
- *   test_result --table     prints the table, "NAME VALUE EXIT" a line (exit_docs.sh reads it)
+ *   test_result --table     prints the table, "NAME VALUE EXIT" a line (exit_docs.py reads it)
  */
 #include "lagsim_test.h"
 
@@ -68,7 +68,7 @@ static void case_table(int arg)
     }
 }
 
-/* The exit statuses the man pages give (tests/result/exit_docs.sh checks the pages and
+/* The exit statuses the man pages give (tests/result/exit_docs.py checks the pages and
  * the programs against the table; this pins the table's side). */
 static void case_exit_statuses(int arg)
 {

@@ -913,7 +913,11 @@ static bool replay_attempt(const char *logger, const char *method, int attempt)
     }
     ENSURE(pclose(p) == 0);
     remove(log_path);
-    if (compared != 200 || gaps != 0) {
+    /* Every state at least once and no gap: lcm-logger records what the bus carries, and a
+     * state the client answered later than the daemon's first retry (20 ms: a loaded
+     * machine) is on the bus again, byte for byte, and compared again (seen: 201 to 234
+     * compared, 0 gaps, difference 0). Fewer, or a gap, is what UDP lost. */
+    if (compared < 200 || gaps != 0) {
         printf("attempt %d: the logger missed states (%ld compared, %ld gaps): retry\n",
                attempt, compared, gaps);
         return false;
@@ -1843,10 +1847,7 @@ static void setup(void)
      * larger requests): a lockstep run publishes hundreds of small datagrams in a few
      * milliseconds, each costing the socket about 1 kB of buffer, and lcm-logger, kept off
      * a core by a loaded machine, lost some with the default 208 kB. */
-    char url[128];
-    snprintf(url, sizeof url, "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304",
-             20000 + 2 * (int)(getpid() % 6000)); /* and the next port: the command URL */
-    setenv("LCM_DEFAULT_URL", url, 1);
+    lt_private_lcm(); /* and the next port: the command URL (lagsim_test.h) */
 }
 
 int main(int argc, char **argv)

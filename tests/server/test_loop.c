@@ -13,7 +13,7 @@
  *                           long_period chunks
  *                           step_paced control_flood command_flood duration signals
  *                           fault_effort lockstep_retry lockstep_loss other_plant
- *                           reject_names waits (--list)
+ *                           reject_names waits foreign copy_rule (--list)
  */
 #include <math.h>
 #include <signal.h>
@@ -1158,7 +1158,7 @@ static void case_command_flood(int arg)
 }
 
 /* --duration: 1e300 s or 1e16 s is refused (more ticks than a run counts exactly);
- * 0.5 s stops after the period that reaches it. */
+ * 0.5 s stops after the period that reaches it, the sim time before a reset counted. */
 static void case_duration(int arg)
 {
     (void)arg;
@@ -1173,6 +1173,27 @@ static void case_duration(int arg)
     ENSURE(g_srv.stop && g_srv.stop_reason == RT_STOP_DURATION && g_srv.sim.tick == 500);
     stop_server();
     ENSURE(n_events("stop") == 1 && !strcmp(last_detail("stop"), "duration reached"));
+    /* the run's sim time counts, resets included: 0.3 s, a RESET, 0.1 s, a RESET_TO, and
+     * the run of 0.5 s ends 0.1 s after it (realtime: the made-up clock paces it) */
+    scene(LAG_RT_REALTIME);
+    g_opts.duration = 0.5;
+    ENSURE(try_start(0) == 0);
+    run_until(g_srv.now + 300 * MS, 1000);
+    int64_t t1 = g_srv.sim.tick;
+    control(LAGSIM_CONTROL_T_RESET, 0);
+    run_until(g_srv.now + 100 * MS, 1000);
+    int64_t t2 = g_srv.sim.tick;
+    uint8_t buf[256];
+    double q[3] = {0, 0.05, 0}, qd[3] = {0};
+    lagsim_control_t m = {0, LAGSIM_CONTROL_T_RESET_TO, 0, 3, q, qd, "", ""};
+    int n = lagsim_control_t_encode(buf, 0, sizeof buf, &m);
+    rt_handle_control(&g_srv, buf, (size_t)n);
+    run_until(g_srv.now + 100 * SEC, 1000);
+    ENSUREF(g_srv.stop && g_srv.stop_reason == RT_STOP_DURATION && t1 > 0 && t2 > 0 &&
+                t1 + t2 + g_srv.sim.tick == 500,
+            "stopped after %lld + %lld + %lld ticks (500 in all)", (long long)t1, (long long)t2,
+            (long long)g_srv.sim.tick);
+    stop_server();
 }
 
 /* Signals: SIGHUP, SIGQUIT, SIGINT and SIGTERM stop with a stop event naming the signal
@@ -1477,6 +1498,139 @@ static void case_waits(int arg)
     stop_server();
 }
 
+/* Control requests for a prefix no plant here has (a misspelt one) are named in the wait:
+ * counted by request since the wait began, once the daemon's own DESCRIBE to that prefix
+ * (its probe: one a prefix) went unanswered for 0.5 s; a prefix that answers with its
+ * scene is another plant's and is not named; a flood of new prefixes costs a bounded
+ * table, at most 4 probes a second (and a burst of 4), at most 3 prefixes named. */
+static int64_t g_probes;
+static void on_probe(const lcm_recv_buf_t *rb, const char *ch, void *u)
+{
+    (void)ch, (void)u;
+    lag_wire_control m;
+    if (lag_wire_decode_control(rb->data, rb->data_size, 0, &m) == LAG_WIRE_OK && m.utime > 0)
+        g_probes++; /* the test's own requests carry utime 0 */
+}
+
+static void request_on(const char *channel, int req)
+{
+    uint8_t buf[256];
+    lagsim_control_t m = {0, (int8_t)req, 0, 0, NULL, NULL, "", ""};
+    int n = lagsim_control_t_encode(buf, 0, sizeof buf, &m);
+    ENSURE(n > 0 && lcm_publish(g_lcm, channel, buf, (unsigned)n) == 0);
+}
+
+static void case_foreign(int arg)
+{
+    (void)arg;
+    scene(LAG_RT_REALTIME);
+    g_sc.realtime.start = LAG_RT_START_FIRST_COMMAND;
+    start();
+    lcm_subscription_t *sub = lcm_subscribe(g_lcm, "TLMISPELT_CONTROL", on_probe, NULL);
+    g_probes = 0;
+    for (int i = 0; i < 5; i++) { /* a controller's DESCRIBE every 0.25 s */
+        request_on("TLMISPELT_CONTROL", LAGSIM_CONTROL_T_DESCRIBE);
+        run_until(g_srv.now + 250 * MS, 1000);
+    }
+    status_now();
+    ENSUREF(g_probes == 1, "%lld probes of TLMISPELT (one)", (long long)g_probes);
+    expect_has(g_out.status_waiting_got, "requests for a prefix no plant here has, on the command "
+               "port 7668: TLMISPELT (DESCRIBE 5); this plant is TL", __LINE__);
+    /* another plant's prefix: its scene answers the probe; a junk request is undecodable */
+    request_on("TLOTHER_CONTROL", LAGSIM_CONTROL_T_STATUS);
+    lcm_publish(g_lcm, "TLJUNK_CONTROL", "junk", 4);
+    run_until(g_srv.now + 10 * MS, 1000);
+    /* its scene (the channel says whose: the daemon does not decode it) */
+    ENSURE(lcm_publish(g_lcm, "TLOTHER_SCENE", "scene", 5) == 0);
+    run_until(g_srv.now + 600 * MS, 1000);
+    status_now();
+    ENSUREF(!strstr(g_out.status_waiting_got, "TLOTHER"), "another plant's prefix named: %s",
+            g_out.status_waiting_got);
+    expect_has(g_out.status_waiting_got, "requests for prefixes no plant here has, on the "
+               "command port 7668: TLJUNK (undecodable 1), TLMISPELT (DESCRIBE 5); this plant "
+               "is TL", __LINE__);
+    /* five misspelt prefixes: three named, the others counted */
+    for (int i = 0; i < 5; i++) {
+        char ch[64];
+        snprintf(ch, sizeof ch, "TLM%d_CONTROL", i);
+        request_on(ch, LAGSIM_CONTROL_T_STATUS);
+        run_until(g_srv.now + 300 * MS, 1000);
+    }
+    run_until(g_srv.now + 600 * MS, 1000);
+    status_now();
+    expect_has(g_out.status_waiting_got, ": TLM4 (STATUS 1), TLM3 (STATUS 1), TLM2 (STATUS 1) "
+               "and 4 more; this plant is TL", __LINE__);
+    /* a flood of new prefixes for 2 s: at most 4 probes a second, a table of 8 */
+    int64_t t0 = g_srv.now, refused0 = g_srv.bus.probes.suppressed;
+    int64_t forgotten0 = g_srv.bus.foreign.forgotten;
+    for (int i = 0; i < 4000; i++) {
+        char ch[64];
+        snprintf(ch, sizeof ch, "F%d_CONTROL", i);
+        request_on(ch, LAGSIM_CONTROL_T_DESCRIBE);
+        if (i % 20 == 19) run_until(g_srv.now + 10 * MS, 1000);
+    }
+    double secs = (double)(g_srv.now - t0) / SEC;
+    int64_t sent = 4000 - (g_srv.bus.probes.suppressed - refused0);
+    ENSUREF(sent <= (int64_t)(4 * secs) + 4 + 1 && sent >= 4,
+            "%lld probes in %.1f s of 4000 new prefixes", (long long)sent, secs);
+    ENSUREF(g_srv.bus.foreign.forgotten - forgotten0 >= 4000 - RT_FOREIGN_MAX,
+            "%lld prefixes forgotten", (long long)(g_srv.bus.foreign.forgotten - forgotten0));
+    /* and after it, a misspelt prefix is named again */
+    for (int i = 0; i < 4; i++) {
+        request_on("TLAGAIN_CONTROL", LAGSIM_CONTROL_T_DESCRIBE);
+        run_until(g_srv.now + 250 * MS, 1000);
+    }
+    run_until(g_srv.now + 500 * MS, 1000);
+    status_now();
+    expect_has(g_out.status_waiting_got, ": TLAGAIN (DESCRIBE 4)", __LINE__);
+    printf("after a flood of 4000 prefixes (%lld probes in %.1f s): %s\n", (long long)sent,
+           secs, g_out.status_waiting_got);
+    lcm_unsubscribe(g_lcm, sub);
+    stop_server();
+}
+
+/* The copy rule's hint: a controller that runs its law again on every copy answers the
+ * copies one law time apart, long after the first answer: once 10 such late answers (and
+ * answers to states older than the last answered) make one for every two states
+ * answered, a copy_rule event says so, once. A controller that answers the copies it got
+ * at once (1 ms after its first answer here) never sees it. */
+static void case_copy_rule(int arg)
+{
+    (void)arg;
+    for (int law_again = 0; law_again < 2; law_again++) {
+        scene(LAG_RT_LOCKSTEP);
+        g_sc.realtime.start = LAG_RT_START_RUNNING;
+        g_sc.realtime.lockstep_timeout = 10.0;
+        start();
+        for (int k = 0; k < 40; k++) {
+            double t = g_out.last_t;              /* the state waited on */
+            run_until(g_srv.now + 5 * MS, 1000);  /* the law's time */
+            command(t, "theta0", 0.0);
+            /* a copy answered again: at once by the rule, 50 ms (a law) later without it */
+            run_until(g_srv.now + (law_again ? 50 : 1) * MS, 1000);
+            command(t, "theta0", 0.0);
+            drain();
+            rt_process(&g_srv);
+        }
+        run_until(g_srv.now + 10 * MS, 1000);
+        printf("%s: %lld states answered, %lld ignored, %lld late; copy_rule events %lld: %s\n",
+               law_again ? "the law again" : "the rule", (long long)g_srv.accepted,
+               (long long)g_srv.commands_ignored, (long long)g_srv.late_answers,
+               (long long)n_events("copy_rule"), last_detail("copy_rule"));
+        ENSURE(g_srv.accepted == 40 && g_srv.commands_ignored == 40);
+        if (law_again)
+            ENSUREF(n_events("copy_rule") == 1 &&
+                        strstr(last_detail("copy_rule"), "the law seems to run again on copies: "
+                               "10 answers came 20 ms or more after their state was answered "
+                               "(10 states answered); answer a copy (same generation, sim_time) "
+                               "at once with the command sent (docs/protocol.md: the copy rule)"),
+                    "%lld copy_rule events", (long long)n_events("copy_rule"));
+        else
+            ENSURE(n_events("copy_rule") == 0 && g_srv.late_answers == 0);
+        stop_server();
+    }
+}
+
 /* Runs a lockstep DIPC for `periods` periods with the test's controller losing `loss` of
  * the states and of the commands; returns the wall time (ns of the made-up clock). */
 static int64_t lockstep_run(double loss, int periods)
@@ -1765,6 +1919,7 @@ int main(int argc, char **argv)
         {"lockstep_retry", case_lockstep_retry, 0, 0}, {"lockstep_loss", case_lockstep_loss, 0, 0},
         {"other_plant", case_other_plant, 0, 0}, {"messages", case_messages, 0, 0},
         {"reject_names", case_reject_names, 0, 0}, {"waits", case_waits, 0, 0},
+        {"foreign", case_foreign, 0, 0},        {"copy_rule", case_copy_rule, 0, 0},
         {"live_error", case_live_error, 0, 0},  {"scene_rules", case_scene_rules, 0, 0},
         {"generation", case_generation, 0, 0},
     };

@@ -38,6 +38,8 @@ import subprocess
 import sys
 import tempfile
 import time
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 failures = 0
 SYNC = 0xEDA1DA01
@@ -236,8 +238,8 @@ def case_lockstep(t):
         [float(x) for x in row.split(",")[5:]] == list(m.r) + list(m.rdot) and
         int(row.split(",")[4]) == m.generation and
         float(row.split(",")[0]) == m.sim_time for row, m in zip(rows[1:], sent))
-    check(p.returncode == 0 and rows[0] == 't,wall_time,log_time,step,generation,"theta0","theta1",'
-          '"theta0_dot","theta1_dot"' and same,
+    check(p.returncode == 0 and rows[0] == 't,wall_time,log_time,step,generation,theta0,theta1,'
+          'theta0_dot,theta1_dot' and same,
           f"lagsim-log2csv: {prefix}_REFERENCE.csv, {len(rows) - 1} rows equal to the "
           f"{len(sent)} references logged: {rows[0]}")
     plot_has_reference(t, os.path.join(out, prefix + "_STATE.csv"), prefix + "_REFERENCE.csv",
@@ -406,8 +408,7 @@ def main():
     ap.add_argument("case", choices=sorted(CASES))
     a = ap.parse_args()
     # a multicast port of this test's own (ttl=0: this host), and the next one for commands
-    os.environ["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
-                                     % (32000 + 2 * (os.getpid() % 6000)))
+    os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")
     t = T(a)
     with tempfile.TemporaryDirectory() as tmp:
         t.tmp = tmp

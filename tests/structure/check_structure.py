@@ -10,12 +10,15 @@
   check_structure.py names BUILD_DIR [--ctest CTEST | --json FILE]
       Every ctest's name is lowercase words joined by "_" (a word may hold a "-": a model's
       name such as flying-stick, a number such as -1 or 1e-04; never a "." or a capital),
-      and every ctest has a label.
+      every ctest has a label, and exactly one tier (a label of LAGSIM_TIERS,
+      tests/common/tiers.cmake, given by the rules there).
   check_structure.py docs SOURCE_DIR BUILD_DIR [--ctest CTEST | --json FILE]
       Every test name the docs (README.md, docs/**/*.md) give in backquotes is a ctest
       (`a_{b,c}` is two names, `a_*` must match one, `_b` after `a_x` is a_b, `a` alone the
-      family of the ctests a_*; a dotted word is a key, not a name), and the label
-      table of docs/testing.md has exactly the labels the ctests carry.
+      family of the ctests a_*; a dotted word is a key, not a name); the tier table of
+      docs/testing.md has exactly the tiers of tests/common/tiers.cmake, its label table
+      exactly the other labels the ctests carry; and every file a doc or a source file's
+      comment names exists (check_named_files).
   check_structure.py function_length SOURCE_DIR [--max 80]
       No C function in server/, clients/, bench/ is longer than 80 lines (universal-ctags:
       from the line of its name to the line of its closing brace).
@@ -103,14 +106,28 @@ def load_tests(build, ctest, json_file):
     return tests
 
 
-def check_names(tests):
+def load_tiers(path):
+    """The tiers tests/common/tiers.cmake defines (set(LAGSIM_TIERS ...))."""
+    m = re.search(r'set\(LAGSIM_TIERS\s+([a-z_\s]+)\)', open(path, encoding='utf-8').read())
+    return m.group(1).split() if m else []
+
+
+def check_names(tests, tiers):
     bad = []
+    if not tiers:
+        bad.append('tests/common/tiers.cmake: no set(LAGSIM_TIERS ...)')
     for name, labels in tests:
         if not NAME.match(name):
             bad.append(f'{name}: not lowercase words joined by "_" (no ".", no capital, '
                        'no empty word)')
         if not labels:
             bad.append(f'{name}: no label')
+        has = [l for l in labels if l in tiers]
+        if tiers and not has:
+            bad.append(f'{name}: no tier (none of {" ".join(tiers)}): no rule of '
+                       'tests/common/tiers.cmake matches it; add one')
+        elif len(has) > 1:
+            bad.append(f'{name}: more than one tier ({" ".join(has)})')
     if not tests:
         bad.append('no ctest at all')
     return bad
@@ -199,12 +216,139 @@ def check_docs(src, tests):
                                 prev = name
                         elif name not in words:
                             bad.append(f'{rel}:{lineno}: `{name}` names no ctest')
-    # docs/testing.md's label table against the labels the ctests carry
-    labels = {l for _, ls in tests for l in ls}
+    # docs/testing.md's tier table against tests/common/tiers.cmake, its label table against
+    # the other labels the ctests carry
+    tiers = load_tiers(os.path.join(src, 'tests', 'common', 'tiers.cmake'))
+    tier_table = doc_table(src, 'tier')
+    for t in tiers:
+        if t not in tier_table:
+            bad.append(f'docs/testing.md: the tier {t} has no row in the tier table')
+    for t in sorted(tier_table - set(tiers)):
+        bad.append(f'docs/testing.md: the tier table names {t}, which tests/common/tiers.cmake '
+                   'does not define')
+    labels = {l for _, ls in tests for l in ls} - set(tiers)
+    table = doc_table(src, 'label')
+    for l in sorted(labels - table):
+        bad.append(f'docs/testing.md: the label {l} has no row in the label table')
+    # a label of another build (bench off, fuzzing on, root's package tests) is declared in
+    # the tests' CMake files though no ctest of this build carries it
+    for l in sorted(table - labels - declared_labels(src)):
+        bad.append(f'docs/testing.md: the label table names {l}, which no ctest carries')
+    return bad + check_named_files(src)
+
+
+# ---------------------------------------------------------------- files named
+
+# Where a file is named: the tree's own directories (a path is read from one of these on)
+TREE_TOPS = ('server', 'clients', 'bench', 'tests', 'docs', 'config', 'lcmtypes', 'cmake',
+             '.ci')
+PATH_RE = re.compile(r'(?<![\w./<>{}$@-])((?:' + '|'.join(re.escape(t) for t in TREE_TOPS) +
+                     r')/[A-Za-z0-9_./@+-]*[A-Za-z0-9_/@+-])')
+# a bare file name in a comment, of the kinds the tree is made of
+BARE_RE = re.compile(r'(?<![\w./@<>{}$*-])([A-Za-z0-9_@+-]+\.(?:c|h|py|sh|cmake|lua|java))'
+                     r'(?![\w./(@-])')
+LINK_RE = re.compile(r'\]\(([^)\s#]+)(?:#[^)\s]*)?\)')
+# Files not in the tree that a comment may name by their bare name (what they are): other
+# projects' files, a user's files that a doc's recipe writes.
+FOREIGN_FILES = {
+    'balance.py': "the controller docs/clients.md's walkthrough has its reader write",
+    'lcm_udpm.c': "LCM's UDP multicast provider (the URL grammar lagsim_url.h makes strict)",
+    'lcmgen.c': "lcm-gen's source (the type fingerprint)",
+    'complex.h': "the C library's header",
+    'ae.c': "redis's event loop (the daemon's loop takes it for a model)",
+    'extra.c': "an example argument in lagsim_fuzz_target's usage",
+}
+COMMENT_RE = {
+    ('.c', '.h', '.java', '.js'): re.compile(r'/\*.*?\*/|//[^\n]*', re.S),
+    ('.py', '.sh', '.cmake', '.txt', '.yaml', '.gp', '.in'): re.compile(r'#[^\n]*'),
+    ('.lua',): re.compile(r'--[^\n]*'),
+    ('.m',): re.compile(r'%[^\n]*'),
+}
+
+
+def tree_files(src):
+    """{relative path} of the tree's own files (the directories TREE_TOPS and README.md)."""
+    out = {'README.md', 'CMakeLists.txt'}
+    for top in TREE_TOPS:
+        for dirpath, dirs, names in os.walk(os.path.join(src, top)):
+            out.add(os.path.relpath(dirpath, src))
+            out.update(os.path.relpath(os.path.join(dirpath, n), src) for n in names)
+    return out
+
+
+def named_paths(rel, text):
+    """(line, path, is_bare) of each file a doc (every line) or a source file (its comments)
+    names."""
+    ext = os.path.splitext(rel)[1]
+    if os.path.basename(rel) == 'CMakeLists.txt':
+        ext = '.cmake'
+    if ext == '.md':
+        spans = [(0, text)]
+    else:
+        rx = next((r for exts, r in COMMENT_RE.items() if ext in exts), None)
+        spans = [(m.start(), m.group(0)) for m in rx.finditer(text)] if rx else []
+    for start, span in spans:
+        for m in PATH_RE.finditer(span):
+            after = span[m.end():m.end() + 2]
+            if after[:1] in ('<', '*', '{', '$') or after == '.{':
+                continue  # a pattern: tests/fuzz/<name>/corpus, docs/*.md, a.{c,h}
+            path = m.group(1).rstrip('.')
+            if re.search(r'(^|/)[A-Z][A-Z0-9_]*(\.|/|$)', path):
+                continue  # a placeholder: config/NAME.yaml
+            yield text.count('\n', 0, start + m.start()) + 1, path, False
+        if ext == '.md':
+            for m in LINK_RE.finditer(span):
+                target = m.group(1)
+                if re.match(r'^[a-z]+:', target):
+                    continue  # https:, mailto:
+                path = os.path.normpath(os.path.join(os.path.dirname(rel), target))
+                yield text.count('\n', 0, start + m.start()) + 1, path, False
+        else:
+            for m in BARE_RE.finditer(span):
+                name = m.group(1)
+                if re.match(r'^[A-Z][A-Z0-9_]*\.', name) or name in FOREIGN_FILES:
+                    continue
+                yield text.count('\n', 0, start + m.start()) + 1, name, True
+
+
+def check_named_files(src):
+    """A file named in a doc or in a source file's comment exists: a path from one of the
+    tree's directories (server/daemon/rt_pace.c, docs/server.md, tests/net/), a link of a
+    page, or a bare file name of a kind the tree is made of (rhs.c, exit_docs.py) in a
+    comment, which must be some file's name."""
+    have = tree_files(src)
+    bases = {os.path.basename(f) for f in have}
+    bad = []
+    readers = ['README.md'] + sorted(f for f in have if f.endswith('.md') and
+                                     f.startswith('docs' + os.sep))
+    readers += sorted(f for f in have if f.split(os.sep)[0] in TREE_TOPS[:4] + ('cmake', '.ci',
+                                                                              'lcmtypes')
+                      and not f.endswith('.md') and '/corpus/' not in f and '/crash/' not in f
+                      and os.path.isfile(os.path.join(src, f)))
+    for rel in readers:
+        try:
+            text = open(os.path.join(src, rel), encoding='utf-8').read()
+        except (OSError, UnicodeDecodeError):
+            continue
+        for line, path, bare in named_paths(rel, text):
+            if bare:
+                if path not in bases:
+                    bad.append(f'{rel}:{line}: names {path}, which is no file of the tree')
+                continue
+            p = path.rstrip('/')
+            # a module named without its extension (server/wire/lagsim_bus: .c and .h)
+            if p in have or any(f.startswith(p + '.') for f in have):
+                continue
+            bad.append(f'{rel}:{line}: names {path}, which does not exist')
+    return bad
+
+
+def doc_table(src, head):
+    """The first column's names of docs/testing.md's table headed `| HEAD |`."""
     table = set()
     in_table = False
     for line in open(os.path.join(src, 'docs', 'testing.md'), encoding='utf-8'):
-        if re.match(r'^\| label \|', line):
+        if re.match(r'^\| ' + head + r' \|', line):
             in_table = True
             continue
         if in_table:
@@ -213,13 +357,7 @@ def check_docs(src, tests):
             m = re.match(r'^\| `([a-z_]+)` \|', line)
             if m:
                 table.add(m.group(1))
-    for l in sorted(labels - table):
-        bad.append(f'docs/testing.md: the label {l} has no row in the label table')
-    # a label of another build (bench off, fuzzing on, root's package tests) is declared in
-    # the tests' CMake files though no ctest of this build carries it
-    for l in sorted(table - labels - declared_labels(src)):
-        bad.append(f'docs/testing.md: the label table names {l}, which no ctest carries')
-    return bad
+    return table
 
 
 def declared_labels(src):
@@ -354,11 +492,14 @@ def main():
     ap.add_argument('--ctest', default='ctest')
     ap.add_argument('--json', help="ctest --show-only=json-v1's output, instead of running it")
     ap.add_argument('--max', type=int, default=80)
+    ap.add_argument('--tiers', default=os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                                    '..', 'common', 'tiers.cmake'),
+                    help="the tiers' table (names: tests/common/tiers.cmake)")
     a = ap.parse_args()
     if a.rule == 'harness':
         bad = check_harness(a.dirs[0])
     elif a.rule == 'names':
-        bad = check_names(load_tests(a.dirs[0], a.ctest, a.json))
+        bad = check_names(load_tests(a.dirs[0], a.ctest, a.json), load_tiers(a.tiers))
     elif a.rule == 'docs':
         bad = check_docs(a.dirs[0], load_tests(a.dirs[1], a.ctest, a.json))
     elif a.rule == 'ticks':

@@ -42,6 +42,8 @@ import urllib.request
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import cdp  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 failures = 0
 
@@ -677,6 +679,9 @@ def main():
     ap.add_argument("case", choices=["browser", "hostile", "stick_flight", "cartpole", "reference",
                                      "charts", "history", "models"])
     a = ap.parse_args()
+    # every process here meets on LCM's default URL, a port pair of this run's own
+    # (tests/common/lcm_port.py): nothing of another run on the machine is heard
+    os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")
     {"browser": case_browser, "hostile": case_hostile, "stick_flight": case_stick_flight,
      "cartpole": case_cartpole, "reference": case_reference, "charts": case_charts,
      "history": case_history, "models": case_models}[a.case](a)

@@ -39,6 +39,8 @@ import urllib.request
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import cdp  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 failures = 0
 GROUP = "239.255.76.67"
@@ -60,11 +62,6 @@ def stop(p):
         except subprocess.TimeoutExpired:
             p.kill()
             p.wait()
-
-
-def lcm_port():
-    """An LCM port of this run's own (even: the command URL is the next one)."""
-    return 20000 + (os.getpid() % 15000) * 2
 
 
 class View:
@@ -452,6 +449,7 @@ def case_slowloris(a):
             s.close()
 
     try:
+        idle = sockets_of(v.p.pid)  # the bridge's own sockets before any attack
         th = threading.Thread(target=attack, args=(True,), daemon=True)
         th.start()
         time.sleep(2.0)
@@ -472,21 +470,41 @@ def case_slowloris(a):
         stop_attack.set()
         th.join(10)
         # a slowloris that does not come back: its connections are closed by the header
-        # deadline, and this address is served again
+        # deadline (3 s after each was accepted), and this address is served again. The
+        # event waited on is the attacker seeing the last of its connections closed (held
+        # 0), not a fixed time: on a loaded machine the bridge's sweep and the attacker's
+        # loop run late, and a request sent while the address still holds its 32 is
+        # refused by the cap (a reset), as it should be. Bounded: 60 s.
         stop_attack.clear()
+        # the count starts when the bridge has closed the first attack's connections (its
+        # sockets back to what it had before: an event, bounded by 30 s), else those still
+        # closing hide the new ones (seen on a loaded machine: "at most 0 more")
+        t = time.monotonic()
+        while sockets_of(v.p.pid) > idle and time.monotonic() - t < 30:
+            time.sleep(0.05)
         base = sockets_of(v.p.pid)
+        held[0] = -1
+        t = time.monotonic()
         th = threading.Thread(target=attack, args=(False,), daemon=True)
         th.start()
-        most, t = 0, time.monotonic()
-        while time.monotonic() - t < 6.0:   # the bridge's own count: its sockets
+        most = 0
+        while time.monotonic() - t < 60 and held[0] != 0:  # the bridge's own count: its sockets
             most = max(most, sockets_of(v.p.pid) - base)
             time.sleep(0.05)
+        closed_after = time.monotonic() - t
         # a connection over the cap is accepted, then closed at once: one may be seen
         check(0 < most <= 33, "one address holds at most 32 connections: the bridge had at most "
               "%d sockets more than before while 300 were opened from 127.0.0.1" % most)
-        r = raw(v.port, b"GET /api/state HTTP/1.1\r\n" + v.hosthdr + b"Connection: close\r\n\r\n", timeout=5)
-        check(r.startswith(b"HTTP/1.1 200") and held[0] == 0,
-              "6 s after 300 slow connections from 127.0.0.1, 127.0.0.1 is served (%d still open)" % held[0])
+        check(held[0] == 0 and closed_after >= 3.0,
+              "the bridge closed every slow connection from 127.0.0.1, not before the 3 s header "
+              "deadline: the last seen closed after %.1f s (%d still open)" % (closed_after, held[0]))
+        try:
+            r = raw(v.port, b"GET /api/state HTTP/1.1\r\n" + v.hosthdr + b"Connection: close\r\n\r\n",
+                    timeout=5)
+        except OSError as e:
+            r = str(e).encode()
+        check(r.startswith(b"HTTP/1.1 200"),
+              "once they are closed, 127.0.0.1 is served again (%r)" % r[:40])
         stop_attack.set()
         th.join(10)
         st, body = v.state()

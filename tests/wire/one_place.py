@@ -8,13 +8,17 @@
   channels  only server/wire/lagsim_bus.c spells a channel suffix ("_STATE", "%s_COMMAND",
             ...): the suffixes are read from its table, and a string literal elsewhere
             that is one, or has one right after a %s, is a second copy; names are built
-            with lag_bus_channel_name / lag_bus_suffix.
+            with lag_bus_channel_name / lag_bus_suffix;
+  num       in server/ and clients/, only server/wire/lagsim_num.c prints a double at a
+            fixed 15 to 17 digits (%.15g, %.16g, %.17g): a number printed to be read back
+            is lag_num's, the shortest decimal that reads back (0.1, not
+            0.10000000000000001). (bench/ writes its peers' model files and its own data.)
 
 Looks at the C files (.c, .h) under server/, clients/ and bench/, comments left out.
 A few files wait to move (EXEMPT below): the check fails when one of them no longer needs
 its exemption too, so the list only shrinks.
 
-usage: one_place.py SOURCE_DIR clock|url|channels
+usage: one_place.py SOURCE_DIR clock|url|channels|num
 """
 import os
 import re
@@ -23,11 +27,20 @@ import sys
 CLOCK_FILE = "server/wire/lagsim_clock.c"
 URL_FILE = "server/wire/lagsim_url.c"
 TABLE_FILE = "server/wire/lagsim_bus.c"
+NUM_FILE = "server/wire/lagsim_num.c"
 DIRS = ("server", "clients", "bench")
 
 # (check, file): files that still hold a copy and are to call the wire layer instead.
 EXEMPT = {
     ("channels", "clients/lagsim_controller.c"),  # messages naming <PREFIX>_SCENE
+    # the C controllers' --trace lines and printed gains are compared as text with the
+    # Python, Lua, Java and Octave controllers', which print %.17g (docs/clients.md)
+    ("num", "clients/lagsim_controller.c"),
+    ("num", "clients/dipc_lqr.c"),
+    ("num", "clients/lqr_balance.c"),
+    ("num", "clients/stick_push.c"),
+    # server/eval links only libm: two sample times in an error message
+    ("num", "server/eval/metrics.c"),
 }
 
 
@@ -79,6 +92,7 @@ def line_of(code, pos):
     return code.count("\n", 0, pos) + 1
 
 
+NUM_RE = re.compile(r"%[-+ #0]*\.1[5-7][lL]?[gGeE]")
 CLOCK_RE = re.compile(r"\b(clock_gettime|gettimeofday|timespec_get|ftime)\s*\(")
 URL_RE = re.compile(r"\b(strn?cmp|strn?casecmp|strstr|memcmp|sscanf)\s*\([^;]*?"
                     r"\"(udpm://|memq://|://|ttl|recv_buf_size)")
@@ -104,7 +118,8 @@ def findings(root, check):
         sfx = "|".join(s[1:] for s in suffixes(root))
         lit_re = re.compile(r"^_(" + sfx + r")$|%[-+ #0-9.*]*s_(" + sfx + r")\b")
     for rel, path in sources(root):
-        if rel == {"clock": CLOCK_FILE, "url": URL_FILE, "channels": TABLE_FILE}[check]:
+        if rel == {"clock": CLOCK_FILE, "url": URL_FILE, "channels": TABLE_FILE,
+                   "num": NUM_FILE}[check] or (check == "num" and rel.startswith("bench/")):
             continue
         with open(path, errors="replace") as f:
             code, lits = split_c(f.read())
@@ -112,6 +127,8 @@ def findings(root, check):
             lines = [line_of(code, m.start()) for m in CLOCK_RE.finditer(code)]
         elif check == "url":
             lines = [line_of(code, m.start()) for m in URL_RE.finditer(code)]
+        elif check == "num":
+            lines = [ln for ln, body in lits if NUM_RE.search(body)]
         else:
             lines = [ln for ln, body in lits if lit_re.search(body)]
         if lines:
@@ -120,13 +137,14 @@ def findings(root, check):
 
 
 def main():
-    if len(sys.argv) != 3 or sys.argv[2] not in ("clock", "url", "channels"):
+    if len(sys.argv) != 3 or sys.argv[2] not in ("clock", "url", "channels", "num"):
         sys.exit(__doc__)
     root, check = sys.argv[1], sys.argv[2]
     what = {"clock": "reads a clock: call lag_clock_* (" + CLOCK_FILE + ")",
             "url": "takes an LCM URL apart: call lag_url_parse (" + URL_FILE + ")",
             "channels": "spells a channel suffix: use lag_bus_channel_name / lag_bus_suffix ("
-                        + TABLE_FILE + ")"}[check]
+                        + TABLE_FILE + ")",
+            "num": "prints a number at 15 to 17 digits: call lag_num (" + NUM_FILE + ")"}[check]
     bad = 0
     found = findings(root, check)
     for rel, lines in sorted(found.items()):

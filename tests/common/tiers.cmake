@@ -1,0 +1,151 @@
+# The tiers: every ctest carries exactly one tier label, given here and nowhere else
+# (docs/testing.md, "Tiers", says what each holds; structure_names fails on a ctest with
+# no tier or with two, and structure_docs on a tier the table there lacks).
+#
+#   quick      waits on no wall clock: the core, scenes, the wire, replays, the bounded
+#              decoders, made-up clocks, lockstep runs; `tests/run.sh` (the developer's loop)
+#   wallclock  paces in real time: a control loop or a daemon that must be scheduled
+#              every period (real-time runs, lagsimctl against a running plant, floods and
+#              signals to a real daemon, the terminal's live line)
+#   waits      waits on the wall clock with next to nothing to compute: a law that sleeps,
+#              a silence, a deadline, a stalled peer, connections held open
+#   browser    drives headless Chromium
+#   octave     starts GNU Octave
+#   root       network namespaces, nftables, sshd per namespace (skipped when not root)
+#   package    installs the Debian package (dpkg: one at a time)
+#   slow       long computations (10^8 ticks, 200-run sweeps); not in the sanitizer pass
+#   bench      benchmarks' quick checks (no sanitizer build)
+#   fuzz_run   bounded fuzzing (the sanitizer pass only)
+#
+# A tier comes from the first rule below that matches the test, by one of its labels
+# (LABEL: the area says it all: a new core_* test is quick by nature) or by its name
+# (NAME, for the areas that hold several natures). A test no rule matches gets no tier and
+# fails structure_names: add its rule here, in the tier its nature says.
+#
+# Read at configure time (lagsim_apply_tiers, for add_test's tests) and by ctest
+# (tests/common/cases.cmake's include files, for the cases a test program lists): so plain
+# script commands only.
+include_guard(GLOBAL)
+
+set(LAGSIM_TIERS quick wallclock waits browser octave root package slow bench fuzz_run)
+
+set(LAGSIM_TIER_RULES
+  "slow      LABEL ^slow$"
+  "fuzz_run  LABEL ^fuzz_run$"
+  "bench     LABEL ^bench$"
+  "package   LABEL ^package$"
+  "quick     LABEL ^(core|effects|wire|result|structure|fuzz|accuracy)$"
+  # the protocol's conformance traces, played against each language's controller
+  "quick     NAME  ^protocol_"
+  # what only waits, in any area (first: some of these names match the rules below)
+  # (not Java's: a JVM starting and classes compiled for the slow law compute; run beside
+  # the others and two busy processes, clients_readme_java_slower_law and
+  # clients_cross_language_slower_law ran past their 90 s)
+  "waits     NAME  ^clients_readme_(c|python|lua)_slow(er)?_law$"
+  "waits     NAME  ^clients_(c|python|lua|java)_[a-z_]+_ends_on_(stop|silence)$"
+  "waits     NAME  ^clients_(c|python|lua|java)_ends_on_signal$"
+  "waits     NAME  ^clients_(python|java)_dipc_late_controller$"
+  "waits     NAME  ^view_attack_(slowloris|stalled)$"
+  "waits     NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
+  "waits     NAME  ^eval_procs_(eval|sweep)_(stalled|gnuplot)$"
+  "waits     NAME  ^eval_lagsim_sweep_unanswered$"
+  "waits     NAME  ^scene_shipped_wait$"
+  "waits     NAME  ^log_term_waits$"
+  "waits     NAME  ^ctl_discover$"
+  # scene: every loader check
+  "quick     LABEL ^scene$"
+  # net: namespaces need root; the URL rule in each language, the receive filter over LCM
+  "root      NAME  ^net_two_hosts_"
+  "octave    NAME  ^net_plant_urls_octave$"
+  "quick     NAME  ^net_(plant_urls|filter)_"
+  # server: the loop, the pacer and the floors on made-up clocks or none; the daemon's
+  # lockstep, fast and offline references; every other server_test case runs lagsimd in
+  # real time (watchdog, floods, signals, plants that conflict)
+  "quick     NAME  ^server_(loop|pace)_"
+  "quick     NAME  ^server_daemon_floors$"
+  "quick     NAME  ^server_reference_(lockstep|fast|offline|manipulator)$"
+  "wallclock NAME  ^server_"
+  # log: the writer on a made-up clock; lockstep and fast runs logged, read, converted;
+  # the terminal's live line and waits in real time
+  "quick     NAME  ^log_(rt|outputs)_"
+  "quick     NAME  ^log_(lqr|lqr_effects|gaps|readers|cli|flood|flood_applied)$"
+  "quick     NAME  ^log_series_"
+  "quick     NAME  ^log_old_version_"
+  "wallclock NAME  ^log_term_"
+  # view: the log tools; Chromium; attacks that take time or namespaces
+  "wallclock NAME  ^view_log2csv_load$"  # a real-time run recorded, then loaded
+  "quick     NAME  ^view_log2csv_"
+  "quick     NAME  ^view_stop_"
+  "wallclock NAME  ^view_attack_(slowloris|stalled)$"
+  "root      NAME  ^view_attack_lan$"
+  "browser   NAME  ^view_(browser|hostile|stick_flight|cartpole|reference|charts|history|models|attack_forged|attack_host)$"
+  # eval: unit tests; lagsim-eval and lagsim-sweep in lockstep; --timeout, a stalled
+  # controller; packet loss and ssh hosts in namespaces
+  "quick     NAME  ^eval_(metrics|reference|sweep_csv)_"
+  "quick     NAME  ^eval_procs_(eval|sweep)_(sigint|sigterm|sigkill|groupkill)$"
+  "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene|owned|outputs|bus|docs_python|stderr)$"
+  "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|merge_rows|merge_foreign|shard|kept|kept_python|vary|scene_c|scene_python)$"
+  "wallclock NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
+  "root      NAME  ^eval_lagsim_sweep_(loss|ssh|scene_loss)$"
+  # clients, ctl, install
+  "quick     NAME  ^clients_octave_matlab_syntax$"
+  "octave    NAME  ^clients_(octave_|readme_octave$)"
+  "octave    NAME  ^clients_cross_language_generation$"  # C, Python, Lua, Java and Octave
+  "wallclock NAME  _(realtime|ends_on_stop|ends_on_silence|late_controller|slow_law|slower_law)$"
+  "wallclock NAME  ^clients_(readme_recipes|walkthrough|scene_params)$"
+  "wallclock NAME  ^ctl_"
+  "quick     NAME  ^install_"
+  "quick     NAME  ^clients_(lqr|status_fields|hostile_messages|library|generation|not_built)$"
+  "quick     NAME  ^clients_[a-z_]+_(usage_.*|help)$"
+  "quick     NAME  ^clients_(python|lua)_(lcm|types)$"
+  "quick     NAME  ^clients_java_release$"
+  "quick     NAME  _(lockstep|hostile|push|reference_lost)$"
+  "quick     NAME  ^clients_cross_language_(dipc|manipulator)$"
+  "quick     NAME  ^clients_readme_(c|python|lua|java)$"
+)
+
+# The tiers whose tests only wait: tests/run.sh runs them, 2 x cores at once, beside the
+# others, which it runs one per core (docs/testing.md, "Tiers").
+set(LAGSIM_WAITING_TIERS waits)
+
+# lagsim_tier_of(NAME "LABELS" OUT): OUT = the tier of the first rule that matches, or "".
+function(lagsim_tier_of name labels out)
+  foreach(rule IN LISTS LAGSIM_TIER_RULES)
+    string(REGEX MATCH "^([a-z_]+) +(LABEL|NAME) +(.+)$" m "${rule}")
+    set(tier ${CMAKE_MATCH_1})
+    set(kind ${CMAKE_MATCH_2})
+    set(rx "${CMAKE_MATCH_3}")
+    if(kind STREQUAL "NAME")
+      if(name MATCHES "${rx}")
+        set(${out} ${tier} PARENT_SCOPE)
+        return()
+      endif()
+    else()
+      foreach(l IN LISTS labels)
+        if(l MATCHES "${rx}")
+          set(${out} ${tier} PARENT_SCOPE)
+          return()
+        endif()
+      endforeach()
+    endif()
+  endforeach()
+  set(${out} "" PARENT_SCOPE)
+endfunction()
+
+# Gives every test of this directory made by add_test its tier (the cases a program lists
+# get theirs when ctest reads them: cases.cmake).
+function(lagsim_apply_tiers)
+  get_property(tests DIRECTORY PROPERTY TESTS)
+  foreach(t IN LISTS tests)
+    get_test_property(${t} LABELS labels)
+    if(NOT labels)
+      set(labels "")
+    endif()
+    lagsim_tier_of(${t} "${labels}" tier)
+    if(tier)
+      list(APPEND labels ${tier})
+      list(REMOVE_DUPLICATES labels)
+      set_tests_properties(${t} PROPERTIES LABELS "${labels}")
+    endif()
+  endforeach()
+endfunction()
