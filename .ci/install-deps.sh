@@ -43,6 +43,7 @@ tests   fonts-dejavu-core
 tests   iproute2              # two hosts on one machine: namespaces, veth ...
 tests   nftables              # ... and packet loss
 tests   lintian               # the Debian package
+tests   abigail-tools         # the ABI check of the client library (abidw, abidiff: clients_abi)
 tests   parallel              # lagsim-sweep shards under GNU parallel ...
 tests   openssh-client        # ... and parallel --sshlogin
 tests   libmujoco-dev         # benchmark peers

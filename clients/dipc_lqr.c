@@ -248,9 +248,11 @@ static int finish(lag_ctl *ctl, const design *d, const balance *b)
 
 static void print_scene(const lag_ctl *ctl)
 {
-    const lag_client_scene *sc = &ctl->scene;
+    const lag_client_scene *sc = ctl->scene;
     printf("dipc_lqr: scene %s on %s_*: mode %s, dt %g s, control period %g s, integrator %s\n",
-           sc->model, ctl->prefix, sc->mode, sc->dt, sc->control_period, sc->integrator);
+           lag_client_scene_model(sc), ctl->prefix, lag_client_scene_mode(sc),
+           lag_client_scene_dt(sc), lag_client_scene_control_period(sc),
+           lag_client_scene_integrator(sc));
     printf("parameters:");
     for (int k = 0; k < LAG_DIPC_NP; k++)
         printf(" %s=%g", lag_model_info_get(LAG_MODEL_DIPC)->param_names[k], ctl->model.p[k]);
@@ -280,15 +282,15 @@ int main(int argc, char **argv)
     if (rc >= 0) return rc;
     if (lag_ctl_start(&ctl, "dipc")) return lag_ctl_fail(&ctl);
     const char *jn[3] = {"theta0", "theta1", "theta2"};
-    int in_scene = lag_client_scene_joint(&ctl.scene, "theta0");
-    if (in_scene < 0 || !ctl.scene.actuated[in_scene]) {
+    int in_scene = lag_client_scene_joint(ctl.scene, "theta0");
+    if (!lag_client_scene_actuated(ctl.scene, in_scene)) {
         fprintf(stderr, "dipc_lqr: the scene has no actuated joint theta0\n");
         return lag_ctl_fail(&ctl);
     }
     print_scene(&ctl);
 
     /* ---- design */
-    design d = {.h = ctl.scene.control_period};
+    design d = {.h = lag_client_scene_control_period(ctl.scene)};
     if (design_continuous(&d, &ctl.model, qw, r_weight) || design_discrete(&d, r_weight) ||
         choose_gain(&d, kgiven, continuous))
         return lag_ctl_fail(&ctl);

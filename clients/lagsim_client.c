@@ -4,9 +4,12 @@
  * Subscriptions are raw lcm_subscribe() handlers that pass the payload to one dispatch
  * function (also behind lag_client_feed), which decodes it with the bounded wire module
  * into scratch structs on the handle, so that a message is kept only whole and valid.
+ * The handle keeps the wire module's structs; what a caller gets is the client's own
+ * types (lagsim_client.h), copied out at the size the caller's header gave them.
  * Nothing is allocated after lag_client_create.
  */
 #include "lagsim_client.h"
+#include "lagsim_client_wire.h"
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -28,6 +31,29 @@
 #include "lagsim_clock.h"
 #include "lagsim_num.h"
 
+/* The capacities of the client's types are the wire module's: a message that fits one
+ * fits the other. */
+_Static_assert(LAG_CLIENT_MAX_JOINTS == LAG_WIRE_MAX_JOINTS, "joints");
+_Static_assert(LAG_CLIENT_MAX_PARAMS == LAG_WIRE_MAX_PARAMS, "parameters");
+_Static_assert(LAG_CLIENT_NAME_LEN == LAG_WIRE_NAME_LEN, "names");
+_Static_assert(LAG_CLIENT_TEXT_LEN == LAG_WIRE_TEXT_LEN, "texts");
+_Static_assert(LAG_CLIENT_URL_LEN == LAG_BUS_URL_LEN, "a plant's URL holds a state URL");
+
+/* The sizes of the client's structs in the first version of the ABI: a caller's size
+ * below these is a mistake (no header ever had a smaller struct). A field appended later
+ * leaves these as they are. */
+#define STATE_SIZE_1 sizeof(lag_client_state)
+#define REFERENCE_SIZE_1 sizeof(lag_client_reference)
+#define COUNTERS_SIZE_1 sizeof(lag_client_counters)
+#define PLANT_SIZE_1 sizeof(lag_client_plant)
+
+struct lag_client_scene {
+    lag_wire_scene m;
+};
+struct lag_client_status {
+    lag_wire_status m;
+};
+
 struct lag_client {
     lcm_t *lcm;                  /* the state URL: states, status, events, scene in */
     lcm_t *lcm_cmd;              /* the command URL: commands and control out (publishing
@@ -41,14 +67,15 @@ struct lag_client {
         ch_reference[LAG_BUS_CHANNEL_LEN];
     char errmsg[256];
 
-    lag_client_state state;      /* latest state */
+    lag_wire_joint_state state;  /* latest state */
+    lag_client_state out_state;  /* the same, as the client's type (on_state, returns) */
     bool have_state, new_state;  /* new: not yet returned by lag_client_wait_state */
     lag_client_scene scene;
     bool have_scene;
     lag_client_scene state_scene; /* the scene of the latest state's generation */
     /* a state whose generation is not the scene's: held until the scene of its
      * generation came (asked for by DESCRIBE every LAG_CLIENT_DESCRIBE_S meanwhile) */
-    lag_client_state held;
+    lag_wire_joint_state held;
     bool have_held;
     double next_describe;        /* monotonic s: when a held state asks again */
     lag_client_status status;
@@ -73,6 +100,8 @@ struct lag_client {
 
     lag_client_state_fn on_state;
     void *on_state_user;
+    lag_client_reference_fn on_reference;
+    void *on_reference_user;
     lag_client_status_fn on_status;
     void *on_status_user;
     lag_client_event_fn on_event;
@@ -83,6 +112,7 @@ struct lag_client {
 
 /* ---------------------------------------------------------------- helpers */
 
+static void set_err(lag_client *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void set_err(lag_client *c, const char *fmt, ...)
 {
     va_list ap;
@@ -92,6 +122,10 @@ static void set_err(lag_client *c, const char *fmt, ...)
 }
 
 double lag_client_now(void) { return lag_clock_mono_s(); }
+
+int lag_client_version(void) { return LAGSIM_VERSION_NUMBER; }
+
+int lag_client_abi(void) { return LAGSIM_CLIENT_ABI; }
 
 /* Copies src into dst[cap]; returns false (dst = truncated copy) if it does not fit. */
 static bool copy_str(char *dst, size_t cap, const char *src)
@@ -107,6 +141,19 @@ static bool copy_str(char *dst, size_t cap, const char *src)
     return true;
 }
 
+/* A struct of the client's, src (ours: src_size bytes), into the caller's dst of
+ * dst_size bytes: what both know is copied, the caller's fields this library does not
+ * know (a newer header's) are zeroed. False, nothing written, for a size below the
+ * first version's (min). */
+static bool copy_out(void *dst, size_t dst_size, const void *src, size_t src_size, size_t min)
+{
+    if (!dst || dst_size < min) return false;
+    size_t n = dst_size < src_size ? dst_size : src_size;
+    memcpy(dst, src, n);
+    if (dst_size > n) memset((uint8_t *)dst + n, 0, dst_size - n);
+    return true;
+}
+
 /* Writes src with every POSIX ERE metacharacter backslash-escaped (dst holds
  * 2 strlen(src) + 1). */
 static void regex_escape(char *dst, size_t cap, const char *src)
@@ -117,6 +164,74 @@ static void regex_escape(char *dst, size_t cap, const char *src)
         dst[j++] = *src;
     }
     dst[j] = '\0';
+}
+
+/* ---------------------------------------------------------------- the client's types */
+
+static void state_from_wire(lag_client_state *o, const lag_wire_joint_state *m)
+{
+    memset(o, 0, sizeof *o);
+    o->utime = m->utime;
+    o->sim_time = m->sim_time;
+    o->step = m->step;
+    o->generation = m->generation;
+    o->num_joints = m->num_joints;
+    memcpy(o->name, m->name, sizeof o->name);
+    memcpy(o->position, m->position, sizeof o->position);
+    memcpy(o->velocity, m->velocity, sizeof o->velocity);
+    memcpy(o->effort, m->effort, sizeof o->effort);
+}
+
+static void reference_from_wire(lag_client_reference *o, const lag_wire_reference *m)
+{
+    memset(o, 0, sizeof *o);
+    o->utime = m->utime;
+    o->sim_time = m->sim_time;
+    o->step = m->step;
+    o->generation = m->generation;
+    o->num_joints = m->num_joints;
+    memcpy(o->name, m->name, sizeof o->name);
+    memcpy(o->r, m->r, sizeof o->r);
+    memcpy(o->rdot, m->rdot, sizeof o->rdot);
+    memcpy(o->rddot, m->rddot, sizeof o->rddot);
+}
+
+static void event_from_wire(lag_client_event *o, const lag_wire_event *m)
+{
+    memset(o, 0, sizeof *o);
+    o->utime = m->utime;
+    o->sim_time = m->sim_time;
+    o->step = m->step;
+    o->value = m->value;
+    memcpy(o->kind, m->kind, sizeof o->kind);
+    memcpy(o->joint, m->joint, sizeof o->joint);
+    memcpy(o->detail, m->detail, sizeof o->detail);
+}
+
+void lag_wire_of_state(const lag_client_state *st, lag_wire_joint_state *o)
+{
+    memset(o, 0, sizeof *o);
+    o->utime = st->utime;
+    o->sim_time = st->sim_time;
+    o->step = st->step;
+    o->generation = st->generation;
+    o->num_joints = (int16_t)st->num_joints;
+    memcpy(o->name, st->name, sizeof o->name);
+    memcpy(o->position, st->position, sizeof o->position);
+    memcpy(o->velocity, st->velocity, sizeof o->velocity);
+    memcpy(o->effort, st->effort, sizeof o->effort);
+}
+
+void lag_wire_of_event(const lag_client_event *ev, lag_wire_event *o)
+{
+    memset(o, 0, sizeof *o);
+    o->utime = ev->utime;
+    o->sim_time = ev->sim_time;
+    o->step = ev->step;
+    o->value = ev->value;
+    memcpy(o->kind, ev->kind, sizeof o->kind);
+    memcpy(o->joint, ev->joint, sizeof o->joint);
+    memcpy(o->detail, ev->detail, sizeof o->detail);
 }
 
 /* ---------------------------------------------------------------- receiving */
@@ -134,14 +249,15 @@ static bool decode(lag_client *c, lag_wire_type t, const void *data, size_t len)
 
 /* A state becomes the latest: returned once (wait_state), passed to on_state. A state
  * held for its scene is older: it is dropped, and asks for nothing more. */
-static void take_state(lag_client *c, const lag_client_state *m)
+static void take_state(lag_client *c, const lag_wire_joint_state *m)
 {
     c->have_held = false;
     c->answer_len = 0;
     c->state = *m;
+    state_from_wire(&c->out_state, m);
     c->state_scene = c->scene; /* its generation's (the scene rule) */
     c->have_state = c->new_state = true;
-    if (c->on_state) c->on_state(&c->state, c->on_state_user);
+    if (c->on_state) c->on_state(&c->out_state, c->on_state_user);
 }
 
 /* A held state asks for its scene: DESCRIBE now and every LAG_CLIENT_DESCRIBE_S (the
@@ -173,7 +289,7 @@ static void on_state_msg(lag_client *c)
             c->counters.repeats++;
         return;
     }
-    if (!c->have_scene || m->generation != c->scene.generation) {
+    if (!c->have_scene || m->generation != c->scene.m.generation) {
         bool first = !c->have_held || c->held.generation != m->generation;
         c->held = *m; /* the newest of its generation */
         c->have_held = true;
@@ -184,37 +300,45 @@ static void on_state_msg(lag_client *c)
     take_state(c, m);
 }
 
+/* A scene, decoded into c->tmp.scene: kept, passed on; a state held for it goes on. */
+static void on_scene_msg(lag_client *c)
+{
+    c->scene.m = c->tmp.scene;
+    c->have_scene = true;
+    c->counters.scenes++;
+    if (c->on_scene) c->on_scene(&c->scene, c->on_scene_user);
+    if (c->have_held && c->held.generation == c->scene.m.generation) {
+        c->have_held = false; /* its scene came: it goes on */
+        lag_wire_joint_state h = c->held;
+        take_state(c, &h);
+    }
+}
+
 /* One message from `channel`: decoded, kept, passed to the callback. */
 static lag_result dispatch(lag_client *c, const char *channel, const void *data, size_t len)
 {
     if (!strcmp(channel, c->ch_state)) {
         if (decode(c, LAG_WIRE_JOINT_STATE, data, len)) on_state_msg(c);
     } else if (!strcmp(channel, c->ch_scene)) {
-        if (!decode(c, LAG_WIRE_SCENE, data, len)) return LAG_CLIENT_OK;
-        c->scene = c->tmp.scene;
-        c->have_scene = true;
-        c->counters.scenes++;
-        if (c->on_scene) c->on_scene(&c->scene, c->on_scene_user);
-        if (c->have_held && c->held.generation == c->scene.generation) {
-            c->have_held = false; /* its scene came: it goes on */
-            lag_client_state h = c->held;
-            take_state(c, &h);
-        }
+        if (decode(c, LAG_WIRE_SCENE, data, len)) on_scene_msg(c);
     } else if (!strcmp(channel, c->ch_status)) {
         if (!decode(c, LAG_WIRE_STATUS, data, len)) return LAG_CLIENT_OK;
-        c->status = c->tmp.status;
+        c->status.m = c->tmp.status;
         c->have_status = true;
         c->counters.statuses++;
         if (c->on_status) c->on_status(&c->status, c->on_status_user);
     } else if (!strcmp(channel, c->ch_reference)) {
         if (!decode(c, LAG_WIRE_REFERENCE, data, len)) return LAG_CLIENT_OK;
-        c->reference = c->tmp.reference;
+        reference_from_wire(&c->reference, &c->tmp.reference);
         c->have_reference = true;
         c->counters.references++;
+        if (c->on_reference) c->on_reference(&c->reference, c->on_reference_user);
     } else if (!strcmp(channel, c->ch_event)) {
         if (!decode(c, LAG_WIRE_EVENT, data, len)) return LAG_CLIENT_OK;
         c->counters.events++;
-        if (c->on_event) c->on_event(&c->tmp.event, c->on_event_user);
+        lag_client_event ev;
+        event_from_wire(&ev, &c->tmp.event);
+        if (c->on_event) c->on_event(&ev, c->on_event_user);
     } else {
         set_err(c, "feed: %s is not one of this handle's channels (%s_*)", channel, c->prefix);
         return LAG_CLIENT_ERR_ARG;
@@ -237,6 +361,33 @@ lag_result lag_client_feed(lag_client *c, const char *channel, const void *data,
 }
 
 /* ---------------------------------------------------------------- life cycle */
+
+/* The handle's channels, from its bus, and its subscriptions on the state URL. */
+static bool subscribe_all(lag_client *c)
+{
+    snprintf(c->ch_state, sizeof c->ch_state, "%s", c->bus.channel[LAG_BUS_STATE]);
+    snprintf(c->ch_status, sizeof c->ch_status, "%s", c->bus.channel[LAG_BUS_STATUS]);
+    snprintf(c->ch_event, sizeof c->ch_event, "%s", c->bus.channel[LAG_BUS_EVENT]);
+    snprintf(c->ch_scene, sizeof c->ch_scene, "%s", c->bus.channel[LAG_BUS_SCENE]);
+    snprintf(c->ch_command, sizeof c->ch_command, "%s", c->bus.channel[LAG_BUS_COMMAND]);
+    snprintf(c->ch_control, sizeof c->ch_control, "%s", c->bus.channel[LAG_BUS_CONTROL]);
+    snprintf(c->ch_reference, sizeof c->ch_reference, "%s", c->bus.channel[LAG_BUS_REFERENCE]);
+    /* lcm_subscribe takes a POSIX regular expression: escape the channel names so that
+     * a prefix with regex characters still matches only itself. */
+    const char *chans[5] = {c->ch_state, c->ch_status, c->ch_event, c->ch_scene,
+                            c->ch_reference};
+    lcm_subscription_t *s[5];
+    for (int k = 0; k < 5; k++) {
+        char re[200];
+        regex_escape(re, sizeof re, chans[k]);
+        if (!(s[k] = lcm_subscribe(c->lcm, re, on_message, c))) return false;
+    }
+    /* The state subscription keeps a deeper queue: a slow controller still sees states
+     * in order rather than losing them inside LCM; each state's reference with it. */
+    lcm_subscription_set_queue_capacity(s[0], 64);
+    lcm_subscription_set_queue_capacity(s[4], 64);
+    return true;
+}
 
 lag_client *lag_client_create(const char *url, const char *prefix, char *err, size_t errlen)
 {
@@ -268,33 +419,11 @@ lag_client *lag_client_create(const char *url, const char *prefix, char *err, si
         return NULL;
     }
     copy_str(c->prefix, sizeof c->prefix, prefix);
-    snprintf(c->ch_state, sizeof c->ch_state, "%s", c->bus.channel[LAG_BUS_STATE]);
-    snprintf(c->ch_status, sizeof c->ch_status, "%s", c->bus.channel[LAG_BUS_STATUS]);
-    snprintf(c->ch_event, sizeof c->ch_event, "%s", c->bus.channel[LAG_BUS_EVENT]);
-    snprintf(c->ch_scene, sizeof c->ch_scene, "%s", c->bus.channel[LAG_BUS_SCENE]);
-    snprintf(c->ch_command, sizeof c->ch_command, "%s", c->bus.channel[LAG_BUS_COMMAND]);
-    snprintf(c->ch_control, sizeof c->ch_control, "%s", c->bus.channel[LAG_BUS_CONTROL]);
-    snprintf(c->ch_reference, sizeof c->ch_reference, "%s", c->bus.channel[LAG_BUS_REFERENCE]);
-    /* lcm_subscribe takes a POSIX regular expression: escape the channel names so that
-     * a prefix with regex characters still matches only itself. */
-    char re[5][200];
-    const char *chans[5] = {c->ch_state, c->ch_status, c->ch_event, c->ch_scene,
-                            c->ch_reference};
-    for (int k = 0; k < 5; k++) regex_escape(re[k], sizeof re[k], chans[k]);
-    lcm_subscription_t *s1 = lcm_subscribe(c->lcm, re[0], on_message, c);
-    lcm_subscription_t *s2 = lcm_subscribe(c->lcm, re[1], on_message, c);
-    lcm_subscription_t *s3 = lcm_subscribe(c->lcm, re[2], on_message, c);
-    lcm_subscription_t *s4 = lcm_subscribe(c->lcm, re[3], on_message, c);
-    lcm_subscription_t *s5 = lcm_subscribe(c->lcm, re[4], on_message, c);
-    if (!s1 || !s2 || !s3 || !s4 || !s5) {
+    if (!subscribe_all(c)) {
         if (err) snprintf(err, errlen, "cannot subscribe to %s_*", prefix);
         lag_client_destroy(c);
         return NULL;
     }
-    /* The state subscription keeps a deeper queue: a slow controller still sees states
-     * in order rather than losing them inside LCM. */
-    lcm_subscription_set_queue_capacity(s1, 64);
-    lcm_subscription_set_queue_capacity(s5, 64); /* each state's reference with it */
     return c;
 }
 
@@ -315,11 +444,19 @@ void lag_client_on_state(lag_client *c, lag_client_state_fn fn, void *user)
     c->on_state = fn;
     c->on_state_user = user;
 }
+
+void lag_client_on_reference(lag_client *c, lag_client_reference_fn fn, void *user)
+{
+    c->on_reference = fn;
+    c->on_reference_user = user;
+}
+
 void lag_client_on_status(lag_client *c, lag_client_status_fn fn, void *user)
 {
     c->on_status = fn;
     c->on_status_user = user;
 }
+
 void lag_client_on_event(lag_client *c, lag_client_event_fn fn, void *user)
 {
     c->on_event = fn;
@@ -332,9 +469,9 @@ void lag_client_on_scene(lag_client *c, lag_client_scene_fn fn, void *user)
     c->on_scene_user = user;
 }
 
-void lag_client_get_counters(const lag_client *c, lag_client_counters *out)
+void lag_client_get_counters(const lag_client *c, lag_client_counters *out, size_t size)
 {
-    *out = c->counters;
+    copy_out(out, size, &c->counters, sizeof c->counters, COUNTERS_SIZE_1);
 }
 
 /* ---------------------------------------------------------------- waiting */
@@ -361,7 +498,7 @@ static lag_result handle_until(lag_client *c, const bool *flag, double deadline)
         double left = deadline - lag_client_now();
         if (!(left > 0.0)) return LAG_CLIENT_TIMEOUT;
         int ms = left < 0.1 ? (int)ceil(left * 1000.0) : 100;
-        int rc = lag_client_handle(c, ms);
+        lag_result rc = lag_client_handle(c, ms);
         if (rc < 0) return rc;
     }
     return LAG_CLIENT_OK;
@@ -371,7 +508,7 @@ lag_result lag_client_wait_scene(lag_client *c, double timeout_s, lag_client_sce
 {
     double t0 = lag_client_now(), deadline = t0 + timeout_s;
     while (!c->have_scene) {
-        int rc = lag_client_request_describe(c);
+        lag_result rc = lag_client_request_describe(c);
         if (rc < 0) return rc;
         double next = lag_client_now() + LAG_CLIENT_DESCRIBE_S;
         rc = handle_until(c, &c->have_scene, next < deadline ? next : deadline);
@@ -387,9 +524,15 @@ lag_result lag_client_wait_scene(lag_client *c, double timeout_s, lag_client_sce
     return LAG_CLIENT_OK;
 }
 
-lag_result lag_client_wait_state(lag_client *c, double timeout_s, lag_client_state *st)
+lag_result lag_client_wait_state(lag_client *c, double timeout_s, lag_client_state *st,
+                                 size_t size)
 {
-    int rc = handle_until(c, &c->new_state, lag_client_now() + timeout_s);
+    if (st && size < STATE_SIZE_1) {
+        set_err(c, "wait_state: a state of %zu bytes (sizeof lag_client_state: %zu)", size,
+                STATE_SIZE_1);
+        return LAG_CLIENT_ERR_ARG;
+    }
+    lag_result rc = handle_until(c, &c->new_state, lag_client_now() + timeout_s);
     if (rc != LAG_CLIENT_OK) {
         if (rc == LAG_CLIENT_TIMEOUT)
             set_err(c, "no state on %s within %.3f s", c->ch_state, timeout_s);
@@ -402,14 +545,14 @@ lag_result lag_client_wait_state(lag_client *c, double timeout_s, lag_client_sta
         if (rc == LAG_CLIENT_TIMEOUT) break;
     }
     c->new_state = false;
-    if (st) *st = c->state;
+    if (st) copy_out(st, size, &c->out_state, sizeof c->out_state, STATE_SIZE_1);
     return LAG_CLIENT_OK;
 }
 
-bool lag_client_latest_state(const lag_client *c, lag_client_state *st)
+bool lag_client_latest_state(const lag_client *c, lag_client_state *st, size_t size)
 {
-    if (c->have_state && st) *st = c->state;
-    return c->have_state;
+    if (!c->have_state) return false;
+    return !st || copy_out(st, size, &c->out_state, sizeof c->out_state, STATE_SIZE_1);
 }
 
 bool lag_client_latest_scene(const lag_client *c, lag_client_scene *sc)
@@ -418,16 +561,16 @@ bool lag_client_latest_scene(const lag_client *c, lag_client_scene *sc)
     return c->have_scene;
 }
 
-bool lag_client_latest_status(const lag_client *c, lag_client_status *st)
+bool lag_client_latest_status(const lag_client *c, lag_client_status *out)
 {
-    if (c->have_status && st) *st = c->status;
+    if (c->have_status && out) *out = c->status;
     return c->have_status;
 }
 
-bool lag_client_latest_reference(const lag_client *c, lag_client_reference *ref)
+bool lag_client_latest_reference(const lag_client *c, lag_client_reference *ref, size_t size)
 {
-    if (c->have_reference && ref) *ref = c->reference;
-    return c->have_reference;
+    if (!c->have_reference) return false;
+    return !ref || copy_out(ref, size, &c->reference, sizeof c->reference, REFERENCE_SIZE_1);
 }
 
 /* ---------------------------------------------------------------- sending */
@@ -475,7 +618,7 @@ lag_result lag_client_send_command(lag_client *c, double sim_time, int n, const 
         set_err(c, "send_command: a NaN or infinite effort or sim_time is never sent");
         return LAG_CLIENT_ERR_ARG;
     }
-    int rc = publish(c, c->ch_command, LAG_WIRE_JOINT_COMMAND, &m);
+    lag_result rc = publish(c, c->ch_command, LAG_WIRE_JOINT_COMMAND, &m);
     if (rc != LAG_CLIENT_OK) return rc;
     c->counters.commands_sent++;
     if (c->have_state && sim_time == c->state.sim_time) { /* answers the latest state */
@@ -484,7 +627,6 @@ lag_result lag_client_send_command(lag_client *c, double sim_time, int n, const 
     }
     return rc;
 }
-
 static lag_result send_control(lag_client *c, int8_t request, int64_t count, int n, const double *q,
                                const double *qd)
 {
@@ -579,47 +721,206 @@ lag_result lag_client_reset_to(lag_client *c, int n, const double *q, const doub
 
 /* ---------------------------------------------------------------- lookups */
 
-int lag_client_scene_joint(const lag_client_scene *sc, const char *name)
-{
-    for (int i = 0; i < sc->num_joints; i++)
-        if (strcmp(sc->joint_name[i], name) == 0) return i;
-    return -1;
-}
-
-double lag_client_scene_param(const lag_client_scene *sc, const char *name)
-{
-    for (int i = 0; i < sc->num_params; i++)
-        if (strcmp(sc->param_name[i], name) == 0) return sc->param_value[i];
-    return NAN;
-}
-
 int lag_client_state_joint(const lag_client_state *st, const char *name)
 {
-    for (int i = 0; i < st->num_joints; i++)
+    for (int i = 0; st && name && i < st->num_joints && i < LAG_CLIENT_MAX_JOINTS; i++)
         if (strcmp(st->name[i], name) == 0) return i;
     return -1;
 }
 
 int lag_client_reference_joint(const lag_client_reference *ref, const char *name)
 {
-    for (int i = 0; i < ref->num_joints; i++)
+    for (int i = 0; ref && name && i < ref->num_joints && i < LAG_CLIENT_MAX_JOINTS; i++)
         if (strcmp(ref->name[i], name) == 0) return i;
     return -1;
 }
 
-/* ---------------------------------------------------------------- discovery */
+/* ---------------------------------------------------------------- the scene */
 
-_Static_assert(sizeof(((lag_client_plant *)0)->url) == LAG_BUS_URL_LEN,
-               "lag_client_plant.url holds a state URL");
+lag_client_scene *lag_client_scene_new(void) { return calloc(1, sizeof(lag_client_scene)); }
+
+void lag_client_scene_free(lag_client_scene *sc) { free(sc); }
+
+void lag_client_scene_copy(lag_client_scene *dst, const lag_client_scene *src)
+{
+    if (dst && src && dst != src) *dst = *src;
+}
+
+const lag_wire_scene *lag_wire_of_scene(const lag_client_scene *sc) { return &sc->m; }
+
+/* Index i of a scene's joints / parameters: valid? */
+static bool joint_ok(const lag_client_scene *sc, int i)
+{
+    return sc && i >= 0 && i < sc->m.num_joints && i < LAG_CLIENT_MAX_JOINTS;
+}
+static bool param_ok(const lag_client_scene *sc, int i)
+{
+    return sc && i >= 0 && i < sc->m.num_params && i < LAG_CLIENT_MAX_PARAMS;
+}
+
+const char *lag_client_scene_model(const lag_client_scene *sc) { return sc->m.model; }
+const char *lag_client_scene_prefix(const lag_client_scene *sc) { return sc->m.prefix; }
+int64_t lag_client_scene_generation(const lag_client_scene *sc) { return sc->m.generation; }
+int64_t lag_client_scene_utime(const lag_client_scene *sc) { return sc->m.utime; }
+int lag_client_scene_num_params(const lag_client_scene *sc) { return sc->m.num_params; }
+int lag_client_scene_num_joints(const lag_client_scene *sc) { return sc->m.num_joints; }
+double lag_client_scene_dt(const lag_client_scene *sc) { return sc->m.dt; }
+double lag_client_scene_control_period(const lag_client_scene *sc) { return sc->m.control_period; }
+double lag_client_scene_rate(const lag_client_scene *sc) { return sc->m.rate; }
+double lag_client_scene_command_timeout(const lag_client_scene *sc) { return sc->m.command_timeout; }
+const char *lag_client_scene_integrator(const lag_client_scene *sc) { return sc->m.integrator; }
+const char *lag_client_scene_mode(const lag_client_scene *sc) { return sc->m.mode; }
+const char *lag_client_scene_effects(const lag_client_scene *sc) { return sc->m.effects; }
+
+const char *lag_client_scene_param_name(const lag_client_scene *sc, int i)
+{
+    return param_ok(sc, i) ? sc->m.param_name[i] : NULL;
+}
+
+double lag_client_scene_param_value(const lag_client_scene *sc, int i)
+{
+    return param_ok(sc, i) ? sc->m.param_value[i] : NAN;
+}
+
+double lag_client_scene_param(const lag_client_scene *sc, const char *name)
+{
+    for (int i = 0; name && param_ok(sc, i); i++)
+        if (strcmp(sc->m.param_name[i], name) == 0) return sc->m.param_value[i];
+    return NAN;
+}
+
+const char *lag_client_scene_joint_name(const lag_client_scene *sc, int i)
+{
+    return joint_ok(sc, i) ? sc->m.joint_name[i] : NULL;
+}
+
+int lag_client_scene_joint(const lag_client_scene *sc, const char *name)
+{
+    for (int i = 0; name && joint_ok(sc, i); i++)
+        if (strcmp(sc->m.joint_name[i], name) == 0) return i;
+    return -1;
+}
+
+bool lag_client_scene_actuated(const lag_client_scene *sc, int i)
+{
+    return joint_ok(sc, i) && sc->m.actuated[i];
+}
+
+double lag_client_scene_initial_q(const lag_client_scene *sc, int i)
+{
+    return joint_ok(sc, i) ? sc->m.initial_q[i] : NAN;
+}
+
+double lag_client_scene_initial_qd(const lag_client_scene *sc, int i)
+{
+    return joint_ok(sc, i) ? sc->m.initial_qd[i] : NAN;
+}
+
+bool lag_client_scene_limit_on(const lag_client_scene *sc, int i)
+{
+    return joint_ok(sc, i) && sc->m.limit_on[i];
+}
+
+double lag_client_scene_limit_lower(const lag_client_scene *sc, int i)
+{
+    return joint_ok(sc, i) ? sc->m.limit_lower[i] : NAN;
+}
+
+double lag_client_scene_limit_upper(const lag_client_scene *sc, int i)
+{
+    return joint_ok(sc, i) ? sc->m.limit_upper[i] : NAN;
+}
+
+/* ---------------------------------------------------------------- the status */
+
+lag_client_status *lag_client_status_new(void) { return calloc(1, sizeof(lag_client_status)); }
+
+void lag_client_status_free(lag_client_status *st) { free(st); }
+
+void lag_client_status_copy(lag_client_status *dst, const lag_client_status *src)
+{
+    if (dst && src && dst != src) *dst = *src;
+}
+
+const lag_wire_status *lag_wire_of_status(const lag_client_status *st) { return &st->m; }
+
+/* status_t's field `name` in the wire module's table (the .lcm file's fields), or NULL. */
+static const lag_wire_field *status_field(const char *name)
+{
+    int n;
+    const lag_wire_field *f = lag_wire_fields(LAG_WIRE_STATUS, &n);
+    for (int i = 0; name && i < n; i++)
+        if (!strcmp(f[i].name, name)) return &f[i];
+    return NULL;
+}
+
+double lag_client_status_number(const lag_client_status *st, const char *field)
+{
+    const lag_wire_field *f = status_field(field);
+    if (!st || !f || f->count_field >= 0) return NAN;
+    const uint8_t *p = (const uint8_t *)&st->m + f->offset;
+    switch (f->kind) {
+    case LAG_WIRE_DOUBLE: {
+        double x;
+        memcpy(&x, p, sizeof x);
+        return x;
+    }
+    case LAG_WIRE_INT64: {
+        int64_t x;
+        memcpy(&x, p, sizeof x);
+        return (double)x;
+    }
+    case LAG_WIRE_BOOLEAN: return *(const bool *)p ? 1.0 : 0.0;
+    case LAG_WIRE_INT8: return (double)*(const int8_t *)p;
+    case LAG_WIRE_INT16: {
+        int16_t x;
+        memcpy(&x, p, sizeof x);
+        return (double)x;
+    }
+    case LAG_WIRE_STRING: break;
+    }
+    return NAN;
+}
+
+const char *lag_client_status_text(const lag_client_status *st, const char *field)
+{
+    const lag_wire_field *f = status_field(field);
+    if (!st || !f || f->kind != LAG_WIRE_STRING || f->count_field >= 0) return NULL;
+    return (const char *)&st->m + f->offset;
+}
+
+int lag_client_status_fields(void)
+{
+    int n;
+    lag_wire_fields(LAG_WIRE_STATUS, &n);
+    return n;
+}
+
+const char *lag_client_status_field_name(int i)
+{
+    int n;
+    const lag_wire_field *f = lag_wire_fields(LAG_WIRE_STATUS, &n);
+    return i >= 0 && i < n ? f[i].name : NULL;
+}
+
+bool lag_client_status_field_is_text(int i)
+{
+    int n;
+    const lag_wire_field *f = lag_wire_fields(LAG_WIRE_STATUS, &n);
+    return i >= 0 && i < n && f[i].kind == LAG_WIRE_STRING;
+}
+
+/* ---------------------------------------------------------------- discovery */
 
 /* What the discovery has heard so far. */
 typedef struct disc {
-    lag_client_plant *p;
+    lag_client_plant p[LAG_CLIENT_MAX_PLANTS];
     int max, n, more;            /* more: plants heard beyond max */
     bool scene[LAG_CLIENT_MAX_PLANTS], status[LAG_CLIENT_MAX_PLANTS];
     double asked[LAG_CLIENT_MAX_PLANTS]; /* monotonic s of the last DESCRIBE + STATUS sent */
     double first;                /* monotonic s when the first plant was heard (0: none) */
     const char *url;
+    uint8_t buf[LAG_WIRE_BUF_SIZE]; /* DESCRIBE, STATUS as encoded */
     union {
         lag_wire_scene scene;
         lag_wire_status status;
@@ -783,13 +1084,61 @@ static void disc_ask(disc *d, lcm_t *cmd, int i, uint8_t *buf, size_t cap)
     d->asked[i] = lag_client_now();
 }
 
+/* Listens on `in` up to wait_s, asking each plant heard for its scene and status on
+ * `cmd` until they come; ends settle_s after the first plant was heard once every plant
+ * heard is described (settle_s < 0: at wait_s). */
+static void disc_listen(disc *d, lcm_t *in, lcm_t *cmd, const lag_bus *b, int max, double wait_s,
+                        double settle_s)
+{
+    d->max = max;
+    d->url = b->state_url;
+    int hfd = host_socket(b);
+    double t0 = lag_client_now(), end = t0 + wait_s;
+    for (;;) {
+        double now = lag_client_now();
+        bool all = d->n > 0;
+        for (int i = 0; i < d->n; i++) {
+            if (!d->scene[i] || !d->status[i]) all = false;
+            if ((!d->scene[i] || !d->status[i]) && now - d->asked[i] >= 0.25)
+                disc_ask(d, cmd, i, d->buf, sizeof d->buf);
+        }
+        /* done: the time is up; or, once a plant was heard, settle_s later (every plant
+         * heard so far described) */
+        if (now >= end || (d->first > 0 && settle_s >= 0 && now >= d->first + settle_s && all))
+            break;
+        double left = end - now;
+        int ms = left < 0.05 ? (int)ceil(left * 1000.0) : 50;
+        errno = 0;
+        if (lcm_handle_timeout(in, ms) < 0 && errno != EINTR) break;
+        read_hosts(d, hfd);
+    }
+    read_hosts(d, hfd);
+    if (hfd >= 0) close(hfd);
+}
+
+/* The plants heard, sorted by prefix (so that a listing does not depend on who spoke
+ * first), into the caller's array of elements of `size` bytes. */
+static void disc_out(disc *d, lag_client_plant *plants, size_t size)
+{
+    lag_client_plant *p = d->p;
+    for (int i = 1; i < d->n; i++)
+        for (int j = i; j > 0 && strcmp(p[j - 1].prefix, p[j].prefix) > 0; j--) {
+            lag_client_plant t = p[j];
+            p[j] = p[j - 1];
+            p[j - 1] = t;
+        }
+    for (int i = 0; i < d->n; i++)
+        copy_out((uint8_t *)plants + (size_t)i * size, size, &p[i], sizeof p[i], PLANT_SIZE_1);
+}
+
 lag_result lag_client_discover(const char *url, double wait_s, double settle_s,
-                               lag_client_plant *plants, int max, int *n, char *err, size_t errlen)
+                               lag_client_plant *plants, int max, size_t size, int *n,
+                               char *err, size_t errlen)
 {
     if (n) *n = 0;
     if (err && errlen) err[0] = '\0';
-    if (!plants || max < 1 || max > LAG_CLIENT_MAX_PLANTS || !n || !(wait_s >= 0) ||
-        !isfinite(wait_s) || !isfinite(settle_s)) {
+    if (!plants || max < 1 || max > LAG_CLIENT_MAX_PLANTS || size < PLANT_SIZE_1 || !n ||
+        !(wait_s >= 0) || !isfinite(wait_s) || !isfinite(settle_s)) {
         if (err) snprintf(err, errlen, "discover: bad arguments");
         return LAG_CLIENT_ERR_ARG;
     }
@@ -806,55 +1155,29 @@ lag_result lag_client_discover(const char *url, double wait_s, double settle_s,
         if (in) lcm_destroy(in);
         return LAG_CLIENT_ERR_LCM;
     }
-    static disc d; /* large: not on the stack; one discovery at a time (not thread-safe) */
-    memset(&d, 0, sizeof d);
-    d.p = plants;
-    d.max = max;
-    d.url = b.state_url;
-    lcm_subscription_t *sub = lcm_subscribe(in, ".*", on_disc, &d);
+    /* large: not on the stack; one per call, so that discoveries may run in several
+     * threads at once */
+    disc *dp = calloc(1, sizeof *dp);
+    lcm_subscription_t *sub = dp ? lcm_subscribe(in, ".*", on_disc, dp) : NULL;
     if (!sub) {
-        if (err) snprintf(err, errlen, "cannot subscribe on %s", b.state_url);
+        lag_result rc = dp ? LAG_CLIENT_ERR_LCM : LAG_CLIENT_ERR_NOMEM;
+        if (err) snprintf(err, errlen, "%s on %s", dp ? "cannot subscribe" : "out of memory",
+                          b.state_url);
         if (cmd != in) lcm_destroy(cmd);
         lcm_destroy(in);
-        return LAG_CLIENT_ERR_LCM;
+        free(dp);
+        return rc;
     }
-    lcm_subscription_set_queue_capacity(sub, 256);
-    int hfd = host_socket(&b);
-    static uint8_t buf[LAG_WIRE_BUF_SIZE];
-    double t0 = lag_client_now(), end = t0 + wait_s;
-    for (;;) {
-        double now = lag_client_now();
-        bool all = d.n > 0;
-        for (int i = 0; i < d.n; i++) {
-            if (!d.scene[i] || !d.status[i]) all = false;
-            if ((!d.scene[i] || !d.status[i]) && now - d.asked[i] >= 0.25)
-                disc_ask(&d, cmd, i, buf, sizeof buf);
-        }
-        /* done: the time is up; or, once a plant was heard, settle_s later (every plant
-         * heard so far described) */
-        if (now >= end || (d.first > 0 && settle_s >= 0 && now >= d.first + settle_s && all))
-            break;
-        double left = end - now;
-        int ms = left < 0.05 ? (int)ceil(left * 1000.0) : 50;
-        errno = 0;
-        if (lcm_handle_timeout(in, ms) < 0 && errno != EINTR) break;
-        read_hosts(&d, hfd);
-    }
-    read_hosts(&d, hfd);
-    if (hfd >= 0) close(hfd);
+    disc_listen(dp, in, cmd, &b, max, wait_s, settle_s);
     lcm_unsubscribe(in, sub);
     if (cmd != in) lcm_destroy(cmd);
     lcm_destroy(in);
-    /* in the order of their prefixes, so that a listing does not depend on who spoke first */
-    for (int i = 1; i < d.n; i++)
-        for (int j = i; j > 0 && strcmp(plants[j - 1].prefix, plants[j].prefix) > 0; j--) {
-            lag_client_plant t = plants[j];
-            plants[j] = plants[j - 1];
-            plants[j - 1] = t;
-        }
-    *n = d.n;
-    if (d.more && err)
-        snprintf(err, errlen, "%d more plants on %s than the %d listed", d.more, b.state_url, max);
+    disc_out(dp, plants, size);
+    *n = dp->n;
+    if (dp->more && err)
+        snprintf(err, errlen, "%d more plants on %s than the %d listed", dp->more, b.state_url,
+                 max);
+    free(dp);
     return LAG_CLIENT_OK;
 }
 
@@ -872,59 +1195,79 @@ static void plant_names(const lag_client_plant *p, int n, char *out, size_t cap)
     }
 }
 
-lag_result lag_client_pick_plant(const char *url, const char *model, double wait_s,
-                                 lag_client_plant *out, char *err, size_t errlen)
+/* The plants of `model` (any: NULL) that answered with a scene, among all[n]: how many,
+ * the last one's index in *match. */
+static int plants_of(const lag_client_plant *all, int n, const char *model, int *match)
 {
-    if (err && errlen) err[0] = '\0';
-    if (!out) {
-        if (err) snprintf(err, errlen, "pick_plant: NULL out");
-        return LAG_CLIENT_ERR_ARG;
-    }
-    memset(out, 0, sizeof *out);
-    static lag_client_plant all[LAG_CLIENT_MAX_PLANTS];
-    int n = 0;
-    /* 0.5 s after the first plant is heard: longer than a plant's state period at any
-     * publish_hz the shipped scenes use, so that a second plant is heard too */
-    int rc = lag_client_discover(url, wait_s, 0.5, all, LAG_CLIENT_MAX_PLANTS, &n, err, errlen);
-    if (rc != LAG_CLIENT_OK) return rc;
-    lag_bus b;
-    char berr[8];
-    const char *where = lag_bus_init(&b, url, "X", berr, sizeof berr) == 0 ? b.state_url : "?";
     /* a plant is what answers DESCRIBE with a scene: a channel that only looks like a
      * plant's (another program's FOO_STATE) is not one to pick */
-    int k = 0, match = -1;
+    int k = 0;
     for (int i = 0; i < n; i++)
         if (all[i].model[0] && (!model || !strcmp(all[i].model, model))) {
             k++;
-            match = i;
+            *match = i;
         }
+    return k;
+}
+
+/* pick_plant's message when k != 1 plants of `model` are among all[n]. */
+static void pick_message(const lag_client_plant *all, int n, int k, const char *model,
+                         const char *where, double wait_s, char *err, size_t errlen)
+{
     char names[1024];
-    plant_names(all, n, names, sizeof names);
-    if (k == 1) {
-        *out = all[match];
-        return LAG_CLIENT_OK;
-    }
     if (k == 0) {
         bool any = false;
         for (int i = 0; i < n; i++) any |= all[i].model[0] != '\0';
-        if (err && !any)
+        plant_names(all, n, names, sizeof names);
+        if (!any)
             snprintf(err, errlen, "no plant on %s within %.1f s (is lagsimd running on this "
                      "LCM URL?)", where, wait_s);
-        else if (err)
+        else
             snprintf(err, errlen, "no %s plant on %s (heard: %s)", model, where, names);
-        return LAG_CLIENT_TIMEOUT;
+        return;
     }
-    if (err) {
-        char mine[1024];
-        int m = 0;
-        static lag_client_plant sel[LAG_CLIENT_MAX_PLANTS];
-        for (int i = 0; i < n; i++)
-            if (all[i].model[0] && (!model || !strcmp(all[i].model, model))) sel[m++] = all[i];
-        plant_names(sel, m, mine, sizeof mine);
-        snprintf(err, errlen, "%d %s%splants on %s: %s; choose one with --prefix", k,
-                 model ? model : "", model ? " " : "", where, mine);
+    lag_client_plant *sel = calloc((size_t)(n > 0 ? n : 1), sizeof *sel); /* not on a thread's
+                                                                           * stack: 1024 plants */
+    int m = 0;
+    for (int i = 0; sel && i < n; i++)
+        if (all[i].model[0] && (!model || !strcmp(all[i].model, model))) sel[m++] = all[i];
+    plant_names(sel ? sel : all, sel ? m : n, names, sizeof names);
+    free(sel);
+    snprintf(err, errlen, "%d %s%splants on %s: %s; choose one with --prefix", k,
+             model ? model : "", model ? " " : "", where, names);
+}
+
+lag_result lag_client_pick_plant(const char *url, const char *model, double wait_s,
+                                 lag_client_plant *out, size_t size, char *err, size_t errlen)
+{
+    if (err && errlen) err[0] = '\0';
+    if (!out || size < PLANT_SIZE_1) {
+        if (err) snprintf(err, errlen, "pick_plant: NULL out or a size below sizeof plant");
+        return LAG_CLIENT_ERR_ARG;
     }
-    return LAG_CLIENT_ERR_AMBIGUOUS;
+    memset(out, 0, size);
+    lag_client_plant *all = calloc(LAG_CLIENT_MAX_PLANTS, sizeof *all);
+    if (!all) {
+        if (err) snprintf(err, errlen, "out of memory");
+        return LAG_CLIENT_ERR_NOMEM;
+    }
+    int n = 0, match = -1;
+    /* 0.5 s after the first plant is heard: longer than a plant's state period at any
+     * publish_hz the shipped scenes use, so that a second plant is heard too */
+    lag_result rc = lag_client_discover(url, wait_s, 0.5, all, LAG_CLIENT_MAX_PLANTS,
+                                        sizeof *all, &n, err, errlen);
+    int k = rc == LAG_CLIENT_OK ? plants_of(all, n, model, &match) : 0;
+    if (rc == LAG_CLIENT_OK && k == 1) {
+        copy_out(out, size, &all[match], sizeof all[match], PLANT_SIZE_1);
+    } else if (rc == LAG_CLIENT_OK) {
+        lag_bus b;
+        char berr[8];
+        const char *where = lag_bus_init(&b, url, "X", berr, sizeof berr) == 0 ? b.state_url : "?";
+        if (err) pick_message(all, n, k, model, where, wait_s, err, errlen);
+        rc = k == 0 ? LAG_CLIENT_TIMEOUT : LAG_CLIENT_ERR_AMBIGUOUS;
+    }
+    free(all);
+    return rc;
 }
 
 /* ---------------------------------------------------------------- a prefix nobody has */
@@ -963,14 +1306,20 @@ static int nearness(const char *heard, const char *asked)
 int lag_client_plants_instead(const char *url, const char *prefix, double wait_s, char *out,
                               size_t len)
 {
-    static lag_client_plant p[LAG_CLIENT_MAX_PLANTS];
     int n = 0;
     char err[256] = "";
     if (!out || len == 0 || !prefix) return LAG_CLIENT_ERR_ARG;
-    lag_result rc = lag_client_discover(url, wait_s, 0.5, p, LAG_CLIENT_MAX_PLANTS, &n, err,
-                                        sizeof err);
+    /* one array per call (any thread may ask), not on its stack (1024 plants: 730 kB) */
+    lag_client_plant *p = calloc(LAG_CLIENT_MAX_PLANTS, sizeof *p);
+    if (!p) {
+        snprintf(out, len, "out of memory");
+        return LAG_CLIENT_ERR_NOMEM;
+    }
+    lag_result rc = lag_client_discover(url, wait_s, 0.5, p, LAG_CLIENT_MAX_PLANTS, sizeof p[0],
+                                        &n, err, sizeof err);
     if (rc != LAG_CLIENT_OK) {
         snprintf(out, len, "%s", err);
+        free(p);
         return rc;
     }
     lag_bus b;
@@ -979,6 +1328,7 @@ int lag_client_plants_instead(const char *url, const char *prefix, double wait_s
     if (n == 0) {
         snprintf(out, len, "no plant heard on %s within %.3g s (is lagsimd running on this "
                  "LCM URL?)", where, wait_s);
+        free(p);
         return 0;
     }
     size_t o = (size_t)snprintf(out, len, "no plant on prefix %s; plants heard on %s: ", prefix,
@@ -993,5 +1343,6 @@ int lag_client_plants_instead(const char *url, const char *prefix, double wait_s
         if (k >= 0 && (near < 0 || k < near)) near = k, best = i;
     }
     if (best >= 0 && o < len) snprintf(out + o, len - o, "; did you mean %s?", p[best].prefix);
+    free(p);
     return n;
 }

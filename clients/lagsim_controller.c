@@ -266,7 +266,7 @@ static int pick_prefix(lag_ctl *ctl, const char *model)
     char perr[1200];
     lag_client_plant p;
     double look = ctl->default_prefix ? 1.0 : ctl->timeout;
-    int rc = lag_client_pick_plant(ctl->url, model, look, &p, perr, sizeof perr);
+    int rc = lag_client_pick_plant(ctl->url, model, look, &p, sizeof p, perr, sizeof perr);
     if (rc == LAG_CLIENT_OK) {
         snprintf(ctl->found_prefix, sizeof ctl->found_prefix, "%s", p.prefix);
         ctl->prefix = ctl->found_prefix;
@@ -316,13 +316,17 @@ static void say_no_scene(const lag_ctl *ctl)
 
 static int wait_scene(lag_ctl *ctl)
 {
+    if (!ctl->scene && !(ctl->scene = lag_client_scene_new())) {
+        fprintf(stderr, "%s: out of memory\n", ctl->name);
+        return 1;
+    }
     /* subscribed: from here on no state is missed (test harnesses wait for this line) */
     printf("%s: waiting for the scene description on %s_SCENE\n", ctl->name, ctl->prefix);
     fflush(stdout);
     double deadline = lag_client_now() + ctl->timeout;
     for (;;) {
         double left = deadline - lag_client_now();
-        int rc = lag_client_wait_scene(ctl->client, left < 0.25 ? left : 0.25, &ctl->scene);
+        int rc = lag_client_wait_scene(ctl->client, left < 0.25 ? left : 0.25, ctl->scene);
         if (rc == LAG_CLIENT_OK) return 0;
         if (g_signal) {
             ctl->end = "signal"; /* lag_ctl_fail: the summary, exit 0 */
@@ -342,10 +346,11 @@ static int wait_scene(lag_ctl *ctl)
 static int model_from_scene(lag_ctl *ctl, const char *model)
 {
     char err[256];
-    if (!model) model = ctl->scene.model; /* any model this build knows */
-    if (strcmp(ctl->scene.model, model) != 0) {
+    const char *runs = lag_client_scene_model(ctl->scene);
+    if (!model) model = runs; /* any model this build knows */
+    if (strcmp(runs, model) != 0) {
         fprintf(stderr, "%s: prefix %s runs model '%s', not %s\n", ctl->name, ctl->prefix,
-                ctl->scene.model, model);
+                runs, model);
         return 1;
     }
     int kind = lag_model_kind_from_name(model);
@@ -355,12 +360,11 @@ static int model_from_scene(lag_ctl *ctl, const char *model)
     }
     ctl->kind = (lag_model_kind)kind;
     lag_model_default_unfinished(&ctl->model, ctl->kind);
-    for (int i = 0; i < ctl->scene.num_params; i++) {
-        int k = lag_model_param_index(ctl->kind, ctl->scene.param_name[i]);
-        if (k >= 0) ctl->model.p[k] = ctl->scene.param_value[i];
-        else
-            fprintf(stderr, "%s: ignoring unknown parameter %s\n", ctl->name,
-                    ctl->scene.param_name[i]);
+    for (int i = 0; i < lag_client_scene_num_params(ctl->scene); i++) {
+        const char *name = lag_client_scene_param_name(ctl->scene, i);
+        int k = lag_model_param_index(ctl->kind, name);
+        if (k >= 0) ctl->model.p[k] = lag_client_scene_param_value(ctl->scene, i);
+        else fprintf(stderr, "%s: ignoring unknown parameter %s\n", ctl->name, name);
     }
     lag_model_finish(&ctl->model);
     if (lag_model_validate(&ctl->model, err, sizeof err) != LAG_OK) {
@@ -386,8 +390,8 @@ int lag_ctl_start(lag_ctl *ctl, const char *model)
  * scene (lagsim_client.h, the scene rule), which becomes ctl->scene and ctl->model. */
 static int scene_changed(lag_ctl *ctl)
 {
-    lag_client_latest_scene(ctl->client, &ctl->scene);
-    if (model_from_scene(ctl, ctl->scene.model) == 0) return 0;
+    lag_client_latest_scene(ctl->client, ctl->scene);
+    if (model_from_scene(ctl, lag_client_scene_model(ctl->scene)) == 0) return 0;
     ctl->failed = true;
     ctl->end = "error";
     return LAG_ERR_RUNTIME;
@@ -397,7 +401,8 @@ int lag_ctl_next_state(lag_ctl *ctl, lag_client_state *st)
 {
     if (ctl->end) return LAG_CLIENT_TIMEOUT;
     if (ctl->duration > 0 && ctl->states > 0 &&
-        ctl->current.sim_time - ctl->t_first >= ctl->duration - 0.5 * ctl->scene.control_period) {
+        ctl->current.sim_time - ctl->t_first >=
+            ctl->duration - 0.5 * lag_client_scene_control_period(ctl->scene)) {
         ctl->end = "duration";
         return LAG_CLIENT_TIMEOUT;
     }
@@ -406,11 +411,12 @@ int lag_ctl_next_state(lag_ctl *ctl, lag_client_state *st)
             ctl->end = "signal";
             return LAG_CLIENT_TIMEOUT;
         }
-        int rc = lag_client_wait_state(ctl->client, 0.05, st);
+        int rc = lag_client_wait_state(ctl->client, 0.05, st, sizeof *st);
         /* a copy of a state already returned never comes back: the client answers it
          * with the same command (lagsim_client.c), so the law runs once per state */
         if (rc == LAG_CLIENT_OK) {
-            if (st->generation != ctl->scene.generation && (rc = scene_changed(ctl)) != 0)
+            if (st->generation != lag_client_scene_generation(ctl->scene) &&
+                (rc = scene_changed(ctl)) != 0)
                 return rc;
             if (ctl->states++ == 0) ctl->t_first = st->sim_time;
             ctl->current = *st;
@@ -459,7 +465,7 @@ int lag_ctl_command(lag_ctl *ctl, const lag_client_state *st, int n, const char 
 int lag_ctl_finish(lag_ctl *ctl, const char *fmt, ...)
 {
     lag_client_counters cnt = {0};
-    if (ctl->client) lag_client_get_counters(ctl->client, &cnt);
+    if (ctl->client) lag_client_get_counters(ctl->client, &cnt, sizeof cnt);
     printf("%s: summary end=%s ", ctl->name, ctl->end ? ctl->end : "none");
     va_list ap;
     va_start(ap, fmt);
@@ -471,6 +477,8 @@ int lag_ctl_finish(lag_ctl *ctl, const char *fmt, ...)
     ctl->trace = NULL;
     lag_client_destroy(ctl->client);
     ctl->client = NULL;
+    lag_client_scene_free(ctl->scene);
+    ctl->scene = NULL;
     return lag_result_exit(ctl->failed ? LAG_ERR_RUNTIME : LAG_OK);
 }
 
@@ -482,5 +490,7 @@ int lag_ctl_fail(lag_ctl *ctl)
     ctl->trace = NULL;
     lag_client_destroy(ctl->client);
     ctl->client = NULL;
+    lag_client_scene_free(ctl->scene);
+    ctl->scene = NULL;
     return ctl->fail_code ? ctl->fail_code : lag_result_exit(LAG_ERR_RUNTIME);
 }

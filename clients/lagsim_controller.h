@@ -12,6 +12,7 @@
  *   if (lag_ctl_start(&ctl, "dipc")) return lag_ctl_fail(&ctl); // connect, scene, model
  *   lag_client_state st;
  *   while (lag_ctl_next_state(&ctl, &st) == LAG_CLIENT_OK)   // each newest state once
+ *       // ... the law, from st and ctl.scene / ctl.model ...
  *       lag_ctl_command(&ctl, &st, 1, names, &u);             // answers it
  *   return lag_ctl_finish(&ctl, "states=%lld", (long long)ctl.states);
  *
@@ -89,7 +90,7 @@ typedef struct lag_ctl {
 
     /* after lag_ctl_start */
     lag_client *client;
-    lag_client_scene scene;
+    lag_client_scene *scene;   /* the scene of the state last returned (lag_client_scene_*) */
     lag_model_kind kind;
     lag_model model;           /* the scene's parameters, finished and validated */
 

@@ -35,6 +35,7 @@
 #include <string.h>
 
 #include "lagsim_client.h"
+#include "lagsim_client_wire.h"
 #include "lagsim_bus.h"
 #include "lagsim_num.h"
 #include "lagsim_wire.h"
@@ -225,7 +226,7 @@ static const char *status_unit(const char *name)
 
 /* The status for people: one field a line, names aligned, numbers with 6 significant
  * digits (--digits N: N) and their units; the counters that are 0 on one line. */
-static void print_status_human(const lag_client_status *st)
+static void print_status_human(const lag_wire_status *st)
 {
     int n, width = 0;
     const lag_wire_field *f = lag_wire_fields(LAG_WIRE_STATUS, &n);
@@ -264,7 +265,9 @@ static void print_status_human(const lag_client_status *st)
 static void print_event(const lag_client_event *ev)
 {
     if (g_json) {
-        print_json("event", LAG_WIRE_EVENT, ev);
+        lag_wire_event w;
+        lag_wire_of_event(ev, &w);
+        print_json("event", LAG_WIRE_EVENT, &w);
         return;
     }
     printf("event %s t=", ev->kind);
@@ -279,9 +282,10 @@ static void print_event(const lag_client_event *ev)
     fflush(stdout);
 }
 
-static void print_status(const lag_client_status *st)
+static void print_status(const lag_client_status *status)
 {
     static const char *const skip[] = {"utime", "sim_time", "step", NULL};
+    const lag_wire_status *st = lag_wire_of_status(status); /* every field, from its table */
     if (g_json) {
         print_json("status", LAG_WIRE_STATUS, st);
         return;
@@ -301,7 +305,9 @@ static void print_status(const lag_client_status *st)
 static void print_state(const lag_client_state *st)
 {
     if (g_json) {
-        print_json("state", LAG_WIRE_JOINT_STATE, st);
+        lag_wire_joint_state w;
+        lag_wire_of_state(st, &w);
+        print_json("state", LAG_WIRE_JOINT_STATE, &w);
         return;
     }
     printf("state t=");
@@ -340,9 +346,10 @@ static void put_elem(const lag_wire_field *f, const void *m, int i)
 /* The scene: a line of its scalar fields, then one line per parameter
  * ("param <name>=<value>") and one per joint ("joint <name> <field>=<value>..." for every
  * array counted by num_joints), so that fields added to scene_t show up by themselves. */
-static void print_scene(const lag_client_scene *sc)
+static void print_scene(const lag_client_scene *scene)
 {
     static const char *const skip[] = {"utime", NULL};
+    const lag_wire_scene *sc = lag_wire_of_scene(scene); /* every field, from its table */
     if (g_json) {
         print_json("scene", LAG_WIRE_SCENE, sc);
         return;
@@ -483,7 +490,8 @@ static lag_result list_plants(const char *url, double wait_s)
     static lag_client_plant p[LAG_CLIENT_MAX_PLANTS];
     int n = 0;
     char err[256];
-    int rc = lag_client_discover(url, wait_s, -1.0, p, LAG_CLIENT_MAX_PLANTS, &n, err, sizeof err);
+    int rc = lag_client_discover(url, wait_s, -1.0, p, LAG_CLIENT_MAX_PLANTS, sizeof p[0], &n,
+                                 err, sizeof err);
     if (rc != LAG_CLIENT_OK) {
         fprintf(stderr, "lagsimctl: %s\n", err);
         return EXIT_NOANSWER;
@@ -729,7 +737,8 @@ static lag_client *connect_plant(options *o, lag_client_plant *chosen, int *code
     char err[1200];
     if (!o->prefix) {
         /* the only plant on the bus */
-        int rc = lag_client_pick_plant(o->url, NULL, o->timeout, chosen, err, sizeof err);
+        int rc = lag_client_pick_plant(o->url, NULL, o->timeout, chosen, sizeof *chosen, err,
+                                       sizeof err);
         if (rc != LAG_CLIENT_OK) {
             fprintf(stderr, "lagsimctl: %s\n", err);
             *code = rc == LAG_CLIENT_ERR_AMBIGUOUS ? EXIT_USAGE : EXIT_NOANSWER;
@@ -844,9 +853,10 @@ static int send_request(lag_client *c, answer *a, const request *r, double timeo
 {
     int rc = LAG_CLIENT_OK;
     if (!strcmp(r->cmd, "describe")) {
-        lag_client_scene sc;
-        rc = lag_client_wait_scene(c, timeout, &sc);
-        if (rc == LAG_CLIENT_OK) print_scene(&sc);
+        lag_client_scene *sc = lag_client_scene_new();
+        rc = sc ? lag_client_wait_scene(c, timeout, sc) : LAG_CLIENT_ERR_NOMEM;
+        if (rc == LAG_CLIENT_OK) print_scene(sc);
+        lag_client_scene_free(sc);
     } else if (!strcmp(r->cmd, "status")) {
         a->want_status = true;
         rc = lag_client_request_status(c);

@@ -93,9 +93,11 @@ static int plant_from_scene(plant *p, const lag_ctl *ctl, const weights *qw, con
             p->inputs[p->m] = i;
             p->in_names[p->m++] = info->joint_names[i];
         }
-    const lag_client_scene *sc = &ctl->scene;
+    const lag_client_scene *sc = ctl->scene;
     printf("lqr_balance: scene %s on %s_*: mode %s, dt %g s, control period %g s, integrator "
-           "%s\n", sc->model, ctl->prefix, sc->mode, sc->dt, sc->control_period, sc->integrator);
+           "%s\n", lag_client_scene_model(sc), ctl->prefix, lag_client_scene_mode(sc),
+           lag_client_scene_dt(sc), lag_client_scene_control_period(sc),
+           lag_client_scene_integrator(sc));
     printf("parameters:");
     for (int k = 0; k < info->np; k++) printf(" %s=%g", info->param_names[k], ctl->model.p[k]);
     printf("\ninputs:");
@@ -318,7 +320,8 @@ int main(int argc, char **argv)
     /* ---- design */
     design d;
     if (design_continuous(&d, &p, &ctl.model, &qw, r_weight) ||
-        design_discrete(&d, &p, ctl.scene.control_period) || choose_gain(&d, &p, continuous))
+        design_discrete(&d, &p, lag_client_scene_control_period(ctl.scene)) ||
+        choose_gain(&d, &p, continuous))
         return lag_ctl_fail(&ctl);
 
     /* ---- control loop: answer every state until the run ends */

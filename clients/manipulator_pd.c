@@ -1,14 +1,16 @@
 /*
  * manipulator_pd: makes the rotary/prismatic manipulator track the scene's reference
  * (its `reference:` key, which lagsimd publishes on <PREFIX>_REFERENCE just before each
- * state: q_d = r, qd_d = r' at the state's sim time; config/manipulator.yaml gives
- * q1 = 0.3 sin(0.5 t), q2 = 0.5 + 0.1 sin(t)) with PD plus model feedforward (computed
- * torque) built from the scene's parameters by the core:
+ * state: q_d = r, qd_d = r', qdd_d = r'' at the state's sim time; config/manipulator.yaml
+ * gives q1 = 0.3 sin(0.5 t), q2 = 0.5 + 0.1 sin(t)) with PD plus model feedforward
+ * (computed torque) built from the scene's parameters by the core:
  *   tau = M(q) (qdd_d + Kp (q_d - q) + Kd (qd_d - qd)) + C(q, qd) qd + g(q).
- * qdd_d is the backward difference of r' over the last control period (0 at the first
- * state and after a gap): an error of about h/2 |d3r/dt3| in the acceleration. A joint
- * the scene gives no reference holds its position at the first state (qd_d = 0). A state
- * whose reference was lost (another sim_time) keeps the last one, and is counted.
+ * r'' is the reference's exact second derivative (docs/evaluation.md), so the feedforward
+ * needs no difference of r'. A joint the scene gives no reference holds its position at
+ * the first state (qd_d = qdd_d = 0). A state whose reference was lost (another sim_time)
+ * keeps the last one, and is counted. clients/manipulator_ct.cpp is the same law in C++
+ * over the client library alone (M, C and g written from the model's closed form), bit
+ * for bit the same numbers.
  * With the exact model the error obeys e'' + Kd e' + Kp e = 0 (Kp = wn^2, Kd = 2 wn,
  * critically damped), up to the zero-order hold of the effort over a control period.
  * Answers every state (lockstep-safe) and prints the tracking error.
@@ -25,18 +27,16 @@ typedef struct desired {
     bool have[2];           /* the joint has a reference (else: hold) */
     double hold[2];         /* a joint without one: its position at the first state */
     double q[2], qd[2], qdd[2];
-    double prev_t, prev_qd[2];
-    bool have_prev;
     int64_t stale;          /* states whose reference did not arrive (the last one kept) */
 } desired;
 
 /* Desired position, velocity, acceleration at state st (q1 at i[0], q2 at i[1]), from
- * the latest reference. */
+ * the latest reference: r, r', r''. */
 static void desired_at(desired *d, lag_ctl *ctl, const lag_client_state *st, const int i[2],
-                       double period, const char *const jn[2], bool first)
+                       const char *const jn[2], bool first)
 {
     lag_client_reference ref;
-    bool have = lag_client_latest_reference(ctl->client, &ref);
+    bool have = lag_client_latest_reference(ctl->client, &ref, sizeof ref);
     if (have && ref.sim_time != st->sim_time) d->stale++;
     for (int k = 0; k < 2; k++) {
         int j = have ? lag_client_reference_joint(&ref, jn[k]) : -1;
@@ -44,15 +44,8 @@ static void desired_at(desired *d, lag_ctl *ctl, const lag_client_state *st, con
         if (first) d->hold[k] = st->position[i[k]];
         d->q[k] = j >= 0 ? ref.r[j] : d->hold[k];
         d->qd[k] = j >= 0 ? ref.rdot[j] : 0.0;
+        d->qdd[k] = j >= 0 ? ref.rddot[j] : 0.0;
     }
-    /* the acceleration: r' one control period ago and now */
-    bool next = d->have_prev && fabs(st->sim_time - d->prev_t - period) <= 1e-9 * period;
-    for (int k = 0; k < 2; k++) {
-        d->qdd[k] = next ? (d->qd[k] - d->prev_qd[k]) / period : 0.0;
-        d->prev_qd[k] = d->qd[k];
-    }
-    d->prev_t = st->sim_time;
-    d->have_prev = true;
 }
 
 /* The control law at one state: tau = M(q) (qdd_d + Kp e + Kd e_dot) + C(q, qd) qd + g(q). */
@@ -115,8 +108,8 @@ static int finish(lag_ctl *ctl, const tracking *tr, double settle, const desired
 static int check_joints(const lag_ctl *ctl, const char *const jn[2])
 {
     for (int k = 0; k < 2; k++) {
-        int j = lag_client_scene_joint(&ctl->scene, jn[k]);
-        if (j < 0 || !ctl->scene.actuated[j]) {
+        int j = lag_client_scene_joint(ctl->scene, jn[k]);
+        if (!lag_client_scene_actuated(ctl->scene, j)) {
             fprintf(stderr, "manipulator_pd: joint %s is not actuated in this scene\n", jn[k]);
             return -1;
         }
@@ -147,7 +140,8 @@ int main(int argc, char **argv)
     const char *jn[2] = {"q1", "q2"};
     if (check_joints(&ctl, jn)) return lag_ctl_fail(&ctl);
     printf("manipulator_pd: scene on %s_*: mode %s, control period %g s; Kp %g, Kd %g\n",
-           ctl.prefix, ctl.scene.mode, ctl.scene.control_period, kp, kd);
+           ctl.prefix, lag_client_scene_mode(ctl.scene),
+           lag_client_scene_control_period(ctl.scene), kp, kd);
     fflush(stdout);
 
     /* ---- control loop: answer every state until the run ends */
@@ -159,7 +153,7 @@ int main(int argc, char **argv)
         if (idx[0] < 0 || idx[1] < 0) continue;
         double q[2] = {st.position[idx[0]], st.position[idx[1]]};
         double qd[2] = {st.velocity[idx[0]], st.velocity[idx[1]]};
-        desired_at(&des, &ctl, &st, idx, ctl.scene.control_period, jn, tr.states == 0);
+        desired_at(&des, &ctl, &st, idx, jn, tr.states == 0);
         if (tr.states == 0) {
             printf("manipulator_pd: tracking %s %s, %s %s\n", jn[0],
                    des.have[0] ? "its reference" : "its first position", jn[1],

@@ -77,14 +77,14 @@ int main(int argc, char **argv)
     ctl.event_user = &s;
 
     if (lag_ctl_start(&ctl, "stick")) return lag_ctl_fail(&ctl);
-    int jx = lag_client_scene_joint(&ctl.scene, "x");
-    if (jx < 0 || !ctl.scene.actuated[jx]) {
+    int jx = lag_client_scene_joint(ctl.scene, "x");
+    if (!lag_client_scene_actuated(ctl.scene, jx)) {
         fprintf(stderr, "stick_push: joint x takes no force in this scene\n");
         return lag_ctl_fail(&ctl);
     }
-    const double m = ctl.model.p[LAG_STICK_M], h = ctl.scene.control_period;
+    const double m = ctl.model.p[LAG_STICK_M], h = lag_client_scene_control_period(ctl.scene);
     printf("stick_push: scene on %s_*: mode %s, control period %g s, m = %g kg; pushing x with "
-           "%g N for %g s\n", ctl.prefix, ctl.scene.mode, h, m, force, push_time);
+           "%g N for %g s\n", ctl.prefix, lag_client_scene_mode(ctl.scene), h, m, force, push_time);
     fflush(stdout);
 
     const char *jn[1] = {"x"};

@@ -3,10 +3,14 @@
 #   bin/                     lagsimd, lagsimctl, lagsim-view, lagsim-log2csv, lagsim-plot,
 #                            lagsim-eval, lagsim-sweep and the C example controllers
 #                            (each when the build has it)
-#   include/lagsim/          lagsim.h (the core), lagsim_client.h, lagsim_controller.h,
+#   include/lagsim/          lagsim_client.h, lagsim_client.hpp, result.h and the version
+#                            header the build writes from version.h.in (the client
+#                            library); lagsim.h (the core), lagsim_controller.h,
 #                            lagsim_wire.h, lagsim_log.h, lagsim_bus.h, the generated C types
-#   lib/                     liblagsim_client.a, liblagsim_controller.a and what they
-#                            link; lagsim-client.pc
+#   lib/                     liblagsim_client.so.<ABI> (SONAME) and .so, liblagsim_client.a;
+#                            liblagsim_controller.a, liblagsim_core.a and what they link
+#   lib/pkgconfig/           lagsim-client.pc (the client library), lagsim-core.pc (the
+#                            core and the C examples' setup, static, no stable ABI)
 #   lib/python3.X/dist-packages/   lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
 #                            (on Debian's sys.path for prefix /usr/local; for prefix /usr,
 #                            lib/python3/dist-packages)
@@ -19,12 +23,12 @@
 #                            LAGSIM_OCTAVE_INSTALL_DIR)
 #   share/man/man1/          a page for each program of bin/
 #   lib/systemd/system/      lagsimd@.service (a plant per /etc/lagsim/NAME.yaml)
-# lagsim-client.pc finds its prefix from its own place, so the tree can be moved.
+# The .pc files find their prefix from their own place, so the tree can be moved.
 # Included last from the top-level CMakeLists.txt, so every target exists already.
 include(GNUInstallDirs)
 
 set(_programs lagsimd lagsimctl lagsim-view lagsim-log2csv lagsim-eval lagsim-sweep
-              dipc_lqr lqr_balance manipulator_pd stick_push)
+              dipc_lqr lqr_balance manipulator_pd manipulator_ct stick_push)
 foreach(t ${_programs})
   if(TARGET ${t})
     install(TARGETS ${t} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
@@ -36,18 +40,21 @@ foreach(s server/tools/lagsim-plot)  # scripts, where the tree has them
   endif()
 endforeach()
 
-# C: the client library, the libraries it and the examples link, their headers.
-set(_libs "")
-foreach(t lagsim_controller lagsim_client lagsim_wire lagsim_wire_base lagsim_lcmtypes lagsim_core)
-  if(TARGET ${t})
-    install(TARGETS ${t} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
-    string(REPLACE "lagsim_" "-llagsim_" _l ${t})
-    string(APPEND _libs " ${_l}")
-  endif()
+# C: the client library, shared (liblagsim_client.so.<ABI> with its links) and static, its
+# headers (lagsim_client.h, lagsim_client.hpp, lagsim/version.h, lagsim/result.h) and
+# lagsim-client.pc: the library with a stable ABI, all a controller links. Beside it, the
+# static libraries of the core and of the C examples' shared setup (lagsim_controller.h,
+# lagsim.h, lagsim_wire.h, ...) and lagsim-core.pc: for building lagsim's own examples
+# against an install, without a stable ABI (docs/clients.md, "The ABI").
+install(TARGETS lagsim_client_shared LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+foreach(t lagsim_client lagsim_controller lagsim_wire lagsim_wire_base lagsim_lcmtypes lagsim_core)
+  install(TARGETS ${t} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endforeach()
 install(FILES ${PROJECT_SOURCE_DIR}/server/include/lagsim/lagsim.h
               ${PROJECT_SOURCE_DIR}/server/include/lagsim/result.h
+              ${PROJECT_BINARY_DIR}/include/lagsim/version.h
               ${PROJECT_SOURCE_DIR}/clients/lagsim_client.h
+              ${PROJECT_SOURCE_DIR}/clients/lagsim_client.hpp
               ${PROJECT_SOURCE_DIR}/clients/lagsim_controller.h
               ${PROJECT_SOURCE_DIR}/server/wire/lagsim_wire.h
               ${PROJECT_SOURCE_DIR}/server/wire/lagsim_log.h
@@ -55,10 +62,22 @@ install(FILES ${PROJECT_SOURCE_DIR}/server/include/lagsim/lagsim.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/lagsim)
 install(DIRECTORY ${CMAKE_BINARY_DIR}/lcmtypes/c/lagsim/
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/lagsim FILES_MATCHING PATTERN "*.h")
-set(LAGSIM_PC_LIBS "${_libs}")
-configure_file(${CMAKE_CURRENT_LIST_DIR}/lagsim-client.pc.in
-               ${CMAKE_BINARY_DIR}/lagsim-client.pc @ONLY)
-install(FILES ${CMAKE_BINARY_DIR}/lagsim-client.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+# pkg-config: the installed files (their prefix from their own place: the tree can be
+# moved), and in <build>/pkgconfig the same packages for the build tree, by pkg-config's
+# convention for uninstalled packages (NAME-uninstalled.pc, preferred when found; NAME.pc
+# there too, the same, for PKG_CONFIG_DISABLE_UNINSTALLED): PKG_CONFIG_PATH=<build>/pkgconfig
+# builds a controller against the build tree, which it then runs from (a run path to
+# <build>/lib).
+foreach(pc lagsim-client lagsim-core)
+  configure_file(${CMAKE_CURRENT_LIST_DIR}/${pc}.pc.in ${CMAKE_BINARY_DIR}/pc-install/${pc}.pc @ONLY)
+  install(FILES ${CMAKE_BINARY_DIR}/pc-install/${pc}.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+  configure_file(${CMAKE_CURRENT_LIST_DIR}/${pc}-uninstalled.pc.in
+                 ${CMAKE_BINARY_DIR}/pc-uninstalled/${pc}.pc.in @ONLY)
+  foreach(name ${pc}-uninstalled ${pc})
+    file(GENERATE OUTPUT ${CMAKE_BINARY_DIR}/pkgconfig/${name}.pc
+         INPUT ${CMAKE_BINARY_DIR}/pc-uninstalled/${pc}.pc.in)
+  endforeach()
+endforeach()
 
 # Message definitions, scenes, man page.
 file(GLOB _lcm ${PROJECT_SOURCE_DIR}/lcmtypes/*.lcm)

@@ -1,6 +1,7 @@
 # `cpack -G DEB` (in the build directory): lagsim_<version>_<arch>.deb, the files of
 # `cmake --install` (cmake/LagsimInstall.cmake) under /usr, in Debian's places:
-#   /usr/bin, /usr/include/lagsim, /usr/lib (static libraries), /usr/lib/pkgconfig,
+#   /usr/bin, /usr/include/lagsim, /usr/lib (liblagsim_client.so.<ABI> with its links, the
+#   static libraries), /usr/lib/pkgconfig,
 #   /usr/lib/python3/dist-packages, /usr/share/lua/5.2, /usr/share/java,
 #   /usr/share/lagsim (scenes, .lcm files, examples), /usr/share/man/man1,
 #   /usr/lib/systemd/system/lagsimd@.service,
@@ -24,14 +25,19 @@ inverted pendulum on a cart or a cart-pole in real time, publishes its joint
 states on LCM channels and takes effort commands from controllers in C, Python,
 Lua, Java or Octave; runs are recorded whole and re-simulated bit for bit.
 .
-This package holds the daemon and its tools, the C client library with its
-headers and pkg-config file, the message types for C, Python, Lua and Java,
+This package holds the daemon and its tools, the client library (shared, with
+a kept ABI, and static) with its C and C++ headers and pkg-config file, the
+message types for C, Python, Lua and Java,
 example controllers, the shipped scenes, and a systemd template unit,
 lagsimd@NAME, that runs /etc/lagsim/NAME.yaml as a service.")
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 set(CPACK_STRIP_FILES ON)                         # the programs; debug info stays in the build
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+# liblagsim_client.so.<ABI>: a shlibs file (a program linked against it depends on this
+# version or later: the library keeps its ABI within its SONAME) and the ldconfig trigger
+set(CPACK_DEBIAN_PACKAGE_GENERATE_SHLIBS ON)
+set(CPACK_DEBIAN_PACKAGE_GENERATE_SHLIBS_POLICY ">=")
 
 # What the package needs beyond the programs' shared libraries (found by dpkg-shlibdeps):
 # relation # Debian package(s) # for
@@ -61,7 +67,8 @@ endforeach()
 # maintainer scripts: systemd reloaded when it runs; instances stopped on removal; their
 # state directories (records written by --log) and enablement links removed on purge
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA ${CMAKE_CURRENT_LIST_DIR}/deb/postinst
-    ${CMAKE_CURRENT_LIST_DIR}/deb/prerm ${CMAKE_CURRENT_LIST_DIR}/deb/postrm)
+    ${CMAKE_CURRENT_LIST_DIR}/deb/prerm ${CMAKE_CURRENT_LIST_DIR}/deb/postrm
+    ${CMAKE_CURRENT_LIST_DIR}/deb/triggers)  # ldconfig for liblagsim_client.so
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION TRUE)
 # after the install into the staging directory, before the archive is made
 set(CPACK_PRE_BUILD_SCRIPTS ${CMAKE_CURRENT_LIST_DIR}/deb/staging.cmake)

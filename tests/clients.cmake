@@ -50,6 +50,18 @@ foreach(bad "--wn;-1" "--settle;x" "--duration;1e999")
            COMMAND ${expect_exit} 2 "^manipulator_pd: --" $<TARGET_FILE:manipulator_pd> ${bad})
   set_tests_properties(clients_manipulator_pd_usage_${bad_name} PROPERTIES TIMEOUT 10)
 endforeach()
+# the C++ example's options, the same rules
+foreach(bad "--wn;-1" "--settle;x" "--duration;1e999" "--timeout;0" "-z" "stray")
+  string(REGEX REPLACE "^-+" "" bad_name "${bad}")
+  string(REPLACE ";" "_" bad_name "${bad_name}")
+  string(REGEX REPLACE "[.:]" "_" bad_name "${bad_name}")
+  string(REGEX REPLACE "[^A-Za-z0-9_-]" "" bad_name "${bad_name}")
+  add_test(NAME clients_manipulator_ct_usage_${bad_name}
+           COMMAND ${expect_exit} 2 "^manipulator_ct: " $<TARGET_FILE:manipulator_ct> ${bad})
+  set_tests_properties(clients_manipulator_ct_usage_${bad_name} PROPERTIES TIMEOUT 10)
+endforeach()
+add_test(NAME clients_manipulator_ct_help
+         COMMAND ${expect_exit} 0 "--duration S" $<TARGET_FILE:manipulator_ct> --help)
 # --help: exit 0, the options listed
 add_test(NAME clients_dipc_lqr_help
          COMMAND ${expect_exit} 0 "--duration S" $<TARGET_FILE:dipc_lqr> --help)
@@ -242,3 +254,64 @@ foreach(t ${clients_tests})
     set_tests_properties(${t} PROPERTIES LABELS clients)
   endif()
 endforeach()
+
+# ---- The client library's version and ABI. test_version links liblagsim_client.so: the
+# version of lagsim/version.h, the core's lag_version(), the shared library's
+# lag_client_version() and project(VERSION) agree; so do the ABI numbers.
+add_executable(test_version ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_version.c)
+target_include_directories(test_version PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common)
+target_link_libraries(test_version PRIVATE lagsim_client_shared lagsim_core)
+lagsim_add_test_cases(test_version clients clients 30 ${PROJECT_VERSION} ${LAGSIM_CLIENT_ABI})
+# clients_abi: the built liblagsim_client.so against the baseline clients/abi/ (abidiff);
+# clients_abi_mutations: the library rebuilt with an incompatible change (a field
+# inserted, one retyped, a function removed) and a compatible one (a field appended, a
+# function added), each judged and refused as it must be (tests/clients/abi_check.py,
+# abi_mutations.py). Not in a sanitizer build: its instrumented library is not what ships.
+find_program(LAGSIM_ABIDIFF abidiff)
+if(LAGSIM_PYTHON3 AND NOT LAGSIM_SANITIZE)
+  if(NOT LAGSIM_ABIDIFF)
+    message(WARNING "abidiff (abigail-tools) not found: clients_abi will fail saying so")
+  endif()
+  add_test(NAME clients_abi
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/abi_check.py
+            --library $<TARGET_FILE:lagsim_client_shared> --headers ${LAGSIM_CLIENT_PUBLIC_HEADERS}
+            --baseline-dir ${PROJECT_SOURCE_DIR}/clients/abi --version ${PROJECT_VERSION}
+            --abi ${LAGSIM_CLIENT_ABI})
+  string(REPLACE ";" " " abi_lcm_libs "${LCM_LINK_LIBRARIES}")
+  string(REPLACE ";" " " abi_lcm_cflags "${LCM_CFLAGS}")
+  add_test(NAME clients_abi_mutations
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/abi_mutations.py
+            --check ${CMAKE_CURRENT_SOURCE_DIR}/clients/abi_check.py
+            --source ${PROJECT_SOURCE_DIR} --build ${CMAKE_BINARY_DIR} --cc ${CMAKE_C_COMPILER}
+            "--objects=$<JOIN:$<TARGET_OBJECTS:lagsim_client_wire_pic>;$<TARGET_OBJECTS:lagsim_lcmtypes_pic>,;>"
+            "--cflags=${abi_lcm_cflags}" "--libs=${abi_lcm_libs} -lm"
+            --version ${PROJECT_VERSION} --abi ${LAGSIM_CLIENT_ABI})
+  set_tests_properties(clients_abi clients_abi_mutations PROPERTIES TIMEOUT 120 LABELS clients)
+endif()
+
+# ---- Stock lcm-gen --cpp types (lcm/lcm-cpp.hpp) against forged states: they take a name
+# without its NUL, bytes after the message and a NaN, as docs/clients.md says; the client
+# library drops each (tests/clients/lcm_cpp_forged.cpp).
+set(lcm_cpp_dir ${CMAKE_CURRENT_BINARY_DIR}/lcm_cpp)
+add_custom_command(OUTPUT ${lcm_cpp_dir}/lagsim/joint_state_t.hpp
+  COMMAND ${CMAKE_COMMAND} -E make_directory ${lcm_cpp_dir}
+  COMMAND ${LCM_GEN} --cpp --cpp-hpath ${lcm_cpp_dir} ${PROJECT_SOURCE_DIR}/lcmtypes/joint_state_t.lcm
+          ${PROJECT_SOURCE_DIR}/lcmtypes/joint_command_t.lcm ${PROJECT_SOURCE_DIR}/lcmtypes/event_t.lcm
+  DEPENDS ${PROJECT_SOURCE_DIR}/lcmtypes/joint_state_t.lcm
+          ${PROJECT_SOURCE_DIR}/lcmtypes/joint_command_t.lcm ${PROJECT_SOURCE_DIR}/lcmtypes/event_t.lcm
+  COMMENT "lcm-gen: C++ types (the stock ones, for clients_lcm_cpp_forged)")
+add_executable(test_lcm_cpp_forged ${CMAKE_CURRENT_SOURCE_DIR}/clients/lcm_cpp_forged.cpp
+                                   ${lcm_cpp_dir}/lagsim/joint_state_t.hpp)
+target_include_directories(test_lcm_cpp_forged PRIVATE ${lcm_cpp_dir})
+target_link_libraries(test_lcm_cpp_forged PRIVATE lagsim_client PkgConfig::LCM)
+add_test(NAME clients_lcm_cpp_forged COMMAND test_lcm_cpp_forged)
+set_tests_properties(clients_lcm_cpp_forged PROPERTIES TIMEOUT 30 LABELS clients)
+
+# ---- lagsim_client.hpp: errors as lagsim::Error with the library's codes, callbacks'
+# exceptions out of the next call (never through C), scene views and copies, the fields
+# as the C library reads them (tests/clients/test_client_hpp.cpp, memq://)
+add_executable(test_client_hpp ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client_hpp.cpp)
+target_link_libraries(test_client_hpp PRIVATE lagsim_client)
+target_compile_options(test_client_hpp PRIVATE -Wpedantic)
+add_test(NAME clients_cpp_header COMMAND test_client_hpp)
+set_tests_properties(clients_cpp_header PROPERTIES TIMEOUT 30 LABELS clients)

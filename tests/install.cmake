@@ -13,7 +13,7 @@ if(LAGSIM_PYTHON3)
   add_test(NAME install_and_run
     COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/install/check_install.py
             --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} --cc ${CMAKE_C_COMPILER}
-            "--cflags=${inst_flags}")
+            --cxx ${CMAKE_CXX_COMPILER} --abi ${LAGSIM_CLIENT_ABI} "--cflags=${inst_flags}")
   set_tests_properties(install_and_run PROPERTIES TIMEOUT 180 LABELS clients)
 endif()
 

@@ -32,6 +32,11 @@ add_executable(conformance_c ${proto_dir}/conformance/conformance.c)
 target_link_libraries(conformance_c PRIVATE lagsim_client)
 protocol_conformance(c clients $<TARGET_FILE:conformance_c> --prefix {prefix} --url {url})
 
+# C++ (clients/lagsim_client.hpp over the C library)
+add_executable(conformance_cpp ${proto_dir}/conformance/conformance.cpp)
+target_link_libraries(conformance_cpp PRIVATE lagsim_client)
+protocol_conformance(cpp clients $<TARGET_FILE:conformance_cpp> --prefix {prefix} --url {url})
+
 # Python (clients/python/lagsim_controller.py)
 protocol_conformance(python clients ${LAGSIM_PYTHON3} ${proto_dir}/conformance/conformance.py
   --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --url {url})

@@ -1,13 +1,13 @@
 --[[
 manipulator_pd.lua: the manipulator tracks the scene's reference, in Lua 5.2: the
-reference_t on <PREFIX>_REFERENCE, published just before each state (q_d = r, qd_d = r';
-qdd_d the backward difference of r' over the last control period, 0 at the first state
-and after a gap; a joint without a reference holds its first position), as manipulator_pd
-in C does, with PD plus computed-torque feedforward from the scene's parameters:
+reference_t on <PREFIX>_REFERENCE, published just before each state (q_d = r, qd_d = r',
+qdd_d = r'', the exact second derivative; a joint without a reference holds its first
+position), as manipulator_pd in C does, with PD plus computed-torque feedforward from the
+scene's parameters:
     tau = M(q) (qdd_d + Kp e + Kd e_dot) + C(q, qd) qd + g(q),  Kp = wn^2, Kd = 2 wn,
 M, C and g in closed form from the model's T and U (docs/models.md), written exactly as
-in clients/python/manipulator_pd.py (same operations in the same order, the same libm),
-so the two give bit-identical runs.
+in clients/python/manipulator_pd.py and the C core (same operations in the same order,
+the same libm), so that Lua, Python, C and C++ give bit-identical runs.
     lua5.2 clients/lua/manipulator_pd.lua --types build/lua [--prefix MANIPULATOR] ...
 Answers every state with a command carrying that state's sim_time (lockstep-safe), until
 the daemon stops, falls silent for --timeout s, or --duration s of sim time have passed;
@@ -19,30 +19,26 @@ local Controller = require('lagsim_controller')
 
 -- q_d, qd_d, qdd_d at a state from the latest reference (manipulator_pd.c's rule)
 local des = { stale = 0, have = { false, false } }
-local function desired(ref, st, q, period)
+local function desired(ref, st, q)
   if not des.hold then des.hold = { q[1], q[2] } end
   if ref and ref.sim_time ~= st.sim_time then des.stale = des.stale + 1 end
-  local qdes, qddes = { des.hold[1], des.hold[2] }, { 0.0, 0.0 }
+  local qdes, qddes, qdd = { des.hold[1], des.hold[2] }, { 0.0, 0.0 }, { 0.0, 0.0 }
   for k, name in ipairs({ 'q1', 'q2' }) do
     local j = ref and Controller.joint(ref, name)
     des.have[k] = j ~= nil
-    if j then qdes[k], qddes[k] = ref.r[j], ref.rdot[j] end
+    if j then qdes[k], qddes[k], qdd[k] = ref.r[j], ref.rdot[j], ref.rddot[j] end
   end
-  local nxt = des.prev_t and math.abs(st.sim_time - des.prev_t - period) <= 1e-9 * period
-  local qdd = { 0.0, 0.0 }
-  for k = 1, 2 do
-    if nxt then qdd[k] = (qddes[k] - des.prev_qd[k]) / period end
-  end
-  des.prev_t, des.prev_qd = st.sim_time, qddes
   return qdes, qddes, qdd
 end
 
 -- tau = M(q) v + C(q, qd) qd + g(q) (closed form, see above)
 local function computed_torque(p, q, qd, v)
   local m1, m2, l1, I1, I2, g = p.m1, p.m2, p.l1, p.I1, p.I2, p.g
-  local M11 = m1 * l1 * l1 + m2 * q[2] * q[2] + I1 + I2
-  local tau1 = M11 * v[1] + 2.0 * m2 * q[2] * qd[1] * qd[2] + (m1 * l1 + m2 * q[2]) * g * math.cos(q[1])
-  local tau2 = m2 * v[2] - m2 * q[2] * qd[1] * qd[1] + m2 * g * math.sin(q[1])
+  local s, c, a = math.sin(q[1]), math.cos(q[1]), m2 * q[2]
+  local M = { m1 * l1 * l1 + I1 + I2 + m2 * q[2] * q[2], 0.0, 0.0, m2 }
+  local h = { 2.0 * a * qd[1] * qd[2] + (m1 * l1 + a) * g * c, -a * qd[1] * qd[1] + m2 * g * s }
+  local tau1 = M[1] * v[1] + M[2] * v[2] + h[1]
+  local tau2 = M[3] * v[1] + M[4] * v[2] + h[2]
   return { tau1, tau2 }
 end
 
@@ -77,7 +73,7 @@ for st in ctl:states() do
   if i1 and i2 then
     local q = { st.position[i1], st.position[i2] }
     local qd = { st.velocity[i1], st.velocity[i2] }
-    local qdes, qddes, qdddes = desired(ctl.reference, st, q, ctl.scene.control_period)
+    local qdes, qddes, qdddes = desired(ctl.reference, st, q)
     if states == 0 and not o.quiet then
       print(string.format('manipulator_pd.lua: tracking q1 %s, q2 %s',
                           des.have[1] and 'its reference' or 'its first position',

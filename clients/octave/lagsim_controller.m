@@ -50,7 +50,7 @@ classdef lagsim_controller < handle
         repeats = 0     % copies of the state answered last, answered again (see next_state)
         held = 0        % states held until the scene of their generation came
         % the scene's reference for the state next_state returned last, as a struct
-        % (sim_time, step, name: a cell of joint names, r, rdot: columns): the one
+        % (sim_time, step, name: a cell of joint names, r, rdot, rddot: columns): the one
         % published with it (the same sim_time), or, when UDP lost that one, the last one
         % received before it (an older sim_time, counted in references_stale); [] before
         % the first (a scene without a reference publishes none)
@@ -319,9 +319,10 @@ classdef lagsim_controller < handle
                 names = r.name;
                 rv = r.r;
                 rdot = r.rdot;
+                rddot = r.rddot;
                 ref = struct('sim_time', r.sim_time, 'step', double(r.step), ...
                              'name', {cell(1, numel(names))}, 'r', double(rv(:)), ...
-                             'rdot', double(rdot(:)));
+                             'rdot', double(rdot(:)), 'rddot', double(rddot(:)));
                 for k = 1:numel(names)
                     ref.name{k} = char(names(k));
                 end

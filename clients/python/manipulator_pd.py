@@ -3,17 +3,19 @@
 
 Talks to lagsimd through lagsim_lcm (ctypes over liblcm.so.1) and the lcm-gen Python
 types (PYTHONPATH=<build>/python, or --types DIR). Tracks the scene's reference (the
-reference_t on <PREFIX>_REFERENCE, published just before each state: q_d = r, qd_d = r';
-qdd_d the backward difference of r' over the last control period, 0 at the first state and
-after a gap; a joint without a reference holds its first position), as manipulator_pd in
-C does, with PD plus computed-torque feedforward, from the parameters of the scene description:
+reference_t on <PREFIX>_REFERENCE, published just before each state: q_d = r, qd_d = r',
+qdd_d = r'', the exact second derivative; a joint without a reference holds its first
+position), as manipulator_pd in C does, with PD plus computed-torque feedforward, from the
+parameters of the scene description:
     tau = M(q) (qdd_d + Kp e + Kd e_dot) + C(q, qd) qd + g(q),  Kp = wn^2, Kd = 2 wn.
 The dynamics are written here in closed form from the model's T and U (docs/models.md),
 independently of the C core:
     T = 1/2 (m1 l1^2 + m2 q2^2 + I1 + I2) q1d^2 + 1/2 m2 q2d^2,
     U = (m1 l1 + m2 q2) g sin q1
-    tau1 = M11 q1dd + 2 m2 q2 q1d q2d + (m1 l1 + m2 q2) g cos q1,  M11 = m1 l1^2 + m2 q2^2 + I1 + I2
+    tau1 = M11 q1dd + 2 m2 q2 q1d q2d + (m1 l1 + m2 q2) g cos q1,  M11 = m1 l1^2 + I1 + I2 + m2 q2^2
     tau2 = m2 q2dd - m2 q2 q1d^2 + m2 g sin q1
+with the C core's operations in its order (M v + h, h the bias), so that Python, Lua, C
+and C++ (clients/manipulator_ct.cpp) answer every state with the same bits.
 Answers every state with a command carrying that state's sim_time (lockstep-safe), until
 the daemon stops, falls silent for --timeout s, or --duration s of sim time have passed;
 then prints a summary line. Exit status: 0 done, 1 no scene (no daemon?), 2 bad usage.
@@ -29,8 +31,8 @@ from lagsim_controller import Controller  # noqa: E402
 class Desired(object):
     """q_d, qd_d, qdd_d at each state, from the latest reference (manipulator_pd.c's rule)."""
 
-    def __init__(self, period):
-        self.period, self.hold, self.prev = period, None, None  # prev: (t, qd_d)
+    def __init__(self):
+        self.hold = None
         self.stale = 0
         self.have = [False, False]
 
@@ -39,25 +41,22 @@ class Desired(object):
             self.hold = q
         if ref is not None and ref.sim_time != st.sim_time:
             self.stale += 1
-        qdes, qddes = list(self.hold), [0.0, 0.0]
+        qdes, qddes, qdd = list(self.hold), [0.0, 0.0], [0.0, 0.0]
         for k, name in enumerate(("q1", "q2")):
             self.have[k] = ref is not None and name in ref.name
             if self.have[k]:
                 j = ref.name.index(name)
-                qdes[k], qddes[k] = ref.r[j], ref.rdot[j]
-        nxt = self.prev is not None and abs(st.sim_time - self.prev[0] - self.period) <= 1e-9 * self.period
-        qdd = [(qddes[k] - self.prev[1][k]) / self.period if nxt else 0.0 for k in range(2)]
-        self.prev = (st.sim_time, qddes)
+                qdes[k], qddes[k], qdd[k] = ref.r[j], ref.rdot[j], ref.rddot[j]
         return qdes, qddes, qdd
 
 
 def computed_torque(p, q, qd, v):
     """tau = M(q) v + C(q, qd) qd + g(q) for the manipulator (closed form above)."""
     m1, m2, l1, I1, I2, g = p["m1"], p["m2"], p["l1"], p["I1"], p["I2"], p["g"]
-    M11 = m1 * l1 * l1 + m2 * q[1] * q[1] + I1 + I2
-    tau1 = M11 * v[0] + 2.0 * m2 * q[1] * qd[0] * qd[1] + (m1 * l1 + m2 * q[1]) * g * math.cos(q[0])
-    tau2 = m2 * v[1] - m2 * q[1] * qd[0] * qd[0] + m2 * g * math.sin(q[0])
-    return tau1, tau2
+    s, c, a = math.sin(q[0]), math.cos(q[0]), m2 * q[1]
+    M = (m1 * l1 * l1 + I1 + I2 + m2 * q[1] * q[1], 0.0, 0.0, m2)
+    h = (2.0 * a * qd[0] * qd[1] + (m1 * l1 + a) * g * c, -a * qd[0] * qd[0] + m2 * g * s)
+    return M[0] * v[0] + M[1] * v[1] + h[0], M[2] * v[0] + M[3] * v[1] + h[1]
 
 
 def main():
@@ -81,7 +80,7 @@ def main():
               % (a.prefix, ctl.scene.mode, ctl.scene.control_period, kp, kd), flush=True)
 
     names = ["q1", "q2"]
-    des = Desired(ctl.scene.control_period)
+    des = Desired()
     states = 0
     n_settled = 0
     t_first = t_last = float("nan")

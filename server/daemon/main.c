@@ -47,7 +47,7 @@ static const char k_options[] =
     "                         not start it again: the sim time run before it counts\n"
     "      --offline          no LCM: simulate as fast as possible, write CSV rows at\n"
     "                         t = 0 and every 1/publish_hz: t,q...,q_dot...,energy\n"
-    "                         (and <joint>_ref,<joint>_ref_dot with a reference)\n"
+    "                         (and <joint>_ref,_ref_dot,_ref_ddot with a reference)\n"
     "      --csv PATH|-       offline CSV destination (- = stdout; absent = no CSV,\n"
     "                         only the summary line on stderr)\n"
     "      --log FILE.lcm     real-time server: write every message published and the\n"

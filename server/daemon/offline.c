@@ -27,11 +27,11 @@ static volatile sig_atomic_t g_stop_signal;
 static void on_stop_signal(int signo) { g_stop_signal = signo; }
 
 /* One CSV row: t, q, qd as published (with the noise effect, if on), and the energy of
- * the true state; then, when the scene has a reference, r and r' of each joint that has
- * one (as lagsimd publishes them on <PREFIX>_REFERENCE). Returns <0 on write error. */
+ * the true state; then, when the scene has a reference, r, r' and r'' of each joint that
+ * has one (as lagsimd publishes them on <PREFIX>_REFERENCE). Returns <0 on write error. */
 static int write_row(FILE *f, const lag_sim *sim, const lag_scene_reference *ref)
 {
-    char line[1024], a[LAG_NUM_LEN], b[LAG_NUM_LEN];
+    char line[1024], a[LAG_NUM_LEN], b[LAG_NUM_LEN], c[LAG_NUM_LEN];
     double q[LAG_MAX_DOF], qd[LAG_MAX_DOF];
     lag_sim_observe(sim, q, qd);
     int n = snprintf(line, sizeof line, "%s", lag_num(lag_sim_time(sim), a));
@@ -44,14 +44,14 @@ static int write_row(FILE *f, const lag_sim *sim, const lag_scene_reference *ref
         lag_wire_reference m;
         lagsimd_reference_at(ref, sim->def.model.kind, lag_sim_time(sim), sim->tick, &m);
         for (int k = 0; k < m.num_joints; k++)
-            n += snprintf(line + n, sizeof line - (size_t)n, ",%s,%s", lag_num(m.r[k], a),
-                          lag_num(m.rdot[k], b));
+            n += snprintf(line + n, sizeof line - (size_t)n, ",%s,%s,%s", lag_num(m.r[k], a),
+                          lag_num(m.rdot[k], b), lag_num(m.rddot[k], c));
     }
     n += snprintf(line + n, sizeof line - (size_t)n, "\n");
     return fwrite(line, 1, (size_t)n, f) == (size_t)n ? 0 : -1;
 }
 
-/* t, q, q_dot, energy; then <joint>_ref, <joint>_ref_dot for the joints with a
+/* t, q, q_dot, energy; then <joint>_ref, _ref_dot, _ref_ddot for the joints with a
  * reference (none without one: the columns before stay where they were) */
 static void write_header(FILE *f, const lag_model_info *info, const lag_scene_reference *ref)
 {
@@ -62,7 +62,9 @@ static void write_header(FILE *f, const lag_model_info *info, const lag_scene_re
         fprintf(f, ",%s_dot", info->joint_names[i]);
     fputs(",energy", f);
     for (int i = 0; i < info->nq && i < LAG_MAX_DOF; i++)
-        if (ref->on[i]) fprintf(f, ",%s_ref,%s_ref_dot", info->joint_names[i], info->joint_names[i]);
+        if (ref->on[i])
+            fprintf(f, ",%s_ref,%s_ref_dot,%s_ref_ddot", info->joint_names[i],
+                    info->joint_names[i], info->joint_names[i]);
     fputs("\n", f);
 }
 

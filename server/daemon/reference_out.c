@@ -22,10 +22,11 @@ void lagsimd_reference_at(const lag_scene_reference *ref, lag_model_kind kind, d
         if (!ref->on[i]) continue;
         int k = m->num_joints++;
         snprintf(m->name[k], sizeof m->name[k], "%s", mi->joint_names[i]);
-        double r = 0.0, rdot = 0.0;
-        lag_reference_eval(&ref->joint[i], t, &r, &rdot);
+        double r = 0.0, rdot = 0.0, rddot = 0.0;
+        lag_reference_eval(&ref->joint[i], t, &r, &rdot, &rddot);
         /* a checked reference is finite everywhere; 0 is the last line of defence */
         m->r[k] = isfinite(r) ? r : 0.0;
         m->rdot[k] = isfinite(rdot) ? rdot : 0.0;
+        m->rddot[k] = isfinite(rddot) ? rddot : 0.0;
     }
 }

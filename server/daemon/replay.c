@@ -410,8 +410,9 @@ static void replay_reference(replay_run *run, const lag_log_record *rec)
 {
     run->refs_seen++;
     lag_wire_reference lr, cr;
+    const char *old = NULL; /* an earlier version's: without r'' (0.1.0) */
     if (!rec->data || lag_wire_decode_any(LAG_WIRE_REFERENCE, rec->data, rec->size,
-                                          LAG_WIRE_MAX_JOINTS, &lr, NULL) != LAG_WIRE_OK) {
+                                          LAG_WIRE_MAX_JOINTS, &lr, &old) != LAG_WIRE_OK) {
         run->refs_bad++;
         return;
     }
@@ -424,8 +425,10 @@ static void replay_reference(replay_run *run, const lag_log_record *rec)
     }
     for (int k = 0; k < lr.num_joints; k++) {
         double a = fabs(cr.r[k] - lr.r[k]), b = fabs(cr.rdot[k] - lr.rdot[k]);
+        double c = old ? 0.0 : fabs(cr.rddot[k] - lr.rddot[k]);
         if (!(a <= run->max_dr)) run->max_dr = a;
         if (!(b <= run->max_dr)) run->max_dr = b;
+        if (!(c <= run->max_dr)) run->max_dr = c;
     }
     run->refs_compared++;
 }
@@ -674,7 +677,7 @@ static lag_result replay_verdict(const replay_run *run, double max_diff)
     if (run->use_input) printf("max |effort - effort_log| = %s\n", lag_num(run->max_deff, a));
     if (run->refs_seen > 0 || run->sc->reference.n > 0) {
         printf("%lld references compared on %s (%lld of other joints, another time or "
-               "undecodable)\nmax |r - r_log|, |rdot - rdot_log| = %s\n",
+               "undecodable)\nmax |r - r_log|, |rdot - rdot_log|, |rddot - rddot_log| = %s\n",
                (long long)run->refs_compared, run->ch_ref, (long long)run->refs_bad,
                lag_num(run->max_dr, a));
         if (run->max_dr > max_diff || isnan(run->max_dr)) max_diff = run->max_dr;

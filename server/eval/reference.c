@@ -77,23 +77,47 @@ int lag_reference_check(const lag_reference *ref, char *key, size_t keylen, char
     return 0;
 }
 
-/* The phase of a chirp tau seconds after its start (rad) and its rate (rad/s). */
-static void chirp_phase(const lag_reference *ref, double tau, double *phi, double *w)
+/* The phase of a chirp tau seconds after its start (rad), its rate (rad/s) and the rate's
+ * rate (rad/s^2: constant during the sweep, 0 after). */
+static void chirp_phase(const lag_reference *ref, double tau, double *phi, double *w,
+                        double *wdot)
 {
     const double f0 = ref->frequency, f1 = ref->frequency_end, d = ref->duration;
     if (tau <= d) {
         *phi = 2 * M_PI * (f0 * tau + 0.5 * (f1 - f0) / d * tau * tau);
         *w = 2 * M_PI * (f0 + (f1 - f0) * tau / d);
+        *wdot = 2 * M_PI * (f1 - f0) / d;
     } else {
         *phi = 2 * M_PI * (0.5 * (f0 + f1) * d + f1 * (tau - d));
         *w = 2 * M_PI * f1;
+        *wdot = 0;
     }
 }
 
-void lag_reference_eval(const lag_reference *ref, double t, double *r, double *rdot)
+/* The waypoints' straight lines at tau: the shape and its slope (0 outside the points). */
+static void waypoints_at(const lag_reference *ref, double tau, double *shape, double *rate)
+{
+    const int n = ref->n_points;
+    const double *pt = ref->point_t, *pw = ref->point_w;
+    *rate = 0;
+    if (n < 1) *shape = 0;
+    else if (tau <= pt[0]) *shape = pw[0];
+    else if (tau >= pt[n - 1]) *shape = pw[n - 1];
+    else {
+        int i = 1;
+        while (pt[i] < tau) i++; /* pt[i-1] < tau <= pt[i] */
+        double slope = (pw[i] - pw[i - 1]) / (pt[i] - pt[i - 1]);
+        *shape = pw[i - 1] + slope * (tau - pt[i - 1]);
+        *rate = slope;
+    }
+}
+
+void lag_reference_eval(const lag_reference *ref, double t, double *r, double *rdot,
+                        double *rddot)
 {
     const double a = ref->amplitude, tau = t - ref->start;
-    double shape = 0, rate = 0; /* the signal without offset and amplitude, and its rate */
+    /* the signal without offset and amplitude, its rate and its second derivative */
+    double shape = 0, rate = 0, accel = 0;
     if (tau >= 0) {
         switch (ref->kind) {
         case LAG_REF_STEP:
@@ -107,13 +131,15 @@ void lag_reference_eval(const lag_reference *ref, double t, double *r, double *r
             double w = 2 * M_PI * ref->frequency;
             shape = sin(w * tau);
             rate = w * cos(w * tau);
+            accel = -w * w * shape;
             break;
         }
         case LAG_REF_CHIRP: {
-            double phi, w;
-            chirp_phase(ref, tau, &phi, &w);
+            double phi, w, wdot;
+            chirp_phase(ref, tau, &phi, &w, &wdot);
             shape = sin(phi);
             rate = w * cos(phi);
+            accel = wdot * cos(phi) - w * w * shape;
             break;
         }
         case LAG_REF_SQUARE: {
@@ -126,20 +152,9 @@ void lag_reference_eval(const lag_reference *ref, double t, double *r, double *r
             break;
         }
     }
-    if (ref->kind == LAG_REF_WAYPOINTS) { /* held before the first point too */
-        const int n = ref->n_points;
-        const double *pt = ref->point_t, *pw = ref->point_w;
-        if (n < 1) shape = 0;
-        else if (tau <= pt[0]) shape = pw[0];
-        else if (tau >= pt[n - 1]) shape = pw[n - 1];
-        else {
-            int i = 1;
-            while (pt[i] < tau) i++; /* pt[i-1] < tau <= pt[i] */
-            double slope = (pw[i] - pw[i - 1]) / (pt[i] - pt[i - 1]);
-            shape = pw[i - 1] + slope * (tau - pt[i - 1]);
-            rate = slope;
-        }
-    }
+    /* waypoints: held before the first point too */
+    if (ref->kind == LAG_REF_WAYPOINTS) waypoints_at(ref, tau, &shape, &rate);
     if (r) *r = ref->offset + a * shape;
     if (rdot) *rdot = a * rate;
+    if (rddot) *rddot = a * accel;
 }

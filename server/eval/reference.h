@@ -1,5 +1,6 @@
 /*
- * Reference signals: what a joint should follow, r(t) and its rate r'(t).
+ * Reference signals: what a joint should follow, r(t), its rate r'(t) and its second
+ * derivative r''(t).
  *
  * A scene gives a joint a reference (the scene key `reference:`); the daemon evaluates it
  * at each state's sim time and publishes it beside the state, so a controller in any
@@ -18,8 +19,17 @@
  *              points (t_i, w_i) (t_i counted from `start`), held before the first point and
  *              after the last
  *
- * r' is the exact derivative (0 at and across a step's or square's jump, where it is a
- * delta). Links only libm; nothing here allocates.
+ * r' and r'' are the exact derivatives (0 at and across a step's or square's jump, where
+ * r' is a delta; r'' is 0 wherever r is piecewise linear or constant, at a ramp's or a
+ * waypoint's corner too, where it is a delta):
+ *
+ *   sine       r'' = -amplitude w^2 sin(w (t - start)),  w = 2 pi frequency
+ *   chirp      r'' = amplitude (phi'' cos(phi) - phi'^2 sin(phi)),
+ *              phi'' = 2 pi (frequency_end - frequency) / duration during the sweep, 0 after
+ *   step, ramp, square, waypoints: r'' = 0
+ *
+ * so that a computed-torque feedforward M(q) r'' needs no difference of r'. Links only
+ * libm; nothing here allocates.
  */
 #ifndef LAGSIM_REFERENCE_H
 #define LAGSIM_REFERENCE_H
@@ -82,7 +92,8 @@ lag_reference lag_reference_default(lag_ref_kind kind);
 int lag_reference_check(const lag_reference *ref, char *key, size_t keylen, char *msg,
                         size_t msglen);
 
-/* r(t) and r'(t) of a checked reference (OUT: r, rdot; either may be NULL). */
-void lag_reference_eval(const lag_reference *ref, double t, double *r, double *rdot);
+/* r(t), r'(t) and r''(t) of a checked reference (OUT: r, rdot, rddot; any may be NULL). */
+void lag_reference_eval(const lag_reference *ref, double t, double *r, double *rdot,
+                        double *rddot);
 
 #endif

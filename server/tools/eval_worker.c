@@ -41,6 +41,7 @@
 #include "lagsim/lagsim.h"
 #include "lagsim_bus.h"
 #include "lagsim_client.h"
+#include "lagsim_client_wire.h"
 #include "lagsim_wire.h"
 
 #define W_ANSWER_S 0.5  /* a SET or RESET_TO unanswered this long is sent again */
@@ -57,6 +58,7 @@ struct eval_worker {
     char cerr[1100], derr[1100]; /* the pair's stderr without -v (eval_stderr_paths) */
     pid_t dpid, cpid;
     lag_client *cl;
+    lag_client_status *status; /* the latest status, read whole (lagsim_client_wire.h) */
     long runs;
     /* the run in progress, from the bus */
     eval_series s;
@@ -121,7 +123,7 @@ static bool reference_at(const eval_worker *w, double t, double *r)
 {
     lag_client_reference ref;
     for (int j = 0; j < w->sc.nj; j++) r[j] = 0;
-    if (!lag_client_latest_reference(w->cl, &ref) || ref.sim_time != t) return false;
+    if (!lag_client_latest_reference(w->cl, &ref, sizeof ref) || ref.sim_time != t) return false;
     for (int j = 0; j < w->sc.nj; j++) {
         int k = lag_client_reference_joint(&ref, w->sc.joint[j]);
         if (k >= 0 && isfinite(ref.r[k])) r[j] = ref.r[k];
@@ -179,7 +181,7 @@ static int w_wait(eval_worker *w, const bool *flag, double seconds)
 
 /* A status newer than now; false when none came within W_ANSWER_S or a state after sim
  * time 0 came first (the daemon moved: the question is answered). OUT: st */
-static bool fresh_status(eval_worker *w, lag_client_status *st, bool stop_on_move)
+static bool fresh_status(eval_worker *w, lag_wire_status *st, bool stop_on_move)
 {
     int64_t asked = (int64_t)(eval_now_wall() * 1e6);
     if (lag_client_request_status(w->cl) != LAG_CLIENT_OK) return false;
@@ -187,7 +189,9 @@ static bool fresh_status(eval_worker *w, lag_client_status *st, bool stop_on_mov
     while (eval_now() < end) {
         w_handle(w, 5);
         if (stop_on_move && w->moved) return false;
-        if (lag_client_latest_status(w->cl, st) && st->utime >= asked) return true;
+        if (lag_client_latest_status(w->cl, w->status) &&
+            (*st = *lag_wire_of_status(w->status)).utime >= asked)
+            return true;
     }
     return false;
 }
@@ -196,7 +200,7 @@ static bool fresh_status(eval_worker *w, lag_client_status *st, bool stop_on_mov
  * is under way it waits for answers instead)? */
 static bool still_at_start(eval_worker *w)
 {
-    lag_client_status st;
+    lag_wire_status st;
     return fresh_status(w, &st, true) && st.sim_time == 0 &&
            !strncmp(st.waiting_for, "RESUME or STEP", 14);
 }
@@ -308,8 +312,11 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
     w->cpid = eval_spawn(NULL, cmd, env, w->cerr);
     w->dpid = env->attach_log ? 0 : start_daemon(w, c);
     w->cl = lag_client_create(env->url, env->prefix, err, errlen);
-    if (w->cpid < 0 || w->dpid < 0 || !w->cl)
-        return start_failed(w, err, errlen, w->cl ? "cannot start the processes" : err);
+    w->status = lag_client_status_new();
+    if (w->cpid < 0 || w->dpid < 0 || !w->cl || !w->status)
+        return start_failed(w, err, errlen, !w->cl      ? err
+                                            : w->status ? "cannot start the processes"
+                                                        : "out of memory");
     lag_client_on_state(w->cl, w_on_state, w);
     lag_client_on_event(w->cl, w_on_event, w);
     lag_bus bus;
@@ -317,8 +324,7 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
         !(w->cmd = lcm_create(bus.command_url)) ||
         !lcm_subscribe(w->cmd, bus.channel[LAG_BUS_COMMAND], w_on_command, w))
         return start_failed(w, err, errlen, "cannot listen to the controller's answers");
-    lag_client_scene scene;
-    if (lag_client_wait_scene(w->cl, 10.0, &scene) != LAG_CLIENT_OK)
+    if (lag_client_wait_scene(w->cl, 10.0, NULL) != LAG_CLIENT_OK)
         return start_failed(w, err, errlen, "no scene from the kept lagsimd");
     /* a host's plant a worker before may have left in the middle of a run: paused first
      * (a plant paused already refuses it, harmlessly) */
@@ -337,6 +343,7 @@ void eval_worker_stop(eval_worker *w)
     if (!w) return;
     stop_pair(w);
     if (w->cl) lag_client_destroy(w->cl);
+    lag_client_status_free(w->status);
     if (w->cmd) lcm_destroy(w->cmd);
     eval_series_free(&w->s);
     if (!w->env.verbose) {
@@ -415,7 +422,7 @@ static void follow(eval_worker *w, double t_goal)
         if (w->s.n != seen) seen = w->s.n, last = eval_now();
         if (eval_now() - start > w->env.wall_timeout) break;
         if (eval_now() - last < W_QUIET_S) continue;
-        lag_client_status st;
+        lag_wire_status st;
         if (fresh_status(w, &st, false) &&
             (!strcmp(st.run_state, "fault") ||
              (st.sim_time >= t_goal && !strncmp(st.waiting_for, "RESUME or STEP", 14))))
@@ -478,7 +485,7 @@ static bool answer_heard(const eval_worker *w)
  * in its status while an answer is owed. */
 static bool daemon_has_answer(eval_worker *w, double *t)
 {
-    lag_client_status st;
+    lag_wire_status st;
     if (!fresh_status(w, &st, false)) return false;
     *t = st.sim_time;
     return (!strcmp(st.run_state, "paused") || !strcmp(st.run_state, "fault")) &&

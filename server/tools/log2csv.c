@@ -331,8 +331,9 @@ static bool write_state(l2c *c, chan *h, const lag_log_record *r, const lag_wire
     return true;
 }
 
-/* A reference: t, times, step, then r and r' under the state CSV's names (<joint>,
- * <joint>_dot), so that a row of the two files with the same t pairs q with r. */
+/* A reference: t, times, step, then r, r' and r'' under the state CSV's names (<joint>,
+ * <joint>_dot; r'': <joint>_ddot), so that a row of the two files with the same t pairs q
+ * with r. */
 static bool write_reference(l2c *c, chan *h, const lag_log_record *r,
                             const lag_wire_reference *m)
 {
@@ -341,10 +342,10 @@ static bool write_reference(l2c *c, chan *h, const lag_log_record *r,
         for (int i = 0; i < m->num_joints; i++) snprintf(h->joint[i], L2C_NAME, "%s", m->name[i]);
         if (!(h->csv = open_csv(c, h))) return false;
         fputs("t,wall_time,log_time,step,generation", h->csv);
-        for (int k = 0; k < 2; k++)
+        for (int k = 0; k < 3; k++)
             for (int i = 0; i < m->num_joints; i++) {
                 fputc(',', h->csv);
-                put_text(h->csv, m->name[i], k ? "_dot" : "");
+                put_text(h->csv, m->name[i], k == 2 ? "_ddot" : k ? "_dot" : "");
             }
         fputc('\n', h->csv);
     }
@@ -362,6 +363,7 @@ static bool write_reference(l2c *c, chan *h, const lag_log_record *r,
     put_i(f, m->generation);
     for (int i = 0; i < m->num_joints; i++) put_d(f, m->r[i]);
     for (int i = 0; i < m->num_joints; i++) put_d(f, m->rdot[i]);
+    for (int i = 0; i < m->num_joints; i++) put_d(f, m->rddot[i]);
     fputc('\n', f);
     return true;
 }

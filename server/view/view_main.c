@@ -214,7 +214,7 @@ static int pick_prefix(view_opts *o)
 {
     static lag_client_plant found;
     char err[1200];
-    int pr = lag_client_pick_plant(o->url, NULL, 2.0, &found, err, sizeof err);
+    int pr = lag_client_pick_plant(o->url, NULL, 2.0, &found, sizeof found, err, sizeof err);
     if (pr == LAG_CLIENT_ERR_AMBIGUOUS) {
         fprintf(stderr, "lagsim-view: %s\n", err);
         return LAG_ERR_AMBIGUOUS;
@@ -238,8 +238,8 @@ static void plant_url(view_opts *o)
     static char url[sizeof all[0].url];
     char err[256];
     int n = 0;
-    if (o->url || lag_client_discover(NULL, 1.0, 0.3, all, LAG_CLIENT_MAX_PLANTS, &n, err,
-                                      sizeof err) != LAG_CLIENT_OK)
+    if (o->url || lag_client_discover(NULL, 1.0, 0.3, all, LAG_CLIENT_MAX_PLANTS, sizeof all[0],
+                                      &n, err, sizeof err) != LAG_CLIENT_OK)
         return;
     for (int i = 0; i < n; i++)
         if (!strcmp(all[i].prefix, o->prefix) && elsewhere(all[i].url)) {

@@ -56,6 +56,7 @@ static const lag_wire_field reference_fields[] = {
     ARRAY(RF, LAG_WIRE_DOUBLE, r, 3),
     ARRAY(RF, LAG_WIRE_DOUBLE, rdot, 3),
     SCALAR(RF, LAG_WIRE_INT64, generation),                     /* 0.2.0 */
+    ARRAY(RF, LAG_WIRE_DOUBLE, rddot, 3),                       /* 0.2.0 */
 };
 
 typedef lag_wire_joint_command JC;
@@ -185,8 +186,10 @@ typedef struct type_info {
     old_version old[OLD_MAX]; /* oldest first; lagsim NULL: no more */
 } type_info;
 
-/* lagsim 0.1.0's types: today's without `generation` */
+/* lagsim 0.1.0's types: today's without the fields 0.2.0 appended (`generation`; and
+ * reference_t's `rddot`) */
 #define V010(f, fp) {"0.1.0", (int)(sizeof f / sizeof f[0]) - 1, (int64_t)fp}
+#define V010N(n, fp) {"0.1.0", n, (int64_t)fp}
 
 #define TYPE(n, f, T, h, ...) {n, f, (int)(sizeof f / sizeof f[0]), sizeof(T), h, {__VA_ARGS__}}
 static const type_info types[LAG_WIRE_TYPE_COUNT] = {
@@ -203,7 +206,7 @@ static const type_info types[LAG_WIRE_TYPE_COUNT] = {
                             V010(scene_fields, 0x1ab54f27e2c0e262)),
     [LAG_WIRE_REFERENCE] = TYPE("reference_t", reference_fields, RF,
                                 __lagsim_reference_t_get_hash,
-                                V010(reference_fields, 0x450a576ca1059690)),
+                                V010N(7, 0x450a576ca1059690)),
 };
 _Static_assert(sizeof types / sizeof types[0] == LAG_WIRE_TYPE_COUNT,
                "one table per message type");

@@ -206,6 +206,7 @@ typedef struct lag_wire_reference {
     double r[LAG_WIRE_MAX_JOINTS];                   /* m or rad */
     double rdot[LAG_WIRE_MAX_JOINTS];                /* m/s or rad/s */
     int64_t generation;                              /* the state's generation */
+    double rddot[LAG_WIRE_MAX_JOINTS];               /* m/s^2 or rad/s^2 */
 } lag_wire_reference;
 
 /* ---------------------------------------------------------------- per type */

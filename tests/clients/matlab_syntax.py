@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The MATLAB/Octave clients must run in MATLAB too: no GNU Octave-only syntax.
 
-    matlab_syntax.py FILE.m ... [--readme README.md]
+    matlab_syntax.py FILE.m ... [--readme README.md] [--snippets docs/clients.md]
 
 GNU Octave accepts a superset of MATLAB's language; what it alone accepts fails in MATLAB,
 and only GNU Octave runs in the tests. Flagged, outside strings and % comments: # comments,
@@ -9,10 +9,12 @@ and only GNU Octave runs in the tests. Flagged, outside strings and % comments: 
 endswitch, end_try_catch, endclassdef, endmethods, endproperties, unwind_protect, double
 quotes (MATLAB reads "..." as a string object, not a char vector), Octave-only functions
 (printf, puts, fputs, fdisp, argv, program_name), and fflush or pkg unless the three lines
-before test exist('OCTAVE_VERSION', 'builtin'). --readme also checks README.md's
-```matlab blocks. Before the files, the checker runs on lines that must be flagged and
+before test exist('OCTAVE_VERSION', 'builtin'). --readme also checks a Markdown file's
+```matlab blocks, --snippets those of its blocks that are marked <!-- snippet: NAME -->
+(programs run as written; the others may show MATLAB's command syntax, `f --opt`). Before the files, the checker runs on lines that must be flagged and
 lines that must pass, so it cannot pass by checking nothing.
 """
+import os
 import re
 import sys
 
@@ -111,10 +113,13 @@ def main():
     files = []
     while args:
         a = args.pop(0)
-        if a == "--readme":
-            text = open(args.pop(0)).read()
-            for k, m in enumerate(re.finditer(r"```matlab\n(.*?)```", text, re.S)):
-                files.append(("README.md block %d" % (k + 1), m.group(1).splitlines()))
+        if a in ("--readme", "--snippets"):
+            path = args.pop(0)
+            text = open(path).read()
+            marked = r"<!-- snippet: \S+ -->\s*\n" if a == "--snippets" else ""
+            for k, m in enumerate(re.finditer(marked + r"```matlab\n(.*?)```", text, re.S)):
+                files.append(("%s block %d" % (os.path.basename(path), k + 1),
+                              m.group(1).splitlines()))
         else:
             files.append((a, open(a).read().splitlines()))
     if not files:

@@ -7,7 +7,12 @@ README.md marks each runnable block with an HTML comment on the line before its 
 <!-- snippet: NAME -->. For each NAME given, the block is written to a fresh temporary
 directory (so it runs from any directory, as the README promises), its channel prefix
 DIPC is replaced by one unique to this run, and it is started the way the README says
-(C: built against the tree's client library with -Wall -Wextra -Werror;
+(C and C++: compiled as the block's first line says, `cc balance.c $(pkg-config --cflags
+--libs lagsim-client)` or `c++ -std=c++17 balance.cpp $(...)`, with the compiler given
+(--cc, --cxx: gcc, g++, clang++) and -Wall -Wextra -Werror, against the build tree
+(PKG_CONFIG_PATH=<build>/pkgconfig, the uninstalled lagsim-client.pc) or, with --install,
+against `cmake --install <build> --prefix TMP` (PKG_CONFIG_PATH=TMP/lib/pkgconfig; run
+with LD_LIBRARY_PATH=TMP/lib, as any library in a prefix off the loader's path);
 PYTHONPATH=<build>/python; LUA_PATH=<build>/lua/...; java -cp
 lcm.jar:types.jar:examples.jar File.java; octave --path <build>/octave --eval balance in
 the file's folder). Once it answers a probe state (sim time -1) it is subscribed; then lagsimd runs config/dipc.yaml in lockstep for 2 s of sim time and stops.
@@ -37,6 +42,7 @@ import argparse
 import math
 import os
 import re
+import shlex
 import signal
 import subprocess
 import sys
@@ -49,7 +55,10 @@ from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this proce
 THINK_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "think")
 # name: (file, command line (build, file, slow: the think wrapper, or ""), environment)
 RUNNERS = {
-    "c": ("balance.c", lambda b, f, slow: [f[:-2]], lambda b: {}),
+    "c": ("balance.c", lambda b, f, slow: [os.path.splitext(f)[0]], lambda b: {}),
+    "cpp": ("balance.cpp", lambda b, f, slow: [os.path.splitext(f)[0]], lambda b: {}),
+    # stock lcm-gen --cpp types with lcm/lcm-cpp.hpp (docs/clients.md), no lagsim library
+    "cpplcm": ("balance.cpp", lambda b, f, slow: [os.path.splitext(f)[0]], lambda b: {}),
     "python": ("balance.py",
                lambda b, f, slow: ["python3"] + ([os.path.join(THINK_DIR, "think.py")]
                                                  if slow else []) + [f],
@@ -96,8 +105,13 @@ def main():
     ap.add_argument("--readme", action="append", required=True,
                     help="a file with marked blocks (repeatable: README.md, docs/clients.md)")
     ap.add_argument("--config", required=True)
-    ap.add_argument("--c-build", default="",
-                    help="how to build the C block: a command line with {src} and {out}")
+    ap.add_argument("--cc", default="cc", help="the C block's compiler")
+    ap.add_argument("--cxx", default="c++", help="the C++ block's compiler")
+    ap.add_argument("--cflags", default="", help="more flags for both (a sanitizer build's)")
+    ap.add_argument("--lcm-cpp-types", default="",
+                    help="where lcm-gen --cpp wrote lagsim's types (the cpplcm block's -Igen)")
+    ap.add_argument("--install", action="store_true",
+                    help="build the C and C++ blocks against an install of the build tree")
     ap.add_argument("--think", type=float, default=0.0,
                     help="also run each block with a law of this many wall s per answer")
     ap.add_argument("--periods", type=int, default=200, help="control periods of a run")
@@ -118,6 +132,17 @@ def main():
     found = {}
     for f in a.readme:
         found.update(snippets(f))
+    a.pkg_config_path, a.lib_path = os.path.join(build, "pkgconfig"), ""
+    if a.install:
+        prefix = os.path.join(tempfile.mkdtemp(prefix="lagsim_readme_inst_"), "prefix")
+        r = subprocess.run(["cmake", "--install", build, "--prefix", prefix],
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+        if r.returncode != 0:
+            print("FAIL: cmake --install %s --prefix %s\n%s" % (build, prefix, r.stdout))
+            return 1
+        print("installed into %s" % prefix)
+        a.pkg_config_path = os.path.join(prefix, "lib", "pkgconfig")
+        a.lib_path = os.path.join(prefix, "lib")
     fails = 0
     for name in a.names:
         lang = name.split("-")[0]
@@ -144,6 +169,39 @@ def main():
     return 1 if fails else 0
 
 
+def build_block(a, text, lang, path, think):
+    """Compiles the C or C++ block as its first line says, against the client library of
+    a.pkg_config_path; with think > 0, with a slow law in front of its sends (think.h)."""
+    said = {"c": r"cc balance\.c \$\(pkg-config --cflags --libs lagsim-client\)",
+            "cpp": r"c\+\+ -std=c\+\+17 balance\.cpp \$\(pkg-config --cflags --libs lagsim-client\)",
+            "cpplcm": r"c\+\+ -std=c\+\+17 -Igen balance\.cpp \$\(pkg-config --cflags --libs lcm\)"}
+    if not re.search(said[lang], text.split("\n")[0] + text.split("\n")[1]):
+        print("FAIL: the %s block's first lines do not say how it builds (%s)" % (lang, said[lang]))
+        return False
+    pkg = "lcm" if lang == "cpplcm" else "lagsim-client"
+    env = dict(os.environ, PKG_CONFIG_PATH=a.pkg_config_path)
+    pc = subprocess.run(["pkg-config", "--cflags", "--libs", pkg], env=env,
+                        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    if pc.returncode != 0:
+        print("FAIL: PKG_CONFIG_PATH=%s pkg-config --cflags --libs %s:\n%s"
+              % (a.pkg_config_path, pkg, pc.stdout))
+        return False
+    cmd = ([a.cc] if lang == "c" else [a.cxx, "-std=c++17"]) + ["-Wall", "-Wextra", "-Werror"]
+    if lang == "cpplcm":  # "-Igen": the build's lcm-gen --cpp types
+        cmd.append("-I" + a.lcm_cpp_types)
+    cmd += shlex.split(a.cflags)
+    if think > 0:  # the same block, built with a slow law in front of its sends
+        cmd += ["-include", os.path.join(THINK_DIR, "think.h")]
+    cmd += [path, "-o", os.path.splitext(path)[0]] + pc.stdout.split()
+    print("$ PKG_CONFIG_PATH=%s %s" % (a.pkg_config_path, " ".join(cmd)))
+    cc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                        universal_newlines=True)
+    if cc.returncode != 0:
+        print("FAIL: the %s block does not build:\n%s" % (lang, cc.stdout))
+        return False
+    return True
+
+
 def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     """Runs one block against lagsimd for a.periods periods in lockstep, its law taking
     `think` wall s per answer (the daemon's lockstep_timeout from think and fast_slowest,
@@ -159,20 +217,15 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
         f.write(text.replace('"DIPC_', '"%s_' % prefix).replace("'DIPC_", "'%s_" % prefix)
                 .replace('"DIPC"', '"%s"' % prefix))
     slow = ""
-    if lang == "c":
-        build_cmd = a.c_build.split()
-        if think > 0:  # the same block, built with a slow law in front of its sends
-            build_cmd[1:1] = ["-include", os.path.join(THINK_DIR, "think.h")]
-        cc = subprocess.run([w.replace("{src}", path).replace("{out}", path[:-2])
-                             for w in build_cmd], stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, universal_newlines=True)
-        if cc.returncode != 0:
-            print("FAIL: the C block does not build:\n" + cc.stdout)
+    if lang in ("c", "cpp", "cpplcm"):
+        if not build_block(a, text, lang, path, think):
             return 1, {}, 0.0
     elif think > 0:
         slow = java_think_classes(build, tmp) if lang == "java" else "yes"
     env = dict(os.environ)
     env.update(env_extra(build))
+    if a.lib_path:
+        env["LD_LIBRARY_PATH"] = a.lib_path
     env["LAGSIM_THINK_S"] = repr(think)
     think_log = os.path.join(tmp, "think.log")
     if think > 0:

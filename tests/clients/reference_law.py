@@ -64,6 +64,7 @@ def forged_references(t):
         m = t.reference_t()
         m.utime, m.sim_time, m.step = 1, sim_time, 500
         m.num_joints, m.name, m.r, m.rdot = len(names), list(names), list(r), list(rdot)
+        m.rddot = [0.0] * len(names)
         return m.encode()
 
     good = valid(["q1", "q2"], [1e3, 1e3], [0.0, 0.0])
@@ -98,7 +99,8 @@ def whole(t, data):
     back to the same bytes (the rule of the Python controller library, _decode)."""
     try:
         m = t.reference_t.decode(data)
-        return m.encode() == data and all(math.isfinite(x) for x in [m.sim_time] + list(m.r) + list(m.rdot))
+        return m.encode() == data and all(math.isfinite(x) for x in
+                                          [m.sim_time] + list(m.r) + list(m.rdot) + list(m.rddot))
     except Exception:
         return False
 

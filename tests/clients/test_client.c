@@ -133,8 +133,8 @@ static void case_library(int arg)
     lcm_subscribe(peer, bus.channel[LAG_BUS_COMMAND], on_wrong_url, NULL);
 
     /* nobody answers DESCRIBE: timeout, requests were sent, message names the prefix */
-    lag_client_scene sc;
-    ENSURE(lag_client_wait_scene(c, 0.6, &sc) == LAG_CLIENT_TIMEOUT);
+    lag_client_scene *sc = lag_client_scene_new();
+    ENSURE(sc && lag_client_wait_scene(c, 0.6, sc) == LAG_CLIENT_TIMEOUT);
     ENSURE(strstr(lag_client_errmsg(c), prefix) != NULL);
     pump(peer, c, 50);
     ENSURE(describes >= 2); /* at once and every 0.25 s */
@@ -154,18 +154,18 @@ static void case_library(int arg)
     publish_state(peer, ch, 3, NULL, 2.5, NAN);     /* a NaN position */
     publish_state(peer, ch, 3, NULL, 3.0, 0.1);     /* valid */
     lag_client_state st;
-    ENSURE(lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK);
+    ENSURE(lag_client_wait_state(c, 2.0, &st, sizeof st) == LAG_CLIENT_OK);
     pump(peer, c, 50);
     ENSURE(st.sim_time == 3.0 && st.step == 3000 && st.num_joints == 3 && st.utime == 42);
     ENSURE(strcmp(st.name[0], "theta0") == 0 && lag_client_state_joint(&st, "theta0") == 0);
     ENSURE(st.position[2] == 0.1 * 3 && st.velocity[1] == -0.2 * 2 && st.effort[2] == 6.0);
     lag_client_counters cnt;
-    lag_client_get_counters(c, &cnt);
+    lag_client_get_counters(c, &cnt, sizeof cnt);
     ENSURE(cnt.states == 1 && cnt.dropped == 4);
     /* no new state: wait_state times out, latest_state still has the valid one */
-    ENSURE(lag_client_wait_state(c, 0.1, &st) == LAG_CLIENT_TIMEOUT);
+    ENSURE(lag_client_wait_state(c, 0.1, &st, sizeof st) == LAG_CLIENT_TIMEOUT);
     ENSURE(strstr(lag_client_errmsg(c), "no state") != NULL);
-    ENSURE(lag_client_latest_state(c, &st) && st.sim_time == 3.0);
+    ENSURE(lag_client_latest_state(c, &st, sizeof st) && st.sim_time == 3.0);
     ENSURE(lag_client_handle(c, 0) == LAG_CLIENT_TIMEOUT);
 
     /* a status, every field different: every one of them reaches the client */
@@ -175,25 +175,37 @@ static void case_library(int arg)
                           "flat", 30, "the first command", 30.5, "", 31, 31.5, "q2", 33.5, 34};
     lagsim_status_t_publish(peer, ch, &gs);
     pump(peer, c, 100);
-    lag_client_status ss;
-    ENSURE(lag_client_latest_status(c, &ss));
-    ENSURE(ss.utime == 1 && ss.sim_time == 2.5 && ss.step == 3 && ss.wall_time == 4.5);
-    ENSURE(ss.rtf == 5.5 && ss.overruns == 6 && ss.step_time_max_us == 7.5);
-    ENSURE(ss.step_time_mean_us == 8.5 && ss.energy == 9.5);
-    ENSURE(!strcmp(ss.integrator, "dopri5") && !strcmp(ss.mode, "lockstep"));
-    ENSURE(!strcmp(ss.run_state, "paused") && ss.commands_accepted == 13);
-    ENSURE(ss.rejected_unknown_joint == 14 && ss.rejected_unactuated == 15);
-    ENSURE(ss.rejected_nonfinite == 16 && ss.rejected_bad_length == 17);
-    ENSURE(ss.rejected_undecodable == 18 && ss.controls_rejected == 19);
-    ENSURE(ss.watchdog_tripped && ss.watchdog_trips == 21 && ss.lockstep_timeouts == 22);
-    ENSURE(ss.numeric_faults == 23 && ss.rejected_stale == 24 && ss.overrun_bursts == 25);
-    ENSURE(ss.states_published == 26 && ss.rejected_effort_limit == 27);
-    ENSURE(ss.lockstep_retries == 28 && ss.commands_ignored == 29 && !strcmp(ss.contact, "flat"));
-    ENSURE(ss.plant_conflicts == 30);
-    ENSURE(!strcmp(ss.waiting_for, "the first command") && ss.waiting_s == 30.5);
-    ENSURE(!strcmp(ss.waiting_got, "") && ss.commands_wrong_port == 31);
-    ENSURE(ss.error_estimate == 31.5 && !strcmp(ss.error_joint, "q2"));
-    ENSURE(ss.error_budget == 33.5 && ss.error_warnings == 34);
+    /* through the accessors, by the field's name (numbers; texts) */
+    lag_client_status *ss = lag_client_status_new();
+    ENSURE(ss && lag_client_latest_status(c, ss));
+#define SN(f) lag_client_status_number(ss, #f)
+#define ST(f) lag_client_status_text(ss, #f)
+    ENSURE(SN(utime) == 1 && SN(sim_time) == 2.5 && SN(step) == 3 && SN(wall_time) == 4.5);
+    ENSURE(SN(rtf) == 5.5 && SN(overruns) == 6 && SN(step_time_max_us) == 7.5);
+    ENSURE(SN(step_time_mean_us) == 8.5 && SN(energy) == 9.5);
+    ENSURE(!strcmp(ST(integrator), "dopri5") && !strcmp(ST(mode), "lockstep"));
+    ENSURE(!strcmp(ST(run_state), "paused") && SN(commands_accepted) == 13);
+    ENSURE(SN(rejected_unknown_joint) == 14 && SN(rejected_unactuated) == 15);
+    ENSURE(SN(rejected_nonfinite) == 16 && SN(rejected_bad_length) == 17);
+    ENSURE(SN(rejected_undecodable) == 18 && SN(controls_rejected) == 19);
+    ENSURE(SN(watchdog_tripped) && SN(watchdog_trips) == 21 && SN(lockstep_timeouts) == 22);
+    ENSURE(SN(numeric_faults) == 23 && SN(rejected_stale) == 24 && SN(overrun_bursts) == 25);
+    ENSURE(SN(states_published) == 26 && SN(rejected_effort_limit) == 27);
+    ENSURE(SN(lockstep_retries) == 28 && SN(commands_ignored) == 29 && !strcmp(ST(contact), "flat"));
+    ENSURE(SN(plant_conflicts) == 30);
+    ENSURE(!strcmp(ST(waiting_for), "the first command") && SN(waiting_s) == 30.5);
+    ENSURE(!strcmp(ST(waiting_got), "") && SN(commands_wrong_port) == 31);
+    ENSURE(SN(error_estimate) == 31.5 && !strcmp(ST(error_joint), "q2"));
+    ENSURE(SN(error_budget) == 33.5 && SN(error_warnings) == 34);
+
+    ENSURE(isnan(SN(no_such_field)) && isnan(SN(mode)) && ST(no_such_field) == NULL &&
+           ST(rtf) == NULL);
+    ENSURE(lag_client_status_fields() >= 39 &&
+           !strcmp(lag_client_status_field_name(0), "utime") &&
+           lag_client_status_field_name(lag_client_status_fields()) == NULL);
+#undef SN
+#undef ST
+    lag_client_status_free(ss);
 
     /* commands */
     const char *names[2] = {"q1", "q2"};
@@ -219,7 +231,7 @@ static void case_library(int arg)
     ENSURE(lag_client_reset_to(c, 2, enan, eff) == LAG_CLIENT_ERR_ARG);
     pump(peer, c, 100);
     ENSURE(commands == 1); /* none of the refused ones went out */
-    lag_client_get_counters(c, &cnt);
+    lag_client_get_counters(c, &cnt, sizeof cnt);
     ENSURE(cnt.commands_sent == 1);
     double q2[2] = {0.25, -0.5}, qd2[2] = {1.0, 2.0};
     ENSURE(lag_client_reset_to(c, 2, q2, qd2) == LAG_CLIENT_OK);
@@ -238,9 +250,9 @@ static void case_library(int arg)
      * command again, at once. */
     snprintf(ch, sizeof ch, "%s_STATE", prefix);
     publish_state(peer, ch, 3, NULL, 4.0, 0.1);
-    ENSURE(lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK && st.sim_time == 4.0);
+    ENSURE(lag_client_wait_state(c, 2.0, &st, sizeof st) == LAG_CLIENT_OK && st.sim_time == 4.0);
     publish_state(peer, ch, 3, NULL, 4.0, 0.1); /* a copy before the answer */
-    ENSURE(lag_client_wait_state(c, 0.3, &st) == LAG_CLIENT_TIMEOUT);
+    ENSURE(lag_client_wait_state(c, 0.3, &st, sizeof st) == LAG_CLIENT_TIMEOUT);
     int before = commands;
     ENSURE(lag_client_send_command(c, 4.0, 2, names, eff) == LAG_CLIENT_OK);
     pump(peer, c, 100);
@@ -248,31 +260,44 @@ static void case_library(int arg)
     int64_t utime_answer = last_cmd.utime;
     publish_state(peer, ch, 3, NULL, 4.0, 0.1); /* a copy after it: answered again */
     pump(peer, c, 100);
-    ENSURE(lag_client_wait_state(c, 0.1, &st) == LAG_CLIENT_TIMEOUT);
+    ENSURE(lag_client_wait_state(c, 0.1, &st, sizeof st) == LAG_CLIENT_TIMEOUT);
     ENSURE(commands == before + 2 && last_cmd.sim_time == 4.0 && last_cmd.utime == utime_answer &&
            last_cmd.effort[1] == -2.25);
-    lag_client_get_counters(c, &cnt);
+    lag_client_get_counters(c, &cnt, sizeof cnt);
     ENSURE(cnt.copies == 2 && cnt.repeats == 1 && cnt.commands_sent == 2);
     publish_state(peer, ch, 3, NULL, 4.01, 0.1); /* the next state: returned */
-    ENSURE(lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK && st.sim_time == 4.01);
+    ENSURE(lag_client_wait_state(c, 2.0, &st, sizeof st) == LAG_CLIENT_OK && st.sim_time == 4.01);
 
     /* lag_client_feed: the same path as the bus; another channel is refused */
     ENSURE(lag_client_feed(c, "OTHER_STATE", junk, sizeof junk) == LAG_CLIENT_ERR_ARG);
     snprintf(ch, sizeof ch, "%s_EVENT", prefix);
-    lag_client_get_counters(c, &cnt);
+    lag_client_get_counters(c, &cnt, sizeof cnt);
     ENSURE(lag_client_feed(c, ch, junk, sizeof junk) == LAG_CLIENT_OK);
     lag_client_counters cnt2;
-    lag_client_get_counters(c, &cnt2);
+    lag_client_get_counters(c, &cnt2, sizeof cnt2);
     ENSURE(cnt2.dropped == cnt.dropped + 1 && cnt2.events == cnt.events);
 
     /* a scene description */
     publish_scene(peer, prefix, 0, 0.5);
-    ENSURE(lag_client_wait_scene(c, 2.0, &sc) == LAG_CLIENT_OK);
-    ENSURE(strcmp(sc.prefix, prefix) == 0 && sc.num_params == 3 && sc.num_joints == 2);
-    ENSURE(strcmp(sc.model, "manipulator") == 0 && strcmp(sc.mode, "lockstep") == 0);
-    ENSURE(lag_client_scene_param(&sc, "g") == 9.81 && isnan(lag_client_scene_param(&sc, "zz")));
-    ENSURE(lag_client_scene_joint(&sc, "q2") == 1 && sc.actuated[0] && !sc.actuated[1]);
-    ENSURE(sc.initial_q[1] == 0.5 && sc.control_period == 0.01);
+    ENSURE(lag_client_wait_scene(c, 2.0, sc) == LAG_CLIENT_OK);
+    ENSURE(strcmp(lag_client_scene_prefix(sc), prefix) == 0 &&
+           lag_client_scene_num_params(sc) == 3 && lag_client_scene_num_joints(sc) == 2);
+    ENSURE(strcmp(lag_client_scene_model(sc), "manipulator") == 0 &&
+           strcmp(lag_client_scene_mode(sc), "lockstep") == 0);
+    ENSURE(lag_client_scene_param(sc, "g") == 9.81 && isnan(lag_client_scene_param(sc, "zz")));
+    ENSURE(lag_client_scene_joint(sc, "q2") == 1 && lag_client_scene_actuated(sc, 0) &&
+           !lag_client_scene_actuated(sc, 1));
+    ENSURE(lag_client_scene_initial_q(sc, 1) == 0.5 && lag_client_scene_control_period(sc) == 0.01);
+    /* out of range: NULL, NaN, false, -1 */
+    ENSURE(lag_client_scene_joint_name(sc, 2) == NULL && lag_client_scene_param_name(sc, -1) == NULL);
+    ENSURE(isnan(lag_client_scene_initial_q(sc, 8)) && !lag_client_scene_actuated(sc, -1));
+    ENSURE(lag_client_scene_joint(sc, "q9") == -1 && lag_client_scene_joint(sc, NULL) == -1);
+    lag_client_scene *copy = lag_client_scene_new();
+    lag_client_scene_copy(copy, sc);
+    ENSURE(copy && !strcmp(lag_client_scene_model(copy), "manipulator") &&
+           lag_client_scene_param_value(copy, 2) == lag_client_scene_param_value(sc, 2));
+    lag_client_scene_free(copy);
+    lag_client_scene_free(sc);
 
     pump(peer, c, 100);
     ENSURE(controls > 0 && commands > 0 && on_state_url == 0); /* each on its own port */
@@ -305,15 +330,15 @@ static void case_generation(int arg)
     const char *names[1] = {"q1"};
     double u1 = 1.5, u2 = -2.5;
     lag_client_state st;
-    lag_client_scene sc;
+    lag_client_scene *sc = lag_client_scene_new();
     lag_client_counters cnt;
 
     /* generation 1: the scene, then its state, returned */
     publish_scene(peer, prefix, 1, 0.5);
     g_gen = 1;
     publish_state(peer, ch, 2, NULL, 0.0, 0.1);
-    ENSURE(lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK && st.generation == 1);
-    ENSURE(lag_client_latest_scene(c, &sc) && sc.generation == 1);
+    ENSURE(lag_client_wait_state(c, 2.0, &st, sizeof st) == LAG_CLIENT_OK && st.generation == 1);
+    ENSURE(lag_client_latest_scene(c, sc) && lag_client_scene_generation(sc) == 1);
     ENSURE(lag_client_send_command(c, 0.0, 1, names, &u1) == LAG_CLIENT_OK);
     pump(peer, c, 100);
     ENSUREF(last_cmd.generation == 1 && last_cmd.sim_time == 0.0 && last_cmd.effort[0] == 1.5,
@@ -324,20 +349,21 @@ static void case_generation(int arg)
      * sent again), held, its scene asked for */
     g_gen = 2;
     publish_state(peer, ch, 2, NULL, 0.0, 0.1);
-    ENSURE(lag_client_wait_state(c, 0.6, &st) == LAG_CLIENT_TIMEOUT);
+    ENSURE(lag_client_wait_state(c, 0.6, &st, sizeof st) == LAG_CLIENT_TIMEOUT);
     pump(peer, c, 50);
-    lag_client_get_counters(c, &cnt);
+    lag_client_get_counters(c, &cnt, sizeof cnt);
     ENSUREF(commands == cmds && cnt.repeats == 0 && cnt.held == 1,
             "a state of the next generation taken for a copy: %d answers sent again, %lld "
             "repeats, %lld held", commands - cmds, (long long)cnt.repeats, (long long)cnt.held);
     ENSUREF(describes >= asked + 2 && cnt.describes >= 2,
             "%d DESCRIBE while the scene of generation 2 was awaited", describes - asked);
-    ENSURE(lag_client_latest_state(c, &st) && st.generation == 1); /* still the last returned */
+    /* still the last returned */
+    ENSURE(lag_client_latest_state(c, &st, sizeof st) && st.generation == 1);
     /* its scene: the held state is returned, with the new scene */
     publish_scene(peer, prefix, 2, 1.25);
-    ENSURE(lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK && st.generation == 2);
-    ENSURE(lag_client_latest_scene(c, &sc) && sc.generation == 2 &&
-           lag_client_scene_param(&sc, "m2") == 1.25);
+    ENSURE(lag_client_wait_state(c, 2.0, &st, sizeof st) == LAG_CLIENT_OK && st.generation == 2);
+    ENSURE(lag_client_latest_scene(c, sc) && lag_client_scene_generation(sc) == 2 &&
+           lag_client_scene_param(sc, "m2") == 1.25);
     ENSURE(lag_client_send_command(c, 0.0, 1, names, &u2) == LAG_CLIENT_OK);
     pump(peer, c, 100);
     ENSURE(last_cmd.generation == 2 && last_cmd.effort[0] == -2.5);
@@ -345,8 +371,8 @@ static void case_generation(int arg)
     cmds = commands;
     publish_state(peer, ch, 2, NULL, 0.0, 0.1);
     pump(peer, c, 100);
-    ENSURE(lag_client_wait_state(c, 0.1, &st) == LAG_CLIENT_TIMEOUT);
-    lag_client_get_counters(c, &cnt);
+    ENSURE(lag_client_wait_state(c, 0.1, &st, sizeof st) == LAG_CLIENT_TIMEOUT);
+    lag_client_get_counters(c, &cnt, sizeof cnt);
     ENSURE(commands == cmds + 1 && last_cmd.generation == 2 && last_cmd.effort[0] == -2.5 &&
            cnt.repeats == 1);
 
@@ -356,10 +382,11 @@ static void case_generation(int arg)
     publish_scene(peer, prefix, 3, 0.75);
     g_gen = 3;
     publish_state(peer, ch, 2, NULL, 0.0, 0.1);
-    ENSURE(lag_client_wait_state(c, 2.0, &st) == LAG_CLIENT_OK && st.generation == 3);
+    ENSURE(lag_client_wait_state(c, 2.0, &st, sizeof st) == LAG_CLIENT_OK && st.generation == 3);
     pump(peer, c, 300);
     ENSURE(describes == asked);
-    ENSURE(lag_client_latest_scene(c, &sc) && lag_client_scene_param(&sc, "m2") == 0.75);
+    ENSURE(lag_client_latest_scene(c, sc) && lag_client_scene_param(sc, "m2") == 0.75);
+    lag_client_scene_free(sc);
     g_gen = 0;
     lag_client_destroy(c);
     lcm_destroy(peer);

@@ -113,7 +113,7 @@ static void case_hostile_messages(int arg)
     lag_client_counters cnt = {0};
     for (int i = 0; i < 400 && cnt.states + cnt.dropped < sent + 1; i++) {
         lag_client_handle(c, 5);
-        lag_client_get_counters(c, &cnt);
+        lag_client_get_counters(c, &cnt, sizeof cnt);
     }
     printf("test_client_hostile: %lld dropped, %lld states kept\n", (long long)cnt.dropped,
            (long long)cnt.states);

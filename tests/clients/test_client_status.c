@@ -1,14 +1,14 @@
 /*
  * Every field of status_t reaches C clients, one by one, with the field list read from
  * lcmtypes/status_t.lcm itself: a field added to the .lcm file and not carried through
- * to lag_client_status fails here, by name.
+ * to lag_client_status (its accessors lag_client_status_number and _text, by the field's
+ * name) fails here, by name.
  *
  * For each field of the .lcm file, a status_t is built by this test's own encoder (from
  * the parsed field list; fingerprint: lcm-gen's) in which that field has a value of its
  * own and every other field is zero or empty, and is fed to a client handle on its
- * <prefix>_STATUS channel (the path of the bus). The field is then looked up in the
- * client's status by its .lcm name (lag_wire_fields gives the member; its offset comes
- * from offsetof on the member of that very name) and must hold the value; every other
+ * <prefix>_STATUS channel (the path of the bus). The field is then read from the client's
+ * status through the accessors by its .lcm name and must hold the value; every other
  * field must still be zero or empty.
  *
  * usage: test_client_status status_fields LCMTYPES_DIR   (tests/common/lagsim_test.h)
@@ -20,6 +20,7 @@
 #include "lagsim/lagsim_status_t.h"
 #include "lagsim_client.h"
 #include "lagsim_test.h"
+#include "lagsim_wire.h"
 #include "lcm_fields.h"
 
 static size_t put(uint8_t *b, size_t p, uint64_t v, int n)
@@ -63,43 +64,24 @@ static size_t encode(const lcm_field *f, int n, int set, uint8_t *b)
     return p;
 }
 
-/* Whether member `w` of the client's status holds field k's value (on) or zero. */
-static bool holds(const lag_client_status *s, const lag_wire_field *w, int k, bool on)
+/* Whether field k (named `name`, of type `type` in the .lcm file) of the client's status,
+ * read through the accessors of lagsim_client.h by its name, holds its value (on) or
+ * zero. */
+static bool holds(const lag_client_status *s, const char *name, const char *type, int k,
+                  bool on)
 {
-    const uint8_t *m = (const uint8_t *)s + w->offset;
-    switch (w->kind) {
-    case LAG_WIRE_INT64: {
-        int64_t v;
-        memcpy(&v, m, sizeof v);
-        return v == (on ? int_value(k) : 0);
-    }
-    case LAG_WIRE_INT16: {
-        int16_t v;
-        memcpy(&v, m, sizeof v);
-        return v == (on ? k + 1 : 0);
-    }
-    case LAG_WIRE_INT8: {
-        int8_t v;
-        memcpy(&v, m, sizeof v);
-        return v == (on ? k + 1 : 0);
-    }
-    case LAG_WIRE_BOOLEAN: {
-        bool v;
-        memcpy(&v, m, sizeof v);
-        return v == on;
-    }
-    case LAG_WIRE_DOUBLE: {
-        double v;
-        memcpy(&v, m, sizeof v);
-        return v == (on ? double_value(k) : 0.0);
-    }
-    case LAG_WIRE_STRING: {
+    if (!strcmp(type, "string")) {
         char want[32] = "";
         if (on) snprintf(want, sizeof want, "field%d", k);
-        return strcmp((const char *)m, want) == 0;
+        const char *t = lag_client_status_text(s, name);
+        return t && strcmp(t, want) == 0 && isnan(lag_client_status_number(s, name));
     }
-    }
-    return false;
+    double v = lag_client_status_number(s, name), want = 0;
+    if (!strcmp(type, "int64_t") || !strcmp(type, "int32_t")) want = (double)int_value(k);
+    else if (!strcmp(type, "int16_t") || !strcmp(type, "int8_t")) want = k + 1;
+    else if (!strcmp(type, "boolean")) want = 1;
+    else if (!strcmp(type, "double")) want = double_value(k);
+    return v == (on ? want : 0.0) && lag_client_status_text(s, name) == NULL;
 }
 
 static void case_status_fields(int arg)
@@ -127,8 +109,9 @@ static void case_status_fields(int arg)
     }
 
     lag_client *c = lag_client_create("memq://", "STATUSFIELDS", err, sizeof err);
-    ENSUREF(c != NULL, "%s", err);
-    if (!c) return;
+    lag_client_status *s = lag_client_status_new();
+    ENSUREF(c != NULL && s != NULL, "%s", err);
+    if (!c || !s) return;
     snprintf(ch, sizeof ch, "STATUSFIELDS_STATUS");
     for (int k = 0; k < n; k++) {
         static uint8_t b[4096];
@@ -137,22 +120,31 @@ static void case_status_fields(int arg)
                 f[k].name, f[k].type, f[k].dim[0] ? " array of " : "", f[k].dim);
         if (len == 0) continue;
         lag_client_counters before, after;
-        lag_client_get_counters(c, &before);
+        lag_client_get_counters(c, &before, sizeof before);
         ENSURE(lag_client_feed(c, ch, b, len) == LAG_CLIENT_OK);
-        lag_client_get_counters(c, &after);
+        lag_client_get_counters(c, &after, sizeof after);
         ENSUREF(after.statuses == before.statuses + 1,
                 "status with status_t.%s set was dropped (the client does not decode the "
                 ".lcm layout)", f[k].name);
-        lag_client_status s;
-        ENSURE(lag_client_latest_status(c, &s));
+        ENSURE(lag_client_latest_status(c, s));
         for (int j = 0; j < n; j++) {
             if (member[j] < 0) continue;
             bool on = j == k;
-            ENSUREF(holds(&s, &w[member[j]], j, on), "status_t.%s %s when status_t.%s was set",
-                    f[j].name, on ? "was not copied to lag_client_status" : "changed",
+            ENSUREF(holds(s, f[j].name, f[j].type, j, on),
+                    "status_t.%s %s when status_t.%s was set", f[j].name,
+                    on ? "does not reach lag_client_status_number/_text" : "changed",
                     f[k].name);
         }
     }
+    /* the accessors' list of fields is the .lcm file's, in its order */
+    ENSUREF(lag_client_status_fields() == n, "%d fields listed, %d in the .lcm file",
+            lag_client_status_fields(), n);
+    for (int k = 0; k < n && k < lag_client_status_fields(); k++)
+        ENSUREF(!strcmp(lag_client_status_field_name(k), f[k].name) &&
+                    lag_client_status_field_is_text(k) == !strcmp(f[k].type, "string"),
+                "field %d: %s listed, %s in the .lcm file", k, lag_client_status_field_name(k),
+                f[k].name);
+    lag_client_status_free(s);
     lag_client_destroy(c);
 }
 

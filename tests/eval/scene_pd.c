@@ -33,7 +33,7 @@ int main(int argc, char **argv)
                            "scene's m2 (a test's scene-reactive controller).", NULL, 0);
     if (rc >= 0) return rc;
     if (lag_ctl_start(&ctl, "manipulator")) return lag_ctl_fail(&ctl);
-    double m2 = lag_client_scene_param(&ctl.scene, "m2");
+    double m2 = lag_client_scene_param(ctl.scene, "m2");
     lag_client_on_scene(ctl.client, on_scene, &m2);
     static const char *const names[2] = {"q1", "q2"};
     static const double target[2] = {0.3, 0.6};

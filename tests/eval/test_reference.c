@@ -1,12 +1,15 @@
 /*
  * Reference signals (server/eval/reference.c): each kind's values at points where the
  * formula gives them in closed form, its rate against a central difference of its values,
+ * its second derivative in closed form and against a central difference of its rate,
  * continuity where the formula changes branch, and the checks of bad definitions.
  *
  * Tolerances: a central difference with step h of a signal whose third derivative is at
  * most D3 is off by h^2 D3 / 6 plus rounding eps |r| / h; with h = 1e-5 and the signals
  * below (|r| <= 3, D3 <= (2 pi 12)^3 * 2) that is under 2e-4 relative to the rate scale,
- * checked at 1e-3 of the largest rate.
+ * checked at 1e-3 of the largest rate. The same for r'' from r': h^2 D4 / 6 with
+ * D4 <= (2 pi 12)^4 * 3 is under 4e-4 of the scale (2 pi 12)^2, plus eps |r'| / h ~ 2e-9:
+ * checked at 1e-3 of the largest r''.
  */
 #include "lagsim_test.h"
 #include "reference.h"
@@ -14,7 +17,7 @@
 static double value(const lag_reference *ref, double t)
 {
     double r;
-    lag_reference_eval(ref, t, &r, NULL);
+    lag_reference_eval(ref, t, &r, NULL, NULL);
     return r;
 }
 
@@ -28,9 +31,39 @@ static void check_rate(const lag_reference *ref, double a, double b, double scal
         double t = lt_uniform(&rng, a, b);
         if (skip && skip(ref, t)) continue;
         double rd;
-        lag_reference_eval(ref, t, NULL, &rd);
+        lag_reference_eval(ref, t, NULL, &rd, NULL);
         double fd = (value(ref, t + h) - value(ref, t - h)) / (2 * h);
         ENSURE_NEAR(rd, fd, 1e-3 * scale, "%s at t = %.9g", lag_ref_kind_table[ref->kind].name, t);
+    }
+}
+
+/* r'' against a central difference of r' at n times in [a, b], away from jumps of r'. */
+static void check_accel(const lag_reference *ref, double a, double b, double scale,
+                        int (*skip)(const lag_reference *, double))
+{
+    lt_rng rng = {43};
+    const double h = 1e-5;
+    for (int i = 0; i < 400; i++) {
+        double t = lt_uniform(&rng, a, b);
+        if (skip && skip(ref, t)) continue;
+        double rdd, rd0, rd1;
+        lag_reference_eval(ref, t, NULL, NULL, &rdd);
+        lag_reference_eval(ref, t - h, NULL, &rd0, NULL);
+        lag_reference_eval(ref, t + h, NULL, &rd1, NULL);
+        ENSURE_NEAR(rdd, (rd1 - rd0) / (2 * h), 1e-3 * scale, "r'' of %s at t = %.9g",
+                    lag_ref_kind_table[ref->kind].name, t);
+    }
+}
+
+/* r'' is exactly 0 at every time in [a, b]: r piecewise linear or constant. */
+static void check_no_accel(const lag_reference *ref, double a, double b)
+{
+    lt_rng rng = {44};
+    for (int i = 0; i < 400; i++) {
+        double t = lt_uniform(&rng, a, b), rdd = 1;
+        lag_reference_eval(ref, t, NULL, NULL, &rdd);
+        ENSUREF(rdd == 0, "r'' of %s at t = %.9g: %.17g, not 0",
+                lag_ref_kind_table[ref->kind].name, t, rdd);
     }
 }
 
@@ -52,13 +85,14 @@ static void case_step(int arg)
     lag_reference s = lag_reference_default(LAG_REF_STEP);
     s.start = 1, s.amplitude = 0.2, s.offset = -0.1;
     double r, rd;
-    lag_reference_eval(&s, 0.999, &r, &rd);
+    lag_reference_eval(&s, 0.999, &r, &rd, NULL);
     ENSURE(r == -0.1 && rd == 0);
-    lag_reference_eval(&s, 1.0, &r, &rd);
+    lag_reference_eval(&s, 1.0, &r, &rd, NULL);
     ENSURE_NEAR(r, 0.1, 1e-15, "step at its start");
     ENSURE(rd == 0);
-    lag_reference_eval(&s, 1e6, &r, &rd);
+    lag_reference_eval(&s, 1e6, &r, &rd, NULL);
     ENSURE_NEAR(r, 0.1, 1e-15, "step held");
+    check_no_accel(&s, 0, 3);
 }
 
 static void case_ramp(int arg)
@@ -71,9 +105,10 @@ static void case_ramp(int arg)
     ENSURE_NEAR(value(&s, 4.5), 3, 1e-15, "the end");
     ENSURE_NEAR(value(&s, 100), 3, 0, "held");
     double rd;
-    lag_reference_eval(&s, 3, NULL, &rd);
+    lag_reference_eval(&s, 3, NULL, &rd, NULL);
     ENSURE_NEAR(rd, 0.5, 1e-15, "slope amplitude / duration");
     check_rate(&s, 0, 6, 0.5, near_kink);
+    check_no_accel(&s, 0, 6);
 }
 
 static void case_sine(int arg)
@@ -86,6 +121,17 @@ static void case_sine(int arg)
     ENSURE_NEAR(value(&s, 1 + 0.25 * 7), 0.5, 1e-13, "3.5 periods: offset");
     ENSURE(value(&s, 0.9) == 0.5);
     check_rate(&s, 0, 5, 2 * M_PI * 2 * 3, near_kink);
+    /* r'' = -a w^2 sin(w tau): -a w^2 at a quarter period, +a w^2 at three quarters, 0
+     * before the start */
+    const double w2a = 3 * (2 * M_PI * 2) * (2 * M_PI * 2);
+    double rdd;
+    lag_reference_eval(&s, 1 + 0.125, NULL, NULL, &rdd);
+    ENSURE_NEAR(rdd, -w2a, 1e-12 * w2a, "r'' a quarter period in");
+    lag_reference_eval(&s, 1 + 0.375, NULL, NULL, &rdd);
+    ENSURE_NEAR(rdd, w2a, 1e-12 * w2a, "r'' three quarters in");
+    lag_reference_eval(&s, 0.9, NULL, NULL, &rdd);
+    ENSURE(rdd == 0);
+    check_accel(&s, 0, 5, w2a, near_kink);
 }
 
 static void case_chirp(int arg)
@@ -106,10 +152,28 @@ static void case_chirp(int arg)
     /* after the sweep: 11 Hz from phase 2 pi (1 + 11) / 2 * 2 = 2 pi 12 */
     ENSURE_NEAR(value(&s, 2 + 1.0 / 44), 1, 1e-12, "a quarter period of 11 Hz after the sweep");
     double r0, r1;
-    lag_reference_eval(&s, 2 - 1e-12, &r0, NULL);
-    lag_reference_eval(&s, 2 + 1e-12, &r1, NULL);
+    lag_reference_eval(&s, 2 - 1e-12, &r0, NULL, NULL);
+    lag_reference_eval(&s, 2 + 1e-12, &r1, NULL, NULL);
     ENSURE_NEAR(r0, r1, 1e-9, "continuous at the sweep's end");
     check_rate(&s, 0, 4, 2 * M_PI * 11, near_kink);
+    /* r'' = phi'' cos(phi) - phi'^2 sin(phi), phi' = 2 pi (1 + 5 tau), phi'' = 10 pi in the
+     * sweep: at a zero crossing of sin (phi = pi k) it is phi'' cos(phi) = +-10 pi; at a
+     * crest (phi = pi/2 + 2 pi k), -phi'^2; after the sweep, -(2 pi 11)^2 sin(phi) */
+    for (int k = 1; k <= 23; k++) {
+        double tau = (-1 + sqrt(1 + 10.0 * k * 0.5)) / 5, rdd;
+        lag_reference_eval(&s, tau, NULL, NULL, &rdd);
+        ENSURE_NEAR(rdd, (k % 2 ? -1 : 1) * 10 * M_PI, 1e-9 * 5000, "r'' at zero crossing %d", k);
+    }
+    for (int k = 0; k <= 10; k++) {
+        double c = 0.25 + k, tau = (-1 + sqrt(1 + 10.0 * c)) / 5, rdd;
+        double w = 2 * M_PI * (1 + 5 * tau);
+        lag_reference_eval(&s, tau, NULL, NULL, &rdd);
+        ENSURE_NEAR(rdd, -w * w, 1e-9 * 5000, "r'' at crest %d", k);
+    }
+    double rdd, w11 = 2 * M_PI * 11;
+    lag_reference_eval(&s, 2 + 1.0 / 44, NULL, NULL, &rdd);
+    ENSURE_NEAR(rdd, -w11 * w11, 1e-9 * 5000, "r'' a quarter period of 11 Hz after the sweep");
+    check_accel(&s, 0, 4, w11 * w11, near_kink);
 }
 
 static void case_square(int arg)
@@ -124,8 +188,9 @@ static void case_square(int arg)
     ENSURE(value(&s, 2.2) == -1);
     ENSURE(value(&s, 2.3) == 3);
     double rd;
-    lag_reference_eval(&s, 1.0, NULL, &rd);
+    lag_reference_eval(&s, 1.0, NULL, &rd, NULL);
     ENSURE(rd == 0);
+    check_no_accel(&s, 0, 5);
 }
 
 static void case_waypoints(int arg)
@@ -142,9 +207,10 @@ static void case_waypoints(int arg)
     ENSURE_NEAR(value(&s, 3.5), 0.5 + 2 * 0.05, 1e-15, "half way to the third");
     ENSURE_NEAR(value(&s, 10), 0.5 - 2 * 0.2, 1e-15, "held after the last");
     double rd;
-    lag_reference_eval(&s, 3.5, NULL, &rd);
+    lag_reference_eval(&s, 3.5, NULL, &rd, NULL);
     ENSURE_NEAR(rd, 2 * -0.5, 1e-15, "slope");
     check_rate(&s, -1, 8, 1, near_kink);
+    check_no_accel(&s, -1, 8);
 }
 
 static void case_check(int arg)

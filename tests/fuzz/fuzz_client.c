@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "lagsim_client.h"
+#include "lagsim_client_wire.h"
 
 static lag_client *g_client;
 
@@ -49,17 +50,17 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     static const char *const channels[] = {"FZ_STATE", "FZ_STATUS", "FZ_EVENT", "FZ_SCENE",
                                            "FZ_REFERENCE"};
     lag_client_counters before, after;
-    lag_client_get_counters(g_client, &before);
+    lag_client_get_counters(g_client, &before, sizeof before);
     if (lag_client_feed(g_client, channels[data[0] % 5], data + 1, size - 1) != LAG_CLIENT_OK)
         fail("feed refused one of the handle's channels");
-    lag_client_get_counters(g_client, &after);
+    lag_client_get_counters(g_client, &after, sizeof after);
     int64_t kept = (after.states - before.states) + (after.statuses - before.statuses) +
                    (after.events - before.events) + (after.scenes - before.scenes) +
                    (after.references - before.references);
     if (kept + (after.dropped - before.dropped) != 1) fail("a message neither kept nor dropped");
 
     lag_client_state st;
-    if (lag_client_latest_state(g_client, &st)) {
+    if (lag_client_latest_state(g_client, &st, sizeof st)) {
         if (st.num_joints < 0 || st.num_joints > LAG_CLIENT_MAX_JOINTS) fail("state joints");
         for (int i = 0; i < st.num_joints; i++) {
             check_terminated(st.name[i], sizeof st.name[i]);
@@ -69,22 +70,31 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (!isfinite(st.sim_time)) fail("non-finite sim_time");
     }
     lag_client_reference rf;
-    if (lag_client_latest_reference(g_client, &rf)) {
+    if (lag_client_latest_reference(g_client, &rf, sizeof rf)) {
         if (rf.num_joints < 0 || rf.num_joints > LAG_CLIENT_MAX_JOINTS) fail("reference joints");
         for (int i = 0; i < rf.num_joints; i++) {
             check_terminated(rf.name[i], sizeof rf.name[i]);
-            if (!isfinite(rf.r[i]) || !isfinite(rf.rdot[i])) fail("non-finite reference");
+            if (!isfinite(rf.r[i]) || !isfinite(rf.rdot[i]) || !isfinite(rf.rddot[i]))
+                fail("non-finite reference");
         }
         if (!isfinite(rf.sim_time)) fail("non-finite reference sim_time");
     }
-    lag_client_status ss;
-    if (lag_client_latest_status(g_client, &ss)) {
-        check_terminated(ss.integrator, sizeof ss.integrator);
-        check_terminated(ss.mode, sizeof ss.mode);
-        check_terminated(ss.run_state, sizeof ss.run_state);
-        check_terminated(ss.waiting_for, sizeof ss.waiting_for);
-        check_terminated(ss.waiting_got, sizeof ss.waiting_got);
-        if (!lag_wire_all_finite(LAG_WIRE_STATUS, &ss)) fail("non-finite status");
+    static lag_client_status *status;
+    if (!status && !(status = lag_client_status_new())) fail("out of memory");
+    if (lag_client_latest_status(g_client, status)) {
+        const lag_wire_status *ss = lag_wire_of_status(status);
+        check_terminated(ss->integrator, sizeof ss->integrator);
+        check_terminated(ss->mode, sizeof ss->mode);
+        check_terminated(ss->run_state, sizeof ss->run_state);
+        check_terminated(ss->waiting_for, sizeof ss->waiting_for);
+        check_terminated(ss->waiting_got, sizeof ss->waiting_got);
+        if (!lag_wire_all_finite(LAG_WIRE_STATUS, ss)) fail("non-finite status");
+        for (int i = 0; i < lag_client_status_fields(); i++) { /* through the accessors */
+            const char *name = lag_client_status_field_name(i);
+            if (lag_client_status_field_is_text(i) ? !lag_client_status_text(status, name)
+                                                   : !isfinite(lag_client_status_number(status, name)))
+                fail("a status field the accessors do not give");
+        }
     }
     return 0;
 }

@@ -80,9 +80,10 @@ static void check_scene(const lag_scene *sc)
             die("accepted reference fails the library's check", key);
         check_in("reference amplitude", rf->amplitude, -d->explode_limit, d->explode_limit);
         check_in("reference offset", rf->offset, -d->explode_limit, d->explode_limit);
-        double r, rdot;
-        lag_reference_eval(rf, rf->start + 0.5, &r, &rdot);
-        if (!isfinite(r) || !isfinite(rdot)) die("accepted reference not finite", NULL);
+        double r, rdot, rddot;
+        lag_reference_eval(rf, rf->start + 0.5, &r, &rdot, &rddot);
+        if (!isfinite(r) || !isfinite(rdot) || !isfinite(rddot))
+            die("accepted reference not finite", NULL);
     }
     if (nref != sc->reference.n) die("reference joints miscounted", NULL);
     int ttl = -1;

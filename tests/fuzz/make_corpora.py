@@ -127,6 +127,7 @@ def reference(n=2, names=("theta0", "theta1"), t=0.01, step=10):
     m.name = list(names[:n])
     m.r = [0.2 * (i + 1) for i in range(n)]
     m.rdot = [-0.5 * i for i in range(n)]
+    m.rddot = [3.0 * i - 1.0 for i in range(n)]
     return m.encode()
 
 

@@ -14,8 +14,13 @@
    /usr/local; lua5.2's default path shape; the jars in TMP/share/java, found by
    TMP/share/lagsim/octave/lagsim_setup.m). Every run must
    answer all 201 states of 2 s and balance.
-3. A C controller (clients/manipulator_pd.c) compiles and links against the installed
-   headers and libraries through pkg-config, and drives the installed lagsimd.
+3. Controllers build against the installed tree through pkg-config and drive the
+   installed lagsimd: the C++ example (clients/manipulator_ct.cpp, `pkg-config
+   lagsim-client`: liblagsim_client.so alone, found at run time through LD_LIBRARY_PATH
+   as for any library in a prefix off the loader's path) and the C example
+   clients/manipulator_pd.c (`pkg-config lagsim-core`: the core and the examples' setup).
+   The installed liblagsim_client.so.N carries the SONAME of LAGSIM_CLIENT_ABI and exports
+   the client's functions only.
 """
 import argparse
 import glob
@@ -33,6 +38,8 @@ def main():
     ap.add_argument("--build", required=True)
     ap.add_argument("--source", required=True)
     ap.add_argument("--cc", default="cc")
+    ap.add_argument("--cxx", default="c++")
+    ap.add_argument("--abi", type=int, required=True, help="LAGSIM_CLIENT_ABI")
     ap.add_argument("--cflags", default="", help="extra compiler flags (a sanitizer build's)")
     a = ap.parse_args()
     # every process here meets on LCM's default URL, a port pair of this run's own
@@ -59,7 +66,11 @@ def main():
     want = ["bin/lagsimd", "bin/dipc_lqr", "bin/manipulator_pd",
             "include/lagsim/lagsim.h", "include/lagsim/lagsim_client.h",
             "include/lagsim/lagsim_joint_state_t.h", "lib/liblagsim_client.a",
-            "lib/pkgconfig/lagsim-client.pc", "share/man/man1/lagsimd.1",
+            "include/lagsim/lagsim_client.hpp", "include/lagsim/version.h",
+            "lib/liblagsim_client.so", "lib/liblagsim_client.so.%d" % a.abi,
+            "bin/manipulator_ct", "share/man/man1/manipulator_ct.1",
+            "lib/pkgconfig/lagsim-client.pc", "lib/pkgconfig/lagsim-core.pc",
+            "share/man/man1/lagsimd.1",
             "share/lagsim/config/dipc.yaml", "share/lagsim/lcmtypes/joint_state_t.lcm",
             "share/lua/5.2/lagsim/init.lua", "share/lua/5.2/lagsim_lcm.lua",
             "share/lagsim/examples/python/dipc_balance.py",
@@ -84,17 +95,32 @@ def main():
             os.path.relpath(pydir, prefix), w))
     check(len(glob.glob(os.path.join(prefix, "share/lagsim/lcmtypes/*.lcm"))) ==
           len(glob.glob(os.path.join(src, "lcmtypes/*.lcm"))), "every .lcm file installed")
-    # a C controller built against the installed tree through pkg-config
+    # the shared library: its SONAME, its links, only the client's functions exported
+    so = os.path.join(prefix, "lib", "liblagsim_client.so")
+    dump = subprocess.run(["objdump", "-p", so], stdout=subprocess.PIPE, universal_newlines=True)
+    check("SONAME               liblagsim_client.so.%d" % a.abi in dump.stdout and
+          os.path.realpath(so) == os.path.realpath(so + ".%d" % a.abi),
+          "lib/liblagsim_client.so -> .so.%d, SONAME liblagsim_client.so.%d" % (a.abi, a.abi))
+    syms = subprocess.run(["nm", "-D", "--defined-only", so], stdout=subprocess.PIPE,
+                          universal_newlines=True).stdout.split()
+    names = [s for s in syms if s.startswith("lag") or s.startswith("__lagsim")]
+    other = [s for s in names if not s.startswith("lag_client_") and not s.startswith("lag_result_")]
+    check("lag_client_wait_state" in names and "lag_result_string" in names and not other,
+          "%d functions exported, none but lag_client_* and lag_result_* (%s)"
+          % (len(names), other[:5]))
+    # controllers built against the installed tree through pkg-config
     env_pc = dict(os.environ, PKG_CONFIG_PATH=os.path.join(prefix, "lib", "pkgconfig"))
-    pc = subprocess.run(["pkg-config", "--cflags", "--libs", "lagsim-client"], env=env_pc,
-                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
-    cbin = os.path.join(tmp, "manipulator_pd_installed")
-    if check(pc.returncode == 0, "pkg-config lagsim-client: %s" % (pc.stdout.strip() or pc.stderr.strip())):
-        cc = subprocess.run([a.cc, "-std=c11", "-D_GNU_SOURCE"] + a.cflags.split() + ["-o", cbin,
-                             os.path.join(src, "clients/manipulator_pd.c")] + pc.stdout.split(),
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
-        if not check(cc.returncode == 0, "clients/manipulator_pd.c builds against the installed tree"):
-            print(cc.stdout)
+    builds = [("lagsim-client", a.cxx, ["-std=c++17"], "clients/manipulator_ct.cpp", "manipulator_ct_installed"),
+              ("lagsim-core", a.cc, ["-std=c11", "-D_GNU_SOURCE"], "clients/manipulator_pd.c", "manipulator_pd_installed")]
+    for pkg, compiler, std, source, out in builds:
+        pc = subprocess.run(["pkg-config", "--cflags", "--libs", pkg], env=env_pc,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+        if check(pc.returncode == 0, "pkg-config %s: %s" % (pkg, pc.stdout.strip() or pc.stderr.strip())):
+            cc = subprocess.run([compiler] + std + a.cflags.split() + ["-o", os.path.join(tmp, out),
+                                 os.path.join(src, source)] + pc.stdout.split(),
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+            if not check(cc.returncode == 0, "%s builds against the installed tree" % source):
+                print(cc.stdout)
 
     lagsimd = os.path.join(prefix, "bin", "lagsimd")
     cfg = os.path.join(prefix, "share/lagsim/config")
@@ -108,7 +134,13 @@ def main():
                     for j in ("lagsim_types.jar", "lagsim_examples.jar")])
     runs = [
         ("C dipc_lqr", dipc, [os.path.join(prefix, "bin/dipc_lqr"), "-q", "--duration", "2"], {}),
-        ("C controller built with pkg-config", manip, [cbin, "-q", "--duration", "2"], {}),
+        ("C controller built with pkg-config lagsim-core", manip,
+         [os.path.join(tmp, "manipulator_pd_installed"), "-q", "--duration", "2"],
+         {"LD_LIBRARY_PATH": os.path.join(prefix, "lib")}),
+        ("C++ controller built with pkg-config lagsim-client", manip,
+         [os.path.join(tmp, "manipulator_ct_installed"), "-q", "--duration", "2"],
+         {"LD_LIBRARY_PATH": os.path.join(prefix, "lib")}),
+        ("C++ manipulator_ct", manip, [os.path.join(prefix, "bin/manipulator_ct"), "-q", "--duration", "2"], {}),
         ("Python dipc_balance.py", dipc,
          [sys.executable, os.path.join(prefix, "share/lagsim/examples/python/dipc_balance.py"), "-q"],
          {"PYTHONPATH": pydir}),
@@ -122,7 +154,7 @@ def main():
                      [os.path.join(src, "tests/clients/octave_run.sh"),
                       os.path.join(prefix, "share/lagsim/octave"), "dipc_balance", "-q"], {}))
     elsewhere = tempfile.mkdtemp(prefix="lagsim_cwd_")
-    for name, checks, client, env_extra in runs:
+    for k, (name, checks, client, env_extra) in enumerate(runs):
         if not os.path.exists(client[0]) and client[0] not in ("lua5.2", "java", sys.executable):
             check(False, "%s: %s missing" % (name, client[0]))
             continue
@@ -130,7 +162,7 @@ def main():
         env.pop("PYTHONPATH", None)
         env.pop("LUA_PATH", None)
         env.update(env_extra)
-        r = subprocess.run(e2e + ["--name", "INST" + name.split()[0].upper()] + checks +
+        r = subprocess.run(e2e + ["--name", "INST%d" % k] + checks +
                            ["--"] + client + ["--prefix", "{prefix}"],
                            cwd=elsewhere, env=env, stdout=subprocess.PIPE,
                            stderr=subprocess.STDOUT, universal_newlines=True)

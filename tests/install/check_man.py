@@ -9,7 +9,7 @@ pages:  every program in bin/ has a man page in share/man/man1 (a ".so" page fol
         --help: an option added without documentation, or documented but gone, fails.
         Options are read from --help's option lines ("  -c, --config FILE ...") and from
         the page's .TP tags under OPTIONS (and, in a page of several programs, under the
-        .SS of that program).
+        .SS of that program, or of several programs naming it: ".SS a, b").
 models: the lists of models, each against the core's table (BIN prints it) name for
         name, missing and extra names alike: lagsimd --help's list, the list of lagsimd.1's
         DESCRIPTION (its .B names between the two dashes) and the comment of scene_t.model
@@ -71,7 +71,8 @@ def untroff(s):
 
 
 def page_options(text, prog):
-    """.TP tags under .SH OPTIONS, or under .SS <prog> of any section."""
+    """.TP tags under .SH OPTIONS, or under .SS <prog> (or .SS <prog>, <other>, ...: the
+    section of several programs) of any section."""
     opts, sh, ss = set(), "", None
     lines = text.splitlines()
     for i, line in enumerate(lines):
@@ -80,7 +81,8 @@ def page_options(text, prog):
         elif line.startswith(".SS"):
             ss = line[3:].strip().strip('"')
         elif line.startswith(".TP") and i + 1 < len(lines):
-            if (sh == "OPTIONS" and ss is None) or ss == prog:
+            if (sh == "OPTIONS" and ss is None) or (ss is not None and
+                                                    prog in [x.strip() for x in ss.split(",")]):
                 opts.update(re.findall(r"(?<![\w-])(%s)" % OPT, untroff(lines[i + 1])))
     return opts
 

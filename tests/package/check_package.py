@@ -106,6 +106,12 @@ def clean_env(**extra):
     return env
 
 
+def client_abi(source):
+    """LAGSIM_CLIENT_ABI, as CMakeLists.txt sets it."""
+    with open(os.path.join(source, "CMakeLists.txt")) as f:
+        return int(re.search(r"set\(LAGSIM_CLIENT_ABI (\d+)\)", f.read()).group(1))
+
+
 def deb_path(build):
     version = None
     with open(os.path.join(build, "CMakeCache.txt")) as f:
@@ -162,6 +168,9 @@ def do_build(a):
 
     # Debian's places, each where Debian's own tools look
     places = ["usr/bin/lagsimd", "usr/bin/dipc_lqr", "usr/include/lagsim/lagsim_client.h",
+              "usr/include/lagsim/lagsim_client.hpp", "usr/include/lagsim/version.h",
+              "usr/lib/liblagsim_client.so.%d" % client_abi(a.source), "usr/lib/liblagsim_client.so",
+              "usr/bin/manipulator_ct",
               "usr/include/lagsim/lagsim_joint_state_t.h", "usr/lib/liblagsim_client.a",
               "usr/lib/pkgconfig/lagsim-client.pc", "usr/lib/python3/dist-packages/lagsim/__init__.py",
               "usr/lib/python3/dist-packages/lagsim_lcm.py", "usr/share/lua/5.2/lagsim/init.lua",
@@ -384,12 +393,21 @@ def installed_checks(a, tmp, env):
         r = run(e2e + opts + ["--"] + client, cwd=tmp, env=env)
         check(r.returncode == 0, "installed lagsimd with the installed %s" % name, r.stdout)
 
-    pc = run(["pkg-config", "--cflags", "--libs", "lagsim-client"], env=env)
-    if check(pc.returncode == 0, "pkg-config lagsim-client (no PKG_CONFIG_PATH): %s" % pc.stdout.strip(),
-             pc.stdout):
-        r = run(["cc", "-std=c11", "-D_GNU_SOURCE", "-o", os.path.join(tmp, "pd"),
-                 os.path.join(a.source, "clients/manipulator_pd.c")] + pc.stdout.split(), env=env)
-        check(r.returncode == 0, "a C controller builds against /usr/include and /usr/lib", r.stdout)
+    # a C++ controller over the client library alone (/usr/lib/liblagsim_client.so, found
+    # by the loader with no LD_LIBRARY_PATH), lagsim's C example over the core
+    for pkg, compiler, source, out in (
+            ("lagsim-client", ["c++", "-std=c++17"], "clients/manipulator_ct.cpp", "ct"),
+            ("lagsim-core", ["cc", "-std=c11", "-D_GNU_SOURCE"], "clients/manipulator_pd.c", "pd")):
+        pc = run(["pkg-config", "--cflags", "--libs", pkg], env=env)
+        if check(pc.returncode == 0, "pkg-config %s (no PKG_CONFIG_PATH): %s" % (pkg, pc.stdout.strip()),
+                 pc.stdout):
+            r = run(compiler + ["-o", os.path.join(tmp, out), os.path.join(a.source, source)] +
+                    pc.stdout.split(), env=env)
+            check(r.returncode == 0, "%s builds against /usr/include and /usr/lib" % source, r.stdout)
+    r = run([os.path.join(tmp, "ct"), "--help"], env=env)
+    check(r.returncode == 0 and "manipulator_ct" in r.stdout,
+          "the C++ controller runs: the loader finds liblagsim_client.so.%d" % client_abi(a.source),
+          r.stdout + r.stderr if hasattr(r, "stderr") and r.stderr else r.stdout)
 
 
 

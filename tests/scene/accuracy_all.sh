@@ -17,7 +17,7 @@ for scene in "$cfg"/*.yaml; do
   ref_dt=$(awk -v hz="$hz" 'BEGIN { printf "%.17g", 1 / hz / 1024 }')
   "$lagsimd" -q --config "$scene" --set integrator.method=gauss4 --set "integrator.dt=$ref_dt" \
       --offline --duration 1 --csv "$work/$name-ref.csv" || { echo "FAIL: $name: reference run"; fail=1; continue; }
-  nq=$(head -1 "$work/$name-ref.csv" | tr ',' '\n' | grep -vc "_dot$\|^t$\|^energy$\|_ref$")
+  nq=$(head -1 "$work/$name-ref.csv" | tr ',' '\n' | grep -vc "_dot$\|_ddot$\|^t$\|^energy$\|_ref$")
   for E in 1e-4 1e-6 1e-9; do
     if ! "$lagsimd" -q --config "$scene" --set "integrator.error=$E" --offline --duration 1 \
          --csv "$work/$name-$E.csv" 2> "$work/err"; then

@@ -74,7 +74,7 @@ check "flight: false: lift-off is a fault (exit 1)" "[ $? -eq 1 ] && grep -qi \"
 
 "$lagsimd" -q --config "$cfg/manipulator.yaml" --offline --duration 1 --csv "$tmp/m.csv"
 check "manipulator exit 0" "[ $? -eq 0 ]"
-check "manipulator header (the scene's reference after energy)" '[ "$(head -1 "$tmp/m.csv")" = "t,q1,q2,q1_dot,q2_dot,energy,q1_ref,q1_ref_dot,q2_ref,q2_ref_dot" ]'
+check "manipulator header (the scene's reference after energy)" '[ "$(head -1 "$tmp/m.csv")" = "t,q1,q2,q1_dot,q2_dot,energy,q1_ref,q1_ref_dot,q1_ref_ddot,q2_ref,q2_ref_dot,q2_ref_ddot" ]'
 check "manipulator row t=0: q = [0, 0.5], qd = 0" '[ "$(sed -n 2p "$tmp/m.csv" | cut -d, -f1-5)" = "0,0,0.5,0,0" ]'
 
 # A numeric fault stops the run with exit 1 and a message; the rows so far stay, and

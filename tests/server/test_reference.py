@@ -10,7 +10,7 @@ against the reference library.
 
 Cases:
   fast       fast mode: a reference just before each state, same sim_time and step, r and
-             r-dot equal to the closed form; only the joints with a reference; a scene
+             r-dot, r-ddot equal to the closed form; only the joints with a reference; a scene
              without one publishes none
   realtime   the same paced in real time
   lockstep   the same in lockstep with dipc_lqr answering; --replay: difference 0 with the
@@ -25,7 +25,7 @@ Cases:
   retry      lockstep, paused, STEP 1 with no controller: the daemon sends the waited-on
              state again (lockstep_retry) until lockstep_timeout, and each copy goes out with
              its reference just before it, as the first (lcm-logger records the bus: --log keeps one state per period)
-  offline    --offline --csv: <joint>_ref and <joint>_ref_dot columns after energy, equal to
+  offline    --offline --csv: <joint>_ref, _ref_dot, _ref_ddot columns after energy, equal to
              the closed form; without a reference the header is unchanged; lagsim-plot
              draws them dashed over q and q dot (also from <PREFIX>_REFERENCE.csv, lockstep)
 """
@@ -64,20 +64,21 @@ def check(cond, what):
 def sine(t, amplitude=SINE["amplitude"]):
     s, o, f = SINE["start"], SINE["offset"], SINE["frequency"]
     if t < s:
-        return o, 0.0
+        return o, 0.0, 0.0
     w = 2 * math.pi * f
-    return o + amplitude * math.sin(w * (t - s)), amplitude * w * math.cos(w * (t - s))
+    return (o + amplitude * math.sin(w * (t - s)), amplitude * w * math.cos(w * (t - s)),
+            -amplitude * w * w * math.sin(w * (t - s)))
 
 
 def waypoints(t):
     u = t - WP_START
     if u <= POINTS[0][0]:
-        return POINTS[0][1], 0.0
+        return POINTS[0][1], 0.0, 0.0
     for (t0, w0), (t1, w1) in zip(POINTS, POINTS[1:]):
         if u < t1:
             k = (w1 - w0) / (t1 - t0)
-            return w0 + k * (u - t0), k
-    return POINTS[-1][1], 0.0
+            return w0 + k * (u - t0), k, 0.0  # straight lines: r'' = 0
+    return POINTS[-1][1], 0.0, 0.0
 
 
 def read_log(path):
@@ -135,11 +136,12 @@ class T:
                         first_after = r.step
                     want = [sine(r.sim_time, amp), waypoints(r.sim_time)]
                     for k in range(2):
-                        d = max(abs(r.r[k] - want[k][0]), abs(r.rdot[k] - want[k][1]))
+                        d = max(abs(r.r[k] - want[k][0]), abs(r.rdot[k] - want[k][1]),
+                                abs(r.rddot[k] - want[k][2]) / 16.0)  # r'' scale: (2 pi 2)^2 A
                         worst = max(worst, d)
                         if d > 1e-12:
                             bad.append(f"{r.name[k]} at t = {r.sim_time}: r {r.r[k]}, rdot "
-                                       f"{r.rdot[k]}; closed form {want[k]}")
+                                       f"{r.rdot[k]}, rddot {r.rddot[k]}; closed form {want[k]}")
             prev = (ch, data)
         check(n_states > 10 and not bad,
               f"{n_states} states, each with its reference just before it (same sim_time, step), "
@@ -235,11 +237,11 @@ def case_lockstep(t):
     rows = open(os.path.join(out, prefix + "_REFERENCE.csv")).read().splitlines()
     sent = [t.t.reference_t.decode(d) for ch, d, _ in recs if ch == prefix + "_REFERENCE"]
     same = len(rows) == len(sent) + 1 and all(
-        [float(x) for x in row.split(",")[5:]] == list(m.r) + list(m.rdot) and
+        [float(x) for x in row.split(",")[5:]] == list(m.r) + list(m.rdot) + list(m.rddot) and
         int(row.split(",")[4]) == m.generation and
         float(row.split(",")[0]) == m.sim_time for row, m in zip(rows[1:], sent))
     check(p.returncode == 0 and rows[0] == 't,wall_time,log_time,step,generation,theta0,theta1,'
-          'theta0_dot,theta1_dot' and same,
+          'theta0_dot,theta1_dot,theta0_ddot,theta1_ddot' and same,
           f"lagsim-log2csv: {prefix}_REFERENCE.csv, {len(rows) - 1} rows equal to the "
           f"{len(sent)} references logged: {rows[0]}")
     plot_has_reference(t, os.path.join(out, prefix + "_STATE.csv"), prefix + "_REFERENCE.csv",
@@ -286,19 +288,22 @@ def case_offline(t):
               "--csv", "-")
     lines = p.stdout.splitlines()
     head = lines[0].split(",")
-    check(head[-5:] == ["energy", "theta0_ref", "theta0_ref_dot", "theta1_ref", "theta1_ref_dot"],
+    check(head[-7:] == ["energy", "theta0_ref", "theta0_ref_dot", "theta0_ref_ddot", "theta1_ref",
+                        "theta1_ref_dot", "theta1_ref_ddot"],
           f"header: {head}")
     worst = 0.0
     for line in lines[1:]:
         v = [float(x) for x in line.split(",")]
         want = sine(v[0]) + waypoints(v[0])
-        worst = max(worst, max(abs(a - b) for a, b in zip(v[-4:], want)))
+        scale = [1, 1, 16, 1, 1, 16]  # r'' of the sine: up to (2 pi 2)^2 0.1 = 15.8
+        worst = max(worst, max(abs(a - b) / s for a, b, s in zip(v[-6:], want, scale)))
     check(len(lines) == 152 and worst <= 1e-12,
-          f"{len(lines) - 1} rows, r and r-dot equal to the closed form (largest difference {worst:.3g})")
+          f"{len(lines) - 1} rows, r, r-dot and r-ddot equal to the closed form (largest "
+          f"difference {worst:.3g})")
     csv = os.path.join(t.tmp, "run.csv")
     open(csv, "w").write(p.stdout)
-    plot_has_reference(t, csv, "run.csv", {"theta0 ref": 9, "theta1 ref": 11,  # one axis: no
-                                           "theta0_dot ref": 10, "theta1_dot ref": 12})  # scene
+    plot_has_reference(t, csv, "run.csv", {"theta0 ref": 9, "theta1 ref": 12,  # one axis: no
+                                           "theta0_dot ref": 10, "theta1_dot ref": 13})  # scene
     p = t.run("lagsimd", "--config", t.dipc, "--offline", "--duration", "0.1", "--csv", "-")
     check(p.stdout.splitlines()[0] == "t,theta0,theta1,theta2,theta0_dot,theta1_dot,theta2_dot,energy",
           "without a reference the header is what it was")

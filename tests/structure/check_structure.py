@@ -20,7 +20,7 @@
       exactly the other labels the ctests carry; and every file a doc or a source file's
       comment names exists (check_named_files).
   check_structure.py function_length SOURCE_DIR [--max 80]
-      No C function in server/, clients/, bench/ is longer than 80 lines (universal-ctags:
+      No C function in server/, clients/, bench/ (nor C++ function in clients/) is longer than 80 lines (universal-ctags:
       from the line of its name to the line of its closing brace).
   check_structure.py ticks SOURCE_DIR
       Time to ticks is converted by the core alone (lag_ticks_ceil / _floor / _exact,
@@ -153,7 +153,7 @@ def source_words(src):
         for dirpath, dirs, names in os.walk(os.path.join(src, top)):
             dirs[:] = [d for d in dirs if d not in ('corpus', 'crash')]
             for n in names:
-                if not n.endswith(('.c', '.h', '.py', '.lua', '.java', '.m', '.sh', '.lcm',
+                if not n.endswith(('.c', '.h', '.cpp', '.hpp', '.py', '.lua', '.java', '.m', '.sh', '.lcm',
                                    '.cmake', '.txt', '.yaml', '.html', '.js')):
                     continue
                 try:
@@ -385,9 +385,15 @@ def check_function_length(src, limit):
     files = []
     for top in ('server', 'clients', 'bench'):
         files += [f for f in c_files(src, top)]
+    cxx = []  # the C++ of clients/ (lagsim_client.hpp, the C++ example) too
+    for dirpath, _, names in os.walk(os.path.join(src, 'clients')):
+        cxx += [os.path.join(dirpath, n) for n in sorted(names) if n.endswith(('.cpp', '.hpp'))]
     try:
         out = subprocess.run(['ctags', '-x', '--c-kinds=f', '--_xformat=%N %F %n %e'] + files,
                              check=True, capture_output=True, text=True).stdout
+        if cxx:
+            out += subprocess.run(['ctags', '-x', '--c++-kinds=f', '--_xformat=%N %F %n %e'] + cxx,
+                                  check=True, capture_output=True, text=True).stdout
     except (OSError, subprocess.CalledProcessError) as e:
         return [f'universal-ctags did not run ({e}): install universal-ctags '
                 '(.ci/install-deps.sh)']

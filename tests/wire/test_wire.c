@@ -163,7 +163,8 @@ static void check_agreement(void)
         /* a reference of two of three joints, and of none */
         char *names[2] = {"theta0", "theta2"};
         double r[2] = {0.2, -1e-300}, rd[2] = {-0.0, 6.283185307179586};
-        lagsim_reference_t g = {12, 1.5, 1500, 2, names, r, rd};
+        double rdd[2] = {-39.47841760435743, 1e300};
+        lagsim_reference_t g = {12, 1.5, 1500, 2, names, r, rd, 5, rdd};
         int nt = lagsim_reference_t_encode(theirs, 0, sizeof theirs, &g);
         lag_wire_reference w;
         memset(&w, 0, sizeof w);
@@ -171,10 +172,12 @@ static void check_agreement(void)
         w.sim_time = 1.5;
         w.step = 1500;
         w.num_joints = 2;
+        w.generation = 5;
         for (int i = 0; i < 2; i++) {
             strcpy(w.name[i], names[i]);
             w.r[i] = r[i];
             w.rdot[i] = rd[i];
+            w.rddot[i] = rdd[i];
         }
         agree(LAG_WIRE_REFERENCE, &w, nt);
         g.num_joints = 0;
@@ -548,20 +551,38 @@ static void check_old_versions(void)
                     tn, v, (unsigned long long)fp, nf,
                     (unsigned long long)lag_wire_table_fingerprint_n(ty, nf));
             /* a message of that version: today's bytes without the appended fields, under
-             * the old fingerprint (every field after nf is an int64 generation here) */
+             * the old fingerprint: every count 1, so that an appended array holds one
+             * element; the appended fields are int64 scalars (a generation) or double
+             * arrays counted by an earlier field (reference_t's rddot), each 77 */
             static _Alignas(max_align_t) uint8_t m[8192], back[8192];
             uint8_t buf[LAG_WIRE_BUF_SIZE];
             memset(m, 0, sizeof m);
             const lag_wire_field *f = lag_wire_fields(ty, &n);
+            for (int j = 0; j < n; j++)
+                if (f[j].capacity > 0 && f[j].count_field < 0) { /* a count */
+                    int16_t one = 1;
+                    memcpy(m + f[j].offset, &one, sizeof one);
+                }
+            int appended = 0; /* bytes */
             for (int j = nf; j < n; j++) {
-                ENSUREF(f[j].kind == LAG_WIRE_INT64 && f[j].count_field < 0,
-                        "%s.%s: an appended field other than a scalar int64", tn, f[j].name);
-                int64_t g = 77;
-                memcpy(m + f[j].offset, &g, sizeof g);
+                bool scalar = f[j].kind == LAG_WIRE_INT64 && f[j].count_field < 0;
+                bool array = f[j].kind == LAG_WIRE_DOUBLE && f[j].count_field >= 0 &&
+                             f[j].count_field < nf;
+                ENSUREF(scalar || array,
+                        "%s.%s: an appended field other than an int64 scalar or a double array "
+                        "counted by an earlier field", tn, f[j].name);
+                if (scalar) {
+                    int64_t g = 77;
+                    memcpy(m + f[j].offset, &g, sizeof g);
+                } else {
+                    double x = 77;
+                    memcpy(m + f[j].offset, &x, sizeof x);
+                }
+                appended += 8;
             }
             int len = lag_wire_encode(ty, m, buf, sizeof buf);
-            ENSURE(len > 8 + 8 * (n - nf));
-            len -= 8 * (n - nf);
+            ENSUREF(len > 8 + appended, "%s: encoded %d bytes", tn, len);
+            len -= appended;
             for (int b = 0; b < 8; b++) buf[b] = (uint8_t)((uint64_t)fp >> (56 - 8 * b));
             const char *by = "?";
             ENSURE(lag_wire_decode(ty, buf, (size_t)len, LAG_WIRE_MAX_JOINTS, back) ==
@@ -573,7 +594,7 @@ static void check_old_versions(void)
             ENSURE(lag_wire_identify_any(buf, (size_t)len, &by) == t && !strcmp(by, v));
             for (int j = nf; j < n; j++) {
                 int64_t g;
-                memcpy(&g, back + f[j].offset, sizeof g);
+                memcpy(&g, back + f[j].offset, sizeof g); /* an int64 or a double's bits */
                 ENSUREF(g == 0, "%s.%s of a %s message: %lld, not 0", tn, f[j].name, v,
                         (long long)g);
             }
@@ -583,7 +604,8 @@ static void check_old_versions(void)
                    LAG_WIRE_OK && by == NULL);
         }
     }
-    /* 0.2.0 appended the generation to the state, the reference, the scene, the command */
+    /* 0.2.0 appended the generation to the state, the reference, the scene, the command
+     * (and r'' to the reference) */
     ENSUREF(changed == 4, "%d types with an earlier version", changed);
     ENSURE(strcmp(lag_wire_version(), "0.1.0") > 0); /* today's types are newer */
 }

@@ -10,6 +10,11 @@
  *
  * Coordinates, T and U are those of docs/models.md; units are SI (m, kg, s, rad, N, N m).
  * Matrices are row-major, n x n with n = model->nq (at most LAG_MAX_DOF).
+ *
+ * Not a stable ABI: the core is a static library for lagsim's own programs, tests and
+ * benchmarks, and its structs (lag_sim, lag_model, ...) change with it. Programs outside
+ * the tree talk to a plant through the client library (lagsim_client.h), whose ABI is
+ * kept (docs/clients.md, "The ABI").
  */
 #ifndef LAGSIM_LAGSIM_H
 #define LAGSIM_LAGSIM_H
@@ -19,10 +24,14 @@
 #include <stdint.h>
 
 #include "lagsim/result.h"
+#include "lagsim/version.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* The core's lagsim version, LAGSIM_VERSION_NUMBER as it was built (lagsim/version.h). */
+int lag_version(void);
 
 #define LAG_MAX_DOF 3
 #define LAG_MAX_STATE (2 * LAG_MAX_DOF)

@@ -12,7 +12,7 @@
 #include <time.h>
 #include "lagsim_client.h"
 
-static inline int lag_test_think_send(lag_client *c, double sim_time, int n,
+static inline lag_result lag_test_think_send(lag_client *c, double sim_time, int n,
                                       const char *const *names, const double *effort)
 {
     const char *log = getenv("LAGSIM_THINK_LOG");

@@ -30,11 +30,12 @@ static int conformance_law(const lag_client_scene *sc, const lag_client_state *s
 {
     double kp = lag_client_scene_param(sc, "kp"), kd = lag_client_scene_param(sc, "kd");
     int n = 0;
-    for (int j = 0; j < sc->num_joints; j++) {
-        if (!sc->actuated[j]) continue;
-        int i = lag_client_state_joint(st, sc->joint_name[j]);
+    for (int j = 0; j < lag_client_scene_num_joints(sc); j++) {
+        if (!lag_client_scene_actuated(sc, j)) continue;
+        const char *name = lag_client_scene_joint_name(sc, j);
+        int i = lag_client_state_joint(st, name);
         if (i < 0) return -1;
-        names[n] = sc->joint_name[j];
+        names[n] = name;
         u[n++] = -(kp * st->position[i] + kd * st->velocity[i]);
     }
     return n;
@@ -68,17 +69,17 @@ int main(int argc, char **argv)
     }
     int laws = 0;
     double heard = lag_client_now();
+    lag_client_scene *sc = lag_client_scene_new(); /* the scene of a state's generation */
     while (!stopped && lag_client_now() - heard < timeout) {
         lag_client_state st;
-        lag_result rc = lag_client_wait_state(c, 0.1, &st);
+        lag_result rc = lag_client_wait_state(c, 0.1, &st, sizeof st);
         if (rc == LAG_CLIENT_TIMEOUT) continue;
         if (rc != LAG_CLIENT_OK) break;
         heard = lag_client_now();
-        lag_client_scene sc; /* the scene of this state's generation */
-        lag_client_latest_scene(c, &sc);
+        if (!sc || !lag_client_latest_scene(c, sc)) break;
         const char *names[LAG_CLIENT_MAX_JOINTS];
         double u[LAG_CLIENT_MAX_JOINTS];
-        int n = conformance_law(&sc, &st, names, u);
+        int n = conformance_law(sc, &st, names, u);
         if (n < 0) continue;
         laws++;
         printf("conformance: law generation=%lld sim_time=%.17g\n", (long long)st.generation,
@@ -87,11 +88,12 @@ int main(int argc, char **argv)
         lag_client_send_command(c, st.sim_time, n, names, u);
     }
     lag_client_counters k;
-    lag_client_get_counters(c, &k);
+    lag_client_get_counters(c, &k, sizeof k);
     printf("conformance_c: summary end=%s laws=%d held=%lld describes=%lld dropped=%lld "
            "repeats=%lld\n",
            stopped ? "stop" : "silence", laws, (long long)k.held, (long long)k.describes,
            (long long)k.dropped, (long long)k.repeats);
+    lag_client_scene_free(sc);
     lag_client_destroy(c);
     return 0;
 }

@@ -1,0 +1,532 @@
+/*
+ * lagsim client library for C++17: a header of RAII handles over the C library
+ * (lagsim_client.h, liblagsim_client.so), as cppzmq's zmq.hpp is over libzmq and LCM's
+ * lcm-cpp.hpp over lcm.h. The rules of the protocol (the plant's two URLs, DESCRIBE until
+ * the scene comes, each state once, a copy answered with the same command, the
+ * generation stamped on every command, a state held until its scene came, every message
+ * decoded whole and bounded) are the C library's; this header only makes them C++:
+ *
+ *   lagsim::Client c("DIPC");                     // LCM's default URL; throws lagsim::Error
+ *   lagsim::Scene sc = c.wait_scene(5.0);         // DESCRIBE until the scene comes
+ *   while (auto st = c.wait_state(2.0)) {         // each state once, the newest
+ *       double u = -k * st->position[st->joint("theta1")];
+ *       c.send_command(*st, {"theta0"}, {u});     // answers this state
+ *   }
+ *
+ * Build: c++ -std=c++17 my.cpp $(pkg-config --cflags --libs lagsim-client).
+ *
+ * Errors are exceptions: lagsim::Error, a std::runtime_error with the library's result
+ * code (code(): a negative lag_result of lagsim/result.h) and its message. Nothing
+ * arriving in time is no error: the waits return std::nullopt (wait_state) or throw
+ * Error with code LAG_TIMEOUT only where a value must come (wait_scene, pick_plant).
+ *
+ * Callbacks are any callable (lambdas); they run inside handle() and the waits, in the
+ * thread that calls them. An exception a callback throws never crosses the C library: it
+ * is kept and thrown again, as it was, from the call that ran the callback.
+ *
+ * Threads: as in C, one Client is used by one thread at a time; Clients, discover() and
+ * pick_plant() may be used from several threads at once.
+ *
+ * The types: State, Reference and Event are the C structs (fields as in lagsim_client.h:
+ * st.sim_time, st.position[i], ...) with helpers; Scene and Status own a C handle (copies
+ * are deep, a moved-from one is empty). Nothing here allocates per state: a State is a
+ * plain struct, send_command builds its name array on the stack.
+ */
+#ifndef LAGSIM_CLIENT_HPP
+#define LAGSIM_CLIENT_HPP
+
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <new>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "lagsim_client.h"
+
+namespace lagsim {
+
+/* An error of the client library: its result code and message. */
+class Error : public std::runtime_error {
+public:
+    Error(lag_result code, const std::string &what) : std::runtime_error(what), code_(code) {}
+    /* LAG_ERR_ARG, LAG_ERR_LCM, LAG_ERR_NOMEM, LAG_ERR_AMBIGUOUS, LAG_TIMEOUT, ... */
+    lag_result code() const noexcept { return code_; }
+
+private:
+    lag_result code_;
+};
+
+namespace detail {
+inline std::string describe(lag_result rc, const char *msg)
+{
+    const char *name = lag_result_name(rc);
+    std::string s = name ? name : "lag_result " + std::to_string(static_cast<int>(rc));
+    return s + ": " + (msg && *msg ? msg : lag_result_string(rc));
+}
+/* rc, or Error when it is an error (rc < 0) */
+inline lag_result check(lag_result rc, const lag_client *c)
+{
+    if (rc < 0) throw Error(rc, describe(rc, c ? lag_client_errmsg(c) : nullptr));
+    return rc;
+}
+} // namespace detail
+
+/* The library's version as it runs (LAGSIM_VERSION_NUMBER at its build) and its ABI
+ * number; the header's are LAGSIM_VERSION_NUMBER and LAGSIM_CLIENT_ABI. */
+inline int version() { return lag_client_version(); }
+inline int abi() { return lag_client_abi(); }
+/* Wall clock (monotonic), s. */
+inline double now() { return lag_client_now(); }
+
+/* A state (lag_client_state: utime, sim_time, step, generation, num_joints, name[],
+ * position[], velocity[], effort[]). */
+struct State : lag_client_state {
+    State() : lag_client_state() {}
+    /* the index of joint `name`, or -1 */
+    int joint(const std::string &n) const { return lag_client_state_joint(this, n.c_str()); }
+    std::vector<std::string> names() const { return {name, name + num_joints}; }
+    std::vector<double> positions() const { return {position, position + num_joints}; }
+    std::vector<double> velocities() const { return {velocity, velocity + num_joints}; }
+};
+
+/* A reference (lag_client_reference: sim_time, step, generation, num_joints, name[], r[],
+ * rdot[], rddot[]): what the joints with a reference follow at the state of that
+ * sim_time. */
+struct Reference : lag_client_reference {
+    Reference() : lag_client_reference() {}
+    /* the index of joint `name`, or -1 (the scene gives it no reference) */
+    int joint(const std::string &n) const { return lag_client_reference_joint(this, n.c_str()); }
+};
+
+/* An event (lag_client_event: utime, sim_time, step, value, kind, joint, detail). */
+struct Event : lag_client_event {
+    Event() : lag_client_event() {}
+    bool is(const char *k) const { return std::string(kind) == k; }
+};
+
+/* A plant heard on the bus (lag_client_plant). */
+struct Plant : lag_client_plant {
+    Plant() : lag_client_plant() {}
+};
+
+/* The scene description: owns a lag_client_scene (or, in a callback, shows the
+ * library's during the call; a copy of it owns its own). */
+class Scene {
+public:
+    Scene() : p_(lag_client_scene_new()), own_(true)
+    {
+        if (!p_) throw std::bad_alloc();
+    }
+    ~Scene()
+    {
+        if (own_) lag_client_scene_free(p_);
+    }
+    Scene(const Scene &o) : Scene() { lag_client_scene_copy(p_, o.p_); }
+    Scene &operator=(const Scene &o)
+    {
+        if (this != &o) {
+            Scene t(o);
+            swap(t);
+        }
+        return *this;
+    }
+    Scene(Scene &&o) noexcept : p_(std::exchange(o.p_, nullptr)), own_(std::exchange(o.own_, false)) {}
+    Scene &operator=(Scene &&o) noexcept
+    {
+        Scene t(std::move(o));
+        swap(t);
+        return *this;
+    }
+    void swap(Scene &o) noexcept
+    {
+        std::swap(p_, o.p_);
+        std::swap(own_, o.own_);
+    }
+    /* a view of the library's scene, valid while `p` is (callbacks) */
+    static Scene view(const lag_client_scene *p) { return Scene(const_cast<lag_client_scene *>(p)); }
+
+    std::string model() const { return lag_client_scene_model(p_); }
+    std::string prefix() const { return lag_client_scene_prefix(p_); }
+    int64_t generation() const { return lag_client_scene_generation(p_); }
+    std::string mode() const { return lag_client_scene_mode(p_); }
+    std::string integrator() const { return lag_client_scene_integrator(p_); }
+    std::string effects() const { return lag_client_scene_effects(p_); }
+    double dt() const { return lag_client_scene_dt(p_); }
+    double control_period() const { return lag_client_scene_control_period(p_); }
+    double rate() const { return lag_client_scene_rate(p_); }
+    double command_timeout() const { return lag_client_scene_command_timeout(p_); }
+
+    std::vector<std::string> joints() const
+    {
+        std::vector<std::string> v;
+        for (int i = 0; i < lag_client_scene_num_joints(p_); i++)
+            v.emplace_back(lag_client_scene_joint_name(p_, i));
+        return v;
+    }
+    /* the index of joint `name`, or -1 */
+    int joint(const std::string &name) const { return lag_client_scene_joint(p_, name.c_str()); }
+    bool actuated(int i) const { return lag_client_scene_actuated(p_, i); }
+    double initial_q(int i) const { return lag_client_scene_initial_q(p_, i); }
+    double initial_qd(int i) const { return lag_client_scene_initial_qd(p_, i); }
+    bool limit_on(int i) const { return lag_client_scene_limit_on(p_, i); }
+    double limit_lower(int i) const { return lag_client_scene_limit_lower(p_, i); }
+    double limit_upper(int i) const { return lag_client_scene_limit_upper(p_, i); }
+
+    std::vector<std::string> param_names() const
+    {
+        std::vector<std::string> v;
+        for (int i = 0; i < lag_client_scene_num_params(p_); i++)
+            v.emplace_back(lag_client_scene_param_name(p_, i));
+        return v;
+    }
+    /* parameter `name`; Error (LAG_ERR_ARG) when the scene has none of that name */
+    double param(const std::string &name) const
+    {
+        double v = lag_client_scene_param(p_, name.c_str());
+        if (std::isnan(v))
+            throw Error(LAG_ERR_ARG, "scene " + model() + " has no parameter " + name);
+        return v;
+    }
+    std::optional<double> find_param(const std::string &name) const
+    {
+        double v = lag_client_scene_param(p_, name.c_str());
+        return std::isnan(v) ? std::nullopt : std::optional<double>(v);
+    }
+
+    const lag_client_scene *get() const { return p_; }
+    lag_client_scene *get() { return p_; }
+
+private:
+    explicit Scene(lag_client_scene *p) : p_(p), own_(false) {}
+    lag_client_scene *p_;
+    bool own_;
+};
+
+/* The daemon's status (status_t), its fields by their .lcm names: owns a
+ * lag_client_status (or, in a callback, shows the library's during the call). */
+class Status {
+public:
+    Status() : p_(lag_client_status_new()), own_(true)
+    {
+        if (!p_) throw std::bad_alloc();
+    }
+    ~Status()
+    {
+        if (own_) lag_client_status_free(p_);
+    }
+    Status(const Status &o) : Status() { lag_client_status_copy(p_, o.p_); }
+    Status &operator=(const Status &o)
+    {
+        if (this != &o) {
+            Status t(o);
+            swap(t);
+        }
+        return *this;
+    }
+    Status(Status &&o) noexcept : p_(std::exchange(o.p_, nullptr)), own_(std::exchange(o.own_, false)) {}
+    Status &operator=(Status &&o) noexcept
+    {
+        Status t(std::move(o));
+        swap(t);
+        return *this;
+    }
+    void swap(Status &o) noexcept
+    {
+        std::swap(p_, o.p_);
+        std::swap(own_, o.own_);
+    }
+    static Status view(const lag_client_status *p) { return Status(const_cast<lag_client_status *>(p)); }
+
+    /* a numeric field (integers exact to 2^53, booleans 0/1); Error when there is none of
+     * that name */
+    double number(const std::string &field) const
+    {
+        double v = lag_client_status_number(p_, field.c_str());
+        if (std::isnan(v)) throw Error(LAG_ERR_ARG, "status_t has no numeric field " + field);
+        return v;
+    }
+    /* a text field; Error when there is none of that name */
+    std::string text(const std::string &field) const
+    {
+        const char *t = lag_client_status_text(p_, field.c_str());
+        if (!t) throw Error(LAG_ERR_ARG, "status_t has no text field " + field);
+        return t;
+    }
+    double sim_time() const { return number("sim_time"); }
+    std::string run_state() const { return text("run_state"); }
+    /* the names of its fields, in the .lcm file's order */
+    static std::vector<std::string> fields()
+    {
+        std::vector<std::string> v;
+        for (int i = 0; i < lag_client_status_fields(); i++)
+            v.emplace_back(lag_client_status_field_name(i));
+        return v;
+    }
+
+    const lag_client_status *get() const { return p_; }
+    lag_client_status *get() { return p_; }
+
+private:
+    explicit Status(lag_client_status *p) : p_(p), own_(false) {}
+    lag_client_status *p_;
+    bool own_;
+};
+
+/* A connection to one plant (lag_client): its URL (empty: LCM's default, honouring
+ * LCM_DEFAULT_URL) and channel prefix; Error LAG_ERR_ARG for a prefix that is empty or
+ * 64 bytes or more, LAG_ERR_LCM when LCM cannot be opened on the URL. Movable, not
+ * copyable. */
+class Client {
+public:
+    explicit Client(const std::string &prefix, const std::string &url = "")
+        : cb_(std::make_unique<Callbacks>())
+    {
+        if (prefix.empty() || prefix.size() >= LAG_CLIENT_NAME_LEN)
+            throw Error(LAG_ERR_ARG, "LAG_ERR_ARG: a prefix of 1 to 63 characters, not '" + prefix + "'");
+        char err[256] = "";
+        c_.reset(lag_client_create(url.empty() ? nullptr : url.c_str(), prefix.c_str(), err,
+                                   sizeof err));
+        if (!c_) throw Error(LAG_ERR_LCM, detail::describe(LAG_ERR_LCM, err));
+    }
+
+    /* The scene (DESCRIBE at once and every 0.25 s until it comes); Error with LAG_TIMEOUT
+     * when none came within timeout_s. */
+    Scene wait_scene(double timeout_s)
+    {
+        Scene sc;
+        lag_result rc = run(lag_client_wait_scene(c_.get(), timeout_s, sc.get()));
+        if (rc == LAG_TIMEOUT) throw Error(rc, detail::describe(rc, lag_client_errmsg(c_.get())));
+        return sc;
+    }
+    /* The newest state not yet returned, or nullopt when none came within timeout_s. */
+    std::optional<State> wait_state(double timeout_s)
+    {
+        State st;
+        if (run(lag_client_wait_state(c_.get(), timeout_s, &st, sizeof st)) != LAG_OK)
+            return std::nullopt;
+        return st;
+    }
+    /* Handles at most one message (waiting up to timeout_ms): true when one was. */
+    bool handle(int timeout_ms) { return run(lag_client_handle(c_.get(), timeout_ms)) == LAG_OK; }
+
+    std::optional<State> latest_state() const
+    {
+        State st;
+        return lag_client_latest_state(c_.get(), &st, sizeof st) ? std::optional<State>(st)
+                                                                 : std::nullopt;
+    }
+    std::optional<Reference> latest_reference() const
+    {
+        Reference r;
+        return lag_client_latest_reference(c_.get(), &r, sizeof r) ? std::optional<Reference>(r)
+                                                                   : std::nullopt;
+    }
+    /* the scene of the latest state's generation */
+    std::optional<Scene> latest_scene() const
+    {
+        Scene sc;
+        return lag_client_latest_scene(c_.get(), sc.get()) ? std::optional<Scene>(std::move(sc))
+                                                           : std::nullopt;
+    }
+    std::optional<Status> latest_status() const
+    {
+        Status s;
+        return lag_client_latest_status(c_.get(), s.get()) ? std::optional<Status>(std::move(s))
+                                                           : std::nullopt;
+    }
+
+    /* Efforts for the joints named, answering the state at sim_time (stamped with the
+     * latest state's generation). Error (LAG_ERR_ARG) for more than 8 joints, sizes that
+     * differ, a non-finite effort or a name of 64 bytes or more. */
+    void send_command(double sim_time, const std::vector<std::string> &names,
+                      const std::vector<double> &effort)
+    {
+        if (names.size() != effort.size() || names.size() > LAG_CLIENT_MAX_JOINTS)
+            throw Error(LAG_ERR_ARG, "send_command: " + std::to_string(names.size()) +
+                                         " names, " + std::to_string(effort.size()) +
+                                         " efforts (equal, at most 8)");
+        const char *n[LAG_CLIENT_MAX_JOINTS];
+        for (size_t i = 0; i < names.size(); i++) n[i] = names[i].c_str();
+        detail::check(lag_client_send_command(c_.get(), sim_time, static_cast<int>(names.size()),
+                                              n, effort.data()),
+                      c_.get());
+    }
+    void send_command(const State &st, const std::vector<std::string> &names,
+                      const std::vector<double> &effort)
+    {
+        send_command(st.sim_time, names, effort);
+    }
+
+    /* Control requests (lagsim_client.h says what each does). */
+    void pause() { detail::check(lag_client_pause(c_.get()), c_.get()); }
+    void resume() { detail::check(lag_client_resume(c_.get()), c_.get()); }
+    void step(int64_t periods) { detail::check(lag_client_step(c_.get(), periods), c_.get()); }
+    void reset() { detail::check(lag_client_reset(c_.get()), c_.get()); }
+    void reset_scene() { detail::check(lag_client_reset_scene(c_.get()), c_.get()); }
+    void reset_to(const std::vector<double> &q, const std::vector<double> &qd)
+    {
+        if (q.size() != qd.size())
+            throw Error(LAG_ERR_ARG, "reset_to: q and qd of different sizes");
+        detail::check(lag_client_reset_to(c_.get(), static_cast<int>(q.size()), q.data(), qd.data()),
+                      c_.get());
+    }
+    void request_status() { detail::check(lag_client_request_status(c_.get()), c_.get()); }
+    void request_describe() { detail::check(lag_client_request_describe(c_.get()), c_.get()); }
+    void set(const std::string &key, const std::string &value)
+    {
+        detail::check(lag_client_set(c_.get(), key.c_str(), value.c_str()), c_.get());
+    }
+    void kick(const std::string &joint, double impulse, double duration = 0.0)
+    {
+        detail::check(lag_client_kick(c_.get(), joint.c_str(), impulse, duration), c_.get());
+    }
+
+    lag_client_counters counters() const
+    {
+        lag_client_counters k{};
+        lag_client_get_counters(c_.get(), &k, sizeof k);
+        return k;
+    }
+    /* for poll()/select(): when readable, handle(0) */
+    int fileno() const { return lag_client_fileno(c_.get()); }
+    lag_client *get() const { return c_.get(); }
+
+    /* Callbacks (an empty function removes one). */
+    void on_state(std::function<void(const State &)> f)
+    {
+        cb_->state = std::move(f);
+        lag_client_on_state(c_.get(), cb_->state ? &Callbacks::on_state : nullptr, cb_.get());
+    }
+    void on_reference(std::function<void(const Reference &)> f)
+    {
+        cb_->reference = std::move(f);
+        lag_client_on_reference(c_.get(), cb_->reference ? &Callbacks::on_reference : nullptr,
+                                cb_.get());
+    }
+    void on_event(std::function<void(const Event &)> f)
+    {
+        cb_->event = std::move(f);
+        lag_client_on_event(c_.get(), cb_->event ? &Callbacks::on_event : nullptr, cb_.get());
+    }
+    void on_scene(std::function<void(const Scene &)> f)
+    {
+        cb_->scene = std::move(f);
+        lag_client_on_scene(c_.get(), cb_->scene ? &Callbacks::on_scene : nullptr, cb_.get());
+    }
+    void on_status(std::function<void(const Status &)> f)
+    {
+        cb_->status = std::move(f);
+        lag_client_on_status(c_.get(), cb_->status ? &Callbacks::on_status : nullptr, cb_.get());
+    }
+
+private:
+    /* The callables, at an address that moves of the Client leave alone; the first
+     * exception one threw, until the call that ran it returns. */
+    struct Callbacks {
+        std::function<void(const State &)> state;
+        std::function<void(const Reference &)> reference;
+        std::function<void(const Event &)> event;
+        std::function<void(const Scene &)> scene;
+        std::function<void(const Status &)> status;
+        std::exception_ptr pending;
+
+        template <class F> void guard(F &&f) noexcept
+        {
+            if (pending) return; /* the first one is thrown; the others are not run */
+            try {
+                f();
+            } catch (...) {
+                pending = std::current_exception();
+            }
+        }
+        /* The structs the library passes are the ones State, Reference and Event derive
+         * from without adding a member: a copy gives the callable the C++ type. */
+        static void on_state(const lag_client_state *s, void *u)
+        {
+            auto *cb = static_cast<Callbacks *>(u);
+            cb->guard([&] {
+                State st;
+                static_cast<lag_client_state &>(st) = *s;
+                cb->state(st);
+            });
+        }
+        static void on_reference(const lag_client_reference *r, void *u)
+        {
+            auto *cb = static_cast<Callbacks *>(u);
+            cb->guard([&] {
+                Reference ref;
+                static_cast<lag_client_reference &>(ref) = *r;
+                cb->reference(ref);
+            });
+        }
+        static void on_event(const lag_client_event *e, void *u)
+        {
+            auto *cb = static_cast<Callbacks *>(u);
+            cb->guard([&] {
+                Event ev;
+                static_cast<lag_client_event &>(ev) = *e;
+                cb->event(ev);
+            });
+        }
+        static void on_scene(const lag_client_scene *s, void *u)
+        {
+            auto *cb = static_cast<Callbacks *>(u);
+            cb->guard([&] { cb->scene(Scene::view(s)); });
+        }
+        static void on_status(const lag_client_status *s, void *u)
+        {
+            auto *cb = static_cast<Callbacks *>(u);
+            cb->guard([&] { cb->status(Status::view(s)); });
+        }
+    };
+    /* A call that may have run callbacks: their exception first, then the call's error. */
+    lag_result run(lag_result rc)
+    {
+        if (cb_->pending) std::rethrow_exception(std::exchange(cb_->pending, nullptr));
+        return detail::check(rc, c_.get());
+    }
+    struct Destroy {
+        void operator()(lag_client *c) const { lag_client_destroy(c); }
+    };
+    std::unique_ptr<Callbacks> cb_;
+    std::unique_ptr<lag_client, Destroy> c_;
+};
+
+/* The plants on the bus at url (lag_client_discover). */
+inline std::vector<Plant> discover(const std::string &url = "", double wait_s = 1.0,
+                                   double settle_s = 0.5)
+{
+    std::vector<Plant> p(LAG_CLIENT_MAX_PLANTS);
+    int n = 0;
+    char err[512] = "";
+    lag_result rc = lag_client_discover(url.empty() ? nullptr : url.c_str(), wait_s, settle_s,
+                                        p.data(), LAG_CLIENT_MAX_PLANTS, sizeof(Plant), &n, err,
+                                        sizeof err);
+    if (rc < 0) throw Error(rc, detail::describe(rc, err));
+    p.resize(static_cast<size_t>(n));
+    return p;
+}
+
+/* The only plant (of `model`, unless empty) on the bus: Error with LAG_TIMEOUT (none) or
+ * LAG_ERR_AMBIGUOUS (several: the message names them). */
+inline Plant pick_plant(const std::string &url = "", const std::string &model = "",
+                        double wait_s = 1.0)
+{
+    Plant p;
+    char err[1200] = "";
+    lag_result rc = lag_client_pick_plant(url.empty() ? nullptr : url.c_str(),
+                                          model.empty() ? nullptr : model.c_str(), wait_s, &p,
+                                          sizeof p, err, sizeof err);
+    if (rc != LAG_OK) throw Error(rc, detail::describe(rc, err));
+    return p;
+}
+
+} // namespace lagsim
+
+#endif

@@ -1,0 +1,199 @@
+/*
+ * lagsim_client.hpp does what its header says, on a memq:// handle fed messages encoded
+ * by the wire module (the bus's path, lag_client_feed):
+ *   - errors are lagsim::Error with the library's code: a bad prefix (LAG_ERR_ARG), no
+ *     scene in time (LAG_TIMEOUT), a command of mismatched sizes or a NaN effort
+ *     (LAG_ERR_ARG, the library's message), a status field that does not exist;
+ *   - nothing in time is no error: wait_state gives std::nullopt;
+ *   - a callback's exception never crosses the C library: it comes out, of its own type,
+ *     from the next call that runs callbacks, once;
+ *   - a Scene handed to a callback is a view; a copy of it owns its own and outlives it;
+ *   - State, Reference, the scene's and the status's fields read as the C library's.
+ *
+ * usage: test_client_hpp   (exit 0 when every check holds)
+ */
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "lagsim_client.hpp"
+#include "lagsim_wire.h"
+
+namespace {
+
+int failures = 0;
+
+void check(bool ok, const std::string &what)
+{
+    std::printf("%s: %s\n", ok ? "ok  " : "FAIL", what.c_str());
+    failures += !ok;
+}
+
+/* The code of the lagsim::Error f throws (LAG_OK if none), its message in *msg. */
+template <class F> lag_result error_of(F f, std::string *msg = nullptr)
+{
+    try {
+        f();
+    } catch (const lagsim::Error &e) {
+        if (msg) *msg = e.what();
+        return e.code();
+    }
+    return LAG_OK;
+}
+
+/* Encodes message m of type t and feeds it to c on <FED>_<suffix>. */
+void feed(lagsim::Client &c, lag_wire_type t, const void *m, const char *suffix)
+{
+    unsigned char buf[LAG_WIRE_BUF_SIZE];
+    int n = lag_wire_encode(t, m, buf, sizeof buf);
+    std::string ch = std::string("FED_") + suffix;
+    if (n <= 0 || lag_client_feed(c.get(), ch.c_str(), buf, static_cast<size_t>(n)) != LAG_OK)
+        check(false, "feeding a " + std::string(lag_wire_type_name(t)));
+}
+
+void feed_scene(lagsim::Client &c)
+{
+    lag_wire_scene s;
+    std::memset(&s, 0, sizeof s);
+    std::strcpy(s.model, "manipulator");
+    std::strcpy(s.prefix, "FED");
+    std::strcpy(s.mode, "lockstep");
+    s.num_params = 2;
+    std::strcpy(s.param_name[0], "m1");
+    std::strcpy(s.param_name[1], "m2");
+    s.param_value[0] = 2.0;
+    s.param_value[1] = 1.25;
+    s.num_joints = 2;
+    std::strcpy(s.joint_name[0], "q1");
+    std::strcpy(s.joint_name[1], "q2");
+    s.actuated[0] = s.actuated[1] = true;
+    s.control_period = 0.01;
+    feed(c, LAG_WIRE_SCENE, &s, "SCENE");
+}
+
+void feed_state(lagsim::Client &c, double t)
+{
+    lag_wire_joint_state s;
+    std::memset(&s, 0, sizeof s);
+    s.sim_time = t;
+    s.step = static_cast<int64_t>(t * 1000);
+    s.num_joints = 2;
+    std::strcpy(s.name[0], "q1");
+    std::strcpy(s.name[1], "q2");
+    s.position[0] = 0.25;
+    s.position[1] = 0.5;
+    feed(c, LAG_WIRE_JOINT_STATE, &s, "STATE");
+}
+
+void errors()
+{
+    check(error_of([] { lagsim::Client c(""); }) == LAG_ERR_ARG, "an empty prefix: LAG_ERR_ARG");
+    check(error_of([] { lagsim::Client c(std::string(64, 'P')); }) == LAG_ERR_ARG,
+          "a prefix of 64 bytes: LAG_ERR_ARG");
+    lagsim::Client c("FED", "memq://");
+    std::string msg;
+    lag_result rc = error_of([&] { c.wait_scene(0.3); }, &msg);
+    check(rc == LAG_TIMEOUT && msg.find("FED_SCENE") != std::string::npos,
+          "no scene in time: LAG_TIMEOUT naming the channel (" + msg + ")");
+    check(!c.wait_state(0.05), "no state in time: std::nullopt, no exception");
+    check(!c.latest_state() && !c.latest_reference() && !c.latest_status(),
+          "nothing latest before anything came");
+    check(error_of([&] { c.send_command(0.0, {"q1", "q2"}, {1.0}); }) == LAG_ERR_ARG,
+          "two names, one effort: LAG_ERR_ARG");
+    rc = error_of([&] { c.send_command(0.0, {"q1"}, {NAN}); }, &msg);
+    check(rc == LAG_ERR_ARG && msg.find("NaN") != std::string::npos,
+          "a NaN effort: LAG_ERR_ARG with the library's message (" + msg + ")");
+    check(error_of([&] { c.step(0); }) == LAG_ERR_ARG, "step(0): LAG_ERR_ARG");
+}
+
+void messages()
+{
+    lagsim::Client c("FED", "memq://");
+    std::optional<lagsim::Scene> kept;
+    int scenes = 0;
+    c.on_scene([&](const lagsim::Scene &sc) {
+        scenes++;
+        kept = sc; /* a copy of the view: its own handle */
+    });
+    feed_scene(c);
+    check(scenes == 1 && kept && kept->model() == "manipulator" && kept->param("m2") == 1.25 &&
+              kept->joint("q2") == 1 && kept->actuated(1) &&
+              kept->joints() == std::vector<std::string>{"q1", "q2"},
+          "on_scene's view copied: model, parameter, joints as sent");
+    check(error_of([&] { kept->param("m9"); }) == LAG_ERR_ARG && !kept->find_param("m9"),
+          "a parameter the scene has not: Error, find_param empty");
+    lagsim::Scene scene = c.wait_scene(1.0);
+    check(scene.control_period() == 0.01 && scene.mode() == "lockstep",
+          "wait_scene: the scene that came");
+
+    feed_state(c, 0.5);
+    std::optional<lagsim::State> st = c.wait_state(1.0);
+    check(st && st->sim_time == 0.5 && st->joint("q2") == 1 && st->position[1] == 0.5 &&
+              st->positions() == std::vector<double>{0.25, 0.5} &&
+              st->names() == std::vector<std::string>{"q1", "q2"},
+          "wait_state: the state, its joints and positions");
+    check(!c.wait_state(0.05), "each state once: not returned again");
+
+    lag_wire_status s;
+    std::memset(&s, 0, sizeof s);
+    s.rtf = 1.5;
+    std::strcpy(s.run_state, "paused");
+    feed(c, LAG_WIRE_STATUS, &s, "STATUS");
+    std::optional<lagsim::Status> status = c.latest_status();
+    check(status && status->number("rtf") == 1.5 && status->run_state() == "paused" &&
+              status->fields().size() == static_cast<size_t>(lag_client_status_fields()),
+          "the status's fields by name");
+    check(error_of([&] { status->number("no_such_field"); }) == LAG_ERR_ARG &&
+              error_of([&] { status->text("rtf"); }) == LAG_ERR_ARG,
+          "a status field that is not there, or not a text: Error");
+}
+
+void callback_exceptions()
+{
+    lagsim::Client c("FED", "memq://");
+    int events = 0;
+    c.on_event([&](const lagsim::Event &ev) {
+        events++;
+        if (ev.is("boom")) throw std::domain_error("boom at " + std::to_string(ev.sim_time));
+    });
+    lag_wire_event e;
+    std::memset(&e, 0, sizeof e);
+    e.sim_time = 2.5;
+    std::strcpy(e.kind, "boom");
+    feed(c, LAG_WIRE_EVENT, &e, "EVENT"); /* the C library runs the callback here */
+    bool caught = false;
+    try {
+        c.handle(0);
+    } catch (const std::domain_error &x) {
+        caught = std::string(x.what()) == "boom at 2.500000";
+    }
+    check(events == 1 && caught, "a callback's exception comes out of the next handle(), its "
+                                 "own type and message");
+    bool again = false;
+    try {
+        c.handle(0);
+    } catch (...) {
+        again = true;
+    }
+    check(!again, "... once");
+    std::strcpy(e.kind, "set");
+    feed(c, LAG_WIRE_EVENT, &e, "EVENT");
+    check(events == 2, "callbacks run again afterwards");
+}
+
+} // namespace
+
+int main()
+{
+    check(lagsim::version() == LAGSIM_VERSION_NUMBER && lagsim::abi() == LAGSIM_CLIENT_ABI,
+          "version() and abi() are the header's");
+    errors();
+    messages();
+    callback_exceptions();
+    std::printf("%d failure(s)\n", failures);
+    return failures ? 1 : 0;
+}
