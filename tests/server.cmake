@@ -59,7 +59,8 @@ endif()
 # A host of plants (lagsimd --plants DIR, several --config) over real LCM, each case on port
 # pairs of its own held by lock files (tests/server/test_host.py): isolation from a hostile
 # neighbour (states bit for bit those of the plant alone; the neighbour's input budget),
-# bad scenes skipped, a directory's files added, changed and removed while running,
+# bad scenes skipped, a directory's files added, changed and removed while running, a
+# file that failed for want of its port tried again on SIGHUP,
 # lagsimctl list through the host's directory.
 if(LAGSIM_PYTHON3)
   foreach(case isolation bad_scene reload list many)

@@ -499,28 +499,39 @@ def host_form_checks(sd, tmp, env):
     with open("/etc/lagsim/%s.env" % name, "w") as f:
         f.write("LCM_DEFAULT_URL=%s\nLAGSIMD_ARGS=--log run.lcm --increment\n" % dir_url)
     unit = "lagsimd@%s.service" % name
+    lenv = dict(env, LCM_DEFAULT_URL=dir_url)
+
+    def listed(want, seconds=30):
+        """lagsimctl list on the directory until it names the plants of `want` (each call
+        listens 2 s: the wait is the listening, no sleep), or `seconds` passed."""
+        deadline, rows, ls = time.monotonic() + seconds, {}, None
+        while time.monotonic() < deadline:
+            ls = run(["/usr/bin/lagsimctl", "--timeout", "2", "list"], env=lenv, timeout=30)
+            rows = {l.split()[0]: l.split()[-1] for l in ls.stdout.splitlines()[1:] if l.strip()}
+            if all(k in rows for k in want):
+                break
+        return rows, ls.stdout if ls else ""
+
     try:
         r = sd.ctl("start", unit)
-        time.sleep(2)
+        rows, out = listed(("ALICE", "BOB"))
         check(r.returncode == 0 and sd.show(unit, "ActiveState") == "active",
               "the host form: systemctl start %s with %s/ (alice.yaml, bob.yaml)" % (unit, d), r.stdout)
-        lenv = dict(env, LCM_DEFAULT_URL=dir_url)
-        ls = run(["/usr/bin/lagsimctl", "list"], env=lenv, timeout=30)
-        rows = {l.split()[0]: l.split()[-1] for l in ls.stdout.splitlines()[1:] if l.strip()}
         check(rows == {"ALICE": url(0), "BOB": url(1)},
               "lagsimctl list: ALICE and BOB, each on its own port pair after the directory's: %s"
-              % rows, ls.stdout)
+              % rows, out)
         lqr = run(["/usr/bin/dipc_lqr", "--prefix", "ALICE", "--url", url(0), "--duration", "2",
                    "--timeout", "10", "-q"], env=env, timeout=60)
         check(lqr.returncode == 0 and "states=" in lqr.stdout,
               "the installed dipc_lqr balances ALICE on its URL", lqr.stdout)
         shutil.copy("/usr/share/lagsim/config/dipc.yaml", "%s/carol.yaml" % d)
         os.chmod("%s/carol.yaml" % d, 0o644)
-        time.sleep(2)
-        ls = run(["/usr/bin/lagsimctl", "list"], env=lenv, timeout=30)
-        check("CAROL" in ls.stdout and url(2) in ls.stdout,
-              "carol.yaml added: CAROL runs, without a restart (NRestarts %s)" %
-              sd.show(unit, "NRestarts"), ls.stdout)
+        pid = sd.show(unit, "MainPID")
+        rows, out = listed(("CAROL",))
+        check(rows.get("CAROL") == url(2) and sd.show(unit, "NRestarts") == "0" and
+              sd.show(unit, "MainPID") == pid,
+              "carol.yaml added: CAROL runs on the next pair, without a restart (NRestarts %s)" %
+              sd.show(unit, "NRestarts"), out)
         r = sd.ctl("stop", unit)
         check(r.returncode == 0 and sd.show(unit, "ExecMainStatus") == "0",
               "systemctl stop: exit %s" % sd.show(unit, "ExecMainStatus"), r.stdout)
