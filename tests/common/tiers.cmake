@@ -61,10 +61,11 @@ set(LAGSIM_TIER_RULES
   "root      NAME  ^net_two_hosts_"
   "octave    NAME  ^net_plant_urls_octave$"
   "quick     NAME  ^net_(plant_urls|filter)_"
-  # server: the loop, the pacer and the floors on made-up clocks or none; the daemon's
-  # lockstep, fast and offline references; every other server_test case runs lagsimd in
-  # real time (watchdog, floods, signals, plants that conflict)
-  "quick     NAME  ^server_(loop|pace)_"
+  # server: the loop, the pacer and the floors on made-up clocks or none; the plant's own
+  # receive sockets against LCM's datagrams (as net_filter_: delivery, no pace); the
+  # daemon's lockstep, fast and offline references; every other server_test case runs
+  # lagsimd in real time (watchdog, floods, signals, plants that conflict, a host's plants)
+  "quick     NAME  ^server_(loop|pace|rx)_"
   "quick     NAME  ^server_daemon_floors$"
   "quick     NAME  ^server_reference_(lockstep|fast|offline|manipulator)$"
   "wallclock NAME  ^server_"
