@@ -4,7 +4,8 @@
 # lagsimd, in the same run. For each: overruns (from each plant's final status), period
 # error p50/p99/max (from the states' utime intervals, read by bench/lab_probe.c without
 # LCM threads), CPU per plant-period of the daemon(s) and of the controllers (user +
-# system, /usr/bin/time), the load average before and after. A benchmark, not a test:
+# system, /usr/bin/time), the daemons' memory (the sum of each one's largest resident
+# set, /usr/bin/time's %M), the load average before and after. A benchmark, not a test:
 # nothing is asserted (docs/benchmarks.md, "A lab host").
 #
 #   bench/lab_host.sh [-n N] [-s SECONDS] [-b BUILD] [-p PORT_BASE] [-m host|separate|both]
@@ -61,6 +62,8 @@ for ((i = 0; i < n; i++)); do cp "$root/config/dipc.yaml" "$work/lab/$(printf 'p
 
 # Sums the user + system CPU seconds of the /usr/bin/time files given.
 cpu_of() { cat "$@" 2>/dev/null | awk '{ s += $2 + $3 } END { printf "%.3f", s }'; }
+# Sums the largest resident sets (KiB, the 4th field of the daemons' files), in MB.
+mem_of() { cat "$@" 2>/dev/null | awk '{ s += $4 } END { printf "%.1f", s / 1024 }'; }
 
 # One configuration: the probe, the controllers, the daemon(s); a line of figures.
 run_mode() {
@@ -80,13 +83,13 @@ run_mode() {
         pids+=($!)
     done
     if [ "$mode" = host ]; then
-        LCM_DEFAULT_URL="udpm://$group:$((base - 2))?ttl=0" /usr/bin/time -f '%e %U %S' -o "$d/d.0" \
+        LCM_DEFAULT_URL="udpm://$group:$((base - 2))?ttl=0" /usr/bin/time -f '%e %U %S %M' -o "$d/d.0" \
             nice -n "$nice" "$bin/lagsimd" --plants "$work/lab" --port-base "$base" --duration "$secs" -q \
             2>"$d/daemon.err" &
         pids+=($!)
     else
         for ((i = 0; i < n; i++)); do
-            /usr/bin/time -f '%e %U %S' -o "$d/d.$i" nice -n "$nice" "$bin/lagsimd" --config \
+            /usr/bin/time -f '%e %U %S %M' -o "$d/d.$i" nice -n "$nice" "$bin/lagsimd" --config \
                 "$work/lab/$(printf 'p%03d' "$i").yaml" --set "lcm.prefix=$(printf 'P%03d' "$i")" \
                 --set "lcm.url=udpm://$group:$((base + 2 * i))?ttl=0" --duration "$secs" -q \
                 2>>"$d/daemon.err" &
@@ -100,9 +103,9 @@ run_mode() {
     dcpu=$(cpu_of "$d"/d.*)
     ccpu=$(cpu_of "$d"/ctl.*)
     periods=$(awk -v n="$n" -v s="$secs" 'BEGIN { printf "%d", n * s * 100 }')
-    printf '%-8s N=%d %s; daemon CPU %s s = %.1f us per plant-period; controllers %s s = %.1f us; load %s -> %s\n' \
+    printf '%-8s N=%d %s; daemon CPU %s s = %.1f us per plant-period, memory %s MB; controllers %s s = %.1f us; load %s -> %s\n' \
         "$mode" "$n" "$(cat "$d/probe.out")" "$dcpu" "$(awk -v c="$dcpu" -v p="$periods" 'BEGIN { print c / p * 1e6 }')" \
-        "$ccpu" "$(awk -v c="$ccpu" -v p="$periods" 'BEGIN { print c / p * 1e6 }')" "$load0" "$load1"
+        "$(mem_of "$d"/d.*)" "$ccpu" "$(awk -v c="$ccpu" -v p="$periods" 'BEGIN { print c / p * 1e6 }')" "$load0" "$load1"
     grep -v -e 'listening on' -e 'event start' -e 'plants starting' -e "host's directory" "$d/daemon.err" | head -5
 }
 
