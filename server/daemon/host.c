@@ -92,8 +92,8 @@ typedef struct plant {
     char state_url[LAG_BUS_URL_LEN];
 } plant;
 
-/* A file of DIR that failed to load, remembered so that a reading of DIR does not say it
- * again until it changes. */
+/* A file that failed to start (DIR's by its NAME, a --config by its path), remembered so
+ * that a reading of the files does not say it again until it changes or SIGHUP asks. */
 typedef struct failed {
     char name[NAME_MAX + 1];
     uint64_t hash;
@@ -108,6 +108,7 @@ struct host {
     int n;
     failed fail[HOST_MAX_PLANTS];
     int nfail;
+    bool retry;                 /* SIGHUP: the next reading tries the failed files again */
     int notify_fd;
     rt_io_src notify;
     /* the directory: LCM_DEFAULT_URL's (or LCM's default) bus, where lagsimctl list
@@ -638,7 +639,7 @@ static void on_signal(void *ctx, int signo)
     host *h = ctx;
     if (signo == SIGHUP && !h->one) { /* a host reads its files again, and tries again */
         h->rescan_at = h->now;       /* those that failed (a port taken meanwhile ...) */
-        h->nfail = 0;
+        h->retry = true;
         return;
     }
     bool stops = signo != SIGUSR1 && signo != SIGUSR2;
@@ -678,12 +679,13 @@ static bool plant_file(const char *dir, const char *fname, char *name, size_t ca
 }
 
 /* A file that failed: remembered with its bytes' hash (one message per version). Returns
- * true when it was remembered already (nothing to say again). */
+ * true when it was remembered already (nothing to say again), never in a reading SIGHUP
+ * asked for (it is tried again). */
 static bool failed_seen(host *h, const char *name, uint64_t hv, bool remember)
 {
     for (int i = 0; i < h->nfail; i++)
         if (!strcmp(h->fail[i].name, name)) {
-            bool seen = h->fail[i].hash == hv;
+            bool seen = h->fail[i].hash == hv && !h->retry;
             if (remember) h->fail[i].hash = hv;
             return seen;
         }
@@ -700,6 +702,13 @@ static char *file_bytes(const char *path, size_t *len)
     char *text = NULL, err[512];
     if (lag_scene_read(path, &text, len, err, sizeof err) != LAG_OK) return NULL;
     return text;
+}
+
+static bool failed_has(const host *h, const char *name)
+{
+    for (int i = 0; i < h->nfail; i++)
+        if (!strcmp(h->fail[i].name, name)) return true;
+    return false;
 }
 
 static void failed_forget(host *h, const char *name)
@@ -723,7 +732,7 @@ static void plant_add(host *h, const char *path, const char *name, int keep)
         failed_seen(h, key, hv, true);
         h->skipped++;
         fprintf(stderr, "lagsimd: %s: skipped (the reason is above); the other plants run; "
-                "it is tried again when it changes and on SIGHUP\n", path);
+                "it is tried again %son SIGHUP\n", path, name ? "when it changes and " : "");
         return;
     }
     failed_forget(h, key);
@@ -762,13 +771,9 @@ static void rescan_plant(host *h, int *i)
     else failed_forget(h, key);
 }
 
-/* Every plant's file read again, then DIR's new files. */
-static void host_rescan(host *h)
+/* DIR's files that are no plant yet: new ones, and those that failed. */
+static void rescan_dir(host *h)
 {
-    h->rescan_at = INT64_MAX;
-    if (h->stopping) return;
-    for (int i = 0; i < h->n;) rescan_plant(h, &i);
-    if (!h->c->dir) return;
     struct dirent **list = NULL;
     int n = scandir(h->c->dir, &list, NULL, alphasort);
     if (n < 0) {
@@ -783,6 +788,20 @@ static void host_rescan(host *h)
         free(list[k]);
     }
     free(list);
+}
+
+/* Every plant's file read again, then the --config files that failed (not watched: on
+ * SIGHUP), then DIR's new files. */
+static void host_rescan(host *h)
+{
+    h->rescan_at = INT64_MAX;
+    if (!h->stopping) {
+        for (int i = 0; i < h->n;) rescan_plant(h, &i);
+        for (int i = 0; i < h->c->nconfigs; i++)
+            if (failed_has(h, h->c->configs[i])) plant_add(h, h->c->configs[i], NULL, 0);
+        if (h->c->dir) rescan_dir(h);
+    }
+    h->retry = false;
 }
 
 /* ---------------------------------------------------------------- the loop */

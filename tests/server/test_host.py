@@ -17,7 +17,9 @@ Cases:
   bad_scene   a directory with a scene that does not load, a file name that is no prefix,
               two files of one prefix, a port pair taken twice: each said (file:line:column,
               both files named) and skipped, the good plant runs, exit 0; a host whose every
-              scene fails exits 2
+              scene fails exits 2; --config several times: a bad one and one whose port
+              another program holds skipped, tried again on SIGHUP (the second then starts),
+              the good one untouched
   reload      a file added starts its plant, a file changed restarts its plant on the same
               ports from the new bytes, a bad new version is said and the plant runs on, a
               file removed stops its plant; a file that failed because another program held
@@ -400,6 +402,43 @@ class T:
                                "--port-base", str(base), "--duration", "1"])
             rc, err = self.finish(host, 30)
             check(rc == 2, "a host whose every scene fails exits 2 (%s)" % rc)
+            self.configs_retry(d)
+
+    def configs_retry(self, d):
+        """--config several times: a file that does not load and one whose command port
+        another program holds are said and skipped, the good one runs; SIGHUP tries the
+        failed ones again (not watched: on SIGHUP only), and the one whose port was freed
+        starts; the good one is not touched."""
+        import socket
+        b = take_pairs(2)
+        paths = {k: os.path.join(d, k + ".yaml") for k in ("good", "held", "bad")}
+        open(paths["good"], "w").write(PLANT + "lcm: {prefix: GOODC, url: '%s'}\n" % url(b))
+        open(paths["held"], "w").write(PLANT + "lcm: {prefix: HELD, url: '%s'}\n" % url(b + 2))
+        open(paths["bad"], "w").write("model: nope\n")
+        held = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)  # no SO_REUSEADDR: exclusive
+        held.bind(("", b + 3))
+        bus = Bus(self.t, [("GOODC", b), ("HELD", b + 2)])
+        host = self.start([self.prog("lagsimd"), "--config", paths["good"], "--config",
+                           paths["held"], "--config", paths["bad"]])
+        check(bus.wait_event("GOODC", "start", 0, 10), "--config x3: the good one starts")
+        check(self.said(host, "held.yaml: skipped (the reason is above); the other plants run; "
+                        "it is tried again on SIGHUP", 10),
+              "held.yaml (its command port held by another program) said and skipped, to be "
+              "tried again on SIGHUP")
+        check(self.said(host, "bad.yaml:1:", 1), "bad.yaml said with its file:line:column")
+        held.close()
+        since = time.monotonic()
+        host.send_signal(signal.SIGHUP)
+        check(bus.wait_event("HELD", "start", since, 10),
+              "SIGHUP: held.yaml tried again, its port free: HELD starts")
+        bus.pump(0.3)
+        check("stop" not in [e.kind for e in bus.events("GOODC")] and
+              len(bus.states("GOODC", since)) > 10, "GOODC runs on, untouched")
+        host.send_signal(signal.SIGTERM)
+        rc, err = self.finish_pumping(host, bus, 30)
+        check(rc == 0 and err.count("bad.yaml: skipped") == 2,
+              "SIGTERM: exit %s; bad.yaml tried again on SIGHUP and said again (%d)" %
+              (rc, err.count("bad.yaml: skipped")))
 
 
     # ------------------------------------------------------------------ reload
