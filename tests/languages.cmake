@@ -247,6 +247,12 @@ if(TARGET dipc_balance_go)
       --run go "discrete LQR \\(h = [^)]*\\): K = \\[([^]]*)\\]"
         "${go_dipc} --prefix {prefix} --duration 0.05 -q")
   list(APPEND lang_tests clients_go_dipc_lockstep clients_go_dipc_hostile clients_go_dipc_gain)
+  # the tree's Go programs are compiled again when a header cgo includes from elsewhere
+  # changes (cmake/go_build.cmake keys Go's cache on them; a plain go build would not)
+  add_test(NAME clients_go_cgo_rebuild
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/go_cgo_rebuild.py --go ${LAGSIM_GO}
+      --script ${PROJECT_SOURCE_DIR}/cmake/go_build.cmake --cache ${CMAKE_BINARY_DIR}/go/cache)
+  list(APPEND lang_tests clients_go_cgo_rebuild)
   # the Go sources as gofmt writes them, and clean by go vet (cgo's rules: no Go pointer
   # held by C, no misuse of unsafe.Pointer)
   find_program(LAGSIM_GOFMT gofmt)

@@ -105,7 +105,7 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^clients_[a-z_]+_(usage_.*|help)$"
   "quick     NAME  ^clients_(python|lua)_(lcm|types)$"
   "quick     NAME  ^clients_java_release$"
-  "quick     NAME  ^clients_(go_dipc_gain|go_vet|binding_lookup)$"
+  "quick     NAME  ^clients_(go_dipc_gain|go_vet|go_cgo_rebuild|binding_lookup)$"
   "quick     NAME  _(lockstep|hostile|push|reference_lost)$"
   "quick     NAME  ^clients_cross_language_(dipc|manipulator)$"
   "quick     NAME  ^clients_readme_(c|cpp|cpplcm|python|lua|java|go)$"
