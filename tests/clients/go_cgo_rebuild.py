@@ -23,7 +23,7 @@ PROGRAM = """package main
 
 /*
 #cgo CFLAGS: -I${SRCDIR}/../include
-#include "PROBE"
+#include "HEADER_NAME"
 */
 import "C"
 import "fmt"
@@ -46,7 +46,7 @@ def main():
         header = os.path.join(tmp, "include", "lagsim_probe" + ".h")
         source = os.path.join(tmp, "prog", "probe.go")
         with open(source, "w") as f:  # the header, made here, by its name
-            f.write(PROGRAM.replace("PROBE", os.path.basename(header)))
+            f.write(PROGRAM.replace("HEADER_NAME", os.path.basename(header)))
         env = ["GOCACHE=" + a.cache, "GOPATH=" + os.path.join(tmp, "gopath"), "GOTOOLCHAIN=local",
                "GOENV=off", "GOFLAGS=", "GO111MODULE=on", "CGO_ENABLED=1"]
         fails = 0
