@@ -263,6 +263,12 @@ if(TARGET dipc_balance_go)
               ${CMAKE_CURRENT_SOURCE_DIR}/protocol/conformance/conformance.go ${CMAKE_BINARY_DIR})
     list(APPEND lang_tests clients_go_vet)
   endif()
+  # its options as the other examples spell them: --q W0,...,W5 the weights, -q quiet and
+  # never a value, each listed once by --help; its messages name the program
+  add_test(NAME clients_go_help
+    COMMAND sh -c "h=$(\"$1\" --help 2>&1) || { echo \"FAIL: --help exits $?\"; exit 1; }; printf '%s\\n' \"$h\"; printf '%s\\n' \"$h\" | grep -q '^  --q W0,...,W5 ' && printf '%s\\n' \"$h\" | grep -q '^  -q  ' && ! printf '%s\\n' \"$h\" | grep -q -e 'also -q' -e '-q string' -e '-quiet' -e '-weights' || { echo 'FAIL: --help does not list --q WEIGHTS and -q apart'; exit 1; }; e=$(\"$1\" --duration -1 2>&1); rc=$?; echo \"$e\"; test $rc = 2 && printf '%s\\n' \"$e\" | grep -q '^dipc_balance_go: ' || { echo 'FAIL: a usage error: exit 2, the message naming dipc_balance_go'; exit 1; }; e=$(\"$1\" -q 5,50,50,20,700,700 --timeout 0.2 2>&1); rc=$?; echo \"$e\"; test $rc = 2 || { echo 'FAIL: -q took a value'; exit 1; }; echo ok"
+            sh ${go_dipc})
+  list(APPEND lang_tests clients_go_help)
   lang_end_tests(go dipc "${lang_dipc_cfg}" ${go_dipc})
   lang_signal_test(go "${lang_dipc_cfg}" ${go_dipc})
   set(go_xl --run go 0 "${go_dipc} --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}")
@@ -543,6 +549,11 @@ foreach(lang IN LISTS readme_langs)
   list(APPEND lang_tests clients_readme_${lang} clients_readme_${lang}_slow_law
     clients_readme_${lang}_slower_law)
 endforeach()
+# docs/clients.md's Go block ends by its silence timeout when the daemon is SIGKILLed
+if(TARGET dipc_balance_go)
+  add_test(NAME clients_readme_go_daemon_killed COMMAND ${readme_run} ${readme_cc} --kill-daemon go-dipc)
+  list(APPEND lang_tests clients_readme_go_daemon_killed)
+endif()
 # docs/clients.md's C++ block over stock lcm-gen --cpp types and lcm/lcm-cpp.hpp, built
 # with the types clients_lcm_cpp_forged's target generates (tests/clients.cmake)
 add_test(NAME clients_readme_cpplcm

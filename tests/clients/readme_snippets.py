@@ -41,6 +41,7 @@ keeps 1 s). A run that answers copies by thinking again falls further behind wit
 state and meets any finite timeout; the law counted once per sim_time is the direct check.
 """
 import argparse
+import hashlib
 import math
 import os
 import re
@@ -120,6 +121,9 @@ def main():
     ap.add_argument("--think", type=float, default=0.0,
                     help="also run each block with a law of this many wall s per answer")
     ap.add_argument("--periods", type=int, default=200, help="control periods of a run")
+    ap.add_argument("--kill-daemon", action="store_true",
+                    help="SIGKILL the daemon once it runs: the block must end by its own silence "
+                    "timeout (its `silence = S` line), with its summary line, and exit 0")
     ap.add_argument("names", nargs="+")
     a = ap.parse_args()
     build = os.path.abspath(a.build)
@@ -207,6 +211,26 @@ def build_block(a, text, lang, path, think):
     return True
 
 
+def cgo_inputs_key(pkg_config_path):
+    """What cmake/go_build.cmake does for the tree's Go programs: the SHA-256 of the client
+    library's headers and library that pkg-config points at, for CGO_CPPFLAGS, where Go's
+    cache key sees it (Go does not hash a header included from another directory: built
+    against a changed lagsim, the block would otherwise reuse cgo objects of the old one)."""
+    r = subprocess.run(["pkg-config", "--cflags-only-I", "--libs-only-L", "lagsim-client"],
+                       env=dict(os.environ, PKG_CONFIG_PATH=pkg_config_path),
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    if r.returncode != 0:
+        print("FAIL: PKG_CONFIG_PATH=%s pkg-config lagsim-client:\n%s" % (pkg_config_path, r.stdout))
+        return None
+    h = hashlib.sha256()
+    for flag in r.stdout.split():
+        for rel in ("lagsim_client.h", "lagsim/version.h", "lagsim/result.h", "liblagsim_client.so.1"):
+            f = os.path.join(flag[2:], rel)
+            if flag[:2] in ("-I", "-L") and os.path.isfile(f):
+                h.update(f.encode() + b"\0" + open(f, "rb").read())
+    return h.hexdigest()[:32]
+
+
 def build_go_block(a, build, text, path, think):
     """Builds the Go block as its first line says (go build balance.go), cgo finding the
     client library through pkg-config (a.pkg_config_path); Go's cache and GOPATH in
@@ -227,7 +251,11 @@ def build_go_block(a, build, text, path, think):
         with open(path, "w") as f:
             f.write(code.replace(directive, directive + "#cgo CFLAGS: -include %s\n"
                                  % os.path.join(THINK_DIR, "think.h"), 1))
+    key = cgo_inputs_key(a.pkg_config_path)
+    if key is None:
+        return False
     env = dict(os.environ, PKG_CONFIG_PATH=a.pkg_config_path, CGO_CFLAGS=cflags,
+               CGO_CPPFLAGS="-DLAGSIM_CGO_INPUTS=" + key,
                GOCACHE=os.path.join(build, "go", "cache"), GOPATH=os.path.join(build, "go", "path"),
                GOTOOLCHAIN="local", GOENV="off", GOFLAGS="", GO111MODULE="on", CGO_ENABLED="1")
     cmd = [a.go, "build", "-o", os.path.splitext(path)[0], os.path.basename(path)]
@@ -238,6 +266,50 @@ def build_go_block(a, build, text, path, think):
         print("FAIL: the go block does not build:\n%s" % r.stdout)
         return False
     return True
+
+
+def killed_daemon(text, name, path, daemon, snip, heard, lcms, th, listening):
+    """--kill-daemon: once the block has answered 20 states, the daemon is SIGKILLed (no
+    stop event, nothing more on the bus). The block must end by itself after its silence
+    timeout (the block's `silence = S`): not before S s (it waited for the daemon) and well
+    within S + 30 s, with its summary line saying so, and exit 0."""
+    m = re.search(r"\bsilence\s*=\s*([0-9.]+)", text)
+    checks = [(m is not None, "the block names its silence timeout (silence = S)")]
+    silence = float(m.group(1)) if m else 5.0
+    deadline = time.monotonic() + 30
+    while heard["states"] < 20 and time.monotonic() < deadline and daemon.poll() is None:
+        time.sleep(0.05)
+    running = heard["states"] >= 20 and daemon.poll() is None
+    daemon.kill()  # SIGKILL: the daemon says nothing more
+    killed = time.monotonic()
+    daemon.communicate()
+    try:
+        out, _ = snip.communicate(timeout=silence + 30)
+    except subprocess.TimeoutExpired:
+        snip.kill()
+        out, _ = snip.communicate()
+        out += "\n(killed: did not end %g s after the daemon's SIGKILL)" % (silence + 30)
+    took = time.monotonic() - killed
+    listening[0] = False
+    th.join()
+    for lc in lcms:
+        lc.close()
+    checks += [
+        (running, "the block answered %d states of the running daemon before its SIGKILL"
+         % heard["states"]),
+        (snip.returncode == 0 and silence - 0.2 <= took <= silence + 30,
+         "the block exited %s %.1f s after the daemon's SIGKILL (its silence timeout: %g s)"
+         % (snip.returncode, took, silence)),
+        (re.search(r"summary end=silence states=[1-9]", out) is not None,
+         "its summary line says it ended on silence, with the states it answered"),
+    ]
+    print("---- %s (%s), the daemon SIGKILLed" % (name, path))
+    if out.strip():
+        print(out.rstrip())
+    for good, what in checks:
+        print("%s: %s" % ("ok  " if good else "FAIL", what))
+    sys.stdout.flush()
+    return sum(0 if good else 1 for good, _ in checks), {}, 0.0
 
 
 def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
@@ -345,9 +417,12 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     daemon = subprocess.Popen(
         [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
          "--set", "realtime.mode=lockstep",
-         "--set", "realtime.lockstep_timeout=%r" % patience,
-         "--duration", repr(periods * 0.01), "-q"],
+         "--set", "realtime.lockstep_timeout=%r" % patience]
+        + ([] if a.kill_daemon else ["--duration", repr(periods * 0.01)]) + ["-q"],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    if a.kill_daemon:
+        return killed_daemon(text, name, path, daemon, snip, heard, (lc, lc_cmd, stray), th,
+                             listening)
     budget = 30 + 3 * think * periods  # three think times a state, and 30 s to start
     try:
         daemon.communicate(timeout=budget)

@@ -42,6 +42,7 @@ set(LAGSIM_TIER_RULES
   # the others and two busy processes, clients_readme_java_slower_law and
   # clients_cross_language_slower_law ran past their 90 s)
   "waits     NAME  ^clients_readme_(c|cpp|python|lua|go)_slow(er)?_law$"
+  "waits     NAME  ^clients_readme_go_daemon_killed$"
   "waits     NAME  ^clients_(c|cpp|python|lua|java|go)_[a-z_]+_ends_on_(stop|silence)$"
   "waits     NAME  ^clients_(c|python|lua|java|go)_ends_on_signal$"
   "waits     NAME  ^clients_(python|java)_dipc_late_controller$"
