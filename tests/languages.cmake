@@ -552,7 +552,10 @@ endforeach()
 # docs/clients.md's Go block ends by its silence timeout when the daemon is SIGKILLed
 if(TARGET dipc_balance_go)
   add_test(NAME clients_readme_go_daemon_killed COMMAND ${readme_run} ${readme_cc} --kill-daemon go-dipc)
-  list(APPEND lang_tests clients_readme_go_daemon_killed)
+  # and built by its static-link recipe against an install: no liblagsim_client.so loaded
+  add_test(NAME clients_readme_go_static
+    COMMAND ${readme_run} ${readme_cc} --install --go-static --periods 20 go-dipc)
+  list(APPEND lang_tests clients_readme_go_daemon_killed clients_readme_go_static)
 endif()
 # docs/clients.md's C++ block over stock lcm-gen --cpp types and lcm/lcm-cpp.hpp, built
 # with the types clients_lcm_cpp_forged's target generates (tests/clients.cmake)

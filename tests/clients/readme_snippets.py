@@ -121,6 +121,11 @@ def main():
     ap.add_argument("--think", type=float, default=0.0,
                     help="also run each block with a law of this many wall s per answer")
     ap.add_argument("--periods", type=int, default=200, help="control periods of a run")
+    ap.add_argument("--go-static", action="store_true",
+                    help="with --install: build the Go block with docs/clients.md's static-link "
+                    "recipe (<!-- recipe: go-static -->) for the install's prefix instead of its "
+                    "pkg-config line; the program must not load liblagsim_client.so, and runs "
+                    "without LD_LIBRARY_PATH")
     ap.add_argument("--kill-daemon", action="store_true",
                     help="SIGKILL the daemon once it runs: the block must end by its own silence "
                     "timeout (its `silence = S` line), with its summary line, and exit 0")
@@ -151,7 +156,9 @@ def main():
             return 1
         print("installed into %s" % prefix)
         a.pkg_config_path = os.path.join(prefix, "lib", "pkgconfig")
-        a.lib_path = os.path.join(prefix, "lib")
+        a.lib_path = "" if a.go_static else os.path.join(prefix, "lib")
+        a.prefix = prefix
+    a.recipes = "".join(open(f).read() for f in a.readme)
     fails = 0
     for name in a.names:
         lang = name.split("-")[0]
@@ -251,6 +258,8 @@ def build_go_block(a, build, text, path, think):
         with open(path, "w") as f:
             f.write(code.replace(directive, directive + "#cgo CFLAGS: -include %s\n"
                                  % os.path.join(THINK_DIR, "think.h"), 1))
+    if a.go_static and not go_static_recipe(a, path):
+        return False
     key = cgo_inputs_key(a.pkg_config_path)
     if key is None:
         return False
@@ -265,6 +274,39 @@ def build_go_block(a, build, text, path, think):
     if r.returncode != 0:
         print("FAIL: the go block does not build:\n%s" % r.stdout)
         return False
+    if a.go_static:
+        ldd = subprocess.run(["ldd", os.path.splitext(path)[0]], stdout=subprocess.PIPE,
+                             stderr=subprocess.STDOUT, universal_newlines=True).stdout
+        print(ldd.rstrip())
+        if "liblagsim_client" in ldd:
+            print("FAIL: built by the static recipe, the block still loads liblagsim_client")
+            return False
+        print("ok  : built by the static recipe, the block loads no liblagsim_client")
+    return True
+
+
+def go_static_recipe(a, path):
+    """The Go block's '#cgo pkg-config: lagsim-client' line replaced by the static-link
+    recipe of docs/clients.md (the #cgo lines after <!-- recipe: go-static -->), its
+    /opt/lagsim the install's prefix."""
+    if not a.install:
+        print("FAIL: --go-static needs --install")
+        return False
+    m = re.search(r"<!-- recipe: go-static -->\s*\n((?:[ \t]*\n|[ \t]+#cgo [^\n]*\n)+)", a.recipes)
+    lines = [ln.strip() for ln in (m.group(1) if m else "").split("\n") if ln.strip()]
+    if not lines:
+        print("FAIL: no #cgo lines after <!-- recipe: go-static -->")
+        return False
+    recipe = "".join(ln.replace("/opt/lagsim", a.prefix) + "\n" for ln in lines)
+    with open(path) as f:
+        code = f.read()
+    directive = "#cgo pkg-config: lagsim-client\n"
+    if directive not in code:
+        print("FAIL: the go block has no '%s' line" % directive.strip())
+        return False
+    with open(path, "w") as f:
+        f.write(code.replace(directive, recipe, 1))
+    print("the static recipe, for %s:\n%s" % (a.prefix, recipe.rstrip()))
     return True
 
 

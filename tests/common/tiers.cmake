@@ -114,6 +114,7 @@ set(LAGSIM_TIER_RULES
   # against an install and by the other C++ compiler (lockstep runs, compilations)
   "quick     NAME  ^clients_(versions|abi|abi_mutations|cpp_header|lcm_cpp_forged)$"
   "quick     NAME  ^clients_readme_(c|cpp)_installed$"
+  "quick     NAME  ^clients_readme_go_static$"
   "quick     NAME  ^clients_(readme_cpp|manipulator_ct)_other_compiler$"
 )
 
