@@ -41,11 +41,13 @@ keeps 1 s). A run that answers copies by thinking again falls further behind wit
 state and meets any finite timeout; the law counted once per sim_time is the direct check.
 """
 import argparse
+import atexit
 import hashlib
 import math
 import os
 import re
 import shlex
+import shutil
 import signal
 import subprocess
 import sys
@@ -54,6 +56,15 @@ import threading
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
+
+_TEMPS = []  # the directories this run made (blocks, an install): removed when it ends
+atexit.register(lambda: [shutil.rmtree(d, ignore_errors=True) for d in _TEMPS])
+
+
+def mkdtemp(prefix):
+    _TEMPS.append(tempfile.mkdtemp(prefix=prefix))
+    return _TEMPS[-1]
+
 
 THINK_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "think")
 # name: (file, command line (build, file, slow: the think wrapper, or ""), environment)
@@ -148,7 +159,7 @@ def main():
         found.update(snippets(f))
     a.pkg_config_path, a.lib_path = os.path.join(build, "pkgconfig"), ""
     if a.install:
-        prefix = os.path.join(tempfile.mkdtemp(prefix="lagsim_readme_inst_"), "prefix")
+        prefix = os.path.join(mkdtemp("lagsim_readme_inst_"), "prefix")
         r = subprocess.run(["cmake", "--install", build, "--prefix", prefix],
                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
         if r.returncode != 0:
@@ -363,7 +374,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     from lagsim import event_t, joint_command_t, joint_state_t, status_t
     fname, cmd, env_extra = RUNNERS[lang]
     prefix = "RDME%s_%d" % (lang.upper(), os.getpid())
-    tmp = tempfile.mkdtemp(prefix="lagsim_readme_")
+    tmp = mkdtemp("lagsim_readme_")
     path = os.path.join(tmp, fname)
     with open(path, "w") as f:
         f.write(text.replace('"DIPC_', '"%s_' % prefix).replace("'DIPC_", "'%s_" % prefix)
