@@ -15,7 +15,9 @@ against `cmake --install <build> --prefix TMP` (PKG_CONFIG_PATH=TMP/lib/pkgconfi
 with LD_LIBRARY_PATH=TMP/lib, as any library in a prefix off the loader's path);
 PYTHONPATH=<build>/python; LUA_PATH=<build>/lua/...; java -cp
 lcm.jar:types.jar:examples.jar File.java; octave --path <build>/octave --eval balance in
-the file's folder). Once it answers a probe state (sim time -1) it is subscribed; then lagsimd runs config/dipc.yaml in lockstep for 2 s of sim time and stops.
+the file's folder). Once it asks for the scene (a DESCRIBE, as the client libraries do
+first) or answers a probe state (sim time -1) it is subscribed; then lagsimd runs
+config/dipc.yaml in lockstep for 2 s of sim time and stops.
 The snippet must exit by itself with status 0 once the daemon announces its stop; the
 daemon's final status must show every state before t = 2 s answered (200
 commands_accepted, no lockstep timeout), and every state heard must keep both rods within 0.1 rad of
@@ -208,7 +210,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     the fast run's slowest answer); prints its checks. Returns (failures, {sim_time: the
     state's positions and velocities}, the slowest answer in s)."""
     from lagsim_lcm import LCM, plant_urls
-    from lagsim import event_t, joint_command_t, joint_state_t, status_t
+    from lagsim import control_t, event_t, joint_command_t, joint_state_t, status_t
     fname, cmd, env_extra = RUNNERS[lang]
     prefix = "RDME%s_%d" % (lang.upper(), os.getpid())
     tmp = tempfile.mkdtemp(prefix="lagsim_readme_")
@@ -260,6 +262,10 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
         else:
             first_command.setdefault(t, time.monotonic())
 
+    def on_control(ch, data):  # a DESCRIBE: subscribed, asking for the scene (protocol.md)
+        if control_t.decode(data).request == control_t.DESCRIBE:
+            heard["ready"] = True
+
     # LCM's own default URL must hear nothing of this run: it is on its own port
     stray = LCM("udpm://239.255.76.67:7667?ttl=0")
     heard["stray"] = 0
@@ -272,6 +278,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     lc.subscribe(prefix + "_STATUS", on_status)
     lc.subscribe(prefix + "_EVENT", on_event)
     lc_cmd.subscribe(prefix + "_COMMAND", on_command)
+    lc_cmd.subscribe(prefix + "_CONTROL", on_control)
     heard["ready"] = False
     listening = [True]
 
@@ -287,9 +294,11 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     th.start()
     snip = subprocess.Popen(cmd(build, path, slow), cwd=tmp, env=env, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, universal_newlines=True)
-    # Ready when it answers: a probe state at sim time -1, every 0.2 s (and more slowly
-    # than its law), until a command for it comes back (java compiles the file first).
-    # Then the daemon starts.
+    # Ready when it is subscribed: it asks for the scene (a DESCRIBE on <PREFIX>_CONTROL,
+    # which a controller of the client libraries sends first, docs/protocol.md) or it
+    # answers a probe state at sim time -1, published every 0.2 s (and more slowly than
+    # its law; a block of lcm-gen's types alone asks for no scene). java compiles the
+    # file first. Then the daemon starts.
     probe = joint_state_t()
     probe.sim_time, probe.num_joints = -1.0, 3
     probe.name = ["theta0", "theta1", "theta2"]
