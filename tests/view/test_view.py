@@ -149,7 +149,11 @@ def case_browser(a):
         check(abs(l1 - 0.5) < 1e-9 and abs(l2 - 0.75) < 1e-9, "rods drawn %.12g m and %.12g m long (l1, l2)" % (l1, l2))
         # the page drew what the daemon published: its drawn cart is at theta0
         check(d1["points"][0][0] == d1["q"][0], "the cart is drawn at the published theta0")
-        time.sleep(1.0)
+        # the second look once the page has drawn 0.5 s of sim time and 10 frames more (a
+        # loaded machine's headless Chromium draws fewer frames a second: waited on, 15 s)
+        chrome.wait_for(sa, "window.lagsimView.drawn.sim_time > %r + 0.5 && "
+                            "window.lagsimView.drawn.frame > %r + 10" % (d1["sim_time"], d1["frame"]),
+                        15, "0.5 s of sim time and 10 frames drawn after the first look")
         d2 = drawn(chrome, sa)
         check(d2["sim_time"] > d1["sim_time"] + 0.5,
               "second look: drawn sim time advanced %.3f -> %.3f s" % (d1["sim_time"], d2["sim_time"]))
@@ -157,7 +161,8 @@ def case_browser(a):
               "second look: the drawn model moved (%.3f m)" % moved(d1["points"], d2["points"]))
         check(d2["frame"] > d1["frame"] + 10, "frames drawn between the looks: %d" % (d2["frame"] - d1["frame"]))
         chrome.front(sb)
-        time.sleep(0.3)
+        chrome.wait_for(sb, "window.lagsimView.drawn.sim_time > %r" % d2["sim_time"], 15,
+                        "tab B, in front, to draw a later state")
         db = drawn(chrome, sb)
         check(db["sim_time"] > d2["sim_time"], "tab B, brought to the front, animates too")
         st = rig.api()["bridge"]
