@@ -77,9 +77,9 @@ build() {
 }
 
 # build_behind DIR CMAKE ARGS...: the build of a later pass, started now at a low priority
-# (nice 10) beside this pass's tests, its output in DIR/build.log; a test that waits on
-# the wall clock holds beside two busy processes (under-load.sh), and the cores the
-# waiting tests leave idle build the next pass. wait_built DIR waits for it.
+# (nice 10) beside this pass's tests, its output in DIR/build.log: a test that waits on
+# the wall clock holds beside two busy processes (as it must on a loaded machine), and the
+# cores the waiting tests leave idle build the next pass. wait_built DIR waits for it.
 build_behind() {
   local dir=$1
   mkdir -p "$dir"
