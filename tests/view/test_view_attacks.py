@@ -452,7 +452,10 @@ def case_slowloris(a):
         idle = sockets_of(v.p.pid)  # the bridge's own sockets before any attack
         th = threading.Thread(target=attack, args=(True,), daemon=True)
         th.start()
-        time.sleep(2.0)
+        t = time.monotonic()  # the attack set up: its first round of 300 made (bounded: 30 s)
+        while held[0] == 0 and time.monotonic() - t < 30:
+            time.sleep(0.05)
+        check(held[0] > 0, "the attack holds %d connections" % held[0])
         answered, times = 0, []
         for i in range(13):
             t = time.monotonic()
