@@ -99,6 +99,41 @@ class T:
         self.t = lagsim
         self.dipc = os.path.join(a.source, "config", "dipc.yaml")
 
+    def logged(self, path, prefix, probe, within=30.0):
+        """Publishes probe on <prefix>_PROBE until lcm-logger has written it to path: the
+        logger records (and, read in order from one socket, has written what came before)"""
+        from lagsim_lcm import LCM
+        lc, deadline = LCM(os.environ["LCM_DEFAULT_URL"]), time.monotonic() + within
+        while not (os.path.exists(path) and probe in open(path, "rb").read()):
+            if time.monotonic() > deadline:
+                check(False, f"lcm-logger wrote a probe within {within} s")
+                break
+            lc.publish(prefix + "_PROBE", probe)
+            time.sleep(0.05)
+        lc.close()
+
+    def answers(self, prefix, within=30.0):
+        """Waits until the daemon of prefix answers lagsimctl status"""
+        deadline = time.monotonic() + within
+        while subprocess.run([os.path.join(self.a.bin, "lagsimctl"), "--prefix", prefix,
+                              "status"], capture_output=True).returncode != 0:
+            if time.monotonic() > deadline:
+                check(False, f"lagsimd {prefix} answered within {within} s")
+                return
+
+    def started(self, proc, within=30.0):
+        """Reads a controller's output until it says it is subscribed ("waiting for the
+        scene"): from there on it misses no state"""
+        deadline, seen = time.monotonic() + within, []
+        for line in proc.stdout:
+            seen.append(line)
+            if "waiting for the scene" in line:
+                return
+            if time.monotonic() > deadline:
+                check(False, "the controller subscribed within %g s" % within)
+                return
+        check(False, "the controller ended before it subscribed: %s" % "".join(seen)[-500:])
+
     def run(self, prog, *args, timeout=120):
         p = subprocess.run([os.path.join(self.a.bin, prog), *args], capture_output=True,
                            text=True, timeout=timeout)
@@ -176,7 +211,7 @@ class T:
         lqr = subprocess.Popen([os.path.join(self.a.bin, "dipc_lqr"), "--prefix", prefix, "-q"],
                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         try:
-            time.sleep(0.3)
+            self.started(lqr)
             d = subprocess.Popen([os.path.join(self.a.bin, "lagsimd"), "--config", self.dipc,
                                   "--set", f"lcm.prefix={prefix}", "--set", f"realtime.mode={mode}",
                                   "--set", REFERENCE, *extra, "--duration", str(duration), "-q", "--log", log])
@@ -341,7 +376,7 @@ def case_manipulator(t):
     pd = subprocess.Popen([os.path.join(t.a.bin, "manipulator_pd"), "--prefix", prefix],
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
-        time.sleep(0.3)
+        t.started(pd)
         d = t.run("lagsimd", "--config", man, "--set", f"lcm.prefix={prefix}", "--set",
                   "realtime.mode=lockstep", "--set", MAN_REFERENCE, "--duration", "10", "-q",
                   "--log", log)
@@ -373,7 +408,7 @@ def case_retry(t):
     bus = os.path.join(t.tmp, "bus.lcm")
     logger = subprocess.Popen(["lcm-logger", "-q", "--channel", prefix + "_.*", bus],
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    time.sleep(0.5)
+    t.logged(bus, prefix, b"logger-up")  # it records
     # paused, then STEP 1: the state at 0 is waited on with retries until lockstep_timeout
     # (nothing answers), then the period runs without a command, as a STEP does
     d = subprocess.Popen([os.path.join(t.a.bin, "lagsimd"), "--config",
@@ -381,12 +416,14 @@ def case_retry(t):
                           "--set", "realtime.mode=lockstep", "--set", "lcm.prefix=" + prefix,
                           "--set", "realtime.start=paused",
                           "--set", "realtime.lockstep_timeout=1", "-q"])
-    time.sleep(0.5)
-    t.run("lagsimctl", "--prefix", prefix, "step", "1", timeout=30)
-    time.sleep(1.5)
+    t.answers(prefix)
+    # lagsimctl step returns on the step_done event: the copies went out, then the period
+    # ran at lockstep_timeout
+    p = t.run("lagsimctl", "--prefix", prefix, "step", "1", timeout=30)
+    check(p.returncode == 0 and "step_done" in p.stdout, "lagsimctl step 1: step done")
     d.terminate()
     d.wait(timeout=10)
-    time.sleep(0.3)
+    t.logged(bus, prefix, b"run-over")  # the logger has written what it heard
     logger.terminate()
     logger.wait(timeout=10)
     recs = [(ch, d) for ch, d, _ in read_log(bus)]
