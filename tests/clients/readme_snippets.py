@@ -37,7 +37,10 @@ set to at least three think times, and to at least the think time plus 20 times 
 slowest answer of the fast run just before (the time from a state's first copy to its
 first command, measured here: what this machine takes to schedule the block, LCM and the
 daemon now; a loaded machine or a sanitizer build gets the patience it needs, an idle one
-keeps 1 s). A run that answers copies by thinking again falls further behind with every
+keeps the floor: 3 s, as a process of a machine with a load of 20 on 2 cores, seen here,
+can wait a second for a core; the daemon's copies still come while the law thinks, the
+first 20 ms after the state, then at most lockstep_timeout / 16 apart, so the copy rule is
+tested as before). A run that answers copies by thinking again falls further behind with every
 state and meets any finite timeout; the law counted once per sim_time is the direct check.
 """
 import argparse
@@ -285,13 +288,17 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     def listen():  # its own thread: the daemon in lockstep outruns a late reader
         while listening[0]:
             lc.handle_timeout(20)
-            while lc_cmd.handle_timeout(0):
-                pass
             while stray.handle_timeout(0):
                 pass
 
+    def listen_commands():  # a thread of its own too: a command is timed when it comes,
+        while listening[0]:  # not when the next state wakes the other reader
+            lc_cmd.handle_timeout(20)
+
     th = threading.Thread(target=listen, daemon=True)
     th.start()
+    th_cmd = threading.Thread(target=listen_commands, daemon=True)
+    th_cmd.start()
     snip = subprocess.Popen(cmd(build, path, slow), cwd=tmp, env=env, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, universal_newlines=True)
     # Ready when it is subscribed: it asks for the scene (a DESCRIBE on <PREFIX>_CONTROL,
@@ -309,7 +316,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
         time.sleep(0.2 + 1.5 * think)
     heard["states"] = 0
     periods = a.periods
-    patience = max(1.0, 3 * think, think + 20 * fast_slowest) if think > 0 else 1.0
+    patience = max(3.0, 3 * think, think + 20 * fast_slowest) if think > 0 else 1.0
     daemon = subprocess.Popen(
         [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
          "--set", "realtime.mode=lockstep",
@@ -333,6 +340,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     time.sleep(0.5)
     listening[0] = False
     th.join()
+    th_cmd.join()
     lc.close()
     lc_cmd.close()
     stray.close()
