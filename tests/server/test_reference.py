@@ -39,6 +39,7 @@ import sys
 import tempfile
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 failures = 0
@@ -99,40 +100,18 @@ class T:
         self.t = lagsim
         self.dipc = os.path.join(a.source, "config", "dipc.yaml")
 
-    def logged(self, path, prefix, probe, within=30.0):
-        """Publishes probe on <prefix>_PROBE until lcm-logger has written it to path: the
-        logger records (and, read in order from one socket, has written what came before)"""
-        from lagsim_lcm import LCM
-        lc, deadline = LCM(os.environ["LCM_DEFAULT_URL"]), time.monotonic() + within
-        while not (os.path.exists(path) and probe in open(path, "rb").read()):
-            if time.monotonic() > deadline:
-                check(False, f"lcm-logger wrote a probe within {within} s")
-                break
-            lc.publish(prefix + "_PROBE", probe)
-            time.sleep(0.05)
-        lc.close()
+    def logged(self, path, prefix, probe):
+        """lcm-logger has written probe, sent on <prefix>_PROBE, to path (waits.py)"""
+        check(waits.logger_wrote(path, prefix + "_PROBE", probe),
+              f"lcm-logger wrote {probe!r} to its file within {waits.WITHIN} s")
 
-    def answers(self, prefix, within=30.0):
-        """Waits until the daemon of prefix answers lagsimctl status"""
-        deadline = time.monotonic() + within
-        while subprocess.run([os.path.join(self.a.bin, "lagsimctl"), "--prefix", prefix,
-                              "status"], capture_output=True).returncode != 0:
-            if time.monotonic() > deadline:
-                check(False, f"lagsimd {prefix} answered within {within} s")
-                return
+    def answers(self, prefix):
+        check(waits.daemon_answers(os.path.join(self.a.bin, "lagsimctl"), prefix),
+              f"lagsimd {prefix} answered lagsimctl status within {waits.WITHIN} s")
 
-    def started(self, proc, within=30.0):
-        """Reads a controller's output until it says it is subscribed ("waiting for the
-        scene"): from there on it misses no state"""
-        deadline, seen = time.monotonic() + within, []
-        for line in proc.stdout:
-            seen.append(line)
-            if "waiting for the scene" in line:
-                return
-            if time.monotonic() > deadline:
-                check(False, "the controller subscribed within %g s" % within)
-                return
-        check(False, "the controller ended before it subscribed: %s" % "".join(seen)[-500:])
+    def started(self, proc):
+        check(waits.subscribed(proc) is not None,
+              f"the controller subscribed within {waits.WITHIN} s")
 
     def run(self, prog, *args, timeout=120):
         p = subprocess.run([os.path.join(self.a.bin, prog), *args], capture_output=True,
