@@ -24,7 +24,7 @@ lagsim_fuzz_target(sweep_merge LIBS lagsim_sweepcsv)
 # codes, case files with mistakes.
 find_program(LAGSIM_PYTHON3 python3)
 if(LAGSIM_PYTHON3)
-  foreach(c metrics require errors scene owned outputs bus stderr)
+  foreach(c metrics require errors scene owned outputs bus notes waits stderr)
     add_test(NAME eval_lagsim_eval_${c}
       COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_eval.py
               $<TARGET_FILE_DIR:lagsim-eval> ${PROJECT_SOURCE_DIR} ${c})
@@ -44,7 +44,8 @@ if(LAGSIM_PYTHON3 AND LAGSIM_GNU_PARALLEL)
   # scene_*, unanswered: a scene-reactive controller (tests/eval/scene_pd.c, scene_pd.py)
   # over m2, one that leaves the paused state unanswered (mute_pd.py)
   foreach(c same slurm merge merge_rows merge_foreign shard kept kept_python loss stalled ssh
-          vary scene_c scene_python scene_loss unanswered)
+          vary scene_c scene_python scene_loss unanswered notes controller_exit
+          progress interrupt)
     add_test(NAME eval_lagsim_sweep_${c}
       COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_sweep.py
               $<TARGET_FILE_DIR:lagsim-sweep> ${PROJECT_SOURCE_DIR} ${c})

@@ -286,10 +286,27 @@ int eval_scene_load(const char *config, const char *const *sets, int nsets, eval
             out->qd0[j] = sc->sim.qd0[j];
         }
         out->has_reference = sc->reference.n > 0;
+        for (int j = 0; j < out->nj; j++) out->reference[j] = sc->reference.on[j];
         out->period = 1.0 / sc->publish_hz;
     }
     free(sc);
     return rc ? -1 : 0;
+}
+
+bool eval_scene_unreferenced(const eval_scene *sc, char *buf, size_t len)
+{
+    int none = 0, k = 0;
+    buf[0] = '\0';
+    for (int j = 0; j < sc->nj; j++) none += !sc->reference[j];
+    if (!sc->has_reference || none == 0) return false;
+    size_t u = 0;
+    for (int j = 0; j < sc->nj && u < len; j++) {
+        if (sc->reference[j]) continue;
+        k++;
+        u += (size_t)snprintf(buf + u, len - u, "%s%s", k == 1 ? "" : k == none ? " and " : ", ",
+                              sc->joint[j]);
+    }
+    return true;
 }
 
 int eval_case_scene_load(const char *config, const char *from, const eval_case *c,
@@ -416,6 +433,39 @@ void eval_sleep(double s)
 {
     struct timespec ts = {(time_t)s, (long)((s - floor(s)) * 1e9)};
     nanosleep(&ts, NULL);
+}
+
+/* Whether cmd has the placeholder ph outside every quote, as sh reads it: '...' quotes
+ * everything, "..." all but \\ before " \\ $ `, and a \\ outside quotes the next byte. */
+static bool bare_placeholder(const char *cmd, const char *ph)
+{
+    size_t n = strlen(ph);
+    char quote = 0;
+    for (const char *p = cmd; *p; p++) {
+        if (quote == '\'') {
+            if (*p == '\'') quote = 0;
+        } else if (*p == '\\' && p[1]) {
+            if (!quote || strchr("\"\\$`", p[1])) p++;
+        } else if (*p == '"') {
+            quote = quote ? 0 : '"';
+        } else if (*p == '\'' && !quote) {
+            quote = '\'';
+        } else if (!quote && !strncmp(p, ph, n)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+void eval_url_hint(const char *cmd, const char *url, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    bool amp = strchr(url, '&') != NULL, glob = strchr(url, '?') != NULL;
+    if ((!amp && !glob) || !bare_placeholder(cmd, "{url}")) return;
+    snprintf(buf, len, "; {url} stands outside quotes in the command and the run's URL has %s%s%s "
+             "(%s%s%s): write '{url}'", amp ? "'&'" : "", amp && glob ? " and " : "",
+             glob ? "'?'" : "", amp ? "the shell ends the command at '&'" : "",
+             amp && glob ? ", " : "", glob ? "'?' is a file pattern" : "");
 }
 
 /* "{prefix}" and "{url}" in cmd replaced by the run's prefix and URL as they are, nothing
@@ -757,6 +807,20 @@ static void daemon_argv(daemon_args *d, const eval_env *env, const eval_case *c,
     d->argv[d->na] = NULL;
 }
 
+/* The controller has ended: whether the daemon ends by itself within 5 s (a controller
+ * ends on the daemon's stop event, a moment before the daemon exits). A daemon whose
+ * status says it waits for a command never will (nothing else answers it): false at
+ * once. OUT: dst */
+static bool daemon_after(eval_watch *watch, pid_t dpid, int *dst)
+{
+    double since = eval_now_wall(), end = eval_now() + 5.0;
+    while (eval_now() < end) {
+        if (eval_wait_until(dpid, eval_now() + 0.05, dst)) return true;
+        if (eval_watch_stuck(watch, since)) return false;
+    }
+    return false;
+}
+
 /* Waits for the daemon's end, or the controller's (true when --timeout ended it): a controller that ends first (it could
  * not start, it crashed) leaves a lockstep plant waiting for ever, so the daemon gets a
  * few seconds to end on its own (a controller ends on the daemon's stop event, a moment
@@ -766,19 +830,24 @@ static bool wait_run(const eval_env *env, pid_t dpid, pid_t cpid, eval_result *r
     int cst = 0;
     double t0 = eval_now();
     bool daemon_done = false, controller_done = false;
+    eval_watch *watch = eval_watch_start(env, env->who[0] ? env->who : NULL);
     while (!daemon_done && eval_now() < t0 + env->wall_timeout) {
         daemon_done = eval_wait_until(dpid, eval_now() + 0.05, dst);
+        eval_watch_poll(watch);
         if (!daemon_done && !controller_done && eval_wait_until(cpid, 0, &cst)) {
             controller_done = true;
-            if (!eval_wait_until(dpid, eval_now() + 5.0, dst)) {
+            if (!daemon_after(watch, dpid, dst)) {
                 eval_stop_group(dpid, dst);
-                eval_fail(res, "the controller ended (%s %d) before the run did",
+                char hint[200];
+                eval_url_hint(env->controller, env->url, hint, sizeof hint);
+                eval_fail(res, "the controller ended (%s %d) before the run did%s",
                      WIFEXITED(cst) ? "exit status" : "signal",
-                     WIFEXITED(cst) ? WEXITSTATUS(cst) : WTERMSIG(cst));
+                     WIFEXITED(cst) ? WEXITSTATUS(cst) : WTERMSIG(cst), hint);
             }
             daemon_done = true;
         }
     }
+    eval_watch_stop(watch);
     bool timed_out = !daemon_done;
     if (timed_out) {
         eval_stop_group(dpid, dst);

@@ -68,7 +68,13 @@ typedef struct eval_scene {
     double period;                          /* s, 1 / publish_hz */
     double q0[EVAL_JOINTS_MAX], qd0[EVAL_JOINTS_MAX]; /* initial state */
     bool has_reference;                     /* publishes <PREFIX>_REFERENCE */
+    bool reference[EVAL_JOINTS_MAX];        /* joint j has one (the others: r = 0) */
 } eval_scene;
+
+/* The joints of a scene that has a reference for some but not all (those are scored
+ * against r = 0), as "q2" or "theta1 and theta2" in buf; false (buf "") when every joint
+ * or none has one. */
+bool eval_scene_unreferenced(const eval_scene *sc, char *buf, size_t len);
 
 /* Loads CONFIG with the overrides (nsets of them); -1 and the loader's message in err. */
 int eval_scene_load(const char *config, const char *const *sets, int nsets,
@@ -134,7 +140,26 @@ typedef struct eval_env {
     bool allow_lan;          /* --allow-lan: the URL's ttl may be above 0 */
     double wall_timeout;     /* s a run may take before it is stopped (and failed) */
     bool verbose;            /* pass the daemon's and the controller's output through */
+    char who[96];            /* "lagsim-eval: case tilt": the start of a line saying that
+                              * the plant still waits for its first answer (eval_watch);
+                              * "": said nothing */
 } eval_env;
+
+/* ---------------------------------------------------------------- watching a run */
+/* A client on a run's URL and prefix (eval_watch.c): its states, its daemon's statuses. */
+#define EVAL_WAIT_SAY_S 5.0 /* a plant still at t = 0 after this: said once (env->who) */
+typedef struct eval_watch eval_watch;
+/* NULL when no client could be made (the run goes on without one). */
+eval_watch *eval_watch_start(const eval_env *env, const char *who);
+/* What came; once the plant has waited EVAL_WAIT_SAY_S at t = 0, a line saying what it
+ * waits for (its status's words), once. */
+void eval_watch_poll(eval_watch *w);
+/* Whether a status of after `since` (wall s) says the daemon waits for a command: with its
+ * controller gone, it never ends by itself. Asks for one when due. */
+bool eval_watch_stuck(eval_watch *w, double since);
+void eval_watch_stop(eval_watch *w);
+/* A line on stderr (printf), the terminal's progress line cleared first. */
+void eval_say(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 
 /* The bus of the tools' runs: the multicast group and the options of --url, else of
  * LCM_DEFAULT_URL, else EVAL_DEFAULT_URL's; the ports a pair of the runs' own
@@ -162,6 +187,12 @@ int eval_bus_take(const eval_bus *b, lag_port_lease *l, char *url, size_t len, c
 /* Whether s holds only characters that mean themselves inside '...' or "..." in a shell
  * and in the strings of Octave, MATLAB and Python: letters, digits and _ - . : / ? = &. */
 bool eval_text_plain(const char *s);
+
+/* Why a controller that ended before its run did may have been cut by the shell: when the
+ * command has {url} outside quotes and the run's URL holds a character the shell reads
+ * there ('&' ends the command, '?' is a pattern), a sentence saying so and to write
+ * '{url}' into buf (starting "; "); else "". */
+void eval_url_hint(const char *cmd, const char *url, char *buf, size_t len);
 
 /* The --set strings a daemon of the tools gets for the owned keys, one a row in the
  * table's order: a daemon of one run (starts on the controller's first command), or one
@@ -301,8 +332,11 @@ void eval_fail(eval_result *res, const char *fmt, ...) __attribute__((format(pri
  * run's numbers are those of a daemon started for it with the same values set live. */
 typedef struct eval_worker eval_worker;
 
+/* NULL with why in err when the pair cannot run: *controller says that the controller is
+ * why (it ended before it answered its first state, or never answered it: the daemon's
+ * status says what it waits for), which no later pair would do otherwise. */
 eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const eval_scene *sc,
-                               char *err, size_t errlen);
+                               bool *controller, char *err, size_t errlen);
 /* One run: sets are "key=value" (initial.* ones skipped: q0/qd0 carry them), q0 and qd0
  * the run's initial state. Returns 0 when the run could be evaluated (failed or not), -1
  * with a message when the worker is lost (stop it and start another). OUT: res */
@@ -311,6 +345,8 @@ int eval_worker_run(eval_worker *w, const eval_case *c, const char *const *sets,
                     size_t errlen);
 /* Runs since the worker started (its log grows with them). */
 long eval_worker_runs(const eval_worker *w);
+/* Whether its controller has ended (a run failed saying so): the pair cannot go on. */
+bool eval_worker_lost(const eval_worker *w);
 void eval_worker_stop(eval_worker *w);
 
 #endif

@@ -57,11 +57,13 @@ static void usage(FILE *f)
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a case may take (default 600); a controller\n"
 "                         not on {prefix} or LAGSIM_PREFIX never answers: its case\n"
-"                         ends here\n"
+"                         ends here (a plant still at t = 0 after 5 s is said on\n"
+"                         stderr before, with what it waits for)\n"
 "  -v, --verbose          pass the daemon's and the controller's output through, keep\n"
-"                         each run's log in the report directory (or TMPDIR, /tmp);\n"
-"                         without it their stderr goes to files of the run, and a\n"
-"                         case that fails shows their last lines under its note\n"
+"                         each run's log in the report directory (or TMPDIR, /tmp)\n"
+"                         and say where; without it their stderr goes to files of\n"
+"                         the run, and a case that fails shows their last lines\n"
+"                         under its note\n"
 "  -h, --help             this help\n"
 "\n"
 "keys lagsim-eval sets on every run (a case's set: naming one, or a mapping above\n"
@@ -540,6 +542,9 @@ static int open_outputs(eval_cli *x)
         fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
         return 2;
     }
+    if (x->verbose) /* kept: said where, once */
+        fprintf(stderr, "%s: -v: each case's log (EVAL%d_<case's index>.lcm) is kept in %s\n",
+                prog, (int)getpid(), x->workdir);
     return -1;
 }
 
@@ -571,6 +576,19 @@ static void write_rows(eval_cli *x, const eval_case *c, const eval_scene *csc,
     }
 }
 
+/* A case whose scene has a reference for some joints and not for others: the table's
+ * notes say which are scored against r = 0 (an sse of -0.5 for a joint held at 0.5 by the
+ * controller's own setpoint is that, not an error of the controller). */
+static void note_unreferenced(const eval_case *c, const eval_scene *csc)
+{
+    char names[EVAL_JOINTS_MAX * (EVAL_NAME_LEN + 6)];
+    if (!eval_scene_unreferenced(csc, names, sizeof names)) return;
+    bool one = !strchr(names, ' ');
+    printf("  %s: %s %s no reference (the scene's reference: names the other joints): %s "
+           "metrics measure %s against r = 0\n", c->name, names, one ? "has" : "have",
+           one ? "its" : "their", one ? "it" : "them");
+}
+
 /* Runs case k (if wanted) and reports it. Returns false when the run could not be made
  * (status 2: no further case runs). */
 static bool run_case(eval_cli *x, int k)
@@ -583,6 +601,7 @@ static bool run_case(eval_cli *x, int k)
     /* the ports of the whole evaluation; a prefix of each case's own */
     snprintf(env.url, sizeof env.url, "%s", x->url);
     snprintf(env.prefix, sizeof env.prefix, "EVAL%d_%d", (int)getpid(), k);
+    snprintf(env.who, sizeof env.who, "%s: case %s", prog, c->name);
     eval_result res;
     eval_series s = {0};
     if (eval_run(&env, c, NULL, 0, &x->csc[k], &res, &s, x->err, sizeof x->err)) {
@@ -605,6 +624,7 @@ static bool run_case(eval_cli *x, int k)
         printf("    %.*s\n", len, l);
         l += len + (nl != NULL);
     }
+    note_unreferenced(c, &x->csc[k]);
     fflush(stdout);
     if (x->report_dir &&
         report(&x->files, x->report_dir, x->force, c, &x->csc[k], &s, &res, met, why))

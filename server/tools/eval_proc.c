@@ -57,6 +57,7 @@
 static volatile pid_t procs[PROCS_MAX];
 static char tmpdir[TMPDIR_MAX + 64];
 static volatile sig_atomic_t have_tmpdir;
+static volatile sig_atomic_t deferring, deferred; /* eval_proc_defer: the signal kept */
 static const int stop_signals[3] = {SIGINT, SIGTERM, SIGHUP};
 
 /* the one clock (lagsim_clock.c: clock_gettime, async-signal-safe) */
@@ -104,6 +105,7 @@ static void forget_all(void)
 {
     for (int i = 0; i < PROCS_MAX; i++) procs[i] = 0;
     have_tmpdir = 0;
+    deferring = deferred = 0;
 }
 
 /* ---------------------------------------------------------------- stopping */
@@ -177,6 +179,10 @@ void eval_proc_at_stop(void (*fn)(void)) { at_stop = fn; }
 
 static void on_stop(int sig)
 {
+    if (deferring) { /* the tool stops itself (eval_proc_pending), writing what it has */
+        if (!deferred) deferred = sig;
+        return;
+    }
     stop_children();
     remove_tmpdir();
     if (at_stop) at_stop();
@@ -190,6 +196,25 @@ static void on_stop(int sig)
 }
 
 static void at_exit_stop(void) { stop_children(); }
+
+void eval_proc_defer(bool on) { deferring = on; }
+
+int eval_proc_pending(void) { return deferred; }
+
+void eval_proc_stop_children(void)
+{
+    sigset_t old;
+    block_stop(&old);
+    stop_children();
+    sigprocmask(SIG_SETMASK, &old, NULL);
+}
+
+void eval_proc_end(int sig)
+{
+    deferring = 0;
+    on_stop(sig);
+    _exit(128 + sig); /* not reached: on_stop ends the process by sig */
+}
 
 void eval_proc_init(void)
 {

@@ -57,6 +57,16 @@ void eval_stop_group(pid_t pid, int *status);
 int eval_make_tmpdir(const char *name, char *buf, size_t len);
 void eval_proc_tmpdir_done(void);
 
+/* While deferred, SIGINT, SIGTERM and SIGHUP stop nothing: the first is kept for the tool,
+ * which asks eval_proc_pending() (its number, 0: none) where it waits, stops its children
+ * (eval_proc_stop_children), writes what it has, and then ends by it (eval_proc_end, as
+ * the handler would have: the temporary directory removed, the at_stop function, the
+ * signal raised). A worker forked meanwhile starts without it. */
+void eval_proc_defer(bool on);
+int eval_proc_pending(void);
+void eval_proc_stop_children(void);
+void eval_proc_end(int sig) __attribute__((noreturn));
+
 /* fn runs when a signal stops the tool, once its children have ended and before it ends
  * by the signal: async-signal-safe work only (unlink the outputs it made and did not
  * finish). One at a time; NULL: none. */

@@ -50,6 +50,7 @@
 #define W_QUIET_S 0.25  /* a run with no new state for this long: a status is asked for */
 #define W_LOG_WAIT_S 3.0 /* the log's writer writes within 0.1 s; this is its margin */
 #define W_PAUSED_S 10.0 /* the controller's answer to the paused state, at most this late */
+#define W_FIRST_S 30.0  /* a new pair's controller answers its first state within this */
 
 struct eval_worker {
     eval_env env;
@@ -74,8 +75,23 @@ struct eval_worker {
                            * them */
     double t_answered;    /* the sim time of the last answer heard */
     int64_t g_answered;   /* and the generation it carried */
-    char ended[96];       /* the controller ended while a STEP was awaited: how */
+    char ended[96];       /* the controller has ended: how ("the controller ended (exit
+                           * status 3)"); "" while it runs */
 };
+
+/* Whether the controller has ended (its keeper reaped): how, in w->ended. Nothing answers
+ * the daemon then: the pair is lost (eval_worker_lost). */
+static bool controller_gone(eval_worker *w)
+{
+    int st;
+    if (w->ended[0]) return true;
+    if (w->cpid <= 0 || !eval_wait_until(w->cpid, 0, &st)) return false;
+    w->cpid = 0;
+    snprintf(w->ended, sizeof w->ended, "the controller ended (%s %d)",
+             WIFEXITED(st) ? "exit status" : "signal",
+             WIFEXITED(st) ? WEXITSTATUS(st) : WTERMSIG(st));
+    return true;
+}
 
 /* ---------------------------------------------------------------- from the bus */
 static void w_on_command(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
@@ -214,15 +230,7 @@ static int step_once(eval_worker *w, long n, double seconds)
     double end = eval_now() + seconds;
     if (lag_client_step(w->cl, n) != LAG_CLIENT_OK) return -1;
     while (!w->moved) {
-        if (eval_now() > end) return -1;
-        int st;
-        if (w->cpid > 0 && eval_wait_until(w->cpid, 0, &st)) { /* nothing will answer */
-            snprintf(w->ended, sizeof w->ended, "the controller ended (%s %d)",
-                     WIFEXITED(st) ? "exit status" : "signal",
-                     WIFEXITED(st) ? WEXITSTATUS(st) : WTERMSIG(st));
-            w->cpid = 0;
-            return -1;
-        }
+        if (eval_now() > end || controller_gone(w)) return -1;
         double next = eval_now() + W_ANSWER_S;
         while (!w->moved && eval_now() < next) w_handle(w, 5);
         if (!w->moved && still_at_start(w) && lag_client_step(w->cl, n) != LAG_CLIENT_OK)
@@ -288,9 +296,37 @@ static eval_worker *start_failed(eval_worker *w, char *err, size_t errlen, const
     return NULL;
 }
 
-eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const eval_scene *sc,
-                               char *err, size_t errlen)
+/* The first STEP of a new pair was never answered: the controller ended before it answered
+ * the first state, or (alive) never answered it, which the daemon's status says in its
+ * words (what it waits for, on which channel and URL, what came instead). Either way
+ * the controller cannot run this sweep: *controller set. */
+static eval_worker *no_first_answer(eval_worker *w, bool *controller, char *err,
+                                    size_t errlen)
 {
+    char hint[200] = "", why[1024];
+    lag_wire_status st;
+    *controller = true;
+    if (controller_gone(w)) {
+        eval_url_hint(w->env.controller, w->env.url, hint, sizeof hint);
+        snprintf(why, sizeof why, "%s before it answered the kept lagsimd's first state%s",
+                 w->ended, hint);
+    } else if (fresh_status(w, &st, false) && st.waiting_for[0]) {
+        snprintf(why, sizeof why, "the controller did not answer the kept lagsimd's first "
+                 "state within %g s: lagsimd waits %.0f s for %s; %s%s (is the controller on "
+                 "the run's prefix: {prefix} or LAGSIM_PREFIX?)", W_FIRST_S, st.waiting_s,
+                 st.waiting_for, st.waiting_got[0] ? "got instead: " : "nothing else came",
+                 st.waiting_got);
+    } else {
+        snprintf(why, sizeof why, "the kept lagsimd did not step within %g s", W_FIRST_S);
+        *controller = false;
+    }
+    return start_failed(w, err, errlen, why);
+}
+
+eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const eval_scene *sc,
+                               bool *controller, char *err, size_t errlen)
+{
+    *controller = false;
     eval_worker *w = calloc(1, sizeof *w);
     if (!w) return NULL;
     w->env = *env;
@@ -321,12 +357,7 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
         return start_failed(w, err, errlen, "cannot listen to the controller's answers");
     if (lag_client_wait_scene(w->cl, 10.0, NULL) != LAG_CLIENT_OK)
         return start_failed(w, err, errlen, "no scene from the kept lagsimd");
-    if (step_once(w, 1, 30)) {
-        char why[160];
-        snprintf(why, sizeof why, "the kept lagsimd did not step%s%s", w->ended[0] ? ": " : "",
-                 w->ended);
-        return start_failed(w, err, errlen, why);
-    }
+    if (step_once(w, 1, W_FIRST_S)) return no_first_answer(w, controller, err, errlen);
     return w;
 }
 
@@ -347,6 +378,8 @@ void eval_worker_stop(eval_worker *w)
 }
 
 long eval_worker_runs(const eval_worker *w) { return w->runs; }
+
+bool eval_worker_lost(const eval_worker *w) { return w->ended[0] != 0; }
 
 /* ---------------------------------------------------------------- a run */
 /* One SET until its `set` event is heard: sent again after W_ANSWER_S without an answer
@@ -409,7 +442,7 @@ static void follow(eval_worker *w, double t_goal)
 {
     double start = eval_now(), last = start;
     size_t seen = w->s.n;
-    while (!(w->s.n && w->s.t[w->s.n - 1] >= t_goal) && !w->fault) {
+    while (!(w->s.n && w->s.t[w->s.n - 1] >= t_goal) && !w->fault && !controller_gone(w)) {
         if (w_handle_on(w, 20, false) < 0) break;
         if (w->s.n != seen) seen = w->s.n, last = eval_now();
         if (eval_now() - start > w->env.wall_timeout) break;
@@ -489,10 +522,14 @@ static bool daemon_has_answer(eval_worker *w, double *t)
 static bool paused_answer(eval_worker *w, eval_result *res)
 {
     double end = eval_now() + W_PAUSED_S, t = w->t_heard;
-    while (eval_now() < end) {
+    while (eval_now() < end && !controller_gone(w)) {
         double next = eval_now() + W_ANSWER_S;
         while (!answer_heard(w) && eval_now() < next) w_handle(w, 5);
         if (answer_heard(w) || daemon_has_answer(w, &t)) return false;
+    }
+    if (w->ended[0]) { /* between runs: the run before had its answers */
+        eval_fail(res, "%s between runs, before this one started", w->ended);
+        return true;
     }
     eval_fail(res, "the controller did not answer the paused state (generation %lld, sim time "
               "%.9g s, the last of the run before) within %g s: not started, so that no "
@@ -517,7 +554,7 @@ static int worker_run(eval_worker *w, const eval_case *c, const char *const *set
     off_t from = stat(w->log, &sb) == 0 ? sb.st_size : 0; /* before the run's RESET_TO */
     if (reset_to(w, q0, qd0, err, errlen)) return -1;
     long periods = lround(c->duration / w->sc.period);
-    if (step_once(w, periods, w->env.wall_timeout)) {
+    if (step_once(w, periods, w->env.wall_timeout) && !w->ended[0]) {
         snprintf(err, errlen, "the kept lagsimd did not step");
         return -1;
     }
@@ -541,6 +578,8 @@ static int worker_run(eval_worker *w, const eval_case *c, const char *const *set
     res->states = w->s.n;
     res->t_end = w->s.n ? w->s.t[w->s.n - 1] : 0;
     if (!w->s.n) eval_fail(res, "no state logged");
+    else if (res->t_end < t_goal && w->ended[0]) /* the daemon waits for its answer since */
+        eval_fail(res, "%s at t = %.6g s, before the run did", w->ended, res->t_end);
     else if (res->t_end < t_goal)
         eval_fail(res, "stopped at t = %.6g s before the duration %.6g s", res->t_end,
                   c->duration);

@@ -11,6 +11,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
+#include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,6 +22,7 @@
 
 #include "eval_case.h"
 #include "scene.h"
+#include "sweep_live.h"
 #include "sweep_merge.h"
 #include "lagsim_num.h"
 
@@ -29,12 +31,14 @@ static const char *prog = "lagsim-sweep";
 #define VARY_MAX 16
 #define ROW_MAX 8192 /* bytes of the CSV header and of a row at most (a row: < 4000) */
 
+static void usage_end(FILE *f);
+
 static void usage(FILE *f)
 {
     fprintf(f,
 "usage: lagsim-sweep --config SCENE --controller 'COMMAND' (--case NAME | --duration S)\n"
 "                    --vary KEY=DIST ... [--runs N] [--seed S] [-j N] [--shard K/N]\n"
-"                    [--restart]\n"
+"                    [--only RUNS] [--restart] [--progress]\n"
 "                    [--suite FILE] [--require EXPR] [--csv OUT.csv] [--plot OUT.png]\n"
 "                    [--metric JOINT.METRIC] [--force] [--url URL] [--allow-lan]\n"
 "                    [--lagsimd PATH] [--timeout S] [-v]\n"
@@ -62,6 +66,9 @@ static void usage(FILE *f)
 "  -j, --jobs N           runs at once on this machine (default 1)\n"
 "      --shard K/N        only runs i with i mod N = K - 1 (K = 1..N, N <= 1e7): one\n"
 "                         machine's part; lagsim-sweep merge joins the parts\n"
+"      --only RUNS        only these runs (of the shard's), as a CSV's held line writes\n"
+"                         them: A-B,C (a sweep stopped before its end says which runs to\n"
+"                         give it); merge joins its CSV with the others\n"
 "      --restart          a daemon and a controller started for each run, with the\n"
 "                         run's values (default: one of each per worker, started\n"
 "                         with the scene's values; each run's values SET and its\n"
@@ -81,7 +88,11 @@ static void usage(FILE *f)
 "      --allow-lan        accept a URL with ttl above 0 (the runs on the network)\n"
 "      --lagsimd PATH     the daemon (default: the lagsimd beside this program)\n"
 "      --timeout S        wall seconds a run may take (default 600)\n"
-"  -v, --verbose          pass the daemon's and the controller's output through;\n"
+"      --progress         the progress line (runs done, failed, rate, ETA) on stderr when\n"
+"                         it is no terminal too: a line every 10 s (on a terminal it is\n"
+"                         drawn without it, up to 4 times a second, unless -v)\n"
+"  -v, --verbose          pass the daemon's and the controller's output through, keep\n"
+"                         the daemons' logs in the temporary directory and say where;\n"
 "                         without it their stderr goes to files of the run, and the\n"
 "                         first failed run of each worker shows their last lines\n"
 "  -o, --output OUT.csv   merge: the joined CSV (the whole sweep's, byte for byte); every\n"
@@ -94,15 +105,25 @@ static void usage(FILE *f)
 "keys lagsim-sweep sets on every run (a case's set: or a --vary naming one, or a\n"
 "mapping above one, is refused):\n");
     eval_owned_usage(f);
+    usage_end(f);
+}
+
+/* --help's end: the exit codes and the signals. */
+static void usage_end(FILE *f)
+{
     fprintf(f,
 "\n"
 "exit codes: 0 every run passed; 1 a run failed or missed --require; 2 usage, scene or\n"
-"case error, an output that exists (checked before the first run), or shard CSVs that\n"
-"do not belong together, hold a malformed row or leave shards or runs out\n"
+"case error, an output that exists (checked before the first run), a controller that\n"
+"cannot answer the first state of a worker's first lagsimd, or shard CSVs that do not\n"
+"belong together, hold a malformed row or leave shards or runs out\n"
 "\n"
-"signals: SIGINT, SIGTERM, SIGHUP stop every process it started (SIGKILL after 2 s)\n"
-"and end it by that signal; after SIGKILL they end within about 2 s. TMPDIR: where\n"
-"the workers' files go (default /tmp)\n");
+"signals: SIGINT, SIGTERM, SIGHUP stop every process it started (SIGKILL after 2 s),\n"
+"write the rows of the runs that ended to --csv in run order (its held line says\n"
+"which, stderr how to run the others: --only) and end it by that signal; after\n"
+"SIGKILL they end within about 2 s, and --csv holds the rows of the runs that had\n"
+"ended (written as each ended; held: unknown). TMPDIR: where the workers' files go\n"
+"(default /tmp)\n");
 }
 
 static int die(const char *fmt, const char *a)
@@ -431,6 +452,16 @@ typedef struct sweep {
     char default_metric[160];
     char tmpdir[160]; /* eval_make_tmpdir: at most 128 + 21 */
     char cmd_files[EVAL_CMD_FILES_MAX][1024]; /* the files the controller command names */
+    bool stopping;       /* the sweep stops before its end (a controller that cannot run) */
+    const char *only;    /* --only RUNS */
+    const char *self;    /* argv[0]: the command, as it was run */
+    const char *duration_text, *timeout_text; /* as given: the command that finishes it */
+    bool progress, lagsimd_given;
+    unsigned char *shards, *want; /* shards[K - 1]: --shard's K (all: the whole sweep);
+                                   * want[run]: this sweep runs it (its shard, --only) */
+    long nwant;
+    sweep_live live;     /* the rows as they come, the CSV, the progress */
+    bool png_new;        /* --plot made by this sweep (empty until its end) */
 } sweep;
 
 /* An integer option: a plain decimal (as a scene writes a number) with no fraction; lo
@@ -466,7 +497,7 @@ static int add_vary(sweep *x, const char *text)
 static int parse_options(sweep *x, int argc, char **argv)
 {
     enum { O_CASE = 256, O_SUITE, O_VARY, O_SEED, O_SHARD, O_REQUIRE, O_CSV, O_PLOT, O_METRIC,
-           O_LAGSIMD, O_TIMEOUT, O_RESTART, O_URL, O_ALLOW_LAN };
+           O_LAGSIMD, O_TIMEOUT, O_RESTART, O_URL, O_ALLOW_LAN, O_ONLY, O_PROGRESS };
     static const struct option opts[] = {
         {"config", required_argument, 0, 'c'},      {"controller", required_argument, 0, 'C'},
         {"case", required_argument, 0, O_CASE},     {"suite", required_argument, 0, O_SUITE},
@@ -479,6 +510,7 @@ static int parse_options(sweep *x, int argc, char **argv)
         {"timeout", required_argument, 0, O_TIMEOUT}, {"verbose", no_argument, 0, 'v'},
         {"restart", no_argument, 0, O_RESTART},     {"help", no_argument, 0, 'h'},
         {"url", required_argument, 0, O_URL},       {"allow-lan", no_argument, 0, O_ALLOW_LAN},
+        {"only", required_argument, 0, O_ONLY},     {"progress", no_argument, 0, O_PROGRESS},
         {0, 0, 0, 0}};
     int o, bad = 0;
     opterr = 0;
@@ -488,7 +520,10 @@ static int parse_options(sweep *x, int argc, char **argv)
         case 'C': x->controller = optarg; break;
         case O_CASE: x->case_name = optarg; break;
         case O_SUITE: x->suite = optarg; break;
-        case 'd': x->duration = parse_pos("--duration", optarg, 1e-3, 1e6, &bad); break;
+        case 'd':
+            x->duration = parse_pos("--duration", optarg, 1e-3, 1e6, &bad);
+            x->duration_text = optarg;
+            break;
         case O_VARY:
             if (add_vary(x, optarg)) return 2;
             break;
@@ -505,8 +540,16 @@ static int parse_options(sweep *x, int argc, char **argv)
         case O_PLOT: x->png = optarg; break;
         case O_METRIC: x->metric = optarg; break;
         case 'f': x->force = true; break;
-        case O_LAGSIMD: snprintf(x->lagsimd, sizeof x->lagsimd, "%s", optarg); break;
-        case O_TIMEOUT: x->timeout = parse_pos("--timeout", optarg, 1, 1e6, &bad); break;
+        case O_LAGSIMD:
+            snprintf(x->lagsimd, sizeof x->lagsimd, "%s", optarg);
+            x->lagsimd_given = true;
+            break;
+        case O_TIMEOUT:
+            x->timeout = parse_pos("--timeout", optarg, 1, 1e6, &bad);
+            x->timeout_text = optarg;
+            break;
+        case O_ONLY: x->only = optarg; break;
+        case O_PROGRESS: x->progress = true; break;
         case 'v': x->verbose = true; break;
         case O_RESTART: x->restart = true; break;
         case O_URL: x->url_opt = optarg; break;
@@ -652,6 +695,27 @@ static int make_identity(sweep *x)
     return -1;
 }
 
+/* The runs this sweep runs: its shard's (--shard K/N: i mod N = K - 1), of those --only's
+ * (ranges counted in the shard's runs, as a held line writes them). -1 or the exit code. */
+static int make_want(sweep *x)
+{
+    if (!(x->shards = calloc((size_t)x->shard_n, 1)) || !(x->want = calloc((size_t)x->total, 1)))
+        return die("%s", "out of memory");
+    x->shards[x->shard_k - 1] = 1;
+    if (x->only && sweep_runs_parse(x->only, x->total, x->want)) {
+        fprintf(stderr, "%s: --only %s: expected runs as A-B,C (ascending, from 0 to %ld), as "
+                "a CSV's held line writes them\n", prog, x->only, x->total - 1);
+        return 2;
+    }
+    for (long i = 0; i < x->total; i++) {
+        x->want[i] = (!x->only || x->want[i]) && i % x->shard_n == x->shard_k - 1;
+        x->nwant += x->want[i];
+    }
+    if (x->nwant == 0)
+        return die("--only %s: no run of this sweep (of its shard) in it", x->only);
+    return -1;
+}
+
 /* ---------------------------------------------------------------- a worker */
 #define KEEP_RUNS 200 /* a kept daemon is started again after this many runs (its log) */
 
@@ -660,8 +724,25 @@ typedef struct worker {
     long w;          /* its number */
     eval_worker *kept; /* the daemon and the controller kept for its runs */
     FILE *rows;
+    long pairs;      /* kept pairs that started (answered their first state) */
+    int refused;     /* new pairs in a row whose controller could not answer */
+    long ran;        /* --restart: runs started */
     bool said_output;  /* the output of a failed run said (once a worker) */
 } worker;
+
+#define PAIR_REFUSALS 3 /* new pairs in a row whose controller cannot answer: the sweep stops */
+#define RUN_FATAL (-2)  /* the controller cannot run the sweep: it stops (exit 2) */
+#define WORKER_FATAL 5  /* a worker's exit status for it; its words in tmpdir/W.fatal */
+
+/* A run that did not run: failed, every metric none. */
+static void fail_unrun(eval_result *res, int nj, const char *why)
+{
+    memset(res, 0, sizeof *res);
+    res->nj = nj;
+    for (int j = 0; j < nj; j++)
+        for (int m = 0; m < LAG_METRIC_COUNT; m++) res->m[j].v[m] = NAN;
+    eval_fail(res, "%s", why);
+}
 
 static eval_env worker_env(const worker *wk, long run)
 {
@@ -676,8 +757,32 @@ static eval_env worker_env(const worker *wk, long run)
     return env;
 }
 
+/* A new kept pair for the worker: 1 when it runs. A controller that cannot answer its
+ * first state (it ended, or listens elsewhere) in the worker's first pair, or in
+ * PAIR_REFUSALS new pairs in a row, cannot run the sweep: RUN_FATAL, why in err. In a
+ * later pair (it ran before) the run fails with that reason (0), and the next run tries
+ * another pair. -1: the pair could not start for another reason. */
+static int start_pair(worker *wk, eval_result *res, char *err, size_t errlen)
+{
+    const sweep *x = wk->x;
+    bool controller;
+    eval_env env = worker_env(wk, -1);
+    if ((wk->kept = eval_worker_start(&env, &x->c, &x->sc, &controller, err, errlen))) {
+        wk->pairs++, wk->refused = 0;
+        return 1;
+    }
+    if (!controller) return -1;
+    if (wk->pairs == 0 || ++wk->refused >= PAIR_REFUSALS) return RUN_FATAL;
+    char why[sizeof res->reason];
+    snprintf(why, sizeof why, "a new lagsimd and controller for this run: %.200s", err);
+    fail_unrun(res, x->sc.nj, why);
+    eval_say("%s: worker %ld: %s\n", prog, wk->w, why);
+    return 0;
+}
+
 /* A run on the kept processes: started when there are none, started again after
- * KEEP_RUNS runs, after a run that stalled, and once for a run the kept ones lost. */
+ * KEEP_RUNS runs, after a run that stalled or whose controller ended, and once for a run
+ * the kept ones lost. */
 static int run_kept(worker *wk, const char *const *sets, int nsets, const eval_scene *rsc,
                     eval_result *res, char *err, size_t errlen)
 {
@@ -687,18 +792,20 @@ static int run_kept(worker *wk, const char *const *sets, int nsets, const eval_s
             eval_worker_stop(wk->kept);
             wk->kept = NULL;
         }
-        eval_env env = worker_env(wk, -1);
-        if (!wk->kept && !(wk->kept = eval_worker_start(&env, &x->c, &x->sc, err, errlen)))
-            return -1;
+        int started = wk->kept ? 1 : start_pair(wk, res, err, errlen);
+        if (started != 1) return started;
         int rc = eval_worker_run(wk->kept, &x->c, sets, nsets, rsc->q0, rsc->qd0, res, err,
                                  errlen);
-        /* a stalled run, or a controller that did not answer the run before's last state:
-         * the run fails, and the next one gets a new worker pair */
+        /* a stalled run, a controller that did not answer the run before's last state or
+         * that ended: the run fails, and the next one gets a new worker pair (a stalled run
+         * is run again on it first) */
         bool unanswered = rc == 0 && strstr(res->reason, "did not answer the paused state");
-        if (rc == 0 && !strstr(res->reason, "before the duration") && !unanswered) return 0;
-        if (unanswered) /* the run fails, and it is said: never a silent restart */
-            fprintf(stderr, "%s: worker %ld: a run failed: %s; a new lagsimd and controller "
-                    "for the next run\n", prog, wk->w, res->reason);
+        bool lost = rc == 0 && eval_worker_lost(wk->kept);
+        if (rc == 0 && !strstr(res->reason, "before the duration") && !unanswered && !lost)
+            return 0;
+        if (unanswered || lost) /* the run fails, and it is said: never a silent restart */
+            eval_say("%s: worker %ld: a run failed: %s; a new lagsimd and controller for the "
+                     "next run\n", prog, wk->w, res->reason);
         eval_worker_stop(wk->kept);
         wk->kept = NULL;
         if (rc == 0) return 0;
@@ -728,6 +835,18 @@ static void write_row(const worker *wk, long i, const double *val, const eval_re
     fflush(f);
 }
 
+/* The controller cannot run the sweep (run i found it): its words for the parent, which
+ * says them once and stops every worker. WORKER_FATAL. */
+static int worker_fatal(const worker *wk, long i, const char *err)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/%ld.fatal", wk->x->tmpdir, wk->w);
+    FILE *f = fopen(path, "w");
+    if (f) fprintf(f, "run %ld, worker %ld: %s", i, wk->w, err), fclose(f);
+    else eval_say("%s: run %ld: %s\n", prog, i, err);
+    return WORKER_FATAL;
+}
+
 /* Run i: its values, then a failed row for values the scene refuses (a negative mass),
  * else the run on the kept processes or on processes of its own. */
 static int run_one(worker *wk, long i)
@@ -747,19 +866,20 @@ static int run_one(worker *wk, long i)
     eval_scene rsc;
     int rc = 0;
     if (eval_scene_load(x->config, xp, x->c.nsets + nx, &rsc, err, sizeof err)) {
-        res.failed = true;
-        snprintf(res.reason, sizeof res.reason, "refused: %.240s", err);
-        res.nj = x->sc.nj;
-        for (int j = 0; j < x->sc.nj; j++)
-            for (int m = 0; m < LAG_METRIC_COUNT; m++) res.m[j].v[m] = NAN;
+        char why[sizeof res.reason];
+        snprintf(why, sizeof why, "refused: %.240s", err);
+        fail_unrun(&res, x->sc.nj, why);
     } else if (!x->restart) {
         rc = run_kept(wk, xp + x->c.nsets, nx, &rsc, &res, err, sizeof err);
     } else {
         eval_env env = worker_env(wk, i);
+        if (!wk->ran++) /* its first run says a plant that waits for its first answer */
+            snprintf(env.who, sizeof env.who, "%s: run %ld", prog, i);
         rc = eval_run(&env, &x->c, xp + x->c.nsets, nx, &rsc, &res, NULL, err, sizeof err);
     }
+    if (rc == RUN_FATAL) return worker_fatal(wk, i, err);
     if (rc) {
-        fprintf(stderr, "%s: run %ld: %s\n", prog, i, err);
+        eval_say("%s: run %ld: %s\n", prog, i, err);
         return 4;
     }
     if (res.output[0] && !wk->said_output) { /* a worker's first failed run: what its
@@ -772,8 +892,8 @@ static int run_one(worker *wk, long i)
     return 0;
 }
 
-/* Worker w runs this shard's runs i with (i / shard_n) mod jobs = w; its rows go to a
- * file of its own. Never returns. */
+/* Worker w runs the sweep's runs it wants (its shard's, --only's) number w, w + jobs, ...
+ * of them; its rows go to a file of its own. Never returns. */
 static void worker_main(const sweep *x, long w)
 {
     char path[256];
@@ -781,19 +901,63 @@ static void worker_main(const sweep *x, long w)
     worker wk = {.x = x, .w = w, .rows = fopen(path, "w")};
     if (!wk.rows) _exit(3);
     int rc = 0;
-    for (long i = x->shard_k - 1; i < x->total && !rc; i += x->shard_n)
-        if ((i / x->shard_n) % x->jobs == w) rc = run_one(&wk, i);
+    for (long i = 0, k = 0; i < x->total && !rc; i++)
+        if (x->want[i] && k++ % x->jobs == w) rc = run_one(&wk, i);
     eval_worker_stop(wk.kept);
     fclose(wk.rows);
     _exit(rc);
 }
 
 /* ---------------------------------------------------------------- the results */
+/* A worker that found the controller cannot run the sweep: its words said once, the
+ * other workers stopped. */
+static void say_fatal(const sweep *x, long w)
+{
+    char path[256], text[4096] = "";
+    snprintf(path, sizeof path, "%s/%ld.fatal", x->tmpdir, w);
+    FILE *f = fopen(path, "r");
+    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
+    text[n] = '\0';
+    if (f) fclose(f);
+    unlink(path);
+    eval_say("%s: %s\n%s: the sweep stops: a controller that cannot answer the first state "
+             "of its lagsimd fails every run\n", prog, text, prog);
+}
+
+/* The workers' ends, as they come: one that stops the sweep stops the others. 0, or 2
+ * when a worker failed. */
+static int wait_workers(sweep *x, const pid_t *pids)
+{
+    bool alive[256];
+    long left = x->jobs;
+    int status = 0;
+    for (long w = 0; w < x->jobs; w++) alive[w] = true;
+    while (left) {
+        sweep_live_poll(&x->live);
+        if (eval_proc_pending()) { /* a signal: every worker stopped, what ended kept */
+            eval_proc_stop_children();
+            return 2;
+        }
+        for (long w = 0; w < x->jobs; w++) {
+            int st = 0;
+            if (!alive[w] || !eval_wait_until(pids[w], 0, &st)) continue;
+            alive[w] = false, left--;
+            if (WIFEXITED(st) && WEXITSTATUS(st) == 0) continue;
+            bool fatal = WIFEXITED(st) && WEXITSTATUS(st) == WORKER_FATAL;
+            if (fatal && !x->stopping) say_fatal(x, w);
+            if (fatal) x->stopping = true;
+            status = 2;
+        }
+        for (long w = 0; x->stopping && w < x->jobs; w++) /* the others end now */
+            if (alive[w]) eval_stop_group(pids[w], &(int){0}), alive[w] = false, left--;
+        if (left) eval_sleep(0.02);
+    }
+    return status;
+}
 /* The workers, forked (each dies with this process: eval_proc_fork), and their ends. */
 static int run_workers(sweep *x)
 {
     pid_t pids[256];
-    int status = 0;
     for (long w = 0; w < x->jobs; w++) {
         pids[w] = eval_proc_fork();
         if (pids[w] < 0) {
@@ -803,31 +967,109 @@ static int run_workers(sweep *x)
         }
         if (pids[w] == 0) worker_main(x, w);
     }
-    for (long w = 0; w < x->jobs; w++) {
-        int st = 0;
-        if (eval_proc_wait(pids[w], &st) != 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0)
-            status = 2;
-    }
-    return status;
+    return wait_workers(x, pids);
 }
 
-static void collect_rows(const sweep *x, rows *r)
+/* A word of the command, quoted for sh when it needs it. */
+static void sh_word(FILE *f, const char *w)
 {
-    char *line = NULL;
-    size_t cap = 0;
-    for (long w = 0; w < x->jobs; w++) {
-        char path[256];
-        snprintf(path, sizeof path, "%s/%ld.rows", x->tmpdir, w);
-        FILE *f = fopen(path, "r");
-        if (!f) continue;
-        while (getline(&line, &cap, f) >= 0) {
-            line[strcspn(line, "\n")] = '\0';
-            rows_add(r, strtol(line, NULL, 10), line);
-        }
-        fclose(f);
-        unlink(path);
+    if (w[0] && strspn(w, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                          "_-./:=,+@%") == strlen(w)) {
+        fputs(w, f);
+        return;
     }
-    free(line);
+    fputc('\'', f);
+    for (const char *p = w; *p; p++) {
+        if (*p == '\'') fputs("'\\''", f);
+        else fputc(*p, f);
+    }
+    fputc('\'', f);
+}
+
+static void sh_opt(FILE *f, const char *opt, const char *value)
+{
+    fprintf(f, " %s ", opt);
+    sh_word(f, value);
+}
+
+/* The sweep's command again, for the runs `only` alone, to CSV rest: every option that
+ * makes the runs what they are (the identity's), as given. */
+static void finish_command(FILE *f, const sweep *x, const char *only, const char *rest)
+{
+    char num[32];
+    fputs("  ", f);
+    sh_word(f, x->self);
+    sh_opt(f, "--config", x->config);
+    sh_opt(f, "--controller", x->controller);
+    if (x->suite) sh_opt(f, "--suite", x->suite);
+    if (x->case_name) sh_opt(f, "--case", x->case_name);
+    else sh_opt(f, "--duration", x->duration_text);
+    for (int k = 0; k < x->nv; k++) sh_opt(f, "--vary", x->vs[k].text);
+    snprintf(num, sizeof num, "%ld", x->runs), sh_opt(f, "--runs", num);
+    snprintf(num, sizeof num, "%llu", (unsigned long long)x->seed), sh_opt(f, "--seed", num);
+    snprintf(num, sizeof num, "%ld", x->jobs), sh_opt(f, "-j", num);
+    if (x->shard_n > 1) fprintf(f, " --shard %ld/%ld", x->shard_k, x->shard_n);
+    if (x->restart) fputs(" --restart", f); /* said, or forced by a key: the same either way */
+    if (x->require) sh_opt(f, "--require", x->require);
+    if (x->url_opt) sh_opt(f, "--url", x->url_opt);
+    if (x->allow_lan) fputs(" --allow-lan", f);
+    if (x->lagsimd_given) sh_opt(f, "--lagsimd", x->lagsimd);
+    if (x->timeout_text) sh_opt(f, "--timeout", x->timeout_text);
+    sh_opt(f, "--only", only);
+    sh_opt(f, "--csv", rest);
+    fputc('\n', f);
+}
+
+/* The CSV holds some of the runs (why: a signal, a worker that failed): which, and how to
+ * run the others and merge them (--only), on stderr. */
+static void say_held(const sweep *x, const char *why)
+{
+    const sweep_live *l = &x->live;
+    char *held = sweep_live_held(l), *miss = sweep_live_missing(l);
+    char of[64] = "";
+    if (x->shard_n > 1) snprintf(of, sizeof of, " of shard %ld/%ld", x->shard_k, x->shard_n);
+    if (!x->csv || !held || !miss) {
+        eval_say("%s: %s: %ld of the %ld runs%s had ended; without --csv they are kept "
+                 "nowhere (their summary: above)\n", prog, why, l->done, x->nwant, of);
+        free(held), free(miss);
+        return;
+    }
+    eval_say("%s: %s: %s holds %ld of the %ld runs%s (held: %.200s%s), in run order; the "
+             "runs missing: %.200s%s. To finish the sweep, run them and merge:\n", prog, why,
+             x->csv, l->done, x->nwant, of, held, strlen(held) > 200 ? "..." : "", miss,
+             strlen(miss) > 200 ? "..." : "");
+    char rest[1100], whole[1100];
+    const char *dot = strrchr(x->csv, '.');
+    int base = dot && !strchr(dot, '/') ? (int)(dot - x->csv) : (int)strlen(x->csv);
+    snprintf(rest, sizeof rest, "%.*s-rest.csv", base, x->csv);
+    snprintf(whole, sizeof whole, "%.*s-whole.csv", base, x->csv);
+    finish_command(stderr, x, miss, rest);
+    fputs("  ", stderr);
+    sh_word(stderr, x->self);
+    /* a shard's or --only's runs made whole are still a part: --partial joins them */
+    fputs(x->shard_n > 1 || x->only ? " merge --partial " : " merge ", stderr);
+    sh_word(stderr, x->csv);
+    fputc(' ', stderr);
+    sh_word(stderr, rest);
+    fprintf(stderr, " -o ");
+    sh_word(stderr, whole);
+    fprintf(stderr, "\n");
+    free(held), free(miss);
+}
+
+/* A signal stopped the sweep (its workers too, and the CSV holds the rows of the runs
+ * that ended): their summary, which runs the CSV holds and how to run the others; a PNG
+ * it made and never drew removed; then it ends by the signal. */
+static void __attribute__((noreturn)) stop_by(sweep *x, int sig)
+{
+    if (x->live.r.n) summary(x->header, &x->live.r);
+    fflush(stdout);
+    char why[64];
+    snprintf(why, sizeof why, "stopped by %s", sig == SIGINT ? "SIGINT" : sig == SIGTERM ?
+             "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "a signal");
+    say_held(x, why);
+    if (x->png_new) unlink(x->png);
+    eval_proc_end(sig);
 }
 
 static int count_passed(const sweep *x, const rows *r)
@@ -861,6 +1103,35 @@ static void release_ports(sweep *x)
     for (long w = 0; w < x->jobs; w++) lag_port_release(&x->lease[w]);
 }
 
+/* A scene with a reference for some joints and not for others: the summary's note says
+ * which are scored against r = 0 (as lagsim-eval's table says it). */
+static void note_unreferenced(const eval_scene *sc)
+{
+    char names[EVAL_JOINTS_MAX * (EVAL_NAME_LEN + 6)];
+    if (!eval_scene_unreferenced(sc, names, sizeof names)) return;
+    bool one = !strchr(names, ' ');
+    printf("note: %s %s no reference (the scene's reference: names the other joints): %s "
+           "metrics measure %s against r = 0\n", names, one ? "has" : "have",
+           one ? "its" : "their", one ? "it" : "them");
+}
+
+/* What sweep_live needs from the sweep. */
+static void live_setup(sweep *x, FILE *fcsv)
+{
+    bool tty = isatty(STDERR_FILENO);
+    x->live = (sweep_live){.tmpdir = x->tmpdir, .jobs = x->jobs, .csv = fcsv,
+                           .identity = x->identity, .header = x->header, .runs = x->total,
+                           .sn = x->shard_n, .shards = x->shards, .want = x->want,
+                           .nwant = x->nwant, .nvary = x->nv, .tty = tty && !x->verbose,
+                           .progress = x->progress || (tty && !x->verbose),
+                           .require = x->require != NULL};
+}
+
+static void say_csv(const sweep *x, const char *why)
+{
+    eval_say("%s: --csv %s: %s\n", prog, x->csv, why);
+}
+
 static int sweep_run(sweep *x)
 {
     char err[2048];
@@ -876,6 +1147,7 @@ static int sweep_run(sweep *x)
      * never runs for hours to lose its results at the end */
     struct stat st;
     bool csv_new = x->csv && lstat(x->csv, &st) != 0;
+    bool png_new = x->png && lstat(x->png, &st) != 0;
     if (x->csv && !(fcsv = eval_open_out(prog, "--csv", x->csv, x->force, in, nin))) return 2;
     if (x->png && !(fpng = eval_open_out(prog, "--plot", x->png, x->force, in, nin + 1))) {
         if (fcsv) fclose(fcsv);
@@ -887,19 +1159,39 @@ static int sweep_run(sweep *x)
         fprintf(stderr, "%s: cannot make a temporary directory: %s\n", prog, strerror(errno));
         return 2;
     }
-    if (x->verbose) eval_proc_tmpdir_done(); /* -v keeps the kept daemons' logs */
+    if (x->verbose) { /* -v keeps the daemons' logs: said where, once */
+        eval_proc_tmpdir_done();
+        fprintf(stderr, "%s: -v: the daemons' logs (SWEEP%d_W<worker>.lcm for a worker's kept "
+                "pair, SWEEP%d_<run>.lcm for a run's own) are kept in %s\n", prog,
+                (int)getpid(), (int)getpid(), x->tmpdir);
+    }
+    x->png_new = png_new;
+    /* a signal from here on is the sweep's to act on: the rows of the runs that ended go
+     * to the CSV before it ends (stop_by) */
+    eval_proc_defer(true);
+    live_setup(x, fcsv);
+    if (sweep_live_start(&x->live, err, sizeof err)) {
+        fprintf(stderr, "%s: %s\n", prog, err);
+        eval_proc_defer(false);
+        if (eval_proc_pending()) eval_proc_end(eval_proc_pending());
+        return 2;
+    }
     int status = run_workers(x);
-    rows r = {0};
-    collect_rows(x, &r);
-    if (fcsv && (rows_write(&r, fcsv, x->identity, x->header, err, sizeof err) ||
-                 fclose(fcsv) != 0))
-        status = 2;
-    summary(x->header, &r);
-    bool all = count_passed(x, &r) == r.n;
-    if (x->png && plot(x->png, x->tmpdir, x->header, &r, x->nv, x->metric)) status = 2;
+    if (sweep_live_finish(&x->live, err, sizeof err)) status = 2, say_csv(x, err);
+    if (fcsv && fclose(fcsv) != 0) status = 2, say_csv(x, strerror(errno));
+    eval_proc_defer(false);
+    if (eval_proc_pending()) stop_by(x, eval_proc_pending());
+    rows *r = &x->live.r;
+    if (r->n || !x->stopping) { /* a sweep stopped before any run has nothing to sum */
+        summary(x->header, r);
+        note_unreferenced(&x->sc);
+    }
+    if (x->live.done < x->nwant) say_held(x, "not every run ended");
+    bool all = count_passed(x, r) == r->n;
+    if (x->png && plot(x->png, x->tmpdir, x->header, r, x->nv, x->metric)) status = 2;
     rmdir(x->tmpdir);
     eval_proc_tmpdir_done();
-    rows_free(&r);
+    sweep_live_free(&x->live);
     return status ? status : all ? 0 : 1;
 }
 
@@ -910,15 +1202,18 @@ int main(int argc, char **argv)
     static sweep x = {.timeout = 600, .runs = 1, .jobs = 1, .shard_k = 1, .shard_n = 1,
                       .seed = 1};
     eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
+    x.self = argv[0];
     int rc;
     if ((rc = parse_options(&x, argc, argv)) >= 0 || (rc = check_options(&x, argc, argv)) >= 0 ||
         (rc = load_case(&x)) >= 0 || (rc = load_scene(&x)) >= 0 ||
         (rc = check_vary_keys(&x)) >= 0)
         return rc;
-    if ((rc = make_header(&x)) >= 0 || (rc = make_identity(&x)) >= 0) return rc;
+    if ((rc = make_header(&x)) >= 0 || (rc = make_identity(&x)) >= 0 ||
+        (rc = make_want(&x)) >= 0)
+        return rc;
     for (long w = 0; w < x.jobs; w++) x.lease[w] = (lag_port_lease){.port = 0, .fd = -1};
     rc = take_ports(&x) ? 2 : sweep_run(&x);
     release_ports(&x);
-    free(x.identity);
+    free(x.identity), free(x.shards), free(x.want);
     return rc;
 }

@@ -485,6 +485,59 @@ static void shard_set_write(FILE *f, const unsigned char *holds, long n)
     fprintf(f, "/%ld", n);
 }
 
+/* ---------------------------------------------------------------- sets of runs */
+int sweep_runs_parse(const char *text, long runs, unsigned char *set)
+{
+    memset(set, 0, (size_t)runs);
+    if (!strcmp(text, "none")) return 0;
+    const char *p = text;
+    long last = -1;
+    for (;;) {
+        long a, b;
+        if (parse_count(p, &p, 0, runs - 1, &a) || a <= last) return -1;
+        b = a;
+        if (*p == '-' && parse_count(p + 1, &p, a + 1, runs - 1, &b)) return -1;
+        memset(set + a, 1, (size_t)(b - a + 1));
+        last = b;
+        if (!*p) return 0;
+        if (*p++ != ',') return -1;
+    }
+}
+
+void sweep_runs_write(FILE *f, const unsigned char *set, long runs, long sn,
+                      const unsigned char *shards)
+{
+    bool any = false;
+    long a = -1, b = -1; /* the range being read: runs of the shards, each in the set */
+    for (long r = 0; r <= runs; r++) {
+        if (r < runs && !shards[r % sn]) continue;
+        if (r < runs && set[r]) {
+            if (a < 0) a = r;
+            b = r;
+            continue;
+        }
+        if (a < 0) continue;
+        fprintf(f, "%s%ld", any ? "," : "", a);
+        if (b > a) fprintf(f, "-%ld", b);
+        any = true, a = -1;
+    }
+    if (!any) fputs("none", f);
+}
+
+char *sweep_runs_text(const unsigned char *set, long runs, long sn, const unsigned char *shards)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (!f) return NULL;
+    sweep_runs_write(f, set, runs, sn, shards);
+    if (fclose(f) != 0) {
+        free(buf);
+        return NULL;
+    }
+    return buf;
+}
+
 /* ---------------------------------------------------------------- the identity */
 /* The identity's keys after the version line. The writer writes them in this order; merge
  * compares them in this order (the first that differs is named). */
@@ -498,6 +551,7 @@ static const ident_key ident_keys[] = {
     {"duration", true, false}, {"set", false, true},          {"bound", false, true},
     {"vary", true, true},      {"runs", true, false},         {"controller", true, false},
     {"restart", true, false},  {"require", false, false},     {"shard", false, false},
+    {"held", false, false},
 };
 #define IDENT_KEYS (int)(sizeof ident_keys / sizeof ident_keys[0])
 #define IDENT_VERSION "# lagsim-sweep "
@@ -582,7 +636,10 @@ typedef struct shard {
     size_t textlen;
     FILE *tf;               /* text's stream while reading */
     long runs, sn;          /* the sweep's runs; the shards it is split in (1: whole) */
-    unsigned char *holds;   /* holds[K - 1]: this file holds shard K of sn */
+    unsigned char *holds;   /* holds[K - 1]: this file's runs are of shard K of sn */
+    unsigned char *held;    /* its held line's runs, held[run] (NULL: no line, or unknown:
+                             * every run of its shards) */
+    bool unknown;           /* held: unknown (a sweep that did not end: its rows say) */
     char *header;
     sweep_columns cols;
 } shard;
@@ -592,9 +649,16 @@ typedef struct merging {
     shard *sh;
     int nsh;
     rows r;
-    int *from;              /* from[run]: 1 + the shard (file) that holds it; 0: none */
-    unsigned char *held;    /* held[K - 1]: a file holds shard K */
+    int *claim;             /* claim[run]: 1 + the file whose identity holds it; 0: none */
+    int *from;              /* from[run]: 1 + the file that has its row; 0: none */
+    unsigned char *held;    /* held[K - 1]: a file holds runs of shard K */
 } merging;
+
+/* Whether shard file s holds run r (its shards, and its held line's runs). */
+static bool file_holds(const shard *s, long r)
+{
+    return s->holds[r % s->sn] && (!s->held || s->held[r]);
+}
 
 static int say(const char *path, long ln, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
@@ -616,6 +680,7 @@ static void shard_free(shard *s)
     if (s->tf) fclose(s->tf); /* first: it writes s->text */
     for (int i = 0; i < s->nid; i++) free(s->key[i]), free(s->val[i]);
     free(s->key), free(s->val), free(s->version), free(s->text), free(s->holds);
+    free(s->held);
     free(s->header);
     sweep_columns_free(&s->cols);
 }
@@ -646,7 +711,7 @@ static int ident_take(shard *s, long ln, const char *line)
     if (v2) s->val = v2;
     if (!k2 || !v2 || !(s->key[s->nid] = strdup(key))) return say(s->path, ln, "out of memory");
     if (!(s->val[s->nid++] = strdup(colon + 2))) return say(s->path, ln, "out of memory");
-    if (strcmp(key, "shard")) fprintf(s->tf, "%s\n", line);
+    if (strcmp(key, "shard") && strcmp(key, "held")) fprintf(s->tf, "%s\n", line);
     return 0;
 }
 
@@ -674,6 +739,13 @@ static int ident_end(shard *s, long ln, const char *line)
     else if (shard_set_parse(sh, &s->sn, &s->holds))
         return say(s->path, 0, "shard: expected K/N (1 <= K <= N) or shards of N as "
                                "A-B,C/N (ascending), found '%s'", sh);
+    const char *held = ident_get(s, "held", 0);
+    s->unknown = held && !strncmp(held, "unknown", 7);
+    if (held && !s->unknown && !(s->held = malloc((size_t)s->runs)))
+        return say(s->path, 0, "out of memory");
+    if (s->held && sweep_runs_parse(held, s->runs, s->held))
+        return say(s->path, 0, "held: expected the runs it holds as A-B,C (ascending, from 0 "
+                   "to %ld), none or unknown, found '%.200s'", s->runs - 1, held);
     int nvary = 0;
     while (ident_get(s, "vary", nvary)) nvary++;
     char why[512];
@@ -685,6 +757,14 @@ static int ident_end(shard *s, long ln, const char *line)
     return 0;
 }
 
+/* How a CSV's sweep is split, in words: "the whole sweep (no --shard)" or "shards of N
+ * (--shard K/N)". */
+static void split_text(long sn, char *buf, size_t len)
+{
+    if (sn == 1) snprintf(buf, len, "the whole sweep (no --shard)");
+    else snprintf(buf, len, "shards of %ld (--shard K/%ld)", sn, sn);
+}
+
 /* The first key (in the table's order) whose values differ between shards a and b: 0, or
  * -1 after naming it and both values. */
 static int ident_compare(const shard *a, const shard *b)
@@ -694,7 +774,7 @@ static int ident_compare(const shard *a, const shard *b)
                                "this one", a->path, a->version, a->path, b->version);
     for (int i = 0; i < IDENT_KEYS; i++) {
         const char *key = ident_keys[i].name;
-        if (!strcmp(key, "shard")) continue;
+        if (!strcmp(key, "shard") || !strcmp(key, "held")) continue; /* which runs: */
         for (int nth = 0;; nth++) {
             const char *va = ident_get(a, key, nth), *vb = ident_get(b, key, nth);
             if (!va && !vb) break;
@@ -708,29 +788,39 @@ static int ident_compare(const shard *a, const shard *b)
     }
     if (strcmp(a->header, b->header))
         return say(b->path, 0, "not a shard of %s's sweep: another header", a->path);
-    if (a->sn != b->sn)
-        return say(b->path, 0, "not a shard of %s's sweep: shards of %ld there (1: the whole "
-                               "sweep), of %ld here", a->path, a->sn, b->sn);
+    if (a->sn != b->sn) {
+        char sa[64], sb[64];
+        split_text(a->sn, sa, sizeof sa);
+        split_text(b->sn, sb, sizeof sb);
+        return say(b->path, 0, "not a shard of %s's sweep: another split: %s holds %s, this "
+                               "file %s", a->path, a->path, sa, sb);
+    }
     return 0;
 }
 
-/* Shard k (read up to its header) against the first and the shards before it. */
+/* Shard k (read up to its header) against the first and the shards before it: the runs
+ * its identity says it holds are its own (a run two files hold is refused). */
 static int shard_admit(merging *m, int k)
 {
     shard *s = &m->sh[k];
     if (k && ident_compare(&m->sh[0], s)) return -1;
     if (!k && (!(m->from = calloc((size_t)s->runs, sizeof *m->from)) ||
+               !(m->claim = calloc((size_t)s->runs, sizeof *m->claim)) ||
                !(m->held = calloc((size_t)s->sn, 1))))
         return say(s->path, 0, "out of memory");
-    for (long K = 0; K < s->sn; K++) {
-        if (!s->holds[K]) continue;
-        if (m->held[K]) {
-            int j = 0;
-            while (!m->sh[j].holds[K]) j++;
-            return say(s->path, 0, "shard %ld/%ld again (%s holds it)", K + 1, s->sn,
-                       m->sh[j].path);
+    for (long K = 0; K < s->sn; K++) m->held[K] |= s->holds[K];
+    for (long r = 0; r < s->runs && !s->unknown; r++) { /* unknown: its rows, as they come */
+        if (!file_holds(s, r)) continue;
+        if (m->claim[r]) {
+            const shard *o = &m->sh[m->claim[r] - 1];
+            long K = r % s->sn;
+            if (!s->held && !o->held) /* each holds the whole shard */
+                return say(s->path, 0, "shard %ld/%ld again (%s holds it)", K + 1, s->sn,
+                           o->path);
+            return say(s->path, 0, "run %ld again (%s holds it too: its held line and "
+                                   "this file's share it)", r, o->path);
         }
-        m->held[K] = 1;
+        m->claim[r] = k + 1;
     }
     return 0;
 }
@@ -747,6 +837,13 @@ static int row_take(merging *m, int k, long ln, const char *line, size_t len)
     if (!s->holds[run % s->sn])
         return say(s->path, ln, "run %ld is shard %ld/%ld's (K = run mod N + 1), not one "
                                 "of the shards this file holds", run, run % s->sn + 1, s->sn);
+    if (!file_holds(s, run))
+        return say(s->path, ln, "run %ld is not one of the runs this file holds (its held "
+                                "line)", run);
+    if (m->claim[run] && m->claim[run] != k + 1)
+        return say(s->path, ln, "run %ld again (%s holds it)", run,
+                   m->sh[m->claim[run] - 1].path);
+    m->claim[run] = k + 1;
     if (m->from[run])
         return say(s->path, ln, "run %ld again (%s holds it)", run, m->sh[m->from[run] - 1].path);
     m->from[run] = k + 1;
@@ -829,6 +926,36 @@ static void missing_runs(const int *from, long runs, char *buf, size_t len)
     }
 }
 
+/* The runs of the sweep no row has, for each shard of N that has some: how to run them
+ * (--shard K/N --only RUNS), then merge. */
+static void merge_hint(const merging *m)
+{
+    const shard *s = &m->sh[0];
+    unsigned char *has = malloc((size_t)s->runs), *one = calloc((size_t)s->sn, 1);
+    int said = 0;
+    for (long r = 0; has && r < s->runs; r++) has[r] = m->from[r] != 0;
+    for (long K = 0; has && one && K < s->sn && said < 4; K++) {
+        long r = K;
+        while (r < s->runs && has[r]) r += s->sn;
+        if (r >= s->runs) continue; /* every run of shard K is there */
+        for (long q = 0; q < s->runs; q++) has[q] = !has[q]; /* the missing ones */
+        one[K] = 1;
+        char *text = sweep_runs_text(has, s->runs, s->sn, one);
+        one[K] = 0;
+        for (long q = 0; q < s->runs; q++) has[q] = !has[q];
+        if (!said++)
+            fprintf(MSG, "%s: merge: to finish the sweep, run its command again for the runs "
+                         "missing (another --csv for each), then merge these with them:\n", prog);
+        if (s->sn > 1) fprintf(MSG, "  --shard %ld/%ld --only %.300s%s\n", K + 1, s->sn,
+                               text ? text : "?", text && strlen(text) > 300 ? "..." : "");
+        else fprintf(MSG, "  --only %.300s%s\n", text ? text : "?",
+                     text && strlen(text) > 300 ? "..." : "");
+        free(text);
+    }
+    if (said == 4) fprintf(MSG, "  (and so on for the other shards that lack runs)\n");
+    free(has), free(one);
+}
+
 /* Without --partial: every shard and every run there. 0, or -1 after naming what lacks. */
 static int merge_whole(const merging *m)
 {
@@ -852,6 +979,7 @@ static int merge_whole(const merging *m)
         fprintf(MSG, "%s: merge: the shards do not make a whole sweep: missing runs %s "
                         "(the sweep has runs 0 to %ld; a shard's sweep stopped early?); "
                         "--partial merges the runs there\n", prog, buf, s->runs - 1);
+        merge_hint(m);
         return -1;
     }
     return 0;
@@ -872,7 +1000,21 @@ static int merge_write(merging *m, const char *out, bool force, const char *cons
         shard_set_write(t, m->held, s->sn);
         fputc('\n', t);
     }
-    if (fclose(t) != 0) return say(out, 0, "out of memory");
+    /* the runs of those shards that have a row, when not every one has */
+    unsigned char *has = malloc((size_t)s->runs);
+    bool all = true;
+    for (long r = 0; has && r < s->runs; r++)
+        all &= (has[r] = m->from[r] != 0) || !m->held[r % s->sn];
+    if (has && !all) {
+        fputs("# held: ", t);
+        sweep_runs_write(t, has, s->runs, s->sn, m->held);
+        fputc('\n', t);
+    }
+    free(has);
+    if (fclose(t) != 0 || !has) {
+        free(ident);
+        return say(out, 0, "out of memory");
+    }
     FILE *fo = eval_open_out(prog, "-o", out, force, in, m->nsh);
     if (!fo) {
         free(ident);
@@ -935,10 +1077,11 @@ int merge(int argc, char **argv, void (*usage)(FILE *))
     if (rc < 0 && merge_write(&m, out, force, in)) rc = 2;
     if (rc < 0) {
         summary(m.sh[0].header, &m.r);
+        if (partial) merge_hint(&m); /* what the output lacks, and how to run it */
         rc = 0;
     }
     for (int k = 0; m.sh && k < m.nsh; k++) shard_free(&m.sh[k]);
-    free(m.sh), free(m.from), free(m.held), free(in);
+    free(m.sh), free(m.from), free(m.claim), free(m.held), free(in);
     rows_free(&m.r);
     return rc;
 }

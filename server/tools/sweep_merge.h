@@ -18,12 +18,23 @@
  *   # restart: no                               --restart: yes
  *   # require: theta.settle<6.5                 --require, when given
  *   # shard: 1/2                                a shard's (a partial merge's: 1-3,5/8)
+ *   # held: 0-41,43                             the runs it holds, when not every run of
+ *                                               its shards (a sweep stopped, --only, a
+ *                                               partial merge); unknown: its rows say (a
+ *                                               sweep that did not end)
  *   run,parameters.m0,...,failed,required,reason,x.rise,...
  *   0,1.4140917868522627,...,0,1,"",nan,6.7393795857533...
  *
  * Values are escaped (\\, \n, \r, \t, \xHH for other control bytes), so each is one line.
  * A whole sweep and the merge of its shards write the same bytes: the shard line is the
- * only one a shard adds. Comment lines are what pandas (comment='#'), gnuplot and R skip.
+ * only one a shard adds, the held line the only one a CSV of some of its runs adds.
+ *
+ * One notion of a CSV that holds some of a sweep's runs: its shard line says of which
+ * shards they are, its held line which of those runs (ranges of run numbers, each range
+ * counted in those shards' runs: "0-40" under "shard: 1/2" is runs 0, 2, ..., 40). A
+ * sweep stopped by a signal, a sweep of --only runs and a partial merge all write it;
+ * merge takes them with the others, every run held by one file alone, and a whole set
+ * of them makes the whole sweep's CSV, byte for byte. Comment lines are what pandas (comment='#'), gnuplot and R skip.
  */
 #ifndef LAGSIM_SWEEP_MERGE_H
 #define LAGSIM_SWEEP_MERGE_H
@@ -85,6 +96,20 @@ int sweep_row_check(const sweep_columns *c, const char *line, size_t len, long r
 
 /* --shard K/N: 1 <= K <= N <= SWEEP_RUNS_MAX, digits only. 0, or -1. OUT: k, n */
 int sweep_shard_parse(const char *text, long *k, long *n);
+
+/* ---------------------------------------------------------------- sets of runs */
+/* A held line's value while the sweep writing it runs: its rows say which runs it holds. */
+#define SWEEP_HELD_UNKNOWN "unknown (the rows below, each written as its run ended: the " \
+                           "sweep writing this file did not end)"
+/* "A-B,C" (ascending, each number digits only from 0 to runs - 1) or "none": set[r] = 1
+ * for each run r it names (set has runs bytes). 0, or -1 when it is none of those. */
+int sweep_runs_parse(const char *text, long runs, unsigned char *set);
+/* The runs r of set[] of the shards shards[K - 1] of sn as ranges of those shards' runs
+ * ("0-40" for 0, 2, ..., 40 of shard 1/2), or "none". */
+void sweep_runs_write(FILE *f, const unsigned char *set, long runs, long sn,
+                      const unsigned char *shards);
+/* The same in a new string (NULL: out of memory). */
+char *sweep_runs_text(const unsigned char *set, long runs, long sn, const unsigned char *shards);
 
 /* ---------------------------------------------------------------- the identity */
 /* What makes a sweep's runs what they are: every shard of one sweep has the same. */

@@ -49,6 +49,9 @@ set(LAGSIM_TIER_RULES
   "waits     NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
   "waits     NAME  ^eval_procs_(eval|sweep)_(stalled|gnuplot)$"
   "waits     NAME  ^eval_lagsim_sweep_unanswered$"
+  # a controller on another prefix: 30 s of a kept pair's wait for its first answer
+  "waits     NAME  ^eval_lagsim_sweep_controller_exit$"
+  "waits     NAME  ^eval_lagsim_eval_waits$"
   "waits     NAME  ^scene_shipped_wait$"
   "waits     NAME  ^log_term_waits$"
   "waits     NAME  ^ctl_discover$"
@@ -84,9 +87,11 @@ set(LAGSIM_TIER_RULES
   # controller; packet loss and ssh hosts in namespaces
   "quick     NAME  ^eval_(metrics|reference|sweep_csv)_"
   "quick     NAME  ^eval_procs_(eval|sweep)_(sigint|sigterm|sigkill|groupkill)$"
-  "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene|owned|outputs|bus|docs_python|stderr)$"
-  "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|merge_rows|merge_foreign|shard|kept|kept_python|vary|scene_c|scene_python)$"
+  "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene|owned|outputs|bus|docs_python|notes|stderr)$"
+  "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|merge_rows|merge_foreign|shard|kept|kept_python|vary|scene_c|scene_python|notes|interrupt)$"
   "wallclock NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
+  # the progress line on a terminal: drawn against the wall clock
+  "wallclock NAME  ^eval_lagsim_sweep_progress$"
   "root      NAME  ^eval_lagsim_sweep_(loss|ssh|scene_loss)$"
   # clients, ctl, install
   "quick     NAME  ^clients_octave_matlab_syntax$"

@@ -22,6 +22,16 @@ usage: test_eval.py BIN_DIR SOURCE_DIR CASE
              two workers run at once on four pairs, each held (its lock file locked) while
              its controller runs; ttl above 0 only with --allow-lan; memq:// and other
              providers refused; {prefix} and {url} replaced as they are, inside quotes too
+  notes      what a new user misread, said: -v names the directory where it keeps the
+             runs' logs; a case with a reference for q1 and none for q2 says in the
+             table's notes that q2 is scored against r = 0 (a case with both: no note); a
+             controller command with {url} outside quotes that ends before its run says
+             to write '{url}' (the URL's '&' ended the command), quoted: no such words
+  waits      a controller on another prefix (alive, waiting for its scene): within
+             seconds of the case's start, long before --timeout, one line on stderr says in
+             the daemon's words what the plant waits for (the first command, on the run's
+             <PREFIX>_COMMAND at its command URL) and to give the command {prefix}; a
+             controller on the run's prefix: no such line
   stderr     without -v the controller's stderr is the run's, not the terminal's: a
              controller that talks on stderr and works says nothing through lagsim-eval
              or lagsim-sweep; one that fails has its last 8 lines shown under the case's
@@ -37,6 +47,7 @@ import glob
 import math
 import os
 import re
+import select
 import shutil
 import subprocess
 import sys
@@ -240,8 +251,8 @@ def case_stderr():
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                            universal_newlines=True, timeout=300)
         print(p.stdout[-300:], p.stderr)
-        check(p.returncode == 2 and "run 0: the kept lagsimd did not step: the controller "
-              "ended (exit status 3)\n" + tail in p.stderr,
+        check(p.returncode == 2 and "run 0, worker 0: the controller ended (exit status 3) "
+              "before it answered the kept lagsimd's first state\n" + tail in p.stderr,
               "lagsim-sweep, a kept pair whose controller fails: why, and its last 8 lines")
         # a pair a run: the run fails, the sweep goes on; the first failure's lines, once
         p = subprocess.run(sweep + ["--restart", "--controller", fail, "--csv",
@@ -665,8 +676,97 @@ def case_outputs():
               "merge -o a hard link to its shard: exit 2, the shard untouched")
 
 
-{"metrics": case_metrics, "require": case_require, "errors": case_errors,
- "scene": case_scene, "owned": case_owned, "outputs": case_outputs, "bus": case_bus,
- "stderr": case_stderr}[CASE]()
+def case_notes():
+    manip = os.path.join(SRC, "config", "manipulator.yaml")
+    pd = os.path.join(BIN, "manipulator_pd") + " -q --prefix {prefix}"
+    with tempfile.TemporaryDirectory() as d:
+        env = dict(os.environ, TMPDIR=d)
+        # -v keeps the runs' logs: where, said once
+        p = subprocess.run([EVAL, "--config", SCENE, "--controller", CTRL, "--suite", SUITE,
+                            "--case", "tilt", "-v"], env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+        m = re.search(r"^lagsim-eval: -v: each case's log \(EVAL\d+_<case's index>\.lcm\) is "
+                      r"kept in (\S+)$", p.stderr, re.M)
+        logs = glob.glob(os.path.join(m.group(1), "EVAL*_*.lcm")) if m else []
+        check(p.returncode == 0 and m and m.group(1).startswith(d) and len(logs) == 1 and
+              p.stderr.count("is kept in") == 1,
+              "-v: the directory of the kept logs said once, the log there (%s, %s)"
+              % (m.group(1) if m else None, logs))
+        # a reference for q1 alone: q2 is scored against r = 0, and the notes say it
+        suite = os.path.join(d, "ref.yaml")
+        with open(suite, "w") as f:
+            f.write('cases:\n  - name: q1_only\n    duration: 1\n'
+                    '    set: ["reference={q1: {type: step, amplitude: 0.2}}"]\n'
+                    '  - name: both\n    duration: 1\n')
+        p = subprocess.run([EVAL, "--config", manip, "--controller", pd, "--suite", suite],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=300)
+        print(p.stdout, p.stderr)
+        notes = re.findall(r"^  (\S+): (.*r = 0.*)$", p.stdout, re.M)
+        check(len(notes) == 1 and notes[0][0] == "q1_only" and
+              notes[0][1].startswith("q2 has no reference") and "q1 has" not in notes[0][1],
+              "a reference for q1 alone: a note says q2 is scored against r = 0, none for the "
+              "case with both (%s)" % notes)
+    # {url} outside quotes: the URL's '&' ends the shell command, and lqr_balance (sent to
+    # the background) ends with it; the reason says to quote it
+    url = "udpm://239.255.76.67?ttl=0&recv_buf_size=4194304"
+    bare = os.path.join(BIN, "lqr_balance") + " -q --prefix {prefix} --url {url}"
+    p = subprocess.run([EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt", "--url",
+                        url, "--controller", bare], stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+    print(p.stdout, p.stderr)
+    check(p.returncode == 1 and "the controller ended (exit status 0) before the run did; "
+          "{url} stands outside quotes" in p.stdout and "write '{url}'" in p.stdout and
+          "'&'" in p.stdout, "a bare {url} whose '&' ended the command: the reason says to "
+          "write '{url}' (exit %d)" % p.returncode)
+    quoted = bare.replace("{url}", "'{url}'")
+    p = subprocess.run([EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt", "--url",
+                        url, "--controller", quoted], stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+    check(p.returncode == 0 and "{url}" not in p.stdout,
+          "'{url}' quoted: the case runs, no such words (exit %d)" % p.returncode)
+
+
+def case_waits():
+    # lqr_balance waits 100 s for a scene on its own prefix: it never answers the run's
+    # plant, which waits at t = 0 for the first command
+    wrong = os.path.join(BIN, "lqr_balance") + " -q --prefix NOT_THE_RUNS --timeout 100"
+    p = subprocess.Popen([EVAL, "--config", SCENE, "--suite", SUITE, "--case", "tilt",
+                          "--timeout", "120", "--controller", wrong], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, universal_newlines=True)
+    t0, text = time.monotonic(), ""
+    while time.monotonic() < t0 + 30 and "has not left" not in text:  # at most 30 s
+        if select.select([p.stderr], [], [], 0.2)[0]:
+            chunk = os.read(p.stderr.fileno(), 65536).decode(errors="replace")
+            if not chunk:
+                break
+            text += chunk
+    took = time.monotonic() - t0
+    p.terminate()
+    while "\n" not in text[text.find("has not left"):] and "has not left" in text:
+        chunk = os.read(p.stderr.fileno(), 65536).decode(errors="replace")
+        if not chunk:
+            break
+        text += chunk
+    lines = text.splitlines(True)
+    line = next((x for x in lines if "has not left" in x), "")
+    rest = "".join(lines[lines.index(line) + 1:]) if line else text
+    p.wait(timeout=60)
+    rest += p.stderr.read()
+    print(line, rest)
+    check(re.match(r"^lagsim-eval: case tilt: the plant has not left t = 0 after 5 s: lagsimd "
+                   r"waits \d+ s for the first command \(sim_time 0\) on EVAL\d+_0_COMMAND at "
+                   r"udpm://[0-9.]+:\d+\?\S+; .*give the command \{prefix\} or LAGSIM_PREFIX "
+                   r"\(else the run ends at --timeout, 120 s\)$", line) and took < 30,
+          "a controller on another prefix: said in %.1f s (--timeout 120): %r" % (took, line))
+    check("has not left" not in rest, "said once")
+    p = run("--suite", SUITE, "--case", "tilt")
+    check(p.returncode == 0 and "has not left" not in p.stderr,
+          "a controller on the run's prefix: no such line")
+
+
+{"metrics": case_metrics, "require": case_require, "errors": case_errors, "notes": case_notes,
+ "waits": case_waits, "scene": case_scene, "owned": case_owned, "outputs": case_outputs,
+ "bus": case_bus, "stderr": case_stderr}[CASE]()
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)

@@ -26,6 +26,9 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             content, case, case override, --vary distribution, controller command,
             --restart, --require, --runs, version line, split (2/3), and a CSV without
             identity lines: exit 2 naming the first field that differs and both values
+  notes     -v names the directory where it keeps the daemons' logs (they are there); a
+            reference for q1 and none for q2: the summary's note says q2 is scored against
+            r = 0
   shard     --shard refuses 1/2x, 0/2, 3/2, 1/0, spaces, signs, leading zeros, 1/2/3,
             numbers past 1e7 or 2^64 (exit 2 before any run); 4/4 runs run 3 alone
   kept      one lagsimd and one controller per worker (counted through wrappers), a
@@ -58,6 +61,28 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             (nftables; root, else skipped): the same CSVs as without loss, byte for byte
   unanswered  a controller that never answers a run's last state: the worker waits for
             that answer; the run after fails saying so, and the next gets a new pair
+  controller_exit  a controller that cannot run the sweep stops it (exit 2, said once, in
+            seconds): one that exits at once ('exit 3': its exit status named), one on
+            another prefix (the daemon's status says what it waits for); one that dies in
+            the runs of a large m2 (tests/eval/mute_pd.py --exit-above) fails those runs
+            (a row each, its exit status in the reason) and the next run gets a new pair;
+            with --restart a controller that exits at once fails each run at once
+  progress  stderr a pseudo-terminal (100 columns): the progress line drawn again and again
+            (each drawing after \\r and a clear), runs done never going back, at most 5
+            drawings a second, none wider than the terminal, the last one the sweep's
+            runs, its failures and its misses as the CSV counts them, ended by a newline;
+            stderr a pipe: no progress text and no control byte; a pipe with --progress:
+            whole lines, the last the count of every run
+  interrupt  SIGINT to the sweep's process group (a terminal's Ctrl-C), SIGTERM to a
+            shard's sweep, SIGHUP, each once the CSV holds a few rows: the sweep ends by
+            the signal; its CSV holds the rows of the runs that ended, in run order, under
+            the sweep's identity and a held line naming exactly them; stderr says so and
+            gives the command that runs the others (--only) and the merge; both run as
+            written give the whole sweep's CSV (the shard's, merged with the other
+            shard), byte for byte. SIGKILL: the CSV as the sweep left it (held: unknown,
+            the rows of the runs that had ended), merge --partial takes it, and with the
+            runs it lacks (--only) it merges into the whole sweep byte for byte. --only
+            mistakes refused before any run
 """
 import csv
 import filecmp
@@ -72,7 +97,7 @@ import sys
 import tempfile
 import time
 
-BIN, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
+BIN, SRC, CASE = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2]), sys.argv[3]
 SCENE = os.path.join(SRC, "config", "cartpole.yaml")
 SWEEP = os.path.join(BIN, "lagsim-sweep")
 CTRL = os.path.join(BIN, "lqr_balance") + " -q --prefix {prefix}"
@@ -452,7 +477,15 @@ def case_merge_foreign(d):
     s3 = os.path.join(d, "third.csv")
     run([SWEEP] + base + ["--shard", "2/3", "--csv", s3])
     p, o = merge(d, s1, s3, out="foreign.csv")
-    refused(p, o, "shard 2/3 with 1/2", "shards of 2 there", "of 3 here")
+    refused(p, o, "shard 2/3 with 1/2", "another split: %s holds shards of 2 (--shard K/2), "
+            "this file shards of 3 (--shard K/3)" % s1)
+    # the whole sweep with a shard: said in words (it was "shards of 1 there (1: the whole
+    # sweep)")
+    w = os.path.join(d, "whole.csv")
+    run([SWEEP] + base + ["--csv", w])
+    p, o = merge(d, w, s3, out="foreign.csv")
+    refused(p, o, "a shard with the whole sweep", "another split: %s holds the whole sweep "
+            "(no --shard), this file shards of 3 (--shard K/3)" % w)
     # a CSV without identity lines (the rows alone)
     plain = os.path.join(d, "plain.csv")
     with open(plain, "w") as f:
@@ -889,6 +922,284 @@ def case_unanswered(d):
           "(a new pair) did not (%.1f s)" % took)
 
 
+def case_notes(d):
+    manip = os.path.join(SRC, "config", "manipulator.yaml")
+    pd = os.path.join(BIN, "manipulator_pd") + " -q --prefix {prefix}"
+    env = dict(os.environ, TMPDIR=d)
+    p = run([SWEEP, "--config", manip, "--controller", pd, "--duration", "0.5", "--vary",
+             "parameters.m2=uniform(0.4,0.6)", "--runs", "2", "-v"], env=env)
+    m = re.search(r"^lagsim-sweep: -v: the daemons' logs .* are kept in (\S+)$", p.stderr, re.M)
+    logs = glob.glob(os.path.join(m.group(1), "SWEEP*_W0.lcm")) if m else []
+    check(p.returncode == 0 and m and m.group(1).startswith(d) and len(logs) == 1,
+          "-v: the directory of the kept logs said, the kept pair's log there (%s)" % logs)
+    check("no reference" not in p.stdout, "both joints with a reference: no note")
+    p = run([SWEEP, "--config", manip, "--controller", pd, "--vary",
+             "parameters.m2=uniform(0.4,0.6)", "--runs", "2", "--suite", write_ref_suite(d),
+             "--case", "q1_only"])
+    check(p.returncode in (0, 1) and re.search(r"^note: q2 has no reference .*r = 0$",
+                                               p.stdout, re.M),
+          "a reference for q1 alone: the summary's note says q2 is scored against r = 0")
+
+
+def write_ref_suite(d):
+    path = os.path.join(d, "ref.yaml")
+    with open(path, "w") as f:
+        f.write('cases:\n  - name: q1_only\n    duration: 0.5\n'
+                '    set: ["reference={q1: {type: step, amplitude: 0.2}}"]\n')
+    return path
+
+
+def pty_run(argv, cols=100, env=None):
+    """argv with stderr on a pseudo-terminal of `cols` columns: (exit status, what it wrote
+    there, the time it took)."""
+    import fcntl
+    import pty
+    import select
+    import struct
+    import termios
+    master, slave = pty.openpty()
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 40, cols, 0, 0))
+    t0 = time.monotonic()
+    p = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                         stderr=slave, env=env)
+    os.close(slave)
+    out = b""
+    while True:
+        r, _, _ = select.select([master], [], [], 0.1)
+        if r:
+            try:
+                chunk = os.read(master, 65536)
+            except OSError:  # EIO: the other end closed
+                chunk = b""
+            if not chunk:
+                break
+            out += chunk
+        elif p.poll() is not None:
+            break
+    os.close(master)
+    return p.wait(), out.decode(errors="replace"), time.monotonic() - t0
+
+
+PROGRESS = re.compile(r"lagsim-sweep: (\d+)/(\d+) runs \(\d+ %\), (\d+) failed, (\d+) missed "
+                      r"--require, [0-9.e+]+ runs/s, ")
+
+
+def case_progress(d):
+    # 200 cart-pole runs (about 10 s here); m1 drawn from normal(0.05,0.1): the scene
+    # refuses the negative ones (failed runs), and some miss --require
+    q = ["--config", SCENE, "--controller", CTRL, "--duration", "8", "--vary",
+         "parameters.m1=normal(0.05,0.1)", "--runs", "200", "--seed", "3", "-j2",
+         "--require", "theta.settle<5.5"]
+    out = os.path.join(d, "p.csv")
+    rc, text, took = pty_run([SWEEP] + q + ["--csv", out])
+    r = rows(out)
+    failed = sum(x["failed"] == "1" for x in r)
+    missed = sum(x["failed"] == "0" and x["required"] == "0" for x in r)
+    draws = text.split("\r\x1b[K")[1:]
+    got = [PROGRESS.match(x) for x in draws]
+    print("%d drawings in %.1f s; the last: %r" % (len(draws), took, draws[-1] if draws else None))
+    check(rc == 1 and len(r) == 200 and failed > 0 and missed > 0,
+          "the sweep ran: 200 rows, %d failed, %d missed --require" % (failed, missed))
+    check(len(draws) >= 2 and all(got), "the progress line drawn %d times, each after \\r and "
+          "a clear" % len(draws))
+    done = [int(m.group(1)) for m in got if m]
+    check(done == sorted(done) and all(int(m.group(2)) == 200 for m in got if m),
+          "runs done never go back, of 200: %s" % done[:40])
+    check(len(draws) <= 5 * took + 2, "at most 5 drawings a second (%d in %.1f s)"
+          % (len(draws), took))
+    last = got[-1] if got else None
+    check(last and draws[-1].endswith("\n") and int(last.group(1)) == 200 and
+          int(last.group(3)) == failed and int(last.group(4)) == missed,
+          "the last drawing: 200 runs, %d failed, %d missed, as the CSV counts them, a newline "
+          "after it (%r)" % (failed, missed, draws[-1] if draws else None))
+    check(all(len(x.rstrip("\r\n")) <= 99 for x in draws), "no drawing wider than the "
+          "terminal's 100 columns")
+    # stderr a pipe: nothing of it
+    p = run([SWEEP] + q + ["--csv", out, "--force"])
+    check(p.returncode == 1 and "runs (" not in p.stderr and "\r" not in p.stderr and
+          "\x1b" not in p.stderr, "stderr a pipe: no progress, no control byte")
+    p = run([SWEEP] + q + ["--csv", out, "--force", "--progress"])
+    lines = [x for x in p.stderr.splitlines() if x.startswith("lagsim-sweep: ") and " runs (" in x]
+    check(p.returncode == 1 and lines and "\r" not in p.stderr and "\x1b" not in p.stderr and
+          PROGRESS.match(lines[-1]) and lines[-1].startswith("lagsim-sweep: 200/200 runs"),
+          "a pipe with --progress: whole lines, the last one of all 200 runs (%s)" % lines[-1:])
+
+
+def rows_now(path):
+    """The rows a CSV holds now (a sweep may be writing it)."""
+    try:
+        return sum(1 for x in open(path) if x[:1].isdigit())
+    except FileNotFoundError:
+        return 0
+
+
+def stopped(argv, csv_path, sig, group=False, at_rows=4):
+    """argv started (a session of its own), sig sent once csv_path holds at_rows rows:
+    (exit status, stdout, stderr)."""
+    p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         universal_newlines=True, start_new_session=True)
+    end = time.monotonic() + 120
+    while rows_now(csv_path) < at_rows and p.poll() is None and time.monotonic() < end:
+        time.sleep(0.05)
+    if p.poll() is None:
+        (os.killpg if group else os.kill)(p.pid, sig)
+    o, e = p.communicate(timeout=120)
+    print("$ sweep, %s after %d rows -> %d\n%s%s" % (signal.Signals(sig).name, at_rows,
+                                                    p.returncode, o[-800:], e[-3000:]))
+    return p.returncode, o, e
+
+
+def finish(e):
+    """The two commands the stopped sweep gave (the runs it lacks, then the merge), run as
+    written where it ran: their exit statuses."""
+    cmds = [x.strip() for x in e.splitlines() if x.startswith("  ") and "lagsim-sweep" in x]
+    out = []
+    for c in cmds:
+        p = subprocess.run(["sh", "-c", c], stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, universal_newlines=True, timeout=600)
+        print("$", c, "->", p.returncode, p.stderr[-500:])
+        out.append(p.returncode)
+    return cmds, out
+
+
+def held_is(path, want_runs):
+    """The CSV's rows are in run order and its held line names exactly them."""
+    runs = [int(x["run"]) for x in rows(path)]
+    held = dict(identity(path)).get("held", "")
+    if not re.match(r"^\d+(-\d+)?(,\d+(-\d+)?)*$", held):
+        return False, runs, held
+    named = set()
+    for part in held.split(","):
+        a, _, b = part.partition("-")
+        named |= set(r for r in range(int(a), int(b or a) + 1) if r in want_runs)
+    return runs == sorted(runs) and named == set(runs), runs, held
+
+
+def case_interrupt(d):
+    q = ["--config", SCENE, "--controller", CTRL, "--duration", "8", "--vary",
+         "parameters.m1=uniform(0.05,0.3)", "--runs", "300", "--seed", "5", "-j2"]
+    whole = os.path.join(d, "whole.csv")
+    run([SWEEP] + q + ["--csv", whole])
+    # SIGINT to the process group, as a terminal's Ctrl-C sends it
+    out = os.path.join(d, "int.csv")
+    rc, o, e = stopped([SWEEP] + q + ["--csv", out], out, signal.SIGINT, group=True)
+    ok, runs, held = held_is(out, set(range(300)))
+    check(rc == -signal.SIGINT and 0 < len(runs) < 300 and ok,
+          "SIGINT: ended by it, the CSV holds %d runs in run order, its held line (%s) names "
+          "them" % (len(runs), held))
+    check([k for k, _ in identity(out)] == [k for k, _ in identity(whole)] + ["held"],
+          "its identity: the whole sweep's and the held line")
+    check("stopped by SIGINT: %s holds %d of the 300 runs" % (out, len(runs)) in e and
+          "%d runs:" % len(runs) in o, "stderr says what it holds, stdout sums it up")
+    cmds, codes = finish(e)
+    merged = os.path.join(d, "int-whole.csv")
+    check(len(cmds) == 2 and "--only" in cmds[0] and codes == [0, 0] and
+          filecmp.cmp(merged, whole, shallow=False),
+          "the commands it gives, run as written: the whole sweep's CSV, byte for byte (%s)"
+          % codes)
+    # SIGTERM to shard 2/2's sweep: the rest is of shard 2/2, merged with shard 1/2
+    s1, s2 = os.path.join(d, "s1.csv"), os.path.join(d, "s2.csv")
+    run([SWEEP] + q + ["--shard", "1/2", "--csv", s1])
+    rc, o, e = stopped([SWEEP] + q + ["--shard", "2/2", "--csv", s2], s2, signal.SIGTERM)
+    ok, runs, held = held_is(s2, set(range(1, 300, 2)))
+    check(rc == -signal.SIGTERM and ok and dict(identity(s2)).get("shard") == "2/2",
+          "SIGTERM to shard 2/2: its %d runs, held %s (counted in the shard's runs)"
+          % (len(runs), held))
+    cmds, codes = finish(e)
+    check(len(cmds) == 2 and "--shard 2/2 --only" in cmds[0] and codes == [0, 0],
+          "its commands: the shard's missing runs (--shard 2/2 --only), then merge")
+    p, m = merge(d, s1, os.path.join(d, "s2-whole.csv"), out="shards.csv")
+    check(p.returncode == 0 and filecmp.cmp(m, whole, shallow=False),
+          "shard 1/2 and the finished shard 2/2 merged: the whole sweep, byte for byte")
+    # SIGHUP: the same partial CSV
+    out = os.path.join(d, "hup.csv")
+    rc, o, e = stopped([SWEEP] + q + ["--csv", out], out, signal.SIGHUP)
+    ok, runs, held = held_is(out, set(range(300)))
+    check(rc == -signal.SIGHUP and ok and "stopped by SIGHUP" in e,
+          "SIGHUP: ended by it, %d runs held (%s)" % (len(runs), held))
+    # SIGKILL: nothing of the sweep runs; the CSV holds what was written as runs ended
+    out = os.path.join(d, "kill.csv")
+    rc, o, e = stopped([SWEEP] + q + ["--csv", out], out, signal.SIGKILL, at_rows=6)
+    ident = dict(identity(out))
+    lines = open(out).read().split("\n")
+    killed = [int(x["run"]) for x in rows(out)]
+    check(rc == -signal.SIGKILL and ident.get("held", "").startswith("unknown") and
+          len(killed) >= 6 and lines[-1] == "", "SIGKILL: the CSV holds the %d rows written as "
+          "their runs ended, whole lines, held: unknown" % len(killed))
+    p, part = merge(d, out, out="kill-part.csv", extra=["--partial"])
+    ok, runs, held = held_is(part, set(range(300)))
+    check(p.returncode == 0 and ok and sorted(killed) == runs and "--only" in p.stderr,
+          "merge --partial takes it: its runs in order, the held line (%s), the runs to give "
+          "--only said" % held)
+    miss = [x.strip() for x in p.stderr.splitlines() if x.strip().startswith("--only")]
+    rest = os.path.join(d, "kill-rest.csv")
+    run([SWEEP] + q + (miss[0].split() if miss else ["--only", "0"]) + ["--csv", rest])
+    p, m = merge(d, out, rest, out="kill-whole.csv")
+    check(p.returncode == 0 and filecmp.cmp(m, whole, shallow=False),
+          "the killed sweep's CSV and its missing runs (%s) merged: the whole sweep, byte "
+          "for byte" % (miss[0] if miss else None))
+    # --only mistakes: before any run
+    for bad, why in (("5-3", "expected runs"), ("a", "expected runs"), ("0-300", "expected runs"),
+                     ("3,2", "expected runs"), ("1", "no run of this sweep")):
+        p = run([SWEEP] + q + ["--shard", "1/2", "--only", bad])
+        check(p.returncode == 2 and why in p.stderr and "runs:" not in p.stdout,
+              "--only %s (shard 1/2): exit 2 before any run, said why" % bad)
+
+
+def case_controller_exit(d):
+    base = ["--config", SCENE, "--duration", "1", "--vary", "parameters.m1=uniform(0.1,0.2)",
+            "--runs", "4", "-j2"]
+    # a controller that cannot start: the sweep stops at once, exit 2, the exit status said
+    out = os.path.join(d, "exit3.csv")
+    t0 = time.monotonic()
+    p = run([SWEEP] + base + ["--controller", "exit 3", "--csv", out])
+    took = time.monotonic() - t0
+    check(p.returncode == 2 and p.stderr.count("the controller ended (exit status 3) before "
+                                               "it answered") == 1 and
+          "the sweep stops" in p.stderr and took < 20,
+          "'exit 3': exit 2, the controller's exit status said once, in %.1f s" % took)
+    # a controller on another prefix (alive: it waits 100 s for its scene): the daemon says
+    # what it waits for, within the worker's first 30 s
+    p = run([SWEEP] + base + ["-j1", "--controller", os.path.join(BIN, "lqr_balance") +
+                              " -q --prefix NOT_THE_RUNS --timeout 100"])
+    check(p.returncode == 2 and "did not answer the kept lagsimd's first state" in p.stderr and
+          re.search(r"lagsimd waits \d+ s for a command answering sim_time 0 on "
+                    r"SWEEP\d+_W0_COMMAND at udpm://", p.stderr) and "{prefix}" in p.stderr,
+          "a controller on another prefix: exit 2, the daemon's wait said")
+    # a controller that dies in some runs (m2 above 0.6): those fail, a row each, and the
+    # next run gets a new pair
+    q, env = scene_sweep("c", 8)
+    q[q.index("--controller") + 1] = "python3 %s -q --exit-above 0.6 --prefix {prefix}" % (
+        os.path.join(SRC, "tests", "eval", "mute_pd.py"))
+    out = os.path.join(d, "dies.csv")
+    t0 = time.monotonic()
+    p = run([SWEEP] + q + ["-j1", "--csv", out], env=env)
+    took = time.monotonic() - t0
+    r = rows(out) if os.path.exists(out) else []
+    big = [x for x in r if float(x["parameters.m2"]) > 0.6]
+    small = [x for x in r if float(x["parameters.m2"]) <= 0.6]
+    check(len(r) == 8 and big and small and
+          all(x["failed"] == "1" and re.match(r"the controller ended \(exit status 7\) at "
+                                              r"t = 0\.2 s, before the run did$", x["reason"])
+              for x in big) and all(x["failed"] == "0" for x in small),
+          "a controller that dies at t = 0.2 in the %d runs of m2 > 0.6: those fail with its "
+          "exit status, the %d others pass (%s)" % (len(big), len(small),
+                                                   [(x["run"], x["reason"]) for x in r]))
+    check(p.stderr.count("a new lagsimd and controller for the next run") == len(big) and
+          took < 120, "each death said, a new pair for the next run (%.1f s)" % took)
+    # --restart: each run's controller exits at once: a failed row each, without the 5 s a
+    # daemon gets to end after its controller (it says it waits: stopped at once)
+    out = os.path.join(d, "restart.csv")
+    t0 = time.monotonic()
+    p = run([SWEEP] + base + ["--restart", "--controller", "exit 3", "--csv", out])
+    took = time.monotonic() - t0
+    r = rows(out) if os.path.exists(out) else []
+    check(p.returncode == 1 and len(r) == 4 and
+          all(x["reason"] == "the controller ended (exit status 3) before the run did"
+              for x in r) and took < 10,
+          "--restart, 'exit 3': 4 failed rows naming exit status 3, in %.1f s" % took)
+
+
 with tempfile.TemporaryDirectory() as tmp:
     {"same": case_same, "vary": case_vary, "slurm": case_slurm, "merge": case_merge,
      "kept": case_kept, "merge_rows": case_merge_rows, "merge_foreign": case_merge_foreign,
@@ -896,6 +1207,8 @@ with tempfile.TemporaryDirectory() as tmp:
      "loss": case_loss, "stalled": case_stalled, "ssh": case_ssh,
      "kept_python": case_kept_python, "scene_c": case_scene_c,
      "scene_python": case_scene_python, "scene_loss": case_scene_loss,
-     "unanswered": case_unanswered}[CASE](tmp)
+     "unanswered": case_unanswered, "notes": case_notes,
+     "controller_exit": case_controller_exit, "progress": case_progress,
+     "interrupt": case_interrupt}[CASE](tmp)
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)

@@ -301,6 +301,38 @@ static void case_merge_many(int arg)
     unlink(out), unlink(scene), rmdir(dir);
 }
 
+/* A held line's runs: what the text names, what the writer writes back (ranges counted in
+ * the shards' runs), the texts that are none of that. */
+static void case_runs(int arg)
+{
+    (void)arg;
+    unsigned char set[20], all[1] = {1}, second[2] = {0, 1};
+    ENSURE(sweep_runs_parse("0-3,5,7-8", 20, set) == 0);
+    for (int r = 0; r < 20; r++)
+        ENSUREF(set[r] == (r <= 3 || r == 5 || r == 7 || r == 8), "run %d: %d", r, set[r]);
+    char *t = sweep_runs_text(set, 20, 1, all);
+    ENSUREF(t && !strcmp(t, "0-3,5,7-8"), "written back as '%s'", t ? t : "(null)");
+    free(t);
+    /* shard 2/2's runs 1, 3, 5, 9 of 20: "1-5,9" (7 is the shard's, not held) */
+    memset(set, 0, sizeof set);
+    set[1] = set[3] = set[5] = set[9] = 1;
+    set[4] = 1; /* shard 1/2's: not written under shard 2/2 */
+    t = sweep_runs_text(set, 20, 2, second);
+    ENSUREF(t && !strcmp(t, "1-5,9"), "shard 2/2: '%s'", t ? t : "(null)");
+    free(t);
+    memset(set, 0, sizeof set);
+    t = sweep_runs_text(set, 20, 1, all);
+    ENSUREF(t && !strcmp(t, "none"), "no run: '%s'", t ? t : "(null)");
+    free(t);
+    ENSURE(sweep_runs_parse("none", 20, set) == 0 && !memchr(set, 1, sizeof set));
+    ENSURE(sweep_runs_parse("19", 20, set) == 0 && set[19] == 1);
+    static const char *const bad[] = {"", "3-1", "1,1", "2,1", "0-20", "20", "-1", "01",
+                                      "1-", "1,", ",1", "1 ,2", "a", "1-2-3", "0x3",
+                                      "18446744073709551617", "unknown"};
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++)
+        ENSUREF(sweep_runs_parse(bad[i], 20, set) == -1, "'%s' taken", bad[i]);
+}
+
 /* --require's reason (eval_require_holds, lagsim-eval's and lagsim-sweep's): every term that
  * fails with its value, none that holds; cut short at the caller's buffer with how many
  * more fail, never past it. */
@@ -346,7 +378,7 @@ int main(int argc, char **argv)
         {"rows", case_rows, 0, 0},         {"reason", case_reason, 0, 0},
         {"shard", case_shard, 0, 0},       {"columns", case_columns, 0, 0},
         {"sha256", case_sha256, 0, 0},     {"identity", case_identity, 0, 0},
-        {"merge_many", case_merge_many, 0, 0},
+        {"merge_many", case_merge_many, 0, 0}, {"runs", case_runs, 0, 0},
     };
     return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
 }
