@@ -398,7 +398,8 @@ def case_cartpole(a):
                   "upward vertical" % (math.hypot(tx - cx, ty - cy), l1, th))
         check(sorted(map(tuple, d1["stops"] or [])) == [("theta", -2), ("theta", 2), ("x", -0.5), ("x", 0.5)],
               "the stops on x and theta are drawn: %s" % d1["stops"])
-        time.sleep(1.0)
+        chrome.wait_for(sid, "window.lagsimView.drawn.sim_time > %r + 0.5" % d1["sim_time"], 15,
+                        "0.5 s of sim time drawn after the first look")
         d2 = drawn(chrome, sid)
         check(d2["sim_time"] > d1["sim_time"] + 0.5,
               "second look: drawn sim time advanced %.3f -> %.3f s" % (d1["sim_time"], d2["sim_time"]))
@@ -414,7 +415,9 @@ def case_cartpole(a):
         chrome.wait_for(sid, "window.lagsimView.drawn.model === 'no such model'", 5, "a frame of the unknown model")
         u1 = drawn(chrome, sid)
         n1 = chrome.eval(sid, "window.lagsimView.charts.q.length")
-        time.sleep(0.5)
+        chrome.wait_for(sid, "window.lagsimView.drawn.sim_time > %r && "
+                             "window.lagsimView.charts.q.length > %d" % (u1["sim_time"], n1), 15,
+                        "a later state drawn and charted")
         u2 = drawn(chrome, sid)
         n2 = chrome.eval(sid, "window.lagsimView.charts.q.length")
         check(u2["note"] is not None and "no such model" in u2["note"] and u2["points"] is None,
@@ -662,7 +665,8 @@ def case_models(a):
                     x, phi, h = d1["q"]
                     check(abs(pts[1][0] - x) < 1e-12 and abs(pts[1][1] - (h + 0.5 * l * math.sin(phi))) < 1e-9,
                           "%s: the centre drawn at (x, h + l/2 sin phi) = (%.6f, %.6f)" % (f, pts[1][0], pts[1][1]))
-                time.sleep(0.5)
+                chrome.wait_for(sid, "window.lagsimView.drawn.sim_time > %r" % d1["sim_time"], 15,
+                                "a later state drawn")
                 d2 = drawn(chrome, sid)
                 check(d2["sim_time"] > d1["sim_time"] and d2["points"],
                       "%s: still drawn as states come (sim time %.3f -> %.3f s)" % (f, d1["sim_time"], d2["sim_time"]))
