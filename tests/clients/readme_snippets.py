@@ -37,10 +37,11 @@ set to at least three think times, and to at least the think time plus 20 times 
 slowest answer of the fast run just before (the time from a state's first copy to its
 first command, measured here: what this machine takes to schedule the block, LCM and the
 daemon now; a loaded machine or a sanitizer build gets the patience it needs, an idle one
-keeps the floor: 3 s, as a process of a machine with a load of 20 on 2 cores, seen here,
-can wait a second for a core; the daemon's copies still come while the law thinks, the
-first 20 ms after the state, then at most lockstep_timeout / 16 apart, so the copy rule is
-tested as before). A run that answers copies by thinking again falls further behind with every
+keeps the floor: 30 s, as the sanitizer pass beside a load of 24 to 33 on 2 cores, seen
+here, took 5.3 s to answer with a law of 0.15 s, 0.002 s being the fast run's slowest just
+before; a lockstep timeout steps nothing, so the floor bounds a hang, and the daemon's
+copies still come while the law thinks, the first 20 ms after the state, so the copy rule
+is tested as before). A run that answers copies by thinking again falls further behind with every
 state and meets any finite timeout; the law counted once per sim_time is the direct check.
 """
 import argparse
@@ -316,7 +317,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
         time.sleep(0.2 + 1.5 * think)
     heard["states"] = 0
     periods = a.periods
-    patience = max(3.0, 3 * think, think + 20 * fast_slowest) if think > 0 else 1.0
+    patience = max(30.0, 3 * think, think + 20 * fast_slowest) if think > 0 else 1.0
     daemon = subprocess.Popen(
         [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
          "--set", "realtime.mode=lockstep",
