@@ -314,6 +314,30 @@ const char *lag_client_scene_integrator(const lag_client_scene *sc);
 const char *lag_client_scene_mode(const lag_client_scene *sc);
 const char *lag_client_scene_effects(const lag_client_scene *sc);   /* comma-separated */
 
+/* ---------------------------------------------------------------- the model's dynamics */
+
+/* The scene's model with the scene's parameters, as the daemon integrates it
+ * (docs/models.md):
+ *
+ *     M(q) qdd + h(q, qd) = tau + (the effects' forces),   h = C(q, qd) qd + g(q),
+ *
+ * M the mass matrix (T = 1/2 qd^T M qd), C qd the Coriolis and centrifugal forces, g = dU/dq
+ * the gravity forces, tau the efforts commanded. Computed by the core's own closed forms
+ * (the daemon's step, bit for bit), for computed torque, feedforward and observers. The
+ * effects (docs/effects.md: damping, friction, springs, limits, the floor, actuator lag,
+ * disturbances, noise) are not in M nor h: a controller that wants them models them.
+ * q and qd are in the scene's joint order (a state's: lag_client_scene_joint_name), n is
+ * their number, which must be the model's (lag_client_scene_num_joints). A stick whose
+ * floor lets it fly (joints x, phi, h) is the flying stick, with h the height of end A
+ * (after end B landed the daemon measures h from end B: docs/models.md).
+ * Return LAG_CLIENT_OK, or LAG_CLIENT_ERR_ARG with a message in err (may be NULL): a model
+ * this library does not know, n not the model's, a parameter missing or out of its range,
+ * a non-finite q or qd. OUT: M (n*n, row-major: M[i*n + j]), h (n) */
+lag_result lag_client_model_mass(const lag_client_scene *sc, int n, const double *q, double *M,
+                                 char *err, size_t errlen);
+lag_result lag_client_model_bias(const lag_client_scene *sc, int n, const double *q,
+                                 const double *qd, double *h, char *err, size_t errlen);
+
 /* ---------------------------------------------------------------- the status */
 
 /* A status of one's own, for lag_client_latest_status; NULL when out of memory. */

@@ -199,6 +199,40 @@ public:
         return std::isnan(v) ? std::nullopt : std::optional<double>(v);
     }
 
+    /* The model's dynamics with this scene's parameters (lag_client_model_mass,
+     * lag_client_model_bias; docs/clients.md): M(q) qdd + h(q, qd) = tau + the effects'
+     * forces, h = C(q, qd) qd + g(q), the effects (damping, friction, springs, limits, ...)
+     * not included. q and qd in the scene's joint order (a state's), as many as its
+     * joints; Error (LAG_ERR_ARG) for another number, a non-finite value, or a scene whose
+     * model or parameters the library cannot use. mass: n*n, row-major (M[i*n + j]). */
+    std::vector<double> mass(const std::vector<double> &q) const
+    {
+        std::vector<double> M(q.size() * q.size());
+        mass(static_cast<int>(q.size()), q.data(), M.data());
+        return M;
+    }
+    std::vector<double> bias(const std::vector<double> &q, const std::vector<double> &qd) const
+    {
+        if (q.size() != qd.size())
+            throw Error(LAG_ERR_ARG, "LAG_ERR_ARG: bias: q and qd of different sizes");
+        std::vector<double> h(q.size());
+        bias(static_cast<int>(q.size()), q.data(), qd.data(), h.data());
+        return h;
+    }
+    /* The same into arrays of the caller's (n and n*n doubles): no allocation. */
+    void mass(int n, const double *q, double *M) const
+    {
+        char err[256] = "";
+        lag_result rc = lag_client_model_mass(p_, n, q, M, err, sizeof err);
+        if (rc != LAG_OK) throw Error(rc, detail::describe(rc, err));
+    }
+    void bias(int n, const double *q, const double *qd, double *h) const
+    {
+        char err[256] = "";
+        lag_result rc = lag_client_model_bias(p_, n, q, qd, h, err, sizeof err);
+        if (rc != LAG_OK) throw Error(rc, detail::describe(rc, err));
+    }
+
     const lag_client_scene *get() const { return p_; }
     lag_client_scene *get() { return p_; }
 

@@ -5,19 +5,16 @@
  *   tau = M(q) (r'' + Kd (r' - qd) + Kp (r - q)) + C(q, qd) qd + g(q),  Kp = wn^2, Kd = 2 wn
  *
  * r, r', r'' from <PREFIX>_REFERENCE (published just before each state with its sim_time:
- * the feedforward is exact, no difference of r'), M, C and g from the scene's parameters.
- * With the exact model the error obeys e'' + Kd e' + Kp e = 0 (critically damped), up to
- * the zero-order hold of the effort over a control period.
+ * the feedforward is exact, no difference of r'); M(q) and the bias h = C(q, qd) qd + g(q)
+ * from the client library (lagsim::Scene::mass, bias: the core's closed forms with the
+ * scene's parameters, docs/clients.md), nothing of the model written here. With the exact
+ * model the error obeys e'' + Kd e' + Kp e = 0 (critically damped), up to the zero-order
+ * hold of the effort over a control period.
  *
  * What it links, and why: only liblagsim_client (pkg-config lagsim-client), as a
- * controller outside lagsim's tree does. The core's model functions (lagsim.h,
- * lag_model_mass and lag_model_bias, which manipulator_pd.c uses) are a static library
- * for lagsim's own programs without a stable ABI, so M, C and g are written here in
- * closed form from the model's T and U (docs/models.md):
- *   M = diag(m1 l1^2 + I1 + I2 + m2 q2^2, m2),
- *   C qd = (2 m2 q2 q1' q2', -m2 q2 q1'^2),  g = ((m1 l1 + m2 q2) g cos q1, m2 g sin q1),
- * with the core's operations in the core's order, so that this controller and the C
- * manipulator_pd answer every state with the same bits (clients_cross_language_manipulator).
+ * controller outside lagsim's tree does. tau = M v + h is summed in the order of the C
+ * manipulator_pd (which calls the core), so that the two answer every state with the same
+ * bits (clients_cross_language_manipulator).
  *
  * The run, its options and its summary line are those of the C examples
  * (docs/clients.md): --prefix (default: the only manipulator on the bus, else
@@ -51,25 +48,14 @@ struct Options {
     bool quiet = false;
 };
 
-/* The model's parameters, from the scene. */
-struct Params {
-    double m1, m2, l1, I1, I2, g;
-    explicit Params(const lagsim::Scene &sc)
-        : m1(sc.param("m1")), m2(sc.param("m2")), l1(sc.param("l1")), I1(sc.param("I1")),
-          I2(sc.param("I2")), g(sc.param("g"))
-    {
-    }
-};
-
 using Vec2 = std::array<double, 2>;
 
-/* tau = M(q) v + C(q, qd) qd + g(q) (the core's model_manipulator.c, term for term). */
-Vec2 computed_torque(const Params &p, const Vec2 &q, const Vec2 &qd, const Vec2 &v)
+/* tau = M(q) v + h(q, qd), M and h = C(q, qd) qd + g(q) from the client library. */
+Vec2 computed_torque(const lagsim::Scene &sc, const Vec2 &q, const Vec2 &qd, const Vec2 &v)
 {
-    const double s = std::sin(q[0]), c = std::cos(q[0]), a = p.m2 * q[1];
-    const double M[4] = {p.m1 * p.l1 * p.l1 + p.I1 + p.I2 + p.m2 * q[1] * q[1], 0.0, 0.0, p.m2};
-    const double h[2] = {2.0 * a * qd[0] * qd[1] + (p.m1 * p.l1 + a) * p.g * c,
-                         -a * qd[0] * qd[0] + p.m2 * p.g * s};
+    double M[4], h[2];
+    sc.mass(2, q.data(), M);
+    sc.bias(2, q.data(), qd.data(), h);
     return {M[0] * v[0] + M[1] * v[1] + h[0], M[2] * v[0] + M[3] * v[1] + h[1]};
 }
 
@@ -95,8 +81,8 @@ int usage(std::ostream &o, int status)
 {
     o << "usage: manipulator_ct [options]\n"
          "Tracks the scene's reference (<PREFIX>_REFERENCE: r, r', r'') on a running lagsimd\n"
-         "manipulator with computed torque, M, C and g written from the model (C++ over the\n"
-         "client library alone).\n"
+         "manipulator with computed torque, M(q) and C(q, qd) qd + g(q) from the client\n"
+         "library (C++ over the client library alone).\n"
          "  --prefix P           channel prefix (default: the only manipulator on the bus;\n"
          "                       none yet: MANIPULATOR)\n"
          "  --url URL            LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)\n"
@@ -202,7 +188,6 @@ std::optional<lagsim::Scene> scene_of(lagsim::Client &c, const Options &o)
 std::string control(lagsim::Client &c, lagsim::Scene &sc, const Options &o, Tracking &tr,
                     std::ofstream &trace)
 {
-    Params p(sc);
     const double kp = o.wn * o.wn, kd = 2.0 * o.wn;
     const std::vector<std::string> jn = {"q1", "q2"};
     bool stopped = false;
@@ -224,7 +209,6 @@ std::string control(lagsim::Client &c, lagsim::Scene &sc, const Options &o, Trac
         }
         if (st->generation != sc.generation()) { /* a reset, a SET: its scene came with it */
             sc = *c.latest_scene();
-            p = Params(sc);
         }
         const int i1 = st->joint(jn[0]), i2 = st->joint(jn[1]);
         if (i1 < 0 || i2 < 0) continue;
@@ -239,7 +223,7 @@ std::string control(lagsim::Client &c, lagsim::Scene &sc, const Options &o, Trac
                 r[k] = ref->r[j], rd[k] = ref->rdot[j], rdd[k] = ref->rddot[j];
         Vec2 v;
         for (int k = 0; k < 2; k++) v[k] = rdd[k] + kp * (r[k] - q[k]) + kd * (rd[k] - qd[k]);
-        Vec2 tau = computed_torque(p, q, qd, v);
+        Vec2 tau = computed_torque(sc, q, qd, v);
         for (double &t : tau) t = std::isfinite(t) ? t : 0.0; /* never a NaN on the bus */
         c.send_command(*st, jn, {tau[0], tau[1]});
         if (trace.is_open()) {

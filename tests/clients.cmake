@@ -315,3 +315,12 @@ target_link_libraries(test_client_hpp PRIVATE lagsim_client)
 target_compile_options(test_client_hpp PRIVATE -Wpedantic)
 add_test(NAME clients_cpp_header COMMAND test_client_hpp)
 set_tests_properties(clients_cpp_header PROPERTIES TIMEOUT 30 LABELS clients)
+
+# ---- The model's dynamics for controllers (lag_client_model_mass, lag_client_model_bias)
+# through liblagsim_client.so, against every model written again from T and U
+# (tests/clients/test_client_model.c; the core links only for the references' table).
+add_executable(test_client_model ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client_model.c)
+target_include_directories(test_client_model PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common
+                                                     ${CMAKE_CURRENT_SOURCE_DIR}/core)
+target_link_libraries(test_client_model PRIVATE lagsim_client_shared lagsim_core lagsim_lcmtypes m)
+lagsim_add_test_cases(test_client_model clients_model clients 60)
