@@ -35,6 +35,7 @@
 #ifndef LAGSIM_CLIENT_HPP
 #define LAGSIM_CLIENT_HPP
 
+#include <csignal>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -46,6 +47,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <signal.h>
 
 #include "lagsim_client.h"
 
@@ -530,6 +533,176 @@ private:
     };
     std::unique_ptr<Callbacks> cb_;
     std::unique_ptr<lag_client, Destroy> c_;
+};
+
+/* A controller's run: a Client and the rules by which the run of every example controller
+ * (C's lag_ctl, Python's, Lua's and Java's Controller) ends, so that a loop over next()
+ * ends when the daemon stops, dies or falls silent:
+ *
+ *   lagsim::Controller ctl("DIPC");                   // ends: stop, silence, signal
+ *   while (std::optional<lagsim::State> st = ctl.next()) {  // each state once, the newest
+ *       double u = ...;                               // ctl.scene(): its scene
+ *       ctl.send_command(*st, {"theta0"}, {u});       // answers it
+ *   }
+ *   // ctl.end(): "stop", "silence", "duration" or "signal"
+ *
+ * next() returns std::nullopt once the run has ended, and end() says why:
+ *   "stop"      the daemon published its stop event (it ends a run: --duration, SIGINT);
+ *   "silence"   nothing came from the daemon (no state, scene, status, event or
+ *               reference) for Options::timeout wall seconds (default 5): a daemon killed,
+ *               hung, or never started (a plant that waits or is paused publishes its
+ *               status at realtime.status_hz, 5 Hz by default: it is not silent);
+ *   "duration"  Options::duration s of sim time passed since the first state (0: never);
+ *   "signal"    SIGINT or SIGTERM came (Options::signals, the default: the handlers are
+ *               installed for the Controller's life and the previous ones put back after).
+ * None of these is an error: the examples exit 0 for each. A client error (the bus
+ * failing) is an Error thrown from next() or send_command().
+ * Events reach ctl.on_event (ctl.client().on_event would replace the Controller's own). */
+class Controller {
+public:
+    struct Options {
+        std::string url;       /* the plant's LCM URL ("": LCM's default, LCM_DEFAULT_URL) */
+        double timeout = 5.0;  /* wall s of silence that end the run (> 0) */
+        double duration = 0.0; /* sim s from the first state that end the run (0: none) */
+        bool signals = true;   /* SIGINT and SIGTERM end the run */
+    };
+
+    explicit Controller(const std::string &prefix) : Controller(prefix, Options()) {}
+    Controller(const std::string &prefix, const Options &o) : o_(o), c_(prefix, o.url)
+    {
+        if (!(o.timeout > 0) || !(o.duration >= 0) || !std::isfinite(o.duration))
+            throw Error(LAG_ERR_ARG, "LAG_ERR_ARG: Controller: timeout > 0 and a finite "
+                                     "duration >= 0, not " + std::to_string(o.timeout) + ", " +
+                                     std::to_string(o.duration));
+        c_.on_event([this](const Event &ev) {
+            stopped_ |= ev.is("stop");
+            if (user_event_) user_event_(ev);
+        });
+        if (o_.signals) {
+            signal_flag() = 0;
+            struct sigaction sa = {};
+            sa.sa_handler = &Controller::on_signal;
+            sigemptyset(&sa.sa_mask); /* no SA_RESTART: a wait returns at once */
+            sigaction(SIGINT, &sa, &old_int_);
+            sigaction(SIGTERM, &sa, &old_term_);
+        }
+        heard_ = lag_client_now();
+    }
+    ~Controller()
+    {
+        if (o_.signals) {
+            sigaction(SIGINT, &old_int_, nullptr);
+            sigaction(SIGTERM, &old_term_, nullptr);
+        }
+    }
+    Controller(const Controller &) = delete;
+    Controller &operator=(const Controller &) = delete;
+
+    /* The scene (DESCRIBE until it comes, Client::wait_scene) within Options::timeout
+     * wall s; std::nullopt when none came (end() "silence") or a signal ended the wait
+     * (end() "signal"). Optional: next() returns states without it, each once its scene
+     * came (the scene rule, lagsim_client.h). */
+    std::optional<Scene> wait_scene()
+    {
+        for (double until = lag_client_now() + o_.timeout;;) {
+            if (o_.signals && signal_flag()) return ended_scene("signal");
+            double left = until - lag_client_now();
+            if (left <= 0) return ended_scene("silence");
+            try {
+                Scene sc = c_.wait_scene(left < 0.25 ? left : 0.25);
+                heard_ = lag_client_now();
+                return sc;
+            } catch (const Error &e) {
+                if (e.code() != LAG_TIMEOUT) throw;
+            }
+        }
+    }
+    /* The newest state not yet returned, or std::nullopt once the run has ended (end()).
+     * A copy of a state already answered is answered by the library with the same
+     * command, never returned: the law runs once per state. */
+    std::optional<State> next()
+    {
+        if (!end_.empty()) return std::nullopt;
+        if (o_.duration > 0 && states_ > 0 &&
+            last_.sim_time - t_first_ >= o_.duration - 0.5 * period()) {
+            end_ = "duration";
+            return std::nullopt;
+        }
+        for (;;) {
+            if (o_.signals && signal_flag()) return ended("signal");
+            std::optional<State> st = c_.wait_state(0.05);
+            if (heard_anything()) heard_ = lag_client_now();
+            if (st) {
+                if (states_++ == 0) t_first_ = st->sim_time;
+                last_ = *st;
+                return st;
+            }
+            if (stopped_) return ended("stop");
+            if (lag_client_now() - heard_ > o_.timeout) return ended("silence");
+        }
+    }
+    /* Answers state st with efforts for the joints named; a non-finite effort is sent as
+     * 0, never NaN (Client::send_command for the errors). */
+    void send_command(const State &st, const std::vector<std::string> &names,
+                      std::vector<double> effort)
+    {
+        for (double &e : effort) e = std::isfinite(e) ? e : 0.0;
+        c_.send_command(st, names, effort);
+    }
+
+    /* why the run ended ("" while it runs): stop, silence, duration, signal */
+    const std::string &end() const { return end_; }
+    /* states returned by next() */
+    long long states() const { return states_; }
+    /* the scene of the state last returned (Client::latest_scene): its parameters */
+    std::optional<Scene> scene() const { return c_.latest_scene(); }
+    /* events from the daemon (after the Controller has looked for its stop) */
+    void on_event(std::function<void(const Event &)> f) { user_event_ = std::move(f); }
+    Client &client() { return c_; }
+    const Options &options() const { return o_; }
+
+private:
+    static volatile std::sig_atomic_t &signal_flag()
+    {
+        static volatile std::sig_atomic_t flag = 0;
+        return flag;
+    }
+    static void on_signal(int sig) { signal_flag() = sig; }
+    std::optional<State> ended(const char *why)
+    {
+        end_ = why;
+        return std::nullopt;
+    }
+    std::optional<Scene> ended_scene(const char *why)
+    {
+        end_ = why;
+        return std::nullopt;
+    }
+    double period() const
+    {
+        std::optional<Scene> sc = c_.latest_scene();
+        double p = sc ? sc->control_period() : 0.0;
+        return std::isfinite(p) ? p : 0.0;
+    }
+    /* whether any message from the daemon came since the last call (the counters moved) */
+    bool heard_anything()
+    {
+        lag_client_counters k = c_.counters();
+        long long n = k.states + k.scenes + k.statuses + k.events + k.references;
+        bool moved = n != seen_;
+        seen_ = n;
+        return moved;
+    }
+
+    Options o_;
+    Client c_;
+    std::function<void(const Event &)> user_event_;
+    struct sigaction old_int_ = {}, old_term_ = {};
+    std::string end_;
+    bool stopped_ = false;
+    double heard_ = 0, t_first_ = 0;
+    long long states_ = 0, seen_ = 0;
+    State last_;
 };
 
 /* The plants on the bus at url (lag_client_discover). */

@@ -28,7 +28,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -38,9 +37,6 @@
 #include "lagsim_client.hpp"
 
 namespace {
-
-volatile std::sig_atomic_t g_signal = 0;
-void on_signal(int sig) { g_signal = sig; }
 
 struct Options {
     std::string prefix, url, trace;
@@ -166,56 +162,35 @@ int choose_prefix(Options &o)
     return -1;
 }
 
-/* The scene, within --timeout (signals heard every 0.25 s). */
-std::optional<lagsim::Scene> scene_of(lagsim::Client &c, const Options &o)
+/* The scene, within --timeout (lagsim::Controller::wait_scene: a signal ends the wait). */
+std::optional<lagsim::Scene> scene_of(lagsim::Controller &ctl, const Options &o)
 {
     std::cout << "manipulator_ct: waiting for the scene description on " << o.prefix << "_SCENE"
               << std::endl; /* subscribed: the harnesses start the daemon on this line */
-    for (double end = lagsim::now() + o.timeout; !g_signal;) {
-        try {
-            return c.wait_scene(std::min(0.25, std::max(0.0, end - lagsim::now())));
-        } catch (const lagsim::Error &e) {
-            if (e.code() != LAG_TIMEOUT || lagsim::now() >= end) {
-                std::cerr << "manipulator_ct: " << e.what() << "\n";
-                return std::nullopt;
-            }
-        }
-    }
-    return std::nullopt;
+    std::optional<lagsim::Scene> sc = ctl.wait_scene();
+    if (!sc && ctl.end() != "signal")
+        std::cerr << "manipulator_ct: no scene on " << o.prefix << "_SCENE within " << o.timeout
+                  << " s\n";
+    return sc;
 }
 
-/* Runs the law on every state until the run ends; returns why it ended. */
-std::string control(lagsim::Client &c, lagsim::Scene &sc, const Options &o, Tracking &tr,
-                    std::ofstream &trace)
+/* Runs the law on every state until the run ends (lagsim::Controller: the daemon's stop,
+ * --timeout s of silence, --duration, SIGINT/SIGTERM). */
+void control(lagsim::Controller &ctl, lagsim::Scene &sc, const Options &o, Tracking &tr,
+             std::ofstream &trace)
 {
     const double kp = o.wn * o.wn, kd = 2.0 * o.wn;
     const std::vector<std::string> jn = {"q1", "q2"};
-    bool stopped = false;
-    double heard = lagsim::now();
-    c.on_event([&](const lagsim::Event &ev) { heard = lagsim::now(), stopped |= ev.is("stop"); });
-    c.on_status([&](const lagsim::Status &) { heard = lagsim::now(); });
-    c.on_state([&](const lagsim::State &) { heard = lagsim::now(); });
     Vec2 hold{};
-    for (;;) {
-        if (o.duration > 0 && tr.states > 0 &&
-            tr.t_last - tr.t_first >= o.duration - 0.5 * sc.control_period())
-            return "duration";
-        if (g_signal) return "signal";
-        std::optional<lagsim::State> st = c.wait_state(0.05);
-        if (!st) {
-            if (stopped) return "stop";
-            if (lagsim::now() - heard > o.timeout) return "silence";
-            continue;
-        }
-        if (st->generation != sc.generation()) { /* a reset, a SET: its scene came with it */
-            sc = *c.latest_scene();
-        }
+    while (std::optional<lagsim::State> st = ctl.next()) {
+        if (st->generation != sc.generation()) /* a reset, a SET: its scene came with it */
+            sc = *ctl.scene();
         const int i1 = st->joint(jn[0]), i2 = st->joint(jn[1]);
         if (i1 < 0 || i2 < 0) continue;
         const Vec2 q = {st->position[i1], st->position[i2]}, qd = {st->velocity[i1], st->velocity[i2]};
         if (tr.states == 0) hold = q;
         /* r, r', r'' of each joint (a joint without a reference holds its first position) */
-        std::optional<lagsim::Reference> ref = c.latest_reference();
+        std::optional<lagsim::Reference> ref = ctl.client().latest_reference();
         if (ref && ref->sim_time != st->sim_time) tr.stale++; /* lost: the last one kept */
         Vec2 r = hold, rd{}, rdd{};
         for (int k = 0; k < 2; k++)
@@ -225,7 +200,7 @@ std::string control(lagsim::Client &c, lagsim::Scene &sc, const Options &o, Trac
         for (int k = 0; k < 2; k++) v[k] = rdd[k] + kp * (r[k] - q[k]) + kd * (rd[k] - qd[k]);
         Vec2 tau = computed_torque(sc, q, qd, v);
         for (double &t : tau) t = std::isfinite(t) ? t : 0.0; /* never a NaN on the bus */
-        c.send_command(*st, jn, {tau[0], tau[1]});
+        ctl.send_command(*st, jn, {tau[0], tau[1]});
         if (trace.is_open()) {
             char buf[64];
             std::snprintf(buf, sizeof buf, "%.17g", st->sim_time);
@@ -247,6 +222,22 @@ std::string control(lagsim::Client &c, lagsim::Scene &sc, const Options &o, Trac
     }
 }
 
+/* The summary line (the C examples' keys); returns the exit status, 0. */
+int summary(lagsim::Controller &ctl, const Tracking &tr, const Options &o)
+{
+    lag_client_counters n = ctl.client().counters();
+    Vec2 rms;
+    for (int k = 0; k < 2; k++) rms[k] = tr.settled ? std::sqrt(tr.esq[k] / tr.settled) : NAN;
+    std::printf("manipulator_ct: summary end=%s states=%lld t_first=%.6f t_last=%.6f settle=%g "
+                "max_abs_e1=%.6g max_abs_e2=%.6g rms_e1=%.6g rms_e2=%.6g max_abs_e1_all=%.6g "
+                "max_abs_e2_all=%.6g references_stale=%lld dropped=%lld repeats=%lld\n",
+                ctl.end().c_str(), tr.states, tr.t_first, tr.t_last, o.settle, tr.emax[0],
+                tr.emax[1], rms[0], rms[1], tr.emax_all[0], tr.emax_all[1], tr.stale,
+                static_cast<long long>(n.dropped), static_cast<long long>(n.repeats));
+    std::fflush(stdout);
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char **argv)
@@ -254,8 +245,6 @@ int main(int argc, char **argv)
     Options o;
     if (int rc = parse(argc, argv, o); rc >= 0) return rc;
     if (int rc = choose_prefix(o); rc >= 0) return rc;
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
     std::ofstream trace;
     if (!o.trace.empty()) {
         trace.open(o.trace);
@@ -265,9 +254,10 @@ int main(int argc, char **argv)
         }
     }
     try {
-        lagsim::Client c(o.prefix, o.url);
-        std::optional<lagsim::Scene> sc = scene_of(c, o);
-        if (!sc) return 1;
+        lagsim::Controller ctl(o.prefix, {o.url, o.timeout, o.duration, true});
+        Tracking tr;
+        std::optional<lagsim::Scene> sc = scene_of(ctl, o);
+        if (!sc) return ctl.end() == "signal" ? summary(ctl, tr, o) : 1;
         if (sc->model() != "manipulator" || !sc->actuated(sc->joint("q1")) ||
             !sc->actuated(sc->joint("q2"))) {
             std::cerr << "manipulator_ct: prefix " << o.prefix << " runs " << sc->model()
@@ -277,18 +267,8 @@ int main(int argc, char **argv)
         std::cout << "manipulator_ct: scene on " << o.prefix << "_*: mode " << sc->mode()
                   << ", control period " << sc->control_period() << " s; Kp " << o.wn * o.wn
                   << ", Kd " << 2 * o.wn << std::endl;
-        Tracking tr;
-        std::string end = control(c, *sc, o, tr, trace);
-        lag_client_counters n = c.counters();
-        Vec2 rms;
-        for (int k = 0; k < 2; k++) rms[k] = tr.settled ? std::sqrt(tr.esq[k] / tr.settled) : NAN;
-        std::printf("manipulator_ct: summary end=%s states=%lld t_first=%.6f t_last=%.6f settle=%g "
-                    "max_abs_e1=%.6g max_abs_e2=%.6g rms_e1=%.6g rms_e2=%.6g max_abs_e1_all=%.6g "
-                    "max_abs_e2_all=%.6g references_stale=%lld dropped=%lld repeats=%lld\n",
-                    end.c_str(), tr.states, tr.t_first, tr.t_last, o.settle, tr.emax[0], tr.emax[1],
-                    rms[0], rms[1], tr.emax_all[0], tr.emax_all[1], tr.stale,
-                    static_cast<long long>(n.dropped), static_cast<long long>(n.repeats));
-        return 0;
+        control(ctl, *sc, o, tr, trace);
+        return summary(ctl, tr, o);
     } catch (const lagsim::Error &e) {
         std::cerr << "manipulator_ct: " << e.what() << "\n";
         return 1;

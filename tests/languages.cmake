@@ -225,13 +225,14 @@ add_test(NAME clients_cross_language_manipulator
 list(APPEND lang_tests clients_cross_language_manipulator)
 
 # ---- C++: manipulator_ct end to end, with the bounds of the C example, and how its run
-# ends (the daemon's stop, a silent daemon)
+# ends (lagsim::Controller: the daemon's stop, a silent daemon, SIGINT and SIGTERM)
 add_test(NAME clients_cpp_manipulator_lockstep
   COMMAND ${lang_e2e} ${lang_manip_cfg} --mode lockstep --name CLCPPMAN --timeout 60
     ${lang_manip_checks} --check "end == 'duration'"
     -- $<TARGET_FILE:manipulator_ct> --prefix {prefix} --duration 10 -q)
 list(APPEND lang_tests clients_cpp_manipulator_lockstep)
 lang_end_tests(cpp manipulator "${lang_manip_cfg}" $<TARGET_FILE:manipulator_ct>)
+lang_signal_test(cpp "${lang_manip_cfg}" $<TARGET_FILE:manipulator_ct>)
 
 # ---- Java
 if(TARGET lagsim_examples_java)
