@@ -270,6 +270,13 @@ lag_result lag_client_kick(lag_client *c, const char *joint, double impulse, dou
  * kicks are undone (a `restore` event says which), then the `reset` event. */
 lag_result lag_client_reset_scene(lag_client *c);
 
+/* When the last message from the daemon was kept (a state or a copy of one, a scene, a
+ * status, an event, a reference), on lag_client_now()'s clock; the handle's creation
+ * before any. A controller ends when lag_client_now() - lag_client_heard(c) exceeds its
+ * silence timeout: the daemon died, hung or never came (a plant that waits or is paused
+ * still publishes its status, at realtime.status_hz). */
+double lag_client_heard(const lag_client *c);
+
 /* size: sizeof *out. OUT: out */
 void lag_client_get_counters(const lag_client *c, lag_client_counters *out, size_t size);
 

@@ -430,6 +430,8 @@ public:
         lag_client_get_counters(c_.get(), &k, sizeof k);
         return k;
     }
+    /* when the last message from the daemon was kept, on now()'s clock (lag_client_heard) */
+    double heard() const { return lag_client_heard(c_.get()); }
     /* for poll()/select(): when readable, handle(0) */
     int fileno() const { return lag_client_fileno(c_.get()); }
     lag_client *get() const { return c_.get(); }
@@ -586,7 +588,6 @@ public:
             sigaction(SIGINT, &sa, &old_int_);
             sigaction(SIGTERM, &sa, &old_term_);
         }
-        heard_ = lag_client_now();
     }
     ~Controller()
     {
@@ -609,9 +610,7 @@ public:
             double left = until - lag_client_now();
             if (left <= 0) return ended_scene("silence");
             try {
-                Scene sc = c_.wait_scene(left < 0.25 ? left : 0.25);
-                heard_ = lag_client_now();
-                return sc;
+                return c_.wait_scene(left < 0.25 ? left : 0.25);
             } catch (const Error &e) {
                 if (e.code() != LAG_TIMEOUT) throw;
             }
@@ -631,14 +630,13 @@ public:
         for (;;) {
             if (o_.signals && signal_flag()) return ended("signal");
             std::optional<State> st = c_.wait_state(0.05);
-            if (heard_anything()) heard_ = lag_client_now();
             if (st) {
                 if (states_++ == 0) t_first_ = st->sim_time;
                 last_ = *st;
                 return st;
             }
             if (stopped_) return ended("stop");
-            if (lag_client_now() - heard_ > o_.timeout) return ended("silence");
+            if (lag_client_now() - c_.heard() > o_.timeout) return ended("silence");
         }
     }
     /* Answers state st with efforts for the joints named; a non-finite effort is sent as
@@ -684,15 +682,6 @@ private:
         double p = sc ? sc->control_period() : 0.0;
         return std::isfinite(p) ? p : 0.0;
     }
-    /* whether any message from the daemon came since the last call (the counters moved) */
-    bool heard_anything()
-    {
-        lag_client_counters k = c_.counters();
-        long long n = k.states + k.scenes + k.statuses + k.events + k.references;
-        bool moved = n != seen_;
-        seen_ = n;
-        return moved;
-    }
 
     Options o_;
     Client c_;
@@ -700,8 +689,8 @@ private:
     struct sigaction old_int_ = {}, old_term_ = {};
     std::string end_;
     bool stopped_ = false;
-    double heard_ = 0, t_first_ = 0;
-    long long states_ = 0, seen_ = 0;
+    double t_first_ = 0;
+    long long states_ = 0;
     State last_;
 };
 

@@ -493,6 +493,13 @@ add_test(NAME clients_readme_c_installed
 add_test(NAME clients_readme_cpp_installed
   COMMAND ${readme_run} ${readme_cc} --install --periods 20 cpp-dipc)
 list(APPEND lang_tests clients_readme_c_installed clients_readme_cpp_installed)
+# the C and C++ blocks under a daemon SIGKILLed after 30 states (no stop event): each ends
+# by its silence rule (5 s of nothing from the daemon, as README says) and exits 0
+foreach(lang c cpp)
+  add_test(NAME clients_readme_${lang}_daemon_killed
+    COMMAND ${readme_run} ${readme_cc} --kill-after 30 --silence 5 ${lang}-dipc)
+  list(APPEND lang_tests clients_readme_${lang}_daemon_killed)
+endforeach()
 if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
   find_program(LAGSIM_OTHER_CXX clang++)
 else()
