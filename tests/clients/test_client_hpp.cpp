@@ -11,7 +11,10 @@
  *   - State, Reference, the scene's and the status's fields read as the C library's;
  *   - Scene::mass and Scene::bias are the manipulator's M(q) and C(q, qd) qd + g(q) of
  *     docs/models.md (written out here), in vectors and in arrays; a scene without its
- *     parameters, or q of the wrong size, is Error LAG_ERR_ARG naming what is missing.
+ *     parameters, or q of the wrong size, is Error LAG_ERR_ARG naming what is missing;
+ *   - a Controller's run ends: on silence after its timeout (heard() moves with every
+ *     message kept, not with a dropped one), on the daemon's stop event, after its duration;
+ *     and its state is returned once.
  *
  * usage: test_client_hpp   (exit 0 when every check holds)
  */
@@ -200,6 +203,54 @@ void dynamics()
     check(refused, "q of another size, qd of another size than q, a NaN: Error (" + msg + ")");
 }
 
+void controller()
+{
+    lagsim::Controller::Options o;
+    o.url = "memq://";
+    o.timeout = 0.3;
+    {
+        lagsim::Controller ctl("FED", o);
+        double t0 = lagsim::now(), h0 = ctl.client().heard();
+        unsigned char junk[3] = {1, 2, 3};
+        lag_client_feed(ctl.client().get(), "FED_STATE", junk, sizeof junk); /* dropped */
+        bool quiet = ctl.client().heard() == h0;
+        feed_scene(ctl.client());
+        bool moved = ctl.client().heard() > h0;
+        std::optional<lagsim::State> st = ctl.next();
+        double waited = lagsim::now() - t0;
+        check(quiet && moved && !st && ctl.end() == "silence" && waited >= 0.3 && waited < 3.0 &&
+                  !ctl.next(),
+              "silence: heard() moves with a message kept, not a dropped one; next() ends after "
+              "the timeout (" + std::to_string(waited) + " s), end silence, and stays ended");
+    }
+    {
+        lagsim::Controller ctl("FED", o);
+        feed_scene(ctl.client());
+        feed_state(ctl.client(), 0.5);
+        std::optional<lagsim::State> st = ctl.next();
+        lag_wire_event ev;
+        std::memset(&ev, 0, sizeof ev);
+        std::strcpy(ev.kind, "stop");
+        feed(ctl.client(), LAG_WIRE_EVENT, &ev, "EVENT");
+        double t0 = lagsim::now();
+        std::optional<lagsim::State> again = ctl.next();
+        check(st && st->sim_time == 0.5 && !again && ctl.end() == "stop" &&
+                  lagsim::now() - t0 < 0.3 && ctl.states() == 1,
+              "stop: the state once, then the stop event ends the run before any silence");
+    }
+    {
+        o.duration = 0.5;
+        lagsim::Controller ctl("FED", o);
+        feed_scene(ctl.client());
+        feed_state(ctl.client(), 0.0);
+        bool first = ctl.next().has_value();
+        feed_state(ctl.client(), 0.5);
+        bool second = ctl.next().has_value();
+        check(first && second && !ctl.next() && ctl.end() == "duration",
+              "duration: 0.5 s of sim time from the first state ends the run");
+    }
+}
+
 void callback_exceptions()
 {
     lagsim::Client c("FED", "memq://");
@@ -242,6 +293,7 @@ int main()
     errors();
     messages();
     dynamics();
+    controller();
     callback_exceptions();
     std::printf("%d failure(s)\n", failures);
     return failures ? 1 : 0;
