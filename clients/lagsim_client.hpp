@@ -38,6 +38,7 @@
 #include <csignal>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <exception>
 #include <functional>
 #include <memory>
@@ -322,7 +323,7 @@ private:
 class Client {
 public:
     explicit Client(const std::string &prefix, const std::string &url = "")
-        : cb_(std::make_unique<Callbacks>())
+        : prefix_(prefix), url_(url), cb_(std::make_unique<Callbacks>())
     {
         if (prefix.empty() || prefix.size() >= LAG_CLIENT_NAME_LEN)
             throw Error(LAG_ERR_ARG, "LAG_ERR_ARG: a prefix of 1 to 63 characters, not '" + prefix + "'");
@@ -333,14 +334,32 @@ public:
     }
 
     /* The scene (DESCRIBE at once and every 0.25 s until it comes); Error with LAG_TIMEOUT
-     * when none came within timeout_s. */
+     * when none came within timeout_s, its message naming the plants heard on the bus
+     * instead (lag_client_plants_instead, listening 1 s more: a misspelt prefix). */
     Scene wait_scene(double timeout_s)
     {
         Scene sc;
-        lag_result rc = run(lag_client_wait_scene(c_.get(), timeout_s, sc.get()));
-        if (rc == LAG_TIMEOUT) throw Error(rc, detail::describe(rc, lag_client_errmsg(c_.get())));
+        if (!try_wait_scene(timeout_s, sc)) throw no_scene(timeout_s);
         return sc;
     }
+    /* The same without the Error: false when no scene came within timeout_s. */
+    bool try_wait_scene(double timeout_s, Scene &sc)
+    {
+        return run(lag_client_wait_scene(c_.get(), timeout_s, sc.get())) == LAG_OK;
+    }
+    /* The Error of no scene within waited_s: what the bus has instead of this prefix. */
+    Error no_scene(double waited_s) const
+    {
+        char instead[1500] = "";
+        lag_client_plants_instead(url_.empty() ? nullptr : url_.c_str(), prefix_.c_str(), 1.0,
+                                  instead, sizeof instead);
+        char head[160];
+        std::snprintf(head, sizeof head, "no scene description on %s_SCENE within %g s: ",
+                      prefix_.c_str(), waited_s);
+        return Error(LAG_TIMEOUT, detail::describe(LAG_TIMEOUT, (head + std::string(instead)).c_str()));
+    }
+    const std::string &prefix() const { return prefix_; }
+    const std::string &url() const { return url_; }
     /* The newest state not yet returned, or nullopt when none came within timeout_s. */
     std::optional<State> wait_state(double timeout_s)
     {
@@ -533,6 +552,7 @@ private:
     struct Destroy {
         void operator()(lag_client *c) const { lag_client_destroy(c); }
     };
+    std::string prefix_, url_;
     std::unique_ptr<Callbacks> cb_;
     std::unique_ptr<lag_client, Destroy> c_;
 };
@@ -600,20 +620,21 @@ public:
     Controller &operator=(const Controller &) = delete;
 
     /* The scene (DESCRIBE until it comes, Client::wait_scene) within Options::timeout
-     * wall s; std::nullopt when none came (end() "silence") or a signal ended the wait
-     * (end() "signal"). Optional: next() returns states without it, each once its scene
-     * came (the scene rule, lagsim_client.h). */
+     * wall s; std::nullopt when a signal ended the wait (end() "signal"); Error with
+     * LAG_TIMEOUT when none came (end() "silence"), naming the plants heard instead.
+     * Optional: next() returns states without it, each once its scene came (the scene
+     * rule, lagsim_client.h). */
     std::optional<Scene> wait_scene()
     {
+        Scene sc;
         for (double until = lag_client_now() + o_.timeout;;) {
             if (o_.signals && signal_flag()) return ended_scene("signal");
             double left = until - lag_client_now();
-            if (left <= 0) return ended_scene("silence");
-            try {
-                return c_.wait_scene(left < 0.25 ? left : 0.25);
-            } catch (const Error &e) {
-                if (e.code() != LAG_TIMEOUT) throw;
+            if (left <= 0) {
+                end_ = "silence";
+                throw c_.no_scene(o_.timeout);
             }
+            if (c_.try_wait_scene(left < 0.25 ? left : 0.25, sc)) return sc;
         }
     }
     /* The newest state not yet returned, or std::nullopt once the run has ended (end()).

@@ -162,16 +162,19 @@ int choose_prefix(Options &o)
     return -1;
 }
 
-/* The scene, within --timeout (lagsim::Controller::wait_scene: a signal ends the wait). */
+/* The scene, within --timeout (lagsim::Controller::wait_scene: a signal ends the wait;
+ * none in time: the plants on the bus instead, for a misspelt --prefix). */
 std::optional<lagsim::Scene> scene_of(lagsim::Controller &ctl, const Options &o)
 {
     std::cout << "manipulator_ct: waiting for the scene description on " << o.prefix << "_SCENE"
               << std::endl; /* subscribed: the harnesses start the daemon on this line */
-    std::optional<lagsim::Scene> sc = ctl.wait_scene();
-    if (!sc && ctl.end() != "signal")
-        std::cerr << "manipulator_ct: no scene on " << o.prefix << "_SCENE within " << o.timeout
-                  << " s\n";
-    return sc;
+    try {
+        return ctl.wait_scene(); /* std::nullopt: a signal */
+    } catch (const lagsim::Error &e) {
+        if (e.code() != LAG_TIMEOUT) throw;
+        std::cerr << "manipulator_ct: " << e.what() << "\n"; /* the plants heard instead */
+        return std::nullopt;
+    }
 }
 
 /* Runs the law on every state until the run ends (lagsim::Controller: the daemon's stop,
