@@ -590,6 +590,15 @@ bool lag_client_latest_reference(const lag_client *c, lag_client_reference *ref,
     return !ref || copy_out(ref, size, &c->reference, sizeof c->reference, REFERENCE_SIZE_1);
 }
 
+bool lag_client_reference_of(const lag_client *c, const lag_client_state *st,
+                             lag_client_reference *ref, size_t size)
+{
+    if (!c->have_reference || !st || c->reference.generation != st->generation ||
+        c->reference.sim_time != st->sim_time)
+        return false;
+    return !ref || copy_out(ref, size, &c->reference, sizeof c->reference, REFERENCE_SIZE_1);
+}
+
 /* ---------------------------------------------------------------- sending */
 
 /* Encodes message m of type t and publishes it on channel. */

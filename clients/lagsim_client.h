@@ -127,7 +127,8 @@ typedef struct lag_client_state {
 } lag_client_state;
 
 /* <PREFIX>_REFERENCE: what the joints with a reference should follow at a state's time
- * (reference_t): published just before the state with the same sim_time. */
+ * (reference_t): published just before the state with the same generation and sim_time
+ * (lag_client_reference_of). */
 typedef struct lag_client_reference {
     int64_t utime;
     double sim_time;                                   /* the state's */
@@ -227,12 +228,18 @@ lag_result lag_client_wait_state(lag_client *c, double timeout_s, lag_client_sta
 
 /* Polling: the latest state / reference / status received, whether or not already
  * returned. False if none has arrived yet (or a size below the first version's).
- * A reference is published just before each state with the same sim_time, so when a
- * state arrives its reference has arrived already, unless UDP lost it: compare the
- * sim_times; a scene without a reference publishes none. OUT: st, ref, out */
+ * A reference is published just before each state with the same generation and
+ * sim_time, so when a state arrives its reference has arrived already, unless UDP lost
+ * it: a reference belongs to a state when both match (after a reset or a SET sim_time
+ * may repeat: the generation tells them apart); lag_client_reference_of checks it. A
+ * scene without a reference publishes none. OUT: st, ref, out */
 bool lag_client_latest_state(const lag_client *c, lag_client_state *st, size_t size);
 bool lag_client_latest_reference(const lag_client *c, lag_client_reference *ref, size_t size);
 bool lag_client_latest_status(const lag_client *c, lag_client_status *out);
+/* The reference of state st: the latest reference when its generation and sim_time are
+ * st's; false when there is none (lost, or a scene without a reference). OUT: ref */
+bool lag_client_reference_of(const lag_client *c, const lag_client_state *st,
+                             lag_client_reference *ref, size_t size);
 /* The scene of the latest state's generation (the scene rule above; a scene of a later
  * generation that came since waits for its own state); before any state, the latest scene
  * received. False if none has arrived. OUT: sc */

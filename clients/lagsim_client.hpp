@@ -101,7 +101,7 @@ struct State : lag_client_state {
 
 /* A reference (lag_client_reference: sim_time, step, generation, num_joints, name[], r[],
  * rdot[], rddot[]): what the joints with a reference follow at the state of that
- * sim_time. */
+ * generation and sim_time (Client::reference_of). */
 struct Reference : lag_client_reference {
     Reference() : lag_client_reference() {}
     /* the index of joint `name`, or -1 (the scene gives it no reference) */
@@ -382,6 +382,14 @@ public:
         Reference r;
         return lag_client_latest_reference(c_.get(), &r, sizeof r) ? std::optional<Reference>(r)
                                                                    : std::nullopt;
+    }
+    /* the reference of state st (the latest one, when its generation and sim_time are
+     * st's), or std::nullopt: lost, or a scene without a reference */
+    std::optional<Reference> reference_of(const State &st) const
+    {
+        Reference r;
+        return lag_client_reference_of(c_.get(), &st, &r, sizeof r) ? std::optional<Reference>(r)
+                                                                     : std::nullopt;
     }
     /* the scene of the latest state's generation */
     std::optional<Scene> latest_scene() const

@@ -193,8 +193,8 @@ void control(lagsim::Controller &ctl, lagsim::Scene &sc, const Options &o, Track
         const Vec2 q = {st->position[i1], st->position[i2]}, qd = {st->velocity[i1], st->velocity[i2]};
         if (tr.states == 0) hold = q;
         /* r, r', r'' of each joint (a joint without a reference holds its first position) */
-        std::optional<lagsim::Reference> ref = ctl.client().latest_reference();
-        if (ref && ref->sim_time != st->sim_time) tr.stale++; /* lost: the last one kept */
+        std::optional<lagsim::Reference> ref = ctl.client().reference_of(*st); /* its own */
+        if (!ref && (ref = ctl.client().latest_reference())) tr.stale++; /* lost: the last kept */
         Vec2 r = hold, rd{}, rdd{};
         for (int k = 0; k < 2; k++)
             if (int j = ref ? ref->joint(jn[k]) : -1; j >= 0)

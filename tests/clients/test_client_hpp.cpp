@@ -12,6 +12,8 @@
  *   - Scene::mass and Scene::bias are the manipulator's M(q) and C(q, qd) qd + g(q) of
  *     docs/models.md (written out here), in vectors and in arrays; a scene without its
  *     parameters, or q of the wrong size, is Error LAG_ERR_ARG naming what is missing;
+ *   - reference_of(state): the latest reference only when its generation and sim_time are
+ *     the state's (a lost one, or one of another generation at the same sim_time: none);
  *   - a Controller's run ends: on silence after its timeout (heard() moves with every
  *     message kept, not with a dropped one), on the daemon's stop event, after its duration;
  *     and its state is returned once.
@@ -203,6 +205,38 @@ void dynamics()
     check(refused, "q of another size, qd of another size than q, a NaN: Error (" + msg + ")");
 }
 
+void feed_reference(lagsim::Client &c, int64_t generation, double t)
+{
+    lag_wire_reference r;
+    std::memset(&r, 0, sizeof r);
+    r.generation = generation;
+    r.sim_time = t;
+    r.num_joints = 1;
+    std::strcpy(r.name[0], "q1");
+    r.r[0] = 0.125;
+    feed(c, LAG_WIRE_REFERENCE, &r, "REFERENCE");
+}
+
+void references()
+{
+    lagsim::Client c("FED", "memq://");
+    feed_scene(c);
+    feed_reference(c, 0, 0.5);
+    feed_state(c, 0.5);
+    std::optional<lagsim::State> st = c.wait_state(1.0);
+    std::optional<lagsim::Reference> ref = st ? c.reference_of(*st) : std::nullopt;
+    check(ref && ref->r[ref->joint("q1")] == 0.125 && ref->sim_time == 0.5,
+          "reference_of: the state's own reference (its generation and sim_time)");
+    feed_state(c, 0.6); /* its reference lost */
+    st = c.wait_state(1.0);
+    check(st && !c.reference_of(*st) && c.latest_reference(), "reference_of: a lost one is none");
+    feed_reference(c, 7, 0.7); /* another generation's, at the sim_time of the next state */
+    feed_state(c, 0.7);
+    st = c.wait_state(1.0);
+    check(st && st->generation == 0 && !c.reference_of(*st),
+          "reference_of: another generation's at the same sim_time is none");
+}
+
 void controller()
 {
     lagsim::Controller::Options o;
@@ -293,6 +327,7 @@ int main()
     errors();
     messages();
     dynamics();
+    references();
     controller();
     callback_exceptions();
     std::printf("%d failure(s)\n", failures);
