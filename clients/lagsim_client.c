@@ -950,6 +950,7 @@ typedef struct disc {
     union {
         lag_wire_scene scene;
         lag_wire_status status;
+        lag_wire_event event;
     } tmp;
 } disc;
 
@@ -994,6 +995,15 @@ static void on_disc(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
             copy_str(p->model, sizeof p->model, d->tmp.scene.model);
             copy_str(p->mode, sizeof p->mode, d->tmp.scene.mode);
             d->scene[i] = true;
+        } else if (outs[k] == LAG_BUS_EVENT &&
+                   lag_wire_decode(LAG_WIRE_EVENT, rbuf->data, rbuf->data_size,
+                                   LAG_WIRE_MAX_JOINTS, &d->tmp) == LAG_WIRE_OK &&
+                   !strcmp(d->tmp.event.kind, "plant")) {
+            /* a host's directory: the plant runs on the state URL its `plant` event names */
+            lag_bus b;
+            char berr[8];
+            if (lag_bus_init(&b, d->tmp.event.detail, p->prefix, berr, sizeof berr) == 0)
+                copy_str(p->url, sizeof p->url, b.state_url);
         } else if (outs[k] == LAG_BUS_STATUS &&
                    lag_wire_decode(LAG_WIRE_STATUS, rbuf->data, rbuf->data_size,
                                    LAG_WIRE_MAX_JOINTS, &d->tmp) == LAG_WIRE_OK &&
@@ -1242,11 +1252,13 @@ static void pick_message(const lag_client_plant *all, int n, int k, const char *
             snprintf(err, errlen, "no %s plant on %s (heard: %s)", model, where, names);
         return;
     }
-    lag_client_plant sel[LAG_CLIENT_MAX_PLANTS];
+    lag_client_plant *sel = calloc((size_t)(n > 0 ? n : 1), sizeof *sel); /* not on a thread's
+                                                                           * stack: 1024 plants */
     int m = 0;
-    for (int i = 0; i < n; i++)
+    for (int i = 0; sel && i < n; i++)
         if (all[i].model[0] && (!model || !strcmp(all[i].model, model))) sel[m++] = all[i];
-    plant_names(sel, m, names, sizeof names);
+    plant_names(sel ? sel : all, sel ? m : n, names, sizeof names);
+    free(sel);
     snprintf(err, errlen, "%d %s%splants on %s: %s; choose one with --prefix", k,
              model ? model : "", model ? " " : "", where, names);
 }
@@ -1320,14 +1332,20 @@ static int nearness(const char *heard, const char *asked)
 int lag_client_plants_instead(const char *url, const char *prefix, double wait_s, char *out,
                               size_t len)
 {
-    lag_client_plant p[LAG_CLIENT_MAX_PLANTS]; /* on the stack: any thread may ask */
     int n = 0;
     char err[256] = "";
     if (!out || len == 0 || !prefix) return LAG_CLIENT_ERR_ARG;
+    /* one array per call (any thread may ask), not on its stack (1024 plants: 730 kB) */
+    lag_client_plant *p = calloc(LAG_CLIENT_MAX_PLANTS, sizeof *p);
+    if (!p) {
+        snprintf(out, len, "out of memory");
+        return LAG_CLIENT_ERR_NOMEM;
+    }
     lag_result rc = lag_client_discover(url, wait_s, 0.5, p, LAG_CLIENT_MAX_PLANTS, sizeof p[0],
                                         &n, err, sizeof err);
     if (rc != LAG_CLIENT_OK) {
         snprintf(out, len, "%s", err);
+        free(p);
         return rc;
     }
     lag_bus b;
@@ -1336,6 +1354,7 @@ int lag_client_plants_instead(const char *url, const char *prefix, double wait_s
     if (n == 0) {
         snprintf(out, len, "no plant heard on %s within %.3g s (is lagsimd running on this "
                  "LCM URL?)", where, wait_s);
+        free(p);
         return 0;
     }
     size_t o = (size_t)snprintf(out, len, "no plant on prefix %s; plants heard on %s: ", prefix,
@@ -1350,5 +1369,6 @@ int lag_client_plants_instead(const char *url, const char *prefix, double wait_s
         if (k >= 0 && (near < 0 || k < near)) near = k, best = i;
     }
     if (best >= 0 && o < len) snprintf(out + o, len - o, "; did you mean %s?", p[best].prefix);
+    free(p);
     return n;
 }

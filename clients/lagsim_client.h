@@ -372,7 +372,7 @@ bool lag_client_status_field_is_text(int i);
 
 /* ---------------------------------------------------------------- finding plants */
 
-#define LAG_CLIENT_MAX_PLANTS 32
+#define LAG_CLIENT_MAX_PLANTS 1024 /* a lab host's plants (lagsimd --plants) */
 
 /* One plant heard on the bus. */
 typedef struct lag_client_plant {
@@ -383,7 +383,9 @@ typedef struct lag_client_plant {
     char run_state[LAG_CLIENT_NAME_LEN]; /* from its status: running, paused, waiting, fault */
     char host[LAG_CLIENT_NAME_LEN];      /* who sends its messages: this host's name, or
                                           * the sender's IPv4 address ("" if not seen) */
-    char url[LAG_CLIENT_URL_LEN];        /* its state URL (commands: the next port) */
+    char url[LAG_CLIENT_URL_LEN];        /* its state URL (commands: the next port): the
+                                          * URL it was heard on, or the one a host's
+                                          * directory names for it (a `plant` event) */
 } lag_client_plant;
 
 /* Lists the plants on the bus at url (NULL or "": LCM's default, honouring

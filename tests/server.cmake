@@ -18,6 +18,11 @@ add_executable(test_pace ${CMAKE_CURRENT_LIST_DIR}/server/test_pace.c)
 target_include_directories(test_pace PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_pace PRIVATE lagsimd_internal)
 lagsim_add_test_cases(test_pace server_pace server 30)
+# A plant's input read by the loop (rt_rx.c) against LCM's own datagrams.
+add_executable(test_rx ${CMAKE_CURRENT_LIST_DIR}/server/test_rx.c)
+target_include_directories(test_rx PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
+target_link_libraries(test_rx PRIVATE lagsimd_internal)
+lagsim_add_test_cases(test_rx server_rx server 30)
 add_executable(test_loop ${CMAKE_CURRENT_LIST_DIR}/server/test_loop.c)
 target_include_directories(test_loop PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
 target_link_libraries(test_loop PRIVATE lagsimd_internal)
@@ -49,4 +54,20 @@ if(LAGSIM_PYTHON3)
            COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/server/daemon_floors.py
                    ${PROJECT_SOURCE_DIR}/server/daemon)
   set_tests_properties(server_daemon_floors PROPERTIES TIMEOUT 30 LABELS server)
+endif()
+
+# A host of plants (lagsimd --plants DIR, several --config) over real LCM, each case on port
+# pairs of its own held by lock files (tests/server/test_host.py): isolation from a hostile
+# neighbour (states bit for bit those of the plant alone; the neighbour's input budget),
+# bad scenes skipped, a directory's files added, changed and removed while running, a
+# file that failed for want of its port tried again on SIGHUP,
+# lagsimctl list through the host's directory.
+if(LAGSIM_PYTHON3)
+  foreach(case isolation bad_scene reload list many)
+    add_test(NAME server_host_${case}
+             COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/server/test_host.py
+                     --bin ${CMAKE_BINARY_DIR}/bin --types ${CMAKE_BINARY_DIR}/python
+                     --source ${PROJECT_SOURCE_DIR} ${case})
+    set_tests_properties(server_host_${case} PROPERTIES TIMEOUT 240 LABELS server)
+  endforeach()
 endif()

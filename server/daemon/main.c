@@ -11,8 +11,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 
 #include "daemon.h"
+#include "host.h"
+#include "scene_run.h"
 #include "rt_log.h"
 
 
@@ -21,7 +24,18 @@ static const char k_options[] =
     "Default: the real-time LCM server (states out, effort commands in) until SIGINT.\n"
     "\n"
     "options:\n"
-    "  -c, --config FILE      YAML scene file (required; see config/*.yaml)\n"
+    "  -c, --config FILE      YAML scene file (see config/*.yaml); given several times\n"
+    "                         (real-time), one process runs each as a plant of its own\n"
+    "      --plants DIR       a host of plants: every DIR/NAME.yaml a plant of its own,\n"
+    "                         its prefix NAME in capitals; read again on SIGHUP and when\n"
+    "                         a file changes (a new file starts its plant, a changed one\n"
+    "                         restarts it, a removed one stops it; no other is touched)\n"
+    "      --port-base P      a host's plants whose scene has no lcm.url get port pairs\n"
+    "                         of their own: P, P + 2, ... (the first free), on the group\n"
+    "                         of LCM_DEFAULT_URL (lagsimctl list shows each plant's URL);\n"
+    "                         default with --plants: the pairs after LCM_DEFAULT_URL's\n"
+    "      --instance BASE    the unit's form (lagsimd@NAME): BASE.yaml as one plant\n"
+    "                         (--config), or BASE.d/ as a host (--plants); not both\n"
     "  -s, --set KEY=VALUE    override a scene key by its dotted path after the file\n"
     "                         is read; VALUE is YAML, e.g. --set integrator.method=dopri5\n"
     "                         --set initial.q=[0,0.1,-0.1]; repeatable, applied in order,\n"
@@ -63,7 +77,8 @@ static const char k_options[] =
     "                         --split-mb; 0.0625 to 1048576. With --keep, the log takes\n"
     "                         at most about N x MIB on disk\n"
     "      --log-buffer MIB   memory between the loop and the log writer, 0.25 to 1024\n"
-    "                         (default 16)\n"
+    "                         (default 16; a host's plant: 1); a host's plant with --log\n"
+    "                         DIR/FILE writes DIR/NAME/FILE, NAME the plant's own\n"
     "      --replay LOG.lcm   re-simulate a run recorded by --log or lcm-logger from the\n"
     "                         efforts in its logged states; print the largest difference\n"
     "      --tolerance X      --replay: exit 1 when the largest difference is above X\n"
@@ -88,7 +103,11 @@ static const char k_options[] =
     "  -V, --version          print the version\n"
     "\n"
     "exit codes: 0 ok, 1 runtime failure (e.g. a numeric fault), 2 usage or scene\n"
-    "error (reported as file:line:column: what was expected; nothing runs)\n";
+    "error (reported as file:line:column: what was expected; nothing runs)\n"
+    "\n"
+    "A host of plants (--plants, several --config): a plant that cannot start is said\n"
+    "and skipped, the others run; exit status 2 only when none started (and none can\n"
+    "come: no --plants), 1 when a plant's --log lost records\n";
 
 static void usage(FILE *f)
 {
@@ -96,6 +115,7 @@ static void usage(FILE *f)
         "usage: lagsimd --config FILE [--set KEY=VALUE ...] [-q] [--duration SECONDS]\n"
         "               [--log FILE.lcm [--log-buffer MIB]\n"
         "                [--force | --increment [--keep N] [--split-mb MIB]]]\n"
+        "       lagsimd --plants DIR [--config FILE ...] [--port-base P] [options as above]\n"
         "       lagsimd --config FILE --offline --duration SECONDS [--csv PATH|- [--force]]\n"
         "               [--set ...]\n"
         "       lagsimd --config FILE --replay LOG.lcm [--tolerance X] [--set ...]\n"
@@ -158,69 +178,6 @@ static lag_result option_error(const struct option *longopts, char **argv, int a
     return usage_error("%s", msg);
 }
 
-/* A scene without lcm.url leaves the choice to LCM, which reads LCM_DEFAULT_URL: that
- * URL gets the scene's checks too (no file:// logs, no ttl above 0 without
- * lcm.allow_lan) and becomes the scene's, so what runs is what was checked.
- * Returns LAG_OK, or LAG_ERR_SCENE after printing why (exit 2: nothing has run). */
-static lag_result resolve_default_url(lag_scene *sc)
-{
-    const char *env = getenv("LCM_DEFAULT_URL");
-    if (sc->lcm.url[0] != '\0' || !env || env[0] == '\0')
-        return LAG_OK;
-    char err[512];
-    if (strlen(env) >= sizeof sc->lcm.url) {
-        fprintf(stderr, "lagsimd: LCM_DEFAULT_URL: longer than %zu characters\n",
-                sizeof sc->lcm.url - 1);
-        return LAG_ERR_SCENE;
-    }
-    if (lag_scene_check_url(env, sc->lcm.allow_lan, &sc->lcm.ttl, err, sizeof err) != 0) {
-        fprintf(stderr, "lagsimd: LCM_DEFAULT_URL: %s\n", err);
-        return LAG_ERR_SCENE;
-    }
-    snprintf(sc->lcm.url, sizeof sc->lcm.url, "%s", env);
-    return LAG_OK;
-}
-
-/* Whether the --set overrides give integrator.method (a scene's integrator.error then
- * chooses nothing: the run is told). */
-static bool integrator_given(const char *const *sets, int nsets)
-{
-    for (int i = 0; i < nsets; i++)
-        if (strncmp(sets[i], "integrator.method=", 18) == 0) return true;
-    return false;
-}
-
-/* integrator.error: the integrator the calibration chooses, or the one the command line
- * names with --set integrator.method=... (a rerun of a choice, or the user's own): then
- * said, and not measured. OUT: ch */
-static lag_result choose(const lag_scene *sc, const char *const *sets, int nsets, bool offline,
-                         bool quiet, lagsimd_choice *ch)
-{
-    ch->n = 0;
-    if (sc->accuracy.error > 0 && integrator_given(sets, nsets)) {
-        fprintf(stderr, "lagsimd: integrator.error %g: the integrator given by --set (%s, dt %g "
-                "s) is used, not measured\n", sc->accuracy.error,
-                lag_method_name(sc->sim.integrator.method), sc->sim.integrator.dt);
-        return LAGSIMD_EXIT_OK;
-    }
-    return lagsimd_choose_integrator(sc, offline, quiet, ch);
-}
-
-/* Appends the calibration's choice to the overrides (main made room for its 4) and
- * loads the scene again with it. */
-static lag_result reload_with(const char *config, const char *text, size_t len,
-                              const char **sets, int *nsets, const lagsimd_choice *ch,
-                              lag_scene *sc)
-{
-    char err[1024];
-    for (int i = 0; i < ch->n; i++) sets[(*nsets)++] = ch->kv[i];
-    if (lag_scene_load_buffer(config, text, len, sets, *nsets, sc, err, sizeof err) != 0) {
-        fprintf(stderr, "lagsimd: the integrator chosen for integrator.error: %s\n", err);
-        return LAG_ERR_SCENE;
-    }
-    return LAG_OK;
-}
-
 /* --list WHAT: the names of one of the core's tables, one a line, in the table's order
  * (what scripts iterate: tests/scene/determinism.sh takes the methods from here). */
 static lag_result print_list(const char *what)
@@ -240,6 +197,12 @@ static lag_result print_list(const char *what)
 /* What the command line says. */
 typedef struct cmdline {
     const char *config, *replay, *plot, *list;
+    const char **configs;   /* every --config, in order */
+    int nconfigs;
+    const char *plants;     /* --plants DIR */
+    const char *instance;   /* --instance BASE */
+    char instance_path[4096];
+    int port_base;          /* --port-base P, 0: none */
     bool cost, offline;
     bool have_duration, have_tolerance, have_ring; /* given, for the checks of combinations */
     lagsimd_opts opts;
@@ -248,7 +211,8 @@ typedef struct cmdline {
 } cmdline;
 
 enum { OPT_OFFLINE = 256, OPT_CSV, OPT_REPLAY, OPT_LOG, OPT_LOG_BUFFER, OPT_TOLERANCE,
-       OPT_COST, OPT_PLOT, OPT_FORCE, OPT_KEEP, OPT_SPLIT, OPT_LIST };
+       OPT_COST, OPT_PLOT, OPT_FORCE, OPT_KEEP, OPT_SPLIT, OPT_LIST, OPT_PLANTS,
+       OPT_PORT_BASE, OPT_INSTANCE };
 static const struct option longopts[] = {
     {"config", required_argument, NULL, 'c'},
     {"set", required_argument, NULL, 's'},
@@ -263,6 +227,9 @@ static const struct option longopts[] = {
     {"plot", required_argument, NULL, OPT_PLOT},
     {"force", no_argument, NULL, OPT_FORCE},
     {"list", required_argument, NULL, OPT_LIST},
+    {"plants", required_argument, NULL, OPT_PLANTS},
+    {"port-base", required_argument, NULL, OPT_PORT_BASE},
+    {"instance", required_argument, NULL, OPT_INSTANCE},
     {"increment", no_argument, NULL, 'i'},
     {"keep", required_argument, NULL, OPT_KEEP},
     {"split-mb", required_argument, NULL, OPT_SPLIT},
@@ -301,6 +268,11 @@ static lag_result take_number(cmdline *cl, int c, const char *arg)
                                "got '%s'", arg);
         cl->opts.log_ring = (size_t)(v * 1048576.0);
         cl->have_ring = true;
+    } else if (c == OPT_PORT_BASE) {
+        if (!plain || !(v >= 1024) || !(v <= 65534) || v != floor(v))
+            return usage_error("--port-base: expected a whole port number from 1024 to 65534, "
+                               "got '%s'", arg);
+        cl->port_base = (int)v;
     } else { /* OPT_TOLERANCE */
         if (!plain || !(v >= 0.0) || !isfinite(v))
             return usage_error("--tolerance: expected a number >= 0, got '%s'", arg);
@@ -314,9 +286,18 @@ static lag_result take_number(cmdline *cl, int c, const char *arg)
 static lag_result take_option(cmdline *cl, int c, const char *arg)
 {
     switch (c) {
-    case 'c': cl->config = arg; break;
+    case 'c':
+        if (!cl->config) cl->config = arg;
+        cl->configs[cl->nconfigs++] = arg;
+        break;
+    case OPT_PLANTS:
+        if (cl->plants) return usage_error("--plants: one directory (got a second: '%s')", arg);
+        cl->plants = arg;
+        break;
+    case OPT_INSTANCE: cl->instance = arg; break;
     case 's': cl->sets[cl->nsets++] = arg; break;
     case 'd': case OPT_LOG_BUFFER: case OPT_TOLERANCE: case OPT_KEEP: case OPT_SPLIT:
+    case OPT_PORT_BASE:
         return take_number(cl, c, arg);
     case OPT_OFFLINE: cl->offline = true; break;
     case OPT_CSV: cl->opts.csv = arg; break;
@@ -355,16 +336,53 @@ static lag_result read_options(cmdline *cl, int argc, char **argv, bool *done)
     return LAG_OK;
 }
 
+/* --instance BASE: BASE.yaml (one plant) or BASE.d/ (a host), exactly one of them. */
+static lag_result take_instance(cmdline *cl)
+{
+    if (!cl->instance) return LAG_OK;
+    if (cl->config || cl->plants)
+        return usage_error("%s", "--instance names the scene or the directory: not with --config "
+                           "or --plants");
+    struct stat y, d;
+    char yaml[4096];
+    bool has_y = snprintf(yaml, sizeof yaml, "%s.yaml", cl->instance) < (int)sizeof yaml &&
+                 stat(yaml, &y) == 0;
+    bool has_d = snprintf(cl->instance_path, sizeof cl->instance_path, "%s.d", cl->instance) <
+                     (int)sizeof cl->instance_path &&
+                 stat(cl->instance_path, &d) == 0 && S_ISDIR(d.st_mode);
+    if (has_y == has_d) {
+        fprintf(stderr, "lagsimd: --instance %s: %s %s.yaml %s %s.d/ (one plant, or a host of "
+                "plants: one of them)\n", cl->instance, has_y ? "both" : "neither",
+                cl->instance, has_y ? "and" : "nor", cl->instance);
+        return LAGSIMD_EXIT_USAGE;
+    }
+    if (has_y) {
+        snprintf(cl->instance_path, sizeof cl->instance_path, "%s", yaml);
+        cl->config = cl->instance_path;
+        cl->configs[cl->nconfigs++] = cl->instance_path;
+    } else {
+        cl->plants = cl->instance_path;
+    }
+    return LAG_OK;
+}
+
 /* The options that need or exclude each other (said as a usage error). */
 static lag_result check_options(cmdline *cl)
 {
     const lagsimd_opts *o = &cl->opts;
     const char *why = NULL;
-    if (cl->list) why = cl->config || cl->nsets || cl->offline || cl->replay || cl->cost || o->log ||
+    if (cl->list) why = cl->config || cl->plants || cl->instance || cl->port_base || cl->nsets || cl->offline || cl->replay || cl->cost || o->log ||
                             o->csv || cl->plot || cl->have_duration || cl->have_tolerance ||
                             o->log_increment || o->log_keep || o->log_split || o->force
                             ? "--list prints a table and exits: not with other options" : NULL;
-    else if (!cl->config) why = "--config FILE is required";
+    else if (!cl->config && !cl->plants)
+        why = "--config FILE is required (or --plants DIR: a host of plants)";
+    else if ((cl->plants || cl->nconfigs > 1) && (cl->offline || cl->replay || cl->cost))
+        why = "--plants and several --config run a host of real-time plants: not with "
+              "--offline, --replay or --cost";
+    else if (cl->port_base && !cl->plants && cl->nconfigs < 2)
+        why = "--port-base gives a host's plants their ports: give --plants DIR (or several "
+              "--config)";
     else if (cl->offline && cl->replay) why = "--offline and --replay exclude each other";
     else if (o->csv && !cl->offline) why = "--csv needs --offline";
     else if (cl->offline && !cl->have_duration) why = "--offline needs --duration SECONDS";
@@ -390,33 +408,23 @@ static lag_result check_options(cmdline *cl)
 static lag_result prepare_scene(cmdline *cl, const char *text, size_t len, lag_scene *sc)
 {
     static lagsimd_choice choice;
-    char err[1024];
-    if (lag_scene_load_buffer(cl->config, text, len, cl->sets, cl->nsets, sc, err,
-                              sizeof err) != LAG_OK) {
-        fprintf(stderr, "%s\n", err);
-        return LAG_ERR_SCENE;
-    }
-    if (cl->cost) return LAG_OK;
-    if (cl->replay && sc->accuracy.error > 0 && !integrator_given(cl->sets, cl->nsets)) {
-        fprintf(stderr, "lagsimd: %s: integrator.error: the recorded run chose its integrator "
-                "when it started; give the same with --set integrator.method=... --set "
-                "integrator.dt=... (and rtol, atol for dopri5), as the run printed them\n",
-                cl->config);
-        return LAG_ERR_USAGE;
-    }
-    choice.n = 0;
-    if (!cl->replay && choose(sc, cl->sets, cl->nsets, cl->offline, cl->opts.quiet,
-                              &choice) != LAG_OK)
-        return LAG_ERR_USAGE; /* said why */
-    if (choice.n > 0)
-        return reload_with(cl->config, text, len, cl->sets, &cl->nsets, &choice, sc);
-    return LAG_OK;
+    scene_run_how how = {cl->cost, cl->replay != NULL, cl->offline, cl->opts.quiet};
+    return scene_run_load(cl->config, text, len, cl->sets, &cl->nsets, how, &choice, sc);
+}
+
+/* A host of plants: --plants DIR and every --config. */
+static lag_result run_host(cmdline *cl)
+{
+    host_conf c = {cl->plants, cl->configs, cl->nconfigs, cl->sets, cl->nsets, cl->port_base,
+                   cl->opts};
+    return lagsimd_host(&c);
 }
 
 /* Reads the scene file once (the scene and any change made while running come from the
  * same bytes) and runs what the command line asks. */
 static lag_result run(cmdline *cl)
 {
+    if (cl->plants || cl->nconfigs > 1) return run_host(cl);
     static lag_scene sc;
     char err[1024];
     char *text = NULL;
@@ -440,7 +448,7 @@ static lag_result run(cmdline *cl)
             rc = lagsimd_offline(&sc, o);
         else if (cl->replay)
             rc = lagsimd_replay(&sc, cl->replay, o);
-        else if ((rc = resolve_default_url(&sc)) == LAG_OK)
+        else if ((rc = scene_run_default_url(&sc)) == LAG_OK)
             rc = lagsimd_realtime(&sc, o);
     }
     free(text);
@@ -476,16 +484,21 @@ static lag_result lagsimd_main(int argc, char **argv)
     cmdline cl = {.opts = {.quiet = false, .duration = 0.0, .csv = NULL}};
     /* the --set overrides, and room for a calibration's choice (lagsimd_choice) */
     cl.sets = calloc((size_t)argc + 1 + 4, sizeof *cl.sets);
-    if (!cl.sets) {
+    cl.configs = calloc((size_t)argc + 1, sizeof *cl.configs);
+    if (!cl.sets || !cl.configs) {
+        free(cl.sets);
+        free(cl.configs);
         fputs("lagsimd: out of memory\n", stderr);
         return LAG_ERR_NOMEM;
     }
     bool done = false;
     lag_result rc = read_options(&cl, argc, argv, &done);
+    if (rc == LAG_OK && !done) rc = take_instance(&cl);
     if (rc == LAG_OK && !done) rc = check_options(&cl);
     if (rc == LAG_OK && !done && cl.opts.log && !cl.list) rc = check_file_limit(&cl.opts);
     if (rc == LAG_OK && !done) rc = cl.list ? print_list(cl.list) : run(&cl);
     free(cl.sets);
+    free(cl.configs);
     return rc;
 }
 

@@ -827,6 +827,7 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
             char *err, size_t errlen)
 {
     memset(s, 0, sizeof *s);
+    s->bus.rx_in.fd = s->bus.rx_watch.fd = -1; /* no socket yet (rt_bus_close) */
     s->sc = sc;
     s->opts = o;
     s->now = now;
@@ -860,7 +861,7 @@ int rt_attach(rt_server *s, lcm_t *out, lcm_t *in, char *err, size_t errlen)
 
 void rt_close(rt_server *s)
 {
-    rt_log_end(&s->rec); /* a no-op when lagsimd_realtime has closed it already */
+    rt_log_end(&s->rec); /* a no-op when rt_plant_end has closed it already */
     rt_bus_detach(&s->bus);
 }
 
@@ -1032,6 +1033,14 @@ void rt_finish(rt_server *s)
     case RT_STOP_DURATION:
         rt_pub_eventf(&s->pub, "stop", lag_sim_time(&s->sim), "duration reached");
         break;
+    case RT_STOP_REMOVED:
+        rt_pub_eventf(&s->pub, "stop", 0, "its scene file was removed from the host's directory: "
+                      "stopping");
+        break;
+    case RT_STOP_CHANGED:
+        rt_pub_eventf(&s->pub, "stop", 0, "its scene file changed: stopping, to start again "
+                      "from it");
+        break;
     default:
         rt_pub_eventf(&s->pub, "stop", 0, "stopping");
         break;
@@ -1040,57 +1049,109 @@ void rt_finish(rt_server *s)
     if (s->term.live_line) rt_term_line(&s->term, s->now, true);
 }
 
-/* ---------------------------------------------------------------- the loop */
-static void on_signal(void *ctx, int signo) { rt_signal(ctx, signo); }
-
-lag_result lagsimd_realtime(const lag_scene *sc, const lagsimd_opts *o)
+/* ---------------------------------------------------------------- one plant of a loop */
+rt_server *rt_plant_new(void)
 {
-    static rt_server srv; /* large (encode buffer): static, one server per process */
-    rt_server *s = &srv;
-    bool quiet = o && o->quiet;
-    char err[512];
-    rt_io io;
-    int rc = LAGSIMD_EXIT_OK;
-    bool opened = false;
+    return calloc(1, sizeof(rt_server));
+}
 
-    if (rt_io_open(&io, &s->now, &s->stop, on_signal, s) != 0) {
-        rc = LAGSIMD_EXIT_RUNTIME;
-        goto out;
-    }
+void rt_plant_free(rt_server *s)
+{
+    free(s);
+}
+
+int rt_plant_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t now,
+                  bool quiet, const char *who, char *err, size_t errlen)
+{
     /* everything that can fail on a bad scene fails before LCM is touched */
-    rc = rt_open(s, sc, o, lag_clock_mono_ns(), quiet, err, sizeof err);
+    int rc = rt_open(s, sc, o, now, quiet, err, errlen);
     if (rc != LAGSIMD_EXIT_OK) {
-        fprintf(stderr, "lagsimd: %s\n", err);
-        goto out;
+        rt_log_end(&s->rec); /* --log opened, then the start failed */
+        return rc;
     }
+    s->term.who = who;
     /* LCM: publishing on the state URL, receiving on the command URL */
-    opened = true;
     rt_bus_handlers h = handlers(s);
     s->bus.quiet = quiet;
-    rc = rt_bus_open(&s->bus, &h, err, sizeof err);
-    if (rc != LAGSIMD_EXIT_OK) {
-        fprintf(stderr, "lagsimd: %s\n", err);
-        goto out;
-    }
-    s->term.live_line = isatty(STDERR_FILENO) && !quiet;
-    rt_io_watch(&io, s->bus.lcm_in, s->bus.lcm != s->bus.lcm_in ? s->bus.lcm : NULL);
+    rc = rt_bus_open_start(&s->bus, &h, err, errlen);
+    if (rc != LAGSIMD_EXIT_OK) rt_log_end(&s->rec);
+    return rc;
+}
 
-    s->now = lag_clock_mono_ns();
+int64_t rt_plant_look_ns(const rt_server *s)
+{
+    return s->bus.urls.udpm ? RT_LOOK_MS * 1000000LL : 0;
+}
+
+int rt_plant_fd(const rt_server *s, rt_plant_input which)
+{
+    return rt_bus_fd(&s->bus, which == RT_PLANT_WATCH);
+}
+
+int rt_plant_drain(rt_server *s, rt_plant_input which, int64_t now, int max)
+{
+    s->now = now;
+    if (s->stop) return 0;
+    return rt_bus_read(&s->bus, which == RT_PLANT_WATCH, max);
+}
+
+int rt_plant_start(rt_server *s, int64_t now, bool live_line, char *err, size_t errlen)
+{
+    int rc = rt_bus_open_finish(&s->bus, err, errlen);
+    if (rc != LAGSIMD_EXIT_OK) {
+        rt_log_end(&s->rec);
+        return rc;
+    }
+    s->term.live_line = live_line;
+    s->now = now;
     s->bus.discard = false;
     rt_begin(s);
-    while (!s->stop) {
-        if (rt_io_wait(&io, rt_next_wake(s)) != 0) {
-            s->stop = true;
-            s->stop_reason = RT_STOP_ERROR;
-        }
-        rt_process(s);
-    }
-    rt_finish(s);
+    return LAGSIMD_EXIT_OK;
+}
+
+bool rt_plant_stopped(const rt_server *s)
+{
+    return s->stop;
+}
+
+void rt_plant_stop(rt_server *s, rt_stop why)
+{
+    if (s->stop) return;
+    s->stop = true;
+    s->stop_reason = why;
+}
+
+void rt_plant_set_now(rt_server *s, int64_t now)
+{
+    s->now = now;
+}
+
+lag_result rt_plant_end(rt_server *s, bool started)
+{
+    lag_result rc = LAGSIMD_EXIT_OK;
+    if (started) rt_finish(s);
     /* --log lost records */
-    if (rt_log_end(&s->rec) != 0 && rc == LAGSIMD_EXIT_OK) rc = LAGSIMD_EXIT_RUNTIME;
-out:
-    rt_log_end(&s->rec); /* --log opened, then the start failed */
-    if (opened) rt_bus_close(&s->bus);
-    rt_io_close(&io);
+    if (rt_log_end(&s->rec) != 0) rc = LAGSIMD_EXIT_RUNTIME;
+    rt_bus_close(&s->bus);
     return rc;
+}
+
+int64_t rt_plant_published(const rt_server *s)
+{
+    return s->pub.states_published + s->pub.lockstep_retries;
+}
+
+void rt_plant_input_limited(rt_server *s, int64_t times, const char *why)
+{
+    rt_pub_limited(&s->pub, RT_EV_INPUT_LIMITED, "", (double)times,
+                   "%s on %s and %s: %s (%lld times so far, in value)", "more messages than "
+                   "the plant can use", s->bus.ch_command, s->bus.ch_control, why,
+                   (long long)times);
+}
+
+unsigned rt_plant_last(const rt_server *s, bool status, const uint8_t **data)
+{
+    const rt_sent *k = status ? &s->pub.last_status : &s->pub.last_scene;
+    *data = k->buf;
+    return k->len;
 }

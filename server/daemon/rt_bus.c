@@ -1,21 +1,22 @@
 /*
- * The daemon's LCM instances (lagsim_bus.h gives the URLs):
- *   b->lcm        the state URL, publishing only: it never subscribes, so LCM never
- *                 opens a receive socket for it and the daemon never reads back its own
- *                 states (in fast mode, tens of thousands a second);
- *   b->lcm_in     the command URL: _COMMAND and _CONTROL. Its receive socket gets a
- *                 filter (lagsim_net.h): only this plant's two channels (and every
- *                 prefix's _CONTROL, below), and unless
- *                 lcm.allow_lan only datagrams sent from this host;
- * For memq:// (tests, one process) one lcm_t is both.
+ * The daemon's bus (lagsim_bus.h gives the URLs). On udpm://:
+ *   b->lcm        publishes on the state URL;
+ *   b->lcm_in     publishes on the command URL (DESCRIBE at start, the sync marker, the
+ *                 probes of rt_foreign.h); neither subscribes, so LCM makes no thread,
+ *                 pipe wait or select(2) for them;
+ *   b->rx_in      the plant's own receive socket on the command URL (rt_rx.h), read by the
+ *                 loop: _COMMAND and _CONTROL (and every prefix's _CONTROL, below). Its
+ *                 socket filter (lagsim_net.h) keeps only those, and unless lcm.allow_lan
+ *                 only datagrams sent from this host;
+ *   b->rx_watch   the plant watch on the state URL: _SCENE (and _COMMAND sent to the wrong
+ *                 port, counted), its filter dropping the daemon's own states in the kernel.
+ * For memq:// (tests, one process) one lcm_t is both, with LCM's subscriptions.
  *
- * One plant per prefix: the state URL's lcm_t subscribes to _SCENE (its receive socket
- * filtered to that channel and _COMMAND, so the kernel drops the daemon's own states
- * instead of handing them back; a command sent there, to the wrong port, is counted). Before it publishes anything, the daemon asks its prefix for a
- * scene (DESCRIBE) and listens RT_LOOK_MS (look_for_other_plant); another plant's scene
+ * One plant per prefix: before it publishes anything, the daemon asks its prefix for a
+ * scene (DESCRIBE) and listens RT_LOOK_MS (rt_bus_open); another plant's scene
  * (rt_bus_foreign_scene: one that decodes, names this prefix and is not one of the
- * daemon's own) makes it refuse to start, and later makes it stop. Whom it hears follows the
- * command URL's rule: this host only unless lcm.allow_lan.
+ * daemon's own) makes it refuse to start, and later is counted and said. Whom it hears
+ * follows the command URL's rule: this host only unless lcm.allow_lan.
  *
  * What is asked where the plant listens but not of it is heard too (rt_foreign.h): every
  * <P>_CONTROL on both ports (another prefix's: a misspelt one; this plant's on the state
@@ -23,11 +24,14 @@
  * plant of its own). The filters keep them by their suffix; control requests are rare, and
  * a flood of them costs what a flood on this plant's own _CONTROL costs, bounded the same.
  */
+#include <poll.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "lagsim_clock.h"
 #include "lagsim_net.h"
+#include "lagsim_url.h"
 #include "daemon.h"
 #include "rt_bus.h"
 #include "rt_pace.h"
@@ -77,11 +81,12 @@ static void on_wrong_port(const lcm_recv_buf_t *rb, const char *ch, void *user)
 /* A control request heard on channel ch (state_port: on the state URL): counted; a prefix
  * heard for the first time is asked for its scene (the probe, within its bucket), so that
  * another plant's prefix is known as such (rt_foreign.h). */
-static void foreign_request(rt_bus *b, const lcm_recv_buf_t *rb, const char *ch, bool state_port)
+static void foreign_request(rt_bus *b, const uint8_t *data, size_t size, const char *ch,
+                            bool state_port)
 {
     if (b->discard) return;
     rt_foreign_prefix *e =
-        rt_foreign_request(&b->foreign, ch, b->ch_control, state_port, rb->data, rb->data_size);
+        rt_foreign_request(&b->foreign, ch, b->ch_control, state_port, data, size);
     int64_t now = b->now ? *b->now : lag_clock_mono_ns();
     if (!e || !rt_limit_take(&b->probes, now)) return; /* asked again at its next request */
     lag_wire_control c;
@@ -99,12 +104,12 @@ static void foreign_request(rt_bus *b, const lcm_recv_buf_t *rb, const char *ch,
 
 static void on_foreign_in(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
-    foreign_request(user, rb, ch, false);
+    foreign_request(user, rb->data, rb->data_size, ch, false);
 }
 
 static void on_foreign_out(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
-    foreign_request(user, rb, ch, true);
+    foreign_request(user, rb->data, rb->data_size, ch, true);
 }
 
 static void on_foreign_scene(const lcm_recv_buf_t *rb, const char *ch, void *user)
@@ -217,8 +222,20 @@ bool rt_bus_foreign_scene(rt_bus *b, const uint8_t *data, size_t len)
 }
 
 /* ---------------------------------------------------------------- opening the bus */
-/* Filters the receive socket of the command URL's lcm_t, then reads until a marker sent
- * after the filter comes back, discarding whatever came before it (it may have come in
+/* The sync marker: sent on the command URL, read back by the plant's own socket. */
+typedef struct sync_marker {
+    rt_bus *b;
+    char text[96];
+} sync_marker;
+
+static void send_marker(void *ctx)
+{
+    sync_marker *m = ctx;
+    lcm_publish(m->b->lcm_in, LAG_NET_MARKER_CHANNEL, m->text, (unsigned)strlen(m->text));
+}
+
+/* Filters the plant's receive socket on the command URL, then reads until a marker sent
+ * after the filter comes back, dropping whatever came before it (it may have come in
  * before the filter did). Returns 0, or an exit code with a message in err. */
 static int filter_input(rt_bus *b, char *err, size_t errlen)
 {
@@ -231,12 +248,17 @@ static int filter_input(rt_bus *b, char *err, size_t errlen)
                                     ferr, sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s%s: cannot restrict the command URL %s to %s", n < 0 ? ferr :
-                 "LCM's receive socket for the command port was not found",
+                 "the receive socket for the command port was not found",
                  host_only ? "" : " (lcm.allow_lan: true)", u->command_url,
                  host_only ? "this host (lcm.allow_lan: false)" : "this plant's channels");
         return LAGSIMD_EXIT_RUNTIME;
     }
-    if (lag_net_sync(b->lcm_in, 3000) != 0) {
+    static unsigned counter;
+    sync_marker m = {b, ""};
+    int64_t t = lag_clock_mono_ns();
+    snprintf(m.text, sizeof m.text, "lagsimd %ld %s sync %u %lld", (long)getpid(),
+             b->sc->lcm.prefix, ++counter, (long long)t);
+    if (rt_rx_sync(&b->rx_in, LAG_NET_MARKER_CHANNEL, m.text, send_marker, &m, 3000) != 0) {
         snprintf(err, errlen, "LCM on %s does not hear its own messages (is there a multicast "
                  "route? docs/network.md)", u->command_url);
         return LAGSIMD_EXIT_RUNTIME;
@@ -244,19 +266,16 @@ static int filter_input(rt_bus *b, char *err, size_t errlen)
     n = lag_net_filter_suffixes(u->command_port, host_only, with_marker, 2, requests, 1, ferr,
                                 sizeof ferr);
     if (n <= 0) {
-        snprintf(err, errlen, "%s", n < 0 ? ferr : "LCM's receive socket went away");
+        snprintf(err, errlen, "%s", n < 0 ? ferr : "the receive socket went away");
         return LAGSIMD_EXIT_RUNTIME;
     }
     return LAGSIMD_EXIT_OK;
 }
 
-#define RT_LOOK_MS 200 /* how long a starting daemon listens for another plant */
-
 /* Before the daemon publishes anything: filters the state URL's receive socket to _SCENE
- * (the plant watch), asks the prefix for its scene (DESCRIBE on the command URL; a daemon
- * there answers on the state URL) and listens RT_LOOK_MS for another plant's. Returns 0,
- * or an exit code with a message. */
-static int look_for_other_plant(rt_bus *b, char *err, size_t errlen)
+ * (the plant watch) and asks the prefix for its scene (DESCRIBE on the command URL; a
+ * daemon there answers on the state URL). Returns 0, or an exit code with a message. */
+static int ask_for_other_plant(rt_bus *b, char *err, size_t errlen)
 {
     const lag_bus *u = &b->urls;
     bool host_only = !b->sc->lcm.allow_lan;
@@ -269,7 +288,7 @@ static int look_for_other_plant(rt_bus *b, char *err, size_t errlen)
                                     sizeof ferr);
     if (n <= 0) {
         snprintf(err, errlen, "%s: cannot filter the state URL %s for the plant watch",
-                 n < 0 ? ferr : "LCM's receive socket for the state port was not found",
+                 n < 0 ? ferr : "the receive socket for the state port was not found",
                  u->state_url);
         return LAGSIMD_EXIT_RUNTIME;
     }
@@ -279,22 +298,84 @@ static int look_for_other_plant(rt_bus *b, char *err, size_t errlen)
     c.request = LAGSIM_CONTROL_T_DESCRIBE;
     int len = lag_wire_encode(LAG_WIRE_CONTROL, &c, b->buf, RT_BUF_SIZE);
     if (len > 0) lcm_publish(b->lcm_in, b->ch_control, b->buf, (unsigned)len);
-    int64_t end = lag_clock_mono_ns() + RT_LOOK_MS * 1000000LL;
-    for (int64_t left; !b->other_plant[0] && (left = end - lag_clock_mono_ns()) > 0;)
-        lcm_handle_timeout(b->lcm, (int)(left / 1000000) + 1);
-    if (b->other_plant[0]) {
-        snprintf(err, errlen, "another plant publishes on prefix %s (%s): refusing to start; "
-                 "one plant per prefix (give this one another lcm.prefix, or stop the other)",
-                 b->sc->lcm.prefix, b->other_plant);
-        return LAGSIMD_EXIT_RUNTIME;
-    }
     return LAGSIMD_EXIT_OK;
 }
 
-int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
+/* rt_rx's handlers: the plant's own sockets (udpm://). */
+static void rx_command(void *ctx, const uint8_t *data, size_t len)
+{
+    rt_bus *b = ctx;
+    if (!b->discard) b->on.command(b->on.ctx, data, len);
+}
+
+static void rx_control(void *ctx, const uint8_t *data, size_t len)
+{
+    rt_bus *b = ctx;
+    if (!b->discard) b->on.control(b->on.ctx, data, len);
+}
+
+static void rx_scene(void *ctx, const uint8_t *data, size_t len)
+{
+    rt_bus *b = ctx;
+    b->on.scene(b->on.ctx, data, len);
+}
+
+static void rx_wrong_port(void *ctx, const uint8_t *data, size_t len)
+{
+    (void)data, (void)len;
+    rt_bus *b = ctx;
+    if (!b->discard) b->commands_wrong_port++;
+}
+
+/* Whether channel ch ends in the suffix of `which` after a prefix. */
+static bool ends_in(const char *ch, lag_bus_channel which)
+{
+    const char *suf = lag_bus_suffix(which);
+    size_t n = strlen(ch), k = strlen(suf);
+    return n > k && !strcmp(ch + n - k, suf);
+}
+
+/* Every datagram of the plant's sockets, as LCM's subscriptions to every prefix's
+ * _CONTROL (both ports) and _SCENE (the state port) would hear them: rt_foreign.h. */
+static void rx_foreign_in(void *ctx, const char *ch, const uint8_t *data, size_t len)
+{
+    if (ends_in(ch, LAG_BUS_CONTROL)) foreign_request(ctx, data, len, ch, false);
+}
+
+static void rx_foreign_out(void *ctx, const char *ch, const uint8_t *data, size_t len)
+{
+    rt_bus *b = ctx;
+    if (ends_in(ch, LAG_BUS_CONTROL)) foreign_request(b, data, len, ch, true);
+    else if (ends_in(ch, LAG_BUS_SCENE) && !b->discard) rt_foreign_scene(&b->foreign, ch, b->ch_scene);
+}
+
+/* udpm://: the plant's two receive sockets (rt_rx.h): _COMMAND and _CONTROL on the command
+ * URL; the plant watch (_SCENE, and _COMMAND sent to the wrong port) on the state URL. */
+static int open_receivers(rt_bus *b, char *err, size_t errlen)
+{
+    const lag_bus *u = &b->urls;
+    lag_url url;
+    long rcvbuf = lag_url_parse(u->state_url, LAG_URL_SCENE_RULES | LAG_URL_ALLOW_LAN, &url,
+                                err, errlen) == 0 ? url.recv_buf_size : 0;
+    b->rx_in = (rt_rx){-1, 2, {"", ""}, {rx_command, rx_control}, rx_foreign_in, b, 0};
+    b->rx_watch = (rt_rx){-1, 2, {"", ""}, {rx_scene, rx_wrong_port}, rx_foreign_out, b, 0};
+    snprintf(b->rx_in.ch[0], sizeof b->rx_in.ch[0], "%s", b->ch_command);
+    snprintf(b->rx_in.ch[1], sizeof b->rx_in.ch[1], "%s", b->ch_control);
+    snprintf(b->rx_watch.ch[0], sizeof b->rx_watch.ch[0], "%s", b->ch_scene);
+    snprintf(b->rx_watch.ch[1], sizeof b->rx_watch.ch[1], "%s", b->ch_command);
+    if (rt_rx_open(&b->rx_in, u->group, u->command_port, rcvbuf, err, errlen) != 0 ||
+        rt_rx_open(&b->rx_watch, u->group, u->state_port, rcvbuf, err, errlen) != 0)
+        return LAGSIMD_EXIT_RUNTIME;
+    return LAGSIMD_EXIT_OK;
+}
+
+int rt_bus_open_start(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
 {
     const lag_bus *u = &b->urls;
     lag_net_note_inherited(); /* a parent's sockets are not filtered */
+    b->rx_in.fd = b->rx_watch.fd = -1;
+    /* udpm: two publishers (no subscription: LCM makes no thread for them) and the plant's
+     * own receive sockets; memq://: one lcm_t, LCM's subscriptions */
     lcm_t *out = lcm_create(u->state_url);
     lcm_t *in = !u->udpm ? out : out ? lcm_create(u->command_url) : NULL;
     if (!out || !in) {
@@ -303,26 +384,45 @@ int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
         return LAGSIMD_EXIT_RUNTIME;
     }
     b->discard = true; /* until rt_begin: nothing that arrives before the start counts */
-    int rc = rt_bus_attach(b, out, in, h, err, errlen);
-    if (rc != LAGSIMD_EXIT_OK) {
-        if (in != out) lcm_destroy(in);
-        lcm_destroy(out);
-        b->lcm = b->lcm_in = NULL;
-        return rc;
+    int rc;
+    if (u->udpm) {
+        b->on = *h;
+        b->lcm = out;
+        b->lcm_in = in;
+        rt_limit_init(&b->probes, RT_FOREIGN_PROBES_PER_S, RT_FOREIGN_PROBES_PER_S,
+                      b->now ? *b->now : lag_clock_mono_ns());
+        rc = open_receivers(b, err, errlen);
+        if (rc == LAGSIMD_EXIT_OK) rc = ask_for_other_plant(b, err, errlen);
+    } else {
+        rc = rt_bus_attach(b, out, in, h, err, errlen);
+        if (rc != LAGSIMD_EXIT_OK) {
+            lcm_destroy(out);
+            b->lcm = b->lcm_in = NULL;
+            return rc;
+        }
     }
-    if (!u->udpm) {
-        if (!b->quiet)
-            fprintf(stderr, "lagsimd: %s: on %s (this process only)\n", b->sc->lcm.prefix,
-                    u->state_url);
-        return LAGSIMD_EXIT_OK;
-    }
-    rc = look_for_other_plant(b, err, errlen);
-    if (rc == LAGSIMD_EXIT_OK) rc = filter_input(b, err, errlen);
-    if (rc != LAGSIMD_EXIT_OK) {
-        rt_bus_close(b);
-        return rc;
-    }
-    /* where the daemon listens, and who can reach it */
+    if (rc != LAGSIMD_EXIT_OK) rt_bus_close(b);
+    return rc;
+}
+
+int rt_bus_fd(const rt_bus *b, bool watch)
+{
+    if (b->urls.udpm) return watch ? b->rx_watch.fd : b->rx_in.fd;
+    return watch || !b->lcm_in ? -1 : lcm_get_fileno(b->lcm_in);
+}
+
+int rt_bus_read(rt_bus *b, bool watch, int max)
+{
+    if (b->urls.udpm) return rt_rx_read(watch ? &b->rx_watch : &b->rx_in, max);
+    int n = 0;
+    while (!watch && b->lcm_in && n < max && lcm_handle_timeout(b->lcm_in, 0) > 0) n++;
+    return n;
+}
+
+/* Where the daemon listens, and who can reach it (said at start). */
+static void say_where(const rt_bus *b)
+{
+    const lag_bus *u = &b->urls;
     char ifname[64];
     if (lag_net_group_iface(u->group, ifname, sizeof ifname) != 0)
         snprintf(ifname, sizeof ifname, "no interface (no route to %s)", u->group);
@@ -342,12 +442,51 @@ int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
                 "host only (lcm.allow_lan: false) on %s; states on %s%s\n", b->sc->lcm.prefix,
                 ifname, u->command_url, u->state_url,
                 ttl == 0 ? ", which stay on this host (ttl=0)" : "");
+}
+
+int rt_bus_open_finish(rt_bus *b, char *err, size_t errlen)
+{
+    const lag_bus *u = &b->urls;
+    if (!u->udpm) {
+        if (!b->quiet)
+            fprintf(stderr, "lagsimd: %s: on %s (this process only)\n", b->sc->lcm.prefix,
+                    u->state_url);
+        return LAGSIMD_EXIT_OK;
+    }
+    int rc = LAGSIMD_EXIT_OK;
+    if (b->other_plant[0]) {
+        snprintf(err, errlen, "another plant publishes on prefix %s (%s): refusing to start; "
+                 "one plant per prefix (give this one another lcm.prefix, or stop the other)",
+                 b->sc->lcm.prefix, b->other_plant);
+        rc = LAGSIMD_EXIT_RUNTIME;
+    }
+    if (rc == LAGSIMD_EXIT_OK) rc = filter_input(b, err, errlen);
+    if (rc != LAGSIMD_EXIT_OK) {
+        rt_bus_close(b);
+        return rc;
+    }
+    say_where(b);
     return LAGSIMD_EXIT_OK;
+}
+
+int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen)
+{
+    int rc = rt_bus_open_start(b, h, err, errlen);
+    if (rc != LAGSIMD_EXIT_OK) return rc;
+    int64_t end = lag_clock_mono_ns() + RT_LOOK_MS * 1000000LL;
+    for (int64_t left; b->urls.udpm && !b->other_plant[0] && (left = end - lag_clock_mono_ns()) > 0;) {
+        struct pollfd pf = {b->rx_watch.fd, POLLIN, 0};
+        poll(&pf, 1, (int)(left / 1000000) + 1);
+        rt_rx_read(&b->rx_watch, 16);
+    }
+    return rt_bus_open_finish(b, err, errlen);
 }
 
 void rt_bus_close(rt_bus *b)
 {
     rt_bus_detach(b);
+    rt_rx_close(&b->rx_in);
+    rt_rx_close(&b->rx_watch);
     if (b->lcm_in && b->lcm_in != b->lcm) lcm_destroy(b->lcm_in);
     if (b->lcm) lcm_destroy(b->lcm);
     b->lcm = b->lcm_in = NULL;

@@ -17,6 +17,7 @@
 #include "lagsim_wire.h"
 #include "rt_foreign.h"
 #include "rt_pace.h"
+#include "rt_rx.h"
 #include "scene.h"
 
 #define RT_CHANNEL_MAX LAG_BUS_CHANNEL_LEN /* prefix (< 64) + "_COMMAND" */
@@ -38,9 +39,13 @@ typedef struct rt_bus {
     char ch_state[RT_CHANNEL_MAX], ch_command[RT_CHANNEL_MAX], ch_status[RT_CHANNEL_MAX],
         ch_event[RT_CHANNEL_MAX], ch_control[RT_CHANNEL_MAX], ch_scene[RT_CHANNEL_MAX],
         ch_reference[RT_CHANNEL_MAX];
-    lcm_t *lcm;                /* publishes on the state URL (never receives but _SCENE) */
-    lcm_t *lcm_in;             /* receives _COMMAND and _CONTROL on the command URL (the
-                                * same lcm_t as `lcm` for memq://) */
+    lcm_t *lcm;                /* publishes on the state URL */
+    lcm_t *lcm_in;             /* udpm: publishes on the command URL (DESCRIBE at start, the
+                                * sync marker); memq://: the same lcm_t as `lcm`, receiving
+                                * _COMMAND and _CONTROL through LCM's subscriptions */
+    rt_rx rx_in;               /* udpm: _COMMAND and _CONTROL, read by the loop (rt_rx.h) */
+    rt_rx rx_watch;            /* udpm: the plant watch on the state URL: _SCENE, and
+                                * _COMMAND sent to the wrong port */
     lcm_subscription_t *sub_command, *sub_control;
     lcm_subscription_t *sub_scene; /* _SCENE on the state URL: another plant's (plant watch) */
     lcm_subscription_t *sub_wrong_port; /* _COMMAND on the state URL: counted, not applied */
@@ -76,13 +81,30 @@ int rt_bus_attach(rt_bus *b, lcm_t *out, lcm_t *in, const rt_bus_handlers *h, ch
                   size_t errlen);
 /* Unsubscribes (the caller destroys its lcm). */
 void rt_bus_detach(rt_bus *b);
-/* The daemon's LCM instances: one publishing on the state URL, one receiving on the
- * command URL (one lcm_t for memq://), attached with `h`; before anything is published,
+/* The daemon's bus: on udpm:// two LCM instances that only publish (state URL, command
+ * URL) and two receive sockets of its own (rt_rx.h: no LCM thread, no select(2)); on
+ * memq:// one lcm_t, attached with `h`; before anything is published,
  * the look for another plant on the prefix; and what the daemon says about them at start.
  * Leaves b->discard set (the loop clears it at the start). Returns 0, or an exit code with
- * a message in err; rt_bus_close detaches and destroys what rt_bus_open made. */
+ * a message in err; rt_bus_close detaches and destroys what rt_bus_open made.
+ *
+ * In two steps, for a loop that serves other plants during the look: rt_bus_open_start
+ * makes the instances, filters the state URL's receive socket to the plant watch and asks
+ * the prefix for its scene (DESCRIBE); the caller then handles b->lcm for RT_LOOK_MS
+ * (another plant's scene is noted in b->other_plant); rt_bus_open_finish refuses the
+ * start if one came, else filters the command URL and says where the plant listens. Each
+ * closes what it made when it fails. rt_bus_open is the three in a row. */
+#define RT_LOOK_MS 200 /* how long a starting daemon listens for another plant */
 int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen);
+int rt_bus_open_start(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen);
+int rt_bus_open_finish(rt_bus *b, char *err, size_t errlen);
 void rt_bus_close(rt_bus *b);
+/* What the loop waits on: the descriptor of the input (watch false) or of the plant watch
+ * (-1: none: memq's watch). */
+int rt_bus_fd(const rt_bus *b, bool watch);
+/* Reads at most max messages of the input or the plant watch, handing each to the
+ * handlers. Returns the number read (0: nothing waiting). */
+int rt_bus_read(rt_bus *b, bool watch, int max);
 
 /* FNV-1a, 64 bits: how a published scene is remembered. */
 uint64_t rt_bus_hash(const uint8_t *data, size_t len);

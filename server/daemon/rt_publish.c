@@ -31,6 +31,7 @@ static const struct {
     /* one in RT_CONFLICT_EVERY_S however many scenes a forger or a log player sends */
     [RT_EV_PLANT_CONFLICT] = {"plant_conflict", 1.0 / RT_CONFLICT_EVERY_S, 1},
     [RT_EV_ERROR_ESTIMATE] = {"error_estimate", 1, 3},
+    [RT_EV_INPUT_LIMITED] = {"input_limited", 1, 3},
 };
 _Static_assert(sizeof ev_limits / sizeof ev_limits[0] == RT_EV_COUNT, "one bucket per rt_ev");
 
@@ -130,10 +131,18 @@ void rt_pub_state_again(rt_pub *p)
     p->lockstep_retries++;
 }
 
+/* A message's bytes as sent (in the bus's buffer), kept. */
+static void keep(rt_sent *k, const rt_bus *bus, int n)
+{
+    if (n <= 0 || (size_t)n > sizeof k->buf) return;
+    memcpy(k->buf, bus->buf, (size_t)n);
+    k->len = (unsigned)n;
+}
+
 void rt_pub_scene(rt_pub *p, const lag_scene *sc, const lag_model_info *info)
 {
     rt_out o = out(p);
-    rt_publish_scene(&o, sc, p->sim, info);
+    keep(&p->last_scene, p->bus, rt_publish_scene(&o, sc, p->sim, info));
 }
 
 void rt_pub_new_generation(rt_pub *p, const lag_scene *sc, const lag_model_info *info)
@@ -146,6 +155,6 @@ void rt_pub_new_generation(rt_pub *p, const lag_scene *sc, const lag_model_info 
 void rt_pub_status(rt_pub *p, lag_wire_status *m)
 {
     rt_out o = out(p);
-    rt_publish_status(&o, m);
+    keep(&p->last_status, p->bus, rt_publish_status(&o, m));
     p->want_status = false;
 }

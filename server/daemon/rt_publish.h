@@ -44,6 +44,7 @@ typedef enum rt_ev {
     RT_EV_EVENTS_DROPPED,
     RT_EV_PLANT_CONFLICT,     /* a scene of another plant heard on this prefix while running */
     RT_EV_ERROR_ESTIMATE,     /* the live error estimate over the scene's budget per period */
+    RT_EV_INPUT_LIMITED,      /* a host's plant: more input than it can use, reading paused */
     RT_EV_COUNT
 } rt_ev;
 
@@ -81,6 +82,7 @@ typedef struct rt_pub {
     int64_t lockstep_retries;  /* states published again, no answer having come */
 
     uint8_t state_buf[RT_BUF_SIZE]; /* the last state published, as sent (lockstep retries) */
+    rt_sent last_scene, last_status; /* the last of each, as sent (a host's directory) */
     rt_sent ref_sent;               /* its reference, as sent (lockstep retries) */
     unsigned state_len;
 } rt_pub;

@@ -1,5 +1,5 @@
 /*
- * The real-time LCM server's loop (realtime.c) and the state it keeps itself: the run,
+ * One plant of the real-time LCM server (realtime.c) and the state it keeps itself: the run,
  * the control period in progress, the commands held, the answers owed, the counters that
  * status publishes. Everything else is a part the loop holds and passes what it needs,
  * each with its own header and struct, none of which includes this one:
@@ -16,12 +16,12 @@
  *   rt_lockstep.h  the state waited on, its timeout and its copies
  *   rt_command.h   what a command must be to be applied (no state)
  *   rt_estimate.h  the live error estimate
- *   rt_io.h        the wait: signalfd, timerfd, one ppoll per wake-up
+ *   rt_io.h        the wait (the loop's, host.c's): signalfd, timerfd, epoll
  *   rt_pace.h      deadlines and token buckets (pure arithmetic)
  *   live_set.h     the changes made while running (SET, kicks)
  *
- * Everything the stepping path touches lives in this struct, allocated once (static in
- * lagsimd_realtime): fixed-size arrays, one encode buffer, no malloc.
+ * Everything the stepping path touches lives in this struct, allocated once per plant
+ * (rt_plant_new): fixed-size arrays, one encode buffer, no malloc.
  */
 #ifndef LAGSIMD_RT_SERVER_H
 #define LAGSIMD_RT_SERVER_H
@@ -32,6 +32,7 @@
 #include <lcm/lcm.h>
 #include "daemon.h"
 #include "live_set.h"
+#include "realtime.h"
 #include "lagsim_bus.h"
 #include "lagsim_wire.h"
 #include "rt_bus.h"
@@ -45,14 +46,6 @@
 #include "rt_term.h"
 #include "rt_wait.h"
 #include "rt_wire.h"
-
-/* Why the server stopped. */
-typedef enum rt_stop {
-    RT_STOP_NONE = 0,
-    RT_STOP_SIGNAL,
-    RT_STOP_DURATION,
-    RT_STOP_ERROR,
-} rt_stop;
 
 typedef struct rt_server {
     const lag_scene *sc;
@@ -135,8 +128,9 @@ typedef struct rt_server {
     bool report_line;          /* SIGUSR1/SIGUSR2: one status line on stderr */
 } rt_server;
 
-/* realtime.c: the server in pieces (lagsimd_realtime strings them together; tests and
- * the fuzz target drive them with their own clock and LCM, e.g. memq://). */
+/* realtime.c: the server in pieces (rt_plant_* in realtime.h string them together for
+ * the loop of host.c; tests and the fuzz target drive them with their own clock and LCM,
+ * e.g. memq://). rt_next_wake, rt_process and rt_signal: realtime.h. */
 /* Checks the scene's real-time settings and initializes the sim, at clock `now`; no LCM
  * yet. Settings the loop clamps are said on stderr unless quiet. Returns 0, or an exit
  * code (2: bad scene or --duration) with a message in err. */
@@ -148,12 +142,6 @@ int rt_open(rt_server *s, const lag_scene *sc, const lagsimd_opts *o, int64_t no
 int rt_attach(rt_server *s, lcm_t *out, lcm_t *in, char *err, size_t errlen);
 /* Publishes the scene, a start event, the initial state and a status; deadlines start. */
 void rt_begin(rt_server *s);
-/* When the loop must next wake up (absolute ns; <= s->now: at once). Pure. */
-int64_t rt_next_wake(const rt_server *s);
-/* Everything due at s->now: the mode's periods, pending answers, the periodic status. */
-void rt_process(rt_server *s);
-/* A signal arrived: SIGUSR1/SIGUSR2 ask for a status, any other stops the server. */
-void rt_signal(rt_server *s, int signo);
 /* A stop event and the final status. */
 void rt_finish(rt_server *s);
 /* Closes --log (if still open) and unsubscribes (the caller destroys its lcm). */

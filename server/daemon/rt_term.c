@@ -34,6 +34,7 @@ static void clear_line(rt_term *t)
 void rt_term_init(rt_term *t, bool quiet, const char *ch_event, int64_t now)
 {
     t->quiet = quiet;
+    t->who = "";
     t->ch_event = ch_event;
     rt_limit_init(&t->lim_print, 20, 20, now);
 }
@@ -47,13 +48,13 @@ void rt_term_event(rt_term *t, int64_t now, double sim_time, const char *kind,
     t->lim_print.suppressed = 0;
     clear_line(t);
     if (suppressed > 0)
-        fprintf(stderr, "lagsimd: (%lld more events not shown: at most 20 lines a second; "
-                "every event is on %s)\n", (long long)suppressed, t->ch_event);
+        fprintf(stderr, "lagsimd: %s(%lld more events not shown: at most 20 lines a second; "
+                "every event is on %s)\n", t->who, (long long)suppressed, t->ch_event);
     if (effect)
-        fprintf(stderr, "lagsimd: event %s at t = %.9f s, joint %s, value %g\n", kind, sim_time,
-                joint && joint[0] ? joint : "-", value);
+        fprintf(stderr, "lagsimd: %sevent %s at t = %.9f s, joint %s, value %g\n", t->who, kind,
+                sim_time, joint && joint[0] ? joint : "-", value);
     else
-        fprintf(stderr, "lagsimd: event %s at t = %.9f s%s%s: %s\n", kind, sim_time,
+        fprintf(stderr, "lagsimd: %sevent %s at t = %.9f s%s%s: %s\n", t->who, kind, sim_time,
                 joint && joint[0] ? ", joint " : "", joint ? joint : "", detail ? detail : "");
     if (t->live_line) rt_term_line(t, now, false);
     else fflush(stderr);

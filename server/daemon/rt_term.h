@@ -27,6 +27,8 @@ typedef struct rt_term_view {
 
 typedef struct rt_term {
     bool quiet;             /* -q: no event lines, no live line */
+    const char *who;        /* what the event lines begin with after "lagsimd: ": "" for a
+                             * daemon of one plant, "ALICE: " for a host's plant */
     bool live_line;         /* stderr is a terminal and not -q */
     const char *ch_event;   /* where every event is (said when lines were not shown) */
     void (*view)(void *ctx, rt_term_view *v); /* the live line's content, from the loop */

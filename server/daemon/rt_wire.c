@@ -110,7 +110,7 @@ void rt_status_base(lag_wire_status *m, const lag_sim *sim, const lag_scene *sc)
     m->error_budget = rt_error_budget(sc);
 }
 
-void rt_publish_status(const rt_out *o, lag_wire_status *m)
+int rt_publish_status(const rt_out *o, lag_wire_status *m)
 {
     m->sim_time = fin(m->sim_time);
     m->wall_time = fin(m->wall_time);
@@ -121,7 +121,7 @@ void rt_publish_status(const rt_out *o, lag_wire_status *m)
     m->waiting_s = fin(m->waiting_s);
     m->error_estimate = fin(m->error_estimate);
     m->error_budget = fin(m->error_budget);
-    publish(o, o->bus->ch_status, LAG_WIRE_STATUS, m);
+    return publish(o, o->bus->ch_status, LAG_WIRE_STATUS, m);
 }
 
 void rt_publish_event(const rt_out *o, double sim_time, int64_t step, const char *kind,
@@ -138,7 +138,7 @@ void rt_publish_event(const rt_out *o, double sim_time, int64_t step, const char
     publish(o, o->bus->ch_event, LAG_WIRE_EVENT, m);
 }
 
-void rt_publish_scene(const rt_out *o, const lag_scene *sc, const lag_sim *sim,
+int rt_publish_scene(const rt_out *o, const lag_scene *sc, const lag_sim *sim,
                       const lag_model_info *info)
 {
     const lag_sim_def *d = &sim->def; /* the parameters and effects now (SET changes them) */
@@ -182,4 +182,5 @@ void rt_publish_scene(const rt_out *o, const lag_scene *sc, const lag_sim *sim,
     int n = publish(o, o->bus->ch_scene, LAG_WIRE_SCENE, &m);
     /* remembered, so that the plant watch knows it when it comes back */
     if (n > 0) rt_bus_sent_scene(o->bus, o->bus->buf, (size_t)n);
+    return n;
 }

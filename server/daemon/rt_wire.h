@@ -43,14 +43,15 @@ int rt_publish_state(const rt_out *o, const lag_sim *sim, const lag_model_info *
 /* The parts of a status the sim and the scene give (time, step, energy, contact, the
  * integrator, the mode, the error budget); the loop fills its counters. */
 void rt_status_base(lag_wire_status *m, const lag_sim *sim, const lag_scene *sc);
-/* Publishes the status m (its doubles made finite first). */
-void rt_publish_status(const rt_out *o, lag_wire_status *m);
+/* Publishes the status m (its doubles made finite first). Returns its bytes, as sent, in
+ * o->bus->buf (0: not sent). */
+int rt_publish_status(const rt_out *o, lag_wire_status *m);
 /* An event at sim_time, at tick `step`; m: the event as sent (what the terminal shows). */
 void rt_publish_event(const rt_out *o, double sim_time, int64_t step, const char *kind,
                       const char *joint, double value, const char *detail, lag_wire_event *m);
 /* The scene as it is now (SET changes the sim's definition), remembered by the plant
- * watch (rt_bus_sent_scene). */
-void rt_publish_scene(const rt_out *o, const lag_scene *sc, const lag_sim *sim,
+ * watch (rt_bus_sent_scene). Returns its bytes, as sent, in o->bus->buf (0: not sent). */
+int rt_publish_scene(const rt_out *o, const lag_scene *sc, const lag_sim *sim,
                       const lag_model_info *info);
 
 #endif

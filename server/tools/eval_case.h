@@ -140,6 +140,9 @@ typedef struct eval_env {
     bool allow_lan;          /* --allow-lan: the URL's ttl may be above 0 */
     double wall_timeout;     /* s a run may take before it is stopped (and failed) */
     bool verbose;            /* pass the daemon's and the controller's output through */
+    const char *attach_log;  /* kept processes on a plant of a host already running
+                              * (lagsim-sweep --plants-per-worker): its --log; NULL: the
+                              * worker starts a daemon of its own */
     char who[96];            /* "lagsim-eval: case tilt": the start of a line saying that
                               * the plant still waits for its first answer (eval_watch);
                               * "": said nothing */

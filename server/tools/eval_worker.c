@@ -272,8 +272,9 @@ static void stop_pair(eval_worker *w)
         kill(w->dpid, SIGTERM);
         if (!eval_wait_until(w->dpid, eval_now() + 3.0, &st)) eval_stop_group(w->dpid, &st);
     }
-    /* a controller ends on the daemon's stop; one that does not is stopped */
-    if (w->cpid > 0 && !eval_wait_until(w->cpid, eval_now() + 3.0, &st))
+    /* a controller ends on the daemon's stop; one that does not is stopped (on a host's
+     * plant, which runs on, at once) */
+    if (w->cpid > 0 && (w->env.attach_log || !eval_wait_until(w->cpid, eval_now() + 3.0, &st)))
         eval_stop_group(w->cpid, &st);
     w->dpid = w->cpid = 0;
 }
@@ -331,8 +332,12 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
     if (!w) return NULL;
     w->env = *env;
     w->sc = *sc;
-    snprintf(w->log, sizeof w->log, "%s/%s.lcm", env->workdir, env->prefix);
-    unlink(w->log);
+    if (env->attach_log) { /* a plant of the sweep's host: its log is the host's */
+        snprintf(w->log, sizeof w->log, "%s", env->attach_log);
+    } else {
+        snprintf(w->log, sizeof w->log, "%s/%s.lcm", env->workdir, env->prefix);
+        unlink(w->log);
+    }
     char cmd[4096];
     if (eval_expand(env->controller, env, cmd, sizeof cmd, err, errlen)) {
         free(w);
@@ -341,7 +346,7 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
     eval_stderr_paths(env, w->cerr, w->derr, sizeof w->cerr);
     /* the controller first, as eval_run starts them */
     w->cpid = eval_spawn(NULL, cmd, env, w->cerr);
-    w->dpid = start_daemon(w, c);
+    w->dpid = env->attach_log ? 0 : start_daemon(w, c);
     w->cl = lag_client_create(env->url, env->prefix, err, errlen);
     w->status = lag_client_status_new();
     if (w->cpid < 0 || w->dpid < 0 || !w->cl || !w->status)
@@ -357,6 +362,9 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
         return start_failed(w, err, errlen, "cannot listen to the controller's answers");
     if (lag_client_wait_scene(w->cl, 10.0, NULL) != LAG_CLIENT_OK)
         return start_failed(w, err, errlen, "no scene from the kept lagsimd");
+    /* a host's plant a worker before may have left in the middle of a run: paused first
+     * (a plant paused already refuses it, harmlessly) */
+    if (env->attach_log) lag_client_pause(w->cl);
     if (step_once(w, 1, W_FIRST_S)) return no_first_answer(w, controller, err, errlen);
     return w;
 }
@@ -370,7 +378,7 @@ void eval_worker_stop(eval_worker *w)
     if (w->cmd) lcm_destroy(w->cmd);
     eval_series_free(&w->s);
     if (!w->env.verbose) {
-        unlink(w->log);
+        if (!w->env.attach_log) unlink(w->log); /* a host's plant's: the sweep's to remove */
         if (w->cerr[0]) unlink(w->cerr);
         if (w->derr[0]) unlink(w->derr);
     }

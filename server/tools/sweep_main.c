@@ -21,6 +21,8 @@
 #include <unistd.h>
 
 #include "eval_case.h"
+#include "lagsim_port.h"
+#include "lagsim_url.h"
 #include "scene.h"
 #include "sweep_live.h"
 #include "sweep_merge.h"
@@ -38,7 +40,7 @@ static void usage(FILE *f)
     fprintf(f,
 "usage: lagsim-sweep --config SCENE --controller 'COMMAND' (--case NAME | --duration S)\n"
 "                    --vary KEY=DIST ... [--runs N] [--seed S] [-j N] [--shard K/N]\n"
-"                    [--only RUNS] [--restart] [--progress]\n"
+"                    [--only RUNS] [--restart | --plants-per-worker K] [--progress]\n"
 "                    [--suite FILE] [--require EXPR] [--csv OUT.csv] [--plot OUT.png]\n"
 "                    [--metric JOINT.METRIC] [--force] [--url URL] [--allow-lan]\n"
 "                    [--lagsimd PATH] [--timeout S] [-v]\n"
@@ -73,6 +75,10 @@ static void usage(FILE *f)
 "                         run's values (default: one of each per worker, started\n"
 "                         with the scene's values; each run's values SET and its\n"
 "                         initial state RESET_TO between runs)\n"
+"      --plants-per-worker K  the workers' plants K to a lagsimd (a host, lagsimd\n"
+"                         --plants), each worker driving its own plant of it; the same\n"
+"                         CSV (default 1: a lagsimd per worker, the faster for\n"
+"                         lockstep runs on this machine: docs/evaluation.md)\n"
 "      --require EXPR     a run that misses EXPR does not pass (as lagsim-eval)\n"
 "      --csv OUT.csv      the runs' CSV\n"
 "      --plot OUT.png     --metric against each varied key (gnuplot); runs without\n"
@@ -441,6 +447,16 @@ typedef struct sweep {
     eval_bus bus;                /* the runs' group and options */
     lag_port_lease lease[256];   /* a pair of ports for each worker, held while it runs */
     char url[256][160];          /* each worker's URL */
+    /* --plants-per-worker K: the workers in groups of K, each group's plants in one
+     * lagsimd (a host, --plants) started before the workers: its directory's pair, then
+     * its plants' pairs, consecutive; each worker drives its own plant of it */
+    long ppw;
+    long ngroups;
+    int ppid;                    /* the sweep's pid: the plants' prefixes */
+    lag_port_lease dir_lease[256];
+    char dir_url[256][160];
+    pid_t host[256];
+    char attach[256][320];       /* each worker's plant's --log in its host */
     vary vs[VARY_MAX];
     int nv;
     char lagsimd[4096];
@@ -497,7 +513,7 @@ static int add_vary(sweep *x, const char *text)
 static int parse_options(sweep *x, int argc, char **argv)
 {
     enum { O_CASE = 256, O_SUITE, O_VARY, O_SEED, O_SHARD, O_REQUIRE, O_CSV, O_PLOT, O_METRIC,
-           O_LAGSIMD, O_TIMEOUT, O_RESTART, O_URL, O_ALLOW_LAN, O_ONLY, O_PROGRESS };
+           O_LAGSIMD, O_TIMEOUT, O_RESTART, O_URL, O_ALLOW_LAN, O_ONLY, O_PROGRESS, O_PPW };
     static const struct option opts[] = {
         {"config", required_argument, 0, 'c'},      {"controller", required_argument, 0, 'C'},
         {"case", required_argument, 0, O_CASE},     {"suite", required_argument, 0, O_SUITE},
@@ -511,7 +527,7 @@ static int parse_options(sweep *x, int argc, char **argv)
         {"restart", no_argument, 0, O_RESTART},     {"help", no_argument, 0, 'h'},
         {"url", required_argument, 0, O_URL},       {"allow-lan", no_argument, 0, O_ALLOW_LAN},
         {"only", required_argument, 0, O_ONLY},     {"progress", no_argument, 0, O_PROGRESS},
-        {0, 0, 0, 0}};
+        {"plants-per-worker", required_argument, 0, O_PPW}, {0, 0, 0, 0}};
     int o, bad = 0;
     opterr = 0;
     while ((o = getopt_long(argc, argv, ":c:C:d:n:j:fvh", opts, NULL)) != -1) {
@@ -554,6 +570,7 @@ static int parse_options(sweep *x, int argc, char **argv)
         case O_RESTART: x->restart = true; break;
         case O_URL: x->url_opt = optarg; break;
         case O_ALLOW_LAN: x->allow_lan = true; break;
+        case O_PPW: x->ppw = (long)parse_int("--plants-per-worker", optarg, 1, 64, &bad); break;
         case 'h': usage(stdout); return 0;
         case ':': return die("%s needs a value (try --help)", argv[optind - 1]);
         default: return die("unknown option '%s' (try --help)", argv[optind - 1]);
@@ -570,6 +587,9 @@ static int check_options(sweep *x, int argc, char **argv)
     if (!x->controller) return die("%s", "--controller 'COMMAND' is required (try --help)");
     if (!x->nv) return die("%s", "at least one --vary KEY=DIST is required (try --help)");
     if (!x->case_name == !x->duration) return die("%s", "give either --case NAME or --duration S");
+    if (x->ppw > 1 && x->restart)
+        return die("%s", "--plants-per-worker shares kept daemons between runs: not with "
+                   "--restart");
     char err[512];
     if (eval_bus_init(&x->bus, x->url_opt, x->allow_lan, err, sizeof err)) return die("%s", err);
     return -1;
@@ -620,6 +640,10 @@ static int load_scene(sweep *x)
                         "initial.qd): a daemon and a controller are started for each run "
                         "(--restart)\n", prog, key);
         x->restart = true;
+        if (x->ppw > 1)
+            fprintf(stderr, "%s: --plants-per-worker %ld: each run has a daemon of its own "
+                    "then: one plant per worker\n", prog, x->ppw);
+        x->ppw = 1;
     }
     x->per_point = x->total = x->runs;
     for (int k = 0; k < x->nv; k++) /* each factor <= 1e7: checked before it can overflow */
@@ -744,6 +768,14 @@ static void fail_unrun(eval_result *res, int nj, const char *why)
     eval_fail(res, "%s", why);
 }
 
+/* Worker w's plant of its group's host: prefix SWEEP<pid>_W<w> (w in three digits, so
+ * that the files' names sort as the workers do and the host gives the plants their pairs
+ * in that order); its file is the prefix in small letters (the host's rule). */
+static void plant_prefix(const sweep *x, long w, char *out, size_t len)
+{
+    snprintf(out, len, "SWEEP%d_W%03ld", x->ppid, w);
+}
+
 static eval_env worker_env(const worker *wk, long run)
 {
     const sweep *x = wk->x;
@@ -752,8 +784,14 @@ static eval_env worker_env(const worker *wk, long run)
                     .allow_lan = x->allow_lan};
     /* the worker's ports, for all its runs; a prefix of each run's own */
     snprintf(env.url, sizeof env.url, "%s", x->url[wk->w]);
-    if (run < 0) snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_W%ld", (int)getpid(), wk->w);
-    else snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_%ld", (int)getpid(), run);
+    if (run < 0 && x->ppw > 1) { /* its plant of the group's host (start_hosts) */
+        plant_prefix(x, wk->w, env.prefix, sizeof env.prefix);
+        env.attach_log = x->attach[wk->w];
+    } else if (run < 0) {
+        snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_W%ld", (int)getpid(), wk->w);
+    } else {
+        snprintf(env.prefix, sizeof env.prefix, "SWEEP%d_%ld", (int)getpid(), run);
+    }
     return env;
 }
 
@@ -1085,10 +1123,44 @@ static int count_passed(const sweep *x, const rows *r)
     return passed;
 }
 
+/* A URL of the runs' group and options on `port`. -1 when it cannot be one. */
+static int url_on(const sweep *x, int port, char *url, size_t len)
+{
+    int n = lag_url_format(&x->bus.u, port, url, len);
+    return n < 0 || (size_t)n >= len ? -1 : 0;
+}
+
+/* --plants-per-worker: for each group of K workers, K + 1 consecutive pairs: the host's
+ * directory's, then each worker's plant's (the host gives its plants the pairs after its
+ * directory's, in the order of their files' names). */
+static int take_blocks(sweep *x)
+{
+    char err[512];
+    x->ngroups = (x->jobs + x->ppw - 1) / x->ppw;
+    for (long g = 0; g < x->ngroups; g++) {
+        long first = g * x->ppw, n = x->jobs - first < x->ppw ? x->jobs - first : x->ppw;
+        lag_port_lease l[65];
+        if (lag_port_take_block((int)n + 1, l, err, sizeof err) != 0) {
+            fprintf(stderr, "%s: the host of workers %ld to %ld: %s\n", prog, first + 1,
+                    first + n, err);
+            return -1;
+        }
+        x->dir_lease[g] = l[0];
+        for (long k = 0; k < n; k++) x->lease[first + k] = l[k + 1];
+        if (url_on(x, l[0].port, x->dir_url[g], sizeof x->dir_url[g]))
+            return die("%s", "the runs' URL is too long"), -1;
+        for (long k = 0; k < n; k++)
+            if (url_on(x, l[k + 1].port, x->url[first + k], sizeof x->url[first + k]))
+                return die("%s", "the runs' URL is too long"), -1;
+    }
+    return 0;
+}
+
 /* A pair of ports for each worker, held until the sweep ends (its workers, forked, share
  * the locks). Returns -1 after saying why when the host has too few free. */
 static int take_ports(sweep *x)
 {
+    if (x->ppw > 1) return take_blocks(x);
     char err[512];
     for (long w = 0; w < x->jobs; w++)
         if (eval_bus_take(&x->bus, &x->lease[w], x->url[w], sizeof x->url[w], err, sizeof err)) {
@@ -1101,6 +1173,97 @@ static int take_ports(sweep *x)
 static void release_ports(sweep *x)
 {
     for (long w = 0; w < x->jobs; w++) lag_port_release(&x->lease[w]);
+    for (long g = 0; g < x->ngroups; g++) lag_port_release(&x->dir_lease[g]);
+}
+
+/* ---------------------------------------------------------------- shared hosts */
+/* Group g's host: a directory of its workers' plants (copies of the scene file, named by
+ * their prefixes), lagsimd --plants on it with the keys the tools own (but each plant's
+ * URL and prefix: the host's rules give them) and the case's sets, --log per plant. */
+static int start_host(sweep *x, long g, const char *text, size_t len)
+{
+    char dir[200], path[512], pre[64];
+    snprintf(dir, sizeof dir, "%s/h%ld", x->tmpdir, g);
+    snprintf(path, sizeof path, "%s/lab", dir);
+    if (mkdir(dir, 0700) != 0 || mkdir(path, 0700) != 0) return -1;
+    long first = g * x->ppw;
+    for (long w = first; w < x->jobs && w < first + x->ppw; w++) {
+        plant_prefix(x, w, pre, sizeof pre);
+        for (char *c = pre; *c; c++) *c = (char)(*c >= 'A' && *c <= 'Z' ? *c - 'A' + 'a' : *c);
+        snprintf(path, sizeof path, "%s/lab/%s.yaml", dir, pre);
+        FILE *f = fopen(path, "w");
+        if (!f || fwrite(text, 1, len, f) != len || fclose(f) != 0) return -1;
+        snprintf(x->attach[w], sizeof x->attach[w], "%s/%s/run.lcm", dir, pre);
+    }
+    eval_env env = {.lagsimd = x->lagsimd, .config = x->config, .workdir = x->tmpdir,
+                    .verbose = x->verbose, .allow_lan = x->allow_lan};
+    snprintf(env.url, sizeof env.url, "%s", x->dir_url[g]); /* LCM_DEFAULT_URL: the directory */
+    char owned[EVAL_OWN_COUNT][EVAL_SET_LEN], lab[512], log[512];
+    eval_owned_sets(&env, true, owned);
+    snprintf(lab, sizeof lab, "%s/lab", dir);
+    snprintf(log, sizeof log, "%s/run.lcm", dir);
+    char *argv[2 * (EVAL_SETS_MAX + EVAL_OWN_COUNT) + 16];
+    int na = 0;
+    argv[na++] = x->lagsimd;
+    argv[na++] = "--plants";
+    argv[na++] = lab;
+    for (int i = 0; i < EVAL_OWN_COUNT; i++)
+        if (i != EVAL_OWN_URL && i != EVAL_OWN_PREFIX) {
+            argv[na++] = "--set";
+            argv[na++] = owned[i];
+        }
+    for (int i = 0; i < x->c.nsets; i++) {
+        argv[na++] = "--set";
+        argv[na++] = (char *)x->c.set[i];
+    }
+    argv[na++] = "--log";
+    argv[na++] = log;
+    argv[na++] = "-q";
+    argv[na] = NULL;
+    x->host[g] = eval_spawn(argv, NULL, &env, NULL);
+    return x->host[g] > 0 ? 0 : -1;
+}
+
+/* Every group's host (--plants-per-worker). -1 after saying why. */
+static int start_hosts(sweep *x)
+{
+    char *text = NULL, err[1024];
+    size_t len = 0;
+    if (lag_scene_read(x->config, &text, &len, err, sizeof err) != LAG_OK)
+        return die("%s", err), -1;
+    int rc = 0;
+    for (long g = 0; g < x->ngroups && !rc; g++)
+        if ((rc = start_host(x, g, text, len)) != 0)
+            fprintf(stderr, "%s: the host of group %ld cannot start in %s\n", prog, g + 1,
+                    x->tmpdir);
+    free(text);
+    return rc;
+}
+
+/* The hosts stopped (SIGTERM: every plant's stop event), their files removed (kept with
+ * -v, as the kept daemons' logs). */
+static void stop_hosts(sweep *x)
+{
+    for (long g = 0; g < x->ngroups; g++) {
+        int st;
+        if (x->host[g] > 0) eval_stop_group(x->host[g], &st);
+        x->host[g] = 0;
+        if (x->verbose) continue;
+        char path[512], pre[64];
+        for (long w = g * x->ppw; w < x->jobs && w < (g + 1) * x->ppw; w++) {
+            plant_prefix(x, w, pre, sizeof pre);
+            for (char *c = pre; *c; c++) *c = (char)(*c >= 'A' && *c <= 'Z' ? *c - 'A' + 'a' : *c);
+            unlink(x->attach[w]);
+            snprintf(path, sizeof path, "%s/h%ld/%s", x->tmpdir, g, pre);
+            rmdir(path);
+            snprintf(path, sizeof path, "%s/h%ld/lab/%s.yaml", x->tmpdir, g, pre);
+            unlink(path);
+        }
+        snprintf(path, sizeof path, "%s/h%ld/lab", x->tmpdir, g);
+        rmdir(path);
+        snprintf(path, sizeof path, "%s/h%ld", x->tmpdir, g);
+        rmdir(path);
+    }
 }
 
 /* A scene with a reference for some joints and not for others: the summary's note says
@@ -1161,9 +1324,13 @@ static int sweep_run(sweep *x)
     }
     if (x->verbose) { /* -v keeps the daemons' logs: said where, once */
         eval_proc_tmpdir_done();
-        fprintf(stderr, "%s: -v: the daemons' logs (SWEEP%d_W<worker>.lcm for a worker's kept "
-                "pair, SWEEP%d_<run>.lcm for a run's own) are kept in %s\n", prog,
-                (int)getpid(), (int)getpid(), x->tmpdir);
+        if (x->ppw > 1)
+            fprintf(stderr, "%s: -v: the hosts' plants' logs (h<group>/sweep%d_w<worker>/run.lcm) "
+                    "are kept in %s\n", prog, (int)getpid(), x->tmpdir);
+        else
+            fprintf(stderr, "%s: -v: the daemons' logs (SWEEP%d_W<worker>.lcm for a worker's "
+                    "kept pair, SWEEP%d_<run>.lcm for a run's own) are kept in %s\n", prog,
+                    (int)getpid(), (int)getpid(), x->tmpdir);
     }
     x->png_new = png_new;
     /* a signal from here on is the sweep's to act on: the rows of the runs that ended go
@@ -1176,7 +1343,8 @@ static int sweep_run(sweep *x)
         if (eval_proc_pending()) eval_proc_end(eval_proc_pending());
         return 2;
     }
-    int status = run_workers(x);
+    int status = x->ppw > 1 && start_hosts(x) ? 2 : run_workers(x);
+    stop_hosts(x);
     if (sweep_live_finish(&x->live, err, sizeof err)) status = 2, say_csv(x, err);
     if (fcsv && fclose(fcsv) != 0) status = 2, say_csv(x, strerror(errno));
     eval_proc_defer(false);
@@ -1200,7 +1368,8 @@ int main(int argc, char **argv)
     if (argc > 1 && !strcmp(argv[1], "merge")) return merge(argc - 1, argv + 1, usage);
     eval_proc_init(); /* every process it starts ends when it ends (eval_proc.h) */
     static sweep x = {.timeout = 600, .runs = 1, .jobs = 1, .shard_k = 1, .shard_n = 1,
-                      .seed = 1};
+                      .seed = 1, .ppw = 1};
+    x.ppid = (int)getpid();
     eval_default_lagsimd(x.lagsimd, sizeof x.lagsimd);
     x.self = argv[0];
     int rc;

@@ -18,6 +18,7 @@
 #include <sys/signalfd.h>
 #include <unistd.h>
 
+#include "lagsim_bus.h"
 #include "lagsim_client.h"
 #include "view.h"
 
@@ -198,6 +199,15 @@ static int block_signals(void)
     return sig_fd;
 }
 
+/* Whether a plant heard on LCM's default bus runs on another URL (a host's plant: its
+ * directory names its URL). */
+static bool elsewhere(const char *url)
+{
+    lag_bus b;
+    char err[64];
+    return lag_bus_init(&b, NULL, "X", err, sizeof err) == 0 && strcmp(b.state_url, url) != 0;
+}
+
 /* Without --prefix: the only plant on the bus; none yet: DIPC, watched until it comes.
  * GO_ON, else the result to exit with. */
 static int pick_prefix(view_opts *o)
@@ -211,6 +221,7 @@ static int pick_prefix(view_opts *o)
     }
     if (pr == LAG_CLIENT_OK) {
         o->prefix = found.prefix;
+        if (!o->url && elsewhere(found.url)) o->url = found.url; /* a host's plant */
     } else {
         o->prefix = "DIPC";
         fprintf(stderr, "lagsim-view: %s; watching prefix %s\n", err, o->prefix);
@@ -218,13 +229,34 @@ static int pick_prefix(view_opts *o)
     return GO_ON;
 }
 
+/* --prefix without --url: a plant of a host (lagsimd --plants) runs on a URL of its own,
+ * which the host's directory on LCM's default bus names (its `plant` event): the view
+ * watches the plant there. A plant of that bus itself, or none heard: the default. */
+static void plant_url(view_opts *o)
+{
+    static lag_client_plant all[LAG_CLIENT_MAX_PLANTS];
+    static char url[sizeof all[0].url];
+    char err[256];
+    int n = 0;
+    if (o->url || lag_client_discover(NULL, 1.0, 0.3, all, LAG_CLIENT_MAX_PLANTS, sizeof all[0],
+                                      &n, err, sizeof err) != LAG_CLIENT_OK)
+        return;
+    for (int i = 0; i < n; i++)
+        if (!strcmp(all[i].prefix, o->prefix) && elsewhere(all[i].url)) {
+            snprintf(url, sizeof url, "%s", all[i].url);
+            o->url = url;
+            return;
+        }
+}
+
 /* The address on stdout; on stderr, who can reach it. */
 static void print_address(const view_opts *o, view_http *h)
 {
     const char *listen = o->ho.listen;
     bool v6 = strchr(listen, ':') != NULL;
-    printf("lagsim-view: http://%s%s%s:%u/  (prefix %s)\n", v6 ? "[" : "", listen,
-           v6 ? "]" : "", view_http_port(h), o->prefix);
+    printf("lagsim-view: http://%s%s%s:%u/  (prefix %s%s%s)\n", v6 ? "[" : "", listen,
+           v6 ? "]" : "", view_http_port(h), o->prefix, o->url ? " on " : "",
+           o->url ? o->url : "");
     fflush(stdout);
     if (!is_loopback(listen))
         fprintf(stderr,
@@ -268,6 +300,7 @@ static lag_result view_main(int argc, char **argv)
     int sig_fd = block_signals();
     if (sig_fd < 0) return LAG_ERR_RUNTIME;
     if (!o.prefix && (code = pick_prefix(&o)) != GO_ON) return code;
+    else if (o.prefix && !o.url) plant_url(&o);
 
     char err[1200];
     static view_bridge vb; /* large (rings): static, one bridge per process */

@@ -181,6 +181,10 @@ static int note_one(int fd, void *user)
 
 void lag_net_note_inherited(void)
 {
+    static bool noted; /* the first call only: later, the process's own sockets exist (a
+                        * host's other plants), and they are not a parent's */
+    if (noted) return;
+    noted = true;
     n_inherited = 0;
     each_udp_socket(-1, note_one, NULL);
 }

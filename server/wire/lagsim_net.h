@@ -33,8 +33,8 @@
 /* Attaches the filter to every UDP socket of this process bound to `port`, but those
  * noted by lag_net_note_inherited (LCM's receive
  * socket of an lcm_t for that port, once it has a subscription): keep only LCM short
- * messages on one of the n channels (exact names), and with host_only only those sent
- * from this host. Returns the number of sockets filtered (0: none found), or -1 with a
+ * messages on one of the n channels (exact names), and with
+ * host_only only those sent from this host. Returns the number of sockets filtered (0: none found), or -1 with a
  * message in err. */
 int lag_net_filter(int port, bool host_only, const char *const *channels, int n, char *err,
                   size_t errlen);
@@ -49,7 +49,9 @@ int lag_net_filter_suffixes(int port, bool host_only, const char *const *channel
 
 /* Notes the UDP sockets this process has now, before it creates its LCM instances:
  * lag_net_filter leaves them alone (a parent that forked without close-on-exec shares
- * them, and a filter would cut the parent's own traffic). */
+ * them, and a filter would cut the parent's own traffic). The first call notes; the later
+ * ones do nothing (by then the process has sockets of its own: a host's plants each call
+ * it before making theirs). */
 void lag_net_note_inherited(void);
 
 /* Sends a marker on LAG_NET_MARKER_CHANNEL through lcm and handles lcm's messages until it

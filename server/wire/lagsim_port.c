@@ -137,21 +137,50 @@ int lag_port_take_in(const char *dir, int first, int last, unsigned start, lag_p
     return -1;
 }
 
-int lag_port_take(lag_port_lease *l, char *err, size_t errlen)
+/* The host's directory of lock files: the first of these that exists. */
+static const char *lock_dir(void)
 {
     static const char *const dirs[] = {LAG_PORT_LOCK_DIR, "/var/lock", "/tmp"};
-    const char *dir = dirs[sizeof dirs / sizeof dirs[0] - 1];
     for (size_t i = 0; i < sizeof dirs / sizeof dirs[0]; i++) {
         struct stat st;
-        if (stat(dirs[i], &st) == 0 && S_ISDIR(st.st_mode)) {
-            dir = dirs[i];
-            break;
-        }
+        if (stat(dirs[i], &st) == 0 && S_ISDIR(st.st_mode)) return dirs[i];
     }
-    /* Knuth's multiplicative hash of the pid: holders started one after another start
-     * their searches far apart */
-    unsigned start = (unsigned)getpid() * 2654435761u >> 16;
-    return lag_port_take_in(dir, LAG_PORT_FIRST, LAG_PORT_LAST, start, l, err, errlen);
+    return dirs[sizeof dirs / sizeof dirs[0] - 1];
+}
+
+/* Knuth's multiplicative hash of the pid: holders started one after another start their
+ * searches far apart */
+static unsigned pid_start(void) { return (unsigned)getpid() * 2654435761u >> 16; }
+
+int lag_port_take(lag_port_lease *l, char *err, size_t errlen)
+{
+    return lag_port_take_in(lock_dir(), LAG_PORT_FIRST, LAG_PORT_LAST, pid_start(), l, err,
+                            errlen);
+}
+
+int lag_port_take_block(int n, lag_port_lease *l, char *err, size_t errlen)
+{
+    const char *dir = lock_dir();
+    const unsigned pairs = (LAG_PORT_LAST - LAG_PORT_FIRST) / 2 + 1;
+    unsigned start = pid_start();
+    for (int k = 0; k < n; k++) l[k] = (lag_port_lease){0, -1};
+    for (unsigned tries = 0; n >= 1 && tries < pairs; tries++) {
+        if (lag_port_take_in(dir, LAG_PORT_FIRST, LAG_PORT_LAST, start, &l[0], err, errlen) != 0)
+            return -1;
+        int k = 1;
+        for (; k < n; k++) {
+            int p = l[0].port + 2 * k;
+            if (p > LAG_PORT_LAST || lag_port_take_in(dir, p, p, 0, &l[k], err, errlen) != 0) break;
+        }
+        if (k == n) return 0;
+        int first = l[0].port;
+        for (int j = 0; j < k; j++) lag_port_release(&l[j]);
+        /* on after the pair that was not free */
+        start = (unsigned)((first - LAG_PORT_FIRST) / 2 + k + 1) % pairs;
+    }
+    snprintf(err, errlen, "no %d consecutive free port pairs in %d..%d", n, LAG_PORT_FIRST,
+             LAG_PORT_LAST + 1);
+    return -1;
 }
 
 void lag_port_release(lag_port_lease *l)

@@ -54,6 +54,11 @@ int lag_port_take_in(const char *dir, int first, int last, unsigned start, lag_p
  * place drawn from the process id (holders seldom meet). OUT: l */
 int lag_port_take(lag_port_lease *l, char *err, size_t errlen);
 
+/* n consecutive pairs (l[0].port, l[0].port + 2, ...) of the tools' range, each held as
+ * lag_port_take holds one: a host of n plants on its --port-base. Returns 0, or -1 with why
+ * in err (none held then). OUT: l[0..n) */
+int lag_port_take_block(int n, lag_port_lease *l, char *err, size_t errlen);
+
 /* Lets the pair go (its lock file stays). The lease is then none. */
 void lag_port_release(lag_port_lease *l);
 

@@ -9,8 +9,14 @@
  * nothing is sent; the scene wait sends DESCRIBE requests and times out cleanly when
  * nobody answers; every function follows one return convention. Commands and control
  * requests go to the plant's command URL (the next port), never to the state URL.
+ * small_stack: the discovery's helper that names the plants instead of a misspelt prefix,
+ * called from a thread of a 256 KiB stack (a controller's worker, a JVM's or a Python
+ * thread), runs: its LAG_CLIENT_MAX_PLANTS plants (a lab host's 1024) are not on the
+ * caller's stack.
  */
 #include <math.h>
+#include <pthread.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -393,9 +399,33 @@ static void case_generation(int arg)
     lcm_destroy(peer_in);
 }
 
+static void *instead_in_thread(void *arg)
+{
+    char *out = arg;
+    /* memq://: this process's own bus, where nobody is */
+    return (void *)(intptr_t)lag_client_plants_instead("memq://", "NOBODY", 0.05, out, 512);
+}
+
+static void case_small_stack(int arg)
+{
+    (void)arg;
+    pthread_attr_t a;
+    ENSURE(pthread_attr_init(&a) == 0);
+    ENSURE(pthread_attr_setstacksize(&a, 256 * 1024) == 0);
+    static char out[512];
+    pthread_t t;
+    void *n = (void *)(intptr_t)-1;
+    ENSURE(pthread_create(&t, &a, instead_in_thread, out) == 0);
+    ENSURE(pthread_join(t, &n) == 0);
+    pthread_attr_destroy(&a);
+    ENSUREF((intptr_t)n == 0 && strstr(out, "no plant heard on memq://"), "%d: %s",
+            (int)(intptr_t)n, out);
+}
+
 int main(int argc, char **argv)
 {
     static const lt_case cases[] = {{"library", case_library, 0, 0},
-                                    {"generation", case_generation, 0, 0}};
-    return lt_main(argc, argv, cases, 2);
+                                    {"generation", case_generation, 0, 0},
+                                    {"small_stack", case_small_stack, 0, 0}};
+    return lt_main(argc, argv, cases, 3);
 }

@@ -63,10 +63,11 @@ set(LAGSIM_TIER_RULES
   "root      NAME  ^net_two_hosts_"
   "octave    NAME  ^net_plant_urls_octave$"
   "quick     NAME  ^net_(plant_urls|filter)_"
-  # server: the loop, the pacer and the floors on made-up clocks or none; the daemon's
-  # lockstep, fast and offline references; every other server_test case runs lagsimd in
-  # real time (watchdog, floods, signals, plants that conflict)
-  "quick     NAME  ^server_(loop|pace)_"
+  # server: the loop, the pacer and the floors on made-up clocks or none; the plant's own
+  # receive sockets against LCM's datagrams (as net_filter_: delivery, no pace); the
+  # daemon's lockstep, fast and offline references; every other server_test case runs
+  # lagsimd in real time (watchdog, floods, signals, plants that conflict, a host's plants)
+  "quick     NAME  ^server_(loop|pace|rx)_"
   "quick     NAME  ^server_daemon_floors$"
   "quick     NAME  ^server_reference_(lockstep|fast|offline|manipulator)$"
   "wallclock NAME  ^server_"
@@ -102,7 +103,7 @@ set(LAGSIM_TIER_RULES
   "wallclock NAME  ^clients_(readme_recipes|walkthrough|scene_params)$"
   "wallclock NAME  ^ctl_"
   "quick     NAME  ^install_"
-  "quick     NAME  ^clients_(lqr|status_fields|hostile_messages|library|generation|not_built)$"
+  "quick     NAME  ^clients_(lqr|status_fields|hostile_messages|library|generation|small_stack|not_built)$"
   "quick     NAME  ^clients_[a-z_]+_(usage_.*|help)$"
   "quick     NAME  ^clients_(python|lua)_(lcm|types)$"
   "quick     NAME  ^clients_java_release$"

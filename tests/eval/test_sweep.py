@@ -2,7 +2,8 @@
 """lagsim-sweep end to end: the cart-pole held by lqr_balance over its masses, 8 runs.
 
 usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
-  same      the CSV of -j1, of -j2, and of two shards (run by GNU parallel on this host)
+  same      the CSV of -j1, of -j2, of -j3 --plants-per-worker 2 (the workers' plants in
+            two lagsimd hosts), and of two shards (run by GNU parallel on this host)
             merged, byte for byte equal; the grid's values are the grid's, the uniform
             ones inside their range and not all equal; a run's metrics equal lagsim-eval's
             for the same overrides; --seed changes the drawn values
@@ -186,6 +187,12 @@ def case_same(d):
           "--plot to an existing PNG without --force: exit 2 before any run, the PNG named")
     run([SWEEP] + ARGS + ["-j2", "--csv", a2])
     check(filecmp.cmp(a1, a2, shallow=False), "-j1 and -j2 give the same CSV, byte for byte")
+    # the workers' plants in lagsimd hosts: two of 2 and 1 plants
+    a3 = os.path.join(d, "ppw.csv")
+    p = run([SWEEP] + ARGS + ["-j3", "--plants-per-worker", "2", "--csv", a3])
+    check(os.path.exists(a3) and filecmp.cmp(a1, a3, shallow=False),
+          "-j3 --plants-per-worker 2 (the workers' plants in two lagsimd hosts, of 2 and 1 "
+          "plants) gives the same CSV, byte for byte (exit %d)" % p.returncode)
     # two shards with GNU parallel on this host, then merged
     sh = os.path.join(d, "shard-{}.csv")
     jl = os.path.join(d, "joblog")

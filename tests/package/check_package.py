@@ -39,13 +39,17 @@ service (root only, else skipped; skipped too when this host cannot start system
   SIGKILL is followed by a restart and `systemctl restart` by another, each writing a new
   file of the series while the earlier stay; `systemctl stop` gives exit 0; a bad scene fails with exit 2
   and is not restarted; `dpkg --purge` run there stops an enabled, running instance and
-  removes its link. Then the checks after the purge, as in install.
+  removes its link. The host form too: /etc/lagsim/NAME.d/ with two scenes runs both,
+  lagsimctl list names each with its URL, dipc_lqr balances one, a file added starts its
+  plant without a restart, each plant's --log lands in /var/lib/lagsim/NAME/STUDENT/ and
+  replays exactly. Then the checks after the purge, as in install.
 One run at a time on a host: a lock file (LOCK) is held for the whole of it.
 """
 import argparse
 import fcntl
 import glob
 import os
+import random
 import re
 import shutil
 import subprocess
@@ -58,10 +62,10 @@ DEBIAN_PYTHON = "/usr/bin/python3"   # the python3 the package depends on (not a
 LOCK = "/var/lock/lagsim-package-test.lock"
 SKIP = 77
 # the unit's settings the deployment relies on (docs/deploy.md)
-UNIT_MUST = ["ExecStart=/usr/bin/lagsimd --config /etc/lagsim/%i.yaml $LAGSIMD_ARGS",
+UNIT_MUST = ["ExecStart=/usr/bin/lagsimd --instance /etc/lagsim/%i $LAGSIMD_ARGS",
              "Restart=on-failure", "RestartPreventExitStatus=2", "DynamicUser=yes",
              "ProtectSystem=strict", "NoNewPrivileges=yes", "StateDirectory=lagsim/%i",
-             "RestrictAddressFamilies=AF_INET", "MemoryMax=256M", "TasksMax=16",
+             "RestrictAddressFamilies=AF_INET", "MemoryMax=512M", "TasksMax=512",
              "LimitFSIZE=4G", "LimitCORE=0"]
 # the unit's resource limits: each has its reason in docs/deploy.md's hardening table
 LIMIT_RE = re.compile(r"^(Memory(?:Max|High|SwapMax)|TasksMax|Limit\w+)=\S+$")
@@ -494,6 +498,85 @@ class NsSystemd:
                 pass
 
 
+def free_pairs(n):
+    """n consecutive port pairs below the kernel's ephemeral ports, none bound now."""
+    bound = set()
+    for f in ("/proc/net/udp", "/proc/net/udp6"):
+        if os.path.exists(f):
+            for line in open(f).read().splitlines()[1:]:
+                bound.add(int(line.split()[1].rsplit(":", 1)[1], 16))
+    for _ in range(200):
+        base = 2 * random.randrange(5000, 16000)
+        if not any(p in bound for p in range(base, base + 2 * n)):
+            return base
+    return 20000
+
+
+def host_form_checks(sd, tmp, env):
+    """The unit's host form: /etc/lagsim/NAME.d/ instead of NAME.yaml, as docs/deploy.md's
+    "A lab host for a class" sets it up."""
+    name, d = "pkglab", "/etc/lagsim/pkglab.d"
+    directory = free_pairs(4)
+    dir_url = "udpm://239.255.76.67:%d?ttl=0" % directory
+    url = lambda k: "udpm://239.255.76.67:%d?ttl=0" % (directory + 2 + 2 * k)
+    os.makedirs(d, exist_ok=True)
+    for st in ("alice", "bob"):
+        shutil.copy("/usr/share/lagsim/config/dipc.yaml", "%s/%s.yaml" % (d, st))
+        os.chmod("%s/%s.yaml" % (d, st), 0o644)
+    os.chmod(d, 0o755)
+    with open("/etc/lagsim/%s.env" % name, "w") as f:
+        f.write("LCM_DEFAULT_URL=%s\nLAGSIMD_ARGS=--log run.lcm --increment\n" % dir_url)
+    unit = "lagsimd@%s.service" % name
+    lenv = dict(env, LCM_DEFAULT_URL=dir_url)
+
+    def listed(want, seconds=30):
+        """lagsimctl list on the directory until it names the plants of `want` (each call
+        listens 2 s: the wait is the listening, no sleep), or `seconds` passed."""
+        deadline, rows, ls = time.monotonic() + seconds, {}, None
+        while time.monotonic() < deadline:
+            ls = run(["/usr/bin/lagsimctl", "--timeout", "2", "list"], env=lenv, timeout=30)
+            rows = {l.split()[0]: l.split()[-1] for l in ls.stdout.splitlines()[1:] if l.strip()}
+            if all(k in rows for k in want):
+                break
+        return rows, ls.stdout if ls else ""
+
+    try:
+        r = sd.ctl("start", unit)
+        rows, out = listed(("ALICE", "BOB"))
+        check(r.returncode == 0 and sd.show(unit, "ActiveState") == "active",
+              "the host form: systemctl start %s with %s/ (alice.yaml, bob.yaml)" % (unit, d), r.stdout)
+        check(rows == {"ALICE": url(0), "BOB": url(1)},
+              "lagsimctl list: ALICE and BOB, each on its own port pair after the directory's: %s"
+              % rows, out)
+        lqr = run(["/usr/bin/dipc_lqr", "--prefix", "ALICE", "--url", url(0), "--duration", "2",
+                   "--timeout", "10", "-q"], env=env, timeout=60)
+        check(lqr.returncode == 0 and "states=" in lqr.stdout,
+              "the installed dipc_lqr balances ALICE on its URL", lqr.stdout)
+        shutil.copy("/usr/share/lagsim/config/dipc.yaml", "%s/carol.yaml" % d)
+        os.chmod("%s/carol.yaml" % d, 0o644)
+        pid = sd.show(unit, "MainPID")
+        rows, out = listed(("CAROL",))
+        check(rows.get("CAROL") == url(2) and sd.show(unit, "NRestarts") == "0" and
+              sd.show(unit, "MainPID") == pid,
+              "carol.yaml added: CAROL runs on the next pair, without a restart (NRestarts %s)" %
+              sd.show(unit, "NRestarts"), out)
+        r = sd.ctl("stop", unit)
+        check(r.returncode == 0 and sd.show(unit, "ExecMainStatus") == "0",
+              "systemctl stop: exit %s" % sd.show(unit, "ExecMainStatus"), r.stdout)
+        j = sd.sh(["journalctl", "-u", unit, "--no-pager", "-o", "cat"]).stdout
+        check("ALICE: listening on" in j and "CAROL: event stop" in j,
+              "its journal: each plant's lines", j)
+        log = "/var/lib/lagsim/%s/alice/run.lcm.000000" % name
+        rp = run(["/usr/bin/lagsimd", "--config", "%s/alice.yaml" % d, "--set", "lcm.prefix=ALICE",
+                  "--replay", log], env=env, cwd=tmp)
+        check(os.path.exists(log) and rp.returncode == 0,
+              "ALICE's --log in %s: --replay exact (exit %d)" % (log, rp.returncode), rp.stdout)
+    finally:
+        shutil.rmtree(d, ignore_errors=True)
+        if os.path.exists("/etc/lagsim/%s.env" % name):
+            os.remove("/etc/lagsim/%s.env" % name)
+
+
 def service_checks(a, tmp):
     units = os.path.join(tmp, "units")
     os.makedirs(units)
@@ -596,7 +679,7 @@ def service_checks(a, tmp):
         lims = {k: v.group(1) if v else None for k, v in lims.items()}
         mem, tasks = sd.show(unit, "MemoryMax"), sd.show(unit, "TasksMax")
         check(lims == {"Max file size": str(4 << 30), "Max core file size": "0",
-                       "Max open files": "128"} and mem == str(256 << 20) and tasks == "16",
+                       "Max open files": "4096"} and mem == str(512 << 20) and tasks == "512",
               "the unit's limits on the daemon: %s, MemoryMax %s, TasksMax %s" % (lims, mem, tasks), lim)
         # restarts with the example: a crash (SIGKILL) restarts it, and a start after a
         # crash goes on logging in a new file; `systemctl restart` once more, the same
@@ -633,6 +716,7 @@ def service_checks(a, tmp):
               sd.show(ubad, "ActiveState") == "failed" and "%s.yaml:2:1: unknown key" % bad in jb,
               "a bad scene: exit %s, %s, not restarted (NRestarts %s), file:line:column in the journal"
               % (sd.show(ubad, "ExecMainStatus"), sd.show(ubad, "ActiveState"), sd.show(ubad, "NRestarts")), jb)
+        host_form_checks(sd, tmp, env)
         # removal where systemd runs: the prerm stops every instance, the purge removes the
         # links of enabled ones (dpkg run inside the namespace, which has /run/systemd/system)
         sd.ctl("enable", "--now", unit)

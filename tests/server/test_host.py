@@ -1,0 +1,651 @@
+#!/usr/bin/env python3
+"""A host of plants (lagsimd --plants DIR, several --config), end to end over real LCM.
+
+    test_host.py --bin BUILD/bin --types BUILD/python --source SRC CASE
+
+Each case takes port pairs of its own, held by the lock files lagsim-eval and lagsim-sweep
+use (/run/lock/lagsim-udp-P.lock, flock), none of them bound by any socket.
+
+Cases:
+  isolation   a victim plant in lockstep with dipc_lqr beside a hostile neighbour in the same
+              daemon: the neighbour faults (explode_limit), is reset, paused, resumed,
+              stepped, SET, asked for status and scenes, flooded with 20000 commands, and
+              its file removed (its plant stops) while the victim runs; the victim's states
+              are bit for bit those of the same plant run alone; the neighbour read at most
+              its input budget (256 + 8 a state published + 100 a second), said so
+              (input_limited events), and shed the rest
+  bad_scene   a directory with a scene that does not load, a file name that is no prefix,
+              two files of one prefix, a port pair taken twice: each said (file:line:column,
+              both files named) and skipped, the good plant runs, exit 0; a host whose every
+              scene fails exits 2; --config several times: a bad one and one whose port
+              another program holds skipped, tried again on SIGHUP (the second then starts),
+              the good one untouched
+  reload      a file added starts its plant, a file changed restarts its plant on the same
+              ports from the new bytes, a bad new version is said and the plant runs on, a
+              file removed stops its plant; a file that failed because another program held
+              its port is not tried again by itself, and is on SIGHUP (which stops no running
+              plant); the other plants never get
+              a stop, a start or a new generation; SIGTERM stops every plant (a stop event
+              each), exit 0
+  list        lagsimctl list through the host's directory: every plant with its own URL;
+              status through it, pause only on the plant's own URL; lagsim-view --prefix P
+              finds P's URL there; a plant on the directory's ports refused
+  many        120 plants in one process (LCM's receive path aborted it at about 85),
+              lagsimctl list naming each on its own pair, SIGTERM stopping all
+"""
+import argparse
+import fcntl
+import os
+import random
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+
+failures = 0
+SYNC = 0xEDA1DA01
+GROUP = "239.255.76.67"
+
+
+def check(cond, what):
+    global failures
+    print(("ok: " if cond else "FAIL: ") + what, flush=True)
+    if not cond:
+        failures += 1
+    return cond
+
+
+def bound_ports():
+    ports = set()
+    for f in ("/proc/net/udp", "/proc/net/udp6"):
+        try:
+            for line in open(f).read().splitlines()[1:]:
+                ports.add(int(line.split()[1].rsplit(":", 1)[1], 16))
+        except OSError:
+            pass
+    return ports
+
+
+_held = []
+
+
+def take_pairs(n):
+    """n consecutive port pairs (state ports P, P + 2, ...), each held by its lock file and
+    bound by no socket; returns P."""
+    lock_dir = next(d for d in ("/run/lock", "/var/lock", "/tmp") if os.path.isdir(d))
+    for _ in range(200):
+        # below the kernel's ephemeral ports (32768 up, /proc/sys/net/ipv4/ip_local_port_range),
+        # which any process's unbound socket may be given
+        base = 2 * random.randrange(5000, 16300 - n)
+        bound, fds = bound_ports(), []
+        try:
+            for k in range(n):
+                p = base + 2 * k
+                if p in bound or p + 1 in bound:
+                    raise OSError
+                fd = os.open(os.path.join(lock_dir, "lagsim-udp-%d.lock" % p),
+                             os.O_RDONLY | os.O_CREAT, 0o644)
+                fds.append(fd)
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            _held.extend(fds)
+            return base
+        except OSError:
+            for fd in fds:
+                os.close(fd)
+    raise SystemExit("test_host: no free port pairs")
+
+
+def url(port):
+    return "udpm://%s:%d?ttl=0" % (GROUP, port)
+
+
+def read_log(path):
+    out, b, i = [], open(path, "rb").read(), 0
+    while i + 28 <= len(b):
+        sync, num, ts, clen, dlen = struct.unpack_from(">IqqII", b, i)
+        assert sync == SYNC
+        out.append((b[i + 28:i + 28 + clen].decode(), b[i + 28 + clen:i + 28 + clen + dlen]))
+        i += 28 + clen + dlen
+    return out
+
+
+class Bus:
+    """Listens to the state URLs of several plants (lagsim_lcm: ctypes over liblcm)."""
+
+    def __init__(self, t, plants):
+        from lagsim_lcm import LCM
+        self.t, self.msgs, self.lcms = t, [], []
+        for prefix, port in plants:
+            lc = LCM(url(port))
+            lc.subscribe(prefix + "_(STATE|EVENT|SCENE|STATUS)",
+                         lambda ch, data: self.msgs.append((time.monotonic(), ch, data)))
+            self.lcms.append(lc)
+
+    def pump(self, seconds):
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            for lc in self.lcms:
+                while lc.handle_timeout(0):
+                    pass
+            time.sleep(0.005)
+
+    def events(self, prefix, since=0.0):
+        return [self.t.event_t.decode(d) for (w, ch, d) in self.msgs
+                if ch == prefix + "_EVENT" and w >= since]
+
+    def states(self, prefix, since=0.0):
+        return [self.t.joint_state_t.decode(d) for (w, ch, d) in self.msgs
+                if ch == prefix + "_STATE" and w >= since]
+
+    def wait_event(self, prefix, kind, since, seconds):
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            if any(e.kind == kind for e in self.events(prefix, since)):
+                return True
+            self.pump(0.05)
+        return False
+
+
+VICTIM = """model: dipc
+initial: {q: [0.0, 0.05, -0.03]}
+realtime: {mode: lockstep, start: first_command}
+"""
+HOSTILE = """model: dipc
+initial: {q: [0.0, 0.05, -0.03]}
+explode_limit: 0.5
+realtime: {mode: realtime, start: running}
+"""
+PLANT = """model: cartpole
+parameters: {m0: 1.0}
+realtime: {mode: realtime, start: running}
+"""
+
+
+class T:
+    def __init__(self, a):
+        self.a = a
+        a.bin = os.path.abspath(a.bin)
+        sys.path.insert(0, a.types)
+        import lagsim
+        self.t = lagsim
+        self.procs = []
+        self.directory = take_pairs(1)  # the hosts' directory (LCM_DEFAULT_URL's bus)
+
+    def prog(self, name):
+        return os.path.join(self.a.bin, name)
+
+    def start(self, args, stdout=subprocess.DEVNULL, **kw):
+        """A child whose stderr goes to a file (a pipe nobody reads could stall it), with
+        LCM_DEFAULT_URL the case's directory bus (set_directory)."""
+        err = tempfile.TemporaryFile(mode="w+")
+        env = dict(os.environ, LCM_DEFAULT_URL=url(self.directory))
+        p = subprocess.Popen(args, stderr=err, stdout=stdout, text=True, env=env, **kw)
+        p.err_file = err
+        self.procs.append(p)
+        return p
+
+    def finish_pumping(self, p, bus, timeout=60):
+        """finish(), the bus read meanwhile."""
+        end = time.monotonic() + timeout
+        while p.poll() is None and time.monotonic() < end:
+            bus.pump(0.05)
+        out = self.finish(p, 1)
+        bus.pump(0.2)
+        return out
+
+    def finish(self, p, timeout=60):
+        try:
+            p.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait()
+        p.err_file.seek(0)
+        err = p.err_file.read()
+        if os.environ.get("TEST_HOST_KEEP_ERR"):
+            open(os.environ["TEST_HOST_KEEP_ERR"], "a").write(err)
+        print("$ %s\n  exit %s\n%s" % (" ".join(p.args), p.returncode,
+                                       "".join("  | %s\n" % l for l in err.splitlines()[-12:])),
+              flush=True)
+        return p.returncode, err
+
+    def cleanup(self):
+        for p in self.procs:
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+
+    def control(self, lc, prefix, request, key="", value="", count=0, q=(), qd=()):
+        m = self.t.control_t()
+        m.utime, m.request, m.count, m.key, m.value = 0, request, count, key, value
+        m.num_joints, m.q, m.qd = len(q), list(q), list(qd)
+        lc.publish(prefix + "_CONTROL", m.encode())
+
+    def command(self, joint, effort):
+        m = self.t.joint_command_t()
+        m.utime, m.sim_time, m.generation = 0, 0.0, 0
+        m.num_joints, m.name, m.effort = 1, [joint], [effort]
+        return m.encode()
+
+    def states_of(self, log, prefix):
+        """The log's states of prefix, each once (a state published again while waiting is
+        not a new one): (generation, step, sim_time, q, qd, effort)."""
+        out, seen = [], set()
+        for ch, data in read_log(log):
+            if ch == prefix + "_STATE":
+                s = self.t.joint_state_t.decode(data)
+                k = (s.generation, s.step)
+                if k not in seen:
+                    seen.add(k)
+                    out.append((s.generation, s.step, s.sim_time, tuple(s.position),
+                                tuple(s.velocity), tuple(s.effort)))
+        return out
+
+    def last_status(self, log, prefix):
+        st = [self.t.status_t.decode(d) for ch, d in read_log(log) if ch == prefix + "_STATUS"]
+        return st[-1] if st else None
+
+    # ------------------------------------------------------------------ isolation
+    def hostile_acts(self, bus, base):
+        """What the neighbour (HOSTILE at base) goes through; returns the commands sent."""
+        from lagsim_lcm import LCM
+        cmd = LCM(url(base + 1))
+        C = self.t.control_t
+        check(bus.wait_event("HOSTILE", "numeric_fault", 0, 10),
+              "the neighbour faults (explode_limit 0.5)")
+        # reset to the upright equilibrium (exact zeros: it stays there), so that what
+        # follows is not refused by a second fault
+        up = {"q": [0.0, 0.0, 0.0], "qd": [0.0, 0.0, 0.0]}
+        for req, kw in ((C.RESET_TO, up), (C.RESUME, {}), (C.PAUSE, {}), (C.STEP, {"count": 5}),
+                        (C.SET, {"key": "parameters.m0", "value": "2.5"}), (C.STATUS, {}),
+                        (C.DESCRIBE, {}), (C.RESUME, {}), (C.RESET, {"count": 1})):
+            self.control(cmd, "HOSTILE", req, **kw)
+            bus.pump(0.1)
+        good, bad = self.command("theta0", 1.0), self.command("cart", 1.0)
+        sent, t0 = 0, time.monotonic()
+        while sent < 20000:
+            cmd.publish("HOSTILE_COMMAND", good if sent % 2 else bad)
+            sent += 1
+            if sent % 500 == 0:
+                bus.pump(0)
+        print("  the flood: %d commands in %.2f s" % (sent, time.monotonic() - t0), flush=True)
+        for _ in range(30):  # a flood of control requests too
+            self.control(cmd, "HOSTILE", C.RESET)
+        bus.pump(0.5)
+        return sent
+
+    def host_run(self, d, base):
+        """The host with VICTIM under dipc_lqr and HOSTILE; returns (victim states,
+        hostile log, wall seconds of the hostile's plant, commands sent to it)."""
+        lab = os.path.join(d, "lab")
+        os.mkdir(lab)
+        open(os.path.join(lab, "hostile.yaml"), "w").write(HOSTILE)
+        open(os.path.join(lab, "victim.yaml"), "w").write(VICTIM)
+        bus = Bus(self.t, [("HOSTILE", base), ("VICTIM", base + 2)])
+        t_start = time.monotonic()
+        host = self.start([self.prog("lagsimd"), "--plants", lab, "--port-base", str(base),
+                           "-q", "--log", "run.lcm"], cwd=d)
+        ctl = self.start([self.prog("dipc_lqr"), "-q", "--prefix", "VICTIM", "--url",
+                          url(base + 2), "--timeout", "30"])
+        check(bus.wait_event("VICTIM", "start", 0, 10), "the victim starts")
+        sent = self.hostile_acts(bus, base)
+        os.unlink(os.path.join(lab, "hostile.yaml"))
+        check(bus.wait_event("HOSTILE", "stop", 0, 10), "the neighbour's file removed: it stops")
+        t_hostile = time.monotonic() - t_start
+        bus.pump(0.5)
+        host.send_signal(signal.SIGTERM)
+        rc, err = self.finish(host)
+        self.finish(ctl)
+        bus.pump(0.3)
+        check(rc == 0, "the host stops on SIGTERM with exit 0")
+        check("hostile.yaml: removed: its plant stops" in err, "the removal is said")
+        vlog = os.path.join(d, "victim", "run.lcm")
+        stops = [self.t.event_t.decode(x) for ch, x in read_log(vlog) if ch == "VICTIM_EVENT"]
+        stops = [e for e in stops if e.kind == "stop"]
+        check(len(stops) == 1 and "SIGTERM" in stops[0].detail,
+              "the victim's one stop event (its log) is SIGTERM's: %s" % [e.detail for e in stops])
+        return (self.states_of(vlog, "VICTIM"),
+                os.path.join(d, "hostile", "run.lcm"), t_hostile, sent)
+
+    def alone_run(self, d, port, duration):
+        """VICTIM alone, in a daemon of its own, to `duration`: its states."""
+        path = os.path.join(d, "victim_alone.yaml")
+        open(path, "w").write(VICTIM)
+        log = os.path.join(d, "alone.lcm")
+        host = self.start([self.prog("lagsimd"), "--config", path, "--set", "lcm.prefix=VICTIM",
+                           "--set", "lcm.url=" + url(port), "-q", "--duration", repr(duration),
+                           "--log", log])
+        ctl = self.start([self.prog("dipc_lqr"), "-q", "--prefix", "VICTIM", "--url", url(port),
+                          "--timeout", "30"])
+        rc, _ = self.finish(host, 300)
+        self.finish(ctl)
+        check(rc == 0, "the victim alone runs to %g s, exit 0" % duration)
+        return self.states_of(log, "VICTIM")
+
+    def budget_checks(self, log, seconds, sent):
+        st = self.last_status(log, "HOSTILE")
+        if not check(st is not None, "the neighbour's log has its final status"):
+            return
+        handled = (st.commands_accepted + st.rejected_unknown_joint + st.rejected_unactuated +
+                   st.rejected_nonfinite + st.rejected_bad_length + st.rejected_undecodable +
+                   st.rejected_stale + st.rejected_effort_limit + st.commands_ignored)
+        published = st.states_published + st.lockstep_retries
+        budget = 256 + 8 * published + 100 * seconds
+        check(handled <= budget, "the neighbour handled %d commands, within its budget %.0f "
+              "(256 + 8 x %d states + 100 x %.1f s)" % (handled, budget, published, seconds))
+        check(handled < sent, "the flood beyond it was shed: %d of %d handled" % (handled, sent))
+        limited = [self.t.event_t.decode(d) for ch, d in read_log(log) if ch == "HOSTILE_EVENT"]
+        limited = [e for e in limited if e.kind == "input_limited"]
+        check(len(limited) >= 1, "the neighbour said so: %d input_limited events%s" % (
+            len(limited), (" (" + limited[0].detail + ")") if limited else ""))
+        kinds = {self.t.event_t.decode(d).kind for ch, d in read_log(log) if ch == "HOSTILE_EVENT"}
+        for k in ("numeric_fault", "reset", "pause", "step", "step_done", "set", "resume",
+                  "restore"):
+            check(k in kinds, "the neighbour went through %s" % k)
+
+    def case_isolation(self):
+        base = take_pairs(2)
+        with tempfile.TemporaryDirectory() as d:
+            host_states, hostile_log, seconds, sent = self.host_run(d, base)
+            check(len(host_states) > 100, "the victim ran %d periods beside its neighbour" %
+                  len(host_states))
+            if not host_states:
+                return
+            last_t = host_states[-1][2]
+            alone = self.alone_run(d, base + 2, last_t)
+            n = min(len(alone), len(host_states))
+            same = n == len(host_states) and alone[:n] == host_states[:n]
+            first = next((k for k in range(n) if alone[k] != host_states[k]), None)
+            check(same, "the victim's %d states (to t = %g s) are bit for bit those of the "
+                  "same plant alone%s" % (len(host_states), last_t,
+                                          "" if first is None else "; first difference at %d" % first))
+            self.budget_checks(hostile_log, seconds, sent)
+
+
+    # ------------------------------------------------------------------ bad scenes
+    def case_bad_scene(self):
+        base = take_pairs(3)
+        with tempfile.TemporaryDirectory() as d:
+            lab = os.path.join(d, "lab")
+            os.mkdir(lab)
+            good = VICTIM.replace("lockstep", "realtime")
+            files = {"good.yaml": good,
+                     "GOOD.yaml": good,                       # prefix GOOD twice
+                     "broken.yaml": "model: dipc\nparameters: {m0: -1}\n",  # a bad value
+                     "no-prefix.yaml": good,                  # '-': not a prefix
+                     "taken.yaml": good + "lcm: {url: '%s'}\n" % url(base + 1),  # overlaps
+                     "notes.txt": "not a scene\n", ".hidden.yaml": "not one either\n"}
+            for name, text in files.items():
+                open(os.path.join(lab, name), "w").write(text)
+            bus = Bus(self.t, [("GOOD", base), ("GOOD", base + 2)])
+            host = self.start([self.prog("lagsimd"), "--plants", lab, "--port-base", str(base),
+                               "--duration", "1", "--set", "realtime.start=running"])
+            rc, err = self.finish_pumping(host, bus, 60)
+            check(rc == 0, "exit 0: the good plant ran its second (%s)" % rc)
+            check(len(bus.states("GOOD")) >= 50, "the good plant published %d states" %
+                  len(bus.states("GOOD")))
+            check("broken.yaml:2:" in err, "broken.yaml said with its file:line:column")
+            check("no-prefix.yaml" in err and "rename the file" in err,
+                  "no-prefix.yaml said: its name is no prefix")
+            check(err.count("prefix GOOD is already the plant of") == 1 and "GOOD.yaml" in err,
+                  "one of GOOD.yaml and good.yaml refused, both named")
+            check("taken.yaml: ports %d and %d" % (base + 1, base + 2) in err,
+                  "taken.yaml's ports overlap the first plant's: said, both named")
+            check(err.count(": skipped (the reason is above)") == 4,
+                  "four files skipped, each said (%d)" % err.count(": skipped"))
+            check("notes.txt" not in err and ".hidden" not in err,
+                  "files that are not NAME.yaml are no plants")
+            bad = os.path.join(d, "bad.yaml")
+            open(bad, "w").write("model: nope\n")
+            host = self.start([self.prog("lagsimd"), "--config", bad, "--config", bad,
+                               "--port-base", str(base), "--duration", "1"])
+            rc, err = self.finish(host, 30)
+            check(rc == 2, "a host whose every scene fails exits 2 (%s)" % rc)
+            self.configs_retry(d)
+
+    def configs_retry(self, d):
+        """--config several times: a file that does not load and one whose command port
+        another program holds are said and skipped, the good one runs; SIGHUP tries the
+        failed ones again (not watched: on SIGHUP only), and the one whose port was freed
+        starts; the good one is not touched."""
+        import socket
+        b = take_pairs(2)
+        paths = {k: os.path.join(d, k + ".yaml") for k in ("good", "held", "bad")}
+        open(paths["good"], "w").write(PLANT + "lcm: {prefix: GOODC, url: '%s'}\n" % url(b))
+        open(paths["held"], "w").write(PLANT + "lcm: {prefix: HELD, url: '%s'}\n" % url(b + 2))
+        open(paths["bad"], "w").write("model: nope\n")
+        held = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)  # no SO_REUSEADDR: exclusive
+        held.bind(("", b + 3))
+        bus = Bus(self.t, [("GOODC", b), ("HELD", b + 2)])
+        host = self.start([self.prog("lagsimd"), "--config", paths["good"], "--config",
+                           paths["held"], "--config", paths["bad"]])
+        check(bus.wait_event("GOODC", "start", 0, 10), "--config x3: the good one starts")
+        check(self.said(host, "held.yaml: skipped (the reason is above); the other plants run; "
+                        "it is tried again on SIGHUP", 10),
+              "held.yaml (its command port held by another program) said and skipped, to be "
+              "tried again on SIGHUP")
+        check(self.said(host, "bad.yaml:1:", 1), "bad.yaml said with its file:line:column")
+        held.close()
+        since = time.monotonic()
+        host.send_signal(signal.SIGHUP)
+        check(bus.wait_event("HELD", "start", since, 10),
+              "SIGHUP: held.yaml tried again, its port free: HELD starts")
+        bus.pump(0.3)
+        check("stop" not in [e.kind for e in bus.events("GOODC")] and
+              len(bus.states("GOODC", since)) > 10, "GOODC runs on, untouched")
+        host.send_signal(signal.SIGTERM)
+        rc, err = self.finish_pumping(host, bus, 30)
+        check(rc == 0 and err.count("bad.yaml: skipped") == 2,
+              "SIGTERM: exit %s; bad.yaml tried again on SIGHUP and said again (%d)" %
+              (rc, err.count("bad.yaml: skipped")))
+
+
+    # ------------------------------------------------------------------ reload
+    def untouched(self, bus, prefixes, what):
+        """Each plant of prefixes: one start event, no stop, generation 1, steps rising."""
+        for pre in prefixes:
+            ev = [e.kind for e in bus.events(pre)]
+            st = bus.states(pre)
+            gens = {s.generation for s in st}
+            steps = [s.step for s in st]
+            check(ev.count("start") == 1 and "stop" not in ev and gens == {1} and
+                  steps == sorted(steps) and len(st) > 20,
+                  "%s: %s untouched (%d states, generations %s, events %s)" %
+                  (what, pre, len(st), sorted(gens), sorted(set(ev))))
+
+    def reload_steps(self, bus, lab, host, base):
+        since = time.monotonic()
+        open(os.path.join(lab, "carol.yaml"), "w").write(PLANT)
+        check(bus.wait_event("CAROL", "start", since, 10), "carol.yaml added: CAROL starts")
+        bus.pump(0.5)
+        since = time.monotonic()
+        open(os.path.join(lab, "bob.yaml"), "w").write(PLANT.replace("m0: 1.0", "m0: 2.0"))
+        check(bus.wait_event("BOB", "stop", since, 10), "bob.yaml changed: BOB stops")
+        check(bus.wait_event("BOB", "start", since, 10), "and starts again")
+        stop = [e for e in bus.events("BOB", since) if e.kind == "stop"]
+        check(stop and "changed" in stop[0].detail, "its stop event says why: %s" %
+              (stop[0].detail if stop else None))
+        bus.pump(0.5)
+        scenes = [self.t.scene_t.decode(d) for (w, ch, d) in bus.msgs
+                  if ch == "BOB_SCENE" and w >= since]
+        check(scenes and dict(zip(scenes[-1].param_name, scenes[-1].param_value))["m0"] == 2.0,
+              "on the same port pair, its scene from the new bytes (m0 = 2)")
+        since = time.monotonic()
+        open(os.path.join(lab, "bob.yaml"), "w").write("model: cartpole\nparameters: {m0: -3}\n")
+        check(self.said(host, "changed, but its new scene cannot run", 10),
+              "a bad new bob.yaml: said")
+        bus.pump(0.5)
+        ev = [e.kind for e in bus.events("BOB", since)]
+        check("stop" not in ev and len(bus.states("BOB", since)) > 20,
+              "a bad new bob.yaml: BOB runs on with its scene before (%s)" % sorted(set(ev)))
+        since = time.monotonic()
+        os.unlink(os.path.join(lab, "carol.yaml"))
+        check(bus.wait_event("CAROL", "stop", since, 10), "carol.yaml removed: CAROL stops")
+        stop = [e for e in bus.events("CAROL", since) if e.kind == "stop"]
+        check(stop and "removed" in stop[0].detail, "its stop event says why")
+        self.sighup_retry(bus, lab, host, base)
+
+    def said(self, p, text, seconds):
+        """Waits until the child's stderr (its file) holds `text`."""
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            p.err_file.seek(0)
+            if text in p.err_file.read():
+                return True
+            time.sleep(0.05)
+        return False
+
+    def sighup_retry(self, bus, lab, host, base):
+        """A file that failed for a reason outside it (its port bound by another program) is
+        tried again on SIGHUP alone: its bytes do not change, so inotify says nothing."""
+        import socket
+        held = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)  # no SO_REUSEADDR: exclusive
+        held.bind(("", base + 7))  # its command port (the state port: this test's bus hears)
+        open(os.path.join(lab, "dave.yaml"), "w").write(PLANT + "lcm: {url: '%s'}\n" % url(base + 6))
+        check(self.said(host, "dave.yaml: skipped", 10),
+              "dave.yaml added while another program holds its command port: said and skipped")
+        held.close()
+        since = time.monotonic()
+        bus.pump(0.5)
+        check(not [e for e in bus.events("DAVE", since) if e.kind == "start"],
+              "the port freed, dave.yaml unchanged: nothing tries it again by itself")
+        host.send_signal(signal.SIGHUP)
+        check(bus.wait_event("DAVE", "start", since, 10),
+              "SIGHUP: the host tries the failed file again, and DAVE starts")
+        bus.pump(0.3)
+        check(host.poll() is None and len(bus.states("ALICE", since)) > 20 and
+              "stop" not in [e.kind for e in bus.events("ALICE", since)] and
+              "stop" not in [e.kind for e in bus.events("BOB", since)],
+              "SIGHUP stops no running plant (ALICE, BOB)")
+
+    def case_reload(self):
+        base = take_pairs(4)
+        with tempfile.TemporaryDirectory() as d:
+            lab = os.path.join(d, "lab")
+            os.mkdir(lab)
+            for name in ("alice", "bob"):
+                open(os.path.join(lab, name + ".yaml"), "w").write(PLANT)
+            # sorted: alice base, bob base + 2, carol (added) base + 4
+            bus = Bus(self.t, [("ALICE", base), ("BOB", base + 2), ("CAROL", base + 4),
+                               ("DAVE", base + 6)])
+            host = self.start([self.prog("lagsimd"), "--plants", lab, "--port-base", str(base)])
+            check(bus.wait_event("ALICE", "start", 0, 10) and bus.wait_event("BOB", "start", 0, 10),
+                  "ALICE and BOB start")
+            self.reload_steps(bus, lab, host, base)
+            self.untouched(bus, ["ALICE"], "through it all")
+            since = time.monotonic()
+            host.send_signal(signal.SIGTERM)
+            rc, err = self.finish_pumping(host, bus, 30)
+            check(rc == 0, "SIGTERM: exit 0")
+            for pre in ("ALICE", "BOB", "DAVE"):
+                check([e.kind for e in bus.events(pre, since)].count("stop") == 1,
+                      "SIGTERM: %s's stop event" % pre)
+            check("changed, but its new scene cannot run" in err and "bob.yaml:2:" in err,
+                  "the bad new bob.yaml is said, with its file:line:column")
+
+
+    # ------------------------------------------------------------------ lagsimctl list
+    def ctl(self, *args):
+        env = dict(os.environ, LCM_DEFAULT_URL=url(self.directory))
+        p = subprocess.run([self.prog("lagsimctl"), *args], capture_output=True, text=True,
+                           timeout=60, env=env)
+        print("$ lagsimctl %s\n  exit %d\n%s" % (" ".join(args), p.returncode, "".join(
+            "  | %s\n" % l for l in (p.stdout + p.stderr).splitlines()[:12])), flush=True)
+        return p
+
+    def case_list(self):
+        base = take_pairs(3)
+        with tempfile.TemporaryDirectory() as d:
+            lab = os.path.join(d, "lab")
+            os.mkdir(lab)
+            for name in ("alice", "bob", "carol"):
+                open(os.path.join(lab, name + ".yaml"), "w").write(PLANT)
+            open(os.path.join(lab, "dir.yaml"), "w").write(
+                PLANT + "lcm: {url: '%s'}\n" % url(self.directory))
+            bus = Bus(self.t, [("ALICE", base), ("BOB", base + 2), ("CAROL", base + 4)])
+            host = self.start([self.prog("lagsimd"), "--plants", lab, "--port-base", str(base)])
+            for pre in ("ALICE", "BOB", "CAROL"):
+                check(bus.wait_event(pre, "start", 0, 10), "%s starts" % pre)
+            p = self.ctl("list")
+            rows = {l.split()[0]: l.split()[-1] for l in p.stdout.splitlines()[1:] if l.strip()}
+            want = {"ALICE": url(base), "BOB": url(base + 2), "CAROL": url(base + 4)}
+            check(p.returncode == 0 and rows == want,
+                  "lagsimctl list on the directory: each plant with its own URL %s" % rows)
+            p = self.ctl("--json", "list")
+            check(p.returncode == 0 and all('"url": "%s"' % u in p.stdout for u in want.values()),
+                  "--json list: the same URLs")
+            p = self.ctl("--prefix", "BOB", "status")
+            check(p.returncode == 0 and "status of BOB" in p.stdout and "running" in p.stdout,
+                  "status through the directory: BOB's last status")
+            p = self.ctl("--url", url(base + 2), "--prefix", "BOB", "pause")
+            check(p.returncode == 0, "pause on BOB's own URL: exit 0")
+            p = self.ctl("--prefix", "ALICE", "--timeout", "1", "pause")
+            check(p.returncode == 3, "pause through the directory: not done there (exit 3)")
+            view = self.start([self.prog("lagsim-view"), "--prefix", "CAROL", "--port", "0"],
+                              stdout=subprocess.PIPE)
+            line = view.stdout.readline()
+            view.send_signal(signal.SIGTERM)
+            self.finish(view, 10)
+            check("(prefix CAROL on %s)" % url(base + 4) in line,
+                  "lagsim-view --prefix CAROL watches CAROL on the URL the directory names: %s"
+                  % line.strip())
+            host.send_signal(signal.SIGTERM)
+            rc, err = self.finish_pumping(host, bus, 30)
+            check("dir.yaml: ports %d and %d are the host's directory" %
+                  (self.directory, self.directory + 1) in err,
+                  "a plant on the directory's ports refused, said")
+            check(rc == 0, "SIGTERM: exit 0")
+
+
+    # ------------------------------------------------------------------ many plants
+    def case_many(self):
+        """120 plants in one process (LCM 1.3.1's receive path took 12 descriptors a plant
+        and select(2) aborted the process past descriptor 1024, at about 85 plants)."""
+        n = 120
+        base = take_pairs(n)
+        with tempfile.TemporaryDirectory() as d:
+            lab = os.path.join(d, "lab")
+            os.mkdir(lab)
+            quiet = PLANT.replace("mode: realtime, start: running", "mode: lockstep, start: paused")
+            for k in range(n):
+                open(os.path.join(lab, "p%03d.yaml" % k), "w").write(quiet)
+            host = self.start([self.prog("lagsimd"), "--plants", lab, "--port-base", str(base)])
+            # each list listens 3 s (the wait is the listening, no sleep); a loaded machine
+            # may need a few before every plant has started and been heard
+            deadline, listed = time.monotonic() + 120, {}
+            while time.monotonic() < deadline and host.poll() is None and len(listed) < n:
+                p = self.ctl("--timeout", "3", "list")
+                listed = {l.split()[0]: l.split()[-1] for l in p.stdout.splitlines()[1:] if l.strip()}
+            check(host.poll() is None, "the host of %d plants runs" % n)
+            check(listed == {"P%03d" % k: url(base + 2 * k) for k in range(n)},
+                  "lagsimctl list: all %d plants, each on its own port pair (%d listed)" %
+                  (n, len(listed)))
+            p = self.ctl("--url", url(base + 2 * (n - 1)), "--prefix", "P%03d" % (n - 1), "step", "3")
+            check(p.returncode == 0 and "step_done" in p.stdout,
+                  "the last plant answers on its own URL (step 3)")
+            host.send_signal(signal.SIGTERM)
+            rc, err = self.finish(host, 60)
+            check(rc == 0 and err.count("stopped") == n, "SIGTERM: exit %s, %d plants stopped" %
+                  (rc, err.count("stopped")))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--bin", required=True)
+    ap.add_argument("--types", required=True)
+    ap.add_argument("--source", required=True)
+    ap.add_argument("case")
+    a = ap.parse_args()
+    sys.path.insert(0, a.types)
+    t = T(a)
+    try:
+        getattr(t, "case_" + a.case)()
+    finally:
+        t.cleanup()
+    print("%s: %d failure(s)" % (a.case, failures))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
