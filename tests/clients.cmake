@@ -283,7 +283,7 @@ if(LAGSIM_PYTHON3 AND NOT LAGSIM_SANITIZE)
     COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/abi_mutations.py
             --check ${CMAKE_CURRENT_SOURCE_DIR}/clients/abi_check.py
             --source ${PROJECT_SOURCE_DIR} --build ${CMAKE_BINARY_DIR} --cc ${CMAKE_C_COMPILER}
-            "--objects=$<JOIN:$<TARGET_OBJECTS:lagsim_client_wire_pic>;$<TARGET_OBJECTS:lagsim_lcmtypes_pic>,;>"
+            "--objects=$<JOIN:$<TARGET_OBJECTS:lagsim_client_wire_pic>;$<TARGET_OBJECTS:lagsim_lcmtypes_pic>;$<TARGET_OBJECTS:lagsim_client_model_objects>;$<TARGET_OBJECTS:lagsim_client_model_pic>,;>"
             "--cflags=${abi_lcm_cflags}" "--libs=${abi_lcm_libs} -lm"
             --version ${PROJECT_VERSION} --abi ${LAGSIM_CLIENT_ABI})
   set_tests_properties(clients_abi clients_abi_mutations PROPERTIES TIMEOUT 120 LABELS clients)
