@@ -830,7 +830,8 @@ static bool wait_run(const eval_env *env, pid_t dpid, pid_t cpid, eval_result *r
     int cst = 0;
     double t0 = eval_now();
     bool daemon_done = false, controller_done = false;
-    eval_watch *watch = eval_watch_start(env, env->who[0] ? env->who : NULL);
+    eval_watch *watch = eval_watch_start(env->url, env->prefix, env->wall_timeout,
+                                         env->who[0] ? env->who : NULL);
     while (!daemon_done && eval_now() < t0 + env->wall_timeout) {
         daemon_done = eval_wait_until(dpid, eval_now() + 0.05, dst);
         eval_watch_poll(watch);

@@ -33,6 +33,7 @@
 #include "lagsim_port.h"
 #include "lagsim_url.h"
 #include "metrics.h"
+#include "eval_watch.h"
 
 #define EVAL_NAME_LEN 64
 #define EVAL_SETS_MAX 32
@@ -149,20 +150,7 @@ typedef struct eval_env {
 } eval_env;
 
 /* ---------------------------------------------------------------- watching a run */
-/* A client on a run's URL and prefix (eval_watch.c): its states, its daemon's statuses. */
-#define EVAL_WAIT_SAY_S 5.0 /* a plant still at t = 0 after this: said once (env->who) */
-typedef struct eval_watch eval_watch;
-/* NULL when no client could be made (the run goes on without one). */
-eval_watch *eval_watch_start(const eval_env *env, const char *who);
-/* What came; once the plant has waited EVAL_WAIT_SAY_S at t = 0, a line saying what it
- * waits for (its status's words), once. */
-void eval_watch_poll(eval_watch *w);
-/* Whether a status of after `since` (wall s) says the daemon waits for a command: with its
- * controller gone, it never ends by itself. Asks for one when due. */
-bool eval_watch_stuck(eval_watch *w, double since);
-void eval_watch_stop(eval_watch *w);
-/* A line on stderr (printf), the terminal's progress line cleared first. */
-void eval_say(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+/* eval_watch.h: a client on a run's URL and prefix, and eval_say. */
 
 /* The bus of the tools' runs: the multicast group and the options of --url, else of
  * LCM_DEFAULT_URL, else EVAL_DEFAULT_URL's; the ports a pair of the runs' own

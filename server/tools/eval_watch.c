@@ -1,6 +1,6 @@
 /*
  * What a run's bus says while lagsim-eval (and a --restart sweep) waits for its end
- * (eval_case.h, "watching a run"): a client of the run's own prefix and URL that hears its
+ * (eval_watch.h): a client of the run's own prefix and URL that hears its
  * states and asks the daemon for its status now and then. Two uses:
  *
  *   - a run whose plant has not left t = 0 after EVAL_WAIT_SAY_S (its controller never
@@ -22,7 +22,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "eval_case.h"
+#include "eval_watch.h"
+#include "lagsim_clock.h"
 #include "lagsim_client.h"
 #include "lagsim_client_wire.h"
 
@@ -51,11 +52,12 @@ void eval_say(const char *fmt, ...)
     fflush(stderr);
 }
 
-eval_watch *eval_watch_start(const eval_env *env, const char *who)
+eval_watch *eval_watch_start(const char *url, const char *prefix, double timeout,
+                             const char *who)
 {
     eval_watch *w = calloc(1, sizeof *w);
     if (!w) return NULL;
-    w->cl = lag_client_create(env->url, env->prefix, NULL, 0);
+    w->cl = lag_client_create(url, prefix, NULL, 0);
     w->status = lag_client_status_new();
     if (!w->cl || !w->status) { /* the run goes on without it: nothing to say, the grace
                                  * as before */
@@ -65,8 +67,8 @@ eval_watch *eval_watch_start(const eval_env *env, const char *who)
         return NULL;
     }
     w->who = who;
-    w->t0 = w->asked = eval_now();
-    w->timeout = env->wall_timeout;
+    w->t0 = w->asked = lag_clock_mono_s();
+    w->timeout = timeout;
     return w;
 }
 
@@ -84,8 +86,8 @@ static void take(eval_watch *w, bool ask)
     while (lag_client_handle(w->cl, 0) == LAG_CLIENT_OK) {}
     lag_client_state st;
     if (lag_client_latest_state(w->cl, &st, sizeof st) && st.sim_time > 0) w->moved = true;
-    if (ask && eval_now() >= w->asked + WATCH_ASK_S) {
-        w->asked = eval_now();
+    if (ask && lag_clock_mono_s() >= w->asked + WATCH_ASK_S) {
+        w->asked = lag_clock_mono_s();
         lag_client_request_status(w->cl);
     }
 }
@@ -93,7 +95,7 @@ static void take(eval_watch *w, bool ask)
 void eval_watch_poll(eval_watch *w)
 {
     if (!w) return;
-    bool due = !w->said && !w->moved && w->who && eval_now() >= w->t0 + EVAL_WAIT_SAY_S;
+    bool due = !w->said && !w->moved && w->who && lag_clock_mono_s() >= w->t0 + EVAL_WAIT_SAY_S;
     take(w, due);
     if (!due || w->moved || !lag_client_latest_status(w->cl, w->status)) return;
     const lag_wire_status st = *lag_wire_of_status(w->status);

@@ -90,7 +90,7 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^eval_(metrics|reference|sweep_csv)_"
   "quick     NAME  ^eval_procs_(eval|sweep)_(sigint|sigterm|sigkill|groupkill)$"
   "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene|owned|outputs|bus|docs_python|notes|stderr)$"
-  "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|merge_rows|merge_foreign|shard|kept|kept_python|vary|scene_c|scene_python|notes|interrupt)$"
+  "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|merge_rows|merge_foreign|shard|kept|kept_python|vary|scene_c|scene_python|notes|interrupt|tmpdir)$"
   "wallclock NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
   # the progress line on a terminal: drawn against the wall clock
   "wallclock NAME  ^eval_lagsim_sweep_progress$"
