@@ -289,7 +289,7 @@ if(LAGSIM_PYTHON3 AND NOT LAGSIM_SANITIZE)
     COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/abi_mutations.py
             --check ${CMAKE_CURRENT_SOURCE_DIR}/clients/abi_check.py
             --source ${PROJECT_SOURCE_DIR} --build ${CMAKE_BINARY_DIR} --cc ${CMAKE_C_COMPILER}
-            "--objects=$<JOIN:$<TARGET_OBJECTS:lagsim_client_wire_pic>;$<TARGET_OBJECTS:lagsim_lcmtypes_pic>,;>"
+            "--objects=$<JOIN:$<TARGET_OBJECTS:lagsim_client_wire_pic>;$<TARGET_OBJECTS:lagsim_lcmtypes_pic>;$<TARGET_OBJECTS:lagsim_client_model_objects>;$<TARGET_OBJECTS:lagsim_client_model_pic>,;>"
             "--cflags=${abi_lcm_cflags}" "--libs=${abi_lcm_libs} -lm"
             --version ${PROJECT_VERSION} --abi ${LAGSIM_CLIENT_ABI})
   set_tests_properties(clients_abi clients_abi_mutations PROPERTIES TIMEOUT 120 LABELS clients)
@@ -321,3 +321,12 @@ target_link_libraries(test_client_hpp PRIVATE lagsim_client)
 target_compile_options(test_client_hpp PRIVATE -Wpedantic)
 add_test(NAME clients_cpp_header COMMAND test_client_hpp)
 set_tests_properties(clients_cpp_header PROPERTIES TIMEOUT 30 LABELS clients)
+
+# ---- The model's dynamics for controllers (lag_client_model_mass, lag_client_model_bias)
+# through liblagsim_client.so, against every model written again from T and U
+# (tests/clients/test_client_model.c; the core links only for the references' table).
+add_executable(test_client_model ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client_model.c)
+target_include_directories(test_client_model PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common
+                                                     ${CMAKE_CURRENT_SOURCE_DIR}/core)
+target_link_libraries(test_client_model PRIVATE lagsim_client_shared lagsim_core lagsim_lcmtypes m)
+lagsim_add_test_cases(test_client_model clients_model clients 60)

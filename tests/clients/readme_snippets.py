@@ -26,6 +26,10 @@ commands_accepted, no lockstep timeout), and every state heard must keep both ro
 upright (the shipped scene starts at 0.05 rad). Everything runs on a multicast port of this
 run's own (LCM_DEFAULT_URL): nothing of it may be heard on LCM's default URL.
 
+--kill-after N SIGKILLs the daemon once N states were heard: the block must then end by
+its silence rule within --silence S (5, as README says) of the last state, exit 0, and say
+end=silence if it prints its end (a block that waits only for the stop event hangs).
+
 --think S runs each block twice for --periods N periods: once as written, then as written
 with a control law that takes S wall seconds per answer it builds (tests/clients/think/:
 every joint_command_t the block constructs, or every lag_client_send_command it calls,
@@ -126,6 +130,12 @@ def main():
     ap.add_argument("--think", type=float, default=0.0,
                     help="also run each block with a law of this many wall s per answer")
     ap.add_argument("--periods", type=int, default=200, help="control periods of a run")
+    ap.add_argument("--kill-after", type=int, default=0,
+                    help="SIGKILL the daemon once this many states were heard: the block must "
+                         "end by its silence rule (--silence S), exit 0, and print end=silence "
+                         "if it prints an end")
+    ap.add_argument("--silence", type=float, default=5.0,
+                    help="the blocks' silence timeout, wall s (README: 5)")
     ap.add_argument("names", nargs="+")
     a = ap.parse_args()
     build = os.path.abspath(a.build)
@@ -246,6 +256,54 @@ def build_go_block(a, build, text, path, think):
     return True
 
 
+def kill_daemon(a, name, path, daemon, snip, heard, listener):
+    """--kill-after: SIGKILLs the daemon once a.kill_after states were heard (no stop event
+    comes), then the block must end by its silence rule: exit 0 within a.silence - 0.5 to
+    a.silence + 3 wall s of the last state heard here (the block's count starts at its own
+    last message, which this listener may hear up to 0.5 s later on a loaded machine), and
+    print end=silence if it prints an end. Returns (failures, {}, 0.0)."""
+    th, listening, lc, lc_cmd, stray = listener
+    deadline = time.monotonic() + 60
+    while heard["states"] < a.kill_after and time.monotonic() < deadline and daemon.poll() is None:
+        time.sleep(0.02)
+    daemon.kill()
+    daemon.communicate()
+    t_kill = time.monotonic()
+    try:
+        out, _ = snip.communicate(timeout=a.silence + 20)
+        t_end = time.monotonic()
+    except subprocess.TimeoutExpired:
+        snip.kill()
+        out, _ = snip.communicate()
+        t_end = None
+        out += "\n(killed: did not exit %g s after the daemon died)" % (a.silence + 20)
+    listening[0] = False
+    th.join()
+    lc.close()
+    lc_cmd.close()
+    stray.close()
+    silent = (t_end - heard.get("last_wall", t_kill)) if t_end else float("inf")
+    ends = re.findall(r"end=(\w+)", out)
+    checks = [
+        (heard["states"] >= a.kill_after,
+         "%d states heard before the daemon was killed (SIGKILL, no stop event)" % heard["states"]),
+        (t_end is not None and snip.returncode == 0,
+         "the snippet exited by itself, status %s (0 documented)" % snip.returncode),
+        (a.silence - 0.5 <= silent < a.silence + 3,
+         "it ended %.2f s after the last state heard (its silence timeout: %g s)" % (silent, a.silence)),
+        (all(e == "silence" for e in ends), "its end: %s" % (ends or "not printed")),
+    ]
+    print("---- %s (%s) under a daemon killed after %d states" % (name, path, a.kill_after))
+    if out.strip():
+        print(out.rstrip())
+    fails = 0
+    for good, what in checks:
+        print("%s: %s" % ("ok  " if good else "FAIL", what))
+        fails += 0 if good else 1
+    sys.stdout.flush()
+    return fails, {}, 0.0
+
+
 def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     """Runs one block against lagsimd for a.periods periods in lockstep, its law taking
     `think` wall s per answer (the daemon's lockstep_timeout from think and fast_slowest,
@@ -288,6 +346,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
             return
         first_state.setdefault(st.sim_time, time.monotonic())
         heard["states"] += 1
+        heard["last_wall"] = time.monotonic()
         heard["t"] = max(heard["t"], st.sim_time)
         heard["max_th"] = max([heard["max_th"]] + [abs(x) for x in st.position[1:3]])
         heard["by_time"][st.sim_time] = tuple(st.position) + tuple(st.velocity)
@@ -363,9 +422,11 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
         [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
          "--set", "realtime.mode=lockstep",
          "--set", "realtime.lockstep_timeout=%r" % patience,
-         "--duration", repr(periods * 0.01), "-q"],
+         "--duration", repr((periods if a.kill_after <= 0 else 100000) * 0.01), "-q"],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
     budget = 30 + 3 * think * periods  # three think times a state, and 30 s to start
+    if a.kill_after > 0:
+        return kill_daemon(a, name, path, daemon, snip, heard, (th, listening, lc, lc_cmd, stray))
     try:
         daemon.communicate(timeout=budget)
         in_time = True

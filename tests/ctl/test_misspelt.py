@@ -10,6 +10,7 @@ waiting for its first command (its stderr read), and a DIPC on DP<pid>. Then:
                             MANIPULATOR<pid>?"
   manipulator_pd --prefix MANIPULATR<pid>  (one letter out) exit 1, the same
   manipulator_pd.py --prefix MANIPULATR<pid>  (Python, its own discovery) the same
+  manipulator_ct --prefix MANIPULATR<pid>  (C++, lagsim_client.hpp) the same
   lagsimctl --prefix DP<pid> status  (another plant's: answered, not reported)
   a STATUS on MANIPULATOR<pid>_CONTROL sent to the state port (the wrong port)
 The plant's wait line (stderr) and its status's waiting_got then name the misspelt
@@ -87,6 +88,11 @@ def main():
                                      % (typo, typo, instead)) in r.stderr,
               "manipulator_pd.py --prefix %s: exit 1, the same (the library's discovery, "
               "through ctypes)" % typo)
+        r = run([b("manipulator_ct"), "--prefix", typo, "--timeout", "1.5"])
+        check(r.returncode == 1 and ("no scene description on %s_SCENE within 1.5 s: no plant "
+                                     "on prefix %s; %s" % (typo, typo, instead)) in r.stderr,
+              "manipulator_ct --prefix %s: exit 1, the same (C++: lagsim::Controller::wait_scene)"
+              % typo)
         r = run([b("lagsimctl"), "--prefix", other, "status"])
         check(r.returncode == 0, "lagsimctl --prefix %s status: the other plant answers" % other)
         # this plant's control request on the state port (the wrong one)
