@@ -17,7 +17,9 @@ against `cmake --install <build> --prefix TMP` (PKG_CONFIG_PATH=TMP/lib/pkgconfi
 with LD_LIBRARY_PATH=TMP/lib, as any library in a prefix off the loader's path);
 PYTHONPATH=<build>/python; LUA_PATH=<build>/lua/...; java -cp
 lcm.jar:types.jar:examples.jar File.java; octave --path <build>/octave --eval balance in
-the file's folder). Once it answers a probe state (sim time -1) it is subscribed; then lagsimd runs config/dipc.yaml in lockstep for 2 s of sim time and stops.
+the file's folder). Once it asks for the scene (a DESCRIBE, as the client libraries do
+first) or answers a probe state (sim time -1) it is subscribed; then lagsimd runs
+config/dipc.yaml in lockstep for 2 s of sim time and stops.
 The snippet must exit by itself with status 0 once the daemon announces its stop; the
 daemon's final status must show every state before t = 2 s answered (200
 commands_accepted, no lockstep timeout), and every state heard must keep both rods within 0.1 rad of
@@ -41,7 +43,11 @@ set to at least three think times, and to at least the think time plus 20 times 
 slowest answer of the fast run just before (the time from a state's first copy to its
 first command, measured here: what this machine takes to schedule the block, LCM and the
 daemon now; a loaded machine or a sanitizer build gets the patience it needs, an idle one
-keeps 1 s). A run that answers copies by thinking again falls further behind with every
+keeps the floor: 30 s, as the sanitizer pass beside a load of 24 to 33 on 2 cores, seen
+here, took 5.3 s to answer with a law of 0.15 s, 0.002 s being the fast run's slowest just
+before; a lockstep timeout steps nothing, so the floor bounds a hang, and the daemon's
+copies still come while the law thinks, the first 20 ms after the state, so the copy rule
+is tested as before). A run that answers copies by thinking again falls further behind with every
 state and meets any finite timeout; the law counted once per sim_time is the direct check.
 """
 import argparse
@@ -304,7 +310,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     the fast run's slowest answer); prints its checks. Returns (failures, {sim_time: the
     state's positions and velocities}, the slowest answer in s)."""
     from lagsim_lcm import LCM, plant_urls
-    from lagsim import event_t, joint_command_t, joint_state_t, status_t
+    from lagsim import control_t, event_t, joint_command_t, joint_state_t, status_t
     fname, cmd, env_extra = RUNNERS[lang]
     prefix = "RDME%s_%d" % (lang.upper(), os.getpid())
     tmp = tempfile.mkdtemp(prefix="lagsim_readme_")
@@ -360,6 +366,10 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
         else:
             first_command.setdefault(t, time.monotonic())
 
+    def on_control(ch, data):  # a DESCRIBE: subscribed, asking for the scene (protocol.md)
+        if control_t.decode(data).request == control_t.DESCRIBE:
+            heard["ready"] = True
+
     # LCM's own default URL must hear nothing of this run: it is on its own port
     stray = LCM("udpm://239.255.76.67:7667?ttl=0")
     heard["stray"] = 0
@@ -372,24 +382,31 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     lc.subscribe(prefix + "_STATUS", on_status)
     lc.subscribe(prefix + "_EVENT", on_event)
     lc_cmd.subscribe(prefix + "_COMMAND", on_command)
+    lc_cmd.subscribe(prefix + "_CONTROL", on_control)
     heard["ready"] = False
     listening = [True]
 
     def listen():  # its own thread: the daemon in lockstep outruns a late reader
         while listening[0]:
             lc.handle_timeout(20)
-            while lc_cmd.handle_timeout(0):
-                pass
             while stray.handle_timeout(0):
                 pass
 
+    def listen_commands():  # a thread of its own too: a command is timed when it comes,
+        while listening[0]:  # not when the next state wakes the other reader
+            lc_cmd.handle_timeout(20)
+
     th = threading.Thread(target=listen, daemon=True)
     th.start()
+    th_cmd = threading.Thread(target=listen_commands, daemon=True)
+    th_cmd.start()
     snip = subprocess.Popen(cmd(build, path, slow), cwd=tmp, env=env, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, universal_newlines=True)
-    # Ready when it answers: a probe state at sim time -1, every 0.2 s (and more slowly
-    # than its law), until a command for it comes back (java compiles the file first).
-    # Then the daemon starts.
+    # Ready when it is subscribed: it asks for the scene (a DESCRIBE on <PREFIX>_CONTROL,
+    # which a controller of the client libraries sends first, docs/protocol.md) or it
+    # answers a probe state at sim time -1, published every 0.2 s (and more slowly than
+    # its law; a block of lcm-gen's types alone asks for no scene). java compiles the
+    # file first. Then the daemon starts.
     probe = joint_state_t()
     probe.sim_time, probe.num_joints = -1.0, 3
     probe.name = ["theta0", "theta1", "theta2"]
@@ -400,7 +417,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
         time.sleep(0.2 + 1.5 * think)
     heard["states"] = 0
     periods = a.periods
-    patience = max(1.0, 3 * think, think + 20 * fast_slowest) if think > 0 else 1.0
+    patience = max(30.0, 3 * think, think + 20 * fast_slowest) if think > 0 else 1.0
     daemon = subprocess.Popen(
         [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
          "--set", "realtime.mode=lockstep",
@@ -426,6 +443,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     time.sleep(0.5)
     listening[0] = False
     th.join()
+    th_cmd.join()
     lc.close()
     lc_cmd.close()
     stray.close()

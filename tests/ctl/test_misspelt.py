@@ -25,6 +25,9 @@ import re
 import subprocess
 import sys
 import time
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import waits  # noqa: E402  (events waited on, bounded)
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
 
@@ -56,8 +59,8 @@ def main():
     pid = os.getpid()
     plant, other = "MANIPULATOR%d" % pid, "DP%d" % pid
     short, typo = "MANIP", "MANIPULATR%d" % pid
-    port = 46000 + 2 * ((pid + 3000) % 6000)
-    url = "udpm://239.255.76.67:%d?ttl=0" % port
+    url = lcm_url()  # a port pair of this process's own (not one drawn from the pid)
+    port = int(url.split(":")[2].split("?")[0])
     os.environ["LCM_DEFAULT_URL"] = url
     err_path = "/tmp/lagsim_misspelt_%d.err" % pid
     err = open(err_path, "w")
@@ -67,7 +70,8 @@ def main():
                            "-q", "--set", "lcm.prefix=" + other],
                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        time.sleep(1.0)
+        for prefix in (plant, other):  # each answers (waited on, bounded)
+            check(waits.daemon_answers(b("lagsimctl"), prefix), "lagsimd %s answers" % prefix)
         instead = ("plants heard on %s: %s (dipc, realtime, waiting), %s (manipulator, realtime, "
                    "waiting); did you mean %s?" % (url, other, plant, plant))
         r = run([b("lagsimctl"), "--prefix", short, "status"])

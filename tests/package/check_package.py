@@ -710,7 +710,14 @@ def service_checks(a, tmp):
               "start, each named in the journal: %s" % files, j)
         ubad = "lagsimd@%s.service" % bad
         sd.ctl("start", ubad)
-        time.sleep(7)   # longer than RestartSec
+        # failed (bounded: 30 s), then RestartSec and 1 s more: a restart would have come
+        t = time.monotonic()
+        while sd.show(ubad, "ActiveState") != "failed" and time.monotonic() - t < 30:
+            time.sleep(0.1)
+        restart_us = sd.show(ubad, "RestartUSec")  # "5s", "100ms", "1min 30s"
+        restart_s = sum(float(v) * {"min": 60, "s": 1, "ms": 1e-3, "us": 1e-6}[u] for v, u in
+                        re.findall(r"([\d.]+)(min|ms|us|s)", restart_us))
+        time.sleep(restart_s + 1)
         jb = sd.sh(["journalctl", "-u", ubad, "--no-pager", "-o", "cat"]).stdout
         check(sd.show(ubad, "ExecMainStatus") == "2" and sd.show(ubad, "NRestarts") == "0" and
               sd.show(ubad, "ActiveState") == "failed" and "%s.yaml:2:1: unknown key" % bad in jb,
@@ -720,7 +727,9 @@ def service_checks(a, tmp):
         # removal where systemd runs: the prerm stops every instance, the purge removes the
         # links of enabled ones (dpkg run inside the namespace, which has /run/systemd/system)
         sd.ctl("enable", "--now", unit)
-        time.sleep(1)
+        t = time.monotonic()  # started (bounded: 30 s)
+        while sd.show(unit, "ActiveState") != "active" and time.monotonic() - t < 30:
+            time.sleep(0.1)
         link = "/etc/systemd/system/multi-user.target.wants/" + unit
         was = (sd.show(unit, "ActiveState"), sd.sh(["test", "-L", link]).returncode == 0)
         # in a mount namespace of its own under systemd's, without the unit directory shown
