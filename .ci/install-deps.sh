@@ -32,7 +32,7 @@ tests   clang                 # the sanitizer pass: clang, ASan+UBSan, libFuzzer
 tests   libclang-rt-14-dev
 tests   lua5.2                # the Lua 5.2 clients (liblcm-lua is built for 5.2 only)
 tests   liblcm-lua
-tests   liblua5.2-dev         # ... the client library's Lua module (clients/lua/lagsim_client_lua.c)
+tests   liblua5.2-dev         # ... the client library'"'"'s Lua module (clients/lua/lagsim_client_lua.c)
 tests   lua-posix             # ... their SIGINT, SIGTERM
 tests   liblcm-java           # the Java clients; lcm-spy with lagsim'"'"'s types
 tests   libjchart2d-java

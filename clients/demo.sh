@@ -31,7 +31,12 @@ finish() {
 }
 trap finish EXIT
 trap 'exit 0' INT TERM
-sleep 0.3
+# its address line, or its end (at most 10 s: a loaded machine starts it late)
+for _ in $(seq 100); do
+    grep -q 'http://' build/lagsim-view.log && break
+    kill -0 "$view" 2>/dev/null || break
+    sleep 0.1
+done
 if addr=$(grep -o 'http://[^ ]*' build/lagsim-view.log); then
     echo "lagsim-view: open $addr in a browser to watch the DIPC" >&2
 else

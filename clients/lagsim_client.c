@@ -83,6 +83,7 @@ struct lag_client {
     lag_client_reference reference; /* latest reference */
     bool have_reference;
     lag_client_counters counters;
+    double heard;                /* monotonic s: the last message kept (creation before) */
     /* the last command sent for the latest state, as encoded (a copy of that state gets
      * it again) */
     uint8_t answer[LAG_WIRE_BUF_SIZE];
@@ -370,9 +371,19 @@ static lag_result dispatch(lag_client *c, const char *channel, const void *data,
     return LAG_CLIENT_OK;
 }
 
+/* Messages kept from the daemon: states (copies too), scenes, statuses, events, references. */
+static int64_t kept(const lag_client *c)
+{
+    const lag_client_counters *k = &c->counters;
+    return k->states + k->scenes + k->statuses + k->events + k->references;
+}
+
 static void on_message(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
-    dispatch(user, channel, rbuf->data, rbuf->data_size);
+    lag_client *c = user;
+    int64_t before = kept(c);
+    dispatch(c, channel, rbuf->data, rbuf->data_size);
+    if (kept(c) != before) c->heard = lag_client_now();
 }
 
 lag_result lag_client_feed(lag_client *c, const char *channel, const void *data, size_t len)
@@ -381,7 +392,10 @@ lag_result lag_client_feed(lag_client *c, const char *channel, const void *data,
         set_err(c, "feed: NULL channel or data");
         return LAG_CLIENT_ERR_ARG;
     }
-    return dispatch(c, channel, data ? data : "", len);
+    int64_t before = kept(c);
+    lag_result rc = dispatch(c, channel, data ? data : "", len);
+    if (kept(c) != before) c->heard = lag_client_now();
+    return rc;
 }
 
 /* ---------------------------------------------------------------- life cycle */
@@ -443,6 +457,7 @@ lag_client *lag_client_create(const char *url, const char *prefix, char *err, si
         return NULL;
     }
     copy_str(c->prefix, sizeof c->prefix, prefix);
+    c->heard = lag_client_now();
     if (!subscribe_all(c)) {
         if (err) snprintf(err, errlen, "cannot subscribe to %s_*", prefix);
         lag_client_destroy(c);
@@ -460,6 +475,8 @@ void lag_client_destroy(lag_client *c)
 }
 
 const char *lag_client_errmsg(const lag_client *c) { return c ? c->errmsg : "no client"; }
+
+double lag_client_heard(const lag_client *c) { return c ? c->heard : NAN; }
 
 int lag_client_fileno(const lag_client *c) { return lcm_get_fileno(c->lcm); }
 
@@ -594,6 +611,15 @@ bool lag_client_latest_status(const lag_client *c, lag_client_status *out)
 bool lag_client_latest_reference(const lag_client *c, lag_client_reference *ref, size_t size)
 {
     if (!c->have_reference) return false;
+    return !ref || copy_out(ref, size, &c->reference, sizeof c->reference, REFERENCE_SIZE_1);
+}
+
+bool lag_client_reference_of(const lag_client *c, const lag_client_state *st,
+                             lag_client_reference *ref, size_t size)
+{
+    if (!c->have_reference || !st || c->reference.generation != st->generation ||
+        c->reference.sim_time != st->sim_time)
+        return false;
     return !ref || copy_out(ref, size, &c->reference, sizeof c->reference, REFERENCE_SIZE_1);
 }
 

@@ -136,7 +136,8 @@ typedef struct lag_client_state {
 } lag_client_state;
 
 /* <PREFIX>_REFERENCE: what the joints with a reference should follow at a state's time
- * (reference_t): published just before the state with the same sim_time. */
+ * (reference_t): published just before the state with the same generation and sim_time
+ * (lag_client_reference_of). */
 typedef struct lag_client_reference {
     int64_t utime;
     double sim_time;                                   /* the state's */
@@ -236,12 +237,18 @@ lag_result lag_client_wait_state(lag_client *c, double timeout_s, lag_client_sta
 
 /* Polling: the latest state / reference / status received, whether or not already
  * returned. False if none has arrived yet (or a size below the first version's).
- * A reference is published just before each state with the same sim_time, so when a
- * state arrives its reference has arrived already, unless UDP lost it: compare the
- * sim_times; a scene without a reference publishes none. OUT: st, ref, out */
+ * A reference is published just before each state with the same generation and
+ * sim_time, so when a state arrives its reference has arrived already, unless UDP lost
+ * it: a reference belongs to a state when both match (after a reset or a SET sim_time
+ * may repeat: the generation tells them apart); lag_client_reference_of checks it. A
+ * scene without a reference publishes none. OUT: st, ref, out */
 bool lag_client_latest_state(const lag_client *c, lag_client_state *st, size_t size);
 bool lag_client_latest_reference(const lag_client *c, lag_client_reference *ref, size_t size);
 bool lag_client_latest_status(const lag_client *c, lag_client_status *out);
+/* The reference of state st: the latest reference when its generation and sim_time are
+ * st's; false when there is none (lost, or a scene without a reference). OUT: ref */
+bool lag_client_reference_of(const lag_client *c, const lag_client_state *st,
+                             lag_client_reference *ref, size_t size);
 /* The scene of the latest state's generation (the scene rule above; a scene of a later
  * generation that came since waits for its own state); before any state, the latest scene
  * received. False if none has arrived. OUT: sc */
@@ -278,6 +285,13 @@ lag_result lag_client_kick(lag_client *c, const char *joint, double impulse, dou
 /* RESET to the scene file's initial state and values: the changes made by SET and the
  * kicks are undone (a `restore` event says which), then the `reset` event. */
 lag_result lag_client_reset_scene(lag_client *c);
+
+/* When the last message from the daemon was kept (a state or a copy of one, a scene, a
+ * status, an event, a reference), on lag_client_now()'s clock; the handle's creation
+ * before any. A controller ends when lag_client_now() - lag_client_heard(c) exceeds its
+ * silence timeout: the daemon died, hung or never came (a plant that waits or is paused
+ * still publishes its status, at realtime.status_hz). */
+double lag_client_heard(const lag_client *c);
 
 /* size: sizeof *out. OUT: out */
 void lag_client_get_counters(const lag_client *c, lag_client_counters *out, size_t size);
@@ -322,6 +336,30 @@ double lag_client_scene_command_timeout(const lag_client_scene *sc);
 const char *lag_client_scene_integrator(const lag_client_scene *sc);
 const char *lag_client_scene_mode(const lag_client_scene *sc);
 const char *lag_client_scene_effects(const lag_client_scene *sc);   /* comma-separated */
+
+/* ---------------------------------------------------------------- the model's dynamics */
+
+/* The scene's model with the scene's parameters, as the daemon integrates it
+ * (docs/models.md):
+ *
+ *     M(q) qdd + h(q, qd) = tau + (the effects' forces),   h = C(q, qd) qd + g(q),
+ *
+ * M the mass matrix (T = 1/2 qd^T M qd), C qd the Coriolis and centrifugal forces, g = dU/dq
+ * the gravity forces, tau the efforts commanded. Computed by the core's own closed forms
+ * (the daemon's step, bit for bit), for computed torque, feedforward and observers. The
+ * effects (docs/effects.md: damping, friction, springs, limits, the floor, actuator lag,
+ * disturbances, noise) are not in M nor h: a controller that wants them models them.
+ * q and qd are in the scene's joint order (a state's: lag_client_scene_joint_name), n is
+ * their number, which must be the model's (lag_client_scene_num_joints). A stick whose
+ * floor lets it fly (joints x, phi, h) is the flying stick, with h the height of end A
+ * (after end B landed the daemon measures h from end B: docs/models.md).
+ * Return LAG_CLIENT_OK, or LAG_CLIENT_ERR_ARG with a message in err (may be NULL): a model
+ * this library does not know, n not the model's, a parameter missing or out of its range,
+ * a non-finite q or qd. OUT: M (n*n, row-major: M[i*n + j]), h (n) */
+lag_result lag_client_model_mass(const lag_client_scene *sc, int n, const double *q, double *M,
+                                 char *err, size_t errlen);
+lag_result lag_client_model_bias(const lag_client_scene *sc, int n, const double *q,
+                                 const double *qd, double *h, char *err, size_t errlen);
 
 /* ---------------------------------------------------------------- the status */
 

@@ -35,8 +35,10 @@
 #ifndef LAGSIM_CLIENT_HPP
 #define LAGSIM_CLIENT_HPP
 
+#include <csignal>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <exception>
 #include <functional>
 #include <memory>
@@ -46,6 +48,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <signal.h>
 
 #include "lagsim_client.h"
 
@@ -97,7 +101,7 @@ struct State : lag_client_state {
 
 /* A reference (lag_client_reference: sim_time, step, generation, num_joints, name[], r[],
  * rdot[], rddot[]): what the joints with a reference follow at the state of that
- * sim_time. */
+ * generation and sim_time (Client::reference_of). */
 struct Reference : lag_client_reference {
     Reference() : lag_client_reference() {}
     /* the index of joint `name`, or -1 (the scene gives it no reference) */
@@ -199,6 +203,40 @@ public:
         return std::isnan(v) ? std::nullopt : std::optional<double>(v);
     }
 
+    /* The model's dynamics with this scene's parameters (lag_client_model_mass,
+     * lag_client_model_bias; docs/clients.md): M(q) qdd + h(q, qd) = tau + the effects'
+     * forces, h = C(q, qd) qd + g(q), the effects (damping, friction, springs, limits, ...)
+     * not included. q and qd in the scene's joint order (a state's), as many as its
+     * joints; Error (LAG_ERR_ARG) for another number, a non-finite value, or a scene whose
+     * model or parameters the library cannot use. mass: n*n, row-major (M[i*n + j]). */
+    std::vector<double> mass(const std::vector<double> &q) const
+    {
+        std::vector<double> M(q.size() * q.size());
+        mass(static_cast<int>(q.size()), q.data(), M.data());
+        return M;
+    }
+    std::vector<double> bias(const std::vector<double> &q, const std::vector<double> &qd) const
+    {
+        if (q.size() != qd.size())
+            throw Error(LAG_ERR_ARG, "LAG_ERR_ARG: bias: q and qd of different sizes");
+        std::vector<double> h(q.size());
+        bias(static_cast<int>(q.size()), q.data(), qd.data(), h.data());
+        return h;
+    }
+    /* The same into arrays of the caller's (n and n*n doubles): no allocation. */
+    void mass(int n, const double *q, double *M) const
+    {
+        char err[256] = "";
+        lag_result rc = lag_client_model_mass(p_, n, q, M, err, sizeof err);
+        if (rc != LAG_OK) throw Error(rc, detail::describe(rc, err));
+    }
+    void bias(int n, const double *q, const double *qd, double *h) const
+    {
+        char err[256] = "";
+        lag_result rc = lag_client_model_bias(p_, n, q, qd, h, err, sizeof err);
+        if (rc != LAG_OK) throw Error(rc, detail::describe(rc, err));
+    }
+
     const lag_client_scene *get() const { return p_; }
     lag_client_scene *get() { return p_; }
 
@@ -285,7 +323,7 @@ private:
 class Client {
 public:
     explicit Client(const std::string &prefix, const std::string &url = "")
-        : cb_(std::make_unique<Callbacks>())
+        : prefix_(prefix), url_(url), cb_(std::make_unique<Callbacks>())
     {
         if (prefix.empty() || prefix.size() >= LAG_CLIENT_NAME_LEN)
             throw Error(LAG_ERR_ARG, "LAG_ERR_ARG: a prefix of 1 to 63 characters, not '" + prefix + "'");
@@ -296,14 +334,32 @@ public:
     }
 
     /* The scene (DESCRIBE at once and every 0.25 s until it comes); Error with LAG_TIMEOUT
-     * when none came within timeout_s. */
+     * when none came within timeout_s, its message naming the plants heard on the bus
+     * instead (lag_client_plants_instead, listening 1 s more: a misspelt prefix). */
     Scene wait_scene(double timeout_s)
     {
         Scene sc;
-        lag_result rc = run(lag_client_wait_scene(c_.get(), timeout_s, sc.get()));
-        if (rc == LAG_TIMEOUT) throw Error(rc, detail::describe(rc, lag_client_errmsg(c_.get())));
+        if (!try_wait_scene(timeout_s, sc)) throw no_scene(timeout_s);
         return sc;
     }
+    /* The same without the Error: false when no scene came within timeout_s. */
+    bool try_wait_scene(double timeout_s, Scene &sc)
+    {
+        return run(lag_client_wait_scene(c_.get(), timeout_s, sc.get())) == LAG_OK;
+    }
+    /* The Error of no scene within waited_s: what the bus has instead of this prefix. */
+    Error no_scene(double waited_s) const
+    {
+        char instead[1500] = "";
+        lag_client_plants_instead(url_.empty() ? nullptr : url_.c_str(), prefix_.c_str(), 1.0,
+                                  instead, sizeof instead);
+        char head[160];
+        std::snprintf(head, sizeof head, "no scene description on %s_SCENE within %g s: ",
+                      prefix_.c_str(), waited_s);
+        return Error(LAG_TIMEOUT, detail::describe(LAG_TIMEOUT, (head + std::string(instead)).c_str()));
+    }
+    const std::string &prefix() const { return prefix_; }
+    const std::string &url() const { return url_; }
     /* The newest state not yet returned, or nullopt when none came within timeout_s. */
     std::optional<State> wait_state(double timeout_s)
     {
@@ -326,6 +382,14 @@ public:
         Reference r;
         return lag_client_latest_reference(c_.get(), &r, sizeof r) ? std::optional<Reference>(r)
                                                                    : std::nullopt;
+    }
+    /* the reference of state st (the latest one, when its generation and sim_time are
+     * st's), or std::nullopt: lost, or a scene without a reference */
+    std::optional<Reference> reference_of(const State &st) const
+    {
+        Reference r;
+        return lag_client_reference_of(c_.get(), &st, &r, sizeof r) ? std::optional<Reference>(r)
+                                                                     : std::nullopt;
     }
     /* the scene of the latest state's generation */
     std::optional<Scene> latest_scene() const
@@ -393,6 +457,8 @@ public:
         lag_client_get_counters(c_.get(), &k, sizeof k);
         return k;
     }
+    /* when the last message from the daemon was kept, on now()'s clock (lag_client_heard) */
+    double heard() const { return lag_client_heard(c_.get()); }
     /* for poll()/select(): when readable, handle(0) */
     int fileno() const { return lag_client_fileno(c_.get()); }
     lag_client *get() const { return c_.get(); }
@@ -494,8 +560,167 @@ private:
     struct Destroy {
         void operator()(lag_client *c) const { lag_client_destroy(c); }
     };
+    std::string prefix_, url_;
     std::unique_ptr<Callbacks> cb_;
     std::unique_ptr<lag_client, Destroy> c_;
+};
+
+/* A controller's run: a Client and the rules by which the run of every example controller
+ * (C's lag_ctl, Python's, Lua's and Java's Controller) ends, so that a loop over next()
+ * ends when the daemon stops, dies or falls silent:
+ *
+ *   lagsim::Controller ctl("DIPC");                   // ends: stop, silence, signal
+ *   while (std::optional<lagsim::State> st = ctl.next()) {  // each state once, the newest
+ *       double u = ...;                               // ctl.scene(): its scene
+ *       ctl.send_command(*st, {"theta0"}, {u});       // answers it
+ *   }
+ *   // ctl.end(): "stop", "silence", "duration" or "signal"
+ *
+ * next() returns std::nullopt once the run has ended, and end() says why:
+ *   "stop"      the daemon published its stop event (it ends a run: --duration, SIGINT);
+ *   "silence"   nothing came from the daemon (no state, scene, status, event or
+ *               reference) for Options::timeout wall seconds (default 5): a daemon killed,
+ *               hung, or never started (a plant that waits or is paused publishes its
+ *               status at realtime.status_hz, 5 Hz by default: it is not silent);
+ *   "duration"  Options::duration s of sim time passed since the first state (0: never);
+ *   "signal"    SIGINT or SIGTERM came (Options::signals, the default: the handlers are
+ *               installed for the Controller's life and the previous ones put back after).
+ * None of these is an error: the examples exit 0 for each. A client error (the bus
+ * failing) is an Error thrown from next() or send_command().
+ * Events reach ctl.on_event (ctl.client().on_event would replace the Controller's own). */
+class Controller {
+public:
+    struct Options {
+        std::string url;       /* the plant's LCM URL ("": LCM's default, LCM_DEFAULT_URL) */
+        double timeout = 5.0;  /* wall s of silence that end the run (> 0) */
+        double duration = 0.0; /* sim s from the first state that end the run (0: none) */
+        bool signals = true;   /* SIGINT and SIGTERM end the run */
+    };
+
+    explicit Controller(const std::string &prefix) : Controller(prefix, Options()) {}
+    Controller(const std::string &prefix, const Options &o) : o_(o), c_(prefix, o.url)
+    {
+        if (!(o.timeout > 0) || !(o.duration >= 0) || !std::isfinite(o.duration))
+            throw Error(LAG_ERR_ARG, "LAG_ERR_ARG: Controller: timeout > 0 and a finite "
+                                     "duration >= 0, not " + std::to_string(o.timeout) + ", " +
+                                     std::to_string(o.duration));
+        c_.on_event([this](const Event &ev) {
+            stopped_ |= ev.is("stop");
+            if (user_event_) user_event_(ev);
+        });
+        if (o_.signals) {
+            signal_flag() = 0;
+            struct sigaction sa = {};
+            sa.sa_handler = &Controller::on_signal;
+            sigemptyset(&sa.sa_mask); /* no SA_RESTART: a wait returns at once */
+            sigaction(SIGINT, &sa, &old_int_);
+            sigaction(SIGTERM, &sa, &old_term_);
+        }
+    }
+    ~Controller()
+    {
+        if (o_.signals) {
+            sigaction(SIGINT, &old_int_, nullptr);
+            sigaction(SIGTERM, &old_term_, nullptr);
+        }
+    }
+    Controller(const Controller &) = delete;
+    Controller &operator=(const Controller &) = delete;
+
+    /* The scene (DESCRIBE until it comes, Client::wait_scene) within Options::timeout
+     * wall s; std::nullopt when a signal ended the wait (end() "signal"); Error with
+     * LAG_TIMEOUT when none came (end() "silence"), naming the plants heard instead.
+     * Optional: next() returns states without it, each once its scene came (the scene
+     * rule, lagsim_client.h). */
+    std::optional<Scene> wait_scene()
+    {
+        Scene sc;
+        for (double until = lag_client_now() + o_.timeout;;) {
+            if (o_.signals && signal_flag()) return ended_scene("signal");
+            double left = until - lag_client_now();
+            if (left <= 0) {
+                end_ = "silence";
+                throw c_.no_scene(o_.timeout);
+            }
+            if (c_.try_wait_scene(left < 0.25 ? left : 0.25, sc)) return sc;
+        }
+    }
+    /* The newest state not yet returned, or std::nullopt once the run has ended (end()).
+     * A copy of a state already answered is answered by the library with the same
+     * command, never returned: the law runs once per state. */
+    std::optional<State> next()
+    {
+        if (!end_.empty()) return std::nullopt;
+        if (o_.duration > 0 && states_ > 0 &&
+            last_.sim_time - t_first_ >= o_.duration - 0.5 * period()) {
+            end_ = "duration";
+            return std::nullopt;
+        }
+        for (;;) {
+            if (o_.signals && signal_flag()) return ended("signal");
+            std::optional<State> st = c_.wait_state(0.05);
+            if (st) {
+                if (states_++ == 0) t_first_ = st->sim_time;
+                last_ = *st;
+                return st;
+            }
+            if (stopped_) return ended("stop");
+            if (lag_client_now() - c_.heard() > o_.timeout) return ended("silence");
+        }
+    }
+    /* Answers state st with efforts for the joints named; a non-finite effort is sent as
+     * 0, never NaN (Client::send_command for the errors). */
+    void send_command(const State &st, const std::vector<std::string> &names,
+                      std::vector<double> effort)
+    {
+        for (double &e : effort) e = std::isfinite(e) ? e : 0.0;
+        c_.send_command(st, names, effort);
+    }
+
+    /* why the run ended ("" while it runs): stop, silence, duration, signal */
+    const std::string &end() const { return end_; }
+    /* states returned by next() */
+    long long states() const { return states_; }
+    /* the scene of the state last returned (Client::latest_scene): its parameters */
+    std::optional<Scene> scene() const { return c_.latest_scene(); }
+    /* events from the daemon (after the Controller has looked for its stop) */
+    void on_event(std::function<void(const Event &)> f) { user_event_ = std::move(f); }
+    Client &client() { return c_; }
+    const Options &options() const { return o_; }
+
+private:
+    static volatile std::sig_atomic_t &signal_flag()
+    {
+        static volatile std::sig_atomic_t flag = 0;
+        return flag;
+    }
+    static void on_signal(int sig) { signal_flag() = sig; }
+    std::optional<State> ended(const char *why)
+    {
+        end_ = why;
+        return std::nullopt;
+    }
+    std::optional<Scene> ended_scene(const char *why)
+    {
+        end_ = why;
+        return std::nullopt;
+    }
+    double period() const
+    {
+        std::optional<Scene> sc = c_.latest_scene();
+        double p = sc ? sc->control_period() : 0.0;
+        return std::isfinite(p) ? p : 0.0;
+    }
+
+    Options o_;
+    Client c_;
+    std::function<void(const Event &)> user_event_;
+    struct sigaction old_int_ = {}, old_term_ = {};
+    std::string end_;
+    bool stopped_ = false;
+    double t_first_ = 0;
+    long long states_ = 0;
+    State last_;
 };
 
 /* The plants on the bus at url (lag_client_discover). */

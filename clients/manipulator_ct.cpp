@@ -5,19 +5,16 @@
  *   tau = M(q) (r'' + Kd (r' - qd) + Kp (r - q)) + C(q, qd) qd + g(q),  Kp = wn^2, Kd = 2 wn
  *
  * r, r', r'' from <PREFIX>_REFERENCE (published just before each state with its sim_time:
- * the feedforward is exact, no difference of r'), M, C and g from the scene's parameters.
- * With the exact model the error obeys e'' + Kd e' + Kp e = 0 (critically damped), up to
- * the zero-order hold of the effort over a control period.
+ * the feedforward is exact, no difference of r'); M(q) and the bias h = C(q, qd) qd + g(q)
+ * from the client library (lagsim::Scene::mass, bias: the core's closed forms with the
+ * scene's parameters, docs/clients.md), nothing of the model written here. With the exact
+ * model the error obeys e'' + Kd e' + Kp e = 0 (critically damped), up to the zero-order
+ * hold of the effort over a control period.
  *
  * What it links, and why: only liblagsim_client (pkg-config lagsim-client), as a
- * controller outside lagsim's tree does. The core's model functions (lagsim.h,
- * lag_model_mass and lag_model_bias, which manipulator_pd.c uses) are a static library
- * for lagsim's own programs without a stable ABI, so M, C and g are written here in
- * closed form from the model's T and U (docs/models.md):
- *   M = diag(m1 l1^2 + I1 + I2 + m2 q2^2, m2),
- *   C qd = (2 m2 q2 q1' q2', -m2 q2 q1'^2),  g = ((m1 l1 + m2 q2) g cos q1, m2 g sin q1),
- * with the core's operations in the core's order, so that this controller and the C
- * manipulator_pd answer every state with the same bits (clients_cross_language_manipulator).
+ * controller outside lagsim's tree does. tau = M v + h is summed in the order of the C
+ * manipulator_pd (which calls the core), so that the two answer every state with the same
+ * bits (clients_cross_language_manipulator).
  *
  * The run, its options and its summary line are those of the C examples
  * (docs/clients.md): --prefix (default: the only manipulator on the bus, else
@@ -31,7 +28,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -42,34 +38,20 @@
 
 namespace {
 
-volatile std::sig_atomic_t g_signal = 0;
-void on_signal(int sig) { g_signal = sig; }
-
 struct Options {
     std::string prefix, url, trace;
     double duration = 0, timeout = 5, wn = 10, settle = 2;
     bool quiet = false;
 };
 
-/* The model's parameters, from the scene. */
-struct Params {
-    double m1, m2, l1, I1, I2, g;
-    explicit Params(const lagsim::Scene &sc)
-        : m1(sc.param("m1")), m2(sc.param("m2")), l1(sc.param("l1")), I1(sc.param("I1")),
-          I2(sc.param("I2")), g(sc.param("g"))
-    {
-    }
-};
-
 using Vec2 = std::array<double, 2>;
 
-/* tau = M(q) v + C(q, qd) qd + g(q) (the core's model_manipulator.c, term for term). */
-Vec2 computed_torque(const Params &p, const Vec2 &q, const Vec2 &qd, const Vec2 &v)
+/* tau = M(q) v + h(q, qd), M and h = C(q, qd) qd + g(q) from the client library. */
+Vec2 computed_torque(const lagsim::Scene &sc, const Vec2 &q, const Vec2 &qd, const Vec2 &v)
 {
-    const double s = std::sin(q[0]), c = std::cos(q[0]), a = p.m2 * q[1];
-    const double M[4] = {p.m1 * p.l1 * p.l1 + p.I1 + p.I2 + p.m2 * q[1] * q[1], 0.0, 0.0, p.m2};
-    const double h[2] = {2.0 * a * qd[0] * qd[1] + (p.m1 * p.l1 + a) * p.g * c,
-                         -a * qd[0] * qd[0] + p.m2 * p.g * s};
+    double M[4], h[2];
+    sc.mass(2, q.data(), M);
+    sc.bias(2, q.data(), qd.data(), h);
     return {M[0] * v[0] + M[1] * v[1] + h[0], M[2] * v[0] + M[3] * v[1] + h[1]};
 }
 
@@ -95,8 +77,8 @@ int usage(std::ostream &o, int status)
 {
     o << "usage: manipulator_ct [options]\n"
          "Tracks the scene's reference (<PREFIX>_REFERENCE: r, r', r'') on a running lagsimd\n"
-         "manipulator with computed torque, M, C and g written from the model (C++ over the\n"
-         "client library alone).\n"
+         "manipulator with computed torque, M(q) and C(q, qd) qd + g(q) from the client\n"
+         "library (C++ over the client library alone).\n"
          "  --prefix P           channel prefix (default: the only manipulator on the bus;\n"
          "                       none yet: MANIPULATOR)\n"
          "  --url URL            LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)\n"
@@ -180,68 +162,48 @@ int choose_prefix(Options &o)
     return -1;
 }
 
-/* The scene, within --timeout (signals heard every 0.25 s). */
-std::optional<lagsim::Scene> scene_of(lagsim::Client &c, const Options &o)
+/* The scene, within --timeout (lagsim::Controller::wait_scene: a signal ends the wait;
+ * none in time: the plants on the bus instead, for a misspelt --prefix). */
+std::optional<lagsim::Scene> scene_of(lagsim::Controller &ctl, const Options &o)
 {
     std::cout << "manipulator_ct: waiting for the scene description on " << o.prefix << "_SCENE"
               << std::endl; /* subscribed: the harnesses start the daemon on this line */
-    for (double end = lagsim::now() + o.timeout; !g_signal;) {
-        try {
-            return c.wait_scene(std::min(0.25, std::max(0.0, end - lagsim::now())));
-        } catch (const lagsim::Error &e) {
-            if (e.code() != LAG_TIMEOUT || lagsim::now() >= end) {
-                std::cerr << "manipulator_ct: " << e.what() << "\n";
-                return std::nullopt;
-            }
-        }
+    try {
+        return ctl.wait_scene(); /* std::nullopt: a signal */
+    } catch (const lagsim::Error &e) {
+        if (e.code() != LAG_TIMEOUT) throw;
+        std::cerr << "manipulator_ct: " << e.what() << "\n"; /* the plants heard instead */
+        return std::nullopt;
     }
-    return std::nullopt;
 }
 
-/* Runs the law on every state until the run ends; returns why it ended. */
-std::string control(lagsim::Client &c, lagsim::Scene &sc, const Options &o, Tracking &tr,
-                    std::ofstream &trace)
+/* Runs the law on every state until the run ends (lagsim::Controller: the daemon's stop,
+ * --timeout s of silence, --duration, SIGINT/SIGTERM). */
+void control(lagsim::Controller &ctl, lagsim::Scene &sc, const Options &o, Tracking &tr,
+             std::ofstream &trace)
 {
-    Params p(sc);
     const double kp = o.wn * o.wn, kd = 2.0 * o.wn;
     const std::vector<std::string> jn = {"q1", "q2"};
-    bool stopped = false;
-    double heard = lagsim::now();
-    c.on_event([&](const lagsim::Event &ev) { heard = lagsim::now(), stopped |= ev.is("stop"); });
-    c.on_status([&](const lagsim::Status &) { heard = lagsim::now(); });
-    c.on_state([&](const lagsim::State &) { heard = lagsim::now(); });
     Vec2 hold{};
-    for (;;) {
-        if (o.duration > 0 && tr.states > 0 &&
-            tr.t_last - tr.t_first >= o.duration - 0.5 * sc.control_period())
-            return "duration";
-        if (g_signal) return "signal";
-        std::optional<lagsim::State> st = c.wait_state(0.05);
-        if (!st) {
-            if (stopped) return "stop";
-            if (lagsim::now() - heard > o.timeout) return "silence";
-            continue;
-        }
-        if (st->generation != sc.generation()) { /* a reset, a SET: its scene came with it */
-            sc = *c.latest_scene();
-            p = Params(sc);
-        }
+    while (std::optional<lagsim::State> st = ctl.next()) {
+        if (st->generation != sc.generation()) /* a reset, a SET: its scene came with it */
+            sc = *ctl.scene();
         const int i1 = st->joint(jn[0]), i2 = st->joint(jn[1]);
         if (i1 < 0 || i2 < 0) continue;
         const Vec2 q = {st->position[i1], st->position[i2]}, qd = {st->velocity[i1], st->velocity[i2]};
         if (tr.states == 0) hold = q;
         /* r, r', r'' of each joint (a joint without a reference holds its first position) */
-        std::optional<lagsim::Reference> ref = c.latest_reference();
-        if (ref && ref->sim_time != st->sim_time) tr.stale++; /* lost: the last one kept */
+        std::optional<lagsim::Reference> ref = ctl.client().reference_of(*st); /* its own */
+        if (!ref && (ref = ctl.client().latest_reference())) tr.stale++; /* lost: the last kept */
         Vec2 r = hold, rd{}, rdd{};
         for (int k = 0; k < 2; k++)
             if (int j = ref ? ref->joint(jn[k]) : -1; j >= 0)
                 r[k] = ref->r[j], rd[k] = ref->rdot[j], rdd[k] = ref->rddot[j];
         Vec2 v;
         for (int k = 0; k < 2; k++) v[k] = rdd[k] + kp * (r[k] - q[k]) + kd * (rd[k] - qd[k]);
-        Vec2 tau = computed_torque(p, q, qd, v);
+        Vec2 tau = computed_torque(sc, q, qd, v);
         for (double &t : tau) t = std::isfinite(t) ? t : 0.0; /* never a NaN on the bus */
-        c.send_command(*st, jn, {tau[0], tau[1]});
+        ctl.send_command(*st, jn, {tau[0], tau[1]});
         if (trace.is_open()) {
             char buf[64];
             std::snprintf(buf, sizeof buf, "%.17g", st->sim_time);
@@ -263,6 +225,22 @@ std::string control(lagsim::Client &c, lagsim::Scene &sc, const Options &o, Trac
     }
 }
 
+/* The summary line (the C examples' keys); returns the exit status, 0. */
+int summary(lagsim::Controller &ctl, const Tracking &tr, const Options &o)
+{
+    lag_client_counters n = ctl.client().counters();
+    Vec2 rms;
+    for (int k = 0; k < 2; k++) rms[k] = tr.settled ? std::sqrt(tr.esq[k] / tr.settled) : NAN;
+    std::printf("manipulator_ct: summary end=%s states=%lld t_first=%.6f t_last=%.6f settle=%g "
+                "max_abs_e1=%.6g max_abs_e2=%.6g rms_e1=%.6g rms_e2=%.6g max_abs_e1_all=%.6g "
+                "max_abs_e2_all=%.6g references_stale=%lld dropped=%lld repeats=%lld\n",
+                ctl.end().c_str(), tr.states, tr.t_first, tr.t_last, o.settle, tr.emax[0],
+                tr.emax[1], rms[0], rms[1], tr.emax_all[0], tr.emax_all[1], tr.stale,
+                static_cast<long long>(n.dropped), static_cast<long long>(n.repeats));
+    std::fflush(stdout);
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char **argv)
@@ -270,8 +248,6 @@ int main(int argc, char **argv)
     Options o;
     if (int rc = parse(argc, argv, o); rc >= 0) return rc;
     if (int rc = choose_prefix(o); rc >= 0) return rc;
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
     std::ofstream trace;
     if (!o.trace.empty()) {
         trace.open(o.trace);
@@ -281,9 +257,10 @@ int main(int argc, char **argv)
         }
     }
     try {
-        lagsim::Client c(o.prefix, o.url);
-        std::optional<lagsim::Scene> sc = scene_of(c, o);
-        if (!sc) return 1;
+        lagsim::Controller ctl(o.prefix, {o.url, o.timeout, o.duration, true});
+        Tracking tr;
+        std::optional<lagsim::Scene> sc = scene_of(ctl, o);
+        if (!sc) return ctl.end() == "signal" ? summary(ctl, tr, o) : 1;
         if (sc->model() != "manipulator" || !sc->actuated(sc->joint("q1")) ||
             !sc->actuated(sc->joint("q2"))) {
             std::cerr << "manipulator_ct: prefix " << o.prefix << " runs " << sc->model()
@@ -293,18 +270,8 @@ int main(int argc, char **argv)
         std::cout << "manipulator_ct: scene on " << o.prefix << "_*: mode " << sc->mode()
                   << ", control period " << sc->control_period() << " s; Kp " << o.wn * o.wn
                   << ", Kd " << 2 * o.wn << std::endl;
-        Tracking tr;
-        std::string end = control(c, *sc, o, tr, trace);
-        lag_client_counters n = c.counters();
-        Vec2 rms;
-        for (int k = 0; k < 2; k++) rms[k] = tr.settled ? std::sqrt(tr.esq[k] / tr.settled) : NAN;
-        std::printf("manipulator_ct: summary end=%s states=%lld t_first=%.6f t_last=%.6f settle=%g "
-                    "max_abs_e1=%.6g max_abs_e2=%.6g rms_e1=%.6g rms_e2=%.6g max_abs_e1_all=%.6g "
-                    "max_abs_e2_all=%.6g references_stale=%lld dropped=%lld repeats=%lld\n",
-                    end.c_str(), tr.states, tr.t_first, tr.t_last, o.settle, tr.emax[0], tr.emax[1],
-                    rms[0], rms[1], tr.emax_all[0], tr.emax_all[1], tr.stale,
-                    static_cast<long long>(n.dropped), static_cast<long long>(n.repeats));
-        return 0;
+        control(ctl, *sc, o, tr, trace);
+        return summary(ctl, tr, o);
     } catch (const lagsim::Error &e) {
         std::cerr << "manipulator_ct: " << e.what() << "\n";
         return 1;

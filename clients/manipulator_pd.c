@@ -7,10 +7,10 @@
  *   tau = M(q) (qdd_d + Kp (q_d - q) + Kd (qd_d - qd)) + C(q, qd) qd + g(q).
  * r'' is the reference's exact second derivative (docs/evaluation.md), so the feedforward
  * needs no difference of r'. A joint the scene gives no reference holds its position at
- * the first state (qd_d = qdd_d = 0). A state whose reference was lost (another sim_time)
- * keeps the last one, and is counted. clients/manipulator_ct.cpp is the same law in C++
- * over the client library alone (M, C and g written from the model's closed form), bit
- * for bit the same numbers.
+ * the first state (qd_d = qdd_d = 0). A state whose reference was lost (none of its
+ * generation and sim_time) keeps the last one, and is counted. clients/manipulator_ct.cpp
+ * is the same law in C++ over the client library alone (M and C qd + g from
+ * lag_client_model_mass and lag_client_model_bias), bit for bit the same numbers.
  * With the exact model the error obeys e'' + Kd e' + Kp e = 0 (Kp = wn^2, Kd = 2 wn,
  * critically damped), up to the zero-order hold of the effort over a control period.
  * Answers every state (lockstep-safe) and prints the tracking error.
@@ -35,9 +35,9 @@ typedef struct desired {
 static void desired_at(desired *d, lag_ctl *ctl, const lag_client_state *st, const int i[2],
                        const char *const jn[2], bool first)
 {
-    lag_client_reference ref;
-    bool have = lag_client_latest_reference(ctl->client, &ref, sizeof ref);
-    if (have && ref.sim_time != st->sim_time) d->stale++;
+    lag_client_reference ref; /* st's own (its generation and sim_time), else the last kept */
+    bool have = lag_client_reference_of(ctl->client, st, &ref, sizeof ref);
+    if (!have && (have = lag_client_latest_reference(ctl->client, &ref, sizeof ref))) d->stale++;
     for (int k = 0; k < 2; k++) {
         int j = have ? lag_client_reference_joint(&ref, jn[k]) : -1;
         d->have[k] = j >= 0;

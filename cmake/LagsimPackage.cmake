@@ -19,17 +19,32 @@ set(CPACK_PACKAGE_CONTACT "${LAGSIM_DEB_MAINTAINER}")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)          # lagsim_<version>_<arch>.deb
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "real-time simulation server for Lagrangian models over LCM")
-# Debian's extended description (the summary above is its first line)
-set(CPACK_DEBIAN_PACKAGE_DESCRIPTION "lagsimd steps a sliding stick, a rotary/prismatic manipulator, a double
-inverted pendulum on a cart or a cart-pole in real time, publishes its joint
-states on LCM channels and takes effort commands from controllers in C, Python,
-Lua, Java or Octave; runs are recorded whole and re-simulated bit for bit.
+# Debian's extended description (the summary above is its first line). Its list of models
+# is the core's table's (lagsim_lists print SOURCE model-titles): the build writes
+# <build>/description/description.cmake from the text below (@MODELS@ replaced, paragraphs
+# wrapped at 72 columns, cmake/LagsimDescription.cmake), which cpack reads when it runs
+# (CPACK_PROJECT_CONFIG_FILE); package_build compares the .deb's Description with the table.
+set(LAGSIM_DEB_DESCRIPTION "lagsimd steps @MODELS@ in real time, publishes its joint \
+states on LCM channels and takes effort commands from controllers in C, C++, \
+Python, Lua, Java or MATLAB/Octave; runs are recorded whole and re-simulated \
+bit for bit.
 .
-This package holds the daemon and its tools, the client library (shared, with
-a kept ABI, and static) with its C and C++ headers and pkg-config file, the
-message types for C, Python, Lua and Java,
-example controllers, the shipped scenes, and a systemd template unit,
-lagsimd@NAME, that runs /etc/lagsim/NAME.yaml as a service.")
+This package holds the daemon and its tools, the client library (shared, with \
+a kept ABI, and static) with its C and C++ headers and pkg-config file, the \
+message types for C, Python, Lua and Java, example controllers, the shipped \
+scenes, and a systemd template unit, lagsimd@NAME, that runs \
+/etc/lagsim/NAME.yaml as a service.")
+file(WRITE ${PROJECT_BINARY_DIR}/description/description.in "${LAGSIM_DEB_DESCRIPTION}")
+add_custom_command(OUTPUT ${PROJECT_BINARY_DIR}/description/description.cmake
+  COMMAND ${CMAKE_COMMAND} -D LISTS=$<TARGET_FILE:lagsim_lists> -D SOURCE=${PROJECT_SOURCE_DIR}
+          -D IN=${PROJECT_BINARY_DIR}/description/description.in
+          -D OUT=${PROJECT_BINARY_DIR}/description/description.cmake
+          -P ${CMAKE_CURRENT_LIST_DIR}/LagsimDescription.cmake
+  DEPENDS lagsim_lists ${CMAKE_CURRENT_LIST_DIR}/LagsimDescription.cmake
+          ${PROJECT_BINARY_DIR}/description/description.in
+  COMMENT "the package's description, its models from the core's table")
+add_custom_target(package_description ALL DEPENDS ${PROJECT_BINARY_DIR}/description/description.cmake)
+set(CPACK_PROJECT_CONFIG_FILE ${PROJECT_BINARY_DIR}/description/description.cmake)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 set(CPACK_STRIP_FILES ON)                         # the programs; debug info stays in the build

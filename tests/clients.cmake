@@ -98,6 +98,12 @@ endif()
 if(LAGSIM_PYTHON3)
   set(e2e ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/run_e2e.py
           --lagsimd ${LAGSIMD_FOR_TESTS})
+  # The controllers' --timeout (a scene, then any message, within it): the harness starts
+  # the daemon once the controller is subscribed, and a daemon on a loaded machine or in the
+  # sanitizer build can take more than a few seconds to publish its scene (seen: "no scene
+  # within 5 s", clients_python_manipulator_lockstep). 30 s, within the harness's own
+  # --timeout, which bounds the run; the tests of the end on silence keep their 2 s.
+  set(ctl_timeout 30)
   set(dipc_cfg --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml --set "initial.q=[0,0.05,-0.03]"
                --set "initial.qd=[0,0,0]")
   # Bounds (DIPC, released at theta1 = 0.05, theta2 = -0.03 rad, Bogdanov's LQR weights):
@@ -115,7 +121,7 @@ if(LAGSIM_PYTHON3)
       --check "max_abs_theta2 <= 1.1 * pred_max_abs_theta2 + 0.002"
       --check "abs(end_theta1) < 1e-3 and abs(end_theta2) < 1e-3"
       --check "max_abs_theta0 < 1.0" --check "dropped == 0" --check "end == 'duration'"
-      -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration 20 --timeout 5 -q)
+      -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration 20 --timeout ${ctl_timeout} -q)
   set_tests_properties(clients_dipc_lqr_lockstep PROPERTIES TIMEOUT 70)
   # Real time (20 s of wall time): the effort now reaches the daemon up to one tick after
   # the state it answers, so the bounds get 25 % + 5 mrad. A controller that is not
@@ -131,7 +137,7 @@ if(LAGSIM_PYTHON3)
       --check "max_abs_theta2 <= 1.25 * pred_max_abs_theta2 + 0.005"
       --check "abs(end_theta1) < 1e-3 and abs(end_theta2) < 1e-3"
       --check "max_abs_theta0 < 1.0"
-      -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration 20 --timeout 5 -q)
+      -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration 20 --timeout ${ctl_timeout} -q)
   set_tests_properties(clients_dipc_lqr_realtime PROPERTIES TIMEOUT 70)
 
   # The cart-pole balanced by lqr_balance, which takes the model, its parameters, joints
@@ -152,7 +158,7 @@ if(LAGSIM_PYTHON3)
       --check "abs(end_theta) < 1e-4 and abs(end_x) < 1e-3"
       --check "dropped == 0" --check "end == 'duration'"
       --check "'applying the discrete gain on x: u = -K x, K =' in out"
-      -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout 5 -q)
+      -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout ${ctl_timeout} -q)
   # A push: upright at rest, then at t = 5 s an impulse of 0.02 N m s on the pole (the
   # scene's disturbance effect). Its velocity jump M(0)^-1 (0, 0.02) = (-0.0293 m/s,
   # 0.644 rad/s) run through the linearized sampled loop peaks at theta 0.0567 rad,
@@ -169,7 +175,7 @@ if(LAGSIM_PYTHON3)
       --check "max_abs_x <= 1.25 * 0.487"
       --check "abs(end_theta) < 1e-4 and abs(end_x) < 1e-3"
       --check "dropped == 0" --check "end == 'duration'"
-      -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout 5 -q)
+      -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout ${ctl_timeout} -q)
   # Real time, as clients_dipc_lqr_realtime: 25 % + 5 mrad (or mm) of the prediction.
   add_test(NAME clients_lqr_balance_cartpole_realtime
     COMMAND ${e2e} ${cartpole_cfg} --mode realtime --name CLCPRT --timeout 50
@@ -178,7 +184,7 @@ if(LAGSIM_PYTHON3)
       --check "max_abs_theta <= 1.25 * pred_max_abs_theta + 0.005"
       --check "max_abs_x <= 1.25 * pred_max_abs_x + 0.005"
       --check "abs(end_theta) < 1e-3 and abs(end_x) < 1e-2"
-      -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout 5 -q)
+      -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout ${ctl_timeout} -q)
   set_tests_properties(clients_lqr_balance_cartpole_lockstep clients_lqr_balance_cartpole_push
                        clients_lqr_balance_cartpole_realtime PROPERTIES TIMEOUT 70)
 
@@ -201,12 +207,12 @@ if(LAGSIM_PYTHON3)
     COMMAND ${e2e} ${manip_cfg} --mode lockstep --name CLPYMAN --timeout 50 ${manip_checks}
       --check "dropped == 0"
       -- ${LAGSIM_PYTHON3} ${PROJECT_SOURCE_DIR}/clients/python/manipulator_pd.py
-         --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --duration 10 --timeout 5 -q)
+         --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --duration 10 --timeout ${ctl_timeout} -q)
   set_tests_properties(clients_python_manipulator_lockstep PROPERTIES TIMEOUT 70)
   add_test(NAME clients_c_manipulator_lockstep
     COMMAND ${e2e} ${manip_cfg} --mode lockstep --name CLCMAN --timeout 50 ${manip_checks}
       --check "dropped == 0 and end == 'duration'"
-      -- $<TARGET_FILE:manipulator_pd> --prefix {prefix} --duration 10 --timeout 5 -q)
+      -- $<TARGET_FILE:manipulator_pd> --prefix {prefix} --duration 10 --timeout ${ctl_timeout} -q)
   set_tests_properties(clients_c_manipulator_lockstep PROPERTIES TIMEOUT 70)
 
   # How a C controller's run ends (the contract of every language's examples): the daemon
@@ -283,7 +289,7 @@ if(LAGSIM_PYTHON3 AND NOT LAGSIM_SANITIZE)
     COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/abi_mutations.py
             --check ${CMAKE_CURRENT_SOURCE_DIR}/clients/abi_check.py
             --source ${PROJECT_SOURCE_DIR} --build ${CMAKE_BINARY_DIR} --cc ${CMAKE_C_COMPILER}
-            "--objects=$<JOIN:$<TARGET_OBJECTS:lagsim_client_wire_pic>;$<TARGET_OBJECTS:lagsim_lcmtypes_pic>,;>"
+            "--objects=$<JOIN:$<TARGET_OBJECTS:lagsim_client_wire_pic>;$<TARGET_OBJECTS:lagsim_lcmtypes_pic>;$<TARGET_OBJECTS:lagsim_client_model_objects>;$<TARGET_OBJECTS:lagsim_client_model_pic>,;>"
             "--cflags=${abi_lcm_cflags}" "--libs=${abi_lcm_libs} -lm"
             --version ${PROJECT_VERSION} --abi ${LAGSIM_CLIENT_ABI})
   set_tests_properties(clients_abi clients_abi_mutations PROPERTIES TIMEOUT 120 LABELS clients)
@@ -315,3 +321,12 @@ target_link_libraries(test_client_hpp PRIVATE lagsim_client)
 target_compile_options(test_client_hpp PRIVATE -Wpedantic)
 add_test(NAME clients_cpp_header COMMAND test_client_hpp)
 set_tests_properties(clients_cpp_header PROPERTIES TIMEOUT 30 LABELS clients)
+
+# ---- The model's dynamics for controllers (lag_client_model_mass, lag_client_model_bias)
+# through liblagsim_client.so, against every model written again from T and U
+# (tests/clients/test_client_model.c; the core links only for the references' table).
+add_executable(test_client_model ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client_model.c)
+target_include_directories(test_client_model PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common
+                                                     ${CMAKE_CURRENT_SOURCE_DIR}/core)
+target_link_libraries(test_client_model PRIVATE lagsim_client_shared lagsim_core lagsim_lcmtypes m)
+lagsim_add_test_cases(test_client_model clients_model clients 60)

@@ -43,7 +43,8 @@ if(LAGSIM_PYTHON3)
   set_tests_properties(ctl_discover PROPERTIES TIMEOUT 120 LABELS clients)
 endif()
 
-# A prefix nobody has (a misspelt one): lagsimctl, manipulator_pd in C and in Python name
+# A prefix nobody has (a misspelt one): lagsimctl, manipulator_pd in C and in Python and
+# manipulator_ct in C++ name
 # the plants heard and the one meant; the plant's wait line and status name the requests
 # for the misspelt prefixes and its own on the wrong port, never another plant's
 # (tests/ctl/test_misspelt.py).

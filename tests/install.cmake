@@ -30,3 +30,12 @@ if(LAGSIM_PYTHON3)
     set_tests_properties(install_man_${case} PROPERTIES TIMEOUT 120 LABELS clients)
   endforeach()
 endif()
+
+# A build for users (-DBUILD_TESTING=OFF): the programs, libraries, types and man pages,
+# no test, fuzz or benchmark target (configured only: tests/install/check_build_testing_off.py).
+if(LAGSIM_PYTHON3)
+  add_test(NAME install_build_testing_off
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/install/check_build_testing_off.py
+            --source ${PROJECT_SOURCE_DIR} --build ${CMAKE_BINARY_DIR})
+  set_tests_properties(install_build_testing_off PROPERTIES TIMEOUT 120 LABELS clients)
+endif()

@@ -288,13 +288,14 @@ add_test(NAME clients_cross_language_manipulator
 list(APPEND lang_tests clients_cross_language_manipulator)
 
 # ---- C++: manipulator_ct end to end, with the bounds of the C example, and how its run
-# ends (the daemon's stop, a silent daemon)
+# ends (lagsim::Controller: the daemon's stop, a silent daemon, SIGINT and SIGTERM)
 add_test(NAME clients_cpp_manipulator_lockstep
   COMMAND ${lang_e2e} ${lang_manip_cfg} --mode lockstep --name CLCPPMAN --timeout 60
     ${lang_manip_checks} --check "end == 'duration'"
     -- $<TARGET_FILE:manipulator_ct> --prefix {prefix} --duration 10 -q)
 list(APPEND lang_tests clients_cpp_manipulator_lockstep)
 lang_end_tests(cpp manipulator "${lang_manip_cfg}" $<TARGET_FILE:manipulator_ct>)
+lang_signal_test(cpp "${lang_manip_cfg}" $<TARGET_FILE:manipulator_ct>)
 
 # ---- Java
 if(TARGET lagsim_examples_java)
@@ -549,13 +550,12 @@ foreach(lang IN LISTS readme_langs)
   list(APPEND lang_tests clients_readme_${lang} clients_readme_${lang}_slow_law
     clients_readme_${lang}_slower_law)
 endforeach()
-# docs/clients.md's Go block ends by its silence timeout when the daemon is SIGKILLed
+# docs/clients.md's Go block built by its static-link recipe against an install: no
+# liblagsim_client.so loaded, and it balances
 if(TARGET dipc_balance_go)
-  add_test(NAME clients_readme_go_daemon_killed COMMAND ${readme_run} ${readme_cc} --kill-daemon go-dipc)
-  # and built by its static-link recipe against an install: no liblagsim_client.so loaded
   add_test(NAME clients_readme_go_static
     COMMAND ${readme_run} ${readme_cc} --install --go-static --periods 20 go-dipc)
-  list(APPEND lang_tests clients_readme_go_daemon_killed clients_readme_go_static)
+  list(APPEND lang_tests clients_readme_go_static)
 endif()
 # docs/clients.md's C++ block over stock lcm-gen --cpp types and lcm/lcm-cpp.hpp, built
 # with the types clients_lcm_cpp_forged's target generates (tests/clients.cmake)
@@ -568,6 +568,17 @@ add_test(NAME clients_readme_c_installed
 add_test(NAME clients_readme_cpp_installed
   COMMAND ${readme_run} ${readme_cc} --install --periods 20 cpp-dipc)
 list(APPEND lang_tests clients_readme_c_installed clients_readme_cpp_installed)
+# the C and C++ blocks under a daemon SIGKILLed after 30 states (no stop event): each ends
+# by its silence rule (5 s of nothing from the daemon, as README says) and exits 0
+set(readme_killed c cpp)
+if(TARGET dipc_balance_go)  # docs/clients.md's Go block (its silence = 5 s)
+  list(APPEND readme_killed go)
+endif()
+foreach(lang IN LISTS readme_killed)
+  add_test(NAME clients_readme_${lang}_daemon_killed
+    COMMAND ${readme_run} ${readme_cc} --kill-after 30 --silence 5 ${lang}-dipc)
+  list(APPEND lang_tests clients_readme_${lang}_daemon_killed)
+endforeach()
 if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
   find_program(LAGSIM_OTHER_CXX clang++)
 else()

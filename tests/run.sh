@@ -20,6 +20,9 @@
 # before failed; the exit status is non-zero when any failed, after every summary.
 #   LAGSIM_SKIP_SANITIZE=1   --full without pass 2
 #   LAGSIM_WAIT_JOBS=N       how many tests of the tier waits at once (2 x cores)
+#   LAGSIM_QUICK_JOBS=N      how many tests at once in the quick tier alone (2 x cores: it
+#                            waits on no clock, so it holds at any load, and its tests wait
+#                            on each other's processes more than they compute)
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root" || exit 2
@@ -43,6 +46,8 @@ done
 "$root/.ci/install-deps.sh" "$([ "${CI:-}" = true ] && echo ci || echo tests)" || exit 1
 cores=$(nproc)
 wait_jobs=${LAGSIM_WAIT_JOBS:-$((2 * cores))}
+compute_jobs=$cores  # the computing half: a core a test (the quick tier alone: quick_jobs)
+quick_jobs=${LAGSIM_QUICK_JOBS:-$((2 * cores))}
 summaries=()
 failed=0
 
@@ -59,43 +64,97 @@ ctest_half() {
 total_passed=0
 total_failed=0
 
-# run_pass NAME BUILD_DIR TIMEOUT SELECT EXCLUDE CMAKE ARGS...
+# build DIR CMAKE ARGS...: configures and builds DIR (-j cores); its status in DIR/build.rc
+# and its seconds in DIR/build.s
+build() {
+  local dir=$1 t0=$SECONDS rc=0
+  shift
+  mkdir -p "$dir"
+  cmake -S . -B "$dir" "$@" >/dev/null && cmake --build "$dir" -j"$cores" || rc=1
+  echo $rc >"$dir/build.rc"
+  echo $((SECONDS - t0)) >"$dir/build.s"
+  return $rc
+}
+
+# build_behind DIR CMAKE ARGS...: the build of a later pass, started now at a low priority
+# (nice 10) beside this pass's tests, its output in DIR/build.log: a test that waits on
+# the wall clock holds beside two busy processes (as it must on a loaded machine), and the
+# cores the waiting tests leave idle build the next pass. wait_built DIR waits for it.
+build_behind() {
+  local dir=$1
+  mkdir -p "$dir"
+  rm -f "$dir/build.rc"
+  (nice -n 10 bash -c "$(declare -f build); cores=$cores; build \"\$@\"" build "$@" \
+     >"$dir/build.log" 2>&1) &
+}
+wait_built() {
+  local dir=$1
+  while [ ! -f "$dir/build.rc" ]; do
+    sleep 1
+  done
+  [ "$(cat "$dir/build.rc")" = 0 ] || { tail -50 "$dir/build.log"; return 1; }
+}
+
+# run_pass NAME BUILD_DIR TIMEOUT SELECT EXCLUDE BUILT CMAKE ARGS...
 #   SELECT: a label regex the tests must match ("" all); EXCLUDE: tiers left out ("" none);
-#   TIMEOUT "-": build only.
-# The tests of the waiting tier (waits) run 2 x cores at once beside the others, which run
-# one per core as before (a test that computes, or a real-time loop that must be scheduled
-# every period, has a core): the waiting ones sleep while the others keep the cores busy.
-# Two ctest processes; the computing one's output is shown as it runs, the other's after.
+#   TIMEOUT "-": build only; BUILT "behind": built by build_behind (waited for here), else
+#   built here.
+# Three ctest processes, "halves" of the pass:
+#   quick      the tier quick, 2 x cores at once (LAGSIM_QUICK_JOBS): it waits on no clock,
+#              so it holds at any load, and its tests wait on each other's processes (a
+#              lockstep round trip, a start) more than they compute;
+#   computing  then every other tier but waits, one test per core (a test that computes,
+#              or a real-time loop that must be scheduled every period, has a core);
+#   waiting    beside both, the tier waits, 2 x cores at once: they sleep while the others
+#              keep the cores busy.
+# The first two are shown as they run, the waiting one's output after.
 run_pass() {
-  local name=$1 dir=$2 timeout=$3 sel=$4 excl=$5
-  shift 5
+  local name=$1 dir=$2 timeout=$3 sel=$4 excl=$5 built=$6
+  shift 6
   local start=$SECONDS result rc_w rc_c half
   echo "==== $name"
-  if ! cmake -S . -B "$dir" "$@" >/dev/null || ! cmake --build "$dir" -j"$cores"; then
+  local ok=0
+  if [ "$built" = behind ]; then
+    wait_built "$dir" || ok=1
+    echo "(built beside the pass before: $(cat "$dir/build.s" 2>/dev/null) s; $dir/build.log)"
+  else
+    build "$dir" "$@" || ok=1
+  fi
+  if [ $ok -ne 0 ]; then
     summaries+=("$name: BUILD FAILED")
     failed=1
     return
   fi
   if [ "$timeout" = - ]; then
-    summaries+=("$name: built, warning-free ($((SECONDS - start)) s)")
+    summaries+=("$name: built, warning-free ($(cat "$dir/build.s") s of build)")
     return
   fi
-  local common=(--timeout "$timeout") waits=(-L "$waiting_rx") computes
+  local common=(--timeout "$timeout") waits=(-L "$waiting_rx") quick=(-L '^quick$') computes
   [ -n "$sel" ] && common+=(-L "$sel")
-  [ -n "$excl" ] && waits+=(-LE "^(${excl// /|})\$")
-  computes=(-LE "^(${waiting// /|}${excl:+|${excl// /|}})\$")
+  [ -n "$excl" ] && waits+=(-LE "^(${excl// /|})\$") && quick+=(-LE "^(${excl// /|})\$")
+  computes=(-LE "^(quick|${waiting// /|}${excl:+|${excl// /|}})\$")
+  : >"$root/$dir/ctest-quick.log"
   : >"$root/$dir/ctest-computing.log"
   ctest_half "$dir" "$root/$dir/ctest-waiting.log" "$wait_jobs" "${common[@]}" "${waits[@]}" &
   local waiter=$!
-  ctest_half "$dir" "$root/$dir/ctest-computing.log" "$cores" "${common[@]}" "${computes[@]}" &
+  (
+    local t0=$SECONDS rc=0
+    ctest_half "$dir" "$root/$dir/ctest-quick.log" "$quick_jobs" "${common[@]}" "${quick[@]}" || rc=1
+    echo "quick half: $((SECONDS - t0)) s" >>"$root/$dir/ctest-quick.log"
+    t0=$SECONDS
+    ctest_half "$dir" "$root/$dir/ctest-computing.log" "$cores" "${common[@]}" "${computes[@]}" || rc=$((rc | 2))
+    echo "computing half: $((SECONDS - t0)) s" >>"$root/$dir/ctest-computing.log"
+    exit $rc
+  ) &
   local computer=$!
-  tail -n +1 --pid="$computer" -f "$root/$dir/ctest-computing.log" 2>/dev/null  # shown as it runs
+  tail -n +1 --pid="$computer" -f "$root/$dir/ctest-quick.log" "$root/$dir/ctest-computing.log" 2>/dev/null  # shown as they run
   wait "$computer"
   rc_c=$?
   wait "$waiter"
   rc_w=$?
-  for half in computing waiting; do
-    local log="$root/$dir/ctest-$half.log" rc=$rc_c
+  for half in quick computing waiting; do
+    local log="$root/$dir/ctest-$half.log" rc=$((rc_c & 1))
+    [ $half = computing ] && rc=$((rc_c & 2))
     [ $half = waiting ] && rc=$rc_w
     if grep -q "No tests were found" "$log"; then
       continue
@@ -112,7 +171,7 @@ run_pass() {
     fi
     if [ "$rc" -eq 0 ]; then
       result=$(grep -E "tests passed" "$log" | tail -1)
-      summaries+=("$name, $half: $result")
+      summaries+=("$name, $half: $result ($(sed -n 's/^Total Test time (real) = *//p' "$log"))")
     else
       failed=1
       result=$(grep -E "tests passed|tests failed" "$log" | tail -1)
@@ -130,24 +189,35 @@ asan_args=(-DCMAKE_C_COMPILER=clang -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_C_FLAGS_DE
            -DLAGSIM_WERROR=ON -DLAGSIM_SANITIZE=ON -DLAGSIM_FUZZ=ON -DLAGSIM_BENCH=OFF)
 asan_env() { export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1; }
 
+release_args=(-DCMAKE_C_COMPILER=gcc -DCMAKE_BUILD_TYPE=Release -DLAGSIM_WERROR=ON)
 case $mode in
   quick)
-    run_pass "quick tier (gcc -Werror)" build 300 "^quick\$" "" "${gcc_args[@]}" ;;
+    run_pass "quick tier (gcc -Werror)" build 300 "^quick\$" "" here "${gcc_args[@]}" ;;
   some)
     if [ $sanitize -eq 1 ]; then
       asan_env
-      run_pass "clang ASan+UBSan+libFuzzer: $select" build-asan 600 "$select" "" "${asan_args[@]}"
+      run_pass "clang ASan+UBSan+libFuzzer: $select" build-asan 600 "$select" "" here "${asan_args[@]}"
     else
-      run_pass "gcc -Werror: $select" build 300 "$select" "" "${gcc_args[@]}"
+      run_pass "gcc -Werror: $select" build 300 "$select" "" here "${gcc_args[@]}"
     fi ;;
   full)
-    run_pass "pass 1 (gcc -Werror)" build 300 "" "" "${gcc_args[@]}"
+    # pass 1's build first; the later passes' builds behind pass 1's tests, one after the
+    # other (two builds at once would be four busy processes beside the real-time tests)
+    echo "==== pass 1's build"
+    build build "${gcc_args[@]}"
+    rm -f build-asan/build.rc build-release/build.rc
+    if [ "${LAGSIM_SKIP_SANITIZE:-0}" != 1 ]; then
+      (build_behind build-asan "${asan_args[@]}"; wait
+       build_behind build-release "${release_args[@]}"; wait) &
+    else
+      build_behind build-release "${release_args[@]}"
+    fi
+    run_pass "pass 1 (gcc -Werror)" build 300 "" "" here "${gcc_args[@]}"
     if [ "${LAGSIM_SKIP_SANITIZE:-0}" != 1 ]; then
       asan_env
-      run_pass "pass 2 (clang ASan+UBSan+libFuzzer)" build-asan 600 "" "slow" "${asan_args[@]}"
+      run_pass "pass 2 (clang ASan+UBSan+libFuzzer)" build-asan 600 "" "slow" behind
     fi
-    run_pass "pass 3 (gcc -Werror Release, build only)" build-release - "" "" \
-      -DCMAKE_C_COMPILER=gcc -DCMAKE_BUILD_TYPE=Release -DLAGSIM_WERROR=ON ;;
+    run_pass "pass 3 (gcc -Werror Release, build only)" build-release - "" "" behind ;;
 esac
 
 echo "==== summary"

@@ -29,3 +29,10 @@ endif()
 add_test(NAME structure_lists
          COMMAND lagsim_lists check ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(structure_lists PROPERTIES TIMEOUT 60 LABELS structure)
+# .ci/install-deps.sh reads: every profile lists its packages (a quote the table's string
+# lost broke tests/run.sh and CI at their first line)
+find_program(LAGSIM_BASH_FOR_DEPS bash REQUIRED)
+add_test(NAME structure_install_deps
+         COMMAND ${LAGSIM_BASH_FOR_DEPS} -c
+           "for p in runtime tests ci dev; do ${PROJECT_SOURCE_DIR}/.ci/install-deps.sh --list $p >/dev/null || exit 1; done")
+set_tests_properties(structure_install_deps PROPERTIES TIMEOUT 60 LABELS structure)

@@ -29,6 +29,8 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
                                 "clients", "python"))
 from lagsim_lcm import LCM  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 failures = []
 
@@ -107,7 +109,7 @@ class Daemon:
 
 def play(t, name, command, k):
     prefix = "GEN%s_%d" % (name.upper(), os.getpid())
-    port = 20000 + 2 * ((os.getpid() + 97 * k) % 6000)
+    port = lcm_port()  # a pair of this run's own
     url = "udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304" % port
     d = Daemon(t, url, url.replace(":%d?" % port, ":%d?" % (port + 1)), prefix)
     env = dict(os.environ, LCM_DEFAULT_URL=url)

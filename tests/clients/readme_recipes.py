@@ -18,6 +18,7 @@ import csv
 import os
 import re
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -231,6 +232,15 @@ def main():
             line = re.sub(r"(^|[\s;&(='])clients/", r"\g<1>%s/clients/" % src, line)
             lines.append(line)
         script = "\n".join(lines) + "\n"
+        # the walkthrough's lagsim-view port (8765, as the page says) becomes a free one of
+        # this run's: another suite on the machine may be walking through it too
+        if ":8765" in script or "--port 8765" in script:
+            with socket.socket() as sk:
+                sk.bind(("127.0.0.1", 0))
+                view_port = sk.getsockname()[1]
+            script = script.replace("--port 8765", "--port %d" % view_port) \
+                           .replace(":8765/", ":%d/" % view_port)
+            print("(lagsim-view's port 8765 taken as %d, a free one)" % view_port)
         tmp = tempfile.mkdtemp(prefix="lagsim_recipe_")
         for fname, text in files.get(name, []):
             with open(os.path.join(tmp, fname), "w") as f:

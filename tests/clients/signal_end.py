@@ -23,13 +23,14 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from run_e2e import hostile_lcm, parse_summary, stop  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def one(a, client, sig, mid_run, n):
     prefix = "SIGEND%d_%d" % (os.getpid(), n)
     env = dict(os.environ)
-    env["LCM_DEFAULT_URL"] = ("udpm://239.255.76.67:%d?ttl=0&recv_buf_size=4194304"
-                              % (20000 + 2 * ((os.getpid() + 3001 * n) % 6000)))
+    env["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")  # a pair of this run's own
     cmd = [c.replace("{prefix}", prefix) for c in client]
     what = "%s %s" % (signal.Signals(sig).name, "mid-run" if mid_run else "waiting for the scene")
     print("---- %s: %s" % (what, " ".join(cmd)), flush=True)

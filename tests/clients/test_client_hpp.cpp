@@ -8,10 +8,19 @@
  *   - a callback's exception never crosses the C library: it comes out, of its own type,
  *     from the next call that runs callbacks, once;
  *   - a Scene handed to a callback is a view; a copy of it owns its own and outlives it;
- *   - State, Reference, the scene's and the status's fields read as the C library's.
+ *   - State, Reference, the scene's and the status's fields read as the C library's;
+ *   - Scene::mass and Scene::bias are the manipulator's M(q) and C(q, qd) qd + g(q) of
+ *     docs/models.md (written out here), in vectors and in arrays; a scene without its
+ *     parameters, or q of the wrong size, is Error LAG_ERR_ARG naming what is missing;
+ *   - reference_of(state): the latest reference only when its generation and sim_time are
+ *     the state's (a lost one, or one of another generation at the same sim_time: none);
+ *   - a Controller's run ends: on silence after its timeout (heard() moves with every
+ *     message kept, not with a dropped one), on the daemon's stop event, after its duration;
+ *     and its state is returned once.
  *
  * usage: test_client_hpp   (exit 0 when every check holds)
  */
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -55,7 +64,7 @@ void feed(lagsim::Client &c, lag_wire_type t, const void *m, const char *suffix)
         check(false, "feeding a " + std::string(lag_wire_type_name(t)));
 }
 
-void feed_scene(lagsim::Client &c)
+void feed_scene(lagsim::Client &c, bool whole = false)
 {
     lag_wire_scene s;
     std::memset(&s, 0, sizeof s);
@@ -72,6 +81,16 @@ void feed_scene(lagsim::Client &c)
     std::strcpy(s.joint_name[1], "q2");
     s.actuated[0] = s.actuated[1] = true;
     s.control_period = 0.01;
+    if (whole) { /* every parameter of the manipulator: m1, m2, l1, I1, I2, g */
+        const char *more[] = {"l1", "I1", "I2", "g"};
+        const double v[] = {0.3, 0.02, 0.05, 9.81};
+        for (int i = 0; i < 4; i++) {
+            std::strcpy(s.param_name[2 + i], more[i]);
+            s.param_value[2 + i] = v[i];
+        }
+        s.num_params = 6;
+        s.generation = 1;
+    }
     feed(c, LAG_WIRE_SCENE, &s, "SCENE");
 }
 
@@ -152,6 +171,120 @@ void messages()
           "a status field that is not there, or not a text: Error");
 }
 
+void dynamics()
+{
+    lagsim::Client c("FED", "memq://");
+    feed_scene(c); /* m1 and m2 only */
+    lagsim::Scene part = *c.latest_scene();
+    std::string msg;
+    bool refused = error_of([&] { part.mass({0.1, 0.5}); }, &msg) == LAG_ERR_ARG &&
+                   msg.find("no parameter l1") != std::string::npos;
+    check(refused, "a scene without the model's parameters: Error naming one (" + msg + ")");
+    feed_scene(c, true);
+    lagsim::Scene sc = *c.latest_scene();
+    const double m1 = 2.0, m2 = 1.25, l1 = 0.3, I1 = 0.02, I2 = 0.05, g = 9.81;
+    const double q1 = 0.7, q2 = 0.45, q1d = -1.3, q2d = 0.8;
+    std::vector<double> M = sc.mass({q1, q2}), h = sc.bias({q1, q2}, {q1d, q2d});
+    const double Mw[4] = {m1 * l1 * l1 + I1 + I2 + m2 * q2 * q2, 0, 0, m2};
+    const double hw[2] = {2 * m2 * q2 * q1d * q2d + (m1 * l1 + m2 * q2) * g * std::cos(q1),
+                          -m2 * q2 * q1d * q1d + m2 * g * std::sin(q1)};
+    bool ok = M.size() == 4 && h.size() == 2;
+    for (int i = 0; ok && i < 4; i++) ok = std::fabs(M[i] - Mw[i]) <= 1e-14 * 2;
+    for (int i = 0; ok && i < 2; i++) ok = std::fabs(h[i] - hw[i]) <= 1e-13 * 20;
+    check(ok, "mass and bias: docs/models.md's M(q) and C(q, qd) qd + g(q) of the manipulator");
+    double Ma[4], ha[2];
+    const double q[2] = {q1, q2}, qd[2] = {q1d, q2d};
+    sc.mass(2, q, Ma);
+    sc.bias(2, q, qd, ha);
+    check(std::equal(Ma, Ma + 4, M.begin()) && std::equal(ha, ha + 2, h.begin()),
+          "the array forms: the same numbers");
+    refused = error_of([&] { sc.mass({q1, q2, 0.0}); }, &msg) == LAG_ERR_ARG &&
+              msg.find("2 coordinates") != std::string::npos &&
+              error_of([&] { sc.bias({q1, q2}, {q1d}); }) == LAG_ERR_ARG &&
+              error_of([&] { sc.bias({q1, NAN}, {q1d, q2d}); }) == LAG_ERR_ARG;
+    check(refused, "q of another size, qd of another size than q, a NaN: Error (" + msg + ")");
+}
+
+void feed_reference(lagsim::Client &c, int64_t generation, double t)
+{
+    lag_wire_reference r;
+    std::memset(&r, 0, sizeof r);
+    r.generation = generation;
+    r.sim_time = t;
+    r.num_joints = 1;
+    std::strcpy(r.name[0], "q1");
+    r.r[0] = 0.125;
+    feed(c, LAG_WIRE_REFERENCE, &r, "REFERENCE");
+}
+
+void references()
+{
+    lagsim::Client c("FED", "memq://");
+    feed_scene(c);
+    feed_reference(c, 0, 0.5);
+    feed_state(c, 0.5);
+    std::optional<lagsim::State> st = c.wait_state(1.0);
+    std::optional<lagsim::Reference> ref = st ? c.reference_of(*st) : std::nullopt;
+    check(ref && ref->r[ref->joint("q1")] == 0.125 && ref->sim_time == 0.5,
+          "reference_of: the state's own reference (its generation and sim_time)");
+    feed_state(c, 0.6); /* its reference lost */
+    st = c.wait_state(1.0);
+    check(st && !c.reference_of(*st) && c.latest_reference(), "reference_of: a lost one is none");
+    feed_reference(c, 7, 0.7); /* another generation's, at the sim_time of the next state */
+    feed_state(c, 0.7);
+    st = c.wait_state(1.0);
+    check(st && st->generation == 0 && !c.reference_of(*st),
+          "reference_of: another generation's at the same sim_time is none");
+}
+
+void controller()
+{
+    lagsim::Controller::Options o;
+    o.url = "memq://";
+    o.timeout = 0.3;
+    {
+        lagsim::Controller ctl("FED", o);
+        double t0 = lagsim::now(), h0 = ctl.client().heard();
+        unsigned char junk[3] = {1, 2, 3};
+        lag_client_feed(ctl.client().get(), "FED_STATE", junk, sizeof junk); /* dropped */
+        bool quiet = ctl.client().heard() == h0;
+        feed_scene(ctl.client());
+        bool moved = ctl.client().heard() > h0;
+        std::optional<lagsim::State> st = ctl.next();
+        double waited = lagsim::now() - t0;
+        check(quiet && moved && !st && ctl.end() == "silence" && waited >= 0.3 && waited < 3.0 &&
+                  !ctl.next(),
+              "silence: heard() moves with a message kept, not a dropped one; next() ends after "
+              "the timeout (" + std::to_string(waited) + " s), end silence, and stays ended");
+    }
+    {
+        lagsim::Controller ctl("FED", o);
+        feed_scene(ctl.client());
+        feed_state(ctl.client(), 0.5);
+        std::optional<lagsim::State> st = ctl.next();
+        lag_wire_event ev;
+        std::memset(&ev, 0, sizeof ev);
+        std::strcpy(ev.kind, "stop");
+        feed(ctl.client(), LAG_WIRE_EVENT, &ev, "EVENT");
+        double t0 = lagsim::now();
+        std::optional<lagsim::State> again = ctl.next();
+        check(st && st->sim_time == 0.5 && !again && ctl.end() == "stop" &&
+                  lagsim::now() - t0 < 0.3 && ctl.states() == 1,
+              "stop: the state once, then the stop event ends the run before any silence");
+    }
+    {
+        o.duration = 0.5;
+        lagsim::Controller ctl("FED", o);
+        feed_scene(ctl.client());
+        feed_state(ctl.client(), 0.0);
+        bool first = ctl.next().has_value();
+        feed_state(ctl.client(), 0.5);
+        bool second = ctl.next().has_value();
+        check(first && second && !ctl.next() && ctl.end() == "duration",
+              "duration: 0.5 s of sim time from the first state ends the run");
+    }
+}
+
 void callback_exceptions()
 {
     lagsim::Client c("FED", "memq://");
@@ -193,6 +326,9 @@ int main()
           "version() and abi() are the header's");
     errors();
     messages();
+    dynamics();
+    references();
+    controller();
     callback_exceptions();
     std::printf("%d failure(s)\n", failures);
     return failures ? 1 : 0;

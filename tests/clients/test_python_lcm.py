@@ -21,6 +21,8 @@ import time
 
 sys.path.insert(0, sys.argv[1])
 from lagsim_lcm import LCM  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
 
@@ -92,7 +94,7 @@ lc.close()
 # a signal during the wait: handle_timeout() returns False, the handler has run
 seen = []
 signal.signal(signal.SIGUSR1, lambda signum, frame: seen.append(signum))
-udp = LCM("udpm://239.255.76.67:%d?ttl=0" % (30000 + 2 * (os.getpid() % 10000)))
+udp = LCM(lcm_url())  # a port pair of this process's own
 udp.subscribe("NOTHING_COMES", lambda ch, data: None)
 main = threading.get_ident()
 threading.Thread(target=lambda: (time.sleep(0.2), signal.pthread_kill(main, signal.SIGUSR1)),

@@ -42,9 +42,10 @@ set(LAGSIM_TIER_RULES
   # the others and two busy processes, clients_readme_java_slower_law and
   # clients_cross_language_slower_law ran past their 90 s)
   "waits     NAME  ^clients_readme_(c|cpp|python|lua|go)_slow(er)?_law$"
-  "waits     NAME  ^clients_readme_go_daemon_killed$"
   "waits     NAME  ^clients_(c|cpp|python|lua|java|go)_[a-z_]+_ends_on_(stop|silence)$"
-  "waits     NAME  ^clients_(c|python|lua|java|go)_ends_on_signal$"
+  "waits     NAME  ^clients_(c|cpp|python|lua|java|go)_ends_on_signal$"
+  # README's C and C++ blocks under a daemon SIGKILLed: each waits out its 5 s of silence
+  "waits     NAME  ^clients_readme_(c|cpp|go)_daemon_killed$"
   "waits     NAME  ^clients_(python|java)_dipc_late_controller$"
   "waits     NAME  ^view_attack_(slowloris|stalled)$"
   "waits     NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
@@ -73,7 +74,8 @@ set(LAGSIM_TIER_RULES
   # log: the writer on a made-up clock; lockstep and fast runs logged, read, converted;
   # the terminal's live line and waits in real time
   "quick     NAME  ^log_(rt|outputs)_"
-  "quick     NAME  ^log_(lqr|lqr_effects|gaps|readers|cli|flood|flood_applied)$"
+  "quick     NAME  ^log_(lqr|lqr_effects|gaps|readers|cli)$"
+  "wallclock NAME  ^log_(flood|flood_applied)$"  # realtime runs flooded for 3 s of 5
   "quick     NAME  ^log_series_"
   "quick     NAME  ^log_old_version_"
   "wallclock NAME  ^log_term_"
@@ -113,6 +115,7 @@ set(LAGSIM_TIER_RULES
   # the client library: its version, its ABI, its C++ header, the README's C and C++ blocks
   # against an install and by the other C++ compiler (lockstep runs, compilations)
   "quick     NAME  ^clients_(versions|abi|abi_mutations|cpp_header|lcm_cpp_forged)$"
+  "quick     NAME  ^clients_model_[a-z_]+$"  # the client library's M and h vs T and U
   "quick     NAME  ^clients_readme_(c|cpp)_installed$"
   "quick     NAME  ^clients_readme_go_static$"
   "quick     NAME  ^clients_(readme_cpp|manipulator_ct)_other_compiler$"

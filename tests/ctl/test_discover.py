@@ -32,6 +32,7 @@ import sys
 import threading
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
@@ -74,7 +75,8 @@ def main():
              "--set", "lcm.prefix=" + prefix, "--set", "realtime.start=" + start],
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        time.sleep(0.7)
+        for prefix in daemons:  # each answers (waited on, bounded), then all are listed
+            check(waits.daemon_answers(b("lagsimctl"), prefix), "lagsimd %s answers" % prefix)
         r = run([b("lagsimctl"), "list"])
         rows = {l.split()[0]: l.split() for l in r.stdout.splitlines()[1:] if l.split()}
         check(r.returncode == 0 and r.stdout.split()[:4] == ["PREFIX", "MODEL", "MODE", "RUN"]

@@ -44,6 +44,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lcm_log import read_log, write_log  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
@@ -112,7 +113,7 @@ def rules(lagsimd, ctl_bin, cfg, prefix, tmp):
                           "--set", "realtime.start=paused", "--log", log],
                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        time.sleep(0.5)
+        check(waits.daemon_answers(ctl_bin, prefix), "lagsimd answers (waited on)")
         for args, item in bad:
             r = ctl("kick", *args)
             rc, words = scene_words(lagsimd, cfg, tmp, item)
@@ -190,7 +191,7 @@ def main():
                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                          universal_newlines=True)
     try:
-        time.sleep(0.5)
+        check(waits.daemon_answers(ctl_bin, prefix), "lagsimd answers (waited on)")
         r = ctl("--json", "kick", "x", "0.5")
         ev = events(r)
         check(r.returncode == 0 and ev and ev[0]["kind"] == "kick" and ev[0]["step"] == 0 and

@@ -32,6 +32,7 @@ import subprocess
 import sys
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
@@ -98,7 +99,7 @@ def main():
                           "--set", "realtime.start=running"],
                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, universal_newlines=True)
     try:
-        time.sleep(0.5)
+        check(waits.daemon_answers(a.lagsimctl, prefix), "lagsimd answers (waited on)")
         r = ctl("status")
         rj = statuses(ctl("--json", "status"))
         out = r.stdout.splitlines()

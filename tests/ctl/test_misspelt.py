@@ -10,6 +10,7 @@ waiting for its first command (its stderr read), and a DIPC on DP<pid>. Then:
                             MANIPULATOR<pid>?"
   manipulator_pd --prefix MANIPULATR<pid>  (one letter out) exit 1, the same
   manipulator_pd.py --prefix MANIPULATR<pid>  (Python, its own discovery) the same
+  manipulator_ct --prefix MANIPULATR<pid>  (C++, lagsim_client.hpp) the same
   lagsimctl --prefix DP<pid> status  (another plant's: answered, not reported)
   a STATUS on MANIPULATOR<pid>_CONTROL sent to the state port (the wrong port)
 The plant's wait line (stderr) and its status's waiting_got then name the misspelt
@@ -24,6 +25,9 @@ import re
 import subprocess
 import sys
 import time
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import waits  # noqa: E402  (events waited on, bounded)
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
 
@@ -55,8 +59,8 @@ def main():
     pid = os.getpid()
     plant, other = "MANIPULATOR%d" % pid, "DP%d" % pid
     short, typo = "MANIP", "MANIPULATR%d" % pid
-    port = 46000 + 2 * ((pid + 3000) % 6000)
-    url = "udpm://239.255.76.67:%d?ttl=0" % port
+    url = lcm_url()  # a port pair of this process's own (not one drawn from the pid)
+    port = int(url.split(":")[2].split("?")[0])
     os.environ["LCM_DEFAULT_URL"] = url
     err_path = "/tmp/lagsim_misspelt_%d.err" % pid
     err = open(err_path, "w")
@@ -66,7 +70,8 @@ def main():
                            "-q", "--set", "lcm.prefix=" + other],
                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        time.sleep(1.0)
+        for prefix in (plant, other):  # each answers (waited on, bounded)
+            check(waits.daemon_answers(b("lagsimctl"), prefix), "lagsimd %s answers" % prefix)
         instead = ("plants heard on %s: %s (dipc, realtime, waiting), %s (manipulator, realtime, "
                    "waiting); did you mean %s?" % (url, other, plant, plant))
         r = run([b("lagsimctl"), "--prefix", short, "status"])
@@ -83,6 +88,11 @@ def main():
                                      % (typo, typo, instead)) in r.stderr,
               "manipulator_pd.py --prefix %s: exit 1, the same (the library's discovery, "
               "through ctypes)" % typo)
+        r = run([b("manipulator_ct"), "--prefix", typo, "--timeout", "1.5"])
+        check(r.returncode == 1 and ("no scene description on %s_SCENE within 1.5 s: no plant "
+                                     "on prefix %s; %s" % (typo, typo, instead)) in r.stderr,
+              "manipulator_ct --prefix %s: exit 1, the same (C++: lagsim::Controller::wait_scene)"
+              % typo)
         r = run([b("lagsimctl"), "--prefix", other, "status"])
         check(r.returncode == 0, "lagsimctl --prefix %s status: the other plant answers" % other)
         # this plant's control request on the state port (the wrong one)

@@ -22,6 +22,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lcm_log import read_log, write_log  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
@@ -55,6 +56,7 @@ def main():
     ap.add_argument("--lcm-logger", default="")
     a = ap.parse_args()
     lagsimd, ctl, lqr = (os.path.join(a.bin, p) for p in ("lagsimd", "lagsimctl", "dipc_lqr"))
+    sys.path.insert(0, os.path.join(os.path.dirname(a.bin), "python"))  # lagsim_lcm
     cfg = os.path.join(a.source, "config", "dipc.yaml")
     prefix = "SETR_%d" % os.getpid()
     # a multicast port of this run's own (ttl=0: this host), through LCM_DEFAULT_URL, which
@@ -74,12 +76,13 @@ def main():
     if a.lcm_logger:
         logs.append(os.path.join(tmp, "logger.lcm"))
         logger = subprocess.Popen([a.lcm_logger, "-q", "-f", "-c", prefix + "_.*", logs[-1]])
+        check(waits.logger_wrote(logs[-1], prefix + "_PROBE", b"logger-up"),
+              "lcm-logger records (a probe in its file)")
     if not check(logs, "a log to replay (lagsimd --log or lcm-logger)"):
         return 1
-    time.sleep(0.5)
     c = subprocess.Popen([lqr, "--prefix", prefix, "-q"], stdout=subprocess.PIPE,
                          stderr=subprocess.STDOUT, universal_newlines=True)
-    time.sleep(0.3)
+    check(waits.subscribed(c) is not None, "dipc_lqr subscribed")
     d = subprocess.Popen(dcmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                          universal_newlines=True)
     t0 = time.monotonic()
@@ -97,8 +100,9 @@ def main():
     print(dout.strip())
     print(cout.strip())
     check(d.returncode == 0, "lagsimd ran 6 s and exited 0")
-    if logger:
-        time.sleep(0.5)
+    if logger:  # stopped once it has written what it heard of the run
+        check(waits.logger_wrote(logs[-1], prefix + "_PROBE", b"run-over"),
+              "lcm-logger wrote a probe sent after the run")
         logger.send_signal(2)
         logger.wait(timeout=10)
 

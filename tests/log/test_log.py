@@ -37,6 +37,7 @@ import tempfile
 import time
 import zlib
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 failures = 0
@@ -126,7 +127,7 @@ class Run:
                                 *lqr_args], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                text=True)
         try:
-            time.sleep(0.3)
+            check(waits.subscribed(lqr) is not None, "dipc_lqr subscribed")
             p = self.lagsimd("--config", config, "--set", f"lcm.prefix={prefix}", "--set",
                              "realtime.mode=lockstep", *sets, "--duration", str(duration),
                              "-q", "--log", log, "--force")  # a case may record twice
@@ -404,7 +405,7 @@ def case_flood(r, a, tmp):
                           f"lcm.prefix={prefix}", "--set", "realtime.start=running",
                           "--duration", str(run_s), "--log", log],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(0.8)
+    check(waits.daemon_answers(os.path.join(r.bin, "lagsimctl"), prefix), "lagsimd answers")
     _, command_url = plant_urls()
     lc = LCM(command_url)
     bad = r.t.joint_command_t()
@@ -482,7 +483,7 @@ def case_flood_applied(r, a, tmp):
                           f"publish_hz={hz}", "--duration", str(run_s), "--log", log],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     t_start = time.monotonic()
-    time.sleep(0.8)
+    check(waits.daemon_answers(os.path.join(r.bin, "lagsimctl"), prefix), "lagsimd answers")
     _, command_url = plant_urls()
     lc = LCM(command_url)
     cmd = r.t.joint_command_t()

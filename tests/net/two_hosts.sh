@@ -90,6 +90,15 @@ started() {
     return 1
 }
 
+# logged IN URL FILE PROBE: publishes PROBE (on the channel LGPROBE) in the namespace IN
+# (its "ip netns exec" words) on URL until lcm-logger has written it to FILE
+# (tests/common/waits.py): the logger records, and has written what came before; 30 s at most
+logged() {
+    $1 python3 -c 'import sys; sys.path[:0] = sys.argv[1:3]; import waits
+sys.exit(0 if waits.logger_wrote(sys.argv[4], "LGPROBE", sys.argv[5].encode(), url=sys.argv[3]) else 1)' \
+        "$src/tests/common" "$types" "$2" "$3" "$4" || echo "lcm-logger did not write $4 to $3 within 30 s"
+}
+
 # jq-less reading of netpeer.py's JSON summary
 field() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$1" "$2"; }
 
@@ -101,7 +110,7 @@ host_local_run() { # allow_lan ttl tag [local]: with "local", a sender in A as w
     local lan=$1 ttl=$2 tag=$3 also_local=${4:-} prefix=HL$id
     local url="udpm://239.255.76.67:7667?ttl=$ttl"
     $inA lcm-logger -q -f --lcm-url "$url" "$work/$tag.lcm" & pids+=($!); local logger=$!
-    sleep 0.5
+    logged "$inA" "$url" "$work/$tag.lcm" up
     $inA "$lagsimd" --config "$config" --set lcm.prefix=$prefix --set lcm.allow_lan=$lan \
         --set "lcm.url=$url" --set realtime.command_timeout=100 \
         2>"$work/$tag.err" & pids+=($!); local d=$!   # not -q: its start line is waited on, checked
@@ -116,7 +125,7 @@ host_local_run() { # allow_lan ttl tag [local]: with "local", a sender in A as w
     fi
     sleep 0.5
     kill -TERM $d; wait $d; local rc=$?
-    sleep 0.3
+    logged "$inA" "$url" "$work/$tag.lcm" over
     kill -INT $logger; wait $logger 2>/dev/null
     cat "$work/$tag.err"
     $netpeer summary --types "$types" --prefix $prefix "$work/$tag.lcm" >"$work/$tag.json"
@@ -172,6 +181,7 @@ lockstep_run() { # tag [lagsimd options]
     local tag=$1 prefix=LS$id url="udpm://239.255.76.67:7667?ttl=1"
     shift
     $inB lcm-logger -q -f --lcm-url "$url" "$work/$tag.lcm" & pids+=($!); local logger=$!
+    logged "$inB" "$url" "$work/$tag.lcm" up
     $inA "$lagsimd" --config "$config" --set lcm.prefix=$prefix --set lcm.allow_lan=true \
         --set "lcm.url=$url" --set realtime.mode=lockstep --set realtime.start=first_command \
         "$@" -q --duration 5 2>"$work/$tag.err" & pids+=($!); local d=$!
@@ -180,7 +190,7 @@ lockstep_run() { # tag [lagsimd options]
         --trace "$work/$tag.trace" >"$work/$tag.out" 2>&1 & pids+=($!); local c=$!
     wait $d; local rc=$?
     wait $c
-    sleep 0.3
+    logged "$inB" "$url" "$work/$tag.lcm" over
     kill -INT $logger; wait $logger 2>/dev/null
     cat "$work/$tag.err"
     grep summary "$work/$tag.out"
@@ -223,7 +233,8 @@ case_realtime_loss() {
     loss_on
     $inA lcm-logger -q -f --lcm-url "$url" "$work/a.lcm" & pids+=($!); local la=$!
     $inB lcm-logger -q -f --lcm-url "$url" "$work/b.lcm" & pids+=($!); local lb=$!
-    sleep 0.5
+    logged "$inA" "$url" "$work/a.lcm" up
+    logged "$inB" "$url" "$work/b.lcm" up
     $inA "$lagsimd" --config "$mconfig" --set lcm.prefix=$prefix --set lcm.allow_lan=true \
         --set "lcm.url=$url" --set realtime.mode=realtime --set realtime.start=first_command \
         --set realtime.command_timeout=0.5 -q 2>"$work/rt.err" & pids+=($!); local d=$!
@@ -239,7 +250,8 @@ case_realtime_loss() {
     sleep 2
     kill -TERM $d; wait $d; local rc=$?
     wait $c
-    sleep 0.3
+    logged "$inA" "$url" "$work/a.lcm" over
+    logged "$inB" "$url" "$work/b.lcm" over
     kill -INT $la $lb; wait $la $lb 2>/dev/null
     loss_off
     cat "$work/rt.err"

@@ -166,6 +166,34 @@ def do_build(a):
           % (len(pkg), "; missing " + " ".join(missing) if missing else "",
              "; extra " + " ".join(extra) if extra else ""))
 
+    # its description names every model of the core's table (lagsimd --list models: each
+    # model's title, lagsim_lists print model-titles) and the languages of the examples
+    desc = run(["dpkg-deb", "-f", deb, "Description"]).stdout
+    flat = " ".join(l.strip() for l in desc.splitlines() if l.strip() != ".")
+    names = run([os.path.join(a.build, "bin", "lagsimd"), "--list", "models"]).stdout.split()
+    titles = run([os.path.join(a.build, "bin", "lagsim_lists"), "print", a.source,
+                  "model-titles"]).stdout.replace("**", "").strip()
+    titled = [re.sub(r"^an? ", "", t) for t in re.split(r", | and ", titles)]
+    check(len(names) >= 5 and len(titled) == len(names) and all(t in flat for t in titled),
+          "the Description names the %d models of lagsimd --list models (%s) as %s"
+          % (len(names), ", ".join(names), "; ".join(t for t in titled if t not in flat) and
+             "missing: " + "; ".join(t for t in titled if t not in flat) or "their titles"), desc)
+    langs = ["C", "C++", "Python", "Lua", "Java", "MATLAB/Octave"]
+    check(all(re.search(r"(^|[ ,])%s[,; ]" % re.escape(l), flat) for l in langs),
+          "the Description names the controllers' languages: " + ", ".join(langs), desc)
+    long_lines = [l for l in desc.splitlines()[1:] if len(l) > 80]
+    check(not long_lines, "the Description's lines are at most 80 columns", "\n".join(long_lines))
+
+    # docs/deploy.md's table names every header and library the package installs (the
+    # generated types as a group; a library's real file by its SONAME)
+    deploy = open(os.path.join(a.source, "docs", "deploy.md")).read()
+    named = [os.path.basename(p) for p in pkg
+             if (re.match(r"usr/include/lagsim/[^/]+$", p) and not p.endswith("_t.h")) or
+             (re.match(r"usr/lib/[^/]+$", p) and not re.search(r"\.so\.\d+\.", p))]
+    unnamed = [n for n in sorted(named) if "`%s`" % n not in deploy]
+    check(named and not unnamed, "docs/deploy.md names the %d headers and libraries installed%s"
+          % (len(named), "; not: " + " ".join(unnamed) if unnamed else ""))
+
     # Debian's places, each where Debian's own tools look
     places = ["usr/bin/lagsimd", "usr/bin/dipc_lqr", "usr/include/lagsim/lagsim_client.h",
               "usr/include/lagsim/lagsim_client.hpp", "usr/include/lagsim/version.h",
@@ -682,7 +710,14 @@ def service_checks(a, tmp):
               "start, each named in the journal: %s" % files, j)
         ubad = "lagsimd@%s.service" % bad
         sd.ctl("start", ubad)
-        time.sleep(7)   # longer than RestartSec
+        # failed (bounded: 30 s), then RestartSec and 1 s more: a restart would have come
+        t = time.monotonic()
+        while sd.show(ubad, "ActiveState") != "failed" and time.monotonic() - t < 30:
+            time.sleep(0.1)
+        restart_us = sd.show(ubad, "RestartUSec")  # "5s", "100ms", "1min 30s"
+        restart_s = sum(float(v) * {"min": 60, "s": 1, "ms": 1e-3, "us": 1e-6}[u] for v, u in
+                        re.findall(r"([\d.]+)(min|ms|us|s)", restart_us))
+        time.sleep(restart_s + 1)
         jb = sd.sh(["journalctl", "-u", ubad, "--no-pager", "-o", "cat"]).stdout
         check(sd.show(ubad, "ExecMainStatus") == "2" and sd.show(ubad, "NRestarts") == "0" and
               sd.show(ubad, "ActiveState") == "failed" and "%s.yaml:2:1: unknown key" % bad in jb,
@@ -692,7 +727,9 @@ def service_checks(a, tmp):
         # removal where systemd runs: the prerm stops every instance, the purge removes the
         # links of enabled ones (dpkg run inside the namespace, which has /run/systemd/system)
         sd.ctl("enable", "--now", unit)
-        time.sleep(1)
+        t = time.monotonic()  # started (bounded: 30 s)
+        while sd.show(unit, "ActiveState") != "active" and time.monotonic() - t < 30:
+            time.sleep(0.1)
         link = "/etc/systemd/system/multi-user.target.wants/" + unit
         was = (sd.show(unit, "ActiveState"), sd.sh(["test", "-L", link]).returncode == 0)
         # in a mount namespace of its own under systemd's, without the unit directory shown

@@ -7,7 +7,9 @@
 set -u
 lagsimd=$1 dir=$2
 fail=0 n=0
-port=$((21000 + 2 * ($$ % 5000)))
+# a port pair of this script's own (tests/common/lcm_port.py), held while it runs
+coproc PORTHOLD { python3 "$(dirname "$0")/../common/lcm_port.py" --hold; }
+read -r port <&"${PORTHOLD[0]}"
 for f in "$dir"/*.yaml; do
     name=$(basename "$f" .yaml)
     n=$((n + 1))

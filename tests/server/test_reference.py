@@ -39,6 +39,7 @@ import sys
 import tempfile
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
 failures = 0
@@ -98,6 +99,19 @@ class T:
         import lagsim
         self.t = lagsim
         self.dipc = os.path.join(a.source, "config", "dipc.yaml")
+
+    def logged(self, path, prefix, probe):
+        """lcm-logger has written probe, sent on <prefix>_PROBE, to path (waits.py)"""
+        check(waits.logger_wrote(path, prefix + "_PROBE", probe),
+              f"lcm-logger wrote {probe!r} to its file within {waits.WITHIN} s")
+
+    def answers(self, prefix):
+        check(waits.daemon_answers(os.path.join(self.a.bin, "lagsimctl"), prefix),
+              f"lagsimd {prefix} answered lagsimctl status within {waits.WITHIN} s")
+
+    def started(self, proc):
+        check(waits.subscribed(proc) is not None,
+              f"the controller subscribed within {waits.WITHIN} s")
 
     def run(self, prog, *args, timeout=120):
         p = subprocess.run([os.path.join(self.a.bin, prog), *args], capture_output=True,
@@ -176,7 +190,7 @@ class T:
         lqr = subprocess.Popen([os.path.join(self.a.bin, "dipc_lqr"), "--prefix", prefix, "-q"],
                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         try:
-            time.sleep(0.3)
+            self.started(lqr)
             d = subprocess.Popen([os.path.join(self.a.bin, "lagsimd"), "--config", self.dipc,
                                   "--set", f"lcm.prefix={prefix}", "--set", f"realtime.mode={mode}",
                                   "--set", REFERENCE, *extra, "--duration", str(duration), "-q", "--log", log])
@@ -341,7 +355,7 @@ def case_manipulator(t):
     pd = subprocess.Popen([os.path.join(t.a.bin, "manipulator_pd"), "--prefix", prefix],
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
-        time.sleep(0.3)
+        t.started(pd)
         d = t.run("lagsimd", "--config", man, "--set", f"lcm.prefix={prefix}", "--set",
                   "realtime.mode=lockstep", "--set", MAN_REFERENCE, "--duration", "10", "-q",
                   "--log", log)
@@ -373,7 +387,7 @@ def case_retry(t):
     bus = os.path.join(t.tmp, "bus.lcm")
     logger = subprocess.Popen(["lcm-logger", "-q", "--channel", prefix + "_.*", bus],
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    time.sleep(0.5)
+    t.logged(bus, prefix, b"logger-up")  # it records
     # paused, then STEP 1: the state at 0 is waited on with retries until lockstep_timeout
     # (nothing answers), then the period runs without a command, as a STEP does
     d = subprocess.Popen([os.path.join(t.a.bin, "lagsimd"), "--config",
@@ -381,12 +395,14 @@ def case_retry(t):
                           "--set", "realtime.mode=lockstep", "--set", "lcm.prefix=" + prefix,
                           "--set", "realtime.start=paused",
                           "--set", "realtime.lockstep_timeout=1", "-q"])
-    time.sleep(0.5)
-    t.run("lagsimctl", "--prefix", prefix, "step", "1", timeout=30)
-    time.sleep(1.5)
+    t.answers(prefix)
+    # lagsimctl step returns on the step_done event: the copies went out, then the period
+    # ran at lockstep_timeout
+    p = t.run("lagsimctl", "--prefix", prefix, "step", "1", timeout=30)
+    check(p.returncode == 0 and "step_done" in p.stdout, "lagsimctl step 1: step done")
     d.terminate()
     d.wait(timeout=10)
-    time.sleep(0.3)
+    t.logged(bus, prefix, b"run-over")  # the logger has written what it heard
     logger.terminate()
     logger.wait(timeout=10)
     recs = [(ch, d) for ch, d, _ in read_log(bus)]

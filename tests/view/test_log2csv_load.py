@@ -22,6 +22,8 @@ import subprocess
 import sys
 import tempfile
 import time
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 fails = 0
 
@@ -51,7 +53,7 @@ def main():
     code = blocks(a.source)
     check(set(code) >= {"octave", "python", "pandas"}, "docs/view.md's blocks: %s" % sorted(code))
     pid = os.getpid()
-    os.environ["LCM_DEFAULT_URL"] = "udpm://239.255.76.67:%d?ttl=0" % (42000 + 2 * (pid % 1000))
+    os.environ["LCM_DEFAULT_URL"] = lcm_url()  # a port pair of this process's own
     tmp = tempfile.mkdtemp(prefix="lagsim_load_")
     try:
         d = subprocess.Popen([b("lagsimd"), "--config", os.path.join(a.source, "config", "dipc.yaml"),

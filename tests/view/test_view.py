@@ -149,7 +149,11 @@ def case_browser(a):
         check(abs(l1 - 0.5) < 1e-9 and abs(l2 - 0.75) < 1e-9, "rods drawn %.12g m and %.12g m long (l1, l2)" % (l1, l2))
         # the page drew what the daemon published: its drawn cart is at theta0
         check(d1["points"][0][0] == d1["q"][0], "the cart is drawn at the published theta0")
-        time.sleep(1.0)
+        # the second look once the page has drawn 0.5 s of sim time and 10 frames more (a
+        # loaded machine's headless Chromium draws fewer frames a second: waited on, 15 s)
+        chrome.wait_for(sa, "window.lagsimView.drawn.sim_time > %r + 0.5 && "
+                            "window.lagsimView.drawn.frame > %r + 10" % (d1["sim_time"], d1["frame"]),
+                        15, "0.5 s of sim time and 10 frames drawn after the first look")
         d2 = drawn(chrome, sa)
         check(d2["sim_time"] > d1["sim_time"] + 0.5,
               "second look: drawn sim time advanced %.3f -> %.3f s" % (d1["sim_time"], d2["sim_time"]))
@@ -157,7 +161,8 @@ def case_browser(a):
               "second look: the drawn model moved (%.3f m)" % moved(d1["points"], d2["points"]))
         check(d2["frame"] > d1["frame"] + 10, "frames drawn between the looks: %d" % (d2["frame"] - d1["frame"]))
         chrome.front(sb)
-        time.sleep(0.3)
+        chrome.wait_for(sb, "window.lagsimView.drawn.sim_time > %r" % d2["sim_time"], 15,
+                        "tab B, in front, to draw a later state")
         db = drawn(chrome, sb)
         check(db["sim_time"] > d2["sim_time"], "tab B, brought to the front, animates too")
         st = rig.api()["bridge"]
@@ -393,7 +398,8 @@ def case_cartpole(a):
                   "upward vertical" % (math.hypot(tx - cx, ty - cy), l1, th))
         check(sorted(map(tuple, d1["stops"] or [])) == [("theta", -2), ("theta", 2), ("x", -0.5), ("x", 0.5)],
               "the stops on x and theta are drawn: %s" % d1["stops"])
-        time.sleep(1.0)
+        chrome.wait_for(sid, "window.lagsimView.drawn.sim_time > %r + 0.5" % d1["sim_time"], 15,
+                        "0.5 s of sim time drawn after the first look")
         d2 = drawn(chrome, sid)
         check(d2["sim_time"] > d1["sim_time"] + 0.5,
               "second look: drawn sim time advanced %.3f -> %.3f s" % (d1["sim_time"], d2["sim_time"]))
@@ -409,7 +415,9 @@ def case_cartpole(a):
         chrome.wait_for(sid, "window.lagsimView.drawn.model === 'no such model'", 5, "a frame of the unknown model")
         u1 = drawn(chrome, sid)
         n1 = chrome.eval(sid, "window.lagsimView.charts.q.length")
-        time.sleep(0.5)
+        chrome.wait_for(sid, "window.lagsimView.drawn.sim_time > %r && "
+                             "window.lagsimView.charts.q.length > %d" % (u1["sim_time"], n1), 15,
+                        "a later state drawn and charted")
         u2 = drawn(chrome, sid)
         n2 = chrome.eval(sid, "window.lagsimView.charts.q.length")
         check(u2["note"] is not None and "no such model" in u2["note"] and u2["points"] is None,
@@ -657,7 +665,8 @@ def case_models(a):
                     x, phi, h = d1["q"]
                     check(abs(pts[1][0] - x) < 1e-12 and abs(pts[1][1] - (h + 0.5 * l * math.sin(phi))) < 1e-9,
                           "%s: the centre drawn at (x, h + l/2 sin phi) = (%.6f, %.6f)" % (f, pts[1][0], pts[1][1]))
-                time.sleep(0.5)
+                chrome.wait_for(sid, "window.lagsimView.drawn.sim_time > %r" % d1["sim_time"], 15,
+                                "a later state drawn")
                 d2 = drawn(chrome, sid)
                 check(d2["sim_time"] > d1["sim_time"] and d2["points"],
                       "%s: still drawn as states come (sim time %.3f -> %.3f s)" % (f, d1["sim_time"], d2["sim_time"]))

@@ -356,7 +356,12 @@ def case_stalled(a):
         # the other 15 slots, and one more, taken by clients that never read
         for _ in range(16):
             sleepers.append(stream_request(v.port, v.hosthdr, rcvbuf=4096))
-        time.sleep(1.0)
+        deadline = time.monotonic() + 15  # the bridge took them: 16 streams (at most 15 s)
+        while time.monotonic() < deadline:
+            st, body = v.state()
+            if st.startswith(b"HTTP/1.1 200") and json.loads(body)["bridge"]["streams"] >= 16:
+                break
+            time.sleep(0.1)
         r = raw(v.port, b"GET /events HTTP/1.1\r\n" + v.hosthdr + b"\r\n", timeout=2)
         check(r.startswith(b"HTTP/1.1 503"), "with every slot taken a new stream gets 503 at once")
         t0 = time.monotonic()
@@ -377,7 +382,10 @@ def case_stalled(a):
             pass
         check(got(chrome, fresh)["states"] > 5, "a new browser (Chromium) gets its stream: %s" % got(chrome, fresh))
         g0 = got(chrome, reader)["states"]
-        time.sleep(1.0)
+        try:
+            chrome.wait_for(reader, "window.got.states > %d" % g0, 15, "the reader's next states")
+        except TimeoutError:
+            pass
         g1 = got(chrome, reader)
         check(g1["states"] > g0 and g1["errors"] == 0,
               "the browser that reads kept its stream all along (%d states, %d errors)" % (g1["states"], g1["errors"]))
@@ -452,7 +460,10 @@ def case_slowloris(a):
         idle = sockets_of(v.p.pid)  # the bridge's own sockets before any attack
         th = threading.Thread(target=attack, args=(True,), daemon=True)
         th.start()
-        time.sleep(2.0)
+        t = time.monotonic()  # the attack set up: its first round of 300 made (bounded: 30 s)
+        while held[0] == 0 and time.monotonic() - t < 30:
+            time.sleep(0.05)
+        check(held[0] > 0, "the attack holds %d connections" % held[0])
         answered, times = 0, []
         for i in range(13):
             t = time.monotonic()
@@ -635,6 +646,10 @@ def case_lan(a):
                 return json.loads(r.stdout)["bridge"]["events"]
             except (ValueError, KeyError):
                 return "no answer: %r" % r.stdout[:80]
+
+        def count(v):  # events(v), -1 for no answer
+            n = events(v)
+            return n if isinstance(n, int) else -1
         for allow_lan in (False, True):
             prefix = "VIEWN%d%s" % (pid, "L" if allow_lan else "")
             v = View(a, prefix, ["--url", url] + (["--allow-lan"] if allow_lan else []),
@@ -642,14 +657,21 @@ def case_lan(a):
             views.append(v)
             time.sleep(0.5)
             send(nsB, prefix, 50)
-            time.sleep(1.0)
+            if allow_lan:  # until the 50 are taken (at most 15 s); 1 s for none to be
+                t = time.monotonic()
+                while count(v) < 50 and time.monotonic() - t < 15:
+                    time.sleep(0.1)
+            else:
+                time.sleep(1.0)
             n = events(v)
             if allow_lan:
                 check(n == 50, "--allow-lan: the 50 events from the other host are taken (%s)" % n)
             else:
                 check(n == 0, "default: 0 of 50 events from the other host (ttl=1) are taken (%s)" % n)
                 send(nsA, prefix, 20)
-                time.sleep(1.0)
+                t = time.monotonic()  # until the 20 are taken (at most 15 s)
+                while count(v) < 20 and time.monotonic() - t < 15:
+                    time.sleep(0.1)
                 n = events(v)
                 check(n == 20, "20 events from this host are taken (%s)" % n)
             v.close()

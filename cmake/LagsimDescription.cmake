@@ -1,0 +1,43 @@
+# cmake -D LISTS=<lagsim_lists> -D SOURCE=<source> -D IN=<text> -D OUT=<file> -P this:
+# writes OUT, the cpack project config file that sets CPACK_DEBIAN_PACKAGE_DESCRIPTION to
+# the text of IN with @MODELS@ replaced by the core's models ("a sliding stick, ... and a
+# flying stick": lagsim_lists print SOURCE model-titles, without its Markdown), each
+# paragraph (separated by a line ".") wrapped at 72 columns, as Debian's control files want.
+execute_process(COMMAND ${LISTS} print ${SOURCE} model-titles
+                OUTPUT_VARIABLE models RESULT_VARIABLE rc OUTPUT_STRIP_TRAILING_WHITESPACE)
+if(NOT rc EQUAL 0 OR models STREQUAL "")
+  message(FATAL_ERROR "lagsim_lists print ${SOURCE} model-titles failed (${rc})")
+endif()
+string(REPLACE "**" "" models "${models}")
+file(READ ${IN} text)
+string(REPLACE "@MODELS@" "${models}" text "${text}")
+string(ASCII 1 sc) # one character in place of ";", a list separator to CMake
+string(REPLACE ";" "${sc}" text "${text}")
+string(REPLACE "\n.\n" ";" paragraphs "${text}")
+set(out "")
+foreach(par IN LISTS paragraphs)
+  string(REGEX REPLACE "[ \n]+" ";" words "${par}")
+  set(line "")
+  set(lines "")
+  foreach(w IN LISTS words)
+    string(LENGTH "${line} ${w}" len)
+    if(line STREQUAL "")
+      set(line "${w}")
+    elseif(len GREATER 72)
+      string(APPEND lines "${line}\n")
+      set(line "${w}")
+    else()
+      string(APPEND line " ${w}")
+    endif()
+  endforeach()
+  string(APPEND lines "${line}")
+  if(out STREQUAL "")
+    set(out "${lines}")
+  else()
+    string(APPEND out "\n.\n${lines}")
+  endif()
+endforeach()
+string(REPLACE "${sc}" ";" out "${out}")
+string(REPLACE "\\" "\\\\" out "${out}")
+string(REPLACE "\"" "\\\"" out "${out}")
+file(WRITE ${OUT} "# written by cmake/LagsimDescription.cmake: the .deb's extended description\nset(CPACK_DEBIAN_PACKAGE_DESCRIPTION \"${out}\")\n")
