@@ -247,6 +247,12 @@ if(TARGET dipc_balance_go)
       --run go "discrete LQR \\(h = [^)]*\\): K = \\[([^]]*)\\]"
         "${go_dipc} --prefix {prefix} --duration 0.05 -q")
   list(APPEND lang_tests clients_go_dipc_lockstep clients_go_dipc_hostile clients_go_dipc_gain)
+  # the tree's Go programs are compiled again when a header cgo includes from elsewhere
+  # changes (cmake/go_build.cmake keys Go's cache on them; a plain go build would not)
+  add_test(NAME clients_go_cgo_rebuild
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/go_cgo_rebuild.py --go ${LAGSIM_GO}
+      --script ${PROJECT_SOURCE_DIR}/cmake/go_build.cmake --cache ${CMAKE_BINARY_DIR}/go/cache)
+  list(APPEND lang_tests clients_go_cgo_rebuild)
   # the Go sources as gofmt writes them, and clean by go vet (cgo's rules: no Go pointer
   # held by C, no misuse of unsafe.Pointer)
   find_program(LAGSIM_GOFMT gofmt)
@@ -257,6 +263,12 @@ if(TARGET dipc_balance_go)
               ${CMAKE_CURRENT_SOURCE_DIR}/protocol/conformance/conformance.go ${CMAKE_BINARY_DIR})
     list(APPEND lang_tests clients_go_vet)
   endif()
+  # its options as the other examples spell them: --q W0,...,W5 the weights, -q quiet and
+  # never a value, each listed once by --help; its messages name the program
+  add_test(NAME clients_go_help
+    COMMAND sh -c "h=$(\"$1\" --help 2>&1) || { echo \"FAIL: --help exits $?\"; exit 1; }; printf '%s\\n' \"$h\"; printf '%s\\n' \"$h\" | grep -q '^  --q W0,...,W5 ' && printf '%s\\n' \"$h\" | grep -q '^  -q  ' && ! printf '%s\\n' \"$h\" | grep -q -e 'also -q' -e '-q string' -e '-quiet' -e '-weights' || { echo 'FAIL: --help does not list --q WEIGHTS and -q apart'; exit 1; }; e=$(\"$1\" --duration -1 2>&1); rc=$?; echo \"$e\"; test $rc = 2 && printf '%s\\n' \"$e\" | grep -q '^dipc_balance_go: ' || { echo 'FAIL: a usage error: exit 2, the message naming dipc_balance_go'; exit 1; }; e=$(\"$1\" -q 5,50,50,20,700,700 --timeout 0.2 2>&1); rc=$?; echo \"$e\"; test $rc = 2 || { echo 'FAIL: -q took a value'; exit 1; }; echo ok"
+            sh ${go_dipc})
+  list(APPEND lang_tests clients_go_help)
   lang_end_tests(go dipc "${lang_dipc_cfg}" ${go_dipc})
   lang_signal_test(go "${lang_dipc_cfg}" ${go_dipc})
   set(go_xl --run go 0 "${go_dipc} --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}")
@@ -538,6 +550,13 @@ foreach(lang IN LISTS readme_langs)
   list(APPEND lang_tests clients_readme_${lang} clients_readme_${lang}_slow_law
     clients_readme_${lang}_slower_law)
 endforeach()
+# docs/clients.md's Go block built by its static-link recipe against an install: no
+# liblagsim_client.so loaded, and it balances
+if(TARGET dipc_balance_go)
+  add_test(NAME clients_readme_go_static
+    COMMAND ${readme_run} ${readme_cc} --install --go-static --periods 20 go-dipc)
+  list(APPEND lang_tests clients_readme_go_static)
+endif()
 # docs/clients.md's C++ block over stock lcm-gen --cpp types and lcm/lcm-cpp.hpp, built
 # with the types clients_lcm_cpp_forged's target generates (tests/clients.cmake)
 add_test(NAME clients_readme_cpplcm
@@ -551,7 +570,11 @@ add_test(NAME clients_readme_cpp_installed
 list(APPEND lang_tests clients_readme_c_installed clients_readme_cpp_installed)
 # the C and C++ blocks under a daemon SIGKILLed after 30 states (no stop event): each ends
 # by its silence rule (5 s of nothing from the daemon, as README says) and exits 0
-foreach(lang c cpp)
+set(readme_killed c cpp)
+if(TARGET dipc_balance_go)  # docs/clients.md's Go block (its silence = 5 s)
+  list(APPEND readme_killed go)
+endif()
+foreach(lang IN LISTS readme_killed)
   add_test(NAME clients_readme_${lang}_daemon_killed
     COMMAND ${readme_run} ${readme_cc} --kill-after 30 --silence 5 ${lang}-dipc)
   list(APPEND lang_tests clients_readme_${lang}_daemon_killed)

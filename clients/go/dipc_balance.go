@@ -47,8 +47,8 @@ import (
 	"unsafe"
 )
 
-const name = "dipc_balance.go"
-const N = 6 // states
+const name = "dipc_balance_go" // the program built from this file: its messages' name
+const N = 6                    // states
 
 type matrix [][]float64
 
@@ -391,26 +391,55 @@ func parseOptions() options {
 	flag.StringVar(&o.url, "url", "", "the plant's LCM URL, its lcm.url (default: LCM's default, LCM_DEFAULT_URL); commands go to the next port")
 	flag.Float64Var(&o.duration, "duration", 0, "stop after S s of sim time from the first state (0: until the daemon stops)")
 	flag.Float64Var(&o.timeout, "timeout", 5, "wall s without a scene, or without a state once running, before ending")
-	flag.StringVar(&o.qweights, "q", "5,50,50,20,700,700", "state weights")
+	flag.StringVar(&o.qweights, "weights", "5,50,50,20,700,700", "state weights")
 	flag.Float64Var(&o.r, "r", 1, "input weight")
 	flag.StringVar(&o.gain, "k", "", "apply this gain k0,...,k5 instead of designing one")
 	flag.StringVar(&o.trace, "trace", "", "write each answered state and the effort sent to this file")
-	quiet := flag.Bool("quiet", false, "quiet: design and summary only (also -q with no value)")
-	// -q alone is the examples' quiet flag; --q WEIGHTS the weights: told apart here
-	args := os.Args[1:]
+	flag.BoolVar(&o.quiet, "quiet", false, "quiet: design and summary only")
+	flag.Usage = usage
+	// the other examples' spelling: --q W0,...,W5 the weights, -q (never a value) quiet;
+	// Go's flag package reads -q and --q alike, so they are told apart here
+	args := append([]string(nil), os.Args[1:]...)
 	for i, a := range args {
-		if a == "-q" && (i+1 == len(args) || strings.HasPrefix(args[i+1], "-")) {
-			args[i] = "--quiet"
+		if a == "--" {
+			break
+		} else if a == "-q" {
+			args[i] = "-quiet"
+		} else if a == "--q" || strings.HasPrefix(a, "--q=") {
+			args[i] = "-weights" + strings.TrimPrefix(a, "--q")
 		}
 	}
-	if err := flag.CommandLine.Parse(args); err != nil || flag.NArg() > 0 {
+	if err := flag.CommandLine.Parse(args); err != nil {
 		os.Exit(2)
 	}
-	o.quiet = *quiet
+	if flag.NArg() > 0 {
+		fail(2, "unexpected argument '%s' (-q takes no value; the weights are --q W0,...,W5)", flag.Arg(0))
+	}
 	if !(o.timeout > 0) || !(o.duration >= 0) || !(o.r > 0) || math.IsInf(o.r, 0) {
 		fail(2, "--timeout and --r must be > 0 and --duration a number >= 0")
 	}
 	return o
+}
+
+// usage lists the options as they are typed: --q the weights, -q quiet, as in the other
+// examples (Go's own listing would show the flags' internal names).
+func usage() {
+	out := flag.CommandLine.Output()
+	fmt.Fprintf(out, "usage: %s [--prefix P] [--url URL] [--duration S] [--timeout S] [--q W0,...,W5]\n"+
+		"       %*s [--r R] [--k K0,...,K5] [--trace FILE] [-q]\n\n"+
+		"Balances the double inverted pendulum on a cart (DIPC) upright with LQR, in Go\n"+
+		"through the client library's C ABI.\n\noptions:\n", name, len(name), "")
+	typed := map[string]string{"prefix": "--prefix P", "url": "--url URL", "duration": "--duration S",
+		"timeout": "--timeout S", "weights": "--q W0,...,W5", "r": "--r R", "k": "--k K0,...,K5",
+		"trace": "--trace FILE", "quiet": "-q"}
+	for _, f := range []string{"prefix", "url", "duration", "timeout", "trace", "quiet", "weights", "r", "k"} {
+		fl := flag.Lookup(f)
+		def := ""
+		if fl.DefValue != "" && fl.DefValue != "false" && fl.DefValue != "0" {
+			def = " (default " + fl.DefValue + ")"
+		}
+		fmt.Fprintf(out, "  %-16s %s%s\n", typed[f], fl.Usage, def)
+	}
 }
 
 // connect: the handle (C memory, freed by lag_client_destroy; the strings passed are

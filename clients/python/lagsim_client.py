@@ -11,7 +11,8 @@ every message decoded whole and bounded) are the C library's, not copied here.
 
 Which library is loaded, in this order (the first that loads; a clear error naming every
 one tried if none does):
-  1. $LAGSIM_CLIENT_LIBRARY, a path to liblagsim_client.so.1;
+  1. $LAGSIM_CLIENT_LIBRARY, a path to liblagsim_client.so.1: when set, that library and
+     no other (one it names that does not load is an error naming it, never skipped);
   2. the path CMake wrote into lagsim_client_path.py beside this module: the build tree's
      <build>/lib/liblagsim_client.so.1, or, once installed, the installed library;
   3. liblagsim_client.so.1 by the dynamic loader's search (ldconfig's cache, LD_LIBRARY_PATH).
@@ -110,9 +111,6 @@ _lib = None
 
 def _candidates():
     tried = []
-    env = os.environ.get("LAGSIM_CLIENT_LIBRARY")
-    if env:
-        tried.append(("$LAGSIM_CLIENT_LIBRARY", env))
     try:
         import lagsim_client_path  # written by CMake: the build tree's, or the install's
         tried.append(("lagsim_client_path.py", lagsim_client_path.LIBRARY))
@@ -128,6 +126,15 @@ def library():
     if _lib is not None:
         return _lib
     errors = []
+    env = os.environ.get("LAGSIM_CLIENT_LIBRARY")
+    if env:  # the user chose this one: used, or an error naming it (no silent fallback)
+        try:
+            lib, path = ctypes.CDLL(env), env
+        except OSError as e:
+            raise ClientError("cannot load lagsim's client library $LAGSIM_CLIENT_LIBRARY=%s: %s "
+                              "(unset LAGSIM_CLIENT_LIBRARY to use the build's or the installed "
+                              "library)" % (env, e))
+        return _typed(lib, path)
     for where, path in _candidates():
         try:
             lib = ctypes.CDLL(path)
@@ -138,6 +145,12 @@ def library():
         raise ClientError("cannot load lagsim's client library; tried %s. Set "
                           "LAGSIM_CLIENT_LIBRARY=<build>/lib/%s, or install lagsim"
                           % ("; ".join(errors), SONAME))
+    return _typed(lib, path)
+
+
+def _typed(lib, path):
+    """lib with its functions typed, once its ABI and release are checked; kept."""
+    global _lib
     for name, (res, args) in _SIGNATURES.items():
         try:
             f = getattr(lib, name)

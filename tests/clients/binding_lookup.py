@@ -9,8 +9,11 @@ Each case runs a fresh interpreter that asks for the plant URLs (lag_client_plan
   - the build's modules (<build>/python, <build>/lua): found, the rule's answer;
   - the source's modules (no path file), $LAGSIM_CLIENT_LIBRARY / LUA_CPATH naming the
     build's library or module: found;
-  - the source's modules with nothing to find (a missing path, no loader path): an error
-    naming each place tried and what to set.
+  - the build's modules with $LAGSIM_CLIENT_LIBRARY naming a missing file: an error naming
+    it (the variable is the user's choice: never skipped for another library);
+  - the source's modules with nothing to find (no path file, no loader path): an error
+    naming each place tried and what to set. (Lua has no such variable: LUA_CPATH is a
+    search path, whose entries that find nothing are passed over by Lua itself.)
 """
 import argparse
 import os
@@ -56,11 +59,18 @@ def main():
     check(rc == 0 and out == WANT, "Python from <build>/python: the library the build wrote", err)
     rc, out, err = run([sys.executable, "-c", PY], {"PYTHONPATH": py_src, "LAGSIM_CLIENT_LIBRARY": lib})
     check(rc == 0 and out == WANT, "Python from the sources, LAGSIM_CLIENT_LIBRARY=%s" % lib, err)
+    # a $LAGSIM_CLIENT_LIBRARY naming no library is an error naming it, even where another
+    # library would be found (the build's path file): who set it expects that one used
     missing = "/nonexistent/liblagsim_client.so.1"
-    rc, out, err = run([sys.executable, "-c", PY], {"PYTHONPATH": py_src, "LAGSIM_CLIENT_LIBRARY": missing})
-    check(rc != 0 and "cannot load lagsim's client library" in err and missing in err and
-          "$LAGSIM_CLIENT_LIBRARY" in err and "liblagsim_client.so.1 (the dynamic loader" in err,
-          "Python with nothing to find: an error naming each place tried", err)
+    rc, out, err = run([sys.executable, "-c", PY], {"PYTHONPATH": os.path.join(a.build, "python"),
+                                                    "LAGSIM_CLIENT_LIBRARY": missing})
+    check(rc != 0 and "cannot load lagsim's client library $LAGSIM_CLIENT_LIBRARY=%s" % missing in err,
+          "Python from <build>/python, LAGSIM_CLIENT_LIBRARY=%s: an error naming it, no other "
+          "library loaded instead" % missing, "exit %d, out %r\n%s" % (rc, out, err))
+    rc, out, err = run([sys.executable, "-c", PY], {"PYTHONPATH": py_src})
+    check(rc != 0 and "cannot load lagsim's client library" in err and
+          "LAGSIM_CLIENT_LIBRARY=<build>/lib/" in err and "liblagsim_client.so.1 (the dynamic loader" in err,
+          "Python with nothing to find: an error naming each place tried and what to set", err)
     if a.lua:
         lua_build = os.path.join(a.build, "lua")
         lua_src = os.path.join(a.source, "clients", "lua")

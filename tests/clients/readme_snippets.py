@@ -51,10 +51,13 @@ is tested as before). A run that answers copies by thinking again falls further 
 state and meets any finite timeout; the law counted once per sim_time is the direct check.
 """
 import argparse
+import atexit
+import hashlib
 import math
 import os
 import re
 import shlex
+import shutil
 import signal
 import subprocess
 import sys
@@ -63,6 +66,15 @@ import threading
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
+
+_TEMPS = []  # the directories this run made (blocks, an install): removed when it ends
+atexit.register(lambda: [shutil.rmtree(d, ignore_errors=True) for d in _TEMPS])
+
+
+def mkdtemp(prefix):
+    _TEMPS.append(tempfile.mkdtemp(prefix=prefix))
+    return _TEMPS[-1]
+
 
 THINK_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "think")
 # name: (file, command line (build, file, slow: the think wrapper, or ""), environment)
@@ -130,6 +142,11 @@ def main():
     ap.add_argument("--think", type=float, default=0.0,
                     help="also run each block with a law of this many wall s per answer")
     ap.add_argument("--periods", type=int, default=200, help="control periods of a run")
+    ap.add_argument("--go-static", action="store_true",
+                    help="with --install: build the Go block with docs/clients.md's static-link "
+                    "recipe (<!-- recipe: go-static -->) for the install's prefix instead of its "
+                    "pkg-config line; the program must not load liblagsim_client.so, and runs "
+                    "without LD_LIBRARY_PATH")
     ap.add_argument("--kill-after", type=int, default=0,
                     help="SIGKILL the daemon once this many states were heard: the block must "
                          "end by its silence rule (--silence S), exit 0, and print end=silence "
@@ -155,7 +172,7 @@ def main():
         found.update(snippets(f))
     a.pkg_config_path, a.lib_path = os.path.join(build, "pkgconfig"), ""
     if a.install:
-        prefix = os.path.join(tempfile.mkdtemp(prefix="lagsim_readme_inst_"), "prefix")
+        prefix = os.path.join(mkdtemp("lagsim_readme_inst_"), "prefix")
         r = subprocess.run(["cmake", "--install", build, "--prefix", prefix],
                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
         if r.returncode != 0:
@@ -163,7 +180,9 @@ def main():
             return 1
         print("installed into %s" % prefix)
         a.pkg_config_path = os.path.join(prefix, "lib", "pkgconfig")
-        a.lib_path = os.path.join(prefix, "lib")
+        a.lib_path = "" if a.go_static else os.path.join(prefix, "lib")
+        a.prefix = prefix
+    a.recipes = "".join(open(f).read() for f in a.readme)
     fails = 0
     for name in a.names:
         lang = name.split("-")[0]
@@ -223,6 +242,26 @@ def build_block(a, text, lang, path, think):
     return True
 
 
+def cgo_inputs_key(pkg_config_path):
+    """What cmake/go_build.cmake does for the tree's Go programs: the SHA-256 of the client
+    library's headers and library that pkg-config points at, for CGO_CPPFLAGS, where Go's
+    cache key sees it (Go does not hash a header included from another directory: built
+    against a changed lagsim, the block would otherwise reuse cgo objects of the old one)."""
+    r = subprocess.run(["pkg-config", "--cflags-only-I", "--libs-only-L", "lagsim-client"],
+                       env=dict(os.environ, PKG_CONFIG_PATH=pkg_config_path),
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    if r.returncode != 0:
+        print("FAIL: PKG_CONFIG_PATH=%s pkg-config lagsim-client:\n%s" % (pkg_config_path, r.stdout))
+        return None
+    h = hashlib.sha256()
+    for flag in r.stdout.split():
+        for rel in ("lagsim_client.h", "lagsim/version.h", "lagsim/result.h", "liblagsim_client.so.1"):
+            f = os.path.join(flag[2:], rel)
+            if flag[:2] in ("-I", "-L") and os.path.isfile(f):
+                h.update(f.encode() + b"\0" + open(f, "rb").read())
+    return h.hexdigest()[:32]
+
+
 def build_go_block(a, build, text, path, think):
     """Builds the Go block as its first line says (go build balance.go), cgo finding the
     client library through pkg-config (a.pkg_config_path); Go's cache and GOPATH in
@@ -243,7 +282,13 @@ def build_go_block(a, build, text, path, think):
         with open(path, "w") as f:
             f.write(code.replace(directive, directive + "#cgo CFLAGS: -include %s\n"
                                  % os.path.join(THINK_DIR, "think.h"), 1))
+    if a.go_static and not go_static_recipe(a, path):
+        return False
+    key = cgo_inputs_key(a.pkg_config_path)
+    if key is None:
+        return False
     env = dict(os.environ, PKG_CONFIG_PATH=a.pkg_config_path, CGO_CFLAGS=cflags,
+               CGO_CPPFLAGS="-DLAGSIM_CGO_INPUTS=" + key,
                GOCACHE=os.path.join(build, "go", "cache"), GOPATH=os.path.join(build, "go", "path"),
                GOTOOLCHAIN="local", GOENV="off", GOFLAGS="", GO111MODULE="on", CGO_ENABLED="1")
     cmd = [a.go, "build", "-o", os.path.splitext(path)[0], os.path.basename(path)]
@@ -253,6 +298,39 @@ def build_go_block(a, build, text, path, think):
     if r.returncode != 0:
         print("FAIL: the go block does not build:\n%s" % r.stdout)
         return False
+    if a.go_static:
+        ldd = subprocess.run(["ldd", os.path.splitext(path)[0]], stdout=subprocess.PIPE,
+                             stderr=subprocess.STDOUT, universal_newlines=True).stdout
+        print(ldd.rstrip())
+        if "liblagsim_client" in ldd:
+            print("FAIL: built by the static recipe, the block still loads liblagsim_client")
+            return False
+        print("ok  : built by the static recipe, the block loads no liblagsim_client")
+    return True
+
+
+def go_static_recipe(a, path):
+    """The Go block's '#cgo pkg-config: lagsim-client' line replaced by the static-link
+    recipe of docs/clients.md (the #cgo lines after <!-- recipe: go-static -->), its
+    /opt/lagsim the install's prefix."""
+    if not a.install:
+        print("FAIL: --go-static needs --install")
+        return False
+    m = re.search(r"<!-- recipe: go-static -->\s*\n((?:[ \t]*\n|[ \t]+#cgo [^\n]*\n)+)", a.recipes)
+    lines = [ln.strip() for ln in (m.group(1) if m else "").split("\n") if ln.strip()]
+    if not lines:
+        print("FAIL: no #cgo lines after <!-- recipe: go-static -->")
+        return False
+    recipe = "".join(ln.replace("/opt/lagsim", a.prefix) + "\n" for ln in lines)
+    with open(path) as f:
+        code = f.read()
+    directive = "#cgo pkg-config: lagsim-client\n"
+    if directive not in code:
+        print("FAIL: the go block has no '%s' line" % directive.strip())
+        return False
+    with open(path, "w") as f:
+        f.write(code.replace(directive, recipe, 1))
+    print("the static recipe, for %s:\n%s" % (a.prefix, recipe.rstrip()))
     return True
 
 
@@ -313,7 +391,7 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     from lagsim import control_t, event_t, joint_command_t, joint_state_t, status_t
     fname, cmd, env_extra = RUNNERS[lang]
     prefix = "RDME%s_%d" % (lang.upper(), os.getpid())
-    tmp = tempfile.mkdtemp(prefix="lagsim_readme_")
+    tmp = mkdtemp("lagsim_readme_")
     path = os.path.join(tmp, fname)
     with open(path, "w") as f:
         f.write(text.replace('"DIPC_', '"%s_' % prefix).replace("'DIPC_", "'%s_" % prefix)

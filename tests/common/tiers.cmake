@@ -45,7 +45,7 @@ set(LAGSIM_TIER_RULES
   "waits     NAME  ^clients_(c|cpp|python|lua|java|go)_[a-z_]+_ends_on_(stop|silence)$"
   "waits     NAME  ^clients_(c|cpp|python|lua|java|go)_ends_on_signal$"
   # README's C and C++ blocks under a daemon SIGKILLed: each waits out its 5 s of silence
-  "waits     NAME  ^clients_readme_(c|cpp)_daemon_killed$"
+  "waits     NAME  ^clients_readme_(c|cpp|go)_daemon_killed$"
   "waits     NAME  ^clients_(python|java)_dipc_late_controller$"
   "waits     NAME  ^view_attack_(slowloris|stalled)$"
   "waits     NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
@@ -108,7 +108,7 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^clients_[a-z_]+_(usage_.*|help)$"
   "quick     NAME  ^clients_(python|lua)_(lcm|types)$"
   "quick     NAME  ^clients_java_release$"
-  "quick     NAME  ^clients_(go_dipc_gain|go_vet|binding_lookup)$"
+  "quick     NAME  ^clients_(go_dipc_gain|go_vet|go_cgo_rebuild|binding_lookup)$"
   "quick     NAME  _(lockstep|hostile|push|reference_lost)$"
   "quick     NAME  ^clients_cross_language_(dipc|manipulator)$"
   "quick     NAME  ^clients_readme_(c|cpp|cpplcm|python|lua|java|go)$"
@@ -117,6 +117,7 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^clients_(versions|abi|abi_mutations|cpp_header|lcm_cpp_forged)$"
   "quick     NAME  ^clients_model_[a-z_]+$"  # the client library's M and h vs T and U
   "quick     NAME  ^clients_readme_(c|cpp)_installed$"
+  "quick     NAME  ^clients_readme_go_static$"
   "quick     NAME  ^clients_(readme_cpp|manipulator_ct)_other_compiler$"
 )
 
