@@ -1085,14 +1085,14 @@ int64_t rt_plant_look_ns(const rt_server *s)
 
 int rt_plant_fd(const rt_server *s, rt_plant_input which)
 {
-    return rt_bus_fd(&s->bus, which == RT_PLANT_WATCH);
+    return rt_bus_fd(&s->bus, (rt_bus_input)which);
 }
 
 int rt_plant_drain(rt_server *s, rt_plant_input which, int64_t now, int max)
 {
     s->now = now;
     if (s->stop) return 0;
-    return rt_bus_read(&s->bus, which == RT_PLANT_WATCH, max);
+    return rt_bus_read(&s->bus, (rt_bus_input)which, max);
 }
 
 int rt_plant_start(rt_server *s, int64_t now, bool live_line, char *err, size_t errlen)
@@ -1147,6 +1147,24 @@ void rt_plant_input_limited(rt_server *s, int64_t times, const char *why)
                    "%s on %s and %s: %s (%lld times so far, in value)", "more messages than "
                    "the plant can use", s->bus.ch_command, s->bus.ch_control, why,
                    (long long)times);
+}
+
+void rt_plant_foreign_limited(rt_server *s, const char *why)
+{
+    const rt_foreign *f = &s->bus.foreign;
+    const rt_foreign_prefix *last = NULL;
+    int64_t heard = 0;
+    for (int i = 0; i < RT_FOREIGN_MAX; i++) {
+        const rt_foreign_prefix *e = &f->p[i];
+        heard += e->total;
+        if (e->prefix[0] && (!last || e->heard > last->heard)) last = e;
+    }
+    int64_t lost = s->bus.rx_foreign.lost;
+    rt_pub_limited(&s->pub, RT_EV_FOREIGN_LIMITED, "", (double)(heard + lost),
+                   "other prefixes' requests on %s's command URL (last: %s%s): %lld read, "
+                   "%lld dropped by the kernel; %s", s->bus.sc->lcm.prefix,
+                   last ? last->prefix : "?", last && last->has_plant ? ", a plant elsewhere" : "",
+                   (long long)heard, (long long)lost, why);
 }
 
 unsigned rt_plant_last(const rt_server *s, bool status, const uint8_t **data)

@@ -32,6 +32,7 @@ static const struct {
     [RT_EV_PLANT_CONFLICT] = {"plant_conflict", 1.0 / RT_CONFLICT_EVERY_S, 1},
     [RT_EV_ERROR_ESTIMATE] = {"error_estimate", 1, 3},
     [RT_EV_INPUT_LIMITED] = {"input_limited", 1, 3},
+    [RT_EV_FOREIGN_LIMITED] = {"foreign_limited", 1, 3},
 };
 _Static_assert(sizeof ev_limits / sizeof ev_limits[0] == RT_EV_COUNT, "one bucket per rt_ev");
 

@@ -30,6 +30,12 @@ Cases:
   list        lagsimctl list through the host's directory: every plant with its own URL;
               status through it, pause only on the plant's own URL; lagsim-view --prefix P
               finds P's URL there; a plant on the directory's ports refused
+  foreign     requests for another prefix (S2's STATUS, several thousand a second, as a
+              student polling on a copied URL) flooding the command ports of S1 (lockstep) and
+              S3 (real time), each under dipc_lqr, in a host beside S2, and of S1 in a daemon
+              of its own: S1's states bit for bit those of S1 alone and unflooded, every
+              command of each controller taken (no input_limited), the foreign requests
+              counted and limited (foreign_limited events)
   many        120 plants in one process (LCM's receive path aborted it at about 85),
               lagsimctl list naming each on its own pair, SIGTERM stopping all
 """
@@ -362,6 +368,109 @@ class T:
                                           "" if first is None else "; first difference at %d" % first))
             self.budget_checks(hostile_log, seconds, sent)
 
+
+    # ------------------------------------------------------------------ foreign requests
+    def flood_other_prefix(self, bus, ports, until, rate=5000):
+        """STATUS requests for S2_CONTROL on the command port (P + 1) of each state port P of
+        `ports`, `rate` a second on each, until until() is true (a student who copied
+        another's URL, polling in a loop); returns how many were sent to each."""
+        from lagsim_lcm import LCM
+        lcs = [LCM(url(p + 1)) for p in ports]
+        m = self.t.control_t()
+        m.utime, m.request, m.count, m.key, m.value = 0, self.t.control_t.STATUS, 0, "", ""
+        m.num_joints, m.q, m.qd = 0, [], []
+        data, sent, t0 = m.encode(), 0, time.monotonic()
+        while not until():
+            due = int((time.monotonic() - t0) * rate)
+            while sent < due:
+                for lc in lcs:
+                    lc.publish("S2_CONTROL", data)
+                sent += 1
+            bus.pump(0.002)
+        print("  the flood: %d requests on each of %d ports in %.2f s" %
+              (sent, len(ports), time.monotonic() - t0), flush=True)
+        return sent
+
+    def foreign_checks(self, log, prefix, who):
+        """prefix's log (who: where it ran): no command of its controller dropped, the other
+        prefix's requests counted and limited."""
+        ev = [self.t.event_t.decode(d) for ch, d in read_log(log) if ch == prefix + "_EVENT"]
+        limited = [e for e in ev if e.kind == "input_limited"]
+        check(not limited, "%s %s: its own input never limited by the flood (%d input_limited%s)"
+              % (prefix, who, len(limited), (": " + limited[0].detail) if limited else ""))
+        foreign = [e for e in ev if e.kind == "foreign_limited"]
+        check(foreign and foreign[-1].value > 0 and "S2" in foreign[-1].detail,
+              "%s %s: the other prefix's requests counted and limited (foreign_limited: %s)" %
+              (prefix, who, foreign[-1].detail if foreign else "none"))
+        st = self.last_status(log, prefix)
+        check(st is not None and st.states_published > 100 and
+              st.commands_accepted >= st.states_published - 3,
+              "%s %s: its controller's commands all taken (%s accepted, %s states)" %
+              (prefix, who, st and st.commands_accepted, st and st.states_published))
+
+    def foreign_host_run(self, d, base):
+        """A host of S1 (lockstep), S3 (real time), each under dipc_lqr, and S2; S1's and S3's
+        command ports flooded with S2's requests for 3 s. Returns S1's states."""
+        lab = os.path.join(d, "lab")
+        os.mkdir(lab)
+        open(os.path.join(lab, "s1.yaml"), "w").write(VICTIM)
+        open(os.path.join(lab, "s2.yaml"), "w").write(PLANT)
+        open(os.path.join(lab, "s3.yaml"), "w").write(VICTIM.replace("lockstep", "realtime"))
+        bus = Bus(self.t, [("S1", base), ("S2", base + 2), ("S3", base + 4)])
+        host = self.start([self.prog("lagsimd"), "--plants", lab, "--port-base", str(base),
+                           "-q", "--log", "run.lcm"], cwd=d)
+        ctls = [self.start([self.prog("dipc_lqr"), "-q", "--prefix", pre, "--url", url(port),
+                            "--timeout", "30"]) for pre, port in (("S1", base), ("S3", base + 4))]
+        check(bus.wait_event("S1", "start", 0, 10) and bus.wait_event("S3", "start", 0, 10),
+              "S1 and S3 start")
+        end = time.monotonic() + 3.0
+        self.flood_other_prefix(bus, [base, base + 4], lambda: time.monotonic() >= end)
+        host.send_signal(signal.SIGTERM)
+        rc, _ = self.finish(host)
+        for c in ctls:
+            self.finish(c)
+        check(rc == 0, "the host stops on SIGTERM with exit 0")
+        for pre in ("S1", "S3"):
+            self.foreign_checks(os.path.join(d, pre.lower(), "run.lcm"), pre, "in the host")
+        return self.states_of(os.path.join(d, "s1", "run.lcm"), "S1")
+
+    def foreign_alone_run(self, d, port, duration, flood):
+        """S1 alone in a daemon of its own to `duration` (flood: its command port flooded
+        with S2's requests meanwhile); returns its states and its log."""
+        path = os.path.join(d, "s1_alone.yaml")
+        open(path, "w").write(VICTIM)
+        log = os.path.join(d, "alone%d.lcm" % flood)
+        bus = Bus(self.t, [("S1", port)])
+        host = self.start([self.prog("lagsimd"), "--config", path, "--set", "lcm.prefix=S1",
+                           "--set", "lcm.url=" + url(port), "-q", "--duration", repr(duration),
+                           "--log", log])
+        ctl = self.start([self.prog("dipc_lqr"), "-q", "--prefix", "S1", "--url", url(port),
+                          "--timeout", "30"])
+        if flood:
+            self.flood_other_prefix(bus, [port], lambda: host.poll() is not None)
+        rc, _ = self.finish(host, 300)
+        self.finish(ctl)
+        check(rc == 0, "S1 alone%s runs to %g s, exit 0" % (" (flooded)" if flood else "", duration))
+        return self.states_of(log, "S1"), log
+
+    def case_foreign(self):
+        base = take_pairs(3)
+        with tempfile.TemporaryDirectory() as d:
+            host_states = self.foreign_host_run(d, base)
+            check(len(host_states) > 100, "S1 ran %d periods in the host" % len(host_states))
+            if not host_states:
+                return
+            last_t = host_states[-1][2]
+            alone, _ = self.foreign_alone_run(d, base, last_t, False)
+            flooded, flog = self.foreign_alone_run(d, base, last_t, True)
+            for what, states in (("in the host beside S2, flooded", host_states),
+                                 ("alone, flooded", flooded)):
+                n = min(len(alone), len(states))
+                first = next((k for k in range(n) if alone[k] != states[k]), None)
+                check(n == len(states) and len(states) > 100 and first is None,
+                      "S1's %d states %s are bit for bit those of S1 alone%s" % (
+                          len(states), what, "" if first is None else "; first difference at %d" % first))
+            self.foreign_checks(flog, "S1", "alone")
 
     # ------------------------------------------------------------------ bad scenes
     def case_bad_scene(self):
