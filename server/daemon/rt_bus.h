@@ -22,7 +22,13 @@
 
 #define RT_CHANNEL_MAX LAG_BUS_CHANNEL_LEN /* prefix (< 64) + "_COMMAND" */
 #define RT_BUF_SIZE LAG_WIRE_BUF_SIZE      /* encode buffer: holds any message */
-#define RT_SCENES_KEPT 8 /* the last scenes published, to tell them from another plant's */
+/* The last scenes published, to tell them from another plant's when they are heard back on
+ * the plant watch: enough for every scene the buckets let out in RT_SCENE_ECHO_S seconds
+ * (a flood of SET and RESET publishes a new generation's scene for each within their
+ * buckets, a burst of them in one pass; rt_publish.c checks the bound), far longer than
+ * a datagram looped back by this host takes to be read. */
+#define RT_SCENES_KEPT 1024
+#define RT_SCENE_ECHO_S 4
 
 /* What the loop does with a message: a command, a control request, a scene heard on the
  * state URL (see rt_bus_foreign_scene). */

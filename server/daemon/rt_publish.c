@@ -2,6 +2,7 @@
  * What the loop publishes, through one place each: see rt_publish.h.
  */
 #include "rt_publish.h"
+#include "rt_control.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -35,6 +36,12 @@ static const struct {
     [RT_EV_FOREIGN_LIMITED] = {"foreign_limited", 1, 3},
 };
 _Static_assert(sizeof ev_limits / sizeof ev_limits[0] == RT_EV_COUNT, "one bucket per rt_ev");
+/* every scene the buckets let out in RT_SCENE_ECHO_S is remembered until heard back (a
+ * new generation's: SET's and RESET's buckets; an answer to DESCRIBE: the scene bucket) */
+_Static_assert(RT_SCENES_KEPT >= RT_SET_BURST + RT_RESET_BURST + RT_SCENE_BURST +
+                                     RT_SCENE_ECHO_S * (RT_SET_PER_S + RT_RESET_PER_S +
+                                                        RT_SCENE_PER_S),
+               "the scenes published are remembered long enough to be known when heard back");
 
 void rt_pub_init(rt_pub *p, rt_bus *bus, rt_record *rec, rt_term *term, const int64_t *now,
                  const lag_sim *sim)

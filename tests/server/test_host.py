@@ -36,6 +36,8 @@ Cases:
               of its own: S1's states bit for bit those of S1 alone and unflooded, every
               command of each controller taken (no input_limited), the foreign requests
               counted and limited (foreign_limited events)
+  own_flood   SET and RESET at about 270 a second on a plant's own prefix (one process): its
+              own scenes, heard back, are never taken for another plant's
   many        120 plants in one process (LCM's receive path aborted it at about 85),
               lagsimctl list naming each on its own pair, SIGTERM stopping all
 """
@@ -471,6 +473,52 @@ class T:
                       "S1's %d states %s are bit for bit those of S1 alone%s" % (
                           len(states), what, "" if first is None else "; first difference at %d" % first))
             self.foreign_checks(flog, "S1", "alone")
+
+    # ------------------------------------------------------------------ own flood
+    def case_own_flood(self):
+        """A student floods their own plant with SET and RESET (about 270 a second, one
+        process): every new generation's scene is heard back on the plant watch, and none
+        may be taken for another plant's (plant_conflict, "another plant publishes")."""
+        base = take_pairs(1)
+        with tempfile.TemporaryDirectory() as d:
+            lab = os.path.join(d, "lab")
+            os.mkdir(lab)
+            open(os.path.join(lab, "alice.yaml"), "w").write(PLANT)
+            bus = Bus(self.t, [("ALICE", base)])
+            host = self.start([self.prog("lagsimd"), "--plants", lab, "--port-base", str(base),
+                               "--log", "run.lcm"], cwd=d)
+            check(bus.wait_event("ALICE", "start", 0, 10), "ALICE starts")
+            from lagsim_lcm import LCM
+            cmd, C = LCM(url(base + 1)), self.t.control_t
+            sent, t0 = 0, time.monotonic()
+            while time.monotonic() - t0 < 3.0:
+                # in bursts of 54 every 0.2 s (a Python loop is bursty; a loaded loop
+                # reads a burst in one pass)
+                due = 54 * (1 + int((time.monotonic() - t0) / 0.2))
+                while sent < due:
+                    if sent % 2:
+                        self.control(cmd, "ALICE", C.RESET)
+                    else:
+                        self.control(cmd, "ALICE", C.SET, key="parameters.m0",
+                                     value="%.3f" % (1.0 + 0.001 * (sent % 100)))
+                    sent += 1
+                bus.pump(0.002)
+            bus.pump(1.0)
+            host.send_signal(signal.SIGTERM)
+            rc, err = self.finish_pumping(host, bus, 30)
+            log = os.path.join(d, "alice", "run.lcm")
+            ev = [self.t.event_t.decode(x) for ch, x in read_log(log) if ch == "ALICE_EVENT"]
+            gens = sum(1 for e in ev if e.kind in ("set", "reset"))
+            conflicts = [e for e in ev if e.kind == "plant_conflict"]
+            st = self.last_status(log, "ALICE")
+            check(gens > 50, "%d requests sent, %d new generations (set, reset events)" %
+                  (sent, gens))
+            check(not conflicts and "another plant" not in err,
+                  "no other plant said: %d plant_conflict events%s" % (
+                      len(conflicts), (" (" + conflicts[0].detail + ")") if conflicts else ""))
+            check(st is not None and st.plant_conflicts == 0,
+                  "status: plant_conflicts %s" % (st and st.plant_conflicts))
+            check(rc == 0, "SIGTERM: exit 0")
 
     # ------------------------------------------------------------------ bad scenes
     def case_bad_scene(self):
