@@ -979,6 +979,7 @@ void rt_process(rt_server *s)
         s->next_status_ns = rt_sat_add(s->next_status_ns, s->status_period_ns);
         if (s->next_status_ns <= s->now) s->next_status_ns = rt_sat_add(s->now, s->status_period_ns);
     }
+    rt_term_tick(&s->term, s->now); /* -q: the losses' journal */
     if (s->term.live_line && s->now >= s->next_line_ns) {
         rt_term_line(&s->term, s->now, false);
         s->next_line_ns = rt_sat_add(s->now, RT_LINE_NS);
@@ -1046,6 +1047,7 @@ void rt_finish(rt_server *s)
         break;
     }
     publish_status(s);
+    rt_term_flush(&s->term, s->now);
     if (s->term.live_line) rt_term_line(&s->term, s->now, true);
 }
 

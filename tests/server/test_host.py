@@ -38,6 +38,8 @@ Cases:
               counted and limited (foreign_limited events)
   own_flood   SET and RESET at about 270 a second on a plant's own prefix (one process): its
               own scenes, heard back, are never taken for another plant's
+  quiet       a host with -q: a plant's watchdog trip and its input limited are on stderr,
+              each kind at most a line per 10 s with its count; no other event line
   many        120 plants in one process (LCM's receive path aborted it at about 85),
               lagsimctl list naming each on its own pair, SIGTERM stopping all
 """
@@ -518,6 +520,49 @@ class T:
                       len(conflicts), (" (" + conflicts[0].detail + ")") if conflicts else ""))
             check(st is not None and st.plant_conflicts == 0,
                   "status: plant_conflicts %s" % (st and st.plant_conflicts))
+            check(rc == 0, "SIGTERM: exit 0")
+
+    # ------------------------------------------------------------------ -q's journal
+    def case_quiet(self):
+        """A host with -q: a plant whose controller falls silent (the watchdog trips), then
+        floods it (its input budget is spent) says both on stderr, each kind in at most
+        one line per 10 s with its count, and nothing else of its events."""
+        base = take_pairs(1)
+        with tempfile.TemporaryDirectory() as d:
+            lab = os.path.join(d, "lab")
+            os.mkdir(lab)
+            open(os.path.join(lab, "alice.yaml"), "w").write(
+                PLANT.replace("start: running", "start: running, command_timeout: 0.2"))
+            bus = Bus(self.t, [("ALICE", base)])
+            host = self.start([self.prog("lagsimd"), "--plants", lab, "--port-base", str(base),
+                               "-q"])
+            check(bus.wait_event("ALICE", "start", 0, 10), "ALICE starts")
+            from lagsim_lcm import LCM
+            cmd = LCM(url(base + 1))
+            t0 = time.monotonic()
+            cmd.publish("ALICE_COMMAND", self.command("x", 0.5))
+            check(bus.wait_event("ALICE", "watchdog_trip", t0, 10), "its controller falls silent: "
+                  "the watchdog trips")
+            t1 = time.monotonic()
+            good = self.command("x", 0.0)
+            for k in range(20000):
+                cmd.publish("ALICE_COMMAND", good)
+                if k % 500 == 0:
+                    bus.pump(0)
+            check(bus.wait_event("ALICE", "input_limited", t1, 10), "flooded: its input is limited")
+            n_limited = len([e for e in bus.events("ALICE", t1) if e.kind == "input_limited"])
+            host.send_signal(signal.SIGTERM)
+            rc, err = self.finish_pumping(host, bus, 30)
+            lines = err.splitlines()
+            trip = [l for l in lines if l.startswith("lagsimd: ALICE: watchdog_trip")]
+            lim = [l for l in lines if l.startswith("lagsimd: ALICE: input_limited")]
+            check(len(trip) >= 1, "-q: the watchdog's trip is on stderr: %s" % trip[:1])
+            check(1 <= len(lim) <= 2 and n_limited > len(lim) and
+                  ("%d in all" % n_limited) in lim[-1],
+                  "-q: input_limited on stderr in %d line(s) for %d events, counted: %s" %
+                  (len(lim), n_limited, lim[-1:]))
+            check(not any(" event " in l for l in lines),
+                  "-q: no other event line (%s)" % [l for l in lines if " event " in l][:2])
             check(rc == 0, "SIGTERM: exit 0")
 
     # ------------------------------------------------------------------ bad scenes
