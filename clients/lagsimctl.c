@@ -37,6 +37,7 @@
 #include "lagsim_client.h"
 #include "lagsim_client_wire.h"
 #include "lagsim_bus.h"
+#include "lagsim_locate.h"
 #include "lagsim_num.h"
 #include "lagsim_wire.h"
 
@@ -735,6 +736,9 @@ static int check_request(request *r)
 static lag_client *connect_plant(options *o, lag_client_plant *chosen, int *code)
 {
     char err[1200];
+    static char located[LAG_CLIENT_URL_LEN];
+    if (o->prefix && !o->url && lag_locate_plant(o->prefix, located, sizeof located))
+        o->url = located; /* a host's plant: where its directory says it runs */
     if (!o->prefix) {
         /* the only plant on the bus */
         int rc = lag_client_pick_plant(o->url, NULL, o->timeout, chosen, sizeof *chosen, err,
@@ -745,6 +749,7 @@ static lag_client *connect_plant(options *o, lag_client_plant *chosen, int *code
             return NULL;
         }
         o->prefix = chosen->prefix;
+        if (!o->url && lag_locate_elsewhere(chosen->url)) o->url = chosen->url;
     }
     g_prefix = o->prefix;
     lag_client *c = lag_client_create(o->url, o->prefix, err, sizeof err);

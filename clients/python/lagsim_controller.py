@@ -321,8 +321,9 @@ class Controller(object):
         self._heard = time.monotonic()
 
     def _on_event(self, channel, data):
-        self._heard = time.monotonic()
         ev = self._decode(self.t.event_t, data)
+        if ev is None or ev.kind != "plant":  # a host's directory's, not the plant's own
+            self._heard = time.monotonic()
         if ev is not None and ev.kind == "stop":
             self._stopped = True
 

@@ -28,8 +28,10 @@ Cases:
               a stop, a start or a new generation; SIGTERM stops every plant (a stop event
               each), exit 0
   list        lagsimctl list through the host's directory: every plant with its own URL;
-              status through it, pause only on the plant's own URL; lagsim-view --prefix P
-              finds P's URL there; a plant on the directory's ports refused
+              status through it, pause without --url done on the URL it names; lagsim-view
+              --prefix P and a C controller (lqr_balance) find P's URL there; a controller
+              put on the directory's bus ends after its --timeout though the directory
+              keeps talking; a plant on the directory's ports refused
   foreign     requests for another prefix (S2's STATUS, several thousand a second, as a
               student polling on a copied URL) flooding the command ports of S1 (lockstep) and
               S3 (real time), each under dipc_lqr, in a host beside S2, and of S1 in a daemon
@@ -782,8 +784,12 @@ class T:
                   "status through the directory: BOB's last status")
             p = self.ctl("--url", url(base + 2), "--prefix", "BOB", "pause")
             check(p.returncode == 0, "pause on BOB's own URL: exit 0")
-            p = self.ctl("--prefix", "ALICE", "--timeout", "1", "pause")
-            check(p.returncode == 3, "pause through the directory: not done there (exit 3)")
+            t0 = time.monotonic()
+            p = self.ctl("--prefix", "ALICE", "--timeout", "2", "pause")
+            st = self.ctl("--url", url(base), "--prefix", "ALICE", "status").stdout
+            check(p.returncode == 0 and "paused" in st,
+                  "pause without --url: the directory names ALICE's URL, the pause is done there")
+            self.controllers_through_directory(bus, base)
             view = self.start([self.prog("lagsim-view"), "--prefix", "CAROL", "--port", "0"],
                               stdout=subprocess.PIPE)
             line = view.stdout.readline()
@@ -799,6 +805,36 @@ class T:
                   "a plant on the directory's ports refused, said")
             check(rc == 0, "SIGTERM: exit 0")
 
+
+    def controllers_through_directory(self, bus, base):
+        """A C controller given --prefix without --url runs its host's plant on the URL the
+        directory names; one put on the directory itself (--url) ends after --timeout
+        though the directory keeps announcing the plant."""
+        t0 = time.monotonic()
+        ctl = self.start([self.prog("lqr_balance"), "--prefix", "CAROL", "--timeout", "3",
+                          "--duration", "1"], stdout=subprocess.PIPE)
+        out, _ = ctl.communicate(timeout=60)
+        rc, _ = self.finish(ctl, 5)
+        check(rc == 0 and ("prefix CAROL runs on %s" % url(base + 4)) in out,
+              "lqr_balance --prefix CAROL without --url: on CAROL's URL, exit %s (%s)" %
+              (rc, out.strip().splitlines()[:2]))
+        bus.pump(1.5)  # CAROL's status, once a second
+        st = [self.t.status_t.decode(d) for (w, ch, d) in bus.msgs if ch == "CAROL_STATUS"]
+        check(st and st[-1].commands_accepted > 0,
+              "CAROL took its commands (%s accepted)" % (st[-1].commands_accepted if st else None))
+        t0 = time.monotonic()
+        ctl = self.start([self.prog("lqr_balance"), "--prefix", "CAROL", "--url",
+                          url(self.directory), "--timeout", "2"], stdout=subprocess.PIPE)
+        try:
+            out, _ = ctl.communicate(timeout=20)
+        except subprocess.TimeoutExpired:
+            out = "(still running after 20 s)"
+        rc, _ = self.finish(ctl, 1)
+        took = time.monotonic() - t0
+        print(out)
+        check(took < 20 and "scene" in out and "silence" in out,
+              "a controller on the directory's bus gets CAROL's scene there but no state: its "
+              "--timeout 2 ends it (after %.1f s, exit %s)" % (took, rc))
 
     # ------------------------------------------------------------------ many plants
     def case_many(self):
