@@ -1168,6 +1168,9 @@ lag_result lag_client_discover(const char *url, double wait_s, double settle_s,
         free(dp);
         return rc;
     }
+    /* a host's directory names a plant every 0.5 s and answers for each: LCM's default
+     * queue (30 messages) would drop most of a class of plants between two reads */
+    lcm_subscription_set_queue_capacity(sub, 4 * LAG_CLIENT_MAX_PLANTS);
     disc_listen(dp, in, cmd, &b, max, wait_s, settle_s);
     lcm_unsubscribe(in, sub);
     if (cmd != in) lcm_destroy(cmd);

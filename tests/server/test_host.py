@@ -43,7 +43,8 @@ Cases:
   quiet       a host with -q: a plant's watchdog trip and its input limited are on stderr,
               each kind at most a line per 10 s with its count; no other event line
   many        120 plants in one process (LCM's receive path aborted it at about 85),
-              lagsimctl list naming each on its own pair, SIGTERM stopping all
+              lagsimctl list naming each on its own pair, the default list with no `?`
+              (it waits for the plants the directory named), SIGTERM stopping all
 """
 import argparse
 import fcntl
@@ -859,6 +860,13 @@ class T:
             check(listed == {"P%03d" % k: url(base + 2 * k) for k in range(n)},
                   "lagsimctl list: all %d plants, each on its own port pair (%d listed)" %
                   (n, len(listed)))
+            # the default list waits for every plant the directory named to answer: no `?`
+            p = self.ctl("list")
+            rows = [l.split() for l in p.stdout.splitlines()[1:] if l.strip()]
+            unknown = [r[0] for r in rows if "?" in r[1:4]]
+            check(len(rows) == n and not unknown,
+                  "lagsimctl list (default wait): %d rows, none with `?` for model, mode or run "
+                  "state (%d with: %s)" % (len(rows), len(unknown), unknown[:5]))
             p = self.ctl("--url", url(base + 2 * (n - 1)), "--prefix", "P%03d" % (n - 1), "step", "3")
             check(p.returncode == 0 and "step_done" in p.stdout,
                   "the last plant answers on its own URL (step 3)")
