@@ -297,13 +297,18 @@ static int pick_prefix(lag_ctl *ctl, const char *model)
 static int connect_client(lag_ctl *ctl)
 {
     char err[256];
-    if (ctl->prefix && !ctl->url && lag_locate_plant(ctl->prefix, ctl->found_url,
-                                                     sizeof ctl->found_url)) {
-        ctl->url = ctl->found_url; /* a host's plant: where its directory says it runs */
+    ctl->client = lag_client_create(ctl->url, ctl->prefix, err, sizeof err);
+    /* --prefix without --url: subscribed first (nothing of a plant of the default bus is
+     * missed while the directory is asked), then moved to the URL a host's directory
+     * names, if it names one */
+    if (ctl->client && ctl->prefix && !ctl->url &&
+        lag_locate_plant(ctl->prefix, ctl->found_url, sizeof ctl->found_url)) {
+        ctl->url = ctl->found_url;
         printf("%s: prefix %s runs on %s (the host's directory)\n", ctl->name, ctl->prefix,
                ctl->url);
+        lag_client_destroy(ctl->client);
+        ctl->client = lag_client_create(ctl->url, ctl->prefix, err, sizeof err);
     }
-    ctl->client = lag_client_create(ctl->url, ctl->prefix, err, sizeof err);
     if (!ctl->client) {
         fprintf(stderr, "%s: %s\n", ctl->name, err);
         return 1;
