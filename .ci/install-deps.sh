@@ -32,6 +32,7 @@ tests   clang                 # the sanitizer pass: clang, ASan+UBSan, libFuzzer
 tests   libclang-rt-14-dev
 tests   lua5.2                # the Lua 5.2 clients (liblcm-lua is built for 5.2 only)
 tests   liblcm-lua
+tests   liblua5.2-dev         # ... the client library's Lua module (clients/lua/lagsim_client_lua.c)
 tests   lua-posix             # ... their SIGINT, SIGTERM
 tests   liblcm-java           # the Java clients; lcm-spy with lagsim'"'"'s types
 tests   libjchart2d-java
@@ -43,6 +44,7 @@ tests   fonts-dejavu-core
 tests   iproute2              # two hosts on one machine: namespaces, veth ...
 tests   nftables              # ... and packet loss
 tests   lintian               # the Debian package
+tests   golang-go             # the Go controllers over the client library'"'"'s C ABI (cgo)
 tests   abigail-tools         # the ABI check of the client library (abidw, abidiff: clients_abi)
 tests   parallel              # lagsim-sweep shards under GNU parallel ...
 tests   openssh-client        # ... and parallel --sshlogin

@@ -125,6 +125,30 @@ double lag_client_now(void) { return lag_clock_mono_s(); }
 
 int lag_client_version(void) { return LAGSIM_VERSION_NUMBER; }
 
+lag_result lag_client_plant_urls(const char *url, char *state_url, size_t state_len,
+                                 char *command_url, size_t command_len, char *err, size_t errlen)
+{
+    lag_bus b;
+    char berr[256];
+    if (err && errlen) err[0] = 0;
+    if (!state_url || !command_url || state_len == 0 || command_len == 0) {
+        if (err && errlen) snprintf(err, errlen, "lag_client_plant_urls: no room for the URLs");
+        return LAG_CLIENT_ERR_ARG;
+    }
+    state_url[0] = command_url[0] = 0;
+    if (lag_bus_init(&b, url, "P", berr, sizeof berr) != 0) { /* the prefix: any valid one */
+        if (err && errlen) snprintf(err, errlen, "%s", berr);
+        return LAG_CLIENT_ERR_ARG;
+    }
+    if (strlen(b.state_url) >= state_len || strlen(b.command_url) >= command_len) {
+        if (err && errlen) snprintf(err, errlen, "lag_client_plant_urls: URL longer than the room given");
+        return LAG_CLIENT_ERR_ARG;
+    }
+    snprintf(state_url, state_len, "%s", b.state_url);
+    snprintf(command_url, command_len, "%s", b.command_url);
+    return LAG_CLIENT_OK;
+}
+
 int lag_client_abi(void) { return LAGSIM_CLIENT_ABI; }
 
 /* Copies src into dst[cap]; returns false (dst = truncated copy) if it does not fit. */

@@ -110,6 +110,15 @@ extern "C" {
 int lag_client_version(void);
 int lag_client_abi(void);
 
+/* The two LCM URLs of the plant whose lcm.url is url (NULL or "": LCM_DEFAULT_URL, else
+ * LCM's default), by the rule lag_client_create follows (docs/network.md): the state URL
+ * (the URL itself, its port made explicit) and the command URL (the same group and options
+ * on the next port; memq:// is both). For bindings that open LCM themselves. Returns
+ * LAG_CLIENT_OK, or LAG_CLIENT_ERR_ARG with the reason in err for a URL a plant cannot
+ * have. state_len, command_len: LAG_CLIENT_URL_LEN is enough. OUT: state_url, command_url */
+lag_result lag_client_plant_urls(const char *url, char *state_url, size_t state_len,
+                                 char *command_url, size_t command_len, char *err, size_t errlen);
+
 /* ---------------------------------------------------------------- messages */
 
 /* <PREFIX>_STATE: one state of the simulated model (joint_state_t). */

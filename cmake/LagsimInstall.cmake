@@ -11,11 +11,14 @@
 #                            liblagsim_controller.a, liblagsim_core.a and what they link
 #   lib/pkgconfig/           lagsim-client.pc (the client library), lagsim-core.pc (the
 #                            core and the C examples' setup, static, no stable ABI)
-#   lib/python3.X/dist-packages/   lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
+#   lib/python3.X/dist-packages/   lagsim (lcm-gen types), lagsim_lcm, lagsim_client,
+#                            lagsim_controller
 #                            (on Debian's sys.path for prefix /usr/local; for prefix /usr,
 #                            lib/python3/dist-packages)
 #   share/lua/5.2/           lagsim (lcm-gen types), lagsim_lcm, lagsim_controller
 #                            (on lua5.2's default path for prefix /usr/local)
+#   lib/lua/5.2/             lagsim_client.so, the client library's Lua module (on lua5.2's
+#                            default C path for /usr/local and /usr)
 #   share/java/              lagsim_types.jar, lagsim_examples.jar
 #   share/lagsim/            config/*.yaml, lcmtypes/*.lcm, examples/{python,lua}/,
 #                            slurm/lagsim-sweep-array.sh
@@ -46,7 +49,14 @@ endforeach()
 # static libraries of the core and of the C examples' shared setup (lagsim_controller.h,
 # lagsim.h, lagsim_wire.h, ...) and lagsim-core.pc: for building lagsim's own examples
 # against an install, without a stable ABI (docs/clients.md, "The ABI").
-install(TARGETS lagsim_client_shared LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+# (A sanitizer build installs the uninstrumented copy the bindings load: installed Python
+# and Lua controllers run in interpreters without a sanitizer runtime; a C program built
+# against it with the sanitizers' flags has their runtime itself.)
+if(LAGSIM_SANITIZE)
+  install(TARGETS lagsim_client_bindings LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+else()
+  install(TARGETS lagsim_client_shared LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+endif()
 foreach(t lagsim_client lagsim_controller lagsim_wire lagsim_wire_base lagsim_lcmtypes lagsim_core)
   install(TARGETS ${t} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endforeach()
@@ -125,7 +135,12 @@ if(LAGSIM_PYTHON3)
   endif()
   install(DIRECTORY ${CMAKE_BINARY_DIR}/python/
           DESTINATION "\${_lagsim_pydir}" FILES_MATCHING PATTERN "*.py"
-          PATTERN "__pycache__" EXCLUDE)
+          PATTERN "__pycache__" EXCLUDE PATTERN "lagsim_client_path.py" EXCLUDE)
+  # lagsim_client.py's pointer to the installed library (the build tree's is not installed)
+  install(CODE "set(_lagsim_lib \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_LIBDIR}/liblagsim_client.so.${LAGSIM_CLIENT_ABI}\")
+    file(WRITE \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/\${_lagsim_pydir}/lagsim_client_path.py\"
+      \"# Where lagsim_client.py finds the client library: the installed one (written by cmake --install).\\nLIBRARY = \\\"\${_lagsim_lib}\\\"\\n\")
+    message(STATUS \"Installing: \$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/\${_lagsim_pydir}/lagsim_client_path.py\")")
   install(PROGRAMS ${PROJECT_SOURCE_DIR}/clients/python/dipc_balance.py
                    ${PROJECT_SOURCE_DIR}/clients/python/manipulator_pd.py
           DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/examples/python)
@@ -133,7 +148,16 @@ endif()
 
 # Lua 5.2: types and helpers where lua5.2 looks, examples in share/lagsim/examples.
 install(DIRECTORY ${CMAKE_BINARY_DIR}/lua/ DESTINATION ${CMAKE_INSTALL_DATADIR}/lua/5.2
-        FILES_MATCHING PATTERN "*.lua")
+        FILES_MATCHING PATTERN "*.lua" PATTERN "lagsim_client_path.lua" EXCLUDE)
+# The client library's Lua module (an architecture's file: in the library directory's
+# lua/5.2, where lua5.2 looks for C modules under /usr/local and /usr), and lagsim_lcm.lua's
+# pointer to it (the build tree's is not installed)
+if(TARGET lagsim_client_lua)
+  install(TARGETS lagsim_client_lua LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/lua/5.2)
+  install(CODE "file(WRITE \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_DATADIR}/lua/5.2/lagsim_client_path.lua\"
+      \"-- Where lagsim_lcm.lua finds the client library's Lua module: the installed one (written by cmake --install).\\nreturn '\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_LIBDIR}/lua/5.2/lagsim_client.so'\\n\")
+    message(STATUS \"Installing: \$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_DATADIR}/lua/5.2/lagsim_client_path.lua\")")
+endif()
 install(FILES ${PROJECT_SOURCE_DIR}/clients/lua/dipc_balance.lua
               ${PROJECT_SOURCE_DIR}/clients/lua/manipulator_pd.lua
         DESTINATION ${CMAKE_INSTALL_DATADIR}/lagsim/examples/lua)

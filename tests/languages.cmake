@@ -192,7 +192,7 @@ lang_signal_test(c "${lang_manip_cfg}" $<TARGET_FILE:manipulator_pd>)
 
 # ---- Lua 5.2
 set(lua_manip_xl "")
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua)
   add_test(NAME clients_lua_lcm
     COMMAND ${LAGSIM_LUA52} ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_lua_lcm.lua ${lua_dir})
   add_test(NAME clients_lua_manipulator_lockstep
@@ -209,7 +209,58 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
   list(APPEND lang_tests clients_lua_dipc_hostile)
   set(lua_manip_xl --run lua 0 "${LAGSIM_LUA52} ${lua_dir}/manipulator_pd.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} --duration 10 -q --trace {trace}")
 else()
-  message(WARNING "lua5.2 or liblcm-lua missing: the Lua clients' tests are not registered")
+  message(WARNING "lua5.2, liblcm-lua or liblua5.2-dev missing: the Lua clients' tests are not registered")
+endif()
+
+# ---- How the Python and Lua bindings find the client library: the build's path, an
+# environment variable, and a clear error naming every place tried (tests/clients/binding_lookup.py)
+set(lookup_lua "")
+if(LAGSIM_LUA52 AND TARGET lagsim_client_lua)
+  set(lookup_lua --lua ${LAGSIM_LUA52})
+endif()
+add_test(NAME clients_binding_lookup
+  COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/binding_lookup.py
+    --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} ${lookup_lua})
+list(APPEND lang_tests clients_binding_lookup)
+
+# ---- Go, through the C ABI alone (clients/go/dipc_balance.go over liblagsim_client.so.1 by
+# cgo): its own design balances the DIPC in lockstep with the bounds of the other
+# examples; forged messages are dropped by the library with the same states; how a run
+# ends (the daemon's stop, a silent daemon, SIGINT and SIGTERM); its design is Python's
+# line for line, so the gains must be equal to the last bit (tolerance 0). Its answers are
+# C's bit for bit in the cross-language tests below.
+set(go_xl "")
+set(go_gen "")
+if(TARGET dipc_balance_go)
+  set(go_dipc ${CMAKE_BINARY_DIR}/bin/dipc_balance_go)
+  add_test(NAME clients_go_dipc_lockstep
+    COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLGODIPC --timeout 60
+      ${lang_dipc_checks} -- ${go_dipc} --prefix {prefix} --duration 20 -q)
+  add_test(NAME clients_go_dipc_hostile
+    COMMAND ${lang_e2e} ${lang_dipc_cfg} --mode lockstep --name CLHOSTGO --timeout 60
+      ${lang_hostile_checks} -- ${go_dipc} --prefix {prefix} --duration 20 -q)
+  add_test(NAME clients_go_dipc_gain
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/same_gain.py
+      --lagsimd ${lang_lagsimd} --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml --tol 0
+      --run python "discrete LQR \\(h = [^)]*\\): K = \\[([^]]*)\\]"
+        "${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --duration 0.05 -q"
+      --run go "discrete LQR \\(h = [^)]*\\): K = \\[([^]]*)\\]"
+        "${go_dipc} --prefix {prefix} --duration 0.05 -q")
+  list(APPEND lang_tests clients_go_dipc_lockstep clients_go_dipc_hostile clients_go_dipc_gain)
+  # the Go sources as gofmt writes them, and clean by go vet (cgo's rules: no Go pointer
+  # held by C, no misuse of unsafe.Pointer)
+  find_program(LAGSIM_GOFMT gofmt)
+  if(LAGSIM_GOFMT)
+    add_test(NAME clients_go_vet
+      COMMAND sh -c "out=$(\"$1\" -l \"$3\" \"$4\") && test -z \"$out\" || { echo \"not gofmt'ed: $out\"; exit 1; }; for f in \"$3\" \"$4\"; do (cd \"$(dirname \"$f\")\" && env GOCACHE=$5/go/cache GOPATH=$5/go/path GOTOOLCHAIN=local GOENV=off GOFLAGS= PKG_CONFIG_PATH=$5/pkgconfig \"$2\" vet \"$(basename \"$f\")\") || exit 1; done; echo ok"
+              sh ${LAGSIM_GOFMT} ${LAGSIM_GO} ${PROJECT_SOURCE_DIR}/clients/go/dipc_balance.go
+              ${CMAKE_CURRENT_SOURCE_DIR}/protocol/conformance/conformance.go ${CMAKE_BINARY_DIR})
+    list(APPEND lang_tests clients_go_vet)
+  endif()
+  lang_end_tests(go dipc "${lang_dipc_cfg}" ${go_dipc})
+  lang_signal_test(go "${lang_dipc_cfg}" ${go_dipc})
+  set(go_xl --run go 0 "${go_dipc} --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}")
+  set(go_gen --run go "${go_dipc} --prefix {prefix} -q --timeout 60 --k ${lang_K}")
 endif()
 
 # ---- The manipulator's computed torque (r, r', r'' from the reference) in C (M and the bias
@@ -386,8 +437,9 @@ endif()
 
 # ---- Cross-language: the DIPC balanced in lockstep for 10 s by u = -K x with the same K,
 # the product summed in the same order (0 - k0 x0 - ... - k5 x5) in C (dipc_lqr --k),
-# Python, Lua, Java and MATLAB/Octave (under GNU Octave), IEEE doubles everywhere: the states must agree bit for bit.
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
+# Python, Lua, Java, MATLAB/Octave (under GNU Octave) and Go (through the C ABI, when go is
+# found), IEEE doubles everywhere: the states must agree bit for bit.
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua AND TARGET lagsim_examples_java)
   set(octave_xl "")
   if(LAGSIM_OCTAVE)   # MATLAB/Octave too, under GNU Octave
     set(octave_xl --run octave 0 "${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh ${CMAKE_BINARY_DIR}/octave dipc_balance --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}")
@@ -398,16 +450,16 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_ja
       --run python 0 "${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}"
       --run lua 0 "${LAGSIM_LUA52} ${lua_dir}/dipc_balance.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}"
       --run java 0 "java -cp /usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${CMAKE_BINARY_DIR}/lagsim_examples.jar lagsim.examples.DipcBalance --prefix {prefix} --duration 10 -q --k ${lang_K} --trace {trace}"
-      ${octave_xl})
+      ${octave_xl} ${go_xl})
   list(APPEND lang_tests clients_cross_language_dipc)
 endif()
 
 # ---- A state is known by its generation, in every language (tests/clients/generation_rule.py
 # plays the daemon): a state of the next generation at the same step, sim time and utime is
 # answered anew, never taken for a copy; one whose scene has not come waits for it
-# (DESCRIBE asked); the answers carry the generation; C, Python, Lua, Java and
-# MATLAB/Octave (under GNU Octave) answer bit for bit alike.
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
+# (DESCRIBE asked); the answers carry the generation; C, Python, Lua, Java,
+# MATLAB/Octave (under GNU Octave) and Go answer bit for bit alike.
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua AND TARGET lagsim_examples_java)
   set(octave_gen "")
   if(LAGSIM_OCTAVE)
     set(octave_gen --run octave "${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh ${CMAKE_BINARY_DIR}/octave dipc_balance --prefix {prefix} -q --timeout 60 --k ${lang_K}")
@@ -419,7 +471,7 @@ if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_ja
       --run python "${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} -q --timeout 60 --k ${lang_K}"
       --run lua "${LAGSIM_LUA52} ${lua_dir}/dipc_balance.lua --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} -q --timeout 60 --k ${lang_K}"
       --run java "java -cp /usr/share/java/lcm.jar:${CMAKE_BINARY_DIR}/lagsim_types.jar:${CMAKE_BINARY_DIR}/lagsim_examples.jar lagsim.examples.DipcBalance --prefix {prefix} -q --timeout 60 --k ${lang_K}"
-      ${octave_gen})
+      ${octave_gen} ${go_gen})
   list(APPEND lang_tests clients_cross_language_generation)
 endif()
 
@@ -427,7 +479,7 @@ endif()
 # command they build takes 0.15 s, or 1.5 s, first): the same states as the C controller's
 # fast run, bit for bit, every state answered (the law runs once per state, a re-sent copy
 # gets the same answer); a law slower than lockstep_timeout is late by definition
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_examples_java)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua AND TARGET lagsim_examples_java)
   set(think_dir ${CMAKE_CURRENT_SOURCE_DIR}/clients/think)
   foreach(pair "slow_law:0.15:21:0.2" "slower_law:1.5:5:0.04")
     string(REPLACE ":" ";" p "${pair}")
@@ -463,11 +515,15 @@ if(LAGSIM_FUZZ)
 endif()
 set(readme_cc --cc ${CMAKE_C_COMPILER} --cxx ${CMAKE_CXX_COMPILER} "--cflags=${readme_c_flags}")
 set(readme_langs c cpp python)
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua)
   list(APPEND readme_langs lua)
 endif()
 if(TARGET lagsim_lcmtypes_java)
   list(APPEND readme_langs java)
+endif()
+if(TARGET dipc_balance_go)  # docs/clients.md's Go block, built by go build (cgo)
+  list(APPEND readme_langs go)
+  list(APPEND readme_cc --go ${LAGSIM_GO})
 endif()
 # each block as written; then beside a run of it as written, the same block with a law of
 # 150 ms per answer (20 periods) and of 1.5 s (4 periods): every state answered, no

@@ -12,13 +12,13 @@ if(LAGSIM_NET_PYTHON3)
   add_test(NAME net_plant_urls_python
     COMMAND ${CMAKE_COMMAND} -E env --unset=LCM_DEFAULT_URL ${LAGSIM_NET_PYTHON3}
             ${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.py ${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.txt
-            ${PROJECT_SOURCE_DIR}/clients/python)
+            ${CMAKE_BINARY_DIR}/python)  # the build's modules, which name the build's library
   set_tests_properties(net_plant_urls_python PROPERTIES TIMEOUT 30 LABELS net)
 endif()
-if(LAGSIM_NET_LUA52)
+if(LAGSIM_NET_LUA52 AND TARGET lagsim_client_lua)
   add_test(NAME net_plant_urls_lua
     COMMAND ${CMAKE_COMMAND} -E env --unset=LCM_DEFAULT_URL
-            "LUA_PATH=${PROJECT_SOURCE_DIR}/clients/lua/?.lua;;"
+            "LUA_PATH=${CMAKE_BINARY_DIR}/lua/?.lua;;"  # the build's modules, which name its C module
             ${LAGSIM_NET_LUA52} ${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.lua
             ${CMAKE_CURRENT_LIST_DIR}/net/plant_urls.txt)
   set_tests_properties(net_plant_urls_lua PROPERTIES TIMEOUT 30 LABELS net)

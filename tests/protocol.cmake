@@ -42,9 +42,17 @@ protocol_conformance(python clients ${LAGSIM_PYTHON3} ${proto_dir}/conformance/c
   --types ${CMAKE_BINARY_DIR}/python --prefix {prefix} --url {url})
 
 # Lua 5.2 (clients/lua/lagsim_controller.lua)
-if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua)
   protocol_conformance(lua clients ${LAGSIM_LUA52} ${proto_dir}/conformance/conformance.lua
     --types ${CMAKE_BINARY_DIR}/lua --prefix {prefix} --url {url})
+endif()
+
+# Go, through the C ABI alone (cgo over liblagsim_client.so.1: clients/go/CMakeLists.txt);
+# built when the go command is found (Debian golang-go), as the Go example is
+if(COMMAND lagsim_go_program)
+  lagsim_go_program(conformance_go ${CMAKE_CURRENT_BINARY_DIR}/conformance_go
+                    ${proto_dir}/conformance/conformance.go)
+  protocol_conformance(go clients ${CMAKE_CURRENT_BINARY_DIR}/conformance_go --prefix {prefix} --url {url})
 endif()
 
 # Java (lagsim.examples.Controller), compiled as the examples are (lint as errors)

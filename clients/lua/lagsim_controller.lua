@@ -27,11 +27,10 @@ local Controller = {}
 Controller.__index = Controller
 
 local WAIT_MS = 50
-local DESCRIBE_MS = 250 -- the pace of DESCRIBE while a scene is awaited (the C client's too)
 
 function Controller.new(name, default_prefix, model, description)
   local self = setmetatable({ name = name, model = model, description = description or '',
-                              opts = {}, order = {}, o = {}, dropped = 0, repeats = 0 }, Controller)
+                              opts = {}, order = {}, o = {}, dropped = 0, repeats = 0, held = 0 }, Controller)
   self:option('prefix', default_prefix, 'channel prefix', 'string')
   self:option('url', '', "the plant's LCM URL, its lcm.url (default: LCM's default); commands go to the next port", 'string')
   self:option('duration', 0, 'stop after S s of sim time from the first state (0: until the daemon stops)')
@@ -121,26 +120,16 @@ function Controller:parse(argv)
   return self.o
 end
 
-local function finite(v)
-  if type(v) == 'number' then return v == v and v ~= math.huge and v ~= -math.huge end
-  if type(v) == 'table' then
-    for _, x in pairs(v) do if not finite(x) then return false end end
-  end
-  return true
-end
+-- The protocol is the C client library's, through its Lua module (lagsim_lcm.client():
+-- lagsim_client_lua.c): the URLs, finding the plant, DESCRIBE until the scene comes, each
+-- state once with its copies answered, the scene rule, the generation on every command,
+-- every message decoded whole and bounded. What is here: options, how a run ends, the
+-- trace, the summary.
 
--- The message of type T in `data`, or nil (counted in self.dropped). Like the C client it
--- keeps only a message that decodes whole: lcm-gen's decoder reads a string without its
--- NUL, or with bytes left over, as if nothing were wrong, so the message must encode back
--- to the very bytes that came; and every number in it must be finite.
-function Controller:decode(T, data)
-  local ok, m = pcall(T.decode, data)
-  if ok then
-    local oke, bytes = pcall(m.encode, m)
-    if oke and bytes == data and finite(m) then return m end
-  end
-  self.dropped = self.dropped + 1
-  return nil
+local function set_scene(self, sc)
+  self.scene = sc
+  self.params = {}
+  for k = 1, sc.num_params do self.params[sc.param_name[k]] = sc.param_value[k] end
 end
 
 function Controller:start(argv)
@@ -157,57 +146,33 @@ function Controller:start(argv)
     self.trace = io.open(o.trace, 'w')
     if not self.trace then fail(self, 2, 'cannot write ' .. o.trace) end
   end
-  local state_url, command_url = lagsim_lcm.plant_urls(o.url ~= '' and o.url or nil)
-  if not state_url then fail(self, 2, '--url: ' .. command_url) end
-  self.lc = lagsim_lcm.new(state_url) -- states, status, events, scene
-  self.lc_cmd = command_url ~= state_url and lagsim_lcm.new(command_url) or self.lc
-  local ch = o.prefix .. '_'
-  self.silent_ms = 0
+  local lc = lagsim_lcm.client()
+  self.lib = lc
+  local url = o.url ~= '' and o.url or nil
+  local state_url, err = lc.plant_urls(url)
+  if not state_url then fail(self, 2, '--url: ' .. err) end
+  local c, cerr = lc.new(o.prefix, url)
+  if not c then fail(self, 1, cerr) end
+  self.client = c
   -- SIGINT, SIGTERM: the run ends (end=signal), with its summary, exit 0
   self.signalled = false
   lagsim_lcm.on_signals(function() self.signalled = true end)
-  self.lc:subscribe(ch .. 'SCENE', function(_, data)
-    self.silent_ms = 0
-    local sc = self:decode(t.scene_t, data)
-    if sc then
-      self.scene = sc
-      self.params = {}
-      for k = 1, sc.num_params do self.params[sc.param_name[k]] = sc.param_value[k] end
-    end
-  end)
-  self.lc:subscribe(ch .. 'STATE', function(_, data)
-    self.silent_ms = 0
-    self.state = self:decode(t.joint_state_t, data) or self.state
-  end)
-  self.lc:subscribe(ch .. 'STATUS', function() self.silent_ms = 0 end)
-  -- the scene's reference, published just before each state with its sim_time
-  self.lc:subscribe(ch .. 'REFERENCE', function(_, data)
-    self.silent_ms = 0
-    self.reference = self:decode(t.reference_t, data) or self.reference
-  end)
-  self.lc:subscribe(ch .. 'EVENT', function(_, data)
-    self.silent_ms = 0
-    local ev = self:decode(t.event_t, data)
-    if ev and ev.kind == 'stop' then self.stopped = true end
-  end)
   -- subscribed: from here on no state is missed (test harnesses wait for this line)
-  print(string.format('%s: waiting for the scene description on %sSCENE', self.name, ch))
+  print(string.format('%s: waiting for the scene description on %s_SCENE', self.name, o.prefix))
   io.stdout:flush()
-  local waited, next_ask = 0, 0
+  local deadline = lc.now() + o.timeout
   while not self.scene do
     if self.signalled then -- a run that ended before its scene came: no failure
       self.end_reason = 'signal'
       os.exit(self:finish('states=0'))
     end
-    if waited >= o.timeout * 1000 then
-      fail(self, 1, string.format('no scene on %sSCENE within %g s (is lagsimd running with this prefix?)',
-                                  ch, o.timeout))
+    local left = deadline - lc.now()
+    if left <= 0 then
+      fail(self, 1, string.format('no scene on %s_SCENE within %g s: %s', o.prefix, o.timeout,
+                                  lc.plants_instead(url, o.prefix, 1.0)))
     end
-    if waited >= next_ask then -- DESCRIBE every 0.25 s until the scene comes
-      self:ask_scene()
-      next_ask = next_ask + DESCRIBE_MS
-    end
-    if not self.lc:handle_timeout(WAIT_MS) then waited = waited + WAIT_MS end
+    local sc = c:wait_scene(math.min(left, 0.25)) -- DESCRIBE every 0.25 s until it comes
+    if sc then set_scene(self, sc) end
   end
   if self.scene.model ~= self.model then
     fail(self, 1, string.format('prefix %s runs model %s, not %s', o.prefix, self.scene.model, self.model))
@@ -215,70 +180,39 @@ function Controller:start(argv)
   return o
 end
 
-function Controller:ask_scene()
-  local req = self.t.control_t:new()
-  req.request = self.t.control_t.DESCRIBE
-  self.lc_cmd:publish(self.o.prefix .. '_CONTROL', req:encode())
-end
-
--- st, or the newest state since, once the scene of its generation came (the daemon
--- publishes it just before the first state of a generation; DESCRIBE asks for it again
--- every 0.25 s, for when UDP lost it); nil when the run ended first. So the control law
--- never answers a state with another run's or scene's parameters (docs/clients.md).
-local function with_scene(self, st)
-  local o, next_ask, waited = self.o, 0, 0
-  while st.generation ~= self.scene.generation do
-    if self.signalled then self.end_reason = 'signal' return nil end
-    if self.stopped then self.end_reason = 'stop' return nil end
-    if self.silent_ms >= o.timeout * 1000 then self.end_reason = 'silence' return nil end
-    if waited >= next_ask then
-      self:ask_scene()
-      next_ask = waited + DESCRIBE_MS
-    end
-    if not self.lc:handle_timeout(WAIT_MS) then
-      self.silent_ms = self.silent_ms + WAIT_MS
-      waited = waited + WAIT_MS
-    end
-    if self.state then st, self.state = self.state, nil end -- a newer state: that one
-  end
-  return st
+-- Messages from the daemon so far (kept or dropped): silence is when this stops growing.
+-- Also keeps self.dropped, self.repeats, self.held: the library's counts.
+local function heard(self, c)
+  local k = c:counters()
+  self.dropped, self.repeats, self.held = k.dropped, k.repeats, k.held
+  return k.states + k.scenes + k.statuses + k.events + k.references + k.dropped + k.copies
 end
 
 -- Iterator over states: each newest state once, until the run ends. A copy of the state
--- answered last (same generation, step and sim time: the daemon published it again
--- because no answer reached it) is answered at once with the same command and not
--- returned: every state received is answered, the control law runs once per state (a law
--- run for every copy would cost a think time per copy and fall behind for good:
--- docs/clients.md, the rule). A state is returned only once self.scene (and self.params)
--- is the scene of its generation.
+-- answered last is answered by the library at once with the same command and not
+-- returned: the control law runs once per state (docs/clients.md, the rule). A state is
+-- returned only once self.scene (and self.params) is the scene of its generation (the
+-- library holds it until that scene came).
 function Controller:states()
-  local o = self.o
+  local o, c, lc = self.o, self.client, self.lib
   local t_first
+  local last_heard, count = lc.now(), heard(self, c)
   return function()
     if self.end_reason then return nil end
     local st
     repeat
-      while not self.state do
+      if self.signalled then self.end_reason = 'signal' return nil end
+      st = c:wait_state(WAIT_MS / 1000)
+      local n = heard(self, c)
+      if n ~= count then last_heard, count = lc.now(), n end
+      if not st then
         if self.signalled then self.end_reason = 'signal' return nil end
-        if self.stopped then self.end_reason = 'stop' return nil end
-        if self.silent_ms >= o.timeout * 1000 then self.end_reason = 'silence' return nil end
-        if not self.lc:handle_timeout(WAIT_MS) then self.silent_ms = self.silent_ms + WAIT_MS end
-      end
-      while self.lc:handle_timeout(0) do end -- drain what is queued: answer the newest
-      st = self.state
-      self.state = nil
-      local last = self.last
-      if last and st.generation == last.generation and st.step == last.step and
-          st.sim_time == last.sim_time then
-        self.lc_cmd:publish(o.prefix .. '_COMMAND', last.data)
-        self.repeats = self.repeats + 1
-        st = nil
-      elseif st.generation ~= self.scene.generation then
-        self.held = (self.held or 0) + 1
-        st = with_scene(self, st)
-        if not st then return nil end
+        if c:stopped() then self.end_reason = 'stop' return nil end
+        if lc.now() - last_heard > o.timeout then self.end_reason = 'silence' return nil end
       end
     until st
+    if st.generation ~= self.scene.generation then set_scene(self, c:latest_scene()) end
+    self.reference = c:latest_reference()
     self.current = st
     t_first = t_first or st.sim_time
     if o.duration > 0 and st.sim_time - t_first >= o.duration - 0.5 * self.scene.control_period then
@@ -289,39 +223,31 @@ function Controller:states()
 end
 
 function Controller:command(sim_time, names, efforts)
-  local cmd = self.t.joint_command_t:new()
-  cmd.utime = os.time() * 1000000 -- informational; Lua's clock has whole seconds
-  cmd.sim_time = sim_time
   local st = self.current
-  cmd.generation = st and st.generation or 0 -- of the state it answers (0: none yet)
-  cmd.num_joints = #names
-  cmd.name = names
-  cmd.effort = {}
+  local e = {}
   for k = 1, #efforts do
     local u = efforts[k]
     if u ~= u or u == math.huge or u == -math.huge then u = 0.0 end -- never send NaN
-    cmd.effort[k] = u
+    e[k] = u
   end
-  local data = cmd:encode()
-  self.lc_cmd:publish(self.o.prefix .. '_COMMAND', data)
-  if st and st.sim_time == sim_time then
-    self.last = { generation = st.generation, step = st.step, sim_time = sim_time, data = data }
-  end
+  self.client:send_command(sim_time, names, e)
   if self.trace and st and st.sim_time == sim_time then
     -- sim_time, positions, velocities, efforts sent: %.17g reads back to the same double
     local f = { string.format('%.17g', st.sim_time) }
     for k = 1, st.num_joints do f[#f + 1] = string.format('%.17g', st.position[k]) end
     for k = 1, st.num_joints do f[#f + 1] = string.format('%.17g', st.velocity[k]) end
-    for k = 1, #cmd.effort do f[#f + 1] = string.format('%.17g', cmd.effort[k]) end
+    for k = 1, #e do f[#f + 1] = string.format('%.17g', e[k]) end
     self.trace:write(table.concat(f, ' '), '\n')
   end
 end
 
 function Controller:finish(summary)
   if self.trace then self.trace:close() end
+  if self.client then heard(self, self.client) end
   print(string.format('%s: summary end=%s %s dropped=%d repeats=%d', self.name,
                       tostring(self.end_reason), summary, self.dropped, self.repeats))
   io.stdout:flush()
+  if self.client then self.client:close() end
   return 0
 end
 

@@ -28,52 +28,43 @@ local M = {}
 local LCM = {}
 LCM.__index = LCM
 
-local DEFAULT_URL = 'udpm://239.255.76.67:7667?ttl=0' -- LCM's own default
+-- The client library's Lua module (lagsim_client_lua.c: the protocol's rules, in C), loaded
+-- once: from the path CMake wrote into <build>/lua/lagsim_client_path.lua (the build
+-- tree's module, or the installed one), else by require('lagsim_client') through
+-- package.cpath (LUA_CPATH). An error names every place tried.
+local client_module
+function M.client()
+  if client_module then return client_module end
+  local tried = {}
+  local okp, path = pcall(require, 'lagsim_client_path')
+  if okp and type(path) == 'string' then
+    local open, err = package.loadlib(path, 'luaopen_lagsim_client')
+    if open then client_module = open() end
+    if not client_module then tried[#tried + 1] = path .. ' (lagsim_client_path.lua): ' .. tostring(err) end
+  end
+  if not client_module then
+    local ok, m = pcall(require, 'lagsim_client')
+    if ok then client_module = m else tried[#tried + 1] = "require('lagsim_client'): " .. tostring(m) end
+  end
+  if not client_module then
+    error("cannot load lagsim's client module lagsim_client.so; tried " .. table.concat(tried, '; ')
+          .. '. Set LUA_CPATH=<build>/lua/?.so;; or install lagsim', 0)
+  end
+  if client_module.abi ~= 1 then
+    error(string.format('lagsim_client.so has ABI %d, not 1', client_module.abi), 0)
+  end
+  return client_module
+end
 
 -- The two LCM URLs of a lagsim plant whose lcm.url is `url` (nil or '': the environment's
 -- LCM_DEFAULT_URL, else LCM's default): state_url, command_url. The daemon publishes
 -- <PREFIX>_STATE, _STATUS, _EVENT and _SCENE on the state URL (the URL itself) and
 -- listens for <PREFIX>_COMMAND and _CONTROL on the command URL: the same group and
--- options on the next port; memq:// is both. The C library's rule (lagsim_bus.h), checked
--- against the same cases (tests/net/plant_urls.txt). A URL a plant cannot have gives
--- nil and a message.
+-- options on the next port; memq:// is both. The C library's rule (lag_client_plant_urls,
+-- through the client module), checked against tests/net/plant_urls.txt. A URL a plant
+-- cannot have gives nil and a message.
 function M.plant_urls(url)
-  if url == nil or url == '' then
-    url = os.getenv('LCM_DEFAULT_URL')
-    if url == nil or url == '' then url = DEFAULT_URL end
-  end
-  if #url >= 256 then return nil, 'LCM URL longer than 255 characters' end
-  if url == 'memq://' then return url, url end
-  local rest = url:match('^udpm://(.*)$')
-  if not rest then
-    return nil, "a lagsim plant speaks udpm://GROUP:PORT (or memq:// in one process), not '" .. url .. "'"
-  end
-  local addr, query = rest:match('^([^?]*)(.*)$')
-  local group, port = '239.255.76.67', 7667
-  if addr ~= '' then
-    local a, b, c, d, p = addr:match('^(%d%d?%d?)%.(%d%d?%d?)%.(%d%d?%d?)%.(%d%d?%d?)(.*)$')
-    if not a then
-      return nil, "expected udpm://GROUP:PORT with GROUP a dotted IPv4 multicast address, got '" .. url .. "'"
-    end
-    local o = { tonumber(a), tonumber(b), tonumber(c), tonumber(d) }
-    for k, txt in ipairs({ a, b, c, d }) do
-      -- no leading zeros: LCM reads the group with inet_aton, which takes those as octal
-      if o[k] > 255 or (#txt > 1 and txt:sub(1, 1) == '0') then
-        return nil, "the group of '" .. url .. "' is not a multicast address written in decimal"
-      end
-    end
-    if o[1] < 224 or o[1] > 239 then return nil, "the group of '" .. url .. "' is not a multicast address" end
-    group = string.format('%d.%d.%d.%d', o[1], o[2], o[3], o[4])
-    if p ~= '' then
-      local ps = p:match('^:(%d%d?%d?%d?%d?)$')
-      port = (ps and not (#ps > 1 and ps:sub(1, 1) == '0')) and tonumber(ps) or -1
-      if port < 1 or port > 65534 then
-        return nil, "expected a port from 1 to 65534 in '" .. url .. "' (commands go to the next port)"
-      end
-    end
-  end
-  return string.format('udpm://%s:%d%s', group, port, query),
-         string.format('udpm://%s:%d%s', group, port + 1, query)
+  return M.client().plant_urls(url)
 end
 
 function M.new(url)

@@ -22,12 +22,9 @@ import math
 import os
 import signal
 import sys
-import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from lagsim_lcm import LCM, plant_urls  # noqa: E402
-
-DESCRIBE_S = 0.25  # the pace of DESCRIBE while a scene is awaited (the C client's too)
+from lagsim_client import Client, ERR_AMBIGUOUS, OK, pick_plant, plant_urls, plants_instead  # noqa: E402
 
 
 def _import_types(types_dir, name):
@@ -42,42 +39,13 @@ def _import_types(types_dir, name):
         sys.exit(2)
 
 
-def _edits(a, b):
-    """Edits (insert, delete, substitute) between a and b, capped at 3."""
-    row = list(range(len(b) + 1))
-    for i in range(1, len(a) + 1):
-        diag, row[0] = row[0], i
-        for j in range(1, len(b) + 1):
-            up = row[j]
-            row[j] = min(diag + (a[i - 1] != b[j - 1]), up + 1, row[j - 1] + 1)
-            diag = up
-    return min(row[len(b)], 3)
-
-
-def _nearness(heard, asked):
-    """0 the same but for letter case, 1 it starts with the asked prefix, 2 + edits (at
-    most 2); -1 not near (lag_client_plants_instead's rule)."""
-    if heard.lower() == asked.lower():
-        return 0
-    if asked and heard.lower().startswith(asked.lower()):
-        return 1
-    e = _edits(heard, asked)
-    return 2 + e if e <= 2 else -1
-
-
-def _sound(v):
-    """Every number finite; no string with a NUL inside (lcm-gen's decoder strips the one
-    NUL a string ends with and keeps any other, which encodes back to the same bytes)."""
-    if isinstance(v, float):
-        return math.isfinite(v)
-    if isinstance(v, str):
-        return "\0" not in v
-    if isinstance(v, (list, tuple)):
-        return all(_sound(x) for x in v)
-    return True
-
-
 class Controller(object):
+    """The protocol is the C client library's (lagsim_client.py, ctypes over
+    liblagsim_client.so.1): the URLs, finding the plant, DESCRIBE until the scene comes,
+    each state once with its copies answered, the scene rule, the generation on every
+    command, every message decoded whole and bounded. This class keeps the options, how a
+    run ends, the trace and the summary."""
+
     def __init__(self, name, default_prefix, model, description=""):
         self.name = name
         self.model = model
@@ -102,9 +70,18 @@ class Controller(object):
         p.add_argument("-q", action="store_true", help="quiet: summary only")
         self.parser = p
         self.end = None
-        self.dropped = 0
+        self.client = None
         self.scene = None
-        self.reference = None  # the latest reference_t (the scene's reference), or None
+        self.reference = None  # the latest reference (reference_t's fields), or None
+
+    def _count(self, name):
+        return self.client.counters()[name] if self.client else 0
+
+    # the library's counts: messages dropped (undecodable, out of range, non-finite), copies
+    # answered again, states held until the scene of their generation came
+    dropped = property(lambda self: self._count("dropped"))
+    repeats = property(lambda self: self._count("repeats"))
+    held = property(lambda self: self._count("held"))
 
     def start(self):
         a = self.parser.parse_args()
@@ -114,9 +91,6 @@ class Controller(object):
         self.t = _import_types(a.types, self.name)
         self._trace = open(a.trace, "w") if a.trace else None
         self._current = None
-        self._last = None  # (generation, step, sim_time, encoded command) of the last answer
-        self.repeats = 0   # copies of a state answered again
-        self.held = 0      # states held until the scene of their generation came
         self._stop = False
 
         def on_signal(signum, frame):
@@ -125,36 +99,24 @@ class Controller(object):
         signal.signal(signal.SIGINT, on_signal)
         signal.signal(signal.SIGTERM, on_signal)
         try:
-            state_url, command_url = plant_urls(a.url)
+            state_url, _ = plant_urls(a.url)
         except ValueError as e:
             self.parser.error("--url: %s" % e)
-        self.lc = LCM(state_url)                 # states, status, events, scene
-        self.lc_cmd = LCM(command_url) if command_url != state_url else self.lc
-        self._state = None
-        self._stopped = False
-        self._heard = time.monotonic()
         if a.prefix is None:
-            a.prefix = self._find_plant(state_url) or self.default_prefix
-        ch = a.prefix + "_"
-        self.lc.subscribe(ch + "SCENE", self._on_scene)
-        self.lc.subscribe(ch + "STATE", self._on_state)
-        self.lc.subscribe(ch + "EVENT", self._on_event)
-        self.lc.subscribe(ch + "STATUS", self._on_status)
-        self.lc.subscribe(ch + "REFERENCE", self._on_reference)
+            a.prefix = self._find_plant(a.url, state_url)
+        self.client = Client(a.prefix, a.url)
         # subscribed: from here on no state is missed (test harnesses wait for this line)
-        print("%s: waiting for the scene description on %sSCENE" % (self.name, ch), flush=True)
-        deadline = time.monotonic() + a.timeout
-        next_ask = 0.0
+        print("%s: waiting for the scene description on %s_SCENE" % (self.name, a.prefix),
+              flush=True)
+        deadline = self.client.now() + a.timeout
         while self.scene is None and not self._stop:
-            now = time.monotonic()
-            if now >= deadline:
-                sys.stderr.write("%s: no scene on %sSCENE within %g s: %s\n"
-                                 % (self.name, ch, a.timeout, self._instead(state_url)))
+            left = deadline - self.client.now()
+            if left <= 0:
+                sys.stderr.write("%s: no scene on %s_SCENE within %g s: %s\n"
+                                 % (self.name, a.prefix, a.timeout,
+                                    plants_instead(a.url, a.prefix, 1.0)))
                 sys.exit(1)
-            if now >= next_ask:  # DESCRIBE every 0.25 s until the scene comes
-                self._ask_scene()
-                next_ask = now + DESCRIBE_S
-            self.lc.handle_timeout(50)
+            self.scene = self.client.wait_scene(min(left, 0.25))  # DESCRIBE every 0.25 s
         if self.scene is None:  # SIGINT or SIGTERM while waiting: a run that ended, cleanly
             self.end = "signal"
             sys.exit(self.finish("states=0"))
@@ -165,196 +127,62 @@ class Controller(object):
         self.params = dict(zip(self.scene.param_name, self.scene.param_value))
         return a
 
-    def _find_plant(self, state_url):
-        """The only plant of this model on the bus, by the C library's rule
-        (lag_client_pick_plant): every <PREFIX>_STATE, _STATUS, _EVENT or _SCENE heard on
-        the state URL names a plant, which is asked for its scene (DESCRIBE) until it
-        comes; listens 1 s at most, 0.5 s after the first plant once all are described.
-        Returns its prefix; None when there is none (the caller waits on its default: a
-        controller may start before its plant); several: named, exit 2."""
-        found = self._plants()
-        mine = sorted(p for p, m in found.items() if m == self.model)
-        heard = ", ".join("%s (%s)" % (p, found[p] or "model unknown") for p in sorted(found))
-        if len(mine) == 1:
-            print("%s: the only %s plant on the bus: prefix %s" % (self.name, self.model, mine[0]),
-                  flush=True)
-            return mine[0]
-        if len(mine) > 1:
-            sys.stderr.write("%s: %d %s plants on %s: %s; choose one with --prefix\n"
-                             % (self.name, len(mine), self.model, state_url,
-                                ", ".join(mine)))
+    def _find_plant(self, url, state_url):
+        """The only plant of this model on the bus (lag_client_pick_plant: 1 s at most);
+        none: the default prefix is waited on (a controller may start before its plant);
+        several: named, exit 2."""
+        rc, plant, msg = pick_plant(url, self.model, 1.0)
+        if rc == OK:
+            print("%s: the only %s plant on the bus: prefix %s" % (self.name, self.model,
+                                                                   plant.prefix), flush=True)
+            return plant.prefix
+        if rc == ERR_AMBIGUOUS:
+            sys.stderr.write("%s: %s; choose one with --prefix\n" % (self.name, msg))
             sys.exit(2)
-        print("%s: no %s plant on %s%s; waiting for prefix %s"
-              % (self.name, self.model, state_url, " (heard: %s)" % heard if found else "",
-                 self.default_prefix), flush=True)
-        return None
+        print("%s: %s; waiting for prefix %s" % (self.name, msg, self.default_prefix), flush=True)
+        return self.default_prefix
 
-    def _instead(self, state_url):
-        """What the bus has instead of a plant on --prefix (no scene came: a misspelt
-        prefix?), as the C library says it (lag_client_plants_instead): the plants heard
-        and the one meant when a heard prefix is the asked one in other letter case,
-        starts with it, or is at most 2 edits from it."""
-        asked = self.args.prefix
-        found = self._plants()
-        if not found:
-            return "no plant heard on %s within 1 s (is lagsimd running on this LCM URL?)" \
-                % state_url
-        heard = ", ".join("%s (%s)" % (p, found[p] or "model unknown") for p in sorted(found))
-        near = [(_nearness(p, asked), p) for p in sorted(found)]
-        near = sorted((k, p) for k, p in near if k >= 0)
-        return "no plant on prefix %s; plants heard on %s: %s%s" % (
-            asked, state_url, heard, "; did you mean %s?" % near[0][1] if near else "")
-
-    def _plants(self):
-        """{prefix: model (None until its scene came)} of the plants heard on the bus: 1 s
-        at most, 0.5 s after the first once every one is described."""
-        found, asked = {}, {}   # prefix -> model (None until its scene came); last ask
-
-        def on_any(channel, data):
-            for suf in ("_STATE", "_STATUS", "_EVENT", "_SCENE"):
-                if channel.endswith(suf) and len(channel) > len(suf):
-                    pre = channel[:-len(suf)]
-                    found.setdefault(pre, None)
-                    if suf == "_SCENE":
-                        sc = self._decode(self.t.scene_t, data)
-                        if sc is not None and sc.prefix == pre:
-                            found[pre] = sc.model
-                    return
-
-        dropped = self.dropped
-        sub = self.lc.subscribe(".*", on_any)
-        t0, first = time.monotonic(), None
-        while not self._stop:
-            now = time.monotonic()
-            if found and first is None:
-                first = now
-            for pre in [p for p, m in found.items() if m is None and now - asked.get(p, -1) >= 0.25]:
-                req = self.t.control_t()
-                req.utime = int(time.time() * 1e6)
-                req.request = self.t.control_t.DESCRIBE
-                self.lc_cmd.publish(pre + "_CONTROL", req.encode())
-                asked[pre] = now
-            if now - t0 >= 1.0 or (first is not None and now - first >= 0.5 and
-                                   all(m is not None for m in found.values())):
-                break
-            self.lc.handle_timeout(50)
-        self.lc.unsubscribe(sub)
-        self.dropped = dropped  # other plants' messages are not this run's
-        return found
-
-    def _decode(self, cls, data):
-        """The message of type `cls` in `data`, or None (counted in `dropped`). Like the C
-        client, it keeps only a message that decodes whole: lcm-gen's decoder reads a
-        string without its NUL, or with bytes left over, as if nothing were wrong, so the
-        message must encode back to the very bytes that came; every number in it must be
-        finite, and no string may hold a NUL but the one it ends with (the C wire module's
-        rule). (lcm-gen gives boolean arrays as one-shot `map` iterators: they become
-        lists.)"""
-        try:
-            m = cls.decode(data)
-            for k in m.__slots__:
-                if isinstance(getattr(m, k), map):
-                    setattr(m, k, list(getattr(m, k)))
-            if m.encode() == data and all(_sound(getattr(m, k)) for k in m.__slots__):
-                return m
-        except Exception:
-            pass
-        self.dropped += 1
-        return None
-
-    def _ask_scene(self):
-        req = self.t.control_t()
-        req.utime = int(time.time() * 1e6)
-        req.request = self.t.control_t.DESCRIBE
-        self.lc_cmd.publish(self.args.prefix + "_CONTROL", req.encode())
-
-    def _on_scene(self, channel, data):
-        self._heard = time.monotonic()
-        sc = self._decode(self.t.scene_t, data)
-        if sc is not None:
-            self.scene = sc
-            self.params = dict(zip(sc.param_name, sc.param_value))
-
-    def _ended(self):
+    def _ended(self, heard):
         """Why the run ended (and self.end set), or None while it goes on."""
         if self._stop:
             self.end = "signal"
-        elif self._stopped:
+        elif self.client.stopped:
             self.end = "stop"
-        elif time.monotonic() - self._heard > self.args.timeout:
+        elif self.client.now() - heard > self.args.timeout:
             self.end = "silence"
         return self.end
 
-    def _with_scene(self, st):
-        """st, or the newest state since, once the scene of its generation came (the
-        daemon publishes it just before the first state of a generation; DESCRIBE asks
-        for it again every 0.25 s, for when UDP lost it); None when the run ended first.
-        So the control law never answers a state with another run's or scene's
-        parameters (docs/clients.md, the scene rule)."""
-        next_ask = 0.0
-        while st.generation != self.scene.generation:
-            if self._ended():
-                return None
-            now = time.monotonic()
-            if now >= next_ask:
-                self._ask_scene()
-                next_ask = now + DESCRIBE_S
-            self.lc.handle_timeout(20)
-            if self._state is not None:  # a newer state: that one is answered
-                st, self._state = self._state, None
-        return st
-
-    def _on_state(self, channel, data):
-        self._heard = time.monotonic()
-        st = self._decode(self.t.joint_state_t, data)
-        if st is not None:
-            self._state = st
-
-    def _on_reference(self, channel, data):
-        """The scene's reference, published just before each state with its sim_time."""
-        self._heard = time.monotonic()
-        r = self._decode(self.t.reference_t, data)
-        if r is not None:
-            self.reference = r
-
-    def _on_status(self, channel, data):
-        self._heard = time.monotonic()
-
-    def _on_event(self, channel, data):
-        ev = self._decode(self.t.event_t, data)
-        if ev is None or ev.kind != "plant":  # a host's directory's, not the plant's own
-            self._heard = time.monotonic()
-        if ev is not None and ev.kind == "stop":
-            self._stopped = True
+    def _heard(self):
+        """How many messages came from the daemon (kept or dropped)."""
+        k = self.client.counters()
+        return sum(k[n] for n in ("states", "scenes", "statuses", "events", "references",
+                                  "dropped", "copies"))
 
     def states(self):
         """Yields each newest state once until the run ends (self.end says why). A copy of
-        the state answered last (same generation, step and sim time: the daemon published
-        it again because no answer reached it) is answered at once with the same command
-        and not yielded: every state received is answered, the control law runs once per
-        state (a law run for every copy would cost a think time per copy and fall behind
-        for good: docs/clients.md, the rule). A state is yielded only once self.scene (and
-        self.params) is the scene of its generation."""
+        the state answered last is answered by the library at once with the same command
+        and not yielded: the control law runs once per state (docs/clients.md, the rule).
+        A state is yielded only once self.scene (and self.params) is the scene of its
+        generation (the library holds it until that scene came)."""
         a = self.args
         t_first = None
+        heard, count = self.client.now(), self._heard()
         while True:
-            while self._state is None:
-                if self._ended():
+            if self._stop:  # a signal ends the run even while states keep coming
+                self.end = "signal"
+                return
+            st = self.client.wait_state(0.05)
+            n = self._heard()
+            if n != count:
+                heard, count = self.client.now(), n
+            if st is None:
+                if self._ended(heard):
                     return
-                self.lc.handle_timeout(50)
-            while self.lc.handle_timeout(0):  # drain what is queued: answer the newest
-                pass
-            st, self._state = self._state, None
-            last = self._last
-            if last is not None and (st.generation, st.step, st.sim_time) == last[:3]:
-                self.lc_cmd.publish(self.args.prefix + "_COMMAND", last[3])
-                self.repeats += 1
                 continue
             if st.generation != self.scene.generation:
-                self.held += 1
-                st = self._with_scene(st)
-                if st is None:
-                    return
+                self.scene = self.client.latest_scene()
+                self.params = dict(zip(self.scene.param_name, self.scene.param_value))
+            self.reference = self.client.latest_reference()
             self._current = st
             if t_first is None:
                 t_first = st.sim_time
@@ -365,22 +193,12 @@ class Controller(object):
                 return
 
     def command(self, sim_time, names, efforts):
-        cmd = self.t.joint_command_t()
-        cmd.utime = int(time.time() * 1e6)
-        cmd.sim_time = sim_time
         st = self._current
-        # the generation of the state it answers (0: none yet, answers no state)
-        cmd.generation = st.generation if st is not None else 0
-        cmd.num_joints = len(names)
-        cmd.name = list(names)
-        cmd.effort = [x if math.isfinite(x) else 0.0 for x in efforts]  # never send NaN
-        data = cmd.encode()
-        self.lc_cmd.publish(self.args.prefix + "_COMMAND", data)
-        if st is not None and st.sim_time == sim_time:
-            self._last = (st.generation, st.step, sim_time, data)
+        efforts = [x if math.isfinite(x) else 0.0 for x in efforts]  # never send NaN
+        self.client.send_command(sim_time, names, efforts)
         if self._trace and st is not None and st.sim_time == sim_time:
             # sim_time, positions, velocities, efforts sent: %.17g reads back to the same double
-            f = [st.sim_time] + list(st.position) + list(st.velocity) + cmd.effort
+            f = [st.sim_time] + list(st.position) + list(st.velocity) + efforts
             self._trace.write(" ".join("%.17g" % x for x in f) + "\n")
 
     def finish(self, summary):
@@ -388,7 +206,7 @@ class Controller(object):
             self._trace.close()
         print("%s: summary end=%s %s dropped=%d repeats=%d"
               % (self.name, self.end, summary, self.dropped, self.repeats), flush=True)
-        if self.lc_cmd is not self.lc:
-            self.lc_cmd.close()
-        self.lc.close()
+        if self.client:
+            self.client.close()
+            self.client = None
         return 0

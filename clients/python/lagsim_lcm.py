@@ -36,17 +36,12 @@ Not thread-safe, like lcm_t itself: use one LCM per thread.
 import ctypes
 import ctypes.util
 import errno
-import os
-import re
 
 __all__ = ["LCM", "LCMError", "plant_urls"]
 
 
 class LCMError(RuntimeError):
     pass
-
-
-_DEFAULT_URL = "udpm://239.255.76.67:7667?ttl=0"  # LCM's own default
 
 
 def plant_urls(url=None):
@@ -56,34 +51,10 @@ def plant_urls(url=None):
     The daemon publishes <PREFIX>_STATE, _STATUS, _EVENT and _SCENE on the state URL (the
     URL itself) and listens for <PREFIX>_COMMAND and _CONTROL on the command URL: the
     same group and options on the next port. memq:// is both. The rule is the C library's
-    (lagsim_bus.h), checked against the same cases (tests/net/plant_urls.txt).
-    Raises ValueError for a URL a plant cannot have."""
-    if not url:
-        url = os.environ.get("LCM_DEFAULT_URL") or _DEFAULT_URL
-    if len(url) >= 256:
-        raise ValueError("LCM URL longer than 255 characters")
-    if url == "memq://":
-        return url, url
-    num = r"(0|[1-9]\d{0,%d})"  # no leading zeros: LCM would read those as octal
-    m = re.match(r"^udpm://(?:(%s\.%s\.%s\.%s)(:%s)?)?(\?.*)?$"
-                 % (num % 2, num % 2, num % 2, num % 2, num % 4), url)
-    if not m:
-        raise ValueError("a lagsim plant speaks udpm://GROUP:PORT (or memq:// in one "
-                         "process), not %r" % url)
-    if m.group(1):
-        octets = [int(m.group(k)) for k in range(2, 6)]
-        if max(octets) > 255 or not 224 <= octets[0] <= 239:
-            raise ValueError("the group of %r is not a multicast address" % url)
-        group = ".".join(str(o) for o in octets)
-    else:
-        group = "239.255.76.67"
-    port = int(m.group(7)) if m.group(6) else 7667
-    if not 1 <= port <= 65534:
-        raise ValueError("expected a port from 1 to 65534 in %r (commands go to the next "
-                         "port)" % url)
-    query = m.group(8) or ""
-    return ("udpm://%s:%d%s" % (group, port, query),
-            "udpm://%s:%d%s" % (group, port + 1, query))
+    own (lag_client_plant_urls, through lagsim_client.py), checked against the cases of
+    tests/net/plant_urls.txt. Raises ValueError for a URL a plant cannot have."""
+    from lagsim_client import plant_urls as rule
+    return rule(url)
 
 
 class _RecvBuf(ctypes.Structure):

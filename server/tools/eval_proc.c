@@ -246,6 +246,8 @@ int eval_make_tmpdir(const char *name, char *buf, size_t len)
 
 void eval_proc_tmpdir_done(void) { have_tmpdir = 0; }
 
+void eval_proc_tmpdir_remove(void) { remove_tmpdir(); }
+
 /* ---------------------------------------------------------------- waiting */
 /* Reaps pid if it ended (and forgets it, the stop signals blocked meanwhile): 1 reaped,
  * 0 running, -1 not a child. */

@@ -56,6 +56,8 @@ void eval_stop_group(pid_t pid, int *status);
  * (eval_proc_tmpdir_done once it is removed otherwise). 0, or -1 with errno. */
 int eval_make_tmpdir(const char *name, char *buf, size_t len);
 void eval_proc_tmpdir_done(void);
+/* The temporary directory removed with its files now (a tool that ends without -v). */
+void eval_proc_tmpdir_remove(void);
 
 /* While deferred, SIGINT, SIGTERM and SIGHUP stop nothing: the first is kept for the tool,
  * which asks eval_proc_pending() (its number, 0: none) where it waits, stops its children

@@ -1357,9 +1357,13 @@ static int sweep_run(sweep *x)
     if (x->live.done < x->nwant) say_held(x, "not every run ended");
     bool all = count_passed(x, r) == r->n;
     if (x->png && plot(x->png, x->tmpdir, x->header, r, x->nv, x->metric)) status = 2;
-    rmdir(x->tmpdir);
-    eval_proc_tmpdir_done();
-    sweep_live_free(&x->live);
+    sweep_live_free(&x->live); /* the workers' row files closed, then removed with the rest */
+    if (x->verbose) { /* -v keeps the daemons' logs (said where) */
+        rmdir(x->tmpdir);
+        eval_proc_tmpdir_done();
+    } else {
+        eval_proc_tmpdir_remove();
+    }
     return status ? status : all ? 0 : 1;
 }
 

@@ -9,7 +9,9 @@ directory (so it runs from any directory, as the README promises), its channel p
 DIPC is replaced by one unique to this run, and it is started the way the README says
 (C and C++: compiled as the block's first line says, `cc balance.c $(pkg-config --cflags
 --libs lagsim-client)` or `c++ -std=c++17 balance.cpp $(...)`, with the compiler given
-(--cc, --cxx: gcc, g++, clang++) and -Wall -Wextra -Werror, against the build tree
+(--cc, --cxx: gcc, g++, clang++) and -Wall -Wextra -Werror; Go: `go build balance.go`
+(--go: the go command; cgo's C with -Wall -Werror, Go's cache in <build>/go, no network);
+all against the build tree
 (PKG_CONFIG_PATH=<build>/pkgconfig, the uninstalled lagsim-client.pc) or, with --install,
 against `cmake --install <build> --prefix TMP` (PKG_CONFIG_PATH=TMP/lib/pkgconfig; run
 with LD_LIBRARY_PATH=TMP/lib, as any library in a prefix off the loader's path);
@@ -57,6 +59,8 @@ THINK_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "think")
 RUNNERS = {
     "c": ("balance.c", lambda b, f, slow: [os.path.splitext(f)[0]], lambda b: {}),
     "cpp": ("balance.cpp", lambda b, f, slow: [os.path.splitext(f)[0]], lambda b: {}),
+    # Go through the C ABI (cgo), built by `go build balance.go` (docs/clients.md)
+    "go": ("balance.go", lambda b, f, slow: [os.path.splitext(f)[0]], lambda b: {}),
     # stock lcm-gen --cpp types with lcm/lcm-cpp.hpp (docs/clients.md), no lagsim library
     "cpplcm": ("balance.cpp", lambda b, f, slow: [os.path.splitext(f)[0]], lambda b: {}),
     "python": ("balance.py",
@@ -108,6 +112,7 @@ def main():
     ap.add_argument("--cc", default="cc", help="the C block's compiler")
     ap.add_argument("--cxx", default="c++", help="the C++ block's compiler")
     ap.add_argument("--cflags", default="", help="more flags for both (a sanitizer build's)")
+    ap.add_argument("--go", default="go", help="the go command (the Go block's)")
     ap.add_argument("--lcm-cpp-types", default="",
                     help="where lcm-gen --cpp wrote lagsim's types (the cpplcm block's -Igen)")
     ap.add_argument("--install", action="store_true",
@@ -202,6 +207,39 @@ def build_block(a, text, lang, path, think):
     return True
 
 
+def build_go_block(a, build, text, path, think):
+    """Builds the Go block as its first line says (go build balance.go), cgo finding the
+    client library through pkg-config (a.pkg_config_path); Go's cache and GOPATH in
+    <build>/go, the installed toolchain, no user configuration, no network. With think > 0,
+    cgo's C includes think.h: every lag_client_send_command the block calls thinks first."""
+    if not re.search(r"go build balance\.go", text.split("\n")[0]):
+        print("FAIL: the go block's first line does not say how it builds (go build balance.go)")
+        return False
+    cflags = "-O2 -g -Wall -Werror"
+    if think > 0:  # the block's preamble (only: CGO_CFLAGS would reach Go's runtime/cgo too)
+        # includes think.h, by a #cgo directive added to the copy built; its code is unchanged
+        with open(path) as f:
+            code = f.read()
+        directive = "#cgo pkg-config: lagsim-client\n"
+        if directive not in code:
+            print("FAIL: the go block has no '%s' line" % directive.strip())
+            return False
+        with open(path, "w") as f:
+            f.write(code.replace(directive, directive + "#cgo CFLAGS: -include %s\n"
+                                 % os.path.join(THINK_DIR, "think.h"), 1))
+    env = dict(os.environ, PKG_CONFIG_PATH=a.pkg_config_path, CGO_CFLAGS=cflags,
+               GOCACHE=os.path.join(build, "go", "cache"), GOPATH=os.path.join(build, "go", "path"),
+               GOTOOLCHAIN="local", GOENV="off", GOFLAGS="", GO111MODULE="on", CGO_ENABLED="1")
+    cmd = [a.go, "build", "-o", os.path.splitext(path)[0], os.path.basename(path)]
+    print("$ PKG_CONFIG_PATH=%s CGO_CFLAGS='%s' %s" % (a.pkg_config_path, cflags, " ".join(cmd)))
+    r = subprocess.run(cmd, cwd=os.path.dirname(path), env=env, stdout=subprocess.PIPE,
+                       stderr=subprocess.STDOUT, universal_newlines=True)
+    if r.returncode != 0:
+        print("FAIL: the go block does not build:\n%s" % r.stdout)
+        return False
+    return True
+
+
 def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
     """Runs one block against lagsimd for a.periods periods in lockstep, its law taking
     `think` wall s per answer (the daemon's lockstep_timeout from think and fast_slowest,
@@ -217,7 +255,10 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
         f.write(text.replace('"DIPC_', '"%s_' % prefix).replace("'DIPC_", "'%s_" % prefix)
                 .replace('"DIPC"', '"%s"' % prefix))
     slow = ""
-    if lang in ("c", "cpp", "cpplcm"):
+    if lang == "go":
+        if not build_go_block(a, build, text, path, think):
+            return 1, {}, 0.0
+    elif lang in ("c", "cpp", "cpplcm"):
         if not build_block(a, text, lang, path, think):
             return 1, {}, 0.0
     elif think > 0:

@@ -41,9 +41,9 @@ set(LAGSIM_TIER_RULES
   # (not Java's: a JVM starting and classes compiled for the slow law compute; run beside
   # the others and two busy processes, clients_readme_java_slower_law and
   # clients_cross_language_slower_law ran past their 90 s)
-  "waits     NAME  ^clients_readme_(c|cpp|python|lua)_slow(er)?_law$"
-  "waits     NAME  ^clients_(c|cpp|python|lua|java)_[a-z_]+_ends_on_(stop|silence)$"
-  "waits     NAME  ^clients_(c|python|lua|java)_ends_on_signal$"
+  "waits     NAME  ^clients_readme_(c|cpp|python|lua|go)_slow(er)?_law$"
+  "waits     NAME  ^clients_(c|cpp|python|lua|java|go)_[a-z_]+_ends_on_(stop|silence)$"
+  "waits     NAME  ^clients_(c|python|lua|java|go)_ends_on_signal$"
   "waits     NAME  ^clients_(python|java)_dipc_late_controller$"
   "waits     NAME  ^view_attack_(slowloris|stalled)$"
   "waits     NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
@@ -88,7 +88,7 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^eval_(metrics|reference|sweep_csv)_"
   "quick     NAME  ^eval_procs_(eval|sweep)_(sigint|sigterm|sigkill|groupkill)$"
   "quick     NAME  ^eval_lagsim_eval_(metrics|require|scene|owned|outputs|bus|docs_python|notes|stderr)$"
-  "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|merge_rows|merge_foreign|shard|kept|kept_python|vary|scene_c|scene_python|notes|interrupt)$"
+  "quick     NAME  ^eval_lagsim_sweep_(same|slurm|merge|merge_rows|merge_foreign|shard|kept|kept_python|vary|scene_c|scene_python|notes|interrupt|tmpdir)$"
   "wallclock NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
   # the progress line on a terminal: drawn against the wall clock
   "wallclock NAME  ^eval_lagsim_sweep_progress$"
@@ -105,9 +105,10 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^clients_[a-z_]+_(usage_.*|help)$"
   "quick     NAME  ^clients_(python|lua)_(lcm|types)$"
   "quick     NAME  ^clients_java_release$"
+  "quick     NAME  ^clients_(go_dipc_gain|go_vet|binding_lookup)$"
   "quick     NAME  _(lockstep|hostile|push|reference_lost)$"
   "quick     NAME  ^clients_cross_language_(dipc|manipulator)$"
-  "quick     NAME  ^clients_readme_(c|cpp|cpplcm|python|lua|java)$"
+  "quick     NAME  ^clients_readme_(c|cpp|cpplcm|python|lua|java|go)$"
   # the client library: its version, its ABI, its C++ header, the README's C and C++ blocks
   # against an install and by the other C++ compiler (lockstep runs, compilations)
   "quick     NAME  ^clients_(versions|abi|abi_mutations|cpp_header|lcm_cpp_forged)$"

@@ -1207,6 +1207,26 @@ def case_controller_exit(d):
           "--restart, 'exit 3': 4 failed rows naming exit status 3, in %.1f s" % took)
 
 
+def case_tmpdir(d):
+    """Nothing of a sweep is left in TMPDIR when it ends without -v: a sweep that passes,
+    one whose runs fail (--restart) and one whose controller cannot run (exit 2)."""
+    lqr = os.path.join(BIN, "lqr_balance") + " -q --prefix {prefix}"
+    base = [SWEEP, "--config", SCENE, "--duration", "0.5", "--runs", "2", "--seed", "1",
+            "--vary", "parameters.m0=uniform(1,1.5)"]
+    for name, extra, codes in [
+            ("passes", ["--controller", lqr, "-j", "2"], (0,)),
+            ("fails", ["--controller", "exit 3", "--restart"], (1, 2)),
+            ("cannot run", ["--controller", "exit 3"], (2,))]:
+        t = os.path.join(d, "t-" + name.replace(" ", "_"))
+        os.mkdir(t)
+        p = run(base + extra + ["--csv", os.path.join(d, name.replace(" ", "_") + ".csv")],
+                env=dict(os.environ, TMPDIR=t))
+        left = [os.path.join(r, f) for r, ds, fs in os.walk(t) for f in ds + fs]
+        check(p.returncode in codes and not left,
+              "a sweep that %s (exit %d): TMPDIR empty after it (%s)" % (name, p.returncode,
+                                                                        left[:5]))
+
+
 with tempfile.TemporaryDirectory() as tmp:
     {"same": case_same, "vary": case_vary, "slurm": case_slurm, "merge": case_merge,
      "kept": case_kept, "merge_rows": case_merge_rows, "merge_foreign": case_merge_foreign,
@@ -1216,6 +1236,6 @@ with tempfile.TemporaryDirectory() as tmp:
      "scene_python": case_scene_python, "scene_loss": case_scene_loss,
      "unanswered": case_unanswered, "notes": case_notes,
      "controller_exit": case_controller_exit, "progress": case_progress,
-     "interrupt": case_interrupt}[CASE](tmp)
+     "interrupt": case_interrupt, "tmpdir": case_tmpdir}[CASE](tmp)
 print("FAILED: %d" % len(failures) if failures else "PASSED")
 sys.exit(1 if failures else 0)

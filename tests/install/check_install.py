@@ -73,6 +73,7 @@ def main():
             "share/man/man1/lagsimd.1",
             "share/lagsim/config/dipc.yaml", "share/lagsim/lcmtypes/joint_state_t.lcm",
             "share/lua/5.2/lagsim/init.lua", "share/lua/5.2/lagsim_lcm.lua",
+            "share/lua/5.2/lagsim_client_path.lua", "lib/lua/5.2/lagsim_client.so",
             "share/lagsim/examples/python/dipc_balance.py",
             "share/lagsim/examples/lua/dipc_balance.lua",
             "share/java/lagsim_types.jar", "share/java/lagsim_examples.jar",
@@ -90,9 +91,18 @@ def main():
     execs = [l for l in open(unit)] if os.path.exists(unit) else []
     check(any(l.startswith("ExecStart=%s/bin/lagsimd " % prefix) for l in execs),
           "installed lib/systemd/system/lagsimd@.service, naming %s/bin/lagsimd" % prefix)
-    for w in ("lagsim/__init__.py", "lagsim_lcm.py", "lagsim_controller.py"):
+    for w in ("lagsim/__init__.py", "lagsim_lcm.py", "lagsim_controller.py", "lagsim_client.py",
+              "lagsim_client_path.py"):
         check(os.path.exists(os.path.join(pydir, w)), "installed %s" % os.path.join(
             os.path.relpath(pydir, prefix), w))
+    # the bindings' pointers name the installed client library and Lua module, not the build's
+    for path, lib in ((os.path.join(pydir, "lagsim_client_path.py"),
+                       os.path.join(prefix, "lib", "liblagsim_client.so.%d" % a.abi)),
+                      (os.path.join(prefix, "share/lua/5.2/lagsim_client_path.lua"),
+                       os.path.join(prefix, "lib/lua/5.2/lagsim_client.so"))):
+        text = open(path).read() if os.path.exists(path) else ""
+        check(lib in text and build not in text, "%s names %s" % (os.path.relpath(path, prefix),
+                                                                   os.path.relpath(lib, prefix)))
     check(len(glob.glob(os.path.join(prefix, "share/lagsim/lcmtypes/*.lcm"))) ==
           len(glob.glob(os.path.join(src, "lcmtypes/*.lcm"))), "every .lcm file installed")
     # the shared library: its SONAME, its links, only the client's functions exported

@@ -1,6 +1,6 @@
 -- plant_urls (clients/lua/lagsim_lcm.lua) against the cases every implementation passes
 -- (tests/net/plant_urls.txt).
---     LUA_PATH=<clients/lua>/?.lua;; lua5.2 plant_urls.lua TABLE
+--     LUA_PATH=<build>/lua/?.lua;; lua5.2 plant_urls.lua TABLE
 -- LCM_DEFAULT_URL must be unset (the ctest runs it so).
 local lagsim_lcm = require('lagsim_lcm')
 local fails, cases = 0, 0
