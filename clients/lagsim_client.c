@@ -359,7 +359,7 @@ static lag_result dispatch(lag_client *c, const char *channel, const void *data,
         if (c->on_reference) c->on_reference(&c->reference, c->on_reference_user);
     } else if (!strcmp(channel, c->ch_event)) {
         if (!decode(c, LAG_WIRE_EVENT, data, len)) return LAG_CLIENT_OK;
-        c->counters.events++;
+        if (strcmp(c->tmp.event.kind, "plant") != 0) c->counters.events++;
         lag_client_event ev;
         event_from_wire(&ev, &c->tmp.event);
         if (c->on_event) c->on_event(&ev, c->on_event_user);

@@ -25,7 +25,7 @@
 /* The last scenes published, to tell them from another plant's when they are heard back on
  * the plant watch: enough for every scene the buckets let out in RT_SCENE_ECHO_S seconds
  * (a flood of SET and RESET publishes a new generation's scene for each within their
- * buckets, a burst of them in one pass; rt_publish.c checks the bound), far longer than
+ * buckets, a burst of them in one pass; rt_control.c checks the bound), far longer than
  * a datagram looped back by this host takes to be read. */
 #define RT_SCENES_KEPT 1024
 #define RT_SCENE_ECHO_S 4

@@ -2,7 +2,6 @@
  * What the loop publishes, through one place each: see rt_publish.h.
  */
 #include "rt_publish.h"
-#include "rt_control.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -48,12 +47,6 @@ static int loss_slot(const char *kind)
         if (ev_limits[k].loss && !strcmp(kind, ev_limits[k].kind)) return k;
     return -1;
 }
-/* every scene the buckets let out in RT_SCENE_ECHO_S is remembered until heard back (a
- * new generation's: SET's and RESET's buckets; an answer to DESCRIBE: the scene bucket) */
-_Static_assert(RT_SCENES_KEPT >= RT_SET_BURST + RT_RESET_BURST + RT_SCENE_BURST +
-                                     RT_SCENE_ECHO_S * (RT_SET_PER_S + RT_RESET_PER_S +
-                                                        RT_SCENE_PER_S),
-               "the scenes published are remembered long enough to be known when heard back");
 
 void rt_pub_init(rt_pub *p, rt_bus *bus, rt_record *rec, rt_term *term, const int64_t *now,
                  const lag_sim *sim)
