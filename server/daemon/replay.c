@@ -658,8 +658,8 @@ static void replay_say_scene(const replay_run *run)
                    lt[k][0] ? lt[k] : "(none)", ht[k][0] ? ht[k] : "(none)");
     if (!strcmp(l->model, h->model)) diff_numbers(l, h, out, sizeof out, sets, sizeof sets);
     if (!out[0]) {
-        fprintf(stderr, "lagsimd: --replay: the log's scene (its first on %s) is this one: the "
-                "difference is elsewhere (another build, or a changed log)\n", run->ch_scene);
+        fprintf(stderr, "lagsimd: --replay: the log's scene (its first on %s) is this one\n",
+                run->ch_scene);
         return;
     }
     fprintf(stderr, "lagsimd: --replay: the log's scene (its first on %s) differs from this "
@@ -836,5 +836,6 @@ lag_result lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsi
     replay_say_counts(&run);
     double max_diff = 0.0;
     r = replay_checked(&run, &max_diff);
+    if (r != LAG_OK) replay_say_scene(&run); /* a re-simulation that failed: the scene? */
     return r != LAG_OK ? r : replay_verdict(&run, max_diff);
 }
