@@ -360,7 +360,7 @@ static lag_result dispatch(lag_client *c, const char *channel, const void *data,
         if (c->on_reference) c->on_reference(&c->reference, c->on_reference_user);
     } else if (!strcmp(channel, c->ch_event)) {
         if (!decode(c, LAG_WIRE_EVENT, data, len)) return LAG_CLIENT_OK;
-        c->counters.events++;
+        if (strcmp(c->tmp.event.kind, "plant") != 0) c->counters.events++;
         lag_client_event ev;
         event_from_wire(&ev, &c->tmp.event);
         if (c->on_event) c->on_event(&ev, c->on_event_user);
@@ -1218,6 +1218,9 @@ lag_result lag_client_discover(const char *url, double wait_s, double settle_s,
         free(dp);
         return rc;
     }
+    /* a host's directory names a plant every 0.5 s and answers for each: LCM's default
+     * queue (30 messages) would drop most of a class of plants between two reads */
+    lcm_subscription_set_queue_capacity(sub, 4 * LAG_CLIENT_MAX_PLANTS);
     disc_listen(dp, in, cmd, &b, max, wait_s, settle_s);
     lcm_unsubscribe(in, sub);
     if (cmd != in) lcm_destroy(cmd);

@@ -168,7 +168,11 @@ typedef struct lag_client_scene lag_client_scene;
 typedef struct lag_client_status lag_client_status;
 
 typedef struct lag_client_counters {
-    int64_t states, scenes, statuses, events;  /* messages received and kept */
+    int64_t states, scenes, statuses, events;  /* messages received and kept (events: the
+                                                * plant's own; a host directory's `plant`
+                                                * announcements are passed to the event
+                                                * callback, not counted: a silence is the
+                                                * plant's) */
     int64_t dropped;                           /* undecodable or out-of-range messages */
     int64_t commands_sent, controls_sent;
     int64_t copies;   /* of states, copies of the latest state (lockstep re-sends): not

@@ -3,6 +3,7 @@
  */
 #include "lagsim_controller.h"
 #include "lagsim_out.h"
+#include "lagsim_locate.h"
 
 #include <errno.h>
 #include <getopt.h>
@@ -221,6 +222,9 @@ int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
 }
 
 /* ---------------------------------------------------------------- the run */
+/* The silence that ends a run counts what the plant itself publishes: its states, its
+ * status, its events; not a host's directory's `plant` events, which go on whether or
+ * not the plant runs. */
 static void heard_state(const lag_client_state *st, void *user)
 {
     (void)st;
@@ -236,7 +240,7 @@ static void heard_status(const lag_client_status *st, void *user)
 static void heard_event(const lag_client_event *ev, void *user)
 {
     lag_ctl *ctl = user;
-    ctl->heard = lag_client_now();
+    if (strcmp(ev->kind, "plant") != 0) ctl->heard = lag_client_now();
     if (!strcmp(ev->kind, "stop")) ctl->stopped = true;
     if (ctl->on_event) ctl->on_event(ev, ctl->event_user);
 }
@@ -270,6 +274,10 @@ static int pick_prefix(lag_ctl *ctl, const char *model)
     if (rc == LAG_CLIENT_OK) {
         snprintf(ctl->found_prefix, sizeof ctl->found_prefix, "%s", p.prefix);
         ctl->prefix = ctl->found_prefix;
+        if (!ctl->url && lag_locate_elsewhere(p.url)) { /* a host's plant */
+            snprintf(ctl->found_url, sizeof ctl->found_url, "%s", p.url);
+            ctl->url = ctl->found_url;
+        }
         printf("%s: the only %s%splant on the bus: prefix %s (%s, %s)\n", ctl->name,
                model ? model : "", model ? " " : "", p.prefix, p.mode, p.run_state);
     } else if (rc == LAG_CLIENT_TIMEOUT && ctl->default_prefix) {
@@ -290,6 +298,17 @@ static int connect_client(lag_ctl *ctl)
 {
     char err[256];
     ctl->client = lag_client_create(ctl->url, ctl->prefix, err, sizeof err);
+    /* --prefix without --url: subscribed first (nothing of a plant of the default bus is
+     * missed while the directory is asked), then moved to the URL a host's directory
+     * names, if it names one */
+    if (ctl->client && ctl->prefix && !ctl->url &&
+        lag_locate_plant(ctl->prefix, ctl->found_url, sizeof ctl->found_url)) {
+        ctl->url = ctl->found_url;
+        printf("%s: prefix %s runs on %s (the host's directory)\n", ctl->name, ctl->prefix,
+               ctl->url);
+        lag_client_destroy(ctl->client);
+        ctl->client = lag_client_create(ctl->url, ctl->prefix, err, sizeof err);
+    }
     if (!ctl->client) {
         fprintf(stderr, "%s: %s\n", ctl->name, err);
         return 1;

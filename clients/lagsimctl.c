@@ -37,6 +37,7 @@
 #include "lagsim_client.h"
 #include "lagsim_client_wire.h"
 #include "lagsim_bus.h"
+#include "lagsim_locate.h"
 #include "lagsim_num.h"
 #include "lagsim_wire.h"
 
@@ -63,7 +64,9 @@ static void usage(FILE *f)
             "Sends a control request to a running lagsimd and prints its answer.\n"
             "commands:\n"
             "  list                 every plant on the bus: prefix, model, mode, run state,\n"
-            "                       sim time, host, URL (listens --timeout s, default 1)\n"
+            "                       sim time, host, URL (listens 1 s, then waits for each\n"
+            "                       plant heard to answer, up to --timeout s, default 5;\n"
+            "                       ? for what a plant has not said by then)\n"
             "  status               the daemon's status, one field a line with units\n"
             "  describe             the scene description (model, parameters, joints, timing)\n"
             "  pause | resume       stop / go on advancing sim time\n"
@@ -483,6 +486,12 @@ static bool event_only(const answer *a) { return a->got_event; }
 static bool step_done(const answer *a) { return a->refused || (a->got_event2 && a->got_status); }
 
 /* ---------------------------------------------------------------- list */
+/* list: plants are heard for LIST_HEAR_S after the first (a host's directory names each every 0.5 s);
+ * then the list waits for every plant heard to answer with its scene and status, up to
+ * --timeout (LIST_TIMEOUT_S by default); a plant that has not answered by then shows `?`. */
+#define LIST_HEAR_S 1.0
+#define LIST_TIMEOUT_S 5.0
+
 /* Every plant on the bus, a table for people (or a JSON array): exit 0, or 3 if none. */
 static lag_result list_plants(const char *url, double wait_s)
 {
@@ -490,8 +499,8 @@ static lag_result list_plants(const char *url, double wait_s)
     static lag_client_plant p[LAG_CLIENT_MAX_PLANTS];
     int n = 0;
     char err[256];
-    int rc = lag_client_discover(url, wait_s, -1.0, p, LAG_CLIENT_MAX_PLANTS, sizeof p[0], &n,
-                                 err, sizeof err);
+    int rc = lag_client_discover(url, wait_s, wait_s < LIST_HEAR_S ? -1.0 : LIST_HEAR_S, p,
+                                 LAG_CLIENT_MAX_PLANTS, sizeof p[0], &n, err, sizeof err);
     if (rc != LAG_CLIENT_OK) {
         fprintf(stderr, "lagsimctl: %s\n", err);
         return EXIT_NOANSWER;
@@ -735,6 +744,9 @@ static int check_request(request *r)
 static lag_client *connect_plant(options *o, lag_client_plant *chosen, int *code)
 {
     char err[1200];
+    static char located[LAG_CLIENT_URL_LEN];
+    if (o->prefix && !o->url && lag_locate_plant(o->prefix, located, sizeof located))
+        o->url = located; /* a host's plant: where its directory says it runs */
     if (!o->prefix) {
         /* the only plant on the bus */
         int rc = lag_client_pick_plant(o->url, NULL, o->timeout, chosen, sizeof *chosen, err,
@@ -745,6 +757,7 @@ static lag_client *connect_plant(options *o, lag_client_plant *chosen, int *code
             return NULL;
         }
         o->prefix = chosen->prefix;
+        if (!o->url && lag_locate_elsewhere(chosen->url)) o->url = chosen->url;
     }
     g_prefix = o->prefix;
     lag_client *c = lag_client_create(o->url, o->prefix, err, sizeof err);
@@ -889,7 +902,8 @@ static lag_result lagsimctl_main(int argc, char **argv)
     code = check_request(&r);
     if (code != GO_ON) return code;
 
-    if (!strcmp(r.cmd, "list")) return list_plants(o.url, o.timeout_set ? o.timeout : 1.0);
+    if (!strcmp(r.cmd, "list"))
+        return list_plants(o.url, o.timeout_set ? o.timeout : LIST_TIMEOUT_S);
     lag_client_plant chosen;
     lag_client *c = connect_plant(&o, &chosen, &code);
     if (!c) return code;

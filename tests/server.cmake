@@ -63,7 +63,7 @@ endif()
 # file that failed for want of its port tried again on SIGHUP,
 # lagsimctl list through the host's directory.
 if(LAGSIM_PYTHON3)
-  foreach(case isolation bad_scene reload list many)
+  foreach(case isolation bad_scene reload list many foreign own_flood quiet)
     add_test(NAME server_host_${case}
              COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/server/test_host.py
                      --bin ${CMAKE_BINARY_DIR}/bin --types ${CMAKE_BINARY_DIR}/python

@@ -19,11 +19,18 @@
  * parked until the budget allows again (the kernel drops what the socket's buffer cannot
  * hold), so that the flood costs the loop, and every other plant, nothing more. Lockstep
  * at any speed keeps its budget, which grows with the states it publishes.
+ *
+ * What is not for the plant (other prefixes' requests on its command URL: a student on a
+ * copied URL, polling) comes on a socket of its own (rt_bus.h) with a budget of its own,
+ * for a daemon of one plant too: HOST_FOREIGN_PER_S a second, HOST_FOREIGN_BURST at once,
+ * counted and said (foreign_limited), the socket parked beyond (the kernel drops the rest,
+ * and counts it). It never costs the plant's own controller a command.
  */
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -50,6 +57,8 @@
 #define HOST_INPUT_PER_STATE 8
 #define HOST_INPUT_PER_S 100.0
 #define HOST_INPUT_BURST 256.0
+#define HOST_FOREIGN_PER_S 20.0      /* other prefixes' requests read a second */
+#define HOST_FOREIGN_BURST 20
 #define HOST_RESCAN_NS 200000000LL   /* a quiet 0.2 s after inotify's last word */
 #define HOST_LOG_RING_DEFAULT (1u << 20) /* a host's plant's --log ring: 1 MiB */
 #define HOST_ANNOUNCE_NS 500000000LL /* each plant's `plant` event on the directory */
@@ -81,7 +90,8 @@ typedef struct plant {
     plant_phase phase;
     int64_t look_end, wake;
     bool marked;                /* heard something since it was last processed */
-    rt_io_src in, watch;
+    rt_io_src in, watch, foreign;
+    rt_limit foreign_lim;       /* other prefixes' requests: their budget */
     /* the input budget */
     double tokens;
     int64_t tokens_ns, published;
@@ -388,6 +398,27 @@ static void on_input(void *ctx)
     if (n == max && p->tokens < 1.0) budget_park(p);
 }
 
+/* Other prefixes' requests on the command URL: read within their budget; parked and said
+ * when it is spent and more wait. */
+static void on_foreign(void *ctx)
+{
+    plant *p = ctx;
+    host *h = p->h;
+    p->marked = true;
+    for (int n = 0; n < HOST_FOREIGN_BURST; n++) {
+        if (rt_limit_ready(&p->foreign_lim, h->now) > h->now) break;
+        if (rt_plant_drain(p->s, RT_PLANT_FOREIGN, h->now, 1) == 0) return;
+        rt_limit_take(&p->foreign_lim, h->now);
+    }
+    rt_io_park(&h->io, &p->foreign, true);
+    struct pollfd pf = {p->foreign.fd, POLLIN, 0};
+    if (poll(&pf, 1, 0) != 1) return;
+    char why[96];
+    snprintf(why, sizeof why, "%g a second read, apart from this plant's own input",
+             HOST_FOREIGN_PER_S);
+    rt_plant_foreign_limited(p->s, why);
+}
+
 /* The plant watch: a scene heard on the prefix. */
 static void on_watch(void *ctx)
 {
@@ -548,6 +579,7 @@ opened:
     p->tokens = HOST_INPUT_BURST;
     p->tokens_ns = h->now;
     rt_limit_init(&p->dir_lim, HOST_DIR_PER_S, (int)HOST_DIR_PER_S, h->now);
+    rt_limit_init(&p->foreign_lim, HOST_FOREIGN_PER_S, HOST_FOREIGN_BURST, h->now);
     p->announce_ns = rt_sat_add(h->now, (int64_t)(hash_bytes(p->sc.lcm.prefix,
                                                              strlen(p->sc.lcm.prefix)) %
                                                   (uint64_t)HOST_ANNOUNCE_NS));
@@ -571,6 +603,8 @@ static void plant_start(host *h, plant *p)
         return;
     }
     p->phase = PLANT_RUNNING;
+    if (add_source(h, &p->foreign, rt_plant_fd(p->s, RT_PLANT_FOREIGN), on_foreign, p) != 0)
+        rt_plant_stop(p->s, RT_STOP_ERROR);
     p->published = rt_plant_published(p->s);
     p->wake = h->now;
     h->started++;
@@ -583,6 +617,7 @@ static void plant_end(host *h, int i, rt_stop why)
     if (why != RT_STOP_NONE) rt_plant_stop(p->s, why);
     rt_io_remove(&h->io, &p->in);
     rt_io_remove(&h->io, &p->watch);
+    rt_io_remove(&h->io, &p->foreign);
     lag_result rc = rt_plant_end(p->s, p->phase == PLANT_RUNNING);
     if (rc != LAG_OK && h->rc == LAG_OK) h->rc = rc;
     if (!h->one && !p->opts.quiet)
@@ -590,6 +625,17 @@ static void plant_end(host *h, int i, rt_stop why)
     plant_free(p);
     memmove(&h->p[i], &h->p[i + 1], (size_t)(h->n - i - 1) * sizeof h->p[0]);
     h->n--;
+}
+
+/* A parked socket of the plant waited on again once its budget allows. */
+static void unpark(host *h, plant *p)
+{
+    if (p->in.parked) {
+        budget_refill(p, h->now);
+        if (p->tokens >= 1.0) rt_io_park(&h->io, &p->in, false);
+    }
+    if (p->foreign.parked && rt_limit_ready(&p->foreign_lim, h->now) <= h->now)
+        rt_io_park(&h->io, &p->foreign, false);
 }
 
 /* One pass over the plants at h->now: the due and the marked processed, the looks that
@@ -606,9 +652,8 @@ static void host_pass(host *h)
             rt_process(p->s); /* once more when stopped: the answers owed, as before */
             p->marked = false;
             p->wake = rt_next_wake(p->s);
-            if (!h->one) budget_refill(p, h->now);
-            if (p->in.parked && p->tokens >= 1.0) rt_io_park(&h->io, &p->in, false);
         }
+        if (p->phase == PLANT_RUNNING) unpark(h, p);
         if (rt_plant_stopped(p->s)) {
             plant_end(h, i, RT_STOP_NONE);
             continue;
@@ -628,6 +673,7 @@ static int64_t host_next_wake(const host *h)
         if (rt_plant_stopped(p->s) || p->marked) return h->now;
         wake = min64(wake, p->phase == PLANT_LOOKING ? p->look_end : p->wake);
         if (p->in.parked) wake = min64(wake, budget_ready(p));
+        if (p->foreign.parked) wake = min64(wake, rt_limit_ready(&p->foreign_lim, h->now));
         if (h->dir_out && p->phase == PLANT_RUNNING) wake = min64(wake, p->announce_ns);
     }
     return wake;

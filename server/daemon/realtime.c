@@ -979,6 +979,7 @@ void rt_process(rt_server *s)
         s->next_status_ns = rt_sat_add(s->next_status_ns, s->status_period_ns);
         if (s->next_status_ns <= s->now) s->next_status_ns = rt_sat_add(s->now, s->status_period_ns);
     }
+    rt_term_tick(&s->term, s->now); /* -q: the losses' journal */
     if (s->term.live_line && s->now >= s->next_line_ns) {
         rt_term_line(&s->term, s->now, false);
         s->next_line_ns = rt_sat_add(s->now, RT_LINE_NS);
@@ -1046,6 +1047,7 @@ void rt_finish(rt_server *s)
         break;
     }
     publish_status(s);
+    rt_term_flush(&s->term, s->now);
     if (s->term.live_line) rt_term_line(&s->term, s->now, true);
 }
 
@@ -1085,14 +1087,14 @@ int64_t rt_plant_look_ns(const rt_server *s)
 
 int rt_plant_fd(const rt_server *s, rt_plant_input which)
 {
-    return rt_bus_fd(&s->bus, which == RT_PLANT_WATCH);
+    return rt_bus_fd(&s->bus, (rt_bus_input)which);
 }
 
 int rt_plant_drain(rt_server *s, rt_plant_input which, int64_t now, int max)
 {
     s->now = now;
     if (s->stop) return 0;
-    return rt_bus_read(&s->bus, which == RT_PLANT_WATCH, max);
+    return rt_bus_read(&s->bus, (rt_bus_input)which, max);
 }
 
 int rt_plant_start(rt_server *s, int64_t now, bool live_line, char *err, size_t errlen)
@@ -1147,6 +1149,24 @@ void rt_plant_input_limited(rt_server *s, int64_t times, const char *why)
                    "%s on %s and %s: %s (%lld times so far, in value)", "more messages than "
                    "the plant can use", s->bus.ch_command, s->bus.ch_control, why,
                    (long long)times);
+}
+
+void rt_plant_foreign_limited(rt_server *s, const char *why)
+{
+    const rt_foreign *f = &s->bus.foreign;
+    const rt_foreign_prefix *last = NULL;
+    int64_t heard = 0;
+    for (int i = 0; i < RT_FOREIGN_MAX; i++) {
+        const rt_foreign_prefix *e = &f->p[i];
+        heard += e->total;
+        if (e->prefix[0] && (!last || e->heard > last->heard)) last = e;
+    }
+    int64_t lost = s->bus.rx_foreign.lost;
+    rt_pub_limited(&s->pub, RT_EV_FOREIGN_LIMITED, "", (double)(heard + lost),
+                   "other prefixes' requests on %s's command URL (last: %s%s): %lld read, "
+                   "%lld dropped by the kernel; %s", s->bus.sc->lcm.prefix,
+                   last ? last->prefix : "?", last && last->has_plant ? ", a plant elsewhere" : "",
+                   (long long)heard, (long long)lost, why);
 }
 
 unsigned rt_plant_last(const rt_server *s, bool status, const uint8_t **data)

@@ -39,9 +39,10 @@ typedef enum rt_stop {
     RT_STOP_CHANGED,   /* a host: its scene file changed (the plant starts again from it) */
 } rt_stop;
 
-/* What a plant reads: its input on the command URL (commands, control requests), and the
- * plant watch on the state URL (another plant's scene on the prefix). */
-typedef enum rt_plant_input { RT_PLANT_IN = 0, RT_PLANT_WATCH } rt_plant_input;
+/* What a plant reads: its input on the command URL (its commands and control requests),
+ * the plant watch on the state URL (another plant's scene on the prefix), and other
+ * prefixes' control requests on the command URL (a budget of their own: rt_bus.h). */
+typedef enum rt_plant_input { RT_PLANT_IN = 0, RT_PLANT_WATCH, RT_PLANT_FOREIGN } rt_plant_input;
 
 /* A plant's struct, zeroed (large: allocated once per plant, never in the stepping path);
  * NULL when out of memory. */
@@ -80,6 +81,11 @@ int64_t rt_plant_published(const rt_server *s);
 /* A host paused reading the plant's input (its budget spent; `why` says the budget): an
  * input_limited event (limited: 3, then 1 a second), `times` in its value. */
 void rt_plant_input_limited(rt_server *s, int64_t times, const char *why);
+
+/* The loop paused reading other prefixes' requests on the plant's command URL (their
+ * budget, `why`, spent): a foreign_limited event (3, then 1 a second) naming what was
+ * heard and dropped, the requests heard so far (read and dropped) in its value. */
+void rt_plant_foreign_limited(rt_server *s, const char *why);
 
 /* The last scene (status false) or status the plant published, as sent: its length (0:
  * none yet), the bytes in *data (valid until the plant publishes the next). OUT: data */

@@ -68,6 +68,7 @@
 #include "lagsim_num.h"
 #include "lagsim_wire.h"
 #include "live_set.h"
+#include "rt_wire.h"
 
 #define REPLAY_DATA_MAX 65536               /* a record larger than this is no state */
 #define REPLAY_STEP_MAX (INT64_C(1) << 53)  /* steps beyond this are not a run's */
@@ -328,7 +329,8 @@ typedef struct replay_run {
     const lag_scene *sc;
     const lagsimd_opts *o;
     const char *log_path;
-    char channel[96], ch_input[96], ch_event[96], ch_ref[96];
+    char channel[96], ch_input[96], ch_event[96], ch_ref[96], ch_scene[96];
+    bool have_scene;            /* the log's first scene (the one its run started with) */
     replay_sets sets;
     lag_sim_def def;            /* the scene's definition, as replayed (replay_def) */
     lag_sim sim;
@@ -368,6 +370,7 @@ static lag_result replay_setup(replay_run *run)
     lag_bus_channel_name(run->ch_ref, sizeof run->ch_ref, sc->lcm.prefix, LAG_BUS_REFERENCE);
     lag_bus_channel_name(run->ch_input, sizeof run->ch_input, sc->lcm.prefix, LAG_BUS_INPUT);
     lag_bus_channel_name(run->ch_event, sizeof run->ch_event, sc->lcm.prefix, LAG_BUS_EVENT);
+    lag_bus_channel_name(run->ch_scene, sizeof run->ch_scene, sc->lcm.prefix, LAG_BUS_SCENE);
     run->def = sc->sim;
     lag_sim_def *def = &run->def;
     if (def->effects.enabled & LAG_EFF_ACTUATOR)
@@ -572,9 +575,108 @@ static replay_step replay_state(replay_run *run, const lag_log_record *rec)
     return REPLAY_NEXT;
 }
 
+/* ---------------------------------------------------------------- the log's scene */
+static lag_wire_scene g_logged, g_here; /* large: not on the stack */
+
+/* One difference: "KEY: log A, here B" into the list, and "--set KEY=A" into the sets
+ * when a --set can give it (set_key not NULL). */
+static void differ(char *out, size_t len, char *sets, size_t slen, const char *key,
+                   const char *set_key, const char *logv, const char *herev)
+{
+    size_t o = strlen(out), s = strlen(sets);
+    if (o < len) snprintf(out + o, len - o, "%s%s: log %s, here %s", o ? "; " : "", key, logv, herev);
+    if (set_key && s < slen) snprintf(sets + s, slen - s, " --set %s=%s", set_key, logv);
+}
+
+/* A vector as a YAML flow sequence, each number exact. */
+static void vec_text(const double *x, int n, char *out, size_t len)
+{
+    char a[LAG_NUM_LEN];
+    size_t o = (size_t)snprintf(out, len, "[");
+    for (int i = 0; i < n && o < len; i++)
+        o += (size_t)snprintf(out + o, len - o, "%s%s", i ? "," : "", lag_num(x[i], a));
+    if (o < len) snprintf(out + o, len - o, "]");
+}
+
+/* The numbers the scene's keys hold, each compared (parameters by name, initial state by
+ * joint, integrator and period, real-time settings). */
+static void diff_numbers(const lag_wire_scene *l, const lag_wire_scene *h, char *out,
+                         size_t len, char *sets, size_t slen)
+{
+    char a[LAG_NUM_LEN], b[LAG_NUM_LEN], key[96];
+    for (int i = 0; i < l->num_params; i++)
+        for (int j = 0; j < h->num_params; j++)
+            if (!strcmp(l->param_name[i], h->param_name[j]) &&
+                l->param_value[i] != h->param_value[j]) {
+                snprintf(key, sizeof key, "parameters.%s", l->param_name[i]);
+                differ(out, len, sets, slen, key, key, lag_num(l->param_value[i], a),
+                       lag_num(h->param_value[j], b));
+            }
+    if (l->num_joints == h->num_joints) {
+        char va[512], vb[512];
+        const double *lv[2] = {l->initial_q, l->initial_qd}, *hv[2] = {h->initial_q, h->initial_qd};
+        const char *names[2] = {"initial.q", "initial.qd"};
+        for (int k = 0; k < 2; k++)
+            if (memcmp(lv[k], hv[k], sizeof(double) * (size_t)l->num_joints) != 0) {
+                vec_text(lv[k], l->num_joints, va, sizeof va);
+                vec_text(hv[k], h->num_joints, vb, sizeof vb);
+                differ(out, len, sets, slen, names[k], names[k], va, vb);
+            }
+    }
+    const double ln[4] = {l->dt, l->control_period > 0 ? 1.0 / l->control_period : 0, l->rate,
+                          l->command_timeout};
+    const double hn[4] = {h->dt, h->control_period > 0 ? 1.0 / h->control_period : 0, h->rate,
+                          h->command_timeout};
+    const char *keys[4] = {"integrator.dt", "publish_hz", "realtime.rate",
+                           "realtime.command_timeout"};
+    for (int k = 0; k < 4; k++)
+        if (ln[k] != hn[k])
+            differ(out, len, sets, slen, keys[k], keys[k], lag_num(ln[k], a), lag_num(hn[k], b));
+}
+
+/* Says how the log's scene differs from this one: each key with both values, and the
+ * --set that gives the log's (the replay failed: "wrong --config or --set?"). */
+static void replay_say_scene(const replay_run *run)
+{
+    if (!run->have_scene) {
+        fprintf(stderr, "lagsimd: --replay: the log holds no scene on %s to compare this one "
+                "with\n", run->ch_scene);
+        return;
+    }
+    const lag_wire_scene *l = &g_logged, *h = &g_here;
+    rt_scene_fill(&g_here, run->sc, &run->sc->sim, run->nq, run->info);
+    static char out[4096], sets[2048];
+    out[0] = sets[0] = '\0';
+    if (strcmp(l->model, h->model) != 0 || l->num_joints != h->num_joints)
+        differ(out, sizeof out, sets, sizeof sets, "model", NULL, l->model, h->model);
+    const char *lt[3] = {l->integrator, l->effects, l->mode}, *ht[3] = {h->integrator, h->effects,
+                                                                       h->mode};
+    const char *keys[3] = {"integrator.method", "effects", "realtime.mode"};
+    for (int k = 0; k < 3; k++)
+        if (strcmp(lt[k], ht[k]) != 0)
+            differ(out, sizeof out, sets, sizeof sets, keys[k], k == 1 ? NULL : keys[k],
+                   lt[k][0] ? lt[k] : "(none)", ht[k][0] ? ht[k] : "(none)");
+    if (!strcmp(l->model, h->model)) diff_numbers(l, h, out, sizeof out, sets, sizeof sets);
+    if (!out[0]) {
+        fprintf(stderr, "lagsimd: --replay: the log's scene (its first on %s) is this one\n",
+                run->ch_scene);
+        return;
+    }
+    fprintf(stderr, "lagsimd: --replay: the log's scene (its first on %s) differs from this "
+            "one: %s\n", run->ch_scene, out);
+    if (sets[0])
+        fprintf(stderr, "lagsimd: --replay: the log's scene is this one with:%s\n", sets);
+}
+
 /* One record of the log, by its channel. */
 static replay_step replay_record(replay_run *run, const lag_log_record *rec)
 {
+    if (!run->have_scene && strcmp(rec->channel, run->ch_scene) == 0) {
+        run->have_scene = rec->data && lag_wire_decode_scene(rec->data, rec->size,
+                                                             LAG_WIRE_MAX_JOINTS,
+                                                             &g_logged) == LAG_WIRE_OK;
+        return REPLAY_NEXT;
+    }
     if (strcmp(rec->channel, run->ch_event) == 0) {
         set_read(&run->sets, rec, run->o);
         return REPLAY_NEXT;
@@ -685,6 +787,7 @@ static lag_result replay_verdict(const replay_run *run, double max_diff)
             fprintf(stderr, "lagsimd: --replay: FAILED: %lld reference(s) on %s are not "
                             "this scene's (wrong --config or --set?)\n",
                     (long long)run->refs_bad, run->ch_ref);
+            replay_say_scene(run);
             return LAG_ERR_MISMATCH;
         }
     }
@@ -696,6 +799,7 @@ static lag_result replay_verdict(const replay_run *run, double max_diff)
                 run->anchor ? "the replay of this log is approximate (see the note above)"
                             : "the log does not match this scene and build (wrong --config "
                               "or --set, another build, or a changed log)");
+        if (!run->anchor) replay_say_scene(run);
         return LAG_ERR_MISMATCH;
     }
     return LAG_OK;
@@ -727,9 +831,11 @@ lag_result lagsimd_replay(const lag_scene *sc, const char *log_path, const lagsi
         step = replay_record(&run, &rec);
     r = step == REPLAY_FAIL ? LAG_ERR_RUNTIME : replay_log_end(&run, log, rc);
     lag_log_close(log);
+    if (run.sets.failed) replay_say_scene(&run); /* "wrong --config or --set?": which */
     if (r != LAG_OK) return r;
     replay_say_counts(&run);
     double max_diff = 0.0;
     r = replay_checked(&run, &max_diff);
+    if (r != LAG_OK) replay_say_scene(&run); /* a re-simulation that failed: the scene? */
     return r != LAG_OK ? r : replay_verdict(&run, max_diff);
 }

@@ -5,9 +5,14 @@
  *                 probes of rt_foreign.h); neither subscribes, so LCM makes no thread,
  *                 pipe wait or select(2) for them;
  *   b->rx_in      the plant's own receive socket on the command URL (rt_rx.h), read by the
- *                 loop: _COMMAND and _CONTROL (and every prefix's _CONTROL, below). Its
- *                 socket filter (lagsim_net.h) keeps only those, and unless lcm.allow_lan
- *                 only datagrams sent from this host;
+ *                 loop: this plant's _COMMAND and _CONTROL alone. Its socket filter
+ *                 (lagsim_net.h) keeps only those, and unless lcm.allow_lan only datagrams
+ *                 sent from this host;
+ *   b->rx_foreign a second socket on the command URL: every other prefix's _CONTROL (below),
+ *                 its filter dropping this plant's own. Apart, so that what is not for this
+ *                 plant has a budget of its own (the loop's) and never costs the plant's
+ *                 controller a command: a flood of it fills this socket's buffer, not the
+ *                 plant's;
  *   b->rx_watch   the plant watch on the state URL: _SCENE (and _COMMAND sent to the wrong
  *                 port, counted), its filter dropping the daemon's own states in the kernel.
  * For memq:// (tests, one process) one lcm_t is both, with LCM's subscriptions.
@@ -21,8 +26,8 @@
  * What is asked where the plant listens but not of it is heard too (rt_foreign.h): every
  * <P>_CONTROL on both ports (another prefix's: a misspelt one; this plant's on the state
  * port: the wrong port) and every <P>_SCENE on the state port (a prefix asked that has a
- * plant of its own). The filters keep them by their suffix; control requests are rare, and
- * a flood of them costs what a flood on this plant's own _CONTROL costs, bounded the same.
+ * plant of its own). The filters keep them by their suffix; on the command URL they come
+ * on a socket of their own (rx_foreign), read within a small budget of their own.
  */
 #include <poll.h>
 #include <stdio.h>
@@ -234,6 +239,26 @@ static void send_marker(void *ctx)
     lcm_publish(m->b->lcm_in, LAG_NET_MARKER_CHANNEL, m->text, (unsigned)strlen(m->text));
 }
 
+/* The command URL's second socket: every prefix's _CONTROL but this plant's (rt_foreign.h),
+ * filtered before anything reaches it but the few datagrams of the moment between its bind
+ * and its filter, which its handler sorts as well (this plant's own are not its). */
+static int open_foreign(rt_bus *b, char *err, size_t errlen)
+{
+    const lag_bus *u = &b->urls;
+    const char *requests[] = {lag_bus_suffix(LAG_BUS_CONTROL)};
+    const char *own[] = {b->ch_control};
+    char ferr[256];
+    if (rt_rx_open(&b->rx_foreign, u->group, u->command_port, b->rcvbuf, err, errlen) != 0)
+        return LAGSIMD_EXIT_RUNTIME;
+    if (lag_net_filter_fd(b->rx_foreign.fd, !b->sc->lcm.allow_lan, NULL, 0, requests, 1, own, 1,
+                          ferr, sizeof ferr) != 0) {
+        snprintf(err, errlen, "%s: cannot filter the command URL %s for other prefixes' "
+                 "requests", ferr, u->command_url);
+        return LAGSIMD_EXIT_RUNTIME;
+    }
+    return LAGSIMD_EXIT_OK;
+}
+
 /* Filters the plant's receive socket on the command URL, then reads until a marker sent
  * after the filter comes back, dropping whatever came before it (it may have come in
  * before the filter did). Returns 0, or an exit code with a message in err. */
@@ -242,13 +267,10 @@ static int filter_input(rt_bus *b, char *err, size_t errlen)
     const lag_bus *u = &b->urls;
     bool host_only = !b->sc->lcm.allow_lan;
     const char *with_marker[] = {b->ch_command, b->ch_control, LAG_NET_MARKER_CHANNEL};
-    const char *requests[] = {lag_bus_suffix(LAG_BUS_CONTROL)}; /* any prefix's: rt_foreign.h */
     char ferr[256];
-    int n = lag_net_filter_suffixes(u->command_port, host_only, with_marker, 3, requests, 1,
-                                    ferr, sizeof ferr);
-    if (n <= 0) {
-        snprintf(err, errlen, "%s%s: cannot restrict the command URL %s to %s", n < 0 ? ferr :
-                 "the receive socket for the command port was not found",
+    if (lag_net_filter_fd(b->rx_in.fd, host_only, with_marker, 3, NULL, 0, NULL, 0, ferr,
+                          sizeof ferr) != 0) {
+        snprintf(err, errlen, "%s%s: cannot restrict the command URL %s to %s", ferr,
                  host_only ? "" : " (lcm.allow_lan: true)", u->command_url,
                  host_only ? "this host (lcm.allow_lan: false)" : "this plant's channels");
         return LAGSIMD_EXIT_RUNTIME;
@@ -263,13 +285,12 @@ static int filter_input(rt_bus *b, char *err, size_t errlen)
                  "route? docs/network.md)", u->command_url);
         return LAGSIMD_EXIT_RUNTIME;
     }
-    n = lag_net_filter_suffixes(u->command_port, host_only, with_marker, 2, requests, 1, ferr,
-                                sizeof ferr);
-    if (n <= 0) {
-        snprintf(err, errlen, "%s", n < 0 ? ferr : "the receive socket went away");
+    if (lag_net_filter_fd(b->rx_in.fd, host_only, with_marker, 2, NULL, 0, NULL, 0, ferr,
+                          sizeof ferr) != 0) {
+        snprintf(err, errlen, "%s", ferr);
         return LAGSIMD_EXIT_RUNTIME;
     }
-    return LAGSIMD_EXIT_OK;
+    return open_foreign(b, err, errlen);
 }
 
 /* Before the daemon publishes anything: filters the state URL's receive socket to _SCENE
@@ -350,15 +371,18 @@ static void rx_foreign_out(void *ctx, const char *ch, const uint8_t *data, size_
 }
 
 /* udpm://: the plant's two receive sockets (rt_rx.h): _COMMAND and _CONTROL on the command
- * URL; the plant watch (_SCENE, and _COMMAND sent to the wrong port) on the state URL. */
+ * URL; the plant watch (_SCENE, and _COMMAND sent to the wrong port) on the state URL (the
+ * third, other prefixes' requests on the command URL, comes with the start: open_foreign). */
 static int open_receivers(rt_bus *b, char *err, size_t errlen)
 {
     const lag_bus *u = &b->urls;
     lag_url url;
     long rcvbuf = lag_url_parse(u->state_url, LAG_URL_SCENE_RULES | LAG_URL_ALLOW_LAN, &url,
                                 err, errlen) == 0 ? url.recv_buf_size : 0;
-    b->rx_in = (rt_rx){-1, 2, {"", ""}, {rx_command, rx_control}, rx_foreign_in, b, 0};
-    b->rx_watch = (rt_rx){-1, 2, {"", ""}, {rx_scene, rx_wrong_port}, rx_foreign_out, b, 0};
+    b->rcvbuf = rcvbuf;
+    b->rx_in = (rt_rx){-1, 2, {"", ""}, {rx_command, rx_control}, NULL, b, 0, 0};
+    b->rx_watch = (rt_rx){-1, 2, {"", ""}, {rx_scene, rx_wrong_port}, rx_foreign_out, b, 0, 0};
+    b->rx_foreign = (rt_rx){-1, 0, {"", ""}, {NULL, NULL}, rx_foreign_in, b, 0, 0};
     snprintf(b->rx_in.ch[0], sizeof b->rx_in.ch[0], "%s", b->ch_command);
     snprintf(b->rx_in.ch[1], sizeof b->rx_in.ch[1], "%s", b->ch_control);
     snprintf(b->rx_watch.ch[0], sizeof b->rx_watch.ch[0], "%s", b->ch_scene);
@@ -373,7 +397,7 @@ int rt_bus_open_start(rt_bus *b, const rt_bus_handlers *h, char *err, size_t err
 {
     const lag_bus *u = &b->urls;
     lag_net_note_inherited(); /* a parent's sockets are not filtered */
-    b->rx_in.fd = b->rx_watch.fd = -1;
+    b->rx_in.fd = b->rx_watch.fd = b->rx_foreign.fd = -1;
     /* udpm: two publishers (no subscription: LCM makes no thread for them) and the plant's
      * own receive sockets; memq://: one lcm_t, LCM's subscriptions */
     lcm_t *out = lcm_create(u->state_url);
@@ -405,17 +429,25 @@ int rt_bus_open_start(rt_bus *b, const rt_bus_handlers *h, char *err, size_t err
     return rc;
 }
 
-int rt_bus_fd(const rt_bus *b, bool watch)
+/* The socket of `which` (udpm://). */
+static const rt_rx *rx_of(const rt_bus *b, rt_bus_input which)
 {
-    if (b->urls.udpm) return watch ? b->rx_watch.fd : b->rx_in.fd;
-    return watch || !b->lcm_in ? -1 : lcm_get_fileno(b->lcm_in);
+    return which == RT_BUS_WATCH ? &b->rx_watch : which == RT_BUS_FOREIGN ? &b->rx_foreign
+                                                                           : &b->rx_in;
 }
 
-int rt_bus_read(rt_bus *b, bool watch, int max)
+int rt_bus_fd(const rt_bus *b, rt_bus_input which)
 {
-    if (b->urls.udpm) return rt_rx_read(watch ? &b->rx_watch : &b->rx_in, max);
+    if (b->urls.udpm) return rx_of(b, which)->fd;
+    return which != RT_BUS_IN || !b->lcm_in ? -1 : lcm_get_fileno(b->lcm_in);
+}
+
+int rt_bus_read(rt_bus *b, rt_bus_input which, int max)
+{
+    if (b->urls.udpm) return rt_rx_read((rt_rx *)rx_of(b, which), max);
     int n = 0;
-    while (!watch && b->lcm_in && n < max && lcm_handle_timeout(b->lcm_in, 0) > 0) n++;
+    while (which == RT_BUS_IN && b->lcm_in && n < max && lcm_handle_timeout(b->lcm_in, 0) > 0)
+        n++;
     return n;
 }
 
@@ -487,6 +519,7 @@ void rt_bus_close(rt_bus *b)
     rt_bus_detach(b);
     rt_rx_close(&b->rx_in);
     rt_rx_close(&b->rx_watch);
+    rt_rx_close(&b->rx_foreign);
     if (b->lcm_in && b->lcm_in != b->lcm) lcm_destroy(b->lcm_in);
     if (b->lcm) lcm_destroy(b->lcm);
     b->lcm = b->lcm_in = NULL;

@@ -22,7 +22,13 @@
 
 #define RT_CHANNEL_MAX LAG_BUS_CHANNEL_LEN /* prefix (< 64) + "_COMMAND" */
 #define RT_BUF_SIZE LAG_WIRE_BUF_SIZE      /* encode buffer: holds any message */
-#define RT_SCENES_KEPT 8 /* the last scenes published, to tell them from another plant's */
+/* The last scenes published, to tell them from another plant's when they are heard back on
+ * the plant watch: enough for every scene the buckets let out in RT_SCENE_ECHO_S seconds
+ * (a flood of SET and RESET publishes a new generation's scene for each within their
+ * buckets, a burst of them in one pass; rt_control.c checks the bound), far longer than
+ * a datagram looped back by this host takes to be read. */
+#define RT_SCENES_KEPT 1024
+#define RT_SCENE_ECHO_S 4
 
 /* What the loop does with a message: a command, a control request, a scene heard on the
  * state URL (see rt_bus_foreign_scene). */
@@ -46,6 +52,10 @@ typedef struct rt_bus {
     rt_rx rx_in;               /* udpm: _COMMAND and _CONTROL, read by the loop (rt_rx.h) */
     rt_rx rx_watch;            /* udpm: the plant watch on the state URL: _SCENE, and
                                 * _COMMAND sent to the wrong port */
+    rt_rx rx_foreign;          /* udpm: other prefixes' _CONTROL on the command URL, apart
+                                * from the plant's own input (read within a budget of its
+                                * own) */
+    long rcvbuf;               /* the URL's recv_buf_size (0: the system's) */
     lcm_subscription_t *sub_command, *sub_control;
     lcm_subscription_t *sub_scene; /* _SCENE on the state URL: another plant's (plant watch) */
     lcm_subscription_t *sub_wrong_port; /* _COMMAND on the state URL: counted, not applied */
@@ -99,12 +109,14 @@ int rt_bus_open(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen);
 int rt_bus_open_start(rt_bus *b, const rt_bus_handlers *h, char *err, size_t errlen);
 int rt_bus_open_finish(rt_bus *b, char *err, size_t errlen);
 void rt_bus_close(rt_bus *b);
-/* What the loop waits on: the descriptor of the input (watch false) or of the plant watch
- * (-1: none: memq's watch). */
-int rt_bus_fd(const rt_bus *b, bool watch);
-/* Reads at most max messages of the input or the plant watch, handing each to the
- * handlers. Returns the number read (0: nothing waiting). */
-int rt_bus_read(rt_bus *b, bool watch, int max);
+/* What the loop reads: the plant's own input (its commands and control requests), the
+ * plant watch (the state URL), other prefixes' requests on the command URL. */
+typedef enum rt_bus_input { RT_BUS_IN = 0, RT_BUS_WATCH, RT_BUS_FOREIGN } rt_bus_input;
+/* What the loop waits on: the descriptor of `which` (-1: none: memq's watch and foreign). */
+int rt_bus_fd(const rt_bus *b, rt_bus_input which);
+/* Reads at most max messages of `which`, handing each to the handlers. Returns the number
+ * read (0: nothing waiting). */
+int rt_bus_read(rt_bus *b, rt_bus_input which, int max);
 
 /* FNV-1a, 64 bits: how a published scene is remembered. */
 uint64_t rt_bus_hash(const uint8_t *data, size_t len);

@@ -10,6 +10,13 @@
 #include "rt_command.h"
 #include "lagsim/lagsim_control_t.h"
 
+/* every scene the buckets let out in RT_SCENE_ECHO_S is remembered until heard back (a
+ * new generation's: SET's and RESET's buckets; an answer to DESCRIBE: the scene bucket) */
+_Static_assert(RT_SCENES_KEPT >= RT_SET_BURST + RT_RESET_BURST + RT_SCENE_BURST +
+                                     RT_SCENE_ECHO_S * (RT_SET_PER_S + RT_RESET_PER_S +
+                                                        RT_SCENE_PER_S),
+               "the scenes published are remembered long enough to be known when heard back");
+
 const char *rt_run_name(rt_run r)
 {
     switch (r) {

@@ -9,31 +9,44 @@
 
 #include <lcm/lcm.h>
 
-/* The buckets of the limited events (rt_ev): name, answers per second, burst. */
+/* The buckets of the limited events (rt_ev): name, answers per second, burst; and whether
+ * the kind says the plant lost something (a command refused, its controller's silence,
+ * periods, input, effects): -q's journal keeps those (rt_term.h). */
 static const struct {
     const char *kind;
     double per_s;
     int burst;
+    bool loss;
 } ev_limits[RT_EV_COUNT] = {
-    [RT_EV_COMMAND_REJECTED] = {"command_rejected", 10, 10},
-    [RT_EV_CONTROL_REJECTED] = {"control_rejected", 10, 10},
+    [RT_EV_COMMAND_REJECTED] = {"command_rejected", 10, 10, true},
+    [RT_EV_CONTROL_REJECTED] = {"control_rejected", 10, 10, true},
     [RT_EV_PAUSE] = {"pause", 10, 10},
     [RT_EV_RESUME] = {"resume", 10, 10},
     [RT_EV_STEP] = {"step", 10, 10},
     [RT_EV_STEP_DONE] = {"step_done", 10, 10},
     [RT_EV_RESET] = {"reset", 10, 10},
-    [RT_EV_WATCHDOG_TRIP] = {"watchdog_trip", 10, 10},
+    [RT_EV_WATCHDOG_TRIP] = {"watchdog_trip", 10, 10, true},
     [RT_EV_WATCHDOG_CLEAR] = {"watchdog_clear", 10, 10},
-    [RT_EV_LOCKSTEP_TIMEOUT] = {"lockstep_timeout", 10, 10},
-    [RT_EV_OVERRUN_BURST] = {"overrun_burst", 1, 3},
-    [RT_EV_NUMERIC_FAULT] = {"numeric_fault", 10, 10},
-    [RT_EV_EVENTS_DROPPED] = {"events_dropped", 1, 3},
+    [RT_EV_LOCKSTEP_TIMEOUT] = {"lockstep_timeout", 10, 10, true},
+    [RT_EV_OVERRUN_BURST] = {"overrun_burst", 1, 3, true},
+    [RT_EV_NUMERIC_FAULT] = {"numeric_fault", 10, 10, true},
+    [RT_EV_EVENTS_DROPPED] = {"events_dropped", 1, 3, true},
     /* one in RT_CONFLICT_EVERY_S however many scenes a forger or a log player sends */
     [RT_EV_PLANT_CONFLICT] = {"plant_conflict", 1.0 / RT_CONFLICT_EVERY_S, 1},
-    [RT_EV_ERROR_ESTIMATE] = {"error_estimate", 1, 3},
-    [RT_EV_INPUT_LIMITED] = {"input_limited", 1, 3},
+    [RT_EV_ERROR_ESTIMATE] = {"error_estimate", 1, 3, true},
+    [RT_EV_INPUT_LIMITED] = {"input_limited", 1, 3, true},
+    [RT_EV_FOREIGN_LIMITED] = {"foreign_limited", 1, 3, true},
 };
 _Static_assert(sizeof ev_limits / sizeof ev_limits[0] == RT_EV_COUNT, "one bucket per rt_ev");
+_Static_assert(RT_EV_COUNT <= RT_TERM_LOSS_KINDS, "a journal slot per limited kind");
+
+/* The journal's slot of an event kind: its rt_ev when the table marks it a loss, else -1. */
+static int loss_slot(const char *kind)
+{
+    for (int k = 0; k < RT_EV_COUNT; k++)
+        if (ev_limits[k].loss && !strcmp(kind, ev_limits[k].kind)) return k;
+    return -1;
+}
 
 void rt_pub_init(rt_pub *p, rt_bus *bus, rt_record *rec, rt_term *term, const int64_t *now,
                  const lag_sim *sim)
@@ -68,7 +81,8 @@ void rt_pub_event_at(rt_pub *p, double sim_time, const char *kind, const char *j
     lag_wire_event m;
     rt_out o = out(p);
     rt_publish_event(&o, sim_time, p->sim->tick, kind, joint, value, detail, &m);
-    rt_term_event(p->term, *p->now, m.sim_time, m.kind, m.joint, m.value, m.detail, effect);
+    rt_term_event(p->term, *p->now, m.sim_time, m.kind, m.joint, m.value, m.detail, effect,
+                  p->term->quiet ? loss_slot(m.kind) : -1);
 }
 
 void rt_pub_event(rt_pub *p, const char *kind, const char *joint, double value,

@@ -45,6 +45,7 @@ typedef enum rt_ev {
     RT_EV_PLANT_CONFLICT,     /* a scene of another plant heard on this prefix while running */
     RT_EV_ERROR_ESTIMATE,     /* the live error estimate over the scene's budget per period */
     RT_EV_INPUT_LIMITED,      /* a host's plant: more input than it can use, reading paused */
+    RT_EV_FOREIGN_LIMITED,    /* other prefixes' requests on the command URL: budget spent */
     RT_EV_COUNT
 } rt_ev;
 

@@ -39,6 +39,8 @@ int rt_rx_open(rt_rx *r, const char *group, int port, long recv_buf, char *err, 
                        setsockopt(r->fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) == 0) &&
         (what = "SO_REUSEPORT",
          setsockopt(r->fd, SOL_SOCKET, SO_REUSEPORT, &one, sizeof one) == 0) &&
+        (what = "SO_RXQ_OVFL", /* the kernel's drops, with each datagram (r->lost) */
+         setsockopt(r->fd, SOL_SOCKET, SO_RXQ_OVFL, &one, sizeof one) == 0) &&
         (what = "SO_RCVBUF", recv_buf <= 0 || setsockopt(r->fd, SOL_SOCKET, SO_RCVBUF,
                                                          &(int){(int)recv_buf}, sizeof(int)) == 0) &&
         (what = "bind", bind(r->fd, (struct sockaddr *)&a, sizeof a) == 0) &&
@@ -68,9 +70,21 @@ static void hand_on(rt_rx *r, const uint8_t *d, size_t n)
     if (r->other) r->other(r->ctx, ch, payload, len);
 }
 
+/* The socket's drop count (SO_RXQ_OVFL) a datagram came with, into r->lost. */
+static void note_lost(rt_rx *r, struct msghdr *h)
+{
+    for (struct cmsghdr *c = CMSG_FIRSTHDR(h); c; c = CMSG_NXTHDR(h, c))
+        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
+            uint32_t n;
+            memcpy(&n, CMSG_DATA(c), sizeof n);
+            r->lost = n;
+        }
+}
+
 int rt_rx_read(rt_rx *r, int max)
 {
     static uint8_t buf[RT_RX_BATCH][RT_RX_DATAGRAM]; /* the loop's one thread reads */
+    static uint8_t ctl[RT_RX_BATCH][CMSG_SPACE(sizeof(uint32_t))];
     struct mmsghdr mm[RT_RX_BATCH];
     struct iovec iov[RT_RX_BATCH];
     int done = 0;
@@ -78,11 +92,16 @@ int rt_rx_read(rt_rx *r, int max)
         int want = max - done < RT_RX_BATCH ? max - done : RT_RX_BATCH;
         for (int k = 0; k < want; k++) {
             iov[k] = (struct iovec){buf[k], sizeof buf[k]};
-            mm[k] = (struct mmsghdr){.msg_hdr = {.msg_iov = &iov[k], .msg_iovlen = 1}};
+            mm[k] = (struct mmsghdr){.msg_hdr = {.msg_iov = &iov[k], .msg_iovlen = 1,
+                                                 .msg_control = ctl[k],
+                                                 .msg_controllen = sizeof ctl[k]}};
         }
         int got = recvmmsg(r->fd, mm, (unsigned)want, MSG_DONTWAIT, NULL);
         if (got <= 0) break;
-        for (int k = 0; k < got; k++) hand_on(r, buf[k], mm[k].msg_len);
+        for (int k = 0; k < got; k++) {
+            note_lost(r, &mm[k].msg_hdr);
+            hand_on(r, buf[k], mm[k].msg_len);
+        }
         done += got;
         if (got < want) break;
     }

@@ -40,6 +40,8 @@ typedef struct rt_rx {
     void (*other)(void *ctx, const char *channel, const uint8_t *data, size_t len);
     void *ctx;
     int64_t dropped;            /* datagrams not handed on (not LC02, another channel) */
+    int64_t lost;               /* datagrams the kernel dropped, its buffer full (as of the
+                                 * last datagram read: SO_RXQ_OVFL) */
 } rt_rx;
 
 /* Takes an LCM short message apart: its channel and payload (pointers into d). Returns

@@ -14,6 +14,13 @@
  * never wraps: the coordinates, and the commands accepted per second over the last
  * second, or "no controller" when no command is held (none yet since start or reset, or
  * the watchdog tripped).
+ *
+ * With -q no event line is printed but for the losses (the kinds rt_publish.c's table
+ * marks: the watchdog tripped, overruns, input left unread, commands refused, ...), which
+ * a journal must show: the first of a kind at once, then at most one line of that kind
+ * every RT_TERM_JOURNAL_S seconds, saying how many came since and in all, and the last:
+ *
+ *   lagsimd: ALICE: watchdog_trip: 4 more in 10.0 s (9 in all), the last at t = 31.200 s: ...
  */
 #include <stdio.h>
 #include <string.h>
@@ -39,10 +46,56 @@ void rt_term_init(rt_term *t, bool quiet, const char *ch_event, int64_t now)
     rt_limit_init(&t->lim_print, 20, 20, now);
 }
 
-void rt_term_event(rt_term *t, int64_t now, double sim_time, const char *kind,
-                   const char *joint, double value, const char *detail, bool effect)
+/* The journal's line of loss kind k: what came since its last line. */
+static void journal_line(rt_term *t, int64_t now, rt_term_loss *l)
 {
-    if (t->quiet) return;
+    if (l->pending == 1 && l->total == 1)
+        fprintf(stderr, "lagsimd: %s%s at t = %.3f s: %s\n", t->who, l->kind, l->t, l->detail);
+    else
+        fprintf(stderr, "lagsimd: %s%s: %lld more in %.1f s (%lld in all), the last at t = "
+                "%.3f s: %s\n", t->who, l->kind, (long long)l->pending,
+                (double)(now - l->line_ns) * 1e-9, (long long)l->total, l->t, l->detail);
+    fflush(stderr);
+    l->pending = 0;
+    l->line_ns = now > 0 ? now : 1;
+}
+
+static void journal(rt_term *t, int64_t now, int k, double sim_time, const char *kind,
+                    const char *detail)
+{
+    if (k < 0 || k >= RT_TERM_LOSS_KINDS) return;
+    rt_term_loss *l = &t->loss[k];
+    l->pending++;
+    l->total++;
+    l->t = sim_time;
+    snprintf(l->kind, sizeof l->kind, "%s", kind);
+    snprintf(l->detail, sizeof l->detail, "%s", detail ? detail : "");
+    if (!l->line_ns || now - l->line_ns >= (int64_t)RT_TERM_JOURNAL_S * RT_NS_PER_S)
+        journal_line(t, now, l);
+}
+
+void rt_term_tick(rt_term *t, int64_t now)
+{
+    for (int k = 0; t->quiet && k < RT_TERM_LOSS_KINDS; k++) {
+        rt_term_loss *l = &t->loss[k];
+        if (l->pending > 0 && now - l->line_ns >= (int64_t)RT_TERM_JOURNAL_S * RT_NS_PER_S)
+            journal_line(t, now, l);
+    }
+}
+
+void rt_term_flush(rt_term *t, int64_t now)
+{
+    for (int k = 0; t->quiet && k < RT_TERM_LOSS_KINDS; k++)
+        if (t->loss[k].pending > 0) journal_line(t, now, &t->loss[k]);
+}
+
+void rt_term_event(rt_term *t, int64_t now, double sim_time, const char *kind,
+                   const char *joint, double value, const char *detail, bool effect, int loss)
+{
+    if (t->quiet) {
+        journal(t, now, loss, sim_time, kind, detail);
+        return;
+    }
     int64_t suppressed = t->lim_print.suppressed;
     if (!rt_limit_take(&t->lim_print, now)) return;
     t->lim_print.suppressed = 0;

@@ -25,8 +25,22 @@ typedef struct rt_term_view {
     const char *run;        /* the run state's name */
 } rt_term_view;
 
+/* -q's journal: the kinds of event that say the plant lost something (rt_publish.c's
+ * table marks them), a line per kind at most every RT_TERM_JOURNAL_S with the count. */
+#define RT_TERM_LOSS_KINDS 24
+#define RT_TERM_JOURNAL_S 10
+
+typedef struct rt_term_loss {
+    int64_t pending;        /* events since the last line */
+    int64_t total;
+    int64_t line_ns;        /* when its last line was printed (0: never) */
+    double t;               /* the last one's sim time */
+    char kind[32];
+    char detail[256];       /* the last one's */
+} rt_term_loss;
+
 typedef struct rt_term {
-    bool quiet;             /* -q: no event lines, no live line */
+    bool quiet;             /* -q: no event lines, no live line; the losses' journal */
     const char *who;        /* what the event lines begin with after "lagsimd: ": "" for a
                              * daemon of one plant, "ALICE: " for a host's plant */
     bool live_line;         /* stderr is a terminal and not -q */
@@ -38,15 +52,24 @@ typedef struct rt_term {
     int nsnap, next_snap;
     rt_limit lim_print;     /* event lines printed */
     bool line_shown;        /* the live line is on screen (cleared before a print) */
+    rt_term_loss loss[RT_TERM_LOSS_KINDS];
 } rt_term;
 
 /* At the loop's clock `now`: at most 20 event lines a second. */
 void rt_term_init(rt_term *t, bool quiet, const char *ch_event, int64_t now);
 /* Without -q every event goes to stderr on its own line (at most 20 a second, the rest
  * counted); on a terminal one live line below them: sim time, RTF, q, commands per second
- * or "no controller", energy, overruns, run state. */
+ * or "no controller", energy, overruns, run state. With -q an event that says the plant
+ * lost something (`loss`: its kind's slot, below RT_TERM_LOSS_KINDS; -1: not such an
+ * event) still goes to the journal: the first of its kind at once, then one line per
+ * RT_TERM_JOURNAL_S with how many came (rt_term_tick, rt_term_flush). */
 void rt_term_event(rt_term *t, int64_t now, double sim_time, const char *kind,
-                   const char *joint, double value, const char *detail, bool effect);
+                   const char *joint, double value, const char *detail, bool effect, int loss);
+/* -q: the journal's lines due at `now` (a kind whose interval is over with events
+ * pending). */
+void rt_term_tick(rt_term *t, int64_t now);
+/* -q: every pending count said (the plant ends). */
+void rt_term_flush(rt_term *t, int64_t now);
 void rt_term_line(rt_term *t, int64_t now, bool final);
 /* One line of the daemon's own (not an event) on stderr, the live line kept below it;
  * nothing with -q. */

@@ -138,29 +138,26 @@ void rt_publish_event(const rt_out *o, double sim_time, int64_t step, const char
     publish(o, o->bus->ch_event, LAG_WIRE_EVENT, m);
 }
 
-int rt_publish_scene(const rt_out *o, const lag_scene *sc, const lag_sim *sim,
-                      const lag_model_info *info)
+void rt_scene_fill(lag_wire_scene *mp, const lag_scene *sc, const lag_sim_def *d, int nq,
+                   const lag_model_info *info)
 {
-    const lag_sim_def *d = &sim->def; /* the parameters and effects now (SET changes them) */
-    lag_wire_scene m;
-    memset(&m, 0, sizeof m);
-    m.utime = lag_clock_wall_us();
-    PUT(m.model, lag_model_info_get(sc->sim.model.kind)->name); /* the scene's model; its joints are info's */
-    PUT(m.prefix, sc->lcm.prefix);
-    m.num_params = (int16_t)info->np;
+    memset(mp, 0, sizeof *mp);
+    PUT(mp->model, lag_model_info_get(sc->sim.model.kind)->name); /* the scene's model; its joints are info's */
+    PUT(mp->prefix, sc->lcm.prefix);
+    mp->num_params = (int16_t)info->np;
     for (int i = 0; i < info->np; i++) {
-        PUT(m.param_name[i], info->param_names[i]);
-        m.param_value[i] = fin(d->model.p[i]);
+        PUT(mp->param_name[i], info->param_names[i]);
+        mp->param_value[i] = fin(d->model.p[i]);
     }
-    m.num_joints = (int16_t)sim->nq;
-    for (int i = 0; i < sim->nq; i++) {
-        PUT(m.joint_name[i], info->joint_names[i]);
-        m.actuated[i] = info->actuated[i];
-        m.initial_q[i] = fin(d->q0[i]);
-        m.initial_qd[i] = fin(d->qd0[i]);
-        m.limit_on[i] = (d->effects.enabled & LAG_EFF_LIMITS) && d->effects.limit_on[i];
-        m.limit_lower[i] = m.limit_on[i] ? fin(d->effects.limit_lower[i]) : 0.0;
-        m.limit_upper[i] = m.limit_on[i] ? fin(d->effects.limit_upper[i]) : 0.0;
+    mp->num_joints = (int16_t)nq;
+    for (int i = 0; i < nq; i++) {
+        PUT(mp->joint_name[i], info->joint_names[i]);
+        mp->actuated[i] = info->actuated[i];
+        mp->initial_q[i] = fin(d->q0[i]);
+        mp->initial_qd[i] = fin(d->qd0[i]);
+        mp->limit_on[i] = (d->effects.enabled & LAG_EFF_LIMITS) && d->effects.limit_on[i];
+        mp->limit_lower[i] = mp->limit_on[i] ? fin(d->effects.limit_lower[i]) : 0.0;
+        mp->limit_upper[i] = mp->limit_on[i] ? fin(d->effects.limit_upper[i]) : 0.0;
     }
     /* the effects that are on, by their scene-file names from the core's table, in the
      * order of their bits */
@@ -168,16 +165,25 @@ int rt_publish_scene(const rt_out *o, const lag_scene *sc, const lag_sim *sim,
     for (int b = 0; b < 32; b++)
         for (int k = 0; k < LAG_EFF_COUNT; k++) {
             lag_effect_info e = lag_effect_info_get(k);
-            if (e.bit == (1u << b) && (d->effects.enabled & e.bit) && ne < sizeof m.effects)
-                ne += (size_t)snprintf(m.effects + ne, sizeof m.effects - ne, "%s%s",
+            if (e.bit == (1u << b) && (d->effects.enabled & e.bit) && ne < sizeof mp->effects)
+                ne += (size_t)snprintf(mp->effects + ne, sizeof mp->effects - ne, "%s%s",
                                        ne ? "," : "", e.name);
         }
-    m.dt = fin(d->integrator.dt);
-    m.control_period = fin((double)sc->ticks_per_period * d->integrator.dt);
-    PUT(m.integrator, lag_method_name(d->integrator.method));
-    PUT(m.mode, lag_rt_mode_name(sc->realtime.mode));
-    m.rate = fin(sc->realtime.rate);
-    m.command_timeout = fin(sc->realtime.command_timeout);
+    mp->dt = fin(d->integrator.dt);
+    mp->control_period = fin((double)sc->ticks_per_period * d->integrator.dt);
+    PUT(mp->integrator, lag_method_name(d->integrator.method));
+    PUT(mp->mode, lag_rt_mode_name(sc->realtime.mode));
+    mp->rate = fin(sc->realtime.rate);
+    mp->command_timeout = fin(sc->realtime.command_timeout);
+}
+
+int rt_publish_scene(const rt_out *o, const lag_scene *sc, const lag_sim *sim,
+                      const lag_model_info *info)
+{
+    lag_wire_scene m;
+    /* the parameters and effects now (SET changes them) */
+    rt_scene_fill(&m, sc, &sim->def, sim->nq, info);
+    m.utime = lag_clock_wall_us();
     m.generation = o->generation;
     int n = publish(o, o->bus->ch_scene, LAG_WIRE_SCENE, &m);
     /* remembered, so that the plant watch knows it when it comes back */

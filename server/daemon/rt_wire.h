@@ -49,6 +49,10 @@ int rt_publish_status(const rt_out *o, lag_wire_status *m);
 /* An event at sim_time, at tick `step`; m: the event as sent (what the terminal shows). */
 void rt_publish_event(const rt_out *o, double sim_time, int64_t step, const char *kind,
                       const char *joint, double value, const char *detail, lag_wire_event *m);
+/* The scene message of scene sc with definition d (nq joints): all but utime and the
+ * generation (the replay compares it with the scene a log holds). */
+void rt_scene_fill(lag_wire_scene *m, const lag_scene *sc, const lag_sim_def *d, int nq,
+                   const lag_model_info *info);
 /* The scene as it is now (SET changes the sim's definition), remembered by the plant
  * watch (rt_bus_sent_scene). Returns its bytes, as sent, in o->bus->buf (0: not sent). */
 int rt_publish_scene(const rt_out *o, const lag_scene *sc, const lag_sim *sim,

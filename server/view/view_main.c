@@ -20,6 +20,7 @@
 
 #include "lagsim_bus.h"
 #include "lagsim_client.h"
+#include "lagsim_locate.h"
 #include "view.h"
 
 static void usage(FILE *f)
@@ -199,15 +200,6 @@ static int block_signals(void)
     return sig_fd;
 }
 
-/* Whether a plant heard on LCM's default bus runs on another URL (a host's plant: its
- * directory names its URL). */
-static bool elsewhere(const char *url)
-{
-    lag_bus b;
-    char err[64];
-    return lag_bus_init(&b, NULL, "X", err, sizeof err) == 0 && strcmp(b.state_url, url) != 0;
-}
-
 /* Without --prefix: the only plant on the bus; none yet: DIPC, watched until it comes.
  * GO_ON, else the result to exit with. */
 static int pick_prefix(view_opts *o)
@@ -221,7 +213,7 @@ static int pick_prefix(view_opts *o)
     }
     if (pr == LAG_CLIENT_OK) {
         o->prefix = found.prefix;
-        if (!o->url && elsewhere(found.url)) o->url = found.url; /* a host's plant */
+        if (!o->url && lag_locate_elsewhere(found.url)) o->url = found.url; /* a host's plant */
     } else {
         o->prefix = "DIPC";
         fprintf(stderr, "lagsim-view: %s; watching prefix %s\n", err, o->prefix);
@@ -234,19 +226,8 @@ static int pick_prefix(view_opts *o)
  * watches the plant there. A plant of that bus itself, or none heard: the default. */
 static void plant_url(view_opts *o)
 {
-    static lag_client_plant all[LAG_CLIENT_MAX_PLANTS];
-    static char url[sizeof all[0].url];
-    char err[256];
-    int n = 0;
-    if (o->url || lag_client_discover(NULL, 1.0, 0.3, all, LAG_CLIENT_MAX_PLANTS, sizeof all[0],
-                                      &n, err, sizeof err) != LAG_CLIENT_OK)
-        return;
-    for (int i = 0; i < n; i++)
-        if (!strcmp(all[i].prefix, o->prefix) && elsewhere(all[i].url)) {
-            snprintf(url, sizeof url, "%s", all[i].url);
-            o->url = url;
-            return;
-        }
+    static char url[LAG_CLIENT_URL_LEN];
+    if (!o->url && lag_locate_plant(o->prefix, url, sizeof url)) o->url = url;
 }
 
 /* The address on stdout; on stderr, who can reach it. */

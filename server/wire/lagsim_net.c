@@ -97,16 +97,25 @@ static void emit_suffixes(prog *p, const char *const *suffixes, int ns)
     emit(p, BPF_RET | BPF_K, 0, 0, 0);
 }
 
-/* The whole program: [from this host] LC02, one of the channels or a channel ending in
- * one of the suffixes; else drop. Every jump is short (a drop next to what fails), but the
- * suffixes' jumps to their compares (BPF_JA takes 32 bits). */
+/* Emits: if the channel at OFF_CHANNEL is `name` (with its NUL), drop; else fall through. */
+static void emit_drop_channel(prog *p, const char *name)
+{
+    emit_compares(p, (const uint8_t *)name, strlen(name) + 1, OFF_CHANNEL, false, 1);
+    emit(p, BPF_RET | BPF_K, 0, 0, 0);
+}
+
+/* The whole program: [from this host] LC02, none of the `except` channels, one of the
+ * channels or a channel ending in one of the suffixes; else drop. Every jump is short (a
+ * drop next to what fails), but the suffixes' jumps to their compares (BPF_JA takes 32
+ * bits). */
 static int build(prog *p, bool host_only, const char *const *channels, int n,
-                 const char *const *suffixes, int ns, char *err, size_t errlen)
+                 const char *const *suffixes, int ns, const char *const *except, int ne,
+                 char *err, size_t errlen)
 {
     p->n = 0;
-    for (int i = 0; i < n + ns; i++) { /* a name the compares can hold; a suffix LCM can */
-        const char *name = i < n ? channels[i] : suffixes[i - n];
-        if (strlen(name) > (i < n ? 64 + 8 : MAX_CHANNEL - 1) || !name[0]) {
+    for (int i = 0; i < n + ns + ne; i++) { /* a name the compares can hold; a suffix LCM can */
+        const char *name = i < n ? channels[i] : i < n + ns ? suffixes[i - n] : except[i - n - ns];
+        if (strlen(name) > (i < n || i >= n + ns ? 64 + 8 : MAX_CHANNEL - 1) || !name[0]) {
             snprintf(err, errlen, "channel name '%s' too long for the filter", name);
             return -1;
         }
@@ -123,6 +132,7 @@ static int build(prog *p, bool host_only, const char *const *channels, int n,
     emit(p, BPF_LD | BPF_W | BPF_ABS, 0, 0, OFF_MAGIC);
     emit(p, BPF_JMP | BPF_JEQ | BPF_K, 1, 0, LCM_MAGIC_SHORT);
     emit(p, BPF_RET | BPF_K, 0, 0, 0);
+    for (int i = 0; i < ne; i++) emit_drop_channel(p, except[i]);
     for (int i = 0; i < n; i++) emit_channel(p, channels[i]);
     if (ns > 0) emit_suffixes(p, suffixes, ns);
     else emit(p, BPF_RET | BPF_K, 0, 0, 0);
@@ -219,7 +229,7 @@ int lag_net_filter_suffixes(int port, bool host_only, const char *const *channel
         return -1;
     }
     static prog p; /* one thread sets filters, at start */
-    if (build(&p, host_only, channels, n, suffixes, ns, err, errlen) < 0) return -1;
+    if (build(&p, host_only, channels, n, suffixes, ns, NULL, 0, err, errlen) < 0) return -1;
     attach a = {{(unsigned short)p.n, p.in}, 0};
     int rc = each_udp_socket(port, attach_one, &a);
     if (rc < 0) {
@@ -232,6 +242,26 @@ int lag_net_filter_suffixes(int port, bool host_only, const char *const *channel
         return -1;
     }
     return a.found;
+}
+
+int lag_net_filter_fd(int fd, bool host_only, const char *const *channels, int n,
+                      const char *const *suffixes, int ns, const char *const *except, int ne,
+                      char *err, size_t errlen)
+{
+    if (n < 0 || n > LAG_NET_MAX_FILTER_CHANNELS || ns < 0 || ns > LAG_NET_MAX_FILTER_CHANNELS ||
+        ne < 0 || ne > LAG_NET_MAX_FILTER_CHANNELS || n + ns < 1) {
+        snprintf(err, errlen, "filter: 0 to %d channels, suffixes and exceptions each, a "
+                 "channel or a suffix at least", LAG_NET_MAX_FILTER_CHANNELS);
+        return -1;
+    }
+    static prog p; /* one thread sets filters */
+    if (build(&p, host_only, channels, n, suffixes, ns, except, ne, err, errlen) < 0) return -1;
+    struct sock_fprog fp = {(unsigned short)p.n, p.in};
+    if (setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &fp, sizeof fp) != 0) {
+        snprintf(err, errlen, "cannot attach a socket filter (descriptor %d)", fd);
+        return -1;
+    }
+    return 0;
 }
 
 /* ---------------------------------------------------------------- sync */

@@ -47,6 +47,14 @@ int lag_net_filter(int port, bool host_only, const char *const *channels, int n,
 int lag_net_filter_suffixes(int port, bool host_only, const char *const *channels, int n,
                             const char *const *suffixes, int ns, char *err, size_t errlen);
 
+/* The filter of lag_net_filter_suffixes on one socket of the caller's own (fd), with the
+ * `except` channels (exact names) dropped before anything is kept: a socket for every
+ * prefix's requests but this plant's own. n may be 0 when ns is not. Returns 0, or -1
+ * with a message in err. */
+int lag_net_filter_fd(int fd, bool host_only, const char *const *channels, int n,
+                      const char *const *suffixes, int ns, const char *const *except, int ne,
+                      char *err, size_t errlen);
+
 /* Notes the UDP sockets this process has now, before it creates its LCM instances:
  * lag_net_filter leaves them alone (a parent that forked without close-on-exec shares
  * them, and a filter would cut the parent's own traffic). The first call notes; the later

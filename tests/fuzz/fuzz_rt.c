@@ -79,7 +79,7 @@ static counts g_c;
 static const char *const k_limited[RT_EV_COUNT] = {
     "command_rejected", "control_rejected", "pause", "resume", "step", "step_done", "reset",
     "watchdog_trip", "watchdog_clear", "lockstep_timeout", "overrun_burst", "numeric_fault",
-    "events_dropped", "plant_conflict", "error_estimate", "input_limited"};
+    "events_dropped", "plant_conflict", "error_estimate", "input_limited", "foreign_limited"};
 
 static void bad(const char *what)
 {

@@ -239,6 +239,24 @@ def case_lqr(r, a, tmp, effects=False):
     rp = r.lagsimd("--config", config, "--set", f"lcm.prefix={prefix}", "--set",
                    "parameters.m0=1.6", "--replay", log)
     check(rp.returncode == 1 and "FAILED" in rp.stderr, "the same log against another scene fails")
+    # ... an edited scene (a cart mass, the initial angles): the failure names each key that
+    # differs with both values, and the --set that gives the log's scene, which then passes
+    edited = ["--set", "parameters.m0=1.6", "--set", "initial.q=[0,0.07,-0.03]"]
+    rp = r.lagsimd("--config", config, "--set", f"lcm.prefix={prefix}", *edited, "--replay", log)
+    said = [l for l in rp.stderr.splitlines() if "differs from this one" in l]
+    m0 = re.search(r"parameters\.m0: log (\S+), here 1\.6", said[0]) if said else None
+    check(rp.returncode == 1 and m0 and "initial.q: log [" in said[0] and
+          "here [0,0.07,-0.03]" in said[0],
+          "the edited scene's failure names parameters.m0 and initial.q with both values: %s"
+          % (said[:1],))
+    sets = re.search(r"the log's scene is this one with: (.*)$", rp.stderr, re.M)
+    check(sets and ("--set parameters.m0=%s" % (m0.group(1) if m0 else "?")) in sets.group(1),
+          "... and says the --set that gives the log's scene: %s" % (sets.group(1) if sets else None))
+    if sets:
+        rp = r.lagsimd("--config", config, "--set", f"lcm.prefix={prefix}", *edited,
+                       *sets.group(1).split(), "--replay", log)
+        check(rp.returncode == 0, "the edited scene with that --set replays the log: exit %d"
+              % rp.returncode)
 
     if effects:
         # as lcm-logger records it: the bus only, no inputs

@@ -28,10 +28,23 @@ Cases:
               a stop, a start or a new generation; SIGTERM stops every plant (a stop event
               each), exit 0
   list        lagsimctl list through the host's directory: every plant with its own URL;
-              status through it, pause only on the plant's own URL; lagsim-view --prefix P
-              finds P's URL there; a plant on the directory's ports refused
+              status through it, pause without --url done on the URL it names; lagsim-view
+              --prefix P and a C controller (lqr_balance) find P's URL there; a controller
+              put on the directory's bus ends after its --timeout though the directory
+              keeps talking; a plant on the directory's ports refused
+  foreign     requests for another prefix (S2's STATUS, several thousand a second, as a
+              student polling on a copied URL) flooding the command ports of S1 (lockstep) and
+              S3 (real time), each under dipc_lqr, in a host beside S2, and of S1 in a daemon
+              of its own: S1's states bit for bit those of S1 alone and unflooded, every
+              command of each controller taken (no input_limited), the foreign requests
+              counted and limited (foreign_limited events)
+  own_flood   SET and RESET at about 270 a second on a plant's own prefix (one process): its
+              own scenes, heard back, are never taken for another plant's
+  quiet       a host with -q: a plant's watchdog trip and its input limited are on stderr,
+              each kind at most a line per 10 s with its count; no other event line
   many        120 plants in one process (LCM's receive path aborted it at about 85),
-              lagsimctl list naming each on its own pair, SIGTERM stopping all
+              lagsimctl list naming each on its own pair, the default list with no `?`
+              (it waits for the plants the directory named), SIGTERM stopping all
 """
 import argparse
 import fcntl
@@ -363,6 +376,198 @@ class T:
             self.budget_checks(hostile_log, seconds, sent)
 
 
+    # ------------------------------------------------------------------ foreign requests
+    def flood_other_prefix(self, bus, ports, until, rate=5000):
+        """STATUS requests for S2_CONTROL on the command port (P + 1) of each state port P of
+        `ports`, `rate` a second on each, until until() is true (a student who copied
+        another's URL, polling in a loop); returns how many were sent to each."""
+        from lagsim_lcm import LCM
+        lcs = [LCM(url(p + 1)) for p in ports]
+        m = self.t.control_t()
+        m.utime, m.request, m.count, m.key, m.value = 0, self.t.control_t.STATUS, 0, "", ""
+        m.num_joints, m.q, m.qd = 0, [], []
+        data, sent, t0 = m.encode(), 0, time.monotonic()
+        while not until():
+            due = int((time.monotonic() - t0) * rate)
+            while sent < due:
+                for lc in lcs:
+                    lc.publish("S2_CONTROL", data)
+                sent += 1
+            bus.pump(0.002)
+        print("  the flood: %d requests on each of %d ports in %.2f s" %
+              (sent, len(ports), time.monotonic() - t0), flush=True)
+        return sent
+
+    def foreign_checks(self, log, prefix, who):
+        """prefix's log (who: where it ran): no command of its controller dropped, the other
+        prefix's requests counted and limited."""
+        ev = [self.t.event_t.decode(d) for ch, d in read_log(log) if ch == prefix + "_EVENT"]
+        limited = [e for e in ev if e.kind == "input_limited"]
+        check(not limited, "%s %s: its own input never limited by the flood (%d input_limited%s)"
+              % (prefix, who, len(limited), (": " + limited[0].detail) if limited else ""))
+        foreign = [e for e in ev if e.kind == "foreign_limited"]
+        check(foreign and foreign[-1].value > 0 and "S2" in foreign[-1].detail,
+              "%s %s: the other prefix's requests counted and limited (foreign_limited: %s)" %
+              (prefix, who, foreign[-1].detail if foreign else "none"))
+        st = self.last_status(log, prefix)
+        check(st is not None and st.states_published > 100,
+              "%s %s: %s states, %s commands accepted (a real-time controller on a loaded "
+              "machine may miss periods of its own: not asserted)" %
+              (prefix, who, st and st.states_published, st and st.commands_accepted))
+
+    def foreign_host_run(self, d, base):
+        """A host of S1 (lockstep), S3 (real time), each under dipc_lqr, and S2; S1's and S3's
+        command ports flooded with S2's requests for 3 s. Returns S1's states."""
+        lab = os.path.join(d, "lab")
+        os.mkdir(lab)
+        open(os.path.join(lab, "s1.yaml"), "w").write(VICTIM)
+        open(os.path.join(lab, "s2.yaml"), "w").write(PLANT)
+        open(os.path.join(lab, "s3.yaml"), "w").write(VICTIM.replace("lockstep", "realtime"))
+        bus = Bus(self.t, [("S1", base), ("S2", base + 2), ("S3", base + 4)])
+        host = self.start([self.prog("lagsimd"), "--plants", lab, "--port-base", str(base),
+                           "-q", "--log", "run.lcm"], cwd=d)
+        ctls = [self.start([self.prog("dipc_lqr"), "-q", "--prefix", pre, "--url", url(port),
+                            "--timeout", "30"]) for pre, port in (("S1", base), ("S3", base + 4))]
+        check(bus.wait_event("S1", "start", 0, 10) and bus.wait_event("S3", "start", 0, 10),
+              "S1 and S3 start")
+        end = time.monotonic() + 3.0
+        self.flood_other_prefix(bus, [base, base + 4], lambda: time.monotonic() >= end)
+        host.send_signal(signal.SIGTERM)
+        rc, _ = self.finish(host)
+        for c in ctls:
+            self.finish(c)
+        check(rc == 0, "the host stops on SIGTERM with exit 0")
+        for pre in ("S1", "S3"):
+            self.foreign_checks(os.path.join(d, pre.lower(), "run.lcm"), pre, "in the host")
+        return self.states_of(os.path.join(d, "s1", "run.lcm"), "S1")
+
+    def foreign_alone_run(self, d, port, duration, flood):
+        """S1 alone in a daemon of its own to `duration` (flood: its command port flooded
+        with S2's requests meanwhile); returns its states and its log."""
+        path = os.path.join(d, "s1_alone.yaml")
+        open(path, "w").write(VICTIM)
+        log = os.path.join(d, "alone%d.lcm" % flood)
+        bus = Bus(self.t, [("S1", port)])
+        host = self.start([self.prog("lagsimd"), "--config", path, "--set", "lcm.prefix=S1",
+                           "--set", "lcm.url=" + url(port), "-q", "--duration", repr(duration),
+                           "--log", log])
+        ctl = self.start([self.prog("dipc_lqr"), "-q", "--prefix", "S1", "--url", url(port),
+                          "--timeout", "30"])
+        if flood:
+            self.flood_other_prefix(bus, [port], lambda: host.poll() is not None)
+        rc, _ = self.finish(host, 300)
+        self.finish(ctl)
+        check(rc == 0, "S1 alone%s runs to %g s, exit 0" % (" (flooded)" if flood else "", duration))
+        return self.states_of(log, "S1"), log
+
+    def case_foreign(self):
+        base = take_pairs(3)
+        with tempfile.TemporaryDirectory() as d:
+            host_states = self.foreign_host_run(d, base)
+            check(len(host_states) > 100, "S1 ran %d periods in the host" % len(host_states))
+            if not host_states:
+                return
+            last_t = host_states[-1][2]
+            alone, _ = self.foreign_alone_run(d, base, last_t, False)
+            flooded, flog = self.foreign_alone_run(d, base, last_t, True)
+            for what, states in (("in the host beside S2, flooded", host_states),
+                                 ("alone, flooded", flooded)):
+                n = min(len(alone), len(states))
+                first = next((k for k in range(n) if alone[k] != states[k]), None)
+                check(n == len(states) and len(states) > 100 and first is None,
+                      "S1's %d states %s are bit for bit those of S1 alone%s" % (
+                          len(states), what, "" if first is None else "; first difference at %d" % first))
+            self.foreign_checks(flog, "S1", "alone")
+
+    # ------------------------------------------------------------------ own flood
+    def case_own_flood(self):
+        """A student floods their own plant with SET and RESET (about 270 a second, one
+        process): every new generation's scene is heard back on the plant watch, and none
+        may be taken for another plant's (plant_conflict, "another plant publishes")."""
+        base = take_pairs(1)
+        with tempfile.TemporaryDirectory() as d:
+            lab = os.path.join(d, "lab")
+            os.mkdir(lab)
+            open(os.path.join(lab, "alice.yaml"), "w").write(PLANT)
+            bus = Bus(self.t, [("ALICE", base)])
+            host = self.start([self.prog("lagsimd"), "--plants", lab, "--port-base", str(base),
+                               "--log", "run.lcm"], cwd=d)
+            check(bus.wait_event("ALICE", "start", 0, 10), "ALICE starts")
+            from lagsim_lcm import LCM
+            cmd, C = LCM(url(base + 1)), self.t.control_t
+            sent, t0 = 0, time.monotonic()
+            while time.monotonic() - t0 < 3.0:
+                # in bursts of 54 every 0.2 s (a Python loop is bursty; a loaded loop
+                # reads a burst in one pass)
+                due = 54 * (1 + int((time.monotonic() - t0) / 0.2))
+                while sent < due:
+                    if sent % 2:
+                        self.control(cmd, "ALICE", C.RESET)
+                    else:
+                        self.control(cmd, "ALICE", C.SET, key="parameters.m0",
+                                     value="%.3f" % (1.0 + 0.001 * (sent % 100)))
+                    sent += 1
+                bus.pump(0.002)
+            bus.pump(1.0)
+            host.send_signal(signal.SIGTERM)
+            rc, err = self.finish_pumping(host, bus, 30)
+            log = os.path.join(d, "alice", "run.lcm")
+            ev = [self.t.event_t.decode(x) for ch, x in read_log(log) if ch == "ALICE_EVENT"]
+            gens = sum(1 for e in ev if e.kind in ("set", "reset"))
+            conflicts = [e for e in ev if e.kind == "plant_conflict"]
+            st = self.last_status(log, "ALICE")
+            check(gens > 50, "%d requests sent, %d new generations (set, reset events)" %
+                  (sent, gens))
+            check(not conflicts and "another plant" not in err,
+                  "no other plant said: %d plant_conflict events%s" % (
+                      len(conflicts), (" (" + conflicts[0].detail + ")") if conflicts else ""))
+            check(st is not None and st.plant_conflicts == 0,
+                  "status: plant_conflicts %s" % (st and st.plant_conflicts))
+            check(rc == 0, "SIGTERM: exit 0")
+
+    # ------------------------------------------------------------------ -q's journal
+    def case_quiet(self):
+        """A host with -q: a plant whose controller falls silent (the watchdog trips), then
+        floods it (its input budget is spent) says both on stderr, each kind in at most
+        one line per 10 s with its count, and nothing else of its events."""
+        base = take_pairs(1)
+        with tempfile.TemporaryDirectory() as d:
+            lab = os.path.join(d, "lab")
+            os.mkdir(lab)
+            open(os.path.join(lab, "alice.yaml"), "w").write(
+                PLANT.replace("start: running", "start: running, command_timeout: 0.2"))
+            bus = Bus(self.t, [("ALICE", base)])
+            host = self.start([self.prog("lagsimd"), "--plants", lab, "--port-base", str(base),
+                               "-q"])
+            check(bus.wait_event("ALICE", "start", 0, 10), "ALICE starts")
+            from lagsim_lcm import LCM
+            cmd = LCM(url(base + 1))
+            t0 = time.monotonic()
+            cmd.publish("ALICE_COMMAND", self.command("x", 0.5))
+            check(bus.wait_event("ALICE", "watchdog_trip", t0, 10), "its controller falls silent: "
+                  "the watchdog trips")
+            t1 = time.monotonic()
+            good = self.command("x", 0.0)
+            for k in range(20000):
+                cmd.publish("ALICE_COMMAND", good)
+                if k % 500 == 0:
+                    bus.pump(0)
+            check(bus.wait_event("ALICE", "input_limited", t1, 10), "flooded: its input is limited")
+            n_limited = len([e for e in bus.events("ALICE", t1) if e.kind == "input_limited"])
+            host.send_signal(signal.SIGTERM)
+            rc, err = self.finish_pumping(host, bus, 30)
+            lines = err.splitlines()
+            trip = [l for l in lines if l.startswith("lagsimd: ALICE: watchdog_trip")]
+            lim = [l for l in lines if l.startswith("lagsimd: ALICE: input_limited")]
+            check(len(trip) >= 1, "-q: the watchdog's trip is on stderr: %s" % trip[:1])
+            check(1 <= len(lim) <= 2 and n_limited > len(lim) and
+                  ("%d in all" % n_limited) in lim[-1],
+                  "-q: input_limited on stderr in %d line(s) for %d events, counted: %s" %
+                  (len(lim), n_limited, lim[-1:]))
+            check(not any(" event " in l for l in lines),
+                  "-q: no other event line (%s)" % [l for l in lines if " event " in l][:2])
+            check(rc == 0, "SIGTERM: exit 0")
+
     # ------------------------------------------------------------------ bad scenes
     def case_bad_scene(self):
         base = take_pairs(3)
@@ -580,8 +785,12 @@ class T:
                   "status through the directory: BOB's last status")
             p = self.ctl("--url", url(base + 2), "--prefix", "BOB", "pause")
             check(p.returncode == 0, "pause on BOB's own URL: exit 0")
-            p = self.ctl("--prefix", "ALICE", "--timeout", "1", "pause")
-            check(p.returncode == 3, "pause through the directory: not done there (exit 3)")
+            t0 = time.monotonic()
+            p = self.ctl("--prefix", "ALICE", "--timeout", "2", "pause")
+            st = self.ctl("--url", url(base), "--prefix", "ALICE", "status").stdout
+            check(p.returncode == 0 and "paused" in st,
+                  "pause without --url: the directory names ALICE's URL, the pause is done there")
+            self.controllers_through_directory(bus, base)
             view = self.start([self.prog("lagsim-view"), "--prefix", "CAROL", "--port", "0"],
                               stdout=subprocess.PIPE)
             line = view.stdout.readline()
@@ -597,6 +806,36 @@ class T:
                   "a plant on the directory's ports refused, said")
             check(rc == 0, "SIGTERM: exit 0")
 
+
+    def controllers_through_directory(self, bus, base):
+        """A C controller given --prefix without --url runs its host's plant on the URL the
+        directory names; one put on the directory itself (--url) ends after --timeout
+        though the directory keeps announcing the plant."""
+        t0 = time.monotonic()
+        ctl = self.start([self.prog("lqr_balance"), "--prefix", "CAROL", "--timeout", "3",
+                          "--duration", "1"], stdout=subprocess.PIPE)
+        out, _ = ctl.communicate(timeout=60)
+        rc, _ = self.finish(ctl, 5)
+        check(rc == 0 and ("prefix CAROL runs on %s" % url(base + 4)) in out,
+              "lqr_balance --prefix CAROL without --url: on CAROL's URL, exit %s (%s)" %
+              (rc, out.strip().splitlines()[:2]))
+        bus.pump(1.5)  # CAROL's status, once a second
+        st = [self.t.status_t.decode(d) for (w, ch, d) in bus.msgs if ch == "CAROL_STATUS"]
+        check(st and st[-1].commands_accepted > 0,
+              "CAROL took its commands (%s accepted)" % (st[-1].commands_accepted if st else None))
+        t0 = time.monotonic()
+        ctl = self.start([self.prog("lqr_balance"), "--prefix", "CAROL", "--url",
+                          url(self.directory), "--timeout", "2"], stdout=subprocess.PIPE)
+        try:
+            out, _ = ctl.communicate(timeout=20)
+        except subprocess.TimeoutExpired:
+            out = "(still running after 20 s)"
+        rc, _ = self.finish(ctl, 1)
+        took = time.monotonic() - t0
+        print(out)
+        check(took < 20 and "scene" in out and "silence" in out,
+              "a controller on the directory's bus gets CAROL's scene there but no state: its "
+              "--timeout 2 ends it (after %.1f s, exit %s)" % (took, rc))
 
     # ------------------------------------------------------------------ many plants
     def case_many(self):
@@ -621,6 +860,13 @@ class T:
             check(listed == {"P%03d" % k: url(base + 2 * k) for k in range(n)},
                   "lagsimctl list: all %d plants, each on its own port pair (%d listed)" %
                   (n, len(listed)))
+            # the default list waits for every plant the directory named to answer: no `?`
+            p = self.ctl("list")
+            rows = [l.split() for l in p.stdout.splitlines()[1:] if l.strip()]
+            unknown = [r[0] for r in rows if "?" in r[1:4]]
+            check(len(rows) == n and not unknown,
+                  "lagsimctl list (default wait): %d rows, none with `?` for model, mode or run "
+                  "state (%d with: %s)" % (len(rows), len(unknown), unknown[:5]))
             p = self.ctl("--url", url(base + 2 * (n - 1)), "--prefix", "P%03d" % (n - 1), "step", "3")
             check(p.returncode == 0 and "step_done" in p.stdout,
                   "the last plant answers on its own URL (step 3)")
