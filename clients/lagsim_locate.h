@@ -48,7 +48,7 @@ static inline void lag_locate_on(const lcm_recv_buf_t *rb, const char *channel, 
     lag_locate *l = user;
     static lag_wire_event ev; /* large: not on the stack */
     size_t n = strlen(l->prefix);
-    bool event = !strcmp(channel + n, "_EVENT");
+    bool event = !strcmp(channel + n, lag_bus_suffix(LAG_BUS_EVENT));
     if (!event) {
         l->found = -1; /* its state, status or scene: a plant of this bus */
         return;

@@ -151,9 +151,12 @@ void rt_log_rx_fate(rt_record *r, int64_t now, rt_rx_fate fate)
     r->rx_pending = false;
     size_t bytes = LAG_LOG_HEADER_SIZE + strlen(r->rx_channel) + r->rx_len;
     int64_t ts = log_clock(r, now);
+    /* written: counted as such only once the ring took it (a full ring's drop is the
+     * log's own count), so that the summary says what the log holds */
     if (fate == RT_RX_ACCEPTED) {
         r->rx_accepted++;
         if (!bucket_take(&r->accepted, ts, now, bytes)) return; /* counted only */
+        if (!rt_log_put(r->log, RT_LOG_IN, ts, r->rx_channel, r->rx_data, r->rx_len)) return;
         r->rx_accepted_written++;
         r->rx_accepted_bytes += (int64_t)bytes;
     } else {
@@ -161,10 +164,10 @@ void rt_log_rx_fate(rt_record *r, int64_t now, rt_rx_fate fate)
         else r->rx_refused++;
         if (fate == RT_RX_UNDECODABLE) r->rx_undecodable++;
         if (!bucket_take(&r->sample, ts, now, bytes)) return; /* counted only */
+        if (!rt_log_put(r->log, RT_LOG_IN, ts, r->rx_channel, r->rx_data, r->rx_len)) return;
         r->rx_sampled++;
         r->rx_sampled_bytes += (int64_t)bytes;
     }
-    rt_log_put(r->log, RT_LOG_IN, ts, r->rx_channel, r->rx_data, r->rx_len);
 }
 
 void rt_log_rx_end(rt_record *r, int64_t now) { rt_log_rx_fate(r, now, RT_RX_ACCEPTED); }

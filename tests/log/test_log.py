@@ -466,7 +466,9 @@ def case_flood(r, a, tmp):
     m = re.search(r"complete; received (\d+) refused commands and control requests \((\d+) "
                   r"undecodable\) and \d+ status or describe requests: (\d+) written as a sample, "
                   r"(\d+) counted only", err)  # the summary at exit
-    in_log = sum(1 for _, _, ch, _ in recs if ch == prefix + "_COMMAND")
+    # the sample holds the refused commands and the status request lagsimctl sent (waiting
+    # for the daemon to answer): every input record, _COMMAND and _CONTROL
+    in_log = sum(1 for _, _, ch, _ in recs if ch in (prefix + "_COMMAND", prefix + "_CONTROL"))
     check(m is not None and int(m.group(1)) == received
           and int(m.group(2)) == last.rejected_undecodable and int(m.group(3)) == in_log,
           "the summary on stderr: refused received (as the last status counts them), "
