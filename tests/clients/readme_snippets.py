@@ -340,7 +340,7 @@ def kill_daemon(a, name, path, daemon, snip, heard, listener):
     a.silence + 3 wall s of the last state heard here (the block's count starts at its own
     last message, which this listener may hear up to 0.5 s later on a loaded machine), and
     print end=silence if it prints an end. Returns (failures, {}, 0.0)."""
-    th, listening, lc, lc_cmd, stray = listener
+    th, th_cmd, listening, lc, lc_cmd, stray = listener
     deadline = time.monotonic() + 60
     while heard["states"] < a.kill_after and time.monotonic() < deadline and daemon.poll() is None:
         time.sleep(0.02)
@@ -357,6 +357,7 @@ def kill_daemon(a, name, path, daemon, snip, heard, listener):
         out += "\n(killed: did not exit %g s after the daemon died)" % (a.silence + 20)
     listening[0] = False
     th.join()
+    th_cmd.join()  # both readers ended before their LCM objects are closed
     lc.close()
     lc_cmd.close()
     stray.close()
@@ -504,7 +505,8 @@ def run_block(a, build, text, name, lang, think, fast_slowest=0.0):
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
     budget = 30 + 3 * think * periods  # three think times a state, and 30 s to start
     if a.kill_after > 0:
-        return kill_daemon(a, name, path, daemon, snip, heard, (th, listening, lc, lc_cmd, stray))
+        listener = (th, th_cmd, listening, lc, lc_cmd, stray)
+        return kill_daemon(a, name, path, daemon, snip, heard, listener)
     try:
         daemon.communicate(timeout=budget)
         in_time = True
