@@ -729,8 +729,12 @@ static int check_request(request *r)
                 r->nargs);
         for (int i = 0; i < r->nargs; i++)
             if (r->args[i][0] == '-') { /* an option after the command: say where it goes */
-                fprintf(stderr, " (options go before the command: lagsimctl %s %s)",
-                        r->args[i], cmd);
+                const char *a = r->args[i];
+                bool valued = !strchr(a, '=') && i + 1 < r->nargs &&
+                              strcmp(a, "--json") && strcmp(a, "-j") && strcmp(a, "--help") &&
+                              strcmp(a, "-h") && strcmp(a, "--version") && strcmp(a, "-V");
+                fprintf(stderr, " (options go before the command: lagsimctl %s%s%s %s)", a,
+                        valued ? " " : "", valued ? r->args[i + 1] : "", cmd);
                 break;
             }
         fputc('\n', stderr);

@@ -20,7 +20,8 @@ A real-time daemon on config/dipc.yaml with a prefix of its own; then, in order:
   set         parameters.m0=2.5: exit 0, `event set`, the scene with the new value; a value
               the loader refuses, or a key outside parameters and effects: exit 1, the reason
   usage       step 0, step abc, reset-to 1 2 3, an unknown command, kick without an
-              impulse or with a duration of 0, reset --sceen: exit 2, nothing sent
+              impulse or with a duration of 0, reset --sceen: exit 2, nothing sent; an option
+              after the command: the line to write instead, with its value
   no daemon   another prefix: exit 3 within the timeout
   watch       a daemon that runs 1 s and stops: states as lines, the stop event, exit 0
 """
@@ -209,6 +210,12 @@ def main():
             r = ctl(*bad)
             check(r.returncode == 2 and r.stderr.startswith("lagsimctl: "),
                   "usage error %s: exit 2 with a message" % bad)
+        # an option after the command: the command line to write instead, its value kept
+        r = subprocess.run([a.lagsimctl, "status", "--prefix", "OTHER"], stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, universal_newlines=True)
+        check(r.returncode == 2 and "lagsimctl --prefix OTHER status)" in r.stderr,
+              "status --prefix OTHER: exit 2, 'lagsimctl --prefix OTHER status' said (%s)"
+              % r.stderr.strip())
         t0 = time.monotonic()
         r = subprocess.run([a.lagsimctl, "--prefix", prefix + "_NONE", "--timeout", "0.5",
                             "status"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
