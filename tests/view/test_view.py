@@ -512,7 +512,10 @@ def case_history(a):
     cfg = os.path.join(os.path.dirname(a.config), "cartpole.yaml")
     rig = Rig(a, "VIEWR", cfg, ("initial.q=[0,0.3]", "initial.qd=[0,0]", "realtime.mode=fast"))
     try:
-        rig.wait_api(lambda s: s["bridge"]["states"] > 8000, 60, "8000 states")
+        # energies come with statuses (paced by the wall clock, not by the states): a fast
+        # run can send 8000 states before a second status, so both are waited for
+        rig.wait_api(lambda s: s["bridge"]["states"] > 8000 and s["bridge"]["statuses"] >= 4,
+                     60, "8000 states and 4 statuses")
         control(rig, "pause")
         rig.wait_api(lambda s: s["status"] and s["status"]["run_state"] == "paused", 10, "paused")
         time.sleep(0.5)
