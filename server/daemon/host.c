@@ -735,8 +735,9 @@ static bool failed_seen(host *h, const char *name, uint64_t hv, bool remember)
             if (remember) h->fail[i].hash = hv;
             return seen;
         }
-    if (remember && h->nfail < HOST_MAX_PLANTS) {
-        snprintf(h->fail[h->nfail].name, sizeof h->fail[0].name, "%s", name);
+    size_t n = strlen(name);
+    if (remember && h->nfail < HOST_MAX_PLANTS && n < sizeof h->fail[0].name) {
+        memcpy(h->fail[h->nfail].name, name, n + 1); /* a longer name is not remembered */
         h->fail[h->nfail++].hash = hv;
     }
     return false;

@@ -59,6 +59,7 @@
  * and exits 1.
  */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -580,12 +581,23 @@ static lag_wire_scene g_logged, g_here; /* large: not on the stack */
 
 /* One difference: "KEY: log A, here B" into the list, and "--set KEY=A" into the sets
  * when a --set can give it (set_key not NULL). */
+/* printf at the end of out (len its size), cut short when it is full */
+static void __attribute__((format(printf, 3, 4))) appendf(char *out, size_t len,
+                                                          const char *fmt, ...)
+{
+    size_t o = strlen(out);
+    if (o + 1 >= len) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(out + o, len - o, fmt, ap);
+    va_end(ap);
+}
+
 static void differ(char *out, size_t len, char *sets, size_t slen, const char *key,
                    const char *set_key, const char *logv, const char *herev)
 {
-    size_t o = strlen(out), s = strlen(sets);
-    if (o < len) snprintf(out + o, len - o, "%s%s: log %s, here %s", o ? "; " : "", key, logv, herev);
-    if (set_key && s < slen) snprintf(sets + s, slen - s, " --set %s=%s", set_key, logv);
+    appendf(out, len, "%s%s: log %s, here %s", out[0] ? "; " : "", key, logv, herev);
+    if (set_key) appendf(sets, slen, " --set %s=%s", set_key, logv);
 }
 
 /* A vector as a YAML flow sequence, each number exact. */
