@@ -29,24 +29,13 @@ they had never come; `hostile` (messages published) joins the summary's keys.
 import argparse
 import math
 import os
-import signal
 import subprocess
 import sys
 import threading
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import stop  # noqa: E402  (tests/common: SIGTERM, SIGKILL after a grace)
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-
-def stop(proc, grace=3.0):
-    if proc is None or proc.poll() is not None:
-        return
-    proc.send_signal(signal.SIGTERM)
-    try:
-        proc.wait(grace)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.wait()
 
 
 def parse_summary(text):
@@ -216,7 +205,7 @@ def main():
                 t_daemon_end = time.monotonic()
             cproc.wait(timeout=a.timeout)
         except subprocess.TimeoutExpired:
-            stop(cproc)
+            stop(cproc, 3.0)
             th.join(5.0)
             print("".join(lines))
             print("FAIL: the client did not finish within %g s" % a.timeout)
@@ -230,8 +219,8 @@ def main():
             fth.join(5.0)
         if wth:
             wth.join(5.0)
-        stop(cproc)
-        stop(dproc)
+        stop(cproc, 3.0)
+        stop(dproc, 3.0)
     out = "".join(lines)
     derr = dproc.stderr.read() if dproc and dproc.stderr else ""
     sys.stdout.write(out)

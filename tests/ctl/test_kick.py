@@ -42,20 +42,10 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, replay, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_log import read_log, write_log  # noqa: E402
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-fails = 0
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-    if not cond:
-        fails += 1
-    return cond
 
 
 def decode_state(data):
@@ -273,21 +263,6 @@ def main():
         check(v150b is not None and abs(2.0 * v150b + 0.5) <= 1e-12,
               "m x_dot after kick x -0.5 with m = 2: %r" % (None if v150b is None else 2 * v150b))
 
-    def replay(path):
-        return replay_cfg(cfg, prefix, path)
-
-    def replay_cfg(config, pre, path):
-        r = subprocess.run([lagsimd, "--config", config, "--set", "lcm.prefix=" + pre,
-                            "--replay", path], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                           universal_newlines=True, timeout=60)
-        print("$ lagsimd --replay %s   -> exit %d" % (os.path.basename(path), r.returncode))
-        print("  " + r.stdout.strip().replace("\n", "\n  "))
-        diff = None
-        for line in r.stdout.splitlines():
-            if line.startswith("max difference = "):
-                diff = float(line.split("=", 1)[1])
-        return r, diff
-
     # a run under control: the cart-pole balanced by lqr_balance in real time, kicked
     # twice while it runs (mid-run, efforts held), logged, then replayed
     cfg_cp = os.path.join(a.source, "config", "cartpole.yaml")
@@ -317,30 +292,29 @@ def main():
             if p.poll() is None:
                 p.kill()
                 p.wait()
-    r, diff = replay_cfg(cfg_cp, pcp, log_cp)
+    r, diff = replay(lagsimd, cfg_cp, pcp, log_cp)
     check(r.returncode == 0 and diff == 0.0 and "2 change(s) made while running" in r.stdout,
           "--replay of the controlled, kicked cart-pole: 2 kicks applied, difference exactly 0 "
           "(%r)" % diff)
     recs_cp = read_log(log_cp)
     bare_cp = os.path.join(tmp, "cartpole_no_events.lcm")
     write_log(bare_cp, [x for x in recs_cp if x[1] != pcp + "_EVENT"])
-    r, diff = replay_cfg(cfg_cp, pcp, bare_cp)
+    r, diff = replay(lagsimd, cfg_cp, pcp, bare_cp)
     check(r.returncode == 1 and diff is not None and diff > 0,
           "the same log without its events: difference %r, not 0" % diff)
 
     rules(lagsimd, ctl_bin, cfg, prefix + "R", tmp)
 
-    r, diff = replay(log)
+    r, diff = replay(lagsimd, cfg, prefix, log)
     check(r.returncode == 0 and diff == 0.0 and "7 change(s) made while running" in r.stdout,
           "--replay: 4 kicks, a set, a kicks_cleared and a restore applied (7), "
           "difference exactly 0 (%r)" % diff)
     bare = os.path.join(tmp, "no_events.lcm")
     write_log(bare, [x for x in recs if x[1] != prefix + "_EVENT"])
-    r, diff = replay(bare)
+    r, diff = replay(lagsimd, cfg, prefix, bare)
     check(r.returncode == 1, "the same log without its events does not replay exactly "
           "(exit %d, difference %r)" % (r.returncode, diff))
-    print("%d failure(s)" % fails)
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

@@ -33,18 +33,9 @@ import subprocess
 import sys
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-fails = 0
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-    if not cond:
-        fails += 1
-    return cond
 
 
 def tokens(line):
@@ -243,8 +234,7 @@ def main():
     check(w.returncode == 0 and stops, "watch: exit 0 after the daemon's stop event")
     check(len(states) >= 50 and all(len(tokens(s)) == 2 + 9 for s in states),
           "watch: %d state lines, each with t, step and 3 x (q, qd, effort)" % len(states))
-    print("%d failure(s)" % fails)
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

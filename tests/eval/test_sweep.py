@@ -98,6 +98,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import SKIP, check, verdict  # noqa: E402  (tests/common: the one harness)
+
 BIN, SRC, CASE = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2]), sys.argv[3]
 SCENE = os.path.join(SRC, "config", "cartpole.yaml")
 SWEEP = os.path.join(BIN, "lagsim-sweep")
@@ -105,13 +108,6 @@ CTRL = os.path.join(BIN, "lqr_balance") + " -q --prefix {prefix}"
 ARGS = ["--config", SCENE, "--controller", CTRL, "--duration", "8",
         "--vary", "parameters.m0=uniform(0.5,2)", "--vary", "parameters.m1=grid(0.05,0.3,4)",
         "--runs", "2", "--seed", "7", "--require", "theta.settle<6.5"]
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
 
 
 def run(cmd, **kw):
@@ -593,11 +589,11 @@ def case_kept_python(d):
 def case_loss(d):
     if os.geteuid() != 0 or not shutil.which("nft") or not shutil.which("ip"):
         print("skipped: needs root, ip and nft")
-        sys.exit(77)
+        sys.exit(SKIP)
     ns = "lgsweep%d" % os.getpid()
     if subprocess.run(["ip", "netns", "add", ns]).returncode != 0:
         print("skipped: cannot make a network namespace here")
-        sys.exit(77)
+        sys.exit(SKIP)
     try:
         inns = ["ip", "netns", "exec", ns]
         for c in (["ip", "link", "set", "lo", "up"],
@@ -653,7 +649,7 @@ def sshd_host(d, name, net):
 def case_ssh(d):
     if os.geteuid() != 0 or not os.path.exists("/usr/sbin/sshd") or not shutil.which("ip"):
         print("skipped: needs root, ip and sshd (openssh-server)")
-        sys.exit(77)
+        sys.exit(SKIP)
     for key in ("hostkey", "id"):
         subprocess.run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-f",
                         os.path.join(d, key)], check=True)
@@ -867,11 +863,11 @@ def case_scene_python(d):
 def case_scene_loss(d):
     if os.geteuid() != 0 or not shutil.which("nft") or not shutil.which("ip"):
         print("skipped: needs root, ip and nft")
-        sys.exit(77)
+        sys.exit(SKIP)
     ns = "lgscene%d" % os.getpid()
     if subprocess.run(["ip", "netns", "add", ns]).returncode != 0:
         print("skipped: cannot make a network namespace here")
-        sys.exit(77)
+        sys.exit(SKIP)
     try:
         inns = ["ip", "netns", "exec", ns]
         for c in (["ip", "link", "set", "lo", "up"],
@@ -1239,5 +1235,4 @@ with tempfile.TemporaryDirectory() as tmp:
      "unanswered": case_unanswered, "notes": case_notes,
      "controller_exit": case_controller_exit, "progress": case_progress,
      "interrupt": case_interrupt, "tmpdir": case_tmpdir}[CASE](tmp)
-print("FAILED: %d" % len(failures) if failures else "PASSED")
-sys.exit(1 if failures else 0)
+sys.exit(verdict(CASE))

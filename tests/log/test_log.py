@@ -37,18 +37,9 @@ import tempfile
 import time
 import zlib
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-failures = 0
-
-
-def check(cond, what):
-    global failures
-    print(("ok: " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
 
 
 # ---------------------------------------------------------------- LCM logs, read here
@@ -588,8 +579,7 @@ def main():
         CASES[a.case](Run(a, tmp), a, tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    print(f"{a.case}: {'FAILED' if failures else 'passed'} ({failures} failures)")
-    return 1 if failures else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":

@@ -33,18 +33,10 @@ import subprocess
 import sys
 import tempfile
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_port import lcm_url  # noqa: E402  (tests/common/lcm_port.py)
 
-failures = 0
 SYNC = 0xEDA1DA01
-
-
-def check(cond, what):
-    global failures
-    print(("ok: " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
 
 
 def read_log(path):
@@ -237,8 +229,7 @@ def main():
         CASES[a.case](Run(a, tmp), tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    print(f"{a.case}: {'FAILED' if failures else 'passed'} ({failures} failures)")
-    return 1 if failures else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":

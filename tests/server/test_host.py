@@ -57,17 +57,11 @@ import sys
 import tempfile
 import time
 
-failures = 0
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+
 SYNC = 0xEDA1DA01
 GROUP = "239.255.76.67"
-
-
-def check(cond, what):
-    global failures
-    print(("ok: " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
 
 
 def bound_ports():
@@ -889,8 +883,7 @@ def main():
         getattr(t, "case_" + a.case)()
     finally:
         t.cleanup()
-    print("%s: %d failure(s)" % (a.case, failures))
-    return 1 if failures else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":

@@ -39,10 +39,10 @@ import sys
 import tempfile
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
 
-failures = 0
 SYNC = 0xEDA1DA01
 
 SINE = dict(start=0.205, amplitude=0.1, offset=0.05, frequency=2.0)
@@ -52,14 +52,6 @@ REFERENCE = ("reference={theta0: {type: sine, start: %g, amplitude: %g, offset: 
              "frequency: %g}, theta1: {type: waypoints, start: %g, points: [%s]}}" %
              (SINE["start"], SINE["amplitude"], SINE["offset"], SINE["frequency"], WP_START,
               ", ".join("[%g, %g]" % p for p in POINTS)))
-
-
-def check(cond, what):
-    global failures
-    print(("ok: " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
 
 
 def sine(t, amplitude=SINE["amplitude"]):
@@ -434,8 +426,7 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         t.tmp = tmp
         CASES[a.case](t)
-    print(f"{failures} failure(s)")
-    return 1 if failures else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":
