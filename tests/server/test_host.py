@@ -51,7 +51,6 @@ import fcntl
 import os
 import random
 import signal
-import struct
 import subprocess
 import sys
 import tempfile
@@ -59,8 +58,8 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+from lcm_log import records  # noqa: E402  (tests/common: LCM's log format)
 
-SYNC = 0xEDA1DA01
 GROUP = "239.255.76.67"
 
 
@@ -109,13 +108,8 @@ def url(port):
 
 
 def read_log(path):
-    out, b, i = [], open(path, "rb").read(), 0
-    while i + 28 <= len(b):
-        sync, num, ts, clen, dlen = struct.unpack_from(">IqqII", b, i)
-        assert sync == SYNC
-        out.append((b[i + 28:i + 28 + clen].decode(), b[i + 28 + clen:i + 28 + clen + dlen]))
-        i += 28 + clen + dlen
-    return out
+    """[(channel, data)] of a whole log (raises otherwise)."""
+    return [(ch, data) for _, _, ch, data, _ in records(path, whole=True)]
 
 
 class Bus:
