@@ -34,8 +34,9 @@ import sys
 import threading
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from lagsim_check import stop  # noqa: E402  (tests/common: SIGTERM, SIGKILL after a grace)
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
+from lagsim_check import check_expressions, stop  # noqa: E402  (tests/common: the one harness)
+import waits  # noqa: E402  (events waited on, bounded)
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def parse_summary(text):
@@ -117,7 +118,7 @@ def main():
     cproc = dproc = fth = None
     done = threading.Event()
     n_hostile = 0
-    t_daemon_end = t_client_end = t_summary = None
+    t_daemon_end = t_client_end = None
     lines = []
     last_state = [None]  # when the last state was heard (--kill-daemon-after)
     wth = None
@@ -132,20 +133,8 @@ def main():
         # is subscribed ("waiting for the scene"), so that it sees the very first state
         # (bounded by --timeout: a JVM, Octave or a compile first takes what the machine's
         # load makes it take; only a client that never gets ready fails here)
-        ready = threading.Event()
-
-        def reader():
-            nonlocal t_summary
-            for line in cproc.stdout:
-                lines.append(line)
-                if "waiting for the scene" in line:
-                    ready.set()
-                if t_summary is None and " summary " in line:
-                    t_summary = time.monotonic()
-            ready.set()
-
-        th = threading.Thread(target=reader, daemon=True)
-        th.start()
+        rd = waits.Reader(cproc, lines, mark=" summary ")
+        ready, th = rd.ready, rd.thread
         t0 = time.monotonic()
         if not ready.wait(a.timeout) or cproc.poll() is not None:
             print("".join(lines))
@@ -222,6 +211,7 @@ def main():
         stop(cproc, 3.0)
         stop(dproc, 3.0)
     out = "".join(lines)
+    t_summary = rd.marked  # when the client printed its summary line
     derr = dproc.stderr.read() if dproc and dproc.stderr else ""
     sys.stdout.write(out)
     if err:
@@ -256,14 +246,7 @@ def main():
               % (names["silent"], t_daemon_end - last_state[0]))
     names["math"] = math
     names["out"] = out  # the client's stdout, for checks of what it prints
-    for expr in a.check:
-        try:
-            res = bool(eval(expr, {"__builtins__": {"abs": abs, "min": min, "max": max}}, names))
-        except Exception as e:  # a missing key is a failure, not a crash
-            res = False
-            print("check %s: %s" % (expr, e))
-        print("%s: %s" % ("ok  " if res else "FAIL", expr))
-        ok = ok and res
+    ok = check_expressions(a.check, names) and ok
     return 0 if ok else 1
 
 

@@ -54,12 +54,13 @@ def verdict(case=None):
     if not _made:
         print("%s: FAILED: no check was made" % name, flush=True)
         return 1
+    checks = "%d check%s" % (_made, "" if _made == 1 else "s")
     if _failed:
-        print("%s: FAILED (%d of %d checks):" % (name, len(_failed), _made), flush=True)
+        print("%s: FAILED (%d of %s):" % (name, len(_failed), checks), flush=True)
         for what in _failed:
             print("  " + what.splitlines()[0][:200], flush=True)
         return 1
-    print("%s: passed (%d checks)" % (name, _made), flush=True)
+    print("%s: passed (%s)" % (name, checks), flush=True)
     return 0
 
 
@@ -91,3 +92,19 @@ def replay(lagsimd, config, prefix, log, timeout=60):
         if line.startswith("max difference = "):
             diff = float(line.split("=", 1)[1])
     return r, diff
+
+
+def check_expressions(exprs, names):
+    """check() of each expression of exprs (a tool's --check "states == 2001"), evaluated
+    over the dictionary names (a run's summary values) with abs, min and max; an
+    expression that does not evaluate (a value the run did not report) fails, saying why.
+    Returns whether every one held."""
+    ok = True
+    for expr in exprs:
+        try:
+            res = bool(eval(expr, {"__builtins__": {"abs": abs, "min": min, "max": max}}, names))
+        except Exception as e:  # a missing key is a failure, not a crash
+            res = False
+            print("check %s: %s" % (expr, e))
+        ok = check(res, expr) and ok
+    return ok
