@@ -31,7 +31,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from lagsim_lcm import LCM  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
+from lcm_port import lcm_port  # noqa: E402  (a port pair of this process's own)
 
 
 # config/dipc.yaml's DIPC

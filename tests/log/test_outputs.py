@@ -28,7 +28,7 @@ import sys
 import tempfile
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def digest(path):

@@ -41,7 +41,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_log import records  # noqa: E402  (tests/common: LCM's log format)
 import waits  # noqa: E402  (events waited on, bounded)
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 SINE = dict(start=0.205, amplitude=0.1, offset=0.05, frequency=2.0)
 POINTS = [(0.0, 0.0), (0.503, 0.02), (1.007, -0.01)]
