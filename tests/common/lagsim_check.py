@@ -14,13 +14,17 @@ tests/*.cmake) when the test cannot run here, which the test says and exits with
 An error of the test itself (an exception) exits as Python does, with 1 and its traceback.
 
 Also here: stop(), the one way a test ends a process it started (SIGTERM, then SIGKILL
-after a grace). LCM logs are read by lcm_log.py, the bus's ports taken by lcm_port.py, events
+after a grace), and daemon(), a lagsimd for the length of a with-block. LCM logs are read
+by lcm_log.py, the bus's ports taken by lcm_port.py, events
 waited on by waits.py, beside this file.
 """
+import contextlib
 import os
 import signal
 import subprocess
 import sys
+
+import waits
 
 SKIP = 77   # ctest's SKIP_RETURN_CODE (tests/*.cmake, tests/common/cases.cmake)
 
@@ -108,3 +112,20 @@ def check_expressions(exprs, names):
             print("check %s: %s" % (expr, e))
         ok = check(res, expr) and ok
     return ok
+
+
+@contextlib.contextmanager
+def daemon(lagsimd, lagsimctl, config, prefix, *args, grace=10.0):
+    """`lagsimd --config CONFIG --set lcm.prefix=PREFIX -q ARGS...` (on LCM_DEFAULT_URL) for
+    the with-block, which gets the process: checked first to answer `lagsimctl status`
+    (waits.daemon_answers; the block runs either way), ended by SIGTERM after it and
+    waited for `grace` s (a daemon that outlives that raises TimeoutExpired: an error of
+    the test, as it should be)."""
+    proc = subprocess.Popen([lagsimd, "--config", config, "--set", "lcm.prefix=" + prefix, "-q",
+                             *args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        check(waits.daemon_answers(lagsimctl, prefix), "lagsimd answers (waited on)")
+        yield proc
+    finally:
+        proc.terminate()
+        proc.wait(grace)

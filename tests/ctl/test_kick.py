@@ -42,9 +42,8 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from lagsim_check import check, replay, verdict  # noqa: E402  (tests/common: the one harness)
+from lagsim_check import check, daemon, replay, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_log import read_log, write_log  # noqa: E402
-import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
@@ -99,11 +98,7 @@ def rules(lagsimd, ctl_bin, cfg, prefix, tmp):
            (["x", "1e300"], "{t: 0, joint: x, impulse: 1e300}"),
            (["x", "1e12", "--duration", "0.5"], "{t: 0, joint: x, force: 2e12, duration: 0.5}"),
            (["cart", "1"], "{t: 0, joint: cart, impulse: 1}")]
-    d = subprocess.Popen([lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix, "-q",
-                          "--set", "realtime.start=paused", "--log", log],
-                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        check(waits.daemon_answers(ctl_bin, prefix), "lagsimd answers (waited on)")
+    with daemon(lagsimd, ctl_bin, cfg, prefix, "--set", "realtime.start=paused", "--log", log):
         for args, item in bad:
             r = ctl("kick", *args)
             rc, words = scene_words(lagsimd, cfg, tmp, item)
@@ -138,9 +133,6 @@ def rules(lagsimd, ctl_bin, cfg, prefix, tmp):
               "kick x 0.5 in the fault: refused, 'in fault state (reset first)'")
         check(ctl("reset").returncode == 0, "reset")
         check(ctl("kick", "x", "0.5").returncode == 0, "kick x 0.5 after the reset: accepted")
-    finally:
-        d.terminate()
-        d.wait(10)
     states = [decode_state(data) for _, ch, data in read_log(log) if ch == prefix + "_STATE"]
     v = [s["qd"][s["names"].index("x")] for s in states if s["step"] == 50]
     check(bool(v) and abs(1.0 * v[0] - 0.5) <= 1e-12,
@@ -176,12 +168,7 @@ def main():
         return [json.loads(l) for l in r.stdout.splitlines()
                 if l.startswith("{") and json.loads(l)["type"] == "event"]
 
-    d = subprocess.Popen([lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix, "-q",
-                          "--set", "realtime.start=paused", "--log", log],
-                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                         universal_newlines=True)
-    try:
-        check(waits.daemon_answers(ctl_bin, prefix), "lagsimd answers (waited on)")
+    with daemon(lagsimd, ctl_bin, cfg, prefix, "--set", "realtime.start=paused", "--log", log):
         r = ctl("--json", "kick", "x", "0.5")
         ev = events(r)
         check(r.returncode == 0 and ev and ev[0]["kind"] == "kick" and ev[0]["step"] == 0 and
@@ -225,9 +212,6 @@ def main():
         m = dict(zip(sc[0]["param_name"], sc[0]["param_value"])).get("m") if sc else None
         check(m == 1.0, "describe after reset --scene: m = %s, the scene file's 1" % m)
         check(ctl("step", "3").returncode == 0, "step 3")
-    finally:
-        d.terminate()
-        d.wait(10)
 
     recs = read_log(log)
     states = [decode_state(data) for _, ch, data in recs if ch == prefix + "_STATE"]

@@ -33,8 +33,7 @@ import subprocess
 import sys
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
-import waits  # noqa: E402  (events waited on, bounded)
+from lagsim_check import check, daemon, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
@@ -87,11 +86,7 @@ def main():
             if m:
                 status_fields.append(m.group(1))
 
-    d = subprocess.Popen([a.lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix, "-q",
-                          "--set", "realtime.start=running"],
-                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, universal_newlines=True)
-    try:
-        check(waits.daemon_answers(a.lagsimctl, prefix), "lagsimd answers (waited on)")
+    with daemon(a.lagsimd, a.lagsimctl, cfg, prefix, "--set", "realtime.start=running", grace=5):
         r = ctl("status")
         rj = statuses(ctl("--json", "status"))
         out = r.stdout.splitlines()
@@ -214,9 +209,6 @@ def main():
         dt = time.monotonic() - t0
         check(r.returncode == 3 and "no answer" in r.stderr and dt < 3.0,
               "no daemon on the prefix: exit 3 after %.2f s with a message" % dt)
-    finally:
-        d.terminate()
-        d.wait(5)
 
     # watch: a daemon that runs 1 s of sim time, then stops by itself
     w = subprocess.Popen([a.lagsimctl, "--prefix", prefix + "W", "watch"], stdout=subprocess.PIPE,
