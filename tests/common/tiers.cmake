@@ -110,6 +110,8 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^clients_java_release$"
   "quick     NAME  ^clients_(go_dipc_gain|go_vet|go_cgo_rebuild|binding_lookup)$"
   "quick     NAME  _(lockstep|hostile|push|reference_lost)$"
+  # a lab host's plants in lockstep, found by their prefix through its directory
+  "quick     NAME  ^clients_(c|cpp|python|lua|go|java)_host_prefix$"
   "quick     NAME  ^clients_cross_language_(dipc|manipulator)$"
   "quick     NAME  ^clients_readme_(c|cpp|cpplcm|python|lua|java|go)$"
   # the client library: its version, its ABI, its C++ header, the README's C and C++ blocks

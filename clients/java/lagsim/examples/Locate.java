@@ -55,6 +55,19 @@ public final class Locate {
     /** The URL to talk to the plant on: the one the directory named (HOST), else the default bus's state URL. */
     public String url() { return url; }
 
+    private static LCM directory;
+    private static String directoryUrl;
+
+    /** One LCM on the default bus for the process, kept open: closing one makes its receive
+     *  thread print a socket exception. */
+    private static synchronized LCM directory(String url) throws IOException {
+        if (directory == null || !url.equals(directoryUrl)) {
+            directory = new LCM(url);
+            directoryUrl = url;
+        }
+        return directory;
+    }
+
     private static final Pattern PREFIX = Pattern.compile("[A-Za-z0-9_]{1,53}");
 
     /** Where the plant on prefix runs; IllegalArgumentException for a prefix a plant cannot
@@ -94,7 +107,7 @@ public final class Locate {
                 }
             }
         };
-        LCM lcm = new LCM(here);
+        LCM lcm = directory(here);
         String re = Pattern.quote(prefix + "_") + "(EVENT|STATE|STATUS|SCENE)";
         lcm.subscribe(re, sub);
         long end = System.nanoTime() + (long) (waitS * 1e9);
@@ -105,7 +118,6 @@ public final class Locate {
             where = decided[0] < 0 ? NONE : decided[0];
         }
         lcm.unsubscribe(re, sub);
-        lcm.close();
         return new Locate(where, where == HOST ? found[0] : here);
     }
 }
