@@ -10,10 +10,9 @@ and no --url; LCM_DEFAULT_URL the directory's bus, as on the host) must ask the 
 where ALICE runs (lag_client_locate, or Java's Locate for Java and MATLAB/Octave), say so
 ("prefix ALICE runs on URL (the host's directory)"), and drive ALICE there: it ends its
 --duration with exit 0, ALICE took its commands and advanced (lockstep advances only on
-them), BOB took none and stayed at t = 0. On a controller that does not ask the directory
-(lagsim 0.2.0 before lag_client_locate, for every language but C) it waits for ALICE's
-scene on the directory, which answers DESCRIBE with ALICE's scene, and then for states
-that never come there: ALICE takes no command.
+them), BOB took none and stayed at t = 0. A controller that does not ask the directory
+gets ALICE's scene there (the directory answers DESCRIBE with it) and then waits for
+states that never come there: ALICE takes no command.
 
 Exit 0 when every check held, 1 otherwise.
 """
