@@ -297,18 +297,19 @@ static void ask_scene(lag_client *c, bool now)
 }
 
 /* A state, decoded into c->tmp.state. Each state once: a copy of the latest state (the
- * same generation, step, sim_time and utime: in lockstep the daemon publishes a state
- * again until an answer to it arrives) is neither returned nor passed to on_state, so the
- * control law runs once per state and a law slower than the copies never falls behind on
- * them; a command already sent for it goes out again at once (the first may have been
- * lost). A state of a generation other than the scene's is held until that scene came:
+ * same generation, step and sim_time, whatever its utime: in lockstep the daemon publishes
+ * a state again until an answer to it arrives, a paused real-time plant its state at
+ * publish_hz) is neither returned nor passed to on_state, so the control law runs once per
+ * state (a law with an integrator does not wind up while the plant is paused) and a law
+ * slower than the copies never falls behind on them; a command already sent for it goes
+ * out again at once (the first may have been lost). A state of a generation other than the scene's is held until that scene came:
  * a control law never answers a state with the parameters of another run or scene. */
 static void on_state_msg(lag_client *c)
 {
     const lag_wire_joint_state *m = &c->tmp.state;
     c->counters.states++; /* received and valid: kept (or held) */
-    if (c->have_state && m->generation == c->state.generation && m->utime == c->state.utime &&
-        m->step == c->state.step && m->sim_time == c->state.sim_time) {
+    if (c->have_state && m->generation == c->state.generation && m->step == c->state.step &&
+        m->sim_time == c->state.sim_time) {
         c->counters.copies++;
         if (c->answer_len > 0 &&
             lcm_publish(c->lcm_cmd, c->ch_command, c->answer, c->answer_len) == 0)

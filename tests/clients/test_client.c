@@ -79,6 +79,7 @@ static void pump(lcm_t *peer, lag_client *c, int ms)
 }
 
 static int64_t g_gen; /* the generation of the states publish_state sends */
+static int64_t g_utime = 42; /* their utime */
 
 static void publish_state(lcm_t *peer, const char *ch, int n, const char *long_name, double t,
                           double p0)
@@ -91,7 +92,7 @@ static void publish_state(lcm_t *peer, const char *ch, int n, const char *long_n
         vel[i] = -0.2 * (i + 1);
         eff[i] = 3.0 * i;
     }
-    lagsim_joint_state_t m = {.utime = 42, .sim_time = t, .step = (int64_t)(t * 1000),
+    lagsim_joint_state_t m = {.utime = g_utime, .sim_time = t, .step = (int64_t)(t * 1000),
                               .num_joints = (int16_t)n, .name = names, .position = pos,
                               .velocity = vel, .effort = eff, .generation = g_gen};
     lagsim_joint_state_t_publish(peer, ch, &m);
@@ -272,6 +273,16 @@ static void case_library(int arg)
            last_cmd.effort[1] == -2.25);
     lag_client_get_counters(c, &cnt, sizeof cnt);
     ENSURE(cnt.copies == 2 && cnt.repeats == 1 && cnt.commands_sent == 2);
+    /* the same state published again with a new utime (a paused real-time plant, a
+     * lockstep plant waiting at its start): a copy too, the law not run again for it */
+    g_utime = 43;
+    publish_state(peer, ch, 3, NULL, 4.0, 0.1);
+    pump(peer, c, 100);
+    ENSURE(lag_client_wait_state(c, 0.1, &st, sizeof st) == LAG_CLIENT_TIMEOUT);
+    ENSURE(commands == before + 3 && last_cmd.utime == utime_answer);
+    lag_client_get_counters(c, &cnt, sizeof cnt);
+    ENSURE(cnt.copies == 3 && cnt.repeats == 2 && cnt.commands_sent == 2);
+    g_utime = 42;
     publish_state(peer, ch, 3, NULL, 4.01, 0.1); /* the next state: returned */
     ENSURE(lag_client_wait_state(c, 2.0, &st, sizeof st) == LAG_CLIENT_OK && st.sim_time == 4.01);
 

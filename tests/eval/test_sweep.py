@@ -1083,20 +1083,22 @@ def held_is(path, want_runs):
 
 
 def case_interrupt(d):
+    # n runs: a signal comes after 4 rows, while most runs are still to come
+    n = 40
     q = ["--config", SCENE, "--controller", CTRL, "--duration", "8", "--vary",
-         "parameters.m1=uniform(0.05,0.3)", "--runs", "300", "--seed", "5", "-j2"]
+         "parameters.m1=uniform(0.05,0.3)", "--runs", str(n), "--seed", "5", "-j2"]
     whole = os.path.join(d, "whole.csv")
     run([SWEEP] + q + ["--csv", whole])
     # SIGINT to the process group, as a terminal's Ctrl-C sends it
     out = os.path.join(d, "int.csv")
     rc, o, e = stopped([SWEEP] + q + ["--csv", out], out, signal.SIGINT, group=True)
-    ok, runs, held = held_is(out, set(range(300)))
-    check(rc == -signal.SIGINT and 0 < len(runs) < 300 and ok,
+    ok, runs, held = held_is(out, set(range(n)))
+    check(rc == -signal.SIGINT and 0 < len(runs) < n and ok,
           "SIGINT: ended by it, the CSV holds %d runs in run order, its held line (%s) names "
           "them" % (len(runs), held))
     check([k for k, _ in identity(out)] == [k for k, _ in identity(whole)] + ["held"],
           "its identity: the whole sweep's and the held line")
-    check("stopped by SIGINT: %s holds %d of the 300 runs" % (out, len(runs)) in e and
+    check("stopped by SIGINT: %s holds %d of the %d runs" % (out, len(runs), n) in e and
           "%d runs:" % len(runs) in o, "stderr says what it holds, stdout sums it up")
     cmds, codes = finish(e)
     merged = os.path.join(d, "int-whole.csv")
@@ -1108,7 +1110,7 @@ def case_interrupt(d):
     s1, s2 = os.path.join(d, "s1.csv"), os.path.join(d, "s2.csv")
     run([SWEEP] + q + ["--shard", "1/2", "--csv", s1])
     rc, o, e = stopped([SWEEP] + q + ["--shard", "2/2", "--csv", s2], s2, signal.SIGTERM)
-    ok, runs, held = held_is(s2, set(range(1, 300, 2)))
+    ok, runs, held = held_is(s2, set(range(1, n, 2)))
     check(rc == -signal.SIGTERM and ok and dict(identity(s2)).get("shard") == "2/2",
           "SIGTERM to shard 2/2: its %d runs, held %s (counted in the shard's runs)"
           % (len(runs), held))
@@ -1121,7 +1123,7 @@ def case_interrupt(d):
     # SIGHUP: the same partial CSV
     out = os.path.join(d, "hup.csv")
     rc, o, e = stopped([SWEEP] + q + ["--csv", out], out, signal.SIGHUP)
-    ok, runs, held = held_is(out, set(range(300)))
+    ok, runs, held = held_is(out, set(range(n)))
     check(rc == -signal.SIGHUP and ok and "stopped by SIGHUP" in e,
           "SIGHUP: ended by it, %d runs held (%s)" % (len(runs), held))
     # SIGKILL: nothing of the sweep runs; the CSV holds what was written as runs ended
@@ -1134,7 +1136,7 @@ def case_interrupt(d):
           len(killed) >= 6 and lines[-1] == "", "SIGKILL: the CSV holds the %d rows written as "
           "their runs ended, whole lines, held: unknown" % len(killed))
     p, part = merge(d, out, out="kill-part.csv", extra=["--partial"])
-    ok, runs, held = held_is(part, set(range(300)))
+    ok, runs, held = held_is(part, set(range(n)))
     check(p.returncode == 0 and ok and sorted(killed) == runs and "--only" in p.stderr,
           "merge --partial takes it: its runs in order, the held line (%s), the runs to give "
           "--only said" % held)
@@ -1146,7 +1148,7 @@ def case_interrupt(d):
           "the killed sweep's CSV and its missing runs (%s) merged: the whole sweep, byte "
           "for byte" % (miss[0] if miss else None))
     # --only mistakes: before any run
-    for bad, why in (("5-3", "expected runs"), ("a", "expected runs"), ("0-300", "expected runs"),
+    for bad, why in (("5-3", "expected runs"), ("a", "expected runs"), ("0-%d" % n, "expected runs"),
                      ("3,2", "expected runs"), ("1", "no run of this sweep")):
         p = run([SWEEP] + q + ["--shard", "1/2", "--only", bad])
         check(p.returncode == 2 and why in p.stderr and "runs:" not in p.stdout,
