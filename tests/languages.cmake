@@ -222,6 +222,17 @@ add_test(NAME clients_binding_lookup
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/binding_lookup.py
     --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} ${lookup_lua})
 list(APPEND lang_tests clients_binding_lookup)
+# ... and the numbers the Python module and Java's Locate copy from the headers (capacities,
+# result codes, lag_client_locate's answers and wait) equal the headers'
+# (tests/clients/binding_constants.py)
+set(constants_jar "")
+if(TARGET lagsim_examples_java)
+  set(constants_jar --jar ${CMAKE_BINARY_DIR}/lagsim_examples.jar)
+endif()
+add_test(NAME clients_binding_constants
+  COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/binding_constants.py
+    --source ${PROJECT_SOURCE_DIR} ${constants_jar})
+list(APPEND lang_tests clients_binding_constants)
 
 # ---- Go, through the C ABI alone (clients/go/dipc_balance.go over liblagsim_client.so.1 by
 # cgo): its own design balances the DIPC in lockstep with the bounds of the other

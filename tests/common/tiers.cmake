@@ -108,7 +108,7 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^clients_[a-z_]+_(usage_.*|help)$"
   "quick     NAME  ^clients_(python|lua)_(lcm|types)$"
   "quick     NAME  ^clients_java_release$"
-  "quick     NAME  ^clients_(go_dipc_gain|go_vet|go_cgo_rebuild|binding_lookup)$"
+  "quick     NAME  ^clients_(go_dipc_gain|go_vet|go_cgo_rebuild|binding_lookup|binding_constants)$"
   "quick     NAME  _(lockstep|hostile|push|reference_lost)$"
   # a lab host's plants in lockstep, found by their prefix through its directory
   "quick     NAME  ^clients_(c|cpp|python|lua|go|java)_host_prefix$"
