@@ -12,6 +12,7 @@
 #include "lagsim_client_wire.h"
 
 #include <arpa/inet.h>
+#include <ctype.h>
 #include <errno.h>
 #include <ifaddrs.h>
 #include <math.h>
@@ -1399,4 +1400,107 @@ int lag_client_plants_instead(const char *url, const char *prefix, double wait_s
     if (best >= 0 && o < len) snprintf(out + o, len - o, "; did you mean %s?", p[best].prefix);
     free(p);
     return n;
+}
+
+/* ---------------------------------------------------------------- a host's directory */
+
+/* What lag_client_locate heard: the first message that decides. */
+typedef struct locate {
+    size_t plen;                /* the prefix's length */
+    const char *default_url;    /* the state URL of LCM's default bus */
+    char url[LAG_CLIENT_URL_LEN];
+    int where;                  /* LAG_CLIENT_LOCATE_*, -1 while undecided */
+    lag_wire_event ev;          /* decoded here: not on the stack */
+} locate;
+
+/* The rule (docs/protocol.md, "A host's directory"): on the default bus, the prefix's
+ * state, status or scene, or an event of any other kind than `plant`, is the plant itself
+ * (HERE); a `plant` event whose detail is a URL a plant can have, other than the default
+ * bus's, names where it runs (HOST). Anything else (an event that does not decode, a
+ * `plant` event naming no such URL or the default bus itself) decides nothing. */
+static void on_locate(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    locate *l = user;
+    if (l->where >= 0) return;
+    if (strcmp(channel + l->plen, lag_bus_suffix(LAG_BUS_EVENT)) != 0) {
+        l->where = LAG_CLIENT_LOCATE_HERE;
+        return;
+    }
+    if (lag_wire_decode(LAG_WIRE_EVENT, rbuf->data, rbuf->data_size, LAG_WIRE_MAX_JOINTS,
+                        &l->ev) != LAG_WIRE_OK)
+        return;
+    if (strcmp(l->ev.kind, "plant") != 0) {
+        l->where = LAG_CLIENT_LOCATE_HERE;
+        return;
+    }
+    lag_bus b;
+    char berr[8];
+    if (lag_bus_init(&b, l->ev.detail, "X", berr, sizeof berr) == 0 &&
+        strcmp(b.state_url, l->default_url) != 0) {
+        copy_str(l->url, sizeof l->url, b.state_url);
+        l->where = LAG_CLIENT_LOCATE_HOST;
+    }
+}
+
+/* Whether prefix can be a plant's: 1 to LAG_BUS_PREFIX_MAX of [A-Za-z0-9_]. */
+static bool prefix_ok(const char *prefix)
+{
+    size_t n = prefix ? strlen(prefix) : 0;
+    if (n == 0 || n > LAG_BUS_PREFIX_MAX) return false;
+    for (size_t i = 0; i < n; i++)
+        if (!isalnum((unsigned char)prefix[i]) && prefix[i] != '_') return false;
+    return true;
+}
+
+/* Listens on `in` until the rule decides or wait_s passed. */
+static void locate_listen(lcm_t *in, locate *l, double wait_s)
+{
+    double end = lag_client_now() + wait_s;
+    for (double left; l->where < 0 && (left = end - lag_client_now()) > 0;)
+        if (lcm_handle_timeout(in, (int)(left * 1000.0) + 1) < 0) break;
+}
+
+int lag_client_locate(const char *prefix, double wait_s, char *url, size_t len, char *err,
+                      size_t errlen)
+{
+    if (err && errlen) err[0] = '\0';
+    if (url && len) url[0] = '\0';
+    lag_bus b;
+    char berr[256];
+    if (!prefix_ok(prefix) || !url || len == 0 || !(wait_s >= 0) || !isfinite(wait_s)) {
+        if (err) snprintf(err, errlen, "locate: a prefix of 1 to %d letters, digits or _, a "
+                          "finite wait >= 0 and a URL buffer", LAG_BUS_PREFIX_MAX);
+        return LAG_CLIENT_ERR_ARG;
+    }
+    if (lag_bus_init(&b, NULL, prefix, berr, sizeof berr) != 0) { /* LCM_DEFAULT_URL */
+        if (err) snprintf(err, errlen, "LCM_DEFAULT_URL: %s", berr);
+        return LAG_CLIENT_ERR_ARG;
+    }
+    locate *l = calloc(1, sizeof *l);
+    lcm_t *in = l ? lcm_create(b.state_url) : NULL;
+    char pattern[LAG_BUS_CHANNEL_LEN + 32];
+    snprintf(pattern, sizeof pattern, "%s_(EVENT|STATE|STATUS|SCENE)", prefix);
+    lcm_subscription_t *sub = in ? lcm_subscribe(in, pattern, on_locate, l) : NULL;
+    if (!sub) {
+        if (err) snprintf(err, errlen, "%s %s", !l ? "out of memory on" : "cannot listen on",
+                          b.state_url);
+        if (in) lcm_destroy(in);
+        free(l);
+        return !l ? LAG_CLIENT_ERR_NOMEM : LAG_CLIENT_ERR_LCM;
+    }
+    lcm_subscription_set_queue_capacity(sub, 64);
+    l->plen = strlen(prefix);
+    l->default_url = b.state_url;
+    l->where = -1;
+    locate_listen(in, l, wait_s);
+    lcm_unsubscribe(in, sub);
+    lcm_destroy(in);
+    int where = l->where < 0 ? LAG_CLIENT_LOCATE_NONE : l->where;
+    if (!copy_str(url, len, where == LAG_CLIENT_LOCATE_HOST ? l->url : b.state_url)) {
+        if (err) snprintf(err, errlen, "locate: a URL buffer of %zu bytes is too short", len);
+        url[0] = '\0';
+        where = LAG_CLIENT_ERR_ARG;
+    }
+    free(l);
+    return where;
 }

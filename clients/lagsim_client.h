@@ -432,6 +432,29 @@ lag_result lag_client_pick_plant(const char *url, const char *model, double wait
 int lag_client_plants_instead(const char *url, const char *prefix, double wait_s, char *out,
                               size_t len);
 
+/* Where the plant on `prefix` runs when a program was given its prefix and no URL: a host
+ * of plants (lagsimd --plants) runs each plant on a URL of its own and keeps a directory on
+ * LCM's default bus (LCM_DEFAULT_URL, else LCM's default), where every 0.5 s each plant's
+ * `plant` event names its state URL (docs/protocol.md, "A host's directory"). Listens to
+ * <prefix>_EVENT, _STATE, _STATUS and _SCENE on that bus until the first message that
+ * decides, at most wait_s (LAG_CLIENT_LOCATE_WAIT_S: a directory's two announcements), and
+ * asks nothing of any plant. Returns:
+ *   LAG_CLIENT_LOCATE_HOST  a `plant` event of prefix names another URL (a URL a plant can
+ *                           have, not the default bus's): url is that state URL;
+ *   LAG_CLIENT_LOCATE_HERE  the plant is on the default bus itself (its state, status or
+ *                           scene, or an event of another kind, came first);
+ *   LAG_CLIENT_LOCATE_NONE  nothing of prefix within wait_s (no plant yet, or no directory);
+ *   for both, url is the default bus's state URL, where a program waits for it;
+ * or a negative lag_result with a message in err (may be NULL): LAG_CLIENT_ERR_ARG (a prefix
+ * that is not 1 to 53 of [A-Za-z0-9_], a bad wait_s, url too short: LAG_CLIENT_URL_LEN is
+ * enough, a bad LCM_DEFAULT_URL), LAG_CLIENT_ERR_LCM, LAG_CLIENT_ERR_NOMEM. OUT: url */
+#define LAG_CLIENT_LOCATE_NONE 0
+#define LAG_CLIENT_LOCATE_HERE 1
+#define LAG_CLIENT_LOCATE_HOST 2
+#define LAG_CLIENT_LOCATE_WAIT_S 1.0
+int lag_client_locate(const char *prefix, double wait_s, char *url, size_t len, char *err,
+                      size_t errlen);
+
 /* Wall clock (CLOCK_MONOTONIC) in seconds, for controllers' own timing. */
 double lag_client_now(void);
 

@@ -591,14 +591,22 @@ private:
 class Controller {
 public:
     struct Options {
-        std::string url;       /* the plant's LCM URL ("": LCM's default, LCM_DEFAULT_URL) */
+        std::string url;       /* the plant's LCM URL ("": the URL a host's directory names
+                                * for the prefix, else LCM's default, LCM_DEFAULT_URL) */
         double timeout = 5.0;  /* wall s of silence that end the run (> 0) */
         double duration = 0.0; /* sim s from the first state that end the run (0: none) */
         bool signals = true;   /* SIGINT and SIGTERM end the run */
+        bool locate = true;    /* url "": ask a host's directory first (lagsim::locate) */
     };
 
     explicit Controller(const std::string &prefix) : Controller(prefix, Options()) {}
-    Controller(const std::string &prefix, const Options &o) : o_(o), c_(prefix, o.url)
+    /* With Options::url "" (and locate), the plant's URL is the one a host's directory on
+     * LCM's default bus names for prefix (lagsim::locate: 1 s at most), else LCM's
+     * default; options().url says which ("" for the default), located() whether the
+     * directory named it. */
+    Controller(const std::string &prefix, const Options &o)
+        : o_(o), located_(o.url.empty() && o.locate && locate_into(prefix, o_.url)),
+          c_(prefix, o_.url)
     {
         if (!(o.timeout > 0) || !(o.duration >= 0) || !std::isfinite(o.duration))
             throw Error(LAG_ERR_ARG, "LAG_ERR_ARG: Controller: timeout > 0 and a finite "
@@ -687,6 +695,8 @@ public:
     void on_event(std::function<void(const Event &)> f) { user_event_ = std::move(f); }
     Client &client() { return c_; }
     const Options &options() const { return o_; }
+    /* whether a host's directory named the plant's URL (options().url) */
+    bool located() const { return located_; }
 
 private:
     static volatile std::sig_atomic_t &signal_flag()
@@ -712,7 +722,10 @@ private:
         return std::isfinite(p) ? p : 0.0;
     }
 
+    static bool locate_into(const std::string &prefix, std::string &url);
+
     Options o_;
+    bool located_;
     Client c_;
     std::function<void(const Event &)> user_event_;
     struct sigaction old_int_ = {}, old_term_ = {};
@@ -750,6 +763,37 @@ inline Plant pick_plant(const std::string &url = "", const std::string &model = 
                                           sizeof p, err, sizeof err);
     if (rc != LAG_OK) throw Error(rc, detail::describe(rc, err));
     return p;
+}
+
+/* Where the plant on prefix runs when no URL was given (lag_client_locate): where is
+ * LAG_CLIENT_LOCATE_HOST when a host's directory on LCM's default bus names another URL
+ * (url), LAG_CLIENT_LOCATE_HERE for a plant of that bus, LAG_CLIENT_LOCATE_NONE when nothing
+ * of it came within wait_s (url: that bus's state URL for both). Error for a prefix a plant
+ * cannot have, LCM failing. */
+struct Located {
+    int where = LAG_CLIENT_LOCATE_NONE;
+    std::string url;
+    bool host() const { return where == LAG_CLIENT_LOCATE_HOST; }
+};
+inline Located locate(const std::string &prefix, double wait_s = LAG_CLIENT_LOCATE_WAIT_S)
+{
+    char url[LAG_CLIENT_URL_LEN] = "", err[256] = "";
+    int where = lag_client_locate(prefix.c_str(), wait_s, url, sizeof url, err, sizeof err);
+    if (where < 0) {
+        lag_result rc = static_cast<lag_result>(where);
+        throw Error(rc, detail::describe(rc, err));
+    }
+    Located l;
+    l.where = where;
+    l.url = url;
+    return l;
+}
+
+inline bool Controller::locate_into(const std::string &prefix, std::string &url)
+{
+    Located l = locate(prefix);
+    if (l.host()) url = l.url;
+    return l.host();
 }
 
 } // namespace lagsim

@@ -164,8 +164,8 @@ int lag_ctl_parse(lag_ctl *ctl, int argc, char **argv, const char *what,
                                                   "on the bus)");
     const lag_ctl_option common[] = {
         {"prefix", "P", prefix_help, set_string, &ctl->prefix},
-        {"url", "URL", "LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)",
-         set_string, &ctl->url},
+        {"url", "URL", "LCM URL (default: the URL a host's directory on LCM's default bus "
+         "names for --prefix, else LCM's default; honours LCM_DEFAULT_URL)", set_string, &ctl->url},
         {"duration", "S", "end after S s of sim time from the first state (default 0: "
                           "until the daemon stops)", lag_ctl_nonnegative, &ctl->duration},
         {"timeout", "S", "wall s without a scene, or without any message from the daemon, "
@@ -302,7 +302,8 @@ static int connect_client(lag_ctl *ctl)
      * missed while the directory is asked), then moved to the URL a host's directory
      * names, if it names one */
     if (ctl->client && ctl->prefix && !ctl->url &&
-        lag_locate_plant(ctl->prefix, ctl->found_url, sizeof ctl->found_url)) {
+        lag_client_locate(ctl->prefix, LAG_CLIENT_LOCATE_WAIT_S, ctl->found_url,
+                          sizeof ctl->found_url, NULL, 0) == LAG_CLIENT_LOCATE_HOST) {
         ctl->url = ctl->found_url;
         printf("%s: prefix %s runs on %s (the host's directory)\n", ctl->name, ctl->prefix,
                ctl->url);

@@ -81,7 +81,7 @@ typedef struct lag_ctl {
     const char *prefix;        /* --prefix, or the plant found (lag_ctl_start) */
     const char *default_prefix; /* when no plant is found (NULL: one must be) */
     char found_prefix[64];
-    char found_url[LAG_CLIENT_URL_LEN]; /* the URL a host's directory named (lagsim_locate.h) */
+    char found_url[LAG_CLIENT_URL_LEN]; /* the URL a host's directory named (lag_client_locate) */
     int fail_code;              /* lag_ctl_fail's exit status (0: 1) */
     const char *url;           /* NULL: LCM's default */
     double duration;           /* sim s, 0: until the run ends otherwise */

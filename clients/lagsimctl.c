@@ -749,7 +749,9 @@ static lag_client *connect_plant(options *o, lag_client_plant *chosen, int *code
 {
     char err[1200];
     static char located[LAG_CLIENT_URL_LEN];
-    if (o->prefix && !o->url && lag_locate_plant(o->prefix, located, sizeof located))
+    if (o->prefix && !o->url &&
+        lag_client_locate(o->prefix, LAG_CLIENT_LOCATE_WAIT_S, located, sizeof located, NULL,
+                          0) == LAG_CLIENT_LOCATE_HOST)
         o->url = located; /* a host's plant: where its directory says it runs */
     if (!o->prefix) {
         /* the only plant on the bus */

@@ -81,7 +81,9 @@ int usage(std::ostream &o, int status)
          "library (C++ over the client library alone).\n"
          "  --prefix P           channel prefix (default: the only manipulator on the bus;\n"
          "                       none yet: MANIPULATOR)\n"
-         "  --url URL            LCM URL (default: LCM's default, honours LCM_DEFAULT_URL)\n"
+         "  --url URL            LCM URL (default: the URL a host's directory on LCM's\n"
+         "                       default bus names for --prefix, else LCM's default;\n"
+         "                       honours LCM_DEFAULT_URL)\n"
          "  --duration S         end after S s of sim time from the first state (default 0:\n"
          "                       until the daemon stops)\n"
          "  --timeout S          wall s without a scene, or without any message from the\n"
@@ -151,6 +153,7 @@ int choose_prefix(Options &o)
     try {
         lagsim::Plant p = lagsim::pick_plant(o.url, "manipulator", 1.0);
         o.prefix = p.prefix;
+        if (o.url.empty()) o.url = p.url; /* a host's plant: the URL its directory names */
         std::cout << "manipulator_ct: the only manipulator plant on the bus: prefix " << o.prefix << "\n";
     } catch (const lagsim::Error &e) {
         if (e.code() != LAG_TIMEOUT) {
@@ -257,7 +260,10 @@ int main(int argc, char **argv)
         }
     }
     try {
-        lagsim::Controller ctl(o.prefix, {o.url, o.timeout, o.duration, true});
+        lagsim::Controller ctl(o.prefix, {o.url, o.timeout, o.duration, true, true});
+        if (ctl.located())
+            std::cout << "manipulator_ct: prefix " << o.prefix << " runs on " << ctl.options().url
+                      << " (the host's directory)\n";
         Tracking tr;
         std::optional<lagsim::Scene> sc = scene_of(ctl, o);
         if (!sc) return ctl.end() == "signal" ? summary(ctl, tr, o) : 1;

@@ -222,6 +222,17 @@ add_test(NAME clients_binding_lookup
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/binding_lookup.py
     --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} ${lookup_lua})
 list(APPEND lang_tests clients_binding_lookup)
+# ... and the numbers the Python module and Java's Locate copy from the headers (capacities,
+# result codes, lag_client_locate's answers and wait) equal the headers'
+# (tests/clients/binding_constants.py)
+set(constants_jar "")
+if(TARGET lagsim_examples_java)
+  set(constants_jar --jar ${CMAKE_BINARY_DIR}/lagsim_examples.jar)
+endif()
+add_test(NAME clients_binding_constants
+  COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/binding_constants.py
+    --source ${PROJECT_SOURCE_DIR} ${constants_jar})
+list(APPEND lang_tests clients_binding_constants)
 
 # ---- Go, through the C ABI alone (clients/go/dipc_balance.go over liblagsim_client.so.1 by
 # cgo): its own design balances the DIPC in lockstep with the bounds of the other
@@ -628,6 +639,47 @@ add_test(NAME clients_scene_params
   COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/readme_recipes.py
           --build ${CMAKE_BINARY_DIR} --source ${PROJECT_SOURCE_DIR} scene-params)
 set_tests_properties(clients_scene_params PROPERTIES TIMEOUT 120 LABELS clients)
+
+# ---- A lab host's plant by its prefix alone (tests/clients/host_prefix.py): a host of two
+# plants, ALICE and BOB, in lockstep on port pairs of their own, its directory on
+# LCM_DEFAULT_URL's bus; each language's controller given --prefix ALICE and no --url asks
+# the directory (lag_client_locate; Java's and Octave's lagsim.examples.Locate), says
+# where ALICE runs and drives it there; BOB takes no command.
+set(host_prefix ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/clients/host_prefix.py
+    --bin ${CMAKE_BINARY_DIR}/bin)
+set(host_dipc --scene ${PROJECT_SOURCE_DIR}/config/dipc.yaml)
+set(host_args --prefix ALICE --duration 2 -q)
+add_test(NAME clients_c_host_prefix
+  COMMAND ${host_prefix} ${host_dipc} c -- $<TARGET_FILE:dipc_lqr> ${host_args})
+add_test(NAME clients_cpp_host_prefix
+  COMMAND ${host_prefix} --scene ${PROJECT_SOURCE_DIR}/config/manipulator.yaml cpp
+    -- $<TARGET_FILE:manipulator_ct> ${host_args})
+add_test(NAME clients_python_host_prefix
+  COMMAND ${host_prefix} ${host_dipc} python -- ${LAGSIM_PYTHON3} ${py_dir}/dipc_balance.py
+    ${py_types} ${host_args})
+list(APPEND lang_tests clients_c_host_prefix clients_cpp_host_prefix clients_python_host_prefix)
+if(LAGSIM_LUA52 AND EXISTS /usr/lib/lua/5.2/lcm.so AND TARGET lagsim_client_lua)
+  add_test(NAME clients_lua_host_prefix
+    COMMAND ${host_prefix} ${host_dipc} lua -- ${LAGSIM_LUA52} ${lua_dir}/dipc_balance.lua
+      ${lua_types} ${host_args})
+  list(APPEND lang_tests clients_lua_host_prefix)
+endif()
+if(TARGET dipc_balance_go)
+  add_test(NAME clients_go_host_prefix
+    COMMAND ${host_prefix} ${host_dipc} go -- ${CMAKE_BINARY_DIR}/bin/dipc_balance_go ${host_args})
+  list(APPEND lang_tests clients_go_host_prefix)
+endif()
+if(TARGET lagsim_examples_java)
+  add_test(NAME clients_java_host_prefix
+    COMMAND ${host_prefix} ${host_dipc} java -- ${java_run} lagsim.examples.DipcBalance ${host_args})
+  list(APPEND lang_tests clients_java_host_prefix)
+  if(LAGSIM_OCTAVE)
+    add_test(NAME clients_octave_host_prefix
+      COMMAND ${host_prefix} ${host_dipc} octave -- sh ${CMAKE_CURRENT_SOURCE_DIR}/clients/octave_run.sh
+        ${CMAKE_BINARY_DIR}/octave dipc_balance ${host_args})
+    list(APPEND lang_tests clients_octave_host_prefix)
+  endif()
+endif()
 
 set_tests_properties(${lang_tests} PROPERTIES TIMEOUT 90 LABELS clients)
 # a block built twice and run twice, the second time with a law of 0.15 s or 1.5 s per

@@ -99,7 +99,8 @@ foreach(neg
     "foreign:foreign:foreign_dropped"
     "old_version:old:old_dropped"
     "stop:stop:ends_on_stop"
-    "faults:events:runs_on")
+    "faults:events:runs_on"
+    "directory:directory:asks_plant_url")
   string(REPLACE ":" ";" n "${neg}")
   list(GET n 0 trace)
   list(GET n 1 rule)

@@ -388,7 +388,7 @@ type options struct {
 func parseOptions() options {
 	var o options
 	flag.StringVar(&o.prefix, "prefix", "DIPC", "the plant's channel prefix")
-	flag.StringVar(&o.url, "url", "", "the plant's LCM URL, its lcm.url (default: LCM's default, LCM_DEFAULT_URL); commands go to the next port")
+	flag.StringVar(&o.url, "url", "", "the plant's LCM URL, its lcm.url (default: the URL a host's directory on LCM's default bus names for --prefix, else LCM's default, LCM_DEFAULT_URL); commands go to the next port")
 	flag.Float64Var(&o.duration, "duration", 0, "stop after S s of sim time from the first state (0: until the daemon stops)")
 	flag.Float64Var(&o.timeout, "timeout", 5, "wall s without a scene, or without a state once running, before ending")
 	flag.StringVar(&o.qweights, "weights", "5,50,50,20,700,700", "state weights")
@@ -442,10 +442,34 @@ func usage() {
 	}
 }
 
+// locate: no --url: the URL a host's directory on LCM's default bus names for prefix
+// (lag_client_locate, 1 s at most), said; else "" (LCM's default: a plant there, or one
+// not started yet).
+func locate(prefix string) string {
+	var url [C.LAG_CLIENT_URL_LEN]C.char
+	var cerr [256]C.char
+	cprefix := C.CString(prefix)
+	where := C.lag_client_locate(cprefix, C.LAG_CLIENT_LOCATE_WAIT_S, &url[0], C.size_t(len(url)),
+		&cerr[0], C.size_t(len(cerr)))
+	C.free(unsafe.Pointer(cprefix))
+	if where < 0 {
+		fail(2, "--prefix: %s", C.GoString(&cerr[0]))
+	}
+	if where != C.LAG_CLIENT_LOCATE_HOST {
+		return ""
+	}
+	found := C.GoString(&url[0])
+	fmt.Printf("%s: prefix %s runs on %s (the host's directory)\n", name, prefix, found)
+	return found
+}
+
 // connect: the handle (C memory, freed by lag_client_destroy; the strings passed are
 // copied by the library) and its scene, awaited.
 func connect(o options, sig chan os.Signal) (*C.lag_client, *C.lag_client_scene) {
 	var cerr [256]C.char
+	if o.url == "" {
+		o.url = locate(o.prefix)
+	}
 	curl, cprefix := C.CString(o.url), C.CString(o.prefix)
 	c := C.lag_client_create(curl, cprefix, &cerr[0], C.size_t(len(cerr)))
 	C.free(unsafe.Pointer(curl))

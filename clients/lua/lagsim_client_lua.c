@@ -7,6 +7,8 @@
  *
  *   local lc = require('lagsim_client')       -- or lagsim_lcm.client(): found for you
  *   local state_url, command_url = lc.plant_urls(url)        -- nil, message if refused
+ *   local where, url = lc.locate('ALICE')      -- 'host', the URL a host's directory names
+ *                                              -- ('here', 'none': the default bus's)
  *   local c = assert(lc.new('DIPC', url))      -- url nil: LCM_DEFAULT_URL, else LCM's default
  *   local scene = c:wait_scene(0.25)           -- a table of scene_t's fields, or nil
  *   local st = c:wait_state(0.05)              -- a table of joint_state_t's fields, or nil
@@ -145,6 +147,27 @@ static int l_plants_instead(lua_State *L)
                               out, sizeof out);
     lua_pushstring(L, out);
     return 1;
+}
+
+/* locate(prefix[, wait_s]) -> 'host'|'here'|'none', url | nil, message (lag_client_locate:
+ * where the plant on prefix runs when no URL was given; url the host's directory's for
+ * 'host', else the default bus's) */
+static int l_locate(lua_State *L)
+{
+    char url[LAG_CLIENT_URL_LEN], err[256];
+    int where = lag_client_locate(luaL_checkstring(L, 1),
+                                  luaL_optnumber(L, 2, LAG_CLIENT_LOCATE_WAIT_S), url,
+                                  sizeof url, err, sizeof err);
+    if (where < 0) {
+        lua_pushnil(L);
+        lua_pushstring(L, err);
+        return 2;
+    }
+    lua_pushstring(L, where == LAG_CLIENT_LOCATE_HOST   ? "host"
+                      : where == LAG_CLIENT_LOCATE_HERE ? "here"
+                                                        : "none");
+    lua_pushstring(L, url);
+    return 2;
 }
 
 static int l_now(lua_State *L)
@@ -358,7 +381,8 @@ int luaopen_lagsim_client(lua_State *L)
         {"stopped", m_stopped}, {"close", m_close}, {NULL, NULL}};
     static const luaL_Reg functions[] = {
         {"plant_urls", l_plant_urls}, {"pick_plant", l_pick_plant},
-        {"plants_instead", l_plants_instead}, {"now", l_now}, {"new", l_new}, {NULL, NULL}};
+        {"plants_instead", l_plants_instead}, {"locate", l_locate}, {"now", l_now},
+        {"new", l_new}, {NULL, NULL}};
     luaL_newmetatable(L, MT);
     luaL_newlib(L, methods);
     lua_setfield(L, -2, "__index");

@@ -32,7 +32,7 @@ function Controller.new(name, default_prefix, model, description)
   local self = setmetatable({ name = name, model = model, description = description or '',
                               opts = {}, order = {}, o = {}, dropped = 0, repeats = 0, held = 0 }, Controller)
   self:option('prefix', default_prefix, 'channel prefix', 'string')
-  self:option('url', '', "the plant's LCM URL, its lcm.url (default: LCM's default); commands go to the next port", 'string')
+  self:option('url', '', "the plant's LCM URL, its lcm.url (default: the URL a host's directory on LCM's default bus names for --prefix, else LCM's default); commands go to the next port", 'string')
   self:option('duration', 0, 'stop after S s of sim time from the first state (0: until the daemon stops)')
   self:option('timeout', 5, 'wall s without a scene, or without any message once running, before ending')
   self:option('types', '', 'directory holding the lcm-gen Lua package lagsim', 'string')
@@ -151,6 +151,17 @@ function Controller:start(argv)
   local url = o.url ~= '' and o.url or nil
   local state_url, err = lc.plant_urls(url)
   if not state_url then fail(self, 2, '--url: ' .. err) end
+  if not url then
+    -- no --url: a host's directory on LCM's default bus may name the prefix's own URL
+    -- (lag_client_locate, 1 s at most); else LCM's default (a plant there, or not yet)
+    local where, found = lc.locate(o.prefix)
+    if not where then fail(self, 2, '--prefix: ' .. found) end
+    if where == 'host' then
+      url = found
+      print(string.format("%s: prefix %s runs on %s (the host's directory)", self.name, o.prefix, url))
+      io.stdout:flush()
+    end
+  end
   local c, cerr = lc.new(o.prefix, url)
   if not c then fail(self, 1, cerr) end
   self.client = c

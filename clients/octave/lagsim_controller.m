@@ -22,7 +22,8 @@ classdef lagsim_controller < handle
 %   k = ctl.joint(ctl.reference, 'q1');            % 0: no reference for q1 (or none at all)
 %   if k > 0, r = ctl.reference.r(k); rdot = ctl.reference.rdot(k); end
 %
-%   Options: --prefix P, --url URL (the plant's lcm.url; commands go to the next port),
+%   Options: --prefix P, --url URL (the plant's lcm.url; commands go to the next port;
+%   none: the URL a host's directory on LCM's default bus names for P, if one does),
 %   --duration S (s of sim time from the first state; 0: until the daemon stops),
 %   --timeout S (wall s without a scene, or without any message once running),
 %   --trace FILE (each answered state and the efforts sent, %.17g), -q, --help.
@@ -84,8 +85,10 @@ classdef lagsim_controller < handle
             obj.name = name;
             obj.model = model;
             obj.option('prefix', default_prefix, 'channel prefix');
-            obj.option('url', '', ['the plant''s LCM URL, its lcm.url (default: LCM''s ' ...
-                                   'default, honours LCM_DEFAULT_URL); commands go to the next port']);
+            obj.option('url', '', ['the plant''s LCM URL, its lcm.url (default: the URL a ' ...
+                                   'host''s directory on LCM''s default bus names for --prefix, ' ...
+                                   'else LCM''s default, honours LCM_DEFAULT_URL); commands go ' ...
+                                   'to the next port']);
             obj.option('duration', '0', ['stop after S s of sim time from the first state ' ...
                                          '(0: until the daemon stops)']);
             obj.option('timeout', '5', ['wall s without a scene, or without any message ' ...
@@ -161,8 +164,12 @@ classdef lagsim_controller < handle
                 obj.usage_error('--timeout must be > 0 and --duration >= 0');
             end
             lagsim_setup();
+            url = obj.get('url');
+            if isempty(url)
+                url = obj.located();
+            end
             try
-                [state_url, command_url] = lagsim_plant_urls(obj.get('url'));
+                [state_url, command_url] = lagsim_plant_urls(url);
             catch err
                 obj.usage_error(['--url: ' err.message]);
             end
@@ -207,6 +214,23 @@ classdef lagsim_controller < handle
                       obj.prefix, char(obj.scene.model), obj.model);
             end
             ok = true;
+        end
+
+        function url = located(obj)
+            % No --url: the URL a host's directory on LCM's default bus names for the
+            % prefix (lagsim.examples.Locate, the C library's rule, 1 s at most), else ''
+            % (LCM's default: a plant there, or one not started yet).
+            url = '';
+            try
+                l = javaMethod('plant', 'lagsim.examples.Locate', obj.prefix, 1.0);
+            catch err
+                obj.usage_error(['--prefix: ' err.message]);
+            end
+            if l.host()
+                url = char(l.url());
+                obj.say('%s: prefix %s runs on %s (the host''s directory)\n', obj.name, ...
+                        obj.prefix, url);
+            end
         end
 
         function ask_scene(obj)

@@ -22,14 +22,17 @@ at least VERSION_NUMBER (the functions used here).
 import ctypes
 import os
 
-__all__ = ["Client", "ClientError", "Plant", "discover", "pick_plant", "plants_instead",
-           "plant_urls", "library", "ABI"]
+__all__ = ["Client", "ClientError", "Plant", "discover", "locate", "pick_plant",
+           "plants_instead", "plant_urls", "library", "ABI", "LOCATE_NONE", "LOCATE_HERE",
+           "LOCATE_HOST", "LOCATE_WAIT_S"]
 
 ABI = 1                 # LAGSIM_CLIENT_ABI this module was written for: the SONAME's number
 VERSION_NUMBER = 2000   # the first release with every function used here (0.2.0)
 SONAME = "liblagsim_client.so.%d" % ABI
 MAX_JOINTS, NAME_LEN, TEXT_LEN, URL_LEN = 8, 64, 256, 320   # the header's capacities
 OK, TIMEOUT, ERR_AMBIGUOUS = 0, 2, -4  # lagsim/result.h
+LOCATE_NONE, LOCATE_HERE, LOCATE_HOST = 0, 1, 2  # lag_client_locate's answers
+LOCATE_WAIT_S = 1.0  # LAG_CLIENT_LOCATE_WAIT_S: a host's directory names a plant every 0.5 s
 
 
 class ClientError(RuntimeError):
@@ -100,6 +103,7 @@ _SIGNATURES = {
     "lag_client_scene_limit_upper": (_D, [_P, _I]),
     "lag_client_pick_plant": (_I, [_S, _S, _D, ctypes.POINTER(_Plant), _SZ, _S, _SZ]),
     "lag_client_plants_instead": (_I, [_S, _S, _D, _S, _SZ]),
+    "lag_client_locate": (_I, [_S, _D, _S, _SZ, _S, _SZ]),
 }
 for _k in ("model", "prefix", "integrator", "mode", "effects"):
     _SIGNATURES["lag_client_scene_" + _k] = (_S, [_P])
@@ -246,6 +250,19 @@ def pick_plant(url, model, wait_s):
     rc = library().lag_client_pick_plant(_b(url), _b(model), wait_s, ctypes.byref(p),
                                          ctypes.sizeof(p), err, len(err))
     return rc, (Plant(p) if rc == OK else None), _s(err.value)
+
+
+def locate(prefix, wait_s=LOCATE_WAIT_S):
+    """(where, url): where the plant on prefix runs when no URL was given
+    (lag_client_locate): LOCATE_HOST, url the one a host's directory on LCM's default bus
+    names for it; LOCATE_HERE (a plant of that bus) or LOCATE_NONE (nothing heard within
+    wait_s), url that bus's state URL. Raises ClientError for a prefix a plant cannot have
+    or LCM failing."""
+    url, err = ctypes.create_string_buffer(URL_LEN), ctypes.create_string_buffer(256)
+    where = library().lag_client_locate(_b(prefix), wait_s, url, URL_LEN, err, len(err))
+    if where < 0:
+        raise ClientError(_s(err.value))
+    return where, _s(url.value)
 
 
 def plants_instead(url, prefix, wait_s):

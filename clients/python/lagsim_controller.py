@@ -24,7 +24,8 @@ import signal
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from lagsim_client import Client, ERR_AMBIGUOUS, OK, pick_plant, plant_urls, plants_instead  # noqa: E402
+from lagsim_client import (Client, ClientError, ERR_AMBIGUOUS, LOCATE_HOST, OK,  # noqa: E402
+                           locate, pick_plant, plant_urls, plants_instead)
 
 
 def _import_types(types_dir, name):
@@ -55,8 +56,9 @@ class Controller(object):
                        help="channel prefix (default: the only %s plant on the bus; none "
                             "yet: %s; several: they are named, exit 2)" % (model, default_prefix))
         p.add_argument("--url", default=None,
-                       help="the plant's LCM URL, its lcm.url (default: LCM's default); "
-                            "commands go to the next port")
+                       help="the plant's LCM URL, its lcm.url (default: the URL a host's "
+                            "directory on LCM's default bus names for --prefix, else LCM's "
+                            "default); commands go to the next port")
         p.add_argument("--duration", type=float, default=0.0,
                        help="stop after S s of sim time from the first state (default 0: "
                             "until the daemon stops)")
@@ -104,6 +106,8 @@ class Controller(object):
             self.parser.error("--url: %s" % e)
         if a.prefix is None:
             a.prefix = self._find_plant(a.url, state_url)
+        elif not a.url:
+            a.url = self._locate(a.prefix)
         self.client = Client(a.prefix, a.url)
         # subscribed: from here on no state is missed (test harnesses wait for this line)
         print("%s: waiting for the scene description on %s_SCENE" % (self.name, a.prefix),
@@ -135,12 +139,28 @@ class Controller(object):
         if rc == OK:
             print("%s: the only %s plant on the bus: prefix %s" % (self.name, self.model,
                                                                    plant.prefix), flush=True)
+            if not url and plant.url != state_url:  # a host's plant: on the URL it names
+                self.args.url = plant.url
             return plant.prefix
         if rc == ERR_AMBIGUOUS:
             sys.stderr.write("%s: %s; choose one with --prefix\n" % (self.name, msg))
             sys.exit(2)
         print("%s: %s; waiting for prefix %s" % (self.name, msg, self.default_prefix), flush=True)
         return self.default_prefix
+
+    def _locate(self, prefix):
+        """--prefix without --url: the URL a host's directory on LCM's default bus names
+        for prefix (lag_client_locate, 1 s at most), else None (LCM's default: a plant of
+        that bus, or one not started yet)."""
+        try:
+            where, url = locate(prefix)
+        except ClientError as e:
+            self.parser.error("--prefix: %s" % e)
+        if where != LOCATE_HOST:
+            return None
+        print("%s: prefix %s runs on %s (the host's directory)" % (self.name, prefix, url),
+              flush=True)
+        return url
 
     def _ended(self, heard):
         """Why the run ended (and self.end set), or None while it goes on."""

@@ -227,7 +227,9 @@ static int pick_prefix(view_opts *o)
 static void plant_url(view_opts *o)
 {
     static char url[LAG_CLIENT_URL_LEN];
-    if (!o->url && lag_locate_plant(o->prefix, url, sizeof url)) o->url = url;
+    if (!o->url && lag_client_locate(o->prefix, LAG_CLIENT_LOCATE_WAIT_S, url, sizeof url,
+                                     NULL, 0) == LAG_CLIENT_LOCATE_HOST)
+        o->url = url;
 }
 
 /* The address on stdout; on stderr, who can reach it. */

@@ -18,6 +18,7 @@
 #include <pthread.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -433,10 +434,45 @@ static void case_small_stack(int arg)
             (int)(intptr_t)n, out);
 }
 
+/* lag_client_locate's answers without a directory, and its refusals (a host's directory
+ * itself: clients_<language>_host_prefix). memq:// as the default bus: this process's own,
+ * where nobody is. */
+static void case_locate(int arg)
+{
+    (void)arg;
+    char url[LAG_CLIENT_URL_LEN], err[256];
+    ENSURE(setenv("LCM_DEFAULT_URL", "memq://", 1) == 0);
+    double t0 = lag_client_now();
+    int where = lag_client_locate("ALICE", 0.1, url, sizeof url, err, sizeof err);
+    ENSUREF(where == LAG_CLIENT_LOCATE_NONE && !strcmp(url, "memq://") && !err[0],
+            "%d %s %s", where, url, err);
+    ENSURE(lag_client_now() - t0 >= 0.1); /* the whole wait: nothing decided it */
+    static const char *const bad[] = {"", "A-B", "A.*", "ALICE_STATE|BOB",
+                                      "P123456789012345678901234567890123456789012345678901234"};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        where = lag_client_locate(bad[k], 0.1, url, sizeof url, err, sizeof err);
+        ENSUREF(where == LAG_CLIENT_ERR_ARG && strstr(err, "prefix") && !url[0], "'%s': %d %s",
+                bad[k], where, err);
+    }
+    ENSURE(lag_client_locate(NULL, 0.1, url, sizeof url, NULL, 0) == LAG_CLIENT_ERR_ARG);
+    ENSURE(lag_client_locate("ALICE", NAN, url, sizeof url, NULL, 0) == LAG_CLIENT_ERR_ARG);
+    ENSURE(lag_client_locate("ALICE", -1.0, url, sizeof url, NULL, 0) == LAG_CLIENT_ERR_ARG);
+    ENSURE(lag_client_locate("ALICE", 0.0, NULL, 0, NULL, 0) == LAG_CLIENT_ERR_ARG);
+    char small[4];
+    where = lag_client_locate("ALICE", 0.0, small, sizeof small, err, sizeof err);
+    ENSUREF(where == LAG_CLIENT_ERR_ARG && !small[0] && strstr(err, "too short"), "%d %s",
+            where, err);
+    ENSURE(setenv("LCM_DEFAULT_URL", "tcpq://nowhere", 1) == 0);
+    where = lag_client_locate("ALICE", 0.0, url, sizeof url, err, sizeof err);
+    ENSUREF(where == LAG_CLIENT_ERR_ARG && strstr(err, "LCM_DEFAULT_URL"), "%d %s", where, err);
+    ENSURE(unsetenv("LCM_DEFAULT_URL") == 0);
+}
+
 int main(int argc, char **argv)
 {
     static const lt_case cases[] = {{"library", case_library, 0, 0},
                                     {"generation", case_generation, 0, 0},
-                                    {"small_stack", case_small_stack, 0, 0}};
-    return lt_main(argc, argv, cases, 3);
+                                    {"small_stack", case_small_stack, 0, 0},
+                                    {"locate", case_locate, 0, 0}};
+    return lt_main(argc, argv, cases, 4);
 }

@@ -104,12 +104,14 @@ set(LAGSIM_TIER_RULES
   "wallclock NAME  ^clients_(readme_recipes|walkthrough|scene_params)$"
   "wallclock NAME  ^ctl_"
   "quick     NAME  ^install_"
-  "quick     NAME  ^clients_(lqr|status_fields|hostile_messages|library|generation|small_stack|not_built)$"
+  "quick     NAME  ^clients_(lqr|status_fields|hostile_messages|library|generation|small_stack|locate|not_built)$"
   "quick     NAME  ^clients_[a-z_]+_(usage_.*|help)$"
   "quick     NAME  ^clients_(python|lua)_(lcm|types)$"
   "quick     NAME  ^clients_java_release$"
-  "quick     NAME  ^clients_(go_dipc_gain|go_vet|go_cgo_rebuild|binding_lookup)$"
+  "quick     NAME  ^clients_(go_dipc_gain|go_vet|go_cgo_rebuild|binding_lookup|binding_constants)$"
   "quick     NAME  _(lockstep|hostile|push|reference_lost)$"
+  # a lab host's plants in lockstep, found by their prefix through its directory
+  "quick     NAME  ^clients_(c|cpp|python|lua|go|java)_host_prefix$"
   "quick     NAME  ^clients_cross_language_(dipc|manipulator)$"
   "quick     NAME  ^clients_readme_(c|cpp|cpplcm|python|lua|java|go)$"
   # the client library: its version, its ABI, its C++ header, the README's C and C++ blocks

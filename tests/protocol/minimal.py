@@ -15,7 +15,8 @@ it has), hold (answers a state whose scene has not come with the scene it has), 
 that scene for ever), trailing (keeps messages with bytes after their end), nan (keeps
 messages with a NaN or an infinity, or a name with a NUL inside), foreign (listens to every prefix), old (reads a
 state of lagsim 0.1.0's types as one of the current generation), stop (does not end on
-the stop event), events (ends on any event).
+the stop event), events (ends on any event), directory (given no URL, runs on the default
+bus without asking a host's directory where the plant is).
 """
 import argparse
 import math
@@ -29,7 +30,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from lagsim_lcm import LCM, plant_urls  # noqa: E402
 
 RULES = ("describe", "copies", "silent", "stamp", "generation", "hold", "forever", "trailing",
-         "nan", "foreign", "old", "stop", "events")
+         "nan", "foreign", "old", "stop", "events", "directory")
 DESCRIBE_S = 0.25
 
 
@@ -49,6 +50,8 @@ def sound(m):
 class Minimal:
     def __init__(self, a, t):
         self.a, self.t, self.brk = a, t, a.brk
+        if not a.url and self.brk != "directory":
+            a.url = self.locate()
         state_url, command_url = plant_urls(a.url)
         self.lc, self.lc_cmd = LCM(state_url), LCM(command_url)
         self.scene = None      # the scene of the newest generation heard
@@ -62,6 +65,39 @@ class Minimal:
         for suffix, fn in (("STATE", self.on_state), ("SCENE", self.on_scene),
                            ("EVENT", self.on_event)):
             self.lc.subscribe(pre + "_" + suffix, fn)
+
+    def locate(self):
+        """No URL: where a host's directory on the default bus says the plant runs
+        (docs/protocol.md, "A host's directory"), or None (the default bus)."""
+        here = plant_urls(None)[0]
+        found = []  # "here", or the plant's state URL
+
+        def on(channel, data):
+            if found:
+                return
+            if not channel.endswith("_EVENT"):
+                found.append("here")  # its state, status or scene
+                return
+            ev = self.decode(self.t.event_t, data)
+            if ev is None:
+                return
+            if ev.kind != "plant":
+                found.append("here")
+                return
+            try:
+                url = plant_urls(ev.detail)[0]
+            except ValueError:
+                return
+            if url != here:
+                found.append(url)
+
+        lc = LCM(here)
+        lc.subscribe(re.escape(self.a.prefix) + "_(EVENT|STATE|STATUS|SCENE)", on)
+        end = time.monotonic() + 1.0
+        while not found and time.monotonic() < end:
+            lc.handle_timeout(max(1, int((end - time.monotonic()) * 1000)))
+        lc.close()
+        return found[0] if found and found[0] != "here" else None
 
     # -- decoding: a message counts only if it is whole (encodes back to its bytes) and
     # every number in it is finite

@@ -91,10 +91,15 @@ def read_trace(path, seen=None):
 
 # ---------------------------------------------------------------- messages
 
+URLS = {}  # "{url}", "{decoy_url}" in a message's strings: the run's (run())
+
+
 def _value(v, prefix):
     if isinstance(v, str):
         if v in SPECIAL:
             return SPECIAL[v]
+        for k, u in URLS.items():
+            v = v.replace(k, u)
         return v.replace("{prefix}", prefix)
     if isinstance(v, list):
         return [_value(x, prefix) for x in v]
@@ -204,7 +209,7 @@ class Controller:
 # ---------------------------------------------------------------- the daemon's side
 
 class Player:
-    def __init__(self, types, state_url, command_url, prefix, ctl, quiet):
+    def __init__(self, types, state_url, command_url, prefix, ctl, quiet, directory=None):
         self.t, self.prefix, self.ctl, self.quiet = types, prefix, ctl, quiet
         self.url = {"state": state_url, "command": command_url}
         self.out = LCM(state_url)
@@ -213,6 +218,16 @@ class Player:
         esc = re.escape(prefix)
         self.inp.subscribe(esc + "_COMMAND", self._on_command)
         self.inp.subscribe(esc + "_CONTROL", self._on_control)
+        # a host's directory (the step "directory"): its bus, LCM_DEFAULT_URL's; DESCRIBE
+        # there answered with a scene, as a host's directory answers it
+        self.out_dir = self.dir_in = None
+        self.dir_describe = None
+        self.dir_describes = 0
+        if directory is not None:
+            self.out_dir = LCM(directory[0])
+            self.dir_in = LCM(directory[1])
+            self.dir_in.subscribe(esc + "_CONTROL", self._on_dir_control)
+        self.every = []        # [period, next time, data, channel, prefix, url]
         self.defs = {}         # name -> {"type", "fields"}
         self.commands = []     # (bytes, decoded or None, reason) not yet taken by a step
         self.received = {}     # name -> bytes of a command an expect step named
@@ -248,6 +263,23 @@ class Player:
         else:
             self.others += 1
 
+    def _on_dir_control(self, channel, data):
+        try:
+            c = self.t.control_t.decode(data)
+        except Exception:
+            return
+        if c.request == self.t.control_t.DESCRIBE and self.dir_describe is not None:
+            self.dir_describes += 1
+            self.out_dir.publish("%s_SCENE" % self.prefix, self.defs_msg(self.dir_describe))
+
+    def _repeat(self):
+        """The sends with an "every": each again when its period has passed."""
+        now = time.monotonic()
+        for r in self.every:
+            if now >= r[1]:
+                self.publish(r[2], r[3], r[4], r[5])
+                r[1] = now + r[0]
+
     def pump(self, seconds, until=None):
         """Handles what arrives for `seconds` (or until until() holds); fails if the
         controller exited meanwhile, unless an exit is what the step waits for."""
@@ -258,8 +290,11 @@ class Player:
             left = end - time.monotonic()
             if left <= 0:
                 return until is not None and until()
+            self._repeat()
+            if self.dir_in is not None:
+                self.dir_in.handle_timeout(1)
             self.inp.handle_timeout(min(20, max(1, int(left * 1000))))
-            if not self.exit_expected and self.ctl.exited() is not None:
+            if not self.exit_expected and self.ctl is not None and self.ctl.exited() is not None:
                 raise StepFailed("the controller exited (status %s)" % self.ctl.exited())
 
     # -- sending
@@ -269,7 +304,9 @@ class Player:
         return build(self.t, self.defs[name], self.prefix).encode()
 
     def publish(self, data, channel, prefix, url):
-        lc = self.out if url == "state" else self.out_cmd
+        if url == "directory" and self.out_dir is None:
+            raise TraceError("\"url\": \"directory\" in a trace without the step \"directory\"")
+        lc = {"state": self.out, "command": self.out_cmd, "directory": self.out_dir}[url]
         lc.publish("%s_%s" % (prefix, channel), data)
 
     # -- the steps
@@ -298,11 +335,29 @@ class Player:
         data = forge(data, s.get("forge", {}))
         prefix = s.get("prefix", "{prefix}").replace("{prefix}", self.prefix)
         url = s.get("url", "state")
+        if url not in ("state", "command", "directory"):
+            raise TraceError("%s: \"url\" is state, command or directory" % s["_where"])
         for _ in range(s.get("times", 1)):
             self.publish(data, s["channel"], prefix, url)
+        if "every" in s:  # again and again until the trace ends, as a directory announces
+            self.every.append([s["every"], time.monotonic() + s["every"], data, s["channel"],
+                               prefix, url])
+            return "%s on %s_%s (%s URL, %d bytes), every %g s" % (
+                s.get("msg", "raw bytes"), prefix, s["channel"], url, len(data), s["every"])
         self.last_send = time.monotonic()
         return "%s on %s_%s (%s URL, %d bytes)" % (s.get("msg", "raw bytes"), prefix,
                                                    s["channel"], url, len(data))
+
+    def do_start(self, s):
+        if self.ctl is not None:
+            raise TraceError("%s: the controller runs already" % s["_where"])
+        self.ctl = self.start_ctl()
+        return "the controller started"
+
+    def do_directory(self, s):
+        self.dir_describe = s.get("describe")
+        return "LCM's default bus is a host's directory (%s); the controller was given no URL" \
+            % URLS.get("{directory_url}")
 
     def do_drop(self, s):
         self.defs_msg(s["msg"])
@@ -475,18 +530,32 @@ def stop_event(types, prefix):
 
 
 def run(a, steps, types):
-    port = a.port or lcm_port()  # a pair held by this process (tests/common/lcm_port.py)
+    hosted = any(s["do"] == "directory" for s in steps)
+    # pairs held by this process (tests/common/lcm_port.py): the plant's; with a directory,
+    # the directory's and a decoy's after it
+    port = a.port or lcm_port(6 if hosted else 2)
     url = "udpm://239.255.76.67:%d?ttl=0" % port
     state_url, command_url = plant_urls(url)
     name = re.sub(r"[^A-Z0-9]", "", os.path.splitext(os.path.basename(a.trace))[0].upper())
     prefix = "PT%s%d" % (name[:24], os.getpid())
-    argv = [w.replace("{prefix}", prefix).replace("{url}", state_url) for w in a.controller]
-    env = dict(os.environ, LCM_DEFAULT_URL=state_url)
+    URLS["{url}"] = state_url
+    directory = None
+    if hosted:  # the controller is given no URL: LCM's default bus is the directory's
+        directory = plant_urls("udpm://239.255.76.67:%d?ttl=0" % (port + 2))
+        URLS["{directory_url}"] = directory[0]
+        URLS["{decoy_url}"] = "udpm://239.255.76.67:%d?ttl=0" % (port + 4)
+    given = "" if hosted else state_url
+    argv = [w.replace("{prefix}", prefix).replace("{url}", given) for w in a.controller]
+    env = dict(os.environ, LCM_DEFAULT_URL=directory[0] if hosted else state_url)
     say = (lambda *x: None) if a.quiet else (lambda *x: print(*x, flush=True))
     say("play %s: prefix %s, state URL %s, commands %s" % (a.trace, prefix, state_url, command_url))
     say("controller: %s" % " ".join(shlex.quote(w) for w in argv))
-    ctl = Controller(argv, env)
-    p = Player(types, state_url, command_url, prefix, ctl, a.quiet)
+    # at once, or at the step "start" (a trace that sets a stage first: a directory that
+    # announces its plant before the controller asks it)
+    late = any(s["do"] == "start" for s in steps)
+    p = Player(types, state_url, command_url, prefix, None if late else Controller(argv, env),
+               a.quiet, directory)
+    p.start_ctl = lambda: Controller(argv, env)
     failed = None
     try:
         for s in steps:
@@ -501,12 +570,15 @@ def run(a, steps, types):
                 break
             say("ok   %s: %s" % (label, got))
     finally:
-        if ctl.exited() is None:
+        ctl = p.ctl
+        if ctl is not None and ctl.exited() is None:
             p.publish(stop_event(types, prefix), "EVENT", prefix, "state")
-        ctl.stop(grace=5.0)
-        for lc in (p.out, p.out_cmd, p.inp):
-            lc.close()
-    if failed or not a.quiet:
+        if ctl is not None:
+            ctl.stop(grace=5.0)
+        for lc in (p.out, p.out_cmd, p.inp, p.out_dir, p.dir_in):
+            if lc is not None:
+                lc.close()
+    if (failed or not a.quiet) and ctl is not None:
         print("controller's output (last lines):\n" + ctl.tail(), flush=True)
     return failed
 

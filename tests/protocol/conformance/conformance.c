@@ -4,6 +4,9 @@
  *
  *   conformance_c --prefix P --url URL [--timeout S]
  *
+ * Without a URL (or an empty one) it asks a host's directory on LCM's default bus where
+ * the plant runs (lag_client_locate: the trace `directory`).
+ *
  * For each state the library returns: u = -(kp q + kd qd) on each actuated joint of the
  * scene of that state's generation (lag_client_latest_scene; kp, kd: its parameters of
  * those names), one line "conformance: law generation=G sim_time=T" on stdout before the
@@ -54,7 +57,11 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    char err[256];
+    char err[256], located[LAG_CLIENT_URL_LEN];
+    /* no URL: where a host's directory on the default bus says the plant runs */
+    if ((!url || !url[0]) && lag_client_locate(prefix, LAG_CLIENT_LOCATE_WAIT_S, located,
+                                               sizeof located, NULL, 0) == LAG_CLIENT_LOCATE_HOST)
+        url = located;
     lag_client *c = lag_client_create(url, prefix, err, sizeof err);
     if (!c) {
         fprintf(stderr, "conformance_c: %s\n", err);

@@ -34,6 +34,10 @@ int main(int argc, char **argv)
         }
     }
     try {
+        if (url.empty()) { /* where a host's directory on the default bus says it runs */
+            lagsim::Located l = lagsim::locate(prefix);
+            if (l.host()) url = l.url;
+        }
         lagsim::Client c(prefix, url);
         bool stopped = false;
         c.on_event([&](const lagsim::Event &ev) { stopped |= ev.is("stop"); });

@@ -52,6 +52,15 @@ func main() {
 		os.Exit(1)
 	}
 	var cerr [256]C.char
+	if *url == "" { // where a host's directory on the default bus says the plant runs
+		var found [C.LAG_CLIENT_URL_LEN]C.char
+		cp := cstr(*prefix)
+		if C.lag_client_locate(cp, C.LAG_CLIENT_LOCATE_WAIT_S, &found[0], C.size_t(len(found)),
+			nil, 0) == C.LAG_CLIENT_LOCATE_HOST {
+			*url = C.GoString(&found[0])
+		}
+		C.free(unsafe.Pointer(cp))
+	}
 	curl, cprefix := cstr(*url), cstr(*prefix)
 	c := C.lag_client_create(curl, cprefix, &cerr[0], C.size_t(len(cerr)))
 	C.free(unsafe.Pointer(curl))

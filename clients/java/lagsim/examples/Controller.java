@@ -86,7 +86,8 @@ public final class Controller {
         this.name = name;
         this.model = model;
         option("prefix", defaultPrefix, "channel prefix");
-        option("url", "", "the plant's LCM URL, its lcm.url (default: LCM's default, honours "
+        option("url", "", "the plant's LCM URL, its lcm.url (default: the URL a host's directory "
+                          + "on LCM's default bus names for --prefix, else LCM's default, honours "
                           + "LCM_DEFAULT_URL); commands go to the next port");
         option("duration", "0", "stop after S s of sim time from the first state (0: until the daemon stops)");
         option("timeout", "5", "wall s without a scene, or without any message once running, before ending");
@@ -172,6 +173,7 @@ public final class Controller {
             usageError("--url: " + e.getMessage());
             return;
         }
+        if (get("url").isEmpty()) urls = located(urls);
         lcm = new LCM(urls[0]);
         lcmCmd = urls[1].equals(urls[0]) ? lcm : new LCM(urls[1]);
         heardNanos = System.nanoTime();
@@ -229,6 +231,22 @@ public final class Controller {
         }
         if (scene == null) System.exit(finish("states=0"));
         if (!scene.model.equals(model)) fail("prefix " + prefix + " runs model " + scene.model + ", not " + model);
+    }
+
+    /** No --url: the URLs a host's directory on LCM's default bus names for the prefix
+     *  (Locate, 1 s at most), else urls (LCM's default: a plant there, or one not started
+     *  yet). */
+    private String[] located(String[] urls) throws IOException, InterruptedException {
+        Locate l;
+        try {
+            l = Locate.plant(prefix, Locate.WAIT_S);
+        } catch (IllegalArgumentException e) {
+            usageError("--prefix: " + e.getMessage());
+            return urls;
+        }
+        if (!l.host()) return urls;
+        System.out.println(name + ": prefix " + prefix + " runs on " + l.url() + " (the host's directory)");
+        return PlantUrls.both(l.url());
     }
 
     private void askScene() {
