@@ -28,59 +28,43 @@ target_include_directories(test_client_hostile PRIVATE ${CMAKE_CURRENT_SOURCE_DI
 target_link_libraries(test_client_hostile PRIVATE lagsim_client)
 lagsim_add_test_cases(test_client_hostile clients clients 30)
 
-# The C controllers' options: a value that is not a number, out of range, an unknown
-# option, a stray argument: exit 2 with a message naming the option.
+# The C and C++ controllers' options: a value that is not a number, out of range, an
+# unknown option, a stray argument: exit 2 with a message naming the option; --help: exit
+# 0, the options listed. lagsim_usage_tests(PROGRAM PATTERN [HELP TEXT] [BEFORE ARG...]
+# BAD "ARGS" ...) makes clients_PROGRAM_usage_NAME for each BAD (its arguments, split at
+# spaces, after the BEFORE ones; NAME: them without leading dashes, joined by _), which
+# must exit 2 with stderr matching PATTERN, and clients_PROGRAM_help when HELP is given.
 set(expect_exit sh ${CMAKE_CURRENT_SOURCE_DIR}/clients/expect_exit.sh)
-foreach(bad "--duration;abc" "--timeout;0" "--duration;-1" "--duration;inf" "--q;1,2"
-            "--r;0" "--gain;foo" "--k;1,2,3" "-z" "stray" "--timeout")
-  string(REGEX REPLACE "^-+" "" bad_name "${bad}")
-  string(REPLACE ";" "_" bad_name "${bad_name}")
-  string(REGEX REPLACE "[.:]" "_" bad_name "${bad_name}")
-  string(REGEX REPLACE "[^A-Za-z0-9_-]" "" bad_name "${bad_name}")
-  add_test(NAME clients_dipc_lqr_usage_${bad_name}
-           COMMAND ${expect_exit} 2 "^dipc_lqr: .*(--|'-z'|'stray')" $<TARGET_FILE:dipc_lqr> ${bad})
-  set_tests_properties(clients_dipc_lqr_usage_${bad_name} PROPERTIES TIMEOUT 10)
-endforeach()
-foreach(bad "--wn;-1" "--settle;x" "--duration;1e999")
-  string(REGEX REPLACE "^-+" "" bad_name "${bad}")
-  string(REPLACE ";" "_" bad_name "${bad_name}")
-  string(REGEX REPLACE "[.:]" "_" bad_name "${bad_name}")
-  string(REGEX REPLACE "[^A-Za-z0-9_-]" "" bad_name "${bad_name}")
-  add_test(NAME clients_manipulator_pd_usage_${bad_name}
-           COMMAND ${expect_exit} 2 "^manipulator_pd: --" $<TARGET_FILE:manipulator_pd> ${bad})
-  set_tests_properties(clients_manipulator_pd_usage_${bad_name} PROPERTIES TIMEOUT 10)
-endforeach()
-# the C++ example's options, the same rules
-foreach(bad "--wn;-1" "--settle;x" "--duration;1e999" "--timeout;0" "-z" "stray")
-  string(REGEX REPLACE "^-+" "" bad_name "${bad}")
-  string(REPLACE ";" "_" bad_name "${bad_name}")
-  string(REGEX REPLACE "[.:]" "_" bad_name "${bad_name}")
-  string(REGEX REPLACE "[^A-Za-z0-9_-]" "" bad_name "${bad_name}")
-  add_test(NAME clients_manipulator_ct_usage_${bad_name}
-           COMMAND ${expect_exit} 2 "^manipulator_ct: " $<TARGET_FILE:manipulator_ct> ${bad})
-  set_tests_properties(clients_manipulator_ct_usage_${bad_name} PROPERTIES TIMEOUT 10)
-endforeach()
-add_test(NAME clients_manipulator_ct_help
-         COMMAND ${expect_exit} 0 "--duration S" $<TARGET_FILE:manipulator_ct> --help)
-# --help: exit 0, the options listed
-add_test(NAME clients_dipc_lqr_help
-         COMMAND ${expect_exit} 0 "--duration S" $<TARGET_FILE:dipc_lqr> --help)
+function(lagsim_usage_tests program pattern)
+  cmake_parse_arguments(U "" "HELP" "BEFORE;BAD" ${ARGN})
+  foreach(bad IN LISTS U_BAD)
+    separate_arguments(bad_args UNIX_COMMAND "${bad}")
+    string(REGEX REPLACE "^-+" "" bad_name "${bad}")
+    string(REPLACE " " "_" bad_name "${bad_name}")
+    string(REGEX REPLACE "[.:]" "_" bad_name "${bad_name}")
+    string(REGEX REPLACE "[^A-Za-z0-9_-]" "" bad_name "${bad_name}")
+    add_test(NAME clients_${program}_usage_${bad_name}
+             COMMAND ${expect_exit} 2 "${pattern}" $<TARGET_FILE:${program}> ${U_BEFORE} ${bad_args})
+    set_tests_properties(clients_${program}_usage_${bad_name} PROPERTIES TIMEOUT 10)
+  endforeach()
+  if(DEFINED U_HELP)
+    add_test(NAME clients_${program}_help
+             COMMAND ${expect_exit} 0 "${U_HELP}" $<TARGET_FILE:${program}> --help)
+  endif()
+endfunction()
+lagsim_usage_tests(dipc_lqr "^dipc_lqr: .*(--|'-z'|'stray')" HELP "--duration S"
+  BAD "--duration abc" "--timeout 0" "--duration -1" "--duration inf" "--q 1,2" "--r 0"
+      "--gain foo" "--k 1,2,3" "-z" "stray" "--timeout")
+lagsim_usage_tests(manipulator_pd "^manipulator_pd: --"
+  BAD "--wn -1" "--settle x" "--duration 1e999")
+lagsim_usage_tests(manipulator_ct "^manipulator_ct: " HELP "--duration S"
+  BAD "--wn -1" "--settle x" "--duration 1e999" "--timeout 0" "-z" "stray")
 # lqr_balance takes its model from the scene, so it has no default prefix: without
 # --prefix it takes the only plant on the bus (tests/ctl/test_discover.py); its own options
-# are checked as dipc_lqr's.
-foreach(bad "--prefix;P;--q;1,-2" "--prefix;P;--q;1,2,3,4,5,6,7" "--prefix;P;--r;0"
-            "--prefix;P;--gain;foo" "--prefix;P;--q0;x")
-  string(REPLACE "--prefix;P;" "" bad_name "${bad}")
-  string(REGEX REPLACE "^-+" "" bad_name "${bad_name}")
-  string(REPLACE ";" "_" bad_name "${bad_name}")
-  string(REGEX REPLACE "[.:]" "_" bad_name "${bad_name}")
-  string(REGEX REPLACE "[^A-Za-z0-9_-]" "" bad_name "${bad_name}")
-  add_test(NAME clients_lqr_balance_usage_${bad_name}
-           COMMAND ${expect_exit} 2 "^lqr_balance: --" $<TARGET_FILE:lqr_balance> ${bad})
-  set_tests_properties(clients_lqr_balance_usage_${bad_name} PROPERTIES TIMEOUT 10)
-endforeach()
-add_test(NAME clients_lqr_balance_help
-         COMMAND ${expect_exit} 0 "--prefix P +channel prefix \\(default: the only plant on the bus" $<TARGET_FILE:lqr_balance> --help)
+# are checked as dipc_lqr's, after a --prefix.
+lagsim_usage_tests(lqr_balance "^lqr_balance: --" BEFORE --prefix P
+  HELP "--prefix P +channel prefix \\(default: the only plant on the bus"
+  BAD "--q 1,-2" "--q 1,2,3,4,5,6,7" "--r 0" "--gain foo" "--q0 x")
 
 # ---- end to end: lagsimd + a controller on real LCM (default udpm URL, ttl=0), each run
 # with its own channel prefix (run_e2e.py makes it unique per process). The harness
@@ -104,6 +88,22 @@ if(LAGSIM_PYTHON3)
   # within 5 s", clients_python_manipulator_lockstep). 30 s, within the harness's own
   # --timeout, which bounds the run; the tests of the end on silence keep their 2 s.
   set(ctl_timeout 30)
+  # lagsim_balance_test(NAME MODE TAG CONTROLLER SCENE ARG... CHECKS ARG...): CONTROLLER
+  # balances the plant of the SCENE arguments for 20 s in MODE (lockstep: every one of the
+  # 2001 states, t = 0 .. 20, answered; realtime: at least half, over 20 s of sim time),
+  # with the CHECKS on its summary besides; run_e2e's --timeout 50, ctest's 70.
+  function(lagsim_balance_test name mode tag controller)
+    cmake_parse_arguments(B "" "" "SCENE;CHECKS" ${ARGN})
+    if(mode STREQUAL "lockstep")
+      set(whole --check "states == 2001" --check "t_first == 0 and t_last >= 20 - 1e-9")
+    else()
+      set(whole --check "states >= 1000" --check "t_last - t_first >= 20 - 0.011")
+    endif()
+    add_test(NAME ${name}
+      COMMAND ${e2e} ${B_SCENE} --mode ${mode} --name ${tag} --timeout 50 ${whole} ${B_CHECKS}
+        -- $<TARGET_FILE:${controller}> --prefix {prefix} --duration 20 --timeout ${ctl_timeout} -q)
+    set_tests_properties(${name} PROPERTIES TIMEOUT 70)
+  endfunction()
   set(dipc_cfg --config ${PROJECT_SOURCE_DIR}/config/dipc.yaml --set "initial.q=[0,0.05,-0.03]"
                --set "initial.qd=[0,0,0]")
   # Bounds (DIPC, released at theta1 = 0.05, theta2 = -0.03 rad, Bogdanov's LQR weights):
@@ -113,32 +113,24 @@ if(LAGSIM_PYTHON3)
   # lie within 10 % + 2 mrad of the prediction; after 20 s the slowest closed-loop pole
   # (-0.52 1/s) has shrunk every mode by e^-10, so both angles must be below 1 mrad.
   # Every state is answered in lockstep: 20 s at 100 Hz = 2001 states, t = 0 .. 20.
-  add_test(NAME clients_dipc_lqr_lockstep
-    COMMAND ${e2e} ${dipc_cfg} --mode lockstep --name CLLQRLS --timeout 50
-      --check "states == 2001" --check "t_first == 0 and t_last >= 20 - 1e-9"
-      --check "max_abs_theta1 >= 0.0499"
+  lagsim_balance_test(clients_dipc_lqr_lockstep lockstep CLLQRLS dipc_lqr SCENE ${dipc_cfg}
+    CHECKS --check "max_abs_theta1 >= 0.0499"
       --check "max_abs_theta1 <= 1.1 * pred_max_abs_theta1 + 0.002"
       --check "max_abs_theta2 <= 1.1 * pred_max_abs_theta2 + 0.002"
       --check "abs(end_theta1) < 1e-3 and abs(end_theta2) < 1e-3"
-      --check "max_abs_theta0 < 1.0" --check "dropped == 0" --check "end == 'duration'"
-      -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration 20 --timeout ${ctl_timeout} -q)
-  set_tests_properties(clients_dipc_lqr_lockstep PROPERTIES TIMEOUT 70)
+      --check "max_abs_theta0 < 1.0" --check "dropped == 0" --check "end == 'duration'")
   # Real time (20 s of wall time): the effort now reaches the daemon up to one tick after
   # the state it answers, so the bounds get 25 % + 5 mrad. A controller that is not
   # scheduled within a period skips to the newest state: beside two busy processes on a
   # 2-core machine, 1813 to 1936 of the 2001 states were answered and the angles met the
   # bounds. The count only shows that the loop ran the whole run (half
   # the states); the contract is the angles and the end time.
-  add_test(NAME clients_dipc_lqr_realtime
-    COMMAND ${e2e} ${dipc_cfg} --mode realtime --name CLLQRRT --timeout 50
-      --check "states >= 1000" --check "t_last - t_first >= 20 - 0.011"
-      --check "max_abs_theta1 >= 0.0499"
+  lagsim_balance_test(clients_dipc_lqr_realtime realtime CLLQRRT dipc_lqr SCENE ${dipc_cfg}
+    CHECKS --check "max_abs_theta1 >= 0.0499"
       --check "max_abs_theta1 <= 1.25 * pred_max_abs_theta1 + 0.005"
       --check "max_abs_theta2 <= 1.25 * pred_max_abs_theta2 + 0.005"
       --check "abs(end_theta1) < 1e-3 and abs(end_theta2) < 1e-3"
-      --check "max_abs_theta0 < 1.0"
-      -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} --duration 20 --timeout ${ctl_timeout} -q)
-  set_tests_properties(clients_dipc_lqr_realtime PROPERTIES TIMEOUT 70)
+      --check "max_abs_theta0 < 1.0")
 
   # The cart-pole balanced by lqr_balance, which takes the model, its parameters, joints
   # and inputs from the scene (no cart-pole code in the controller), with
@@ -149,16 +141,14 @@ if(LAGSIM_PYTHON3)
   # after 20 s the slowest pole has shrunk every mode by e^-16 (1e-7): both coordinates
   # within 1e-4 rad, 1e-3 m of upright and centre. 20 s at 100 Hz = 2001 states.
   set(cartpole_cfg --config ${PROJECT_SOURCE_DIR}/config/cartpole.yaml)
-  add_test(NAME clients_lqr_balance_cartpole_lockstep
-    COMMAND ${e2e} ${cartpole_cfg} --mode lockstep --name CLCPLS --timeout 50
-      --check "states == 2001" --check "t_first == 0 and t_last >= 20 - 1e-9"
-      --check "max_abs_theta >= 0.0499"
+  lagsim_balance_test(clients_lqr_balance_cartpole_lockstep lockstep CLCPLS lqr_balance
+    SCENE ${cartpole_cfg}
+    CHECKS --check "max_abs_theta >= 0.0499"
       --check "max_abs_theta <= 1.1 * pred_max_abs_theta + 0.002"
       --check "max_abs_x <= 1.1 * pred_max_abs_x + 0.002"
       --check "abs(end_theta) < 1e-4 and abs(end_x) < 1e-3"
       --check "dropped == 0" --check "end == 'duration'"
-      --check "'applying the discrete gain on x: u = -K x, K =' in out"
-      -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout ${ctl_timeout} -q)
+      --check "'applying the discrete gain on x: u = -K x, K =' in out")
   # A push: upright at rest, then at t = 5 s an impulse of 0.02 N m s on the pole (the
   # scene's disturbance effect). Its velocity jump M(0)^-1 (0, 0.02) = (-0.0293 m/s,
   # 0.644 rad/s) run through the linearized sampled loop peaks at theta 0.0567 rad,
@@ -166,27 +156,20 @@ if(LAGSIM_PYTHON3)
   # control period, so the loop answers up to 10 ms late: 25 % more is allowed. It must
   # move the pole (>= 0.05 rad), and 15 s later (e^-12 of the slowest mode) the pole is
   # upright within 1e-4 rad and the cart back within 1e-3 m.
-  add_test(NAME clients_lqr_balance_cartpole_push
-    COMMAND ${e2e} ${cartpole_cfg} --set "initial.q=[0,0]"
+  lagsim_balance_test(clients_lqr_balance_cartpole_push lockstep CLCPPU lqr_balance
+    SCENE ${cartpole_cfg} --set "initial.q=[0,0]"
       --set "effects={disturbance: [{t: 5.0, joint: theta, impulse: 0.02}]}"
-      --mode lockstep --name CLCPPU --timeout 50
-      --check "states == 2001" --check "t_first == 0 and t_last >= 20 - 1e-9"
-      --check "max_abs_theta >= 0.05 and max_abs_theta <= 1.25 * 0.0567"
+    CHECKS --check "max_abs_theta >= 0.05 and max_abs_theta <= 1.25 * 0.0567"
       --check "max_abs_x <= 1.25 * 0.487"
       --check "abs(end_theta) < 1e-4 and abs(end_x) < 1e-3"
-      --check "dropped == 0" --check "end == 'duration'"
-      -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout ${ctl_timeout} -q)
+      --check "dropped == 0" --check "end == 'duration'")
   # Real time, as clients_dipc_lqr_realtime: 25 % + 5 mrad (or mm) of the prediction.
-  add_test(NAME clients_lqr_balance_cartpole_realtime
-    COMMAND ${e2e} ${cartpole_cfg} --mode realtime --name CLCPRT --timeout 50
-      --check "states >= 1000" --check "t_last - t_first >= 20 - 0.011"
-      --check "max_abs_theta >= 0.0499"
+  lagsim_balance_test(clients_lqr_balance_cartpole_realtime realtime CLCPRT lqr_balance
+    SCENE ${cartpole_cfg}
+    CHECKS --check "max_abs_theta >= 0.0499"
       --check "max_abs_theta <= 1.25 * pred_max_abs_theta + 0.005"
       --check "max_abs_x <= 1.25 * pred_max_abs_x + 0.005"
-      --check "abs(end_theta) < 1e-3 and abs(end_x) < 1e-2"
-      -- $<TARGET_FILE:lqr_balance> --prefix {prefix} --duration 20 --timeout ${ctl_timeout} -q)
-  set_tests_properties(clients_lqr_balance_cartpole_lockstep clients_lqr_balance_cartpole_push
-                       clients_lqr_balance_cartpole_realtime PROPERTIES TIMEOUT 70)
+      --check "abs(end_theta) < 1e-3 and abs(end_x) < 1e-2")
 
   # Manipulator tracking (q1 = 0.3 sin 0.5t, q2 = 0.5 + 0.1 sin t from rest at q = (0, 0.5)),
   # computed torque with wn = 10 (Kp 100, Kd 20, critically damped). Bounds:

@@ -28,13 +28,8 @@ import subprocess
 import sys
 import tempfile
 
-failures = []
-
-
-def check(cond, what):
-    print(("ok: " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures.append(what)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 
 
 def mutate(name, src, dst):
@@ -164,8 +159,7 @@ def main():
               % (next_minor, a.abi + 1, a.abi + 1, rc, out))
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    print("%d failures" % len(failures))
-    return 1 if failures else 0
+    return verdict()
 
 
 def build_named(a, name, abi, tmp, label):

@@ -15,6 +15,9 @@ import re
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+
 # the binding's name: the header's
 PYTHON = {"MAX_JOINTS": "LAG_CLIENT_MAX_JOINTS", "NAME_LEN": "LAG_CLIENT_NAME_LEN",
           "TEXT_LEN": "LAG_CLIENT_TEXT_LEN", "URL_LEN": "LAG_CLIENT_URL_LEN",
@@ -44,25 +47,19 @@ def main():
     want = header_values(a.source)
     sys.path.insert(0, os.path.join(a.source, "clients", "python"))
     import lagsim_client
-    bad = 0
     for ours, theirs in PYTHON.items():
         got = getattr(lagsim_client, ours)
-        ok = theirs in want and got == want[theirs]
-        print("%s: lagsim_client.%s = %r, %s = %r" % ("ok" if ok else "FAIL", ours, got, theirs,
-                                                      want.get(theirs)))
-        bad += not ok
+        check(theirs in want and got == want[theirs],
+              "lagsim_client.%s = %r, %s = %r" % (ours, got, theirs, want.get(theirs)))
     if a.jar:
         out = subprocess.run(["javap", "-constants", "-cp", a.jar, "lagsim.examples.Locate"],
                              capture_output=True, text=True).stdout
         for ours, theirs in JAVA.items():
             m = re.search(r"static final \w+ %s = ([-0-9.]+)d?;" % ours, out)
             got = float(m.group(1)) if m else None
-            ok = got is not None and theirs in want and got == want[theirs]
-            print("%s: Locate.%s = %r, %s = %r" % ("ok" if ok else "FAIL", ours, got, theirs,
-                                                   want.get(theirs)))
-            bad += not ok
-    print("%d disagreement(s)" % bad)
-    return 1 if bad else 0
+            check(got is not None and theirs in want and got == want[theirs],
+                  "Locate.%s = %r, %s = %r" % (ours, got, theirs, want.get(theirs)))
+    return verdict()
 
 
 if __name__ == "__main__":

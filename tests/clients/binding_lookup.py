@@ -20,6 +20,9 @@ import os
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+
 URL = "udpm://239.9.9.9:9000?ttl=0"
 WANT = "udpm://239.9.9.9:9000?ttl=0 udpm://239.9.9.9:9001?ttl=0"
 PY = ("import sys; from lagsim_lcm import plant_urls; print(' '.join(plant_urls(%r)))" % URL)
@@ -43,12 +46,6 @@ def main():
     ap.add_argument("--lua", default="")
     a = ap.parse_args()
     a.build, a.source = os.path.abspath(a.build), os.path.abspath(a.source)
-    fails = 0
-
-    def check(cond, what, detail=""):
-        nonlocal fails
-        print("%s: %s%s" % ("ok  " if cond else "FAIL", what, "" if cond else "\n" + detail))
-        fails += 0 if cond else 1
 
     # the library the build's path file names (in a sanitizer build the uninstrumented copy)
     lib = {}
@@ -84,7 +81,7 @@ def main():
         check(rc != 0 and "cannot load lagsim's client module" in err and
               "/nonexistent/lagsim_client.so" in err and "LUA_CPATH" in err,
               "Lua with nothing to find: an error naming each place tried", err)
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

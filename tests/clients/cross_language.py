@@ -21,6 +21,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, failures, verdict  # noqa: E402  (tests/common: the one harness)
+
 
 def load(path):
     rows = []
@@ -43,7 +46,6 @@ def main():
     e2e = os.path.join(os.path.dirname(os.path.abspath(__file__)), "run_e2e.py")
     tmp = tempfile.mkdtemp(prefix="lagsim_xlang_")
     traces = []
-    ok = True
     for name, tol, command in a.run:
         trace = os.path.join(tmp, name + ".trace")
         client = [c.replace("{trace}", trace) for c in shlex.split(command)]
@@ -56,38 +58,30 @@ def main():
                            stderr=subprocess.STDOUT, universal_newlines=True)
         print("---- %s: %s" % (name, " ".join(client)))
         print(r.stdout.rstrip())
-        if r.returncode != 0 or not os.path.exists(trace):
-            print("FAIL: the %s run failed" % name)
-            ok = False
+        if not check(r.returncode == 0 and os.path.exists(trace),
+                     "the %s run: %d states answered, its trace written" % (name, a.states)):
             continue
         traces.append((name, float(tol), load(trace)))
-    if not ok or not traces:
-        return 1
+    if failures():
+        return verdict()
     ref_name, _, ref = traces[0]
     print("---- comparison with %s (%d states)" % (ref_name, len(ref)))
     for name, tol, rows in traces[1:]:
-        if len(rows) != len(ref) or any(len(r) != len(s) for r, s in zip(rows, ref)):
-            print("FAIL: %s: %d rows against %d, or rows of another length"
-                  % (name, len(rows), len(ref)))
-            ok = False
+        if not check(len(rows) == len(ref) and all(len(r) == len(s) for r, s in zip(rows, ref)),
+                     "%s: %d rows against %d, each of the same length" % (name, len(rows), len(ref))):
             continue
-        if any(r[0] != s[0] for r, s in zip(rows, ref)):
-            print("FAIL: %s: the sim times differ" % name)
-            ok = False
+        if not check(all(r[0] == s[0] for r, s in zip(rows, ref)), "%s: the same sim times" % name):
             continue
         diff = max(abs(x - y) for r, s in zip(rows, ref) for x, y in zip(r, s))
         if tol == 0.0:
             same = all(struct.pack("<d", x) == struct.pack("<d", y)
                        for r, s in zip(rows, ref) for x, y in zip(r, s))
-            print("%s: %s: bit for bit with %s%s" % ("ok  " if same else "FAIL", name, ref_name,
+            check(same, "%s: bit for bit with %s%s" % (name, ref_name,
                   "" if same else " (largest difference %.3g)" % diff))
-            ok = ok and same
         else:
-            good = diff <= tol
-            print("%s: %s: largest difference from %s %.3g (allowed %.3g)"
-                  % ("ok  " if good else "FAIL", name, ref_name, diff, tol))
-            ok = ok and good
-    return 0 if ok else 1
+            check(diff <= tol, "%s: largest difference from %s %.3g (allowed %.3g)"
+                  % (name, ref_name, diff, tol))
+    return verdict()
 
 
 if __name__ == "__main__":

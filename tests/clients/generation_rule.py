@@ -30,15 +30,8 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
                                 "clients", "python"))
 from lagsim_lcm import LCM  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what, flush=True)
-    if not ok:
-        failures.append(what)
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+from lcm_port import lcm_port  # noqa: E402  (a port pair of this process's own)
 
 
 # config/dipc.yaml's DIPC
@@ -195,8 +188,7 @@ def main():
                    [struct.pack(">d", v) for v in x[2]] == [struct.pack(">d", v) for v in y[2]]
                    for x, y in zip(ref[1], got))
         check(same, "%s: the answers of generations 1, 2, 3 equal %s's bit for bit" % (name, ref[0]))
-    print("FAILED: %d" % len(failures) if failures else "PASSED")
-    return 1 if failures else 0
+    return verdict()
 
 
 if __name__ == "__main__":

@@ -19,6 +19,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+
 PROGRAM = """package main
 
 /*
@@ -49,7 +52,6 @@ def main():
             f.write(PROGRAM.replace("HEADER_NAME", os.path.basename(header)))
         env = ["GOCACHE=" + a.cache, "GOPATH=" + os.path.join(tmp, "gopath"), "GOTOOLCHAIN=local",
                "GOENV=off", "GOFLAGS=", "GO111MODULE=on", "CGO_ENABLED=1"]
-        fails = 0
         for value in (1, 2):
             with open(header, "w") as f:  # the same path, the same size: only the value moves
                 f.write("#define LAGSIM_PROBE %d\n" % value)
@@ -60,10 +62,8 @@ def main():
                                stderr=subprocess.STDOUT, universal_newlines=True)
             got = subprocess.run([out], stdout=subprocess.PIPE, universal_newlines=True).stdout.strip() \
                 if r.returncode == 0 else "(build failed: %s)" % r.stdout.strip()
-            good = got == str(value)
-            fails += 0 if good else 1
-            print("%s: header says %d, the program built by go_build.cmake prints %s"
-                  % ("ok  " if good else "FAIL", value, got))
+            check(got == str(value), "header says %d, the program built by go_build.cmake prints %s"
+                  % (value, got))
         plain = os.path.join(tmp, "probe_plain")  # what Go's own cache does, for the record
         penv = dict(os.environ, **dict(e.split("=", 1) for e in env))
         with open(header, "w") as f:
@@ -76,7 +76,7 @@ def main():
             got = subprocess.run([plain], stdout=subprocess.PIPE, universal_newlines=True).stdout.strip()
             print("info: a plain `go build` after the header became 3 prints %s%s"
                   % (got, " (stale: why the script keys the cache)" if got != "3" else ""))
-        return 1 if fails else 0
+        return verdict()
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 

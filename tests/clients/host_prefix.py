@@ -26,17 +26,8 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_port import lcm_port  # noqa: E402
-
-failures = 0
-
-
-def check(cond, what):
-    global failures
-    print(("ok: " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
 
 
 def url(port):
@@ -126,8 +117,7 @@ def main():
             err.seek(0)
             tail = err.read().splitlines()[-8:]
             print("host: exit %s\n%s" % (host.returncode, "".join("  | %s\n" % ln for ln in tail)))
-    print("%s: %d failure(s)" % (a.lang, failures))
-    return 1 if failures else 0
+    return verdict(a.lang)
 
 
 if __name__ == "__main__":

@@ -19,15 +19,10 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+
 OBJECT = {"wait", "equals", "toString", "hashCode", "getClass", "notify", "notifyAll"}
-fails = 0
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-    if not cond:
-        fails += 1
 
 
 def octave(code, cwd, path=None):
@@ -73,8 +68,7 @@ def main():
         stat = own(p.stdout.splitlines())
         check(p.returncode == 0 and stat == table, "methods(..., '-full') with the jars on the "
               "static class path: the same (%s)" % sorted(stat ^ table))
-    print("messages_methods: %s (%d failures)" % ("FAILED" if fails else "passed", fails))
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

@@ -23,7 +23,8 @@ import subprocess
 import sys
 import tempfile
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 DOCS = ("README.md", os.path.join("docs", "clients.md"), os.path.join("docs", "evaluation.md"))
@@ -215,11 +216,9 @@ def main():
     a = ap.parse_args()
     build, src = os.path.abspath(a.build), os.path.abspath(a.source)
     found, files = recipes(src)
-    fails = 0
     for name in a.names:
-        if name not in found or name not in CHECKS:
-            print("FAIL: no recipe %s in %s (or no checks for it)" % (name, " or ".join(DOCS)))
-            fails += 1
+        if not check(name in found and name in CHECKS,
+                     "a recipe %s in %s, and checks for it" % (name, " or ".join(DOCS))):
             continue
         lines = []
         for line in found[name].splitlines():
@@ -272,9 +271,8 @@ def main():
         want = EXIT.get(name, 0)
         checks = [(code == want, "the recipe exited %d (%d)" % (want, code))] + CHECKS[name](out, tmp)
         for good, what in checks:
-            print("%s: %s" % ("ok  " if good else "FAIL", what))
-            fails += 0 if good else 1
-    return 1 if fails else 0
+            check(good, what)
+    return verdict()
 
 
 if __name__ == "__main__":

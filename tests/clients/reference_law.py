@@ -48,9 +48,10 @@ sys.path.insert(0, os.path.join(HERE, "..", "common"))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "clients", "python"))
 from lcm_log import read_log  # noqa: E402
 from lagsim_lcm import LCM  # noqa: E402
-from run_e2e import parse_summary, stop  # noqa: E402
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
+from run_e2e import parse_summary  # noqa: E402
+from lagsim_check import check_expressions, stop  # noqa: E402  (tests/common: the one harness)
+import waits  # noqa: E402  (events waited on, bounded)
+from lcm_port import lcm_port  # noqa: E402  (a port pair of this process's own)
 
 
 def url(port):
@@ -213,17 +214,8 @@ def main():
     try:
         cproc = subprocess.Popen(client, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                  universal_newlines=True, env=env)
-        ready = threading.Event()
-
-        def reader():
-            for line in cproc.stdout:
-                lines.append(line)
-                if "waiting for the scene" in line:
-                    ready.set()
-            ready.set()
-
-        th = threading.Thread(target=reader, daemon=True)
-        th.start()
+        rd = waits.Reader(cproc, lines)
+        ready, th = rd.ready, rd.thread
         if not ready.wait(20.0) or cproc.poll() is not None:
             print("".join(lines) + "FAIL: the client did not get ready")
             return 1
@@ -272,11 +264,11 @@ def main():
         except subprocess.TimeoutExpired:
             pass
         if cproc.poll() is None:
-            stop(cproc)
+            stop(cproc, 3.0)
             print("".join(lines) + "FAIL: the client did not finish within %g s" % a.timeout)
             print("client stderr:\n" + cproc.stderr.read())
             return 1
-        stop(dproc)
+        stop(dproc, 3.0)
         th.join(5.0)
         err = cproc.stderr.read()
     finally:
@@ -285,8 +277,8 @@ def main():
             fth.join(5.0)
         if relay:
             relay.close()
-        stop(cproc)
-        stop(dproc)
+        stop(cproc, 3.0)
+        stop(dproc, 3.0)
     out = "".join(lines)
     sys.stdout.write(out)
     if err:
@@ -310,14 +302,7 @@ def main():
     ok = not fails
     names = dict(vals, expected_stale=stale, lost=len(lost), hostile=n_hostile[0], commands=n,
                  math=math)
-    for expr in a.check:
-        try:
-            res = bool(eval(expr, {"__builtins__": {"abs": abs, "min": min, "max": max}}, names))
-        except Exception as e:  # a missing key is a failure, not a crash
-            res = False
-            print("check %s: %s" % (expr, e))
-        print("%s: %s" % ("ok  " if res else "FAIL", expr))
-        ok = ok and res
+    ok = check_expressions(a.check, names) and ok
     if ok:
         os.remove(log)
         os.rmdir(tmp)

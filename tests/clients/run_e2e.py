@@ -29,24 +29,14 @@ they had never come; `hostile` (messages published) joins the summary's keys.
 import argparse
 import math
 import os
-import signal
 import subprocess
 import sys
 import threading
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-
-def stop(proc, grace=3.0):
-    if proc is None or proc.poll() is not None:
-        return
-    proc.send_signal(signal.SIGTERM)
-    try:
-        proc.wait(grace)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.wait()
+from lagsim_check import check_expressions, stop  # noqa: E402  (tests/common: the one harness)
+import waits  # noqa: E402  (events waited on, bounded)
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def parse_summary(text):
@@ -128,7 +118,7 @@ def main():
     cproc = dproc = fth = None
     done = threading.Event()
     n_hostile = 0
-    t_daemon_end = t_client_end = t_summary = None
+    t_daemon_end = t_client_end = None
     lines = []
     last_state = [None]  # when the last state was heard (--kill-daemon-after)
     wth = None
@@ -143,20 +133,8 @@ def main():
         # is subscribed ("waiting for the scene"), so that it sees the very first state
         # (bounded by --timeout: a JVM, Octave or a compile first takes what the machine's
         # load makes it take; only a client that never gets ready fails here)
-        ready = threading.Event()
-
-        def reader():
-            nonlocal t_summary
-            for line in cproc.stdout:
-                lines.append(line)
-                if "waiting for the scene" in line:
-                    ready.set()
-                if t_summary is None and " summary " in line:
-                    t_summary = time.monotonic()
-            ready.set()
-
-        th = threading.Thread(target=reader, daemon=True)
-        th.start()
+        rd = waits.Reader(cproc, lines, mark=" summary ")
+        ready, th = rd.ready, rd.thread
         t0 = time.monotonic()
         if not ready.wait(a.timeout) or cproc.poll() is not None:
             print("".join(lines))
@@ -216,7 +194,7 @@ def main():
                 t_daemon_end = time.monotonic()
             cproc.wait(timeout=a.timeout)
         except subprocess.TimeoutExpired:
-            stop(cproc)
+            stop(cproc, 3.0)
             th.join(5.0)
             print("".join(lines))
             print("FAIL: the client did not finish within %g s" % a.timeout)
@@ -230,9 +208,10 @@ def main():
             fth.join(5.0)
         if wth:
             wth.join(5.0)
-        stop(cproc)
-        stop(dproc)
+        stop(cproc, 3.0)
+        stop(dproc, 3.0)
     out = "".join(lines)
+    t_summary = rd.marked  # when the client printed its summary line
     derr = dproc.stderr.read() if dproc and dproc.stderr else ""
     sys.stdout.write(out)
     if err:
@@ -267,14 +246,7 @@ def main():
               % (names["silent"], t_daemon_end - last_state[0]))
     names["math"] = math
     names["out"] = out  # the client's stdout, for checks of what it prints
-    for expr in a.check:
-        try:
-            res = bool(eval(expr, {"__builtins__": {"abs": abs, "min": min, "max": max}}, names))
-        except Exception as e:  # a missing key is a failure, not a crash
-            res = False
-            print("check %s: %s" % (expr, e))
-        print("%s: %s" % ("ok  " if res else "FAIL", expr))
-        ok = ok and res
+    ok = check_expressions(a.check, names) and ok
     return 0 if ok else 1
 
 

@@ -18,6 +18,9 @@ import shlex
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+
 
 def main():
     ap = argparse.ArgumentParser()
@@ -37,26 +40,20 @@ def main():
         r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                            universal_newlines=True)
         m = re.search(regex, r.stdout)
-        if r.returncode != 0 or not m:
-            print(r.stdout)
-            print("FAIL: the %s run failed or printed no gain matching %r" % (name, regex))
-            return 1
+        if not check(r.returncode == 0 and m, "the %s run ended by itself and printed a gain "
+                     "matching %r" % (name, regex), r.stdout):
+            return verdict()
         k = [float(x) for x in re.split(r"[,\s]+", m.group(1).strip())]
         print("%s: K = [%s]" % (name, ", ".join("%.17g" % x for x in k)))
         gains.append((name, k))
     ref_name, ref = gains[0]
-    ok = True
     for name, k in gains[1:]:
-        if len(k) != len(ref):
-            print("FAIL: %s has %d entries, %s %d" % (name, len(k), ref_name, len(ref)))
-            ok = False
+        if not check(len(k) == len(ref), "%s has %d entries, %s %d" % (name, len(k), ref_name, len(ref))):
             continue
         rel = max(abs(x - y) / abs(y) if y != 0 else abs(x) for x, y in zip(k, ref))
-        good = rel <= a.tol
-        print("%s: %s: largest relative difference from %s %.3g (allowed %.3g)"
-              % ("ok  " if good else "FAIL", name, ref_name, rel, a.tol))
-        ok = ok and good
-    return 0 if ok else 1
+        check(rel <= a.tol, "%s: largest relative difference from %s %.3g (allowed %.3g)"
+              % (name, ref_name, rel, a.tol))
+    return verdict()
 
 
 if __name__ == "__main__":

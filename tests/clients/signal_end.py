@@ -18,13 +18,14 @@ import re
 import signal
 import subprocess
 import sys
-import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from run_e2e import hostile_lcm, parse_summary, stop  # noqa: E402
+from run_e2e import hostile_lcm, parse_summary  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
+import waits  # noqa: E402  (events waited on, bounded)
+from lagsim_check import stop  # noqa: E402  (tests/common: the one harness)
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def one(a, client, sig, mid_run, n):
@@ -39,17 +40,8 @@ def one(a, client, sig, mid_run, n):
     try:
         cproc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                  universal_newlines=True, env=env)
-        ready = threading.Event()
-
-        def reader():
-            for line in cproc.stdout:
-                lines.append(line)
-                if "waiting for the scene" in line:
-                    ready.set()
-            ready.set()
-
-        th = threading.Thread(target=reader, daemon=True)
-        th.start()
+        rd = waits.Reader(cproc, lines)
+        ready, th = rd.ready, rd.thread
         if not ready.wait(30.0) or cproc.poll() is not None:
             return ["%s: the client did not get ready (%s)" % (what, "".join(lines)[-500:])]
         if mid_run:
@@ -76,8 +68,8 @@ def one(a, client, sig, mid_run, n):
         th.join(5.0)
         err = cproc.stderr.read()
     finally:
-        stop(cproc)
-        stop(dproc)
+        stop(cproc, 3.0)
+        stop(dproc, 3.0)
     out = "".join(lines)
     sys.stdout.write(out[-600:])
     if err.strip():

@@ -22,16 +22,8 @@ import time
 sys.path.insert(0, sys.argv[1])
 from lagsim_lcm import LCM  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-fails = 0
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what))
-    if not cond:
-        fails += 1
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def drain(lc):
@@ -108,5 +100,4 @@ try:
 except Exception as e:
     check(False, "a signal ends handle_timeout()'s wait with False, not %r" % e)
 udp.close()
-print("%d failure(s)" % fails)
-sys.exit(1 if fails else 0)
+sys.exit(verdict())

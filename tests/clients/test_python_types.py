@@ -4,20 +4,14 @@ every array as a list: a scene's `actuated` and `limit_on` (booleans) as well as
 names and numbers, read as often as one likes.
 usage: test_python_types.py PYTHON_TYPES_DIR
 """
+import os
 import sys
 
 sys.path.insert(0, sys.argv[1])
 import lagsim  # noqa: E402
 
-fails = 0
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what))
-    if not cond:
-        fails += 1
-
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 
 s = lagsim.scene_t()
 s.model, s.prefix, s.integrator, s.mode, s.effects = "cartpole", "T", "rk4", "realtime", ""
@@ -31,4 +25,4 @@ for k in d.__slots__:
 check(d.actuated == [True, False] and d.actuated == [True, False], "actuated: [True, False], twice")
 check(d.limit_on == [False, True], "limit_on: [False, True]")
 check(repr(d.actuated) == "[True, False]", "actuated prints as a list (%r)" % (d.actuated,))
-sys.exit(1 if fails else 0)
+sys.exit(verdict())

@@ -3,10 +3,11 @@ subscribed, a logger that has written what came before. Each is bounded by a dea
 (30 s: what a loaded 2-core machine or the sanitizer build may take to start a process) and
 returns whether the event came, so that the test says what it waited for; none sleeps a
 fixed time in the hope that the event came meanwhile (docs/testing.md, "The suite under
-load").
+load"). Reader keeps reading a controller's output in a thread, its readiness an event.
 """
 import os
 import subprocess
+import threading
 import time
 
 WITHIN = 30.0
@@ -56,3 +57,28 @@ def logger_wrote(path, channel, probe, url=None, within=WITHIN):
         return False
     finally:
         lc.close()
+
+
+class Reader:
+    """A process's standard output read in a thread of its own, so that it never blocks on
+    a full pipe: every line appended to `lines` (a list of the caller's, or a new one);
+    `ready` set once a line holds `line` (a controller's "waiting for the scene": from there
+    on it misses no state) or the output ended; `marked`, the time.monotonic() at which a
+    line first held `mark` (when given), else None; `thread`, to join."""
+
+    def __init__(self, proc, lines=None, line="waiting for the scene", mark=None):
+        self.lines = [] if lines is None else lines
+        self.ready = threading.Event()
+        self.marked = None
+
+        def read():
+            for got in proc.stdout:
+                self.lines.append(got)
+                if line in got:
+                    self.ready.set()
+                if mark is not None and self.marked is None and mark in got:
+                    self.marked = time.monotonic()
+            self.ready.set()
+
+        self.thread = threading.Thread(target=read, daemon=True)
+        self.thread.start()

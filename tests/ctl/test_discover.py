@@ -32,18 +32,9 @@ import sys
 import threading
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 import waits  # noqa: E402  (events waited on, bounded)
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-fails = 0
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-    if not cond:
-        fails += 1
-    return cond
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def run(args, timeout=60):
@@ -167,8 +158,7 @@ def main():
     r = run([b("lagsimctl"), "--timeout", "0.5", "list"])
     check(r.returncode == 3 and "no plant heard" in r.stderr,
           "list with no plant on the bus: exit 3, said")
-    print("%d failure(s)" % fails)
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

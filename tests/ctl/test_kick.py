@@ -42,20 +42,9 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, daemon, replay, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_log import read_log, write_log  # noqa: E402
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-import waits  # noqa: E402  (events waited on, bounded)
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-fails = 0
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-    if not cond:
-        fails += 1
-    return cond
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def decode_state(data):
@@ -109,11 +98,7 @@ def rules(lagsimd, ctl_bin, cfg, prefix, tmp):
            (["x", "1e300"], "{t: 0, joint: x, impulse: 1e300}"),
            (["x", "1e12", "--duration", "0.5"], "{t: 0, joint: x, force: 2e12, duration: 0.5}"),
            (["cart", "1"], "{t: 0, joint: cart, impulse: 1}")]
-    d = subprocess.Popen([lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix, "-q",
-                          "--set", "realtime.start=paused", "--log", log],
-                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        check(waits.daemon_answers(ctl_bin, prefix), "lagsimd answers (waited on)")
+    with daemon(lagsimd, ctl_bin, cfg, prefix, "--set", "realtime.start=paused", "--log", log):
         for args, item in bad:
             r = ctl("kick", *args)
             rc, words = scene_words(lagsimd, cfg, tmp, item)
@@ -148,9 +133,6 @@ def rules(lagsimd, ctl_bin, cfg, prefix, tmp):
               "kick x 0.5 in the fault: refused, 'in fault state (reset first)'")
         check(ctl("reset").returncode == 0, "reset")
         check(ctl("kick", "x", "0.5").returncode == 0, "kick x 0.5 after the reset: accepted")
-    finally:
-        d.terminate()
-        d.wait(10)
     states = [decode_state(data) for _, ch, data in read_log(log) if ch == prefix + "_STATE"]
     v = [s["qd"][s["names"].index("x")] for s in states if s["step"] == 50]
     check(bool(v) and abs(1.0 * v[0] - 0.5) <= 1e-12,
@@ -186,12 +168,7 @@ def main():
         return [json.loads(l) for l in r.stdout.splitlines()
                 if l.startswith("{") and json.loads(l)["type"] == "event"]
 
-    d = subprocess.Popen([lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix, "-q",
-                          "--set", "realtime.start=paused", "--log", log],
-                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                         universal_newlines=True)
-    try:
-        check(waits.daemon_answers(ctl_bin, prefix), "lagsimd answers (waited on)")
+    with daemon(lagsimd, ctl_bin, cfg, prefix, "--set", "realtime.start=paused", "--log", log):
         r = ctl("--json", "kick", "x", "0.5")
         ev = events(r)
         check(r.returncode == 0 and ev and ev[0]["kind"] == "kick" and ev[0]["step"] == 0 and
@@ -235,9 +212,6 @@ def main():
         m = dict(zip(sc[0]["param_name"], sc[0]["param_value"])).get("m") if sc else None
         check(m == 1.0, "describe after reset --scene: m = %s, the scene file's 1" % m)
         check(ctl("step", "3").returncode == 0, "step 3")
-    finally:
-        d.terminate()
-        d.wait(10)
 
     recs = read_log(log)
     states = [decode_state(data) for _, ch, data in recs if ch == prefix + "_STATE"]
@@ -273,21 +247,6 @@ def main():
         check(v150b is not None and abs(2.0 * v150b + 0.5) <= 1e-12,
               "m x_dot after kick x -0.5 with m = 2: %r" % (None if v150b is None else 2 * v150b))
 
-    def replay(path):
-        return replay_cfg(cfg, prefix, path)
-
-    def replay_cfg(config, pre, path):
-        r = subprocess.run([lagsimd, "--config", config, "--set", "lcm.prefix=" + pre,
-                            "--replay", path], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                           universal_newlines=True, timeout=60)
-        print("$ lagsimd --replay %s   -> exit %d" % (os.path.basename(path), r.returncode))
-        print("  " + r.stdout.strip().replace("\n", "\n  "))
-        diff = None
-        for line in r.stdout.splitlines():
-            if line.startswith("max difference = "):
-                diff = float(line.split("=", 1)[1])
-        return r, diff
-
     # a run under control: the cart-pole balanced by lqr_balance in real time, kicked
     # twice while it runs (mid-run, efforts held), logged, then replayed
     cfg_cp = os.path.join(a.source, "config", "cartpole.yaml")
@@ -317,30 +276,29 @@ def main():
             if p.poll() is None:
                 p.kill()
                 p.wait()
-    r, diff = replay_cfg(cfg_cp, pcp, log_cp)
+    r, diff = replay(lagsimd, cfg_cp, pcp, log_cp)
     check(r.returncode == 0 and diff == 0.0 and "2 change(s) made while running" in r.stdout,
           "--replay of the controlled, kicked cart-pole: 2 kicks applied, difference exactly 0 "
           "(%r)" % diff)
     recs_cp = read_log(log_cp)
     bare_cp = os.path.join(tmp, "cartpole_no_events.lcm")
     write_log(bare_cp, [x for x in recs_cp if x[1] != pcp + "_EVENT"])
-    r, diff = replay_cfg(cfg_cp, pcp, bare_cp)
+    r, diff = replay(lagsimd, cfg_cp, pcp, bare_cp)
     check(r.returncode == 1 and diff is not None and diff > 0,
           "the same log without its events: difference %r, not 0" % diff)
 
     rules(lagsimd, ctl_bin, cfg, prefix + "R", tmp)
 
-    r, diff = replay(log)
+    r, diff = replay(lagsimd, cfg, prefix, log)
     check(r.returncode == 0 and diff == 0.0 and "7 change(s) made while running" in r.stdout,
           "--replay: 4 kicks, a set, a kicks_cleared and a restore applied (7), "
           "difference exactly 0 (%r)" % diff)
     bare = os.path.join(tmp, "no_events.lcm")
     write_log(bare, [x for x in recs if x[1] != prefix + "_EVENT"])
-    r, diff = replay(bare)
+    r, diff = replay(lagsimd, cfg, prefix, bare)
     check(r.returncode == 1, "the same log without its events does not replay exactly "
           "(exit %d, difference %r)" % (r.returncode, diff))
-    print("%d failure(s)" % fails)
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

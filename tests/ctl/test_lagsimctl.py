@@ -33,18 +33,8 @@ import subprocess
 import sys
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-import waits  # noqa: E402  (events waited on, bounded)
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-fails = 0
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-    if not cond:
-        fails += 1
-    return cond
+from lagsim_check import check, daemon, verdict  # noqa: E402  (tests/common: the one harness)
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def tokens(line):
@@ -96,11 +86,7 @@ def main():
             if m:
                 status_fields.append(m.group(1))
 
-    d = subprocess.Popen([a.lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix, "-q",
-                          "--set", "realtime.start=running"],
-                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, universal_newlines=True)
-    try:
-        check(waits.daemon_answers(a.lagsimctl, prefix), "lagsimd answers (waited on)")
+    with daemon(a.lagsimd, a.lagsimctl, cfg, prefix, "--set", "realtime.start=running", grace=5):
         r = ctl("status")
         rj = statuses(ctl("--json", "status"))
         out = r.stdout.splitlines()
@@ -223,9 +209,6 @@ def main():
         dt = time.monotonic() - t0
         check(r.returncode == 3 and "no answer" in r.stderr and dt < 3.0,
               "no daemon on the prefix: exit 3 after %.2f s with a message" % dt)
-    finally:
-        d.terminate()
-        d.wait(5)
 
     # watch: a daemon that runs 1 s of sim time, then stops by itself
     w = subprocess.Popen([a.lagsimctl, "--prefix", prefix + "W", "watch"], stdout=subprocess.PIPE,
@@ -243,8 +226,7 @@ def main():
     check(w.returncode == 0 and stops, "watch: exit 0 after the daemon's stop event")
     check(len(states) >= 50 and all(len(tokens(s)) == 2 + 9 for s in states),
           "watch: %d state lines, each with t, step and 3 x (q, qd, effort)" % len(states))
-    print("%d failure(s)" % fails)
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

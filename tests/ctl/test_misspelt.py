@@ -26,18 +26,9 @@ import subprocess
 import sys
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
-
-fails = 0
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-    if not cond:
-        fails += 1
-    return cond
 
 
 def run(args, timeout=60):
@@ -133,8 +124,7 @@ def main():
     check(any(typo in l and "no plant here has" in l and "this plant is " + plant in l
               for l in lines) and not any(other in l for l in lines),
           "the daemon's wait line names the misspelt prefix, not the other plant's")
-    print("misspelt: %s (%d failures)" % ("FAILED" if fails else "passed", fails))
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

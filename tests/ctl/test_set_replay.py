@@ -20,33 +20,10 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, replay, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_log import read_log, write_log  # noqa: E402
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 import waits  # noqa: E402  (events waited on, bounded)
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-fails = 0
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-    if not cond:
-        fails += 1
-    return cond
-
-
-def replay(lagsimd, cfg, prefix, log):
-    r = subprocess.run([lagsimd, "--config", cfg, "--set", "lcm.prefix=" + prefix, "--replay", log],
-                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
-                       timeout=60)
-    print("$ lagsimd --replay %s   -> exit %d" % (os.path.basename(log), r.returncode))
-    print("  " + r.stdout.strip().replace("\n", "\n  "))
-    diff = None
-    for line in r.stdout.splitlines():
-        if line.startswith("max difference = "):
-            diff = float(line.split("=", 1)[1])
-    return r, diff
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def main():
@@ -122,7 +99,7 @@ def main():
     for f in os.listdir(tmp):
         os.remove(os.path.join(tmp, f))
     os.rmdir(tmp)
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

@@ -54,18 +54,14 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+
 BIN, SRC, CASE = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2]), sys.argv[3]
 SCENE = os.path.join(SRC, "config", "cartpole.yaml")
 SUITE = os.path.join(SRC, "tests", "eval", "cartpole_cases.yaml")
 CTRL = os.path.join(BIN, "lqr_balance") + " -q --prefix {prefix}"
 EVAL = os.path.join(BIN, "lagsim-eval")
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
 
 
 def run(*args, timeout=300):
@@ -768,5 +764,4 @@ def case_waits():
 {"metrics": case_metrics, "require": case_require, "errors": case_errors, "notes": case_notes,
  "waits": case_waits, "scene": case_scene, "owned": case_owned, "outputs": case_outputs,
  "bus": case_bus, "stderr": case_stderr}[CASE]()
-print("FAILED: %d" % len(failures) if failures else "PASSED")
-sys.exit(1 if failures else 0)
+sys.exit(verdict(CASE))

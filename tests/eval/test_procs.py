@@ -34,18 +34,14 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+
 BIN, SRC, TOOL, HOW = sys.argv[1:5]
 SCENE = os.path.join(SRC, "config", "cartpole.yaml")
 CTRL = os.path.join(SRC, "tests", "eval", "procs_controller.py")
 PROCS_WAIT_S = 20.0   # after a kill: the keepers stop what is left (2 s grace, then SIGKILL)
 READY_WAIT_S = 120.0  # python controllers start slowly on a loaded machine
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what, flush=True)
-    if not ok:
-        failures.append(what)
 
 
 def marked(marker):
@@ -225,5 +221,4 @@ def main():
 
 
 main()
-print("FAILED: %d" % len(failures) if failures else "PASSED")
-sys.exit(1 if failures else 0)
+sys.exit(verdict(TOOL + " " + HOW))

@@ -85,6 +85,7 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             runs it lacks (--only) it merges into the whole sweep byte for byte. --only
             mistakes refused before any run
 """
+import contextlib
 import csv
 import filecmp
 import glob
@@ -98,6 +99,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import SKIP, check, verdict  # noqa: E402  (tests/common: the one harness)
+
 BIN, SRC, CASE = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2]), sys.argv[3]
 SCENE = os.path.join(SRC, "config", "cartpole.yaml")
 SWEEP = os.path.join(BIN, "lagsim-sweep")
@@ -105,13 +109,6 @@ CTRL = os.path.join(BIN, "lqr_balance") + " -q --prefix {prefix}"
 ARGS = ["--config", SCENE, "--controller", CTRL, "--duration", "8",
         "--vary", "parameters.m0=uniform(0.5,2)", "--vary", "parameters.m1=grid(0.05,0.3,4)",
         "--runs", "2", "--seed", "7", "--require", "theta.settle<6.5"]
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
 
 
 def run(cmd, **kw):
@@ -590,14 +587,19 @@ def case_kept_python(d):
           "byte for byte" % same)
 
 
-def case_loss(d):
+@contextlib.contextmanager
+def loss_namespace(name):
+    """A network namespace of this process (NAME and the pid), its loopback up with the
+    multicast route, and an nft chain `inet loss in` for rules that drop datagrams; the
+    command prefix that runs in it is yielded, and it is removed after. The test is skipped
+    where it cannot be made (root, ip and nft)."""
     if os.geteuid() != 0 or not shutil.which("nft") or not shutil.which("ip"):
         print("skipped: needs root, ip and nft")
-        sys.exit(77)
-    ns = "lgsweep%d" % os.getpid()
+        sys.exit(SKIP)
+    ns = "%s%d" % (name, os.getpid())
     if subprocess.run(["ip", "netns", "add", ns]).returncode != 0:
         print("skipped: cannot make a network namespace here")
-        sys.exit(77)
+        sys.exit(SKIP)
     try:
         inns = ["ip", "netns", "exec", ns]
         for c in (["ip", "link", "set", "lo", "up"],
@@ -606,6 +608,13 @@ def case_loss(d):
                   ["nft", "add", "chain", "inet", "loss", "in",
                    "{ type filter hook input priority 0; }"]):
             subprocess.run(inns + c, check=True)
+        yield inns
+    finally:
+        subprocess.run(["ip", "netns", "del", ns])
+
+
+def case_loss(d):
+    with loss_namespace("lgsweep") as inns:
         q = ARGS[:-2] + ["--vary", "initial.q[1]=normal(0,0.05)", "-j2", "-v"]
         clean, lossy = os.path.join(d, "clean.csv"), os.path.join(d, "lossy.csv")
         run(inns + [SWEEP] + q + ["--csv", clean])
@@ -620,8 +629,6 @@ def case_loss(d):
         check(p.returncode in (0, 1), "the sweep ran under loss (exit %d)" % p.returncode)
         check(filecmp.cmp(clean, lossy, shallow=False),
               "1 datagram in 15 lost: the same CSV as without loss, byte for byte")
-    finally:
-        subprocess.run(["ip", "netns", "del", ns])
 
 
 def sshd_host(d, name, net):
@@ -653,7 +660,7 @@ def sshd_host(d, name, net):
 def case_ssh(d):
     if os.geteuid() != 0 or not os.path.exists("/usr/sbin/sshd") or not shutil.which("ip"):
         print("skipped: needs root, ip and sshd (openssh-server)")
-        sys.exit(77)
+        sys.exit(SKIP)
     for key in ("hostkey", "id"):
         subprocess.run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-f",
                         os.path.join(d, key)], check=True)
@@ -865,21 +872,7 @@ def case_scene_python(d):
 
 
 def case_scene_loss(d):
-    if os.geteuid() != 0 or not shutil.which("nft") or not shutil.which("ip"):
-        print("skipped: needs root, ip and nft")
-        sys.exit(77)
-    ns = "lgscene%d" % os.getpid()
-    if subprocess.run(["ip", "netns", "add", ns]).returncode != 0:
-        print("skipped: cannot make a network namespace here")
-        sys.exit(77)
-    try:
-        inns = ["ip", "netns", "exec", ns]
-        for c in (["ip", "link", "set", "lo", "up"],
-                  ["ip", "route", "add", "224.0.0.0/4", "dev", "lo"],
-                  ["nft", "add", "table", "inet", "loss"],
-                  ["nft", "add", "chain", "inet", "loss", "in",
-                   "{ type filter hook input priority 0; }"]):
-            subprocess.run(inns + c, check=True)
+    with loss_namespace("lgscene") as inns:
         for lang in ("c", "python"):
             q, env = scene_sweep(lang, 20)
             clean, lossy = (os.path.join(d, lang + n) for n in ("clean.csv", "lossy.csv"))
@@ -900,8 +893,6 @@ def case_scene_loss(d):
             check(filecmp.cmp(clean, lossy, shallow=False),
                   "%s, m2 varied, 10 %% of datagrams lost: the CSV without loss, byte for byte"
                   % lang)
-    finally:
-        subprocess.run(["ip", "netns", "del", ns])
 
 
 def case_unanswered(d):
@@ -1239,5 +1230,4 @@ with tempfile.TemporaryDirectory() as tmp:
      "unanswered": case_unanswered, "notes": case_notes,
      "controller_exit": case_controller_exit, "progress": case_progress,
      "interrupt": case_interrupt, "tmpdir": case_tmpdir}[CASE](tmp)
-print("FAILED: %d" % len(failures) if failures else "PASSED")
-sys.exit(1 if failures else 0)
+sys.exit(verdict(CASE))

@@ -18,6 +18,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+
 
 def targets_of(build):
     h = subprocess.run(["cmake", "--build", build, "--target", "help"], stdout=subprocess.PIPE,
@@ -31,32 +34,25 @@ def main():
     ap.add_argument("--build", required=True)
     a = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="lagsim_user_build_")
-    fails = 0
     try:
         r = subprocess.run(["cmake", "-S", a.source, "-B", tmp, "-DBUILD_TESTING=OFF"],
                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
-        if r.returncode != 0:
-            print("FAIL: cmake -DBUILD_TESTING=OFF:\n" + r.stdout)
-            return 1
+        if not check(r.returncode == 0, "cmake -DBUILD_TESTING=OFF configures", r.stdout):
+            return verdict()
         targets, full = targets_of(tmp), targets_of(a.build)
         programs = [os.path.basename(p)[:-2] for p in glob.glob(os.path.join(a.source, "docs/man/*.1"))]
         programs = [p for p in programs if p in full]
         want = programs + ["lagsim_client_shared", "lagsim_client", "man_pages", "lagsim_lcmtypes"]
         missing = [t for t in want if t not in targets]
         unwanted = sorted(t for t in targets if re.match(r"(test_|fuzz_|bench_|lagsim_bench)", t))
-        checks = [
-            (not missing, "the %d programs with a man page, the client library, the man pages "
-             "and the types are built%s" % (len(programs), "; missing: " + " ".join(missing) if missing else "")),
-            (not unwanted, "no test, fuzz or benchmark target%s"
-             % ("; found: " + " ".join(unwanted[:20]) if unwanted else "")),
-            (not os.path.exists(os.path.join(tmp, "CTestTestfile.cmake")), "no ctest file"),
-        ]
-        for ok, what in checks:
-            print("%s: %s" % ("ok  " if ok else "FAIL", what))
-            fails += 0 if ok else 1
+        check(not missing, "the %d programs with a man page, the client library, the man pages "
+              "and the types are built%s" % (len(programs), "; missing: " + " ".join(missing) if missing else ""))
+        check(not unwanted, "no test, fuzz or benchmark target%s"
+              % ("; found: " + " ".join(unwanted[:20]) if unwanted else ""))
+        check(not os.path.exists(os.path.join(tmp, "CTestTestfile.cmake")), "no ctest file")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

@@ -30,6 +30,7 @@ import subprocess
 import sys
 import tempfile
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, failures, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
@@ -48,13 +49,6 @@ def main():
     build, src = os.path.abspath(a.build), os.path.abspath(a.source)
     tmp = tempfile.mkdtemp(prefix="lagsim_install_")
     prefix = os.path.join(tmp, "prefix")
-    fails = 0
-
-    def check(cond, what):
-        nonlocal fails
-        print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-        fails += 0 if cond else 1
-        return cond
 
     r = subprocess.run(["cmake", "--install", build, "--prefix", prefix],
                        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
@@ -178,10 +172,9 @@ def main():
                            stderr=subprocess.STDOUT, universal_newlines=True)
         if not check(r.returncode == 0, "installed lagsimd with the installed %s" % name):
             print(r.stdout)
-    if fails == 0:
+    if failures() == 0:
         shutil.rmtree(tmp, ignore_errors=True)
-    print("%d failure(s)" % fails)
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

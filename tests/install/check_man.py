@@ -28,14 +28,8 @@ import subprocess
 import sys
 import tempfile
 
-fails = 0
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-    fails += 0 if cond else 1
-    return cond
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 
 
 def run_help(cmd, env=None):
@@ -246,8 +240,7 @@ def main():
             models = subprocess.run([a.models], stdout=subprocess.PIPE, universal_newlines=True,
                                     check=True).stdout.split()
             case_models(prefix, models, os.path.abspath(a.source))
-    print("%s: %d failure(s)" % ("FAILED" if fails else "passed", fails))
-    return 1 if fails else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":

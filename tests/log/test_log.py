@@ -30,52 +30,27 @@ import ctypes
 import os
 import re
 import shutil
-import struct
 import subprocess
 import sys
 import tempfile
 import time
 import zlib
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+import lcm_log  # noqa: E402  (tests/common: LCM's log format)
 import waits  # noqa: E402  (events waited on, bounded)
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-failures = 0
-
-
-def check(cond, what):
-    global failures
-    print(("ok: " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 # ---------------------------------------------------------------- LCM logs, read here
-SYNC = 0xEDA1DA01
-
-
 def read_log(path):
     """[(eventnum, timestamp, channel, data)] of a whole, undamaged log (raises otherwise)."""
-    out = []
-    with open(path, "rb") as f:
-        b = f.read()
-    i = 0
-    while i < len(b):
-        sync, num, ts, clen, dlen = struct.unpack_from(">IqqII", b, i)
-        if sync != SYNC or i + 28 + clen + dlen > len(b):
-            raise ValueError(f"{path}: not a whole record at byte {i}")
-        ch = b[i + 28:i + 28 + clen].decode()
-        out.append((num, ts, ch, b[i + 28 + clen:i + 28 + clen + dlen]))
-        i += 28 + clen + dlen
-    return out
+    return [r[:4] for r in lcm_log.records(path, whole=True)]
 
 
-def write_log(path, records):
-    with open(path, "wb") as f:
-        for k, (_, ts, ch, data) in enumerate(records):
-            c = ch.encode()
-            f.write(struct.pack(">IqqII", SYNC, k, ts, len(c), len(data)) + c + data)
+def write_log(path, recs):
+    """Writes [(eventnum, timestamp, channel, data)], numbered again from 0."""
+    lcm_log.write_log(path, [r[1:] for r in recs])
 
 
 def read_log_liblcm(path):
@@ -588,8 +563,7 @@ def main():
         CASES[a.case](Run(a, tmp), a, tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    print(f"{a.case}: {'FAILED' if failures else 'passed'} ({failures} failures)")
-    return 1 if failures else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":

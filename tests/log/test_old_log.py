@@ -17,16 +17,12 @@ import re
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+
 BIN, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
 FIX = os.path.join(SRC, "tests", "log", "fixtures")
 LOG = os.path.join(FIX, "dipc_lockstep_0.1.0.lcm")
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
 
 
 def run(cmd):
@@ -78,5 +74,4 @@ if __name__ == "__main__":
     import tempfile
     with tempfile.TemporaryDirectory() as tmp:
         {"replay": case_replay, "log2csv": case_log2csv}[CASE](tmp)
-    print("FAILED: %d" % len(failures) if failures else "PASSED")
-    sys.exit(1 if failures else 0)
+    sys.exit(verdict(CASE))

@@ -27,17 +27,8 @@ import subprocess
 import sys
 import tempfile
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-failures = 0
-
-
-def check(cond, what):
-    global failures
-    print(("ok: " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 def digest(path):
@@ -206,8 +197,7 @@ def main():
                   f"{name}: --increment with --force refused: exit {p.returncode}")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    print(f"{failures} failure(s)")
-    sys.exit(1 if failures else 0)
+    sys.exit(verdict())
 
 
 main()

@@ -28,37 +28,18 @@ import argparse
 import os
 import resource
 import shutil
-import struct
 import subprocess
 import sys
 import tempfile
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+from lcm_log import records  # noqa: E402  (tests/common/lcm_log.py)
 from lcm_port import lcm_url  # noqa: E402  (tests/common/lcm_port.py)
-
-failures = 0
-SYNC = 0xEDA1DA01
-
-
-def check(cond, what):
-    global failures
-    print(("ok: " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
 
 
 def read_log(path):
     """[(eventnum, timestamp, channel, data)] of a whole LCM log (raises otherwise)."""
-    with open(path, "rb") as f:
-        b = f.read()
-    out, i = [], 0
-    while i < len(b):
-        sync, num, ts, clen, dlen = struct.unpack_from(">IqqII", b, i)
-        if sync != SYNC or i + 28 + clen + dlen > len(b):
-            raise ValueError(f"{path}: not a whole record at byte {i}")
-        out.append((num, ts, b[i + 28:i + 28 + clen].decode(), b[i + 28 + clen:i + 28 + clen + dlen]))
-        i += 28 + clen + dlen
-    return out
+    return [r[:4] for r in records(path, whole=True)]
 
 
 class Run:
@@ -237,8 +218,7 @@ def main():
         CASES[a.case](Run(a, tmp), tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    print(f"{a.case}: {'FAILED' if failures else 'passed'} ({failures} failures)")
-    return 1 if failures else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":

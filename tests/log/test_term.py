@@ -34,17 +34,8 @@ import sys
 import termios
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-failures = 0
-
-
-def check(cond, what):
-    global failures
-    print(("ok: " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 
 class Daemon:
@@ -323,8 +314,7 @@ def main():
     os.environ["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")  # and the next port: commands
     a.bin, a.python, a.source = (os.path.abspath(x) for x in (a.bin, a.python, a.source))
     CASES[a.case](a)
-    print(f"{a.case}: {'FAILED' if failures else 'passed'} ({failures} failures)")
-    return 1 if failures else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":

@@ -57,10 +57,12 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import SKIP, check, failures, verdict  # noqa: E402  (tests/common: the one harness)
+
 EXPOSURE_MAX = 2.0   # systemd-analyze security: the unit scores 1.1 ("OK" is below 4.5)
 DEBIAN_PYTHON = "/usr/bin/python3"   # the python3 the package depends on (not a pyenv's)
 LOCK = "/var/lock/lagsim-package-test.lock"
-SKIP = 77
 # the unit's settings the deployment relies on (docs/deploy.md)
 UNIT_MUST = ["ExecStart=/usr/bin/lagsimd --instance /etc/lagsim/%i $LAGSIMD_ARGS",
              "Restart=on-failure", "RestartPreventExitStatus=2", "DynamicUser=yes",
@@ -76,18 +78,6 @@ def unit_example(text):
     quotes it and this test runs it)."""
     m = re.search(r"^#\s+(LAGSIMD_ARGS=.*\S)\s*$", text, re.M)
     return m.group(1)[len("LAGSIMD_ARGS="):] if m else None
-
-fails = 0
-
-
-def check(cond, what, detail=""):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-    if not cond:
-        fails += 1
-        if detail:
-            print(detail.rstrip())
-    return cond
 
 
 def run(cmd, **kw):
@@ -301,7 +291,7 @@ def do_build(a):
         check(tags and not errors or r.returncode == 0,
               "lintian: no error (%d warning(s) printed above)" % sum(l.startswith("W: ") for l in tags),
               r.stdout)
-    if fails == 0:
+    if failures() == 0:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
@@ -360,7 +350,7 @@ def do_install(a, service=False):
     if state:
         check(not os.path.lexists("/var/lib/lagsim") and not os.path.lexists("/var/lib/private/lagsim"),
               "the purge removed the instances' state (/var/lib/lagsim, /var/lib/private/lagsim)")
-    if fails == 0:
+    if failures() == 0:
         shutil.rmtree(tmp, ignore_errors=True)
     return result
 
@@ -783,10 +773,9 @@ def main():
             return SKIP
         if a.what == "build":
             do_build(a)
-        elif do_install(a, service=a.what == "service") == SKIP and fails == 0:
+        elif do_install(a, service=a.what == "service") == SKIP and failures() == 0:
             return SKIP
-    print("%d failure(s)" % fails)
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

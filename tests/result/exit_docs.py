@@ -80,7 +80,7 @@ def help_statuses(text):
     return inline_statuses(m.group(1)) if m else None
 
 
-def check(prog, where, got, words):
+def check_statuses(prog, where, got, words):
     if got is None:
         fail(prog, "%s states no exit statuses" % where)
         return
@@ -106,8 +106,8 @@ for prog, page, words in PROGRAMS:
     man = man_statuses(os.path.join(mandir, page))
     h = subprocess.run([exe, "--help"], capture_output=True, text=True, timeout=30)
     helped = help_statuses(h.stdout + h.stderr)
-    check(prog, page, man, words)
-    check(prog, "--help", helped, words)
+    check_statuses(prog, page, man, words)
+    check_statuses(prog, "--help", helped, words)
     if man is not None and helped is not None and set(man) != set(helped):
         fail(prog, "%s lists statuses %s, --help %s" % (page, sorted(man), sorted(helped)))
     if h.returncode != OK:
@@ -124,7 +124,7 @@ for path in ["clients/python/lagsim_controller.py", "clients/lua/lagsim_controll
     text = open(os.path.join(srcdir, path)).read()
     m = re.search(r"Exit\s+status:(.*?\.)\s", text, re.S)
     got = inline_statuses(m.group(1)) if m else None
-    check(path, "its doc", got, {"usage": "LAG_ERR_USAGE", "no scene": "LAG_ERR_RUNTIME"})
+    check_statuses(path, "its doc", got, {"usage": "LAG_ERR_USAGE", "no scene": "LAG_ERR_RUNTIME"})
     if got is not None and page is not None and set(got) != set(page):
         fail(path, "its doc lists statuses %s, lagsim-controllers.1 %s" % (sorted(got), sorted(page)))
 

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "lagsim_test.h"
+#include "scene_yaml.h"
 #include "scene.h"
 #include "scene_schema.h"
 
@@ -24,31 +25,6 @@ typedef struct ctx {
     lag_sim_def defaults;
     int keys, core_keys, compared, skipped;
 } ctx;
-
-/* "effects.disturbance[0].t" = V as flow YAML (tests/scene/test_ranges.c's form). */
-static void yaml_for(char *out, size_t len, const char *path, const char *value, int nq)
-{
-    const char *dot = strchr(path, '.');
-    size_t seg = dot ? (size_t)(dot - path) : strlen(path);
-    const char *br = memchr(path, '[', seg);
-    size_t name = br ? (size_t)(br - path) : seg;
-    char inner[512];
-    if (!dot && br) {
-        int at = atoi(br + 1);
-        size_t u = (size_t)snprintf(inner, sizeof inner, "[");
-        for (int i = 0; i < nq; i++)
-            u += (size_t)snprintf(inner + u, sizeof inner - u, "%s%s", i ? ", " : "",
-                                  i == at ? value : "0");
-        snprintf(inner + u, sizeof inner - u, "]");
-    } else if (dot) {
-        char rest[512];
-        yaml_for(rest, sizeof rest, dot + 1, value, nq);
-        snprintf(inner, sizeof inner, br ? "[{%s}]" : "{%s}", rest);
-    } else {
-        snprintf(inner, sizeof inner, "%s", value);
-    }
-    snprintf(out, len, "%.*s: %s", (int)name, path, inner);
-}
 
 static int load(const ctx *c, const char *path, const char *value, lag_scene *sc, char *err,
                 size_t errlen)

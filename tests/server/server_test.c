@@ -113,6 +113,13 @@ static int reap(pid_t pid, double timeout)
     return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
 }
 
+/* Ends a case's daemon: SIGTERM, after which it must exit 0 within 5 s. */
+static void stop_daemon(pid_t d)
+{
+    kill(d, SIGTERM);
+    ENSUREF(reap(d, 5.0) == 0, "the daemon did not exit 0 within 5 s of SIGTERM");
+}
+
 /* ---------------------------------------------------------------- a client */
 #define MAX_EVENTS 4096
 #define MAX_REC 4096
@@ -521,8 +528,7 @@ static void case_control(int arg)
     control(&c, LAGSIM_CONTROL_T_DESCRIBE, 0, 0, NULL, NULL);
     WAIT_FOR(&c, c.n_scene > ns, 3.0);
     ENSURE(!c.nonfinite_seen);
-    kill(d, SIGTERM);
-    ENSURE(reap(d, 5.0) == 0);
+    stop_daemon(d);
 }
 
 /* ---- raw payloads for hostile commands */
@@ -648,8 +654,7 @@ static void case_hostile(int arg)
     ENSURE(!c.nonfinite_seen);
     printf("hostile: flood of 6000 bad commands: %lld counted (rest dropped by the socket)\n",
            (long long)flood);
-    kill(d, SIGTERM);
-    ENSURE(reap(d, 5.0) == 0);
+    stop_daemon(d);
 }
 
 /* The watchdog zeroes a stale command's effort, with an event and a status flag; the next
@@ -683,8 +688,7 @@ static void case_watchdog(int arg)
     fresh_status(&c);
     ENSURE(!c.status->watchdog_tripped && c.status->watchdog_trips == 1);
     ENSURE(!c.nonfinite_seen);
-    kill(d, SIGTERM);
-    ENSURE(reap(d, 5.0) == 0);
+    stop_daemon(d);
 }
 
 /* Lockstep waits for its controller and never steps without it.
@@ -749,8 +753,7 @@ static void case_lockstep_timeout(int arg)
     fresh_status(&c);
     ENSURE(strcmp(c.status->run_state, "running") == 0);
     ENSURE(!c.nonfinite_seen);
-    kill(d, SIGTERM);
-    ENSURE(reap(d, 5.0) == 0);
+    stop_daemon(d);
 }
 
 /* Two daemons with different prefixes do not hear each other. */
@@ -829,8 +832,7 @@ static void case_fault(int arg)
     ENSUREF(fabs(c.last.q[0] - 0.5 * c.last.t) < 1e-9, "x %.17g at t %g", c.last.q[0], c.last.t);
     ENSURE(count_events(&c, "numeric_fault") == 1);
     ENSURE(!c.nonfinite_seen);
-    kill(d, SIGTERM);
-    ENSURE(reap(d, 5.0) == 0);
+    stop_daemon(d);
 }
 
 /* Runs one lockstep run of 2 s sim time with the test's deterministic controller.
@@ -1016,8 +1018,7 @@ static void case_sigterm(int arg)
     WAIT_FOR(&c, c.n_states > 5 && c.n_status > 0, 5.0);
     pump(&c, 0.1);
     int64_t ns = c.n_status;
-    kill(d, SIGTERM);
-    ENSURE(reap(d, 5.0) == 0);
+    stop_daemon(d);
     pump(&c, 0.2);
     ENSURE(c.n_status > ns);
     ENSURE(count_events(&c, "stop") == 1);
@@ -1271,8 +1272,7 @@ static void case_control_flood(int arg)
     control(&c, LAGSIM_CONTROL_T_PAUSE, 0, 0, NULL, NULL);
     WAIT_FOR(&c, last_event(&c, "pause") >= 0, 3.0);
     ENSURE(!c.nonfinite_seen);
-    kill(d, SIGTERM);
-    ENSURE(reap(d, 5.0) == 0);
+    stop_daemon(d);
 }
 
 /* Anything on the state URL but the plant's four output channels (and LCM's self-test,
@@ -1345,8 +1345,7 @@ static void case_command_flood_ports(int arg)
             (long long)c.missing);
     ENSURE(c.n_states - n0 >= 200 && !c.nonfinite_seen);
     lcm_unsubscribe(c.lcm, all);
-    kill(d, SIGTERM);
-    ENSURE(reap(d, 5.0) == 0);
+    stop_daemon(d);
 }
 
 /* STEP with count 2^62 while paused goes at the mode's pace (realtime: 100 periods a
@@ -1379,8 +1378,7 @@ static void case_step_flood(int arg)
     int64_t held = c.last.step;
     pump(&c, 0.3);
     ENSURE(c.last.step == held);
-    kill(d, SIGTERM);
-    ENSURE(reap(d, 5.0) == 0);
+    stop_daemon(d);
 }
 
 /* lockstep_timeout 1e10 s (or 1e300): the daemon waits for its controller, quietly and
@@ -1411,8 +1409,7 @@ static void case_lockstep_huge(int arg)
         ENSURE(c.n_states == 1 && c.status->step == 0 && c.status->lockstep_timeouts == 0);
         ENSURE(last_event(&c, "lockstep_timeout") < 0);
         ENSUREF(cpu < 0.2, "%.3f s of CPU in 1 s of waiting", cpu);
-        kill(d, SIGTERM);
-        ENSURE(reap(d, 5.0) == 0);
+        stop_daemon(d);
     }
 }
 
@@ -1442,8 +1439,7 @@ static void case_status_rate(int arg)
         int64_t n = c.n_status - s0;
         printf("%s: %lld statuses in %.2f s\n", values[i], (long long)n, wall);
         ENSUREF(n <= (int64_t)(most[i] * wall) + 1, "%lld statuses in %.2f s", (long long)n, wall);
-        kill(d, SIGTERM);
-        ENSURE(reap(d, 5.0) == 0);
+        stop_daemon(d);
     }
 }
 
@@ -1475,8 +1471,7 @@ static void case_rate_huge(int arg)
                values[i], c.status->sim_time, wall, bursts, (long long)c.status->overrun_bursts);
         ENSUREF(c.status->sim_time > 0.5, "sim time %g", c.status->sim_time);
         ENSUREF(bursts <= 3 + (int)wall + 2, "%d overrun_burst events", bursts);
-        kill(d, SIGTERM);
-        ENSURE(reap(d, 5.0) == 0);
+        stop_daemon(d);
     }
 }
 
@@ -1584,8 +1579,7 @@ static void case_effort_absurd(int arg)
     ENSURE(c.status->rejected_effort_limit == 1 && c.status->commands_accepted == 0);
     ENSURE(strcmp(c.status->run_state, "running") == 0 && c.last.eff[0] == 0.0);
     ENSURE(last_event(&c, "numeric_fault") < 0);
-    kill(d, SIGTERM);
-    ENSURE(reap(d, 5.0) == 0);
+    stop_daemon(d);
 
     d = start_daemon(g_prefix, "--set", "realtime.effort_limit={theta0: 1e12}", NULL);
     WAIT_FOR(&c, count_events(&c, "start") == 2 && c.last.t > 0.05, 5.0);
@@ -1596,8 +1590,7 @@ static void case_effort_absurd(int arg)
     printf("numeric_fault: %s\n", c.ev_detail[k]);
     ENSUREF(strstr(c.ev_detail[k], "theta0 = 1e+12"), "detail '%s'", c.ev_detail[k]);
     ENSURE(!c.nonfinite_seen);
-    kill(d, SIGTERM);
-    ENSURE(reap(d, 5.0) == 0);
+    stop_daemon(d);
 }
 
 /* An LCM URL with ttl > 0 is said at start: the daemon's messages leave this host. */
@@ -1756,8 +1749,7 @@ static void case_plant_conflict(int arg)
             "%d plant_conflict events in %.1f s", count_events(&c, "plant_conflict"), took);
     ENSURE(c.n_states > states + (int64_t)(took * 50));
     ENSURE(count_events(&c, "stop") == 0 && !c.nonfinite_seen);
-    kill(d, SIGTERM);
-    ENSURE(reap(d, 5.0) == 0);
+    stop_daemon(d);
     char text[8192];
     slurp(err_path, text, sizeof text);
     remove(err_path);

@@ -51,23 +51,16 @@ import fcntl
 import os
 import random
 import signal
-import struct
 import subprocess
 import sys
 import tempfile
 import time
 
-failures = 0
-SYNC = 0xEDA1DA01
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+from lcm_log import records  # noqa: E402  (tests/common: LCM's log format)
+
 GROUP = "239.255.76.67"
-
-
-def check(cond, what):
-    global failures
-    print(("ok: " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
 
 
 def bound_ports():
@@ -115,13 +108,8 @@ def url(port):
 
 
 def read_log(path):
-    out, b, i = [], open(path, "rb").read(), 0
-    while i + 28 <= len(b):
-        sync, num, ts, clen, dlen = struct.unpack_from(">IqqII", b, i)
-        assert sync == SYNC
-        out.append((b[i + 28:i + 28 + clen].decode(), b[i + 28 + clen:i + 28 + clen + dlen]))
-        i += 28 + clen + dlen
-    return out
+    """[(channel, data)] of a whole log (raises otherwise)."""
+    return [(ch, data) for _, _, ch, data, _ in records(path, whole=True)]
 
 
 class Bus:
@@ -889,8 +877,7 @@ def main():
         getattr(t, "case_" + a.case)()
     finally:
         t.cleanup()
-    print("%s: %d failure(s)" % (a.case, failures))
-    return 1 if failures else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":

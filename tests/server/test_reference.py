@@ -33,17 +33,15 @@ import argparse
 import math
 import os
 import re
-import struct
 import subprocess
 import sys
 import tempfile
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+from lcm_log import records  # noqa: E402  (tests/common: LCM's log format)
 import waits  # noqa: E402  (events waited on, bounded)
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
-
-failures = 0
-SYNC = 0xEDA1DA01
+from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
 
 SINE = dict(start=0.205, amplitude=0.1, offset=0.05, frequency=2.0)
 POINTS = [(0.0, 0.0), (0.503, 0.02), (1.007, -0.01)]
@@ -52,14 +50,6 @@ REFERENCE = ("reference={theta0: {type: sine, start: %g, amplitude: %g, offset: 
              "frequency: %g}, theta1: {type: waypoints, start: %g, points: [%s]}}" %
              (SINE["start"], SINE["amplitude"], SINE["offset"], SINE["frequency"], WP_START,
               ", ".join("[%g, %g]" % p for p in POINTS)))
-
-
-def check(cond, what):
-    global failures
-    print(("ok: " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
 
 
 def sine(t, amplitude=SINE["amplitude"]):
@@ -83,13 +73,8 @@ def waypoints(t):
 
 
 def read_log(path):
-    out, b, i = [], open(path, "rb").read(), 0
-    while i < len(b):
-        sync, num, ts, clen, dlen = struct.unpack_from(">IqqII", b, i)
-        assert sync == SYNC
-        out.append((b[i + 28:i + 28 + clen].decode(), b[i + 28 + clen:i + 28 + clen + dlen], i + 28 + clen))
-        i += 28 + clen + dlen
-    return out
+    """[(channel, data, offset of the data in the file)] of a whole log (raises otherwise)."""
+    return [(ch, data, at) for _, _, ch, data, at in records(path, whole=True)]
 
 
 class T:
@@ -434,8 +419,7 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         t.tmp = tmp
         CASES[a.case](t)
-    print(f"{failures} failure(s)")
-    return 1 if failures else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":

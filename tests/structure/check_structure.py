@@ -6,7 +6,9 @@
       tests/ but tests/common/ defines a check macro (ENSURE*, CHECK*, EXPECT*, ASSERT*,
       REQUIRE*, LT_*) or a file-scope check/failure counter; every test program
       (tests/**/test_*.c, tests/**/*_test.c) runs its cases through lt_main or lt_run, and
-      none dispatches them through a strcmp chain.
+      none dispatches them through a strcmp chain. The Python tests have theirs
+      (tests/common/lagsim_check.py): no .py file under tests/ but tests/common/ defines a
+      check() of its own.
   check_structure.py names BUILD_DIR [--ctest CTEST | --json FILE]
       Every ctest's name is lowercase words joined by "_" (a word may hold a "-": a model's
       name such as flying-stick, a number such as -1 or 1e-04; never a "." or a capital),
@@ -51,10 +53,13 @@ CHAIN = re.compile(r'\bstrcmp\s*\([^;{}()]*(?:\([^;{}()]*\)[^;{}()]*)*\)\s*(?:==
                    r'\{?\s*(?:case|test|check|run)_\w+\s*\(')
 
 
-def c_files(root, sub):
+PY_CHECK = re.compile(r'^[ \t]*def[ \t]+check[ \t]*\(', re.M)
+
+
+def c_files(root, sub, endings=('.c', '.h')):
     for dirpath, _, names in os.walk(os.path.join(root, sub)):
         for n in sorted(names):
-            if n.endswith(('.c', '.h')):
+            if n.endswith(endings):
                 yield os.path.join(dirpath, n)
 
 
@@ -82,6 +87,14 @@ def check_harness(src):
                 line = text.count('\n', 0, m.start()) + 1
                 bad.append(f'{rel}:{line}: dispatches through a strcmp chain: list the cases '
                            'in an lt_case table')
+    for path in c_files(src, 'tests', ('.py',)):
+        if path.startswith(common):
+            continue
+        text = open(path, encoding='utf-8', errors='replace').read()
+        for m in PY_CHECK.finditer(text):
+            line = text.count('\n', 0, m.start()) + 1
+            bad.append(f'{os.path.relpath(path, src)}:{line}: defines check() of its own: use '
+                       'tests/common/lagsim_check.py')
     return bad
 
 # ---------------------------------------------------------------- names

@@ -14,16 +14,8 @@ import tempfile
 
 import lcmlog
 
-failures = 0
-
-
-def check(cond, what):
-    global failures
-    if not cond:
-        failures += 1
-        print("FAIL:", what)
-    else:
-        print("ok:", what)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 
 
 def run(binary, *args, timeout=20):
@@ -385,8 +377,7 @@ def main():
     with tempfile.TemporaryDirectory(prefix="lagsim-log2csv-") as tmp:
         {"exact": case_exact, "hostile": case_hostile, "injection": case_injection,
          "plot": case_plot}[a.case](a, t, tmp)
-    print(f"{'FAILED' if failures else 'passed'}: {failures} failure(s)")
-    return 1 if failures else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":

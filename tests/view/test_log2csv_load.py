@@ -23,17 +23,8 @@ import sys
 import tempfile
 import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
-
-fails = 0
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-    if not cond:
-        fails += 1
-    return cond
 
 
 def blocks(src):
@@ -130,8 +121,7 @@ def main():
             os.chdir(cwd)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    print("load: %s (%d failures)" % ("FAILED" if fails else "passed", fails))
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":

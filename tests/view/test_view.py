@@ -32,7 +32,6 @@ import json
 import math
 import os
 import re
-import signal
 import socket
 import subprocess
 import sys
@@ -43,27 +42,8 @@ import urllib.request
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import cdp  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, stop, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
-
-failures = 0
-
-
-def check(cond, what):
-    global failures
-    print(("ok:   " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
-
-
-def stop(p):
-    if p and p.poll() is None:
-        p.send_signal(signal.SIGTERM)
-        try:
-            p.wait(5)
-        except subprocess.TimeoutExpired:
-            p.kill()
-            p.wait()
 
 
 class Rig:
@@ -697,8 +677,7 @@ def main():
     {"browser": case_browser, "hostile": case_hostile, "stick_flight": case_stick_flight,
      "cartpole": case_cartpole, "reference": case_reference, "charts": case_charts,
      "history": case_history, "models": case_models}[a.case](a)
-    print("%s: %d failure(s)" % ("FAILED" if failures else "passed", failures))
-    return 1 if failures else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":

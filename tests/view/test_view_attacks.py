@@ -28,7 +28,6 @@ import os
 import re
 import select
 import shutil
-import signal
 import socket
 import struct
 import subprocess
@@ -40,28 +39,10 @@ import urllib.request
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import cdp  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (a port pair of this process's own)
+from lagsim_check import SKIP, check, stop, verdict  # noqa: E402  (tests/common: the one harness)
+from lcm_port import lcm_port  # noqa: E402  (a port pair of this process's own)
 
-failures = 0
 GROUP = "239.255.76.67"
-
-
-def check(cond, what):
-    global failures
-    print(("ok:   " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
-
-
-def stop(p):
-    if p and p.poll() is None:
-        p.send_signal(signal.SIGTERM)
-        try:
-            p.wait(5)
-        except subprocess.TimeoutExpired:
-            p.kill()
-            p.wait()
 
 
 class View:
@@ -607,7 +588,7 @@ def case_host(a):
 def case_lan(a):
     if os.geteuid() != 0 or not shutil.which("ip"):
         print("SKIPPED: needs root and iproute2 (network namespaces)")
-        return 77
+        return SKIP
     pid = os.getpid()
     nsA, nsB, vA, vB = "lsvA%d" % pid, "lsvB%d" % pid, "lva%d" % pid, "lvb%d" % pid
 
@@ -618,7 +599,7 @@ def case_lan(a):
         return r
     if ip("netns", "add", nsA, check_rc=False).returncode != 0:
         print("SKIPPED: cannot create a network namespace here")
-        return 77
+        return SKIP
     views = []
     try:
         ip("netns", "add", nsB)
@@ -717,10 +698,9 @@ def main():
         return helper_get(a)
     rc = {"forged": case_forged, "stalled": case_stalled, "slowloris": case_slowloris,
           "host": case_host, "lan": case_lan}[a.case](a)
-    if rc == 77:
-        return 77
-    print("%s: %d failure(s)" % ("FAILED" if failures else "passed", failures))
-    return 1 if failures else 0
+    if rc == SKIP:
+        return SKIP
+    return verdict(a.case)
 
 
 if __name__ == "__main__":

@@ -25,16 +25,10 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from test_view_attacks import View, lcm_port, start_daemon, stop, stream_request  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+
 STOP_WAIT_S = 10.0
-failures = 0
-
-
-def check(cond, what):
-    global failures
-    print(("ok:   " if cond else "FAIL: ") + what, flush=True)
-    if not cond:
-        failures += 1
-    return cond
 
 
 def read_until(s, pred, timeout):
@@ -107,8 +101,7 @@ def main():
             one_try(a, k, sig, prefix, url)
     finally:
         stop(d)
-    print("%s: %d failure(s)" % ("FAILED" if failures else "passed", failures))
-    return 1 if failures else 0
+    return verdict(a.case)
 
 
 if __name__ == "__main__":
