@@ -579,9 +579,9 @@ add_test(NAME clients_readme_c_installed
 add_test(NAME clients_readme_cpp_installed
   COMMAND ${readme_run} ${readme_cc} --install --periods 20 cpp-dipc)
 list(APPEND lang_tests clients_readme_c_installed clients_readme_cpp_installed)
-# the C and C++ blocks under a daemon SIGKILLed after 30 states (no stop event): each ends
-# by its silence rule (5 s of nothing from the daemon, as README says) and exits 0
-set(readme_killed c cpp)
+# the C, C++ and Python blocks under a daemon SIGKILLed after 30 states (no stop event):
+# each ends by its silence rule (5 s of nothing from the daemon, as README says), exit 0
+set(readme_killed c cpp python)
 if(TARGET dipc_balance_go)  # docs/clients.md's Go block (its silence = 5 s)
   list(APPEND readme_killed go)
 endif()

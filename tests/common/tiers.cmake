@@ -44,8 +44,8 @@ set(LAGSIM_TIER_RULES
   "waits     NAME  ^clients_readme_(c|cpp|python|lua|go)_slow(er)?_law$"
   "waits     NAME  ^clients_(c|cpp|python|lua|java|go)_[a-z_]+_ends_on_(stop|silence)$"
   "waits     NAME  ^clients_(c|cpp|python|lua|java|go)_ends_on_signal$"
-  # README's C and C++ blocks under a daemon SIGKILLed: each waits out its 5 s of silence
-  "waits     NAME  ^clients_readme_(c|cpp|go)_daemon_killed$"
+  # README's C, C++ and Python blocks under a daemon SIGKILLed: each waits out its 5 s of silence
+  "waits     NAME  ^clients_readme_(c|cpp|python|go)_daemon_killed$"
   "waits     NAME  ^clients_(python|java)_dipc_late_controller$"
   "waits     NAME  ^view_attack_(slowloris|stalled)$"
   "waits     NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
