@@ -764,11 +764,30 @@ lag_result lag_client_step(lag_client *c, int64_t count)
 
 lag_result lag_client_reset_to(lag_client *c, int n, const double *q, const double *qd)
 {
+    return lag_client_reset_with(c, 0, n, q, qd);
+}
+
+/* The flags are control_t's count bits as the daemon reads them (lagsim_wire.h). */
+_Static_assert(LAG_CLIENT_RESET_SCENE == LAG_WIRE_RESET_SCENE &&
+                   LAG_CLIENT_RESET_WAIT == LAG_WIRE_RESET_WAIT,
+               "LAG_CLIENT_RESET_* are control_t's RESET count bits");
+
+lag_result lag_client_reset_with(lag_client *c, int flags, int n, const double *q, const double *qd)
+{
+    const int all = LAG_CLIENT_RESET_SCENE | LAG_CLIENT_RESET_WAIT;
+    if (n == 0 && !q && !qd && flags >= 0 && (flags & ~all) == 0)
+        return send_control(c, LAGSIM_CONTROL_T_RESET, flags, 0, NULL, NULL);
+    if (flags != 0 && flags != LAG_CLIENT_RESET_WAIT) {
+        set_err(c, "reset: flags %d; accepted: an OR of LAG_CLIENT_RESET_SCENE (%d, without "
+                   "joints) and LAG_CLIENT_RESET_WAIT (%d)", flags, LAG_CLIENT_RESET_SCENE,
+                LAG_CLIENT_RESET_WAIT);
+        return LAG_CLIENT_ERR_ARG;
+    }
     if (n < 1 || n > LAG_CLIENT_MAX_JOINTS || !q || !qd) {
         set_err(c, "reset_to: %d joints (1 to %d, with q and qd)", n, LAG_CLIENT_MAX_JOINTS);
         return LAG_CLIENT_ERR_ARG;
     }
-    return send_control(c, LAGSIM_CONTROL_T_RESET_TO, 0, n, q, qd);
+    return send_control(c, LAGSIM_CONTROL_T_RESET_TO, flags, n, q, qd);
 }
 
 /* ---------------------------------------------------------------- lookups */

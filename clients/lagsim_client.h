@@ -289,6 +289,18 @@ lag_result lag_client_kick(lag_client *c, const char *joint, double impulse, dou
 /* RESET to the scene file's initial state and values: the changes made by SET and the
  * kicks are undone (a `restore` event says which), then the `reset` event. */
 lag_result lag_client_reset_scene(lag_client *c);
+/* RESET (n = 0, q and qd NULL) or RESET_TO (n joints at q, qd) with flags, an OR of:
+ *   LAG_CLIENT_RESET_SCENE  the scene file's values too, as lag_client_reset_scene (RESET
+ *                           only: with n > 0 it is refused here)
+ *   LAG_CLIENT_RESET_WAIT   then wait at t = 0 for the first command (run_state waiting,
+ *                           as realtime.start: first_command): the state is republished,
+ *                           and the first valid command or a RESUME starts the run, its
+ *                           real-time deadlines counted from then. In the fault state too.
+ * Without LAG_CLIENT_RESET_WAIT a reset keeps the run state (running or paused). Other
+ * bits: LAG_CLIENT_ERR_ARG (the daemon refuses them too, with control_rejected). */
+#define LAG_CLIENT_RESET_SCENE 1
+#define LAG_CLIENT_RESET_WAIT 2
+lag_result lag_client_reset_with(lag_client *c, int flags, int n, const double *q, const double *qd);
 
 /* When the last message from the daemon was kept (a state or a copy of one, a scene, a
  * status, an event, a reference), on lag_client_now()'s clock; the handle's creation

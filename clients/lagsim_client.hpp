@@ -433,11 +433,14 @@ public:
     void step(int64_t periods) { detail::check(lag_client_step(c_.get(), periods), c_.get()); }
     void reset() { detail::check(lag_client_reset(c_.get()), c_.get()); }
     void reset_scene() { detail::check(lag_client_reset_scene(c_.get()), c_.get()); }
-    void reset_to(const std::vector<double> &q, const std::vector<double> &qd)
+    /* flags: an OR of LAG_CLIENT_RESET_SCENE and LAG_CLIENT_RESET_WAIT */
+    void reset_with(int flags) { detail::check(lag_client_reset_with(c_.get(), flags, 0, nullptr, nullptr), c_.get()); }
+    void reset_to(const std::vector<double> &q, const std::vector<double> &qd, int flags = 0)
     {
         if (q.size() != qd.size())
             throw Error(LAG_ERR_ARG, "reset_to: q and qd of different sizes");
-        detail::check(lag_client_reset_to(c_.get(), static_cast<int>(q.size()), q.data(), qd.data()),
+        detail::check(lag_client_reset_with(c_.get(), flags, static_cast<int>(q.size()), q.data(),
+                                            qd.data()),
                       c_.get());
     }
     void request_status() { detail::check(lag_client_request_status(c_.get()), c_.get()); }

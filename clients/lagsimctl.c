@@ -2,8 +2,9 @@
  * lagsimctl: the control requests of a running lagsimd from a shell.
  *
  *   lagsimctl [--prefix P] [--url URL] [--timeout S] [--json] COMMAND [ARGS...]
- *   COMMAND: list, status, describe, pause, resume, step N, reset [--scene],
- *            reset-to Q... QD..., set KEY=VALUE, kick JOINT IMPULSE [--duration S], watch
+ *   COMMAND: list, status, describe, pause, resume, step N, reset [--scene] [--wait],
+ *            reset-to Q... QD... [--wait], set KEY=VALUE, kick JOINT IMPULSE [--duration S],
+ *            watch
  *
  * Sends one control request on <P>_CONTROL and prints the daemon's answer as text lines
  * (an event, a status, a scene), or with `watch` prints what the daemon publishes until
@@ -71,10 +72,15 @@ static void usage(FILE *f)
             "  describe             the scene description (model, parameters, joints, timing)\n"
             "  pause | resume       stop / go on advancing sim time\n"
             "  step N               while paused: advance N control periods, then pause\n"
-            "  reset [--scene]      back to the scene's initial state at sim time 0, keeping\n"
-            "                       the changes made by set (it says which); --scene: back\n"
-            "                       to the scene file's values too\n"
-            "  reset-to Q... QD...  back to this state: all positions, then all velocities\n"
+            "  reset [--scene] [--wait]\n"
+            "                       back to the scene's initial state at sim time 0, keeping\n"
+            "                       the changes made by set (it says which) and the run state\n"
+            "                       (running or paused); --scene: back to the scene file's\n"
+            "                       values too; --wait: then wait at t = 0 for the first\n"
+            "                       command, as at the daemon's start (run state waiting: the\n"
+            "                       next controller's first command or resume starts the run)\n"
+            "  reset-to Q... QD... [--wait]\n"
+            "                       back to this state: all positions, then all velocities\n"
             "  set KEY=VALUE        change a parameter, an effect's setting or the reference\n"
             "                       while running, e.g. set parameters.m2=1.5, set\n"
             "                       reference.q1.amplitude=0.2 (validated as the scene file)\n"
@@ -632,8 +638,22 @@ typedef struct request {
     int nq;                     /* reset-to */
     const char *kick_joint;
     double kick_impulse, kick_duration;
-    bool reset_scene;           /* reset --scene */
+    int reset_flags;            /* reset --scene --wait, reset-to --wait: LAG_CLIENT_RESET_* */
 } request;
+
+/* reset's and reset-to's options, anywhere among the arguments: taken out of them into
+ * reset_flags (--scene only where scene_ok). */
+static void take_reset_flags(request *r, bool scene_ok)
+{
+    int k = 0;
+    for (int i = 0; i < r->nargs; i++) {
+        if (!strcmp(r->args[i], "--wait")) r->reset_flags |= LAG_CLIENT_RESET_WAIT;
+        else if (scene_ok && !strcmp(r->args[i], "--scene"))
+            r->reset_flags |= LAG_CLIENT_RESET_SCENE;
+        else r->args[k++] = r->args[i];
+    }
+    r->nargs = k;
+}
 
 static int check_step(request *r)
 {
@@ -648,6 +668,7 @@ static int check_step(request *r)
 
 static int check_reset_to(request *r)
 {
+    take_reset_flags(r, false);
     if (r->nargs < 2 || r->nargs % 2 || r->nargs / 2 > LAG_CLIENT_MAX_JOINTS) {
         fprintf(stderr, "lagsimctl: reset-to wants every position, then every velocity "
                         "(2, 4 or 6 numbers for 1 to 3 joints), got %d\n", r->nargs);
@@ -698,12 +719,13 @@ static int check_kick(request *r)
 
 static int check_reset(request *r)
 {
-    r->want_args = r->nargs == 1 ? 1 : 0;
-    if (r->nargs == 1 && strcmp(r->args[0], "--scene")) {
-        fprintf(stderr, "lagsimctl: reset takes --scene or nothing, not '%s'\n", r->args[0]);
+    take_reset_flags(r, true);
+    r->want_args = 0;
+    if (r->nargs > 0) {
+        fprintf(stderr, "lagsimctl: reset takes --scene, --wait or nothing, not '%s'\n",
+                r->args[0]);
         return EXIT_USAGE;
     }
-    r->reset_scene = r->nargs == 1;
     return GO_ON;
 }
 
@@ -847,10 +869,10 @@ static int send_run_control(lag_client *c, answer *a, const request *r, double t
         rc = lag_client_resume(c);
     } else if (!strcmp(cmd, "reset")) {
         a->want = "reset";
-        rc = r->reset_scene ? lag_client_reset_scene(c) : lag_client_reset(c);
+        rc = lag_client_reset_with(c, r->reset_flags, 0, NULL, NULL);
     } else if (!strcmp(cmd, "reset-to")) {
         a->want = "reset";
-        rc = lag_client_reset_to(c, r->nq, r->q, r->qd);
+        rc = lag_client_reset_with(c, r->reset_flags, r->nq, r->q, r->qd);
     } else { /* step */
         a->want = "step";
         a->want2 = "step_done";
@@ -899,7 +921,7 @@ static lag_result lagsimctl_main(int argc, char **argv)
     if (code != GO_ON) return code;
     if (optind >= argc) {
         fprintf(stderr, "lagsimctl: which command? (list, status, describe, pause, resume, "
-                        "step N, reset [--scene], reset-to Q... QD..., set KEY=VALUE, kick "
+                        "step N, reset [--scene] [--wait], reset-to Q... QD... [--wait], set KEY=VALUE, kick "
                         "JOINT IMPULSE [--duration S], watch)\n");
         usage(stderr);
         return EXIT_USAGE;

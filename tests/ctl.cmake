@@ -35,3 +35,17 @@ if(LAGSIM_PYTHON3)
   # never another plant's (tests/ctl/test_misspelt.py).
   lagsim_ctl_test(ctl_misspelt_prefix test_misspelt.py ${ctl_tree})
 endif()
+
+# A reset that waits for the first command (lagsimctl reset --wait, RESET/RESET_TO count
+# bit 2): the real-time DIPC run by dipc_lqr, the controller stopped, reset --wait: the
+# plant waits at sim time 0 republishing its state until the next dipc_lqr starts the run;
+# reset --scene --wait while paused and in the fault, reset-to --wait: waiting; other count
+# bits refused with control_rejected; --replay of the log exact
+# (tests/ctl/test_reset_wait.py).
+if(LAGSIM_PYTHON3)
+  add_test(NAME ctl_reset_wait
+    COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/ctl/test_reset_wait.py
+            --bin $<TARGET_FILE_DIR:lagsimd> --source ${PROJECT_SOURCE_DIR}
+            --types ${CMAKE_BINARY_DIR}/python)
+  set_tests_properties(ctl_reset_wait PROPERTIES TIMEOUT 120 LABELS clients)
+endif()

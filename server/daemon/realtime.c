@@ -605,7 +605,7 @@ static void handle_command(rt_server *s, const uint8_t *data, size_t len)
 /* ---------------------------------------------------------------- control requests */
 /* What a control request asks of the run (rt_control.c checked it and made its changes
  * to the scene); a status follows where it says (want_status). */
-static void do_reset(rt_server *s, const double *q, const double *qd, const char *what)
+static void do_reset(rt_server *s, const rt_act *a)
 {
     if (s->ctl.live.nk > 0) { /* sim time starts over: the kicks are the old run's */
         char detail[96];
@@ -615,7 +615,7 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
         event(s, "kicks_cleared", "", 0, detail); /* --replay applies it here */
     }
     s->ticks_before_reset = rt_sat_add(s->ticks_before_reset, s->sim.tick); /* --duration */
-    lag_sim_reset(&s->sim, q, qd);
+    lag_sim_reset(&s->sim, a->to ? a->q : NULL, a->to ? a->qd : NULL);
     s->effect_events_dropped = s->sim.events_dropped;
     for (int i = 0; i < s->nq; i++) s->held[i] = 0.0;
     s->have_command = false;
@@ -624,13 +624,19 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
     s->period_left = 0;
     s->ls.waiting = false; /* lockstep: the new state is waited on once it is published */
     s->ls.have_answered = false;
-    if (s->run == RT_FAULT) s->run = RT_PAUSED;
+    if (a->wait) { /* as realtime.start: first_command: the next command starts the run */
+        s->run = RT_WAITING;
+        s->restart_pace = true; /* the state at t = 0 is republished from now on */
+    } else if (s->run == RT_FAULT) {
+        s->run = RT_PAUSED;
+    }
     char kept[200];
     live_set_describe(&s->ctl.live, kept, sizeof kept);
     /* which changes made while running the reset keeps (a reset with count 1 keeps none) */
-    rt_pub_limited(&s->pub, RT_EV_RESET, "", 0, "%s: sim time 0, efforts zero, %s; %s%s%s", what,
+    rt_pub_limited(&s->pub, RT_EV_RESET, "", 0, "%s: sim time 0, efforts zero, %s; %s%s%s", a->what,
                   s->run == RT_PAUSED    ? "paused (resume to run)"
-                  : s->run == RT_WAITING ? "waiting for a command"
+                  : s->run == RT_WAITING ? "waiting for the first command (it, or resume, "
+                                           "starts the run)"
                                          : "running",
                   kept[0] ? "keeps the changes made while running: " : "the scene file's values",
                   kept, kept[0] ? " (lagsimctl reset --scene, RESET count 1: the scene file's "
@@ -638,6 +644,7 @@ static void do_reset(rt_server *s, const double *q, const double *qd, const char
     rt_pub_new_generation(&s->pub, s->sc, s->info); /* the scene, before the new state */
     s->pub.want_state = true;
     s->pub.want_status = true;
+    wait_update(s); /* a wait for the first command begins now */
 }
 
 /* Lockstep, when the run goes on (resume, step): the state already published is waited
@@ -686,7 +693,7 @@ static void run_act(rt_server *s, const rt_act *a)
     case RT_ACT_PAUSE: run_pause(s); return;
     case RT_ACT_RESUME: run_resume(s); return;
     case RT_ACT_STEP: run_step(s, a->count); return;
-    case RT_ACT_RESET: do_reset(s, a->to ? a->q : NULL, a->to ? a->qd : NULL, a->what); return;
+    case RT_ACT_RESET: do_reset(s, a); return;
     }
 }
 

@@ -215,12 +215,34 @@ static bool reset_allowed(rt_control *c, const char *what)
     return false;
 }
 
-/* RESET; count 1: the scene file's values too, after a `restore` event (never
- * suppressed: --replay undoes the changes where it says) before the reset's. */
+/* RESET and RESET_TO's count: a set of the bits `accepted` (LAG_WIRE_RESET_*); false:
+ * refused, naming the values accepted. Checked before the reset bucket is drawn on. */
+static bool reset_flags_ok(rt_control *c, const char *what, int64_t count, int64_t accepted)
+{
+    if (count >= 0 && (count & ~accepted) == 0) return true;
+    char why[LAG_WIRE_TEXT_LEN];
+    if (accepted & LAG_WIRE_RESET_SCENE)
+        snprintf(why, sizeof why, "%s: count %lld; accepted: 0, %d (the scene file's values "
+                 "too), %d (then wait for the first command) or %d (both)", what,
+                 (long long)count, LAG_WIRE_RESET_SCENE, LAG_WIRE_RESET_WAIT,
+                 LAG_WIRE_RESET_SCENE | LAG_WIRE_RESET_WAIT);
+    else
+        snprintf(why, sizeof why, "%s: count %lld; accepted: 0 or %d (then wait for the first "
+                 "command)", what, (long long)count, LAG_WIRE_RESET_WAIT);
+    rt_control_rejected(c, why);
+    return false;
+}
+
+/* RESET; count bit LAG_WIRE_RESET_SCENE: the scene file's values too, after a `restore`
+ * event (never suppressed: --replay undoes the changes where it says) before the reset's;
+ * bit LAG_WIRE_RESET_WAIT: then wait for the first command. */
 static rt_act control_reset(rt_control *c, int64_t count)
 {
+    if (!reset_flags_ok(c, "reset", count, LAG_WIRE_RESET_SCENE | LAG_WIRE_RESET_WAIT))
+        return (rt_act){.kind = RT_ACT_NONE};
     if (!reset_allowed(c, "reset")) return (rt_act){.kind = RT_ACT_NONE};
-    if (count == 1 && (c->live.n > 0 || c->live.nk > 0)) {
+    bool scene = (count & LAG_WIRE_RESET_SCENE) != 0;
+    if (scene && (c->live.n > 0 || c->live.nk > 0)) {
         char err[512], why[700];
         if (lag_sim_redefine(c->sim, &c->sc->sim, err, sizeof err) != LAG_OK) {
             snprintf(why, sizeof why, "reset to the scene file's values: %s", err);
@@ -236,12 +258,14 @@ static rt_act control_reset(rt_control *c, int64_t count)
         c->ref = c->sc->reference;
     }
     return (rt_act){.kind = RT_ACT_RESET,
-                    .what = count == 1 ? "reset to the scene file's initial state and values"
-                                       : "reset to the scene's initial state"};
+                    .what = scene ? "reset to the scene file's initial state and values"
+                                  : "reset to the scene's initial state",
+                    .wait = (count & LAG_WIRE_RESET_WAIT) != 0};
 }
 
 /* RESET_TO: a state of the model's joints, finite, within explode_limit, where the mass
- * matrix is positive definite and the stick is not below the floor. */
+ * matrix is positive definite and the stick is not below the floor; count: 0 or
+ * LAG_WIRE_RESET_WAIT. */
 static rt_act control_reset_to(rt_control *c, const lag_wire_control *m)
 {
     rt_act none = {.kind = RT_ACT_NONE};
@@ -270,8 +294,10 @@ static rt_act control_reset_to(rt_control *c, const lag_wire_control *m)
                                "floor (h >= 0)");
         return none;
     }
+    if (!reset_flags_ok(c, "reset_to", m->count, LAG_WIRE_RESET_WAIT)) return none;
     if (!reset_allowed(c, "reset_to")) return none;
-    rt_act a = {.kind = RT_ACT_RESET, .to = true, .what = "reset to a given state"};
+    rt_act a = {.kind = RT_ACT_RESET, .to = true, .what = "reset to a given state",
+                .wait = (m->count & LAG_WIRE_RESET_WAIT) != 0};
     for (int i = 0; i < c->nq; i++) {
         a.q[i] = m->q[i];
         a.qd[i] = m->qd[i];

@@ -79,6 +79,7 @@ typedef struct rt_act {
     bool to;
     double q[LAG_MAX_DOF], qd[LAG_MAX_DOF];
     const char *what;  /* RESET: what the reset event says it is */
+    bool wait;         /* RESET: then wait for the first command (RT_WAITING) */
 } rt_act;
 
 /* What it reads and acts on; the reference is the scene's, the SET bucket full at now. */

@@ -104,11 +104,18 @@ typedef struct lag_wire_joint_command {
     int64_t generation;                              /* of the state it answers; 0: none */
 } lag_wire_joint_command;
 
+/* RESET and RESET_TO's count, a bit set (lcmtypes/control_t.lcm): the scene file's values
+ * too (RESET only), then wait for the first command (run_state waiting). The client
+ * library's LAG_CLIENT_RESET_* are these (checked where it is compiled). */
+#define LAG_WIRE_RESET_SCENE 1
+#define LAG_WIRE_RESET_WAIT 2
+
 /* <PREFIX>_CONTROL: pause, resume, step, reset, reset_to, status, describe, set. */
 typedef struct lag_wire_control {
     int64_t utime;
     int8_t request;                                  /* LAGSIM_CONTROL_T_* */
-    int64_t count;                                   /* STEP: periods */
+    int64_t count;                                   /* STEP: periods; RESET, RESET_TO:
+                                                      * LAG_WIRE_RESET_* bits */
     int16_t num_joints;                              /* RESET_TO */
     double q[LAG_WIRE_MAX_JOINTS];
     double qd[LAG_WIRE_MAX_JOINTS];

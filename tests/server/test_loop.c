@@ -609,6 +609,106 @@ static void case_start(int arg)
     stop_server();
 }
 
+/* RESET and RESET_TO with count bit 2 (LAG_WIRE_RESET_WAIT): back to waiting for the first
+ * command, as realtime.start: first_command, from running, paused and the fault state, in
+ * each mode: nothing advances however long (the state at t = 0 republished: realtime 250
+ * to 302 states in 3 s as at the start; lockstep no lockstep_timeout), the first command
+ * starts the run, realtime deadlines counted from it (500 periods in the next 0.5 s).
+ * Counts with other bits (4, -1; 1 on RESET_TO) are refused and reset nothing. */
+static void reset_wait_from(lag_rt_mode mode, rt_run from)
+{
+    scene(mode);
+    g_sc.realtime.effort_limit[0] = INFINITY;
+    g_sc.realtime.lockstep_timeout = 0.5;
+    start();
+    for (int k = 0; k < 20; k++) { /* lockstep: every state answered */
+        command(g_out.last_t, "theta0", from == RT_FAULT && k == 19 ? 1e308 : 0.25);
+        run_until(g_srv.now + 10 * MS, 1000);
+    }
+    if (from == RT_PAUSED) control(LAGSIM_CONTROL_T_PAUSE, 0);
+    run_until(g_srv.now + 1 * MS, 1000);
+    ENSUREF(g_srv.run == from && g_srv.sim.tick > 0, "%s: run %d, tick %lld",
+            lag_rt_mode_name(mode), g_srv.run, (long long)g_srv.sim.tick);
+    int64_t resets = n_events("reset"), timeouts = n_events("lockstep_timeout");
+    control(LAGSIM_CONTROL_T_RESET, LAG_WIRE_RESET_SCENE | LAG_WIRE_RESET_WAIT);
+    ENSUREF(g_srv.run == RT_WAITING && g_srv.sim.tick == 0, "%s from %s: run %d",
+            lag_rt_mode_name(mode), rt_run_name(from), g_srv.run);
+    drain();
+    int64_t states = g_out.state;
+    run_until(g_srv.now + 3 * SEC, 1000);
+    ENSUREF(g_srv.sim.tick == 0 && g_srv.run == RT_WAITING && g_out.last_t == 0.0 &&
+                strcmp(g_out.status_run, "waiting") == 0,
+            "%s from %s: tick %lld, run %d 3 s after the reset", lag_rt_mode_name(mode),
+            rt_run_name(from), (long long)g_srv.sim.tick, g_srv.run);
+    ENSURE(n_events("reset") == resets + 1 &&
+           strstr(last_detail("reset"), "waiting for the first command"));
+    if (mode == LAG_RT_LOCKSTEP)
+        ENSUREF(n_events("lockstep_timeout") == timeouts && g_out.state - states >= 5,
+                "lockstep: %lld timeouts, %lld states while waiting",
+                (long long)(n_events("lockstep_timeout") - timeouts),
+                (long long)(g_out.state - states));
+    else if (mode == LAG_RT_REALTIME)
+        ENSUREF(g_out.state - states >= 250 && g_out.state - states <= 302,
+                "%lld states while waiting 3 s", (long long)(g_out.state - states));
+    command(0.0, "theta0", 0.25);
+    ENSURE(g_srv.run == RT_RUNNING);
+    run_until(g_srv.now + (mode == LAG_RT_FAST ? MS : SEC / 2 + MS), 1000);
+    if (mode == LAG_RT_REALTIME)
+        ENSUREF(g_srv.sim.tick == 500, "realtime: tick %lld 0.5 s after the first command",
+                (long long)g_srv.sim.tick);
+    else
+        ENSUREF(g_srv.sim.tick >= 10, "%s: tick %lld after the first command",
+                lag_rt_mode_name(mode), (long long)g_srv.sim.tick);
+    stop_server();
+}
+
+static void case_reset_wait(int arg)
+{
+    (void)arg;
+    const lag_rt_mode modes[] = {LAG_RT_REALTIME, LAG_RT_FAST, LAG_RT_LOCKSTEP};
+    const rt_run from[] = {RT_RUNNING, RT_PAUSED, RT_FAULT};
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) reset_wait_from(modes[i], from[j]);
+
+    /* a reset without the bit keeps the run state; other bits are refused */
+    scene(LAG_RT_REALTIME);
+    start();
+    run_until(g_srv.now + SEC / 2, 1000);
+    int64_t tick = g_srv.sim.tick, rejected = g_srv.ctl.controls_rejected;
+    const int64_t bad[] = {4, -1, 8, 7, INT64_MIN};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        control(LAGSIM_CONTROL_T_RESET, bad[k]);
+        drain();
+        ENSUREF(strstr(last_detail("control_rejected"), "reset: count ") &&
+                    strstr(last_detail("control_rejected"), "accepted: 0, 1 (the scene file's "
+                                                             "values too), 2 (then wait for "
+                                                             "the first command) or 3 (both)"),
+                "count %lld: '%s'", (long long)bad[k], last_detail("control_rejected"));
+    }
+    uint8_t buf[512];
+    double q[3] = {0, 0.1, 0}, qd[3] = {0, 0, 0};
+    lagsim_control_t m = {0, LAGSIM_CONTROL_T_RESET_TO, LAG_WIRE_RESET_SCENE, 3, q, qd, "", ""};
+    int n = lagsim_control_t_encode(buf, 0, sizeof buf, &m);
+    ENSURE(n > 0);
+    rt_handle_control(&g_srv, buf, (size_t)n);
+    drain();
+    ENSUREF(strstr(last_detail("control_rejected"), "reset_to: count 1; accepted: 0 or 2 "
+                                                    "(then wait for the first command)"),
+            "'%s'", last_detail("control_rejected"));
+    ENSUREF(g_srv.sim.tick == tick && g_srv.run == RT_RUNNING && n_events("reset") == 0 &&
+                g_srv.ctl.controls_rejected == rejected + 6,
+            "tick %lld (was %lld), %lld resets", (long long)g_srv.sim.tick, (long long)tick,
+            (long long)n_events("reset"));
+    m.count = LAG_WIRE_RESET_WAIT;
+    n = lagsim_control_t_encode(buf, 0, sizeof buf, &m);
+    rt_handle_control(&g_srv, buf, (size_t)n);
+    ENSURE(g_srv.run == RT_WAITING && g_srv.sim.tick == 0 && g_srv.sim.q[1] == 0.1);
+    control(LAGSIM_CONTROL_T_RESUME, 0);
+    control(LAGSIM_CONTROL_T_RESET, 0);
+    ENSURE(g_srv.run == RT_RUNNING);
+    stop_server();
+}
+
 /* A control request SET key=value, as lagsimctl sends it. */
 static void set_request(const char *key, const char *value)
 {
@@ -1925,7 +2025,7 @@ int main(int argc, char **argv)
         {"reject_names", case_reject_names, 0, 0}, {"waits", case_waits, 0, 0},
         {"foreign", case_foreign, 0, 0},        {"copy_rule", case_copy_rule, 0, 0},
         {"live_error", case_live_error, 0, 0},  {"scene_rules", case_scene_rules, 0, 0},
-        {"generation", case_generation, 0, 0},
+        {"generation", case_generation, 0, 0},  {"reset_wait", case_reset_wait, 0, 0},
     };
     /* a failed check ends the case: what follows it needs what failed */
     const lt_program p = {.cases = cases, .n = (int)(sizeof cases / sizeof cases[0]),
