@@ -35,17 +35,9 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port  # noqa: E402  (a port pair of this process's own)
+from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
 
-fails = 0
 WITHIN = 30.0  # s: what a loaded 2-core machine may take (tests/common/waits.py)
-
-
-def check(cond, what):
-    global fails
-    print("%s: %s" % ("ok  " if cond else "FAIL", what), flush=True)
-    if not cond:
-        fails += 1
-    return cond
 
 
 class Plant:
@@ -262,8 +254,7 @@ def main():
         lc_control.close()
         stop(d)
     replay(a, cfg, prefix, log)
-    print("%d failure(s)" % fails)
-    return 1 if fails else 0
+    return verdict()
 
 
 if __name__ == "__main__":
