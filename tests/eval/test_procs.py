@@ -99,8 +99,8 @@ def command(tmp, ready):
     cmd = [os.path.join(BIN, "lagsim-sweep"), "--config", SCENE, "--controller", ctrl,
            "--duration", duration, "--vary", "parameters.m0=uniform(0.9,1.1)", "--runs",
            "1000", "-j", "2"]
-    if HOW == "gnuplot":
-        cmd += ["--plot", os.path.join(tmp, "sweep.png")]
+    if HOW == "gnuplot":  # the signal comes once every run ended, as gnuplot draws
+        cmd += ["--plot", os.path.join(tmp, "sweep.png"), "--csv", os.path.join(tmp, "sweep.csv")]
     return cmd
 
 
@@ -151,6 +151,20 @@ def deliver(p, ready):
     return -signal.SIGKILL
 
 
+def drawn_whole(tmp, err):
+    """A sweep stopped while gnuplot draws: every run ended and its CSV was written whole
+    before (1000 rows, no held line), and it names no command to finish it."""
+    err.flush()
+    err.seek(0)
+    text = err.read()
+    path = os.path.join(tmp, "sweep.csv")
+    lines = open(path).read().splitlines() if os.path.exists(path) else []
+    rows = [x for x in lines if x and not x.startswith("#")][1:]
+    check(len(rows) == 1000 and not any(x.startswith("# held") for x in lines) and
+          "--only" not in text, "the CSV whole (%d rows, no held line), no command said to "
+          "finish it" % len(rows))
+
+
 def main():
     marker = "%d.%d" % (os.getpid(), time.monotonic_ns())
     tmp = tempfile.mkdtemp(prefix="lagsim-procs.")
@@ -196,6 +210,8 @@ def main():
                 rep = os.listdir(os.path.join(tmp, "report"))
                 check(rep == [], "the report's files it made and did not finish removed: %s"
                       % sorted(rep))
+        if TOOL == "sweep" and HOW == "gnuplot":
+            drawn_whole(tmp, err)
         while left and time.monotonic() < t0 + PROCS_WAIT_S:
             time.sleep(0.1)
             left = marked(marker)

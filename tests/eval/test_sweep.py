@@ -1074,9 +1074,11 @@ def held_is(path, want_runs):
 
 
 def case_interrupt(d):
-    # n runs: a signal comes after 4 rows, while most runs are still to come
+    # n runs: a signal comes after 4 rows, while most runs are still to come (each run's
+    # controller starts 0.1 s late: 40 runs take 2 s or more however fast the machine; a
+    # quiet one ran all 40 in the 50 ms between two looks at the CSV)
     n = 40
-    q = ["--config", SCENE, "--controller", CTRL, "--duration", "8", "--vary",
+    q = ["--config", SCENE, "--controller", "sleep 0.1; " + CTRL, "--duration", "8", "--vary",
          "parameters.m1=uniform(0.05,0.3)", "--runs", str(n), "--seed", "5", "-j2"]
     whole = os.path.join(d, "whole.csv")
     run([SWEEP] + q + ["--csv", whole])
