@@ -1077,30 +1077,26 @@ static void say_held(const sweep *x, const char *why)
     int base = dot && !strchr(dot, '/') ? (int)(dot - x->csv) : (int)strlen(x->csv);
     snprintf(rest, sizeof rest, "%.*s-rest.csv", base, x->csv);
     snprintf(whole, sizeof whole, "%.*s-whole.csv", base, x->csv);
-    if (l->done >= x->nwant) { /* every run had ended: nothing to run, one file to merge */
+    bool all = l->done >= x->nwant; /* every run had ended: nothing to run, one file */
+    if (all)
         eval_say("%s: %s: %s holds all %ld runs%s, in run order, with a held line; nothing is "
-                 "missing. To make it the whole sweep's CSV:\n  ", prog, why, x->csv, x->nwant, of);
-        sh_word(stderr, x->self);
-        fputs(x->shard_n > 1 || x->only ? " merge --partial " : " merge ", stderr);
-        sh_word(stderr, x->csv);
-        fprintf(stderr, " -o ");
-        sh_word(stderr, whole);
-        fprintf(stderr, "\n");
-        free(held), free(miss);
-        return;
+                 "missing. To make it the whole sweep's CSV:\n", prog, why, x->csv, x->nwant, of);
+    else {
+        eval_say("%s: %s: %s holds %ld of the %ld runs%s (held: %.200s%s), in run order; the "
+                 "runs missing: %.200s%s. To finish the sweep, run them and merge:\n", prog,
+                 why, x->csv, l->done, x->nwant, of, held, strlen(held) > 200 ? "..." : "",
+                 miss, strlen(miss) > 200 ? "..." : "");
+        finish_command(stderr, x, miss, rest);
     }
-    eval_say("%s: %s: %s holds %ld of the %ld runs%s (held: %.200s%s), in run order; the "
-             "runs missing: %.200s%s. To finish the sweep, run them and merge:\n", prog, why,
-             x->csv, l->done, x->nwant, of, held, strlen(held) > 200 ? "..." : "", miss,
-             strlen(miss) > 200 ? "..." : "");
-    finish_command(stderr, x, miss, rest);
     fputs("  ", stderr);
     sh_word(stderr, x->self);
     /* a shard's or --only's runs made whole are still a part: --partial joins them */
     fputs(x->shard_n > 1 || x->only ? " merge --partial " : " merge ", stderr);
     sh_word(stderr, x->csv);
-    fputc(' ', stderr);
-    sh_word(stderr, rest);
+    if (!all) {
+        fputc(' ', stderr);
+        sh_word(stderr, rest);
+    }
     fprintf(stderr, " -o ");
     sh_word(stderr, whole);
     fprintf(stderr, "\n");

@@ -35,7 +35,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 import waits  # noqa: E402  (events waited on, bounded)
 from lcm_port import lcm_port  # noqa: E402  (a port pair of this process's own)
-from lagsim_check import check, verdict  # noqa: E402  (tests/common: the one harness)
+from lagsim_check import check, replay, stop, verdict  # noqa: E402  (tests/common: the one harness)
 
 WITHIN = 30.0  # s: what a loaded 2-core machine may take (tests/common/waits.py)
 
@@ -77,16 +77,6 @@ class Plant:
                               "-q", "--timeout", "60"], stdout=subprocess.PIPE,
                              stderr=subprocess.STDOUT, universal_newlines=True)
         return p
-
-
-def stop(p):
-    if p.poll() is None:
-        p.terminate()
-        try:
-            p.wait(10)
-        except subprocess.TimeoutExpired:
-            p.kill()
-            p.wait()
 
 
 def states_for(lc, prefix, lagsim, seconds):
@@ -206,16 +196,8 @@ def bad_counts(pl, lc, lc_control, lagsim):
           (before.get("sim_time"), after.get("sim_time")))
 
 
-def replay(a, cfg, prefix, log):
-    r = subprocess.run([os.path.join(a.bin, "lagsimd"), "--config", cfg, "--set",
-                        "lcm.prefix=" + prefix, "--replay", log], stdout=subprocess.PIPE,
-                       stderr=subprocess.STDOUT, universal_newlines=True, timeout=120)
-    print("$ lagsimd --replay   -> exit %d\n  %s" % (r.returncode,
-                                                     r.stdout.strip().replace("\n", "\n  ")))
-    diff = None
-    for line in r.stdout.splitlines():
-        if line.startswith("max difference = "):
-            diff = float(line.split("=", 1)[1])
+def replay_exact(a, cfg, prefix, log):
+    r, diff = replay(os.path.join(a.bin, "lagsimd"), cfg, prefix, log, timeout=120)
     check(r.returncode == 0 and diff == 0.0,
           "--replay of the run with its resets that wait: difference exactly 0 (%r)" % diff)
 
@@ -253,7 +235,7 @@ def main():
         lc.close()
         lc_control.close()
         stop(d)
-    replay(a, cfg, prefix, log)
+    replay_exact(a, cfg, prefix, log)
     return verdict()
 
 
