@@ -10,8 +10,9 @@
  *   tau_k = m2 (KP (target_k - q_k) - KD qd_k),  KP = 40, KD = 12, targets 0.3 rad, 0.6 m
  *
  * --think S sleeps S s before each answer: a lockstep run then lasts at least S s a period
- * of wall time at no CPU (test_sweep.py's `interrupt` signals a sweep while most of its
- * runs are still to come, whatever the machine's speed).
+ * of wall time at no CPU, whatever the machine's speed (test_sweep.py: `interrupt` signals
+ * a sweep while most of its runs are still to come; `progress` draws a line of many runs'
+ * ends over seconds).
  */
 #include <math.h>
 #include <stdio.h>

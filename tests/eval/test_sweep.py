@@ -997,14 +997,15 @@ PROGRESS = re.compile(r"lagsim-sweep: (\d+)/(\d+) runs \(\d+ %\), (\d+) failed, 
 
 
 def case_progress(d):
-    # 200 cart-pole runs of 1 s: many more ends than the 4 drawings a second the line may
-    # have (a worker's run takes 20 ms or more of wall time between its ends, so the sweep
-    # lasts seconds however fast the machine); m1 drawn from normal(0.05,0.1): the scene
-    # refuses the negative ones (failed runs), and some miss --require (theta.rise 0.333 to
-    # 0.362 s)
-    q = ["--config", SCENE, "--controller", CTRL, "--duration", "1", "--vary",
-         "parameters.m1=normal(0.05,0.1)", "--runs", "200", "--seed", "3", "-j2",
-         "--require", "theta.rise<0.34"]
+    # 200 manipulator runs of 0.2 s, many more ends than the 4 drawings a second the line
+    # may have: the controller (tests/eval/scene_pd.c) sleeps 1 ms before each of a run's
+    # 20 answers, so that the sweep lasts 2 s or more however fast the machine, at next to
+    # no CPU; m2 drawn from normal(0.5,0.5): the scene refuses the negative ones (failed
+    # runs), and about half the others miss --require (q1.iae 0.0002 to 0.03)
+    q = ["--config", os.path.join(SRC, "config", "manipulator.yaml"), "--controller",
+         os.path.join(BIN, "scene_pd") + " -q --think 0.001 --prefix {prefix}", "--duration",
+         "0.2", "--vary", "parameters.m2=normal(0.5,0.5)", "--runs", "200", "--seed", "3",
+         "-j2", "--require", "q1.iae<0.0054"]
     out = os.path.join(d, "p.csv")
     rc, text, took = pty_run([SWEEP] + q + ["--csv", out])
     r = rows(out)
