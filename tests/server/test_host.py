@@ -850,14 +850,26 @@ class T:
             bus = Bus(self.t, [("LOOK", base)])
             host = self.start([strace, "-f", "-qq", "-c", "-e", "trace=epoll_wait", "-o", counts,
                                self.prog("lagsimd"), "--config", scene, "-q"])
-            check(bus.wait_event("LOOK", "start", 0, 30), "the plant starts after its look")
-            bus.pump(0.5)
-            # SIGTERM to the daemon (strace, running a command, ignores it); strace then
-            # writes its counts and exits with the daemon's status
-            kids = open("/proc/%d/task/%d/children" % (host.pid, host.pid)).read().split()
-            for k in kids:
-                os.kill(int(k), signal.SIGTERM)
-            rc, err = self.finish(host, 30)
+            kids = []
+            try:
+                check(bus.wait_event("LOOK", "start", 0, 30), "the plant starts after its look")
+                bus.pump(0.5)
+                # SIGTERM to the daemon (strace, running a command, ignores it); strace then
+                # writes its counts and exits with the daemon's status
+                kids = [int(k) for k in open("/proc/%d/task/%d/children" %
+                                             (host.pid, host.pid)).read().split()]
+                for k in kids:
+                    os.kill(k, signal.SIGTERM)
+                rc, err = self.finish(host, 30)
+            finally:  # the daemon of a failed case is not left running (strace killed)
+                if not kids and host.poll() is None:
+                    kids = [int(k) for k in open("/proc/%d/task/%d/children" %
+                                                 (host.pid, host.pid)).read().split()]
+                for k in kids:
+                    try:
+                        os.kill(k, signal.SIGKILL)
+                    except ProcessLookupError:
+                        pass
             text = open(counts).read() if os.path.exists(counts) else ""
             print(text)
             calls = [int(l.split()[3]) for l in text.splitlines()
