@@ -227,6 +227,17 @@ if(LAGSIM_PYTHON3)
     set_tests_properties(clients_c_${ex}_ends_on_stop clients_c_${ex}_ends_on_silence
                          PROPERTIES TIMEOUT 60)
   endforeach()
+  # The same end on silence with a daemon that starts 3 s late, as a loaded machine starts
+  # it (seen beside a load of 20: "no scene within 2 s"): the controller's --timeout 2
+  # bounds its wait for the scene too, so the harness starts the daemon first and the
+  # controller once the daemon is heard on the bus, and kills the daemon 1 s after the
+  # controller's first command (run_e2e.py).
+  add_test(NAME clients_c_dipc_lqr_late_daemon_ends_on_silence
+    COMMAND ${e2e} ${dipc_cfg} --mode realtime --name CLSILD --timeout 30 --kill-daemon-after 1
+      --daemon-start-delay 3
+      --check "end == 'silence'" --check "states >= 1" --check "silent >= 2 - 0.5 and silent < 2 + 3"
+      -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} -q --timeout 2)
+  set_tests_properties(clients_c_dipc_lqr_late_daemon_ends_on_silence PROPERTIES TIMEOUT 60)
 endif()
 
 # Fuzz target: what arrives on a controller's channels, through the client library
