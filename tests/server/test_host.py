@@ -119,17 +119,23 @@ class Bus:
         from lagsim_lcm import LCM
         self.t, self.msgs, self.lcms = t, [], []
         for prefix, port in plants:
-            lc = LCM(url(port))
+            # 4 MB: a plant's states and events held while the test floods or waits (a
+            # loaded machine's flood of 20000 commands outlasted the default buffer's
+            # second or two of states, and an event was lost)
+            lc = LCM(url(port) + "&recv_buf_size=4194304")
             lc.subscribe(prefix + "_(STATE|EVENT|SCENE|STATUS)",
                          lambda ch, data: self.msgs.append((time.monotonic(), ch, data)))
             self.lcms.append(lc)
 
     def pump(self, seconds):
+        """Reads what came, then for `seconds` more (0: what came, once)."""
         end = time.monotonic() + seconds
-        while time.monotonic() < end:
+        while True:
             for lc in self.lcms:
                 while lc.handle_timeout(0):
                     pass
+            if time.monotonic() >= end:
+                return
             time.sleep(0.005)
 
     def events(self, prefix, since=0.0):
