@@ -342,7 +342,8 @@ def case_manipulator(t):
     prefix = "REFM" + str(os.getpid())
     log = os.path.join(t.tmp, "man.lcm")
     man = os.path.join(t.a.source, "config", "manipulator.yaml")
-    pd = subprocess.Popen([os.path.join(t.a.bin, "manipulator_pd"), "--prefix", prefix],
+    pd = subprocess.Popen([os.path.join(t.a.bin, "manipulator_pd"), "--prefix", prefix,
+                           "--timeout", "30"],  # the daemon starts after it (as lockstep() says)
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         t.started(pd)
