@@ -206,9 +206,10 @@ if(LAGSIM_PYTHON3)
   # last state, which may precede the kill by far when a loaded daemon stalls: 0.6 s seen
   # under a sanitizer build, where a bound from the kill failed; 0.5 s is what the
   # harness's own hearing may lag the controller's).
-  # The kill comes 1 wall s after the daemon is started; beside three busy processes its
-  # start took most of that second (10 states answered, t_last 0.12 s), so the count only
-  # says the controller was running (>= 1): the contract is how it ends.
+  # The daemon is started first and the controller once the daemon is heard on the bus
+  # (its --timeout 2 bounds its wait for the scene too); the kill comes 1 wall s after the
+  # controller's first command is heard. The count only says the controller was running
+  # (>= 1): the contract is how it ends.
   foreach(ex dipc_lqr manipulator_pd)
     if(ex STREQUAL dipc_lqr)
       set(cfg ${dipc_cfg})
