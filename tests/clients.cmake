@@ -238,7 +238,17 @@ if(LAGSIM_PYTHON3)
       --daemon-start-delay 3
       --check "end == 'silence'" --check "states >= 1" --check "silent >= 2 - 0.5 and silent < 2 + 3"
       -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} -q --timeout 2)
-  set_tests_properties(clients_c_dipc_lqr_late_daemon_ends_on_silence PROPERTIES TIMEOUT 60)
+  # ... and with the daemon held off the processor (SIGSTOP) for 3 s once the controller
+  # answers, as beside a load of 26 (2.26 s): the controller ends on that silence, before
+  # the kill, and its silence counts from its own last state (t_last), not from the states
+  # the daemon published after it went on (which made `silent` -0.03 s)
+  add_test(NAME clients_c_dipc_lqr_stalled_daemon_ends_on_silence
+    COMMAND ${e2e} ${dipc_cfg} --mode realtime --name CLSILS --timeout 30 --kill-daemon-after 1
+      --stall-daemon 3
+      --check "end == 'silence'" --check "states >= 1" --check "silent >= 2 - 0.5 and silent < 2 + 3"
+      -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} -q --timeout 2)
+  set_tests_properties(clients_c_dipc_lqr_late_daemon_ends_on_silence
+                       clients_c_dipc_lqr_stalled_daemon_ends_on_silence PROPERTIES TIMEOUT 60)
 endif()
 
 # Fuzz target: what arrives on a controller's channels, through the client library

@@ -21,7 +21,10 @@ and starts the daemon first, the controller once the daemon was heard: such a co
 runs with a short --timeout (2 s), which bounds its wait for the scene too, and a daemon
 started after it may take longer than that to publish its scene on a loaded machine
 (seen: "no scene within 2 s" beside a load of 20). --daemon-start-delay S starts the
-daemon's command S s late, as a loaded machine may (the order above is tested by it).
+daemon's command S s late, as a loaded machine may (the order above is tested by it);
+--stall-daemon S stops the daemon (SIGSTOP) for S s once the controller's first command was
+heard, before the kill: with S over the controller's --timeout it ends on that silence,
+and `silent` counts from its last state (its t_last), not the states heard after it.
 The controller's last line
 "... summary key=value ..." is parsed and every --check expression (Python, over those
 keys; `wall` is the time from the daemon's end to the controller's summary line, s; with
@@ -38,6 +41,8 @@ import argparse
 import math
 import os
 import re
+import signal
+import struct
 import subprocess
 import sys
 import threading
@@ -87,11 +92,13 @@ class BusWatch:
     """The run's bus as the harness hears it, each URL read in a thread of its own: `up` is
     set once anything of the daemon came on the state URL (its scene, a state, its status
     or an event: it runs and answers), `answered` once a command came on the command URL
-    (the controller runs its law); `last_state`, the time.monotonic() of the last state."""
+    (the controller runs its law); `last_state`, the time.monotonic() of the last state;
+    `heard_at`, the last time each state was heard, by its sim time (to 1e-6 s)."""
 
     def __init__(self, state_url, command_url, prefix):
         self.up, self.answered, self.done = threading.Event(), threading.Event(), threading.Event()
         self.last_state = None
+        self.heard_at = {}
         self.lcms = [hostile_lcm(state_url), hostile_lcm(command_url)]
         self.lcms[0].subscribe(re.escape(prefix) + "_(STATE|SCENE|STATUS|EVENT)", self._daemon)
         self.lcms[1].subscribe(re.escape(prefix) + "_COMMAND", lambda ch, data: self.answered.set())
@@ -103,6 +110,8 @@ class BusWatch:
     def _daemon(self, channel, data):
         if channel.endswith("_STATE"):
             self.last_state = time.monotonic()
+            if len(data) >= 24:  # joint_state_t: fingerprint, utime, then sim_time
+                self.heard_at[round(struct.unpack(">d", data[16:24])[0], 6)] = self.last_state
         self.up.set()
 
     def _pump(self, lc):
@@ -126,6 +135,7 @@ def main():
     ap.add_argument("--kill-daemon-after", type=float, default=None)
     ap.add_argument("--daemon-first", type=float, default=None)
     ap.add_argument("--daemon-start-delay", type=float, default=0.0)
+    ap.add_argument("--stall-daemon", type=float, default=0.0)
     ap.add_argument("--check", action="append", default=[])
     ap.add_argument("--hostile", action="append", default=[])
     ap.add_argument("--timeout", type=float, default=60.0)
@@ -230,6 +240,12 @@ def main():
                 pass
             if watch.answered.is_set():
                 print("the controller's first command heard", flush=True)
+            if a.stall_daemon > 0:  # held off the processor, as a loaded machine may hold it
+                dproc.send_signal(signal.SIGSTOP)
+                time.sleep(a.stall_daemon)
+                dproc.send_signal(signal.SIGCONT)
+                print("the daemon stopped for %g s (SIGSTOP), then went on" % a.stall_daemon,
+                      flush=True)
             try:
                 dproc.wait(a.kill_daemon_after)
             except subprocess.TimeoutExpired:
@@ -288,10 +304,18 @@ def main():
         print("wall = %.3f s from the daemon's end to the controller's summary line (its exit: "
               "%.3f s)" % (names["wall"], t_client_end - t_daemon_end))
     if a.kill_daemon_after is not None and watch.last_state is not None:
-        names["silent"] = (t_summary if t_summary is not None else t_client_end) - watch.last_state
-        print("silent = %.3f s from the last state heard to the controller's summary line "
-              "(the last state %.3f s before the kill)"
-              % (names["silent"], t_daemon_end - watch.last_state))
+        # from the controller's last state (its t_last) as this harness heard it: a daemon
+        # held off the processor beside a load of 26 went silent 2.26 s before the kill, the
+        # controller ended on that silence, and the states after it (heard, not the
+        # controller's) made a silence counted from the last state on the bus negative
+        end = t_summary if t_summary is not None else t_client_end
+        t_last = vals.get("t_last")
+        last = watch.heard_at.get(round(t_last, 6)) if isinstance(t_last, float) else None
+        last = last if last is not None and last <= end else watch.last_state
+        names["silent"] = end - last
+        print("silent = %.3f s from the controller's last state, as heard, to its summary line "
+              "(that state %.3f s before the kill, the last on the bus %.3f s)"
+              % (names["silent"], t_daemon_end - last, t_daemon_end - watch.last_state))
     names["math"] = math
     names["out"] = out  # the client's stdout, for checks of what it prints
     ok = check_expressions(a.check, names) and ok
