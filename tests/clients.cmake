@@ -202,7 +202,7 @@ if(LAGSIM_PYTHON3)
   # stops by itself (--duration 1: 101 states, then its stop event) and the controller
   # ends with end=stop within 3 wall s; or the daemon is killed (SIGKILL: no stop event)
   # and the controller, run with --timeout 2, ends with end=silence 2 - 0.5 to 2 + 3 wall s
-  # after the last state the harness heard on the bus (`silent`: its 2 s count from its
+  # after its own last state (its t_last) as the harness heard it (`silent`: its 2 s count from its
   # last state, which may precede the kill by far when a loaded daemon stalls: 0.6 s seen
   # under a sanitizer build, where a bound from the kill failed; 0.5 s is what the
   # harness's own hearing may lag the controller's).

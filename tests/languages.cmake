@@ -95,8 +95,9 @@ set(lang_tests clients_python_lcm clients_python_types clients_python_dipc_locks
 # --timeout 2 bounds its wait for the scene too, and a daemon started after it took more
 # than 2 s to publish its scene beside a load of 20), and the controller, run with
 # --timeout 2, ends with end=silence between 2 - 0.5 and 2 + 3
-# wall s after the last state the harness heard on the bus (`silent`, run_e2e.py). Its 2 s
-# count from the last state it received, which may precede the kill by far on a loaded
+# wall s after its own last state (its t_last) as the harness heard it (`silent`,
+# run_e2e.py; a daemon held off the processor for 2 s before the kill ends the run there,
+# and what it publishes after is no part of it). Its 2 s count from the last state it received, which may precede the kill by far on a loaded
 # machine where the daemon stalls (an ASan build: 0.6 s seen, where a bound counted from
 # the kill failed): measured, not assumed; 0.5 s is what the harness's hearing may lag the
 # controller's, 3 s covers a loaded machine's scheduling at the other end.
