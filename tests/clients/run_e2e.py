@@ -92,13 +92,16 @@ class BusWatch:
     """The run's bus as the harness hears it, each URL read in a thread of its own: `up` is
     set once anything of the daemon came on the state URL (its scene, a state, its status
     or an event: it runs and answers), `answered` once a command came on the command URL
-    (the controller runs its law); `last_state`, the time.monotonic() of the last state;
-    `heard_at`, the last time each state was heard, by its sim time (to 1e-6 s)."""
+    (the controller runs its law); `published`, when the daemon published each state, by
+    its sim time (to 1e-6 s), and `last_published`, the last: the state's own utime, the
+    daemon's wall clock (time.time()) as it published it, s. (Not when this harness heard
+    it: its reader is a Python thread, which a loaded machine runs seconds late: a state
+    heard 1.4 s after the daemon's SIGKILL was seen.)"""
 
     def __init__(self, state_url, command_url, prefix):
         self.up, self.answered, self.done = threading.Event(), threading.Event(), threading.Event()
-        self.last_state = None
-        self.heard_at = {}
+        self.last_published = None
+        self.published = {}
         self.lcms = [hostile_lcm(state_url), hostile_lcm(command_url)]
         self.lcms[0].subscribe(re.escape(prefix) + "_(STATE|SCENE|STATUS|EVENT)", self._daemon)
         self.lcms[1].subscribe(re.escape(prefix) + "_COMMAND", lambda ch, data: self.answered.set())
@@ -108,10 +111,10 @@ class BusWatch:
             th.start()
 
     def _daemon(self, channel, data):
-        if channel.endswith("_STATE"):
-            self.last_state = time.monotonic()
-            if len(data) >= 24:  # joint_state_t: fingerprint, utime, then sim_time
-                self.heard_at[round(struct.unpack(">d", data[16:24])[0], 6)] = self.last_state
+        if channel.endswith("_STATE") and len(data) >= 24:
+            # joint_state_t: its fingerprint, utime (us since the epoch), sim_time
+            utime, sim_time = struct.unpack(">qd", data[8:24])
+            self.published[round(sim_time, 6)] = self.last_published = utime * 1e-6
         self.up.set()
 
     def _pump(self, lc):
@@ -303,19 +306,22 @@ def main():
         names["wall"] = end - t_daemon_end
         print("wall = %.3f s from the daemon's end to the controller's summary line (its exit: "
               "%.3f s)" % (names["wall"], t_client_end - t_daemon_end))
-    if a.kill_daemon_after is not None and watch.last_state is not None:
-        # from the controller's last state (its t_last) as this harness heard it: a daemon
-        # held off the processor beside a load of 26 went silent 2.26 s before the kill, the
-        # controller ended on that silence, and the states after it (heard, not the
-        # controller's) made a silence counted from the last state on the bus negative
-        end = t_summary if t_summary is not None else t_client_end
+    if a.kill_daemon_after is not None and watch.last_published is not None:
+        # from the publication of the controller's last state (its t_last; the controller
+        # counts from when it got it, a little later): a daemon held off the processor
+        # beside a load of 26 went silent 2.26 s before the kill, the controller ended on
+        # that silence, and the states after it (not the controller's) made a silence
+        # counted from the last state on the bus negative
+        wall = time.time() - time.monotonic()  # monotonic to wall clock, s
+        end = (t_summary if t_summary is not None else t_client_end) + wall
         t_last = vals.get("t_last")
-        last = watch.heard_at.get(round(t_last, 6)) if isinstance(t_last, float) else None
-        last = last if last is not None and last <= end else watch.last_state
+        last = watch.published.get(round(t_last, 6)) if isinstance(t_last, float) else None
+        last = last if last is not None else watch.last_published
         names["silent"] = end - last
-        print("silent = %.3f s from the controller's last state, as heard, to its summary line "
-              "(that state %.3f s before the kill, the last on the bus %.3f s)"
-              % (names["silent"], t_daemon_end - last, t_daemon_end - watch.last_state))
+        print("silent = %.3f s from the publication of the controller's last state to its "
+              "summary line (that state %.3f s before the kill, the last on the bus %.3f s)"
+              % (names["silent"], t_daemon_end + wall - last,
+                 t_daemon_end + wall - watch.last_published))
     names["math"] = math
     names["out"] = out  # the client's stdout, for checks of what it prints
     ok = check_expressions(a.check, names) and ok
