@@ -51,6 +51,7 @@ tests   openssh-client        # ... and parallel --sshlogin
 tests   libmujoco-dev         # benchmark peers
 tests   libsundials-dev
 tests   universal-ctags       # structure_function_length: each C function'"'"'s first and last line
+tests   strace                # server_host_look: the waits of a starting daemon, counted
 service openssh-server        # eval_lagsim_sweep_ssh: an sshd per namespace (the package starts one)
 service systemd               # package_*: systemd-analyze; the unit run by systemd in a namespace
 '

@@ -652,6 +652,10 @@ static void host_pass(host *h)
             rt_process(p->s); /* once more when stopped: the answers owed, as before */
             p->marked = false;
             p->wake = rt_next_wake(p->s);
+        } else if (p->phase == PLANT_LOOKING) {
+            /* what came during the look was read (its own DESCRIBE comes back to it): nothing
+             * is due before the look's end (a mark kept made every wait until then a spin) */
+            p->marked = false;
         }
         if (p->phase == PLANT_RUNNING) unpark(h, p);
         if (rt_plant_stopped(p->s)) {

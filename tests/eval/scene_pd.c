@@ -8,10 +8,16 @@
  * tests/eval/test_sweep.py's `scene` cases run it; scene_pd.py is the same in Python.
  *
  *   tau_k = m2 (KP (target_k - q_k) - KD qd_k),  KP = 40, KD = 12, targets 0.3 rad, 0.6 m
+ *
+ * --think S sleeps S s before each answer: a lockstep run then lasts at least S s a period
+ * of wall time at no CPU, whatever the machine's speed (test_sweep.py: `interrupt` signals
+ * a sweep while most of its runs are still to come; `progress` draws a line of many runs'
+ * ends over seconds).
  */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <time.h>
 
 #include "lagsim_controller.h"
 
@@ -29,8 +35,11 @@ int main(int argc, char **argv)
 {
     lag_ctl ctl;
     lag_ctl_init(&ctl, "scene_pd", "MANIPULATOR");
+    double think = 0;
+    const lag_ctl_option mine[] = {{"think", "S", "sleep S s before each answer (default 0)",
+                                    lag_ctl_nonnegative, &think, 0}};
     int rc = lag_ctl_parse(&ctl, argc, argv, "PD on the manipulator, gains scaled by the "
-                           "scene's m2 (a test's scene-reactive controller).", NULL, 0);
+                           "scene's m2 (a test's scene-reactive controller).", mine, 1);
     if (rc >= 0) return rc;
     if (lag_ctl_start(&ctl, "manipulator")) return lag_ctl_fail(&ctl);
     double m2 = lag_client_scene_param(ctl.scene, "m2");
@@ -40,6 +49,10 @@ int main(int argc, char **argv)
     lag_client_state st;
     while (lag_ctl_next_state(&ctl, &st) == LAG_CLIENT_OK) {
         double tau[2];
+        if (think > 0) {
+            struct timespec ts = {(time_t)think, (long)((think - floor(think)) * 1e9)};
+            nanosleep(&ts, NULL);
+        }
         for (int k = 0; k < 2; k++) {
             int i = lag_client_state_joint(&st, names[k]);
             tau[k] = i < 0 ? 0.0 : m2 * (KP * (target[k] - st.position[i]) - KD * st.velocity[i]);

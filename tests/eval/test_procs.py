@@ -41,6 +41,10 @@ BIN, SRC, TOOL, HOW = sys.argv[1:5]
 SCENE = os.path.join(SRC, "config", "cartpole.yaml")
 CTRL = os.path.join(SRC, "tests", "eval", "procs_controller.py")
 PROCS_WAIT_S = 20.0   # after a kill: the keepers stop what is left (2 s grace, then SIGKILL)
+# a sweep's runs: more than one per worker (-j 2), so that a worker's kept pair runs again;
+# signalled mid-sweep they are never all run; gnuplot, signalled once every run ended,
+# draws them all (1000 runs made it 100000 lockstep periods of a Python controller)
+SWEEP_RUNS = 4 if HOW == "gnuplot" else 1000
 READY_WAIT_S = 120.0  # python controllers start slowly on a loaded machine
 
 
@@ -98,7 +102,7 @@ def command(tmp, ready):
         return cmd
     cmd = [os.path.join(BIN, "lagsim-sweep"), "--config", SCENE, "--controller", ctrl,
            "--duration", duration, "--vary", "parameters.m0=uniform(0.9,1.1)", "--runs",
-           "1000", "-j", "2"]
+           str(SWEEP_RUNS), "-j", "2"]
     if HOW == "gnuplot":  # the signal comes once every run ended, as gnuplot draws
         cmd += ["--plot", os.path.join(tmp, "sweep.png"), "--csv", os.path.join(tmp, "sweep.csv")]
     return cmd
@@ -153,14 +157,14 @@ def deliver(p, ready):
 
 def drawn_whole(tmp, err):
     """A sweep stopped while gnuplot draws: every run ended and its CSV was written whole
-    before (1000 rows, no held line), and it names no command to finish it."""
+    before (SWEEP_RUNS rows, no held line), and it names no command to finish it."""
     err.flush()
     err.seek(0)
     text = err.read()
     path = os.path.join(tmp, "sweep.csv")
     lines = open(path).read().splitlines() if os.path.exists(path) else []
     rows = [x for x in lines if x and not x.startswith("#")][1:]
-    check(len(rows) == 1000 and not any(x.startswith("# held") for x in lines) and
+    check(len(rows) == SWEEP_RUNS and not any(x.startswith("# held") for x in lines) and
           "--only" not in text, "the CSV whole (%d rows, no held line), no command said to "
           "finish it" % len(rows))
 

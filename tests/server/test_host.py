@@ -42,6 +42,11 @@ Cases:
               own scenes, heard back, are never taken for another plant's
   quiet       a host with -q: a plant's watchdog trip and its input limited are on stderr,
               each kind at most a line per 10 s with its count; no other event line
+  look        a daemon's start (one --config, as lagsim-eval and lagsim-sweep start them):
+              through its look for another plant on its prefix (0.2 s, its own DESCRIBE
+              heard back), its start and 0.5 s of waiting for a first command, it waits in
+              epoll_wait fewer than 100 times (strace -c: a wake-up per message and timer);
+              it spun there, about 10000 calls a start
   many        120 plants in one process (LCM's receive path aborted it at about 85),
               lagsimctl list naming each on its own pair, the default list with no `?`
               (it waits for the plants the directory named), SIGTERM stopping all
@@ -837,6 +842,58 @@ class T:
         check(took < 20 and "scene" in out and "silence" in out,
               "a controller on the directory's bus gets CAROL's scene there but no state: its "
               "--timeout 2 ends it (after %.1f s, exit %s)" % (took, rc))
+
+    # ------------------------------------------------------------------ the look
+    def case_look(self):
+        """A daemon waits for its look's end, never spins: a message during the look (its
+        own DESCRIBE, heard back) marked the plant, and the mark, cleared only for a running
+        plant, made every wait until the look's end return at once."""
+        import shutil
+        strace = shutil.which("strace")
+        check(strace is not None, "strace is installed (.ci/install-deps.sh tests)")
+        if not strace:
+            return
+        base = take_pairs(1)
+        with tempfile.TemporaryDirectory() as d:
+            scene = os.path.join(d, "look.yaml")
+            open(scene, "w").write(PLANT.replace("mode: realtime, start: running",
+                                                 "mode: lockstep, start: first_command") +
+                                   "lcm: {prefix: LOOK, url: '%s'}\n" % url(base))
+            counts = os.path.join(d, "strace.txt")
+            # LeakSanitizer cannot run under ptrace (a sanitizer build): leaks are every
+            # other test's to find
+            opts = os.environ.get("ASAN_OPTIONS", "")
+            os.environ["ASAN_OPTIONS"] = (opts + ":" if opts else "") + "detect_leaks=0"
+            bus = Bus(self.t, [("LOOK", base)])
+            host = self.start([strace, "-f", "-qq", "-c", "-e", "trace=epoll_wait", "-o", counts,
+                               self.prog("lagsimd"), "--config", scene, "-q"])
+            kids = []
+            try:
+                check(bus.wait_event("LOOK", "start", 0, 30), "the plant starts after its look")
+                bus.pump(0.5)
+                # SIGTERM to the daemon (strace, running a command, ignores it); strace then
+                # writes its counts and exits with the daemon's status
+                kids = [int(k) for k in open("/proc/%d/task/%d/children" %
+                                             (host.pid, host.pid)).read().split()]
+                for k in kids:
+                    os.kill(k, signal.SIGTERM)
+                rc, err = self.finish(host, 30)
+            finally:  # the daemon of a failed case is not left running (strace killed)
+                if not kids and host.poll() is None:
+                    kids = [int(k) for k in open("/proc/%d/task/%d/children" %
+                                                 (host.pid, host.pid)).read().split()]
+                for k in kids:
+                    try:
+                        os.kill(k, signal.SIGKILL)
+                    except ProcessLookupError:
+                        pass
+            text = open(counts).read() if os.path.exists(counts) else ""
+            print(text)
+            calls = [int(l.split()[3]) for l in text.splitlines()
+                     if l.split()[-1:] == ["epoll_wait"] and len(l.split()) >= 5]
+            check(rc == 0 and len(calls) == 1 and calls[0] < 100,
+                  "look, start and 0.5 s waiting for a command: %s epoll_wait calls (fewer than "
+                  "100: a wake-up per message and timer, no spin), exit %s" % (calls, rc))
 
     # ------------------------------------------------------------------ many plants
     def case_many(self):
