@@ -9,7 +9,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 "$root/.ci/install-deps.sh" runtime  # the programs' packages only: no test tool, no service
-cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$(nproc)" --target lagsimd dipc_lqr lagsim-view >/dev/null
 
 # The controller first: it waits for the daemon's scene description, designs its LQR

@@ -2,27 +2,24 @@
 # The test command. Installs what the tests need when it is missing (.ci/install-deps.sh
 # tests; under CI=true, ci), builds, runs ctest, and prints a summary per pass.
 #
-#   tests/run.sh                the quick tier (a developer's loop): gcc -Werror build,
-#                               every test of the tier quick (docs/testing.md, "Tiers")
-#   tests/run.sh --full         what CI runs (.ci/run), in three passes:
-#                                1. gcc, -Werror, optimized (build/): every test;
+#   tests/run.sh                the quick tier (a developer's loop): gcc -Werror Release
+#                               build, every test of the tier quick (docs/testing.md, "Tiers")
+#   tests/run.sh --full         what CI runs (.ci/run), in two passes:
+#                                1. gcc, -Werror, Release (build/): every test;
 #                                2. clang, -Werror, -O1, ASan + UBSan (float-cast-overflow
 #                                   too) + libFuzzer (build-asan/): every test but the tier slow
 #                                   (no bench or package test is made there), and each
-#                                   fuzz target for LAGSIM_FUZZ_SECONDS (default 20);
-#                                3. gcc, -Werror, Release (build-release/): built, not run.
+#                                   fuzz target for LAGSIM_FUZZ_SECONDS (default 20).
 #   tests/run.sh --tier T,...   those tiers of pass 1 (e.g. --tier quick,wallclock)
 #   tests/run.sh --label L      ctest -L L in pass 1 (a regular expression, as ctest takes it)
 #   tests/run.sh --sanitize ... pass 2's build instead of pass 1's (with --tier or --label)
 #
-# Inside a pass the tier that only waits (waits: tests/common/tiers.cmake) runs 2 x cores
-# tests at once beside the others, which run one per core. Every pass runs even when one
-# before failed; the exit status is non-zero when any failed, after every summary.
+# A pass is one ctest, -j (100 x cores): each test takes its tier's share of a core
+# (PROCESSORS, tests/common/tiers.cmake's LAGSIM_TIER_RUN), so many tests that wait run
+# beside few that compute. Every pass runs even when one before failed; the exit status is
+# non-zero when any failed, after every summary.
 #   LAGSIM_SKIP_SANITIZE=1   --full without pass 2
-#   LAGSIM_WAIT_JOBS=N       how many tests of the tier waits at once (2 x cores)
-#   LAGSIM_QUICK_JOBS=N      how many tests at once in the quick tier alone (2 x cores: it
-#                            waits on no clock, so it holds at any load, and its tests wait
-#                            on each other's processes more than they compute)
+#   LAGSIM_TEST_CORES=N      the cores a pass plans for (default: nproc)
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root" || exit 2
@@ -45,22 +42,9 @@ done
 
 "$root/.ci/install-deps.sh" "$([ "${CI:-}" = true ] && echo ci || echo tests)" || exit 1
 cores=$(nproc)
-wait_jobs=${LAGSIM_WAIT_JOBS:-$((2 * cores))}
-compute_jobs=$cores  # the computing half: a core a test (the quick tier alone: quick_jobs)
-quick_jobs=${LAGSIM_QUICK_JOBS:-$((2 * cores))}
+jobs=$((100 * ${LAGSIM_TEST_CORES:-$cores}))  # hundredths of a core (PROCESSORS)
 summaries=()
 failed=0
-
-# The tiers whose tests mostly wait (tests/common/tiers.cmake's LAGSIM_WAITING_TIERS).
-waiting=$(sed -n 's/^set(LAGSIM_WAITING_TIERS \(.*\))$/\1/p' "$root/tests/common/tiers.cmake")
-waiting_rx="^(${waiting// /|})\$"
-
-# ctest_half DIR LOG JOBS ARGS...: ctest of one half of a pass, its output in LOG
-ctest_half() {
-  local dir=$1 log=$2 jobs=$3
-  shift 3
-  (cd "$dir" && ctest --output-on-failure -j"$jobs" "$@") >"$log" 2>&1
-}
 total_passed=0
 total_failed=0
 
@@ -76,10 +60,10 @@ build() {
   return $rc
 }
 
-# build_behind DIR CMAKE ARGS...: the build of a later pass, started now at a low priority
-# (nice 10) beside this pass's tests, its output in DIR/build.log: a test that waits on
-# the wall clock holds beside two busy processes (as it must on a loaded machine), and the
-# cores the waiting tests leave idle build the next pass. wait_built DIR waits for it.
+# build_behind DIR CMAKE ARGS...: the next pass's build, started now at a low priority
+# (nice 10) beside this pass's tests, its output in DIR/build.log: it takes the CPU the
+# tests leave, and a test that waits on the wall clock holds beside busy processes anyway
+# (as it must on a loaded machine). wait_built DIR waits for it.
 build_behind() {
   local dir=$1
   mkdir -p "$dir"
@@ -98,20 +82,11 @@ wait_built() {
 # run_pass NAME BUILD_DIR TIMEOUT SELECT EXCLUDE BUILT CMAKE ARGS...
 #   SELECT: a label regex the tests must match ("" all); EXCLUDE: tiers left out ("" none);
 #   TIMEOUT "-": build only; BUILT "behind": built by build_behind (waited for here), else
-#   built here.
-# Three ctest processes, "halves" of the pass:
-#   quick      the tier quick, 2 x cores at once (LAGSIM_QUICK_JOBS): it waits on no clock,
-#              so it holds at any load, and its tests wait on each other's processes (a
-#              lockstep round trip, a start) more than they compute;
-#   computing  then every other tier but waits, one test per core (a test that computes,
-#              or a real-time loop that must be scheduled every period, has a core);
-#   waiting    beside both, the tier waits, 2 x cores at once: they sleep while the others
-#              keep the cores busy.
-# The first two are shown as they run, the waiting one's output after.
+#   built here. One ctest, its output shown as it runs and kept in BUILD_DIR/ctest.log.
 run_pass() {
   local name=$1 dir=$2 timeout=$3 sel=$4 excl=$5 built=$6
   shift 6
-  local start=$SECONDS result rc_w rc_c half
+  local start=$SECONDS result rc=0
   echo "==== $name"
   local ok=0
   if [ "$built" = behind ]; then
@@ -129,59 +104,31 @@ run_pass() {
     summaries+=("$name: built, warning-free ($(cat "$dir/build.s") s of build)")
     return
   fi
-  local common=(--timeout "$timeout") waits=(-L "$waiting_rx") quick=(-L '^quick$') computes
-  [ -n "$sel" ] && common+=(-L "$sel")
-  [ -n "$excl" ] && waits+=(-LE "^(${excl// /|})\$") && quick+=(-LE "^(${excl// /|})\$")
-  computes=(-LE "^(quick|${waiting// /|}${excl:+|${excl// /|}})\$")
-  : >"$root/$dir/ctest-quick.log"
-  : >"$root/$dir/ctest-computing.log"
-  ctest_half "$dir" "$root/$dir/ctest-waiting.log" "$wait_jobs" "${common[@]}" "${waits[@]}" &
-  local waiter=$!
-  (
-    local t0=$SECONDS rc=0
-    ctest_half "$dir" "$root/$dir/ctest-quick.log" "$quick_jobs" "${common[@]}" "${quick[@]}" || rc=1
-    echo "quick half: $((SECONDS - t0)) s" >>"$root/$dir/ctest-quick.log"
-    t0=$SECONDS
-    ctest_half "$dir" "$root/$dir/ctest-computing.log" "$cores" "${common[@]}" "${computes[@]}" || rc=$((rc | 2))
-    echo "computing half: $((SECONDS - t0)) s" >>"$root/$dir/ctest-computing.log"
-    exit $rc
-  ) &
-  local computer=$!
-  tail -n +1 --pid="$computer" -f "$root/$dir/ctest-quick.log" "$root/$dir/ctest-computing.log" 2>/dev/null  # shown as they run
-  wait "$computer"
-  rc_c=$?
-  wait "$waiter"
-  rc_w=$?
-  for half in quick computing waiting; do
-    local log="$root/$dir/ctest-$half.log" rc=$((rc_c & 1))
-    [ $half = computing ] && rc=$((rc_c & 2))
-    [ $half = waiting ] && rc=$rc_w
-    if grep -q "No tests were found" "$log"; then
-      continue
-    fi
-    if [ $half = waiting ]; then
-      echo "---- $name, the tier waits (run beside the above)"
-      cat "$log"
-    fi
-    local counts
-    counts=$(sed -n 's/.*tests passed, \([0-9]*\) tests\{0,1\} failed out of \([0-9]*\).*/\1 \2/p' "$log" | tail -1)
-    if [ -n "$counts" ]; then
-      total_failed=$((total_failed + ${counts% *}))
-      total_passed=$((total_passed + ${counts#* } - ${counts% *}))
-    fi
-    if [ "$rc" -eq 0 ]; then
-      result=$(grep -E "tests passed" "$log" | tail -1)
-      summaries+=("$name, $half: $result ($(sed -n 's/^Total Test time (real) = *//p' "$log"))")
-    else
-      failed=1
-      result=$(grep -E "tests passed|tests failed" "$log" | tail -1)
-      summaries+=("$name, $half: ${result:-ctest failed}"$'\n'"$(sed -n '/The following tests FAILED/,$p' "$log" | grep -E '^\s+[0-9]+ - ')")
-    fi
-  done
+  local args=(--output-on-failure -j"$jobs" --timeout "$timeout")
+  [ -n "$sel" ] && args+=(-L "$sel")
+  [ -n "$excl" ] && args+=(-LE "^(${excl// /|})\$")
+  (cd "$dir" && ctest "${args[@]}") 2>&1 | tee "$root/$dir/ctest.log"
+  rc=${PIPESTATUS[0]}
+  local log="$root/$dir/ctest.log" counts
+  counts=$(sed -n 's/.*tests passed, \([0-9]*\) tests\{0,1\} failed out of \([0-9]*\).*/\1 \2/p' "$log" | tail -1)
+  if [ -n "$counts" ]; then
+    total_failed=$((total_failed + ${counts% *}))
+    total_passed=$((total_passed + ${counts#* } - ${counts% *}))
+  fi
+  if [ "$rc" -eq 0 ]; then
+    result=$(grep -E "tests passed" "$log" | tail -1)
+    summaries+=("$name: $result ($(sed -n 's/^Total Test time (real) = *//p' "$log"))")
+  else
+    failed=1
+    result=$(grep -E "tests passed|tests failed" "$log" | tail -1)
+    summaries+=("$name: ${result:-ctest failed}"$'\n'"$(sed -n '/The following tests FAILED/,$p' "$log" | grep -E '^\s+[0-9]+ - ')")
+  fi
   summaries+=("$name: $((SECONDS - start)) s")
 }
 
-gcc_args=(-DCMAKE_C_COMPILER=gcc -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLAGSIM_WERROR=ON)
+# Release: what the package ships (-O3, NDEBUG), and the optimizer's warnings that -O2
+# does not find (a format truncation gcc sees only when a helper is inlined)
+gcc_args=(-DCMAKE_C_COMPILER=gcc -DCMAKE_BUILD_TYPE=Release -DLAGSIM_WERROR=ON)
 # -O1 with the sanitizers (as AddressSanitizer's documentation advises): the same checks,
 # its physics tests 2.1 to 2.3 times as fast as at -O0 (test_hard chaos 20.7 s -> 9.1 s,
 # test_accuracy_cost dipc_1e-04 11.5 s -> 5.5 s); assertions stay (no NDEBUG)
@@ -189,35 +136,27 @@ asan_args=(-DCMAKE_C_COMPILER=clang -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_C_FLAGS_DE
            -DLAGSIM_WERROR=ON -DLAGSIM_SANITIZE=ON -DLAGSIM_FUZZ=ON -DLAGSIM_BENCH=OFF)
 asan_env() { export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1; }
 
-release_args=(-DCMAKE_C_COMPILER=gcc -DCMAKE_BUILD_TYPE=Release -DLAGSIM_WERROR=ON)
 case $mode in
   quick)
-    run_pass "quick tier (gcc -Werror)" build 300 "^quick\$" "" here "${gcc_args[@]}" ;;
+    run_pass "quick tier (gcc -Werror Release)" build 300 "^quick\$" "" here "${gcc_args[@]}" ;;
   some)
     if [ $sanitize -eq 1 ]; then
       asan_env
       run_pass "clang ASan+UBSan+libFuzzer: $select" build-asan 600 "$select" "" here "${asan_args[@]}"
     else
-      run_pass "gcc -Werror: $select" build 300 "$select" "" here "${gcc_args[@]}"
+      run_pass "gcc -Werror Release: $select" build 300 "$select" "" here "${gcc_args[@]}"
     fi ;;
   full)
-    # pass 1's build first; the later passes' builds behind pass 1's tests, one after the
-    # other (two builds at once would be four busy processes beside the real-time tests)
+    # pass 1's build first; pass 2's behind pass 1's tests, at a low priority
     echo "==== pass 1's build"
     build build "${gcc_args[@]}"
-    rm -f build-asan/build.rc build-release/build.rc
-    if [ "${LAGSIM_SKIP_SANITIZE:-0}" != 1 ]; then
-      (build_behind build-asan "${asan_args[@]}"; wait
-       build_behind build-release "${release_args[@]}"; wait) &
-    else
-      build_behind build-release "${release_args[@]}"
-    fi
-    run_pass "pass 1 (gcc -Werror)" build 300 "" "" here "${gcc_args[@]}"
+    rm -f build-asan/build.rc
+    [ "${LAGSIM_SKIP_SANITIZE:-0}" != 1 ] && build_behind build-asan "${asan_args[@]}"
+    run_pass "pass 1 (gcc -Werror Release)" build 300 "" "" here "${gcc_args[@]}"
     if [ "${LAGSIM_SKIP_SANITIZE:-0}" != 1 ]; then
       asan_env
       run_pass "pass 2 (clang ASan+UBSan+libFuzzer)" build-asan 600 "" "slow" behind
-    fi
-    run_pass "pass 3 (gcc -Werror Release, build only)" build-release - "" "" behind ;;
+    fi ;;
 esac
 
 echo "==== summary"

@@ -123,9 +123,40 @@ set(LAGSIM_TIER_RULES
   "quick     NAME  ^clients_(readme_cpp|manipulator_ct)_other_compiler$"
 )
 
-# The tiers whose tests only wait: tests/run.sh runs them, 2 x cores at once, beside the
-# others, which it runs one per core (docs/testing.md, "Tiers").
-set(LAGSIM_WAITING_TIERS waits)
+# How a tier's tests run inside a pass: tests/run.sh runs one ctest per pass with
+# -j (100 x cores), and each test takes its tier's share of that (its PROCESSORS), the
+# hundredths of a core its tests use on average while they run (user + system CPU over
+# wall time, measured by tests/common/cpu_profile.py on the 2-core machine: docs/testing.md,
+# "Time"). So ctest keeps about as many tests running as the cores can serve: many that
+# wait (a real-time loop at 100 Hz, a silence, a stalled peer), few that compute. The
+# cost (COST) is the order ctest starts them in when it has no timings of its own (a fresh
+# build): the long ones first, so that none of them is left running alone at the end.
+#   tier       share cost
+set(LAGSIM_TIER_RUN
+  "quick        35    10"
+  "wallclock    25    30"
+  "waits        15    40"
+  "browser      30    20"
+  "octave       30    30"
+  "root         15    40"
+  "package      50    60"
+  "slow         25    30"
+  "bench       100    10"
+  "fuzz_run    100    20"
+)
+
+# lagsim_tier_run(TIER OUT): OUT = the properties a test of TIER runs with
+# (PROCESSORS <share> COST <cost>), or "" for a tier the table lacks.
+function(lagsim_tier_run tier out)
+  set(props "")
+  foreach(row IN LISTS LAGSIM_TIER_RUN)
+    string(REGEX MATCH "^([a-z_]+) +([0-9]+) +([0-9]+)$" m "${row}")
+    if(CMAKE_MATCH_1 STREQUAL "${tier}")
+      set(props PROCESSORS ${CMAKE_MATCH_2} COST ${CMAKE_MATCH_3})
+    endif()
+  endforeach()
+  set(${out} "${props}" PARENT_SCOPE)
+endfunction()
 
 # lagsim_tier_of(NAME "LABELS" OUT): OUT = the tier of the first rule that matches, or "".
 function(lagsim_tier_of name labels out)
@@ -164,7 +195,8 @@ function(lagsim_apply_tiers)
     if(tier)
       list(APPEND labels ${tier})
       list(REMOVE_DUPLICATES labels)
-      set_tests_properties(${t} PROPERTIES LABELS "${labels}")
+      lagsim_tier_run(${tier} run)
+      set_tests_properties(${t} PROPERTIES LABELS "${labels}" ${run})
     endif()
   endforeach()
 endfunction()

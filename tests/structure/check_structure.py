@@ -115,14 +115,29 @@ def load_tests(build, ctest, json_file):
         for p in t.get('properties', []):
             if p['name'] == 'LABELS':
                 labels = p['value']
+            if p['name'] == 'PROCESSORS':
+                SHARES[t['name']] = p['value']
         tests.append((t['name'], labels))
     return tests
 
 
+SHARES = {}  # a test's PROCESSORS: its tier's share (LAGSIM_TIER_RUN), read by load_tests
+
+
 def load_tiers(path):
-    """The tiers tests/common/tiers.cmake defines (set(LAGSIM_TIERS ...))."""
-    m = re.search(r'set\(LAGSIM_TIERS\s+([a-z_\s]+)\)', open(path, encoding='utf-8').read())
-    return m.group(1).split() if m else []
+    """The tiers tests/common/tiers.cmake defines (set(LAGSIM_TIERS ...)), each with a row
+    of how it runs (LAGSIM_TIER_RUN): a tier without one, or a row of no tier, is named
+    by check_names as the tier '?'."""
+    text = open(path, encoding='utf-8').read()
+    m = re.search(r'set\(LAGSIM_TIERS\s+([a-z_\s]+)\)', text)
+    tiers = m.group(1).split() if m else []
+    run = re.search(r'set\(LAGSIM_TIER_RUN\s+(.*?)\n\)', text, re.S)
+    rows = re.findall(r'"([a-z_]+) +[0-9]+ +[0-9]+"', run.group(1)) if run else []
+    RUN_ROWS[:] = rows
+    return tiers
+
+
+RUN_ROWS = []  # the tiers LAGSIM_TIER_RUN has a row for, read by load_tiers
 
 
 def check_names(tests, tiers):
@@ -141,6 +156,16 @@ def check_names(tests, tiers):
                        'tests/common/tiers.cmake matches it; add one')
         elif len(has) > 1:
             bad.append(f'{name}: more than one tier ({" ".join(has)})')
+        elif has and name not in SHARES:
+            bad.append(f'{name}: no PROCESSORS (its tier {has[0]} has no row of '
+                       'LAGSIM_TIER_RUN in tests/common/tiers.cmake, or it was not applied)')
+    for t in tiers:
+        if t not in RUN_ROWS:
+            bad.append(f'tests/common/tiers.cmake: the tier {t} has no row in LAGSIM_TIER_RUN')
+    for t in RUN_ROWS:
+        if t not in tiers:
+            bad.append(f'tests/common/tiers.cmake: LAGSIM_TIER_RUN has a row for {t}, '
+                       'which is no tier of LAGSIM_TIERS')
     if not tests:
         bad.append('no ctest at all')
     return bad
