@@ -202,13 +202,14 @@ if(LAGSIM_PYTHON3)
   # stops by itself (--duration 1: 101 states, then its stop event) and the controller
   # ends with end=stop within 3 wall s; or the daemon is killed (SIGKILL: no stop event)
   # and the controller, run with --timeout 2, ends with end=silence 2 - 0.5 to 2 + 3 wall s
-  # after the last state the harness heard on the bus (`silent`: its 2 s count from its
+  # after its own last state (its t_last) as the harness heard it (`silent`: its 2 s count from its
   # last state, which may precede the kill by far when a loaded daemon stalls: 0.6 s seen
   # under a sanitizer build, where a bound from the kill failed; 0.5 s is what the
   # harness's own hearing may lag the controller's).
-  # The kill comes 1 wall s after the daemon is started; beside three busy processes its
-  # start took most of that second (10 states answered, t_last 0.12 s), so the count only
-  # says the controller was running (>= 1): the contract is how it ends.
+  # The daemon is started first and the controller once the daemon is heard on the bus
+  # (its --timeout 2 bounds its wait for the scene too); the kill comes 1 wall s after the
+  # controller's first command is heard. The count only says the controller was running
+  # (>= 1): the contract is how it ends.
   foreach(ex dipc_lqr manipulator_pd)
     if(ex STREQUAL dipc_lqr)
       set(cfg ${dipc_cfg})
@@ -227,6 +228,27 @@ if(LAGSIM_PYTHON3)
     set_tests_properties(clients_c_${ex}_ends_on_stop clients_c_${ex}_ends_on_silence
                          PROPERTIES TIMEOUT 60)
   endforeach()
+  # The same end on silence with a daemon that starts 3 s late, as a loaded machine starts
+  # it (seen beside a load of 20: "no scene within 2 s"): the controller's --timeout 2
+  # bounds its wait for the scene too, so the harness starts the daemon first and the
+  # controller once the daemon is heard on the bus, and kills the daemon 1 s after the
+  # controller's first command (run_e2e.py).
+  add_test(NAME clients_c_dipc_lqr_late_daemon_ends_on_silence
+    COMMAND ${e2e} ${dipc_cfg} --mode realtime --name CLSILD --timeout 30 --kill-daemon-after 1
+      --daemon-start-delay 3
+      --check "end == 'silence'" --check "states >= 1" --check "silent >= 2 - 0.5 and silent < 2 + 3"
+      -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} -q --timeout 2)
+  # ... and with the daemon held off the processor (SIGSTOP) for 3 s once the controller
+  # answers, as beside a load of 26 (2.26 s): the controller ends on that silence, before
+  # the kill, and its silence counts from its own last state (t_last), not from the states
+  # the daemon published after it went on (which made `silent` -0.03 s)
+  add_test(NAME clients_c_dipc_lqr_stalled_daemon_ends_on_silence
+    COMMAND ${e2e} ${dipc_cfg} --mode realtime --name CLSILS --timeout 30 --kill-daemon-after 1
+      --stall-daemon 3
+      --check "end == 'silence'" --check "states >= 1" --check "silent >= 2 - 0.5 and silent < 2 + 3"
+      -- $<TARGET_FILE:dipc_lqr> --prefix {prefix} -q --timeout 2)
+  set_tests_properties(clients_c_dipc_lqr_late_daemon_ends_on_silence
+                       clients_c_dipc_lqr_stalled_daemon_ends_on_silence PROPERTIES TIMEOUT 60)
 endif()
 
 # Fuzz target: what arrives on a controller's channels, through the client library

@@ -21,7 +21,7 @@ endif()
 
 # The daemon on a terminal: a pseudo-terminal as its stderr, a controller of the test's own.
 if(LAGSIM_LOG_PYTHON3)
-  foreach(case live effects quiet pipe waits)
+  foreach(case live effects quiet pipe waits stalled)
     add_test(NAME log_term_${case}
              COMMAND ${LAGSIM_LOG_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/log/test_term.py
                      --bin ${CMAKE_BINARY_DIR}/bin --python ${CMAKE_BINARY_DIR}/python

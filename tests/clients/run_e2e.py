@@ -10,11 +10,22 @@ description, i.e. it is subscribed and will see the very first state) the daemon
 (--set lcm.prefix=<prefix>; "{prefix}" in the client's arguments is replaced by it) so
 that tests running in parallel never cross-talk. The controller must exit by itself
 within --timeout wall seconds; the daemon is always stopped (SIGTERM, then SIGKILL).
---daemon-first S starts the daemon first and the controller S wall seconds later (a late
-controller: the scene's realtime.start decides what it meets). --daemon-arg adds an
+--daemon-first S starts the daemon first and the controller S wall seconds after the
+daemon was heard on the bus (its scene, first state, status or start event: a late
+controller, which the scene's realtime.start decides what it meets; counted from a
+fixed start instead, a loaded machine's daemon was not up yet). --daemon-arg adds an
 argument to the daemon's command line (e.g. --duration 2: the daemon
-stops by itself and announces it); --kill-daemon-after S kills it with SIGKILL after S
-wall seconds (it goes silent without a word). The controller's last line
+stops by itself and announces it); --kill-daemon-after S kills it with SIGKILL S wall
+seconds after the controller's first command was heard (it goes silent without a word),
+and starts the daemon first, the controller once the daemon was heard: such a controller
+runs with a short --timeout (2 s), which bounds its wait for the scene too, and a daemon
+started after it may take longer than that to publish its scene on a loaded machine
+(seen: "no scene within 2 s" beside a load of 20). --daemon-start-delay S starts the
+daemon's command S s late, as a loaded machine may (the order above is tested by it);
+--stall-daemon S stops the daemon (SIGSTOP) for S s once the controller's first command was
+heard, before the kill: with S over the controller's --timeout it ends on that silence,
+and `silent` counts from its last state (its t_last), not the states heard after it.
+The controller's last line
 "... summary key=value ..." is parsed and every --check expression (Python, over those
 keys; `wall` is the time from the daemon's end to the controller's summary line, s; with
 --kill-daemon-after, `silent` is the time from the last state this harness heard on the
@@ -29,6 +40,9 @@ they had never come; `hostile` (messages published) joins the summary's keys.
 import argparse
 import math
 import os
+import re
+import signal
+import struct
 import subprocess
 import sys
 import threading
@@ -36,7 +50,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lagsim_check import check_expressions, stop  # noqa: E402  (tests/common: the one harness)
 import waits  # noqa: E402  (events waited on, bounded)
-from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
+from lcm_port import lcm_urls  # noqa: E402  (a port pair of this process's own)
 
 
 def parse_summary(text):
@@ -74,6 +88,45 @@ def hostile_lcm(url):
     return LCM(url)
 
 
+class BusWatch:
+    """The run's bus as the harness hears it, each URL read in a thread of its own: `up` is
+    set once anything of the daemon came on the state URL (its scene, a state, its status
+    or an event: it runs and answers), `answered` once a command came on the command URL
+    (the controller runs its law); `published`, when the daemon published each state, by
+    its sim time (to 1e-6 s), and `last_published`, the last: the state's own utime, the
+    daemon's wall clock (time.time()) as it published it, s. (Not when this harness heard
+    it: its reader is a Python thread, which a loaded machine runs seconds late: a state
+    heard 1.4 s after the daemon's SIGKILL was seen.)"""
+
+    def __init__(self, state_url, command_url, prefix):
+        self.up, self.answered, self.done = threading.Event(), threading.Event(), threading.Event()
+        self.last_published = None
+        self.published = {}
+        self.lcms = [hostile_lcm(state_url), hostile_lcm(command_url)]
+        self.lcms[0].subscribe(re.escape(prefix) + "_(STATE|SCENE|STATUS|EVENT)", self._daemon)
+        self.lcms[1].subscribe(re.escape(prefix) + "_COMMAND", lambda ch, data: self.answered.set())
+        self.threads = [threading.Thread(target=self._pump, args=(lc,), daemon=True)
+                        for lc in self.lcms]
+        for th in self.threads:
+            th.start()
+
+    def _daemon(self, channel, data):
+        if channel.endswith("_STATE") and len(data) >= 24:
+            # joint_state_t: its fingerprint, utime (us since the epoch), sim_time
+            utime, sim_time = struct.unpack(">qd", data[8:24])
+            self.published[round(sim_time, 6)] = self.last_published = utime * 1e-6
+        self.up.set()
+
+    def _pump(self, lc):
+        while not self.done.is_set():
+            lc.handle_timeout(20)
+
+    def close(self):
+        self.done.set()
+        for th in self.threads:
+            th.join(5.0)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lagsimd", required=True)
@@ -84,6 +137,8 @@ def main():
     ap.add_argument("--daemon-arg", action="append", default=[])
     ap.add_argument("--kill-daemon-after", type=float, default=None)
     ap.add_argument("--daemon-first", type=float, default=None)
+    ap.add_argument("--daemon-start-delay", type=float, default=0.0)
+    ap.add_argument("--stall-daemon", type=float, default=0.0)
     ap.add_argument("--check", action="append", default=[])
     ap.add_argument("--hostile", action="append", default=[])
     ap.add_argument("--timeout", type=float, default=60.0)
@@ -101,13 +156,16 @@ def main():
     # datagram costs a socket about 1 kB of buffer, and a controller kept off a core by a
     # loaded machine must not lose a lockstep burst.
     env = dict(os.environ)
-    env["LCM_DEFAULT_URL"] = lcm_url("recv_buf_size=4194304")  # and the next port
+    state_url, command_url = lcm_urls("recv_buf_size=4194304")
+    env["LCM_DEFAULT_URL"] = state_url
     client = [c.replace("{prefix}", prefix) for c in client]
     dcmd = [a.lagsimd, "--config", a.config, "--set", "lcm.prefix=" + prefix,
             "--set", "realtime.mode=" + a.mode, "-q"]
     for s in a.set:
         dcmd += ["--set", s]
     dcmd += a.daemon_arg
+    if a.daemon_start_delay > 0:  # a daemon that starts late, as on a loaded machine
+        dcmd = ["sh", "-c", 'sleep "$0" && exec "$@"', repr(a.daemon_start_delay)] + dcmd
     print("LCM_DEFAULT_URL=%s" % env["LCM_DEFAULT_URL"])
     print("client:", " ".join(client))
     print("daemon:", " ".join(dcmd), flush=True)
@@ -120,13 +178,23 @@ def main():
     n_hostile = 0
     t_daemon_end = t_client_end = None
     lines = []
-    last_state = [None]  # when the last state was heard (--kill-daemon-after)
-    wth = None
+    watch = None
+    daemon_first = a.daemon_first
+    if daemon_first is None and a.kill_daemon_after is not None:
+        daemon_first = 0.0
     try:
-        if a.daemon_first is not None:
+        if daemon_first is not None or a.kill_daemon_after is not None:
+            watch = BusWatch(state_url, command_url, prefix)
+        if daemon_first is not None:
+            t0 = time.monotonic()
             dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                      universal_newlines=True, env=env)
-            time.sleep(a.daemon_first)
+            if not watch.up.wait(a.timeout) or dproc.poll() is not None:
+                print("FAIL: the daemon was not heard on the bus within %g s (exit %s)"
+                      % (a.timeout, dproc.poll()))
+                return 1
+            print("daemon heard after %.1f s" % (time.monotonic() - t0), flush=True)
+            time.sleep(daemon_first)  # the controller's lateness, from the daemon's start
         cproc = subprocess.Popen(client, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                  universal_newlines=True, env=env)
         # read the client's stdout in a thread; start the daemon once the client says it
@@ -160,28 +228,27 @@ def main():
 
             fth = threading.Thread(target=flood, daemon=True)
             fth.start()
-        if a.kill_daemon_after is not None:
-            # the last state on the bus, heard as the controller hears it: the start of the
-            # silence it must count (the kill may come long after it when a loaded machine
-            # stalls the daemon: seen 0.6 s before the kill, under a sanitizer build)
-            watcher = hostile_lcm(env["LCM_DEFAULT_URL"])
-
-            def heard(channel, data):
-                last_state[0] = time.monotonic()
-
-            watcher.subscribe(prefix + "_STATE", heard)
-
-            def watch():
-                while not done.is_set():
-                    watcher.handle_timeout(20)
-
-            wth = threading.Thread(target=watch, daemon=True)
-            wth.start()
         if dproc is None:
             dproc = subprocess.Popen(dcmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                      universal_newlines=True, env=env)
         t_daemon_end = None
         if a.kill_daemon_after is not None:
+            # the controller runs (its first command heard), then S s more; the last state
+            # on the bus, heard as the controller hears it, starts the silence it must count
+            # (the kill may come long after it when a loaded machine stalls the daemon: seen
+            # 0.6 s before the kill, under a sanitizer build)
+            deadline = time.monotonic() + a.timeout
+            while not watch.answered.wait(0.1) and cproc.poll() is None and \
+                    time.monotonic() < deadline:
+                pass
+            if watch.answered.is_set():
+                print("the controller's first command heard", flush=True)
+            if a.stall_daemon > 0:  # held off the processor, as a loaded machine may hold it
+                dproc.send_signal(signal.SIGSTOP)
+                time.sleep(a.stall_daemon)
+                dproc.send_signal(signal.SIGCONT)
+                print("the daemon stopped for %g s (SIGSTOP), then went on" % a.stall_daemon,
+                      flush=True)
             try:
                 dproc.wait(a.kill_daemon_after)
             except subprocess.TimeoutExpired:
@@ -206,8 +273,8 @@ def main():
         done.set()
         if fth:
             fth.join(5.0)
-        if wth:
-            wth.join(5.0)
+        if watch:
+            watch.close()
         stop(cproc, 3.0)
         stop(dproc, 3.0)
     out = "".join(lines)
@@ -239,11 +306,22 @@ def main():
         names["wall"] = end - t_daemon_end
         print("wall = %.3f s from the daemon's end to the controller's summary line (its exit: "
               "%.3f s)" % (names["wall"], t_client_end - t_daemon_end))
-    if a.kill_daemon_after is not None and last_state[0] is not None:
-        names["silent"] = (t_summary if t_summary is not None else t_client_end) - last_state[0]
-        print("silent = %.3f s from the last state heard to the controller's summary line "
-              "(the last state %.3f s before the kill)"
-              % (names["silent"], t_daemon_end - last_state[0]))
+    if a.kill_daemon_after is not None and watch.last_published is not None:
+        # from the publication of the controller's last state (its t_last; the controller
+        # counts from when it got it, a little later): a daemon held off the processor
+        # beside a load of 26 went silent 2.26 s before the kill, the controller ended on
+        # that silence, and the states after it (not the controller's) made a silence
+        # counted from the last state on the bus negative
+        wall = time.time() - time.monotonic()  # monotonic to wall clock, s
+        end = (t_summary if t_summary is not None else t_client_end) + wall
+        t_last = vals.get("t_last")
+        last = watch.published.get(round(t_last, 6)) if isinstance(t_last, float) else None
+        last = last if last is not None else watch.last_published
+        names["silent"] = end - last
+        print("silent = %.3f s from the publication of the controller's last state to its "
+              "summary line (that state %.3f s before the kill, the last on the bus %.3f s)"
+              % (names["silent"], t_daemon_end + wall - last,
+                 t_daemon_end + wall - watch.last_published))
     names["math"] = math
     names["out"] = out  # the client's stdout, for checks of what it prints
     ok = check_expressions(a.check, names) and ok

@@ -124,6 +124,14 @@ def lcm_url(options=""):
     return "udpm://%s:%d?ttl=0%s" % (GROUP, lcm_port(), "&" + options if options else "")
 
 
+def lcm_urls(options=""):
+    """lcm_url's pair as a plant whose lcm.url is the first uses it: (state URL, command
+    URL), the command URL the same group and options on the next port, for a test that
+    listens to both (lag_client_plant_urls' rule, tests/net/plant_urls.txt)."""
+    port, opts = lcm_port(), "&" + options if options else ""
+    return tuple("udpm://%s:%d?ttl=0%s" % (GROUP, p, opts) for p in (port, port + 1))
+
+
 if __name__ == "__main__":
     import sys
     # a port for a shell: printed, and held by this process until its standard input closes

@@ -45,6 +45,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from lagsim_check import check, daemon, replay, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_log import read_log, write_log  # noqa: E402
 from lcm_port import lcm_url  # noqa: E402  (a port pair of this process's own)
+import waits  # noqa: E402  (events waited on, bounded)
 
 
 def decode_state(data):
@@ -252,13 +253,18 @@ def main():
     cfg_cp = os.path.join(a.source, "config", "cartpole.yaml")
     log_cp = os.path.join(tmp, "cartpole.lcm")
     pcp = prefix + "CP"
-    c = subprocess.Popen([os.path.join(a.bin, "lqr_balance"), "--prefix", pcp, "-q"],
+    # --timeout 30: the daemon starts once the controller is subscribed, and a loaded
+    # machine's daemon may take more than the default 5 s to publish its scene; the kicks
+    # come 1 s after the daemon answers (counted from its start, it was not up yet)
+    c = subprocess.Popen([os.path.join(a.bin, "lqr_balance"), "--prefix", pcp, "-q",
+                          "--timeout", "30"],
                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
     c.stdout.readline()  # "waiting for the scene description": subscribed
     d = subprocess.Popen([lagsimd, "--config", cfg_cp, "--set", "lcm.prefix=" + pcp, "-q",
                           "--set", "realtime.start=first_command", "--duration", "3",
                           "--log", log_cp], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
+        check(waits.daemon_answers(ctl_bin, pcp), "the cart-pole's daemon answers")
         time.sleep(1.0)
         r1 = subprocess.run([ctl_bin, "--prefix", pcp, "kick", "theta", "0.01"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)

@@ -57,11 +57,15 @@ def main():
               "lcm-logger records (a probe in its file)")
     if not check(logs, "a log to replay (lagsimd --log or lcm-logger)"):
         return 1
-    c = subprocess.Popen([lqr, "--prefix", prefix, "-q"], stdout=subprocess.PIPE,
-                         stderr=subprocess.STDOUT, universal_newlines=True)
+    # --timeout 30: the daemon starts once the controller is subscribed, and a loaded
+    # machine's may take more than the default 5 s to publish its scene; the sets' times
+    # count from the daemon answering (from its start, it may not be up yet)
+    c = subprocess.Popen([lqr, "--prefix", prefix, "-q", "--timeout", "30"],
+                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
     check(waits.subscribed(c) is not None, "dipc_lqr subscribed")
     d = subprocess.Popen(dcmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                          universal_newlines=True)
+    check(waits.daemon_answers(ctl, prefix), "the daemon answers")
     t0 = time.monotonic()
     sets = [(2.0, "parameters.m2=1.0"), (3.5, "effects.damping={theta1: 0.01, theta2: 0.01}")]
     for at, kv in sets:

@@ -98,8 +98,11 @@ class Run:
 
     def record(self, config, prefix, log, duration, *sets, lqr_args=()):
         """A lockstep run with dipc_lqr, logged; returns lagsimd's CompletedProcess."""
+        # --timeout 30: the daemon starts once the controller is subscribed, and a loaded
+        # machine's may take more than the default 5 s to publish its scene
         lqr = subprocess.Popen([os.path.join(self.bin, "dipc_lqr"), "--prefix", prefix, "-q",
-                                *lqr_args], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                "--timeout", "30", *lqr_args], stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT,
                                text=True)
         try:
             check(waits.subscribed(lqr) is not None, "dipc_lqr subscribed")

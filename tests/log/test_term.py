@@ -16,10 +16,13 @@ Cases:
             listens), with lcm.allow_lan only that line (a warning: the network reaches the
             plant)
   pipe      stderr not a terminal: event lines only, no live line, no control codes
-  waits     no controller: every 3 s a line says what the plant waits for (the first
-            command, on <PREFIX>_COMMAND at the command URL) and, once a command for an
-            unknown joint came and one on the state URL's port, what came instead; each
-            on its own line above the live line
+  waits     no controller: after 3 s, 6 s, 12 s ... a line says what the plant waits for
+            (the first command, on <PREFIX>_COMMAND at the command URL) and, once a
+            command for an unknown joint came and one on the state URL's port, what came
+            instead; each on its own line above the live line
+  stalled   waits, with the daemon held off the processor (SIGSTOP) for 2 s before its
+            first line: the lines say the waits as they were, each at least twice the one
+            before
 """
 import argparse
 import fcntl
@@ -257,38 +260,70 @@ def wait_lines(text, prefix):
     return ok, lines
 
 
-def case_waits(a):
+def waited(line):
+    """The seconds a wait line says the plant waited ("waits 6 s for ..."), or None."""
+    m = re.search(r" waits (\d+) s for ", line)
+    return int(m.group(1)) if m else None
+
+
+def doubling(lines):
+    """Whether the lines come as the daemon schedules them: the first after 3 s of the
+    wait, each next once the wait has doubled (3, 6, 12, ... s; the seconds said are the
+    wait's when the line was printed, rounded: a loaded machine's loop wakes late and says
+    4 s where it meant 3, then 7, so each is checked against the one it follows, not
+    against fixed times)."""
+    w = [waited(l) for l in lines]
+    return bool(w) and None not in w and w[0] >= 3 and all(b >= 2 * a - 1 for a, b in zip(w, w[1:]))
+
+
+def case_waits(a, stall=0.0):
     prefix = f"TT{os.getpid()}W"
     sys.path.insert(0, a.python)
     from lagsim_lcm import LCM, plant_urls
     state_url, command_url = plant_urls()
     d = Daemon(a, os.path.join(a.source, "config", "dipc.yaml"), prefix)
     s = Sender(a, prefix)
+    if stall:  # held off the processor across its first line's time, as a loaded machine may
+        d.read_until(lambda t: len(live_lines(t, prefix)) > 0)
+        d.read(2.0)
+        d.p.send_signal(signal.SIGSTOP)
+        time.sleep(stall)
+        d.p.send_signal(signal.SIGCONT)
     # the events, not fixed times: the first wait line (3 s after the daemon's start, which
     # a loaded machine delays: after a fixed 4 s the sanitizer build had printed none), then
-    # 0.5 s more, in which no second line may come
+    # 0.5 s more, in which no second line may come (doubling: a second line is 3 s away)
     d.read_until(lambda t: len(wait_lines(t, prefix)[1]) >= 1)
     d.read(0.5)
     ok, lines = wait_lines(d.text(), prefix)
     for l in lines:
         print("  wait line:", l)
-    check(ok and len(lines) == 1, f"one line after 3 s of waiting, on its own line ({len(lines)})")
-    check(lines and lines[0].startswith(f"lagsimd: {prefix} waits 3 s for the first command on "
-                                        f"{prefix}_COMMAND at {command_url}; nothing else came"),
+    check(ok and len(lines) >= 1 and doubling(lines),
+          f"one line after 3 s of waiting, on its own line, no other in the next 3 s "
+          f"({[waited(l) for l in lines]} s)")
+    check(lines and re.match(f"lagsimd: {prefix} waits \\d+ s for the first command on "
+                             f"{prefix}_COMMAND at {re.escape(command_url)}; nothing else came$",
+                             lines[0]) is not None,
           "it says what it waits for, on which channel and URL, and that nothing else came")
     s.command(name="cart")
     wrong = LCM(state_url)
     s.command(lc=wrong)  # a controller publishing on the state URL's port
-    d.read_until(lambda t: len(wait_lines(t, prefix)[1]) >= 2)  # the line after 6 s
+    # the next line that says what came instead: the one after 6 s of the wait, or, when a
+    # loaded machine delivered the commands after that line was printed, the one after 12 s
+    d.read_until(lambda t: any("got instead" in l for l in wait_lines(t, prefix)[1]))
     d.read(0.5)
     rc = d.stop()
     wrong.close()
     ok, lines = wait_lines(d.text(), prefix)
     for l in lines[1:]:
         print("  wait line:", l)
-    check(ok and len(lines) == 2, f"a line every 3 s, each on its own line ({len(lines)})")
-    last = lines[-1] if lines else ""
-    check("waits 6 s for the first command" in last and "got instead: 1 command rejected "
+    came = [l for l in lines if "got instead" in l]
+    check(ok and len(lines) >= 2 and doubling(lines) and
+          all(l.endswith("nothing else came") for l in lines[:lines.index(came[0])] if came),
+          f"a line at 3, 6, 12 s ... of the wait, each on its own line, 'nothing else came' "
+          f"until the commands came ({[waited(l) for l in lines]} s)")
+    last = came[0] if came else ""
+    check(last.startswith(f"lagsimd: {prefix} waits ") and " s for the first command" in last and
+          "got instead: 1 command rejected "
           "(unknown joint 1; the last: unknown joint: 'cart'; joints of dipc: theta0 (actuated), "
           "theta1, theta2)" in last, "what came instead: the rejected command and why")
     sport, cport = (int(re.search(r":(\d+)", u).group(1)) for u in (state_url, command_url))
@@ -298,7 +333,13 @@ def case_waits(a):
     check(rc == 0, f"exit {rc}")
 
 
-CASES = {"waits": case_waits, "live": case_live, "effects": case_effects, "quiet": case_quiet, "pipe": case_pipe}
+def case_stalled(a):
+    """waits, the daemon stopped (SIGSTOP) 2 s after its first live line for 2 s: its
+    lines come later than 3 and 6 s and say so (4 and 8 s, or so), still doubling"""
+    case_waits(a, stall=2.0)
+
+
+CASES = {"waits": case_waits, "stalled": case_stalled, "live": case_live, "effects": case_effects, "quiet": case_quiet, "pipe": case_pipe}
 
 
 def main():

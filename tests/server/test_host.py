@@ -119,17 +119,23 @@ class Bus:
         from lagsim_lcm import LCM
         self.t, self.msgs, self.lcms = t, [], []
         for prefix, port in plants:
-            lc = LCM(url(port))
+            # 4 MB: a plant's states and events held while the test floods or waits (a
+            # loaded machine's flood of 20000 commands outlasted the default buffer's
+            # second or two of states, and an event was lost)
+            lc = LCM(url(port) + "&recv_buf_size=4194304")
             lc.subscribe(prefix + "_(STATE|EVENT|SCENE|STATUS)",
                          lambda ch, data: self.msgs.append((time.monotonic(), ch, data)))
             self.lcms.append(lc)
 
     def pump(self, seconds):
+        """Reads what came, then for `seconds` more (0: what came, once)."""
         end = time.monotonic() + seconds
-        while time.monotonic() < end:
+        while True:
             for lc in self.lcms:
                 while lc.handle_timeout(0):
                     pass
+            if time.monotonic() >= end:
+                return
             time.sleep(0.005)
 
     def events(self, prefix, since=0.0):
@@ -541,17 +547,24 @@ class T:
                 if k % 500 == 0:
                     bus.pump(0)
             check(bus.wait_event("ALICE", "input_limited", t1, 10), "flooded: its input is limited")
-            n_limited = len([e for e in bus.events("ALICE", t1) if e.kind == "input_limited"])
             host.send_signal(signal.SIGTERM)
             rc, err = self.finish_pumping(host, bus, 30)
+            # the events counted once the host has ended (the bus read until its exit and
+            # 0.2 s more), not when the first was heard: a loaded host still works through
+            # the flood then, and its count went on (the last line's "N in all" past the
+            # harness's N); a line at once, then at most one every RT_TERM_JOURNAL_S (10 s)
+            # and one at the end, over the time from the flood's start to the exit heard
+            span = time.monotonic() - t1
+            n_limited = len([e for e in bus.events("ALICE", t1) if e.kind == "input_limited"])
+            most = 2 + int(span // 10)
             lines = err.splitlines()
             trip = [l for l in lines if l.startswith("lagsimd: ALICE: watchdog_trip")]
             lim = [l for l in lines if l.startswith("lagsimd: ALICE: input_limited")]
             check(len(trip) >= 1, "-q: the watchdog's trip is on stderr: %s" % trip[:1])
-            check(1 <= len(lim) <= 2 and n_limited > len(lim) and
+            check(1 <= len(lim) <= most and n_limited > len(lim) and
                   ("%d in all" % n_limited) in lim[-1],
-                  "-q: input_limited on stderr in %d line(s) for %d events, counted: %s" %
-                  (len(lim), n_limited, lim[-1:]))
+                  "-q: input_limited on stderr in %d line(s) (at most %d in %.1f s) for %d "
+                  "events, counted: %s" % (len(lim), most, span, n_limited, lim[-1:]))
             check(not any(" event " in l for l in lines),
                   "-q: no other event line (%s)" % [l for l in lines if " event " in l][:2])
             check(rc == 0, "SIGTERM: exit 0")

@@ -172,7 +172,10 @@ class T:
         self.none_without(prefix, *sets)
 
     def lockstep(self, prefix, log, extra=(), during=None, mode="lockstep", duration=3):
-        lqr = subprocess.Popen([os.path.join(self.a.bin, "dipc_lqr"), "--prefix", prefix, "-q"],
+        # --timeout 30: the daemon starts once the controller is subscribed, and a loaded
+        # machine's may take more than the default 5 s to publish its scene
+        lqr = subprocess.Popen([os.path.join(self.a.bin, "dipc_lqr"), "--prefix", prefix, "-q",
+                                "--timeout", "30"],
                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         try:
             self.started(lqr)
@@ -266,7 +269,9 @@ def case_set(t):
     prefix = "REFS" + str(os.getpid())
     log = os.path.join(t.tmp, "set.lcm")
 
-    def during():
+    def during():  # 1 s into the run: after the daemon answers (from its start, it may not be up)
+        check(waits.daemon_answers(os.path.join(t.a.bin, "lagsimctl"), prefix),
+              "the daemon answers")
         time.sleep(1.0)
         p = t.run("lagsimctl", "--prefix", prefix, "set", "reference.theta0.amplitude=0.3")
         check(p.returncode == 0, "lagsimctl set reference.theta0.amplitude=0.3 accepted")
@@ -337,7 +342,8 @@ def case_manipulator(t):
     prefix = "REFM" + str(os.getpid())
     log = os.path.join(t.tmp, "man.lcm")
     man = os.path.join(t.a.source, "config", "manipulator.yaml")
-    pd = subprocess.Popen([os.path.join(t.a.bin, "manipulator_pd"), "--prefix", prefix],
+    pd = subprocess.Popen([os.path.join(t.a.bin, "manipulator_pd"), "--prefix", prefix,
+                           "--timeout", "30"],  # the daemon starts after it (as lockstep() says)
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         t.started(pd)
