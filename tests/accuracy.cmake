@@ -2,8 +2,7 @@
 # every shipped scene stays within E of an independent reference (tests/accuracy/).
 add_executable(test_accuracy_cost ${CMAKE_CURRENT_LIST_DIR}/accuracy/test_cost.c)
 target_include_directories(test_accuracy_cost PRIVATE ${CMAKE_CURRENT_LIST_DIR}/common)
-target_compile_definitions(test_accuracy_cost PRIVATE LAGSIM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
-                           $<$<BOOL:${LAGSIM_SANITIZE}>:LAGSIM_SANITIZED>)
+target_compile_definitions(test_accuracy_cost PRIVATE LAGSIM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 target_link_libraries(test_accuracy_cost PRIVATE lagsim_accuracy lagsim_scene lagsim_core m)
 lagsim_add_test_cases(test_accuracy_cost accuracy_cost accuracy 300)
 

@@ -13,6 +13,10 @@
  * gauss4 and dopri5 at two tolerances, over 4 s (400 periods; at least 50 must have a
  * true error above the floor). Also: the shadow never changes the run (bit-identical states with it on in
  * every period and off), and it refuses what it cannot estimate.
+ *
+ * Under the sanitizers (lt_span) the run still covers the 4 s and is estimated in every
+ * period, but the reference, which costs most, is run for every 4th period only: the claim
+ * is checked in those 100 periods, at least 12 of them above the floor.
  */
 #include "lagsim_test.h"
 #include "scene.h"
@@ -21,6 +25,7 @@
 #define REF_SUB 1024
 #define TRUTH_FLOOR 1e-12
 #define FACTOR 10.0
+#define MIN_COUNTED 50 /* periods above the floor, of the 400 compared */
 
 typedef struct live_case {
     const char *name, *scene;
@@ -90,7 +95,8 @@ static void case_live(int arg)
     const double period = 1.0 / sc.publish_hz;
     const int64_t per = c->dt_per_period > 0 ? llround(1.0 / c->dt_per_period) : sc.ticks_per_period;
     const int nper = (int)llround(RUN_S / period);
-    int counted = 0, outside = 0;
+    const int stride = (int)lt_span(1, 4); /* compare every stride-th period */
+    int counted = 0, outside = 0, compared = 0;
     double worst_hi = 0, worst_lo = INFINITY, sum_log = 0;
     double est[LAG_MAX_DOF], qref[LAG_MAX_DOF];
     for (int k = 0; k < nper; k++) {
@@ -100,6 +106,9 @@ static void case_live(int arg)
             return;
         }
         ENSURE(lag_sim_shadow_error(&start, &s, est) == LAG_OK);
+        for (int i = 0; i < s.nq; i++) ENSURE(isfinite(est[i]) && est[i] >= 0);
+        if (k % stride != 0) continue;
+        compared++;
         if (reference(&start, period, qref) != 0) {
             LT_FAIL("%s: the reference faulted at period %d", c->name, k);
             return;
@@ -107,7 +116,6 @@ static void case_live(int arg)
         double truth = 0, e = 0;
         for (int i = 0; i < s.nq; i++) {
             truth = fmax(truth, fabs(s.q[i] - qref[i]));
-            ENSURE(isfinite(est[i]) && est[i] >= 0);
             e = fmax(e, est[i]);
         }
         if (truth < TRUTH_FLOOR) continue;
@@ -122,10 +130,11 @@ static void case_live(int arg)
                         c->name, lag_sim_time(&start), e, truth, ratio);
         }
     }
-    printf("%s: %d of %d periods above %g; estimate/true from %.3g to %.3g (geometric mean "
-           "%.3g); %d outside [1/%g, %g]\n", c->name, counted, nper, TRUTH_FLOOR, worst_lo,
-           worst_hi, counted ? pow(10, sum_log / counted) : 0.0, outside, FACTOR, FACTOR);
-    ENSURE(counted >= 50); /* the comparison says something */
+    printf("%s: %d of %d periods compared (of %d) above %g; estimate/true from %.3g to %.3g "
+           "(geometric mean %.3g); %d outside [1/%g, %g]\n", c->name, counted, compared, nper,
+           TRUTH_FLOOR, worst_lo, worst_hi, counted ? pow(10, sum_log / counted) : 0.0, outside,
+           FACTOR, FACTOR);
+    ENSURE(counted >= MIN_COUNTED / stride); /* the comparison says something */
     ENSURE(outside == 0);
 }
 

@@ -50,17 +50,6 @@
 #include "lagsim_test.h"
 #include "scene.h"
 
-#if defined(__SANITIZE_ADDRESS__)
-#define SANITIZED 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define SANITIZED 1
-#endif
-#endif
-#ifndef SANITIZED
-#define SANITIZED 0
-#endif
-
 static const char *g_lagsimd, *g_scene;
 static const char *g_write_dir; /* write_logs: keep the logs, run nothing */
 static char g_log[1024];
@@ -428,7 +417,7 @@ static void case_undecodable_flood(int arg)
     fclose(f);
     result r;
     /* 2000 leaked blocks of 32767 pointers would need 524 MB */
-    if (!replay(g_log, 60, SANITIZED ? 0 : 256L << 20, &r)) return;
+    if (!replay(g_log, 60, LT_SANITIZED ? 0 : 256L << 20, &r)) return;
     ensure_checked(&r, 20); /* state 10 follows the flood: 9 -> 10 is still one period */
     ENSURE(strstr(r.out, "2000 undecodable") != NULL);
 }
