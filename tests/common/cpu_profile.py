@@ -60,13 +60,13 @@ def main():
         p = subprocess.Popen(t[1], cwd=t[2].get('WORKING_DIRECTORY'), env=env,
                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                              start_new_session=True)
-        running[p.pid] = (t, time.monotonic())
+        running[p.pid] = (t, time.monotonic(), p)  # kept: a Popen let go is reaped by subprocess
 
     def reap():
         pid, status, ru = os.wait4(-1, 0)
         if pid not in running:
             return
-        t, t0 = running.pop(pid)
+        t, t0, _ = running.pop(pid)
         try:
             os.killpg(pid, signal.SIGKILL)
         except OSError:

@@ -133,16 +133,16 @@ set(LAGSIM_TIER_RULES
 # build): the long ones first, so that none of them is left running alone at the end.
 #   tier       share cost
 set(LAGSIM_TIER_RUN
-  "quick        35    10"
-  "wallclock    25    30"
-  "waits        15    40"
-  "browser      30    20"
-  "octave       30    30"
-  "root         15    40"
-  "package      50    60"
-  "slow         25    30"
-  "bench       100    10"
-  "fuzz_run    100    20"
+  "quick         35    10"
+  "wallclock     15    30"
+  "waits         10    40"
+  "browser       25    20"
+  "octave        30    30"
+  "root          15    40"
+  "package       50    60"
+  "slow          25    30"
+  "bench        100    10"
+  "fuzz_run     100    20"
 )
 
 # lagsim_tier_run(TIER OUT): OUT = the properties a test of TIER runs with
