@@ -165,6 +165,9 @@ void lag_diag_format(const lag_diag *d, char *err, size_t errlen);
 
 /* True if every entry is finite and |x_i| <= limit. */
 bool lag_state_ok(int n, const double *x, double limit);
+/* The one check of a state: LAG_OK when lag_state_ok(n, x, limit), else LAG_ERR_NONFINITE
+ * for a NaN or Inf, LAG_ERR_EXPLODE for a finite value past limit. */
+lag_result lag_state_check(int n, const double *x, double limit);
 
 /* ================================================================ events.c: the engine;
  * contact.c: impulses, holds, stops; event_queue.c: the sim's events */
@@ -244,7 +247,8 @@ lag_result lag_lock_forces(lag_sim *s, const double *y, double *lambda);
 lag_event_kind lag_friction_settle(lag_sim *s, double *y, int i);
 void lag_refresh_slip(lag_sim *s, double *y);
 void lag_effects_init_modes(lag_sim *s);
-/* One tick with event location, from y (in place). */
+/* One tick with event location, from y (in place). The state it ends with, after the
+ * last step or the last event's map, is checked by its caller (lag_sim_advance_within). */
 lag_result lag_events_tick(lag_sim *s, double *y);
 void lag_sim_record_event(lag_sim *s, lag_event_kind kind, int joint, double t, double value);
 

@@ -273,8 +273,7 @@ static lag_result floor_land(lag_sim *s, const lag_watcher *w, const double *y0,
         double yt[LAG_MAX_STATE], vn;
         lag_result r = lag_step(s, hn, y0, yt);
         if (r != LAG_OK) return r;
-        if (!lag_state_ok(N, yt, s->def.explode_limit))
-            return lag_state_ok(N, yt, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
+        if ((r = lag_state_check(N, yt, s->def.explode_limit)) != LAG_OK) return r;
         rate = watch_rate(s, w, yt, &vn);
         hp = h; vp = val;
         h = hn; val = vn;

@@ -270,13 +270,6 @@ static int due_now(lag_sim *s, const lag_watch_set *ws, const double *y, const d
     return -1;
 }
 
-/* A tick's end state y1 must be finite and within explode_limit. */
-static lag_result checked(int N, const double *y, double limit)
-{
-    if (!lag_state_ok(N, y, limit)) return lag_state_ok(N, y, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
-    return LAG_OK;
-}
-
 lag_result lag_events_tick(lag_sim *s, double *y)
 {
     const int n = s->nq, N = 2 * n;
@@ -295,8 +288,6 @@ lag_result lag_events_tick(lag_sim *s, double *y)
             if (events >= LAG_MAX_EVENTS_PER_TICK)
                 lag_sim_record_event(s, LAG_EV_EVENT_LIMIT, -1, t_tick + tloc, events);
             if ((r = lag_step(s, H, y, y1)) != LAG_OK) return r;
-            if (!lag_state_ok(N, y1, INFINITY)) return LAG_ERR_NONFINITE;
-            if (!lag_state_ok(N, y1, s->def.explode_limit)) return LAG_ERR_EXPLODE;
             memcpy(y, y1, sizeof(double) * (size_t)N);
             break;
         }
@@ -315,8 +306,9 @@ lag_result lag_events_tick(lag_sim *s, double *y)
 
         s->mode.released = 0;
         if ((r = lag_step(s, H, y, y1)) != LAG_OK) return r;
-        if (!lag_state_ok(N, y1, INFINITY)) return LAG_ERR_NONFINITE;
-        if (!lag_state_ok(N, y1, s->def.explode_limit)) return LAG_ERR_EXPLODE;
+        /* a step the watchers are located on and an event mapped from: checked here (the
+         * tick's end state is checked by lag_sim_advance_within, whatever ended the tick) */
+        if ((r = lag_state_check(N, y1, s->def.explode_limit)) != LAG_OK) return r;
         double f0[LAG_MAX_STATE], f1[LAG_MAX_STATE];
         if ((r = lag_sim_rhs(s, y, f0)) != LAG_OK) return r;
         if ((r = lag_sim_rhs(s, y1, f1)) != LAG_OK) return r;
@@ -337,7 +329,7 @@ lag_result lag_events_tick(lag_sim *s, double *y)
         double ys[LAG_MAX_STATE];
         if (hs > 0) {
             if ((r = lag_step(s, hs, y, ys)) != LAG_OK) return r;
-            if ((r = checked(N, ys, s->def.explode_limit)) != LAG_OK) return r;
+            if ((r = lag_state_check(N, ys, s->def.explode_limit)) != LAG_OK) return r;
         } else {
             memcpy(ys, y, sizeof(double) * (size_t)N);
         }

@@ -161,8 +161,7 @@ static lag_result dp_run(lag_sim *s, double *t, double t_end, double t_stop, dou
             last_rejected = true;
             continue;
         }
-        if (!lag_state_ok(N, y1, s->def.explode_limit))
-            return lag_state_ok(N, y1, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
+        if ((r = lag_state_check(N, y1, s->def.explode_limit)) != LAG_OK) return r;
         if (dense) {
             memcpy(s->dp.rcont, rc, sizeof rc);
             s->dp.t_prev = *t;
@@ -227,9 +226,9 @@ lag_result lag_dopri5_advance(lag_sim *s, int64_t nticks, int64_t stop)
         memcpy(ye, s->dp.y, sizeof(double) * N);
     } else {
         dense(s, N, t_end, ye);
-        if (!lag_state_ok(N, ye, s->def.explode_limit)) {
+        if ((r = lag_state_check(N, ye, s->def.explode_limit)) != LAG_OK) {
             s->dp.valid = false;
-            return lag_state_ok(N, ye, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
+            return r;
         }
     }
     memcpy(s->q, ye, sizeof(double) * n);

@@ -270,3 +270,9 @@ bool lag_state_ok(int n, const double *x, double limit)
         if (!isfinite(x[i]) || fabs(x[i]) > limit) return false;
     return true;
 }
+
+lag_result lag_state_check(int n, const double *x, double limit)
+{
+    if (lag_state_ok(n, x, limit)) return LAG_OK;
+    return lag_state_ok(n, x, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
+}

@@ -202,15 +202,14 @@ double lag_sim_energy(const lag_sim *s)
     return s->fx.n_potential ? E + lag_effects_potential(s, s->q) : E;
 }
 
-/* One tick without events: a step of dt, checked. OUT: y (in place) */
+/* One tick without events: a step of dt (its end state checked by the caller, as every
+ * tick's). OUT: y (in place) */
 static lag_result plain_tick(lag_sim *s, double *y)
 {
     const int N = 2 * s->nq;
     double y1[LAG_MAX_STATE];
     lag_result r = lag_step(s, s->def.integrator.dt, y, y1);
     if (r != LAG_OK) return r;
-    if (!lag_state_ok(N, y1, s->def.explode_limit))
-        return lag_state_ok(N, y1, INFINITY) ? LAG_ERR_EXPLODE : LAG_ERR_NONFINITE;
     for (int i = 0; i < N; i++) y[i] = y1[i];
     return LAG_OK;
 }
@@ -324,6 +323,9 @@ lag_result lag_sim_advance_within(lag_sim *s, int64_t nticks, int64_t stop)
     if (!per_tick && adaptive) {
         if (stop < s->tick + nticks) stop = s->tick + nticks;
         lag_result r = lag_adaptive_advance(s, nticks, stop);
+        /* the method checks every step it accepts and the state it interpolates */
+        LAG_ASSERT(r != LAG_OK || (lag_state_ok(n, s->q, s->def.explode_limit) &&
+                                   lag_state_ok(n, s->qd, s->def.explode_limit)));
         return r == LAG_OK ? r : classify_fault(s, r, s->qd);
     }
     for (int64_t k = 0; k < nticks; k++) {
@@ -336,6 +338,9 @@ lag_result lag_sim_advance_within(lag_sim *s, int64_t nticks, int64_t stop)
         if (per_tick) lag_effects_pre_tick(s);
         for (int i = 0; i < n; i++) { y[i] = s->q[i]; y[n + i] = s->qd[i]; }
         r = events ? lag_events_tick(s, y) : plain_tick(s, y);
+        /* The one check of a tick's end state, whatever ended the tick: a step, or an
+         * event's map (an impulse, a hold, a change of coordinates), which no step checks */
+        if (r == LAG_OK) r = lag_state_check(2 * n, y, s->def.explode_limit);
         if (r != LAG_OK) {
             r = classify_fault(s, r, qd_good); /* at the tick's start, after its impulses */
             memcpy(s->qd, qd_good, sizeof qd_good);

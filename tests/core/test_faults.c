@@ -16,6 +16,14 @@
  *   suffices the same tick completes.
  * singular: lag_model_forward tells a singular mass matrix at a finite state
  *   (LAG_ERR_SINGULAR) from a non-finite argument (LAG_ERR_NONFINITE).
+ * event_map: a tick that ends on an event's map (an impulse, a landing) is checked as one
+ *   that ends on a step. A stick on its floor with flight (explicit Euler), after 40
+ *   ticks at a small effort, given 2.98e7 N m on phi: the tick after the first strong one
+ *   bounces off the floor and lands and ends on the free end's impact at phi = 0, whose
+ *   impulse leaves phi_dot = -1.57e6 rad/s, past explode_limit = 1e6 (the scene of a
+ *   fuzz_sim input, tests/fuzz/sim/crash/floor-impact-ends-tick-past-explode-limit.bin,
+ *   with its other effects left out). The tick must be LAG_ERR_EXPLODE, the state left at
+ *   the last good tick; every tick reported good within explode_limit.
  */
 #include "test_core.h"
 
@@ -172,6 +180,51 @@ static void check_max_steps(int arg)
     printf("max_steps: a tick of 6.4 s took %lld steps (default max_steps %d)\n",
            (long long)(s.stats.steps_accepted + s.stats.steps_rejected), d.integrator.max_steps);
 }
+/* The state s holds (the one it publishes) finite and within explode_limit. */
+static bool state_within_limit(const lag_sim *s)
+{
+    for (int i = 0; i < s->nq; ++i)
+        if (!(fabs(s->q[i]) <= s->def.explode_limit && fabs(s->qd[i]) <= s->def.explode_limit))
+            return false;
+    return true;
+}
+
+static void check_event_map(int arg)
+{
+    (void)arg;
+    const double a = 2.3644e-4;
+    lag_sim_def d = lag_default_sim_def(LAG_MODEL_STICK);
+    d.integrator.method = LAG_EULER;
+    d.effects.enabled = LAG_EFF_FLOOR;
+    d.effects.floor_flight = true;
+    d.effects.floor_restitution = 194.0 / 255.0;
+    d.q0[0] = d.q0[1] = d.qd0[0] = d.qd0[1] = a;
+    static lag_sim s;
+    if (tc_sim_init(&s, &d)) return;
+    ENSURE(s.nq == 3 && strcmp(lag_sim_contact(&s), "contact") == 0);
+    lag_sim_set_input(&s, (const double[LAG_MAX_DOF]){a, a});
+    if (tc_advance(&s, 40, false)) return;
+    lag_sim_set_input(&s, (const double[LAG_MAX_DOF]){0.0, 2.9812e7});
+    lag_result r = LAG_OK;
+    double q[LAG_MAX_DOF] = {0}, qd[LAG_MAX_DOF] = {0};
+    int k = 0;
+    for (; k < 5 && r == LAG_OK; ++k) {
+        memcpy(q, s.q, sizeof q);
+        memcpy(qd, s.qd, sizeof qd);
+        r = lag_sim_advance(&s, 1, false);
+        /* good or refused, the state the sim holds is one it may publish */
+        ENSUREF(state_within_limit(&s), "tick %lld (%s): q = (%g, %g, %g), qd = (%g, %g, %g) "
+                "past explode_limit = %g", (long long)s.tick, lag_result_string(r), s.q[0],
+                s.q[1], s.q[2], s.qd[0], s.qd[1], s.qd[2], s.def.explode_limit);
+    }
+    char text[256];
+    lag_sim_fault_describe(&s, text, sizeof text);
+    printf("event_map: %s after %d ticks: \"%s\"\n", lag_result_string(r), k, text);
+    ENSUREF(r == LAG_ERR_EXPLODE && s.tick == 41 && s.fault.tick == 41,
+            "expected state exceeded explode_limit at tick 41, got %s at tick %lld",
+            lag_result_string(r), (long long)s.tick);
+    ENSURE(memcmp(q, s.q, sizeof q) == 0 && memcmp(qd, s.qd, sizeof qd) == 0);
+}
 
 int main(int argc, char **argv)
 {
@@ -181,6 +234,7 @@ int main(int argc, char **argv)
         {"impulse", check_impulse, 0, 0},
         {"max_steps", check_max_steps, 0, 0},
         {"singular", check_singular, 0, 0},
+        {"event_map", check_event_map, 0, 0},
     };
     return lt_main(argc, argv, cases, (int)(sizeof cases / sizeof cases[0]));
 }
