@@ -130,18 +130,21 @@ set(LAGSIM_TIER_RULES
 # "Time"), rounded up; more for what starts many threads or processes at once (a JVM
 # under Octave, Chromium, dpkg): with every share at its average, a real-time plant fell
 # behind by up to 1 s (overrun bursts of 25 to 98 periods) and a README recipe's DIPC
-# fell, on an otherwise quiet machine. So ctest keeps about as many tests running as the cores can serve: many
-# that wait (a real-time loop at 100 Hz, a silence, a stalled peer), few that compute. The
+# fell, on an otherwise quiet machine; and no share below 25, so that at most 4 tests
+# a core run at once (with shares of 10, 20 started together, and beside two busy
+# processes a real-time DIPC fell behind by 1.65 s). So ctest keeps about as many tests
+# running as the cores can serve: several that wait (a real-time loop at 100 Hz, a
+# silence, a stalled peer), few that compute. The
 # cost (COST) is the order ctest starts them in when it has no timings of its own (a fresh
 # build): the long ones first, so that none of them is left running alone at the end.
 #   tier       share cost
 set(LAGSIM_TIER_RUN
   "quick         40    10"
-  "wallclock     15    30"
-  "waits         10    40"
+  "wallclock     25    30"
+  "waits         25    40"
   "browser       50    20"
   "octave        50    30"
-  "root          20    40"
+  "root          25    40"
   "package      100    60"
   "slow          25    30"
   "bench        100    10"
