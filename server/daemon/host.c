@@ -653,8 +653,8 @@ static void host_pass(host *h)
             p->marked = false;
             p->wake = rt_next_wake(p->s);
         } else if (p->phase == PLANT_LOOKING) {
-            /* what came during the look was read (its own DESCRIBE comes back to it): nothing
-             * is due before the look's end (a mark kept made every wait until then a spin) */
+            /* what came during the look was read (its own DESCRIBE comes back to it): a
+             * looking plant has nothing due before its look's end, so no mark is kept */
             p->marked = false;
         }
         if (p->phase == PLANT_RUNNING) unpark(h, p);

@@ -1,15 +1,18 @@
 #!/usr/bin/env python3
 """End-to-end harness: one lagsimd plus one controller on real LCM (loopback).
 
-    run_e2e.py --lagsimd BIN --config YAML --mode lockstep [--set k=v ...]
+    run_e2e.py --lagsimd BIN --config YAML --mode lockstep [--name NAME] [--set k=v ...]
                [--daemon-arg ARG ...] [--kill-daemon-after S] [--daemon-first S]
-               [--check EXPR ...] [--hostile DIR ...] [--timeout S] -- CLIENT ARGS...
+               [--daemon-start-delay S] [--stall-daemon S] [--check EXPR ...]
+               [--hostile DIR ...] [--timeout S] -- CLIENT ARGS...
 
 The controller is started first, then (once it prints that it is waiting for the scene
-description, i.e. it is subscribed and will see the very first state) the daemon, with a channel prefix unique to this run
-(--set lcm.prefix=<prefix>; "{prefix}" in the client's arguments is replaced by it) so
-that tests running in parallel never cross-talk. The controller must exit by itself
-within --timeout wall seconds; the daemon is always stopped (SIGTERM, then SIGKILL).
+description, i.e. it is subscribed and will see the very first state) the daemon, with a
+channel prefix unique to this run (--set lcm.prefix=<prefix>; "{prefix}" in the client's
+arguments is replaced by it) so that tests running in parallel never cross-talk; with
+--daemon-first or --kill-daemon-after the daemon is started first instead (below). The
+controller must exit by itself within --timeout wall seconds; the daemon is always
+stopped (SIGTERM, then SIGKILL).
 --daemon-first S starts the daemon first and the controller S wall seconds after the
 daemon was heard on the bus (its scene, first state, status or start event: a late
 controller, which the scene's realtime.start decides what it meets; counted from a
@@ -28,8 +31,10 @@ and `silent` counts from its last state (its t_last), not the states heard after
 The controller's last line
 "... summary key=value ..." is parsed and every --check expression (Python, over those
 keys; `wall` is the time from the daemon's end to the controller's summary line, s; with
---kill-daemon-after, `silent` is the time from the last state this harness heard on the
-bus to that line, s: the silence the controller measured) must hold.
+--kill-daemon-after, `silent` is the time from the daemon's publication of the
+controller's last state (its t_last; the state's utime, the daemon's wall clock) to the
+controller's summary line as this harness read it, s: at least the silence the controller
+counted, which starts when that state reached it) must hold.
 --hostile DIR (repeatable) publishes every file of DIR (the fuzz_client corpus layout: the
 first byte chooses the channel, _STATE, _STATUS, _EVENT or _SCENE, the rest is the payload)
 on the run's channels: three times once the controller is subscribed, before the daemon
@@ -233,10 +238,10 @@ def main():
                                      universal_newlines=True, env=env)
         t_daemon_end = None
         if a.kill_daemon_after is not None:
-            # the controller runs (its first command heard), then S s more; the last state
-            # on the bus, heard as the controller hears it, starts the silence it must count
-            # (the kill may come long after it when a loaded machine stalls the daemon: seen
-            # 0.6 s before the kill, under a sanitizer build)
+            # the controller runs (its first command heard), then S s more; the silence it
+            # must count starts at its own last state (its t_last), which may precede the
+            # kill by far when a loaded machine stalls the daemon (seen 0.6 s before the
+            # kill, under a sanitizer build)
             deadline = time.monotonic() + a.timeout
             while not watch.answered.wait(0.1) and cproc.poll() is None and \
                     time.monotonic() < deadline:
@@ -311,12 +316,19 @@ def main():
         # counts from when it got it, a little later): a daemon held off the processor
         # beside a load of 26 went silent 2.26 s before the kill, the controller ended on
         # that silence, and the states after it (not the controller's) made a silence
-        # counted from the last state on the bus negative
+        # counted from the last state on the bus negative. One clock: the state's utime is
+        # CLOCK_REALTIME (lag_clock_wall_us), as time.time() is; the summary line's
+        # monotonic time is put on it by their offset now.
         wall = time.time() - time.monotonic()  # monotonic to wall clock, s
         end = (t_summary if t_summary is not None else t_client_end) + wall
         t_last = vals.get("t_last")
         last = watch.published.get(round(t_last, 6)) if isinstance(t_last, float) else None
-        last = last if last is not None else watch.last_published
+        if last is None:
+            # counted from a later state than the controller's own: `silent` comes out
+            # short by the time between the two, and says so
+            print("silent: the controller's last state (t_last %r) was not heard on the bus; "
+                  "counted from the last state heard instead" % (t_last,))
+            last = watch.last_published
         names["silent"] = end - last
         print("silent = %.3f s from the publication of the controller's last state to its "
               "summary line (that state %.3f s before the kill, the last on the bus %.3f s)"

@@ -127,7 +127,9 @@ def lcm_url(options=""):
 def lcm_urls(options=""):
     """lcm_url's pair as a plant whose lcm.url is the first uses it: (state URL, command
     URL), the command URL the same group and options on the next port, for a test that
-    listens to both (lag_client_plant_urls' rule, tests/net/plant_urls.txt)."""
+    listens to both: the client library's rule (lag_client_plant_urls), written here for
+    run_e2e.py, which also runs against installed and packaged trees where this build's
+    library cannot be loaded; net_plant_urls_python fails when the two disagree."""
     port, opts = lcm_port(), "&" + options if options else ""
     return tuple("udpm://%s:%d?ttl=0%s" % (GROUP, p, opts) for p in (port, port + 1))
 

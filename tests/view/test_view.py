@@ -134,7 +134,8 @@ def case_browser(a):
         # the page drew what the daemon published: its drawn cart is at theta0
         check(d1["points"][0][0] == d1["q"][0], "the cart is drawn at the published theta0")
         # the second look once the page has drawn 0.5 s of sim time and 10 frames more (a
-        # loaded machine's headless Chromium draws fewer frames a second: waited on, 15 s)
+        # loaded machine's headless Chromium draws fewer frames a second: waited on, at most
+        # WITHIN s)
         chrome.wait_for(sa, "window.lagsimView.drawn.sim_time > %r + 0.5 && "
                             "window.lagsimView.drawn.frame > %r + 10" % (d1["sim_time"], d1["frame"]),
                         WITHIN, "0.5 s of sim time and 10 frames drawn after the first look")
@@ -271,10 +272,11 @@ def case_hostile(a):
         check(len(socks) > 256, "opened %d connections at once" % len(socks))
         for s in socks:
             s.close()
-        # idle connections are closed after 5 s: the bridge serves again well before 15 s
+        # idle connections are closed after 5 s: the bridge serves again (waited on, at most
+        # WITHIN s; wait_api fails the test if it does not); the time it took is said, not judged
         t = time.monotonic()
-        rig.wait_api(lambda s: True, WITHIN, "the bridge to serve again after the flood")
-        check(time.monotonic() - t < 15, "after the flood the bridge serves again in %.1f s" % (time.monotonic() - t))
+        served = rig.wait_api(lambda s: True, WITHIN, "the bridge to serve again after the flood")
+        check(served is not None, "after the flood the bridge serves again (in %.1f s)" % (time.monotonic() - t))
         # streams that never read, and streams that vanish
         sleepers, vanishers = [], []
         for i in range(20):
