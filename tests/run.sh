@@ -42,7 +42,12 @@ done
 
 "$root/.ci/install-deps.sh" "$([ "${CI:-}" = true ] && echo ci || echo tests)" || exit 1
 cores=$(nproc)
-jobs=$((100 * ${LAGSIM_TEST_CORES:-$cores}))  # hundredths of a core (PROCESSORS)
+plan=${LAGSIM_TEST_CORES:-$cores}
+case $plan in
+  '' | *[!0-9]* | 0*) echo "tests/run.sh: LAGSIM_TEST_CORES='$plan': expected a whole number of cores, 1 or more" >&2
+                      exit 2 ;;
+esac
+jobs=$((100 * plan))  # hundredths of a core (PROCESSORS)
 summaries=()
 failed=0
 total_passed=0

@@ -8,13 +8,13 @@ column holds; then the tests that cost the most CPU.
 
     tests/common/cpu_profile.py build [--jobs 4] [--exclude-tier slow] [--tsv out.tsv]
 
-A test's process group is killed when the test ends (a daemon it left behind). Run it on
-a quiet machine: a loaded one stretches the wall times and lowers the shares.
+A test's process group is killed when the test ends (a daemon it left behind), when it
+runs past its TIMEOUT (then counted as failed), and when this tool ends or is stopped.
+Run it on a quiet machine: a loaded one stretches the wall times and lowers the shares.
 """
 import argparse
 import json
 import os
-import re
 import signal
 import subprocess
 import sys
@@ -24,8 +24,10 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def tiers():
-    text = open(os.path.join(HERE, 'tiers.cmake'), encoding='utf-8').read()
-    return re.search(r'set\(LAGSIM_TIERS\s+([a-z_\s]+)\)', text).group(1).split()
+    """The tiers, as structure_names reads them (tests/structure/check_structure.py)."""
+    sys.path.insert(0, os.path.join(HERE, '..', 'structure'))
+    import check_structure
+    return check_structure.load_tiers(os.path.join(HERE, "tiers.cmake"))[0]
 
 
 def main():
@@ -62,8 +64,23 @@ def main():
                              start_new_session=True)
         running[p.pid] = (t, time.monotonic(), p)  # kept: a Popen let go is reaped by subprocess
 
+    def overdue():
+        """Kills the group of each test past its TIMEOUT (its wait4 then reaps it)."""
+        now = time.monotonic()
+        for pid, (t, t0, _) in running.items():
+            if now - t0 > float(t[2].get('TIMEOUT', 1500)):
+                try:
+                    os.killpg(pid, signal.SIGKILL)
+                except OSError:
+                    pass
+
     def reap():
-        pid, status, ru = os.wait4(-1, 0)
+        while True:
+            pid, status, ru = os.wait4(-1, os.WNOHANG)
+            if pid:
+                break
+            overdue()
+            time.sleep(0.05)
         if pid not in running:
             return
         t, t0, _ = running.pop(pid)
@@ -74,16 +91,23 @@ def main():
         rows.append((t[0], t[3], time.monotonic() - t0, ru.ru_utime, ru.ru_stime,
                      os.waitstatus_to_exitcode(status), ','.join(t[2].get('LABELS', []))))
 
-    for t in todo:
-        while len(running) >= a.jobs:
-            reap()
-        start(t)
-    while running:
-        reap()
-    for t in alone:
-        start(t)
+    try:
+        for t in todo:
+            while len(running) >= a.jobs:
+                reap()
+            start(t)
         while running:
             reap()
+        for t in alone:
+            start(t)
+            while running:
+                reap()
+    finally:  # stopped (Ctrl-C) or failed: no test's processes outlive the tool
+        for pid in running:
+            try:
+                os.killpg(pid, signal.SIGKILL)
+            except OSError:
+                pass
     if a.tsv:
         with open(a.tsv, 'w') as f:
             for r in rows:

@@ -124,19 +124,14 @@ set(LAGSIM_TIER_RULES
 )
 
 # How a tier's tests run inside a pass: tests/run.sh runs one ctest per pass with
-# -j (100 x cores), and each test takes its tier's share of that (its PROCESSORS), the
-# hundredths of a core its tests use on average while they run (user + system CPU over
-# wall time, measured by tests/common/cpu_profile.py on the 2-core machine: docs/testing.md,
-# "Time"), rounded up; more for what starts many threads or processes at once (a JVM
-# under Octave, Chromium, dpkg): with every share at its average, a real-time plant fell
-# behind by up to 1 s (overrun bursts of 25 to 98 periods) and a README recipe's DIPC
-# fell, on an otherwise quiet machine; and no share below 25, so that at most 4 tests
-# a core run at once (with shares of 10, 20 started together, and beside two busy
-# processes a real-time DIPC fell behind by 1.65 s). So ctest keeps about as many tests
-# running as the cores can serve: several that wait (a real-time loop at 100 Hz, a
-# silence, a stalled peer), few that compute. The
-# cost (COST) is the order ctest starts them in when it has no timings of its own (a fresh
-# build): the long ones first, so that none of them is left running alone at the end.
+# -j (100 x cores), and each test takes its tier's share of that (its PROCESSORS): the
+# hundredths of a core its tests use on average while they run, as measured by
+# tests/common/cpu_profile.py, rounded up; more for the tiers that start many threads or
+# processes at once (Octave's JVM, Chromium, dpkg); and never less than 25, so that at
+# most 4 tests a core run at once (docs/testing.md, "Time", has the measures and what a
+# smaller share did to a real-time plant). The cost (COST) is the order ctest starts
+# them in: an explicit cost, which ctest's timings of earlier runs do not change; the
+# long kinds first, so that none of them is left running alone at the end.
 #   tier       share cost
 set(LAGSIM_TIER_RUN
   "quick         40    10"
@@ -146,7 +141,7 @@ set(LAGSIM_TIER_RUN
   "octave        50    30"
   "root          25    40"
   "package      100    60"
-  "slow          25    30"
+  "slow          30    30"
   "bench        100    10"
   "fuzz_run     100    20"
 )

@@ -13,7 +13,8 @@
       Every ctest's name is lowercase words joined by "_" (a word may hold a "-": a model's
       name such as flying-stick, a number such as -1 or 1e-04; never a "." or a capital),
       every ctest has a label, and exactly one tier (a label of LAGSIM_TIERS,
-      tests/common/tiers.cmake, given by the rules there).
+      tests/common/tiers.cmake, given by the rules there) with that tier's share of a core
+      as its PROCESSORS; every tier has a row of LAGSIM_TIER_RUN, and every row a tier.
   check_structure.py docs SOURCE_DIR BUILD_DIR [--ctest CTEST | --json FILE]
       Every test name the docs (README.md, docs/**/*.md) give in backquotes is a ctest
       (`a_{b,c}` is two names, `a_*` must match one, `_b` after `a_x` is a_b, `a` alone the
@@ -104,43 +105,37 @@ NAME = re.compile(r'^[a-z][a-z0-9]*(_-?[a-z0-9]+(-[a-z0-9]+)*)+$')
 
 
 def load_tests(build, ctest, json_file):
+    """[(name, labels)] of every ctest, and {name: PROCESSORS} of those that have it."""
     if json_file:
         text = open(json_file).read()
     else:
         text = subprocess.run([ctest, '--show-only=json-v1'], cwd=build, check=True,
                               capture_output=True, text=True).stdout
-    tests = []
+    tests, shares = [], {}
     for t in json.loads(text)['tests']:
         labels = []
         for p in t.get('properties', []):
             if p['name'] == 'LABELS':
                 labels = p['value']
             if p['name'] == 'PROCESSORS':
-                SHARES[t['name']] = p['value']
+                shares[t['name']] = p['value']
         tests.append((t['name'], labels))
-    return tests
-
-
-SHARES = {}  # a test's PROCESSORS: its tier's share (LAGSIM_TIER_RUN), read by load_tests
+    return tests, shares
 
 
 def load_tiers(path):
-    """The tiers tests/common/tiers.cmake defines (set(LAGSIM_TIERS ...)), each with a row
-    of how it runs (LAGSIM_TIER_RUN): a tier without one, or a row of no tier, is named
-    by check_names as the tier '?'."""
+    """The tiers tests/common/tiers.cmake defines (set(LAGSIM_TIERS ...)), and the share
+    of a core its table of how they run gives each ({tier: share}, LAGSIM_TIER_RUN)."""
     text = open(path, encoding='utf-8').read()
     m = re.search(r'set\(LAGSIM_TIERS\s+([a-z_\s]+)\)', text)
     tiers = m.group(1).split() if m else []
     run = re.search(r'set\(LAGSIM_TIER_RUN\s+(.*?)\n\)', text, re.S)
-    rows = re.findall(r'"([a-z_]+) +[0-9]+ +[0-9]+"', run.group(1)) if run else []
-    RUN_ROWS[:] = rows
-    return tiers
+    rows = re.findall(r'"([a-z_]+) +([0-9]+) +[0-9]+"', run.group(1)) if run else []
+    return tiers, {t: int(share) for t, share in rows}
 
 
-RUN_ROWS = []  # the tiers LAGSIM_TIER_RUN has a row for, read by load_tiers
-
-
-def check_names(tests, tiers):
+def check_names(loaded, tiers_rows):
+    (tests, shares), (tiers, rows) = loaded, tiers_rows
     bad = []
     if not tiers:
         bad.append('tests/common/tiers.cmake: no set(LAGSIM_TIERS ...)')
@@ -156,13 +151,14 @@ def check_names(tests, tiers):
                        'tests/common/tiers.cmake matches it; add one')
         elif len(has) > 1:
             bad.append(f'{name}: more than one tier ({" ".join(has)})')
-        elif has and name not in SHARES:
-            bad.append(f'{name}: no PROCESSORS (its tier {has[0]} has no row of '
-                       'LAGSIM_TIER_RUN in tests/common/tiers.cmake, or it was not applied)')
+        elif has and shares.get(name) != rows.get(has[0]):
+            bad.append(f'{name}: PROCESSORS {shares.get(name)}, not its tier\'s share '
+                       f'({has[0]}: {rows.get(has[0])}, LAGSIM_TIER_RUN in '
+                       'tests/common/tiers.cmake)')
     for t in tiers:
-        if t not in RUN_ROWS:
+        if t not in rows:
             bad.append(f'tests/common/tiers.cmake: the tier {t} has no row in LAGSIM_TIER_RUN')
-    for t in RUN_ROWS:
+    for t in rows:
         if t not in tiers:
             bad.append(f'tests/common/tiers.cmake: LAGSIM_TIER_RUN has a row for {t}, '
                        'which is no tier of LAGSIM_TIERS')
@@ -260,7 +256,7 @@ def check_docs(src, tests, absent=()):
                             bad.append(f'{rel}:{lineno}: `{name}` names no ctest')
     # docs/testing.md's tier table against tests/common/tiers.cmake, its label table against
     # the other labels the ctests carry
-    tiers = load_tiers(os.path.join(src, 'tests', 'common', 'tiers.cmake'))
+    tiers, _ = load_tiers(os.path.join(src, 'tests', 'common', 'tiers.cmake'))
     tier_table = doc_table(src, 'tier')
     for t in tiers:
         if t not in tier_table:
@@ -551,7 +547,7 @@ def main():
     elif a.rule == 'names':
         bad = check_names(load_tests(a.dirs[0], a.ctest, a.json), load_tiers(a.tiers))
     elif a.rule == 'docs':
-        bad = check_docs(a.dirs[0], load_tests(a.dirs[1], a.ctest, a.json), a.absent)
+        bad = check_docs(a.dirs[0], load_tests(a.dirs[1], a.ctest, a.json)[0], a.absent)
     elif a.rule == 'ticks':
         bad = check_ticks(a.dirs[0])
     else:
