@@ -256,7 +256,7 @@ def case_same(d):
     req = [float(x["theta.settle"]) < 4.5 for x in r]
     check([x["required"] == "1" for x in r] == req and 0 < sum(req) < 8,
           "required column = theta.settle < 4.5 (%d of 8 runs)" % sum(req))
-    # the values drawn are the seed's whatever the runs' length: runs of 0.1 s
+    # the values drawn depend on --seed alone, whatever the runs' length: runs of 0.1 s
     s8 = os.path.join(d, "seed8.csv")
     run([SWEEP] + [{"7": "8", DUR: "0.1"}.get(a, a) for a in ARGS] + ["-j2", "--csv", s8])
     check([x["parameters.m0"] for x in rows(s8)] != [x["parameters.m0"] for x in r],
