@@ -1515,6 +1515,9 @@ int lag_client_locate(const char *prefix, double wait_s, char *url, size_t len, 
     lcm_unsubscribe(in, sub);
     lcm_destroy(in);
     int where = l->where < 0 ? LAG_CLIENT_LOCATE_NONE : l->where;
+    if (where == LAG_CLIENT_LOCATE_NONE && err)
+        snprintf(err, errlen, "nothing of prefix %s heard on %s within %.3g s and no host's "
+                 "directory named it: waiting for it there", prefix, b.state_url, wait_s);
     if (!copy_str(url, len, where == LAG_CLIENT_LOCATE_HOST ? l->url : b.state_url)) {
         if (err) snprintf(err, errlen, "locate: a URL buffer of %zu bytes is too short", len);
         url[0] = '\0';

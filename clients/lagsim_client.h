@@ -455,7 +455,9 @@ int lag_client_plants_instead(const char *url, const char *prefix, double wait_s
  *                           have, not the default bus's): url is that state URL;
  *   LAG_CLIENT_LOCATE_HERE  the plant is on the default bus itself (its state, status or
  *                           scene, or an event of another kind, came first);
- *   LAG_CLIENT_LOCATE_NONE  nothing of prefix within wait_s (no plant yet, or no directory);
+ *   LAG_CLIENT_LOCATE_NONE  nothing of prefix within wait_s (no plant yet, no directory, or
+ *                           a directory that did not announce in time: a busy machine);
+ *                           err (when given) says so, for the program to print;
  *   for both, url is the default bus's state URL, where a program waits for it;
  * or a negative lag_result with a message in err (may be NULL): LAG_CLIENT_ERR_ARG (a prefix
  * that is not 1 to 53 of [A-Za-z0-9_], a bad wait_s, url too short: LAG_CLIENT_URL_LEN is

@@ -296,14 +296,17 @@ static int pick_prefix(lag_ctl *ctl, const char *model)
 /* The client, its callbacks and the signal handlers. */
 static int connect_client(lag_ctl *ctl)
 {
-    char err[256];
+    char err[LAG_CLIENT_URL_LEN + 256];
     ctl->client = lag_client_create(ctl->url, ctl->prefix, err, sizeof err);
     /* --prefix without --url: subscribed first (nothing of a plant of the default bus is
      * missed while the directory is asked), then moved to the URL a host's directory
      * names, if it names one */
-    if (ctl->client && ctl->prefix && !ctl->url &&
-        lag_client_locate(ctl->prefix, LAG_CLIENT_LOCATE_WAIT_S, ctl->found_url,
-                          sizeof ctl->found_url, NULL, 0) == LAG_CLIENT_LOCATE_HOST) {
+    int where = ctl->client && ctl->prefix && !ctl->url
+                    ? lag_client_locate(ctl->prefix, LAG_CLIENT_LOCATE_WAIT_S, ctl->found_url,
+                                        sizeof ctl->found_url, err, sizeof err)
+                    : LAG_CLIENT_LOCATE_HERE;
+    if (where == LAG_CLIENT_LOCATE_NONE) printf("%s: %s\n", ctl->name, err);
+    if (where == LAG_CLIENT_LOCATE_HOST) {
         ctl->url = ctl->found_url;
         printf("%s: prefix %s runs on %s (the host's directory)\n", ctl->name, ctl->prefix,
                ctl->url);

@@ -771,10 +771,14 @@ static lag_client *connect_plant(options *o, lag_client_plant *chosen, int *code
 {
     char err[1200];
     static char located[LAG_CLIENT_URL_LEN];
-    if (o->prefix && !o->url &&
-        lag_client_locate(o->prefix, LAG_CLIENT_LOCATE_WAIT_S, located, sizeof located, NULL,
-                          0) == LAG_CLIENT_LOCATE_HOST)
+    int where = o->prefix && !o->url
+                    ? lag_client_locate(o->prefix, LAG_CLIENT_LOCATE_WAIT_S, located,
+                                        sizeof located, err, sizeof err)
+                    : LAG_CLIENT_LOCATE_HERE;
+    if (where == LAG_CLIENT_LOCATE_HOST)
         o->url = located; /* a host's plant: where its directory says it runs */
+    else if (where == LAG_CLIENT_LOCATE_NONE)
+        fprintf(stderr, "lagsimctl: %s\n", err);
     if (!o->prefix) {
         /* the only plant on the bus */
         int rc = lag_client_pick_plant(o->url, NULL, o->timeout, chosen, sizeof *chosen, err,

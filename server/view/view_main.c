@@ -223,13 +223,18 @@ static int pick_prefix(view_opts *o)
 
 /* --prefix without --url: a plant of a host (lagsimd --plants) runs on a URL of its own,
  * which the host's directory on LCM's default bus names (its `plant` event): the view
- * watches the plant there. A plant of that bus itself, or none heard: the default. */
+ * watches the plant there. A plant of that bus itself, or none heard: the default (and,
+ * none heard, it says so: a busy host can miss the window). */
 static void plant_url(view_opts *o)
 {
     static char url[LAG_CLIENT_URL_LEN];
-    if (!o->url && lag_client_locate(o->prefix, LAG_CLIENT_LOCATE_WAIT_S, url, sizeof url,
-                                     NULL, 0) == LAG_CLIENT_LOCATE_HOST)
-        o->url = url;
+    char err[LAG_CLIENT_URL_LEN + 256];
+    int where = o->url ? LAG_CLIENT_LOCATE_HERE
+                       : lag_client_locate(o->prefix, LAG_CLIENT_LOCATE_WAIT_S, url, sizeof url,
+                                           err, sizeof err);
+    if (where == LAG_CLIENT_LOCATE_HOST) o->url = url;
+    else if (where == LAG_CLIENT_LOCATE_NONE && !o->quiet)
+        fprintf(stderr, "lagsim-view: %s\n", err);
 }
 
 /* The address on stdout; on stderr, who can reach it. */

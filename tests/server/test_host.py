@@ -64,6 +64,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lagsim_check import SKIP, check, verdict  # noqa: E402  (tests/common: the one harness)
 from lcm_log import records  # noqa: E402  (tests/common: LCM's log format)
+from waits import WITHIN  # noqa: E402  (tests/common: how long an event may take)
 
 GROUP = "239.255.76.67"
 
@@ -221,6 +222,22 @@ class T:
                                        "".join("  | %s\n" % l for l in err.splitlines()[-12:])),
               flush=True)
         return p.returncode, err
+
+    # what lag_client_locate's message says when no announcement came within its window
+    MISSED = "no host's directory named it"
+
+    def located(self, run, what):
+        """run() -> (its output, its result), for a program given --prefix without --url.
+        Runs it again while it says the directory named nothing within the window
+        (LAG_CLIENT_LOCATE_WAIT_S: on a busy machine a host can miss its announcements), up
+        to WITHIN; returns the last result. A program that locates wrongly, or never asks,
+        does not say so: it is not run again."""
+        end = time.monotonic() + WITHIN
+        while True:
+            text, result = run()
+            if self.MISSED not in text or time.monotonic() > end:
+                return result
+            print("(%s: no announcement heard within the window; run again)" % what, flush=True)
 
     def cleanup(self):
         for p in self.procs:
@@ -792,16 +809,30 @@ class T:
             p = self.ctl("--url", url(base + 2), "--prefix", "BOB", "pause")
             check(p.returncode == 0, "pause on BOB's own URL: exit 0")
             t0 = time.monotonic()
-            p = self.ctl("--prefix", "ALICE", "--timeout", "2", "pause")
+            p = self.located(lambda: (lambda p: (p.stderr, p))(
+                self.ctl("--prefix", "ALICE", "--timeout", "2", "pause")), "lagsimctl")
             st = self.ctl("--url", url(base), "--prefix", "ALICE", "status").stdout
             check(p.returncode == 0 and "paused" in st,
                   "pause without --url: the directory names ALICE's URL, the pause is done there")
             self.controllers_through_directory(bus, base)
-            view = self.start([self.prog("lagsim-view"), "--prefix", "CAROL", "--port", "0"],
-                              stdout=subprocess.PIPE)
-            line = view.stdout.readline()
-            view.send_signal(signal.SIGTERM)
-            self.finish(view, 10)
+            def view_line():
+                view = self.start([self.prog("lagsim-view"), "--prefix", "CAROL", "--port", "0"],
+                                  stdout=subprocess.PIPE)
+                line = view.stdout.readline()
+                view.send_signal(signal.SIGTERM)
+                return self.finish(view, 10)[1], line
+
+            # a host stalled across the view's window (SIGSTOP): the view says it heard no
+            # directory and watches the default bus; once the host runs again it is found
+            host.send_signal(signal.SIGSTOP)
+            try:
+                err, line = view_line()
+            finally:
+                host.send_signal(signal.SIGCONT)
+            check(self.MISSED in err and " on " not in line,
+                  "lagsim-view --prefix CAROL beside a stalled host says so and watches the "
+                  "default bus: %s / %s" % (line.strip(), err.strip().splitlines()[:2]))
+            line = self.located(view_line, "lagsim-view")
             check("(prefix CAROL on %s)" % url(base + 4) in line,
                   "lagsim-view --prefix CAROL watches CAROL on the URL the directory names: %s"
                   % line.strip())
@@ -817,11 +848,14 @@ class T:
         """A C controller given --prefix without --url runs its host's plant on the URL the
         directory names; one put on the directory itself (--url) ends after --timeout
         though the directory keeps announcing the plant."""
-        t0 = time.monotonic()
-        ctl = self.start([self.prog("lqr_balance"), "--prefix", "CAROL", "--timeout", "3",
-                          "--duration", "1"], stdout=subprocess.PIPE)
-        out, _ = ctl.communicate(timeout=60)
-        rc, _ = self.finish(ctl, 5)
+        def lqr():
+            ctl = self.start([self.prog("lqr_balance"), "--prefix", "CAROL", "--timeout", "3",
+                              "--duration", "1"], stdout=subprocess.PIPE)
+            out, _ = ctl.communicate(timeout=60)
+            rc, _ = self.finish(ctl, 5)
+            return out, (out, rc)
+
+        out, rc = self.located(lqr, "lqr_balance")
         check(rc == 0 and ("prefix CAROL runs on %s" % url(base + 4)) in out,
               "lqr_balance --prefix CAROL without --url: on CAROL's URL, exit %s (%s)" %
               (rc, out.strip().splitlines()[:2]))
