@@ -223,6 +223,16 @@ static void set_read(replay_sets *rs, const lag_log_record *rec, const lagsimd_o
     if (!strcmp(ev.kind, "set") && !strncmp(ev.detail, "reference", 9) &&
         (ev.detail[9] == '.' || ev.detail[9] == '=') && !ref_read(rs, ev.detail, o))
         return;
+    /* the daemon's changes are at steps from 0, as its states: one outside [0, 2^53] was
+     * not published by it, and the run cannot be followed past it */
+    if (ev.step < 0 || ev.step > REPLAY_STEP_MAX) {
+        if (!rs->failed)
+            fprintf(stderr, "lagsimd: --replay: a %s event at step %lld, outside [0, 2^53]: "
+                            "not the daemon's, the log could not be checked\n",
+                    ev.kind, (long long)ev.step);
+        rs->failed = true;
+        return;
+    }
     if (rs->n == REPLAY_SETS_PENDING) {
         if (!rs->failed)
             fprintf(stderr, "lagsimd: --replay: more than %d changes (set events) between two "
@@ -314,6 +324,7 @@ static lag_result advance_with_sets(lag_sim *sim, int64_t n, replay_sets *rs,
                                     const lagsimd_opts *o, bool use_input)
 {
     const int64_t end = sim->tick + n;
+    /* steps and ticks lie in [0, 2^53] (set_read): the differences cannot overflow */
     while (rs->n > 0 && rs->step[rs->head] < end) {
         int64_t k = rs->step[rs->head] - sim->tick;
         if (k > 0) {

@@ -294,6 +294,17 @@ write("replay", "crash", "huge-data-length.lcm", s0 + huge + s10 + huge)  # cras
 write("replay", "crash", "step-jump.lcm", at_step(0) + at_step(1 << 52))  # hung
 write("replay", "crash", "step-int64-min.lcm",                             # overflow, hung
       at_step(0) + at_step(10) + at_step(-(1 << 63)))
+
+
+def set_at(step):
+    """A `set` event of a change at `step` (as the daemon publishes them, but any step)."""
+    e = event_t()
+    e.sim_time, e.step, e.kind, e.joint, e.value, e.detail = 0.0, step, "set", "", 0.0, "parameters.m2=1.0"
+    return record("DIPC_EVENT", e.encode())
+
+
+write("replay", "crash", "set-step-int64-min.lcm",                         # overflow (UBSan)
+      at_step(0) + at_step(10) + set_at(-(1 << 63)) + at_step(20))
 flood = record("DIPC_STATE", forged_state(7, b"theta0\0", n=32767, rest=False))
 write("replay", "crash", "undecodable-flood.lcm", s0 + flood * 100 + s10)  # leaked 262 kB each
 # ---- view (tests/fuzz/fuzz_view.c): first byte 0 = messages' bytes, 1 = an HTTP request

@@ -21,6 +21,8 @@
  *   step_jump             steps of 2^62 and 2^52 among good states: not re-simulated
  *                         across (no hang), exit 0
  *   step_int64_min        a step of INT64_MIN: no signed overflow, no hang, exit 0
+ *   set_step_int64_min    a change (`set` event) at step INT64_MIN: not the daemon's, said,
+ *                         no signed overflow, never "max difference = 0"
  *   dev_zero              /dev/zero: "not an LCM log", exit 1, promptly
  *   not_a_log             the scene file itself: no records, exit 1
  *   undecodable_flood     2000 undecodable states claiming 32767 joints each: counted,
@@ -46,6 +48,7 @@
 #include <unistd.h>
 
 #include "lagsim/lagsim.h"
+#include "lagsim/lagsim_event_t.h"
 #include "lagsim/lagsim_joint_state_t.h"
 #include "lagsim_test.h"
 #include "scene.h"
@@ -373,6 +376,31 @@ static void case_step_int64_min(int arg)
     ENSURE(strstr(r.out, "2 states with a non-finite number or a step outside") != NULL);
 }
 
+static void hook_set_min(FILE *f, int k)
+{
+    if (k != 20) return;
+    char ch[104];
+    snprintf(ch, sizeof ch, "%.*s_EVENT", (int)(strlen(g_channel) - strlen("_STATE")), g_channel);
+    lagsim_event_t e = {0, 0.0, INT64_MIN, "set", "", 0.0, "parameters.m2=1.0"};
+    static uint8_t buf[1024];
+    int n = lagsim_event_t_encode(buf, 0, sizeof buf, &e);
+    record(f, ch, buf, (uint32_t)n);
+}
+
+static void case_set_step_int64_min(int arg)
+{
+    (void)arg;
+    FILE *f = log_create();
+    run(f, 40, hook_set_min);
+    fclose(f);
+    result r;
+    if (!replay(g_log, 30, 0, &r)) return;
+    ENSUREF(r.status != 0, "status %d", r.status);
+    ENSURE(strstr(r.out, "a set event at step -9223372036854775808, outside [0, 2^53]: not "
+                         "the daemon's, the log could not be checked") != NULL);
+    ENSURE(strstr(r.out, "max difference = 0\n") == NULL);
+}
+
 static void case_dev_zero(int arg)
 {
     (void)arg;
@@ -476,6 +504,7 @@ static const lt_case cases[] = {
     {"huge_data_length", case_huge_data_length, 0, 0},
     {"step_jump", case_step_jump, 0, 0},
     {"step_int64_min", case_step_int64_min, 0, 0},
+    {"set_step_int64_min", case_set_step_int64_min, 0, 0},
     {"dev_zero", case_dev_zero, 0, 0},
     {"not_a_log", case_not_a_log, 0, 0},
     {"undecodable_flood", case_undecodable_flood, 0, 0},
