@@ -533,13 +533,31 @@ lag_result lag_client_handle(lag_client *c, int timeout_ms)
     return rc > 0 ? LAG_CLIENT_OK : LAG_CLIENT_TIMEOUT;
 }
 
-/* Handles messages until `flag` becomes true or the deadline (monotonic s) passes.
- * Returns LAG_CLIENT_OK if flag, LAG_CLIENT_TIMEOUT, or an error. */
+/* Reads what is already queued, without waiting, until `flag` (NULL: never) or nothing
+ * is left: a process stalled past its deadline (a busy machine) still takes the answers
+ * that came meanwhile before it says none came. 0, or an error. */
+static lag_result handle_queued(lag_client *c, const bool *flag)
+{
+    for (int i = 0; i < 1000 && !(flag && *flag); i++) {
+        lag_result rc = lag_client_handle(c, 0);
+        if (rc < 0) return rc;
+        if (rc == LAG_CLIENT_TIMEOUT) break;
+    }
+    return 0;
+}
+
+/* Handles messages until `flag` becomes true or the deadline (monotonic s) passes (what
+ * was queued by then read first). Returns LAG_CLIENT_OK if flag, LAG_CLIENT_TIMEOUT, or
+ * an error. */
 static lag_result handle_until(lag_client *c, const bool *flag, double deadline)
 {
     while (!*flag) {
         double left = deadline - lag_client_now();
-        if (!(left > 0.0)) return LAG_CLIENT_TIMEOUT;
+        if (!(left > 0.0)) {
+            lag_result rc = handle_queued(c, flag);
+            if (rc < 0) return rc;
+            return *flag ? LAG_CLIENT_OK : LAG_CLIENT_TIMEOUT;
+        }
         int ms = left < 0.1 ? (int)ceil(left * 1000.0) : 100;
         lag_result rc = lag_client_handle(c, ms);
         if (rc < 0) return rc;
@@ -582,11 +600,7 @@ lag_result lag_client_wait_state(lag_client *c, double timeout_s, lag_client_sta
         return rc;
     }
     /* drain what is already queued so that the newest state is returned */
-    for (int i = 0; i < 1000; i++) {
-        rc = lag_client_handle(c, 0);
-        if (rc < 0) return rc;
-        if (rc == LAG_CLIENT_TIMEOUT) break;
-    }
+    if ((rc = handle_queued(c, NULL)) < 0) return rc;
     c->new_state = false;
     if (st) copy_out(st, size, &c->out_state, sizeof c->out_state, STATE_SIZE_1);
     return LAG_CLIENT_OK;
@@ -1183,6 +1197,9 @@ static void disc_listen(disc *d, lcm_t *in, lcm_t *cmd, const lag_bus *b, int ma
         if (lcm_handle_timeout(in, ms) < 0 && errno != EINTR) break;
         read_hosts(d, hfd);
     }
+    /* what came while this process was stalled past the time (a busy machine) */
+    for (int i = 0; i < 1000; i++)
+        if (lcm_handle_timeout(in, 0) <= 0) break;
     read_hosts(d, hfd);
     if (hfd >= 0) close(hfd);
 }
@@ -1471,12 +1488,15 @@ static bool prefix_ok(const char *prefix)
     return true;
 }
 
-/* Listens on `in` until the rule decides or wait_s passed. */
+/* Listens on `in` until the rule decides or wait_s passed; then reads what is already
+ * queued (a process stalled past its window still takes the announcements that came). */
 static void locate_listen(lcm_t *in, locate *l, double wait_s)
 {
     double end = lag_client_now() + wait_s;
     for (double left; l->where < 0 && (left = end - lag_client_now()) > 0;)
-        if (lcm_handle_timeout(in, (int)(left * 1000.0) + 1) < 0) break;
+        if (lcm_handle_timeout(in, (int)(left * 1000.0) + 1) < 0) return;
+    for (int i = 0; i < 1000 && l->where < 0; i++)
+        if (lcm_handle_timeout(in, 0) <= 0) break;
 }
 
 int lag_client_locate(const char *prefix, double wait_s, char *url, size_t len, char *err,

@@ -474,8 +474,14 @@ static lag_result wait_for(lag_client *c, answer *a, double timeout, bool silenc
 {
     double t0 = lag_client_now();
     while (!done(a) && !g_signal) {
-        if (lag_client_now() - (silence && a->heard > t0 ? a->heard : t0) >= timeout)
-            return LAG_CLIENT_TIMEOUT;
+        if (lag_client_now() - (silence && a->heard > t0 ? a->heard : t0) >= timeout) {
+            /* what came while this process was stalled past the time (a busy machine) */
+            int rc = LAG_CLIENT_OK;
+            for (int i = 0; i < 1000 && !done(a) && rc == LAG_CLIENT_OK; i++)
+                rc = lag_client_handle(c, 0);
+            if (rc < 0) return rc;
+            return done(a) ? LAG_CLIENT_OK : LAG_CLIENT_TIMEOUT;
+        }
         int rc = lag_client_handle(c, 50);
         if (rc < 0) return rc;
     }
