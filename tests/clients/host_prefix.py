@@ -37,7 +37,8 @@ def url(port):
 def status(a, env, prefix, port):
     """The plant's status (lagsimctl --json status on its own URL), or {}."""
     p = subprocess.run([os.path.join(a.bin, "lagsimctl"), "--json", "--url", url(port),
-                        "--prefix", prefix, "status"], capture_output=True, text=True,
+                        "--prefix", prefix, "--timeout", "10", "status"], capture_output=True,
+                       text=True,
                        timeout=60, env=env)
     for line in p.stdout.splitlines():
         try:

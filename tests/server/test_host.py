@@ -803,15 +803,16 @@ class T:
             p = self.ctl("--json", "list")
             check(p.returncode == 0 and all('"url": "%s"' % u in p.stdout for u in want.values()),
                   "--json list: the same URLs")
-            p = self.ctl("--prefix", "BOB", "status")
+            p = self.ctl("--prefix", "BOB", "--timeout", "10", "status")
             check(p.returncode == 0 and "status of BOB" in p.stdout and "running" in p.stdout,
                   "status through the directory: BOB's last status")
-            p = self.ctl("--url", url(base + 2), "--prefix", "BOB", "pause")
+            p = self.ctl("--url", url(base + 2), "--prefix", "BOB", "--timeout", "10", "pause")
             check(p.returncode == 0, "pause on BOB's own URL: exit 0")
             t0 = time.monotonic()
             p = self.located(lambda: (lambda p: (p.stderr, p))(
-                self.ctl("--prefix", "ALICE", "--timeout", "2", "pause")), "lagsimctl")
-            st = self.ctl("--url", url(base), "--prefix", "ALICE", "status").stdout
+                self.ctl("--prefix", "ALICE", "--timeout", "10", "pause")), "lagsimctl")
+            st = self.ctl("--url", url(base), "--prefix", "ALICE", "--timeout", "10",
+                          "status").stdout
             check(p.returncode == 0 and "paused" in st,
                   "pause without --url: the directory names ALICE's URL, the pause is done there")
             self.controllers_through_directory(bus, base)
