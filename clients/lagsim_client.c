@@ -535,7 +535,7 @@ lag_result lag_client_handle(lag_client *c, int timeout_ms)
 
 /* Reads what is already queued, without waiting, until `flag` (NULL: never) or nothing
  * is left: a process stalled past its deadline (a busy machine) still takes the answers
- * that came meanwhile before it says none came. 0, or an error. */
+ * that came meanwhile before it says none came. LAG_CLIENT_OK, or an error. */
 static lag_result handle_queued(lag_client *c, const bool *flag)
 {
     for (int i = 0; i < 1000 && !(flag && *flag); i++) {
@@ -543,7 +543,7 @@ static lag_result handle_queued(lag_client *c, const bool *flag)
         if (rc < 0) return rc;
         if (rc == LAG_CLIENT_TIMEOUT) break;
     }
-    return 0;
+    return LAG_CLIENT_OK;
 }
 
 /* Handles messages until `flag` becomes true or the deadline (monotonic s) passes (what
