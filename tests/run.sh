@@ -9,7 +9,7 @@
 #                                2. clang, -Werror, -O1, ASan + UBSan (float-cast-overflow
 #                                   too) + libFuzzer (build-asan/): every test but the tier slow
 #                                   (no bench or package test is made there), and each
-#                                   fuzz target for LAGSIM_FUZZ_SECONDS (default 20).
+#                                   fuzz target for LAGSIM_FUZZ_SECONDS (default 25).
 #   tests/run.sh --tier T,...   those tiers of pass 1 (e.g. --tier quick,wallclock)
 #   tests/run.sh --label L      ctest -L L in pass 1 (a regular expression, as ctest takes it)
 #   tests/run.sh --sanitize ... pass 2's build instead of pass 1's (with --tier or --label)

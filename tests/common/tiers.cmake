@@ -131,7 +131,10 @@ set(LAGSIM_TIER_RULES
 # most 4 tests a core run at once (docs/testing.md, "Time", has the measures and what a
 # smaller share did to a real-time plant). The cost (COST) is the order ctest starts
 # them in: an explicit cost, which ctest's timings of earlier runs do not change; the
-# long kinds first, so that none of them is left running alone at the end.
+# long kinds first, so that none of them is left running alone at the end. The fuzz
+# targets start first, one at a time (a resource lock, tests/fuzz/fuzz.cmake), with half
+# a core: a fuzzer takes the CPU the others leave for a fixed time, so it runs beside
+# them through the pass instead of after them, two at a time, with nothing else.
 #   tier       share cost
 set(LAGSIM_TIER_RUN
   "quick         40    10"
@@ -143,7 +146,7 @@ set(LAGSIM_TIER_RUN
   "package      100    60"
   "slow          30    30"
   "bench        100    10"
-  "fuzz_run     100    20"
+  "fuzz_run      50    70"
 )
 
 # lagsim_tier_run(TIER OUT): OUT = the properties a test of TIER runs with

@@ -10,7 +10,7 @@
 # target is linked with libFuzzer, and fuzz_<name>_run fuzzes for LAGSIM_FUZZ_SECONDS
 # from a copy of the corpus in the build tree (new inputs never dirty the checkout).
 set(LAGSIM_FUZZ_DIR ${CMAKE_CURRENT_LIST_DIR})
-set(LAGSIM_FUZZ_SECONDS 20 CACHE STRING "seconds each fuzz_<name>_run test fuzzes (LAGSIM_FUZZ=ON)")
+set(LAGSIM_FUZZ_SECONDS 25 CACHE STRING "seconds each fuzz_<name>_run test fuzzes (LAGSIM_FUZZ=ON)")
 
 function(lagsim_fuzz_target name)
   cmake_parse_arguments(F "" "" "SOURCES;LIBS" ${ARGN})
@@ -51,6 +51,8 @@ function(lagsim_fuzz_target name)
                      -rss_limit_mb=2048 -print_final_stats=1
                      -artifact_prefix=${work}/artifacts/ ${work}/corpus ${dirs})
     math(EXPR limit "${LAGSIM_FUZZ_SECONDS} * 3 + 120")
-    set_tests_properties(fuzz_${name}_run PROPERTIES TIMEOUT ${limit} LABELS "fuzz;fuzz_run")
+    # one at a time, beside the pass's other tests (tests/common/tiers.cmake: fuzz_run)
+    set_tests_properties(fuzz_${name}_run PROPERTIES TIMEOUT ${limit} LABELS "fuzz;fuzz_run"
+                         RESOURCE_LOCK lagsim_fuzz_run)
   endif()
 endfunction()
