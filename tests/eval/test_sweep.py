@@ -592,7 +592,12 @@ def case_kept_python(d):
     for k in range(3):
         kept = os.path.join(d, "kept%d.csv" % k)
         run([SWEEP] + q + ["--seed", "2", "--csv", kept], env=env)
-        same += same_but_restart(kept, fresh)
+        if same_but_restart(kept, fresh):
+            same += 1
+        else:  # which runs differ, for the one who reads the failure
+            a, b = open(kept).read().splitlines(), open(fresh).read().splitlines()
+            print("kept%d.csv and fresh.csv differ:\n%s" % (k, "\n".join(
+                "  kept  %s\n  fresh %s" % (x, y) for x, y in zip(a, b) if x != y)))
     check(len(rows(fresh)) == 4 and same == 3,
           "Python controller, 3 sweeps with kept processes: %d of 3 equal to --restart's, "
           "byte for byte" % same)
