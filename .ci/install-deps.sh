@@ -61,7 +61,7 @@ rank() {
     runtime) echo 1 ;;
     tests) echo 2 ;;
     dev | ci | service) echo 3 ;;
-    *) echo "usage: $0 runtime|tests|dev|ci [--list]" >&2; exit 2 ;;
+    *) echo "usage: $0 [--list] runtime|tests|dev|ci" >&2; exit 2 ;;
   esac
 }
 
@@ -70,7 +70,11 @@ if [ "${1:-}" = --list ]; then
   list=1
   shift
 fi
-[ $# -eq 1 ] || { echo "usage: $0 [--list] runtime|tests|dev|ci" >&2; exit 2; }
+# a profile to install or list (`service` is a kind of row of the table, not a profile)
+case "$#:${1:-}" in
+  1:runtime | 1:tests | 1:dev | 1:ci) ;;
+  *) echo "usage: $0 [--list] runtime|tests|dev|ci" >&2; exit 2 ;;
+esac
 want=$(rank "$1")
 pkgs=()
 while read -r profile pkg _; do

@@ -20,6 +20,9 @@
 # non-zero when any failed, after every summary.
 #   LAGSIM_SKIP_SANITIZE=1   --full without pass 2
 #   LAGSIM_TEST_CORES=N      the cores a pass plans for (default: nproc)
+#   LAGSIM_FUZZ_SECONDS=S    each fuzz target's time in pass 2 (kept in build-asan/'s cache)
+# A pass's whole ctest output: BUILD_DIR/ctest.log (the summary names it); one test by
+# name: cd build && ctest -R '^NAME$' --output-on-failure.
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root" || exit 2
@@ -27,18 +30,32 @@ cd "$root" || exit 2
 mode=quick
 select=""
 sanitize=0
+usage() { echo "tests/run.sh: $* (--help)" >&2; exit 2; }
+# the tiers: tests/common/tiers.cmake's LAGSIM_TIERS
+tiers=$(sed -n 's/^set(LAGSIM_TIERS \(.*\))$/\1/p' "$root/tests/common/tiers.cmake")
 while [ $# -gt 0 ]; do
   case $1 in
     --full) mode=full ;;
     --quick) mode=quick ;;
-    --tier) mode=some; shift; select="^(${1//,/|})\$" ;;
-    --label) mode=some; shift; select=$1 ;;
+    --tier | --label)
+      [ $# -ge 2 ] && [ -n "$2" ] || usage "$1 takes a value"
+      mode=some
+      if [ "$1" = --tier ]; then
+        for t in ${2//,/ }; do
+          [[ " $tiers " == *" $t "* ]] || usage "no tier '$t': the tiers are $tiers"
+        done
+        select="^(${2//,/|})\$"
+      else
+        select=$2
+      fi
+      shift ;;
     --sanitize) sanitize=1 ;;
     -h | --help) sed -n '2,/^set -uo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
-    *) echo "tests/run.sh: unknown argument '$1' (--help)" >&2; exit 2 ;;
+    *) usage "unknown argument '$1'" ;;
   esac
   shift
 done
+[ $sanitize -eq 0 ] || [ $mode = some ] || usage "--sanitize goes with --tier or --label"
 
 "$root/.ci/install-deps.sh" "$([ "${CI:-}" = true ] && echo ci || echo tests)" || exit 1
 cores=$(nproc)
@@ -59,7 +76,9 @@ build() {
   local dir=$1 t0=$SECONDS rc=0
   shift
   mkdir -p "$dir"
-  cmake -S . -B "$dir" "$@" >/dev/null && cmake --build "$dir" -j"$cores" || rc=1
+  echo "(configuring $dir: cmake's output in $dir/configure.log; then building it)"
+  cmake -S . -B "$dir" "$@" >"$dir/configure.log" 2>&1 && cmake --build "$dir" -j"$cores" ||
+    { rc=1; tail -30 "$dir/configure.log"; }
   echo $rc >"$dir/build.rc"
   echo $((SECONDS - t0)) >"$dir/build.s"
   return $rc
@@ -109,7 +128,8 @@ run_pass() {
     summaries+=("$name: built, warning-free ($(cat "$dir/build.s") s of build)")
     return
   fi
-  local args=(--output-on-failure -j"$jobs" --timeout "$timeout")
+  # --no-tests=error: a selection that matches no test fails, it does not pass
+  local args=(--output-on-failure --no-tests=error -j"$jobs" --timeout "$timeout")
   [ -n "$sel" ] && args+=(-L "$sel")
   [ -n "$excl" ] && args+=(-LE "^(${excl// /|})\$")
   (cd "$dir" && ctest "${args[@]}") 2>&1 | tee "$root/$dir/ctest.log"
@@ -122,11 +142,11 @@ run_pass() {
   fi
   if [ "$rc" -eq 0 ]; then
     result=$(grep -E "tests passed" "$log" | tail -1)
-    summaries+=("$name: $result ($(sed -n 's/^Total Test time (real) = *//p' "$log"))")
+    summaries+=("$name: $result ($(sed -n 's/^Total Test time (real) = *//p' "$log"); $dir/ctest.log)")
   else
     failed=1
     result=$(grep -E "tests passed|tests failed" "$log" | tail -1)
-    summaries+=("$name: ${result:-ctest failed}"$'\n'"$(sed -n '/The following tests FAILED/,$p' "$log" | grep -E '^\s+[0-9]+ - ')")
+    summaries+=("$name: ${result:-ctest failed} ($dir/ctest.log)"$'\n'"$(sed -n '/The following tests FAILED/,$p' "$log" | grep -E '^\s+[0-9]+ - ')")
   fi
   summaries+=("$name: $((SECONDS - start)) s")
 }
@@ -138,7 +158,8 @@ gcc_args=(-DCMAKE_C_COMPILER=gcc -DCMAKE_BUILD_TYPE=Release -DLAGSIM_WERROR=ON)
 # its physics tests 2.1 to 2.3 times as fast as at -O0 (test_hard chaos 20.7 s -> 9.1 s,
 # test_accuracy_cost dipc_1e-04 11.5 s -> 5.5 s); assertions stay (no NDEBUG)
 asan_args=(-DCMAKE_C_COMPILER=clang -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_C_FLAGS_DEBUG=-g -O1"
-           -DLAGSIM_WERROR=ON -DLAGSIM_SANITIZE=ON -DLAGSIM_FUZZ=ON -DLAGSIM_BENCH=OFF)
+           -DLAGSIM_WERROR=ON -DLAGSIM_SANITIZE=ON -DLAGSIM_FUZZ=ON -DLAGSIM_BENCH=OFF
+           ${LAGSIM_FUZZ_SECONDS:+-DLAGSIM_FUZZ_SECONDS=$LAGSIM_FUZZ_SECONDS})
 asan_env() { export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1; }
 
 case $mode in

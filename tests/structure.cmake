@@ -44,3 +44,9 @@ add_test(NAME structure_install_deps
          COMMAND ${LAGSIM_BASH_FOR_DEPS} -c
            "for p in runtime tests ci dev; do ${PROJECT_SOURCE_DIR}/.ci/install-deps.sh --list $p >/dev/null || exit 1; done")
 set_tests_properties(structure_install_deps PROPERTIES TIMEOUT 60 LABELS structure)
+# tests/run.sh refuses what it cannot do (a --tier or --label without a value, a tier
+# tiers.cmake lacks, --sanitize alone) with exit 2 and a line, and takes every tier
+add_test(NAME structure_run_usage
+         COMMAND ${LAGSIM_BASH_FOR_DEPS} ${CMAKE_CURRENT_LIST_DIR}/structure/run_usage.sh
+                 ${PROJECT_SOURCE_DIR})
+set_tests_properties(structure_run_usage PROPERTIES TIMEOUT 60 LABELS structure)
