@@ -13,7 +13,8 @@
  * Checked for every input: no crash or undefined behaviour (ASan/UBSan), no number that
  * is NaN or Inf in any message published, the sim's state finite unless in the fault
  * state, and bounded output: a handler call publishes at most one message (answers are
- * deferred and coalesced), a wake-up at most a burst of periods' worth, and over the
+ * deferred and coalesced) besides a new generation's scene and a reset's `restore`
+ * event, a wake-up at most a burst of periods' worth, and over the
  * input every limited event kind, statuses, scene descriptions and states stay within
  * what their buckets allow for the made-up time that passed.
  */
@@ -73,6 +74,7 @@ static double dbl(bytes *b)
 /* ---------------------------------------------------------------- what is published */
 typedef struct counts {
     int64_t state, status, scene, event;
+    int64_t restore; /* `restore` events: a RESET to the scene file's values names its undoing */
     int64_t ev_kind[RT_EV_COUNT + 3]; /* limited kinds, then start/stop, set, others */
 } counts;
 static counts g_c;
@@ -128,6 +130,7 @@ static void on_any(const lcm_recv_buf_t *rb, const char *ch, void *user)
             if (!strcmp(m.kind, k_limited[i])) k = i;
         if (!strcmp(m.kind, "start") || !strcmp(m.kind, "stop")) k = RT_EV_COUNT;
         if (!strcmp(m.kind, "set")) k = RT_EV_COUNT + 1; /* never suppressed: SET's bucket */
+        if (!strcmp(m.kind, "restore")) g_c.restore++;
         if (k == RT_EV_COUNT + 2) fprintf(stderr, "fuzz_rt: event of kind %s\n", m.kind);
         g_c.ev_kind[k]++;
         g_c.event++;
@@ -191,12 +194,16 @@ static void wake(void)
 
 static void handler_done(int64_t before)
 {
-    int64_t scenes = g_c.scene;
+    int64_t scenes = g_c.scene, restores = g_c.restore;
     drain();
-    /* one answer, and the scene of a new generation (a SET, a kick, a reset) before it */
+    /* one answer, and the scene of a new generation (a SET, a kick, a reset) before it;
+     * a RESET to the scene file's values first names what it undid: a `restore` event
+     * (docs/server.md, RESET) */
     if (g_c.scene - scenes > 1) bad("a handler call published more than one scene");
-    if (out_total() - before - (g_c.scene - scenes) > 1)
-        bad("a handler call published more than one message besides a new generation's scene");
+    if (g_c.restore - restores > 1) bad("a handler call published more than one restore");
+    if (out_total() - before - (g_c.scene - scenes) - (g_c.restore - restores) > 1)
+        bad("a handler call published more than one message besides a new generation's "
+            "scene and a reset's restore");
     check_state();
 }
 
