@@ -1169,6 +1169,14 @@ static void disc_ask(disc *d, lcm_t *cmd, int i, uint8_t *buf, size_t cap)
     d->asked[i] = lag_client_now();
 }
 
+/* Reads what `in` already has queued, without waiting: a process stalled past its time
+ * (a busy machine) still takes what came meanwhile. */
+static void read_queued(lcm_t *in)
+{
+    for (int i = 0; i < 1000; i++)
+        if (lcm_handle_timeout(in, 0) <= 0) break;
+}
+
 /* Listens on `in` up to wait_s, asking each plant heard for its scene and status on
  * `cmd` until they come; ends settle_s after the first plant was heard once every plant
  * heard is described (settle_s < 0: at wait_s). */
@@ -1197,9 +1205,7 @@ static void disc_listen(disc *d, lcm_t *in, lcm_t *cmd, const lag_bus *b, int ma
         if (lcm_handle_timeout(in, ms) < 0 && errno != EINTR) break;
         read_hosts(d, hfd);
     }
-    /* what came while this process was stalled past the time (a busy machine) */
-    for (int i = 0; i < 1000; i++)
-        if (lcm_handle_timeout(in, 0) <= 0) break;
+    read_queued(in);
     read_hosts(d, hfd);
     if (hfd >= 0) close(hfd);
 }
@@ -1495,8 +1501,7 @@ static void locate_listen(lcm_t *in, locate *l, double wait_s)
     double end = lag_client_now() + wait_s;
     for (double left; l->where < 0 && (left = end - lag_client_now()) > 0;)
         if (lcm_handle_timeout(in, (int)(left * 1000.0) + 1) < 0) return;
-    for (int i = 0; i < 1000 && l->where < 0; i++)
-        if (lcm_handle_timeout(in, 0) <= 0) break;
+    if (l->where < 0) read_queued(in); /* on_locate keeps the first that decides */
 }
 
 int lag_client_locate(const char *prefix, double wait_s, char *url, size_t len, char *err,
