@@ -413,9 +413,13 @@ static bool subscribe_all(lag_client *c)
     snprintf(c->ch_control, sizeof c->ch_control, "%s", c->bus.channel[LAG_BUS_CONTROL]);
     snprintf(c->ch_reference, sizeof c->ch_reference, "%s", c->bus.channel[LAG_BUS_REFERENCE]);
     /* lcm_subscribe takes a POSIX regular expression: escape the channel names so that
-     * a prefix with regex characters still matches only itself. */
-    const char *chans[5] = {c->ch_state, c->ch_status, c->ch_event, c->ch_scene,
-                            c->ch_reference};
+     * a prefix with regex characters still matches only itself. The state's channel
+     * last: LCM drops a message that no subscription takes when it arrives, and the
+     * daemon publishes a state's reference (and a generation's scene) just before the
+     * state, so a state subscribed first could be kept while its reference, come a moment
+     * earlier, was not: a law would answer it without its reference. */
+    const char *chans[5] = {c->ch_reference, c->ch_scene, c->ch_status, c->ch_event,
+                            c->ch_state};
     lcm_subscription_t *s[5];
     for (int k = 0; k < 5; k++) {
         char re[200];
@@ -424,8 +428,8 @@ static bool subscribe_all(lag_client *c)
     }
     /* The state subscription keeps a deeper queue: a slow controller still sees states
      * in order rather than losing them inside LCM; each state's reference with it. */
-    lcm_subscription_set_queue_capacity(s[0], 64);
     lcm_subscription_set_queue_capacity(s[4], 64);
+    lcm_subscription_set_queue_capacity(s[0], 64);
     return true;
 }
 

@@ -222,13 +222,15 @@ bool view_bridge_open(view_bridge *vb, const char *url, const char *prefix, bool
         view_bridge_close(vb);
         return false;
     }
-    lcm_subscription_t *subs[5] = {
-        lcm_subscribe(vb->lcm, vb->ch_state, on_state, vb),
-        lcm_subscribe(vb->lcm, vb->ch_status, on_status, vb),
-        lcm_subscribe(vb->lcm, vb->ch_event, on_event, vb),
-        lcm_subscribe(vb->lcm, vb->ch_scene, on_scene, vb),
-        lcm_subscribe(vb->lcm, vb->ch_reference, on_reference, vb),
-    };
+    /* one at a time, the state's channel last: LCM drops a message that no subscription
+     * takes when it arrives, and a state's reference (a generation's scene) is published
+     * just before it: a state is drawn with its reference (the client library's rule) */
+    lcm_subscription_t *subs[5];
+    subs[0] = lcm_subscribe(vb->lcm, vb->ch_reference, on_reference, vb);
+    subs[1] = lcm_subscribe(vb->lcm, vb->ch_scene, on_scene, vb);
+    subs[2] = lcm_subscribe(vb->lcm, vb->ch_status, on_status, vb);
+    subs[3] = lcm_subscribe(vb->lcm, vb->ch_event, on_event, vb);
+    subs[4] = lcm_subscribe(vb->lcm, vb->ch_state, on_state, vb);
     for (int i = 0; i < 5; i++) {
         if (!subs[i]) {
             snprintf(err, errlen, "cannot subscribe to the %s channels", prefix);

@@ -13,7 +13,12 @@
  * called from a thread of a 256 KiB stack (a controller's worker, a JVM's or a Python
  * thread), runs: its LAG_CLIENT_MAX_PLANTS plants (a lab host's 1024) are not on the
  * caller's stack.
+ * first_burst: the daemon's first scene, reference and state published at each moment of
+ * lag_client_create (after each of its subscriptions, through a wrapper of lcm_subscribe
+ * on memq://, where a message no subscription takes is dropped at once): a state the
+ * client keeps has its reference.
  */
+#include <dlfcn.h>
 #include <math.h>
 #include <poll.h>
 #include <pthread.h>
@@ -27,6 +32,7 @@
 
 #include "lagsim/lagsim_control_t.h"
 #include "lagsim/lagsim_joint_state_t.h"
+#include "lagsim/lagsim_reference_t.h"
 #include "lagsim/lagsim_scene_t.h"
 #include "lagsim/lagsim_status_t.h"
 #include "lagsim_bus.h"
@@ -479,11 +485,102 @@ static void case_locate(int arg)
     ENSURE(unsetenv("LCM_DEFAULT_URL") == 0);
 }
 
+/* lcm_subscribe, wrapped: while g_burst_at > 0, the g_burst_at-th subscription to a
+ * channel of g_burst_prefix is followed at once by the daemon's first burst (its scene,
+ * the reference at t = 0, the state at t = 0) on the subscribing lcm_t. Otherwise LCM's. */
+static const char *g_burst_prefix;
+static int g_burst_at, g_burst_seen;
+static lcm_t *g_burst_lcm;
+#define BURST_GEN 7
+
+static void publish_reference(lcm_t *lcm, const char *prefix, double t)
+{
+    char ch[128];
+    snprintf(ch, sizeof ch, "%s_REFERENCE", prefix);
+    char *names[1] = {"q1"};
+    double r[1] = {0.25}, rd[1] = {0.5}, rdd[1] = {0.0};
+    lagsim_reference_t m = {.utime = 1, .sim_time = t, .step = (int64_t)(t * 1000),
+                            .num_joints = 1, .name = names, .r = r, .rdot = rd,
+                            .generation = BURST_GEN, .rddot = rdd};
+    lagsim_reference_t_publish(lcm, ch, &m);
+}
+
+static void publish_burst(lcm_t *lcm, const char *prefix)
+{
+    char ch[128];
+    snprintf(ch, sizeof ch, "%s_STATE", prefix);
+    publish_scene(lcm, prefix, BURST_GEN, 1.0);
+    publish_reference(lcm, prefix, 0.0);
+    publish_state(lcm, ch, 2, NULL, 0.0, 0.1);
+}
+
+lcm_subscription_t *lcm_subscribe(lcm_t *lcm, const char *channel, lcm_msg_handler_t handler,
+                                  void *userdata)
+{
+    typedef lcm_subscription_t *(*subscribe_fn)(lcm_t *, const char *, lcm_msg_handler_t,
+                                                void *);
+    static subscribe_fn real;
+    if (!real) {
+        void *sym = dlsym(RTLD_NEXT, "lcm_subscribe");
+        memcpy(&real, &sym, sizeof real);
+    }
+    lcm_subscription_t *sub = real(lcm, channel, handler, userdata);
+    if (sub && g_burst_at > 0 && strstr(channel, g_burst_prefix) &&
+        ++g_burst_seen == g_burst_at) {
+        g_burst_lcm = lcm;
+        publish_burst(lcm, g_burst_prefix);
+    }
+    return sub;
+}
+
+static void case_first_burst(int arg)
+{
+    (void)arg;
+    char err[256];
+    int kept = 0, moments = 0;
+    g_gen = BURST_GEN;
+    for (int at = 1;; at++) {
+        g_burst_prefix = "BURST";
+        g_burst_at = at;
+        g_burst_seen = 0;
+        g_burst_lcm = NULL;
+        lag_client *c = lag_client_create("memq://", g_burst_prefix, err, sizeof err);
+        ENSUREF(c != NULL, "%s", err);
+        int subscriptions = g_burst_seen;
+        g_burst_at = 0;
+        if (!g_burst_lcm) { /* after the last subscription: every moment was tried */
+            lag_client_destroy(c);
+            break;
+        }
+        moments++;
+        /* what was kept, then the scene again (the daemon's answer to DESCRIBE) */
+        while (lag_client_handle(c, 0) == LAG_CLIENT_OK) {}
+        publish_scene(g_burst_lcm, g_burst_prefix, BURST_GEN, 1.0);
+        while (lag_client_handle(c, 0) == LAG_CLIENT_OK) {}
+        lag_client_state st;
+        lag_client_reference ref;
+        if (lag_client_wait_state(c, 0.0, &st, sizeof st) == LAG_CLIENT_OK) {
+            kept++;
+            ENSUREF(st.sim_time == 0.0 && st.generation == BURST_GEN, "%g %lld", st.sim_time,
+                    (long long)st.generation);
+            ENSUREF(lag_client_reference_of(c, &st, &ref, sizeof ref) && ref.r[0] == 0.25,
+                    "the burst after subscription %d of %d: its state kept, its reference "
+                    "not",
+                    at, subscriptions);
+        }
+        lag_client_destroy(c);
+    }
+    /* the burst after the last subscription reaches every channel */
+    ENSUREF(moments >= 5 && kept >= 1, "%d moments, %d states kept", moments, kept);
+    g_gen = 0;
+}
+
 int main(int argc, char **argv)
 {
     static const lt_case cases[] = {{"library", case_library, 0, 0},
                                     {"generation", case_generation, 0, 0},
                                     {"small_stack", case_small_stack, 0, 0},
-                                    {"locate", case_locate, 0, 0}};
-    return lt_main(argc, argv, cases, 4);
+                                    {"locate", case_locate, 0, 0},
+                                    {"first_burst", case_first_burst, 0, 0}};
+    return lt_main(argc, argv, cases, 5);
 }

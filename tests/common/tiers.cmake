@@ -104,7 +104,7 @@ set(LAGSIM_TIER_RULES
   "wallclock NAME  ^clients_(readme_recipes|walkthrough|scene_params)$"
   "wallclock NAME  ^ctl_"
   "quick     NAME  ^install_"
-  "quick     NAME  ^clients_(lqr|status_fields|hostile_messages|library|generation|small_stack|locate|not_built)$"
+  "quick     NAME  ^clients_(lqr|status_fields|hostile_messages|library|generation|small_stack|locate|first_burst|not_built)$"
   "quick     NAME  ^clients_[a-z_]+_(usage_.*|help)$"
   "quick     NAME  ^clients_(python|lua)_(lcm|types)$"
   "quick     NAME  ^clients_java_release$"
