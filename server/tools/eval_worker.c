@@ -50,7 +50,9 @@
 #define W_QUIET_S 0.25  /* a run with no new state for this long: a status is asked for */
 #define W_LOG_WAIT_S 3.0 /* the log's writer writes within 0.1 s; this is its margin */
 #define W_PAUSED_S 10.0 /* the controller's answer to the paused state, at most this late */
-#define W_FIRST_S 30.0  /* a new pair's controller answers its first state within this */
+#define W_FIRST_S 30.0  /* a new pair's controller answers its first state within this, or
+                         * within a run's wall time (--timeout) when that is shorter: the
+                         * first run could not end within it either */
 
 struct eval_worker {
     eval_env env;
@@ -297,6 +299,12 @@ static eval_worker *start_failed(eval_worker *w, char *err, size_t errlen, const
     return NULL;
 }
 
+/* How long a new pair's controller has to answer its first state. */
+static double first_wait(const eval_worker *w)
+{
+    return w->env.wall_timeout < W_FIRST_S ? w->env.wall_timeout : W_FIRST_S;
+}
+
 /* The first STEP of a new pair was never answered: the controller ended before it answered
  * the first state, or (alive) never answered it, which the daemon's status says in its
  * words (what it waits for, on which channel and URL, what came instead). Either way
@@ -314,11 +322,11 @@ static eval_worker *no_first_answer(eval_worker *w, bool *controller, char *err,
     } else if (fresh_status(w, &st, false) && st.waiting_for[0]) {
         snprintf(why, sizeof why, "the controller did not answer the kept lagsimd's first "
                  "state within %g s: lagsimd waits %.0f s for %s; %s%s (is the controller on "
-                 "the run's prefix: {prefix} or LAGSIM_PREFIX?)", W_FIRST_S, st.waiting_s,
+                 "the run's prefix: {prefix} or LAGSIM_PREFIX?)", first_wait(w), st.waiting_s,
                  st.waiting_for, st.waiting_got[0] ? "got instead: " : "nothing else came",
                  st.waiting_got);
     } else {
-        snprintf(why, sizeof why, "the kept lagsimd did not step within %g s", W_FIRST_S);
+        snprintf(why, sizeof why, "the kept lagsimd did not step within %g s", first_wait(w));
         *controller = false;
     }
     return start_failed(w, err, errlen, why);
@@ -365,7 +373,7 @@ eval_worker *eval_worker_start(const eval_env *env, const eval_case *c, const ev
     /* a host's plant a worker before may have left in the middle of a run: paused first
      * (a plant paused already refuses it, harmlessly) */
     if (env->attach_log) lag_client_pause(w->cl);
-    if (step_once(w, 1, W_FIRST_S)) return no_first_answer(w, controller, err, errlen);
+    if (step_once(w, 1, first_wait(w))) return no_first_answer(w, controller, err, errlen);
     return w;
 }
 

@@ -1189,13 +1189,19 @@ def case_controller_exit(d):
           "the sweep stops" in p.stderr and took < 20,
           "'exit 3': exit 2, the controller's exit status said once, in %.1f s" % took)
     # a controller on another prefix (alive: it waits 100 s for its scene): the daemon says
-    # what it waits for, within the worker's first 30 s
-    p = run([SWEEP] + base + ["-j1", "--controller", os.path.join(BIN, "lqr_balance") +
+    # what it waits for, after the worker's first wait: 30 s, or a run's --timeout (8 s)
+    t0 = time.monotonic()
+    p = run([SWEEP] + base + ["-j1", "--timeout", "8", "--controller",
+                              os.path.join(BIN, "lqr_balance") +
                               " -q --prefix NOT_THE_RUNS --timeout 100"])
-    check(p.returncode == 2 and "did not answer the kept lagsimd's first state" in p.stderr and
+    took = time.monotonic() - t0
+    check(p.returncode == 2 and "did not answer the kept lagsimd's first state within 8 s" in
+          p.stderr and
           re.search(r"lagsimd waits \d+ s for a command answering sim_time 0 on "
-                    r"SWEEP\d+_W0_COMMAND at udpm://", p.stderr) and "{prefix}" in p.stderr,
-          "a controller on another prefix: exit 2, the daemon's wait said")
+                    r"SWEEP\d+_W0_COMMAND at udpm://", p.stderr) and "{prefix}" in p.stderr and
+          8 <= took < 30,
+          "a controller on another prefix, --timeout 8: exit 2 after 8 s (%.1f s), the "
+          "daemon's wait said" % took)
     # a controller that dies in some runs (m2 above 0.6): those fail, a row each, and the
     # next run gets a new pair
     q, env = scene_sweep("c", 8)
