@@ -143,7 +143,7 @@ set(LAGSIM_TIER_RUN
   "browser       50    20"
   "octave        50    30"
   "root          25    40"
-  "package      100    60"
+  "package       60    60"
   "slow          30    30"
   "bench        100    10"
   "fuzz_run      50    70"
