@@ -194,8 +194,9 @@ typedef void (*lag_client_scene_fn)(const lag_client_scene *sc, void *user);
 /* ---------------------------------------------------------------- a handle */
 
 /* Connects to the plant whose LCM URL is url (the daemon's lcm.url; NULL or "": LCM's
- * default, which honours LCM_DEFAULT_URL) and prefix: subscribes to <prefix>_STATE,
- * _STATUS, _EVENT, _SCENE, _REFERENCE on that (state) URL, and sends commands and control
+ * default, which honours LCM_DEFAULT_URL) and prefix: subscribes to <prefix>_REFERENCE,
+ * _SCENE, _STATUS, _EVENT and, last, _STATE on that (state) URL (a state is never kept
+ * without what was published just before it), and sends commands and control
  * requests to the plant's command URL, the same group on the next port. Returns NULL on
  * failure with a message in err (may be NULL). */
 lag_client *lag_client_create(const char *url, const char *prefix, char *err, size_t errlen);

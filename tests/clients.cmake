@@ -11,7 +11,7 @@ lagsim_add_test_cases(test_lqr clients clients 30)
 # dropped and counted, exact copies, commands/control as sent, DESCRIBE and timeouts.
 add_executable(test_client ${CMAKE_CURRENT_SOURCE_DIR}/clients/test_client.c)
 target_include_directories(test_client PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/common)
-target_link_libraries(test_client PRIVATE lagsim_client m)
+target_link_libraries(test_client PRIVATE lagsim_client m ${CMAKE_DL_LIBS})
 lagsim_add_test_cases(test_client clients clients 30)
 
 # Every field of status_t (read from lcmtypes/status_t.lcm) reaches lag_client_status.

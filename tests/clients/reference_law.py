@@ -117,9 +117,9 @@ class Relay(object):
         self.times = {}       # sim_time of a reference -> lost
         self.done = threading.Event()
         p = prefix + "_"
+        self.a_state.subscribe(p + "REFERENCE", self.on_reference)  # before its state's
         self.a_state.subscribe(p + "(STATE|STATUS|EVENT|SCENE)",
                                lambda ch, d: self.b_state.publish(ch, d))
-        self.a_state.subscribe(p + "REFERENCE", self.on_reference)
         self.b_cmd.subscribe(p + "(COMMAND|CONTROL)", lambda ch, d: self.a_cmd.publish(ch, d))
         self.th = threading.Thread(target=self.run, daemon=True)
         self.th.start()

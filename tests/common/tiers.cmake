@@ -51,7 +51,7 @@ set(LAGSIM_TIER_RULES
   "waits     NAME  ^eval_lagsim_(eval_errors|sweep_stalled)$"
   "waits     NAME  ^eval_procs_(eval|sweep)_(stalled|gnuplot)$"
   "waits     NAME  ^eval_lagsim_sweep_unanswered$"
-  # a controller on another prefix: 30 s of a kept pair's wait for its first answer
+  # a controller on another prefix: a kept pair's wait for its first answer (--timeout 8)
   "waits     NAME  ^eval_lagsim_sweep_controller_exit$"
   "waits     NAME  ^eval_lagsim_eval_waits$"
   "waits     NAME  ^scene_shipped_wait$"
