@@ -43,6 +43,9 @@ service (root only, else skipped; skipped too when this host cannot start system
   lagsimctl list names each with its URL, dipc_lqr balances one, a file added starts its
   plant without a restart, each plant's --log lands in /var/lib/lagsim/NAME/STUDENT/ and
   replays exactly. Then the checks after the purge, as in install.
+install and service run in a mount namespace of their own where /usr, /etc and /var are
+overlays of the host's (in_own_root): what they install is seen by them and their children
+only, and checked to be unseen outside, so the suite's other tests run beside them.
 One run at a time on a host: a lock file (LOCK) is held for the whole of it.
 """
 import argparse
@@ -322,6 +325,14 @@ def do_install(a, service=False):
         files = [p for p in listed if os.path.isfile(p) or os.path.islink(p)]
         check(all(os.path.exists("/" + p) for p in before),
               "dpkg -L lagsim: %d paths, %d files; every file of the .deb is on disk" % (len(listed), len(files)))
+        # other tests run beside this one: the host (the root of the process that made this
+        # check's mount namespace) has none of what it installed
+        host = "/proc/%s/root" % os.environ.get("LAGSIM_PKG_HOST_PID", "1")
+        new = [p for p in files if not before.get(p.lstrip("/"), False)]
+        seen = [p for p in new if os.path.lexists(host + p)]
+        check(new and not seen and os.path.isdir(host + "/usr"),
+              "outside this check's mount namespace none of the %d files it installed is seen%s"
+              % (len(new), ": " + " ".join(seen[:5]) if seen else ""))
 
         state, result = False, None
         if service:
@@ -745,6 +756,35 @@ def service_checks(a, tmp):
     return 0
 
 
+# What an install writes to (the package's files, dpkg's and apt's state, ldconfig's cache).
+OVERLAID = ("usr", "etc", "var")
+NO_ROOT = 97  # the overlays could not be made
+
+
+def in_own_root():
+    """Runs this check again in a mount namespace of its own, where /usr, /etc and /var are
+    overlays of the host's with their changes in a directory of /tmp: the package it
+    installs (its Python and Lua modules, its library, its programs) is seen by this check
+    and its children only, and goes with them, so other tests run beside it. /run (the
+    port and package locks) is the host's. Exit status: the check's."""
+    root = tempfile.mkdtemp(prefix="lagsim_pkg_root_")
+    script = ('for m in %s; do mkdir "$R/$m.up" "$R/$m.work" && mount -t overlay overlay -o '
+              '"lowerdir=/$m,upperdir=$R/$m.up,workdir=$R/$m.work" "/$m" || exit %d; done; '
+              'exec "$@"' % (" ".join(OVERLAID), NO_ROOT))
+    env = dict(os.environ, LAGSIM_PKG_ROOT=root, R=root, LAGSIM_PKG_HOST_PID=str(os.getpid()))
+    try:
+        r = subprocess.run(["unshare", "--mount", "--propagation", "private", "sh", "-c",
+                            script, "sh", sys.executable, os.path.abspath(__file__)] +
+                           sys.argv[1:], env=env)
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+    if r.returncode == NO_ROOT:
+        print("FAIL cannot overlay /%s in a mount namespace of its own (`unshare --mount`, "
+              "overlayfs): the package is installed there only" % ", /".join(OVERLAID))
+        return 1
+    return r.returncode
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("what", choices=("build", "install", "service"))
@@ -765,6 +805,8 @@ def main():
             print("SKIP: a lagsim package is installed on this host already; this test would "
                   "replace and purge it (dpkg --purge lagsim first to run it)")
             return SKIP
+    if a.what in ("install", "service") and "LAGSIM_PKG_ROOT" not in os.environ:
+        return in_own_root()
     os.makedirs(os.path.dirname(LOCK), exist_ok=True)
     with open(LOCK if a.what != "build" else os.path.join(a.build, ".package.lock"), "w") as lk:
         fcntl.flock(lk, fcntl.LOCK_EX)   # one run at a time: dpkg, one package name
