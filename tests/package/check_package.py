@@ -52,7 +52,6 @@ import argparse
 import fcntl
 import glob
 import os
-import random
 import re
 import shutil
 import subprocess
@@ -62,10 +61,11 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lagsim_check import SKIP, check, failures, verdict  # noqa: E402  (tests/common: the one harness)
+from lcm_port import lcm_port, lcm_url  # noqa: E402  (ports held, as every test takes them)
 
 EXPOSURE_MAX = 2.0   # systemd-analyze security: the unit scores 1.1 ("OK" is below 4.5)
 DEBIAN_PYTHON = "/usr/bin/python3"   # the python3 the package depends on (not a pyenv's)
-LOCK = "/var/lock/lagsim-package-test.lock"
+LOCK = "/run/lock/lagsim-package-test.lock"  # the host's: /run is not overlaid (in_own_root)
 # the unit's settings the deployment relies on (docs/deploy.md)
 UNIT_MUST = ["ExecStart=/usr/bin/lagsimd --instance /etc/lagsim/%i $LAGSIMD_ARGS",
              "Restart=on-failure", "RestartPreventExitStatus=2", "DynamicUser=yes",
@@ -499,25 +499,11 @@ class NsSystemd:
                 pass
 
 
-def free_pairs(n):
-    """n consecutive port pairs below the kernel's ephemeral ports, none bound now."""
-    bound = set()
-    for f in ("/proc/net/udp", "/proc/net/udp6"):
-        if os.path.exists(f):
-            for line in open(f).read().splitlines()[1:]:
-                bound.add(int(line.split()[1].rsplit(":", 1)[1], 16))
-    for _ in range(200):
-        base = 2 * random.randrange(5000, 16000)
-        if not any(p in bound for p in range(base, base + 2 * n)):
-            return base
-    return 20000
-
-
 def host_form_checks(sd, tmp, env):
     """The unit's host form: /etc/lagsim/NAME.d/ instead of NAME.yaml, as docs/deploy.md's
     "A lab host for a class" sets it up."""
     name, d = "pkglab", "/etc/lagsim/pkglab.d"
-    directory = free_pairs(4)
+    directory = lcm_port(8)  # the directory's pair and three plants' (held: lcm_port.py)
     dir_url = "udpm://239.255.76.67:%d?ttl=0" % directory
     url = lambda k: "udpm://239.255.76.67:%d?ttl=0" % (directory + 2 + 2 * k)
     os.makedirs(d, exist_ok=True)
@@ -604,8 +590,9 @@ def service_checks(a, tmp):
                  "the installed unit's header gives an example LAGSIMD_ARGS with --log run.lcm: %s"
                  % example):
         return 0
+    bus = lcm_url()  # a port pair of this test's own: other tests run beside it
     with open(ours[1], "w") as f:
-        f.write("LAGSIMD_ARGS=--set lcm.prefix=%s %s\n" % (prefix, example))
+        f.write("LCM_DEFAULT_URL=%s\nLAGSIMD_ARGS=--set lcm.prefix=%s %s\n" % (bus, prefix, example))
     with open(ours[2], "w") as f:
         f.write("model: dipc\nbogus: 1\n")
     os.chmod(ours[2], 0o644)
@@ -622,7 +609,7 @@ def service_checks(a, tmp):
         unit = "lagsimd@%s.service" % name
         r = sd.ctl("start", unit)
         check(r.returncode == 0, "systemctl start %s" % unit, r.stdout)
-        env = clean_env()
+        env = clean_env(LCM_DEFAULT_URL=bus)
         lqr = run(["/usr/bin/dipc_lqr", "--prefix", prefix, "--duration", "3", "--timeout", "10", "-q"],
                   env=env, timeout=60)
         summ = {k: v for k, v in re.findall(r"(\w+)=(\S+)", lqr.stdout.splitlines()[-1] if lqr.stdout else "")}
@@ -763,21 +750,28 @@ NO_ROOT = 97  # the overlays could not be made
 
 def in_own_root():
     """Runs this check again in a mount namespace of its own, where /usr, /etc and /var are
-    overlays of the host's with their changes in a directory of /tmp: the package it
+    overlays of the host's with their changes on a tmpfs of its own: the package it
     installs (its Python and Lua modules, its library, its programs) is seen by this check
     and its children only, and goes with them, so other tests run beside it. /run (the
     port and package locks) is the host's. Exit status: the check's."""
+    if run(["unshare", "--mount", "true"]).returncode != 0:
+        print("SKIP: this host cannot make a mount namespace (unshare --mount needs "
+              "CAP_SYS_ADMIN), where the package is installed without other tests seeing it")
+        return SKIP
     root = tempfile.mkdtemp(prefix="lagsim_pkg_root_")
-    script = ('for m in %s; do mkdir "$R/$m.up" "$R/$m.work" && mount -t overlay overlay -o '
-              '"lowerdir=/$m,upperdir=$R/$m.up,workdir=$R/$m.work" "/$m" || exit %d; done; '
-              'exec "$@"' % (" ".join(OVERLAID), NO_ROOT))
-    env = dict(os.environ, LAGSIM_PKG_ROOT=root, R=root, LAGSIM_PKG_HOST_PID=str(os.getpid()))
+    # the changes on a tmpfs of the namespace's own: gone with it, even when the check is
+    # killed, and never an overlay's upper directory on an overlay (a container's /tmp)
+    script = ('r=$1; shift; mount -t tmpfs lagsim_pkg "$r" || exit %d; for m in %s; do '
+              'mkdir "$r/$m.up" "$r/$m.work" && mount -t overlay overlay -o '
+              '"lowerdir=/$m,upperdir=$r/$m.up,workdir=$r/$m.work" "/$m" || exit %d; done; '
+              'exec "$@"' % (NO_ROOT, " ".join(OVERLAID), NO_ROOT))
+    env = dict(os.environ, LAGSIM_PKG_ROOT=root, LAGSIM_PKG_HOST_PID=str(os.getpid()))
     try:
         r = subprocess.run(["unshare", "--mount", "--propagation", "private", "sh", "-c",
-                            script, "sh", sys.executable, os.path.abspath(__file__)] +
+                            script, "sh", root, sys.executable, os.path.abspath(__file__)] +
                            sys.argv[1:], env=env)
     finally:
-        shutil.rmtree(root, ignore_errors=True)
+        os.rmdir(root)
     if r.returncode == NO_ROOT:
         print("FAIL cannot overlay /%s in a mount namespace of its own (`unshare --mount`, "
               "overlayfs): the package is installed there only" % ", /".join(OVERLAID))
