@@ -61,7 +61,7 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from lagsim_check import SKIP, check, failures, verdict  # noqa: E402  (tests/common: the one harness)
-from lcm_port import lcm_port, lcm_url  # noqa: E402  (ports held, as every test takes them)
+from lcm_port import GROUP, lcm_port, lcm_url  # noqa: E402  (ports held, as every test takes them)
 
 EXPOSURE_MAX = 2.0   # systemd-analyze security: the unit scores 1.1 ("OK" is below 4.5)
 DEBIAN_PYTHON = "/usr/bin/python3"   # the python3 the package depends on (not a pyenv's)
@@ -327,7 +327,7 @@ def do_install(a, service=False):
               "dpkg -L lagsim: %d paths, %d files; every file of the .deb is on disk" % (len(listed), len(files)))
         # other tests run beside this one: the host (the root of the process that made this
         # check's mount namespace) has none of what it installed
-        host = "/proc/%s/root" % os.environ.get("LAGSIM_PKG_HOST_PID", "1")
+        host = "/proc/%s/root" % os.environ["LAGSIM_PKG_HOST_PID"]
         new = [p for p in files if not before.get(p.lstrip("/"), False)]
         seen = [p for p in new if os.path.lexists(host + p)]
         check(new and not seen and os.path.isdir(host + "/usr"),
@@ -504,8 +504,8 @@ def host_form_checks(sd, tmp, env):
     "A lab host for a class" sets it up."""
     name, d = "pkglab", "/etc/lagsim/pkglab.d"
     directory = lcm_port(8)  # the directory's pair and three plants' (held: lcm_port.py)
-    dir_url = "udpm://239.255.76.67:%d?ttl=0" % directory
-    url = lambda k: "udpm://239.255.76.67:%d?ttl=0" % (directory + 2 + 2 * k)
+    dir_url = "udpm://%s:%d?ttl=0" % (GROUP, directory)
+    url = lambda k: "udpm://%s:%d?ttl=0" % (GROUP, directory + 2 + 2 * k)
     os.makedirs(d, exist_ok=True)
     for st in ("alice", "bob"):
         shutil.copy("/usr/share/lagsim/config/dipc.yaml", "%s/%s.yaml" % (d, st))
@@ -765,7 +765,8 @@ def in_own_root():
               'mkdir "$r/$m.up" "$r/$m.work" && mount -t overlay overlay -o '
               '"lowerdir=/$m,upperdir=$r/$m.up,workdir=$r/$m.work" "/$m" || exit %d; done; '
               'exec "$@"' % (NO_ROOT, " ".join(OVERLAID), NO_ROOT))
-    env = dict(os.environ, LAGSIM_PKG_ROOT=root, LAGSIM_PKG_HOST_PID=str(os.getpid()))
+    # set only here: the run inside the namespace knows itself by it, and the host by its PID
+    env = dict(os.environ, LAGSIM_PKG_HOST_PID=str(os.getpid()))
     try:
         r = subprocess.run(["unshare", "--mount", "--propagation", "private", "sh", "-c",
                             script, "sh", root, sys.executable, os.path.abspath(__file__)] +
@@ -799,7 +800,7 @@ def main():
             print("SKIP: a lagsim package is installed on this host already; this test would "
                   "replace and purge it (dpkg --purge lagsim first to run it)")
             return SKIP
-    if a.what in ("install", "service") and "LAGSIM_PKG_ROOT" not in os.environ:
+    if a.what in ("install", "service") and "LAGSIM_PKG_HOST_PID" not in os.environ:
         return in_own_root()
     os.makedirs(os.path.dirname(LOCK), exist_ok=True)
     with open(LOCK if a.what != "build" else os.path.join(a.build, ".package.lock"), "w") as lk:
