@@ -943,6 +943,19 @@ static void log_check(rt_server *s, bool running)
     for (int k = 0; k < n; k++) event(s, notes[k].kind, "", notes[k].value, notes[k].detail);
 }
 
+/* A DESCRIBE is how a controller starts (it asks for the scene until it has it), so one
+ * may come from a controller that subscribed after the state it is to answer went out,
+ * while that state's copies are far apart (they double up to lockstep_timeout / 16: 225 s
+ * for a kept lagsim-sweep pair's 3600 s). While a state is owed an answer and none was
+ * heard, the scene's answer is followed by a copy of it, as paced as the scene's. */
+static void state_after_scene(rt_server *s)
+{
+    if (s->sc->realtime.mode != LAG_RT_LOCKSTEP || s->pub.state_len == 0 || s->run == RT_FAULT)
+        return;
+    if (!s->ls.waiting || s->ls.answered || s->ls.answer_heard) return;
+    rt_pub_state_again(&s->pub);
+}
+
 /* Answers held back by their bucket go out when it allows, one for many requests. */
 static void flush_answers(rt_server *s)
 {
@@ -954,6 +967,7 @@ static void flush_answers(rt_server *s)
         rt_limit_take(&s->pub.lim_scene, s->now);
         publish_scene(s);
         s->pub.want_scene = false;
+        state_after_scene(s);
     }
     if (s->pub.want_status && rt_limit_ready(&s->pub.lim_status, s->now) <= s->now) {
         rt_limit_take(&s->pub.lim_status, s->now);

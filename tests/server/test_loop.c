@@ -12,7 +12,8 @@
  *   test_loop CASE    CASE: pacing rate_huge status_hz lockstep_wait start set set_replay
  *                           long_period chunks
  *                           step_paced control_flood command_flood duration signals
- *                           fault_effort lockstep_retry lockstep_loss other_plant
+ *                           fault_effort lockstep_retry lockstep_loss late_controller
+ *                           other_plant
  *                           reject_names waits foreign copy_rule (--list)
  */
 #include <math.h>
@@ -1441,6 +1442,61 @@ static void case_lockstep_retry(int arg)
     stop_server();
 }
 
+/* A controller that starts after the state it is to answer went out: that state's copies
+ * are far apart by then (they double up to lockstep_timeout / 16: 225 s for a lockstep_timeout
+ * of 3600 s, lagsim-sweep's kept pairs'), so it would hear the state only at the next one.
+ * Its DESCRIBE (every client asks for the scene until it has it) brings the scene and a
+ * copy of the state owed, at the scene's pace; once an answer to that state was heard (even
+ * a rejected one), the scene alone. Running, and paused (the state a kept pair waits on
+ * between runs). */
+static void case_late_controller(int arg)
+{
+    (void)arg;
+    for (int paused = 0; paused < 2; paused++) {
+        scene(LAG_RT_LOCKSTEP);
+        g_sc.realtime.start = paused ? LAG_RT_START_PAUSED : LAG_RT_START_RUNNING;
+        g_sc.realtime.lockstep_timeout = 3600.0;
+        g_sc.realtime.lockstep_retry = 0.02;
+        start();
+        ENSURE(g_out.state == 1 && g_srv.ls.waiting && !g_srv.ls.answered);
+        const int64_t t0 = g_srv.now;
+        /* copies at 0.02 (2^k - 1) s: the 10th at 20.46 s, the 11th due at 40.94 s */
+        run_until(t0 + 21 * SEC, 1000);
+        ENSUREF(g_out.state == 11 && g_srv.pub.lockstep_retries == 10, "%s: %lld states in 21 s",
+                paused ? "paused" : "running", (long long)g_out.state);
+        int64_t states = g_out.state, scenes = g_out.scene;
+        control(LAGSIM_CONTROL_T_DESCRIBE, 0);
+        run_until(g_srv.now + 1 * MS, 1000);
+        ENSUREF(g_out.scene == scenes + 1 && g_out.state == states + 1 && g_out.last_t == 0.0 &&
+                    g_out.state_before_scene == 0,
+                "%s: a DESCRIBE 21 s after the state at t = 0 brought %lld scenes and %lld "
+                "states (1 and 1)", paused ? "paused" : "running",
+                (long long)(g_out.scene - scenes), (long long)(g_out.state - states));
+        /* a flood of DESCRIBEs (1000 a second): a copy with each scene, no more */
+        states = g_out.state, scenes = g_out.scene;
+        for (int k = 0; k < 1000; k++) {
+            control(LAGSIM_CONTROL_T_DESCRIBE, 0);
+            run_until(g_srv.now + 1 * MS, 1000);
+        }
+        ENSUREF(g_out.scene - scenes <= RT_SCENE_PER_S + RT_SCENE_BURST &&
+                    g_out.state - states == g_out.scene - scenes,
+                "%s: 1000 DESCRIBEs in 1 s: %lld scenes, %lld states", paused ? "paused" : "running",
+                (long long)(g_out.scene - scenes), (long long)(g_out.state - states));
+        ENSURE(g_srv.sim.tick == 0);
+        /* an answer heard (rejected: a joint the DIPC does not have): the scene alone */
+        command(0.0, "cart", 1.0);
+        ENSURE(g_srv.ls.answer_heard && !g_srv.ls.answered);
+        run_until(g_srv.now + 1 * SEC, 1000);
+        states = g_out.state, scenes = g_out.scene;
+        control(LAGSIM_CONTROL_T_DESCRIBE, 0);
+        run_until(g_srv.now + 1 * MS, 1000);
+        ENSUREF(g_out.scene == scenes + 1 && g_out.state == states,
+                "%s: after an answer was heard a DESCRIBE brought %lld states (0)",
+                paused ? "paused" : "running", (long long)(g_out.state - states));
+        stop_server();
+    }
+}
+
 /* A rejection names what would be accepted: the DIPC's joints with the actuated one
  * marked (theta0, the cart: its only input), the actuated joints alone, the effort limit,
  * the sim_time waited on, the requests by value, a count >= 1, the joint count. */
@@ -2021,6 +2077,7 @@ int main(int argc, char **argv)
         {"command_flood", case_command_flood, 0, 0}, {"duration", case_duration, 0, 0},
         {"signals", case_signals, 0, 0},         {"fault_effort", case_fault_effort, 0, 0},
         {"lockstep_retry", case_lockstep_retry, 0, 0}, {"lockstep_loss", case_lockstep_loss, 0, 0},
+        {"late_controller", case_late_controller, 0, 0},
         {"other_plant", case_other_plant, 0, 0}, {"messages", case_messages, 0, 0},
         {"reject_names", case_reject_names, 0, 0}, {"waits", case_waits, 0, 0},
         {"foreign", case_foreign, 0, 0},        {"copy_rule", case_copy_rule, 0, 0},
