@@ -45,7 +45,7 @@ if(LAGSIM_PYTHON3 AND LAGSIM_GNU_PARALLEL)
   # over m2, one that leaves the paused state unanswered (mute_pd.py)
   foreach(c same slurm merge merge_rows merge_foreign shard kept kept_python loss stalled ssh
           vary scene_c scene_python scene_loss unanswered notes controller_exit
-          progress interrupt tmpdir)
+          slow_start progress interrupt tmpdir)
     add_test(NAME eval_lagsim_sweep_${c}
       COMMAND ${LAGSIM_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/eval/test_sweep.py
               $<TARGET_FILE_DIR:lagsim-sweep> ${PROJECT_SOURCE_DIR} ${c})

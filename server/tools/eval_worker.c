@@ -321,10 +321,12 @@ static eval_worker *no_first_answer(eval_worker *w, bool *controller, char *err,
                  w->ended, hint);
     } else if (fresh_status(w, &st, false) && st.waiting_for[0]) {
         snprintf(why, sizeof why, "the controller did not answer the kept lagsimd's first "
-                 "state within %g s: lagsimd waits %.0f s for %s; %s%s (is the controller on "
-                 "the run's prefix: {prefix} or LAGSIM_PREFIX?)", first_wait(w), st.waiting_s,
-                 st.waiting_for, st.waiting_got[0] ? "got instead: " : "nothing else came",
-                 st.waiting_got);
+                 "state within %g s: lagsimd waits %.0f s for %s; %s%s (is the "
+                 "controller on the run's prefix: {prefix} or LAGSIM_PREFIX? does it start "
+                 "within %g s? --restart gives each run's controller its --timeout to start)",
+                 first_wait(w), st.waiting_s, st.waiting_for,
+                 st.waiting_got[0] ? "got instead: " : "nothing else came", st.waiting_got,
+                 first_wait(w));
     } else {
         snprintf(why, sizeof why, "the kept lagsimd did not step within %g s", first_wait(w));
         *controller = false;

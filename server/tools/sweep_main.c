@@ -1069,7 +1069,8 @@ static void say_held(const sweep *x, const char *why)
     if (x->shard_n > 1) snprintf(of, sizeof of, " of shard %ld/%ld", x->shard_k, x->shard_n);
     if (!x->csv || !held || !miss) {
         eval_say("%s: %s: %ld of the %ld runs%s had ended; without --csv they are kept "
-                 "nowhere (their summary: above)\n", prog, why, l->done, x->nwant, of);
+                 "nowhere%s\n", prog, why, l->done, x->nwant, of,
+                 l->done > 0 ? " (their summary: above)" : "");
         free(held), free(miss);
         return;
     }

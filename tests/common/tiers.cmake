@@ -53,6 +53,8 @@ set(LAGSIM_TIER_RULES
   "waits     NAME  ^eval_lagsim_sweep_unanswered$"
   # a controller on another prefix: a kept pair's wait for its first answer (--timeout 8)
   "waits     NAME  ^eval_lagsim_sweep_controller_exit$"
+  # a kept pair's controller that starts after a wait of 12 s (sleep 12)
+  "waits     NAME  ^eval_lagsim_sweep_slow_start$"
   "waits     NAME  ^eval_lagsim_eval_waits$"
   "waits     NAME  ^scene_shipped_wait$"
   "waits     NAME  ^log_term_waits$"

@@ -68,6 +68,10 @@ usage: test_sweep.py BIN_DIR SOURCE_DIR CASE
             the runs of a large m2 (tests/eval/mute_pd.py --exit-above) fails those runs
             (a row each, its exit status in the reason) and the next run gets a new pair;
             with --restart a controller that exits at once fails each run at once
+  slow_start  a kept pair's controller that starts 12 s after its daemon (sleep 12), with
+            --timeout 19: its scene request brings the state it is to answer, so the sweep
+            runs (before, that state's copies had grown 10 s apart: the one after 10.2 s
+            came at 20.5 s, past the 19 s, and the sweep stopped)
   progress  stderr a pseudo-terminal (100 columns): the progress line drawn again and again
             (each drawing after \\r and a clear), runs done never going back, at most 5
             drawings a second, none wider than the terminal, the last one the sweep's
@@ -1188,6 +1192,11 @@ def case_controller_exit(d):
                                                "it answered") == 1 and
           "the sweep stops" in p.stderr and took < 20,
           "'exit 3': exit 2, the controller's exit status said once, in %.1f s" % took)
+    # without --csv: no run ended, so no summary is pointed at
+    p = run([SWEEP] + base + ["--controller", "exit 3"])
+    check(p.returncode == 2 and "0 of the 4 runs had ended; without --csv they are kept "
+          "nowhere\n" in p.stderr and "summary" not in p.stderr + p.stdout,
+          "'exit 3' without --csv: 0 runs ended, no summary named (%s)" % p.stderr[-300:])
     # a controller on another prefix (alive: it waits 100 s for its scene): the daemon says
     # what it waits for, after the worker's first wait: 30 s, or a run's --timeout (8 s)
     t0 = time.monotonic()
@@ -1199,6 +1208,7 @@ def case_controller_exit(d):
           p.stderr and
           re.search(r"lagsimd waits \d+ s for a command answering sim_time 0 on "
                     r"SWEEP\d+_W0_COMMAND at udpm://", p.stderr) and "{prefix}" in p.stderr and
+          "does it start within 8 s? --restart" in p.stderr and
           8 <= took < 30,
           "a controller on another prefix, --timeout 8: exit 2 after 8 s (%.1f s), the "
           "daemon's wait said" % took)
@@ -1236,6 +1246,22 @@ def case_controller_exit(d):
           "--restart, 'exit 3': 4 failed rows naming exit status 3, in %.1f s" % took)
 
 
+def case_slow_start(d):
+    out = os.path.join(d, "slow.csv")
+    lqr = os.path.join(BIN, "lqr_balance") + " -q --prefix {prefix}"
+    t0 = time.monotonic()
+    p = run([SWEEP, "--config", SCENE, "--duration", "0.5", "--runs", "2", "--seed", "1",
+             "--vary", "parameters.m0=uniform(1,1.5)", "-j1", "--timeout", "19",
+             "--controller", "sleep 12; exec " + lqr, "--csv", out])
+    took = time.monotonic() - t0
+    r = rows(out) if os.path.exists(out) else []
+    check(p.returncode == 0 and len(r) == 2 and all(x["failed"] == "0" for x in r) and
+          12 <= took < 19,
+          "a controller 12 s slow to start, --timeout 19: exit %d, %d rows passed, in %.1f s "
+          "(12 to 19)%s" % (p.returncode, len([x for x in r if x["failed"] == "0"]), took,
+                            "" if p.returncode == 0 else ": " + p.stderr[-600:]))
+
+
 def case_tmpdir(d):
     """Nothing of a sweep is left in TMPDIR when it ends without -v: a sweep that passes,
     one whose runs fail (--restart) and one whose controller cannot run (exit 2)."""
@@ -1264,6 +1290,6 @@ with tempfile.TemporaryDirectory() as tmp:
      "kept_python": case_kept_python, "scene_c": case_scene_c,
      "scene_python": case_scene_python, "scene_loss": case_scene_loss,
      "unanswered": case_unanswered, "notes": case_notes,
-     "controller_exit": case_controller_exit, "progress": case_progress,
+     "controller_exit": case_controller_exit, "slow_start": case_slow_start, "progress": case_progress,
      "interrupt": case_interrupt, "tmpdir": case_tmpdir}[CASE](tmp)
 sys.exit(verdict(CASE))
