@@ -294,6 +294,20 @@ def do_build(a):
         check(tags and not errors or r.returncode == 0,
               "lintian: no error (%d warning(s) printed above)" % sum(l.startswith("W: ") for l in tags),
               r.stdout)
+        # the warnings it prints are the ones docs/deploy.md keeps, each with its reason
+        seen = {l.split()[2] for l in tags if l.startswith("W: ") and len(l.split()) > 2}
+        doc = open(os.path.join(a.source, "docs", "deploy.md")).read()
+        after = doc.split("lintian's warnings, kept", 1)[-1].splitlines()
+        start = next((i for i, l in enumerate(after) if l.startswith("|")), len(after))
+        rows = []
+        for l in after[start + 2:]:
+            if not l.startswith("|"):
+                break
+            rows.append(l)
+        kept = {t for row in rows for t in re.findall(r"`([a-z0-9-]+)`", row.split("|")[1])}
+        check(seen == kept, "lintian's warnings are docs/deploy.md's kept ones (printed, not "
+              "kept: %s; kept, not printed: %s)" % (sorted(seen - kept) or "none",
+                                                    sorted(kept - seen) or "none"))
     if failures() == 0:
         shutil.rmtree(tmp, ignore_errors=True)
 
